@@ -1,0 +1,61 @@
+"""Occupancy grids, map formats, exact inflation and octile-optimal A*.
+
+Public names are imported lazily (PEP 562), so ``import astar`` is cheap and the
+compiled search kernel (numba) is loaded only when a search runs.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+from typing import TYPE_CHECKING, Any
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+__version__ = "0.1.0"
+
+_EXPORTS: dict[str, str] = {
+    # values and errors
+    "OccupancyGrid": "astar.grid",
+    "AstarError": "astar.errors",
+    "InvalidInputError": "astar.errors",
+    "MapFormatError": "astar.errors",
+    "NoPathError": "astar.errors",
+    # map formats
+    "load_map": "astar.io",
+    "save_map": "astar.io",
+    "from_intensity": "astar.io",
+    "read_scenarios": "astar.io",
+    "Scenario": "astar.io",
+    # inflation
+    "inflate": "astar.inflate",
+    "clearance": "astar.inflate",
+    "avoidance_area": "astar.inflate",
+    "clearance_cost": "astar.inflate",
+    # search
+    "find_path": "astar.search",
+    "GridPath": "astar.search",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'astar' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+if TYPE_CHECKING:  # pragma: no cover
+    from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
+    from astar.grid import OccupancyGrid
+    from astar.inflate import avoidance_area, clearance, clearance_cost, inflate
+    from astar.io import Scenario, from_intensity, load_map, read_scenarios, save_map
+    from astar.search import GridPath, find_path

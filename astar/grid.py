@@ -1,0 +1,222 @@
+"""The occupancy grid value and its cell/world coordinate conversions.
+
+Conventions (as ROS ``nav_msgs/OccupancyGrid`` and Nav2):
+
+* ``occupied[iy, ix]``; ``iy`` grows with world y, so row 0 is the *bottom* row.
+* A cell is written ``(ix, iy)``, x first.
+* Cell ``(ix, iy)`` covers the world rectangle
+  ``[ox + ix*res, ox + (ix+1)*res) x [oy + iy*res, oy + (iy+1)*res)`` with
+  ``(ox, oy) = origin``; its centre is ``(ox + (ix+0.5)*res, oy + (iy+0.5)*res)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from astar.errors import InvalidInputError
+
+__all__ = ["OccupancyGrid"]
+
+
+@dataclass(frozen=True, slots=True)
+class OccupancyGrid:
+    """A 2-D occupancy grid: which cells are blocked, their size and where they are.
+
+    Parameters
+    ----------
+    occupied : array_like of bool, shape (ny, nx)
+        ``True`` where the cell is occupied. Copied and made read-only. Integer arrays
+        holding only 0 and 1 are accepted; anything else is rejected.
+    resolution : float
+        Cell side in metres (> 0, finite).
+    origin : tuple of float, optional
+        World ``(x, y)`` in metres of the lower-left corner of cell ``(0, 0)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g = OccupancyGrid(np.zeros((3, 4), bool), resolution=0.5, origin=(1.0, 2.0))
+    >>> g.nx, g.ny
+    (4, 3)
+    >>> g.cell_to_world([1, 0]).tolist()
+    [1.75, 2.25]
+    """
+
+    occupied: np.ndarray
+    resolution: float
+    origin: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        occ = _as_bool_grid(self.occupied)
+        res = _as_positive_float(self.resolution, "resolution")
+        try:
+            ox, oy = (float(v) for v in self.origin)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(
+                f"origin must be two numbers (x, y) in metres, got {self.origin!r}"
+            ) from exc
+        if not (math.isfinite(ox) and math.isfinite(oy)):
+            raise InvalidInputError(f"origin must be finite, got ({ox}, {oy})")
+        object.__setattr__(self, "occupied", occ)
+        object.__setattr__(self, "resolution", res)
+        object.__setattr__(self, "origin", (ox, oy))
+
+    @classmethod
+    def _construct_fast(
+        cls, occupied: np.ndarray, resolution: float, origin: tuple[float, float]
+    ) -> OccupancyGrid:
+        """Build without validation (internal: ``occupied`` must be a fresh bool array)."""
+        self = object.__new__(cls)
+        occ = np.ascontiguousarray(occupied, dtype=bool)
+        occ.flags.writeable = False
+        object.__setattr__(self, "occupied", occ)
+        object.__setattr__(self, "resolution", float(resolution))
+        object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
+        return self
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(ny, nx)``: rows, columns."""
+        return self.occupied.shape  # type: ignore[return-value]
+
+    @property
+    def nx(self) -> int:
+        """Number of columns (cells along x)."""
+        return int(self.occupied.shape[1])
+
+    @property
+    def ny(self) -> int:
+        """Number of rows (cells along y)."""
+        return int(self.occupied.shape[0])
+
+    @property
+    def width(self) -> float:
+        """Extent along x in metres."""
+        return self.nx * self.resolution
+
+    @property
+    def height(self) -> float:
+        """Extent along y in metres."""
+        return self.ny * self.resolution
+
+    @property
+    def free(self) -> np.ndarray:
+        """Read-only bool array ``[ny, nx]``, ``True`` where the cell is free."""
+        out = ~self.occupied
+        out.flags.writeable = False
+        return out
+
+    def with_occupied(self, occupied: np.ndarray) -> OccupancyGrid:
+        """A grid with the same resolution and origin and new occupancy (validated)."""
+        return OccupancyGrid(occupied, self.resolution, self.origin)
+
+    # ------------------------------------------------------- conversions
+    def world_to_cell(self, xy: np.ndarray | tuple[float, float]) -> np.ndarray:
+        """Cells ``(ix, iy)`` containing world points.
+
+        Parameters
+        ----------
+        xy : array_like, shape (..., 2)
+            World coordinates in metres.
+
+        Returns
+        -------
+        ndarray of int64, shape (..., 2)
+            ``floor((xy - origin) / resolution)``; may lie outside the grid (see
+            :meth:`in_bounds`).
+        """
+        p = np.asarray(xy, dtype=float)
+        if p.shape[-1:] != (2,):
+            raise InvalidInputError(f"xy must have shape (..., 2), got {p.shape}")
+        if not np.all(np.isfinite(p)):
+            raise InvalidInputError(f"xy must be finite, got {p.tolist()}")
+        cells = np.floor((p - np.asarray(self.origin)) / self.resolution)
+        return cells.astype(np.int64)
+
+    def cell_to_world(self, cells: np.ndarray | tuple[int, int]) -> np.ndarray:
+        """World coordinates (metres) of cell centres.
+
+        Parameters
+        ----------
+        cells : array_like of int, shape (..., 2)
+            Cells ``(ix, iy)``.
+
+        Returns
+        -------
+        ndarray of float, shape (..., 2)
+        """
+        c = np.asarray(cells, dtype=float)
+        if c.shape[-1:] != (2,):
+            raise InvalidInputError(f"cells must have shape (..., 2), got {c.shape}")
+        return np.asarray(self.origin) + (c + 0.5) * self.resolution
+
+    def in_bounds(self, cells: np.ndarray | tuple[int, int]) -> np.ndarray | bool:
+        """Whether cells ``(ix, iy)`` (shape ``(..., 2)``) lie inside the grid."""
+        c = np.asarray(cells)
+        if c.shape[-1:] != (2,):
+            raise InvalidInputError(f"cells must have shape (..., 2), got {c.shape}")
+        ix, iy = c[..., 0], c[..., 1]
+        out = (ix >= 0) & (ix < self.nx) & (iy >= 0) & (iy < self.ny)
+        return bool(out) if out.ndim == 0 else out
+
+    def is_free(self, cells: np.ndarray | tuple[int, int]) -> np.ndarray | bool:
+        """Whether cells ``(ix, iy)`` are inside the grid and free (shape ``(...)``)."""
+        c = np.asarray(cells, dtype=np.int64)
+        inside = np.asarray(self.in_bounds(c))
+        ix = np.where(inside, c[..., 0], 0)
+        iy = np.where(inside, c[..., 1], 0)
+        out = inside & ~self.occupied[iy, ix]
+        return bool(out) if out.ndim == 0 else out
+
+    def __repr__(self) -> str:
+        return (
+            f"OccupancyGrid(nx={self.nx}, ny={self.ny}, resolution={self.resolution!r}, "
+            f"origin={self.origin!r}, occupied_cells={int(self.occupied.sum())})"
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, OccupancyGrid):
+            return NotImplemented
+        return (
+            self.resolution == other.resolution
+            and self.origin == other.origin
+            and self.occupied.shape == other.occupied.shape
+            and bool(np.array_equal(self.occupied, other.occupied))
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def _as_positive_float(value: object, name: str) -> float:
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"{name} must be a number, got {value!r}") from exc
+    if not math.isfinite(v) or v <= 0.0:
+        raise InvalidInputError(f"{name} must be finite and > 0, got {v!r}")
+    return v
+
+
+def _as_bool_grid(occupied: object) -> np.ndarray:
+    a = np.asarray(occupied)
+    if a.ndim != 2:
+        raise InvalidInputError(f"occupied must be a 2-D array [ny, nx], got shape {a.shape}")
+    if a.shape[0] == 0 or a.shape[1] == 0:
+        raise InvalidInputError(f"occupied must not be empty, got shape {a.shape}")
+    if a.dtype != bool:
+        if a.dtype.kind not in "iuf":
+            raise InvalidInputError(f"occupied must be bool or 0/1 numbers, got dtype {a.dtype}")
+        if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+            raise InvalidInputError("occupied must not contain NaN or infinity")
+        if not np.all((a == 0) | (a == 1)):
+            bad = a[(a != 0) & (a != 1)].ravel()[0]
+            raise InvalidInputError(
+                f"occupied must hold only 0/1 (or bool) values, found {bad!r}"
+            )
+    out = np.array(a, dtype=bool, order="C", copy=True)
+    out.flags.writeable = False
+    return out

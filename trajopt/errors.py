@@ -1,0 +1,51 @@
+"""The exceptions of :mod:`trajopt`: one hierarchy, every failure typed.
+
+``TrajoptError`` is the base of everything :mod:`trajopt` raises on purpose.
+``InvalidInputError`` and ``NoPathError`` also derive from their :mod:`astar`
+counterparts (and ``InvalidInputError`` from :class:`ValueError`), so one ``except``
+clause catches a failure whichever stage raised it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import astar.errors as _astar_errors
+
+__all__ = [
+    "TrajoptError",
+    "InvalidInputError",
+    "NoPathError",
+    "SmoothingError",
+    "TimingError",
+]
+
+
+class TrajoptError(Exception):
+    """Base class of every exception raised by :mod:`trajopt`."""
+
+
+class InvalidInputError(TrajoptError, _astar_errors.InvalidInputError):
+    """An argument breaks a documented rule (the message names the field, value and rule)."""
+
+
+class NoPathError(TrajoptError, _astar_errors.NoPathError):
+    """The grid search found no path between start and goal."""
+
+
+class SmoothingError(TrajoptError):
+    """The smoother could not produce a curve meeting every guarantee.
+
+    Attributes
+    ----------
+    stats : dict
+        Solver statistics of the last attempt (status, iterations, time, ...).
+    """
+
+    def __init__(self, message: str, stats: dict[str, Any] | None = None) -> None:
+        super().__init__(message)
+        self.stats: dict[str, Any] = dict(stats or {})
+
+
+class TimingError(TrajoptError):
+    """The time parameterisation cannot meet the requested boundary speeds or limits."""
