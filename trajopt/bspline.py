@@ -64,7 +64,8 @@ class BSplineCurve(ParametricCurve):
     @classmethod
     def from_scipy(cls, spline) -> BSplineCurve:
         """Wrap a :class:`scipy.interpolate.BSpline` whose coefficients have shape (n, 2)."""
-        return cls(spline.t, spline.c, spline.k)
+        n = len(spline.t) - spline.k - 1
+        return cls(spline.t, np.asarray(spline.c)[:n], spline.k)
 
     @property
     def control_points(self) -> np.ndarray:

@@ -1,0 +1,71 @@
+"""BSplineCurve against scipy and closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline, make_lsq_spline
+
+from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.errors import InvalidInputError
+
+
+def _curve(n=8, k=3, seed=0):
+    rng = np.random.default_rng(seed)
+    return BSplineCurve(clamped_uniform_knots(n, k, (0.0, 2.0)), rng.normal(size=(n, 2)), k)
+
+
+def test_matches_scipy_per_axis():
+    c = _curve()
+    u = np.linspace(0, 2, 37)
+    for nu in range(4):
+        for axis in range(2):
+            ref = BSpline(c.t, c.c[:, axis], c.k)(u, nu)
+            np.testing.assert_allclose(c(u, nu)[:, axis], ref, atol=1e-12)
+
+
+def test_clamped_endpoints_and_derivative():
+    c = _curve()
+    np.testing.assert_allclose(c(0.0), c.c[0], atol=1e-14)
+    np.testing.assert_allclose(c(2.0), c.c[-1], atol=1e-14)
+    d = c.derivative()
+    u = np.linspace(0, 2, 11)
+    np.testing.assert_allclose(d(u), c(u, 1), atol=1e-12)
+    assert d.k == 2
+
+
+def test_convex_hull_of_spans():
+    c = _curve(n=12, seed=3)
+    u = np.linspace(0, 2, 2001)
+    span = c.span_of(u)
+    p = c(u)
+    for j in np.unique(span):
+        pts = c.c[j : j + c.k + 1]
+        sel = p[span == j]
+        assert np.all(sel >= pts.min(0) - 1e-12) and np.all(sel <= pts.max(0) + 1e-12)
+
+
+def test_circle_fit_curvature():
+    r = 2.0
+    th = np.linspace(0, np.pi, 300)
+    xy = np.c_[r * np.cos(th), r * np.sin(th)]
+    t = clamped_uniform_knots(20, 3, (0, np.pi))
+    c = BSplineCurve.from_scipy(make_lsq_spline(th, xy, t, 3))
+    assert c.length == pytest.approx(np.pi * r, rel=1e-5)
+    np.testing.assert_allclose(c.curvature(np.linspace(0.3, 2.8, 9)), 1 / r, rtol=5e-3)
+
+
+@pytest.mark.parametrize(
+    ("t", "c", "k", "match"),
+    [
+        (np.arange(8.0), np.zeros((3, 2)), 3, "at least k \\+ 1"),
+        (np.arange(7.0), np.zeros((4, 2)), 3, "need n \\+ k \\+ 1 = 8 knots"),
+        (np.arange(8.0)[::-1], np.zeros((4, 2)), 3, "non-decreasing"),
+        (np.arange(8.0), np.zeros((4, 3)), 3, "shape \\(n, 2\\)"),
+        (np.arange(8.0), np.full((4, 2), np.nan), 3, "finite"),
+        (np.arange(8.0), np.zeros((4, 2)), 0, "degree k must be >= 1"),
+    ],
+)
+def test_invalid(t, c, k, match):
+    with pytest.raises(InvalidInputError, match=match):
+        BSplineCurve(t, c, k)

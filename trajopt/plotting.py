@@ -1,0 +1,186 @@
+"""Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11),
+and time plots of a trajectory with its limits.
+
+matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
+Every function returns the matplotlib objects it drew on, for further styling.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from astar.grid import OccupancyGrid
+from trajopt.curve import ParametricCurve
+
+__all__ = ["plot_map", "plot_paths", "plot_profiles", "path_points"]
+
+_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+
+
+def path_points(path: Any, spacing: float | None = None) -> np.ndarray:
+    """Points (m), shape (m, 2), of a curve, a GridPath-like polyline or an (m, 2) array.
+
+    Parameters
+    ----------
+    path : ParametricCurve or array_like, shape (m, 2)
+        Curves are sampled every ``spacing`` metres (default: 400 samples).
+    spacing : float, optional
+        Sample spacing in metres for curves.
+    """
+    if isinstance(path, ParametricCurve):
+        return path.sample(ds=spacing).xy if spacing else path.sample(400).xy
+    pts = np.asarray(path, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"path must be a curve or an (m, 2) array, got shape {pts.shape}")
+    return pts
+
+
+def plot_map(
+    grid: OccupancyGrid,
+    *,
+    inflated: OccupancyGrid | None = None,
+    corridor: Any = None,
+    ax: Any = None,
+) -> tuple[Any, Any]:
+    """Draw the raw obstacles (black), the avoidance area (grey) and corridor boxes.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        Raw map.
+    inflated : OccupancyGrid, optional
+        Inflated grid of the same shape; cells blocked only by inflation are shaded grey.
+    corridor : Corridor, optional
+        Anything with ``boxes`` whose items have ``xmin, xmax, ymin, ymax`` (m).
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    (Figure, Axes)
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6, 6))
+    else:
+        fig = ax.figure
+    img = np.zeros(grid.shape, dtype=float)
+    if inflated is not None:
+        if inflated.shape != grid.shape:
+            raise ValueError(
+                f"inflated grid shape {inflated.shape} differs from the map's {grid.shape}"
+            )
+        img[inflated.occupied] = 0.35
+    img[grid.occupied] = 1.0
+    ox, oy = grid.origin
+    extent = (ox, ox + grid.width, oy, oy + grid.height)
+    ax.imshow(img, origin="lower", extent=extent, cmap="Greys", vmin=0, vmax=1,
+              interpolation="nearest")
+    if corridor is not None:
+        for box in corridor.boxes:
+            ax.add_patch(
+                Rectangle((box.xmin, box.ymin), box.xmax - box.xmin, box.ymax - box.ymin,
+                          fill=False, lw=0.7, ec="tab:cyan", alpha=0.8)
+            )
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_aspect("equal")
+    return fig, ax
+
+
+def plot_paths(
+    grid: OccupancyGrid,
+    paths: Mapping[str, Any],
+    *,
+    inflated: OccupancyGrid | None = None,
+    corridor: Any = None,
+    start: Sequence[float] | None = None,
+    goals: Mapping[str, Sequence[float]] | None = None,
+    zoom: tuple[float, float, float, float] | None = None,
+    ax: Any = None,
+) -> tuple[Any, Any]:
+    """The map with every method's path (the chapter's Figures 7-10; with ``zoom``, 11).
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        Raw map.
+    paths : mapping of str to curve or array_like (m, 2)
+        Method name -> path in metres.
+    inflated, corridor : optional
+        See :func:`plot_map`.
+    start : (x, y), optional
+        Start point (m), drawn as a square marker.
+    goals : mapping of str to (x, y), optional
+        Named targets (m).
+    zoom : (xmin, xmax, ymin, ymax), optional
+        Axis limits in metres for a zoomed view.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    (Figure, Axes)
+    """
+    fig, ax = plot_map(grid, inflated=inflated, corridor=corridor, ax=ax)
+    for i, (name, path) in enumerate(paths.items()):
+        pts = path_points(path)
+        style = "-" if isinstance(path, ParametricCurve) else "--"
+        ax.plot(pts[:, 0], pts[:, 1], style, color=_COLORS[i % len(_COLORS)], lw=1.4, label=name)
+    if start is not None:
+        ax.plot(*start, "ks", ms=7, label="start")
+    for name, g in (goals or {}).items():
+        ax.plot(*g, "r*", ms=10)
+        ax.annotate(name, g, textcoords="offset points", xytext=(4, 4))
+    if zoom is not None:
+        ax.set_xlim(zoom[0], zoom[1])
+        ax.set_ylim(zoom[2], zoom[3])
+    ax.legend(loc="best", fontsize="small")
+    return fig, ax
+
+
+def plot_profiles(trajectory: Any, robot: Any = None, *, n: int = 1000) -> tuple[Any, Any]:
+    """Speed, acceleration, jerk, heading and yaw rate over time, with limits dashed.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        Anything with ``duration`` (s) and ``sample(t)`` returning named arrays
+        ``t, v, a, jerk, theta, omega``.
+    robot : Robot, optional
+        Limits to draw (default: ``trajectory.robot`` when present).
+    n : int
+        Number of samples.
+
+    Returns
+    -------
+    (Figure, ndarray of Axes), five rows.
+    """
+    import matplotlib.pyplot as plt
+
+    robot = robot if robot is not None else getattr(trajectory, "robot", None)
+    t = np.linspace(0.0, trajectory.duration, n)
+    smp = trajectory.sample(t)
+    rows = [
+        ("v", "speed [m/s]", "v_max"),
+        ("a", "acceleration [m/s²]", "a_max"),
+        ("jerk", "jerk [m/s³]", "j_max"),
+        ("theta", "heading [rad]", None),
+        ("omega", "yaw rate [rad/s]", "omega_max"),
+    ]
+    fig, axes = plt.subplots(len(rows), 1, figsize=(7, 9), sharex=True)
+    for ax, (key, label, limit) in zip(axes, rows, strict=True):
+        ax.plot(smp.t if hasattr(smp, "t") else t, getattr(smp, key), lw=1.2)
+        if robot is not None and limit is not None:
+            lim = getattr(robot, limit)
+            ax.axhline(lim, ls="--", c="tab:red", lw=0.8)
+            if key != "v":
+                ax.axhline(-lim, ls="--", c="tab:red", lw=0.8)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    fig.tight_layout()
+    return fig, axes
