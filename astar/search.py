@@ -1,0 +1,568 @@
+"""Octile-optimal A* on occupancy grids, compiled with numba.
+
+:func:`find_path` searches the 8-connected (or 4-connected) grid graph of the free cells of an
+:class:`~astar.grid.OccupancyGrid`:
+
+* a straight step costs 1 (cell), a diagonal step ``sqrt(2)``;
+* without corner cutting (the default, the Moving AI benchmark rule) a diagonal step needs both
+  orthogonal neighbours it passes between to be free; with ``corner_cutting=True`` a diagonal step
+  only needs its target cell free;
+* with a per-cell ``cost`` array (clearance-aware search, :func:`astar.clearance_cost`) a step
+  costs its length times ``1 + (cost[a] + cost[b]) / 2`` for its two cells ``a``, ``b``.
+
+The heuristic is the octile distance (Manhattan for ``connectivity=4``), which is admissible and
+consistent for both cost models (the step costs are never below their length), so with a closed
+set the first expansion of the goal is optimal.
+
+Implementation notes
+--------------------
+The kernel works on a flat ``uint8`` copy of the grid padded with one ring of blocked cells (no
+bounds checks in the loop), with ``int32`` indices, precomputed neighbour offsets, a binary heap
+on arrays with lazy deletion (a node pushed with the same ``f`` as the node being expanded is
+already minimal, so it bypasses the heap on a stack), and work buffers reused between calls (a generation stamp marks
+which cells the current search has touched, so nothing is cleared per call). Without ``cost`` the
+cost-so-far of a cell is kept as two integers -- its numbers of straight and diagonal steps --
+so equal costs compare exactly equal and ties are broken exactly: among equal ``f = g + h`` the
+deeper node (larger ``g``) is expanded first, then the earlier pushed one. The search is
+therefore deterministic. The padded grid of the last few grids searched is cached (grids are
+immutable).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numba import njit
+
+from astar.errors import InvalidInputError, NoPathError
+from astar.grid import OccupancyGrid
+
+__all__ = ["GridPath", "find_path"]
+
+logger = logging.getLogger(__name__)
+
+_SQRT2 = math.sqrt(2.0)
+
+
+# --------------------------------------------------------------------------- result value
+@dataclass(frozen=True, slots=True, eq=False)
+class GridPath:
+    """A path of grid cells found by :func:`find_path`.
+
+    Parameters
+    ----------
+    cells : array_like of int, shape (n, 2)
+        Cells ``(ix, iy)`` from start to goal, both included (``n >= 1``). Copied to a read-only
+        ``int64`` array.
+    length : float
+        Length in cells: 1 per straight step, ``sqrt(2)`` per diagonal step.
+    cost : float
+        The cost the search minimised: equal to ``length`` without a cost grid, otherwise the sum
+        of ``step length * (1 + mean cost of the step's two cells)``.
+    expanded : int
+        Number of nodes the search closed (popped from the open list), the goal included.
+    """
+
+    cells: np.ndarray
+    length: float
+    cost: float
+    expanded: int
+
+    def __post_init__(self) -> None:
+        c = np.array(self.cells, dtype=np.int64, copy=True)
+        if c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1:
+            raise InvalidInputError(f"cells must have shape (n, 2) with n >= 1, got {c.shape}")
+        c.flags.writeable = False
+        object.__setattr__(self, "cells", c)
+        object.__setattr__(self, "length", float(self.length))
+        object.__setattr__(self, "cost", float(self.cost))
+        object.__setattr__(self, "expanded", int(self.expanded))
+
+    def __len__(self) -> int:
+        """Number of cells ``n``."""
+        return int(self.cells.shape[0])
+
+    def to_world(self, grid: OccupancyGrid) -> np.ndarray:
+        """World coordinates of the cell centres along the path.
+
+        Parameters
+        ----------
+        grid : OccupancyGrid
+            The grid the path was found on (its resolution and origin are used).
+
+        Returns
+        -------
+        ndarray of float64, shape (n, 2)
+            ``(x, y)`` in metres.
+        """
+        return grid.cell_to_world(self.cells)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, GridPath):
+            return NotImplemented
+        return (
+            self.length == other.length
+            and self.cost == other.cost
+            and self.expanded == other.expanded
+            and bool(np.array_equal(self.cells, other.cells))
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return (
+            f"GridPath(n={len(self)}, start={tuple(self.cells[0].tolist())}, "
+            f"goal={tuple(self.cells[-1].tolist())}, length={self.length:.6g}, "
+            f"cost={self.cost:.6g}, expanded={self.expanded})"
+        )
+
+
+# --------------------------------------------------------------------------- the kernel
+@njit(cache=True)
+def _astar_kernel(
+    free,  # uint8 [H*W], padded with a blocked ring
+    width,  # W = nx + 2
+    start,  # padded flat index
+    goal,
+    conn8,  # bool
+    cut,  # corner cutting allowed
+    weighted,  # bool: use `cost`
+    cost,  # float64 [H*W] (ignored unless weighted)
+    rec,  # int32 [4*H*W] per-cell record: stamp, straight steps, diagonal steps, parent
+    gf,  # float64 [H*W]: cost so far (weighted)
+    gen,  # this search's stamp; gen + 1 marks closed
+):  # pragma: no cover - numba
+    sqrt2 = 1.4142135623730951
+    w = width
+    gx = goal % w
+    gy = goal // w
+
+    # neighbour table: E, W, N, S, then NE, NW, SE, SW
+    ndir = 8 if conn8 else 4
+    ddx = np.array([1, -1, 0, 0, 1, -1, 1, -1], dtype=np.int32)
+    ddy = np.array([0, 0, 1, -1, 1, 1, -1, -1], dtype=np.int32)
+
+    cap = 1024
+    hf = np.empty(cap, dtype=np.float64)
+    hg = np.empty(cap, dtype=np.float64)
+    hn = np.empty(cap, dtype=np.int32)
+    size = 0
+
+    closed = gen + 1
+    rec[4 * start] = gen
+    rec[4 * start + 1] = 0
+    rec[4 * start + 2] = 0
+    rec[4 * start + 3] = -1
+    gf[start] = 0.0
+    sx = start % w
+    sy = start // w
+    ax = abs(sx - gx)
+    ay = abs(sy - gy)
+    if conn8:
+        h0 = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
+    else:
+        h0 = float(ax + ay)
+    hf[0] = h0
+    hg[0] = 0.0
+    hn[0] = start
+    size = 1
+
+    # a node pushed with f equal to the f being expanded is minimal (consistent heuristic):
+    # it bypasses the heap on a LIFO stack, which is popped first
+    scap = 256
+    stk = np.empty(scap, dtype=np.int32)
+    ssize = 0
+    fcur = h0
+
+    expanded = 0
+    found = False
+    fr = np.zeros(8, dtype=np.bool_)
+    while size > 0 or ssize > 0:
+        if ssize > 0:
+            ssize -= 1
+            u = stk[ssize]
+        else:
+            # ---- pop the heap's root
+            u = hn[0]
+            fcur = hf[0]
+            size -= 1
+            if size > 0:
+                lf = hf[size]
+                lg = hg[size]
+                ln = hn[size]
+                i = 0
+                while True:
+                    c = 2 * i + 1
+                    if c >= size:
+                        break
+                    if c + 1 < size and (
+                        hf[c + 1] < hf[c] or (hf[c + 1] == hf[c] and hg[c + 1] > hg[c])
+                    ):
+                        c += 1
+                    if hf[c] < lf or (hf[c] == lf and hg[c] > lg):
+                        hf[i] = hf[c]
+                        hg[i] = hg[c]
+                        hn[i] = hn[c]
+                        i = c
+                    else:
+                        break
+                hf[i] = lf
+                hg[i] = lg
+                hn[i] = ln
+        if rec[4 * u] == closed:
+            continue  # stale entry (lazy deletion)
+        rec[4 * u] = closed
+        expanded += 1
+        if u == goal:
+            found = True
+            break
+        ux = u % w
+        uy = u // w
+        gu = gf[u]
+        cu = cost[u] if weighted else 0.0
+        gau = rec[4 * u + 1]
+        gbu = rec[4 * u + 2]
+        for k in range(4):
+            fr[k] = free[u + ddy[k] * w + ddx[k]] != 0
+        for k in range(ndir):
+            dx = ddx[k]
+            dy = ddy[k]
+            v = u + dy * w + dx
+            if k < 4:
+                if not fr[k]:
+                    continue
+            else:
+                if free[v] == 0:
+                    continue
+                if not cut:
+                    # both orthogonal neighbours: (dx, 0) is E/W = k 0/1, (0, dy) is N/S = k 2/3
+                    if not fr[0 if dx > 0 else 1] or not fr[2 if dy > 0 else 3]:
+                        continue
+            r4 = 4 * v
+            sv = rec[r4]
+            if sv == closed:
+                continue
+            vx = ux + dx
+            vy = uy + dy
+            ax = abs(vx - gx)
+            ay = abs(vy - gy)
+            if weighted:
+                step = 1.0 if k < 4 else sqrt2
+                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v]))
+                if sv == gen and gnew >= gf[v]:
+                    continue
+                gf[v] = gnew
+                if conn8:
+                    hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
+                else:
+                    hv = float(ax + ay)
+                fnew = gnew + hv
+            else:
+                na = gau + (1 if k < 4 else 0)
+                nb = gbu + (0 if k < 4 else 1)
+                gnew = na + nb * sqrt2
+                if sv == gen and gnew >= rec[r4 + 1] + rec[r4 + 2] * sqrt2:
+                    continue
+                rec[r4 + 1] = na
+                rec[r4 + 2] = nb
+                if conn8:
+                    mn = min(ax, ay)
+                    fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
+                else:
+                    fnew = (na + ax + ay) + nb * sqrt2
+            rec[r4] = gen
+            rec[r4 + 3] = u
+            if fnew == fcur:
+                if ssize == scap:
+                    scap *= 2
+                    ns = np.empty(scap, dtype=np.int32)
+                    ns[:ssize] = stk[:ssize]
+                    stk = ns
+                stk[ssize] = v
+                ssize += 1
+                continue
+            # ---- push (sift up)
+            if size == cap:
+                cap *= 2
+                nf = np.empty(cap, dtype=np.float64)
+                ng = np.empty(cap, dtype=np.float64)
+                nn = np.empty(cap, dtype=np.int32)
+                nf[:size] = hf[:size]
+                ng[:size] = hg[:size]
+                nn[:size] = hn[:size]
+                hf = nf
+                hg = ng
+                hn = nn
+            i = size
+            size += 1
+            while i > 0:
+                p = (i - 1) >> 1
+                if fnew < hf[p] or (fnew == hf[p] and gnew > hg[p]):
+                    hf[i] = hf[p]
+                    hg[i] = hg[p]
+                    hn[i] = hn[p]
+                    i = p
+                else:
+                    break
+            hf[i] = fnew
+            hg[i] = gnew
+            hn[i] = v
+
+    if not found:
+        return False, np.empty(0, dtype=np.int64), expanded, 0.0, 0, 0
+    n = 1
+    v = goal
+    while v != start:
+        v = rec[4 * v + 3]
+        n += 1
+    path = np.empty(n, dtype=np.int64)
+    v = goal
+    for i in range(n - 1, -1, -1):
+        path[i] = v
+        if i > 0:
+            v = rec[4 * v + 3]
+    if weighted:
+        return True, path, expanded, gf[goal], 0, 0
+    return True, path, expanded, 0.0, rec[4 * goal + 1], rec[4 * goal + 2]
+
+
+# --------------------------------------------------------------------------- caches
+class _Workspace:
+    """Work buffers of one padded size, reused between searches (guarded by a lock)."""
+
+    __slots__ = ("gen", "gf", "rec")
+
+    def __init__(self, n: int) -> None:
+        # one cache line touch per cell: [stamp, straight steps, diagonal steps, parent]
+        self.rec = np.zeros(4 * n, dtype=np.int32)
+        self.gf = np.empty(n, dtype=np.float64)
+        self.gen = 1
+
+    def next_gen(self) -> int:
+        self.gen += 2
+        if self.gen >= 2**31 - 4:
+            self.rec[0::4] = 0
+            self.gen = 1
+        return self.gen
+
+
+_LOCK = threading.Lock()
+_WORKSPACES: OrderedDict[int, _Workspace] = OrderedDict()
+_PADDED: OrderedDict[int, tuple[np.ndarray, np.ndarray]] = OrderedDict()
+_CACHE_SIZE = 4
+_EMPTY_COST = np.zeros(1, dtype=np.float64)
+
+
+def _workspace(n: int) -> _Workspace:
+    ws = _WORKSPACES.get(n)
+    if ws is None:
+        ws = _Workspace(n)
+        _WORKSPACES[n] = ws
+        while len(_WORKSPACES) > _CACHE_SIZE:
+            _WORKSPACES.popitem(last=False)
+    else:
+        _WORKSPACES.move_to_end(n)
+    return ws
+
+
+def _padded_free(occupied: np.ndarray) -> np.ndarray:
+    """Flat uint8 free mask of ``occupied`` with a blocked one-cell ring (cached by identity)."""
+    key = id(occupied)
+    hit = _PADDED.get(key)
+    if hit is not None and hit[0] is occupied:
+        _PADDED.move_to_end(key)
+        return hit[1]
+    ny, nx = occupied.shape
+    free = np.zeros((ny + 2, nx + 2), dtype=np.uint8)
+    free[1:-1, 1:-1] = ~occupied
+    flat = free.ravel()
+    flat.flags.writeable = False
+    # keep a reference to `occupied` so its id cannot be reused while cached
+    _PADDED[key] = (occupied, flat)
+    while len(_PADDED) > _CACHE_SIZE:
+        _PADDED.popitem(last=False)
+    return flat
+
+
+# --------------------------------------------------------------------------- validation
+def _check_cell(value: object, name: str, grid: OccupancyGrid) -> tuple[int, int]:
+    bad = InvalidInputError(f"{name} must be a cell (ix, iy) of two integers, got {value!r}")
+    if isinstance(value, (str, bytes)) or (
+        isinstance(value, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in value)
+    ):
+        raise bad
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise bad from exc
+    if arr.shape != (2,):
+        raise bad
+    if arr.dtype.kind not in "iu" and not (arr.dtype == object and all(_is_int(v) for v in arr)):
+        raise bad
+    ix, iy = int(arr[0]), int(arr[1])
+    if not (0 <= ix < grid.nx and 0 <= iy < grid.ny):
+        raise InvalidInputError(
+            f"{name} cell ({ix}, {iy}) is outside the grid: need 0 <= ix < {grid.nx} "
+            f"and 0 <= iy < {grid.ny}"
+        )
+    if grid.occupied[iy, ix]:
+        raise InvalidInputError(
+            f"{name} cell ({ix}, {iy}) is blocked: it is occupied in the grid given to "
+            "find_path (an obstacle, or inside the inflated avoidance area)"
+        )
+    return ix, iy
+
+
+def _is_int(v: object) -> bool:
+    return isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
+
+
+def _check_cost(cost: object, grid: OccupancyGrid) -> np.ndarray:
+    try:
+        c = np.asarray(cost, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"cost must be a float array of shape {grid.shape} (per-cell cost >= 0), "
+            f"got {type(cost).__name__}"
+        ) from exc
+    if c.shape != grid.shape:
+        raise InvalidInputError(
+            f"cost must have the grid's shape (ny, nx) = {grid.shape}, got {c.shape}"
+        )
+    if not np.all(np.isfinite(c)):
+        raise InvalidInputError("cost must be finite everywhere (found NaN or infinity)")
+    if c.size and c.min() < 0.0:
+        raise InvalidInputError(f"cost must be >= 0 everywhere, found {float(c.min())!r}")
+    return c
+
+
+# --------------------------------------------------------------------------- public API
+def find_path(
+    grid: OccupancyGrid,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    *,
+    connectivity: Literal[4, 8] = 8,
+    corner_cutting: bool = False,
+    cost: np.ndarray | None = None,
+) -> GridPath:
+    """Shortest (or cheapest) path of free cells from ``start`` to ``goal`` by A*.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        The grid to search, shape ``(ny, nx)``; usually already inflated
+        (:func:`astar.inflate`). Occupied cells are never entered.
+    start, goal : tuple of int
+        Cells ``(ix, iy)`` (x first; row ``iy = 0`` at the bottom), inside the grid and free.
+    connectivity : {8, 4}, optional
+        8 (default): straight and diagonal steps, octile heuristic. 4: straight steps only,
+        Manhattan heuristic.
+    corner_cutting : bool, optional
+        ``False`` (default, the Moving AI rule): a diagonal step needs both orthogonal
+        neighbours it passes between to be free. ``True``: a diagonal step only needs its target
+        free (it may pass between two blocked cells touching at a corner).
+    cost : array_like of float, shape (ny, nx), optional
+        Per-cell traversal cost (finite, ``>= 0``, dimensionless), e.g. from
+        :func:`astar.clearance_cost`. A step then costs its length times
+        ``1 + (cost[a] + cost[b]) / 2`` for its two cells; the heuristic is unchanged (still
+        admissible and consistent), so the path is optimal for that cost.
+
+    Returns
+    -------
+    GridPath
+        ``cells`` (int64, shape ``(n, 2)``, start and goal included), ``length`` (cells),
+        ``cost`` (equal to ``length`` without ``cost``) and ``expanded``. With
+        ``start == goal`` the path is that one cell, of length 0.
+
+    Raises
+    ------
+    InvalidInputError
+        ``grid`` is not an :class:`OccupancyGrid`; ``start`` or ``goal`` is not two integers,
+        lies outside the grid or on an occupied cell (the message names which, the cell and
+        why); ``connectivity`` is not 4 or 8; ``cost`` has the wrong shape or holds negative or
+        non-finite values.
+    NoPathError
+        No path of free cells joins ``start`` and ``goal``.
+
+    Notes
+    -----
+    The search is deterministic: ties in ``f`` are broken towards the larger cost-so-far,
+    then by insertion order. It is not thread-parallel: concurrent calls are serialised.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g = OccupancyGrid(np.zeros((3, 4), bool), resolution=1.0)
+    >>> p = find_path(g, (0, 0), (3, 2))
+    >>> p.cells.tolist(), round(p.length, 6)
+    ([[0, 0], [1, 1], [2, 2], [3, 2]], 3.828427)
+    """
+    if not isinstance(grid, OccupancyGrid):
+        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}")
+    if isinstance(connectivity, bool) or connectivity not in (4, 8):
+        raise InvalidInputError(f"connectivity must be 4 or 8, got {connectivity!r}")
+    sx, sy = _check_cell(start, "start", grid)
+    gx, gy = _check_cell(goal, "goal", grid)
+    weighted = cost is not None
+    if weighted:
+        c = _check_cost(cost, grid)
+        cpad = np.zeros((grid.ny + 2, grid.nx + 2), dtype=np.float64)
+        cpad[1:-1, 1:-1] = c
+        cflat = cpad.ravel()
+    else:
+        cflat = _EMPTY_COST
+    width = grid.nx + 2
+    s = (sy + 1) * width + sx + 1
+    t = (gy + 1) * width + gx + 1
+    with _LOCK:
+        free = _padded_free(grid.occupied)
+        ws = _workspace(free.shape[0])
+        gen = ws.next_gen()
+        found, path, expanded, gcost, na, nb = _astar_kernel(
+            free,
+            width,
+            s,
+            t,
+            connectivity == 8,
+            bool(corner_cutting),
+            weighted,
+            cflat,
+            ws.rec,
+            ws.gf,
+            gen,
+        )
+    if not found:
+        raise NoPathError(
+            f"no path from start ({sx}, {sy}) to goal ({gx}, {gy}) on the "
+            f"{grid.nx} x {grid.ny} grid (connectivity={connectivity}, "
+            f"corner_cutting={bool(corner_cutting)}); {expanded} cells reachable from start"
+        )
+    iy, ix = np.divmod(path, width)
+    cells = np.stack([ix - 1, iy - 1], axis=1)
+    if weighted:
+        steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+        nb = int(np.count_nonzero(steps == 2))
+        na = int(steps.shape[0] - nb)
+        length = na + nb * _SQRT2
+        total = float(gcost)
+    else:
+        length = int(na) + int(nb) * _SQRT2
+        total = length
+    logger.debug(
+        "find_path (%d, %d) -> (%d, %d): %d cells, length %.6g, expanded %d",
+        sx,
+        sy,
+        gx,
+        gy,
+        cells.shape[0],
+        length,
+        expanded,
+    )
+    return GridPath(cells, length, total, expanded)

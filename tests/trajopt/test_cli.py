@@ -1,0 +1,111 @@
+"""The ``trajopt`` command line: outputs, one-line errors with exit code 2, atomic files."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import astar
+from trajopt.cli import main
+
+
+@pytest.fixture()
+def door_map(tmp_path):
+    occ = np.zeros((40, 60), bool)
+    occ[:, 30] = True
+    occ[16:28, 30] = False
+    grid = astar.OccupancyGrid(occ, 0.05)
+    return astar.save_map(grid, tmp_path / "door.yaml")
+
+
+def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
+    out = tmp_path / "traj.csv"
+    rc = main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+               "--radius", "0.12", "--out", str(out), "--dt", "0.05"])
+    assert rc == 0
+    with open(out) as fh:
+        rows = [r for r in csv.reader(fh) if r and not r[0].startswith("#")]
+    header, body = rows[0], np.array(rows[1:], float)
+    t = body[:, header.index(next(h for h in header if h.startswith("t")))]
+    assert t[0] == 0.0 and np.all(np.diff(t) > 0)
+    assert "duration" in capsys.readouterr().out
+    js = tmp_path / "traj.json"
+    assert main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+                 "--radius", "0.12", "--out", str(js)]) == 0
+    assert "duration" in json.loads(js.read_text())
+
+
+@pytest.mark.parametrize(
+    ("argv", "match"),
+    [
+        (["plan", "MISSING.yaml", "--start", "0", "0", "--goal", "1", "1"], "does not exist"),
+        (["plan", "{map}", "--start", "1.52", "0.3", "--goal", "2.6", "1.6"], "occupied cell"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "9", "9"], "outside the map"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "-1"],
+         "v_max"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--out", "x.txt"],
+         "--out must end in .csv or .json"),
+        (["plan", "{map}", "--start", "0.4"], "expected 2 arguments"),
+        (["bench", "{map}", "--limit", "0"], "--limit must be >= 1"),
+        (["nonsense"], "invalid choice"),
+    ],
+)
+def run(argv) -> int:
+    """Exit code of ``trajopt argv`` whether it returns or raises SystemExit."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
+
+
+def test_errors_are_one_line_exit_2(argv, match, door_map, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    argv = [a.replace("{map}", str(door_map)) for a in argv]
+    assert run(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert match in err
+
+
+def test_help_for_every_command(capsys):
+    for cmd in ("plan", "compare", "demo", "bench"):
+        with pytest.raises(SystemExit) as exc:
+            main([cmd, "--help"])
+        assert exc.value.code == 0
+        assert "usage: trajopt " + cmd in capsys.readouterr().out
+
+
+def test_failed_write_keeps_the_old_file(door_map, tmp_path):
+    out = tmp_path / "traj.csv"
+    out.write_text("good\n")
+    rc = main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "9", "9",
+               "--out", str(out)])
+    assert rc == 2
+    assert out.read_text() == "good\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["door.pgm", "door.yaml", "traj.csv"]
+
+
+def test_compare_markdown(door_map, capsys):
+    rc = main(["compare", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+               "--radius", "0.12", "--format", "markdown"])
+    assert rc == 0
+    out = capsys.readouterr().out
+    assert out.count("|") > 20 and "proposed" in out
+
+
+def test_bench_serial_equals_parallel(shared_data, capsys):
+    scen = shared_data / "movingai" / "scen" / "arena.map.scen"
+    args = ["bench", str(scen), "--limit", "3"]
+    assert main(args + ["--jobs", "1"]) == 0
+    serial = capsys.readouterr().out
+    assert main(args + ["--jobs", "2"]) == 0
+    parallel = capsys.readouterr().out
+
+    def strip_times(text):
+        return [ln for ln in text.splitlines() if "time" not in ln]
+
+    assert strip_times(serial) == strip_times(parallel)
+    assert "scenarios                      3" in serial

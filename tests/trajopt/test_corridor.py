@@ -1,0 +1,166 @@
+"""Tests of :mod:`trajopt.corridor` against brute force on hand-built and random grids.
+
+The helpers here (brute-force square inflation and an octile Dijkstra) are independent of
+:mod:`astar` and are reused by ``test_smoother.py``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from astar.grid import OccupancyGrid
+from trajopt.corridor import Box, Corridor, build_corridor
+from trajopt.errors import InvalidInputError
+
+
+# ---------------------------------------------------------------- references
+def brute_inflate_square(occ: np.ndarray, radius_cells: float) -> np.ndarray:
+    """Blocked where the cell centre is closer than ``radius_cells`` to an occupied cell
+    taken as a unit square, or to the outside of the map (brute force over all pairs)."""
+    ny, nx = occ.shape
+    pad = int(math.ceil(radius_cells)) + 1
+    big = np.ones((ny + 2 * pad, nx + 2 * pad), bool)
+    big[pad:-pad, pad:-pad] = occ
+    oy, ox = np.nonzero(big)
+    oy = oy - pad
+    ox = ox - pad
+    out = np.zeros_like(occ)
+    for iy in range(ny):
+        for ix in range(nx):
+            cx, cy = ix + 0.5, iy + 0.5
+            dx = np.maximum(0, np.maximum(ox - cx, cx - (ox + 1)))
+            dy = np.maximum(0, np.maximum(oy - cy, cy - (oy + 1)))
+            out[iy, ix] = bool(np.any(np.hypot(dx, dy) < radius_cells))
+    return out
+
+
+def dijkstra_path(free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -> np.ndarray:
+    """Octile shortest path (no corner cutting) by plain Dijkstra; cells ``(ix, iy)``."""
+    ny, nx = free.shape
+    dist = {start: 0.0}
+    prev: dict = {}
+    pq = [(0.0, start)]
+    moves = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1) if dx or dy]
+    while pq:
+        d, c = heapq.heappop(pq)
+        if c == goal:
+            break
+        if d > dist.get(c, math.inf):
+            continue
+        for dx, dy in moves:
+            x, y = c[0] + dx, c[1] + dy
+            if not (0 <= x < nx and 0 <= y < ny) or not free[y, x]:
+                continue
+            if dx and dy and not (free[c[1], x] and free[y, c[0]]):
+                continue
+            nd = d + (math.sqrt(2) if dx and dy else 1.0)
+            if nd < dist.get((x, y), math.inf) - 1e-12:
+                dist[(x, y)] = nd
+                prev[(x, y)] = c
+                heapq.heappush(pq, (nd, (x, y)))
+    if goal not in dist:
+        raise ValueError("unreachable")
+    out = [goal]
+    while out[-1] != start:
+        out.append(prev[out[-1]])
+    return np.array(out[::-1], dtype=np.int64)
+
+
+def assert_corridor_valid(corr: Corridor, free: np.ndarray, cells: np.ndarray, res: float, origin):
+    """Every box free (brute force), consecutive boxes overlap, the path is covered."""
+    ox, oy = origin
+    for b in corr.boxes:
+        assert free[b.iy0 : b.iy1 + 1, b.ix0 : b.ix1 + 1].all()
+        assert b.xmin == pytest.approx(ox + (b.ix0 + 0.5) * res)
+        assert b.ymax == pytest.approx(oy + (b.iy1 + 0.5) * res)
+    for a, b in zip(corr.boxes[:-1], corr.boxes[1:], strict=True):
+        assert max(a.ix0, b.ix0) <= min(a.ix1, b.ix1) and max(a.iy0, b.iy0) <= min(a.iy1, b.iy1)
+    covered = np.zeros(len(cells), bool)
+    for k, (b, (i0, i1)) in enumerate(zip(corr.boxes, corr.path_ranges, strict=True)):
+        assert b.contains_cells(cells[i0 : i1 + 1]).all()
+        covered[i0 : i1 + 1] = True
+        if k:
+            assert i0 <= corr.path_ranges[k - 1][1]  # shares path cells with its predecessor
+    assert covered.all()
+    pts = np.asarray(origin) + (cells + 0.5) * res
+    assert corr.contains(pts).all()
+    assert np.all(np.diff(corr.transitions_m) > 0)
+    assert np.all(corr.transitions_m >= corr.overlap_start_m - 1e-12)
+    assert np.all(corr.transitions_m <= corr.overlap_end_m + 1e-12)
+
+
+def l_shaped_grid() -> np.ndarray:
+    occ = np.ones((30, 30), bool)
+    occ[3:10, 3:27] = False  # horizontal hall
+    occ[3:27, 19:27] = False  # vertical hall
+    return occ
+
+
+# --------------------------------------------------------------------- tests
+def test_l_shaped_corridor_valid_and_deterministic():
+    occ = l_shaped_grid()
+    infl = brute_inflate_square(occ, 1.5)
+    grid = OccupancyGrid(infl, 0.1, (-1.0, 2.0))
+    cells = dijkstra_path(~infl, (5, 6), (23, 24))
+    c1 = build_corridor(grid, cells, radius=0.15)
+    c2 = build_corridor(grid, cells, radius=0.15)
+    assert_corridor_valid(c1, ~infl, cells, 0.1, (-1.0, 2.0))
+    assert c1.boxes == c2.boxes
+    assert np.array_equal(c1.transitions_m, c2.transitions_m)
+    assert c1.radius == 0.15
+    assert all(b.cells_x <= 32 and b.cells_y <= 32 for b in c1.boxes)
+
+
+def test_max_side_cells_bounds_boxes():
+    free = np.ones((60, 80), bool)
+    cells = np.array([(x, 30) for x in range(2, 78)], dtype=np.int64)
+    corr = build_corridor(OccupancyGrid(~free, 1.0), cells, max_side_cells=8)
+    assert len(corr) >= 76 // 8
+    assert all(b.cells_x <= 8 and b.cells_y <= 8 for b in corr.boxes)
+    assert_corridor_valid(corr, free, cells, 1.0, (0.0, 0.0))
+
+
+def test_single_cell_path_and_box_helpers():
+    free = np.ones((5, 5), bool)
+    corr = build_corridor(OccupancyGrid(~free, 0.5), np.array([[2, 2]]))
+    assert len(corr) == 1 and corr.length_m == 0.0
+    b = Box(0.0, 1.0, 0.0, 2.0, 0, 2, 0, 4)
+    assert b.contains(np.array([[0.5, 1.0], [1.5, 1.0]])).tolist() == [True, False]
+
+
+def test_rejects_blocked_or_broken_paths():
+    occ = np.zeros((5, 5), bool)
+    occ[2, 2] = True
+    grid = OccupancyGrid(occ, 1.0)
+    with pytest.raises(InvalidInputError, match="blocked"):
+        build_corridor(grid, np.array([[1, 2], [2, 2], [3, 2]]))
+    with pytest.raises(InvalidInputError, match="8-neighbour"):
+        build_corridor(grid, np.array([[0, 0], [2, 0]]))
+    with pytest.raises(InvalidInputError, match="outside"):
+        build_corridor(grid, np.array([[0, 0], [-1, 0]]))
+    with pytest.raises(InvalidInputError, match="max_side_cells"):
+        build_corridor(grid, np.array([[0, 0]]), max_side_cells=1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), density=st.floats(0.05, 0.3))
+def test_random_grids_brute_force(seed, density):
+    rng = np.random.default_rng(seed)
+    occ = rng.random((24, 28)) < density
+    free = ~occ
+    ys, xs = np.nonzero(free)
+    if len(xs) < 2:
+        return
+    i, j = rng.choice(len(xs), 2, replace=False)
+    try:
+        cells = dijkstra_path(free, (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j])))
+    except ValueError:
+        return
+    corr = build_corridor(OccupancyGrid(occ, 0.25, (1.0, -2.0)), cells, max_side_cells=6)
+    assert_corridor_valid(corr, free, cells, 0.25, (1.0, -2.0))

@@ -1,0 +1,244 @@
+"""Tests of trajopt.fits against independent references (numpy polyfit, brute force,
+explicit B-spline design matrices) and hand cases."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline
+
+from trajopt import fits
+from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.curve import ParametricCurve
+from trajopt.errors import InvalidInputError
+
+
+def _staircase(n: int = 60) -> np.ndarray:
+    """An x-monotone A*-like path: diagonal then straight steps of 0.03 m."""
+    steps = [(1, 1)] * (n // 3) + [(1, 0)] * (n // 3) + [(1, 1)] * (n - 2 * (n // 3))
+    return 0.03 * np.vstack([[0, 0], np.cumsum(steps, axis=0)]).astype(float)
+
+
+# ------------------------------------------------------------------ polynomial y = f(x)
+def test_least_squares_matches_numpy_polyfit_with_weights() -> None:
+    rng = np.random.default_rng(1)
+    x = np.sort(rng.uniform(0.0, 3.0, 40))
+    y = 0.2 * x**3 - x + 0.05 * rng.standard_normal(40)
+    w = rng.uniform(0.5, 2.0, 40)
+    fit = fits.fit_polynomial(np.c_[x, y], 3, method="least_squares", weights=w)
+    # numpy's w multiplies the unsquared residual: pass sqrt of our squared-residual weights
+    ref = np.polynomial.polynomial.Polynomial.fit(x, y, 3, w=np.sqrt(w))
+    xs = np.linspace(x[0], x[-1], 50)  # the curve is defined on the data's x range
+    assert fit.valid and fit.reason == ""
+    np.testing.assert_allclose(fit.curve(xs)[:, 1], ref(xs), atol=1e-9)
+    np.testing.assert_allclose(fit.curve(xs)[:, 0], xs)
+    assert fit.mse == pytest.approx(np.mean((ref(x) - y) ** 2), rel=1e-9)
+
+
+def test_lar_line_is_the_best_line_through_two_points_brute_force() -> None:
+    # an L1 line fit has an optimum through two data points: enumerate them all
+    rng = np.random.default_rng(2)
+    x = np.sort(rng.uniform(0, 1, 9))
+    y = 1.0 + 0.5 * x + rng.laplace(0, 0.1, 9)
+    best = min(
+        np.sum(np.abs(y - (y[i] + (y[j] - y[i]) / (x[j] - x[i]) * (x - x[i]))))
+        for i, j in itertools.combinations(range(9), 2)
+    )
+    fit = fits.fit_polynomial(np.c_[x, y], 1, method="lar")
+    ours = np.sum(np.abs(fit.curve(x)[:, 1] - y))
+    assert ours == pytest.approx(best, rel=1e-7, abs=1e-10)
+
+
+@pytest.mark.parametrize("method", ["lar", "bisquare"])
+def test_robust_methods_ignore_gross_outliers(method: str) -> None:
+    x = np.linspace(0.0, 2.0, 41)
+    y = 0.3 * x**2 - 0.4 * x + 0.1
+    y_bad = y.copy()
+    y_bad[[5, 17, 30]] += [1.0, -2.0, 1.5]
+    fit = fits.fit_polynomial(np.c_[x, y_bad], 2, method=method)
+    np.testing.assert_allclose(fit.curve(x)[:, 1], y, atol=1e-6)
+    ls = fits.fit_polynomial(np.c_[x, y_bad], 2, method="least_squares")
+    assert np.max(np.abs(ls.curve(x)[:, 1] - y)) > 0.1  # least squares is pulled away
+    if method == "bisquare":
+        assert fit.converged and fit.iterations >= 1
+        assert np.all(fit.weights[[5, 17, 30]] == 0.0)
+
+
+def test_bisquare_on_clean_data_equals_least_squares() -> None:
+    p = _staircase(45)
+    ls = fits.fit_polynomial(p, 4)
+    bi = fits.fit_polynomial(p, 4, method="bisquare", tol=1e-10, max_iter=200)
+    assert bi.mse >= ls.mse - 1e-15  # least squares minimises the MSE
+    assert bi.mse < 2.0 * ls.mse
+
+
+def test_polynomial_curve_derivatives_and_curvature() -> None:
+    x = np.linspace(-1.0, 1.0, 30)
+    fit = fits.fit_polynomial(np.c_[x, x**2], 2)
+    c = fit.curve
+    assert isinstance(c, ParametricCurve)
+    assert c.domain == pytest.approx((-1.0, 1.0))
+    assert c.curvature(0.0) == pytest.approx(2.0, rel=1e-9)  # y = x^2 at the vertex
+    u = np.array([-0.5, 0.3])
+    h = 1e-6
+    fd = (c(u + h) - c(u - h)) / (2 * h)
+    np.testing.assert_allclose(c(u, 1), fd, atol=1e-6)
+    np.testing.assert_allclose(c(u, 2), [[0.0, 2.0], [0.0, 2.0]], atol=1e-9)
+    assert c.heading(0.0) == pytest.approx(0.0, abs=1e-12)
+    s = c.sample(50)
+    assert s.xy.shape == (50, 2)
+    # arc length of y = x^2 on [-1, 1]: 2 * (sqrt(5)/2 + asinh(2)/4)
+    assert c.length == pytest.approx(math.sqrt(5) + math.asinh(2) / 2, rel=1e-8)
+
+
+def test_polynomial_path_towards_smaller_x_starts_at_its_first_point() -> None:
+    x = np.linspace(2.0, 0.0, 25)
+    fit = fits.fit_polynomial(np.c_[x, 0.5 * x], 1)
+    assert fit.valid
+    c = fit.curve
+    np.testing.assert_allclose(c(c.domain[0]), [2.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(c(c.domain[1]), [0.0, 0.0], atol=1e-12)
+    assert c.heading(c.domain[0]) == pytest.approx(math.atan2(-0.5, -1.0))
+
+
+def test_path_going_back_in_x_is_flagged_not_a_crash() -> None:
+    t = np.linspace(0, np.pi, 40)
+    p = np.c_[np.cos(t), np.sin(t)]  # a half circle: x goes back
+    p = np.vstack([p[:20], p[19::-1] + [0.0, -0.01]])
+    fit = fits.fit_polynomial(p, 3)
+    assert not fit.valid
+    assert "not a function y = f(x)" in fit.reason
+    assert fit.curve is not None and fit.n_backtracks > 0
+
+
+def test_vertical_step_flags_and_vertical_path_has_no_curve() -> None:
+    p = _staircase(30)
+    p = np.vstack([p, p[-1] + [0.0, 0.03]])  # one vertical step
+    fit = fits.fit_polynomial(p, 2)
+    assert not fit.valid and fit.n_backtracks == 1
+    vertical = np.c_[np.full(10, 1.0), np.linspace(0, 1, 10)]
+    v = fits.fit_polynomial(vertical, 2)
+    assert not v.valid and v.curve is None and math.isinf(v.mse)
+    assert "vertical" in v.reason
+    # the parametric variant fits it
+    par = fits.fit_polynomial_parametric(vertical, 2)
+    assert par.valid and par.mse < 1e-20
+    np.testing.assert_allclose(par.curve(par.params), vertical, atol=1e-10)
+
+
+def test_parametric_polynomial_fits_a_circle_arc() -> None:
+    t = np.linspace(0, 1.5 * np.pi, 80)
+    p = np.c_[np.cos(t), np.sin(t)]
+    for method in fits.FIT_METHODS:
+        fit = fits.fit_polynomial_parametric(p, 8, method=method)
+        assert fit.valid
+        assert np.max(np.linalg.norm(fit.residuals, axis=1)) < 1e-3
+    k = fit.curve.curvature(np.linspace(0.1, 0.9, 9))
+    np.testing.assert_allclose(k, 1.0, atol=2e-2)
+
+
+# ------------------------------------------------------------------------ B-spline
+@pytest.mark.parametrize("kind", fits.PARAMETERIZATIONS)
+def test_bspline_fit_equals_explicit_weighted_least_squares(kind: str) -> None:
+    rng = np.random.default_rng(3)
+    p = _staircase(60) + 0.002 * rng.standard_normal((61, 2))
+    w = rng.uniform(0.5, 3.0, len(p))
+    k, n = 3, 14
+    curve = fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind, weights=w)
+    assert isinstance(curve, BSplineCurve) and isinstance(curve, ParametricCurve)
+    # independent reference: the full collocation matrix and numpy's lstsq
+    u = fits.curve_parameters(p, kind)
+    t = clamped_uniform_knots(n, k)
+    a = BSpline.design_matrix(u, t, k).toarray()
+    sw = np.sqrt(w)[:, None]
+    c_ref, *_ = np.linalg.lstsq(sw * a, sw * p, rcond=None)
+    np.testing.assert_allclose(curve.c, c_ref, atol=1e-9)
+    np.testing.assert_allclose(curve.params, u)
+    assert curve.mse == pytest.approx(np.mean(np.sum((a @ c_ref - p) ** 2, axis=1)), rel=1e-9)
+    assert curve.parameterization == kind
+    # end points are not forced onto the data (plain least squares)
+    assert np.linalg.norm(curve(0.0) - p[0]) > 0.0
+
+
+def test_curve_parameters_hand_case() -> None:
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 4.0]])
+    np.testing.assert_allclose(fits.curve_parameters(p, "uniform"), [0, 0.5, 1])
+    np.testing.assert_allclose(fits.curve_parameters(p, "chord"), [0, 0.2, 1])
+    np.testing.assert_allclose(fits.curve_parameters(p, "centripetal"), [0, 1 / 3, 1])
+
+
+def test_bspline_with_many_control_points_interpolates_data() -> None:
+    p = _staircase(20)
+    curve = fits.fit_bspline(p, degree=3, n_ctrl=len(p))
+    assert curve.mse < 1e-20
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"parameterization": "arc"}, "parameterization"),
+        ({"degree": 0}, "degree"),
+        ({"n_ctrl": 3, "degree": 3}, "n_ctrl"),
+        ({"n_ctrl": 500}, "n_ctrl"),
+        ({"weights": np.zeros(61)}, "weights"),
+    ],
+)
+def test_bspline_bad_options_raise(kwargs: dict, field: str) -> None:
+    with pytest.raises(InvalidInputError, match=field):
+        fits.fit_bspline(_staircase(60), **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("call", "field"),
+    [
+        (lambda p: fits.fit_polynomial(p, 3, method="ransac"), "method"),
+        (lambda p: fits.fit_polynomial(p, 0), "order"),
+        (lambda p: fits.fit_polynomial(p[:3], 5), "order"),
+        (lambda p: fits.fit_polynomial(p, 3, tol=-1.0), "tol"),
+        (lambda p: fits.fit_polynomial(p, 3, weights=np.ones(3)), "weights"),
+        (lambda p: fits.fit_polynomial(np.ones((5, 3)), 2), "shape"),
+        (lambda p: fits.fit_polynomial_parametric(p, 3, parameterization="x"), "parameter"),
+    ],
+)
+def test_polynomial_bad_options_raise(call, field: str) -> None:
+    with pytest.raises(InvalidInputError, match=field):
+        call(_staircase(30))
+
+
+# ------------------------------------------------------------------------- sweeps
+def test_sweep_polynomial_ranks_thirty_combinations() -> None:
+    p = _staircase(60)
+    recs = fits.sweep_polynomial(p)
+    assert len(recs) == 30
+    assert [r.rank for r in recs] == list(range(1, 31))
+    mses = [r.mse for r in recs]
+    assert mses == sorted(mses)
+    assert {(r.params["method"], r.params["order"]) for r in recs} == set(
+        itertools.product(fits.FIT_METHODS, range(1, 11))
+    )
+    best = recs[0]
+    assert fits.fit_polynomial(p, **best.kwargs).mse == pytest.approx(best.mse)
+    # least squares over nested models: MSE never grows with the order
+    ls = sorted((r.params["order"], r.mse) for r in recs if r.params["method"] == "least_squares")
+    assert all(b <= a * (1 + 1e-9) + 1e-15 for (_, a), (_, b) in itertools.pairwise(ls))
+    assert best.params["method"] == "least_squares"  # LS minimises exactly this MSE
+
+
+def test_sweep_bspline_subset_matches_single_fits() -> None:
+    p = _staircase(60)
+    recs = fits.sweep_bspline(p, degrees=(2, 3), n_ctrls=(3, 8, 12, 70))
+    assert len(recs) == 3 * 2 * 4
+    bad = [r for r in recs if not r.valid]
+    # n_ctrl 3 is too few for degree 3, 70 exceeds the 61 points
+    assert {(r.params["degree"], r.params["n_ctrl"]) for r in bad} == {(3, 3), (2, 70), (3, 70)}
+    assert all(math.isinf(r.mse) for r in bad) and recs[-1] in bad
+    for r in recs:
+        if r.valid:
+            assert fits.fit_bspline(p, **r.kwargs).mse == pytest.approx(r.mse, rel=1e-9)
+    assert recs[0].as_dict()["rank"] == 1
+    assert fits.SWEEP_N_CTRL and len(fits.PARAMETERIZATIONS) * len(fits.SWEEP_DEGREES) * len(
+        fits.SWEEP_N_CTRL
+    ) == pytest.approx(500, abs=10)

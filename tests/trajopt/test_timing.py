@@ -1,0 +1,304 @@
+"""Tests of trajopt.timing: every limit on dense samples, hand cases, ruckig as reference."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.curve import ParametricCurve
+from trajopt.errors import InvalidInputError, TimingError
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+from trajopt.trajectory import Trajectory
+
+TOL = 1e-3  # relative tolerance of the curvature-dependent limits on dense samples
+
+
+# ------------------------------------------------------------------ test curves
+class Arc(ParametricCurve):
+    """An exact circular arc of radius r (counter-clockwise), parameter = angle (rad)."""
+
+    def __init__(self, r: float, angle: float) -> None:
+        self.r, self.angle = r, angle
+
+    @property
+    def domain(self):
+        return (0.0, self.angle)
+
+    def __call__(self, u, nu=0):
+        u = np.clip(np.asarray(u, dtype=float), 0.0, self.angle)
+        c, s = np.cos(u), np.sin(u)
+        r = self.r
+        out = {
+            0: (r * c, r * s),
+            1: (-r * s, r * c),
+            2: (-r * c, -r * s),
+            3: (r * s, -r * c),
+        }[nu]
+        return np.stack(out, axis=-1)
+
+    @property
+    def length(self):
+        return self.r * self.angle
+
+    def s_at_u(self, u):
+        return self.r * np.clip(np.asarray(u, dtype=float), 0.0, self.angle)
+
+    def u_at_s(self, s):
+        return np.clip(np.asarray(s, dtype=float), 0.0, self.length) / self.r
+
+
+def line(length: float, direction: float = 0.3) -> BSplineCurve:
+    """A straight segment as a cubic B-spline with uniformly spaced control points."""
+    t = clamped_uniform_knots(5, 3)
+    d = np.array([math.cos(direction), math.sin(direction)])
+    c = np.linspace(0.0, length, 5)[:, None] * d[None, :]
+    return BSplineCurve(t, c, 3)
+
+
+def hairpin() -> BSplineCurve:
+    """Up 2 m, a tight U-turn of about 0.3 m radius, back down."""
+    p = np.array(
+        [[0, 0], [0, 1.0], [0, 2.0], [0.05, 2.35], [0.3, 2.5], [0.55, 2.35], [0.6, 2.0],
+         [0.6, 1.0], [0.6, 0.0]]
+    )  # fmt: skip
+    return BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
+
+
+def lsq_circle(r: float, turns: float) -> BSplineCurve:
+    from scipy.interpolate import make_lsq_spline
+
+    th = np.linspace(0.0, 2 * np.pi * turns, 800)
+    t = clamped_uniform_knots(int(40 * turns) + 8, 3, (0.0, th[-1]))
+    sp = make_lsq_spline(th, np.column_stack([r * np.cos(th), r * np.sin(th)]), t, 3)
+    return BSplineCurve.from_scipy(sp)
+
+
+# ------------------------------------------------------------------ the checker
+def check_limits(traj: Trajectory, robot: Robot, v_start=0.0, v_end=0.0, n=20001):
+    """Every limit on dense samples (independent of the timing's own cap table)."""
+    ts = np.linspace(0.0, traj.duration, n)
+    smp = traj.sample(ts)
+    path = traj.path
+    kappa = np.asarray(path.curvature(path.u_at_s(smp.s)))  # curvature from the curve itself
+    cap = robot.speed_cap(kappa)
+    tiny = 1e-9
+    assert np.all(smp.v <= cap * (1 + TOL) + tiny), float(np.max(smp.v / cap))
+    assert np.all(np.abs(smp.a) <= robot.a_max * (1 + 1e-9) + tiny)
+    assert np.all(np.abs(smp.jerk) <= robot.j_max * (1 + 1e-9) + tiny)
+    assert np.all(np.abs(kappa) * smp.v**2 <= robot.a_lat_max * (1 + TOL) + tiny)
+    assert np.all(np.abs(kappa) * smp.v <= robot.omega_max * (1 + TOL) + tiny)
+    assert np.all(np.abs(smp.a_lat) <= robot.a_lat_max * (1 + TOL) + tiny)
+    assert np.all(np.abs(smp.omega) <= robot.omega_max * (1 + TOL) + tiny)
+    if robot.track_width is not None:
+        wheel = np.maximum(np.abs(smp.v_left), np.abs(smp.v_right))
+        assert np.all(wheel <= robot.wheel_v_max * (1 + TOL) + tiny)
+    assert np.all(smp.v >= -1e-9)
+    assert np.all(np.diff(smp.s) >= -1e-12)  # s never decreases
+    # boundary states, exactly
+    assert smp.s[0] == 0.0 and smp.t[0] == 0.0
+    assert smp.v[0] == pytest.approx(v_start, abs=1e-9)
+    assert smp.a[0] == pytest.approx(0.0, abs=1e-9)
+    assert smp.s[-1] == traj.path.length
+    assert smp.v[-1] == v_end and smp.a[-1] == 0.0
+    # continuity of the chain: speed and acceleration change at most as limits allow
+    dt = ts[1] - ts[0]
+    assert np.all(np.abs(np.diff(smp.v)) <= robot.a_max * dt * (1 + 1e-6) + 1e-9)
+    assert np.all(np.abs(np.diff(smp.a)) <= robot.j_max * dt * (1 + 1e-6) + 1e-9)
+    assert np.all(np.hypot(np.diff(smp.x), np.diff(smp.y)) <= cap.max() * dt * 1.001 + 1e-9)
+    # heading continuous and equal to the tangent direction
+    assert np.all(np.abs(np.diff(smp.theta)) < 0.2)
+    d1 = path(path.u_at_s(smp.s), 1)
+    tangent = np.arctan2(d1[:, 1], d1[:, 0])
+    assert np.allclose(np.angle(np.exp(1j * (smp.theta - tangent))), 0.0, atol=1e-6)
+    assert np.allclose(smp.omega, smp.kappa * smp.v)
+    return smp
+
+
+def ruckig_duration(length, v0, v1, robot, v_max):
+    from ruckig import InputParameter, Result, Ruckig, Trajectory as RT
+
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [v0], [0.0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [length], [v1], [0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v_max], [robot.a_max], [robot.j_max]
+    tr = RT(1)
+    assert Ruckig(1).calculate(inp, tr) == Result.Working
+    return tr.duration, tr
+
+
+# ------------------------------------------------------------------ hand cases
+ROBOT = Robot()
+
+
+@pytest.mark.parametrize("length", [5.0, 0.4, 0.02])
+def test_straight_line_is_ruckigs_1dof_answer(length):
+    traj = time_parameterize(line(length), ROBOT)
+    smp = check_limits(traj, ROBOT)
+    ref, _ = ruckig_duration(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
+    # the cap carries a 1e-4 relative margin: never faster than ruckig, at most that slower
+    assert ref - 1e-9 <= traj.duration <= ref * (1 + 2e-4) + 1e-9
+    assert np.allclose(smp.theta, 0.3)
+    assert np.allclose(smp.kappa, 0.0, atol=1e-9)
+
+
+def test_short_line_does_not_reach_v_max():
+    length = 0.3
+    traj = time_parameterize(line(length), ROBOT)
+    smp = check_limits(traj, ROBOT)
+    assert smp.v.max() < 0.9 * ROBOT.v_max
+    ref, _ = ruckig_duration(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
+    assert traj.duration == pytest.approx(ref, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "robot,r",
+    [
+        (ROBOT, 0.3),  # lateral acceleration binds: sqrt(0.5*0.3) = 0.387 m/s
+        (Robot(omega_max=0.5, track_width=None, wheel_v_max=None), 0.5),  # yaw rate: 0.25 m/s
+        (Robot(v_max=0.4, track_width=None, wheel_v_max=None), 2.0),  # v_max
+        (Robot(a_lat_max=5.0, omega_max=5.0, track_width=0.5, wheel_v_max=0.45), 0.5),  # wheels
+    ],
+)
+def test_circle_steady_speed(robot, r):
+    arc = Arc(r, 1.5 * 2 * np.pi)
+    traj = time_parameterize(arc, robot)
+    smp = check_limits(traj, robot)
+    expect = min(robot.v_max, math.sqrt(robot.a_lat_max * r), robot.omega_max * r)
+    if robot.track_width is not None:
+        expect = min(expect, robot.wheel_v_max / (1 + robot.track_width / (2 * r)))
+    mid = (smp.s > 0.4 * arc.length) & (smp.s < 0.6 * arc.length)
+    assert np.all(np.abs(smp.v[mid] - expect) <= 2e-3 * expect)
+    assert np.allclose(smp.kappa, 1.0 / r)
+    # heading unwraps past 2 pi: 1.5 turns
+    assert smp.theta[-1] - smp.theta[0] == pytest.approx(3 * np.pi, abs=1e-6)
+
+
+def test_lsq_circle_two_turns():
+    c = lsq_circle(0.4, 2.0)
+    traj = time_parameterize(c, ROBOT)
+    smp = check_limits(traj, ROBOT)
+    assert smp.theta[-1] - smp.theta[0] == pytest.approx(4 * np.pi, abs=1e-3)
+
+
+def test_hairpin_slows_in_the_turn():
+    c = hairpin()
+    traj = time_parameterize(c, ROBOT)
+    smp = check_limits(traj, ROBOT)
+    turn = np.abs(smp.kappa) > 0.5 * np.abs(smp.kappa).max()
+    assert smp.v[turn].max() < ROBOT.v_max * 0.95
+    assert smp.v.max() > smp.v[turn].max()
+
+
+def test_boundary_speeds():
+    c = line(3.0)
+    traj = time_parameterize(c, ROBOT, v_start=0.3, v_end=0.2)
+    check_limits(traj, ROBOT, v_start=0.3, v_end=0.2)
+    ref, _ = ruckig_duration(3.0, 0.3, 0.2, ROBOT, ROBOT.v_max)
+    assert ref - 1e-9 <= traj.duration <= ref * (1 + 2e-4)
+    # at the cap exactly is allowed
+    traj = time_parameterize(c, ROBOT, v_start=ROBOT.v_max, v_end=ROBOT.v_max)
+    check_limits(traj, ROBOT, v_start=ROBOT.v_max, v_end=ROBOT.v_max)
+
+
+def test_boundary_speed_on_a_circle():
+    arc = Arc(0.3, np.pi)
+    cap = ROBOT.speed_cap(1 / 0.3)
+    traj = time_parameterize(arc, ROBOT, v_start=cap, v_end=0.5 * cap)
+    check_limits(traj, ROBOT, v_start=cap, v_end=0.5 * cap)
+
+
+def test_unreachable_boundary_speeds():
+    with pytest.raises(TimingError, match=r"v_start=0\.6.*exceeds"):
+        time_parameterize(line(3.0), ROBOT, v_start=0.6)
+    cap = ROBOT.speed_cap(1 / 0.3)
+    with pytest.raises(TimingError, match="v_end"):
+        time_parameterize(Arc(0.3, 2.0), ROBOT, v_end=cap * 1.01)
+    # too short to stop from v_max: needs 0.5*(0.5/0.5 + 0.5/2)*0.5 m > 0.1 m
+    with pytest.raises(TimingError, match=r"within the path length 0\.1"):
+        time_parameterize(line(0.1), ROBOT, v_start=0.5)
+    with pytest.raises(TimingError, match="within the path length"):
+        time_parameterize(line(0.05), ROBOT, v_end=0.5)
+
+
+def test_cannot_brake_for_a_turn_right_after_the_start():
+    # full speed straight into a tight arc 5 cm ahead
+    p = np.array([[0, 0], [0.02, 0], [0.05, 0], [0.07, 0.05], [0.07, 0.1], [0.05, 0.12]])
+    c = BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
+    with pytest.raises(TimingError, match="v_start"):
+        time_parameterize(c, ROBOT, v_start=0.45)
+
+
+def test_invalid_inputs():
+    c = line(1.0)
+    with pytest.raises(InvalidInputError, match="robot"):
+        time_parameterize(c, "fast")  # type: ignore[arg-type]
+    with pytest.raises(InvalidInputError, match="curve"):
+        time_parameterize(np.zeros((3, 2)), ROBOT)  # type: ignore[arg-type]
+    for bad in (-0.1, math.nan, math.inf, "x"):
+        with pytest.raises(InvalidInputError, match="v_start"):
+            time_parameterize(c, ROBOT, v_start=bad)
+        with pytest.raises(InvalidInputError, match="v_end"):
+            time_parameterize(c, ROBOT, v_end=bad)
+    for bad in (0.0, -0.01, 1.0, math.nan):
+        with pytest.raises(InvalidInputError, match="dt"):
+            time_parameterize(c, ROBOT, dt=bad)
+
+
+def test_default_robot_and_stats():
+    traj = time_parameterize(line(1.0))
+    assert traj.robot == Robot()
+    for key in ("timing_cap_table_s", "timing_greedy_s", "timing_compress_s", "timing_total_s"):
+        assert traj.stats[key] >= 0.0
+    assert traj.path.length == pytest.approx(1.0)
+
+
+def test_near_time_optimal_against_forward_backward():
+    """Jerk-free time-optimal duration (forward-backward pass on a fine grid) is a lower
+    bound; on the hairpin the jerk-limited answer stays within 25% of it."""
+    c = hairpin()
+    traj = time_parameterize(c, ROBOT)
+    s = np.linspace(0.0, c.length, 20001)
+    h = s[1] - s[0]
+    v2 = ROBOT.speed_cap(c.curvature(c.u_at_s(s))) ** 2
+    v2[0] = v2[-1] = 0.0
+    for i in range(1, len(s)):
+        v2[i] = min(v2[i], v2[i - 1] + 2 * ROBOT.a_max * h)
+    for i in range(len(s) - 2, -1, -1):
+        v2[i] = min(v2[i], v2[i + 1] + 2 * ROBOT.a_max * h)
+    v = np.sqrt(v2)
+    lower = float(np.sum(2 * h / np.maximum(v[1:] + v[:-1], 1e-12)))
+    assert lower * 0.999 <= traj.duration <= 1.25 * lower
+
+
+# ------------------------------------------------------------------ random curves
+@settings(
+    max_examples=12,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+@given(
+    pts=st.lists(
+        st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=9, unique=True
+    ),
+    v_start=st.sampled_from([0.0, 0.05]),
+)
+def test_random_bsplines_hold_every_limit(pts, v_start):
+    p = np.asarray(pts, dtype=float)
+    assume(np.min(np.hypot(*np.diff(p, axis=0).T)) > 0.2)
+    c = BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
+    u = np.linspace(*c.domain, 2001)
+    assume(np.min(c.speed(u)) > 0.05 * np.max(c.speed(u)))  # no cusps
+    assume(c.length > 0.5)
+    try:
+        traj = time_parameterize(c, ROBOT, v_start=v_start)
+    except TimingError:
+        if v_start == 0.0:
+            raise
+        assume(False)  # legitimate only when v_start cannot be brought under the cap
+    check_limits(traj, ROBOT, v_start=v_start)

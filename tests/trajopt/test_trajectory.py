@@ -1,0 +1,178 @@
+"""Tests of trajopt.trajectory: vectorised evaluation against independent references."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+
+from tests.trajopt.test_timing import Arc, line
+from trajopt.errors import InvalidInputError
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+from trajopt.trajectory import SAMPLE_UNITS, Trajectory
+
+J = 2.0
+PLAIN = Robot(track_width=None, wheel_v_max=None)
+
+
+def _rest_to_rest():
+    """Jerk +J, 0, -J, 0 (cruise), -J, 0, +J: phase durations and jerks."""
+    d = np.array([0.25, 0.5, 0.25, 1.0, 0.25, 0.5, 0.25])
+    j = np.array([J, 0, -J, 0, -J, 0, J], dtype=float)
+    return d, j
+
+
+def _integrate(d, j, dt=1e-5):
+    """Reference: integrate the jerk signal numerically (no polynomial formulas)."""
+    t = np.arange(0.0, d.sum() + dt / 2, dt)
+    edges = np.concatenate([[0.0], np.cumsum(d)])
+    k = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, len(d) - 1)
+    jerk = j[k]
+    a = np.concatenate([[0.0], np.cumsum(0.5 * (jerk[1:] + jerk[:-1]) * dt)])
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * dt)])
+    s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * dt)])
+    return t, s, v, a
+
+
+def _hand_trajectory(robot=PLAIN):
+    d, j = _rest_to_rest()
+    t_ref, s_ref, v_ref, a_ref = _integrate(d, j)
+    edges = np.concatenate([[0.0], np.cumsum(d)])
+    idx = np.round(edges[:-1] / (t_ref[1] - t_ref[0])).astype(int)
+    length = float(s_ref[-1])
+    traj = Trajectory(
+        path=line(length, direction=0.0),
+        robot=robot,
+        phase_t=edges[:-1],
+        phase_s=s_ref[idx],
+        phase_v=v_ref[idx],
+        phase_a=a_ref[idx],
+        phase_j=j,
+        duration=float(edges[-1]),
+        v_start=0.0,
+        v_end=0.0,
+    )
+    return traj, (t_ref, s_ref, v_ref, a_ref)
+
+
+def test_evaluation_matches_numerical_integration():
+    traj, (t_ref, s_ref, v_ref, a_ref) = _hand_trajectory()
+    pick = np.linspace(0, len(t_ref) - 1, 997).astype(int)
+    smp = traj.sample(t_ref[pick])
+    assert np.allclose(smp.s, np.minimum(s_ref[pick], traj.length), atol=1e-8)
+    assert np.allclose(smp.v, v_ref[pick], atol=1e-8)
+    assert np.allclose(smp.a, a_ref[pick], atol=1e-8)
+    assert np.allclose(smp.x, smp.s) and np.allclose(smp.y, 0.0)
+    assert np.allclose(smp.theta, 0.0) and np.allclose(smp.omega, 0.0)
+
+
+def test_evaluation_matches_ruckig_at_time():
+    from ruckig import InputParameter, Ruckig, Trajectory as RT
+
+    length = 0.3  # short: the speed cap never binds, so the answer is ruckig's own
+    traj = time_parameterize(line(length), PLAIN)
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [0.0], [0.0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [length], [0.0], [0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [PLAIN.v_max], [PLAIN.a_max], [J]
+    ref = RT(1)
+    Ruckig(1).calculate(inp, ref)
+    assert traj.duration == pytest.approx(ref.duration, rel=1e-9)
+    ts = np.linspace(0.0, ref.duration, 101)
+    smp = traj.sample(ts)
+    for i, t in enumerate(ts):
+        p, v, a = ref.at_time(t)
+        assert smp.s[i] == pytest.approx(p[0], abs=1e-9)
+        assert smp.v[i] == pytest.approx(v[0], abs=1e-9)
+        assert smp.a[i] == pytest.approx(a[0], abs=1e-9)
+
+
+def test_shapes_clipping_and_readonly():
+    traj, _ = _hand_trajectory()
+    t = np.linspace(-1.0, traj.duration + 1.0, 12).reshape(3, 4)
+    smp = traj.sample(t)
+    for name, arr in smp.as_dict().items():
+        assert arr.shape == (3, 4), name
+        assert not arr.flags.writeable
+    assert smp.t.min() == 0.0 and smp.t.max() == traj.duration
+    end = traj.sample(traj.duration + 5.0)
+    assert end.s.shape == ()
+    assert float(end.s) == traj.length and float(end.v) == 0.0 and float(end.a) == 0.0
+    start = traj.sample(-3.0)
+    assert float(start.s) == 0.0 and float(start.v) == 0.0
+    assert smp.v_left is None and smp.v_right is None
+    assert "v_left" not in smp.as_dict()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        traj.duration = 1.0  # type: ignore[misc]
+    assert not traj.phase_t.flags.writeable
+
+
+def test_wheel_speeds_and_heading_on_an_arc():
+    robot = Robot()
+    r = 0.5
+    arc = Arc(r, 1.5 * 2 * np.pi)
+    traj = time_parameterize(arc, robot)
+    ts = np.linspace(0.0, traj.duration, 3001)
+    smp = traj.sample(ts)
+    half = 0.5 * robot.track_width
+    assert np.allclose(smp.v_left, smp.v * (1 - half / r))
+    assert np.allclose(smp.v_right, smp.v * (1 + half / r))
+    assert np.allclose(smp.kappa, 1 / r)
+    assert np.allclose(smp.omega, smp.v / r)
+    assert np.allclose(smp.a_lat, smp.v**2 / r)
+    # heading = polar angle + pi/2, unwrapped over 1.5 turns
+    assert np.allclose(smp.theta, smp.s / r + np.pi / 2, atol=1e-7)
+    # same answer when sampled in a random order (unwrapping does not depend on order)
+    rng = np.random.default_rng(1)
+    perm = rng.permutation(len(ts))
+    shuffled = traj.sample(ts[perm])
+    assert np.allclose(shuffled.theta, smp.theta[perm])
+
+
+def test_sample_uniform():
+    traj, _ = _hand_trajectory()
+    smp = traj.sample_uniform(0.1)
+    assert smp.t[0] == 0.0 and smp.t[-1] == traj.duration
+    assert np.allclose(np.diff(smp.t)[:-1], 0.1)
+    assert np.all(np.diff(smp.t) > 0)
+    for bad in (0.0, -1.0, math.nan, "x"):
+        with pytest.raises(InvalidInputError, match="dt"):
+            traj.sample_uniform(bad)  # type: ignore[arg-type]
+
+
+def test_exports(tmp_path):
+    traj = time_parameterize(Arc(0.5, 2.0), Robot())
+    d = traj.to_dict(dt=0.05)
+    assert d["units"]["v"] == "m/s" and d["units"]["theta"] == "rad"
+    assert d["duration"] == traj.duration and d["duration_unit"] == "s"
+    assert set(d["samples"]) == set(SAMPLE_UNITS)  # v_left/v_right present with track_width
+    smp = traj.sample_uniform(0.05)
+    assert np.allclose(d["samples"]["x"], smp.x)
+    p = traj.to_json(tmp_path / "sub" / "traj.json", dt=0.05)
+    loaded = json.loads(p.read_text())
+    assert loaded["robot"]["v_max"] == Robot().v_max
+    assert np.allclose(loaded["phases"]["t"], traj.phase_t)
+    q = traj.to_csv(tmp_path / "traj.csv", dt=0.05)
+    with open(q, newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][0] == "t [s]" and "v [m/s]" in rows[0] and "theta [rad]" in rows[0]
+    table = np.array(rows[1:], dtype=float)
+    assert table.shape == (len(smp.t), len(rows[0]))
+    assert np.allclose(table[:, rows[0].index("theta [rad]")], smp.theta)
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["sub", "traj.csv"]  # no temp files
+    assert [x.name for x in (tmp_path / "sub").iterdir()] == ["traj.json"]
+
+
+def test_invalid_construction():
+    traj, _ = _hand_trajectory()
+    with pytest.raises(InvalidInputError, match="phase_s"):
+        dataclasses.replace(traj, phase_s=np.zeros(3))
+    with pytest.raises(InvalidInputError, match="duration"):
+        dataclasses.replace(traj, duration=0.1)
+    with pytest.raises(InvalidInputError, match="duration"):
+        dataclasses.replace(traj, duration=math.nan)

@@ -1,0 +1,361 @@
+"""Compiled kernels of the jerk-limited timing along arc length (private to :mod:`trajopt.timing`).
+
+All kernels work on a 1-DoF motion ``s(t)`` made of constant-jerk pieces and on a speed cap
+given as one value per interval of a uniform arc-length grid (spacing ``h``), stored as a
+sparse table for O(1) range minima. See :mod:`trajopt.timing` for the method.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: greedy exit codes
+OK_FINISH = 1  # the end condition binds: finish with one position call to (L, v_end, 0)
+STUCK = 2  # at rest and no step is safe (speed cap ~0 ahead)
+START_INFEASIBLE = 3  # the initial state cannot stay under the cap
+MAX_STEPS = 4
+
+_NEG_V_TOL = 1e-9  # a piece whose speed dips below -1e-9 m/s reverses
+_CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
+
+
+@njit(cache=True)
+def advance(s, v, a, j, t):
+    """State after ``t`` seconds of constant jerk ``j`` from ``(s, v, a)``."""
+    return (
+        s + t * (v + t * (0.5 * a + t * j / 6.0)),
+        v + t * (a + 0.5 * j * t),
+        a + j * t,
+    )
+
+
+@njit(cache=True)
+def build_table(ci):
+    """Sparse table of range minima over ``ci`` (shape (n,)): returns (table, log2 table)."""
+    n = ci.shape[0]
+    levels = 1
+    while (1 << levels) <= n:
+        levels += 1
+    st = np.empty((levels, n))
+    st[0, :] = ci
+    for k in range(1, levels):
+        w = 1 << (k - 1)
+        for i in range(n - (1 << k) + 1):
+            x = st[k - 1, i]
+            y = st[k - 1, i + w]
+            st[k, i] = x if x < y else y
+    lg = np.zeros(n + 2, dtype=np.int64)
+    for i in range(2, n + 2):
+        lg[i] = lg[i // 2] + 1
+    return st, lg
+
+
+@njit(cache=True)
+def range_min(st, lg, h, sa, sb):
+    """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
+    n = st.shape[1]
+    ia = int(sa / h)
+    ib = int(sb / h)
+    if ia < 0:
+        ia = 0
+    if ib < 0:
+        ib = 0
+    if ia > n - 1:
+        ia = n - 1
+    if ib > n - 1:
+        ib = n - 1
+    if ib < ia:
+        ia, ib = ib, ia
+    k = lg[ib - ia + 1]
+    x = st[k, ia]
+    y = st[k, ib - (1 << k) + 1]
+    return x if x < y else y
+
+
+@njit(cache=True)
+def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
+    """True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
+
+    Conservative and exact on the grid: a piece passes when its speed maximum is below the
+    minimum cap over the arc-length range it covers; otherwise it is bisected in time down
+    to ``tmin`` seconds.
+    """
+    if T <= 0.0:
+        return True
+    stk = np.empty((96, 4))
+    stk[0, 0] = s
+    stk[0, 1] = v
+    stk[0, 2] = a
+    stk[0, 3] = T
+    top = 1
+    while top > 0:
+        top -= 1
+        s0 = stk[top, 0]
+        v0 = stk[top, 1]
+        a0 = stk[top, 2]
+        t0 = stk[top, 3]
+        if s0 >= length:
+            continue
+        s1, v1, a1 = advance(s0, v0, a0, j, t0)
+        vmax = v0 if v0 > v1 else v1
+        vmin = v0 if v0 < v1 else v1
+        if a0 > 0.0 and a1 < 0.0:
+            pk = v0 - a0 * a0 / (2.0 * j)
+            if pk > vmax:
+                vmax = pk
+        elif a0 < 0.0 and a1 > 0.0:
+            tr = v0 - a0 * a0 / (2.0 * j)
+            if tr < vmin:
+                vmin = tr
+        if vmin < -_NEG_V_TOL:
+            return False
+        se = s1 if s1 < length else length
+        if se < s0:
+            se = s0
+        if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
+            continue
+        if t0 <= tmin or top + 2 > stk.shape[0]:
+            return False
+        half = 0.5 * t0
+        sm, vm, am = advance(s0, v0, a0, j, half)
+        stk[top, 0] = sm
+        stk[top, 1] = vm
+        stk[top, 2] = am
+        stk[top, 3] = half
+        stk[top + 1, 0] = s0
+        stk[top + 1, 1] = v0
+        stk[top + 1, 2] = a0
+        stk[top + 1, 3] = half
+        top += 2
+    return True
+
+
+@njit(cache=True)
+def brake_times(v, a, vt, j, amax):
+    """Time-optimal jerk-limited change from ``(v, a)`` down to ``(vt, 0)``.
+
+    Returns ``(t1, t2, t3, kind)``: phases of jerk ``-j``, ``0``, ``+j``. ``kind`` 0: a real
+    slow-down; 1: the speed never exceeds ``vt`` (``t1`` ramps ``a >= 0`` down to 0); 2: the
+    state already decelerates so hard that ramping ``a`` up to 0 (``t3``) ends below ``vt``.
+    """
+    q = j * (v - vt) + 0.5 * a * a
+    if a >= 0.0 and q <= 0.0:
+        return a / j, 0.0, 0.0, 1
+    if a < 0.0 and q < a * a:
+        return 0.0, 0.0, -a / j, 2
+    ap = np.sqrt(q)
+    if ap <= amax:
+        t1 = (a + ap) / j
+        if t1 < 0.0:
+            t1 = 0.0
+        return t1, 0.0, ap / j, 0
+    t1 = (a + amax) / j
+    if t1 < 0.0:
+        t1 = 0.0
+    t2 = (q - amax * amax) / (j * amax)
+    if t2 < 0.0:
+        t2 = 0.0
+    return t1, t2, amax / j, 0
+
+
+@njit(cache=True)
+def brake_end(s, v, a, t1, t2, t3, j):
+    """Arc length at the end of the ``brake_times`` phases."""
+    s, v, a = advance(s, v, a, -j, t1)
+    s, v, a = advance(s, v, a, 0.0, t2)
+    s, v, a = advance(s, v, a, j, t3)
+    return s
+
+
+@njit(cache=True)
+def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin):
+    """Is the stop profile from ``(s, v, a)`` under the cap? Returns ``(ok, s_stop)``."""
+    t1, t2, t3, kind = brake_times(v, a, 0.0, j, amax)
+    if kind == 2 and a < -1e-12:
+        # cannot stop without reversing unless the undershoot is round-off
+        if v - a * a / (2.0 * j) < -_NEG_V_TOL:
+            return False, s
+    if not piece_ok(st, lg, h, length, s, v, a, -j, t1, tmin):
+        return False, s
+    s, v, a = advance(s, v, a, -j, t1)
+    if not piece_ok(st, lg, h, length, s, v, a, 0.0, t2, tmin):
+        return False, s
+    s, v, a = advance(s, v, a, 0.0, t2)
+    if not piece_ok(st, lg, h, length, s, v, a, j, t3, tmin):
+        return False, s
+    s, v, a = advance(s, v, a, j, t3)
+    return True, s
+
+
+@njit(cache=True)
+def _push(buf, n, t, s, v, a, j):
+    if n == buf.shape[0]:
+        nb = np.empty((2 * n, buf.shape[1]))
+        nb[:n] = buf
+        buf = nb
+    buf[n, 0] = t
+    buf[n, 1] = s
+    buf[n, 2] = v
+    buf[n, 3] = a
+    buf[n, 4] = j
+    return buf, n + 1
+
+
+@njit(cache=True)
+def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin, max_steps):
+    """Forward greedy over piecewise-constant jerk with an exact stop-profile safety test.
+
+    Returns
+    -------
+    phases : ndarray, shape (p, 5)
+        Rows ``(t0, s0, v0, a0, jerk)`` of the constant-jerk phases, in time order.
+    bounds : ndarray, shape (m, 5)
+        Rows ``(t, s, v, a, phase_index)`` at every step boundary (the first is the start).
+    status : int
+        One of the exit codes of this module.
+    """
+    phases = np.empty((1024, 5))
+    n_ph = 0
+    bounds = np.empty((256, 5))
+    n_b = 0
+    s = 0.0
+    v = v0
+    a = 0.0
+    t = 0.0
+    bounds, n_b = _push(bounds, n_b, t, s, v, a, 0.0)
+    ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin)
+    if not ok0:
+        return phases[:n_ph], bounds[:n_b], START_INFEASIBLE
+    nmin = min_s.shape[0]
+    ptr = 0
+    cands = np.empty(ncand + 1)
+    status = MAX_STEPS
+    for _ in range(max_steps):
+        while ptr < nmin and min_s[ptr] <= s:
+            ptr += 1
+        # candidate jerks, descending, plus the one that zeroes a at the step end
+        uz = -a / dt
+        nc = 0
+        placed = not (-j <= uz <= j)
+        for i in range(ncand):
+            ui = j * (1.0 - 2.0 * i / (ncand - 1))
+            if not placed and uz >= ui:
+                if uz != ui:
+                    cands[nc] = uz
+                    nc += 1
+                placed = True
+            cands[nc] = ui
+            nc += 1
+        chosen = np.nan
+        safe = np.nan
+        safe_noend = False
+        for ic in range(nc):
+            u = cands[ic]
+            # exact step with clamping at +-amax
+            ta = dt
+            if u > 0.0 and a + u * dt > amax:
+                ta = max(0.0, (amax - a) / u)
+            elif u < 0.0 and a + u * dt < -amax:
+                ta = max(0.0, (-amax - a) / u)
+            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
+                continue
+            sa, va, aa = advance(s, v, a, u, ta)
+            if ta < dt:
+                aa = amax if u > 0.0 else -amax
+                if not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
+                    continue
+                s1, v1, a1 = advance(sa, va, aa, 0.0, dt - ta)
+            else:
+                s1, v1, a1 = sa, va, aa
+            if u == uz or abs(a1) < 1e-9:
+                a1 = 0.0
+            if s1 >= length:
+                safe_noend = True
+                continue
+            ok, s_stop = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)
+            if not ok:
+                continue
+            if v_end == 0.0:
+                end_ok = s_stop <= length
+            else:
+                b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
+                if kind == 1:
+                    end_ok = s1 < length
+                else:
+                    end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
+            if not end_ok:
+                safe_noend = True
+                continue
+            if np.isnan(safe):
+                safe = u
+            target_ok = True
+            k = ptr
+            while k < nmin and min_s[k] <= s_stop:
+                if min_s[k] > s1:
+                    b1, b2, b3, kind = brake_times(v1, a1, min_v[k], j, amax)
+                    if kind != 1 and brake_end(s1, v1, a1, b1, b2, b3, j) > min_s[k]:
+                        target_ok = False
+                        break
+                k += 1
+            if target_ok:
+                chosen = u
+                break
+        if np.isnan(chosen):
+            chosen = safe
+        if not np.isnan(chosen):
+            u = chosen
+            ta = dt
+            if u > 0.0 and a + u * dt > amax:
+                ta = max(0.0, (amax - a) / u)
+            elif u < 0.0 and a + u * dt < -amax:
+                ta = max(0.0, (-amax - a) / u)
+            if ta > 0.0:
+                phases, n_ph = _push(phases, n_ph, t, s, v, a, u)
+                s, v, a = advance(s, v, a, u, ta)
+                t += ta
+            if ta < dt:
+                a = amax if u > 0.0 else -amax
+                phases, n_ph = _push(phases, n_ph, t, s, v, a, 0.0)
+                s, v, a = advance(s, v, a, 0.0, dt - ta)
+                t += dt - ta
+            if u == uz or abs(a) < 1e-9:
+                a = 0.0
+            bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+            continue
+        if safe_noend:
+            status = OK_FINISH
+            break
+        # follow the stop profile (safe by construction) for one step
+        if v <= 0.0 and a == 0.0:
+            status = STUCK
+            break
+        t1, t2, t3, kind = brake_times(v, a, 0.0, j, amax)
+        rem = dt
+        for p in range(3):
+            tp = t1 if p == 0 else (t2 if p == 1 else t3)
+            jp = -j if p == 0 else (0.0 if p == 1 else j)
+            tp = min(tp, rem)
+            if tp > 0.0:
+                phases, n_ph = _push(phases, n_ph, t, s, v, a, jp)
+                s, v, a = advance(s, v, a, jp, tp)
+                t += tp
+                rem -= tp
+        if rem > 0.0:  # stopped inside the step
+            v = 0.0 if v < 1e-12 else v
+            a = 0.0
+        if abs(a) < 1e-9:
+            a = 0.0
+        bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+    return phases[:n_ph], bounds[:n_b], status
+
+
+@njit(cache=True)
+def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
+    """Every phase (rows of start states and jerks, ending at ``t_end``) under the cap."""
+    n = ph_t.shape[0]
+    for i in range(n):
+        te = ph_t[i + 1] if i + 1 < n else t_end
+        if not piece_ok(st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin):
+            return False
+    return True

@@ -1,0 +1,301 @@
+"""Private: B-spline basis evaluation, the banded least-squares/smoothness QP data, and
+cached CasADi solvers (a ``casadi.conic`` QP and an IPOPT curvature-bounded NLP) built once
+per padded problem size.
+
+Everything here works in *cell units* (positions and parameters divided by the grid
+resolution), so one set of weights and tolerances serves every map.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import threading
+
+import numpy as np
+
+logger = logging.getLogger(__name__)
+
+_SIZES = (16, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192, 256, 320, 384, 512, 640, 768, 1024)
+
+
+def bucket_size(n: int) -> int:
+    """Padded number of control points for ``n`` (sizes repeat so solvers can be cached)."""
+    for s in _SIZES:
+        if n <= s:
+            return s
+    return int(256 * np.ceil(n / 256))
+
+
+# ---------------------------------------------------------------------- basis
+def basis_derivs(t: np.ndarray, p: int, span: np.ndarray, u: np.ndarray, nu: int) -> np.ndarray:
+    """``nu``-th derivatives of the ``p + 1`` B-splines of degree ``p`` that are non-zero on
+    span ``span`` (control points ``span .. span + p``), evaluated at ``u``.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n + p + 1,)
+        Clamped knots.
+    p : int
+        Degree.
+    span : ndarray of int, shape (M,)
+        Span index ``j`` (knot interval ``[t[j + p], t[j + p + 1]]``) of each point.
+    u : ndarray, shape (M,)
+        Parameters (inside or on the boundary of their spans).
+    nu : int
+        Derivative order (0 .. p).
+
+    Returns
+    -------
+    ndarray, shape (M, p + 1)
+    """
+    k = np.asarray(span, dtype=np.int64) + p  # knot interval index
+    u = np.asarray(u, dtype=float)
+    m = len(u)
+    q0 = p - nu
+    # degree-q0 non-zero basis values N_{k-q0 .. k, q0}(u) by Cox-de Boor
+    vals = np.ones((m, 1))
+    for q in range(1, q0 + 1):
+        new = np.zeros((m, q + 1))
+        for a in range(q + 1):
+            i = k - q + a  # basis index
+            if a >= 1:  # N_{i, q-1} is vals[:, a-1]
+                den = t[i + q] - t[i]
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    w = np.where(den > 0, (u - t[i]) / np.where(den > 0, den, 1.0), 0.0)
+                new[:, a] += w * vals[:, a - 1]
+            if a <= q - 1:  # N_{i+1, q-1} is vals[:, a]
+                den = t[i + q + 1] - t[i + 1]
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    w = np.where(den > 0, (t[i + q + 1] - u) / np.where(den > 0, den, 1.0), 0.0)
+                new[:, a] += w * vals[:, a]
+        vals = new
+    # raise to degree p through the derivative recurrence
+    for q in range(q0 + 1, p + 1):
+        new = np.zeros((m, q + 1))
+        for a in range(q + 1):
+            i = k - q + a
+            if a >= 1:
+                den = t[i + q] - t[i]
+                new[:, a] += np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a - 1]
+            if a <= q - 1:
+                den = t[i + q + 1] - t[i + 1]
+                new[:, a] -= (
+                    np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a]
+                )
+        vals = new
+    return vals
+
+
+def find_spans(t: np.ndarray, p: int, n: int, u: np.ndarray) -> np.ndarray:
+    """Span index (0 .. n - p - 1) holding each parameter ``u``."""
+    j = np.searchsorted(t, u, side="right") - 1
+    return np.clip(j, p, n - 1) - p
+
+
+def band_gram(span: np.ndarray, vals: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
+    """Upper band of ``sum_r w_r b_r b_r^T`` for rows ``b_r`` with ``p + 1`` consecutive
+    non-zeros ``vals[r]`` starting at column ``span[r]``: ``band[d, i] = M[i, i + d]``."""
+    p = vals.shape[1] - 1
+    band = np.zeros((p + 1, n))
+    for a in range(p + 1):
+        for b in range(a, p + 1):
+            band[b - a] += np.bincount(span + a, weights=weights * vals[:, a] * vals[:, b], minlength=n)
+    return band
+
+
+def band_rhs(span: np.ndarray, vals: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
+    """``B^T rhs`` for the row-banded matrix of :func:`band_gram`; ``rhs`` shape (M, d)."""
+    out = np.zeros((n, rhs.shape[1]))
+    for a in range(vals.shape[1]):
+        for dim in range(rhs.shape[1]):
+            out[:, dim] += np.bincount(span + a, weights=vals[:, a] * rhs[:, dim], minlength=n)
+    return out
+
+
+def smoothness_band(t: np.ndarray, p: int, n: int, order: int) -> np.ndarray:
+    """Upper band of ``S[i, j] = integral B_i^(order)(u) B_j^(order)(u) du`` (exact, by
+    Gauss-Legendre quadrature on every non-empty span)."""
+    nq = max(1, p - order + 1)
+    gx, gw = np.polynomial.legendre.leggauss(nq)
+    a = t[p:n]
+    b = t[p + 1 : n + 1]
+    half = 0.5 * (b - a)
+    keep = half > 0
+    spans = np.nonzero(keep)[0]
+    uq = (0.5 * (a + b))[keep][:, None] + half[keep][:, None] * gx[None, :]
+    wq = half[keep][:, None] * gw[None, :]
+    span_q = np.repeat(spans, nq)
+    vals = basis_derivs(t, p, span_q, uq.ravel(), order)
+    return band_gram(span_q, vals, wq.ravel(), n)
+
+
+# -------------------------------------------------------------------- solvers
+_LOCK = threading.Lock()
+
+
+def _band_pattern(nb: int, p: int):
+    """CCS (row, col) of the symmetric band |i - j| <= p of an nb x nb matrix."""
+    rows, cols = [], []
+    for c in range(nb):
+        r = np.arange(max(0, c - p), min(nb, c + p + 1))
+        rows.append(r)
+        cols.append(np.full(len(r), c))
+    return np.concatenate(rows), np.concatenate(cols)
+
+
+@functools.lru_cache(maxsize=64)
+def qp_layout(nb: int, p: int):
+    """Sparsity of the two-block banded Hessian (x block then y block) and the index map
+    from CCS non-zeros to ``(band offset, band column, block)``."""
+    import casadi as ca
+
+    r, c = _band_pattern(nb, p)
+    rows = np.concatenate([r, r + nb])
+    cols = np.concatenate([c, c + nb])
+    order = np.lexsort((rows, cols))
+    rows, cols = rows[order], cols[order]
+    colind = np.concatenate([[0], np.cumsum(np.bincount(cols, minlength=2 * nb))])
+    sp_h = ca.Sparsity(2 * nb, 2 * nb, colind.tolist(), rows.tolist())
+    rr, cc = rows % nb, cols % nb
+    d = np.abs(cc - rr)
+    col = np.minimum(rr, cc)
+    sp_a = ca.Sparsity.dense(4, 2 * nb)
+    return sp_h, d, col, sp_a
+
+
+def h_nonzeros(band: np.ndarray, nb: int, p: int) -> np.ndarray:
+    """CCS non-zeros of ``blockdiag(Hb, Hb)`` for the upper band ``band`` of ``Hb``."""
+    _, d, col, _ = qp_layout(nb, p)
+    return band[d, col]
+
+
+@functools.lru_cache(maxsize=32)
+def qp_solver(nb: int, p: int, solver: str, verbose: bool):
+    """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
+    with the banded two-block Hessian pattern; built once per ``(nb, p, solver)``."""
+    import casadi as ca
+
+    sp_h, _, _, sp_a = qp_layout(nb, p)
+    if solver == "osqp":
+        opts = {
+            "osqp": {
+                "verbose": verbose,
+                "eps_abs": 1e-7,
+                "eps_rel": 1e-7,
+                "max_iter": 20000,
+                "polish": True,
+            },
+            "warm_start_primal": True,
+            "error_on_fail": False,
+        }
+    elif solver == "piqp":
+        opts = {"piqp": {"verbose": verbose}, "error_on_fail": False}
+    else:  # pragma: no cover - validated by the caller
+        raise ValueError(f"unknown QP solver {solver!r}")
+    if not verbose:
+        opts["print_time"] = False
+        opts["print_problem"] = False
+    with _LOCK:
+        return ca.conic("smoother_qp", solver, {"h": sp_h, "a": sp_a}, opts)
+
+
+@functools.lru_cache(maxsize=32)
+def qp_ipopt(nb: int, p: int, verbose: bool):
+    """The same convex problem solved by IPOPT (fallback / reference); parameters
+    ``[h band (p+1)*nb, g (2nb), a (8nb)]``."""
+    import casadi as ca
+
+    z = ca.SX.sym("z", 2 * nb)
+    hb = ca.SX.sym("hb", (p + 1) * nb)
+    g = ca.SX.sym("g", 2 * nb)
+    a = ca.SX.sym("a", 4 * 2 * nb)
+    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
+    amat = ca.reshape(a, 4, 2 * nb)
+    nlp = {"x": z, "p": ca.vertcat(hb, g, a), "f": f, "g": ca.mtimes(amat, z)}
+    with _LOCK:
+        return ca.nlpsol("smoother_qp_ipopt", "ipopt", nlp, _ipopt_opts(verbose))
+
+
+def _band_quadratic(z, hb, nb: int, p: int):
+    import casadi as ca
+
+    x, y = z[:nb], z[nb:]
+    f = 0
+    for d in range(p + 1):
+        w = 0.5 if d == 0 else 1.0
+        h = hb[d * nb : d * nb + nb - d]
+        f = f + w * (ca.dot(h, x[: nb - d] * x[d:]) + ca.dot(h, y[: nb - d] * y[d:]))
+    return f
+
+
+def _ipopt_opts(verbose: bool) -> dict:
+    return {
+        "ipopt": {
+            "print_level": 5 if verbose else 0,
+            "sb": "yes",
+            "max_iter": 300,
+            "tol": 1e-8,
+            "acceptable_tol": 1e-6,
+            "mu_strategy": "adaptive",
+            "bound_relax_factor": 0.0,
+            "honor_original_bounds": "yes",
+        },
+        "print_time": verbose,
+        "error_on_fail": False,
+    }
+
+
+#: curvature samples per span (both span ends included)
+CURV_SAMPLES = 5
+
+
+@functools.lru_cache(maxsize=16)
+def curvature_nlp(nb: int, p: int, verbose: bool):
+    """IPOPT problem: the QP objective, the heading rows, and per sample ``r`` (``CURV_SAMPLES``
+    per span, span ``j`` touching control points ``j .. j + p``)
+
+    ``cross_r^2 - kmax^2 * speed2_r^3 <= 0`` and ``speed2_r >= floor_r^2`` (via ``lbg``),
+
+    with ``cross = x'y'' - y'x''`` and ``speed2 = x'^2 + y'^2`` from basis-derivative values
+    passed as parameters. Parameters: ``[hb, g, a, b1 (S*(p+1)), b2 (S*(p+1)), kmax^2]``.
+    Constraint order: 4 heading rows, then ``S`` curvature rows, then ``S`` speed rows.
+    """
+    import casadi as ca
+
+    ns = nb - p
+    S = ns * CURV_SAMPLES
+    z = ca.SX.sym("z", 2 * nb)
+    hb = ca.SX.sym("hb", (p + 1) * nb)
+    g = ca.SX.sym("g", 2 * nb)
+    a = ca.SX.sym("a", 4 * 2 * nb)
+    b1 = ca.SX.sym("b1", S * (p + 1))
+    b2 = ca.SX.sym("b2", S * (p + 1))
+    k2 = ca.SX.sym("k2")
+    x, y = z[:nb], z[nb:]
+    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
+    amat = ca.reshape(a, 4, 2 * nb)
+    span = np.repeat(np.arange(ns), CURV_SAMPLES)
+    B1 = ca.reshape(b1, S, p + 1)
+    B2 = ca.reshape(b2, S, p + 1)
+    dx = 0
+    dy = 0
+    ddx = 0
+    ddy = 0
+    for c in range(p + 1):
+        idx = (span + c).tolist()
+        dx = dx + B1[:, c] * x[idx]
+        dy = dy + B1[:, c] * y[idx]
+        ddx = ddx + B2[:, c] * x[idx]
+        ddy = ddy + B2[:, c] * y[idx]
+    cross = dx * ddy - dy * ddx
+    sp2 = dx * dx + dy * dy
+    gcurv = cross * cross - k2 * sp2 * sp2 * sp2
+    nlp = {
+        "x": z,
+        "p": ca.vertcat(hb, g, a, b1, b2, k2),
+        "f": f,
+        "g": ca.vertcat(ca.mtimes(amat, z), gcurv, sp2),
+    }
+    with _LOCK:
+        return ca.nlpsol("smoother_curv", "ipopt", nlp, _ipopt_opts(verbose))

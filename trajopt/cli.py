@@ -1,0 +1,384 @@
+"""The ``trajopt`` command line: ``plan``, ``compare``, ``demo`` and ``bench``.
+
+Every failure the user can fix (bad arguments, unreadable maps, blocked or unreachable
+start/goal, infeasible limits) exits with code 2 and one line on stderr, no traceback.
+Output files are written atomically: a partial file never replaces a good one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+__all__ = ["main", "build_parser"]
+
+logger = logging.getLogger(__name__)
+
+EXIT_USAGE = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports errors as one line and exit code 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+class CliError(Exception):
+    """A user-facing failure: printed as one line, exit code 2."""
+
+
+# ----------------------------------------------------------------- arguments
+def _robot_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("robot and limits (SI units; defaults: trajopt.Robot())")
+    g.add_argument("--radius", type=float, help="footprint radius [m]")
+    g.add_argument("--v-max", type=float, help="max speed [m/s]")
+    g.add_argument("--a-max", type=float, help="max tangential acceleration [m/s^2]")
+    g.add_argument("--j-max", type=float, help="max jerk [m/s^3]")
+    g.add_argument("--a-lat-max", type=float, help="max lateral acceleration [m/s^2]")
+    g.add_argument("--omega-max", type=float, help="max yaw rate [rad/s]")
+    g.add_argument("--track-width", type=float, help="differential-drive track width [m]")
+    g.add_argument("--wheel-v-max", type=float, help="max wheel speed [m/s]")
+    g.add_argument(
+        "--no-wheels", action="store_true", help="no differential-drive wheel-speed limit"
+    )
+
+
+def _map_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("map", metavar="MAP", help="map file: ROS .yaml, Moving AI .map, .pgm/.png, .npy")
+    p.add_argument(
+        "--resolution", type=float, help="cell size [m] for images/.npy (and to override .map)"
+    )
+    p.add_argument("--start", nargs=2, type=float, metavar=("X", "Y"), required=True,
+                   help="start point [m]")
+    p.add_argument("--goal", nargs=2, type=float, metavar=("X", "Y"), required=True,
+                   help="goal point [m]")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``trajopt`` command."""
+    parser = _Parser(
+        prog="trajopt",
+        description="Occupancy grid + start + goal -> timed, collision-free, smooth trajectory.",
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("plan", help="plan a timed trajectory on a map",
+                       description="Plan a timed trajectory: inflate -> A* -> corridor -> "
+                       "smoother -> ruckig timing.")
+    _map_args(p)
+    _robot_args(p)
+    p.add_argument("--inflation", choices=("exact", "paper"), default="exact",
+                   help="exact disk inflation or the chapter's avoidance area (default exact)")
+    p.add_argument("--search", choices=("clearance", "shortest"), default="clearance",
+                   help="A* cost (default clearance-aware)")
+    p.add_argument("--kappa-max", type=float, help="curvature bound [1/m] for the smoother")
+    p.add_argument("--start-heading", type=float, help="exact start heading [rad]")
+    p.add_argument("--goal-heading", type=float, help="exact goal heading [rad]")
+    p.add_argument("--out", help="write the trajectory (.csv or .json)")
+    p.add_argument("--dt", type=float, default=0.01, help="sample step of --out [s]")
+    p.add_argument("--plot", help="write a figure (.png/.pdf/.svg)")
+    p.set_defaults(func=_cmd_plan)
+
+    p = sub.add_parser("compare", help="compare the chapter's methods and the proposed one",
+                       description="Table of path metrics: traditional A*, A* with avoidance "
+                       "area, polynomial fit, B-spline fit and the proposed smoother.")
+    _map_args(p)
+    p.add_argument("--radius", type=float, help="robot radius [m] (default trajopt.Robot())")
+    p.add_argument("--format", choices=("text", "markdown", "csv"), default="text",
+                   help="table format on stdout (default text)")
+    p.add_argument("--out", help="also write the table to this file (.csv, .md or .txt)")
+    p.add_argument("--plot", help="write a figure of all paths (.png/.pdf/.svg)")
+    p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser("demo", help="the paper scene, SP to A-D, every method",
+                       description="Runs the chapter's scene (trajopt.scenes.paper()): every "
+                       "method from SP to each target; writes tables and figures.")
+    p.add_argument("--out", default="trajopt_demo", help="output folder (default trajopt_demo)")
+    p.add_argument("--no-plots", action="store_true", help="skip the figures")
+    p.set_defaults(func=_cmd_demo)
+
+    p = sub.add_parser("bench", help="run the methods on a Moving AI scenario file",
+                       description="Proposed method and plain B-spline fit on the scenarios of "
+                       "a Moving AI .scen; prints aggregate metrics.")
+    p.add_argument("scen", metavar="SCEN_FILE", help="Moving AI .scen file")
+    p.add_argument("--map", help="the .map file (default: found beside the .scen or in ../maps)")
+    p.add_argument("--limit", type=int, default=20, help="number of scenarios (default 20)")
+    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    p.add_argument("--radius-cells", type=float, default=2.5,
+                   help="robot radius in cells (default 2.5; the map has 1 m cells)")
+    p.set_defaults(func=_cmd_bench)
+    return parser
+
+
+# --------------------------------------------------------------------- helpers
+def _atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then move it into place."""
+    target = Path(path)
+    if target.parent and not target.parent.exists():
+        raise CliError(f"output folder {str(target.parent)!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix,
+                               dir=target.parent or ".")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, target)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return target
+
+
+def _save_figure(fig: Any, path: str | os.PathLike) -> Path:
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".png", ".pdf", ".svg", ".jpg", ".jpeg"):
+        raise CliError(f"--plot file must end in .png, .pdf, .svg or .jpg, got {str(path)!r}")
+    out = _atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=150, format=suffix[1:]))
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return out
+
+
+def _load(args: argparse.Namespace):
+    import astar
+
+    kwargs: dict[str, Any] = {}
+    if args.resolution is not None:
+        kwargs["resolution"] = args.resolution
+    return astar.load_map(args.map, **kwargs)
+
+
+def _robot(args: argparse.Namespace):
+    from trajopt.robot import Robot
+
+    fields = {
+        "radius": args.radius, "v_max": args.v_max, "a_max": args.a_max, "j_max": args.j_max,
+        "a_lat_max": args.a_lat_max, "omega_max": args.omega_max,
+        "track_width": args.track_width, "wheel_v_max": args.wheel_v_max,
+    }
+    kwargs = {k: v for k, v in fields.items() if v is not None}
+    if getattr(args, "no_wheels", False):
+        kwargs["track_width"] = None
+        kwargs["wheel_v_max"] = None
+    return Robot(**kwargs)
+
+
+def _require_matplotlib() -> None:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+    except ImportError as exc:
+        raise CliError(
+            "figures need matplotlib: pip install 'trajopt[analysis]'"
+        ) from exc
+
+
+# -------------------------------------------------------------------- commands
+def _cmd_plan(args: argparse.Namespace) -> int:
+    from trajopt.pipeline import Planner
+    from trajopt.smoother import Smoother
+
+    grid = _load(args)
+    robot = _robot(args)
+    smoother = Smoother(kappa_max=args.kappa_max) if args.kappa_max is not None else None
+    planner = Planner(grid, robot, inflation=args.inflation, search=args.search,
+                      smoother=smoother)
+    traj = planner.plan(args.start, args.goal, start_heading=args.start_heading,
+                        goal_heading=args.goal_heading)
+    stages = traj.stats.get("stages_s", {})
+    print(f"duration {traj.duration:.3f} s, length {traj.path.length:.3f} m, "
+          f"planned in {1e3 * stages.get('total', float('nan')):.1f} ms")
+    if args.out:
+        suffix = Path(args.out).suffix.lower()
+        if suffix == ".csv":
+            traj.to_csv(args.out, dt=args.dt)
+        elif suffix == ".json":
+            traj.to_json(args.out, dt=args.dt)
+        else:
+            raise CliError(f"--out must end in .csv or .json, got {args.out!r}")
+        print(f"wrote {args.out}")
+    if args.plot:
+        _require_matplotlib()
+        import matplotlib.pyplot as plt
+
+        from trajopt.plotting import plot_paths
+
+        steps = traj.steps
+        fig, ax = plt.subplots(figsize=(7, 7))
+        plot_paths(grid, {"A*": steps.grid_path.to_world(grid), "proposed": traj.path},
+                   inflated=steps.inflated_grid, corridor=steps.corridor,
+                   start=steps.start, goals={"goal": steps.goal}, ax=ax)
+        print(f"wrote {_save_figure(fig, args.plot)}")
+    return 0
+
+
+def _table_text(table: Any, fmt: str) -> str:
+    if fmt == "markdown":
+        return table.to_markdown()
+    if fmt == "csv":
+        return table.to_csv()
+    return str(table)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from trajopt.compare import compare
+    from trajopt.robot import Robot
+
+    grid = _load(args)
+    radius = Robot().radius if args.radius is None else args.radius
+    table = compare(grid, tuple(args.start), tuple(args.goal), robot_radius=radius)
+    print(_table_text(table, args.format))
+    if args.out:
+        suffix = Path(args.out).suffix.lower()
+        fmt = {".csv": "csv", ".md": "markdown"}.get(suffix, "text")
+        text = _table_text(table, fmt)
+        _atomic_write(args.out, lambda tmp: tmp.write_text(text + "\n"))
+    if args.plot:
+        _require_matplotlib()
+        from trajopt.plotting import plot_paths
+
+        fig, _ = plot_paths(grid, table.paths, inflated=table.inflated_grid,
+                            start=tuple(args.start), goals={"goal": tuple(args.goal)})
+        print(f"wrote {_save_figure(fig, args.plot)}")
+    return 0
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from trajopt.compare import compare
+    from trajopt.scenes import paper
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    scene = paper()
+    plots = not args.no_plots
+    if plots:
+        try:
+            _require_matplotlib()
+        except CliError as exc:
+            print(f"note: {exc}; figures skipped", file=sys.stderr)
+            plots = False
+    sections = []
+    for name in scene.target_names:
+        t0 = time.perf_counter()
+        table = compare(scene.grid, scene.start, scene.goal(name),
+                        robot_radius=scene.robot_radius, w_cells=scene.w_cells)
+        dt = time.perf_counter() - t0
+        print(f"\n== SP -> {name} ({dt:.2f} s) ==")
+        print(table)
+        sections.append(f"## SP -> {name}\n\n{table.to_markdown()}\n")
+        csv_text = table.to_csv()
+        _atomic_write(out / f"compare_{name}.csv", lambda tmp, s=csv_text: tmp.write_text(s))
+        if plots:
+            from trajopt.plotting import plot_paths
+
+            fig, _ = plot_paths(scene.grid, table.paths, inflated=table.inflated_grid,
+                                start=scene.start, goals={name: scene.goal(name)})
+            _save_figure(fig, out / f"paths_{name}.png")
+            proposed = table.paths.get("proposed")
+            traj = getattr(table, "trajectory", None)
+            if proposed is not None and traj is not None:
+                from trajopt.plotting import plot_profiles
+
+                fig, _ = plot_profiles(traj)
+                _save_figure(fig, out / f"profile_{name}.png")
+    report = "# trajopt demo: the paper scene\n\n" + "\n".join(sections)
+    _atomic_write(out / "compare.md", lambda tmp: tmp.write_text(report))
+    print(f"\nwrote tables{' and figures' if plots else ''} to {out}/")
+    return 0
+
+
+def _find_map(scen: Path, explicit: str | None, map_name: str) -> Path:
+    if explicit:
+        return Path(explicit)
+    for cand in (scen.parent / map_name, scen.parent.parent / "maps" / map_name,
+                 scen.with_suffix("")):
+        if cand.is_file() and cand.suffix == ".map":
+            return cand
+    raise CliError(f"map {map_name!r} of {str(scen)!r} not found beside it or in ../maps; "
+                   "give --map")
+
+
+def _bench_one(job: tuple[str, float, Any]) -> dict[str, Any]:
+    from trajopt._bench import run_scenario
+
+    map_path, radius_cells, scenario = job
+    return run_scenario(map_path, radius_cells, scenario)
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    import astar
+    from trajopt._bench import select_scenarios, summarize
+
+    if args.limit < 1:
+        raise CliError(f"--limit must be >= 1, got {args.limit}")
+    if args.jobs < 1:
+        raise CliError(f"--jobs must be >= 1, got {args.jobs}")
+    if not args.radius_cells > 0:
+        raise CliError(f"--radius-cells must be > 0, got {args.radius_cells}")
+    scen = Path(args.scen)
+    scenarios = astar.read_scenarios(scen)
+    if not scenarios:
+        raise CliError(f"{str(scen)!r} holds no scenarios")
+    map_path = _find_map(scen, args.map, scenarios[0].map_name)
+    astar.load_map(map_path)  # fail early, with one line, on a bad map
+    chosen = select_scenarios(scenarios, args.limit)
+    jobs = [(str(map_path), args.radius_cells, s) for s in chosen]
+    results: list[dict[str, Any]] = []
+    t0 = time.perf_counter()
+    if args.jobs == 1:
+        for i, job in enumerate(jobs):
+            results.append(_bench_one(job))
+            _progress(i + 1, len(jobs), t0)
+    else:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+            for i, res in enumerate(pool.map(_bench_one, jobs)):
+                results.append(res)
+                _progress(i + 1, len(jobs), t0)
+    print(file=sys.stderr)
+    print(summarize(results))
+    return 0
+
+
+def _progress(done: int, total: int, t0: float) -> None:
+    width = 30
+    filled = int(width * done / total)
+    bar = "#" * filled + "-" * (width - filled)
+    sys.stderr.write(f"\r[{bar}] {done}/{total} {time.perf_counter() - t0:.1f} s")
+    sys.stderr.flush()
+
+
+# ------------------------------------------------------------------------ main
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``trajopt`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    if args.command is None:
+        parser.print_help()
+        return EXIT_USAGE
+    from astar.errors import AstarError
+    from trajopt.errors import TrajoptError
+
+    try:
+        return int(args.func(args))
+    except (CliError, AstarError, TrajoptError, OSError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"trajopt {args.command}: error: {type(exc).__name__}: {msg}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,431 @@
+"""Safe corridors: overlapping axis-aligned boxes of free cells grown around a grid path.
+
+A :class:`Corridor` is the convex decomposition of free space that the smoother uses to
+certify clearance: every span of the B-spline keeps its control points inside one box, so
+(by the convex-hull property) the whole continuous curve lies inside the union of boxes.
+
+Contract for certified clearance
+--------------------------------
+To certify a clearance ``r`` (metres) from the *raw* map, two things are needed together:
+
+1. the grid given to :func:`build_corridor` must be
+   ``astar.inflate(raw, r, metric="square", outside_occupied=True)``: a cell is blocked
+   when its centre is closer than ``r`` to an occupied cell taken as a *square* (and the
+   outside of the map counts as occupied);
+2. every box of free cells is shrunk to the rectangle spanned by its cell *centres*
+   (half a cell per side), which :func:`build_corridor` always does.
+
+Then any point of a shrunk box is at least ``r`` from every occupied square: for an
+occupied square ``Q`` outside the box, the box's cell centre nearest to ``Q`` along each
+axis is no farther from ``Q`` on either axis than the point, and that centre is free, so
+its distance to ``Q`` is ``>= r``. With centre-to-centre inflation, or without the
+shrink, the curve can cut obstacle corners (GUIDE.md section 6).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import InvalidInputError
+
+__all__ = ["Box", "Corridor", "build_corridor"]
+
+logger = logging.getLogger(__name__)
+
+
+def _readonly(a: np.ndarray, dtype: Any) -> np.ndarray:
+    out = np.array(a, dtype=dtype, copy=True)
+    out.flags.writeable = False
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    """An axis-aligned box of free cells, shrunk to the rectangle of its cell centres.
+
+    Attributes
+    ----------
+    xmin, xmax, ymin, ymax : float
+        The shrunk box in world metres (cell centres of the outermost cells).
+    ix0, ix1, iy0, iy1 : int
+        The cell rectangle, inclusive: cells ``ix0..ix1`` by ``iy0..iy1``.
+    """
+
+    xmin: float
+    xmax: float
+    ymin: float
+    ymax: float
+    ix0: int
+    ix1: int
+    iy0: int
+    iy1: int
+
+    @property
+    def cells_x(self) -> int:
+        """Width in cells."""
+        return self.ix1 - self.ix0 + 1
+
+    @property
+    def cells_y(self) -> int:
+        """Height in cells."""
+        return self.iy1 - self.iy0 + 1
+
+    def contains(self, points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+        """Whether world points (shape ``(..., 2)``, m) lie in the box (``tol`` m of slack)."""
+        p = np.asarray(points, dtype=float)
+        return (
+            (p[..., 0] >= self.xmin - tol)
+            & (p[..., 0] <= self.xmax + tol)
+            & (p[..., 1] >= self.ymin - tol)
+            & (p[..., 1] <= self.ymax + tol)
+        )
+
+    def contains_cells(self, cells: np.ndarray) -> np.ndarray:
+        """Whether cells ``(ix, iy)`` (shape ``(..., 2)``) lie in the cell rectangle."""
+        c = np.asarray(cells)
+        return (
+            (c[..., 0] >= self.ix0)
+            & (c[..., 0] <= self.ix1)
+            & (c[..., 1] >= self.iy0)
+            & (c[..., 1] <= self.iy1)
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Corridor:
+    """A chain of overlapping boxes covering a grid path.
+
+    Attributes
+    ----------
+    boxes : tuple of Box, length m
+        Consecutive boxes overlap (share at least one path cell).
+    path_ranges : ndarray of int64, shape (m, 2)
+        For each box the inclusive range ``[first, last]`` of path indices whose cells it
+        contains (a contiguous run).
+    transitions_m : ndarray of float, shape (m - 1,)
+        Arc length along the path polyline (m) where box ``i`` hands over to box ``i + 1``:
+        a point inside the run of path cells shared by both boxes.
+    overlap_start_m, overlap_end_m : ndarray of float, shape (m - 1,)
+        Arc-length interval (m) of the shared run of path cells.
+    path_points : ndarray of float, shape (n, 2)
+        World coordinates (m) of the path cell centres.
+    path_s : ndarray of float, shape (n,)
+        Arc length (m) of each path point along the polyline.
+    resolution : float
+        Cell side of the grid (m).
+    origin : tuple of float
+        Grid origin (m).
+    radius : float or None
+        Clearance (m) the inflated grid was built for, when given.
+    """
+
+    boxes: tuple[Box, ...]
+    path_ranges: np.ndarray
+    transitions_m: np.ndarray
+    overlap_start_m: np.ndarray
+    overlap_end_m: np.ndarray
+    path_points: np.ndarray
+    path_s: np.ndarray
+    resolution: float
+    origin: tuple[float, float]
+    radius: float | None = None
+    _lo: np.ndarray = field(init=False, repr=False, compare=False)
+    _hi: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "boxes", tuple(self.boxes))
+        object.__setattr__(self, "path_ranges", _readonly(self.path_ranges, np.int64))
+        for name in ("transitions_m", "overlap_start_m", "overlap_end_m", "path_s"):
+            object.__setattr__(self, name, _readonly(getattr(self, name), float))
+        object.__setattr__(self, "path_points", _readonly(self.path_points, float))
+        lo = np.array([[b.xmin, b.ymin] for b in self.boxes], dtype=float).reshape(-1, 2)
+        hi = np.array([[b.xmax, b.ymax] for b in self.boxes], dtype=float).reshape(-1, 2)
+        lo.flags.writeable = False
+        hi.flags.writeable = False
+        object.__setattr__(self, "_lo", lo)
+        object.__setattr__(self, "_hi", hi)
+
+    def __len__(self) -> int:
+        return len(self.boxes)
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower corners ``(xmin, ymin)`` of all boxes, shape (m, 2) (m)."""
+        return self._lo
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper corners ``(xmax, ymax)`` of all boxes, shape (m, 2) (m)."""
+        return self._hi
+
+    @property
+    def length_m(self) -> float:
+        """Length of the path polyline (m)."""
+        return float(self.path_s[-1])
+
+    def contains(self, points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+        """Whether each world point (shape ``(..., 2)``, m) lies in at least one box."""
+        p = np.asarray(points, dtype=float)
+        flat = p.reshape(-1, 2)
+        inside = np.all(
+            (flat[:, None, :] >= self._lo[None] - tol) & (flat[:, None, :] <= self._hi[None] + tol),
+            axis=2,
+        )
+        return inside.any(axis=1).reshape(p.shape[:-1])
+
+    def box_of(self, s_m: np.ndarray | float) -> np.ndarray:
+        """Index of the box whose share of the path holds arc length ``s_m`` (m)."""
+        return np.searchsorted(self.transitions_m, np.asarray(s_m, dtype=float), side="right")
+
+
+class _RectTester:
+    """O(1) "is this cell rectangle all free" tests from a summed-area table."""
+
+    __slots__ = ("sat", "nx", "ny")
+
+    def __init__(self, occupied: np.ndarray) -> None:
+        ny, nx = occupied.shape
+        sat = np.zeros((ny + 1, nx + 1), dtype=np.int64)
+        sat[1:, 1:] = np.cumsum(np.cumsum(occupied, axis=0, dtype=np.int64), axis=1)
+        self.sat = sat
+        self.nx, self.ny = nx, ny
+
+    def free(self, x0: int, x1: int, y0: int, y1: int) -> bool:
+        if x0 < 0 or y0 < 0 or x1 >= self.nx or y1 >= self.ny or x0 > x1 or y0 > y1:
+            return False
+        s = self.sat
+        return int(s[y1 + 1, x1 + 1] - s[y0, x1 + 1] - s[y1 + 1, x0] + s[y0, x0]) == 0
+
+
+def _as_cells(grid_path: Any) -> np.ndarray:
+    cells = getattr(grid_path, "cells", grid_path)
+    c = np.asarray(cells)
+    if c.ndim != 2 or c.shape[1] != 2 or len(c) < 1:
+        raise InvalidInputError(f"grid_path cells must have shape (n, 2) with n >= 1, got {c.shape}")
+    if not np.issubdtype(c.dtype, np.integer):
+        if not np.all(np.isfinite(c)) or np.any(c != np.round(c)):
+            raise InvalidInputError("grid_path cells must be integer (ix, iy) pairs")
+        c = c.astype(np.int64)
+    c = c.astype(np.int64)
+    steps = np.abs(np.diff(c, axis=0))
+    if len(c) > 1 and (np.any(steps.max(axis=1) != 1)):
+        bad = int(np.nonzero(steps.max(axis=1) != 1)[0][0])
+        raise InvalidInputError(
+            f"grid_path must move to an 8-neighbour at every step; step {bad} goes from "
+            f"{c[bad].tolist()} to {c[bad + 1].tolist()}"
+        )
+    return c
+
+
+def build_corridor(
+    inflated_grid: Any,
+    grid_path: Any,
+    *,
+    max_side_cells: int = 32,
+    seed_back_cells: int = 3,
+    min_share_cells: float = 1.5,
+    radius: float | None = None,
+) -> Corridor:
+    """Grow a chain of overlapping free boxes around a grid path.
+
+    Parameters
+    ----------
+    inflated_grid : astar.OccupancyGrid
+        The grid the robot *centre* moves in. For certified clearance ``r`` from the raw
+        map it must be ``astar.inflate(raw, r, metric="square", outside_occupied=True)``
+        (module docstring).
+    grid_path : astar.GridPath or array_like of int, shape (n, 2)
+        Path cells ``(ix, iy)``, 8-connected, all free in ``inflated_grid``.
+    max_side_cells : int, optional
+        Largest box side in cells (>= 2). Default 32.
+    seed_back_cells : int, optional
+        How many already covered path cells each new box is seeded with (>= 1), so that
+        consecutive boxes share a run of path cells. Default 3.
+    min_share_cells : float, optional
+        Transitions are moved inside their overlap runs so that each box's share of the
+        path is at least this long (cells) where possible. Default 1.5.
+    radius : float, optional
+        The clearance (m) ``inflated_grid`` was built for; stored on the corridor.
+
+    Returns
+    -------
+    Corridor
+
+    Raises
+    ------
+    InvalidInputError
+        When a path cell is blocked or outside the grid, or an option breaks its rule.
+
+    Notes
+    -----
+    Each box starts from the first path cell not yet covered, seeded with the bounding
+    box of up to ``seed_back_cells`` previous path cells (shrunk until free), extends
+    forward along the path while its bounding box stays free, then grows one cell at a
+    time round-robin (+x, -x, +y, -y) while free and within ``max_side_cells``, using
+    O(1) summed-area-table tests. A box made redundant by its successor (the successor
+    overlaps the box before it) is dropped. Deterministic: no randomness, no ties broken
+    by hashing.
+    """
+    if int(max_side_cells) != max_side_cells or max_side_cells < 2:
+        raise InvalidInputError(f"max_side_cells must be an integer >= 2, got {max_side_cells!r}")
+    if int(seed_back_cells) != seed_back_cells or seed_back_cells < 1:
+        raise InvalidInputError(
+            f"seed_back_cells must be an integer >= 1, got {seed_back_cells!r}"
+        )
+    if not (np.isfinite(min_share_cells) and min_share_cells >= 0):
+        raise InvalidInputError(f"min_share_cells must be finite and >= 0, got {min_share_cells!r}")
+    if radius is not None and not (np.isfinite(radius) and radius >= 0):
+        raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
+    occ = np.asarray(inflated_grid.occupied, dtype=bool)
+    ny, nx = occ.shape
+    cells = _as_cells(grid_path)
+    inb = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
+    if not np.all(inb):
+        i = int(np.nonzero(~inb)[0][0])
+        raise InvalidInputError(
+            f"grid_path cell {i} = {cells[i].tolist()} is outside the {nx}x{ny} grid"
+        )
+    blocked = occ[cells[:, 1], cells[:, 0]]
+    if np.any(blocked):
+        i = int(np.nonzero(blocked)[0][0])
+        raise InvalidInputError(
+            f"grid_path cell {i} = {cells[i].tolist()} is blocked in the inflated grid; "
+            "the path must be searched on the same inflated grid"
+        )
+    res = float(inflated_grid.resolution)
+    ox, oy = (float(v) for v in inflated_grid.origin)
+    tester = _RectTester(occ)
+    n = len(cells)
+    cap = int(max_side_cells)
+
+    rects: list[tuple[int, int, int, int]] = []
+    runs: list[tuple[int, int]] = []
+
+    def inside(r: tuple[int, int, int, int], j: int) -> bool:
+        x, y = cells[j]
+        return r[0] <= x <= r[1] and r[2] <= y <= r[3]
+
+    i = 0
+    while True:
+        # seed: bounding box of cells [i - back, i], shrunk until free
+        back = min(int(seed_back_cells), i)
+        while True:
+            seg = cells[i - back : i + 1]
+            r = (int(seg[:, 0].min()), int(seg[:, 0].max()), int(seg[:, 1].min()), int(seg[:, 1].max()))
+            if (r[1] - r[0] < cap and r[3] - r[2] < cap and tester.free(*r)) or back == 0:
+                break
+            back -= 1
+        # extend forward along the path
+        j = i + 1
+        while j < n:
+            x, y = cells[j]
+            cand = (min(r[0], int(x)), max(r[1], int(x)), min(r[2], int(y)), max(r[3], int(y)))
+            if cand[1] - cand[0] >= cap or cand[3] - cand[2] >= cap or not tester.free(*cand):
+                break
+            r = cand
+            j += 1
+        # round-robin growth
+        grew = True
+        while grew:
+            grew = False
+            for side in range(4):
+                x0, x1, y0, y1 = r
+                if side == 0:
+                    cand = (x0, x1 + 1, y0, y1)
+                elif side == 1:
+                    cand = (x0 - 1, x1, y0, y1)
+                elif side == 2:
+                    cand = (x0, x1, y0, y1 + 1)
+                else:
+                    cand = (x0, x1, y0 - 1, y1)
+                if cand[1] - cand[0] < cap and cand[3] - cand[2] < cap and tester.free(*cand):
+                    r = cand
+                    grew = True
+        # contiguous run of path cells containing i
+        a = i
+        while a > 0 and inside(r, a - 1):
+            a -= 1
+        b = i
+        while b + 1 < n and inside(r, b + 1):
+            b += 1
+        # drop predecessors made redundant (this box overlaps the one before them)
+        while len(rects) >= 2 and a <= runs[-2][1]:
+            rects.pop()
+            runs.pop()
+        rects.append(r)
+        runs.append((a, b))
+        if b >= n - 1:
+            break
+        i = b + 1
+
+    pts = np.column_stack([ox + (cells[:, 0] + 0.5) * res, oy + (cells[:, 1] + 0.5) * res])
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+    m = len(rects)
+    ov_lo = np.empty(m - 1)
+    ov_hi = np.empty(m - 1)
+    for k in range(m - 1):
+        lo_i = max(runs[k][0], runs[k + 1][0])
+        hi_i = runs[k][1]
+        if lo_i > hi_i:  # pragma: no cover - guaranteed by the seeding
+            raise InvalidInputError(f"internal error: boxes {k} and {k + 1} share no path cell")
+        ov_lo[k], ov_hi[k] = s[lo_i], s[hi_i]
+    trans = _place_transitions(ov_lo, ov_hi, float(s[-1]), min_share_cells * res)
+    boxes = tuple(
+        Box(
+            xmin=ox + (r[0] + 0.5) * res,
+            xmax=ox + (r[1] + 0.5) * res,
+            ymin=oy + (r[2] + 0.5) * res,
+            ymax=oy + (r[3] + 0.5) * res,
+            ix0=r[0],
+            ix1=r[1],
+            iy0=r[2],
+            iy1=r[3],
+        )
+        for r in rects
+    )
+    logger.debug("corridor: %d boxes for %d path cells", m, n)
+    return Corridor(
+        boxes=boxes,
+        path_ranges=np.array(runs, dtype=np.int64).reshape(-1, 2),
+        transitions_m=trans,
+        overlap_start_m=ov_lo,
+        overlap_end_m=ov_hi,
+        path_points=pts,
+        path_s=s,
+        resolution=res,
+        origin=(ox, oy),
+        radius=None if radius is None else float(radius),
+    )
+
+
+def _place_transitions(lo: np.ndarray, hi: np.ndarray, length: float, min_share: float) -> np.ndarray:
+    """Transitions at the overlap midpoints, then nudged (inside their overlaps) so that
+    every box's share is at least ``min_share`` where the overlaps allow it."""
+    t = 0.5 * (lo + hi)
+    m = len(t)
+    if m == 0:
+        return t
+    for _ in range(3):
+        for k in range(m + 1):
+            left = t[k - 1] if k > 0 else 0.0
+            right = t[k] if k < m else length
+            deficit = min_share - (right - left)
+            if deficit <= 0:
+                continue
+            if k < m:
+                room = hi[k] - t[k]
+                step = min(room, 0.5 * deficit if k > 0 else deficit)
+                t[k] += step
+                deficit -= step
+            if k > 0 and deficit > 0:
+                room = t[k - 1] - lo[k - 1]
+                t[k - 1] -= min(room, deficit)
+    # keep strictly increasing (guaranteed by the overlap structure; enforce defensively)
+    for k in range(1, m):
+        if t[k] <= t[k - 1]:
+            t[k] = min(hi[k], t[k - 1] + 1e-9 * max(1.0, length))
+    return t

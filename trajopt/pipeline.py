@@ -1,0 +1,449 @@
+"""One call from map to timed trajectory: :func:`plan`, and :class:`Planner` for many queries.
+
+Stages (each timed in ``Trajectory.stats["stages_s"]``):
+
+1. **inflate**: ``astar.inflate(grid, r, metric="square", outside_occupied=True)`` (the
+   grid the corridor certifies against; GUIDE section 6). ``inflation="paper"`` adds the
+   chapter's avoidance area (``W`` rounds of 8-neighbour marking, ``W = round(width/res)``)
+   on top, so the result is never less safe than the certified inflation.
+2. **search**: octile A* on the inflated grid; by default (``search="clearance"``) with
+   the soft clearance cost of :func:`astar.clearance_cost`, which keeps paths off the walls;
+   ``search="shortest"`` is the plain shortest path.
+3. **corridor**: :func:`trajopt.build_corridor`. When the exact start or goal is not a cell
+   centre, the end box is widened to contain it after an exact box-to-obstacle clearance
+   check.
+4. **smooth**: :class:`trajopt.Smoother` (certified clearance ``>= radius`` from the raw
+   map, exact endpoints, continuous heading).
+5. **timing**: :func:`trajopt.time_parameterize`.
+
+The returned :class:`~trajopt.trajectory.Trajectory` carries every intermediate result in
+``trajectory.steps`` (a :class:`PlanSteps`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt.corridor import Box, Corridor, build_corridor
+from trajopt.errors import InvalidInputError, NoPathError
+from trajopt.robot import Robot
+from trajopt.smoother import Smoother, SmoothPath
+from trajopt.timing import time_parameterize
+from trajopt.trajectory import Trajectory
+
+__all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search"]
+
+logger = logging.getLogger(__name__)
+
+Inflation = Literal["exact", "paper"]
+Search = Literal["clearance", "shortest"]
+_INFLATIONS = ("exact", "paper")
+_SEARCHES = ("clearance", "shortest")
+
+
+@dataclass(frozen=True, slots=True)
+class PlanSteps:
+    """Every intermediate result of one :meth:`Planner.plan` query.
+
+    Attributes
+    ----------
+    raw_grid : astar.OccupancyGrid
+        The map as given.
+    inflated_grid : astar.OccupancyGrid
+        The grid the robot centre moves in.
+    grid_path : astar.GridPath
+        The A* path on ``inflated_grid``.
+    corridor : Corridor
+        The free boxes around the path (end boxes widened to the exact start/goal).
+    smooth_path : SmoothPath
+        The certified B-spline.
+    start, goal : tuple of float
+        The query's end points (m).
+    stages_s : dict of str to float
+        Wall time of each stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
+        ``timing``, ``total``. ``inflate`` is ~0 when the planner's cache served it.
+    """
+
+    raw_grid: OccupancyGrid
+    inflated_grid: OccupancyGrid
+    grid_path: Any
+    corridor: Corridor
+    smooth_path: SmoothPath
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    stages_s: dict[str, float]
+
+
+class Planner:
+    """Plans timed trajectories on one map, caching what repeated queries share.
+
+    The inflated grid and the clearance cost are computed once per planner; the smoother's
+    built CasADi solvers are cached per problem size for the whole process.
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        The raw map.
+    robot : Robot, optional
+        Size and limits; default ``Robot()`` (the chapter's robot).
+    inflation : {"exact", "paper"}
+        ``"exact"``: obstacles grown by ``robot.radius`` (square metric, certified).
+        ``"paper"``: the chapter's avoidance area of ``w_cells`` rounds on top of it.
+    w_cells : int, optional
+        ``W`` for ``inflation="paper"``; default ``round(robot.width / resolution)`` (11 on
+        the paper scene).
+    search : {"clearance", "shortest"}
+        A* cost: clearance-aware (default) or plain shortest path.
+    smoother : Smoother, optional
+        Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
+    timing_dt : float
+        Step of the timing's forward greedy (s).
+
+    Notes
+    -----
+    A planner may be shared between threads: queries are serialised by a lock (the CasADi
+    solvers it reuses keep per-call work memory).
+    """
+
+    def __init__(
+        self,
+        grid: OccupancyGrid,
+        robot: Robot | None = None,
+        *,
+        inflation: Inflation = "exact",
+        w_cells: int | None = None,
+        search: Search = "clearance",
+        smoother: Smoother | None = None,
+        timing_dt: float = 0.02,
+    ) -> None:
+        if not isinstance(grid, OccupancyGrid):
+            raise InvalidInputError(
+                f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}"
+            )
+        robot = Robot() if robot is None else robot
+        if not isinstance(robot, Robot):
+            raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
+        if inflation not in _INFLATIONS:
+            raise InvalidInputError(f"inflation must be one of {_INFLATIONS}, got {inflation!r}")
+        if search not in _SEARCHES:
+            raise InvalidInputError(f"search must be one of {_SEARCHES}, got {search!r}")
+        if w_cells is None:
+            w_cells = max(1, round(robot.width / grid.resolution))
+        if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
+            raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
+        smoother = Smoother() if smoother is None else smoother
+        if not isinstance(smoother, Smoother):
+            raise InvalidInputError(
+                f"smoother must be a trajopt.Smoother, got {type(smoother).__name__}"
+            )
+        self.grid = grid
+        self.robot = robot
+        self.inflation: Inflation = inflation
+        self.w_cells = int(w_cells)
+        self.search: Search = search
+        self.smoother = smoother
+        self.timing_dt = float(timing_dt)
+        self._lock = threading.RLock()
+        self._inflated: OccupancyGrid | None = None
+        self._cost: np.ndarray | None = None
+
+    # -------------------------------------------------------------- caches
+    @property
+    def inflated_grid(self) -> OccupancyGrid:
+        """The grid the robot centre moves in (computed once)."""
+        with self._lock:
+            if self._inflated is None:
+                g = astar.inflate(
+                    self.grid, self.robot.radius, metric="square", outside_occupied=True
+                )
+                if self.inflation == "paper":
+                    area = astar.avoidance_area(self.grid, self.w_cells, border=True)
+                    g = self.grid.with_occupied(g.occupied | area.occupied)
+                self._inflated = g
+            return self._inflated
+
+    @property
+    def search_cost(self) -> np.ndarray | None:
+        """Per-cell A* cost (``None`` for ``search="shortest"``), computed once."""
+        if self.search == "shortest":
+            return None
+        with self._lock:
+            if self._cost is None:
+                self._cost = astar.clearance_cost(
+                    self.grid, self.robot.radius, outside_occupied=True
+                )
+            return self._cost
+
+    # ---------------------------------------------------------------- query
+    def plan(
+        self,
+        start: Sequence[float],
+        goal: Sequence[float],
+        *,
+        start_heading: float | None = None,
+        goal_heading: float | None = None,
+        v_start: float = 0.0,
+        v_end: float = 0.0,
+    ) -> Trajectory:
+        """Plan a timed trajectory from ``start`` to ``goal`` (world metres).
+
+        Parameters
+        ----------
+        start, goal : sequence of float, shape (2,)
+            End points ``(x, y)`` in metres.
+        start_heading, goal_heading : float, optional
+            Exact headings at the ends (rad).
+        v_start, v_end : float
+            Speeds at the ends (m/s).
+
+        Returns
+        -------
+        Trajectory
+            With ``trajectory.steps`` (:class:`PlanSteps`) and per-stage wall times in
+            ``trajectory.stats["stages_s"]``.
+
+        Raises
+        ------
+        InvalidInputError
+            Non-finite or malformed points, a point outside the map, on an obstacle or
+            closer to one than the robot radius (the message gives the clearance found),
+            start and goal in the same cell.
+        NoPathError
+            The goal cannot be reached on the inflated grid.
+        SmoothingError, TimingError
+            From the smoother or the timing (with their statistics).
+        """
+        with self._lock:
+            return self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
+
+    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> Trajectory:
+        t0 = time.perf_counter()
+        stages: dict[str, float] = {}
+        p0 = _point("start", start)
+        p1 = _point("goal", goal)
+        c0 = self._check_endpoint("start", p0)
+        c1 = self._check_endpoint("goal", p1)
+        t = time.perf_counter()
+        inflated = self.inflated_grid
+        stages["inflate"] = time.perf_counter() - t
+        for name, p, c in (("start", p0, c0), ("goal", p1, c1)):
+            if inflated.occupied[c[1], c[0]]:
+                raise InvalidInputError(
+                    f"{name} {p.tolist()} m lies in cell {tuple(c)}, which is blocked by the "
+                    f"inflation={self.inflation!r} avoidance area (robot radius "
+                    f"{self.robot.radius} m); clearance of the cell centre "
+                    f"{_clearance_of(self.grid, self.grid.cell_to_world(c)):.4g} m"
+                )
+        if tuple(c0) == tuple(c1):
+            raise InvalidInputError(
+                f"start {p0.tolist()} m and goal {p1.tolist()} m lie in the same cell "
+                f"{tuple(c0)}; the planner needs them at least one cell apart"
+            )
+        t = time.perf_counter()
+        cost = self.search_cost
+        try:
+            path = astar.find_path(inflated, tuple(c0), tuple(c1), cost=cost)
+        except astar.NoPathError as exc:
+            raise NoPathError(
+                f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot of "
+                f"radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
+            ) from exc
+        stages["search"] = time.perf_counter() - t
+        t = time.perf_counter()
+        corridor = build_corridor(inflated, path, radius=self.robot.radius)
+        corridor = _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
+        stages["corridor"] = time.perf_counter() - t
+        t = time.perf_counter()
+        smooth = self.smoother.fit(
+            path,
+            corridor,
+            raw_grid=self.grid,
+            radius=self.robot.radius,
+            start=p0,
+            goal=p1,
+            start_heading=start_heading,
+            goal_heading=goal_heading,
+        )
+        stages["smooth"] = time.perf_counter() - t
+        t = time.perf_counter()
+        traj = time_parameterize(
+            smooth, self.robot, v_start=v_start, v_end=v_end, dt=self.timing_dt
+        )
+        stages["timing"] = time.perf_counter() - t
+        stages["total"] = time.perf_counter() - t0
+        steps = PlanSteps(
+            raw_grid=self.grid,
+            inflated_grid=inflated,
+            grid_path=path,
+            corridor=corridor,
+            smooth_path=smooth,
+            start=(float(p0[0]), float(p0[1])),
+            goal=(float(p1[0]), float(p1[1])),
+            stages_s=stages,
+        )
+        stats = dict(traj.stats)
+        stats["stages_s"] = dict(stages)
+        stats["inflation"] = self.inflation
+        stats["search"] = self.search
+        stats["smoother"] = dict(smooth.stats)
+        return dataclasses.replace(traj, stats=stats, steps=steps)
+
+    def _check_endpoint(self, name: str, p: np.ndarray) -> np.ndarray:
+        grid = self.grid
+        c = grid.world_to_cell(p)
+        if not grid.in_bounds(c):
+            ox, oy = grid.origin
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m is outside the map "
+                f"[{ox}, {ox + grid.width}] x [{oy}, {oy + grid.height}] m"
+            )
+        if grid.occupied[c[1], c[0]]:
+            raise InvalidInputError(f"{name} {p.tolist()} m lies on an occupied cell {tuple(c)}")
+        clr = _clearance_of(grid, p)
+        if clr < self.robot.radius:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
+                f"edge); the robot needs at least its radius {self.robot.radius} m"
+            )
+        return c
+
+
+def plan(
+    grid: OccupancyGrid,
+    start: Sequence[float],
+    goal: Sequence[float],
+    robot: Robot | None = None,
+    *,
+    start_heading: float | None = None,
+    goal_heading: float | None = None,
+    v_start: float = 0.0,
+    v_end: float = 0.0,
+    inflation: Inflation = "exact",
+    search: Search = "clearance",
+    smoother: Smoother | None = None,
+    w_cells: int | None = None,
+) -> Trajectory:
+    """Plan a timed, collision-free, smooth trajectory in one call.
+
+    Runs inflate -> A* -> corridor -> smoother -> timing (module docstring). For repeated
+    queries on one map use :class:`Planner`, which caches the inflated grid.
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        Raw map.
+    start, goal : sequence of float, shape (2,)
+        End points ``(x, y)`` in world metres.
+    robot : Robot, optional
+        Size and limits; default ``Robot()``.
+    start_heading, goal_heading : float, optional
+        Exact headings at the ends (rad).
+    v_start, v_end : float
+        Speeds at the ends (m/s).
+    inflation, search, smoother, w_cells
+        See :class:`Planner`.
+
+    Returns
+    -------
+    Trajectory
+        ``trajectory.steps`` holds every intermediate result (:class:`PlanSteps`).
+
+    Examples
+    --------
+    >>> import trajopt
+    >>> scene = trajopt.scenes.paper()
+    >>> traj = trajopt.plan(scene.grid, scene.start, scene.goal("A"))  # doctest: +SKIP
+    >>> traj.duration  # doctest: +SKIP
+    """
+    planner = Planner(
+        grid, robot, inflation=inflation, search=search, smoother=smoother, w_cells=w_cells
+    )
+    return planner.plan(
+        start,
+        goal,
+        start_heading=start_heading,
+        goal_heading=goal_heading,
+        v_start=v_start,
+        v_end=v_end,
+    )
+
+
+# ------------------------------------------------------------------ helpers
+def _point(name: str, value: Any) -> np.ndarray:
+    try:
+        p = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"{name} must be two numbers (x, y) in metres, got {value!r}") from exc
+    if p.shape != (2,):
+        raise InvalidInputError(f"{name} must be two numbers (x, y) in metres, got {value!r}")
+    if not np.all(np.isfinite(p)):
+        raise InvalidInputError(f"{name} must be finite, got {p.tolist()}")
+    return p
+
+
+def _box_clearance(grid: OccupancyGrid, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Exact distance (m) from the box ``[lo, hi]`` to the nearest occupied square or the
+    map's outside (which counts as occupied)."""
+    ox, oy = grid.origin
+    res = grid.resolution
+    edge = min(lo[0] - ox, lo[1] - oy, ox + grid.width - hi[0], oy + grid.height - hi[1])
+    if edge <= 0:
+        return 0.0
+    reach = edge  # nothing farther than the map edge matters
+    c_lo = np.floor((lo - reach - (ox, oy)) / res).astype(int)
+    c_hi = np.floor((hi + reach - (ox, oy)) / res).astype(int)
+    x0, y0 = max(c_lo[0], 0), max(c_lo[1], 0)
+    x1, y1 = min(c_hi[0], grid.nx - 1), min(c_hi[1], grid.ny - 1)
+    iy, ix = np.nonzero(grid.occupied[y0 : y1 + 1, x0 : x1 + 1])
+    if ix.size == 0:
+        return float(edge)
+    sx0 = ox + (ix + x0) * res
+    sy0 = oy + (iy + y0) * res
+    dx = np.maximum(0.0, np.maximum(sx0 - hi[0], lo[0] - (sx0 + res)))
+    dy = np.maximum(0.0, np.maximum(sy0 - hi[1], lo[1] - (sy0 + res)))
+    return float(min(edge, np.hypot(dx, dy).min()))
+
+
+def _clearance_of(grid: OccupancyGrid, p: np.ndarray) -> float:
+    p = np.asarray(p, dtype=float)
+    return _box_clearance(grid, p, p)
+
+
+def _widen_end_boxes(
+    corridor: Corridor, raw: OccupancyGrid, p0: np.ndarray, p1: np.ndarray, radius: float
+) -> Corridor:
+    """Widen the first/last box to hold the exact start/goal, after an exact clearance check."""
+    boxes = list(corridor.boxes)
+    changed = False
+    for name, idx, p in (("start", 0, p0), ("goal", len(boxes) - 1, p1)):
+        b = boxes[idx]
+        if b.contains(p):
+            continue
+        lo = np.minimum([b.xmin, b.ymin], p)
+        hi = np.maximum([b.xmax, b.ymax], p)
+        clr = _box_clearance(raw, lo, hi)
+        if clr < radius:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m cannot join the corridor with clearance {radius} m: "
+                f"the box joining it to the path comes {clr:.4g} m from an obstacle; move it "
+                "towards free space or onto the centre of its cell"
+            )
+        boxes[idx] = Box(
+            xmin=float(lo[0]), xmax=float(hi[0]), ymin=float(lo[1]), ymax=float(hi[1]),
+            ix0=b.ix0, ix1=b.ix1, iy0=b.iy0, iy1=b.iy1,
+        )
+        changed = True
+    if not changed:
+        return corridor
+    return dataclasses.replace(corridor, boxes=tuple(boxes))
+

@@ -1,0 +1,133 @@
+"""The robot's size and motion limits, and the curvature-dependent speed limit they imply.
+
+The default :class:`Robot` is the chapter's robot, the National Instruments Robotics
+Starter Kit 2.0 ("DaNI"), a two-wheel differential drive 0.33 m wide (so the footprint
+radius used for obstacle inflation is 0.165 m). The kinematic limits are not published by
+the vendor; the defaults are plausible, conservative values for its 12 V geared motors
+and 10 cm wheels:
+
+========================  =========  =========================================================
+field                     default    meaning
+========================  =========  =========================================================
+``radius``                0.165 m    footprint radius (half of the 0.33 m width)
+``v_max``                 0.5 m/s    forward speed
+``a_max``                 0.5 m/s^2  tangential acceleration (both signs)
+``j_max``                 2.0 m/s^3  tangential jerk (both signs)
+``a_lat_max``             0.5 m/s^2  lateral (centripetal) acceleration ``kappa * v^2``
+``omega_max``             1.5 rad/s  yaw rate ``kappa * v``
+``track_width``           0.28 m     distance between the two drive wheels
+``wheel_v_max``           0.6 m/s    speed of either wheel ``v * (1 +- kappa * track_width/2)``
+========================  =========  =========================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import InvalidInputError
+
+__all__ = ["Robot"]
+
+
+@dataclass(frozen=True, slots=True)
+class Robot:
+    """Size and motion limits of a planar mobile robot (all SI units).
+
+    Parameters
+    ----------
+    radius : float
+        Footprint radius (m), used to inflate obstacles.
+    v_max : float
+        Maximum forward speed (m/s).
+    a_max : float
+        Maximum tangential acceleration and deceleration (m/s^2).
+    j_max : float
+        Maximum tangential jerk (m/s^3).
+    a_lat_max : float
+        Maximum lateral acceleration ``|kappa| v^2`` (m/s^2).
+    omega_max : float
+        Maximum yaw rate ``|kappa| v`` (rad/s).
+    track_width : float or None
+        Distance between the drive wheels of a differential drive (m); give it together
+        with ``wheel_v_max`` or leave both ``None``.
+    wheel_v_max : float or None
+        Maximum speed of either wheel (m/s).
+
+    Raises
+    ------
+    InvalidInputError
+        A limit is not a finite number > 0, or only one of ``track_width`` and
+        ``wheel_v_max`` is given.
+    """
+
+    radius: float = 0.165
+    v_max: float = 0.5
+    a_max: float = 0.5
+    j_max: float = 2.0
+    a_lat_max: float = 0.5
+    omega_max: float = 1.5
+    track_width: float | None = 0.28
+    wheel_v_max: float | None = 0.6
+
+    def __post_init__(self) -> None:
+        for name in ("radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max"):
+            object.__setattr__(self, name, _positive(name, getattr(self, name)))
+        if (self.track_width is None) != (self.wheel_v_max is None):
+            raise InvalidInputError(
+                "track_width and wheel_v_max must be given together or both be None, got "
+                f"track_width={self.track_width!r}, wheel_v_max={self.wheel_v_max!r}"
+            )
+        if self.track_width is not None:
+            object.__setattr__(self, "track_width", _positive("track_width", self.track_width))
+            object.__setattr__(self, "wheel_v_max", _positive("wheel_v_max", self.wheel_v_max))
+
+    @property
+    def width(self) -> float:
+        """Footprint diameter ``2 * radius`` (m)."""
+        return 2.0 * self.radius
+
+    def speed_cap(self, kappa: np.ndarray | float) -> np.ndarray | float:
+        """Curvature-dependent speed limit (m/s).
+
+        ``min(v_max, sqrt(a_lat_max/|k|), omega_max/|k|, wheel_v_max/(1 + |k| track_width/2))``
+        (the wheel term only when ``track_width`` is set). ``k = 0`` gives ``v_max``; an
+        infinite or NaN curvature gives 0.
+
+        Parameters
+        ----------
+        kappa : float or array_like, any shape
+            Signed curvature (1/m).
+
+        Returns
+        -------
+        float or ndarray, shape of ``kappa``
+        """
+        k = np.abs(np.asarray(kappa, dtype=float))
+        k = np.where(np.isnan(k), np.inf, k)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cap = np.minimum(self.v_max, np.sqrt(self.a_lat_max / k))
+            cap = np.minimum(cap, self.omega_max / k)
+            if self.track_width is not None:
+                cap = np.minimum(cap, self.wheel_v_max / (1.0 + 0.5 * self.track_width * k))
+        cap = np.where(np.isinf(k), 0.0, cap)
+        if cap.ndim == 0:
+            return float(cap)
+        return cap
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
+        return asdict(self)
+
+
+def _positive(name: str, value: Any) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"Robot.{name} must be a number, got {value!r}") from None
+    if not math.isfinite(x) or x <= 0.0:
+        raise InvalidInputError(f"Robot.{name} must be finite and > 0, got {value!r}")
+    return x

@@ -1,0 +1,919 @@
+"""The proposed smoother: a corridor-constrained B-spline fit, certified collision-free.
+
+:class:`Smoother` fits a clamped B-spline ``C(u) = sum_i c_i B_i(u)`` (parameter ``u`` =
+arc length along the A* polyline) to the A* points ``p_r`` at their arc lengths ``u_r``:
+
+    minimise   sum_r |C(u_r) - p_r|^2  +  w * integral |C^(m)(u)|^2 du          (cell units)
+    subject to c_0 = start, c_{n-1} = goal,
+               c_i in the intersection of the corridor boxes of every span it touches,
+               optional: c_1 on the start-heading ray, c_{n-2} on the reverse goal ray,
+               optional: |kappa| <= kappa_max at dense samples (with a speed floor).
+
+The first term is the chapter's least-squares fidelity (equation (3)); the second is the
+knot-aware integrated squared ``m``-th derivative (exact Gram matrix of the derivative
+basis). Positions and parameters are divided by the grid resolution first, so the default
+weights work on every map.
+
+The corridor constraint uses the convex-hull property: span ``j`` lies in the convex hull
+of ``c_j .. c_{j+p}``; with all of them inside the span's box the whole continuous span is
+inside it. Knots are graded so that every box holds at least ``p`` spans (then no control
+point touches more than two consecutive boxes, which always intersect), so the bounds are
+plain variable bounds and the QP is feasible by construction. The convex problem is solved
+as a sparse banded QP by ``casadi.conic`` (osqp by default), the curvature-bounded one by
+IPOPT warm-started from the QP. Solvers are built once per padded size and cached.
+
+Every result is verified (:class:`Certificate`) before it is returned: control points in
+their boxes, exact endpoints, dense-sample clearance against the raw map, no cusp, and the
+curvature bound. On failure the knots are refined; when that is exhausted
+:class:`~trajopt.errors.SmoothingError` is raised with the solver statistics.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from trajopt import _qp
+from trajopt.bspline import BSplineCurve
+from trajopt.corridor import Corridor
+from trajopt.curve import ParametricCurve
+from trajopt.errors import InvalidInputError, SmoothingError
+
+__all__ = ["Smoother", "SmoothPath", "Certificate"]
+
+logger = logging.getLogger(__name__)
+
+QPSolver = Literal["osqp", "piqp", "ipopt"]
+_QP_SOLVERS = ("osqp", "piqp", "ipopt")
+
+
+# ----------------------------------------------------------------------- values
+@dataclass(frozen=True, slots=True)
+class Certificate:
+    """Evidence that a smoothed curve keeps every guarantee.
+
+    Attributes
+    ----------
+    span_box : ndarray of int, shape (n_spans,)
+        Corridor box holding each span's control points.
+    control_points_in_boxes : bool
+        Every span's control points lie in its box (exact comparison).
+    endpoint_error_m : float
+        ``max(|C(u0) - start|, |C(u1) - goal|)`` (m).
+    radius_m : float or None
+        Clearance that was checked (m).
+    min_clearance_m : float or None
+        Smallest distance from a dense sample of the curve to an occupied square of the raw
+        map (outside the map counts as occupied); exact below ``radius_m + 2`` cells,
+        otherwise reported as that search window. ``None`` without a raw map.
+    n_samples : int
+        Number of dense samples (spacing <= resolution / 8 along ``u``).
+    kappa_max_sampled : float
+        Largest ``|curvature|`` on the dense samples (1/m).
+    kappa_bound : float or None
+        The requested bound (1/m).
+    min_speed_ratio : float
+        Smallest ``|C'(u)|`` over the samples divided by the mean (1 = uniform speed).
+    max_heading_step_rad : float
+        Largest heading change between consecutive samples (rad).
+    ok : bool
+        All checks passed.
+    failures : tuple of str
+        Names of the failed checks.
+    """
+
+    span_box: np.ndarray
+    control_points_in_boxes: bool
+    endpoint_error_m: float
+    radius_m: float | None
+    min_clearance_m: float | None
+    n_samples: int
+    kappa_max_sampled: float
+    kappa_bound: float | None
+    min_speed_ratio: float
+    max_heading_step_rad: float
+    ok: bool
+    failures: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        sb = np.array(self.span_box, dtype=np.int64)
+        sb.flags.writeable = False
+        object.__setattr__(self, "span_box", sb)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SmoothPath(ParametricCurve):
+    """A certified smooth path: a :class:`~trajopt.bspline.BSplineCurve` plus evidence.
+
+    The :class:`~trajopt.curve.ParametricCurve` interface (``__call__(u, nu)``, ``heading``,
+    ``curvature``, ``length``, ``u_at_s``, ``sample``) delegates to :attr:`curve`; ``u`` is
+    in metres (arc length of the A* polyline) and positions are world metres.
+
+    Attributes
+    ----------
+    curve : BSplineCurve
+        The clamped B-spline in world coordinates.
+    stats : dict
+        Solver statistics: ``status``, ``success``, ``solver``, ``iterations``,
+        ``solve_time_s`` (solver calls), ``build_time_s`` (solvers built in this call),
+        ``total_time_s``, ``cost``, ``attempts``, ``n_control_points``, ``padded_size``.
+    certificate : Certificate
+    """
+
+    curve: BSplineCurve
+    stats: dict[str, Any] = field(default_factory=dict)
+    certificate: Certificate | None = None
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        return self.curve.domain
+
+    def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        return self.curve(u, nu)
+
+    def breakpoints(self) -> np.ndarray:
+        return self.curve.breakpoints()
+
+    def _arc_table(self):
+        return self.curve._arc_table()
+
+    @property
+    def control_points(self) -> np.ndarray:
+        """Control points, shape (n, 2) (m, read-only)."""
+        return self.curve.c
+
+    @property
+    def knots(self) -> np.ndarray:
+        """Knot vector, shape (n + k + 1,) (m, read-only)."""
+        return self.curve.t
+
+    @property
+    def degree(self) -> int:
+        return self.curve.k
+
+
+# --------------------------------------------------------------------- smoother
+@dataclass(frozen=True, slots=True)
+class Smoother:
+    """Corridor-constrained B-spline smoother (options validated on construction).
+
+    Parameters
+    ----------
+    degree : int, optional
+        Spline degree, 3 to 5. Default 3 (C2 curve: continuous curvature).
+    smoothness_weight : float, optional
+        ``w`` of the integrated squared derivative, in cell units (>= 0). Default 50.
+    smoothness_order : int, optional
+        Derivative order ``m`` of the smoothness term, 1 .. degree - 1. Default 2.
+    span_cells : float, optional
+        Longest knot span in cells (the grading shortens spans near box transitions).
+        Default 4.
+    kappa_max : float or None, optional
+        Curvature bound (1/m); ``None`` (default) for the QP only.
+    kappa_margin : float, optional
+        The bound imposed at the collocation samples is ``kappa_margin * kappa_max`` (0, 1]
+        so that it also holds between them. Default 0.9.
+    speed_floor : float, optional
+        With a curvature bound, ``|C'(u)| >= speed_floor`` at the samples (cells per cell of
+        ``u``; 1 is the A* polyline's speed). Prevents cusps. Default 0.2.
+    qp_solver : {"osqp", "piqp", "ipopt"}, optional
+        Solver of the convex problem. Default "osqp".
+    time_budget_s : float, optional
+        Wall-time budget per :meth:`fit` call (s); exceeded -> ``SmoothingError``.
+        Default 5 (the first call of a new size also builds its solvers).
+    max_attempts : int, optional
+        Knot refinements (span length halved each time) before giving up. Default 3.
+    samples_per_cell : int, optional
+        Certificate sampling density along ``u`` (samples per cell). Default 8.
+    verbose : bool, optional
+        Let the solvers print. Default False.
+    """
+
+    degree: int = 3
+    smoothness_weight: float = 50.0
+    smoothness_order: int = 2
+    span_cells: float = 4.0
+    kappa_max: float | None = None
+    kappa_margin: float = 0.9
+    speed_floor: float = 0.2
+    qp_solver: QPSolver = "osqp"
+    time_budget_s: float = 5.0
+    max_attempts: int = 3
+    samples_per_cell: int = 8
+    verbose: bool = False
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.degree, (int, np.integer)) or not 3 <= self.degree <= 5:
+            raise InvalidInputError(f"degree must be an integer in 3..5, got {self.degree!r}")
+        _check_float("smoothness_weight", self.smoothness_weight, lo=0.0)
+        if (
+            not isinstance(self.smoothness_order, (int, np.integer))
+            or not 1 <= self.smoothness_order <= self.degree - 1
+        ):
+            raise InvalidInputError(
+                f"smoothness_order must be an integer in 1..degree-1 = 1..{self.degree - 1}, "
+                f"got {self.smoothness_order!r}"
+            )
+        _check_float("span_cells", self.span_cells, lo=0.5)
+        if self.kappa_max is not None:
+            _check_float("kappa_max", self.kappa_max, lo=0.0, strict=True)
+        _check_float("kappa_margin", self.kappa_margin, lo=0.0, strict=True)
+        if self.kappa_margin > 1:
+            raise InvalidInputError(f"kappa_margin must be in (0, 1], got {self.kappa_margin!r}")
+        _check_float("speed_floor", self.speed_floor, lo=0.0)
+        if self.qp_solver not in _QP_SOLVERS:
+            raise InvalidInputError(
+                f"qp_solver must be one of {_QP_SOLVERS}, got {self.qp_solver!r}"
+            )
+        _check_float("time_budget_s", self.time_budget_s, lo=0.0, strict=True)
+        if not isinstance(self.max_attempts, (int, np.integer)) or self.max_attempts < 1:
+            raise InvalidInputError(f"max_attempts must be an integer >= 1, got {self.max_attempts!r}")
+        if not isinstance(self.samples_per_cell, (int, np.integer)) or self.samples_per_cell < 2:
+            raise InvalidInputError(
+                f"samples_per_cell must be an integer >= 2, got {self.samples_per_cell!r}"
+            )
+
+    # ----------------------------------------------------------------- public
+    def fit(
+        self,
+        grid_path_or_points: Any,
+        corridor: Corridor,
+        *,
+        raw_grid: Any = None,
+        radius: float | None = None,
+        start: np.ndarray | tuple[float, float] | None = None,
+        goal: np.ndarray | tuple[float, float] | None = None,
+        start_heading: float | None = None,
+        goal_heading: float | None = None,
+    ) -> SmoothPath:
+        """Fit a certified smooth path inside ``corridor``.
+
+        Parameters
+        ----------
+        grid_path_or_points : astar.GridPath or array_like, shape (n, 2)
+            The A* path (a GridPath or an *integer* array of cells ``(ix, iy)``: the cell
+            centres are the fidelity targets) or float target points in world metres, one
+            per path cell of ``corridor`` (``None``: the corridor's path).
+        corridor : Corridor
+            From :func:`~trajopt.corridor.build_corridor` on the same path.
+        raw_grid : astar.OccupancyGrid, optional
+            The raw (not inflated) map; when given, the certificate checks the clearance by
+            dense sampling (point-to-square distance, outside the map counts as occupied).
+        radius : float, optional
+            Clearance to certify (m); default ``corridor.radius``.
+        start, goal : array_like, shape (2,), optional
+            Exact end points (m); default the first and last path cell centres. Each must lie
+            in its end box.
+        start_heading, goal_heading : float, optional
+            Exact tangent directions (rad) at the ends.
+
+        Returns
+        -------
+        SmoothPath
+
+        Raises
+        ------
+        InvalidInputError
+            Malformed input (message names the field, value and rule).
+        SmoothingError
+            No curve meeting every guarantee within ``max_attempts`` refinements or the time
+            budget; ``.stats`` holds the statistics of every attempt.
+        """
+        t_call = time.perf_counter()
+        if not isinstance(corridor, Corridor):
+            raise InvalidInputError(f"corridor must be a Corridor, got {type(corridor).__name__}")
+        res = corridor.resolution
+        origin = np.asarray(corridor.origin, dtype=float)
+        targets = _targets(grid_path_or_points, corridor)
+        rad = corridor.radius if radius is None else float(radius)
+        if radius is not None and not (math.isfinite(rad) and rad >= 0):
+            raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
+        if raw_grid is not None and rad is None:
+            raise InvalidInputError("radius is required (or corridor.radius) with raw_grid")
+        p0 = _point("start", start, targets[0])
+        p1 = _point("goal", goal, targets[-1])
+        b0, b1 = corridor.boxes[0], corridor.boxes[-1]
+        if not b0.contains(p0):
+            raise InvalidInputError(f"start {p0.tolist()} m must lie in the first box {b0}")
+        if not b1.contains(p1):
+            raise InvalidInputError(f"goal {p1.tolist()} m must lie in the last box {b1}")
+        hs = _heading("start_heading", start_heading)
+        hg = _heading("goal_heading", goal_heading)
+        if corridor.length_m <= 0:
+            raise InvalidInputError("the corridor's path has zero length (start == goal)")
+
+        prob = _Problem(
+            targets=(targets - origin) / res,
+            u=corridor.path_s / res,
+            lo=(corridor.lower - origin) / res,
+            hi=(corridor.upper - origin) / res,
+            trans=corridor.transitions_m / res,
+            overlap=(corridor.overlap_end_m - corridor.overlap_start_m) / res,
+            start=(p0 - origin) / res,
+            goal=(p1 - origin) / res,
+            start_dir=None if hs is None else np.array([math.cos(hs), math.sin(hs)]),
+            goal_dir=None if hg is None else np.array([math.cos(hg), math.sin(hg)]),
+            res=res,
+        )
+        attempts: list[dict[str, Any]] = []
+        h = float(self.span_cells)
+        for attempt in range(int(self.max_attempts)):
+            remaining = self.time_budget_s - (time.perf_counter() - t_call)
+            if remaining <= 0:
+                break
+            st: dict[str, Any] = {"attempt": attempt + 1, "span_cells": h}
+            attempts.append(st)
+            try:
+                c_cells, t_cells, span_box, st2 = self._solve(prob, h, remaining)
+            except _AttemptFailed as exc:
+                st.update(exc.stats)
+                st["failure"] = str(exc)
+                h = max(0.5, h / 2)
+                continue
+            st.update(st2)
+            c = origin + res * c_cells
+            c[0] = p0
+            c[-1] = p1
+            curve = BSplineCurve(t_cells * res, c, self.degree)
+            cert = certify(
+                curve,
+                corridor,
+                span_box,
+                start=p0,
+                goal=p1,
+                raw_grid=raw_grid,
+                radius=rad,
+                kappa_bound=self.kappa_max,
+                samples_per_cell=self.samples_per_cell,
+            )
+            st["certificate_ok"] = cert.ok
+            if cert.ok:
+                stats = _summary(attempts, time.perf_counter() - t_call, success=True)
+                return SmoothPath(curve=curve, stats=stats, certificate=cert)
+            st["failure"] = "certificate: " + ", ".join(cert.failures)
+            logger.debug("attempt %d failed its certificate: %s", attempt + 1, cert.failures)
+            h = max(0.5, h / 2)
+        stats = _summary(attempts, time.perf_counter() - t_call, success=False)
+        last = attempts[-1].get("failure", "time budget exhausted") if attempts else "no attempt"
+        raise SmoothingError(
+            f"no certified curve after {len(attempts)} attempt(s) "
+            f"(time_budget_s={self.time_budget_s}): {last}",
+            stats,
+        )
+
+    def fit_free(
+        self, points: np.ndarray, u: np.ndarray, knots: np.ndarray
+    ) -> BSplineCurve:
+        """The same objective with *no* constraints (no corridor, free ends, no bound).
+
+        A reference and test hook: with ``smoothness_weight = 0`` it is the least-squares
+        spline of ``points`` at parameters ``u`` on ``knots`` (as
+        :func:`scipy.interpolate.make_lsq_spline`). No guarantee of any kind.
+
+        Parameters
+        ----------
+        points : array_like, shape (N, 2)
+        u : array_like, shape (N,)
+            Non-decreasing parameters inside the knot domain.
+        knots : array_like, shape (n + k + 1,)
+            Clamped knots.
+        """
+        pts = np.asarray(points, dtype=float)
+        uu = np.asarray(u, dtype=float)
+        t = np.asarray(knots, dtype=float)
+        p = self.degree
+        n = len(t) - p - 1
+        if pts.ndim != 2 or pts.shape[1] != 2 or uu.shape != (len(pts),):
+            raise InvalidInputError(
+                f"points must have shape (N, 2) and u shape (N,), got {pts.shape} and {uu.shape}"
+            )
+        if n < p + 1:
+            raise InvalidInputError(f"need at least {2 * p + 2} knots for degree {p}, got {len(t)}")
+        band, g, _ = _objective(pts, uu, t, p, n, self.smoothness_weight, self.smoothness_order)
+        nb = _qp.bucket_size(n)
+        lbx = np.full(2 * nb, -np.inf)
+        ubx = np.full(2 * nb, np.inf)
+        z, info = self._solve_qp(band, g, n, nb, lbx, ubx, None, None, None, 60.0)
+        if not info["success"]:
+            raise SmoothingError(f"unconstrained fit failed: {info['status']}", info)
+        return BSplineCurve(t, np.column_stack([z[:n], z[nb : nb + n]]), p)
+
+    # ---------------------------------------------------------------- internal
+    def _solve(self, prob: _Problem, h: float, remaining: float):
+        p = self.degree
+        t, span_box = graded_knots(prob.u[-1], prob.trans, prob.overlap, p, h)
+        n = len(t) - p - 1
+        nb = _qp.bucket_size(n)
+        # control-point bounds: intersection of the boxes of the spans each one touches
+        lo = np.full((n, 2), -np.inf)
+        hi = np.full((n, 2), np.inf)
+        for off in range(p + 1):
+            idx = np.arange(len(span_box)) + off
+            lo[idx] = np.maximum(lo[idx], prob.lo[span_box])
+            hi[idx] = np.minimum(hi[idx], prob.hi[span_box])
+        if np.any(lo > hi):
+            raise _AttemptFailed("empty control-point bound (boxes do not intersect)", {})
+        lo[0] = hi[0] = prob.start
+        lo[-1] = hi[-1] = prob.goal
+        band, g, const = _objective(
+            prob.targets, prob.u, t, p, n, self.smoothness_weight, self.smoothness_order
+        )
+        band[0] += 1e-9 * (1.0 + band[0].max())  # keeps the Hessian definite
+        lbx = np.zeros(2 * nb)
+        ubx = np.zeros(2 * nb)
+        lbx[:n], lbx[nb : nb + n] = lo[:, 0], lo[:, 1]
+        ubx[:n], ubx[nb : nb + n] = hi[:, 0], hi[:, 1]
+        amat, lba, uba = _heading_rows(prob, n, nb)
+        x0 = np.zeros(2 * nb)
+        # warm start: the targets projected to the bounds, by parameter
+        greville = np.array([t[i + 1 : i + p + 1].mean() for i in range(n)])
+        for d in range(2):
+            guess = np.interp(greville, prob.u, prob.targets[:, d])
+            x0[d * nb : d * nb + n] = np.clip(guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n])
+        z, info = self._solve_qp(band, g, n, nb, lbx, ubx, amat, lba, uba, remaining, x0=x0)
+        stats = {
+            "n_control_points": n,
+            "padded_size": nb,
+            "qp": info,
+            "solver": info["solver"],
+            "status": info["status"],
+            "iterations": info["iterations"],
+            "solve_time_s": info["solve_time_s"],
+            "build_time_s": info["build_time_s"],
+        }
+        if not info["success"]:
+            raise _AttemptFailed(f"QP solver {info['solver']}: {info['status']}", stats)
+        z = np.clip(z, lbx, ubx)
+        if self.kappa_max is not None:
+            kmax_cells = self.kappa_max * prob_res_scale(prob)
+            z, cinfo = self._solve_curvature(
+                prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z, kmax_cells, remaining
+            )
+            stats["nlp"] = cinfo
+            stats["solver"] = info["solver"] + "+ipopt"
+            stats["status"] = cinfo["status"]
+            stats["iterations"] = info["iterations"] + cinfo["iterations"]
+            stats["solve_time_s"] = info["solve_time_s"] + cinfo["solve_time_s"]
+            stats["build_time_s"] = info["build_time_s"] + cinfo["build_time_s"]
+            if not cinfo["success"]:
+                raise _AttemptFailed(f"IPOPT (curvature bound): {cinfo['status']}", stats)
+            z = np.clip(z, lbx, ubx)
+        c = np.column_stack([z[:n], z[nb : nb + n]])
+        _project_heading(c, prob, lo, hi)
+        zx, zy = c[:, 0], c[:, 1]
+        cost = 0.0
+        for d in range(p + 1):
+            w = 0.5 if d == 0 else 1.0
+            cost += w * float(band[d, : n - d] @ (zx[: n - d] * zx[d:] + zy[: n - d] * zy[d:]))
+        cost += float(g[:n] @ zx + g[nb : nb + n] @ zy) + const
+        stats["cost"] = cost
+        return c, t, span_box, stats
+
+    def _solve_qp(self, band, g, n, nb, lbx, ubx, amat, lba, uba, remaining, x0=None):
+        p = self.degree
+        full = np.zeros((p + 1, nb))
+        full[:, :n] = band[:, :n]
+        full[0, n:] = 1.0  # padded variables: fixed at 0 by their bounds
+        lbx = lbx.copy()
+        ubx = ubx.copy()
+        lbx[n:nb] = ubx[n:nb] = 0.0
+        lbx[nb + n :] = ubx[nb + n :] = 0.0
+        gg = np.zeros(2 * nb)
+        gg[:n], gg[nb : nb + n] = g[:n], g[nb : nb + n]
+        if amat is None:
+            amat = np.zeros((4, 2 * nb))
+            lba = np.full(4, -np.inf)
+            uba = np.full(4, np.inf)
+        if x0 is None:
+            x0 = np.zeros(2 * nb)
+        solver_name = self.qp_solver
+        tb = time.perf_counter()
+        built = _is_cached(solver_name, nb, p, self.verbose)
+        if solver_name == "ipopt":
+            solver = _qp.qp_ipopt(nb, p, self.verbose)
+        else:
+            solver = _qp.qp_solver(nb, p, solver_name, self.verbose)
+        build = 0.0 if built else time.perf_counter() - tb
+        ts = time.perf_counter()
+        if solver_name == "ipopt":
+            par = np.concatenate([full.ravel(), gg, amat.ravel(order="F")])
+            out = solver(x0=x0, p=par, lbx=lbx, ubx=ubx, lbg=lba, ubg=uba)
+        else:
+            import casadi as ca
+
+            sp_h, _, _, _ = _qp.qp_layout(nb, p)
+            hval = ca.DM(sp_h, _qp.h_nonzeros(full, nb, p))
+            out = solver(h=hval, g=gg, a=amat, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+        solve = time.perf_counter() - ts
+        st = solver.stats()
+        z = np.asarray(out["x"], dtype=float).ravel()
+        success = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
+        info = {
+            "solver": solver_name,
+            "success": success,
+            "status": str(st.get("return_status", st.get("unified_return_status", ""))),
+            "iterations": int(st.get("iter_count", st.get("iter", 0)) or 0),
+            "solve_time_s": solve,
+            "build_time_s": build,
+        }
+        return z, info
+
+    def _solve_curvature(self, prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z0, kmax, remaining):
+        p = self.degree
+        ms = _qp.CURV_SAMPLES
+        ns_b = nb - p
+        ns = n - p
+        # basis derivative values at CURV_SAMPLES points per span (ends included)
+        fr = np.linspace(0.0, 1.0, ms)
+        a = t[p : p + ns]
+        b = t[p + 1 : p + ns + 1]
+        span = np.repeat(np.arange(ns), ms)
+        uu = (a[:, None] + (b - a)[:, None] * fr[None, :]).ravel()
+        B1 = np.zeros((ns_b * ms, p + 1))
+        B2 = np.zeros((ns_b * ms, p + 1))
+        B1[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 1)
+        B2[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 2)
+        full = np.zeros((p + 1, nb))
+        full[:, :n] = band[:, :n]
+        full[0, n:] = 1.0
+        gg = np.zeros(2 * nb)
+        gg[:n], gg[nb : nb + n] = g[:n], g[nb : nb + n]
+        lbx = lbx.copy()
+        ubx = ubx.copy()
+        lbx[n:nb] = ubx[n:nb] = 0.0
+        lbx[nb + n :] = ubx[nb + n :] = 0.0
+        par = np.concatenate(
+            [
+                full.ravel(),
+                gg,
+                amat.ravel(order="F"),
+                B1.ravel(order="F"),
+                B2.ravel(order="F"),
+                [(self.kappa_margin * kmax) ** 2],
+            ]
+        )
+        S = ns_b * ms
+        lbg = np.concatenate([lba, np.full(S, -np.inf), np.full(S, -np.inf)])
+        ubg = np.concatenate([uba, np.zeros(S), np.full(S, np.inf)])
+        lbg[4 + S : 4 + S + ns * ms] = self.speed_floor**2
+        tb = time.perf_counter()
+        built = _is_cached("curv", nb, p, self.verbose)
+        solver = _qp.curvature_nlp(nb, p, self.verbose)
+        build = 0.0 if built else time.perf_counter() - tb
+        left = max(0.05, remaining - build - 0.02)
+        ts = time.perf_counter()
+        out = solver(x0=z0, p=par, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        solve = time.perf_counter() - ts
+        st = solver.stats()
+        z = np.asarray(out["x"], dtype=float).ravel()
+        success = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
+        if solve > left:
+            success = False
+        info = {
+            "solver": "ipopt",
+            "success": success,
+            "status": str(st.get("return_status", "")) + ("" if solve <= left else " (over budget)"),
+            "iterations": int(st.get("iter_count", 0) or 0),
+            "solve_time_s": solve,
+            "build_time_s": build,
+        }
+        return z, info
+
+
+def prob_res_scale(prob: _Problem) -> float:
+    """Factor turning 1/m into 1/cell (the problem is in cell units)."""
+    return prob.res
+
+
+# ----------------------------------------------------------------- internals
+class _AttemptFailed(Exception):
+    def __init__(self, message: str, stats: dict[str, Any]) -> None:
+        super().__init__(message)
+        self.stats = stats
+
+
+@dataclass(slots=True)
+class _Problem:
+    targets: np.ndarray
+    u: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    trans: np.ndarray
+    overlap: np.ndarray
+    start: np.ndarray
+    goal: np.ndarray
+    start_dir: np.ndarray | None
+    goal_dir: np.ndarray | None
+    res: float = 1.0
+
+
+_BUILT: set[tuple] = set()
+
+
+def _is_cached(kind: str, nb: int, p: int, verbose: bool) -> bool:
+    key = (kind, nb, p, verbose)
+    if key in _BUILT:
+        return True
+    _BUILT.add(key)
+    return False
+
+
+def _check_float(name: str, value: Any, *, lo: float, strict: bool = False) -> None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v) or v < lo or (strict and v == lo):
+        rule = f"> {lo}" if strict else f">= {lo}"
+        raise InvalidInputError(f"{name} must be finite and {rule}, got {value!r}")
+
+
+def _point(name: str, value: Any, default: np.ndarray) -> np.ndarray:
+    if value is None:
+        return np.array(default, dtype=float)
+    p = np.asarray(value, dtype=float)
+    if p.shape != (2,) or not np.all(np.isfinite(p)):
+        raise InvalidInputError(f"{name} must be a finite (x, y) in metres, got {value!r}")
+    return p.copy()
+
+
+def _heading(name: str, value: Any) -> float | None:
+    if value is None:
+        return None
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be an angle in radians, got {value!r}") from None
+    if not math.isfinite(v):
+        raise InvalidInputError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _targets(src: Any, corridor: Corridor) -> np.ndarray:
+    if src is None:
+        return np.array(corridor.path_points)
+    cells = getattr(src, "cells", None)
+    if cells is None and np.issubdtype(np.asarray(src).dtype, np.integer):
+        cells = src  # an integer array is a list of cells (ix, iy)
+    if cells is not None:
+        c = np.asarray(cells, dtype=float)
+        pts = np.asarray(corridor.origin) + (c + 0.5) * corridor.resolution
+    else:
+        pts = np.asarray(src, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(np.isfinite(pts)):
+        raise InvalidInputError(f"grid_path_or_points must be finite with shape (n, 2), got {pts.shape}")
+    if len(pts) != len(corridor.path_points):
+        raise InvalidInputError(
+            f"grid_path_or_points has {len(pts)} points but the corridor was built on a path "
+            f"of {len(corridor.path_points)} cells; they must match"
+        )
+    return pts
+
+
+def graded_knots(
+    length: float, trans: np.ndarray, overlap: np.ndarray, p: int, h: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Clamped knots on ``[0, length]`` (cells) graded towards the box transitions.
+
+    Every transition is a knot; inside box ``k`` the span length at ``x`` is
+    ``min(h, d + 0.5 * distance to the nearest transition)`` with
+    ``d = clip(overlap / (p - 1), 0.5, h)`` of that transition, and each box gets at least
+    ``p`` spans. Returns the knots (shape ``(n + p + 1,)``) and the box of every span.
+    """
+    edges = np.concatenate([[0.0], trans, [length]])
+    d_tr = np.clip(overlap / max(p - 1, 1), 0.5, h)
+    bps: list[np.ndarray] = []
+    boxes: list[np.ndarray] = []
+    for k in range(len(edges) - 1):
+        a, b = edges[k], edges[k + 1]
+        dl = d_tr[k - 1] if k > 0 else None
+        dr = d_tr[k] if k < len(trans) else None
+
+        def step(x: float, a=a, b=b, dl=dl, dr=dr) -> float:
+            s = h
+            if dl is not None:
+                s = min(s, dl + 0.5 * (x - a))
+            if dr is not None:
+                s = min(s, dr + 0.5 * (b - x))
+            return max(s, 1e-3)
+
+        pos = [a]
+        x = a
+        while True:
+            s = step(x)
+            rest = b - x
+            if rest <= s * 1.25:
+                break
+            if rest <= 2 * s:
+                x = x + 0.5 * rest
+                pos.append(x)
+                break
+            x += s
+            pos.append(x)
+        pos.append(b)
+        arr = np.array(pos)
+        if len(arr) - 1 < p:
+            arr = np.linspace(a, b, p + 1)
+        bps.append(arr[:-1])
+        boxes.append(np.full(len(arr) - 1, k))
+    bp = np.concatenate(bps + [[length]])
+    t = np.concatenate([np.full(p, 0.0), bp, np.full(p, length)])
+    return t, np.concatenate(boxes).astype(np.int64)
+
+
+def _objective(pts, u, t, p, n, weight, order):
+    """Upper band of ``H`` (one coordinate block), ``g`` (2n: x then y, padded layout
+    resolved later) and the constant, for ``1/2 z'Hz + g'z + const`` =
+    ``sum |C(u_r) - p_r|^2 + weight * integral |C^(order)|^2``."""
+    span = _qp.find_spans(t, p, n, u)
+    vals = _qp.basis_derivs(t, p, span, u, 0)
+    band = 2.0 * _qp.band_gram(span, vals, np.ones(len(u)), n)
+    if weight > 0:
+        band += 2.0 * weight * _qp.smoothness_band(t, p, n, order)
+    rhs = _qp.band_rhs(span, vals, pts, n)
+    g = np.zeros(2 * n)
+    nb = _qp.bucket_size(n)
+    g = np.zeros(2 * nb)
+    g[:n] = -2.0 * rhs[:, 0]
+    g[nb : nb + n] = -2.0 * rhs[:, 1]
+    const = float(np.sum(pts * pts))
+    return band, g, const
+
+
+def _heading_rows(prob: _Problem, n: int, nb: int):
+    amat = np.zeros((4, 2 * nb))
+    lba = np.full(4, -np.inf)
+    uba = np.full(4, np.inf)
+    eps = 1e-3  # cells: keeps c_1 != c_0 so the end heading is defined
+    if prob.start_dir is not None:
+        dx, dy = prob.start_dir
+        # cross(d, c1 - c0) = 0 ; dot(d, c1 - c0) >= eps
+        amat[0, 1], amat[0, nb + 1] = -dy, dx
+        lba[0] = uba[0] = -dy * prob.start[0] + dx * prob.start[1]
+        amat[1, 1], amat[1, nb + 1] = dx, dy
+        lba[1] = dx * prob.start[0] + dy * prob.start[1] + eps
+    if prob.goal_dir is not None:
+        dx, dy = prob.goal_dir
+        j = n - 2
+        amat[2, j], amat[2, nb + j] = -dy, dx
+        lba[2] = uba[2] = -dy * prob.goal[0] + dx * prob.goal[1]
+        # dot(d, goal - c_{n-2}) >= eps
+        amat[3, j], amat[3, nb + j] = dx, dy
+        uba[3] = dx * prob.goal[0] + dy * prob.goal[1] - eps
+    return amat, lba, uba
+
+
+def _project_heading(c: np.ndarray, prob: _Problem, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Put ``c_1`` (``c_{n-2}``) exactly on the start (reversed goal) heading ray, inside
+    its bounds, at least ``1e-3`` cells from the end point when the bounds allow it."""
+    ends = []
+    if prob.start_dir is not None:
+        ends.append((1, prob.start, prob.start_dir))
+    if prob.goal_dir is not None:
+        ends.append((len(c) - 2, prob.goal, -prob.goal_dir))
+    for idx, end, d in ends:
+        a_lo, a_hi = 0.0, np.inf
+        for ax in range(2):
+            if abs(d[ax]) > 1e-15:
+                t1 = (lo[idx, ax] - end[ax]) / d[ax]
+                t2 = (hi[idx, ax] - end[ax]) / d[ax]
+                a_lo = max(a_lo, min(t1, t2))
+                a_hi = min(a_hi, max(t1, t2))
+        a = float(np.dot(c[idx] - end, d))
+        a = min(max(a, a_lo, min(1e-3, a_hi)), a_hi)
+        c[idx] = np.clip(end + a * d, lo[idx], hi[idx])
+
+
+def _summary(attempts: list[dict[str, Any]], total: float, *, success: bool) -> dict[str, Any]:
+    last = attempts[-1] if attempts else {}
+    return {
+        "success": success,
+        "status": last.get("status", "not run"),
+        "solver": last.get("solver", ""),
+        "iterations": last.get("iterations", 0),
+        "solve_time_s": float(sum(a.get("solve_time_s", 0.0) for a in attempts)),
+        "build_time_s": float(sum(a.get("build_time_s", 0.0) for a in attempts)),
+        "total_time_s": total,
+        "cost": last.get("cost", float("nan")),
+        "attempts": len(attempts),
+        "n_control_points": last.get("n_control_points", 0),
+        "padded_size": last.get("padded_size", 0),
+        "attempt_log": [dict(a) for a in attempts],
+    }
+
+
+# -------------------------------------------------------------------- certify
+def point_square_clearance(
+    points: np.ndarray, raw_grid: Any, window_m: float
+) -> np.ndarray:
+    """Distance (m) from each world point to the nearest occupied square of ``raw_grid``
+    (cells outside the grid count as occupied), searched within ``window_m``; points with
+    nothing occupied inside the window get ``window_m``.
+
+    Parameters
+    ----------
+    points : ndarray, shape (M, 2)
+    raw_grid : astar.OccupancyGrid
+    window_m : float
+    """
+    occ = np.asarray(raw_grid.occupied, dtype=bool)
+    res = float(raw_grid.resolution)
+    ox, oy = (float(v) for v in raw_grid.origin)
+    q = (np.asarray(points, dtype=float) - [ox, oy]) / res
+    w = int(math.ceil(window_m / res)) + 1
+    cx = np.floor(q[:, 0]).astype(np.int64)
+    cy = np.floor(q[:, 1]).astype(np.int64)
+    offs = np.arange(-w, w + 1)
+    gx = cx[:, None, None] + offs[None, None, :]
+    gy = cy[:, None, None] + offs[None, :, None]
+    gx, gy = np.broadcast_arrays(gx, gy)
+    ny, nx = occ.shape
+    inside = (gx >= 0) & (gx < nx) & (gy >= 0) & (gy < ny)
+    blocked = np.ones(gx.shape, dtype=bool)
+    blocked[inside] = occ[gy[inside], gx[inside]]
+    pi, yi, xi = np.nonzero(blocked)
+    sx = gx[pi, yi, xi]
+    sy = gy[pi, yi, xi]
+    dx = np.maximum(0.0, np.maximum(sx - q[pi, 0], q[pi, 0] - (sx + 1)))
+    dy = np.maximum(0.0, np.maximum(sy - q[pi, 1], q[pi, 1] - (sy + 1)))
+    dist = np.hypot(dx, dy) * res
+    out = np.full(len(q), float(window_m))
+    np.minimum.at(out, pi, dist)
+    return np.minimum(out, window_m)
+
+
+def certify(
+    curve: BSplineCurve,
+    corridor: Corridor,
+    span_box: np.ndarray,
+    *,
+    start: np.ndarray,
+    goal: np.ndarray,
+    raw_grid: Any = None,
+    radius: float | None = None,
+    kappa_bound: float | None = None,
+    samples_per_cell: int = 8,
+) -> Certificate:
+    """Check every guarantee of a smoothed curve (see :class:`Certificate`)."""
+    failures: list[str] = []
+    k = curve.k
+    c = curve.c
+    ns = len(c) - k
+    lo = corridor.lower[span_box]
+    hi = corridor.upper[span_box]
+    inside = True
+    for off in range(k + 1):
+        cp = c[off : off + ns]
+        inside &= bool(np.all((cp >= lo) & (cp <= hi)))
+    if not inside:
+        failures.append("control_points_in_boxes")
+    u0, u1 = curve.domain
+    ends = curve(np.array([u0, u1]))
+    end_err = float(max(np.hypot(*(ends[0] - start)), np.hypot(*(ends[1] - goal))))
+    if end_err > 1e-9:
+        failures.append("endpoints")
+    res = corridor.resolution
+    m = max(2, int(math.ceil((u1 - u0) / res * samples_per_cell)) + 1)
+    u = np.linspace(u0, u1, m)
+    xy = curve(u)
+    d1 = curve(u, 1)
+    d2 = curve(u, 2)
+    sp = np.hypot(d1[:, 0], d1[:, 1])
+    mean_sp = float(np.mean(sp)) if m else 0.0
+    min_ratio = float(sp.min() / mean_sp) if mean_sp > 0 else 0.0
+    cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kap = np.where(sp > 0, np.abs(cross) / sp**3, np.inf)
+    kmax_s = float(np.max(kap))
+    hd = np.arctan2(d1[:, 1], d1[:, 0])
+    step = np.abs(np.angle(np.exp(1j * np.diff(hd)))) if m > 1 else np.zeros(1)
+    max_step = float(step.max()) if step.size else 0.0
+    if min_ratio < 1e-3 or max_step > math.pi / 2:
+        failures.append("heading_continuity")
+    if kappa_bound is not None and not kmax_s <= kappa_bound * (1 + 1e-6):
+        failures.append("curvature_bound")
+    min_clear = None
+    if raw_grid is not None and radius is not None:
+        window = radius + 2 * float(raw_grid.resolution)
+        min_clear = float(point_square_clearance(xy, raw_grid, window).min())
+        if min_clear < radius - 1e-9:
+            failures.append("clearance")
+    return Certificate(
+        span_box=span_box,
+        control_points_in_boxes=inside,
+        endpoint_error_m=end_err,
+        radius_m=radius,
+        min_clearance_m=min_clear,
+        n_samples=m,
+        kappa_max_sampled=kmax_s,
+        kappa_bound=kappa_bound,
+        min_speed_ratio=min_ratio,
+        max_heading_step_rad=max_step,
+        ok=not failures,
+        failures=tuple(failures),
+    )

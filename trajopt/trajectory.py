@@ -1,0 +1,375 @@
+"""A timed trajectory along a planar curve: ``t -> (x, y, theta, v, omega, a, jerk, ...)``.
+
+The motion along arc length ``s(t)`` is a chain of constant-jerk phases (the pieces of the
+ruckig profiles and greedy steps made by :func:`trajopt.time_parameterize`). Each phase is
+stored as its start time and start state ``(s, v, a)`` plus its jerk, so sampling any
+number of times is a vectorised ``searchsorted`` and a cubic polynomial: no per-sample call
+into ruckig. Pose, heading and curvature then come from the curve at ``u = u_at_s(s)``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from trajopt.curve import ParametricCurve
+from trajopt.errors import InvalidInputError
+from trajopt.robot import Robot
+
+__all__ = ["Trajectory", "TrajectorySample", "SAMPLE_UNITS"]
+
+#: Unit of every sampled quantity.
+SAMPLE_UNITS: dict[str, str] = {
+    "t": "s",
+    "x": "m",
+    "y": "m",
+    "theta": "rad",
+    "v": "m/s",
+    "omega": "rad/s",
+    "a": "m/s^2",
+    "jerk": "m/s^3",
+    "a_lat": "m/s^2",
+    "kappa": "1/m",
+    "s": "m",
+    "v_left": "m/s",
+    "v_right": "m/s",
+}
+
+
+class TrajectorySample(NamedTuple):
+    """Samples of a :class:`Trajectory`; every array has the shape of the query times.
+
+    Attributes
+    ----------
+    t : time (s), clipped to ``[0, duration]``
+    x, y : position (m)
+    theta : heading from the curve's tangent, continuous and unwrapped (rad)
+    v : speed along the path ``ds/dt`` (m/s)
+    omega : yaw rate ``kappa * v`` (rad/s)
+    a : tangential acceleration (m/s^2)
+    jerk : tangential jerk (m/s^3)
+    a_lat : signed lateral acceleration ``kappa * v^2`` (m/s^2)
+    kappa : signed curvature (1/m)
+    s : arc length travelled (m)
+    v_left, v_right : wheel speeds ``v * (1 -+ kappa * track_width / 2)`` (m/s), or ``None``
+        when the robot has no ``track_width``
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    a: np.ndarray
+    jerk: np.ndarray
+    a_lat: np.ndarray
+    kappa: np.ndarray
+    s: np.ndarray
+    v_left: np.ndarray | None = None
+    v_right: np.ndarray | None = None
+
+    def as_dict(self) -> dict[str, np.ndarray]:
+        """The arrays by name (``v_left``/``v_right`` only when present)."""
+        return {k: v for k, v in self._asdict().items() if v is not None}
+
+
+def _readonly(x: Any) -> np.ndarray:
+    arr = np.array(x, dtype=float)
+    arr.flags.writeable = False
+    return arr
+
+
+@dataclass(frozen=True, slots=True)
+class Trajectory:
+    """A jerk-limited timed motion along a curve.
+
+    Built by :func:`trajopt.time_parameterize`; the constructor checks shapes only.
+
+    Parameters
+    ----------
+    path : ParametricCurve
+        The curve followed (e.g. the smoother's ``SmoothPath``).
+    robot : Robot
+        The limits the timing holds.
+    phase_t : array_like, shape (p,)
+        Start time of each constant-jerk phase (s); ``phase_t[0] == 0``, non-decreasing.
+    phase_s, phase_v, phase_a : array_like, shape (p,)
+        Arc length (m), speed (m/s) and acceleration (m/s^2) at the start of each phase.
+    phase_j : array_like, shape (p,)
+        Jerk during each phase (m/s^3).
+    duration : float
+        End time (s); the motion ends at ``s = path.length`` with speed ``v_end``.
+    v_start, v_end : float
+        Speeds at the start and at the end (m/s).
+    stats : dict
+        Per-stage wall times (s) and counts; the pipeline may add its own entries.
+    theta_grid_s, theta_grid : array_like, shape (g,)
+        A dense table of the unwrapped heading (rad) against arc length (m), the reference
+        that makes sampled headings continuous.
+    u_grid : array_like, shape (g,) or (0,)
+        Curve parameter at ``theta_grid_s``: a table that speeds up the arc-length lookup.
+    steps : object, optional
+        The pipeline's intermediate results (``trajopt.pipeline.PlanSteps``) when planned by
+        :func:`trajopt.plan`, else ``None``.
+    """
+
+    path: ParametricCurve
+    robot: Robot
+    phase_t: np.ndarray
+    phase_s: np.ndarray
+    phase_v: np.ndarray
+    phase_a: np.ndarray
+    phase_j: np.ndarray
+    duration: float
+    v_start: float
+    v_end: float
+    stats: dict[str, Any] = field(default_factory=dict)
+    theta_grid_s: np.ndarray = field(default_factory=lambda: _readonly([]))
+    theta_grid: np.ndarray = field(default_factory=lambda: _readonly([]))
+    u_grid: np.ndarray = field(default_factory=lambda: _readonly([]))
+    steps: Any = None
+
+    def __post_init__(self) -> None:
+        names = ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j")
+        arrays = [_readonly(getattr(self, n)) for n in names]
+        p = arrays[0].shape
+        for n, arr in zip(names, arrays, strict=True):
+            if arr.ndim != 1 or arr.shape != p or p[0] < 1:
+                raise InvalidInputError(
+                    f"{n} must have shape (p,) with p >= 1 like phase_t {p}, got {arr.shape}"
+                )
+            object.__setattr__(self, n, arr)
+        if not math.isfinite(self.duration) or self.duration < arrays[0][-1]:
+            raise InvalidInputError(
+                f"duration must be finite and >= the last phase start {arrays[0][-1]}, "
+                f"got {self.duration!r}"
+            )
+        object.__setattr__(self, "duration", float(self.duration))
+        gs, gt = _readonly(self.theta_grid_s), _readonly(self.theta_grid)
+        if gs.shape != gt.shape or gs.ndim != 1:
+            raise InvalidInputError(
+                f"theta_grid_s and theta_grid must have equal shapes (g,), got {gs.shape}, "
+                f"{gt.shape}"
+            )
+        object.__setattr__(self, "theta_grid_s", gs)
+        object.__setattr__(self, "theta_grid", gt)
+        ug = _readonly(self.u_grid)
+        if ug.shape[0] and ug.shape != gs.shape:
+            raise InvalidInputError(
+                f"u_grid must be empty or have the shape of theta_grid_s {gs.shape}, "
+                f"got {ug.shape}"
+            )
+        object.__setattr__(self, "u_grid", ug)
+
+    # ------------------------------------------------------------------ basic
+    @property
+    def length(self) -> float:
+        """Arc length of the path (m)."""
+        return float(self.path.length)
+
+    @property
+    def n_phases(self) -> int:
+        """Number of constant-jerk phases."""
+        return int(self.phase_t.shape[0])
+
+    def motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
+        """The motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
+
+        Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
+        ``(length, v_end, 0, 0)``.
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        k = np.searchsorted(self.phase_t, tt, side="right") - 1
+        k = np.clip(k, 0, self.phase_t.shape[0] - 1)
+        tau = tt - self.phase_t[k]
+        j = self.phase_j[k]
+        a0 = self.phase_a[k]
+        v0 = self.phase_v[k]
+        s = self.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
+        v = v0 + tau * (a0 + 0.5 * j * tau)
+        a = a0 + j * tau
+        end = tt >= self.duration
+        length = self.length
+        s = np.where(end, length, np.clip(s, 0.0, length))
+        v = np.where(end, self.v_end, np.where((v < 0.0) & (v > -1e-9), 0.0, v))
+        a = np.where(end, 0.0, a)
+        j = np.where(end, 0.0, j)
+        return s, v, a, j
+
+    def _u_at_s(self, s: np.ndarray) -> np.ndarray:
+        """Curve parameter at arc length ``s``: the dense ``u_grid`` table plus one Newton
+        step on ``path.s_at_u`` (falls back to ``path.u_at_s`` without a table)."""
+        path = self.path
+        if self.u_grid.shape[0] < 2:
+            return np.asarray(path.u_at_s(s))
+        u = np.interp(s, self.theta_grid_s, self.u_grid)
+        sp = np.asarray(path.speed(u))
+        err = np.asarray(path.s_at_u(u)) - s
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = np.where(sp > 0, err / sp, 0.0)
+        lo, hi = path.domain
+        return np.clip(u - step, lo, hi)
+
+    def sample(self, t: np.ndarray | float) -> TrajectorySample:
+        """Evaluate the trajectory at times ``t`` (vectorised).
+
+        Parameters
+        ----------
+        t : float or array_like, any shape
+            Times (s); clipped to ``[0, duration]``.
+
+        Returns
+        -------
+        TrajectorySample
+            Read-only arrays of the shape of ``t`` (see :class:`TrajectorySample`).
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        s, v, a, j = self.motion(tt)
+        path = self.path
+        u = self._u_at_s(s)
+        xy = np.asarray(path(u))
+        raw = np.asarray(path.heading(u))
+        kappa = np.asarray(path.curvature(u))
+        if self.theta_grid_s.shape[0] >= 2:
+            ref = np.interp(s, self.theta_grid_s, self.theta_grid)
+            theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
+        else:
+            theta = raw
+        omega = kappa * v
+        out: dict[str, Any] = dict(
+            t=tt,
+            x=xy[..., 0],
+            y=xy[..., 1],
+            theta=theta,
+            v=v,
+            omega=omega,
+            a=a,
+            jerk=j,
+            a_lat=omega * v,
+            kappa=kappa,
+            s=s,
+        )
+        if self.robot.track_width is not None:
+            half = 0.5 * self.robot.track_width
+            out["v_left"] = v - omega * half
+            out["v_right"] = v + omega * half
+        return TrajectorySample(**{k: _readonly(x) for k, x in out.items()})
+
+    def sample_uniform(self, dt: float) -> TrajectorySample:
+        """Samples every ``dt`` seconds from 0, plus the end time ``duration``.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), > 0.
+        """
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise InvalidInputError(f"dt must be a finite number > 0 s, got {dt!r}")
+        n = int(math.floor(self.duration / dt + 1e-9))
+        t = np.arange(n + 1) * dt
+        if t[-1] < self.duration - 1e-12:
+            t = np.append(t, self.duration)
+        else:
+            t[-1] = min(t[-1], self.duration)
+        return self.sample(t)
+
+    # ------------------------------------------------------------------ export
+    def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
+        """A JSON-ready description: units, robot, stats, the exact phases and samples.
+
+        Parameters
+        ----------
+        dt : float
+            Sample spacing (s) of the ``samples`` table.
+        """
+        smp = self.sample_uniform(dt).as_dict()
+        units = {k: u for k, u in SAMPLE_UNITS.items() if k in smp}
+        return {
+            "format": "trajopt.Trajectory",
+            "units": units,
+            "duration": self.duration,
+            "duration_unit": "s",
+            "length": self.length,
+            "length_unit": "m",
+            "v_start": self.v_start,
+            "v_end": self.v_end,
+            "robot": self.robot.to_dict(),
+            "stats": _jsonable(self.stats),
+            "phases": {
+                "units": {"t": "s", "s": "m", "v": "m/s", "a": "m/s^2", "jerk": "m/s^3"},
+                "t": self.phase_t.tolist(),
+                "s": self.phase_s.tolist(),
+                "v": self.phase_v.tolist(),
+                "a": self.phase_a.tolist(),
+                "jerk": self.phase_j.tolist(),
+            },
+            "samples": {k: np.asarray(x).tolist() for k, x in smp.items()},
+        }
+
+    def to_json(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
+        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path."""
+        text = json.dumps(self.to_dict(dt), indent=1)
+        return _atomic_write(Path(path), text)
+
+    def to_csv(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
+        """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
+
+        The header names each column with its unit, e.g. ``t [s]``, ``v [m/s]``.
+        """
+        smp = self.sample_uniform(dt).as_dict()
+        names = list(smp)
+        import io
+
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow([f"{n} [{SAMPLE_UNITS[n]}]" for n in names])
+        cols = np.column_stack([np.asarray(smp[n]) for n in names])
+        for row in cols:
+            w.writerow([repr(float(x)) for x in row])
+        return _atomic_write(Path(path), buf.getvalue())
+
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory(duration={self.duration:.4g} s, length={self.length:.4g} m, "
+            f"phases={self.n_phases})"
+        )
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, (str, int, float, bool)) or x is None:
+        return x
+    return repr(x)
+
+
+def _atomic_write(path: Path, text: str) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return path
