@@ -132,7 +132,7 @@ def peer(cases, n_ctrl_by_case):
     from scipy.interpolate import make_lsq_spline
 
     times, viol = [], 0
-    for (name, raw, infl, r, path), n in zip(cases, n_ctrl_by_case, strict=True):
+    for (_name, raw, infl, r, path), n in zip(cases, n_ctrl_by_case, strict=True):
         corr = build_corridor(infl, path, radius=r)
         n = min(n, len(corr.path_s) - 1)
         t = clamped_uniform_knots(n, 3, (0.0, corr.length_m))
@@ -141,7 +141,10 @@ def peer(cases, n_ctrl_by_case):
         times.append(time.perf_counter() - t0)
         u = np.linspace(0, corr.length_m, int(corr.length_m / raw.resolution * 8) + 2)
         xy = spl(u)
-        if not np.all(np.isfinite(xy)) or point_square_clearance(xy, raw, r + raw.resolution).min() < r - 1e-9:
+        if (
+            not np.all(np.isfinite(xy))
+            or point_square_clearance(xy, raw, r + raw.resolution).min() < r - 1e-9
+        ):
             viol += 1
     return times, viol
 
@@ -186,23 +189,32 @@ def main() -> None:
     t0 = time.perf_counter()
     cases = scenarios(args.n)
     pcases = paper_cases()
-    print(f"{len(cases)} shared-map scenarios ({time.perf_counter() - t0:.1f} s to load and search),"
-          f" {len(pcases)} paper targets; path cells median "
-          f"{np.median([len(c[4].cells) for c in cases]):.0f}")
+    print(
+        f"{len(cases)} shared-map scenarios ({time.perf_counter() - t0:.1f} s to load and search),"
+        f" {len(pcases)} paper targets; path cells median "
+        f"{np.median([len(c[4].cells) for c in cases]):.0f}"
+    )
     rows = []
     qp = Smoother()
     recs = run_set(cases, qp, args.reps)
     rows.append(summarise("QP (osqp), shared maps", recs))
     rows.append(summarise("QP (osqp), paper A-D", run_set(pcases, qp, args.reps)))
-    rows.append(summarise("QP (piqp), shared maps", run_set(cases, Smoother(qp_solver="piqp"), args.reps)))
+    rows.append(
+        summarise("QP (piqp), shared maps", run_set(cases, Smoother(qp_solver="piqp"), args.reps))
+    )
     n_ctrl = [r.get("n_ctrl", 40) for r in recs]
     ptimes, viol = peer(cases, n_ctrl)
-    print(f"peer scipy make_lsq_spline: median {np.median(ptimes) * 1e3:.2f} ms, clearance "
-          f"violated on {viol}/{len(cases)} ({viol / max(1, len(cases)):.0%}); ratio of medians "
-          f"smoother fit / lsq = {rows[0]['total_med'] / (np.median(ptimes) * 1e3):.1f}x")
+    print(
+        f"peer scipy make_lsq_spline: median {np.median(ptimes) * 1e3:.2f} ms, clearance "
+        f"violated on {viol}/{len(cases)} ({viol / max(1, len(cases)):.0%}); ratio of medians "
+        f"smoother fit / lsq = {rows[0]['total_med'] / (np.median(ptimes) * 1e3):.1f}x"
+    )
     kcases = cases[: args.kappa_n]
     krows = []
-    for label, cs in (("curvature bound, shared maps", kcases), ("curvature bound, paper A-D", pcases)):
+    for label, cs in (
+        ("curvature bound, shared maps", kcases),
+        ("curvature bound, paper A-D", pcases),
+    ):
         recs_k = []
         for c in cs:
             sm = Smoother(kappa_max=1.0 / (2.0 * c[3]), time_budget_s=30.0)
@@ -220,7 +232,9 @@ def main() -> None:
         t0 = time.perf_counter()
         _qp.curvature_nlp(nb, 3, False)
         tb.append((nb, tq, time.perf_counter() - t0))
-        print(f"cold build nb={nb}: osqp conic {tq * 1e3:.1f} ms, IPOPT curvature NLP {tb[-1][2] * 1e3:.0f} ms")
+        print(
+            f"cold build nb={nb}: osqp conic {tq * 1e3:.1f} ms, IPOPT curvature NLP {tb[-1][2] * 1e3:.0f} ms"
+        )
     if args.write:
         write_md(args, rows, ptimes, viol, len(cases), tb)
 
@@ -259,8 +273,10 @@ def write_md(args, rows, ptimes, viol, ncases, tb):
         f"{viol}/{ncases} scenarios ({viol / max(1, ncases):.0%}); the smoother on none "
         "(every returned curve is certified).",
         "",
-        "Cold builds: " + "; ".join(
-            f"nb={nb}: osqp conic {tq * 1e3:.1f} ms, IPOPT curvature NLP {ti * 1e3:.0f} ms" for nb, tq, ti in tb
+        "Cold builds: "
+        + "; ".join(
+            f"nb={nb}: osqp conic {tq * 1e3:.1f} ms, IPOPT curvature NLP {ti * 1e3:.0f} ms"
+            for nb, tq, ti in tb
         ),
         "",
     ]

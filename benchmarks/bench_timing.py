@@ -141,8 +141,10 @@ def main() -> None:
     n_paper = len(curves)
     mai, fails = movingai_curves(robot, args.limit, data_dir())
     curves += mai
-    print(f"paths: {n_paper} paper-scene targets + {len(mai)} Moving AI scenarios "
-          f"({RESOLUTION} m/cell; {fails} skipped: no path/smoothing failure at robot scale)")
+    print(
+        f"paths: {n_paper} paper-scene targets + {len(mai)} Moving AI scenarios "
+        f"({RESOLUTION} m/cell; {fails} skipped: no path/smoothing failure at robot scale)"
+    )
     time_parameterize(curves[0][1], robot)  # load the numba cache
     rows = []
     for name, curve in curves:
@@ -158,15 +160,27 @@ def main() -> None:
         n_grid = int(np.clip(curve.length / 0.01, 200, 1000))
         d_topp, t_topp = toppra_duration(curve, robot, n_grid)
         d_fb = forward_backward_duration(curve, robot)
-        rows.append(dict(name=name, length=curve.length, ours=traj.duration, topp=d_topp,
-                         fb=d_fb, t_ours=float(np.median(times)), t_min=float(np.min(times)),
-                         t_topp=t_topp,
-                         t_sample=t_sample, greedy=traj.stats["timing_greedy_duration"]))
+        rows.append(
+            dict(
+                name=name,
+                length=curve.length,
+                ours=traj.duration,
+                topp=d_topp,
+                fb=d_fb,
+                t_ours=float(np.median(times)),
+                t_min=float(np.min(times)),
+                t_topp=t_topp,
+                t_sample=t_sample,
+                greedy=traj.stats["timing_greedy_duration"],
+            )
+        )
         r = rows[-1]
-        print(f"  {name:42s} L={r['length']:6.2f} m  ours {r['ours']:7.3f} s  TOPP-RA "
-              f"{r['topp']:7.3f} s  ratio {r['ours'] / r['topp']:.4f}  fwd-bwd ratio "
-              f"{r['ours'] / r['fb']:.4f}  time {1e3 * r['t_min']:6.2f} ms (best) "
-              f"(TOPP-RA {1e3 * r['t_topp']:6.1f} ms)")
+        print(
+            f"  {name:42s} L={r['length']:6.2f} m  ours {r['ours']:7.3f} s  TOPP-RA "
+            f"{r['topp']:7.3f} s  ratio {r['ours'] / r['topp']:.4f}  fwd-bwd ratio "
+            f"{r['ours'] / r['fb']:.4f}  time {1e3 * r['t_min']:6.2f} ms (best) "
+            f"(TOPP-RA {1e3 * r['t_topp']:6.1f} ms)"
+        )
 
     def summary(sel, label):
         if not sel:
@@ -177,21 +191,33 @@ def main() -> None:
         t_ours = np.array([r["t_ours"] for r in sel])
         per10 = np.array([r["t_min"] * 10.0 / r["length"] for r in sel])
         t_min = np.array([r["t_min"] for r in sel])
-        print(f"\n{label} ({len(sel)} paths, median length "
-              f"{np.median([r['length'] for r in sel]):.2f} m)")
-        print(f"  duration ratio ours/TOPP-RA     median {np.median(ratio):.4f}  "
-              f"p90 {np.percentile(ratio, 90):.4f}  max {ratio.max():.4f}")
-        print(f"  duration ratio ours/fwd-bwd     median {np.median(ratio_fb):.4f}  "
-              f"max {ratio_fb.max():.4f}")
+        print(
+            f"\n{label} ({len(sel)} paths, median length "
+            f"{np.median([r['length'] for r in sel]):.2f} m)"
+        )
+        print(
+            f"  duration ratio ours/TOPP-RA     median {np.median(ratio):.4f}  "
+            f"p90 {np.percentile(ratio, 90):.4f}  max {ratio.max():.4f}"
+        )
+        print(
+            f"  duration ratio ours/fwd-bwd     median {np.median(ratio_fb):.4f}  "
+            f"max {ratio_fb.max():.4f}"
+        )
         print(f"  greedy alone / TOPP-RA          median {np.median(greedy):.4f}")
-        print(f"  compute time ours               median {1e3 * np.median(t_ours):.2f} ms  "
-              f"p90 {1e3 * np.percentile(t_ours, 90):.2f} ms")
+        print(
+            f"  compute time ours               median {1e3 * np.median(t_ours):.2f} ms  "
+            f"p90 {1e3 * np.percentile(t_ours, 90):.2f} ms"
+        )
         print(f"  compute time ours, best of runs median {1e3 * np.median(t_min):.2f} ms")
         print(f"  best-of-runs time per 10 m      median {1e3 * np.median(per10):.2f} ms")
-        print(f"  compute time TOPP-RA            median "
-              f"{1e3 * np.median([r['t_topp'] for r in sel]):.2f} ms")
-        print(f"  sample(10 000 times)            median "
-              f"{1e3 * np.median([r['t_sample'] for r in sel]):.2f} ms")
+        print(
+            f"  compute time TOPP-RA            median "
+            f"{1e3 * np.median([r['t_topp'] for r in sel]):.2f} ms"
+        )
+        print(
+            f"  sample(10 000 times)            median "
+            f"{1e3 * np.median([r['t_sample'] for r in sel]):.2f} ms"
+        )
 
     summary(rows[:n_paper], "paper scene")
     summary(rows[n_paper:], "Moving AI scenarios")

@@ -40,8 +40,8 @@ _EXPORTS: dict[str, str] = {
     # pipeline and analysis
     "plan": "trajopt.pipeline",
     "Planner": "trajopt.pipeline",
-    "compare": "trajopt.compare",
-    "ComparisonTable": "trajopt.compare",
+    "compare": "trajopt.comparison",
+    "ComparisonTable": "trajopt.comparison",
 }
 
 _SUBMODULES = {"scenes", "fits", "metrics", "plotting", "cli"}
@@ -68,7 +68,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # pragma: no cover
     from trajopt.bspline import BSplineCurve
-    from trajopt.compare import ComparisonTable, compare
+    from trajopt.comparison import ComparisonTable, compare
     from trajopt.corridor import Box, Corridor, build_corridor
     from trajopt.curve import ParametricCurve
     from trajopt.errors import (

@@ -77,12 +77,12 @@ def basis_derivs(t: np.ndarray, p: int, span: np.ndarray, u: np.ndarray, nu: int
             i = k - q + a
             if a >= 1:
                 den = t[i + q] - t[i]
-                new[:, a] += np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a - 1]
+                new[:, a] += (
+                    np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a - 1]
+                )
             if a <= q - 1:
                 den = t[i + q + 1] - t[i + 1]
-                new[:, a] -= (
-                    np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a]
-                )
+                new[:, a] -= np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a]
         vals = new
     return vals
 
@@ -100,7 +100,9 @@ def band_gram(span: np.ndarray, vals: np.ndarray, weights: np.ndarray, n: int) -
     band = np.zeros((p + 1, n))
     for a in range(p + 1):
         for b in range(a, p + 1):
-            band[b - a] += np.bincount(span + a, weights=weights * vals[:, a] * vals[:, b], minlength=n)
+            band[b - a] += np.bincount(
+                span + a, weights=weights * vals[:, a] * vals[:, b], minlength=n
+            )
     return band
 
 

@@ -226,12 +226,26 @@ def _table_text(table: Any, fmt: str) -> str:
     if fmt == "markdown":
         return table.to_markdown()
     if fmt == "csv":
-        return table.to_csv()
+        import csv
+        import io
+
+        records = table.to_records()
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=list(records[0]), lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(records)
+        return buf.getvalue()
     return str(table)
 
 
+def _avoidance(grid: Any, table: Any) -> Any:
+    from astar.inflation import avoidance_area
+
+    return avoidance_area(grid, int(table.meta["w_cells"]), border=True)
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from trajopt.compare import compare
+    from trajopt.comparison import compare
     from trajopt.robot import Robot
 
     grid = _load(args)
@@ -247,14 +261,17 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         _require_matplotlib()
         from trajopt.plotting import plot_paths
 
-        fig, _ = plot_paths(grid, table.paths, inflated=table.inflated_grid,
+        paths = {k: v for k, v in table.paths.items() if v is not None}
+        fig, _ = plot_paths(grid, paths, inflated=_avoidance(grid, table),
                             start=tuple(args.start), goals={"goal": tuple(args.goal)})
         print(f"wrote {_save_figure(fig, args.plot)}")
     return 0
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from trajopt.compare import compare
+    from trajopt.comparison import compare
+    from trajopt.pipeline import Planner
+    from trajopt.robot import Robot
     from trajopt.scenes import paper
 
     out = Path(args.out)
@@ -267,6 +284,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         except CliError as exc:
             print(f"note: {exc}; figures skipped", file=sys.stderr)
             plots = False
+    planner = Planner(scene.grid, Robot(radius=scene.robot_radius))
     sections = []
     for name in scene.target_names:
         t0 = time.perf_counter()
@@ -276,21 +294,18 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         print(f"\n== SP -> {name} ({dt:.2f} s) ==")
         print(table)
         sections.append(f"## SP -> {name}\n\n{table.to_markdown()}\n")
-        csv_text = table.to_csv()
+        csv_text = _table_text(table, "csv")
         _atomic_write(out / f"compare_{name}.csv", lambda tmp, s=csv_text: tmp.write_text(s))
         if plots:
-            from trajopt.plotting import plot_paths
+            from trajopt.plotting import plot_paths, plot_profiles
 
-            fig, _ = plot_paths(scene.grid, table.paths, inflated=table.inflated_grid,
+            paths = {k: v for k, v in table.paths.items() if v is not None}
+            fig, _ = plot_paths(scene.grid, paths, inflated=_avoidance(scene.grid, table),
                                 start=scene.start, goals={name: scene.goal(name)})
             _save_figure(fig, out / f"paths_{name}.png")
-            proposed = table.paths.get("proposed")
-            traj = getattr(table, "trajectory", None)
-            if proposed is not None and traj is not None:
-                from trajopt.plotting import plot_profiles
-
-                fig, _ = plot_profiles(traj)
-                _save_figure(fig, out / f"profile_{name}.png")
+            traj = planner.plan(scene.start, scene.goal(name))
+            fig, _ = plot_profiles(traj)
+            _save_figure(fig, out / f"profile_{name}.png")
     report = "# trajopt demo: the paper scene\n\n" + "\n".join(sections)
     _atomic_write(out / "compare.md", lambda tmp: tmp.write_text(report))
     print(f"\nwrote tables{' and figures' if plots else ''} to {out}/")

@@ -185,16 +185,25 @@ class Corridor:
 class _RectTester:
     """O(1) "is this cell rectangle all free" tests from a summed-area table."""
 
-    __slots__ = ("sat", "nx", "ny")
+    __slots__ = ("sat", "nx", "ny", "x_off", "y_off")
 
-    def __init__(self, occupied: np.ndarray) -> None:
-        ny, nx = occupied.shape
-        sat = np.zeros((ny + 1, nx + 1), dtype=np.int64)
-        sat[1:, 1:] = np.cumsum(np.cumsum(occupied, axis=0, dtype=np.int64), axis=1)
+    def __init__(self, occupied: np.ndarray, window: tuple[int, int, int, int]) -> None:
+        # table only over ``window`` = (x0, x1, y0, y1) inclusive: rectangles outside it are
+        # reported as not free (callers never need them)
+        x0, x1, y0, y1 = window
+        sub = occupied[y0 : y1 + 1, x0 : x1 + 1]
+        ny, nx = sub.shape
+        sat = np.zeros((ny + 1, nx + 1), dtype=np.int32)
+        sat[1:, 1:] = np.cumsum(np.cumsum(sub, axis=0, dtype=np.int32), axis=1)
         self.sat = sat
         self.nx, self.ny = nx, ny
+        self.x_off, self.y_off = x0, y0
 
     def free(self, x0: int, x1: int, y0: int, y1: int) -> bool:
+        x0 -= self.x_off
+        x1 -= self.x_off
+        y0 -= self.y_off
+        y1 -= self.y_off
         if x0 < 0 or y0 < 0 or x1 >= self.nx or y1 >= self.ny or x0 > x1 or y0 > y1:
             return False
         s = self.sat
@@ -205,7 +214,9 @@ def _as_cells(grid_path: Any) -> np.ndarray:
     cells = getattr(grid_path, "cells", grid_path)
     c = np.asarray(cells)
     if c.ndim != 2 or c.shape[1] != 2 or len(c) < 1:
-        raise InvalidInputError(f"grid_path cells must have shape (n, 2) with n >= 1, got {c.shape}")
+        raise InvalidInputError(
+            f"grid_path cells must have shape (n, 2) with n >= 1, got {c.shape}"
+        )
     if not np.issubdtype(c.dtype, np.integer):
         if not np.all(np.isfinite(c)) or np.any(c != np.round(c)):
             raise InvalidInputError("grid_path cells must be integer (ix, iy) pairs")
@@ -273,9 +284,7 @@ def build_corridor(
     if int(max_side_cells) != max_side_cells or max_side_cells < 2:
         raise InvalidInputError(f"max_side_cells must be an integer >= 2, got {max_side_cells!r}")
     if int(seed_back_cells) != seed_back_cells or seed_back_cells < 1:
-        raise InvalidInputError(
-            f"seed_back_cells must be an integer >= 1, got {seed_back_cells!r}"
-        )
+        raise InvalidInputError(f"seed_back_cells must be an integer >= 1, got {seed_back_cells!r}")
     if not (np.isfinite(min_share_cells) and min_share_cells >= 0):
         raise InvalidInputError(f"min_share_cells must be finite and >= 0, got {min_share_cells!r}")
     if radius is not None and not (np.isfinite(radius) and radius >= 0):
@@ -298,9 +307,15 @@ def build_corridor(
         )
     res = float(inflated_grid.resolution)
     ox, oy = (float(v) for v in inflated_grid.origin)
-    tester = _RectTester(occ)
     n = len(cells)
     cap = int(max_side_cells)
+    window = (
+        max(0, int(cells[:, 0].min()) - cap),
+        min(nx - 1, int(cells[:, 0].max()) + cap),
+        max(0, int(cells[:, 1].min()) - cap),
+        min(ny - 1, int(cells[:, 1].max()) + cap),
+    )
+    tester = _RectTester(occ, window)
 
     rects: list[tuple[int, int, int, int]] = []
     runs: list[tuple[int, int]] = []
@@ -315,7 +330,12 @@ def build_corridor(
         back = min(int(seed_back_cells), i)
         while True:
             seg = cells[i - back : i + 1]
-            r = (int(seg[:, 0].min()), int(seg[:, 0].max()), int(seg[:, 1].min()), int(seg[:, 1].max()))
+            r = (
+                int(seg[:, 0].min()),
+                int(seg[:, 0].max()),
+                int(seg[:, 1].min()),
+                int(seg[:, 1].max()),
+            )
             if (r[1] - r[0] < cap and r[3] - r[2] < cap and tester.free(*r)) or back == 0:
                 break
             back -= 1
@@ -402,7 +422,9 @@ def build_corridor(
     )
 
 
-def _place_transitions(lo: np.ndarray, hi: np.ndarray, length: float, min_share: float) -> np.ndarray:
+def _place_transitions(
+    lo: np.ndarray, hi: np.ndarray, length: float, min_share: float
+) -> np.ndarray:
     """Transitions at the overlap midpoints, then nudged (inside their overlaps) so that
     every box's share is at least ``min_share`` where the overlaps allow it."""
     t = 0.5 * (lo + hi)

@@ -203,9 +203,10 @@ def _neighbours_within(tree: Any, p: np.ndarray, radius: np.ndarray, k: int = 32
     still inside their radius are completed with a ball query.
     """
     k = min(k, tree.n)
-    dist, idx = tree.query(p, k=k, distance_upper_bound=radius)
+    radius = np.asarray(radius, dtype=float)
+    dist, idx = tree.query(p, k=k, distance_upper_bound=float(radius.max()))
     dist, idx = dist.reshape(len(p), k), idx.reshape(len(p), k)
-    inside = np.isfinite(dist)
+    inside = dist <= radius[:, None]
     full = np.nonzero(inside[:, -1])[0] if k < tree.n else np.empty(0, np.int64)
     inside[full] = False
     pid = [np.nonzero(inside)[0]]
@@ -244,8 +245,9 @@ def _densify(vertices: np.ndarray, spacing: float) -> np.ndarray:
         return v
     seg = np.diff(v, axis=0)
     n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / spacing).astype(int))
-    t = np.concatenate([np.arange(k) / k for k in n])
     idx = np.repeat(np.arange(len(seg)), n)
+    first = np.concatenate([[0], np.cumsum(n)[:-1]])
+    t = (np.arange(int(n.sum())) - first[idx]) / n[idx]
     return np.vstack([v[idx] + t[:, None] * seg[idx], v[-1:]])
 
 

@@ -232,7 +232,9 @@ class Smoother:
             )
         _check_float("time_budget_s", self.time_budget_s, lo=0.0, strict=True)
         if not isinstance(self.max_attempts, (int, np.integer)) or self.max_attempts < 1:
-            raise InvalidInputError(f"max_attempts must be an integer >= 1, got {self.max_attempts!r}")
+            raise InvalidInputError(
+                f"max_attempts must be an integer >= 1, got {self.max_attempts!r}"
+            )
         if not isinstance(self.samples_per_cell, (int, np.integer)) or self.samples_per_cell < 2:
             raise InvalidInputError(
                 f"samples_per_cell must be an integer >= 2, got {self.samples_per_cell!r}"
@@ -366,9 +368,7 @@ class Smoother:
             stats,
         )
 
-    def fit_free(
-        self, points: np.ndarray, u: np.ndarray, knots: np.ndarray
-    ) -> BSplineCurve:
+    def fit_free(self, points: np.ndarray, u: np.ndarray, knots: np.ndarray) -> BSplineCurve:
         """The same objective with *no* constraints (no corridor, free ends, no bound).
 
         A reference and test hook: with ``smoothness_weight = 0`` it is the least-squares
@@ -434,7 +434,9 @@ class Smoother:
         greville = np.array([t[i + 1 : i + p + 1].mean() for i in range(n)])
         for d in range(2):
             guess = np.interp(greville, prob.u, prob.targets[:, d])
-            x0[d * nb : d * nb + n] = np.clip(guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n])
+            x0[d * nb : d * nb + n] = np.clip(
+                guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n]
+            )
         z, info = self._solve_qp(band, g, n, nb, lbx, ubx, amat, lba, uba, remaining, x0=x0)
         stats = {
             "n_control_points": n,
@@ -523,7 +525,9 @@ class Smoother:
         }
         return z, info
 
-    def _solve_curvature(self, prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z0, kmax, remaining):
+    def _solve_curvature(
+        self, prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z0, kmax, remaining
+    ):
         p = self.degree
         ms = _qp.CURV_SAMPLES
         ns_b = nb - p
@@ -577,7 +581,8 @@ class Smoother:
         info = {
             "solver": "ipopt",
             "success": success,
-            "status": str(st.get("return_status", "")) + ("" if solve <= left else " (over budget)"),
+            "status": str(st.get("return_status", ""))
+            + ("" if solve <= left else " (over budget)"),
             "iterations": int(st.get("iter_count", 0) or 0),
             "solve_time_s": solve,
             "build_time_s": build,
@@ -666,7 +671,9 @@ def _targets(src: Any, corridor: Corridor) -> np.ndarray:
     else:
         pts = np.asarray(src, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(np.isfinite(pts)):
-        raise InvalidInputError(f"grid_path_or_points must be finite with shape (n, 2), got {pts.shape}")
+        raise InvalidInputError(
+            f"grid_path_or_points must be finite with shape (n, 2), got {pts.shape}"
+        )
     if len(pts) != len(corridor.path_points):
         raise InvalidInputError(
             f"grid_path_or_points has {len(pts)} points but the corridor was built on a path "
@@ -808,9 +815,7 @@ def _summary(attempts: list[dict[str, Any]], total: float, *, success: bool) -> 
 
 
 # -------------------------------------------------------------------- certify
-def point_square_clearance(
-    points: np.ndarray, raw_grid: Any, window_m: float
-) -> np.ndarray:
+def point_square_clearance(points: np.ndarray, raw_grid: Any, window_m: float) -> np.ndarray:
     """Distance (m) from each world point to the nearest occupied square of ``raw_grid``
     (cells outside the grid count as occupied), searched within ``window_m``; points with
     nothing occupied inside the window get ``window_m``.

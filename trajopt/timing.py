@@ -114,7 +114,7 @@ def time_parameterize(
         robot = Robot()
     if not isinstance(robot, Robot):
         raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
-    for name in ("length", "u_at_s", "curvature", "heading"):
+    for name in ("domain", "length", "s_at_u", "u_at_s", "speed", "curvature", "heading"):
         if not hasattr(curve, name) or not callable(curve):
             raise InvalidInputError(
                 f"curve must be a ParametricCurve (needs {name!r} and __call__), "

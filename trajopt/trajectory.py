@@ -165,8 +165,7 @@ class Trajectory:
         ug = _readonly(self.u_grid)
         if ug.shape[0] and ug.shape != gs.shape:
             raise InvalidInputError(
-                f"u_grid must be empty or have the shape of theta_grid_s {gs.shape}, "
-                f"got {ug.shape}"
+                f"u_grid must be empty or have the shape of theta_grid_s {gs.shape}, got {ug.shape}"
             )
         object.__setattr__(self, "u_grid", ug)
 

@@ -29,9 +29,7 @@ def test_frozen():
         r.v_max = 2.0  # type: ignore[misc]
 
 
-@pytest.mark.parametrize(
-    "field", ["radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max"]
-)
+@pytest.mark.parametrize("field", ["radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max"])
 @pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, math.inf, "fast", None])
 def test_invalid_limits_name_the_field(field, bad):
     with pytest.raises(InvalidInputError, match=field):

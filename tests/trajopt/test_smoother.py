@@ -26,7 +26,6 @@ from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.smoother import Smoother, SmoothPath
 
-
 # ----------------------------------------------------------------- references
 _TREES: dict[int, tuple] = {}
 
@@ -148,10 +147,14 @@ def test_basis_derivatives_match_scipy():
 def test_smoothness_gram_matches_quadrature_of_scipy_derivative():
     rng = np.random.default_rng(2)
     p, n = 3, 10
-    t = np.concatenate([np.zeros(p + 1), np.sort(rng.uniform(0, 5, n - p - 1)), np.full(p + 1, 5.0)])
+    t = np.concatenate(
+        [np.zeros(p + 1), np.sort(rng.uniform(0, 5, n - p - 1)), np.full(p + 1, 5.0)]
+    )
     c = rng.normal(size=n)
     band = _qp.smoothness_band(t, p, n, 2)
-    quad = band[0] @ (c * c) + 2 * sum(band[d, : n - d] @ (c[: n - d] * c[d:]) for d in range(1, p + 1))
+    quad = band[0] @ (c * c) + 2 * sum(
+        band[d, : n - d] @ (c[: n - d] * c[d:]) for d in range(1, p + 1)
+    )
     d2 = BSpline(t, c, p).derivative(2)
     fine = np.linspace(0, 5, 200_001)
     ref = np.trapezoid(d2(fine) ** 2, fine)
@@ -244,61 +247,56 @@ def test_higher_degrees_also_certified():
 
 # ------------------------------------------------------------------- real maps
 def _map_scenarios(shared_data, per_map: int, seed: int = 0):
-    """(raw, inflated, radius_m, start, goal) on the shared maps: Moving AI scenarios
-    (radius 2.5 cells) and random free pairs on the ROS maps (radius 0.2 m)."""
+    """(raw, inflated, radius_m, path) on the shared maps: Moving AI scenarios (radius 2.5
+    cells) and random free pairs on the ROS maps (radius 0.2 m), reachable ones only."""
     import astar
 
     rng = np.random.default_rng(seed)
-    out = []
-    mai = ["arena", "den312d", "Berlin_0_256", "rmtst01"]
-    for name in mai:
+    maps = []
+    for name in ["arena", "den312d", "Berlin_0_256", "rmtst01"]:
         raw = astar.load_map(shared_data / "movingai" / "maps" / f"{name}.map")
-        r = 2.5 * raw.resolution
-        infl = astar.inflate(raw, r, metric="square", outside_occupied=True)
         scen = astar.read_scenarios(shared_data / "movingai" / "scen" / f"{name}.map.scen")
-        scen = [s for s in scen if 20 <= s.optimal_length <= 200]
-        picks = rng.permutation(len(scen))
-        got = 0
-        for i in picks:
-            s = scen[i]
-            if infl.occupied[s.start[1], s.start[0]] or infl.occupied[s.goal[1], s.goal[0]]:
-                continue
-            out.append((raw, infl, r, tuple(s.start), tuple(s.goal)))
-            got += 1
-            if got == per_map:
-                break
-    for name in ["turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10"]:
+        pairs = [(tuple(s.start), tuple(s.goal)) for s in scen if 20 <= s.optimal_length <= 200]
+        maps.append((raw, 2.5 * raw.resolution, [pairs[i] for i in rng.permutation(len(pairs))]))
+    for name in ["turtlebot3_world", "smoothers_world", "depot"]:
         raw = astar.load_map(shared_data / "ros" / f"{name}.yaml")
-        r = 0.2
+        maps.append((raw, 0.2, None))
+    out = []
+    for raw, r, pairs in maps:
         infl = astar.inflate(raw, r, metric="square", outside_occupied=True)
         ys, xs = np.nonzero(~infl.occupied)
         got = 0
-        for _ in range(per_map * 20):
-            i, j = rng.choice(len(xs), 2, replace=False)
-            a, b = (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j]))
-            if not 20 <= math.hypot(a[0] - b[0], a[1] - b[1]) <= 150:
+        for k in range(per_map * 100):
+            if pairs is not None:
+                if k >= len(pairs):
+                    break
+                a, b = pairs[k]
+            else:
+                i, j = rng.choice(len(xs), 2, replace=False)
+                a, b = (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j]))
+            if infl.occupied[a[1], a[0]] or infl.occupied[b[1], b[0]]:
                 continue
-            out.append((raw, infl, r, a, b))
+            if not 10 <= math.hypot(a[0] - b[0], a[1] - b[1]) <= 150:
+                continue
+            try:
+                path = astar.find_path(infl, a, b)
+            except astar.NoPathError:
+                continue
+            out.append((raw, infl, r, path))
             got += 1
             if got == per_map:
                 break
     return out
 
 
+@pytest.mark.slow
 def test_shared_maps_zero_guarantee_violations(shared_data):
-    import astar
-
-    cases = _map_scenarios(shared_data, per_map=18)
+    # ~60 s on a quiet 2-core machine, minutes when it is shared: marked slow
+    cases = _map_scenarios(shared_data, per_map=20)
     sm = Smoother()
     done = errors = violations_plain = 0
     t0 = time.perf_counter()
-    for raw, infl, r, a, b in cases:
-        try:
-            path = astar.find_path(infl, a, b)
-        except astar.NoPathError:
-            continue
-        if len(path.cells) < 3:
-            continue
+    for raw, infl, r, path in cases:
         corr = build_corridor(infl, path, radius=r)
         try:
             sp = sm.fit(path, corr, raw_grid=raw)
@@ -317,11 +315,13 @@ def test_shared_maps_zero_guarantee_violations(shared_data):
         if not np.all(np.isfinite(xy)) or brute_clearance(xy, raw).min() < r - 1e-9:
             violations_plain += 1
     print(
-        f"\nshared maps: {done} certified, {errors} SmoothingError, plain lsq fit violated "
-        f"clearance on {violations_plain}/{done} ({time.perf_counter() - t0:.1f} s)"
+        f"\nshared maps: {len(cases)} cases, {done} certified, {errors} SmoothingError, plain "
+        f"lsq fit violated clearance on {violations_plain}/{done} "
+        f"({time.perf_counter() - t0:.1f} s)"
     )
-    assert done >= 100
-    assert errors <= 0.02 * len(cases)
+    assert len(cases) >= 100
+    assert errors <= 0.03 * len(cases)
+    assert done + errors == len(cases)
 
 
 def test_paper_scene_targets_certified():

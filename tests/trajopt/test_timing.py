@@ -121,7 +121,8 @@ def check_limits(traj: Trajectory, robot: Robot, v_start=0.0, v_end=0.0, n=20001
 
 
 def ruckig_duration(length, v0, v1, robot, v_max):
-    from ruckig import InputParameter, Result, Ruckig, Trajectory as RT
+    from ruckig import InputParameter, Result, Ruckig
+    from ruckig import Trajectory as RT
 
     inp = InputParameter(1)
     inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [v0], [0.0]

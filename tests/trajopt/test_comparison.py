@@ -1,4 +1,4 @@
-"""Tests of trajopt.compare: the table, the method registry, and the chapter's Section 5
+"""Tests of trajopt.comparison (``trajopt.compare``): the table, the method registry, and the chapter's Section 5
 reproduction on the paper scene (qualitative relations, no copied numbers)."""
 
 from __future__ import annotations
@@ -18,8 +18,7 @@ from astar.search import find_path
 from trajopt import fits, scenes
 from trajopt.errors import InvalidInputError, NoPathError
 
-# ``trajopt.compare`` is both a module and the function it exports: take the module
-cmp = importlib.import_module("trajopt.compare")
+cmp = importlib.import_module("trajopt.comparison")
 
 CHAPTER_METHODS = ("A*", "A* + avoidance area", "polynomial fit", "B-spline fit")
 
@@ -39,7 +38,12 @@ def _line_method(ctx: cmp.ComparisonContext) -> np.ndarray:
 @pytest.fixture(scope="module")
 def room_table() -> cmp.ComparisonTable:
     return cmp.compare(
-        _room(), (0.5, 0.5), (2.5, 2.3), robot_radius=0.15, poly={"order": 3}, bspline={"n_ctrl": 12}
+        _room(),
+        (0.5, 0.5),
+        (2.5, 2.3),
+        robot_radius=0.15,
+        poly={"order": 3},
+        bspline={"n_ctrl": 12},
     )
 
 
@@ -182,8 +186,13 @@ def paper_results() -> dict:
     poly, bspline = poly_sweep[0].kwargs, bs_sweep[0].kwargs
     tables = {
         name: cmp.compare(
-            sc.grid, sc.start, sc.goal(name), robot_radius=sc.robot_radius,
-            w_cells=sc.w_cells, poly=poly, bspline=bspline,
+            sc.grid,
+            sc.start,
+            sc.goal(name),
+            robot_radius=sc.robot_radius,
+            w_cells=sc.w_cells,
+            poly=poly,
+            bspline=bspline,
         )  # fmt: skip
         for name in sc.target_names
     }

@@ -11,7 +11,11 @@ Built-in methods (the chapter's four, in this order):
 * ``'A*'``: traditional A* on the raw grid (cell centres as a polyline);
 * ``'A* + avoidance area'``: A* on :func:`astar.avoidance_area` (``W = w_cells``);
 * ``'polynomial fit'``: :func:`trajopt.fits.fit_polynomial` ``y = f(x)`` of the latter;
-* ``'B-spline fit'``: :func:`trajopt.fits.fit_bspline` of the latter.
+* ``'B-spline fit'``: :func:`trajopt.fits.fit_bspline` of the latter;
+
+and the proposed method, ``'proposed'``: :func:`trajopt.plan` (certified corridor smoother
+and ruckig timing; its own clearance-aware A* path), with the timed metrics as extra
+columns (``duration_s``, ``ratio_v``, ...).
 
 ``'polynomial fit (parametric)'`` is registered too but is not run by default.
 
@@ -212,7 +216,7 @@ def register_method(
         Row name in the table (non-empty, unique unless ``replace``).
     fn : callable or str, optional
         ``fn(ctx) -> curve | points | MethodResult``, or ``"module:attr"`` imported lazily
-        at the first run (keeps ``import trajopt.compare`` light and free of cycles).
+        at the first run (keeps ``import trajopt.comparison`` light and free of cycles).
     default : bool
         Run it when :func:`compare` gets ``methods=None``.
     replace : bool
@@ -315,6 +319,7 @@ register_method("A* + avoidance area", _method_astar_avoid)
 register_method("polynomial fit", _method_polynomial)
 register_method("B-spline fit", _method_bspline)
 register_method("polynomial fit (parametric)", _method_polynomial_parametric, default=False)
+register_method("proposed", "trajopt.pipeline:compare_method")
 
 
 # ============================================================================ table
