@@ -28,10 +28,10 @@ _EXPORTS: dict[str, str] = {
     "read_scenarios": "astar.io",
     "Scenario": "astar.io",
     # inflation
-    "inflate": "astar.inflate",
-    "clearance": "astar.inflate",
-    "avoidance_area": "astar.inflate",
-    "clearance_cost": "astar.inflate",
+    "inflate": "astar.inflation",
+    "clearance": "astar.inflation",
+    "avoidance_area": "astar.inflation",
+    "clearance_cost": "astar.inflation",
     # search
     "find_path": "astar.search",
     "GridPath": "astar.search",
@@ -56,6 +56,6 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # pragma: no cover
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid
-    from astar.inflate import avoidance_area, clearance, clearance_cost, inflate
+    from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
     from astar.io import Scenario, from_intensity, load_map, read_scenarios, save_map
     from astar.search import GridPath, find_path

@@ -458,7 +458,7 @@ def find_path(
     ----------
     grid : OccupancyGrid
         The grid to search, shape ``(ny, nx)``; usually already inflated
-        (:func:`astar.inflate`). Occupied cells are never entered.
+        (:func:`astar.inflation`). Occupied cells are never entered.
     start, goal : tuple of int
         Cells ``(ix, iy)`` (x first; row ``iy = 0`` at the bottom), inside the grid and free.
     connectivity : {8, 4}, optional

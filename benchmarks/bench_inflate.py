@@ -1,7 +1,7 @@
-"""Inflation speed: ``astar.inflate`` against a plain ``distance_transform_edt`` threshold.
+"""Inflation speed: ``astar.inflation`` against a plain ``distance_transform_edt`` threshold.
 
 A random 4000 x 4000 grid (0.03 m cells, 120 m x 120 m) is inflated by a 0.3 m radius (10
-cells) with both metrics of :func:`astar.inflate` and, in the same run, by thresholding
+cells) with both metrics of :func:`astar.inflation` and, in the same run, by thresholding
 ``scipy.ndimage.distance_transform_edt`` (the textbook exact method). Each is timed ``--repeat``
 times; the script prints the medians, the ratio, and checks that the centre-metric results are
 identical.
@@ -62,8 +62,8 @@ def main(argv: list[str] | None = None) -> int:
         f"grid {args.size} x {args.size}, {args.resolution} m cells, radius {args.radius} m "
         f"({r_cells:.2f} cells), density {args.density}, median of {args.repeat}"
     )
-    print(f"  astar.inflate (centre)         {1e3 * t_centre:9.1f} ms")
-    print(f"  astar.inflate (square)         {1e3 * t_square:9.1f} ms")
+    print(f"  astar.inflation (centre)         {1e3 * t_centre:9.1f} ms")
+    print(f"  astar.inflation (square)         {1e3 * t_square:9.1f} ms")
     print(f"  distance_transform_edt <= r    {1e3 * t_edt:9.1f} ms")
     print(f"  ratio edt / inflate(centre)    {t_edt / t_centre:9.2f}x   identical: {same}")
     return 0 if same else 1

@@ -136,7 +136,7 @@ class ComparisonContext:
     avoidance : astar.OccupancyGrid
         :func:`astar.avoidance_area` of ``grid`` with ``W = w_cells``.
     inflated : astar.OccupancyGrid
-        :func:`astar.inflate` of ``grid`` by ``robot_radius`` with ``metric="square"``.
+        :func:`astar.inflation` of ``grid`` by ``robot_radius`` with ``metric="square"``.
     path_raw, path_avoid : astar.GridPath
         A* on the raw grid and on the avoidance area.
     reference : ndarray, shape (n, 2)
@@ -604,8 +604,8 @@ def compare(
     runs = _resolve_methods(methods)
 
     timings: dict[str, float] = {}
-    # direct imports: the package attribute ``astar.inflate`` can be the submodule
-    from astar.inflate import avoidance_area, inflate
+    # direct imports: the package attribute ``astar.inflation`` can be the submodule
+    from astar.inflation import avoidance_area, inflate
 
     t0 = time.perf_counter()
     avoid = avoidance_area(grid, w, border=border_occupied)

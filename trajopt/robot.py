@@ -108,7 +108,7 @@ class Robot:
         """
         k = np.abs(np.asarray(kappa, dtype=float))
         k = np.where(np.isnan(k), np.inf, k)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             cap = np.minimum(self.v_max, np.sqrt(self.a_lat_max / k))
             cap = np.minimum(cap, self.omega_max / k)
             if self.track_width is not None:

@@ -291,7 +291,9 @@ def test_movingai_optimal_lengths(shared_data, name):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [m for m in MAPS if m.startswith(("Berlin", "random", "maze", "Boston"))])
+@pytest.mark.parametrize(
+    "name", [m for m in MAPS if m.startswith(("Berlin", "random", "maze", "Boston"))]
+)
 def test_movingai_optimal_lengths_full_sample(shared_data, name):
     """At least 200 scenarios per large map, the longest bucket included (slow: ~10 s/map)."""
     _check_scenarios(shared_data, name, FULL_SAMPLE)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from astar.grid import OccupancyGrid
-from astar.inflate import avoidance_area
+from astar.inflation import avoidance_area
 from astar.search import find_path
 from trajopt import fits, scenes
 from trajopt.errors import InvalidInputError, NoPathError

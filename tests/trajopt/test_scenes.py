@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from astar.inflate import avoidance_area, inflate
+from astar.inflation import avoidance_area, inflate
 from astar.search import find_path
 from trajopt import scenes
 from trajopt.errors import InvalidInputError

@@ -267,10 +267,8 @@ def _map_scenarios(shared_data, per_map: int, seed: int = 0):
         ys, xs = np.nonzero(~infl.occupied)
         got = 0
         for k in range(per_map * 100):
-            if pairs is not None:
-                if k >= len(pairs):
-                    break
-                a, b = pairs[k]
+            if pairs is not None and k < len(pairs):
+                a, b = pairs[k]  # the benchmark's own scenarios first, then random pairs
             else:
                 i, j = rng.choice(len(xs), 2, replace=False)
                 a, b = (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j]))

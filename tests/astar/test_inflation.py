@@ -1,4 +1,4 @@
-"""Tests of astar.inflate: exact disks, clearance fields, the chapter's square dilation.
+"""Tests of astar.inflation: exact disks, clearance fields, the chapter's square dilation.
 
 References are brute force over all pairs of cells (written from the definitions, independent of
 the row decomposition and of the refined-lattice transform used by the code) and
@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from astar import InvalidInputError, OccupancyGrid
-from astar.inflate import avoidance_area, clearance, clearance_cost, inflate
+from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
 
 TOL = 1e-9  # documented: distances within this relative tolerance of the radius equal it
 
