@@ -58,6 +58,8 @@ def scenarios(n_total: int, seed: int = 0):
     for name, raw, r in maps:
         infl = astar.inflate(raw, r, metric="square", outside_occupied=True)
         ys, xs = np.nonzero(~infl.occupied)
+        if len(xs) < 2:  # e.g. random512-40-5 has no room for this radius
+            continue
         got = tries = 0
         while got < per_map and tries < 60 * per_map:
             tries += 1
