@@ -59,6 +59,8 @@ __all__ = [
 #: Default arc-length spacing of the samples (m).
 DEFAULT_SAMPLE_SPACING = 0.005
 _COLLISION_TOL = 1e-9
+#: Most samples taken along one path; beyond it the spacing grows (and is reported).
+_MAX_SAMPLES = 200_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -398,6 +400,13 @@ def path_metrics(
     curve = _as_curve(path, grid)
     is_poly = isinstance(curve, PolylineCurve)
 
+    length = float(curve.length)
+    if not math.isfinite(length):
+        raise InvalidInputError(f"path length must be finite, got {length!r} m")
+    if length / ds > _MAX_SAMPLES:
+        # a wildly oscillating fit (e.g. y = f(x) across a vertical stretch) would need
+        # billions of samples; coarsen the spacing (reported in sample_spacing_m)
+        ds = length / _MAX_SAMPLES
     smp = curve.sample(ds=ds)
     xy = np.asarray(smp.xy, dtype=float)
     geom = np.vstack([xy, curve.points]) if is_poly else xy

@@ -38,6 +38,14 @@ def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     assert "duration" in json.loads(js.read_text())
 
 
+def run(argv) -> int:
+    """Exit code of ``trajopt argv`` whether it returns or raises SystemExit."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
+
+
 @pytest.mark.parametrize(
     ("argv", "match"),
     [
@@ -53,14 +61,6 @@ def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
         (["nonsense"], "invalid choice"),
     ],
 )
-def run(argv) -> int:
-    """Exit code of ``trajopt argv`` whether it returns or raises SystemExit."""
-    try:
-        return main(argv)
-    except SystemExit as exc:
-        return int(exc.code)
-
-
 def test_errors_are_one_line_exit_2(argv, match, door_map, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     argv = [a.replace("{map}", str(door_map)) for a in argv]
