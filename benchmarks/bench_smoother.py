@@ -10,7 +10,7 @@ Measures, on A* paths of about 100-500 cells from the shared Moving AI maps (rob
 * the peer: scipy ``make_lsq_spline`` on the same points (uniform knots, same number of
   control points): its time and how often it violates the clearance.
 
-Run: ``python benchmarks/bench_smoother.py [--n 40] [--kappa-n 20] [--write docs/benchmarks_smoother.md]``
+Run: ``python benchmarks/bench_smoother.py [--n 40] [--kappa-n 20] [--write /tmp/smoother_results.md]``
 """
 
 from __future__ import annotations
@@ -248,7 +248,7 @@ def write_md(args, rows, ptimes, viol, ncases, tb):
         "## Smoother (`benchmarks/bench_smoother.py`)",
         "",
         f"Rerun: `python benchmarks/bench_smoother.py --n {args.n} --kappa-n {args.kappa_n} "
-        f"--reps {args.reps} --write docs/benchmarks_smoother.md`",
+        f"--reps {args.reps} --write /tmp/smoother_results.md`",
         "",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
         f"load average at the end {os.getloadavg()[0]:.1f} (the machine was shared: wall times "

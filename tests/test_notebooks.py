@@ -56,6 +56,9 @@ def test_notebooks_stored_without_outputs() -> None:
         assert not dirty, f"{path.name}: code cells {dirty} have stored outputs; clear them"
 
 
+# Not yet in the default run: notebooks 01 and 02 have not been shown to finish within the
+# CI budget (issue 6 stays open until they do); run them with `pytest -m slow`.
+@pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_executes(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     _require_jupyter()

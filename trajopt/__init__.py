@@ -80,6 +80,6 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from trajopt.pipeline import Planner, plan
     from trajopt.robot import Robot
-    from trajopt.smoother import SmoothPath, Smoother
+    from trajopt.smoother import Smoother, SmoothPath
     from trajopt.timing import time_parameterize
     from trajopt.trajectory import Trajectory
