@@ -21,6 +21,8 @@ from trajopt.errors import InvalidInputError, NoPathError
 cmp = importlib.import_module("trajopt.comparison")
 
 CHAPTER_METHODS = ("A*", "A* + avoidance area", "polynomial fit", "B-spline fit")
+#: What compare runs by default: the chapter's four and the proposed method.
+DEFAULT_METHODS = (*CHAPTER_METHODS, "proposed")
 
 
 def _room() -> OccupancyGrid:
@@ -49,11 +51,15 @@ def room_table() -> cmp.ComparisonTable:
 
 # ---------------------------------------------------------------------------- table
 def test_default_rows_and_columns(room_table: cmp.ComparisonTable) -> None:
-    assert room_table.methods == CHAPTER_METHODS
+    assert room_table.methods == DEFAULT_METHODS
     for col in ("mse_m2", "hausdorff_m", "min_clearance_m", "collision", "length_ratio",
                 "max_curvature_1pm", "max_heading_jump_rad", "runtime_s", "note"):  # fmt: skip
         assert col in room_table.columns
     assert room_table.meta["w_cells"] == math.ceil(2 * 0.15 / 0.05)
+    proposed = room_table.row("proposed")
+    assert proposed["valid"] and not proposed["collision"]
+    assert proposed["min_clearance_m"] >= 0.15 - 1e-9
+    assert proposed["duration_s"] > 0 and proposed["ratio_v"] <= 1 + 1e-3
     avoid = room_table.row("A* + avoidance area")
     assert avoid["mse_m2"] == 0.0 and avoid["length_ratio"] == pytest.approx(1.0)
     assert room_table.row("polynomial fit")["note"].startswith("least_squares, order 3")
@@ -64,22 +70,22 @@ def test_default_rows_and_columns(room_table: cmp.ComparisonTable) -> None:
 
 def test_table_conversions(room_table: cmp.ComparisonTable, tmp_path) -> None:
     recs = room_table.to_records()
-    assert [r["method"] for r in recs] == list(CHAPTER_METHODS)
+    assert [r["method"] for r in recs] == list(DEFAULT_METHODS)
     recs[0]["method"] = "changed"  # fresh copies
     assert room_table.rows[0]["method"] == "A*"
     text = str(room_table)
     lines = text.splitlines()
-    assert all(m in lines[0] for m in CHAPTER_METHODS)
+    assert all(m in lines[0] for m in DEFAULT_METHODS)
     assert any(line.startswith("mse_m2") for line in lines)
     wide = room_table.to_text(transpose=False).splitlines()
-    assert len(wide) == 2 + 4 and wide[2].startswith("A*")
+    assert len(wide) == 2 + len(DEFAULT_METHODS) and wide[2].startswith("A*")
     # aligned: every body line of the wide table has the same width up to the note column
     md = room_table.to_markdown().splitlines()
-    assert len(md) == 2 + 4 and md[0].startswith("| method |")
+    assert len(md) == 2 + len(DEFAULT_METHODS) and md[0].startswith("| method |")
     path = room_table.to_csv(tmp_path / "t.csv")
     with path.open() as fh:
         rows = list(csv.DictReader(fh))
-    assert [r["method"] for r in rows] == list(CHAPTER_METHODS)
+    assert [r["method"] for r in rows] == list(DEFAULT_METHODS)
     assert float(rows[2]["hausdorff_m"]) == pytest.approx(room_table.rows[2]["hausdorff_m"])
 
 
@@ -97,7 +103,7 @@ def test_to_dataframe(room_table: cmp.ComparisonTable, monkeypatch) -> None:
     monkeypatch.undo()
     pd = pytest.importorskip("pandas")
     df = room_table.to_dataframe()
-    assert isinstance(df, pd.DataFrame) and list(df.index) == list(CHAPTER_METHODS)
+    assert isinstance(df, pd.DataFrame) and list(df.index) == list(DEFAULT_METHODS)
 
 
 # ------------------------------------------------------------------------- registry
@@ -121,13 +127,13 @@ def test_one_off_methods_by_mapping() -> None:
 
 def test_register_method_adds_a_row_without_touching_others() -> None:
     name = "straight line (test)"
-    cmp.register_method(name, "tests.trajopt.test_compare:_line_method")
+    cmp.register_method(name, "tests.trajopt.test_comparison:_line_method")
     try:
         assert name in cmp.registered_methods()
         with pytest.raises(InvalidInputError, match="already registered"):
             cmp.register_method(name, _line_method)
         t = cmp.compare(_room(), (0.5, 0.5), (2.5, 2.3), robot_radius=0.15, bspline={"n_ctrl": 8})
-        assert t.methods == (*CHAPTER_METHODS, name)
+        assert t.methods == (*DEFAULT_METHODS, name)
         t2 = cmp.compare(_room(), (0.5, 0.5), (2.5, 2.3), robot_radius=0.15, methods=[name])
         assert t2.methods == (name,)
     finally:
