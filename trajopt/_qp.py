@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import logging
 import threading
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -146,10 +147,14 @@ def _band_pattern(nb: int, p: int):
     return np.concatenate(rows), np.concatenate(cols)
 
 
+#: heading rows at the top of every constraint matrix (start/goal tangent; see smoother)
+N_HEADING_ROWS = 4
+
+
 @functools.lru_cache(maxsize=64)
 def qp_layout(nb: int, p: int):
     """Sparsity of the two-block banded Hessian (x block then y block) and the index map
-    from CCS non-zeros to ``(band offset, band column, block)``."""
+    from CCS non-zeros to ``(band offset, band column)``."""
     import casadi as ca
 
     r, c = _band_pattern(nb, p)
@@ -162,23 +167,153 @@ def qp_layout(nb: int, p: int):
     rr, cc = rows % nb, cols % nb
     d = np.abs(cc - rr)
     col = np.minimum(rr, cc)
-    sp_a = ca.Sparsity.dense(4, 2 * nb)
-    return sp_h, d, col, sp_a
+    return sp_h, d, col
 
 
 def h_nonzeros(band: np.ndarray, nb: int, p: int) -> np.ndarray:
     """CCS non-zeros of ``blockdiag(Hb, Hb)`` for the upper band ``band`` of ``Hb``."""
-    _, d, col, _ = qp_layout(nb, p)
+    _, d, col = qp_layout(nb, p)
     return band[d, col]
 
 
-@functools.lru_cache(maxsize=32)
-def qp_solver(nb: int, p: int, solver: str, verbose: bool):
-    """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
-    with the banded two-block Hessian pattern; built once per ``(nb, p, solver)``."""
+@dataclass(frozen=True)
+class ConstraintLayout:
+    """Rows of the linear constraints ``lba <= A z <= uba`` for ``nb`` padded control
+    points (``z = [x_0..x_{nb-1}, y_0..y_{nb-1}]``, then with ``m > 0`` one slack per
+    curvature sample) and ``m`` curvature samples per span.
+
+    Rows, in order: the :data:`N_HEADING_ROWS` heading rows (dense); for every control
+    point ``i`` the rows ``x_i + y_i`` and ``x_i - y_i`` (the 45-degree bounds of bridge
+    regions); then, for every sample ``r`` (``S = (nb - p) * m``, span ``r // m``), the
+    rows ``curvature+``, ``curvature-`` and ``speed`` of the sequential convex programme
+    (each over the ``2 (p + 1)`` coordinates of the span's control points and the sample's
+    slack, with coefficients -1, -1 and +1: an exact l1 penalty keeps every QP feasible).
+    """
+
+    nb: int
+    p: int
+    m: int
+    n_rows: int
+    sparsity: object
+    #: CCS non-zero k takes triplet value ``nz_from_triplet[k]``
+    nz_from_triplet: np.ndarray
+    n_triplets: int
+    #: row and column of every triplet
+    trip_rows: np.ndarray
+    trip_cols: np.ndarray
+
+    @property
+    def n_samples(self) -> int:
+        return (self.nb - self.p) * self.m
+
+    @property
+    def sample_row0(self) -> int:
+        return N_HEADING_ROWS + 2 * self.nb
+
+    def values(
+        self, heading: np.ndarray, sample_vals: np.ndarray | None = None
+    ) -> np.ndarray:
+        """Triplet values of ``A`` from the dense heading rows (4, 2nb) and the sample
+        rows' coefficients (S, 3, 2 (p + 1)): ``[x_j..x_{j+p}, y_j..y_{j+p}]`` per row."""
+        nb = self.nb
+        trip = np.empty(self.n_triplets)
+        k = N_HEADING_ROWS * 2 * nb
+        trip[:k] = heading.ravel()
+        diag = np.empty((nb, 4))
+        diag[:, 0] = diag[:, 1] = diag[:, 2] = 1.0
+        diag[:, 3] = -1.0
+        trip[k : k + 4 * nb] = diag.ravel()
+        k += 4 * nb
+        if self.m:
+            rows = trip[k:].reshape(self.n_samples, 3, 2 * (self.p + 1) + 1)
+            rows[:, :, :-1] = 0.0 if sample_vals is None else sample_vals
+            rows[:, :, -1] = (-1.0, -1.0, 1.0)  # slack: relaxes each row towards feasible
+        return trip
+
+    def nonzeros(self, trip: np.ndarray) -> np.ndarray:
+        """CCS non-zeros from triplet values (:meth:`values`)."""
+        return trip[self.nz_from_triplet]
+
+    def implied_range(
+        self, trip: np.ndarray, lbx: np.ndarray, ubx: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Range of every row ``A z`` over the variable bounds (interval arithmetic)."""
+        lo_v = lbx[self.trip_cols]
+        hi_v = ubx[self.trip_cols]
+        with np.errstate(invalid="ignore"):
+            a = np.where(trip >= 0, trip * lo_v, trip * hi_v)
+            b = np.where(trip >= 0, trip * hi_v, trip * lo_v)
+        a[trip == 0] = 0.0
+        b[trip == 0] = 0.0
+        lo = np.bincount(self.trip_rows, weights=a, minlength=self.n_rows)
+        hi = np.bincount(self.trip_rows, weights=b, minlength=self.n_rows)
+        return lo, hi
+
+
+@functools.lru_cache(maxsize=64)
+def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
+    """The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p`` and
+    ``m`` curvature samples per span (0: no sample rows)."""
     import casadi as ca
 
-    sp_h, _, _, sp_a = qp_layout(nb, p)
+    rows: list[np.ndarray] = []
+    cols: list[np.ndarray] = []
+    cols2 = np.arange(2 * nb)
+    for r in range(N_HEADING_ROWS):
+        rows.append(np.full(2 * nb, r))
+        cols.append(cols2)
+    i = np.arange(nb)
+    r0 = N_HEADING_ROWS + 2 * i
+    rows.append(np.column_stack([r0, r0, r0 + 1, r0 + 1]).ravel())
+    cols.append(np.column_stack([i, nb + i, i, nb + i]).ravel())
+    n_rows = N_HEADING_ROWS + 2 * nb
+    n_cols = 2 * nb
+    if m:
+        S = (nb - p) * m
+        span = np.arange(S) // m
+        base = n_rows + 3 * np.arange(S)
+        # per row: the span's x and y coordinates, then the sample's slack column
+        cc = np.concatenate(
+            [span[:, None] + np.arange(p + 1), nb + span[:, None] + np.arange(p + 1),
+             2 * nb + np.arange(S)[:, None]],
+            axis=1,
+        )
+        rr = base[:, None, None] + np.arange(3)[None, :, None]
+        w = 2 * (p + 1) + 1
+        rows.append(np.broadcast_to(rr, (S, 3, w)).ravel())
+        cols.append(np.broadcast_to(cc[:, None, :], (S, 3, w)).ravel())
+        n_rows += 3 * S
+        n_cols += S
+    rows_a = np.concatenate(rows).astype(np.int64)
+    cols_a = np.concatenate(cols).astype(np.int64)
+    sp, mapping = ca.Sparsity.triplet(n_rows, n_cols, rows_a.tolist(), cols_a.tolist(), False)
+    return ConstraintLayout(
+        nb=nb,
+        p=p,
+        m=m,
+        n_rows=n_rows,
+        sparsity=sp,
+        nz_from_triplet=np.asarray(mapping, dtype=np.int64),
+        n_triplets=len(rows_a),
+        trip_rows=rows_a,
+        trip_cols=cols_a,
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool):
+    """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
+    with the banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m)``; built
+    once per ``(nb, p, solver, m)``."""
+    import casadi as ca
+
+    sp_h = qp_layout(nb, p)[0]
+    layout = constraint_layout(nb, p, m)
+    sp_a = layout.sparsity
+    if m:  # slack columns: no Hessian entries
+        extra = layout.n_samples
+        colind = list(sp_h.colind()) + [sp_h.nnz()] * extra
+        sp_h = ca.Sparsity(2 * nb + extra, 2 * nb + extra, colind, list(sp_h.row()))
     if solver == "osqp":
         opts = {
             "osqp": {
@@ -199,24 +334,33 @@ def qp_solver(nb: int, p: int, solver: str, verbose: bool):
         opts["print_time"] = False
         opts["print_problem"] = False
     with _LOCK:
-        return ca.conic("smoother_qp", solver, {"h": sp_h, "a": sp_a}, opts)
+        return ca.conic(f"smoother_qp_{m}", solver, {"h": sp_h, "a": sp_a}, opts)
 
 
 @functools.lru_cache(maxsize=32)
 def qp_ipopt(nb: int, p: int, verbose: bool):
-    """The same convex problem solved by IPOPT (fallback / reference); parameters
-    ``[h band (p+1)*nb, g (2nb), a (8nb)]``."""
+    """The same convex problem (no sample rows) solved by IPOPT (fallback / reference);
+    parameters ``[h band (p+1)*nb, g (2nb), heading rows (4*2nb)]``."""
     import casadi as ca
 
     z = ca.SX.sym("z", 2 * nb)
     hb = ca.SX.sym("hb", (p + 1) * nb)
     g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", 4 * 2 * nb)
+    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
     f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, 4, 2 * nb)
-    nlp = {"x": z, "p": ca.vertcat(hb, g, a), "f": f, "g": ca.mtimes(amat, z)}
+    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
+    nlp = {"x": z, "p": ca.vertcat(hb, g, a), "f": f,
+           "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb))}
     with _LOCK:
         return ca.nlpsol("smoother_qp_ipopt", "ipopt", nlp, _ipopt_opts(verbose))
+
+
+def _diag_rows(z, nb: int):
+    """``[x_0 + y_0, x_0 - y_0, x_1 + y_1, ...]`` (the layout's diagonal rows)."""
+    import casadi as ca
+
+    x, y = z[:nb], z[nb:]
+    return ca.reshape(ca.horzcat(x + y, x - y).T, 2 * nb, 1)
 
 
 def _band_quadratic(z, hb, nb: int, p: int):
@@ -254,14 +398,15 @@ CURV_SAMPLES = 5
 
 @functools.lru_cache(maxsize=16)
 def curvature_nlp(nb: int, p: int, verbose: bool):
-    """IPOPT problem: the QP objective, the heading rows, and per sample ``r`` (``CURV_SAMPLES``
-    per span, span ``j`` touching control points ``j .. j + p``)
+    """IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``
+    (``CURV_SAMPLES`` per span, span ``j`` touching control points ``j .. j + p``)
 
     ``cross_r^2 - kmax^2 * speed2_r^3 <= 0`` and ``speed2_r >= floor_r^2`` (via ``lbg``),
 
     with ``cross = x'y'' - y'x''`` and ``speed2 = x'^2 + y'^2`` from basis-derivative values
     passed as parameters. Parameters: ``[hb, g, a, b1 (S*(p+1)), b2 (S*(p+1)), kmax^2]``.
-    Constraint order: 4 heading rows, then ``S`` curvature rows, then ``S`` speed rows.
+    Constraint order: 4 heading rows, ``2 nb`` diagonal rows, then ``S`` curvature rows,
+    then ``S`` speed rows.
     """
     import casadi as ca
 
@@ -270,13 +415,13 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
     z = ca.SX.sym("z", 2 * nb)
     hb = ca.SX.sym("hb", (p + 1) * nb)
     g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", 4 * 2 * nb)
+    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
     b1 = ca.SX.sym("b1", S * (p + 1))
     b2 = ca.SX.sym("b2", S * (p + 1))
     k2 = ca.SX.sym("k2")
     x, y = z[:nb], z[nb:]
     f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, 4, 2 * nb)
+    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
     span = np.repeat(np.arange(ns), CURV_SAMPLES)
     B1 = ca.reshape(b1, S, p + 1)
     B2 = ca.reshape(b2, S, p + 1)
@@ -297,7 +442,7 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
         "x": z,
         "p": ca.vertcat(hb, g, a, b1, b2, k2),
         "f": f,
-        "g": ca.vertcat(ca.mtimes(amat, z), gcurv, sp2),
+        "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb), gcurv, sp2),
     }
     with _LOCK:
         return ca.nlpsol("smoother_curv", "ipopt", nlp, _ipopt_opts(verbose))

@@ -45,14 +45,25 @@ def _readonly(a: np.ndarray, dtype: Any) -> np.ndarray:
 
 @dataclass(frozen=True, slots=True)
 class Box:
-    """An axis-aligned box of free cells, shrunk to the rectangle of its cell centres.
+    """A convex free region of a corridor (m).
+
+    Usually an axis-aligned box of free cells of the inflated grid, shrunk to the rectangle
+    of its cell centres. A *bridge* (``diagonal`` set) is a 45-degree rotated rectangle
+    placed where the path crosses diagonally between two boxes that touch only at a point
+    or along a line; it is certified by an exact polygon-to-square distance against the raw
+    map instead (see :func:`build_corridor`).
 
     Attributes
     ----------
     xmin, xmax, ymin, ymax : float
-        The shrunk box in world metres (cell centres of the outermost cells).
+        The shrunk box in world metres (cell centres of the outermost cells); for a bridge,
+        its bounding box.
     ix0, ix1, iy0, iy1 : int
-        The cell rectangle, inclusive: cells ``ix0..ix1`` by ``iy0..iy1``.
+        The cell rectangle, inclusive: cells ``ix0..ix1`` by ``iy0..iy1`` (for a bridge the
+        cells its bounding box touches, not all free).
+    diagonal : tuple of float or None
+        ``(smin, smax, dmin, dmax)``: a bridge is ``smin <= x + y <= smax`` and
+        ``dmin <= x - y <= dmax`` (m) intersected with the bounding box; ``None`` for a box.
     """
 
     xmin: float
@@ -63,6 +74,29 @@ class Box:
     ix1: int
     iy0: int
     iy1: int
+    diagonal: tuple[float, float, float, float] | None = None
+
+    @property
+    def is_diagonal(self) -> bool:
+        """Whether this is a 45-degree *bridge* region (``diagonal`` is set)."""
+        return self.diagonal is not None
+
+    def vertices(self) -> np.ndarray:
+        """Corners of the region, counter-clockwise, shape (k, 2) (m).
+
+        The axis-aligned rectangle, or for a bridge its (possibly clipped) rotated one.
+        """
+        if self.diagonal is None:
+            return np.array(
+                [[self.xmin, self.ymin], [self.xmax, self.ymin], [self.xmax, self.ymax],
+                 [self.xmin, self.ymax]]
+            )
+        smin, smax, dmin, dmax = self.diagonal
+        # corners of the rotated rectangle in (s, d) = (x + y, x - y)
+        sd = np.array([[smin, dmax], [smin, dmin], [smax, dmin], [smax, dmax]])
+        xy = np.column_stack([(sd[:, 0] + sd[:, 1]) / 2, (sd[:, 0] - sd[:, 1]) / 2])
+        order = np.argsort(np.arctan2(*(xy - xy.mean(axis=0)).T[::-1]))
+        return xy[order]
 
     @property
     def cells_x(self) -> int:
@@ -77,12 +111,19 @@ class Box:
     def contains(self, points: np.ndarray, tol: float = 0.0) -> np.ndarray:
         """Whether world points (shape ``(..., 2)``, m) lie in the box (``tol`` m of slack)."""
         p = np.asarray(points, dtype=float)
-        return (
+        inside = (
             (p[..., 0] >= self.xmin - tol)
             & (p[..., 0] <= self.xmax + tol)
             & (p[..., 1] >= self.ymin - tol)
             & (p[..., 1] <= self.ymax + tol)
         )
+        if self.diagonal is not None:
+            smin, smax, dmin, dmax = self.diagonal
+            s = p[..., 0] + p[..., 1]
+            d = p[..., 0] - p[..., 1]
+            t2 = 2 * tol
+            inside &= (s >= smin - t2) & (s <= smax + t2) & (d >= dmin - t2) & (d <= dmax + t2)
+        return inside
 
     def contains_cells(self, cells: np.ndarray) -> np.ndarray:
         """Whether cells ``(ix, iy)`` (shape ``(..., 2)``) lie in the cell rectangle."""
@@ -135,6 +176,8 @@ class Corridor:
     radius: float | None = None
     _lo: np.ndarray = field(init=False, repr=False, compare=False)
     _hi: np.ndarray = field(init=False, repr=False, compare=False)
+    _dlo: np.ndarray = field(init=False, repr=False, compare=False)
+    _dhi: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "boxes", tuple(self.boxes))
@@ -144,10 +187,21 @@ class Corridor:
         object.__setattr__(self, "path_points", _readonly(self.path_points, float))
         lo = np.array([[b.xmin, b.ymin] for b in self.boxes], dtype=float).reshape(-1, 2)
         hi = np.array([[b.xmax, b.ymax] for b in self.boxes], dtype=float).reshape(-1, 2)
-        lo.flags.writeable = False
-        hi.flags.writeable = False
+        inf = np.inf
+        dlo = np.array(
+            [[-inf, -inf] if b.diagonal is None else [b.diagonal[0], b.diagonal[2]]
+             for b in self.boxes], dtype=float,
+        ).reshape(-1, 2)
+        dhi = np.array(
+            [[inf, inf] if b.diagonal is None else [b.diagonal[1], b.diagonal[3]]
+             for b in self.boxes], dtype=float,
+        ).reshape(-1, 2)
+        for a in (lo, hi, dlo, dhi):
+            a.flags.writeable = False
         object.__setattr__(self, "_lo", lo)
         object.__setattr__(self, "_hi", hi)
+        object.__setattr__(self, "_dlo", dlo)
+        object.__setattr__(self, "_dhi", dhi)
 
     def __len__(self) -> int:
         return len(self.boxes)
@@ -163,6 +217,18 @@ class Corridor:
         return self._hi
 
     @property
+    def diag_lower(self) -> np.ndarray:
+        """Lower bounds ``(smin, dmin)`` on ``x + y`` and ``x - y`` (m), shape (m, 2);
+        ``-inf`` for axis-aligned boxes."""
+        return self._dlo
+
+    @property
+    def diag_upper(self) -> np.ndarray:
+        """Upper bounds ``(smax, dmax)`` on ``x + y`` and ``x - y`` (m), shape (m, 2);
+        ``+inf`` for axis-aligned boxes."""
+        return self._dhi
+
+    @property
     def length_m(self) -> float:
         """Length of the path polyline (m)."""
         return float(self.path_s[-1])
@@ -173,6 +239,12 @@ class Corridor:
         flat = p.reshape(-1, 2)
         inside = np.all(
             (flat[:, None, :] >= self._lo[None] - tol) & (flat[:, None, :] <= self._hi[None] + tol),
+            axis=2,
+        )
+        sd = np.column_stack([flat[:, 0] + flat[:, 1], flat[:, 0] - flat[:, 1]])
+        inside &= np.all(
+            (sd[:, None, :] >= self._dlo[None] - 2 * tol)
+            & (sd[:, None, :] <= self._dhi[None] + 2 * tol),
             axis=2,
         )
         return inside.any(axis=1).reshape(p.shape[:-1])
@@ -240,6 +312,7 @@ def build_corridor(
     seed_back_cells: int = 3,
     min_share_cells: float = 1.5,
     radius: float | None = None,
+    raw_grid: Any = None,
 ) -> Corridor:
     """Grow a chain of overlapping free boxes around a grid path.
 
@@ -261,6 +334,14 @@ def build_corridor(
         path is at least this long (cells) where possible. Default 1.5.
     radius : float, optional
         The clearance (m) ``inflated_grid`` was built for; stored on the corridor.
+    raw_grid : astar.OccupancyGrid, optional
+        The raw map ``inflated_grid`` was inflated from (same shape, resolution and
+        origin; requires ``radius``). When given, *bridges* are inserted where the path
+        crosses diagonally between two boxes that meet only at a point or along a line
+        (diagonal gaps, staircase passages): 45-degree rectangles around the path, grown
+        while their exact distance to every occupied square of ``raw_grid`` (and to the
+        outside of the map) stays ``>= radius``. Without bridges the smoother's control
+        points are squeezed into that point and the curve stops there.
 
     Returns
     -------
@@ -290,6 +371,22 @@ def build_corridor(
     if radius is not None and not (np.isfinite(radius) and radius >= 0):
         raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
     occ = np.asarray(inflated_grid.occupied, dtype=bool)
+    raw_occ = None
+    if raw_grid is not None:
+        if radius is None:
+            raise InvalidInputError("radius is required with raw_grid (bridges certify it)")
+        raw_occ = np.asarray(raw_grid.occupied, dtype=bool)
+        same = (
+            raw_occ.shape == occ.shape
+            and float(raw_grid.resolution) == float(inflated_grid.resolution)
+            and tuple(map(float, raw_grid.origin)) == tuple(map(float, inflated_grid.origin))
+        )
+        if not same:
+            raise InvalidInputError(
+                "raw_grid must have the inflated grid's shape, resolution and origin; got "
+                f"{raw_occ.shape} at {raw_grid.resolution} m vs {occ.shape} at "
+                f"{inflated_grid.resolution} m"
+            )
     ny, nx = occ.shape
     cells = _as_cells(grid_path)
     inb = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
@@ -382,6 +479,10 @@ def build_corridor(
             break
         i = b + 1
 
+    diags: list[tuple[float, float, float, float] | None] = [None] * len(rects)
+    if raw_occ is not None:
+        rects, runs, diags = _insert_bridges(rects, runs, cells, raw_occ, float(radius) / res)
+
     pts = np.column_stack([ox + (cells[:, 0] + 0.5) * res, oy + (cells[:, 1] + 0.5) * res])
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
     m = len(rects)
@@ -405,7 +506,9 @@ def build_corridor(
             iy0=r[2],
             iy1=r[3],
         )
-        for r in rects
+        if dg is None
+        else _bridge_box(dg, res, ox, oy)
+        for r, dg in zip(rects, diags, strict=True)
     )
     logger.debug("corridor: %d boxes for %d path cells", m, n)
     return Corridor(
@@ -451,3 +554,212 @@ def _place_transitions(
         if t[k] <= t[k - 1]:
             t[k] = min(hi[k], t[k - 1] + 1e-9 * max(1.0, length))
     return t
+
+
+# ------------------------------------------------------------------ bridges
+_SQRT2 = float(np.sqrt(2.0))
+
+
+def _occupied_squares(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
+    """Lower-left corners (cells) of the occupied unit squares among cells ``x0..x1`` by
+    ``y0..y1``; cells outside the map count as occupied. Shape (M, 2)."""
+    ny, nx = occ.shape
+    xs = np.arange(x0, x1 + 1)
+    ys = np.arange(y0, y1 + 1)
+    gx, gy = np.meshgrid(xs, ys)
+    inside = (gx >= 0) & (gx < nx) & (gy >= 0) & (gy < ny)
+    blocked = np.ones(gx.shape, dtype=bool)
+    blocked[inside] = occ[gy[inside], gx[inside]]
+    return np.column_stack([gx[blocked], gy[blocked]]).astype(float)
+
+
+def rotated_rect_clearance(sd: tuple[float, float, float, float], squares: np.ndarray) -> float:
+    """Exact distance from a 45-degree rectangle to a set of axis-aligned unit squares.
+
+    Parameters
+    ----------
+    sd : (smin, smax, dmin, dmax)
+        The rectangle ``smin <= x + y <= smax``, ``dmin <= x - y <= dmax`` (cell units).
+    squares : ndarray, shape (M, 2)
+        Lower-left corners of the unit squares (cell units).
+
+    Returns
+    -------
+    float
+        ``0`` when the rectangle meets a square, ``inf`` for no squares; otherwise the
+        distance (cells): two disjoint convex polygons are closest at a vertex of one of
+        them, so it is the smaller of the rectangle's corners to the squares and the
+        squares' corners to the rectangle. Separation is decided exactly by the four axes
+        of the two shapes (separating-axis theorem).
+    """
+    if len(squares) == 0:
+        return float("inf")
+    smin, smax, dmin, dmax = sd
+    qx = squares[:, 0]
+    qy = squares[:, 1]
+    separated = (
+        (qx > 0.5 * (smax + dmax))
+        | (qx + 1 < 0.5 * (smin + dmin))
+        | (qy > 0.5 * (smax - dmin))
+        | (qy + 1 < 0.5 * (smin - dmax))
+        | (qx + qy > smax)
+        | (qx + qy + 2 < smin)
+        | (qx - qy - 1 > dmax)
+        | (qx - qy + 1 < dmin)
+    )
+    if not separated.all():
+        return 0.0
+    vs = np.array([smin, smin, smax, smax])
+    vd = np.array([dmin, dmax, dmin, dmax])
+    vx = (0.5 * (vs + vd))[:, None]
+    vy = (0.5 * (vs - vd))[:, None]
+    gx = np.maximum(0.0, np.maximum(qx[None] - vx, vx - (qx[None] + 1)))
+    gy = np.maximum(0.0, np.maximum(qy[None] - vy, vy - (qy[None] + 1)))
+    best = float(np.hypot(gx, gy).min())
+    for cx, cy in ((0, 0), (1, 0), (0, 1), (1, 1)):
+        s = qx + cx + qy + cy
+        d = qx + cx - qy - cy
+        gs = np.maximum(0.0, np.maximum(smin - s, s - smax))
+        gd = np.maximum(0.0, np.maximum(dmin - d, d - dmax))
+        best = min(best, float(np.hypot(gs, gd).min()) / _SQRT2)
+    return best
+
+
+def _diagonal_bridge(
+    raw_occ: np.ndarray,
+    cells: np.ndarray,
+    t: int,
+    radius_cells: float,
+    *,
+    reach: int = 3,
+    step: float = 0.25,
+    grow_along: float = 2.0,
+    max_width: float = 4.0,
+    min_width: float = 0.5,
+) -> tuple[float, float, float, float] | None:
+    """A certified 45-degree rectangle (cell units, ``(smin, smax, dmin, dmax)``) around the
+    path near cell ``t`` when the path runs diagonally there, else ``None``.
+
+    Seeded with the path cell centres ``t - k .. t + k`` (``k <= reach``, reduced until
+    the seed is certified), then grown ``step`` at a time, round-robin across and along the
+    path, while its exact distance to every occupied square of the raw map (and to the
+    outside of the map) stays ``>= radius_cells``.
+    """
+    n = len(cells)
+    k = min(reach, t, n - 1 - t)
+    if k < 1:
+        return None
+    dv = cells[t + k] - cells[t - k]
+    ax, ay = abs(int(dv[0])), abs(int(dv[1]))
+    if ax == 0 or ay == 0 or max(ax, ay) > 2 * min(ax, ay):
+        return None  # not a diagonal stretch: axis-aligned boxes serve it
+    along_s = dv[0] * dv[1] > 0  # direction (1, 1): along x + y; else along x - y
+    pad = int(np.ceil(radius_cells)) + reach + int(np.ceil(grow_along + max_width)) + 2
+    cx, cy = int(cells[t, 0]), int(cells[t, 1])
+    squares = _occupied_squares(raw_occ, cx - pad, cx + pad, cy - pad, cy + pad)
+
+    def certified(r: list[float]) -> bool:
+        return rotated_rect_clearance((r[0], r[1], r[2], r[3]), squares) >= radius_cells
+
+    rect = None
+    while k >= 1:
+        seg = cells[t - k : t + k + 1] + 0.5
+        s = seg[:, 0] + seg[:, 1]
+        d = seg[:, 0] - seg[:, 1]
+        cand = [float(s.min()), float(s.max()), float(d.min()), float(d.max())]
+        if certified(cand):
+            rect = cand
+            break
+        k -= 1
+    if rect is None:
+        return None
+    # indices into rect: across (perpendicular) and along the path
+    across = (2, 3) if along_s else (0, 1)
+    along = (0, 1) if along_s else (2, 3)
+    limit = {
+        across[0]: rect[across[0]] - 0.5 * max_width,
+        across[1]: rect[across[1]] + 0.5 * max_width,
+        along[0]: rect[along[0]] - grow_along,
+        along[1]: rect[along[1]] + grow_along,
+    }
+    sides = [across[0], across[1], along[0], along[1]]
+    active = set(sides)
+    while active:
+        for side in sides:
+            if side not in active:
+                continue
+            cand = list(rect)
+            sign = -1.0 if side in (0, 2) else 1.0
+            cand[side] += sign * step
+            beyond = cand[side] < limit[side] if sign < 0 else cand[side] > limit[side]
+            if beyond or not certified(cand):
+                active.discard(side)
+                continue
+            rect = cand
+    if rect[across[1]] - rect[across[0]] < min_width:
+        return None
+    return (rect[0], rect[1], rect[2], rect[3])
+
+
+def _bridge_box(dg: tuple[float, float, float, float], res: float, ox: float, oy: float) -> Box:
+    """World-metre :class:`Box` of a bridge given in cell units."""
+    smin, smax, dmin, dmax = dg
+    xmin, xmax = 0.5 * (smin + dmin), 0.5 * (smax + dmax)
+    ymin, ymax = 0.5 * (smin - dmax), 0.5 * (smax - dmin)
+    return Box(
+        xmin=ox + xmin * res,
+        xmax=ox + xmax * res,
+        ymin=oy + ymin * res,
+        ymax=oy + ymax * res,
+        ix0=int(np.floor(xmin)),
+        ix1=int(np.ceil(xmax)) - 1,
+        iy0=int(np.floor(ymin)),
+        iy1=int(np.ceil(ymax)) - 1,
+        diagonal=(
+            smin * res + ox + oy,
+            smax * res + ox + oy,
+            dmin * res + ox - oy,
+            dmax * res + ox - oy,
+        ),
+    )
+
+
+def _in_bridge(dg: tuple[float, float, float, float], cell: np.ndarray) -> bool:
+    x, y = float(cell[0]) + 0.5, float(cell[1]) + 0.5
+    eps = 1e-9
+    return (
+        dg[0] - eps <= x + y <= dg[1] + eps and dg[2] - eps <= x - y <= dg[3] + eps
+    )
+
+
+def _insert_bridges(rects, runs, cells, raw_occ, radius_cells):
+    """Insert a certified 45-degree bridge between consecutive boxes whose shrunk boxes
+    meet only at a point or along a line, where the path crosses them diagonally."""
+    out_r = [rects[0]]
+    out_run = [runs[0]]
+    out_d: list = [None]
+    for k in range(len(rects) - 1):
+        a, b = rects[k], rects[k + 1]
+        ext_x = min(a[1], b[1]) - max(a[0], b[0])
+        ext_y = min(a[3], b[3]) - max(a[2], b[2])
+        if ext_x < 1 or ext_y < 1:
+            lo_i, hi_i = runs[k + 1][0], runs[k][1]
+            t = (lo_i + hi_i) // 2
+            dg = _diagonal_bridge(raw_occ, cells, t, radius_cells)
+            if dg is not None:
+                i0 = i1 = t
+                while i0 > 0 and _in_bridge(dg, cells[i0 - 1]):
+                    i0 -= 1
+                while i1 + 1 < len(cells) and _in_bridge(dg, cells[i1 + 1]):
+                    i1 += 1
+                # it must share path cells with both neighbours, beyond the single cell t
+                left = (max(runs[k][0], i0), min(runs[k][1], i1))
+                right = (max(runs[k + 1][0], i0), min(runs[k + 1][1], i1))
+                if left[0] <= left[1] and right[0] <= right[1] and left[0] < right[1]:
+                    out_r.append(None)  # a bridge has no cell rectangle
+                    out_run.append((i0, i1))
+                    out_d.append(dg)
+        out_r.append(b)
+        out_run.append(runs[k + 1])
+        out_d.append(None)
+    return out_r, out_run, out_d

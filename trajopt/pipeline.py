@@ -141,6 +141,12 @@ class Planner:
             w_cells = max(1, round(robot.width / grid.resolution))
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
             raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
+        if (
+            isinstance(timing_dt, bool)
+            or not isinstance(timing_dt, (int, float, np.integer, np.floating))
+            or not 0.0 < float(timing_dt) <= 0.5
+        ):
+            raise InvalidInputError(f"timing_dt must be a number in (0, 0.5] s, got {timing_dt!r}")
         smoother = Smoother() if smoother is None else smoother
         if not isinstance(smoother, Smoother):
             raise InvalidInputError(
@@ -239,7 +245,7 @@ class Planner:
         for name, p, c in (("start", p0, c0), ("goal", p1, c1)):
             if inflated.occupied[c[1], c[0]]:
                 raise InvalidInputError(
-                    f"{name} {p.tolist()} m lies in cell {tuple(c)}, which is blocked by the "
+                    f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
                     f"inflation={self.inflation!r} avoidance area (robot radius "
                     f"{self.robot.radius} m); clearance of the cell centre "
                     f"{_clearance_of(self.grid, self.grid.cell_to_world(c)):.4g} m"
@@ -247,7 +253,7 @@ class Planner:
         if tuple(c0) == tuple(c1):
             raise InvalidInputError(
                 f"start {p0.tolist()} m and goal {p1.tolist()} m lie in the same cell "
-                f"{tuple(c0)}; the planner needs them at least one cell apart"
+                f"{_cell(c0)}; the planner needs them at least one cell apart"
             )
         t = time.perf_counter()
         cost = self.search_cost
@@ -260,7 +266,12 @@ class Planner:
             ) from exc
         stages["search"] = time.perf_counter() - t
         t = time.perf_counter()
-        corridor = build_corridor(inflated, path, radius=self.robot.radius)
+        # bridges (45-degree regions certified against the raw map) across diagonal gaps;
+        # not with the chapter's avoidance area, which the curve must not enter either
+        bridge_map = self.grid if self.inflation == "exact" else None
+        corridor = build_corridor(
+            inflated, path, radius=self.robot.radius, raw_grid=bridge_map
+        )
         corridor = _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
         stages["corridor"] = time.perf_counter() - t
         t = time.perf_counter()
@@ -308,7 +319,9 @@ class Planner:
                 f"[{ox}, {ox + grid.width}] x [{oy}, {oy + grid.height}] m"
             )
         if grid.occupied[c[1], c[0]]:
-            raise InvalidInputError(f"{name} {p.tolist()} m lies on an occupied cell {tuple(c)}")
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
+            )
         clr = _clearance_of(grid, p)
         if clr < self.robot.radius:
             raise InvalidInputError(
@@ -389,6 +402,11 @@ def _point(name: str, value: Any) -> np.ndarray:
     if not np.all(np.isfinite(p)):
         raise InvalidInputError(f"{name} must be finite, got {p.tolist()}")
     return p
+
+
+def _cell(c: np.ndarray) -> tuple[int, int]:
+    """A cell ``(ix, iy)`` as plain ints (for messages)."""
+    return (int(c[0]), int(c[1]))
 
 
 def _box_clearance(grid: OccupancyGrid, lo: np.ndarray, hi: np.ndarray) -> float:

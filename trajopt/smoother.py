@@ -5,7 +5,7 @@ arc length along the A* polyline) to the A* points ``p_r`` at their arc lengths 
 
     minimise   sum_r |C(u_r) - p_r|^2  +  w * integral |C^(m)(u)|^2 du          (cell units)
     subject to c_0 = start, c_{n-1} = goal,
-               c_i in the intersection of the corridor boxes of every span it touches,
+               c_i in the intersection of the corridor regions of every span it touches,
                optional: c_1 on the start-heading ray, c_{n-2} on the reverse goal ray,
                optional: |kappa| <= kappa_max at dense samples (with a speed floor).
 
@@ -15,12 +15,17 @@ basis). Positions and parameters are divided by the grid resolution first, so th
 weights work on every map.
 
 The corridor constraint uses the convex-hull property: span ``j`` lies in the convex hull
-of ``c_j .. c_{j+p}``; with all of them inside the span's box the whole continuous span is
-inside it. Knots are graded so that every box holds at least ``p`` spans (then no control
-point touches more than two consecutive boxes, which always intersect), so the bounds are
-plain variable bounds and the QP is feasible by construction. The convex problem is solved
-as a sparse banded QP by ``casadi.conic`` (osqp by default), the curvature-bounded one by
-IPOPT warm-started from the QP. Solvers are built once per padded size and cached.
+of ``c_j .. c_{j+p}``; with all of them inside the span's region the whole continuous span
+is inside it. Knots are graded so that every region holds at least ``p`` spans (then no
+control point touches more than two consecutive regions, which always intersect), so each
+control point is bounded by one intersection: variable bounds for the axis-aligned boxes
+plus two rows ``x + y`` and ``x - y`` for the 45-degree *bridges* the corridor places in
+diagonal gaps. The convex problem is a sparse banded QP solved by ``casadi.conic`` (piqp by
+default). The curvature-bounded problem is solved by sequential convex programming (a few
+QPs with the bound linearised at the current iterate, l1-penalised slacks and a trust
+region; ``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex
+problem, warm-started from the QP (``curvature_solver="ipopt"``). Solvers are built once
+per padded size and cached.
 
 Every result is verified (:class:`Certificate`) before it is returned: control points in
 their boxes, exact endpoints, dense-sample clearance against the raw map, no cusp, and the
@@ -50,6 +55,8 @@ logger = logging.getLogger(__name__)
 
 QPSolver = Literal["osqp", "piqp", "ipopt"]
 _QP_SOLVERS = ("osqp", "piqp", "ipopt")
+CurvatureSolver = Literal["scp", "ipopt"]
+_CURVATURE_SOLVERS = ("scp", "ipopt")
 
 
 # ----------------------------------------------------------------------- values
@@ -181,8 +188,19 @@ class Smoother:
     speed_floor : float, optional
         With a curvature bound, ``|C'(u)| >= speed_floor`` at the samples (cells per cell of
         ``u``; 1 is the A* polyline's speed). Prevents cusps. Default 0.2.
-    qp_solver : {"osqp", "piqp", "ipopt"}, optional
-        Solver of the convex problem. Default "osqp".
+    qp_solver : {"piqp", "osqp", "ipopt"}, optional
+        Solver of the convex problem. Default "piqp" (an interior-point method: steady
+        iteration counts, and no state kept between calls, so results are reproducible
+        bit for bit; osqp warm-starts its duals from the previous call).
+    curvature_solver : {"scp", "ipopt"}, optional
+        How the curvature-bounded problem is solved. ``"scp"`` (default): sequential
+        convex programming, a few piqp QPs in which
+        the bound is linearised conservatively around the previous iterate's tangents,
+        inside a trust region. ``"ipopt"``: the exact non-convex problem by IPOPT, warm
+        started from the QP (slower by one to two orders of magnitude; see
+        ``docs/benchmarks.md``).
+    scp_iterations : int, optional
+        Most SCP iterations. Default 25.
     time_budget_s : float, optional
         Wall-time budget per :meth:`fit` call (s); exceeded -> ``SmoothingError``.
         Default 5 (the first call of a new size also builds its solvers).
@@ -201,7 +219,9 @@ class Smoother:
     kappa_max: float | None = None
     kappa_margin: float = 0.9
     speed_floor: float = 0.2
-    qp_solver: QPSolver = "osqp"
+    qp_solver: QPSolver = "piqp"
+    curvature_solver: CurvatureSolver = "scp"
+    scp_iterations: int = 25
     time_budget_s: float = 5.0
     max_attempts: int = 3
     samples_per_cell: int = 8
@@ -229,6 +249,15 @@ class Smoother:
         if self.qp_solver not in _QP_SOLVERS:
             raise InvalidInputError(
                 f"qp_solver must be one of {_QP_SOLVERS}, got {self.qp_solver!r}"
+            )
+        if self.curvature_solver not in _CURVATURE_SOLVERS:
+            raise InvalidInputError(
+                f"curvature_solver must be one of {_CURVATURE_SOLVERS}, "
+                f"got {self.curvature_solver!r}"
+            )
+        if not isinstance(self.scp_iterations, (int, np.integer)) or self.scp_iterations < 1:
+            raise InvalidInputError(
+                f"scp_iterations must be an integer >= 1, got {self.scp_iterations!r}"
             )
         _check_float("time_budget_s", self.time_budget_s, lo=0.0, strict=True)
         if not isinstance(self.max_attempts, (int, np.integer)) or self.max_attempts < 1:
@@ -314,6 +343,8 @@ class Smoother:
             u=corridor.path_s / res,
             lo=(corridor.lower - origin) / res,
             hi=(corridor.upper - origin) / res,
+            dlo=(corridor.diag_lower - _sd(origin)) / res,
+            dhi=(corridor.diag_upper - _sd(origin)) / res,
             trans=corridor.transitions_m / res,
             overlap=(corridor.overlap_end_m - corridor.overlap_start_m) / res,
             start=(p0 - origin) / res,
@@ -396,9 +427,17 @@ class Smoother:
             raise InvalidInputError(f"need at least {2 * p + 2} knots for degree {p}, got {len(t)}")
         band, g, _ = _objective(pts, uu, t, p, n, self.smoothness_weight, self.smoothness_order)
         nb = _qp.bucket_size(n)
+        full = np.zeros((p + 1, nb))
+        full[:, :n] = band[:, :n]
+        full[0, n:] = 1.0
         lbx = np.full(2 * nb, -np.inf)
         ubx = np.full(2 * nb, np.inf)
-        z, info = self._solve_qp(band, g, n, nb, lbx, ubx, None, None, None, 60.0)
+        lbx[n:nb] = ubx[n:nb] = lbx[nb + n :] = ubx[nb + n :] = 0.0
+        n_rows = _qp.N_HEADING_ROWS + 2 * nb
+        qp = _QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx,
+                     heading=np.zeros((_qp.N_HEADING_ROWS, 2 * nb)),
+                     lba=np.full(n_rows, -np.inf), uba=np.full(n_rows, np.inf))
+        z, info = self._solve_qp(qp, 60.0)
         if not info["success"]:
             raise SmoothingError(f"unconstrained fit failed: {info['status']}", info)
         return BSplineCurve(t, np.column_stack([z[:n], z[nb : nb + n]]), p)
@@ -409,26 +448,38 @@ class Smoother:
         t, span_box = graded_knots(prob.u[-1], prob.trans, prob.overlap, p, h)
         n = len(t) - p - 1
         nb = _qp.bucket_size(n)
-        # control-point bounds: intersection of the boxes of the spans each one touches
+        # control-point bounds: intersection of the regions of the spans each one touches
         lo = np.full((n, 2), -np.inf)
         hi = np.full((n, 2), np.inf)
+        dlo = np.full((n, 2), -np.inf)
+        dhi = np.full((n, 2), np.inf)
         for off in range(p + 1):
             idx = np.arange(len(span_box)) + off
             lo[idx] = np.maximum(lo[idx], prob.lo[span_box])
             hi[idx] = np.minimum(hi[idx], prob.hi[span_box])
-        if np.any(lo > hi):
-            raise _AttemptFailed("empty control-point bound (boxes do not intersect)", {})
+            dlo[idx] = np.maximum(dlo[idx], prob.dlo[span_box])
+            dhi[idx] = np.minimum(dhi[idx], prob.dhi[span_box])
+        if np.any(lo > hi) or np.any(dlo > dhi):
+            raise _AttemptFailed("empty control-point bound (regions do not intersect)", {})
         lo[0] = hi[0] = prob.start
         lo[-1] = hi[-1] = prob.goal
+        dlo[[0, -1]] = -np.inf  # the fixed ends were checked against their regions
+        dhi[[0, -1]] = np.inf
         band, g, const = _objective(
             prob.targets, prob.u, t, p, n, self.smoothness_weight, self.smoothness_order
         )
         band[0] += 1e-9 * (1.0 + band[0].max())  # keeps the Hessian definite
+        full = np.zeros((p + 1, nb))
+        full[:, :n] = band[:, :n]
+        full[0, n:] = 1.0  # padded variables: fixed at 0 by their bounds
         lbx = np.zeros(2 * nb)
         ubx = np.zeros(2 * nb)
         lbx[:n], lbx[nb : nb + n] = lo[:, 0], lo[:, 1]
         ubx[:n], ubx[nb : nb + n] = hi[:, 0], hi[:, 1]
-        amat, lba, uba = _heading_rows(prob, n, nb)
+        heading, lba, uba = _heading_rows(prob, n, nb)
+        rlb, rub = _diag_row_bounds(dlo, dhi, nb)
+        lba = np.concatenate([lba, rlb])
+        uba = np.concatenate([uba, rub])
         x0 = np.zeros(2 * nb)
         # warm start: the targets projected to the bounds, by parameter
         greville = np.array([t[i + 1 : i + p + 1].mean() for i in range(n)])
@@ -437,7 +488,9 @@ class Smoother:
             x0[d * nb : d * nb + n] = np.clip(
                 guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n]
             )
-        z, info = self._solve_qp(band, g, n, nb, lbx, ubx, amat, lba, uba, remaining, x0=x0)
+        qp = _QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx, heading=heading,
+                     lba=lba, uba=uba)
+        z, info = self._solve_qp(qp, remaining, x0=x0)
         stats = {
             "n_control_points": n,
             "padded_size": nb,
@@ -452,18 +505,21 @@ class Smoother:
             raise _AttemptFailed(f"QP solver {info['solver']}: {info['status']}", stats)
         z = np.clip(z, lbx, ubx)
         if self.kappa_max is not None:
-            kmax_cells = self.kappa_max * prob_res_scale(prob)
-            z, cinfo = self._solve_curvature(
-                prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z, kmax_cells, remaining
-            )
+            kmax_cells = self.kappa_max * prob.res
+            if self.curvature_solver == "scp":
+                z, cinfo = self._solve_curvature_scp(qp, t, z, kmax_cells, remaining)
+            else:
+                z, cinfo = self._solve_curvature_ipopt(qp, t, z, kmax_cells, remaining)
             stats["nlp"] = cinfo
-            stats["solver"] = info["solver"] + "+ipopt"
+            stats["solver"] = info["solver"] + "+" + cinfo["solver"]
             stats["status"] = cinfo["status"]
             stats["iterations"] = info["iterations"] + cinfo["iterations"]
             stats["solve_time_s"] = info["solve_time_s"] + cinfo["solve_time_s"]
             stats["build_time_s"] = info["build_time_s"] + cinfo["build_time_s"]
             if not cinfo["success"]:
-                raise _AttemptFailed(f"IPOPT (curvature bound): {cinfo['status']}", stats)
+                raise _AttemptFailed(
+                    f"curvature bound ({cinfo['solver']}): {cinfo['status']}", stats
+                )
             z = np.clip(z, lbx, ubx)
         c = np.column_stack([z[:n], z[nb : nb + n]])
         _project_heading(c, prob, lo, hi)
@@ -476,102 +532,276 @@ class Smoother:
         stats["cost"] = cost
         return c, t, span_box, stats
 
-    def _solve_qp(self, band, g, n, nb, lbx, ubx, amat, lba, uba, remaining, x0=None):
+    def _solve_qp(self, qp: _QPData, remaining: float, x0=None, *, solver_name=None,
+                  m: int = 0, sample_vals=None, lba=None, uba=None, lbx=None, ubx=None,
+                  slack_open=None):
+        """One QP solve (``m`` curvature samples per span when ``sample_vals`` is given)."""
         p = self.degree
-        full = np.zeros((p + 1, nb))
-        full[:, :n] = band[:, :n]
-        full[0, n:] = 1.0  # padded variables: fixed at 0 by their bounds
-        lbx = lbx.copy()
-        ubx = ubx.copy()
-        lbx[n:nb] = ubx[n:nb] = 0.0
-        lbx[nb + n :] = ubx[nb + n :] = 0.0
-        gg = np.zeros(2 * nb)
-        gg[:n], gg[nb : nb + n] = g[:n], g[nb : nb + n]
-        if amat is None:
-            amat = np.zeros((4, 2 * nb))
-            lba = np.full(4, -np.inf)
-            uba = np.full(4, np.inf)
+        nb = qp.nb
+        solver_name = solver_name or self.qp_solver
+        lbx = qp.lbx if lbx is None else lbx
+        ubx = qp.ubx if ubx is None else ubx
+        lba = qp.lba if lba is None else lba
+        uba = qp.uba if uba is None else uba
         if x0 is None:
             x0 = np.zeros(2 * nb)
-        solver_name = self.qp_solver
         tb = time.perf_counter()
-        built = _is_cached(solver_name, nb, p, self.verbose)
+        built = _is_cached(f"{solver_name}-{m}", nb, p, self.verbose)
         if solver_name == "ipopt":
             solver = _qp.qp_ipopt(nb, p, self.verbose)
         else:
-            solver = _qp.qp_solver(nb, p, solver_name, self.verbose)
+            solver = _qp.qp_solver(nb, p, solver_name, m, self.verbose)
         build = 0.0 if built else time.perf_counter() - tb
         ts = time.perf_counter()
+        tc = time.process_time()
         if solver_name == "ipopt":
-            par = np.concatenate([full.ravel(), gg, amat.ravel(order="F")])
+            par = np.concatenate([qp.full.ravel(), qp.g, qp.heading.ravel(order="F")])
             out = solver(x0=x0, p=par, lbx=lbx, ubx=ubx, lbg=lba, ubg=uba)
         else:
             import casadi as ca
 
-            sp_h, _, _, _ = _qp.qp_layout(nb, p)
-            hval = ca.DM(sp_h, _qp.h_nonzeros(full, nb, p))
-            out = solver(h=hval, g=gg, a=amat, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+            layout = _qp.constraint_layout(nb, p, m)
+            hnz = _qp.h_nonzeros(qp.full, nb, p)
+            gg = qp.g
+            if m:  # one slack per sample, l1-penalised, >= 0
+                S = layout.n_samples
+                gg = np.concatenate([qp.g, np.full(S, _SLACK_PENALTY)])
+                lbx = np.concatenate([lbx, np.zeros(S)])
+                ubx = np.concatenate([ubx, np.where(slack_open, _SLACK_MAX, 0.0)])
+                x0 = np.concatenate([x0, np.zeros(S)])
+            trip = layout.values(qp.heading, sample_vals)
+            if solver_name == "piqp":
+                # piqp warns about (and drops) infinite rows, and large finite ones hurt
+                # its conditioning: bound every row by its range over the variable bounds
+                lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
+                lba = np.maximum(lba, lo_r - 1.0)
+                uba = np.minimum(uba, hi_r + 1.0)
+            hval = ca.DM(solver.sparsity_in("h"), hnz)
+            aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
+            out = solver(h=hval, g=gg, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
         solve = time.perf_counter() - ts
+        cpu = time.process_time() - tc
         st = solver.stats()
-        z = np.asarray(out["x"], dtype=float).ravel()
+        z = np.asarray(out["x"], dtype=float).ravel()[: 2 * nb]
         success = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
         info = {
             "solver": solver_name,
+            "cost": float(out["cost"]) if "cost" in out else float("nan"),
             "success": success,
             "status": str(st.get("return_status", st.get("unified_return_status", ""))),
             "iterations": int(st.get("iter_count", st.get("iter", 0)) or 0),
             "solve_time_s": solve,
+            "solve_cpu_s": cpu,
             "build_time_s": build,
         }
         return z, info
 
-    def _solve_curvature(
-        self, prob, t, n, nb, band, g, lbx, ubx, amat, lba, uba, z0, kmax, remaining
-    ):
+    def _curvature_samples(self, t: np.ndarray, n: int, nb: int):
+        """Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per
+        span (ends included), padded to ``nb - p`` spans."""
         p = self.degree
         ms = _qp.CURV_SAMPLES
-        ns_b = nb - p
         ns = n - p
-        # basis derivative values at CURV_SAMPLES points per span (ends included)
         fr = np.linspace(0.0, 1.0, ms)
         a = t[p : p + ns]
         b = t[p + 1 : p + ns + 1]
         span = np.repeat(np.arange(ns), ms)
         uu = (a[:, None] + (b - a)[:, None] * fr[None, :]).ravel()
-        B1 = np.zeros((ns_b * ms, p + 1))
-        B2 = np.zeros((ns_b * ms, p + 1))
+        S = (nb - p) * ms
+        B1 = np.zeros((S, p + 1))
+        B2 = np.zeros((S, p + 1))
         B1[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 1)
         B2[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 2)
-        full = np.zeros((p + 1, nb))
-        full[:, :n] = band[:, :n]
-        full[0, n:] = 1.0
-        gg = np.zeros(2 * nb)
-        gg[:n], gg[nb : nb + n] = g[:n], g[nb : nb + n]
-        lbx = lbx.copy()
-        ubx = ubx.copy()
-        lbx[n:nb] = ubx[n:nb] = 0.0
-        lbx[nb + n :] = ubx[nb + n :] = 0.0
+        return span, B1, B2
+
+    def _solve_curvature_scp(self, qp: _QPData, t, z0, kmax, remaining):
+        """Sequential convex programming for ``|kappa| <= kappa_margin * kmax`` and
+        ``|C'| >= speed_floor`` at the samples.
+
+        With the current iterate's unit tangent ``T_r``, normal ``N_r`` and speed ``v_r`` at
+        sample ``r``, each QP imposes ``T_r . C'(u_r) >= floor`` (which implies
+        ``|C'| >= floor``) and ``|N_r . C''(u_r)| <= kb (2 v_r (T_r . C') - v_r^2)``: since
+        ``s^2 >= 2 v s - v^2`` this is a conservative form of ``|N . C''| <= kb |C'|^2``,
+        the curvature bound when ``C'`` is along ``T``. Every row has an l1-penalised slack,
+        so each QP is feasible; a trust region on the control points is grown or shrunk by
+        the ratio of actual to predicted decrease of the merit ``objective + penalty *
+        violation`` (steps that do not decrease it are rejected). Iterations stop once the
+        exact sampled bound holds and the merit stalls. The caller's certificate then
+        checks the result on dense samples.
+        """
+        p = self.degree
+        n, nb = qp.n, qp.nb
+        ms = _qp.CURV_SAMPLES
+        S = (nb - p) * ms
+        ns_real = (n - p) * ms
+        span, B1, B2 = self._curvature_samples(t, n, nb)
+        B1, B2 = B1[:ns_real], B2[:ns_real]
+        idx = span[:, None] + np.arange(p + 1)[None, :]
+        kb = self.kappa_margin * kmax
+        floor = self.speed_floor
+        solver_name = "piqp"  # interior point: steady iteration counts on these QPs
+        n_fixed = _qp.N_HEADING_ROWS + 2 * nb
+        lba = np.full(n_fixed + 3 * S, -np.inf)
+        uba = np.full(n_fixed + 3 * S, np.inf)
+        lba[:n_fixed] = qp.lba
+        uba[:n_fixed] = qp.uba
+        vals = np.zeros((S, 3, 2 * (p + 1)))
+        slack_open = np.zeros(S, dtype=bool)
+        slack_open[:ns_real] = True
+        rows = n_fixed + 3 * np.arange(ns_real)
+        full = qp.full
+
+        def quad(zz):
+            x, y = zz[:nb], zz[nb:]
+            f = float(qp.g @ zz)
+            for d in range(p + 1):
+                w = 0.5 if d == 0 else 1.0
+                f += w * float(full[d, : nb - d] @ (x[: nb - d] * x[d:] + y[: nb - d] * y[d:]))
+            return f
+
+        def measure(zz):
+            X = zz[:nb][idx]
+            Y = zz[nb:][idx]
+            d1 = np.column_stack([(B1 * X).sum(1), (B1 * Y).sum(1)])
+            d2 = np.column_stack([(B2 * X).sum(1), (B2 * Y).sum(1)])
+            derivs[0], derivs[1] = d1, d2
+            sp = np.hypot(d1[:, 0], d1[:, 1])
+            cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+            spc = np.maximum(sp, 1e-12)
+            kap = np.abs(cross) / spc**3
+            viol = np.maximum(0.0, np.abs(cross) / spc - kb * sp**2) + np.maximum(0.0, floor - sp)
+            ok = bool(kap.max() <= kb * _SAMPLE_SLACK and sp.min() >= floor / _SAMPLE_SLACK)
+            merit = quad(zz) + _SLACK_PENALTY * float(viol.sum())
+            return d1, sp, kap, ok, merit
+
+        derivs: list[np.ndarray] = [np.empty(0), np.empty(0)]
+
+        delta = 1.0  # trust region (cells)
+        z = z0.copy()
+        d1, sp, kap, ok, merit = measure(z)
+        d2 = derivs[1]
+        t0 = time.perf_counter()
+        build = solve = 0.0
+        iters = 0
+        status = "feasible at the QP solution" if ok else "not converged"
+        for it in range(int(self.scp_iterations)):
+            if time.perf_counter() - t0 > remaining:
+                status = "time budget exceeded"
+                break
+            # c = X / v - kb v^2 (X = d1 x d2, v = |d1|) and its mirror -X / v - kb v^2,
+            # linearised: X / v to first order, -kb v^2 by its tangent plane (an upper
+            # bound, so that part is conservative)
+            v = np.maximum(sp, 1e-9)
+            T = d1 / v[:, None]
+            N = np.column_stack([-T[:, 1], T[:, 0]])
+            X = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+            gx1 = d2[:, 1] / v - X * d1[:, 0] / v**3  # d(X/v)/d(d1)
+            gy1 = -d2[:, 0] / v - X * d1[:, 1] / v**3
+            kx = -2 * kb * d1[:, 0]  # d(-kb v^2)/d(d1)
+            ky = -2 * kb * d1[:, 1]
+            for row, sgn in ((0, 1.0), (1, -1.0)):
+                ax_ = sgn * gx1 + kx
+                ay_ = sgn * gy1 + ky
+                bx_ = sgn * N[:, 0]
+                by_ = sgn * N[:, 1]
+                vals[:ns_real, row, : p + 1] = B1 * ax_[:, None] + B2 * bx_[:, None]
+                vals[:ns_real, row, p + 1 :] = B1 * ay_[:, None] + B2 * by_[:, None]
+                # value at the iterate: sgn X / v - kb v^2; row(z_k) = the linear part
+                lin_k = ax_ * d1[:, 0] + ay_ * d1[:, 1] + bx_ * d2[:, 0] + by_ * d2[:, 1]
+                uba[rows + row] = lin_k - (sgn * X / v - kb * sp**2)
+            vals[:ns_real, 2, : p + 1] = B1 * T[:, 0:1]
+            vals[:ns_real, 2, p + 1 :] = B1 * T[:, 1:2]
+            lba[rows + 2] = floor
+            lbx = np.maximum(qp.lbx, z - delta)
+            ubx = np.minimum(qp.ubx, z + delta)
+            znew, info = self._solve_qp(
+                qp, remaining, x0=z, solver_name=solver_name, m=ms, sample_vals=vals,
+                lba=lba, uba=uba, lbx=lbx, ubx=ubx, slack_open=slack_open,
+            )
+            iters += 1
+            build += info["build_time_s"]
+            solve += info["solve_time_s"]
+            if not info["success"]:
+                status = f"SCP iteration {it + 1}: {info['solver']} {info['status']}"
+                break
+            znew = np.clip(znew, lbx, ubx)
+            step = float(np.max(np.abs(znew - z)))
+            predicted = merit - info["cost"]
+            d2_old = d2
+            d1n, spn, kapn, okn, meritn = measure(znew)
+            d2 = derivs[1]
+            actual = merit - meritn
+            tol = 1e-9 * (1.0 + abs(merit))
+            logger.debug(
+                "SCP %d: %.1f ms (cpu %.1f ms, %d it), step %.3g (trust %.3g), max kappa/bound "
+                "%.4g, min speed %.3g, merit %.6g -> %.6g (predicted %.6g)", it + 1,
+                1e3 * info["solve_time_s"], 1e3 * info["solve_cpu_s"], info["iterations"], step, delta, kapn.max() / kb, spn.min(), merit,
+                meritn, merit - predicted,
+            )
+            if predicted <= tol:  # no decrease predicted: a stationary point of the model
+                status = "converged" if ok else "stalled"
+                break
+            ratio = actual / predicted
+            if ratio >= 0.1:  # accept
+                z, d1, sp, kap, ok, merit = znew, d1n, spn, kapn, okn, meritn
+                if ratio > 0.75 and step >= 0.99 * delta:
+                    delta = min(2 * delta, 8.0)
+                elif ratio < 0.25:
+                    delta *= 0.5
+                if ok and (actual <= 1e-5 * (1.0 + abs(merit)) or step < 1e-2):
+                    status = "converged"
+                    break
+            else:
+                delta *= 0.25
+                d2 = d2_old
+            if delta < 1e-4:
+                status = "converged" if ok else "trust region collapsed"
+                break
+        success = ok
+        if success and status not in ("converged", "feasible at the QP solution"):
+            status = "feasible (" + status + ")"
+        if not success and status in ("not converged", "converged", "stalled"):
+            status = (
+                f"not converged after {iters} iterations (sampled max kappa "
+                f"{kap.max() / kmax:.3g} x the bound, min speed {sp.min():.3g})"
+            )
+        info = {
+            "solver": "scp",
+            "success": success,
+            "status": status,
+            "iterations": iters,
+            "solve_time_s": solve,
+            "build_time_s": build,
+        }
+        return z, info
+
+    def _solve_curvature_ipopt(self, qp: _QPData, t, z0, kmax, remaining):
+        p = self.degree
+        n, nb = qp.n, qp.nb
+        ms = _qp.CURV_SAMPLES
+        _, B1, B2 = self._curvature_samples(t, n, nb)
         par = np.concatenate(
             [
-                full.ravel(),
-                gg,
-                amat.ravel(order="F"),
+                qp.full.ravel(),
+                qp.g,
+                qp.heading.ravel(order="F"),
                 B1.ravel(order="F"),
                 B2.ravel(order="F"),
                 [(self.kappa_margin * kmax) ** 2],
             ]
         )
-        S = ns_b * ms
-        lbg = np.concatenate([lba, np.full(S, -np.inf), np.full(S, -np.inf)])
-        ubg = np.concatenate([uba, np.zeros(S), np.full(S, np.inf)])
-        lbg[4 + S : 4 + S + ns * ms] = self.speed_floor**2
+        S = (nb - p) * ms
+        lbg = np.concatenate([qp.lba, np.full(S, -np.inf), np.full(S, -np.inf)])
+        ubg = np.concatenate([qp.uba, np.zeros(S), np.full(S, np.inf)])
+        off = len(qp.lba) + S
+        lbg[off : off + (n - p) * ms] = self.speed_floor**2
         tb = time.perf_counter()
         built = _is_cached("curv", nb, p, self.verbose)
         solver = _qp.curvature_nlp(nb, p, self.verbose)
         build = 0.0 if built else time.perf_counter() - tb
         left = max(0.05, remaining - build - 0.02)
         ts = time.perf_counter()
-        out = solver(x0=z0, p=par, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        out = solver(x0=z0, p=par, lbx=qp.lbx, ubx=qp.ubx, lbg=lbg, ubg=ubg)
         solve = time.perf_counter() - ts
         st = solver.stats()
         z = np.asarray(out["x"], dtype=float).ravel()
@@ -608,6 +838,8 @@ class _Problem:
     u: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
+    dlo: np.ndarray
+    dhi: np.ndarray
     trans: np.ndarray
     overlap: np.ndarray
     start: np.ndarray
@@ -615,6 +847,57 @@ class _Problem:
     start_dir: np.ndarray | None
     goal_dir: np.ndarray | None
     res: float = 1.0
+
+
+@dataclass(slots=True)
+class _QPData:
+    """The convex problem of one attempt (cell units, padded to ``nb``)."""
+
+    full: np.ndarray  # Hessian upper band, shape (p + 1, nb)
+    g: np.ndarray  # linear term, shape (2 nb,)
+    n: int
+    nb: int
+    lbx: np.ndarray
+    ubx: np.ndarray
+    heading: np.ndarray  # heading rows, shape (4, 2 nb)
+    lba: np.ndarray  # bounds of the heading and diagonal rows, shape (4 + 2 nb,)
+    uba: np.ndarray
+
+
+def _sd(xy: np.ndarray) -> np.ndarray:
+    """``(x + y, x - y)`` of a point."""
+    return np.array([xy[0] + xy[1], xy[0] - xy[1]])
+
+
+#: the SCP accepts sampled curvature up to this factor over ``kappa_margin * kappa_max``
+#: (and speeds down to the floor over it): the margin leaves room, and the certificate
+#: checks the true bound on dense samples
+_SAMPLE_SLACK = 1.01
+
+#: largest SCP slack (keeps every row's range finite for the interior-point solver)
+_SLACK_MAX = 1e3
+
+#: l1 penalty on the SCP slacks (cell units); large against the objective's multipliers
+_SLACK_PENALTY = 1e4
+
+#: the 45-degree rows are imposed this far (cells) inside their bounds, so that solver
+#: tolerances never put a control point outside its region
+_DIAG_MARGIN = 1e-6
+
+
+def _diag_row_bounds(dlo: np.ndarray, dhi: np.ndarray, nb: int):
+    """Bounds of the rows ``x_i + y_i``, ``x_i - y_i`` (interleaved), padded to ``nb``."""
+    n = len(dlo)
+    lb = np.full((nb, 2), -np.inf)
+    ub = np.full((nb, 2), np.inf)
+    lo = dlo + _DIAG_MARGIN
+    hi = dhi - _DIAG_MARGIN
+    thin = lo > hi  # only for finite bounds: -inf + m > inf - m never holds
+    mid = 0.5 * (dlo[thin] + dhi[thin])
+    lo[thin] = mid
+    hi[thin] = mid
+    lb[:n], ub[:n] = lo, hi
+    return lb.ravel(), ub.ravel()
 
 
 _BUILT: set[tuple] = set()
@@ -871,10 +1154,13 @@ def certify(
     ns = len(c) - k
     lo = corridor.lower[span_box]
     hi = corridor.upper[span_box]
+    dlo = corridor.diag_lower[span_box]
+    dhi = corridor.diag_upper[span_box]
     inside = True
     for off in range(k + 1):
         cp = c[off : off + ns]
-        inside &= bool(np.all((cp >= lo) & (cp <= hi)))
+        sd = np.column_stack([cp[:, 0] + cp[:, 1], cp[:, 0] - cp[:, 1]])
+        inside &= bool(np.all((cp >= lo) & (cp <= hi) & (sd >= dlo) & (sd <= dhi)))
     if not inside:
         failures.append("control_points_in_boxes")
     u0, u1 = curve.domain
