@@ -164,3 +164,109 @@ def test_random_grids_brute_force(seed, density):
         return
     corr = build_corridor(OccupancyGrid(occ, 0.25, (1.0, -2.0)), cells, max_side_cells=6)
     assert_corridor_valid(corr, free, cells, 0.25, (1.0, -2.0))
+
+
+# ------------------------------------------------------------------- bridges
+def _sampled_rect_clearance(sd, squares, m=81):
+    """Min distance from points sampled on a 45-degree rectangle (interior and boundary)
+    to axis-aligned unit squares: an upper bound on the exact distance, within the
+    sampling spacing."""
+    smin, smax, dmin, dmax = sd
+    s, d = np.meshgrid(np.linspace(smin, smax, m), np.linspace(dmin, dmax, m))
+    px, py = ((s + d) / 2).ravel(), ((s - d) / 2).ravel()
+    qx, qy = squares[:, 0], squares[:, 1]
+    gx = np.maximum(0, np.maximum(qx[None] - px[:, None], px[:, None] - (qx[None] + 1)))
+    gy = np.maximum(0, np.maximum(qy[None] - py[:, None], py[:, None] - (qy[None] + 1)))
+    spacing = max(smax - smin, dmax - dmin) / (m - 1) / math.sqrt(2)
+    return float(np.hypot(gx, gy).min()), spacing
+
+
+def test_rotated_rect_clearance_matches_sampling():
+    from trajopt.corridor import rotated_rect_clearance
+
+    rng = np.random.default_rng(3)
+    hits = 0
+    for _ in range(300):
+        s0, d0 = rng.uniform(-5, 5, 2)
+        sd = (s0, s0 + rng.uniform(0, 4), d0, d0 + rng.uniform(0, 4))
+        squares = rng.integers(-6, 6, size=(int(rng.integers(1, 6)), 2)).astype(float)
+        exact = rotated_rect_clearance(sd, squares)
+        sampled, spacing = _sampled_rect_clearance(sd, squares)
+        assert exact <= sampled + 1e-12
+        assert sampled <= exact + spacing + 1e-12
+        hits += exact == 0.0
+    assert 20 < hits < 280  # both outcomes exercised
+    assert rotated_rect_clearance((0, 1, 0, 1), np.empty((0, 2))) == math.inf
+
+
+def diagonal_gap_grid() -> np.ndarray:
+    """Two blocks whose corners leave a gap that is only open along the diagonal once the
+    obstacles are inflated by 2.5 cells."""
+    n = 40
+    yy, xx = np.mgrid[0:n, 0:n]
+    return ((xx <= 16) & (yy >= 21)) | ((xx >= 22) & (yy <= 15))
+
+
+def test_bridge_across_a_diagonal_gap_is_certified_and_lets_the_curve_flow():
+    import astar
+    from trajopt.errors import SmoothingError
+    from trajopt.smoother import Smoother
+
+    raw = OccupancyGrid(diagonal_gap_grid(), resolution=0.1, origin=(-1.0, 2.0))
+    r = 0.25
+    infl = astar.inflate(raw, r, metric="square", outside_occupied=True)
+    path = astar.find_path(infl, (5, 5), (35, 35))
+    plain = build_corridor(infl, path, radius=r)
+    bridged = build_corridor(infl, path, radius=r, raw_grid=raw)
+    assert not any(b.is_diagonal for b in plain.boxes)
+    bridges = [b for b in bridged.boxes if b.is_diagonal]
+    assert len(bridges) == 1
+    # the bridge keeps the clearance: dense samples of it against every occupied square
+    occ = np.pad(raw.occupied, 3, constant_values=True)  # the outside counts as occupied
+    oy, ox = np.nonzero(occ)
+    squares = np.column_stack([ox - 3, oy - 3]).astype(float)
+    dg = bridges[0].diagonal
+    ox0, oy0 = raw.origin
+    sd_cells = (
+        (dg[0] - ox0 - oy0) / 0.1, (dg[1] - ox0 - oy0) / 0.1,
+        (dg[2] - ox0 + oy0) / 0.1, (dg[3] - ox0 + oy0) / 0.1,
+    )
+    sampled, _ = _sampled_rect_clearance(sd_cells, squares)
+    assert sampled >= r / 0.1 - 1e-9
+    # its vertices satisfy its own containment test, and the chain still covers the path
+    assert np.all(bridges[0].contains(bridges[0].vertices(), tol=1e-12))
+    assert np.all(bridged.contains(bridged.path_points, tol=1e-9))
+    # without the bridge the boxes meet at a point and the curve cannot keep its speed
+    try:
+        sp_plain = Smoother().fit(path, plain, raw_grid=raw)
+        assert sp_plain.certificate.min_speed_ratio < 0.05
+    except SmoothingError:
+        pass
+    sp = Smoother().fit(path, bridged, raw_grid=raw)
+    assert sp.certificate.ok
+    assert sp.certificate.min_speed_ratio > 0.3
+    assert sp.certificate.min_clearance_m >= r - 1e-9
+
+
+def test_raw_grid_must_match_and_needs_radius():
+    import astar
+
+    raw = OccupancyGrid(diagonal_gap_grid(), resolution=0.1)
+    infl = astar.inflate(raw, 0.25, metric="square", outside_occupied=True)
+    path = astar.find_path(infl, (5, 5), (35, 35))
+    with pytest.raises(InvalidInputError, match="radius"):
+        build_corridor(infl, path, raw_grid=raw)
+    other = OccupancyGrid(diagonal_gap_grid(), resolution=0.2)
+    with pytest.raises(InvalidInputError, match="raw_grid"):
+        build_corridor(infl, path, radius=0.25, raw_grid=other)
+
+
+def test_diagonal_box_containment():
+    b = Box(0.0, 2.0, 0.0, 2.0, 0, 1, 0, 1, diagonal=(1.0, 3.0, -1.0, 1.0))
+    pts = np.array([[1.0, 1.0], [0.1, 0.1], [1.9, 1.9], [0.5, 1.5], [0.0, 1.0]])
+    # x + y in [1, 3] and x - y in [-1, 1]
+    assert b.contains(pts).tolist() == [True, False, False, True, True]
+    assert b.is_diagonal and not Box(0.0, 1.0, 0.0, 1.0, 0, 1, 0, 1).is_diagonal
+    v = b.vertices()
+    assert v.shape == (4, 2)
+    np.testing.assert_allclose(sorted(map(tuple, v)), [(0.0, 1.0), (1.0, 0.0), (1.0, 2.0), (2.0, 1.0)])

@@ -290,15 +290,14 @@ def _map_scenarios(shared_data, per_map: int, seed: int = 0):
     return out
 
 
-@pytest.mark.slow
 def test_shared_maps_zero_guarantee_violations(shared_data):
-    # ~60 s on a quiet 2-core machine, minutes when it is shared: marked slow
-    cases = _map_scenarios(shared_data, per_map=20)
+    # 105 shortest-path scenarios (the hardest seed: paths hug the walls)
+    cases = _map_scenarios(shared_data, per_map=15)
     sm = Smoother()
     done = errors = violations_plain = 0
     t0 = time.perf_counter()
     for raw, infl, r, path in cases:
-        corr = build_corridor(infl, path, radius=r)
+        corr = build_corridor(infl, path, radius=r, raw_grid=raw)
         try:
             sp = sm.fit(path, corr, raw_grid=raw)
         except SmoothingError:

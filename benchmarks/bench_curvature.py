@@ -1,0 +1,189 @@
+"""Benchmark of the curvature-bounded smoother with both A* seeds (issue 8, section 3).
+
+On scenarios drawn from the shared Moving AI maps (robot radius 2.5 cells) and ROS maps
+(radius 0.2 m), for the shortest-path seed and the clearance-aware seed
+(:func:`astar.clearance_cost`), each with the corridor's 45-degree bridges, fits
+``Smoother(kappa_max=1 / (2 r))`` and reports side by side:
+
+* success rate of the curvature-bounded smoother (a certified curve returned);
+* median and p95 warm solve time: the whole ``fit`` call (QP, SCP, certificate) and the
+  solver time alone, measured on a second call of the same query (solvers built);
+* median minimum clearance over the radius (dense samples against the raw map);
+* median Hausdorff deviation from the A* polyline (cells) and the length ratio;
+* near-stops of the timed trajectory (``time_parameterize`` with ``Robot(radius=r)``):
+  intervals inside the path (not touching its start or end) where the speed is below
+  20 % of ``v_max``.
+
+Targets (issue 8): success >= 98 %, median <= 10 ms, p95 <= 50 ms.
+
+Run: ``python benchmarks/bench_curvature.py [--per-map 25] [--seed 0]``
+(``TRAJOPT_DATA`` may point to the shared data).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.distance import directed_hausdorff
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import astar  # noqa: E402
+from trajopt.corridor import build_corridor  # noqa: E402
+from trajopt.errors import SmoothingError, TimingError  # noqa: E402
+from trajopt.robot import Robot  # noqa: E402
+from trajopt.smoother import Smoother  # noqa: E402
+from trajopt.timing import time_parameterize  # noqa: E402
+
+MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5"]
+ROS = ["turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10"]
+
+
+def data_dir() -> Path:
+    env = os.environ.get("TRAJOPT_DATA")
+    return Path(env) if env else ROOT.parent / "shared" / "data"
+
+
+def load_maps() -> list[tuple[str, object, float]]:
+    d = data_dir()
+    out = []
+    for name in MOVINGAI:
+        raw = astar.load_map(d / "movingai" / "maps" / f"{name}.map")
+        out.append((name, raw, 2.5 * raw.resolution))
+    for name in ROS:
+        out.append((name, astar.load_map(d / "ros" / f"{name}.yaml"), 0.2))
+    return out
+
+
+def draw_pairs(raw, radius: float, n: int, rng: np.random.Generator):
+    """``n`` start/goal cell pairs, free after inflation, reachable, 20-300 cells apart."""
+    infl = astar.inflate(raw, radius, metric="square", outside_occupied=True)
+    ys, xs = np.nonzero(~infl.occupied)
+    if len(xs) < 2:
+        return infl, []
+    pairs = []
+    for _ in range(200 * n):
+        if len(pairs) == n:
+            break
+        i, j = rng.choice(len(xs), 2, replace=False)
+        a, b = (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j]))
+        if not 20 <= math.hypot(a[0] - b[0], a[1] - b[1]) <= 300:
+            continue
+        try:
+            astar.find_path(infl, a, b)
+        except astar.NoPathError:
+            continue
+        pairs.append((a, b))
+    return infl, pairs
+
+
+def near_stops(traj, v_max: float) -> int:
+    """Intervals with speed < 0.2 v_max that touch neither end of the trajectory."""
+    smp = traj.sample_uniform(0.01)
+    slow = smp.v < 0.2 * v_max
+    if not slow.any():
+        return 0
+    edges = np.diff(slow.astype(np.int8))
+    starts = np.nonzero(edges == 1)[0] + 1
+    ends = np.nonzero(edges == -1)[0] + 1
+    if slow[0]:
+        ends = ends[1:]
+    if slow[-1]:
+        starts = starts[:-1]
+    return int(min(len(starts), len(ends)))
+
+
+def run_case(raw, infl, radius, a, b, cost, smoother):
+    path = astar.find_path(infl, a, b, cost=cost)
+    corr = build_corridor(infl, path, radius=radius, raw_grid=raw)
+    try:
+        smoother.fit(path, corr, raw_grid=raw, radius=radius)  # builds any new solver size
+        t0 = time.perf_counter()
+        sp = smoother.fit(path, corr, raw_grid=raw, radius=radius)
+        wall = time.perf_counter() - t0
+    except SmoothingError as exc:
+        return {"ok": False, "why": str(exc)}
+    res = raw.resolution
+    u = np.linspace(*sp.domain, max(200, int(sp.length / res * 4)))
+    xy = sp(u) / res
+    poly = corr.path_points / res
+    haus = max(directed_hausdorff(xy, poly)[0], directed_hausdorff(poly, xy)[0])
+    rec = {
+        "ok": True,
+        "wall": wall,
+        "solve": sp.stats["solve_time_s"],
+        "clear_ratio": sp.certificate.min_clearance_m / radius,
+        "hausdorff": haus,
+        "length_ratio": sp.length / corr.length_m,
+        "attempts": sp.stats["attempts"],
+    }
+    robot = Robot(radius=radius)
+    try:
+        traj = time_parameterize(sp, robot)
+        rec["near_stops"] = near_stops(traj, robot.v_max)
+    except TimingError:
+        rec["near_stops"] = float("nan")
+    return rec
+
+
+def pct(values, q):
+    return float(np.percentile(values, q)) if len(values) else float("nan")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--per-map", type=int, default=25, help="scenarios per map")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    rng = np.random.default_rng(args.seed)
+    cases = []
+    for name, raw, r in load_maps():
+        infl, pairs = draw_pairs(raw, r, args.per_map, rng)
+        cost = astar.clearance_cost(raw, r, outside_occupied=True)
+        cases += [(name, raw, infl, r, a, b, cost) for a, b in pairs]
+    print(f"{len(cases)} scenarios on {len(MOVINGAI) + len(ROS)} maps")
+    table = {}
+    failures = {}
+    for seed_name in ("shortest", "clearance"):
+        recs = []
+        fails = []
+        for name, raw, infl, r, a, b, cost in cases:
+            sm = Smoother(kappa_max=1.0 / (2.0 * r), time_budget_s=10.0)
+            rec = run_case(raw, infl, r, a, b, cost if seed_name == "clearance" else None, sm)
+            rec["map"] = name
+            recs.append(rec)
+            if not rec["ok"]:
+                fails.append(f"{name} {a}->{b}: {rec['why'][:120]}")
+        ok = [x for x in recs if x["ok"]]
+        table[seed_name] = {
+            "success": f"{len(ok)}/{len(recs)} ({len(ok) / max(1, len(recs)):.1%})",
+            "fit median ms": f"{1e3 * pct([x['wall'] for x in ok], 50):.1f}",
+            "fit p95 ms": f"{1e3 * pct([x['wall'] for x in ok], 95):.1f}",
+            "solver median ms": f"{1e3 * pct([x['solve'] for x in ok], 50):.1f}",
+            "solver p95 ms": f"{1e3 * pct([x['solve'] for x in ok], 95):.1f}",
+            "min clearance / r (median)": f"{pct([x['clear_ratio'] for x in ok], 50):.2f}",
+            "Hausdorff to A* (cells, median)": f"{pct([x['hausdorff'] for x in ok], 50):.2f}",
+            "length ratio (median)": f"{pct([x['length_ratio'] for x in ok], 50):.3f}",
+            "near-stops (total)": f"{int(np.nansum([x['near_stops'] for x in ok]))}",
+            "refined (attempts > 1)": f"{sum(x['attempts'] > 1 for x in ok)}",
+        }
+        failures[seed_name] = fails
+    keys = list(table["shortest"])
+    w = max(len(k) for k in keys)
+    print(f"\n{'':{w}}  {'shortest seed':>16}  {'clearance seed':>16}")
+    for k in keys:
+        print(f"{k:{w}}  {table['shortest'][k]:>16}  {table['clearance'][k]:>16}")
+    for seed_name, fails in failures.items():
+        for f in fails:
+            print(f"failed ({seed_name}): {f}")
+
+
+if __name__ == "__main__":
+    main()
