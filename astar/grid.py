@@ -213,7 +213,7 @@ def _as_bool_grid(occupied: object) -> np.ndarray:
         if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
             raise InvalidInputError("occupied must not contain NaN or infinity")
         if not np.all((a == 0) | (a == 1)):
-            bad = a[(a != 0) & (a != 1)].ravel()[0]
+            bad = a[(a != 0) & (a != 1)].ravel()[0].item()
             raise InvalidInputError(
                 f"occupied must hold only 0/1 (or bool) values, found {bad!r}"
             )

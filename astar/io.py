@@ -28,6 +28,7 @@ import logging
 import math
 import os
 import re
+import reprlib
 import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -41,6 +42,7 @@ from astar.grid import OccupancyGrid
 
 __all__ = [
     "IMAGE_SUFFIXES",
+    "MAX_IMAGE_PIXELS",
     "Scenario",
     "from_intensity",
     "load_map",
@@ -64,6 +66,10 @@ IMAGE_SUFFIXES: tuple[str, ...] = (
     ".jpg",
     ".jpeg",
 )
+#: Largest image (pixels) a map may declare; checked from the header before decoding, so a
+#: small compressed file cannot make the loader allocate gigabytes (Pillow's own limit only
+#: warns below twice its default of about 89 million pixels).
+MAX_IMAGE_PIXELS = 89_478_485
 _YAML_SUFFIXES = (".yaml", ".yml")
 _SUPPORTED = (*_YAML_SUFFIXES, ".map", *IMAGE_SUFFIXES, ".npy")
 
@@ -596,7 +602,9 @@ def _read_ros_yaml(p: Path) -> _RosMeta:
         )
     image = doc["image"]
     if not isinstance(image, str) or not image.strip():
-        raise MapFormatError(f"{p}: field image must be a non-empty file name, got {image!r}")
+        raise MapFormatError(
+            f"{p}: field image must be a non-empty file name, got {_short_repr(image)}"
+        )
     image_path = Path(image)
     if not image_path.is_absolute():
         image_path = p.parent / image_path
@@ -606,7 +614,7 @@ def _read_ros_yaml(p: Path) -> _RosMeta:
     raw_origin = doc["origin"]
     if not isinstance(raw_origin, list | tuple) or len(raw_origin) != 3:
         raise MapFormatError(
-            f"{p}: field origin must be a list of 3 numbers [x, y, yaw], got {raw_origin!r}"
+            f"{p}: field origin must be a list of 3 numbers [x, y, yaw], got {_short_repr(raw_origin)}"
         )
     ox, oy, yaw = (_yaml_number(p, f"origin[{i}]", v) for i, v in enumerate(raw_origin))
     if yaw != 0.0:
@@ -626,7 +634,8 @@ def _read_ros_yaml(p: Path) -> _RosMeta:
         mode = "trinary"
     if not isinstance(mode, str) or mode not in _MODES:
         raise MapFormatError(
-            f"{p}: field mode must be one of {', '.join(_MODES)} (default trinary), got {mode!r}"
+            f"{p}: field mode must be one of {', '.join(_MODES)} (default trinary), "
+            f"got {_short_repr(mode)}"
         )
     return _RosMeta(image_path, res, (ox, oy), negate, occ_th, free_th, mode)
 
@@ -635,11 +644,13 @@ def _yaml_number(p: Path, name: str, value: object) -> float:
     # PyYAML (YAML 1.1) reads "1e-3" as a string; map_server's yaml-cpp reads it as a
     # number, so numeric strings are accepted. Booleans are not numbers here.
     if isinstance(value, bool) or not isinstance(value, int | float | str):
-        raise MapFormatError(f"{p}: field {name} must be a number, got {value!r}")
+        raise MapFormatError(f"{p}: field {name} must be a number, got {_short_repr(value)}")
     try:
         v = float(value)
     except ValueError:
-        raise MapFormatError(f"{p}: field {name} must be a number, got {value!r}") from None
+        raise MapFormatError(
+            f"{p}: field {name} must be a number, got {_short_repr(value)}"
+        ) from None
     if not math.isfinite(v):
         raise MapFormatError(f"{p}: field {name} must be finite, got {value!r}")
     return v
@@ -656,7 +667,7 @@ def _yaml_negate(p: Path, value: object) -> bool:
         return value != 0
     if isinstance(value, str) and re.fullmatch(r"[+-]?[0-9]+", value.strip()):
         return int(value) != 0
-    raise MapFormatError(f"{p}: field negate must be 0, 1 or a bool, got {value!r}")
+    raise MapFormatError(f"{p}: field negate must be 0, 1 or a bool, got {_short_repr(value)}")
 
 
 def _map_server_values(
@@ -733,6 +744,12 @@ def _read_pixels(image: Path, source: Path) -> _Pixels:
     _check_netpbm_size(image, source)
     try:
         with Image.open(image) as im:
+            w, h = im.size  # from the header, before any pixel is decoded
+            if w * h > MAX_IMAGE_PIXELS:
+                raise MapFormatError(
+                    f"{source}: image {str(image)!r} declares {w} x {h} = {w * h} pixels, "
+                    f"more than astar.io.MAX_IMAGE_PIXELS = {MAX_IMAGE_PIXELS}"
+                )
             im.load()
             mode = im.mode
             if mode in _GREY_MODES:
@@ -967,6 +984,20 @@ def _read_text(p: Path) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise MapFormatError(f"{p}: not UTF-8/ASCII text ({exc})") from None
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel = 2
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = 4
+_REPR.maxstring = 80
+_REPR.maxother = 80
+
+
+def _short_repr(value: object) -> str:
+    """A bounded repr for error messages: YAML aliases can make a tiny file describe a
+    structure with billions of elements (a "billion laughs" document), whose full repr
+    would never finish."""
+    return _REPR.repr(value)
 
 
 def _positive_float_arg(value: object, name: str) -> float:

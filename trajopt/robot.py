@@ -124,6 +124,8 @@ class Robot:
 
 
 def _positive(name: str, value: Any) -> float:
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidInputError(f"Robot.{name} must be a number, got {value!r}")
     try:
         x = float(value)
     except (TypeError, ValueError):

@@ -11,6 +11,8 @@ import io
 import math
 import os
 import re
+import time
+import tracemalloc
 from pathlib import Path
 
 import numpy as np
@@ -777,3 +779,112 @@ def test_fuzz_truncated_or_corrupted(fuzz_dir: Path, suffix: str, cut: float, fl
 
 def test_no_temp_files_left_by_fuzz(fuzz_dir: Path) -> None:
     assert not [p for p in os.listdir(fuzz_dir) if p.endswith(".tmp")]
+
+
+# ------------------------------------------------------------- hostile input (issue 7)
+def test_yaml_alias_bomb_fails_fast(tmp_path: Path) -> None:
+    # "billion laughs": 9 levels of 9 aliases describe 9^9 elements in a few hundred bytes;
+    # safe_load shares them, and the error message must not expand them either
+    (tmp_path / "a.pgm").write_bytes(b"P5\n2 2\n255\n" + bytes(4))
+    lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
+    lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]" for i in range(1, 9)]
+    base = ["image: a.pgm", "origin: [0, 0, 0]", "negate: 0", "occupied_thresh: 0.65",
+            "free_thresh: 0.196", "resolution: 0.1"]
+    for key in ("resolution", "origin", "negate", "image", "mode", "free_thresh"):
+        body = [ln for ln in base if not ln.startswith(key + ":")] + [f"{key}: *a8"]
+        path = tmp_path / f"bomb_{key}.yaml"
+        path.write_text("\n".join(lines + body) + "\n")
+        t0 = time.perf_counter()
+        with pytest.raises(MapFormatError, match=f"bomb_{key}.yaml.*{key}") as info:
+            load_map(path)
+        assert time.perf_counter() - t0 < 5.0
+        assert len(str(info.value)) < 1000
+
+
+def test_png_declaring_huge_size_is_refused_before_decoding(tmp_path: Path) -> None:
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    for w, h in ((10_000, 10_000), (100_000, 100_000), (2**31 - 1, 2**31 - 1)):
+        ihdr = struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)  # 8-bit grey
+        data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr)
+                + chunk(b"IDAT", zlib.compress(b"\x00" * 1000)) + chunk(b"IEND", b""))
+        (tmp_path / "big.png").write_bytes(data)
+        tracemalloc.start()
+        try:
+            with pytest.raises(MapFormatError, match="big.png"):
+                load_map(tmp_path / "big.png", resolution=0.05)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert peak < 50e6, f"{w} x {h}: peak {peak / 1e6:.0f} MB"
+
+
+@pytest.mark.parametrize(
+    ("name", "data"),
+    [
+        ("h.map", b"type octile\nheight 99999999\nwidth 99999999\nmap\n" + b"." * 100),
+        ("h.pgm", b"P5\n60000 60000\n255\n" + bytes(100)),
+        ("h.pbm", b"P4\n2000000000 2000000000\n" + bytes(100)),
+        ("h.npy", b"\x93NUMPY\x01\x00\x46\x00{'descr': '|b1', 'fortran_order': False, "
+                  b"'shape': (999999, 999999), }   \n" + bytes(8)),
+    ],
+)
+def test_huge_declared_sizes_allocate_nothing(tmp_path: Path, name: str, data: bytes) -> None:
+    (tmp_path / name).write_bytes(data)
+    tracemalloc.start()
+    try:
+        with pytest.raises(_ALLOWED):
+            load_map(tmp_path / name, resolution=1.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 20e6, f"{name}: peak {peak / 1e6:.0f} MB"
+
+
+_NUMBER = st.one_of(
+    st.integers(-(2**70), 2**70).map(str),
+    st.sampled_from(["-1", "0", "1e9", "nan", "inf", "-0", "0x10", "1_000", "", "9" * 40]),
+)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    kind=st.sampled_from(["map", "scen", "pgm", "ppm", "yaml"]),
+    a=_NUMBER,
+    b=_NUMBER,
+    c=_NUMBER,
+    tail=st.binary(max_size=64),
+)
+def test_fuzz_hostile_headers(fuzz_dir: Path, kind: str, a: str, b: str, c: str,
+                              tail: bytes) -> None:
+    # well-formed looking headers with hostile numbers: negative, huge, NaN, empty
+    if kind == "map":
+        data = f"type octile\nheight {a}\nwidth {b}\nmap\n".encode() + tail
+    elif kind == "scen":
+        data = f"version 1\n{c}\tx.map\t{a}\t{b}\t0\t{c}\t1\t1\t{a}\n".encode() + tail
+    elif kind in ("pgm", "ppm"):
+        magic = "P5" if kind == "pgm" else "P3"
+        data = f"{magic}\n{a} {b}\n{c}\n".encode() + tail
+    else:
+        data = (f"image: valid.pgm\nresolution: {a}\norigin: [{b}, {c}, 0]\nnegate: {c}\n"
+                f"occupied_thresh: {b}\nfree_thresh: {a}\nmode: !!python/name:os.system\n"
+                ).encode() + tail
+    path = fuzz_dir / f"hostile.{kind}"
+    path.write_bytes(data)
+    t0 = time.perf_counter()
+    tracemalloc.start()
+    try:
+        try:
+            _load_any(path) if kind != "ppm" else load_map(path, resolution=0.1)
+        except _ALLOWED as exc:
+            assert str(exc)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 5.0
+    assert peak < 50e6

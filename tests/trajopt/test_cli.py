@@ -59,11 +59,40 @@ def run(argv) -> int:
         (["plan", "{map}", "--start", "0.4"], "expected 2 arguments"),
         (["bench", "{map}", "--limit", "0"], "--limit must be >= 1"),
         (["nonsense"], "invalid choice"),
+        # issue 7: bad values reach the library's typed errors, still one line and exit 2
+        (["plan", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
+         "start must be finite"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "inf", "1.6"],
+         "goal must be finite"),
+        (["plan", "{map}", "--start", "1.40", "0.3", "--goal", "2.6", "1.6"],
+         "0.1 m from the nearest obstacle (or the map edge); the robot needs at least its "
+         "radius 0.165 m"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--radius", "0"],
+         "Robot.radius must be finite and > 0"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "inf"],
+         "Robot.v_max must be finite"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+          "--resolution", "-1"], "resolution must be finite and > 0"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+          "--kappa-max", "-2"], "kappa_max"),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+          "--radius", "abc"], "invalid float value"),
+        (["plan", "{garbage}", "--start", "0", "0", "--goal", "1", "1"], "MapFormatError"),
+        (["compare", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
+          "--radius", "-1"], "robot_radius must be finite and > 0"),
+        (["compare", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
+         "start must be finite"),
+        (["bench", "{badscen}"], "field start_y must be an integer >= 0"),
+        (["bench", "{map}", "--jobs", "0"], "--jobs must be >= 1"),
+        (["bench", "{map}", "--radius-cells", "nan"], "--radius-cells must be > 0"),
     ],
 )
 def test_errors_are_one_line_exit_2(argv, match, door_map, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    argv = [a.replace("{map}", str(door_map)) for a in argv]
+    (tmp_path / "garbage.map").write_bytes(b"\x00\xff\xfe garbage")
+    (tmp_path / "bad.scen").write_text("version 1\n0\tx.map\t4\t4\t0\t-1\t1\t1\t1\n")
+    subs = {"{map}": str(door_map), "{garbage}": "garbage.map", "{badscen}": "bad.scen"}
+    argv = [subs.get(a, a) for a in argv]
     assert run(argv) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1, err

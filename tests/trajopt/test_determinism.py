@@ -1,0 +1,123 @@
+"""Determinism (issue 7, section 4): the same inputs give the same trajectory bit for bit.
+
+Every comparison here is exact (``np.array_equal``, ``==``), never ``allclose``: a planner
+whose answer depends on what it solved before cannot be replayed or debugged.
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+import astar
+import trajopt
+
+ROBOT = trajopt.Robot(radius=0.12)
+START, GOAL = (0.4, 0.3), (2.6, 1.6)
+OTHER_QUERIES = [((0.4, 0.3), (2.8, 0.3)), ((0.4, 1.6), (2.0, 1.8)), ((2.6, 1.6), (0.4, 0.3))]
+
+
+def door_grid() -> astar.OccupancyGrid:
+    """60 x 40 cells of 5 cm: a wall at x = 1.5 m with a 0.6 m door, a block below."""
+    occ = np.zeros((40, 60), bool)
+    occ[:, 30] = True
+    occ[16:28, 30] = False
+    occ[5:12, 40:50] = True
+    return astar.OccupancyGrid(occ, 0.05, (0.0, 0.0))
+
+
+def fingerprint(traj: trajopt.Trajectory) -> dict[str, np.ndarray]:
+    """Everything a user can read from a trajectory, as arrays to compare exactly."""
+    out = {f"sample_{k}": np.asarray(v) for k, v in
+           traj.sample(np.linspace(0.0, traj.duration, 1000)).as_dict().items()}
+    out["control_points"] = np.asarray(traj.path.control_points)
+    out["knots"] = np.asarray(traj.path.knots)
+    for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
+        out[name] = np.asarray(getattr(traj, name))
+    out["duration"] = np.asarray([traj.duration])
+    return out
+
+
+def assert_identical(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> None:
+    assert a.keys() == b.keys()
+    for k in a:
+        assert a[k].shape == b[k].shape, k
+        if not np.array_equal(a[k], b[k]):
+            diff = float(np.max(np.abs(a[k] - b[k])))
+            pytest.fail(f"{k} differs between identical runs (max |difference| {diff!r})")
+
+
+def test_two_fresh_planners_are_bit_identical() -> None:
+    grid = door_grid()
+    a = fingerprint(trajopt.Planner(grid, ROBOT).plan(START, GOAL))
+    b = fingerprint(trajopt.Planner(grid, ROBOT).plan(START, GOAL))
+    assert_identical(a, b)
+
+
+def test_plan_equals_planner_bit_for_bit() -> None:
+    grid = door_grid()
+    a = fingerprint(trajopt.plan(grid, START, GOAL, ROBOT))
+    b = fingerprint(trajopt.Planner(grid, ROBOT).plan(START, GOAL))
+    c = fingerprint(trajopt.plan(grid, START, GOAL, ROBOT))
+    assert_identical(a, b)
+    assert_identical(a, c)
+
+
+def test_answer_does_not_depend_on_earlier_queries() -> None:
+    # the same query before and after other queries of the same process (and the same
+    # planner): cached solvers must not carry state from one query to the next
+    grid = door_grid()
+    planner = trajopt.Planner(grid, ROBOT)
+    first = fingerprint(planner.plan(START, GOAL))
+    for s, g in OTHER_QUERIES:
+        planner.plan(s, g)
+        trajopt.plan(grid, s, g, ROBOT)
+    assert_identical(first, fingerprint(planner.plan(START, GOAL)))
+    assert_identical(first, fingerprint(trajopt.plan(grid, START, GOAL, ROBOT)))
+
+
+def _plan_in_worker(query: tuple[tuple[float, float], tuple[float, float]]) -> dict:
+    return fingerprint(trajopt.plan(door_grid(), query[0], query[1], ROBOT))
+
+
+def test_fresh_process_gives_the_same_answer() -> None:
+    here = fingerprint(trajopt.plan(door_grid(), START, GOAL, ROBOT))
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        there = pool.submit(_plan_in_worker, (START, GOAL)).result()
+    assert_identical(here, there)
+
+
+def _records_equal(a: dict, b: dict) -> bool:
+    """Exact equality of two ``run_scenario`` records, wall times left out."""
+    ka = {k for k in a if not k.endswith("time_s") and k != "smooth_s"}
+    kb = {k for k in b if not k.endswith("time_s") and k != "smooth_s"}
+    if ka != kb:
+        return False
+    for k in ka:
+        x, y = a[k], b[k]
+        if isinstance(x, float) and isinstance(y, float) and math.isnan(x) and math.isnan(y):
+            continue
+        if x != y:
+            return False
+    return True
+
+
+def test_bench_records_serial_equal_parallel_exactly(shared_data) -> None:
+    # `trajopt bench --jobs N` prints medians rounded to 4 digits; compare the raw records
+    # (every metric of every scenario) of a serial run and a 2-process run exactly
+    from trajopt._bench import select_scenarios
+    from trajopt.cli import _bench_one
+
+    scen = shared_data / "movingai" / "scen" / "arena.map.scen"
+    map_path = shared_data / "movingai" / "maps" / "arena.map"
+    chosen = select_scenarios(astar.read_scenarios(scen), 4)
+    jobs = [(str(map_path), 2.5, s) for s in chosen]
+    serial = [_bench_one(j) for j in jobs]
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        parallel = list(pool.map(_bench_one, jobs))
+    assert len(serial) == len(parallel) == len(jobs)
+    for i, (a, b) in enumerate(zip(serial, parallel, strict=True)):
+        assert _records_equal(a, b), f"scenario {i}: serial {a} != parallel {b}"
