@@ -230,8 +230,11 @@ def _table_text(table: Any, fmt: str) -> str:
         import io
 
         records = table.to_records()
+        # rows differ in their columns (the proposed method adds timed metrics): the
+        # union, in first-seen order, with empty cells where a method has no value
+        fields = list(dict.fromkeys(k for rec in records for k in rec))
         buf = io.StringIO()
-        writer = csv.DictWriter(buf, fieldnames=list(records[0]), lineterminator="\n")
+        writer = csv.DictWriter(buf, fieldnames=fields, restval="", lineterminator="\n")
         writer.writeheader()
         writer.writerows(records)
         return buf.getvalue()
