@@ -29,7 +29,6 @@ import math
 import os
 import re
 import reprlib
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +36,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from astar._files import atomic_write
 from astar.errors import InvalidInputError, MapFormatError
 from astar.grid import OccupancyGrid
 
@@ -1034,19 +1034,5 @@ def _nonneg_int(value: object, name: str) -> int:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder.
-
-    :func:`os.replace` is atomic, so readers see the old file or the new one, never a
-    partial one (the data is not fsynced: durability after a power loss is not promised).
-    """
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    """Write ``data`` to ``path`` atomically (:func:`astar._files.atomic_write`)."""
+    atomic_write(path, lambda tmp: tmp.write_bytes(data))

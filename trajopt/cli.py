@@ -11,11 +11,12 @@ import argparse
 import logging
 import os
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
+
+from astar._files import atomic_write
 
 __all__ = ["main", "build_parser"]
 
@@ -125,16 +126,7 @@ def _atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Pat
     target = Path(path)
     if target.parent and not target.parent.exists():
         raise CliError(f"output folder {str(target.parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=target.suffix,
-                               dir=target.parent or ".")
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return target
+    return atomic_write(target, write)
 
 
 def _save_figure(fig: Any, path: str | os.PathLike) -> Path:

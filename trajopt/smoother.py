@@ -86,9 +86,11 @@ class Certificate:
     kappa_bound : float or None
         The requested bound (1/m).
     min_speed_ratio : float
-        Smallest ``|C'(u)|`` over the samples divided by the mean (1 = uniform speed).
+        Smallest ``|C'(u)|`` over the samples divided by the mean (1 = uniform speed);
+        heading continuity requires at least 0.01.
     max_heading_step_rad : float
-        Largest heading change between consecutive samples (rad).
+        Largest heading change between consecutive samples (rad); heading continuity
+        requires at most pi / 8 (a larger turn within an eighth of a cell is a near-cusp).
     ok : bool
         All checks passed.
     failures : tuple of str
@@ -879,6 +881,13 @@ _SAMPLE_SLACK = 1.01
 #: largest SCP slack (keeps every row's range finite for the interior-point solver)
 _SLACK_MAX = 1e3
 
+#: heading continuity in the certificate: the tangent may turn at most this much between
+#: consecutive dense samples (rad; an eighth of a cell apart by default, so only a near-cusp,
+#: with a radius of curvature of a fraction of a cell, comes close), and the speed
+#: ``|C'(u)|`` must stay above this fraction of its mean
+_MAX_HEADING_STEP = math.pi / 8
+_MIN_SPEED_RATIO = 1e-2
+
 #: the SCP stops once the bound holds and an accepted step lowers the objective by less
 #: than this fraction (or moves no control point by 0.05 cell)
 _SCP_RTOL = 1e-3
@@ -1206,7 +1215,7 @@ def certify(
     hd = np.arctan2(d1[:, 1], d1[:, 0])
     step = np.abs(np.angle(np.exp(1j * np.diff(hd)))) if m > 1 else np.zeros(1)
     max_step = float(step.max()) if step.size else 0.0
-    if min_ratio < 1e-3 or max_step > math.pi / 2:
+    if min_ratio < _MIN_SPEED_RATIO or max_step > _MAX_HEADING_STEP:
         failures.append("heading_continuity")
     if kappa_bound is not None and not kmax_s <= kappa_bound * (1 + 1e-6):
         failures.append("curvature_bound")

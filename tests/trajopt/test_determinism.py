@@ -14,19 +14,11 @@ import pytest
 
 import astar
 import trajopt
+from tests.trajopt.test_pipeline import door_grid
 
 ROBOT = trajopt.Robot(radius=0.12)
 START, GOAL = (0.4, 0.3), (2.6, 1.6)
 OTHER_QUERIES = [((0.4, 0.3), (2.8, 0.3)), ((0.4, 1.6), (2.0, 1.8)), ((2.6, 1.6), (0.4, 0.3))]
-
-
-def door_grid() -> astar.OccupancyGrid:
-    """60 x 40 cells of 5 cm: a wall at x = 1.5 m with a 0.6 m door, a block below."""
-    occ = np.zeros((40, 60), bool)
-    occ[:, 30] = True
-    occ[16:28, 30] = False
-    occ[5:12, 40:50] = True
-    return astar.OccupancyGrid(occ, 0.05, (0.0, 0.0))
 
 
 def fingerprint(traj: trajopt.Trajectory) -> dict[str, np.ndarray]:
