@@ -60,7 +60,7 @@ __all__ = [
 DEFAULT_SAMPLE_SPACING = 0.005
 _COLLISION_TOL = 1e-9
 #: Most samples taken along one path; beyond it the spacing grows (and is reported).
-_MAX_SAMPLES = 200_000
+_MAX_SAMPLES = 20_000
 
 
 @dataclass(frozen=True, slots=True)
