@@ -824,11 +824,6 @@ class Smoother:
         return z, info
 
 
-def prob_res_scale(prob: _Problem) -> float:
-    """Factor turning 1/m into 1/cell (the problem is in cell units)."""
-    return prob.res
-
-
 # ----------------------------------------------------------------- internals
 class _AttemptFailed(Exception):
     def __init__(self, message: str, stats: dict[str, Any]) -> None:
