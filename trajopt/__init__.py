@@ -37,6 +37,9 @@ _EXPORTS: dict[str, str] = {
     "Robot": "trajopt.robot",
     "time_parameterize": "trajopt.timing",
     "Trajectory": "trajopt.trajectory",
+    # the opt-in stop-and-turn fallback
+    "StopAndTurnTrajectory": "trajopt.fallback",
+    "stop_and_turn": "trajopt.fallback",
     # pipeline and analysis
     "plan": "trajopt.pipeline",
     "Planner": "trajopt.pipeline",
@@ -44,7 +47,7 @@ _EXPORTS: dict[str, str] = {
     "ComparisonTable": "trajopt.comparison",
 }
 
-_SUBMODULES = {"scenes", "fits", "metrics", "plotting", "cli"}
+_SUBMODULES = {"scenes", "fits", "metrics", "plotting", "cli", "fallback"}
 
 __all__ = sorted(_EXPORTS) + sorted(_SUBMODULES)
 
@@ -78,6 +81,7 @@ if TYPE_CHECKING:  # pragma: no cover
         TimingError,
         TrajoptError,
     )
+    from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
     from trajopt.pipeline import Planner, plan
     from trajopt.robot import Robot
     from trajopt.smoother import Smoother, SmoothPath

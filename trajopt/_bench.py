@@ -24,31 +24,37 @@ def select_scenarios(scenarios: list[Any], limit: int) -> list[Any]:
 
 
 @functools.lru_cache(maxsize=4)
-def _planner(map_path: str, radius_cells: float):
+def _planner(map_path: str, radius_cells: float, fallback: str | None = None):
     import astar
     from trajopt.pipeline import Planner
     from trajopt.robot import Robot
 
     grid = astar.load_map(map_path)
     robot = Robot(radius=radius_cells * grid.resolution)
-    return Planner(grid, robot)
+    return Planner(grid, robot, fallback=fallback)  # type: ignore[arg-type]
 
 
-def run_scenario(map_path: str, radius_cells: float, scenario: Any) -> dict[str, Any]:
+def run_scenario(
+    map_path: str, radius_cells: float, scenario: Any, *, fallback: str | None = None
+) -> dict[str, Any]:
     """Plan one scenario with the proposed method and score a plain B-spline fit of the
     same A* path. Returns a flat dict of outcomes and metrics (never raises for planning
-    failures: they are recorded as ``outcome``)."""
+    failures: they are recorded as ``outcome``). With ``fallback="stop_and_turn"`` the
+    planner may return the stop-and-turn fallback; the record then has ``fallback=True``."""
     import astar
     from trajopt import fits
     from trajopt.errors import TrajoptError
     from trajopt.metrics import path_metrics
 
-    planner = _planner(map_path, radius_cells)
+    planner = _planner(map_path, radius_cells, fallback)
     grid = planner.grid
     start = grid.cell_to_world(scenario.start)
     goal = grid.cell_to_world(scenario.goal)
-    rec: dict[str, Any] = {"bucket": scenario.bucket, "start": tuple(scenario.start),
-                           "goal": tuple(scenario.goal)}
+    rec: dict[str, Any] = {
+        "bucket": scenario.bucket,
+        "start": tuple(scenario.start),
+        "goal": tuple(scenario.goal),
+    }
     t0 = time.perf_counter()
     path = None
     try:
@@ -58,13 +64,21 @@ def run_scenario(map_path: str, radius_cells: float, scenario: Any) -> dict[str,
         rec["time_s"] = time.perf_counter() - t0
     else:
         rec["outcome"] = "ok"
+        if fallback is not None:
+            rec["fallback"] = bool(traj.stats.get("fallback"))
         rec["time_s"] = traj.stats["stages_s"]["total"]
         rec["smooth_s"] = traj.stats["stages_s"]["smooth"]
         rec["duration_s"] = traj.duration
         path = traj.steps.grid_path
         ref = path.to_world(grid)
-        m = path_metrics(traj.path, grid=grid, reference=ref, radius=planner.robot.radius,
-                         sample_spacing=0.05 * grid.resolution, border_occupied=True)
+        m = path_metrics(
+            traj.path,
+            grid=grid,
+            reference=ref,
+            radius=planner.robot.radius,
+            sample_spacing=0.05 * grid.resolution,
+            border_occupied=True,
+        )
         rec["collision"] = bool(m.collision)
         rec["clearance_margin_m"] = m.min_clearance_m - planner.robot.radius
         rec["hausdorff_m"] = m.hausdorff_m
@@ -72,16 +86,26 @@ def run_scenario(map_path: str, radius_cells: float, scenario: Any) -> dict[str,
         rec["length_ratio"] = m.length_ratio
     if path is None:
         try:
-            path = astar.find_path(planner.inflated_grid, tuple(scenario.start),
-                                   tuple(scenario.goal), cost=planner.search_cost)
+            path = astar.find_path(
+                planner.inflated_grid,
+                tuple(scenario.start),
+                tuple(scenario.goal),
+                cost=planner.search_cost,
+            )
         except astar.AstarError:
             return rec
     ref = path.to_world(grid)
     if len(ref) >= 8:
         n_ctrl = int(min(max(6, len(ref) // 4), len(ref) - 1))
         plain = fits.fit_bspline(ref, degree=3, n_ctrl=n_ctrl, parameterization="chord")
-        pm = path_metrics(plain, grid=grid, reference=ref, radius=planner.robot.radius,
-                          sample_spacing=0.05 * grid.resolution, border_occupied=True)
+        pm = path_metrics(
+            plain,
+            grid=grid,
+            reference=ref,
+            radius=planner.robot.radius,
+            sample_spacing=0.05 * grid.resolution,
+            border_occupied=True,
+        )
         rec["plain_collision"] = bool(pm.collision)
         rec["plain_hausdorff_m"] = pm.hausdorff_m
     return rec
@@ -104,6 +128,11 @@ def summarize(results: list[dict[str, Any]]) -> str:
     lines = [
         f"scenarios                      {n}",
         f"proposed: success              {len(ok)}/{n} ({100 * len(ok) / max(n, 1):.1f}%)",
+    ]
+    if any("fallback" in r for r in ok):
+        fb = sum(bool(r.get("fallback")) for r in ok)
+        lines.append(f"proposed: of which fallback    {fb} (stop and turn)")
+    lines += [
         f"proposed: failures             {fails or 'none'}",
         f"proposed: collisions           {sum(r['collision'] for r in ok)}",
         f"proposed: median plan time     {med('time_s', ok, 1e3)} ms",

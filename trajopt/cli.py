@@ -53,14 +53,18 @@ def _robot_args(p: argparse.ArgumentParser) -> None:
 
 
 def _map_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("map", metavar="MAP", help="map file: ROS .yaml, Moving AI .map, .pgm/.png, .npy")
+    p.add_argument(
+        "map", metavar="MAP", help="map file: ROS .yaml, Moving AI .map, .pgm/.png, .npy"
+    )
     p.add_argument(
         "--resolution", type=float, help="cell size [m] for images/.npy (and to override .map)"
     )
-    p.add_argument("--start", nargs=2, type=float, metavar=("X", "Y"), required=True,
-                   help="start point [m]")
-    p.add_argument("--goal", nargs=2, type=float, metavar=("X", "Y"), required=True,
-                   help="goal point [m]")
+    p.add_argument(
+        "--start", nargs=2, type=float, metavar=("X", "Y"), required=True, help="start point [m]"
+    )
+    p.add_argument(
+        "--goal", nargs=2, type=float, metavar=("X", "Y"), required=True, help="goal point [m]"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -72,50 +76,91 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    p = sub.add_parser("plan", help="plan a timed trajectory on a map",
-                       description="Plan a timed trajectory: inflate -> A* -> corridor -> "
-                       "smoother -> ruckig timing.")
+    p = sub.add_parser(
+        "plan",
+        help="plan a timed trajectory on a map",
+        description="Plan a timed trajectory: inflate -> A* -> corridor -> "
+        "smoother -> ruckig timing.",
+    )
     _map_args(p)
     _robot_args(p)
-    p.add_argument("--inflation", choices=("exact", "paper"), default="exact",
-                   help="exact disk inflation or the chapter's avoidance area (default exact)")
-    p.add_argument("--search", choices=("clearance", "shortest"), default="clearance",
-                   help="A* cost (default clearance-aware)")
+    p.add_argument(
+        "--inflation",
+        choices=("exact", "paper"),
+        default="exact",
+        help="exact disk inflation or the chapter's avoidance area (default exact)",
+    )
+    p.add_argument(
+        "--search",
+        choices=("clearance", "shortest"),
+        default="clearance",
+        help="A* cost (default clearance-aware)",
+    )
     p.add_argument("--kappa-max", type=float, help="curvature bound [1/m] for the smoother")
     p.add_argument("--start-heading", type=float, help="exact start heading [rad]")
     p.add_argument("--goal-heading", type=float, help="exact goal heading [rad]")
+    p.add_argument(
+        "--fallback",
+        action="store_true",
+        help="if the smoother (or the timing) fails, return the A* polyline driven "
+        "with stops and turns in place at the corners (differential drive; "
+        "checked against the map) instead of an error",
+    )
     p.add_argument("--out", help="write the trajectory (.csv or .json)")
     p.add_argument("--dt", type=float, default=0.01, help="sample step of --out [s]")
     p.add_argument("--plot", help="write a figure (.png/.pdf/.svg)")
     p.set_defaults(func=_cmd_plan)
 
-    p = sub.add_parser("compare", help="compare the chapter's methods and the proposed one",
-                       description="Table of path metrics: traditional A*, A* with avoidance "
-                       "area, polynomial fit, B-spline fit and the proposed smoother.")
+    p = sub.add_parser(
+        "compare",
+        help="compare the chapter's methods and the proposed one",
+        description="Table of path metrics: traditional A*, A* with avoidance "
+        "area, polynomial fit, B-spline fit and the proposed smoother.",
+    )
     _map_args(p)
     p.add_argument("--radius", type=float, help="robot radius [m] (default trajopt.Robot())")
-    p.add_argument("--format", choices=("text", "markdown", "csv"), default="text",
-                   help="table format on stdout (default text)")
+    p.add_argument(
+        "--format",
+        choices=("text", "markdown", "csv"),
+        default="text",
+        help="table format on stdout (default text)",
+    )
     p.add_argument("--out", help="also write the table to this file (.csv, .md or .txt)")
     p.add_argument("--plot", help="write a figure of all paths (.png/.pdf/.svg)")
     p.set_defaults(func=_cmd_compare)
 
-    p = sub.add_parser("demo", help="the paper scene, SP to A-D, every method",
-                       description="Runs the chapter's scene (trajopt.scenes.paper()): every "
-                       "method from SP to each target; writes tables and figures.")
+    p = sub.add_parser(
+        "demo",
+        help="the paper scene, SP to A-D, every method",
+        description="Runs the chapter's scene (trajopt.scenes.paper()): every "
+        "method from SP to each target; writes tables and figures.",
+    )
     p.add_argument("--out", default="trajopt_demo", help="output folder (default trajopt_demo)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.set_defaults(func=_cmd_demo)
 
-    p = sub.add_parser("bench", help="run the methods on a Moving AI scenario file",
-                       description="Proposed method and plain B-spline fit on the scenarios of "
-                       "a Moving AI .scen; prints aggregate metrics.")
+    p = sub.add_parser(
+        "bench",
+        help="run the methods on a Moving AI scenario file",
+        description="Proposed method and plain B-spline fit on the scenarios of "
+        "a Moving AI .scen; prints aggregate metrics.",
+    )
     p.add_argument("scen", metavar="SCEN_FILE", help="Moving AI .scen file")
     p.add_argument("--map", help="the .map file (default: found beside the .scen or in ../maps)")
     p.add_argument("--limit", type=int, default=20, help="number of scenarios (default 20)")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
-    p.add_argument("--radius-cells", type=float, default=2.5,
-                   help="robot radius in cells (default 2.5; the map has 1 m cells)")
+    p.add_argument(
+        "--radius-cells",
+        type=float,
+        default=2.5,
+        help="robot radius in cells (default 2.5; the map has 1 m cells)",
+    )
+    p.add_argument(
+        "--fallback",
+        action="store_true",
+        help="plan with the stop-and-turn fallback (as plan --fallback) and count "
+        "how often it was used",
+    )
     p.set_defaults(func=_cmd_bench)
     return parser
 
@@ -153,9 +198,14 @@ def _robot(args: argparse.Namespace):
     from trajopt.robot import Robot
 
     fields = {
-        "radius": args.radius, "v_max": args.v_max, "a_max": args.a_max, "j_max": args.j_max,
-        "a_lat_max": args.a_lat_max, "omega_max": args.omega_max,
-        "track_width": args.track_width, "wheel_v_max": args.wheel_v_max,
+        "radius": args.radius,
+        "v_max": args.v_max,
+        "a_max": args.a_max,
+        "j_max": args.j_max,
+        "a_lat_max": args.a_lat_max,
+        "omega_max": args.omega_max,
+        "track_width": args.track_width,
+        "wheel_v_max": args.wheel_v_max,
     }
     kwargs = {k: v for k, v in fields.items() if v is not None}
     if getattr(args, "no_wheels", False):
@@ -170,9 +220,7 @@ def _require_matplotlib() -> None:
 
         matplotlib.use("Agg")
     except ImportError as exc:
-        raise CliError(
-            "figures need matplotlib: pip install 'trajopt[analysis]'"
-        ) from exc
+        raise CliError("figures need matplotlib: pip install 'trajopt[analysis]'") from exc
 
 
 # -------------------------------------------------------------------- commands
@@ -183,13 +231,29 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     grid = _load(args)
     robot = _robot(args)
     smoother = Smoother(kappa_max=args.kappa_max) if args.kappa_max is not None else None
-    planner = Planner(grid, robot, inflation=args.inflation, search=args.search,
-                      smoother=smoother)
-    traj = planner.plan(args.start, args.goal, start_heading=args.start_heading,
-                        goal_heading=args.goal_heading)
+    planner = Planner(
+        grid,
+        robot,
+        inflation=args.inflation,
+        search=args.search,
+        smoother=smoother,
+        fallback="stop_and_turn" if args.fallback else None,
+    )
+    traj = planner.plan(
+        args.start, args.goal, start_heading=args.start_heading, goal_heading=args.goal_heading
+    )
     stages = traj.stats.get("stages_s", {})
-    print(f"duration {traj.duration:.3f} s, length {traj.path.length:.3f} m, "
-          f"planned in {1e3 * stages.get('total', float('nan')):.1f} ms")
+    line = (
+        f"duration {traj.duration:.3f} s, length {traj.path.length:.3f} m, "
+        f"planned in {1e3 * stages.get('total', float('nan')):.1f} ms"
+    )
+    if traj.stats.get("fallback"):
+        reason = str(traj.stats.get("fallback_reason", "")).splitlines()[0][:120]
+        line += (
+            f"; FALLBACK {traj.stats['fallback']} ({traj.stats['n_turns']} turns in "
+            f"place) after {traj.stats.get('fallback_error')}: {reason}"
+        )
+    print(line)
     if args.out:
         suffix = Path(args.out).suffix.lower()
         if suffix == ".csv":
@@ -207,9 +271,16 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
-        plot_paths(grid, {"A*": steps.grid_path.to_world(grid), "proposed": traj.path},
-                   inflated=steps.inflated_grid, corridor=steps.corridor,
-                   start=steps.start, goals={"goal": steps.goal}, ax=ax)
+        name = "stop and turn" if traj.stats.get("fallback") else "proposed"
+        plot_paths(
+            grid,
+            {"A*": steps.grid_path.to_world(grid), name: traj.path},
+            inflated=steps.inflated_grid,
+            corridor=steps.corridor,
+            start=steps.start,
+            goals={"goal": steps.goal},
+            ax=ax,
+        )
         print(f"wrote {_save_figure(fig, args.plot)}")
     return 0
 
@@ -257,8 +328,13 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         from trajopt.plotting import plot_paths
 
         paths = {k: v for k, v in table.paths.items() if v is not None}
-        fig, _ = plot_paths(grid, paths, inflated=_avoidance(grid, table),
-                            start=tuple(args.start), goals={"goal": tuple(args.goal)})
+        fig, _ = plot_paths(
+            grid,
+            paths,
+            inflated=_avoidance(grid, table),
+            start=tuple(args.start),
+            goals={"goal": tuple(args.goal)},
+        )
         print(f"wrote {_save_figure(fig, args.plot)}")
     return 0
 
@@ -283,8 +359,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     sections = []
     for name in scene.target_names:
         t0 = time.perf_counter()
-        table = compare(scene.grid, scene.start, scene.goal(name),
-                        robot_radius=scene.robot_radius, w_cells=scene.w_cells)
+        table = compare(
+            scene.grid,
+            scene.start,
+            scene.goal(name),
+            robot_radius=scene.robot_radius,
+            w_cells=scene.w_cells,
+        )
         dt = time.perf_counter() - t0
         print(f"\n== SP -> {name} ({dt:.2f} s) ==")
         print(table)
@@ -295,8 +376,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             from trajopt.plotting import plot_paths, plot_profiles
 
             paths = {k: v for k, v in table.paths.items() if v is not None}
-            fig, _ = plot_paths(scene.grid, paths, inflated=_avoidance(scene.grid, table),
-                                start=scene.start, goals={name: scene.goal(name)})
+            fig, _ = plot_paths(
+                scene.grid,
+                paths,
+                inflated=_avoidance(scene.grid, table),
+                start=scene.start,
+                goals={name: scene.goal(name)},
+            )
             _save_figure(fig, out / f"paths_{name}.png")
             traj = planner.plan(scene.start, scene.goal(name))
             fig, _ = plot_profiles(traj)
@@ -310,19 +396,23 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _find_map(scen: Path, explicit: str | None, map_name: str) -> Path:
     if explicit:
         return Path(explicit)
-    for cand in (scen.parent / map_name, scen.parent.parent / "maps" / map_name,
-                 scen.with_suffix("")):
+    for cand in (
+        scen.parent / map_name,
+        scen.parent.parent / "maps" / map_name,
+        scen.with_suffix(""),
+    ):
         if cand.is_file() and cand.suffix == ".map":
             return cand
-    raise CliError(f"map {map_name!r} of {str(scen)!r} not found beside it or in ../maps; "
-                   "give --map")
+    raise CliError(
+        f"map {map_name!r} of {str(scen)!r} not found beside it or in ../maps; give --map"
+    )
 
 
-def _bench_one(job: tuple[str, float, Any]) -> dict[str, Any]:
+def _bench_one(job: tuple[str, float, Any, str | None]) -> dict[str, Any]:
     from trajopt._bench import run_scenario
 
-    map_path, radius_cells, scenario = job
-    return run_scenario(map_path, radius_cells, scenario)
+    map_path, radius_cells, scenario, fallback = job
+    return run_scenario(map_path, radius_cells, scenario, fallback=fallback)
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -342,7 +432,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     map_path = _find_map(scen, args.map, scenarios[0].map_name)
     astar.load_map(map_path)  # fail early, with one line, on a bad map
     chosen = select_scenarios(scenarios, args.limit)
-    jobs = [(str(map_path), args.radius_cells, s) for s in chosen]
+    fallback = "stop_and_turn" if args.fallback else None
+    jobs = [(str(map_path), args.radius_cells, s, fallback) for s in chosen]
     results: list[dict[str, Any]] = []
     t0 = time.perf_counter()
     if args.jobs == 1:
@@ -374,8 +465,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``trajopt`` console script; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format="%(levelname)s %(name)s: %(message)s",
+    )
     if args.command is None:
         parser.print_help()
         return EXIT_USAGE

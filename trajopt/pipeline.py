@@ -18,6 +18,22 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 
 The returned :class:`~trajopt.trajectory.Trajectory` carries every intermediate result in
 ``trajectory.steps`` (a :class:`PlanSteps`).
+
+**Fallback** (opt-in, ``fallback="stop_and_turn"``). When the smoother raises
+:class:`~trajopt.errors.SmoothingError` (after its own refinements), or the timing raises
+:class:`~trajopt.errors.TimingError` on the smooth curve, and both end speeds are 0, the
+planner returns a :class:`~trajopt.fallback.StopAndTurnTrajectory` instead: the polyline
+*exact start -> centres of the A* path cells -> exact goal*, driven straight with a
+rest-to-rest profile per segment and turning in place at rest at every corner (a
+differential drive can do this; see :mod:`trajopt.fallback`). The A* moves between
+adjacent free cells of the square-metric inflated grid without corner cutting keep the
+centre at clearance ``>= radius``; the planner does not rely on that argument but checks the
+polyline's exact distance to the raw map's obstacle squares (cells outside the map count
+as occupied) and re-raises the original error if it is below the radius. The trajectory's
+``stats`` hold ``fallback = "stop_and_turn"``, ``fallback_error`` (the exception's type),
+``fallback_reason`` (its message) and ``fallback_min_clearance_m``; ``steps.smooth_path``
+is ``None``. With ``v_start`` or ``v_end`` not 0 the original error is raised: a
+stop-and-turn motion starts and ends at rest, so it could not honour those speeds.
 """
 
 from __future__ import annotations
@@ -35,20 +51,25 @@ import numpy as np
 import astar
 from astar.grid import OccupancyGrid
 from trajopt.corridor import Box, Corridor, build_corridor
-from trajopt.errors import InvalidInputError, NoPathError
+from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
+from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
 from trajopt.robot import Robot
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
 
-__all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search"]
+__all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
 
 logger = logging.getLogger(__name__)
 
 Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest"]
+Fallback = Literal["stop_and_turn"]
+#: What :meth:`Planner.plan` returns: a smooth trajectory, or the stop-and-turn fallback.
+PlanResult = Trajectory | StopAndTurnTrajectory
 _INFLATIONS = ("exact", "paper")
 _SEARCHES = ("clearance", "shortest")
+_FALLBACKS = (None, "stop_and_turn")
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,20 +86,23 @@ class PlanSteps:
         The A* path on ``inflated_grid``.
     corridor : Corridor
         The free boxes around the path (end boxes widened to the exact start/goal).
-    smooth_path : SmoothPath
-        The certified B-spline.
+    smooth_path : SmoothPath or None
+        The certified B-spline; ``None`` when the planner returned the stop-and-turn
+        fallback (the trajectory's ``path`` is then the polyline it drives).
     start, goal : tuple of float
         The query's end points (m).
     stages_s : dict of str to float
         Wall time of each stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
-        ``timing``, ``total``. ``inflate`` is ~0 when the planner's cache served it.
+        ``timing``, ``total``. ``inflate`` is ~0 when the planner's cache served it. With
+        the fallback: ``fallback`` (checking and timing the polyline) and no ``timing``
+        unless the timing was the stage that failed.
     """
 
     raw_grid: OccupancyGrid
     inflated_grid: OccupancyGrid
     grid_path: Any
     corridor: Corridor
-    smooth_path: SmoothPath
+    smooth_path: SmoothPath | None
     start: tuple[float, float]
     goal: tuple[float, float]
     stages_s: dict[str, float]
@@ -108,6 +132,11 @@ class Planner:
         Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
     timing_dt : float
         Step of the timing's forward greedy (s).
+    fallback : {None, "stop_and_turn"}
+        ``None`` (default): smoother and timing failures raise. ``"stop_and_turn"``: when
+        they fail and both end speeds are 0, return a
+        :class:`~trajopt.fallback.StopAndTurnTrajectory` along the A* polyline, checked
+        against the raw map (module docstring); ``stats["fallback"]`` says so.
 
     Notes
     -----
@@ -125,6 +154,7 @@ class Planner:
         search: Search = "clearance",
         smoother: Smoother | None = None,
         timing_dt: float = 0.02,
+        fallback: Fallback | None = None,
     ) -> None:
         if not isinstance(grid, OccupancyGrid):
             raise InvalidInputError(
@@ -137,6 +167,8 @@ class Planner:
             raise InvalidInputError(f"inflation must be one of {_INFLATIONS}, got {inflation!r}")
         if search not in _SEARCHES:
             raise InvalidInputError(f"search must be one of {_SEARCHES}, got {search!r}")
+        if not (fallback is None or (isinstance(fallback, str) and fallback in _FALLBACKS)):
+            raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
         if w_cells is None:
             w_cells = max(1, round(robot.width / grid.resolution))
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
@@ -159,6 +191,7 @@ class Planner:
         self.search: Search = search
         self.smoother = smoother
         self.timing_dt = float(timing_dt)
+        self.fallback: Fallback | None = fallback
         self._lock = threading.RLock()
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
@@ -200,7 +233,7 @@ class Planner:
         goal_heading: float | None = None,
         v_start: float = 0.0,
         v_end: float = 0.0,
-    ) -> Trajectory:
+    ) -> PlanResult:
         """Plan a timed trajectory from ``start`` to ``goal`` (world metres).
 
         Parameters
@@ -214,9 +247,11 @@ class Planner:
 
         Returns
         -------
-        Trajectory
+        Trajectory or StopAndTurnTrajectory
             With ``trajectory.steps`` (:class:`PlanSteps`) and per-stage wall times in
-            ``trajectory.stats["stages_s"]``.
+            ``trajectory.stats["stages_s"]``. A :class:`~trajopt.fallback.StopAndTurnTrajectory`
+            (``stats["fallback"] == "stop_and_turn"``) only with the planner's ``fallback``
+            option, when the smoother or the timing failed.
 
         Raises
         ------
@@ -227,12 +262,14 @@ class Planner:
         NoPathError
             The goal cannot be reached on the inflated grid.
         SmoothingError, TimingError
-            From the smoother or the timing (with their statistics).
+            From the smoother or the timing (with their statistics); with the fallback
+            enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
+            its clearance check.
         """
         with self._lock:
             return self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
 
-    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> Trajectory:
+    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
         t0 = time.perf_counter()
         stages: dict[str, float] = {}
         p0 = _point("start", start)
@@ -269,28 +306,35 @@ class Planner:
         # bridges (45-degree regions certified against the raw map) across diagonal gaps;
         # not with the chapter's avoidance area, which the curve must not enter either
         bridge_map = self.grid if self.inflation == "exact" else None
-        corridor = build_corridor(
-            inflated, path, radius=self.robot.radius, raw_grid=bridge_map
-        )
+        corridor = build_corridor(inflated, path, radius=self.robot.radius, raw_grid=bridge_map)
         corridor = _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
         stages["corridor"] = time.perf_counter() - t
         t = time.perf_counter()
-        smooth = self.smoother.fit(
-            path,
-            corridor,
-            raw_grid=self.grid,
-            radius=self.robot.radius,
-            start=p0,
-            goal=p1,
-            start_heading=start_heading,
-            goal_heading=goal_heading,
-        )
-        stages["smooth"] = time.perf_counter() - t
-        t = time.perf_counter()
-        traj = time_parameterize(
-            smooth, self.robot, v_start=v_start, v_end=v_end, dt=self.timing_dt
-        )
-        stages["timing"] = time.perf_counter() - t
+        smooth = None
+        try:
+            smooth = self.smoother.fit(
+                path,
+                corridor,
+                raw_grid=self.grid,
+                radius=self.robot.radius,
+                start=p0,
+                goal=p1,
+                start_heading=start_heading,
+                goal_heading=goal_heading,
+            )
+            stages["smooth"] = time.perf_counter() - t
+            t = time.perf_counter()
+            traj = time_parameterize(
+                smooth, self.robot, v_start=v_start, v_end=v_end, dt=self.timing_dt
+            )
+            stages["timing"] = time.perf_counter() - t
+        except (SmoothingError, TimingError) as exc:
+            stages["smooth" if smooth is None else "timing"] = time.perf_counter() - t
+            if self.fallback is None or v_start != 0.0 or v_end != 0.0:
+                raise
+            return self._fallback(
+                exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
+            )
         stages["total"] = time.perf_counter() - t0
         steps = PlanSteps(
             raw_grid=self.grid,
@@ -307,6 +351,52 @@ class Planner:
         stats["inflation"] = self.inflation
         stats["search"] = self.search
         stats["smoother"] = dict(smooth.stats)
+        return dataclasses.replace(traj, stats=stats, steps=steps)
+
+    def _fallback(
+        self, exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
+    ) -> StopAndTurnTrajectory:
+        """The stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
+        t = time.perf_counter()
+        grid = self.grid
+        centres = np.asarray(grid.cell_to_world(np.asarray(path.cells)), dtype=float)
+        points = np.vstack([p0, centres.reshape(-1, 2), p1])
+        radius = self.robot.radius
+        window = radius + 2.0 * float(grid.resolution)
+        clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
+        if clearance < radius - 1e-9:
+            logger.warning(
+                "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an "
+                "obstacle (radius %.6g m)",
+                clearance,
+                radius,
+            )
+            raise exc
+        traj = stop_and_turn(
+            points, self.robot, start_heading=start_heading, goal_heading=goal_heading
+        )
+        stages["fallback"] = time.perf_counter() - t
+        stages["total"] = time.perf_counter() - t0
+        logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
+        steps = PlanSteps(
+            raw_grid=grid,
+            inflated_grid=inflated,
+            grid_path=path,
+            corridor=corridor,
+            smooth_path=None,
+            start=(float(p0[0]), float(p0[1])),
+            goal=(float(p1[0]), float(p1[1])),
+            stages_s=stages,
+        )
+        stats = dict(traj.stats)
+        stats["fallback_error"] = type(exc).__name__
+        stats["fallback_reason"] = str(exc)
+        stats["fallback_min_clearance_m"] = float(clearance)
+        stats["stages_s"] = dict(stages)
+        stats["inflation"] = self.inflation
+        stats["search"] = self.search
+        if isinstance(exc, SmoothingError):
+            stats["smoother"] = dict(exc.stats)
         return dataclasses.replace(traj, stats=stats, steps=steps)
 
     def _check_endpoint(self, name: str, p: np.ndarray) -> np.ndarray:
@@ -345,7 +435,8 @@ def plan(
     search: Search = "clearance",
     smoother: Smoother | None = None,
     w_cells: int | None = None,
-) -> Trajectory:
+    fallback: Fallback | None = None,
+) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
     Runs inflate -> A* -> corridor -> smoother -> timing (module docstring). For repeated
@@ -365,11 +456,15 @@ def plan(
         Speeds at the ends (m/s).
     inflation, search, smoother, w_cells
         See :class:`Planner`.
+    fallback : {None, "stop_and_turn"}
+        Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
+        module docstring); default ``None``: the failure raises.
 
     Returns
     -------
-    Trajectory
-        ``trajectory.steps`` holds every intermediate result (:class:`PlanSteps`).
+    Trajectory or StopAndTurnTrajectory
+        ``trajectory.steps`` holds every intermediate result (:class:`PlanSteps`); the
+        second type only with ``fallback="stop_and_turn"`` (``stats["fallback"]``).
 
     Examples
     --------
@@ -379,7 +474,13 @@ def plan(
     >>> traj.duration  # doctest: +SKIP
     """
     planner = Planner(
-        grid, robot, inflation=inflation, search=search, smoother=smoother, w_cells=w_cells
+        grid,
+        robot,
+        inflation=inflation,
+        search=search,
+        smoother=smoother,
+        w_cells=w_cells,
+        fallback=fallback,
     )
     return planner.plan(
         start,
@@ -396,7 +497,9 @@ def _point(name: str, value: Any) -> np.ndarray:
     try:
         p = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be two numbers (x, y) in metres, got {value!r}") from exc
+        raise InvalidInputError(
+            f"{name} must be two numbers (x, y) in metres, got {value!r}"
+        ) from exc
     if p.shape != (2,):
         raise InvalidInputError(f"{name} must be two numbers (x, y) in metres, got {value!r}")
     if not np.all(np.isfinite(p)):
@@ -457,14 +560,19 @@ def _widen_end_boxes(
                 "towards free space or onto the centre of its cell"
             )
         boxes[idx] = Box(
-            xmin=float(lo[0]), xmax=float(hi[0]), ymin=float(lo[1]), ymax=float(hi[1]),
-            ix0=b.ix0, ix1=b.ix1, iy0=b.iy0, iy1=b.iy1,
+            xmin=float(lo[0]),
+            xmax=float(hi[0]),
+            ymin=float(lo[1]),
+            ymax=float(hi[1]),
+            ix0=b.ix0,
+            ix1=b.ix1,
+            iy0=b.iy0,
+            iy1=b.iy1,
         )
         changed = True
     if not changed:
         return corridor
     return dataclasses.replace(corridor, boxes=tuple(boxes))
-
 
 
 def compare_method(ctx: Any) -> Any:
@@ -484,8 +592,11 @@ def compare_method(ctx: Any) -> Any:
     traj = Planner(ctx.grid, robot, **opts).plan(ctx.start, ctx.goal)
     runtime = time.perf_counter() - t0
     timed = trajectory_metrics(traj, robot)
-    extras = {k: timed[k] for k in ("duration_s", "ratio_v", "ratio_a", "ratio_jerk",
-                                    "ratio_omega", "ratio_a_lat") if k in timed}
+    extras = {
+        k: timed[k]
+        for k in ("duration_s", "ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat")
+        if k in timed
+    }
     attempts = traj.stats.get("smoother", {}).get("attempts")
     note = f"duration {traj.duration:.3g} s"
     if attempts:

@@ -88,8 +88,82 @@ def _readonly(x: Any) -> np.ndarray:
     return arr
 
 
+class _SampledExport:
+    """The sampling and file export shared by every timed trajectory of :mod:`trajopt`.
+
+    A subclass provides ``duration`` (s), ``sample(t)`` returning a
+    :class:`TrajectorySample` and ``to_dict(dt)``; the helpers below give it
+    ``sample_uniform``, ``to_json`` and ``to_csv`` (atomic writes).
+    """
+
+    __slots__ = ()
+
+    def sample_uniform(self, dt: float) -> TrajectorySample:
+        """Samples every ``dt`` seconds from 0, plus the end time ``duration``.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), > 0.
+        """
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise InvalidInputError(f"dt must be a finite number > 0 s, got {dt!r}")
+        duration = self.duration  # type: ignore[attr-defined]
+        n = int(math.floor(duration / dt + 1e-9))
+        t = np.arange(n + 1) * dt
+        if t[-1] < duration - 1e-12:
+            t = np.append(t, duration)
+        else:
+            t[-1] = min(t[-1], duration)
+        return self.sample(t)  # type: ignore[attr-defined]
+
+    def to_json(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
+        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path."""
+        text = json.dumps(self.to_dict(dt), indent=1)  # type: ignore[attr-defined]
+        return _atomic_write(Path(path), text)
+
+    def to_csv(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
+        """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
+
+        The header names each column with its unit, e.g. ``t [s]``, ``v [m/s]``.
+        """
+        smp = self.sample_uniform(dt).as_dict()
+        names = list(smp)
+        import io
+
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow([f"{n} [{SAMPLE_UNITS[n]}]" for n in names])
+        cols = np.column_stack([np.asarray(smp[n]) for n in names])
+        for row in cols:
+            w.writerow([repr(float(x)) for x in row])
+        return _atomic_write(Path(path), buf.getvalue())
+
+
+def _export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:
+    """The ``to_dict`` layout shared by the trajectory classes: a header (format, units,
+    duration, length, end speeds, robot, stats), then ``extra``, then the ``samples``."""
+    smp = traj.sample_uniform(dt).as_dict()
+    units = {k: u for k, u in SAMPLE_UNITS.items() if k in smp}
+    out: dict[str, Any] = {
+        "format": fmt,
+        "units": units,
+        "duration": traj.duration,
+        "duration_unit": "s",
+        "length": traj.length,
+        "length_unit": "m",
+        "v_start": traj.v_start,
+        "v_end": traj.v_end,
+        "robot": traj.robot.to_dict(),
+        "stats": _jsonable(traj.stats),
+    }
+    out.update(extra)
+    out["samples"] = {k: np.asarray(x).tolist() for k, x in smp.items()}
+    return out
+
+
 @dataclass(frozen=True, slots=True)
-class Trajectory:
+class Trajectory(_SampledExport):
     """A jerk-limited timed motion along a curve.
 
     Built by :func:`trajopt.time_parameterize`; the constructor checks shapes only.
@@ -263,24 +337,6 @@ class Trajectory:
             out["v_right"] = v + omega * half
         return TrajectorySample(**{k: _readonly(x) for k, x in out.items()})
 
-    def sample_uniform(self, dt: float) -> TrajectorySample:
-        """Samples every ``dt`` seconds from 0, plus the end time ``duration``.
-
-        Parameters
-        ----------
-        dt : float
-            Time step (s), > 0.
-        """
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            raise InvalidInputError(f"dt must be a finite number > 0 s, got {dt!r}")
-        n = int(math.floor(self.duration / dt + 1e-9))
-        t = np.arange(n + 1) * dt
-        if t[-1] < self.duration - 1e-12:
-            t = np.append(t, self.duration)
-        else:
-            t[-1] = min(t[-1], self.duration)
-        return self.sample(t)
-
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
         """A JSON-ready description: units, robot, stats, the exact phases and samples.
@@ -290,51 +346,15 @@ class Trajectory:
         dt : float
             Sample spacing (s) of the ``samples`` table.
         """
-        smp = self.sample_uniform(dt).as_dict()
-        units = {k: u for k, u in SAMPLE_UNITS.items() if k in smp}
-        return {
-            "format": "trajopt.Trajectory",
-            "units": units,
-            "duration": self.duration,
-            "duration_unit": "s",
-            "length": self.length,
-            "length_unit": "m",
-            "v_start": self.v_start,
-            "v_end": self.v_end,
-            "robot": self.robot.to_dict(),
-            "stats": _jsonable(self.stats),
-            "phases": {
-                "units": {"t": "s", "s": "m", "v": "m/s", "a": "m/s^2", "jerk": "m/s^3"},
-                "t": self.phase_t.tolist(),
-                "s": self.phase_s.tolist(),
-                "v": self.phase_v.tolist(),
-                "a": self.phase_a.tolist(),
-                "jerk": self.phase_j.tolist(),
-            },
-            "samples": {k: np.asarray(x).tolist() for k, x in smp.items()},
+        phases = {
+            "units": {"t": "s", "s": "m", "v": "m/s", "a": "m/s^2", "jerk": "m/s^3"},
+            "t": self.phase_t.tolist(),
+            "s": self.phase_s.tolist(),
+            "v": self.phase_v.tolist(),
+            "a": self.phase_a.tolist(),
+            "jerk": self.phase_j.tolist(),
         }
-
-    def to_json(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
-        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path."""
-        text = json.dumps(self.to_dict(dt), indent=1)
-        return _atomic_write(Path(path), text)
-
-    def to_csv(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
-        """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
-
-        The header names each column with its unit, e.g. ``t [s]``, ``v [m/s]``.
-        """
-        smp = self.sample_uniform(dt).as_dict()
-        names = list(smp)
-        import io
-
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow([f"{n} [{SAMPLE_UNITS[n]}]" for n in names])
-        cols = np.column_stack([np.asarray(smp[n]) for n in names])
-        for row in cols:
-            w.writerow([repr(float(x)) for x in row])
-        return _atomic_write(Path(path), buf.getvalue())
+        return _export_dict(self, "trajopt.Trajectory", dt, {"phases": phases})
 
     def __repr__(self) -> str:
         return (

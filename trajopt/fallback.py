@@ -1,0 +1,679 @@
+"""Stop-and-turn: drive a polyline straight, turning in place at rest at every corner.
+
+The opt-in fallback of :class:`trajopt.Planner` (``fallback="stop_and_turn"``) for queries
+the smoother cannot solve (typically one-cell passages of the inflated grid): the A*
+polyline is driven by a differential drive as
+
+* one **rest-to-rest straight move per segment**: a time-optimal, jerk-limited 1-DoF
+  profile along the segment computed by ruckig (position interface, never
+  ``intermediate_positions``) with ``|v| <= min(v_max, wheel_v_max)`` (the speed cap
+  :meth:`Robot.speed_cap` at curvature 0), ``|a| <= a_max`` and ``|jerk| <= j_max``;
+* one **rest-to-rest turn in place** at every corner (and at the start and the end when
+  ``start_heading`` / ``goal_heading`` are given), a ruckig profile of the heading by the
+  shortest signed angle (``+pi`` for an exact U-turn), with
+
+  - ``|omega| <= omega_max`` and, with a ``track_width``, ``|omega| <= wheel_v_max / h``,
+  - ``|d omega/dt| <= a_max / h`` and ``|d^2 omega/dt^2| <= j_max / h``,
+
+  where ``h = track_width / 2`` (``h = radius`` when the robot has no ``track_width``).
+  ``h`` times an angular quantity is the tangential motion of a wheel (or of the
+  footprint's rim) during the turn, so the wheels never move faster, accelerate harder or
+  jerk more than the translation limits allow.
+
+The heading is continuous and unwrapped; it is constant on every segment and changes only
+while the robot is at rest. Consecutive points closer than 1e-9 m and vertices where the
+path goes straight on (turn below 1e-12 rad) are dropped before planning.
+
+Sampling conventions (:class:`~trajopt.trajectory.TrajectorySample`): ``v``, ``a``,
+``jerk`` and ``s`` describe the motion along the path (``s`` is the distance travelled, it
+never decreases); ``omega`` is ``d theta / dt``. **``kappa`` is 0 everywhere**: the path is
+straight between its vertices, and at a vertex the robot turns at rest, where the curvature
+``omega / v`` is undefined; a finite convention keeps the CSV/JSON writers and
+:mod:`trajopt.metrics` working (``a_lat = kappa v^2 = 0`` as well). The wheel speeds are
+``v -+ omega * track_width / 2``, which is right both on segments and during turns.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from trajopt.curve import PolylineCurve
+from trajopt.errors import InvalidInputError, TimingError
+from trajopt.robot import Robot
+from trajopt.trajectory import TrajectorySample, _export_dict, _readonly, _SampledExport
+
+__all__ = ["StopAndTurnTrajectory", "stop_and_turn", "turn_limits", "polyline_clearance"]
+
+#: Consecutive points closer than this are merged (m).
+MIN_SEGMENT_M = 1e-9
+#: A vertex whose turn angle is below this (rad) is dropped (the path goes straight on).
+MIN_TURN_RAD = 1e-12
+_MAX_POINTS = 1_000_000
+
+
+# ====================================================================== limits
+def turn_limits(robot: Robot) -> tuple[float, float, float]:
+    """Limits of a turn in place: ``(omega_lim, alpha_lim, zeta_lim)``.
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    tuple of float
+        Yaw rate (rad/s) ``min(omega_max, wheel_v_max / h)``, yaw acceleration (rad/s^2)
+        ``a_max / h`` and yaw jerk (rad/s^3) ``j_max / h``, with ``h = track_width / 2``
+        (``h = radius`` when the robot has no ``track_width``; then the wheel term is absent).
+    """
+    if robot.track_width is not None:
+        half = 0.5 * robot.track_width
+        omega = min(robot.omega_max, robot.wheel_v_max / half)  # type: ignore[operator]
+    else:
+        half = robot.radius
+        omega = robot.omega_max
+    return float(omega), robot.a_max / half, robot.j_max / half
+
+
+# ====================================================================== ruckig
+class _RestToRest:
+    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits."""
+
+    def __init__(self, vmax: float, amax: float, jmax: float) -> None:
+        from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+
+        self.inp = InputParameter(1)
+        self.otg = Ruckig(1)
+        self.traj = Trajectory(1)
+        self.ok = (Result.Working, Result.Finished)
+        self.errors = (RuntimeError, RuckigError)
+        self.inp.max_velocity = [vmax]
+        self.inp.max_acceleration = [amax]
+        self.inp.max_jerk = [jmax]
+        self.inp.current_position = [0.0]
+        self.inp.current_velocity = [0.0]
+        self.inp.current_acceleration = [0.0]
+        self.inp.target_velocity = [0.0]
+        self.inp.target_acceleration = [0.0]
+
+    def solve(self, d: float) -> np.ndarray:
+        """Rows ``(duration, q0, dq0, ddq0, jerk)`` of the profile's non-empty phases."""
+        self.inp.target_position = [d]
+        try:
+            res = self.otg.calculate(self.inp, self.traj)
+        except self.errors as exc:
+            raise TimingError(f"ruckig rejected a rest-to-rest move of {d!r}: {exc}") from exc
+        if res not in self.ok:
+            raise TimingError(f"ruckig returned {res} for a rest-to-rest move of {d!r}")
+        prof = self.traj.profiles[0][0]
+        rows = [
+            (prof.t[i], prof.p[i], prof.v[i], prof.a[i], prof.j[i])
+            for i in range(7)
+            if prof.t[i] > 0.0
+        ]
+        return np.array(rows, dtype=float).reshape(-1, 5)
+
+
+# ====================================================================== trajectory
+@dataclass(frozen=True, slots=True)
+class StopAndTurnTrajectory(_SampledExport):
+    """A polyline driven with stops and turns in place (see the module docstring).
+
+    Built by :func:`stop_and_turn` (or by :class:`trajopt.Planner` with
+    ``fallback="stop_and_turn"``); the constructor is internal and checks shapes only.
+    It offers the public interface of :class:`trajopt.Trajectory`: ``duration``,
+    ``length``, ``sample``, ``sample_uniform``, ``motion``, ``to_dict``, ``to_json``,
+    ``to_csv``, ``stats``, ``steps``, ``path``, ``robot``, ``v_start``, ``v_end``.
+
+    Parameters
+    ----------
+    path : PolylineCurve
+        The polyline driven (vertices ``path.points``, shape (n, 2), m), after dropping
+        zero-length segments and straight-on vertices.
+    robot : Robot
+        The limits held.
+    phase_t : array_like, shape (p,)
+        Start time of each constant-jerk phase (s), non-decreasing, ``phase_t[0] == 0``.
+    phase_seg : array_like of int, shape (p,)
+        Segment of each phase: the robot is on segment ``k`` (from vertex ``k`` to
+        ``k + 1``) at in-segment distance ``sigma``.
+    phase_sigma, phase_v, phase_a, phase_j : array_like, shape (p,)
+        Start state along the segment (m, m/s, m/s^2) and jerk (m/s^3) of each phase; all
+        zero but ``sigma`` (0 or the segment's length) during a turn.
+    phase_theta, phase_omega, phase_alpha, phase_zeta : array_like, shape (p,)
+        Start heading (rad, unwrapped), yaw rate (rad/s), yaw acceleration (rad/s^2) and yaw
+        jerk (rad/s^3) of each phase; all zero but ``theta`` while driving.
+    duration : float
+        End time (s).
+    theta_end : float
+        Heading at the end (rad, unwrapped).
+    stats : dict
+        ``fallback = "stop_and_turn"``, counts and durations; the planner adds the reason.
+    steps : object, optional
+        ``trajopt.pipeline.PlanSteps`` when planned by :class:`trajopt.Planner`
+        (its ``smooth_path`` is ``None``).
+    """
+
+    path: PolylineCurve
+    robot: Robot
+    phase_t: np.ndarray
+    phase_seg: np.ndarray
+    phase_sigma: np.ndarray
+    phase_v: np.ndarray
+    phase_a: np.ndarray
+    phase_j: np.ndarray
+    phase_theta: np.ndarray
+    phase_omega: np.ndarray
+    phase_alpha: np.ndarray
+    phase_zeta: np.ndarray
+    duration: float
+    theta_end: float
+    stats: dict[str, Any] = field(default_factory=dict)
+    steps: Any = None
+    _seg_s: np.ndarray = field(init=False, repr=False, compare=False)
+    _seg_len: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        names = (
+            "phase_t", "phase_sigma", "phase_v", "phase_a", "phase_j", "phase_theta",
+            "phase_omega", "phase_alpha", "phase_zeta",
+        )  # fmt: skip
+        shape = np.shape(self.phase_t)
+        for n in names:
+            arr = _readonly(getattr(self, n))
+            if arr.ndim != 1 or arr.shape != shape or arr.shape[0] < 1:
+                raise InvalidInputError(
+                    f"{n} must have shape (p,) with p >= 1 like phase_t {shape}, got {arr.shape}"
+                )
+            object.__setattr__(self, n, arr)
+        seg = np.array(self.phase_seg, dtype=np.int64)
+        pts = self.path.points
+        if seg.shape != shape or (seg.size and (seg.min() < 0 or seg.max() > len(pts) - 2)):
+            raise InvalidInputError(
+                f"phase_seg must have shape {shape} with segment indices in 0..{len(pts) - 2}"
+            )
+        seg.flags.writeable = False
+        object.__setattr__(self, "phase_seg", seg)
+        object.__setattr__(self, "duration", float(self.duration))
+        object.__setattr__(self, "theta_end", float(self.theta_end))
+        seg_len = np.hypot(*np.diff(pts, axis=0).T)
+        seg_s = np.concatenate([[0.0], np.cumsum(seg_len)])
+        object.__setattr__(self, "_seg_s", _readonly(seg_s))
+        object.__setattr__(self, "_seg_len", _readonly(seg_len))
+
+    # ------------------------------------------------------------------ basic
+    @property
+    def vertices(self) -> np.ndarray:
+        """The polyline's vertices, shape (n, 2) (m): ``path.points``."""
+        return self.path.points
+
+    @property
+    def length(self) -> float:
+        """Length of the polyline (m)."""
+        return float(self._seg_s[-1])
+
+    @property
+    def v_start(self) -> float:
+        """Speed at the start: always 0 (m/s)."""
+        return 0.0
+
+    @property
+    def v_end(self) -> float:
+        """Speed at the end: always 0 (m/s)."""
+        return 0.0
+
+    @property
+    def n_phases(self) -> int:
+        """Number of constant-jerk phases (translations and turns)."""
+        return int(self.phase_t.shape[0])
+
+    def _phase(self, t: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        k = np.searchsorted(self.phase_t, tt, side="right") - 1
+        k = np.clip(k, 0, self.phase_t.shape[0] - 1)
+        return tt, k, tt - self.phase_t[k]
+
+    def _translation(self, k: np.ndarray, tau: np.ndarray, end: np.ndarray):
+        seg = self.phase_seg[k]
+        j = self.phase_j[k]
+        a0 = self.phase_a[k]
+        v0 = self.phase_v[k]
+        sig = self.phase_sigma[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
+        sig = np.clip(sig, 0.0, self._seg_len[seg])
+        v = v0 + tau * (a0 + 0.5 * j * tau)
+        a = a0 + j * tau
+        sig = np.where(end, self._seg_len[seg], sig)
+        v = np.where(end, 0.0, np.maximum(v, 0.0))
+        a = np.where(end, 0.0, a)
+        j = np.where(end, 0.0, j)
+        return seg, sig, v, a, j
+
+    def motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
+        """The motion along the path: ``(s, v, a, jerk)`` at times ``t`` (s).
+
+        Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
+        ``(length, 0, 0, 0)``. During a turn ``v = a = jerk = 0``.
+        """
+        tt, k, tau = self._phase(t)
+        end = tt >= self.duration
+        seg, sig, v, a, j = self._translation(k, tau, end)
+        return self._seg_s[seg] + sig, v, a, j
+
+    def heading_motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
+        """The heading: ``(theta, omega, alpha, zeta)`` at times ``t`` (s).
+
+        Heading (rad, unwrapped), yaw rate (rad/s), yaw acceleration (rad/s^2) and yaw jerk
+        (rad/s^3); ``omega = alpha = zeta = 0`` while driving. At and after ``duration``:
+        exactly ``(theta_end, 0, 0, 0)``.
+        """
+        tt, k, tau = self._phase(t)
+        end = tt >= self.duration
+        return self._heading(k, tau, end)
+
+    def _heading(self, k: np.ndarray, tau: np.ndarray, end: np.ndarray):
+        z = self.phase_zeta[k]
+        al0 = self.phase_alpha[k]
+        w0 = self.phase_omega[k]
+        th = self.phase_theta[k] + tau * (w0 + tau * (0.5 * al0 + tau * z / 6.0))
+        w = w0 + tau * (al0 + 0.5 * z * tau)
+        al = al0 + z * tau
+        th = np.where(end, self.theta_end, th)
+        w = np.where(end, 0.0, w)
+        al = np.where(end, 0.0, al)
+        z = np.where(end, 0.0, z)
+        return th, w, al, z
+
+    def sample(self, t: np.ndarray | float) -> TrajectorySample:
+        """Evaluate the trajectory at times ``t`` (vectorised).
+
+        Parameters
+        ----------
+        t : float or array_like, any shape
+            Times (s); clipped to ``[0, duration]``.
+
+        Returns
+        -------
+        TrajectorySample
+            Read-only arrays of the shape of ``t``; ``kappa = a_lat = 0`` (module docstring).
+        """
+        tt, k, tau = self._phase(t)
+        end = tt >= self.duration
+        seg, sig, v, a, j = self._translation(k, tau, end)
+        theta, omega, _, _ = self._heading(k, tau, end)
+        pts = self.path.points
+        f = (sig / self._seg_len[seg])[..., None]
+        xy = (1.0 - f) * pts[seg] + f * pts[seg + 1]
+        zero = np.zeros_like(tt)
+        out: dict[str, Any] = dict(
+            t=tt,
+            x=xy[..., 0],
+            y=xy[..., 1],
+            theta=theta,
+            v=v,
+            omega=omega,
+            a=a,
+            jerk=j,
+            a_lat=zero,
+            kappa=zero,
+            s=self._seg_s[seg] + sig,
+        )
+        if self.robot.track_width is not None:
+            half = 0.5 * self.robot.track_width
+            out["v_left"] = v - omega * half
+            out["v_right"] = v + omega * half
+        return TrajectorySample(**{n: _readonly(x) for n, x in out.items()})
+
+    # ------------------------------------------------------------------ export
+    def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
+        """A JSON-ready description: units, robot, stats, vertices, exact phases, samples.
+
+        Parameters
+        ----------
+        dt : float
+            Sample spacing (s) of the ``samples`` table.
+        """
+        phases = {
+            "units": {
+                "t": "s", "segment": "index", "sigma": "m", "v": "m/s", "a": "m/s^2",
+                "jerk": "m/s^3", "theta": "rad", "omega": "rad/s", "alpha": "rad/s^2",
+                "zeta": "rad/s^3",
+            },
+            "t": self.phase_t.tolist(),
+            "segment": self.phase_seg.tolist(),
+            "sigma": self.phase_sigma.tolist(),
+            "v": self.phase_v.tolist(),
+            "a": self.phase_a.tolist(),
+            "jerk": self.phase_j.tolist(),
+            "theta": self.phase_theta.tolist(),
+            "omega": self.phase_omega.tolist(),
+            "alpha": self.phase_alpha.tolist(),
+            "zeta": self.phase_zeta.tolist(),
+        }  # fmt: skip
+        extra = {
+            "vertices": {"unit": "m", "xy": self.vertices.tolist()},
+            "theta_end": self.theta_end,
+            "phases": phases,
+        }
+        return _export_dict(self, "trajopt.StopAndTurnTrajectory", dt, extra)
+
+    def __repr__(self) -> str:
+        return (
+            f"StopAndTurnTrajectory(duration={self.duration:.4g} s, length={self.length:.4g} m, "
+            f"vertices={len(self.vertices)}, turns={self.stats.get('n_turns', '?')})"
+        )
+
+
+# ====================================================================== builder
+def stop_and_turn(
+    points: Any,
+    robot: Robot | None = None,
+    *,
+    start_heading: float | None = None,
+    goal_heading: float | None = None,
+) -> StopAndTurnTrajectory:
+    """Drive a polyline with rest-to-rest straight moves and turns in place.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Vertices in metres, in order; at least two distinct points. Points closer than
+        1e-9 m to the previous one and vertices where the path goes straight on are dropped.
+    robot : Robot, optional
+        Limits; default ``Robot()``. The turn limits are :func:`turn_limits`.
+    start_heading, goal_heading : float, optional
+        Headings (rad) at the start and at the end; when given, the robot first turns in
+        place from ``start_heading`` to the first segment's direction, and at the end from
+        the last segment's direction to ``goal_heading`` (shortest signed angles). Without
+        them the motion starts and ends along the first and last segment.
+
+    Returns
+    -------
+    StopAndTurnTrajectory
+        Starts at ``points[0]``, ends exactly at ``points[-1]`` at rest; ``stats`` holds
+        ``fallback = "stop_and_turn"``, ``n_segments``, ``n_turns``, ``turn_total_rad``
+        (sum of absolute turns), ``drive_time_s``, ``turn_time_s`` and ``compute_s``.
+
+    Raises
+    ------
+    InvalidInputError
+        ``points`` not of shape (n, 2) with n >= 2, non-finite, spanning no length;
+        ``robot`` not a :class:`Robot`; a heading that is not a finite number.
+    TimingError
+        ruckig rejects a move (only for absurd magnitudes, e.g. coordinates near 1e300).
+
+    Examples
+    --------
+    >>> from trajopt.fallback import stop_and_turn
+    >>> traj = stop_and_turn([(0, 0), (1, 0), (1, 1)])
+    >>> round(traj.length, 6), traj.stats["n_turns"]
+    (2.0, 1)
+    """
+    t_start = time.perf_counter()
+    robot = Robot() if robot is None else robot
+    if not isinstance(robot, Robot):
+        raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
+    pts = _clean_points(points)
+    h0 = _heading_arg("start_heading", start_heading)
+    h1 = _heading_arg("goal_heading", goal_heading)
+
+    d = np.diff(pts, axis=0)
+    seg_len = np.hypot(d[:, 0], d[:, 1])
+    dirs = np.arctan2(d[:, 1], d[:, 0])
+    n_seg = len(seg_len)
+
+    # unwrapped segment headings, turning by the shortest signed angle
+    theta0 = float(dirs[0]) if h0 is None else h0
+    seg_theta = np.empty(n_seg)
+    prev = theta0
+    for k in range(n_seg):
+        prev = prev + math.remainder(float(dirs[k]) - prev, 2.0 * math.pi)
+        seg_theta[k] = prev
+    theta_end = float(seg_theta[-1])
+    if h1 is not None:
+        theta_end = theta_end + math.remainder(h1 - theta_end, 2.0 * math.pi)
+
+    drive = _RestToRest(float(robot.speed_cap(0.0)), robot.a_max, robot.j_max)
+    w_lim, al_lim, z_lim = turn_limits(robot)
+    turn = _RestToRest(w_lim, al_lim, z_lim)
+
+    blocks: list[np.ndarray] = []  # rows (dur, seg, sigma, v, a, j, theta, omega, alpha, zeta)
+    n_turns = 0
+    drive_time = turn_time = turn_total = 0.0
+
+    def add_turn(th_from: float, th_to: float, seg: int, sigma: float) -> None:
+        nonlocal n_turns, turn_time, turn_total
+        delta = th_to - th_from
+        if delta == 0.0:
+            return
+        rows = turn.solve(abs(delta))
+        sgn = 1.0 if delta > 0 else -1.0
+        out = np.zeros((len(rows), 10))
+        out[:, 0] = rows[:, 0]
+        out[:, 1] = seg
+        out[:, 2] = sigma
+        out[:, 6] = th_from + sgn * rows[:, 1]
+        out[:, 7:10] = sgn * rows[:, 2:5] + 0.0  # no -0.0 in the exports
+        blocks.append(out)
+        n_turns += 1
+        turn_time += float(rows[:, 0].sum())
+        turn_total += abs(delta)
+
+    add_turn(theta0, float(seg_theta[0]), 0, 0.0)
+    for k in range(n_seg):
+        if k > 0:
+            add_turn(float(seg_theta[k - 1]), float(seg_theta[k]), k, 0.0)
+        rows = drive.solve(float(seg_len[k]))
+        out = np.zeros((len(rows), 10))
+        out[:, 0] = rows[:, 0]
+        out[:, 1] = k
+        out[:, 2:6] = rows[:, 1:5]
+        out[:, 6] = seg_theta[k]
+        blocks.append(out)
+        drive_time += float(rows[:, 0].sum())
+    add_turn(float(seg_theta[-1]), theta_end, n_seg - 1, float(seg_len[-1]))
+
+    table = np.vstack(blocks)
+    dur = table[:, 0]
+    phase_t = np.concatenate([[0.0], np.cumsum(dur[:-1])])
+    duration = float(phase_t[-1] + dur[-1])
+    stats: dict[str, Any] = {
+        "fallback": "stop_and_turn",
+        "n_segments": int(n_seg),
+        "n_turns": int(n_turns),
+        "turn_total_rad": float(turn_total),
+        "drive_time_s": float(drive_time),
+        "turn_time_s": float(turn_time),
+        "turn_limits": {"omega": w_lim, "alpha": al_lim, "zeta": z_lim},
+        "compute_s": time.perf_counter() - t_start,
+    }
+    return StopAndTurnTrajectory(
+        path=PolylineCurve(pts),
+        robot=robot,
+        phase_t=phase_t,
+        phase_seg=table[:, 1].astype(np.int64),
+        phase_sigma=table[:, 2],
+        phase_v=table[:, 3],
+        phase_a=table[:, 4],
+        phase_j=table[:, 5],
+        phase_theta=table[:, 6],
+        phase_omega=table[:, 7],
+        phase_alpha=table[:, 8],
+        phase_zeta=table[:, 9],
+        duration=duration,
+        theta_end=theta_end,
+        stats=stats,
+    )
+
+
+def _clean_points(points: Any) -> np.ndarray:
+    """Validated ``(n, 2)`` float vertices without short segments and straight-on vertices."""
+    try:
+        p = np.array(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"points must be an array of shape (n, 2) in metres, got {_short(points)}"
+        ) from exc
+    if p.ndim != 2 or p.shape[1] != 2 or not 2 <= p.shape[0] <= _MAX_POINTS:
+        raise InvalidInputError(
+            f"points must have shape (n, 2) with 2 <= n <= {_MAX_POINTS}, got {p.shape}"
+        )
+    bad = ~np.isfinite(p).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError(f"points must be finite, got points[{i}] = {p[i].tolist()}")
+    keep = [0]
+    for i in range(1, len(p)):
+        if math.hypot(*(p[i] - p[keep[-1]])) >= MIN_SEGMENT_M:
+            keep.append(i)
+    if len(keep) < 2:
+        raise InvalidInputError(
+            f"points must span a length: all {len(p)} points lie within {MIN_SEGMENT_M} m "
+            f"of {p[0].tolist()}"
+        )
+    if keep[-1] != len(p) - 1:  # end exactly at the last point
+        keep[-1] = len(p) - 1
+        if len(keep) > 2 and math.hypot(*(p[keep[-1]] - p[keep[-2]])) < MIN_SEGMENT_M:
+            del keep[-2]
+    q = p[keep]
+    # drop vertices where the path goes straight on (no turn)
+    out = [q[0]]
+    for i in range(1, len(q) - 1):
+        a = q[i] - out[-1]
+        b = q[i + 1] - q[i]
+        turn = math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+        if abs(turn) >= MIN_TURN_RAD:
+            out.append(q[i])
+    out.append(q[-1])
+    return np.array(out)
+
+
+def _heading_arg(name: str, value: Any) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidInputError(f"{name} must be a number (rad) or None, got {value!r}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError(
+            f"{name} must be a number (rad) or None, got {_short(value)}"
+        ) from None
+    if not math.isfinite(x):
+        raise InvalidInputError(f"{name} must be finite (rad), got {value!r}")
+    return x
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+# ====================================================================== clearance
+def polyline_clearance(
+    points: Any, raw_grid: Any, *, window_m: float, outside_occupied: bool = True
+) -> float:
+    """Exact distance (m) from a polyline to the nearest occupied square of a grid.
+
+    Every segment is cut into pieces no longer than one cell; for each piece the exact
+    segment-to-square distance (0 when they intersect; else the least distance between a
+    vertex of one and the other) is taken over the occupied cells (and, with
+    ``outside_occupied``, the cells outside the map) within ``window_m`` of it.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Vertices (m), n >= 1.
+    raw_grid : astar.OccupancyGrid
+        The map, obstacles as closed squares of side ``resolution``.
+    window_m : float
+        Search distance (m); the result is capped at it (nothing occupied that close).
+    outside_occupied : bool
+        Count the cells outside the map as occupied.
+
+    Returns
+    -------
+    float
+        ``min(clearance, window_m)`` (m).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    res = float(raw_grid.resolution)
+    ox, oy = (float(v) for v in raw_grid.origin)
+    q = (p - [ox, oy]) / res  # cell units
+    if len(q) == 1:
+        q = np.vstack([q, q])
+    a_list, b_list = [], []
+    for i in range(len(q) - 1):
+        n = max(1, int(math.ceil(math.hypot(*(q[i + 1] - q[i])))))
+        f = np.arange(n + 1) / n
+        seg = q[i] + f[:, None] * (q[i + 1] - q[i])
+        a_list.append(seg[:-1])
+        b_list.append(seg[1:])
+    pa = np.vstack(a_list)
+    pb = np.vstack(b_list)
+    cap = float(window_m) / res
+    w = int(math.ceil(cap)) + 2
+    offs = np.arange(-w, w + 1)
+    ox_, oy_ = np.meshgrid(offs, offs)
+    ox_, oy_ = ox_.ravel(), oy_.ravel()
+    occ = np.asarray(raw_grid.occupied, dtype=bool)
+    ny, nx = occ.shape
+    best = cap
+    chunk = max(1, 400_000 // len(ox_))  # pieces per vectorised batch (bounded memory)
+    for c0 in range(0, len(pa), chunk):
+        a = pa[c0 : c0 + chunk]
+        b = pb[c0 : c0 + chunk]
+        mid = np.floor(0.5 * (a + b)).astype(np.int64)
+        gx = mid[:, 0:1] + ox_[None, :]
+        gy = mid[:, 1:2] + oy_[None, :]
+        inside = (gx >= 0) & (gx < nx) & (gy >= 0) & (gy < ny)
+        blocked = np.zeros(gx.shape, bool)
+        blocked[inside] = occ[gy[inside], gx[inside]]
+        if outside_occupied:
+            blocked |= ~inside
+        r, c = np.nonzero(blocked)
+        if r.size == 0:
+            continue
+        dist = _segment_square_distance(a[r], b[r], gx[r, c].astype(float), gy[r, c].astype(float))
+        best = min(best, float(dist.min()))
+    return min(best, cap) * res
+
+
+def _segment_square_distance(a, b, x0, y0) -> np.ndarray:
+    """Exact distance between segments ``a -> b`` (shape (m, 2)) and unit squares
+    ``[x0, x0 + 1] x [y0, y0 + 1]`` (shape (m,)), all in cell units."""
+    x1, y1 = x0 + 1.0, y0 + 1.0
+    d = b - a
+    # Liang-Barsky clip: the segment meets the square when the parameter interval survives
+    t_lo = np.zeros(len(a))
+    t_hi = np.ones(len(a))
+    hit = np.ones(len(a), bool)
+    for ax, lo, hi in ((0, x0, x1), (1, y0, y1)):
+        da = d[:, ax]
+        pa = a[:, ax]
+        flat = da == 0.0
+        hit &= ~flat | ((pa >= lo) & (pa <= hi))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta = (lo - pa) / da
+            tb = (hi - pa) / da
+        t_lo = np.where(flat, t_lo, np.maximum(t_lo, np.minimum(ta, tb)))
+        t_hi = np.where(flat, t_hi, np.minimum(t_hi, np.maximum(ta, tb)))
+    hit &= t_lo <= t_hi
+
+    def point_box(px, py):
+        dx = np.maximum(0.0, np.maximum(x0 - px, px - x1))
+        dy = np.maximum(0.0, np.maximum(y0 - py, py - y1))
+        return np.hypot(dx, dy)
+
+    dist = np.minimum(point_box(a[:, 0], a[:, 1]), point_box(b[:, 0], b[:, 1]))
+    dd = np.einsum("ij,ij->i", d, d)
+    for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = ((cx - a[:, 0]) * d[:, 0] + (cy - a[:, 1]) * d[:, 1]) / dd
+        t = np.where(dd > 0, np.clip(t, 0.0, 1.0), 0.0)
+        dist = np.minimum(dist, np.hypot(a[:, 0] + t * d[:, 0] - cx, a[:, 1] + t * d[:, 1] - cy))
+    return np.where(hit, 0.0, dist)
