@@ -115,6 +115,8 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
             se = s0
         if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
             continue
+        if s1 < length and v1 > range_min(st, lg, h, s1, s1) + _CAP_TOL:
+            return False  # the end of the piece is over the cap: bisection would end there
         if t0 <= tmin or top + 2 > stk.shape[0]:
             return False
         half = 0.5 * t0
@@ -359,3 +361,31 @@ def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
         if not piece_ok(st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin):
             return False
     return True
+
+
+@njit(cache=True)
+def rows_ok(st, lg, h, length, rows, tmin):
+    """Rows ``(t0, s0, v0, a0, jerk, duration)`` (shape (k, 6)) all under the cap."""
+    for i in range(rows.shape[0]):
+        if not piece_ok(
+            st, lg, h, length, rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4], rows[i, 5], tmin
+        ):
+            return False
+    return True
+
+
+@njit(cache=True)
+def phase_peaks(phases, t_next):
+    """Highest speed reached in each greedy phase (rows ``(t0, s0, v0, a0, jerk)``)."""
+    n = phases.shape[0]
+    out = np.empty(n)
+    for i in range(n):
+        v0, a0, j = phases[i, 2], phases[i, 3], phases[i, 4]
+        d = t_next[i] - phases[i, 0]
+        v1 = v0 + d * (a0 + 0.5 * j * d)
+        a1 = a0 + j * d
+        pk = max(v0, v1)
+        if a0 > 0.0 and a1 < 0.0 and j < 0.0:
+            pk = max(pk, v0 - a0 * a0 / (2.0 * j))
+        out[i] = pk
+    return out

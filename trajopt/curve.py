@@ -125,12 +125,14 @@ class ParametricCurve(ABC):
         q = mid[..., None] + half[..., None] * _GL_X
         return half * (self.speed(q) @ _GL_W)
 
-    def u_at_s(self, s: np.ndarray | float) -> np.ndarray:
+    def u_at_s(self, s: np.ndarray | float, *, exact: bool = True) -> np.ndarray:
         """Parameter at arc length ``s`` (m) from the start, vectorised.
 
-        ``s`` is clipped to ``[0, length]``. A cubic Hermite model of ``s(u)`` gives the
-        first guess, then safeguarded Newton steps on the quadrature refine it to about
-        1e-12 m on smooth curves.
+        ``s`` is clipped to ``[0, length]``. Newton steps on a cubic Hermite model of
+        ``s(u)`` (the arc-length table's nodes and speeds) give a first answer; with
+        ``exact=True`` safeguarded Newton steps on the quadrature refine it to about 1e-12 m
+        on smooth curves. ``exact=False`` skips that refinement (no curve evaluation: about
+        1e-7 of the table spacing on smooth curves, for dense tables).
         """
         nodes, s_nodes, v_nodes = self._arc_table()
         ss = np.clip(np.asarray(s, dtype=float), 0.0, s_nodes[-1])
@@ -146,7 +148,7 @@ class ParametricCurve(ABC):
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(df > 0, f / df, 0.0)
             u = np.clip(u - step, lo, hi)
-        for _ in range(2):
+        for _ in range(2 if exact else 0):
             f = s_nodes[i] + self._partial_length(lo, u) - ss
             df = self.speed(u)
             with np.errstate(divide="ignore", invalid="ignore"):

@@ -138,11 +138,10 @@ def time_parameterize(
     n_int = int(np.clip(math.ceil(length / _GRID_SPACING), _MIN_INTERVALS, _MAX_INTERVALS))
     h = length / n_int
     s_nodes = np.linspace(0.0, length, n_int + 1)
-    u_tab, s_tab = _u_table(curve, n_int + 1)
-    u_nodes = np.interp(s_nodes, s_tab, u_tab)
+    u_nodes = _table_u_at_s(curve, s_nodes)
     u_nodes[0], u_nodes[-1] = curve.domain
-    kappa = np.asarray(curve.curvature(u_nodes), dtype=float)
-    theta = np.unwrap(np.asarray(curve.heading(u_nodes), dtype=float))
+    kappa, theta = _curvature_heading(curve, u_nodes)
+    theta = np.unwrap(theta)
     raw = np.asarray(robot.speed_cap(kappa), dtype=float)
     cap0 = float(robot.speed_cap(kappa[0]))
     cap1 = float(robot.speed_cap(kappa[-1]))
@@ -156,7 +155,7 @@ def time_parameterize(
             f"v_end={v_end:.6g} m/s exceeds the speed cap {cap1:.6g} m/s at s=L={length:.6g} m "
             f"(curvature {kappa[-1]:.6g} 1/m)"
         )
-    ci = _interval_caps(raw, curve, robot, s_nodes, (s_tab, u_tab))
+    ci = _interval_caps(raw, curve, robot, s_nodes)
     v_bound = max(v_start, v_end)
     ci = np.maximum(ci * (1.0 - _CAP_MARGIN), np.minimum(ci, v_bound))
     ci[0] = max(ci[0], min(v_start, raw[0], raw[1]))
@@ -269,21 +268,37 @@ def _speed(name: str, value: Any) -> float:
     return x
 
 
-def _u_table(curve: ParametricCurve, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(u, s)`` at ``n`` uniform parameters: a table to invert ``s(u)`` by interpolation.
+def _table_u_at_s(curve: ParametricCurve, s: np.ndarray) -> np.ndarray:
+    """``u`` at dense arc lengths ``s`` for the cap table.
 
-    Linear interpolation between uniform-``u`` samples is accurate to ~1e-6 m on the dense
-    grids used here; the trajectory refines it with a Newton step when sampling.
+    For the library's curves (the base class's ``u_at_s``) the cubic Hermite model of the
+    arc-length table is enough (about 1e-8 m here, no curve evaluation); any other curve
+    answers with its own ``u_at_s``.
     """
-    lo, hi = (float(x) for x in curve.domain)
-    uf = np.linspace(lo, hi, n)
-    sf = np.maximum.accumulate(np.asarray(curve.s_at_u(uf), dtype=float))
-    return uf, sf
+    if type(curve).u_at_s is ParametricCurve.u_at_s:
+        return np.asarray(curve.u_at_s(s, exact=False), dtype=float)
+    return np.asarray(curve.u_at_s(s), dtype=float)
 
 
-def _interval_caps(
-    raw: np.ndarray, curve, robot: Robot, s_nodes: np.ndarray, table: tuple[np.ndarray, ...]
-) -> np.ndarray:
+def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Signed curvature (1/m) and heading (rad) at ``u``, sharing one first-derivative
+    evaluation when the curve uses the base class's formulas."""
+    base = ParametricCurve
+    if type(curve).curvature is base.curvature and type(curve).heading is base.heading:
+        d1 = np.asarray(curve(u, 1), dtype=float)
+        d2 = np.asarray(curve(u, 2), dtype=float)
+        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+        sp3 = np.hypot(d1[:, 0], d1[:, 1]) ** 3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kappa = np.where(sp3 > 0, cross / sp3, np.inf)
+        return kappa, np.arctan2(d1[:, 1], d1[:, 0])
+    return (
+        np.asarray(curve.curvature(u), dtype=float),
+        np.asarray(curve.heading(u), dtype=float),
+    )
+
+
+def _interval_caps(raw: np.ndarray, curve, robot: Robot, s_nodes: np.ndarray) -> np.ndarray:
     """Cap per grid interval (shape (n,)) from the cap at the ``n + 1`` nodes.
 
     An interval gets the smaller of its end values minus ``d2/8``, with ``d2`` the largest
@@ -298,7 +313,7 @@ def _interval_caps(
         m = _REFINE
         frac = np.arange(m + 1) / m
         s_sub = s_nodes[bad, None] + (s_nodes[bad + 1] - s_nodes[bad])[:, None] * frac[None, :]
-        u_sub = np.interp(s_sub.ravel(), *table)
+        u_sub = _table_u_at_s(curve, s_sub.ravel())
         cap_sub = np.asarray(robot.speed_cap(curve.curvature(u_sub)), dtype=float).reshape(
             s_sub.shape
         )
@@ -402,27 +417,9 @@ def _rows_from_greedy(phases: np.ndarray, i0: int, i1: int, t_end: float) -> np.
     return np.column_stack([ph[:, :5], t_next - ph[:, 0]])
 
 
-def _rows_ok(g, st, lg, h, length, rows: np.ndarray, s0: float) -> bool:
-    t = rows[:, 0]
-    t_end = float(t[-1] + rows[-1, 5])
-    return bool(
-        g.phases_ok(
-            st, lg, h, length, np.ascontiguousarray(t), np.ascontiguousarray(rows[:, 1] - 0.0),
-            np.ascontiguousarray(rows[:, 2]), np.ascontiguousarray(rows[:, 3]),
-            np.ascontiguousarray(rows[:, 4]), t_end, _T_MIN,
-        )
-    )  # fmt: skip
-
-
-def _peak_speed(rows: np.ndarray) -> float:
-    v0, a0, j, d = rows[:, 2], rows[:, 3], rows[:, 4], rows[:, 5]
-    v1 = v0 + d * (a0 + 0.5 * j * d)
-    a1 = a0 + j * d
-    pk = np.maximum(v0, v1)
-    inner = (a0 > 0) & (a1 < 0) & (j < 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        pk = np.where(inner, v0 - a0 * a0 / (2.0 * np.where(inner, j, -1.0)), pk)
-    return float(pk.max())
+def _rows_ok(g, st, lg, h, length, rows: np.ndarray) -> bool:
+    """Rows ``(t0, s0, v0, a0, jerk, duration)`` all under the speed cap (exact on the grid)."""
+    return bool(g.rows_ok(st, lg, h, length, np.ascontiguousarray(rows), _T_MIN))
 
 
 def _finish(rk, g, st, lg, h, length, phases, bounds, v_end, jmax, amax):
@@ -440,7 +437,7 @@ def _finish(rk, g, st, lg, h, length, phases, bounds, v_end, jmax, amax):
             continue
         v_pk = v_b + (a_b * a_b / (2.0 * jmax) if a_b > 0 else 0.0)
         rows = rk.solve((s_b, v_b, a_b), target, max(v_pk, v_end))
-        if rows is None or not _rows_ok(g, st, lg, h, length, rows, s_b):
+        if rows is None or not _rows_ok(g, st, lg, h, length, rows):
             continue
         rows = rows.copy()
         rows[:, 0] += t_b
@@ -455,50 +452,54 @@ def _compress(rk, g, st, lg, h, length, ci, phases, bounds) -> list[np.ndarray]:
     """Replace the greedy between its speed minima by ruckig's time-optimal sections."""
     nb = bounds.shape[0]
     v, a = bounds[:, 2], bounds[:, 3]
-    knots = [0]
-    for i in range(1, nb - 1):
-        if a[i] != 0.0:
-            continue
-        if v[i] <= v[i - 1] and v[i] <= v[i + 1] and not (v[i - 1] == v[i] == v[i + 1]):
-            knots.append(i)
-    knots.append(nb - 1)
+    vm, vc, vp = v[:-2], v[1:-1], v[2:]
+    inner = (a[1:-1] == 0.0) & (vc <= vm) & (vc <= vp) & ~((vm == vc) & (vc == vp))
+    knots = [0, *(np.flatnonzero(inner) + 1).tolist(), nb - 1]
+    t_next = np.append(phases[1:, 0], bounds[-1, 0])
+    peaks = g.phase_peaks(phases, t_next)
+    ph_index = bounds[:, 4].astype(np.int64)
+    n_ci = ci.shape[0]
     chain: list[np.ndarray] = []
     t_out = 0.0
     budget = [3 * len(knots) + 32]  # ruckig calls; the greedy answer is kept beyond it
 
     def greedy_rows(i0: int, i1: int) -> np.ndarray:
-        p0, p1 = int(bounds[i0, 4]), int(bounds[i1, 4])
-        return _rows_from_greedy(phases, p0, p1, float(bounds[i1, 0]))
+        return _rows_from_greedy(phases, ph_index[i0], ph_index[i1], float(bounds[i1, 0]))
+
+    def fits(rows, g_dur: float) -> bool:
+        return (
+            rows is not None
+            and float(rows[:, 5].sum()) <= g_dur
+            and _rows_ok(g, st, lg, h, length, rows)
+        )
 
     def solve(i0: int, i1: int, depth: int) -> list[np.ndarray]:
-        grows = greedy_rows(i0, i1)
-        if grows.shape[0] == 0:
+        p0, p1 = ph_index[i0], ph_index[i1]
+        if p1 <= p0:
             return []
         if i1 - i0 < 2 or budget[0] <= 0:
-            return [grows]
+            return [greedy_rows(i0, i1)]
         budget[0] -= 1
         g_dur = float(bounds[i1, 0] - bounds[i0, 0])
-        st0 = tuple(bounds[i0, 1:4])
-        st1 = tuple(bounds[i1, 1:4])
-        peak = _peak_speed(grows)
-        i_a = min(int(st0[0] / h), ci.shape[0] - 1)
-        i_b = min(int(st1[0] / h), ci.shape[0] - 1)
+        st0 = (bounds[i0, 1], bounds[i0, 2], bounds[i0, 3])
+        st1 = (bounds[i1, 1], bounds[i1, 2], bounds[i1, 3])
+        peak = float(peaks[p0:p1].max())
+        i_a = min(int(st0[0] / h), n_ci - 1)
+        i_b = min(int(st1[0] / h), n_ci - 1)
         top = float(ci[i_a : i_b + 1].max())
         if top > peak * (1.0 + 1e-6):
             # first try the highest cap in the section: better than the greedy's peak if it fits
             rows = rk.solve(st0, st1, top)
-            if rows is not None and float(rows[:, 5].sum()) <= g_dur:
-                if _rows_ok(g, st, lg, h, length, rows, st0[0]):
-                    return [rows]
-        rows = rk.solve(st0, st1, peak)
-        if rows is not None and float(rows[:, 5].sum()) <= g_dur:
-            if _rows_ok(g, st, lg, h, length, rows, st0[0]):
+            if fits(rows, g_dur):
                 return [rows]
+        rows = rk.solve(st0, st1, peak)
+        if fits(rows, g_dur):
+            return [rows]
         if i1 - i0 >= _MIN_SPLIT_STEPS and depth < _MAX_SPLIT_DEPTH:
             t_mid = 0.5 * (bounds[i0, 0] + bounds[i1, 0])
             im = int(np.clip(np.searchsorted(bounds[:, 0], t_mid), i0 + 1, i1 - 1))
             return solve(i0, im, depth + 1) + solve(im, i1, depth + 1)
-        return [grows]
+        return [greedy_rows(i0, i1)]
 
     for k0, k1 in zip(knots[:-1], knots[1:], strict=True):
         for rows in solve(k0, k1, 0):

@@ -72,6 +72,15 @@ def test_parabola_arc_length_and_inverse(u):
     assert float(p.u_at_s(_parabola_length(u))) == pytest.approx(u, abs=1e-9)
 
 
+def test_u_at_s_table_model_is_accurate():
+    # exact=False (Hermite model of the arc-length table only) against the closed form
+    p = Parabola()
+    s = np.linspace(0.0, p.length, 4001)
+    u = p.u_at_s(s, exact=False)
+    assert np.max(np.abs(_parabola_length(u) - s)) < 1e-7
+    assert np.all(np.diff(u) >= 0)
+
+
 def test_u_at_s_clips_and_is_monotone():
     p = Parabola()
     s = np.linspace(-1, p.length + 1, 101)
