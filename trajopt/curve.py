@@ -131,8 +131,9 @@ class ParametricCurve(ABC):
         ``s`` is clipped to ``[0, length]``. Newton steps on a cubic Hermite model of
         ``s(u)`` (the arc-length table's nodes and speeds) give a first answer; with
         ``exact=True`` safeguarded Newton steps on the quadrature refine it to about 1e-12 m
-        on smooth curves. ``exact=False`` skips that refinement (no curve evaluation: about
-        1e-7 of the table spacing on smooth curves, for dense tables).
+        on smooth curves. ``exact=False`` skips that refinement (no curve evaluation; the cubic
+        model's error, O(spacing^4): ~3e-7 m with 6 cm table spacing on a parabola,
+        ~1e-8 m on the smoother's B-splines).
         """
         nodes, s_nodes, v_nodes = self._arc_table()
         ss = np.clip(np.asarray(s, dtype=float), 0.0, s_nodes[-1])

@@ -73,11 +73,12 @@ def test_parabola_arc_length_and_inverse(u):
 
 
 def test_u_at_s_table_model_is_accurate():
-    # exact=False (Hermite model of the arc-length table only) against the closed form
+    # exact=False (Hermite model of the arc-length table only) against the closed form:
+    # 16 table intervals on a 1.48 m curve give ~3e-7 m (the model's error is O(spacing^4))
     p = Parabola()
     s = np.linspace(0.0, p.length, 4001)
     u = p.u_at_s(s, exact=False)
-    assert np.max(np.abs(_parabola_length(u) - s)) < 1e-7
+    assert np.max(np.abs(_parabola_length(u) - s)) < 1e-6
     assert np.all(np.diff(u) >= 0)
 
 
