@@ -105,6 +105,7 @@ def run_map(name: str, kappa: bool, limit: int | None, data: Path, snap: float =
     counts: Counter[str] = Counter()
     times: dict[str, list[float]] = {"smoother": [], "fallback": []}
     fb_clear: list[float] = []
+    reasons: Counter[str] = Counter()
     examples: list[str] = []
     t_map = time.perf_counter()
     for i, sc in enumerate(scen):
@@ -126,6 +127,7 @@ def run_map(name: str, kappa: bool, limit: int | None, data: Path, snap: float =
             counts[kind] += 1
             times[kind].append(time.perf_counter() - t0)
             if kind == "fallback":
+                reasons[reason_of(traj.stats)] += 1
                 m = path_metrics(
                     traj.path,
                     grid=grid,
@@ -151,8 +153,20 @@ def run_map(name: str, kappa: bool, limit: int | None, data: Path, snap: float =
         "times": times,
         "fb_clear": fb_clear,
         "examples": examples,
+        "reasons": reasons,
         "wall_s": time.perf_counter() - t_map,
     }
+
+
+def reason_of(stats: dict) -> str:
+    """A short group name for why the smoother (or timing) failed: the last attempt's failure
+    up to its first colon, e.g. ``certificate``, ``curvature bound (scp)``, ``time budget
+    exhausted``; ``TimingError`` for a timing failure."""
+    if stats.get("fallback_error") != "SmoothingError":
+        return str(stats.get("fallback_error"))
+    msg = str(stats.get("fallback_reason", "")).splitlines()[0]
+    tail = msg.split("): ", 1)[1] if "): " in msg else msg
+    return tail.split(":", 1)[0].strip()[:60]
 
 
 def pct(k: int, n: int) -> str:
@@ -204,6 +218,10 @@ def print_table(rows: list[dict], kappa: bool, snap: float) -> None:
             f"| {c['fallback collisions']} | {min_clear} "
             f"| {med_ms(times['smoother'])}/{med_ms(times['fallback'])} | {w:.0f} |"
         )
+    for r in rows:
+        if r["reasons"]:
+            why = ", ".join(f"{k} {v}" for k, v in r["reasons"].most_common())
+            print(f"fallback reasons ({r['map']}): {why}")
     for r in rows:
         for ex in r["examples"]:
             print(f"failed ({r['map']}): {ex}")
