@@ -106,7 +106,7 @@ def test_bench_records_serial_equal_parallel_exactly(shared_data) -> None:
     scen = shared_data / "movingai" / "scen" / "arena.map.scen"
     map_path = shared_data / "movingai" / "maps" / "arena.map"
     chosen = select_scenarios(astar.read_scenarios(scen), 4)
-    jobs = [(str(map_path), 2.5, s) for s in chosen]
+    jobs = [(str(map_path), 2.5, s, None) for s in chosen]  # (map, radius, scenario, fallback)
     serial = [_bench_one(j) for j in jobs]
     with ProcessPoolExecutor(max_workers=2) as pool:
         parallel = list(pool.map(_bench_one, jobs))
