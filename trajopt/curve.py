@@ -75,13 +75,7 @@ class ParametricCurve(ABC):
 
     def curvature(self, u: np.ndarray | float) -> np.ndarray:
         """Signed curvature ``(x'y'' - y'x'') / |c'|^3`` (1/m); ``inf`` where ``c' = 0``."""
-        d1 = self(u, 1)
-        d2 = self(u, 2)
-        cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
-        sp3 = np.hypot(d1[..., 0], d1[..., 1]) ** 3
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = cross / sp3
-        return np.where(sp3 > 0, k, np.inf)
+        return _signed_curvature(self(u, 1), self(u, 2))
 
     # ------------------------------------------------------------- arc length
     def _arc_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -186,6 +180,15 @@ class ParametricCurve(ABC):
             heading=np.unwrap(self.heading(u)),
             curvature=self.curvature(u),
         )
+
+
+def _signed_curvature(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    """``(x'y'' - y'x'') / |c'|^3`` from first and second derivatives (..., 2); inf at c' = 0."""
+    cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
+    sp3 = np.hypot(d1[..., 0], d1[..., 1]) ** 3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = cross / sp3
+    return np.where(sp3 > 0, k, np.inf)
 
 
 def _hermite(nodes, s_nodes, v_nodes, i, u):

@@ -82,41 +82,21 @@ def turn_limits(robot: Robot) -> tuple[float, float, float]:
 
 # ====================================================================== ruckig
 class _RestToRest:
-    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits."""
+    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits
+    (the timing's ruckig wrapper, without its velocity margin)."""
 
     def __init__(self, vmax: float, amax: float, jmax: float) -> None:
-        from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+        from trajopt.timing import _Ruckig
 
-        self.inp = InputParameter(1)
-        self.otg = Ruckig(1)
-        self.traj = Trajectory(1)
-        self.ok = (Result.Working, Result.Finished)
-        self.errors = (RuntimeError, RuckigError)
-        self.inp.max_velocity = [vmax]
-        self.inp.max_acceleration = [amax]
-        self.inp.max_jerk = [jmax]
-        self.inp.current_position = [0.0]
-        self.inp.current_velocity = [0.0]
-        self.inp.current_acceleration = [0.0]
-        self.inp.target_velocity = [0.0]
-        self.inp.target_acceleration = [0.0]
+        self.vmax = vmax
+        self.rk = _Ruckig(amax, jmax)
 
     def solve(self, d: float) -> np.ndarray:
         """Rows ``(duration, q0, dq0, ddq0, jerk)`` of the profile's non-empty phases."""
-        self.inp.target_position = [d]
-        try:
-            res = self.otg.calculate(self.inp, self.traj)
-        except self.errors as exc:
-            raise TimingError(f"ruckig rejected a rest-to-rest move of {d!r}: {exc}") from exc
-        if res not in self.ok:
-            raise TimingError(f"ruckig returned {res} for a rest-to-rest move of {d!r}")
-        prof = self.traj.profiles[0][0]
-        rows = [
-            (prof.t[i], prof.p[i], prof.v[i], prof.a[i], prof.j[i])
-            for i in range(7)
-            if prof.t[i] > 0.0
-        ]
-        return np.array(rows, dtype=float).reshape(-1, 5)
+        rows = self.rk.solve((0.0, 0.0, 0.0), (d, 0.0, 0.0), self.vmax, v_margin=0.0)
+        if rows is None:
+            raise TimingError(f"ruckig found no rest-to-rest move of {d!r}")
+        return rows[:, [5, 1, 2, 3, 4]]
 
 
 # ====================================================================== trajectory

@@ -29,6 +29,7 @@ import numpy as np
 from numba import njit
 
 from trajopt.errors import InvalidInputError
+from trajopt.smoother import square_dist2
 
 __all__ = ["curvature_witness"]
 
@@ -175,21 +176,8 @@ def _sample_finish(x, y, th, goal, turn_r, psi, side) -> np.ndarray:
 @njit(cache=True)
 def _clear(px, py, occ, w, r):
     """Distance from ``(px, py)`` (cells) to the nearest occupied square is >= ``r``."""
-    ny, nx = occ.shape
-    cx = int(math.floor(px))
-    cy = int(math.floor(py))
     r2 = r * r - 1e-9
-    for gy in range(cy - w, cy + w + 1):
-        dy = max(0.0, max(gy - py, py - (gy + 1)))
-        if dy * dy >= r2:
-            continue
-        for gx in range(cx - w, cx + w + 1):
-            if 0 <= gx < nx and 0 <= gy < ny and not occ[gy, gx]:
-                continue
-            dx = max(0.0, max(gx - px, px - (gx + 1)))
-            if dx * dx + dy * dy < r2:
-                return False
-    return True
+    return square_dist2(px, py, occ, w, r2) >= r2
 
 
 @njit(cache=True)

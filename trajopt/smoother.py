@@ -1138,27 +1138,31 @@ def point_square_clearance(points: np.ndarray, raw_grid: Any, window_m: float) -
 def _square_clearance_kernel(q, occ, w, cap):
     """Per point (cell units): exact distance to the nearest occupied unit square among the
     cells within ``w`` of the point's cell (outside the grid counts as occupied), capped."""
-    ny, nx = occ.shape
     out = np.empty(q.shape[0])
     for k in range(q.shape[0]):
-        px = q[k, 0]
-        py = q[k, 1]
-        cx = int(math.floor(px))
-        cy = int(math.floor(py))
-        best = cap * cap
-        for gy in range(cy - w, cy + w + 1):
-            dy = max(0.0, max(gy - py, py - (gy + 1)))
-            if dy * dy >= best:
-                continue
-            for gx in range(cx - w, cx + w + 1):
-                if 0 <= gx < nx and 0 <= gy < ny and not occ[gy, gx]:
-                    continue
-                dx = max(0.0, max(gx - px, px - (gx + 1)))
-                d2 = dx * dx + dy * dy
-                if d2 < best:
-                    best = d2
-        out[k] = math.sqrt(best)
+        out[k] = math.sqrt(square_dist2(q[k, 0], q[k, 1], occ, w, cap * cap))
     return out
+
+
+@njit(cache=True)
+def square_dist2(px, py, occ, w, best):
+    """``min(best, d^2)``: ``d`` the distance (cells) from ``(px, py)`` to the nearest
+    occupied unit square within ``w`` cells of its cell (outside the grid is occupied)."""
+    ny, nx = occ.shape
+    cx = int(math.floor(px))
+    cy = int(math.floor(py))
+    for gy in range(cy - w, cy + w + 1):
+        dy = max(0.0, max(gy - py, py - (gy + 1)))
+        if dy * dy >= best:
+            continue
+        for gx in range(cx - w, cx + w + 1):
+            if 0 <= gx < nx and 0 <= gy < ny and not occ[gy, gx]:
+                continue
+            dx = max(0.0, max(gx - px, px - (gx + 1)))
+            d2 = dx * dx + dy * dy
+            if d2 < best:
+                best = d2
+    return best
 
 
 def certify(

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from trajopt.curve import ParametricCurve
+from trajopt.curve import ParametricCurve, _signed_curvature
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
 from trajopt.trajectory import Trajectory
@@ -286,11 +286,7 @@ def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarra
     base = ParametricCurve
     if type(curve).curvature is base.curvature and type(curve).heading is base.heading:
         d1 = np.asarray(curve(u, 1), dtype=float)
-        d2 = np.asarray(curve(u, 2), dtype=float)
-        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-        sp3 = np.hypot(d1[:, 0], d1[:, 1]) ** 3
-        with np.errstate(divide="ignore", invalid="ignore"):
-            kappa = np.where(sp3 > 0, cross / sp3, np.inf)
+        kappa = _signed_curvature(d1, np.asarray(curve(u, 2), dtype=float))
         return kappa, np.arctan2(d1[:, 1], d1[:, 0])
     return (
         np.asarray(curve.curvature(u), dtype=float),
@@ -369,8 +365,12 @@ class _Ruckig:
         self.inp.max_jerk = [jmax]
         self.inp.min_velocity = [0.0]
 
-    def solve(self, state0, state1, vmax: float) -> np.ndarray | None:
-        """Rows ``(t0, s0, v0, a0, jerk, duration)`` from ``state0`` to ``state1`` or None."""
+    def solve(
+        self, state0, state1, vmax: float, *, v_margin: float = _RUCKIG_V_MARGIN
+    ) -> np.ndarray | None:
+        """Rows ``(t0, s0, v0, a0, jerk, duration)`` from ``state0`` to ``state1`` or None.
+
+        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s)."""
         inp = self.inp
         s0, v0, a0 = state0
         s1, v1, a1 = state1
@@ -380,7 +380,7 @@ class _Ruckig:
         inp.target_position = [s1]
         inp.target_velocity = [v1]
         inp.target_acceleration = [a1]
-        inp.max_velocity = [max(vmax, v0, v1) + _RUCKIG_V_MARGIN]
+        inp.max_velocity = [max(vmax, v0, v1) + v_margin]
         try:
             res = self.otg.calculate(inp, self.traj)
         except self.errors:  # ruckig rejects some target states (e.g. a != 0 near v limit)
