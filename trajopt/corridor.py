@@ -491,8 +491,16 @@ def build_corridor(
     for k in range(m - 1):
         lo_i = max(runs[k][0], runs[k + 1][0])
         hi_i = runs[k][1]
-        if lo_i > hi_i:  # pragma: no cover - guaranteed by the seeding
-            raise InvalidInputError(f"internal error: boxes {k} and {k + 1} share no path cell")
+        if lo_i > hi_i:
+            # only a diagonal step between two blocked cells (corner cutting) leaves two
+            # consecutive path cells that no free box holds together
+            a_c, b_c = cells[runs[k][1]].tolist(), cells[runs[k + 1][0]].tolist()
+            raise InvalidInputError(
+                f"grid_path step {runs[k][1]} from {a_c} to {b_c} cuts a corner of the inflated "
+                "grid (a diagonal step whose two orthogonal neighbours are not both free), so no "
+                "free box holds both cells; search with corner_cutting=False"
+                + ("" if raw_occ is not None else " or pass raw_grid and radius for bridges")
+            )
         ov_lo[k], ov_hi[k] = s[lo_i], s[hi_i]
     trans = _place_transitions(ov_lo, ov_hi, float(s[-1]), min_share_cells * res)
     boxes = tuple(

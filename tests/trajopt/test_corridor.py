@@ -148,6 +148,20 @@ def test_rejects_blocked_or_broken_paths():
         build_corridor(grid, np.array([[0, 0]]), max_side_cells=1)
 
 
+def test_corner_cutting_path_is_rejected_with_the_step_named():
+    # two blocked cells touching at a corner; the diagonal step (4,4)->(5,5) passes between
+    # them, so no free box holds both cells
+    occ = np.zeros((10, 10), bool)
+    occ[4, 5] = occ[5, 4] = True
+    grid = OccupancyGrid(occ, 1.0)
+    cells = np.array([[k, k] for k in range(2, 8)])
+    with pytest.raises(InvalidInputError, match=r"step 2 from \[4, 4\] to \[5, 5\] cuts a corner"):
+        build_corridor(grid, cells)
+    # the same path without the blocked corner is fine
+    corridor = build_corridor(OccupancyGrid(np.zeros((10, 10), bool), 1.0), cells)
+    assert corridor.contains(corridor.path_points).all()
+
+
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 10_000), density=st.floats(0.05, 0.3))
 def test_random_grids_brute_force(seed, density):
