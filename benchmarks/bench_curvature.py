@@ -2,12 +2,16 @@
 
 On scenarios drawn from the shared Moving AI maps (robot radius 2.5 cells) and ROS maps
 (radius 0.2 m), for the shortest-path seed and the clearance-aware seed
-(:func:`astar.clearance_cost`), each with the corridor's 45-degree bridges, fits
-``Smoother(kappa_max=1 / (2 r))`` and reports side by side:
+(:func:`astar.clearance_cost`), each with the corridor's 45-degree bridges, plans with
+``Planner(..., smoother=Smoother(kappa_max=1 / (2 r)))`` (the smoother along the A* path,
+then, if it fails, the planner's witness rescue along a curvature witness) and reports side
+by side:
 
 * success rate of the curvature-bounded smoother (a certified curve returned);
-* median and p95 warm solve time: the whole ``fit`` call (QP, SCP, certificate) and the
-  solver time alone, measured on a second call of the same query (solvers built);
+* median and p95 warm solve time: the whole smoothing stage (QP, SCP, certificate; for a
+  rescued query also the witness search and the second fit) and the solver time alone
+  (for a rescued query, the whole stage), measured on a second call of the same query
+  (solvers built);
 * median minimum clearance over the radius (dense samples against the raw map);
 * median Hausdorff deviation from the A* polyline (cells) and the length ratio;
 * near-stops of the timed trajectory (``time_parameterize`` with ``Robot(radius=r)``):
@@ -43,12 +47,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
-from trajopt.corridor import build_corridor  # noqa: E402
 from trajopt.errors import SmoothingError, TimingError  # noqa: E402
 from trajopt.feasibility import curvature_witness  # noqa: E402
+from trajopt.pipeline import Planner  # noqa: E402
 from trajopt.robot import Robot  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
-from trajopt.timing import time_parameterize  # noqa: E402
 
 MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5"]
 ROS = ["turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10"]
@@ -108,51 +111,48 @@ def near_stops(traj, v_max: float) -> int:
     return int(min(len(starts), len(ends)))
 
 
-def run_case(raw, infl, radius, a, b, cost, smoother):
+def run_case(raw, infl, radius, a, b, cost, planner):
+    """One query through ``planner.plan`` (smoother, witness rescue, timing), timed warm."""
     path = astar.find_path(infl, a, b, cost=cost)
-    corr = build_corridor(infl, path, radius=radius, raw_grid=raw)
+    p0, p1 = raw.cell_to_world(np.array(a)), raw.cell_to_world(np.array(b))
     try:
-        smoother.fit(path, corr, raw_grid=raw, radius=radius)  # builds any new solver size
+        planner.plan(p0, p1)  # builds any new solver size
+    except (SmoothingError, TimingError):
+        pass
+    try:
         t0 = time.perf_counter()
-        sp = smoother.fit(path, corr, raw_grid=raw, radius=radius)
+        traj = planner.plan(p0, p1)
         wall = time.perf_counter() - t0
-    except SmoothingError as exc:
+    except (SmoothingError, TimingError) as exc:
         t0 = time.perf_counter()
-        w = curvature_witness(
-            raw,
-            radius,
-            corr.path_points[0],
-            corr.path_points[-1],
-            smoother.kappa_max,
-            time_limit_s=20.0,
-        )
+        w = curvature_witness(raw, radius, p0, p1, planner.smoother.kappa_max, time_limit_s=20.0)
         return {
             "ok": False,
             "why": str(exc),
             "witness": w is not None,
             "witness_s": time.perf_counter() - t0,
         }
+    sp = traj.steps.smooth_path
+    st = traj.stats["smoother"]
+    rescued = st["rescue"] is not None
     res = raw.resolution
     u = np.linspace(*sp.domain, max(200, int(sp.length / res * 4)))
     xy = sp(u) / res
-    poly = corr.path_points / res
+    poly = raw.cell_to_world(path.cells) / res
     haus = max(directed_hausdorff(xy, poly)[0], directed_hausdorff(poly, xy)[0])
-    rec = {
+    return {
         "ok": True,
-        "wall": wall,
-        "solve": sp.stats["solve_time_s"],
+        "wall": traj.stats["stages_s"]["smooth"],
+        # a rescued query's solver time is the whole smoothing stage (both fits, witness)
+        "solve": traj.stats["stages_s"]["smooth"] if rescued else st["solve_time_s"],
+        "plan": wall,
+        "rescued": rescued,
         "clear_ratio": sp.certificate.min_clearance_m / radius,
         "hausdorff": haus,
-        "length_ratio": sp.length / corr.length_m,
-        "attempts": sp.stats["attempts"],
+        "length_ratio": sp.length / (path.length * res),
+        "attempts": st["attempts"],
+        "near_stops": near_stops(traj, planner.robot.v_max),
     }
-    robot = Robot(radius=radius)
-    try:
-        traj = time_parameterize(sp, robot)
-        rec["near_stops"] = near_stops(traj, robot.v_max)
-    except TimingError:
-        rec["near_stops"] = float("nan")
-    return rec
 
 
 def pct(values, q):
@@ -176,9 +176,13 @@ def main() -> None:
     for seed_name in ("shortest", "clearance"):
         recs = []
         fails = []
+        planners = {}
         for name, raw, infl, r, a, b, cost in cases:
-            sm = Smoother(kappa_max=1.0 / (2.0 * r), time_budget_s=10.0)
-            rec = run_case(raw, infl, r, a, b, cost if seed_name == "clearance" else None, sm)
+            if name not in planners:
+                sm = Smoother(kappa_max=1.0 / (2.0 * r), time_budget_s=10.0)
+                planners[name] = Planner(raw, Robot(radius=r), search=seed_name, smoother=sm)
+            c = cost if seed_name == "clearance" else None
+            rec = run_case(raw, infl, r, a, b, c, planners[name])
             rec["map"] = name
             recs.append(rec)
             if not rec["ok"]:
@@ -199,6 +203,7 @@ def main() -> None:
             "length ratio (median)": f"{pct([x['length_ratio'] for x in ok], 50):.3f}",
             "near-stops (total)": f"{int(np.nansum([x['near_stops'] for x in ok]))}",
             "refined (attempts > 1)": f"{sum(x['attempts'] > 1 for x in ok)}",
+            "rescued along a witness": f"{sum(x['rescued'] for x in ok)}",
         }
         failures[seed_name] = fails
     keys = list(table["shortest"])

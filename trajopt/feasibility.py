@@ -16,6 +16,10 @@ the raw map with the exact point-to-square distance. ``None`` means that the sea
 find one within its budget: the query is *probably* infeasible, not proven so. The
 benchmark of the curvature-bounded smoother (``benchmarks/bench_curvature.py``) uses it to
 tell the smoother's failures on feasible queries from queries no curve can serve.
+
+:func:`witness_grid_path` turns a witness into a grid path of the inflated grid, so that the
+corridor and the smoother can be run again along it (the planner's *witness rescue*, used
+when the curvature-bounded smoother fails along the A* path).
 """
 
 from __future__ import annotations
@@ -28,10 +32,11 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+import astar
 from trajopt.errors import InvalidInputError
 from trajopt.smoother import square_dist2
 
-__all__ = ["curvature_witness"]
+__all__ = ["curvature_witness", "witness_grid_path"]
 
 _SAMPLE = 0.125  # cells between clearance samples
 
@@ -282,3 +287,72 @@ def _distance_field(occ, w, r, gx, gy):
                     qx[tail], qy[tail] = ex, ey
                     tail += 1
     return dist
+
+
+def witness_grid_path(witness: np.ndarray, inflated_grid: Any) -> np.ndarray | None:
+    """A grid path of ``inflated_grid`` that follows ``witness`` (for the witness rescue).
+
+    The cells the witness passes through are taken in order; those blocked in the inflated
+    grid (a witness point may keep the exact clearance where its cell centre does not) are
+    skipped, and consecutive kept cells that are not 8-neighbours, or are diagonal
+    neighbours across a blocked corner, are joined by a shortest A* path. Revisited cells
+    (loops) are cut out.
+
+    Parameters
+    ----------
+    witness : array_like, shape (m, 2)
+        Points in metres, consecutive points less than a cell apart (as returned by
+        :func:`curvature_witness`).
+    inflated_grid : astar.OccupancyGrid
+        The grid the robot centre moves in (the A* grid of the planner).
+
+    Returns
+    -------
+    ndarray of int64, shape (n, 2), or None
+        Cells ``(ix, iy)``, 8-connected without corner cutting, all free; its first and
+        last cells hold the witness's end points. ``None`` when an end cell is blocked or
+        outside the grid, or two kept cells are not connected in the inflated grid.
+    """
+    pts = np.asarray(witness, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 1 or not np.all(np.isfinite(pts)):
+        raise InvalidInputError(
+            f"witness must be a finite array of shape (m, 2) with m >= 1, got {pts.shape}"
+        )
+    occ = np.asarray(inflated_grid.occupied, dtype=bool)
+    ny, nx = occ.shape
+    cells = np.floor((pts - np.asarray(inflated_grid.origin, dtype=float))
+                     / float(inflated_grid.resolution)).astype(np.int64)
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
+    if not (inside[0] and inside[-1]):
+        return None
+    cells = cells[inside]
+    free = ~occ[cells[:, 1], cells[:, 0]]
+    if not (free[0] and free[-1]):
+        return None
+    way = cells[free]
+    way = way[np.concatenate([[True], np.any(np.diff(way, axis=0) != 0, axis=1)])]
+    out: list[tuple[int, int]] = [(int(way[0, 0]), int(way[0, 1]))]
+    for c in way[1:]:
+        a = out[-1]
+        b = (int(c[0]), int(c[1]))
+        dx, dy = abs(b[0] - a[0]), abs(b[1] - a[1])
+        if max(dx, dy) == 1 and (min(dx, dy) == 0 or not (occ[a[1], b[0]] or occ[b[1], a[0]])):
+            out.append(b)
+            continue
+        try:
+            seg = astar.find_path(inflated_grid, a, b).cells
+        except astar.NoPathError:
+            return None
+        out.extend((int(x), int(y)) for x, y in seg[1:])
+    simple: list[tuple[int, int]] = []
+    where: dict[tuple[int, int], int] = {}
+    for c in out:
+        k = where.get(c)
+        if k is not None:  # a loop: cut back to the first visit
+            for q in simple[k + 1 :]:
+                del where[q]
+            del simple[k + 1 :]
+            continue
+        where[c] = len(simple)
+        simple.append(c)
+    return np.array(simple, dtype=np.int64).reshape(-1, 2)

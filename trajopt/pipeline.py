@@ -13,7 +13,13 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
    centre, the end box is widened to contain it after an exact box-to-obstacle clearance
    check.
 4. **smooth**: :class:`trajopt.Smoother` (certified clearance ``>= radius`` from the raw
-   map, exact endpoints, continuous heading).
+   map, exact endpoints, continuous heading). **Witness rescue**: when the smoother has a
+   curvature bound and fails along the A* path, the planner looks for a curvature-bounded
+   path with :func:`trajopt.feasibility.curvature_witness`, rebuilds the corridor around
+   the grid path that follows it (:func:`trajopt.feasibility.witness_grid_path`) and fits
+   again. Both tries share the smoother's ``time_budget_s``; ``stats["smoother"]["rescue"]``
+   is ``"witness"`` when the second try gave the curve (``None`` otherwise), and
+   ``steps.grid_path`` / ``steps.corridor`` are then the ones along the witness.
 5. **timing**: :func:`trajopt.time_parameterize`.
 
 The returned :class:`~trajopt.trajectory.Trajectory` carries every intermediate result in
@@ -53,6 +59,7 @@ from astar.grid import OccupancyGrid
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
+from trajopt.feasibility import curvature_witness, witness_grid_path
 from trajopt.robot import Robot
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.timing import time_parameterize
@@ -83,7 +90,8 @@ class PlanSteps:
     inflated_grid : astar.OccupancyGrid
         The grid the robot centre moves in.
     grid_path : astar.GridPath
-        The A* path on ``inflated_grid``.
+        The A* path on ``inflated_grid`` (after a witness rescue, the grid path along the
+        witness: ``expanded`` 0, ``cost`` its length).
     corridor : Corridor
         The free boxes around the path (end boxes widened to the exact start/goal).
     smooth_path : SmoothPath or None
@@ -303,25 +311,29 @@ class Planner:
             ) from exc
         stages["search"] = time.perf_counter() - t
         t = time.perf_counter()
-        # bridges (45-degree regions certified against the raw map) across diagonal gaps;
-        # not with the chapter's avoidance area, which the curve must not enter either
-        bridge_map = self.grid if self.inflation == "exact" else None
-        corridor = build_corridor(inflated, path, radius=self.robot.radius, raw_grid=bridge_map)
-        corridor = _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
+        corridor = self._corridor(inflated, path, p0, p1)
         stages["corridor"] = time.perf_counter() - t
         t = time.perf_counter()
         smooth = None
+        rescue = None
         try:
-            smooth = self.smoother.fit(
-                path,
-                corridor,
-                raw_grid=self.grid,
-                radius=self.robot.radius,
-                start=p0,
-                goal=p1,
-                start_heading=start_heading,
-                goal_heading=goal_heading,
-            )
+            try:
+                smooth = self.smoother.fit(
+                    path,
+                    corridor,
+                    raw_grid=self.grid,
+                    radius=self.robot.radius,
+                    start=p0,
+                    goal=p1,
+                    start_heading=start_heading,
+                    goal_heading=goal_heading,
+                )
+            except SmoothingError as exc:
+                found = self._witness_rescue(exc, inflated, p0, p1, start_heading, goal_heading, t)
+                if found is None:
+                    raise
+                path, corridor, smooth = found
+                rescue = "witness"
             stages["smooth"] = time.perf_counter() - t
             t = time.perf_counter()
             traj = time_parameterize(
@@ -351,7 +363,54 @@ class Planner:
         stats["inflation"] = self.inflation
         stats["search"] = self.search
         stats["smoother"] = dict(smooth.stats)
+        stats["smoother"]["rescue"] = rescue
         return dataclasses.replace(traj, stats=stats, steps=steps)
+
+    def _corridor(self, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray):
+        # bridges (45-degree regions certified against the raw map) across diagonal gaps;
+        # not with the chapter's avoidance area, which the curve must not enter either
+        bridge_map = self.grid if self.inflation == "exact" else None
+        corridor = build_corridor(inflated, path, radius=self.robot.radius, raw_grid=bridge_map)
+        return _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
+
+    def _witness_rescue(self, exc, inflated, p0, p1, start_heading, goal_heading, t_start):
+        """The second try of a curvature-bounded fit, along a witness; ``None`` if none."""
+        sm = self.smoother
+        if sm.kappa_max is None:
+            return None
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            return None
+        witness = curvature_witness(
+            self.grid, self.robot.radius, p0, p1, sm.kappa_max, time_limit_s=left
+        )
+        if witness is None:
+            return None
+        cells = witness_grid_path(witness, inflated)
+        if cells is None or len(cells) < 2:
+            return None
+        steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+        length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
+        path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            return None
+        try:
+            corridor = self._corridor(inflated, path, p0, p1)
+            smooth = dataclasses.replace(sm, time_budget_s=left).fit(
+                path,
+                corridor,
+                raw_grid=self.grid,
+                radius=self.robot.radius,
+                start=p0,
+                goal=p1,
+                start_heading=start_heading,
+                goal_heading=goal_heading,
+            )
+        except (SmoothingError, InvalidInputError) as exc2:
+            logger.debug("witness rescue failed after %s: %s", exc, exc2)
+            return None
+        return path, corridor, smooth
 
     def _fallback(
         self, exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
