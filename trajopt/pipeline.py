@@ -15,7 +15,8 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 4. **smooth**: :class:`trajopt.Smoother` (certified clearance ``>= radius`` from the raw
    map, exact endpoints, continuous heading). **Witness rescue**: when the smoother has a
    curvature bound and fails along the A* path, the planner looks for a curvature-bounded
-   path with :func:`trajopt.feasibility.curvature_witness`, rebuilds the corridor around
+   path with :func:`trajopt.feasibility.curvature_witness` (first one keeping a cell more
+   than the radius, then one with the exact radius), rebuilds the corridor around
    the grid path that follows it (:func:`trajopt.feasibility.witness_grid_path`) and fits
    again. Both tries share the smoother's ``time_budget_s``; ``stats["smoother"]["rescue"]``
    is ``"witness"`` when the second try gave the curve (``None`` otherwise), and
@@ -46,6 +47,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import threading
 import time
 from collections.abc import Sequence
@@ -374,43 +376,49 @@ class Planner:
         return _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
 
     def _witness_rescue(self, exc, inflated, p0, p1, start_heading, goal_heading, t_start):
-        """The second try of a curvature-bounded fit, along a witness; ``None`` if none."""
+        """The second try of a curvature-bounded fit, along a witness; ``None`` if none.
+
+        A witness that keeps one cell more than the radius is tried first (its grid path
+        stays off the inflated grid's edges, so the corridor has room to turn; its search
+        is capped at 1 s), then one with the exact radius.
+        """
         sm = self.smoother
         if sm.kappa_max is None:
             return None
-        left = sm.time_budget_s - (time.perf_counter() - t_start)
-        if left <= 0:
-            return None
-        witness = curvature_witness(
-            self.grid, self.robot.radius, p0, p1, sm.kappa_max, time_limit_s=left
-        )
-        if witness is None:
-            return None
-        cells = witness_grid_path(witness, inflated)
-        if cells is None or len(cells) < 2:
-            return None
-        steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
-        length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
-        path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
-        left = sm.time_budget_s - (time.perf_counter() - t_start)
-        if left <= 0:
-            return None
-        try:
-            corridor = self._corridor(inflated, path, p0, p1)
-            smooth = dataclasses.replace(sm, time_budget_s=left).fit(
-                path,
-                corridor,
-                raw_grid=self.grid,
-                radius=self.robot.radius,
-                start=p0,
-                goal=p1,
-                start_heading=start_heading,
-                goal_heading=goal_heading,
+        radius = self.robot.radius
+        for margin, cap_s in ((self.grid.resolution, 1.0), (0.0, math.inf)):
+            left = sm.time_budget_s - (time.perf_counter() - t_start)
+            if left <= 0:
+                return None
+            witness = curvature_witness(
+                self.grid, radius + margin, p0, p1, sm.kappa_max, time_limit_s=min(left, cap_s)
             )
-        except (SmoothingError, InvalidInputError) as exc2:
-            logger.debug("witness rescue failed after %s: %s", exc, exc2)
-            return None
-        return path, corridor, smooth
+            cells = None if witness is None else witness_grid_path(witness, inflated)
+            if cells is None or len(cells) < 2:
+                continue
+            steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+            length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
+            path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
+            left = sm.time_budget_s - (time.perf_counter() - t_start)
+            if left <= 0:
+                return None
+            try:
+                corridor = self._corridor(inflated, path, p0, p1)
+                smooth = dataclasses.replace(sm, time_budget_s=left).fit(
+                    path,
+                    corridor,
+                    raw_grid=self.grid,
+                    radius=radius,
+                    start=p0,
+                    goal=p1,
+                    start_heading=start_heading,
+                    goal_heading=goal_heading,
+                )
+            except (SmoothingError, InvalidInputError) as exc2:
+                logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
+                continue
+            return path, corridor, smooth
+        return None
 
     def _fallback(
         self, exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
