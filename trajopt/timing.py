@@ -18,8 +18,11 @@ Method
    ``max(v_start, v_end)`` may use the cap without that factor so that boundary speeds equal
    to the cap are allowed. Where that dip bound is large (a sharp curvature peak) the interval
    is resampled at 16 inner points, and a golden-section search next to the lowest of them
-   finds a peak narrower than that spacing (a near-cusp of the curve; the 10 000-example
-   property run found two such peaks that the samples alone missed by 0.1-0.8 %). A sparse
+   finds a peak narrower than that spacing (a near-cusp of the curve). An interval is also
+   resampled where the curvature may peak inside it while both ends are capped by ``v_max``
+   alone (flat cap, no second difference): when the heading turned across it, or a
+   second-difference bound on ``|kappa|``, exceeds the curvature at both ends. (The
+   10 000-example property runs found both kinds of peak, missed by 0.1-0.8 %.) A sparse
    table answers "minimum cap over ``[s_a, s_b]``" in O(1).
 2. **Forward greedy** (compiled with numba). Steps of ``dt`` (20 ms) with a constant jerk
    ``u`` from ``{j, 0.75 j, ..., -j}`` plus the ``u`` that zeroes ``a`` (clamped at
@@ -160,7 +163,7 @@ def time_parameterize(
             f"v_end={v_end:.6g} m/s exceeds the speed cap {cap1:.6g} m/s at s=L={length:.6g} m "
             f"(curvature {kappa[-1]:.6g} 1/m)"
         )
-    ci = _interval_caps(raw, curve, robot, s_nodes)
+    ci = _interval_caps(raw, curve, robot, s_nodes, kappa, theta)
     v_bound = max(v_start, v_end)
     ci = np.maximum(ci * (1.0 - _CAP_MARGIN), np.minimum(ci, v_bound))
     ci[0] = max(ci[0], min(v_start, raw[0], raw[1]))
@@ -299,17 +302,34 @@ def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarra
     )
 
 
-def _interval_caps(raw: np.ndarray, curve, robot: Robot, s_nodes: np.ndarray) -> np.ndarray:
+def _interval_caps(
+    raw: np.ndarray, curve, robot: Robot, s_nodes: np.ndarray, kappa: np.ndarray,
+    theta: np.ndarray,
+) -> np.ndarray:
     """Cap per grid interval (shape (n,)) from the cap at the ``n + 1`` nodes.
 
     An interval gets the smaller of its end values minus ``d2/8``, with ``d2`` the largest
     positive second difference at its ends: the most a convex dip between the nodes can go
-    below them. Where that correction exceeds 1e-4 of the value (sharp curvature peaks), the
-    interval is resampled at 16 inner points and the same bound is applied on the finer grid.
+    below them. The interval is resampled at 16 inner points (and the same bound applied on
+    the finer grid) where that correction exceeds 1e-4 of the value, and also where the
+    curvature itself may peak inside it while the cap at both ends is flat (``v_max``): its
+    second-difference bound on ``|kappa|``, or the heading turned across the interval over
+    its length, exceeds ``|kappa|`` at both ends (unwrapped ``theta``, rad).
     """
     ci = np.minimum(raw[:-1], raw[1:])
     dip = _dip(raw)
-    bad = np.flatnonzero(dip > 1e-4 * ci)
+    h = np.diff(s_nodes)
+    ak = np.abs(kappa)
+    k_end = np.maximum(ak[:-1], ak[1:])
+    d2k = np.zeros_like(ak)
+    d2k[1:-1] = 2.0 * ak[1:-1] - ak[:-2] - ak[2:]  # > 0 at a peak of |kappa|
+    k_bump = np.maximum(0.0, np.maximum(d2k[:-1], d2k[1:])) / 8.0
+    turned = np.abs(np.diff(theta)) / np.maximum(h, 1e-300)
+    k_inner = np.maximum(k_end + k_bump, turned)
+    peak = (k_inner > k_end * (1.0 + 1e-6)) & (
+        np.asarray(robot.speed_cap(k_inner), dtype=float) < ci
+    )
+    bad = np.flatnonzero((dip > 1e-4 * ci) | peak)
     if bad.size:
         m = _REFINE
         frac = np.arange(m + 1) / m

@@ -423,10 +423,12 @@ def test_easy_case_is_solved_and_checked() -> None:
     assert run_case(case) == "ok"
 
 
-#: Cases on which the 10 000-example run (session 4) found a trajectory 0.1-0.8 % above its
-#: speed cap: a curvature peak of the smooth curve (|kappa| ~ 25 1/m on 2 cm cells) narrower
-#: than the timing's cap-table refinement. Kept as regressions of the fix (golden-section
-#: search for the lowest cap next to the lowest fine sample).
+#: Cases on which the 10 000-example runs (session 4) found a trajectory 0.1-0.8 % above its
+#: speed cap. First run: a curvature peak (|kappa| ~ 25 1/m on 2 cm cells) narrower than the
+#: timing's cap-table refinement (fix: golden-section search next to the lowest fine sample).
+#: Rerun: a curvature peak inside one table interval whose two ends were both capped by
+#: ``v_max`` alone, so the cap's second differences saw nothing (fix: the refinement is also
+#: triggered by the curvature and the heading turned across the interval).
 LONG_RUN_REGRESSIONS = [
     CaseParams(nx=37, ny=35, resolution=0.02, origin=(-42.03455006990392, 1.0610332041184023),
                kind="noise", density=0.04461853399020709, seed=271, radius_cells=0.3,
@@ -442,9 +444,25 @@ LONG_RUN_REGRESSIONS = [
                wheels=None, placement="free",
                start_u=(0.44158910125218054, 0.45388536497759757),
                goal_u=(0.6248740044942592, 0.39199239484726056), search="shortest"),
+    CaseParams(nx=263, ny=53, resolution=0.02, origin=(-32.635599283490635, 8.560444051930936),
+               kind="open", density=0.0, seed=88951, radius_cells=3.7341887608176094,
+               limits=(0.19640807923914286, 0.6048735300260856, 2.9379557705089585,
+                       0.477313259224586, 1.1985725787341952),
+               wheels=(0.1350596797315405, 0.7925183391904915), placement="free",
+               start_u=(0.9039971539893077, 0.552487378838519),
+               goal_u=(0.10263176663338891, 0.5327734746412508), search="shortest"),
+    CaseParams(nx=241, ny=241, resolution=0.02, origin=(-7.063890756780431, -37.04815565142743),
+               kind="open", density=0.0, seed=241, radius_cells=1.793505217775715,
+               limits=(0.12334911502200994, 0.256570939580716, 4.997715717676668,
+                       0.3549876964665092, 0.24937269029064907),
+               wheels=(0.06206227062020115, 0.398343455474496), placement="free",
+               start_u=(0.25276862474180684, 0.614340341618957),
+               goal_u=(0.6050592382758567, 0.7928488771994384), search="clearance"),
 ]
 
 
-@pytest.mark.parametrize("params", LONG_RUN_REGRESSIONS, ids=["yaw-rate", "speed-cap"])
+@pytest.mark.parametrize(
+    "params", LONG_RUN_REGRESSIONS, ids=["yaw-rate", "speed-cap", "flat-cap-yaw", "flat-cap-speed"]
+)
 def test_long_run_regressions(params: CaseParams) -> None:
     assert run_case(build_case(params)) == "ok"
