@@ -320,16 +320,7 @@ class Planner:
         rescue = None
         try:
             try:
-                smooth = self.smoother.fit(
-                    path,
-                    corridor,
-                    raw_grid=self.grid,
-                    radius=self.robot.radius,
-                    start=p0,
-                    goal=p1,
-                    start_heading=start_heading,
-                    goal_heading=goal_heading,
-                )
+                smooth = self._fit(self.smoother, path, corridor, p0, p1, start_heading, goal_heading)
             except SmoothingError as exc:
                 found = self._witness_rescue(exc, inflated, p0, p1, start_heading, goal_heading, t)
                 if found is None:
@@ -375,6 +366,18 @@ class Planner:
         corridor = build_corridor(inflated, path, radius=self.robot.radius, raw_grid=bridge_map)
         return _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
 
+    def _fit(self, smoother: Smoother, path, corridor, p0, p1, start_heading, goal_heading):
+        return smoother.fit(
+            path,
+            corridor,
+            raw_grid=self.grid,
+            radius=self.robot.radius,
+            start=p0,
+            goal=p1,
+            start_heading=start_heading,
+            goal_heading=goal_heading,
+        )
+
     def _witness_rescue(self, exc, inflated, p0, p1, start_heading, goal_heading, t_start):
         """The second try of a curvature-bounded fit, along a witness; ``None`` if none.
 
@@ -404,15 +407,9 @@ class Planner:
                 return None
             try:
                 corridor = self._corridor(inflated, path, p0, p1)
-                smooth = dataclasses.replace(sm, time_budget_s=left).fit(
-                    path,
-                    corridor,
-                    raw_grid=self.grid,
-                    radius=radius,
-                    start=p0,
-                    goal=p1,
-                    start_heading=start_heading,
-                    goal_heading=goal_heading,
+                smooth = self._fit(
+                    dataclasses.replace(sm, time_budget_s=left),
+                    path, corridor, p0, p1, start_heading, goal_heading,
                 )
             except (SmoothingError, InvalidInputError) as exc2:
                 logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
