@@ -629,9 +629,10 @@ class Smoother:
         the curvature bound when ``C'`` is along ``T``. Every row has an l1-penalised slack,
         so each QP is feasible; a trust region on the control points is grown or shrunk by
         the ratio of actual to predicted decrease of the merit ``objective + penalty *
-        violation`` (steps that do not decrease it are rejected). Iterations stop once the
-        exact sampled bound holds and the merit stalls. The caller's certificate then
-        checks the result on dense samples.
+        violation`` (steps that do not decrease it are rejected, and the region shrinks to a
+        quarter of the rejected step). Iterations stop once the exact sampled bound holds
+        and the merit stalls, or the model predicts a relative decrease below
+        ``_SCP_RTOL``. The caller's certificate then checks the result on dense samples.
         """
         p = self.degree
         n, nb = qp.n, qp.nb
@@ -745,6 +746,11 @@ class Smoother:
             if predicted <= tol:  # no decrease predicted: a stationary point of the model
                 status = "converged" if ok else "stalled"
                 break
+            if ok and predicted <= _SCP_RTOL * (1.0 + abs(merit)):
+                # the bound holds and even the model's best step would lower the merit by
+                # less than the tolerance: stop at the current iterate
+                status = "converged"
+                break
             ratio = actual / predicted
             if ratio >= 0.1:  # accept
                 z, d1, sp, kap, ok, merit = znew, d1n, spn, kapn, okn, meritn
@@ -755,8 +761,8 @@ class Smoother:
                 if ok and (actual <= _SCP_RTOL * (1.0 + abs(merit)) or step < 0.05):
                     status = "converged"
                     break
-            else:
-                delta *= 0.25
+            else:  # reject; the next region is smaller than the rejected step
+                delta = min(0.25 * delta, 0.5 * step)
                 d2 = d2_old
             if delta < 1e-3:
                 status = "converged" if ok else "trust region collapsed"
@@ -884,7 +890,7 @@ _MAX_HEADING_STEP = math.pi / 8
 _MIN_SPEED_RATIO = 1e-2
 
 #: the SCP stops once the bound holds and an accepted step lowers the objective by less
-#: than this fraction (or moves no control point by 0.05 cell)
+#: than this fraction (or moves no control point by 0.05 cell), or the model predicts less
 _SCP_RTOL = 1e-3
 
 #: l1 penalty on the SCP slacks (cell units); large against the objective's multipliers
