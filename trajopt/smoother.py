@@ -629,8 +629,8 @@ class Smoother:
         the curvature bound when ``C'`` is along ``T``. Every row has an l1-penalised slack,
         so each QP is feasible; a trust region on the control points is grown or shrunk by
         the ratio of actual to predicted decrease of the merit ``objective + penalty *
-        violation`` (steps that do not decrease it are rejected, and the region shrinks to a
-        quarter of the rejected step). Iterations stop once the exact sampled bound holds
+        violation`` (steps that do not decrease it are rejected, and the region shrinks to at
+        most half the rejected step). Iterations stop once the exact sampled bound holds
         and the merit stalls, or the model predicts a relative decrease below
         ``_SCP_RTOL``. The caller's certificate then checks the result on dense samples.
         """
