@@ -392,8 +392,8 @@ def _ipopt_opts(verbose: bool) -> dict:
     }
 
 
-#: curvature samples per span (both span ends included)
-CURV_SAMPLES = 5
+#: curvature samples per span (its start and interior points; the last span also its end)
+CURV_SAMPLES = 4
 
 
 @functools.lru_cache(maxsize=16)

@@ -602,15 +602,22 @@ class Smoother:
 
     def _curvature_samples(self, t: np.ndarray, n: int, nb: int):
         """Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per
-        span (ends included), padded to ``nb - p`` spans."""
+        span, padded to ``nb - p`` spans.
+
+        A span is sampled at its start and at evenly spaced interior points; its end is the
+        next span's start (``C'`` and ``C''`` are continuous at the simple interior knots, so
+        a sample there would repeat a row). The last span spreads its samples from its start
+        to its end, so the curve's end is sampled too.
+        """
         p = self.degree
         ms = _qp.CURV_SAMPLES
         ns = n - p
-        fr = np.linspace(0.0, 1.0, ms)
+        fr = np.tile(np.arange(ms) / ms, (ns, 1))
+        fr[-1] = np.linspace(0.0, 1.0, ms)
         a = t[p : p + ns]
         b = t[p + 1 : p + ns + 1]
         span = np.repeat(np.arange(ns), ms)
-        uu = (a[:, None] + (b - a)[:, None] * fr[None, :]).ravel()
+        uu = (a[:, None] + (b - a)[:, None] * fr).ravel()
         S = (nb - p) * ms
         B1 = np.zeros((S, p + 1))
         B2 = np.zeros((S, p + 1))
@@ -631,8 +638,8 @@ class Smoother:
         the ratio of actual to predicted decrease of the merit ``objective + penalty *
         violation`` (steps that do not decrease it are rejected, and the region shrinks to at
         most half the rejected step). Iterations stop once the exact sampled bound holds
-        and the merit stalls, or the model predicts a relative decrease below
-        ``_SCP_RTOL``. The caller's certificate then checks the result on dense samples.
+        and the merit stalls or comes within ``_SCP_RTOL`` (relative) of the model's
+        optimum, or the model predicts a relative decrease below ``_SCP_RTOL``. The caller's certificate then checks the result on dense samples.
         """
         p = self.degree
         n, nb = qp.n, qp.nb
@@ -753,12 +760,14 @@ class Smoother:
                 break
             ratio = actual / predicted
             if ratio >= 0.1:  # accept
+                model = merit - predicted  # the model's optimum around the old iterate
                 z, d1, sp, kap, ok, merit = znew, d1n, spn, kapn, okn, meritn
                 if ratio > 0.75 and step >= 0.99 * delta:
                     delta = min(2 * delta, 8.0)
                 elif ratio < 0.25:
                     delta *= 0.5
-                if ok and (actual <= _SCP_RTOL * (1.0 + abs(merit)) or step < 0.05):
+                rtol = _SCP_RTOL * (1.0 + abs(merit))
+                if ok and (actual <= rtol or step < 0.05 or merit - model <= rtol):
                     status = "converged"
                     break
             else:  # reject; the next region is smaller than the rejected step
@@ -889,9 +898,10 @@ _SLACK_MAX = 1e3
 _MAX_HEADING_STEP = math.pi / 8
 _MIN_SPEED_RATIO = 1e-2
 
-#: the SCP stops once the bound holds and an accepted step lowers the objective by less
-#: than this fraction (or moves no control point by 0.05 cell), or the model predicts less
-_SCP_RTOL = 1e-3
+#: the SCP stops once the bound holds and an accepted step lowers the merit by less than
+#: this fraction (or moves no control point by 0.05 cell, or lands within this fraction of
+#: the model's optimum), or the model predicts a smaller decrease
+_SCP_RTOL = 1e-2
 
 #: l1 penalty on the SCP slacks (cell units); large against the objective's multipliers
 _SLACK_PENALTY = 1e4
