@@ -10,8 +10,10 @@ by side:
 * success rate of the curvature-bounded smoother (a certified curve returned);
 * median and p95 warm solve time: the whole smoothing stage (QP, SCP, certificate; for a
   rescued query also the witness search and the second fit) and the solver time alone
-  (for a rescued query, the whole stage), measured on a second call of the same query
-  (solvers built);
+  (for a rescued query, the whole stage), each the best of ``--repeats`` calls of the same
+  query after an untimed first call (solvers built). The best of repeats, because the
+  shared VM this was written on takes the CPU away for 0.1-2 s in a good fraction of calls;
+  the outcome of a query is the same in every call (the pipeline is deterministic);
 * median minimum clearance over the radius (dense samples against the raw map);
 * median Hausdorff deviation from the A* polyline (cells) and the length ratio;
 * near-stops of the timed trajectory (``time_parameterize`` with ``Robot(radius=r)``):
@@ -27,7 +29,7 @@ feasible query; one without is counted apart (probably infeasible, not proven). 
 its own witness, so the success rate over feasible queries is
 ``successes / (successes + failures with a witness)``.
 
-Run: ``python benchmarks/bench_curvature.py [--per-map 25] [--seed 0]``
+Run: ``python benchmarks/bench_curvature.py [--per-map 25] [--seed 0] [--repeats 5]``
 (``TRAJOPT_DATA`` may point to the shared data).
 """
 
@@ -111,8 +113,10 @@ def near_stops(traj, v_max: float) -> int:
     return int(min(len(starts), len(ends)))
 
 
-def run_case(raw, infl, radius, a, b, cost, planner):
-    """One query through ``planner.plan`` (smoother, witness rescue, timing), timed warm."""
+def run_case(raw, infl, radius, a, b, cost, planner, repeats=1):
+    """One query through ``planner.plan`` (smoother, witness rescue, timing), timed warm:
+    the best of ``repeats`` calls (the first call, which builds new solver sizes, is not
+    timed)."""
     path = astar.find_path(infl, a, b, cost=cost)
     p0, p1 = raw.cell_to_world(np.array(a)), raw.cell_to_world(np.array(b))
     try:
@@ -120,9 +124,16 @@ def run_case(raw, infl, radius, a, b, cost, planner):
     except (SmoothingError, TimingError):
         pass
     try:
-        t0 = time.perf_counter()
-        traj = planner.plan(p0, p1)
-        wall = time.perf_counter() - t0
+        best_smooth = best_solve = wall = math.inf
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            traj = planner.plan(p0, p1)
+            wall = min(wall, time.perf_counter() - t0)
+            smooth_s = traj.stats["stages_s"]["smooth"]
+            st = traj.stats["smoother"]
+            best_smooth = min(best_smooth, smooth_s)
+            # a rescued query's solver time is the whole smoothing stage (both fits, witness)
+            best_solve = min(best_solve, smooth_s if st["rescue"] else st["solve_time_s"])
     except (SmoothingError, TimingError) as exc:
         t0 = time.perf_counter()
         w = curvature_witness(raw, radius, p0, p1, planner.smoother.kappa_max, time_limit_s=20.0)
@@ -142,9 +153,8 @@ def run_case(raw, infl, radius, a, b, cost, planner):
     haus = max(directed_hausdorff(xy, poly)[0], directed_hausdorff(poly, xy)[0])
     return {
         "ok": True,
-        "wall": traj.stats["stages_s"]["smooth"],
-        # a rescued query's solver time is the whole smoothing stage (both fits, witness)
-        "solve": traj.stats["stages_s"]["smooth"] if rescued else st["solve_time_s"],
+        "wall": best_smooth,
+        "solve": best_solve,
         "plan": wall,
         "rescued": rescued,
         "clear_ratio": sp.certificate.min_clearance_m / radius,
@@ -163,7 +173,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--per-map", type=int, default=25, help="scenarios per map")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--repeats", type=int, default=5,
+                    help="timed calls per query; the best is reported (default 5)")
     args = ap.parse_args()
+    if args.repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {args.repeats}")
     rng = np.random.default_rng(args.seed)
     cases = []
     for name, raw, r in load_maps():
@@ -182,7 +196,7 @@ def main() -> None:
                 sm = Smoother(kappa_max=1.0 / (2.0 * r), time_budget_s=10.0)
                 planners[name] = Planner(raw, Robot(radius=r), search=seed_name, smoother=sm)
             c = cost if seed_name == "clearance" else None
-            rec = run_case(raw, infl, r, a, b, c, planners[name])
+            rec = run_case(raw, infl, r, a, b, c, planners[name], args.repeats)
             rec["map"] = name
             recs.append(rec)
             if not rec["ok"]:

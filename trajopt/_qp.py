@@ -17,7 +17,10 @@ import numpy as np
 
 logger = logging.getLogger(__name__)
 
-_SIZES = (16, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192, 256, 320, 384, 512, 640, 768, 1024)
+#: padded problem sizes, about 12 % apart (the padded variables and sample rows cost solver
+#: time, each new size costs a solver build of a few ms)
+_SIZES = (16, 20, 24, 28, 32, 36, 40, 44, 48, 56, 64, 72, 80, 88, 96, 104, 112, 128, 144, 160,
+          176, 192, 216, 240, 272, 304, 336, 376, 416, 464, 512, 576, 640, 720, 800, 896, 1024)
 
 
 def bucket_size(n: int) -> int:
@@ -250,7 +253,7 @@ class ConstraintLayout:
         return lo, hi
 
 
-@functools.lru_cache(maxsize=64)
+@functools.lru_cache(maxsize=128)
 def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
     """The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p`` and
     ``m`` curvature samples per span (0: no sample rows)."""
@@ -300,7 +303,7 @@ def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
     )
 
 
-@functools.lru_cache(maxsize=32)
+@functools.lru_cache(maxsize=128)
 def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool):
     """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
     with the banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m)``; built
