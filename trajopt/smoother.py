@@ -208,7 +208,10 @@ class Smoother:
         Wall-time budget per :meth:`fit` call (s); exceeded -> ``SmoothingError``.
         Default 5 (the first call of a new size also builds its solvers).
     max_attempts : int, optional
-        Knot refinements (span length halved each time) before giving up. Default 3.
+        Knot refinements (span length halved each time) before giving up. Default 3. When
+        the certificate finds only the curvature bound broken (between the samples), the
+        same knots are first solved once more, warm started, with the sampled bound
+        tightened by the excess found.
     samples_per_cell : int, optional
         Certificate sampling density along ``u`` (samples per cell). Default 8.
     verbose : bool, optional
@@ -359,18 +362,24 @@ class Smoother:
         )
         attempts: list[dict[str, Any]] = []
         h = float(self.span_cells)
-        for attempt in range(int(self.max_attempts)):
+        margin = self.kappa_margin
+        warm = None  # control points (cells) of a retry on the same knots
+        spans_tried = 0
+        while spans_tried < int(self.max_attempts):
             remaining = self.time_budget_s - (time.perf_counter() - t_call)
             if remaining <= 0:
                 break
-            st: dict[str, Any] = {"attempt": attempt + 1, "span_cells": h}
+            st: dict[str, Any] = {"attempt": len(attempts) + 1, "span_cells": h}
+            if warm is not None:
+                st["kappa_margin"] = margin
             attempts.append(st)
             try:
-                c_cells, t_cells, span_box, st2 = self._solve(prob, h, remaining)
+                c_cells, t_cells, span_box, st2 = self._solve(prob, h, remaining, margin, warm)
             except _AttemptFailed as exc:
                 st.update(exc.stats)
                 st["failure"] = str(exc)
-                h = max(0.5, h / 2)
+                h, margin, warm = max(0.5, h / 2), self.kappa_margin, None
+                spans_tried += 1
                 continue
             st.update(st2)
             c = origin + res * c_cells
@@ -393,8 +402,21 @@ class Smoother:
                 stats = _summary(attempts, time.perf_counter() - t_call, success=True)
                 return SmoothPath(curve=curve, stats=stats, certificate=cert)
             st["failure"] = "certificate: " + ", ".join(cert.failures)
-            logger.debug("attempt %d failed its certificate: %s", attempt + 1, cert.failures)
-            h = max(0.5, h / 2)
+            logger.debug("attempt %d failed its certificate: %s", len(attempts), cert.failures)
+            if (
+                warm is None
+                and self.kappa_max is not None
+                and cert.failures == ("curvature_bound",)
+                and cert.kappa_max_sampled > 0
+            ):
+                # the bound broke between the samples only: the same knots again, warm
+                # started, with the sampled bound tightened by the excess found (cheaper
+                # than a refinement, which doubles the problem)
+                margin *= _MARGIN_RETRY * self.kappa_max / cert.kappa_max_sampled
+                warm = c_cells
+                continue
+            h, margin, warm = max(0.5, h / 2), self.kappa_margin, None
+            spans_tried += 1
         stats = _summary(attempts, time.perf_counter() - t_call, success=False)
         last = attempts[-1].get("failure", "time budget exhausted") if attempts else "no attempt"
         raise SmoothingError(
@@ -447,7 +469,13 @@ class Smoother:
         return BSplineCurve(t, np.column_stack([z[:n], z[nb : nb + n]]), p)
 
     # ---------------------------------------------------------------- internal
-    def _solve(self, prob: _Problem, h: float, remaining: float):
+    def _solve(self, prob: _Problem, h: float, remaining: float, margin: float,
+               warm: np.ndarray | None = None):
+        """One attempt on the knots of span ``h`` (cells): the QP, then with a curvature
+        bound the SCP (sampled bound ``margin * kappa_max``). ``warm``: control points (cells)
+        of an earlier attempt on the same knots; the SCP then starts from them instead of
+        the QP solution."""
+        t_enter = time.perf_counter()
         p = self.degree
         t, span_box = graded_knots(prob.u[-1], prob.trans, prob.overlap, p, h)
         n = len(t) - p - 1
@@ -494,7 +522,15 @@ class Smoother:
             )
         qp = _QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx, heading=heading,
                      lba=lba, uba=uba)
-        z, info = self._solve_qp(qp, remaining, x0=x0)
+        if warm is None:
+            z, info = self._solve_qp(qp, remaining, x0=x0)
+        else:
+            z = x0.copy()
+            z[:n], z[nb : nb + n] = warm[:, 0], warm[:, 1]
+            z = np.clip(z, lbx, ubx)
+            info = {"solver": "warm", "cost": float("nan"), "success": True,
+                    "status": "warm start", "iterations": 0, "solve_time_s": 0.0,
+                    "solve_cpu_s": 0.0, "build_time_s": 0.0}
         stats = {
             "n_control_points": n,
             "padded_size": nb,
@@ -510,10 +546,13 @@ class Smoother:
         z = np.clip(z, lbx, ubx)
         if self.kappa_max is not None:
             kmax_cells = self.kappa_max * prob.res
+            remaining -= time.perf_counter() - t_enter  # what the QP stage left
             if self.curvature_solver == "scp":
-                z, cinfo = self._solve_curvature_scp(qp, t, z, kmax_cells, remaining, const)
+                z, cinfo = self._solve_curvature_scp(
+                    qp, t, z, kmax_cells, remaining, margin, const
+                )
             else:
-                z, cinfo = self._solve_curvature_ipopt(qp, t, z, kmax_cells, remaining)
+                z, cinfo = self._solve_curvature_ipopt(qp, t, z, kmax_cells, remaining, margin)
             stats["nlp"] = cinfo
             stats["solver"] = info["solver"] + "+" + cinfo["solver"]
             stats["status"] = cinfo["status"]
@@ -625,9 +664,9 @@ class Smoother:
         B2[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 2)
         return span, B1, B2
 
-    def _solve_curvature_scp(self, qp: _QPData, t, z0, kmax, remaining, const=0.0):
+    def _solve_curvature_scp(self, qp: _QPData, t, z0, kmax, remaining, margin, const=0.0):
         """Sequential convex programming for ``|kappa| <= kappa_margin * kmax`` and
-        ``|C'| >= speed_floor`` at the samples.
+        ``|C'| >= speed_floor`` at the samples (``margin`` replaces ``kappa_margin``).
 
         With the current iterate's unit tangent ``T_r``, normal ``N_r`` and speed ``v_r`` at
         sample ``r``, each QP imposes ``T_r . C'(u_r) >= floor`` (which implies
@@ -649,7 +688,7 @@ class Smoother:
         span, B1, B2 = self._curvature_samples(t, n, nb)
         B1, B2 = B1[:ns_real], B2[:ns_real]
         idx = span[:, None] + np.arange(p + 1)[None, :]
-        kb = self.kappa_margin * kmax
+        kb = margin * kmax
         floor = self.speed_floor
         solver_name = "piqp"  # interior point: steady iteration counts on these QPs
         n_fixed = _qp.N_HEADING_ROWS + 2 * nb
@@ -794,7 +833,7 @@ class Smoother:
         }
         return z, info
 
-    def _solve_curvature_ipopt(self, qp: _QPData, t, z0, kmax, remaining):
+    def _solve_curvature_ipopt(self, qp: _QPData, t, z0, kmax, remaining, margin):
         p = self.degree
         n, nb = qp.n, qp.nb
         ms = _qp.CURV_SAMPLES
@@ -806,7 +845,7 @@ class Smoother:
                 qp.heading.ravel(order="F"),
                 B1.ravel(order="F"),
                 B2.ravel(order="F"),
-                [(self.kappa_margin * kmax) ** 2],
+                [(margin * kmax) ** 2],
             ]
         )
         S = (nb - p) * ms
@@ -887,6 +926,10 @@ def _sd(xy: np.ndarray) -> np.ndarray:
 #: (and speeds down to the floor over it): the margin leaves room, and the certificate
 #: checks the true bound on dense samples
 _SAMPLE_SLACK = 1.01
+
+#: a warm-started retry after the certificate found the curvature bound broken between the
+#: samples tightens the sampled bound by the excess found times this factor
+_MARGIN_RETRY = 0.98
 
 #: largest SCP slack (keeps every row's range finite for the interior-point solver)
 _SLACK_MAX = 1e3
