@@ -527,7 +527,6 @@ class Smoother:
         else:
             z = x0.copy()
             z[:n], z[nb : nb + n] = warm[:, 0], warm[:, 1]
-            z = np.clip(z, lbx, ubx)
             info = {"solver": "warm", "cost": float("nan"), "success": True,
                     "status": "warm start", "iterations": 0, "solve_time_s": 0.0,
                     "solve_cpu_s": 0.0, "build_time_s": 0.0}
@@ -678,7 +677,8 @@ class Smoother:
         violation`` (steps that do not decrease it are rejected, and the region shrinks to at
         most half the rejected step). Iterations stop once the exact sampled bound holds
         and the merit stalls or comes within ``_SCP_RTOL`` (relative) of the model's
-        optimum, or the model predicts a relative decrease below ``_SCP_RTOL``. The caller's certificate then checks the result on dense samples.
+        optimum, or the model predicts a relative decrease below ``_SCP_RTOL``. The caller's
+        certificate then checks the result on dense samples.
         """
         p = self.degree
         n, nb = qp.n, qp.nb
