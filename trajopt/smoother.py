@@ -407,11 +407,15 @@ class Smoother:
                 warm is None
                 and self.kappa_max is not None
                 and cert.failures == ("curvature_bound",)
-                and cert.kappa_max_sampled > 0
+                and 0 < cert.kappa_max_sampled <= _RETRY_MAX_EXCESS * self.kappa_max
             ):
-                # the bound broke between the samples only: the same knots again, warm
-                # started, with the sampled bound tightened by the excess found (cheaper
-                # than a refinement, which doubles the problem)
+                # the bound broke between the samples only, and by a little: the same knots
+                # again, warm started, with the sampled bound tightened by the excess found
+                # (cheaper than a refinement, which doubles the problem; a larger excess
+                # tightens the bound at many samples at once, and the warm start is then no
+                # better than a cold one)
+                logger.debug("dense max kappa %.4g x the bound: same knots again",
+                             cert.kappa_max_sampled / self.kappa_max)
                 margin *= _MARGIN_RETRY * self.kappa_max / cert.kappa_max_sampled
                 warm = c_cells
                 continue
@@ -548,7 +552,8 @@ class Smoother:
             remaining -= time.perf_counter() - t_enter  # what the QP stage left
             if self.curvature_solver == "scp":
                 z, cinfo = self._solve_curvature_scp(
-                    qp, t, z, kmax_cells, remaining, margin, const
+                    qp, t, z, kmax_cells, remaining, margin, const,
+                    trust=_TRUST_WARM if warm is not None else _TRUST_COLD,
                 )
             else:
                 z, cinfo = self._solve_curvature_ipopt(qp, t, z, kmax_cells, remaining, margin)
@@ -663,7 +668,8 @@ class Smoother:
         B2[: ns * ms] = _qp.basis_derivs(t, p, span, uu, 2)
         return span, B1, B2
 
-    def _solve_curvature_scp(self, qp: _QPData, t, z0, kmax, remaining, margin, const=0.0):
+    def _solve_curvature_scp(self, qp: _QPData, t, z0, kmax, remaining, margin, const=0.0,
+                             trust=1.0):
         """Sequential convex programming for ``|kappa| <= kappa_margin * kmax`` and
         ``|C'| >= speed_floor`` at the samples (``margin`` replaces ``kappa_margin``).
 
@@ -674,11 +680,16 @@ class Smoother:
         the curvature bound when ``C'`` is along ``T``. Every row has an l1-penalised slack,
         so each QP is feasible; a trust region on the control points is grown or shrunk by
         the ratio of actual to predicted decrease of the merit ``objective + penalty *
-        violation`` (steps that do not decrease it are rejected, and the region shrinks to at
-        most half the rejected step). Iterations stop once the exact sampled bound holds
-        and the merit stalls or comes within ``_SCP_RTOL`` (relative) of the model's
-        optimum, or the model predicts a relative decrease below ``_SCP_RTOL``. The caller's
-        certificate then checks the result on dense samples.
+        violation`` (it starts at ``trust`` cells; steps that do not decrease the merit are
+        rejected, and the region shrinks to at most half the rejected step). Iterations stop
+        once the sampled bound holds (within ``_SAMPLE_SLACK``) and either the merit stalls,
+        or the objective comes within ``_SCP_RTOL`` (relative) of the model's optimum, or
+        the model predicts a relative decrease below ``_SCP_RTOL`` of the merit or (its
+        optimum inside the trust region) of the objective. They give up when the bound
+        is still broken and the merit fell by less than ``_SCP_RTOL`` over
+        ``_SCP_STALL_WINDOW`` iterations (a local minimum of the penalty: the caller
+        refines the knots). The caller's certificate then checks the result on dense
+        samples.
         """
         p = self.degree
         n, nb = qp.n, qp.nb
@@ -727,10 +738,12 @@ class Smoother:
 
         derivs: list[np.ndarray] = [np.empty(0), np.empty(0)]
 
-        delta = 1.0  # trust region (cells)
+        delta = float(trust)  # trust region (cells)
         z = z0.copy()
         d1, sp, kap, ok, merit = measure(z)
         d2 = derivs[1]
+        q_cur = quad(z)
+        history = [merit]  # the merit after each iteration
         t0 = time.perf_counter()
         build = solve = 0.0
         iters = 0
@@ -797,16 +810,26 @@ class Smoother:
                 # less than the tolerance: stop at the current iterate
                 status = "converged"
                 break
+            interior = step < 0.99 * delta  # the model's optimum lies inside the region
+            if ok and interior and q_cur - quad(znew) <= _SCP_RTOL * (1.0 + q_cur):
+                # the bound holds (within the sample slack) and the model's optimum, inside
+                # the trust region, lowers the objective itself by less than the tolerance:
+                # what is left to gain is the penalty on violations inside that slack
+                status = "converged"
+                break
             ratio = actual / predicted
             if ratio >= 0.1:  # accept
                 model = merit - predicted  # the model's optimum around the old iterate
                 z, d1, sp, kap, ok, merit = znew, d1n, spn, kapn, okn, meritn
-                if ratio > 0.75 and step >= 0.99 * delta:
+                q_cur = quad(z)
+                if ratio > 0.5 and step >= 0.99 * delta:
                     delta = min(2 * delta, 8.0)
                 elif ratio < 0.25:
                     delta *= 0.5
                 rtol = _SCP_RTOL * (1.0 + abs(merit))
-                if ok and (actual <= rtol or step < 0.05 or merit - model <= rtol):
+                # (the objective, not the merit, against the model's optimum: the penalty
+                # left is on violations inside the sample slack)
+                if ok and (actual <= rtol or (interior and step < 0.05) or q_cur - model <= rtol):
                     status = "converged"
                     break
             else:  # reject; the next region is smaller than the rejected step
@@ -814,6 +837,16 @@ class Smoother:
                 d2 = d2_old
             if delta < 1e-3:
                 status = "converged" if ok else "trust region collapsed"
+                break
+            history.append(merit)
+            if (
+                not ok
+                and len(history) > _SCP_STALL_WINDOW
+                and history[-1 - _SCP_STALL_WINDOW] - merit <= _SCP_RTOL * (1.0 + abs(merit))
+            ):
+                # the bound still broken and the merit flat over the window: a local
+                # minimum of the penalty (the caller refines the knots)
+                status = "stalled"
                 break
         success = ok
         if success and status not in ("converged", "feasible at the QP solution"):
@@ -931,6 +964,14 @@ _SAMPLE_SLACK = 1.01
 #: samples tightens the sampled bound by the excess found times this factor
 _MARGIN_RETRY = 0.98
 
+#: ... only when the dense samples exceed the bound by at most this factor (else refine)
+_RETRY_MAX_EXCESS = 1.1
+
+#: initial SCP trust region (cells): from the QP solution, and on a warm-started retry
+#: (already close to a solution: a large first step there can leave for a worse local one)
+_TRUST_COLD = 1.0
+_TRUST_WARM = 0.25
+
 #: largest SCP slack (keeps every row's range finite for the interior-point solver)
 _SLACK_MAX = 1e3
 
@@ -942,9 +983,15 @@ _MAX_HEADING_STEP = math.pi / 8
 _MIN_SPEED_RATIO = 1e-2
 
 #: the SCP stops once the bound holds and an accepted step lowers the merit by less than
-#: this fraction (or moves no control point by 0.05 cell, or lands within this fraction of
-#: the model's optimum), or the model predicts a smaller decrease
+#: this fraction (or moves no control point by 0.05 cell inside the trust region, or
+#: brings the objective within this fraction of the model's optimum), or the model
+#: predicts a smaller decrease of the merit, or (its optimum inside the trust region) of
+#: the objective
 _SCP_RTOL = 1e-2
+
+#: the SCP gives up (the caller refines) when the bound is still broken and the merit fell
+#: by less than ``_SCP_RTOL`` (relative) over this many iterations
+_SCP_STALL_WINDOW = 3
 
 #: l1 penalty on the SCP slacks (cell units); large against the objective's multipliers
 _SLACK_PENALTY = 1e4
