@@ -25,6 +25,6 @@ def test_all_exports_resolve():
 
 
 def test_import_is_light():
-    code = "import sys, trajopt, astar; print(' '.join(sorted(m for m in ('casadi', 'ruckig', 'numba', 'matplotlib', 'scipy') if m in sys.modules)))"
+    code = "import sys, trajopt, astar; print(' '.join(sorted(m for m in ('casadi', 'piqp', 'ruckig', 'numba', 'matplotlib', 'scipy') if m in sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""

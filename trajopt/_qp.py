@@ -449,3 +449,96 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
     }
     with _LOCK:
         return ca.nlpsol("smoother_curv", "ipopt", nlp, _ipopt_opts(verbose))
+
+
+@functools.lru_cache(maxsize=64)
+def upper_band_triplets(nb: int, p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Upper triangle of the two-block banded Hessian: rows, columns, and the ``(band
+    offset, band column)`` of each entry's value."""
+    r, c = _band_pattern(nb, p)
+    up = r <= c
+    r, c = r[up], c[up]
+    rows = np.concatenate([r, r + nb])
+    cols = np.concatenate([c, c + nb])
+    return rows, cols, np.concatenate([c - r, c - r]), np.concatenate([r, r])
+
+
+def solve_working_set(
+    full: np.ndarray,
+    g: np.ndarray,
+    layout: ConstraintLayout,
+    trip: np.ndarray,
+    lbx: np.ndarray,
+    ubx: np.ndarray,
+    lba: np.ndarray,
+    uba: np.ndarray,
+    active: np.ndarray,
+    slack_penalty: float,
+) -> tuple[np.ndarray, float, bool, str, int]:
+    """One QP of the sequential convex programme with only the ``active`` curvature
+    samples, solved by piqp directly (the rows of the other samples and their slacks are
+    left out: the problem's sparsity changes with the working set, which a
+    ``casadi.conic`` fixes at build time).
+
+    Parameters
+    ----------
+    full : ndarray, shape (p + 1, nb)
+        Upper band of the per-coordinate Hessian.
+    g : ndarray, shape (2 nb,)
+        Linear term of the control points.
+    layout : ConstraintLayout
+        :func:`constraint_layout` ``(nb, p, m)`` with ``m > 0``.
+    trip : ndarray
+        Its triplet values (:meth:`ConstraintLayout.values`).
+    lbx, ubx : ndarray, shape (2 nb + S,)
+        Variable bounds, slacks last.
+    lba, uba : ndarray, shape (layout.n_rows,)
+        Row bounds (infinite allowed).
+    active : ndarray of bool, shape (S,)
+        The samples whose rows (and slack) enter the problem.
+    slack_penalty : float
+        Linear cost of each slack.
+
+    Returns
+    -------
+    z : ndarray, shape (2 nb,)
+        The control points (zeros on failure).
+    cost : float
+        The objective ``1/2 z'Hz + g'z + penalty * sum(slacks)`` at the solution.
+    success : bool
+    status : str
+    iterations : int
+    """
+    import piqp
+    import scipy.sparse as sps
+
+    nb, p = layout.nb, layout.p
+    n_fixed = layout.sample_row0
+    keep_row = np.ones(layout.n_rows, dtype=bool)
+    keep_row[n_fixed:] = np.repeat(active, 3)
+    keep_row &= np.isfinite(lba) | np.isfinite(uba)
+    keep_col = np.concatenate([np.ones(2 * nb, dtype=bool), active])
+    sel = keep_row[layout.trip_rows] & keep_col[layout.trip_cols] & (trip != 0.0)
+    new_row = np.cumsum(keep_row) - 1
+    new_col = np.cumsum(keep_col) - 1
+    n_cols = int(keep_col.sum())
+    A = sps.csc_matrix(
+        (trip[sel], (new_row[layout.trip_rows[sel]], new_col[layout.trip_cols[sel]])),
+        shape=(int(keep_row.sum()), n_cols),
+    )
+    hr, hc, hd, hcol = upper_band_triplets(nb, p)
+    P = sps.csc_matrix((full[hd, hcol], (hr, hc)), shape=(n_cols, n_cols))
+    c = np.concatenate([g, np.full(int(active.sum()), slack_penalty)])
+    # large finite row bounds hurt piqp's conditioning: bound each row by its range
+    lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
+    h_l = np.maximum(lba, lo_r - 1.0)[keep_row]
+    h_u = np.minimum(uba, hi_r + 1.0)[keep_row]
+    solver = piqp.SparseSolver()
+    solver.settings.verbose = False
+    solver.setup(P, c, None, None, A, h_l, h_u, lbx[keep_col], ubx[keep_col])
+    status = solver.solve()
+    x = np.asarray(solver.result.x, dtype=float)
+    success = status == piqp.PIQP_SOLVED and bool(np.all(np.isfinite(x)))
+    z = x[: 2 * nb] if success else np.zeros(2 * nb)
+    cost = float(solver.result.info.primal_obj) if success else float("nan")
+    return z, cost, success, str(status), int(solver.result.info.iter)

@@ -23,7 +23,8 @@ plus two rows ``x + y`` and ``x - y`` for the 45-degree *bridges* the corridor p
 diagonal gaps. The convex problem is a sparse banded QP solved by ``casadi.conic`` (piqp by
 default). The curvature-bounded problem is solved by sequential convex programming (a few
 QPs with the bound linearised at the current iterate, l1-penalised slacks and a trust
-region; ``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex
+region, solved by piqp directly over a working set of the samples near the bound;
+``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex
 problem, warm-started from the QP (``curvature_solver="ipopt"``). Solvers are built once
 per padded size and cached.
 
@@ -197,9 +198,10 @@ class Smoother:
         bit for bit; osqp warm-starts its duals from the previous call).
     curvature_solver : {"scp", "ipopt"}, optional
         How the curvature-bounded problem is solved. ``"scp"`` (default): sequential
-        convex programming, a few piqp QPs in which
-        the bound is linearised conservatively around the previous iterate's tangents,
-        inside a trust region. ``"ipopt"``: the exact non-convex problem by IPOPT, warm
+        convex programming, a few piqp QPs in which the bound is linearised
+        conservatively around the previous iterate's tangents, inside a trust region
+        (from 64 control points up, only the samples near the bound, and their
+        neighbours, enter the QPs; the step's acceptance still checks every sample). ``"ipopt"``: the exact non-convex problem by IPOPT, warm
         started from the QP (slower by one to two orders of magnitude; see
         ``docs/benchmarks.md``).
     scp_iterations : int, optional
@@ -209,9 +211,9 @@ class Smoother:
         Default 5 (the first call of a new size also builds its solvers).
     max_attempts : int, optional
         Knot refinements (span length halved each time) before giving up. Default 3. When
-        the certificate finds only the curvature bound broken (between the samples), the
-        same knots are first solved once more, warm started, with the sampled bound
-        tightened by the excess found.
+        the certificate finds only the curvature bound broken (between the samples) and
+        by at most 10 %, the same knots are first solved once more, warm started, with
+        the sampled bound tightened by the excess found.
     samples_per_cell : int, optional
         Certificate sampling density along ``u`` (samples per cell). Default 8.
     verbose : bool, optional
@@ -579,25 +581,20 @@ class Smoother:
         stats["cost"] = cost
         return c, t, span_box, stats
 
-    def _solve_qp(self, qp: _QPData, remaining: float, x0=None, *, solver_name=None,
-                  m: int = 0, sample_vals=None, lba=None, uba=None, lbx=None, ubx=None,
-                  slack_open=None):
-        """One QP solve (``m`` curvature samples per span when ``sample_vals`` is given)."""
+    def _solve_qp(self, qp: _QPData, remaining: float, x0=None):
+        """One solve of the corridor QP (no curvature rows) by ``self.qp_solver``."""
         p = self.degree
         nb = qp.nb
-        solver_name = solver_name or self.qp_solver
-        lbx = qp.lbx if lbx is None else lbx
-        ubx = qp.ubx if ubx is None else ubx
-        lba = qp.lba if lba is None else lba
-        uba = qp.uba if uba is None else uba
+        solver_name = self.qp_solver
+        lbx, ubx, lba, uba = qp.lbx, qp.ubx, qp.lba, qp.uba
         if x0 is None:
             x0 = np.zeros(2 * nb)
         tb = time.perf_counter()
-        built = _is_cached(f"{solver_name}-{m}", nb, p, self.verbose)
+        built = _is_cached(f"{solver_name}-0", nb, p, self.verbose)
         if solver_name == "ipopt":
             solver = _qp.qp_ipopt(nb, p, self.verbose)
         else:
-            solver = _qp.qp_solver(nb, p, solver_name, m, self.verbose)
+            solver = _qp.qp_solver(nb, p, solver_name, 0, self.verbose)
         build = 0.0 if built else time.perf_counter() - tb
         ts = time.perf_counter()
         tc = time.process_time()
@@ -607,16 +604,9 @@ class Smoother:
         else:
             import casadi as ca
 
-            layout = _qp.constraint_layout(nb, p, m)
+            layout = _qp.constraint_layout(nb, p, 0)
             hnz = _qp.h_nonzeros(qp.full, nb, p)
-            gg = qp.g
-            if m:  # one slack per sample, l1-penalised, >= 0
-                S = layout.n_samples
-                gg = np.concatenate([qp.g, np.full(S, _SLACK_PENALTY)])
-                lbx = np.concatenate([lbx, np.zeros(S)])
-                ubx = np.concatenate([ubx, np.where(slack_open, _SLACK_MAX, 0.0)])
-                x0 = np.concatenate([x0, np.zeros(S)])
-            trip = layout.values(qp.heading, sample_vals)
+            trip = layout.values(qp.heading)
             if solver_name == "piqp":
                 # piqp warns about (and drops) infinite rows, and large finite ones hurt
                 # its conditioning: bound every row by its range over the variable bounds
@@ -625,7 +615,7 @@ class Smoother:
                 uba = np.minimum(uba, hi_r + 1.0)
             hval = ca.DM(solver.sparsity_in("h"), hnz)
             aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
-            out = solver(h=hval, g=gg, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+            out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
         solve = time.perf_counter() - ts
         cpu = time.process_time() - tc
         st = solver.stats()
@@ -640,6 +630,31 @@ class Smoother:
             "solve_time_s": solve,
             "solve_cpu_s": cpu,
             "build_time_s": build,
+        }
+        return z, info
+
+    def _solve_scp_qp(self, qp: _QPData, layout, vals, lba, uba, lbx, ubx, work):
+        """One SCP QP over the working set ``work`` (bool per sample) of curvature samples,
+        by :func:`_qp.solve_working_set`; ``vals`` holds every sample's row coefficients."""
+        S = layout.n_samples
+        trip = layout.values(qp.heading, vals)
+        lbx_s = np.concatenate([lbx, np.zeros(S)])
+        ubx_s = np.concatenate([ubx, np.full(S, _SLACK_MAX)])
+        ts = time.perf_counter()
+        tc = time.process_time()
+        z, cost, success, status, iters = _qp.solve_working_set(
+            qp.full, qp.g, layout, trip, lbx_s, ubx_s, lba, uba, work, _SLACK_PENALTY
+        )
+        info = {
+            "solver": "piqp",
+            "cost": cost,
+            "success": success,
+            "status": status,
+            "iterations": iters,
+            "solve_time_s": time.perf_counter() - ts,
+            "solve_cpu_s": time.process_time() - tc,
+            "build_time_s": 0.0,
+            "n_samples": int(work.sum()),
         }
         return z, info
 
@@ -701,16 +716,25 @@ class Smoother:
         idx = span[:, None] + np.arange(p + 1)[None, :]
         kb = margin * kmax
         floor = self.speed_floor
-        solver_name = "piqp"  # interior point: steady iteration counts on these QPs
+        layout = _qp.constraint_layout(nb, p, ms)
         n_fixed = _qp.N_HEADING_ROWS + 2 * nb
         lba = np.full(n_fixed + 3 * S, -np.inf)
         uba = np.full(n_fixed + 3 * S, np.inf)
         lba[:n_fixed] = qp.lba
         uba[:n_fixed] = qp.uba
         vals = np.zeros((S, 3, 2 * (p + 1)))
-        slack_open = np.zeros(S, dtype=bool)
-        slack_open[:ns_real] = True
         rows = n_fixed + 3 * np.arange(ns_real)
+        # the working set: samples near either bound at some iterate so far, with the
+        # samples of the neighbouring spans (the others' rows are left out of the QPs; the
+        # merit, and so the step acceptance, still counts every sample)
+        work = np.zeros(S, dtype=bool)
+        if n < _WS_MIN_POINTS:  # small: every sample (a cheap QP; fewer iterations)
+            work[:ns_real] = True
+        kernel = np.ones(2 * ms + 1, dtype=bool)
+
+        def near_active(kap_, sp_):
+            near = (kap_ > _WS_KAPPA * kb) | (sp_ < _WS_SPEED * floor)
+            return np.convolve(near, kernel, mode="same") > 0
         full = qp.full
 
         def quad(zz):  # the objective itself (>= 0), constant included
@@ -778,10 +802,8 @@ class Smoother:
             lba[rows + 2] = floor
             lbx = np.maximum(qp.lbx, z - delta)
             ubx = np.minimum(qp.ubx, z + delta)
-            znew, info = self._solve_qp(
-                qp, remaining, x0=z, solver_name=solver_name, m=ms, sample_vals=vals,
-                lba=lba, uba=uba, lbx=lbx, ubx=ubx, slack_open=slack_open,
-            )
+            work[:ns_real] |= near_active(kap, sp)
+            znew, info = self._solve_scp_qp(qp, layout, vals, lba, uba, lbx, ubx, work)
             iters += 1
             build += info["build_time_s"]
             solve += info["solve_time_s"]
@@ -794,13 +816,15 @@ class Smoother:
             d2_old = d2
             d1n, spn, kapn, okn, meritn = measure(znew)
             d2 = derivs[1]
+            work[:ns_real] |= near_active(kapn, spn)  # samples the step moved near the bounds
             actual = merit - meritn
             tol = 1e-9 * (1.0 + abs(merit))
             logger.debug(
-                "SCP %d: %.1f ms (cpu %.1f ms, %d it), step %.3g (trust %.3g), max kappa/bound "
-                "%.4g, min speed %.3g, merit %.6g -> %.6g (predicted %.6g)", it + 1,
-                1e3 * info["solve_time_s"], 1e3 * info["solve_cpu_s"], info["iterations"], step, delta, kapn.max() / kb, spn.min(), merit,
-                meritn, merit - predicted,
+                "SCP %d: %.1f ms (cpu %.1f ms, %d it, %d samples), step %.3g (trust %.3g), "
+                "max kappa/bound %.4g, min speed %.3g, merit %.6g -> %.6g (predicted %.6g)",
+                it + 1, 1e3 * info["solve_time_s"], 1e3 * info["solve_cpu_s"],
+                info["iterations"], info["n_samples"], step, delta, kapn.max() / kb,
+                spn.min(), merit, meritn, merit - predicted,
             )
             if predicted <= tol:  # no decrease predicted: a stationary point of the model
                 status = "converged" if ok else "stalled"
@@ -993,6 +1017,14 @@ _SCP_RTOL = 1e-2
 #: by less than ``_SCP_RTOL`` (relative) over this many iterations
 _SCP_STALL_WINDOW = 3
 
+#: the SCP's QPs carry the rows of the samples whose curvature exceeds this fraction of the
+#: sampled bound, or whose speed is below this multiple of the floor, at any iterate so far
+#: (and those of the neighbouring spans)
+_WS_KAPPA = 0.5
+_WS_SPEED = 2.0
+#: ... when the curve has at least this many control points (below, every sample)
+_WS_MIN_POINTS = 64
+
 #: l1 penalty on the SCP slacks (cell units); large against the objective's multipliers
 _SLACK_PENALTY = 1e4
 
@@ -1022,7 +1054,9 @@ _BUILT: set[tuple] = set()
 def _warm_imports() -> None:
     """Import the lazily loaded heavy modules (casadi, scipy.interpolate) once."""
     import casadi  # noqa: F401
+    import piqp  # noqa: F401
     import scipy.interpolate  # noqa: F401
+    import scipy.sparse  # noqa: F401
 
 
 def _is_cached(kind: str, nb: int, p: int, verbose: bool) -> bool:

@@ -144,6 +144,73 @@ def test_basis_derivatives_match_scipy():
             np.testing.assert_allclose(dense, ref, atol=1e-9 * 10.0**nu)
 
 
+def _random_scp_qp(rng, nb=20, p=3, m=4):
+    """A random strictly convex QP with the SCP's row layout (heading, 45-degree and sample
+    rows, one l1-penalised slack per sample)."""
+    full = np.zeros((p + 1, nb))
+    full[0] = 4.0 + rng.uniform(0, 1, nb)
+    full[1:] = rng.uniform(-0.5, 0.5, (p, nb))  # diagonally dominant: positive definite
+    g = rng.normal(0, 3, 2 * nb)
+    layout = _qp.constraint_layout(nb, p, m)
+    S = layout.n_samples
+    heading = np.zeros((_qp.N_HEADING_ROWS, 2 * nb))
+    heading[0, :4] = rng.normal(0, 1, 4)
+    vals = rng.normal(0, 1, (S, 3, 2 * (p + 1)))
+    lba = np.full(layout.n_rows, -np.inf)
+    uba = np.full(layout.n_rows, np.inf)
+    lba[0], uba[0] = -1.0, 1.0
+    r0 = layout.sample_row0
+    lba[_qp.N_HEADING_ROWS : r0] = -3.0
+    uba[_qp.N_HEADING_ROWS : r0] = 3.0
+    rows = r0 + 3 * np.arange(S)
+    uba[rows] = rng.uniform(-1, 1, S)
+    uba[rows + 1] = rng.uniform(-1, 1, S)
+    lba[rows + 2] = rng.uniform(-1, 1, S)
+    lbx = np.concatenate([np.full(2 * nb, -5.0), np.zeros(S)])
+    ubx = np.concatenate([np.full(2 * nb, 5.0), np.full(S, 1e3)])
+    return full, g, layout, heading, vals, lba, uba, lbx, ubx
+
+
+@pytest.mark.parametrize("fraction", [1.0, 0.3])
+def test_working_set_qp_matches_a_reference_solver(fraction):
+    """The SCP's piqp QP over a working set of samples equals osqp (through casadi, a
+    different algorithm and interface) on the same problem with the other samples' rows
+    dropped and their slacks fixed at zero."""
+    import casadi as ca
+
+    rng = np.random.default_rng(7)
+    full, g, layout, heading, vals, lba, uba, lbx, ubx = _random_scp_qp(rng)
+    nb, p, S = layout.nb, layout.p, layout.n_samples
+    active = rng.uniform(0, 1, S) < fraction
+    penalty = 50.0
+    trip = layout.values(heading, vals)
+    z, cost, ok, status, _ = _qp.solve_working_set(
+        full, g, layout, trip, lbx, ubx, lba, uba, active, penalty
+    )
+    assert ok, status
+    # reference: every row, the inactive ones unbounded, their slacks fixed at 0
+    lba_r, uba_r, ubx_r = lba.copy(), uba.copy(), ubx.copy()
+    off = np.repeat(~active, 3)
+    lba_r[layout.sample_row0 :][off] = -np.inf
+    uba_r[layout.sample_row0 :][off] = np.inf
+    ubx_r[2 * nb :][~active] = 0.0
+    ref = ca.conic(
+        "ref", "osqp",
+        {"h": _qp.qp_solver(nb, p, "osqp", layout.m, False).sparsity_in("h"),
+         "a": layout.sparsity},
+        {"osqp": {"verbose": False, "eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 200000,
+                  "polish": True}, "print_time": False, "error_on_fail": True},
+    )
+    gg = np.concatenate([g, np.full(S, penalty)])
+    out = ref(h=ca.DM(ref.sparsity_in("h"), _qp.h_nonzeros(full, nb, p)), g=gg,
+              a=ca.DM(layout.sparsity, layout.nonzeros(trip)),
+              lbx=lbx, ubx=ubx_r, lba=lba_r, uba=uba_r)
+    x_ref = np.asarray(out["x"]).ravel()
+    np.testing.assert_allclose(cost, float(out["cost"]), rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(z, x_ref[: 2 * nb], atol=1e-4)
+    assert int(active.sum()) < S or fraction == 1.0
+
+
 def test_smoothness_gram_matches_quadrature_of_scipy_derivative():
     rng = np.random.default_rng(2)
     p, n = 3, 10
