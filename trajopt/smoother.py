@@ -201,9 +201,9 @@ class Smoother:
         convex programming, a few piqp QPs in which the bound is linearised
         conservatively around the previous iterate's tangents, inside a trust region
         (from 64 control points up, only the samples near the bound, and their
-        neighbours, enter the QPs; the step's acceptance still checks every sample). ``"ipopt"``: the exact non-convex problem by IPOPT, warm
-        started from the QP (slower by one to two orders of magnitude; see
-        ``docs/benchmarks.md``).
+        neighbours, enter the QPs; the step's acceptance still checks every sample).
+        ``"ipopt"``: the exact non-convex problem by IPOPT, warm started from the QP
+        (slower by one to two orders of magnitude; see ``docs/benchmarks.md``).
     scp_iterations : int, optional
         Most SCP iterations. Default 25.
     time_budget_s : float, optional
