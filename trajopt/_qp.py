@@ -238,18 +238,22 @@ class ConstraintLayout:
         return trip[self.nz_from_triplet]
 
     def implied_range(
-        self, trip: np.ndarray, lbx: np.ndarray, ubx: np.ndarray
+        self, trip: np.ndarray, lbx: np.ndarray, ubx: np.ndarray, select: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Range of every row ``A z`` over the variable bounds (interval arithmetic)."""
-        lo_v = lbx[self.trip_cols]
-        hi_v = ubx[self.trip_cols]
+        """Range of every row ``A z`` over the variable bounds (interval arithmetic);
+        ``select`` (bool per triplet): only those triplets (rows with none get 0)."""
+        rows, cols = self.trip_rows, self.trip_cols
+        if select is not None:
+            trip, rows, cols = trip[select], rows[select], cols[select]
+        lo_v = lbx[cols]
+        hi_v = ubx[cols]
         with np.errstate(invalid="ignore"):
             a = np.where(trip >= 0, trip * lo_v, trip * hi_v)
             b = np.where(trip >= 0, trip * hi_v, trip * lo_v)
         a[trip == 0] = 0.0
         b[trip == 0] = 0.0
-        lo = np.bincount(self.trip_rows, weights=a, minlength=self.n_rows)
-        hi = np.bincount(self.trip_rows, weights=b, minlength=self.n_rows)
+        lo = np.bincount(rows, weights=a, minlength=self.n_rows)
+        hi = np.bincount(rows, weights=b, minlength=self.n_rows)
         return lo, hi
 
 
@@ -530,7 +534,8 @@ def solve_working_set(
     P = sps.csc_matrix((full[hd, hcol], (hr, hc)), shape=(n_cols, n_cols))
     c = np.concatenate([g, np.full(int(active.sum()), slack_penalty)])
     # large finite row bounds hurt piqp's conditioning: bound each row by its range
-    lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
+    # (every triplet of a kept row is selected: its columns are kept, zeros add nothing)
+    lo_r, hi_r = layout.implied_range(trip, lbx, ubx, select=sel)
     h_l = np.maximum(lba, lo_r - 1.0)[keep_row]
     h_u = np.minimum(uba, hi_r + 1.0)[keep_row]
     solver = piqp.SparseSolver()
