@@ -7,8 +7,10 @@ Two families, both returning objects that follow :class:`trajopt.curve.Parametri
   the A* points, with its three fitting methods: ``'least_squares'``, ``'lar'`` (least
   absolute residual, solved exactly as a linear programme with
   :func:`scipy.optimize.linprog`) and ``'bisquare'`` (iteratively reweighted least squares
-  with Tukey bisquare weights, leverage-adjusted residuals and a MAD scale, stopping at a
-  relative change below ``tol = 1e-4``). Its weakness is kept honest: a path that goes back
+  as MATLAB's ``robustfit``: Tukey bisquare weights with ``c = 4.685`` on leverage-adjusted
+  residuals ``r_i / sqrt(1 - h_i)``, scaled by ``MAD / 0.6745`` with the MAD taken about
+  zero after dropping the ``p - 1`` smallest, stopping at a relative change below
+  ``tol = 1e-4``; see :func:`fit_polynomial`). Its weakness is kept honest: a path that goes back
   in x, or has a vertical step, is not a function ``y = f(x)``; the fit is still computed
   when x has a spread, but the result carries ``valid=False`` and a ``reason``. When x has
   no spread at all (a vertical path) no function exists and ``curve`` is ``None``.
@@ -68,6 +70,9 @@ PARAMETERIZATIONS: tuple[str, ...] = ("uniform", "chord", "centripetal")
 
 #: Tukey bisquare tuning constant (95% efficiency for Gaussian residuals).
 BISQUARE_C = 4.685
+#: ``MAD / 0.6745`` estimates the standard deviation of Gaussian residuals (MATLAB's value
+#: of the normal quartile ``Phi^-1(3/4) = 0.67449``).
+_MAD_NORMAL = 0.6745
 #: Default polynomial orders of the sweep (Table 1: 3 methods x 10 orders).
 SWEEP_ORDERS: tuple[int, ...] = tuple(range(1, 11))
 #: Default B-spline degrees and control-point counts of the sweep (Table 2: 3 x 4 x 42).
@@ -228,7 +233,8 @@ class PolynomialFit:
     residuals : ndarray, shape (n, 2)
         ``curve(params) - points`` (m); for ``y = f(x)`` only the y column is non-zero.
     weights : ndarray, shape (n,)
-        Final weights (user weights times robust weights).
+        Final weights (user weights times the bisquare weights of the last iteration;
+        0 for the points the bisquare fit rejects as outliers).
     mse : float
         ``mean_i |residual_i|^2`` (m^2): equation (3) at the fitted parameters with unit
         weights; ``inf`` when ``curve`` is ``None``.
@@ -403,30 +409,58 @@ def _lar(v: np.ndarray, y: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 def _bisquare(
-    v: np.ndarray, y: np.ndarray, w: np.ndarray, tol: float, max_iter: int
+    v: np.ndarray,
+    y: np.ndarray,
+    w: np.ndarray,
+    tol: float,
+    max_iter: int,
+    *,
+    leverage: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, int, bool]:
-    """Robust IRLS with Tukey bisquare weights (MAD scale, leverage-adjusted residuals)."""
+    """Robust IRLS with Tukey bisquare weights, as MATLAB's ``robustfit`` (``'bisquare'``).
+
+    Starting from the (user-weighted) least-squares fit, each iteration computes
+
+    * residuals ``r_i = y_i - V_i c`` (the Euclidean norm of the row when ``y`` has
+      several columns), adjusted for leverage: ``r_adj_i = r_i / sqrt(1 - h_i)``, with
+      ``h_i`` the diagonal of the hat matrix of the weighted design ``sqrt(w) V`` (fixed,
+      clipped to 0.9999);
+    * the scale ``s = max(MAD / 0.6745, s_min)``: ``MAD`` is the median of ``|r_adj_i|``
+      (about **zero**, not about the median) over the points with ``w_i > 0`` after
+      dropping the ``p - 1`` smallest (``p`` = number of coefficients), as ``robustfit``'s
+      ``madsigma``; ``s_min = 1e-6`` times the largest standard deviation of a ``y``
+      column (1 when that is 0) keeps an exact fit from dividing by zero;
+    * Tukey weights ``b_i = (1 - u_i^2)^2`` for ``|u_i| < 1``, else 0, with
+      ``u_i = r_adj_i / (c s)`` and ``c = BISQUARE_C = 4.685``;
+    * the weighted least-squares fit with weights ``w_i b_i``;
+
+    and stops when the fitted values move by at most ``tol`` times their largest
+    magnitude. ``leverage=False`` (private, for tests) uses ``r_adj_i = r_i``.
+    """
+    p = v.shape[1]
     coef = _wls(v, y, w)
-    # leverages of the weighted design (fixed, as in the usual robust-fit recipe)
-    sw = np.sqrt(w)[:, None]
-    q, _ = np.linalg.qr(sw * v)
-    h = np.clip(np.sum(q * q, axis=1), 0.0, 0.9999)
-    adj = 1.0 / np.sqrt(1.0 - h)
-    scale_y = max(float(np.max(np.abs(y))), 1e-12)
+    active = w > 0
+    if leverage:
+        # leverages of the weighted design (fixed, as in the usual robust-fit recipe)
+        q, _ = np.linalg.qr(np.sqrt(w)[:, None] * v)
+        h = np.clip(np.sum(q * q, axis=1), 0.0, 0.9999)
+        adj = 1.0 / np.sqrt(1.0 - h)
+    else:
+        adj = np.ones(len(y))
+    spread = float(np.max(np.std(y[active], axis=0)))
+    s_min = 1e-6 * spread if spread > 0 else 1.0
+    n_drop = min(p, int(np.count_nonzero(active))) - 1
     robust = np.ones(len(y))
     for it in range(1, max_iter + 1):
         fit = v @ coef
         r = y - fit
-        rr = (np.linalg.norm(r, axis=1) if r.shape[1] > 1 else r[:, 0]) * adj
-        active = w > 0
-        centre = np.median(rr[active]) if r.shape[1] == 1 else 0.0
-        s = np.median(np.abs(rr[active] - centre)) / 0.6745
-        if not s > 1e-12 * scale_y:
-            return coef, robust, it - 1, True
-        uu = rr / (BISQUARE_C * s)
+        r_adj = (np.linalg.norm(r, axis=1) if r.shape[1] > 1 else r[:, 0]) * adj
+        mad = float(np.median(np.sort(np.abs(r_adj[active]))[n_drop:]))
+        s = max(mad / _MAD_NORMAL, s_min)
+        uu = r_adj / (BISQUARE_C * s)
         robust = np.where(np.abs(uu) < 1.0, (1.0 - uu * uu) ** 2, 0.0)
         ww = w * robust
-        if np.count_nonzero(ww > 0) < v.shape[1]:
+        if np.count_nonzero(ww > 0) < p:
             logger.warning("bisquare: fewer positive weights than coefficients; stopping")
             return coef, robust, it, False
         new = _wls(v, y, ww)
@@ -467,7 +501,15 @@ def fit_polynomial(
         Polynomial order ``m`` (1..30); needs ``n >= m + 1``.
     method : {'least_squares', 'lar', 'bisquare'}
         Least squares; least absolute residual (exact, linear programme); bisquare
-        (robust IRLS, Tukey weights, ``c = 4.685``, MAD scale).
+        (robust iteratively reweighted least squares, the recipe of MATLAB's
+        ``robustfit``): starting from least squares, every iteration takes the residuals
+        ``r_i``, adjusts them for leverage, ``r_adj_i = r_i / sqrt(1 - h_i)`` (``h_i``:
+        diagonal of the hat matrix of the weighted design, at most 0.9999), estimates the
+        scale ``s = MAD / 0.6745`` where ``MAD`` is the median of ``|r_adj_i|`` about
+        **zero** over the points with positive weight after dropping the ``p - 1``
+        smallest (``p = order + 1``; never below ``1e-6 * std(y)``), and refits with
+        weights ``w_i (1 - u_i^2)^2`` for ``|u_i| < 1`` (else 0), ``u_i = r_adj_i / (4.685
+        s)``. Without outliers it is close to least squares (95 % Gaussian efficiency).
     weights : array_like, shape (n,), optional
         Non-negative per-point weights on the residuals (``w_i`` on ``r_i^2`` for least
         squares and bisquare, on ``|r_i|`` for LAR).
@@ -475,7 +517,9 @@ def fit_polynomial(
         Bisquare stops when the fitted values change by less than ``tol`` times their
         magnitude (default 1e-4, the chapter's tolerance).
     max_iter : int
-        Bisquare iteration cap.
+        Bisquare iteration cap; a fit that has not met ``tol`` by then (a redescending
+        weight function can cycle between two weight patterns) is returned with
+        ``converged=False`` and ``valid=False``.
 
     Returns
     -------

@@ -67,6 +67,155 @@ def test_robust_methods_ignore_gross_outliers(method: str) -> None:
         assert np.all(fit.weights[[5, 17, 30]] == 0.0)
 
 
+# bisquare against statsmodels' RLM (TukeyBiweight, c = 4.685): RLM has no leverage
+# adjustment and scales by MAD about zero / Phi^-1(3/4); given a scale callable with our
+# documented rule (MAD about zero of the residuals after dropping the p - 1 smallest, over
+# 0.6745) it computes the same estimator as ``_bisquare(..., leverage=False)``.
+def _rlm_tukey():
+    sm = pytest.importorskip("statsmodels.api", reason="statsmodels is not installed")
+    return sm.RLM, sm.robust.norms.TukeyBiweight(c=4.685)
+
+
+def _our_scale_rule(p: int):
+    def scale(model, resid):  # the two-argument form: used by RLM without a dof correction
+        return np.median(np.sort(np.abs(resid))[p - 1 :]) / 0.6745
+
+    return scale
+
+
+def _chebyshev_design(x: np.ndarray, order: int) -> np.ndarray:
+    lo, hi = x.min(), x.max()
+    return np.polynomial.chebyshev.chebvander((2.0 * x - (lo + hi)) / (hi - lo), order)
+
+
+def _noisy_quadratic(seed: int, outlier_share: float, n: int = 200, sigma: float = 0.01):
+    """``y = 0.3 x^2 - 2 x + 1`` on [0, 10] plus N(0, sigma^2) noise; a share of the points
+    moved by 1-25 m up or down (gross outliers)."""
+    rng = np.random.default_rng(seed)
+    x = np.sort(rng.uniform(0.0, 10.0, n))
+    truth = 0.3 * x**2 - 2.0 * x + 1.0
+    y = truth + sigma * rng.standard_normal(n)
+    n_bad = int(round(outlier_share * n))
+    bad = rng.choice(n, n_bad, replace=False)
+    y[bad] += rng.uniform(1.0, 25.0, n_bad) * rng.choice([-1.0, 1.0], n_bad)
+    return x, y, truth, bad
+
+
+@pytest.mark.parametrize("share", [0.0, 0.10, 0.15, 0.20])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_bisquare_without_leverage_is_statsmodels_rlm(seed: int, share: float) -> None:
+    rlm, tukey = _rlm_tukey()
+    x, y, _, _ = _noisy_quadratic(seed, share)
+    v = _chebyshev_design(x, 2)
+    coef, robust, _, conv = fits._bisquare(
+        v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
+    )
+    ref = rlm(y, v, M=tukey).fit(scale_est=_our_scale_rule(3), conv="coefs", tol=1e-13, maxiter=500)
+    assert conv
+    # the same estimator: equal up to the two iterations' stopping tolerances (sigma = 0.01)
+    np.testing.assert_allclose(v @ coef[:, 0], v @ ref.params, atol=1e-8)
+    np.testing.assert_allclose(robust, ref.weights, atol=1e-6)
+
+
+@pytest.mark.parametrize("share", [0.0, 0.10, 0.15, 0.20])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_bisquare_with_leverage_is_close_to_rlm_and_to_the_true_curve(
+    seed: int, share: float
+) -> None:
+    rlm, tukey = _rlm_tukey()
+    sigma, n, p = 0.01, 200, 3
+    x, y, truth, bad = _noisy_quadratic(seed, share, n=n, sigma=sigma)
+    fit = fits.fit_polynomial(np.c_[x, y], 2, method="bisquare", tol=1e-10, max_iter=500)
+    ref = rlm(y, _chebyshev_design(x, 2), M=tukey).fit(conv="coefs", tol=1e-13, maxiter=500)
+    ours = fit.curve(x)[:, 1]
+    assert fit.converged and fit.valid
+    # the leverage factors 1/sqrt(1 - h_i) are within 3 % of 1 here, so the weights and the
+    # fit move by a small part of the fit's own standard error sigma * sqrt(p / n)
+    assert np.max(np.abs(ours - ref.fittedvalues)) < 0.2 * sigma * math.sqrt(p / n)
+    # both estimate the true curve within the noise (LS is metres off with outliers)
+    assert np.max(np.abs(ours - truth)) < sigma
+    assert np.all(fit.weights[bad] == 0.0)
+
+
+def test_bisquare_regression_every_seventh_point_raised() -> None:
+    """Issue 17 item 4: the MAD was taken about the median but the weights used raw residuals,
+    so every weight was 0 after the first step and the fit stayed least squares (4.05 m off)."""
+    rng = np.random.default_rng(17)
+    x = np.linspace(0.0, 10.0, 200)
+    truth = 0.3 * x**2 - 2.0 * x + 1.0
+    y = truth + 0.01 * rng.standard_normal(200)
+    y[::7] += 25.0
+    fit = fits.fit_polynomial(np.c_[x, y], 2, method="bisquare")
+    assert fit.converged and fit.valid and fit.reason == ""
+    assert np.max(np.abs(fit.curve(x)[:, 1] - truth)) < 0.01
+    assert np.all(fit.weights[::7] == 0.0)
+    ls = fits.fit_polynomial(np.c_[x, y], 2)
+    assert np.max(np.abs(ls.curve(x)[:, 1] - truth)) > 1.0
+
+
+@pytest.fixture(scope="module")
+def paper_paths() -> dict[str, np.ndarray]:
+    """Cell centres (m) of the A* paths from SP to A-D on the paper scene's avoidance area."""
+    from astar.inflation import avoidance_area
+    from astar.search import find_path
+    from trajopt import scenes
+
+    sc = scenes.paper()
+    avoid = avoidance_area(sc.grid, sc.w_cells, border=True)
+    return {
+        name: sc.grid.cell_to_world(find_path(avoid, sc.start_cell, sc.goal_cell(name)).cells)
+        for name in sc.target_names
+    }
+
+
+def test_bisquare_on_paper_paths_without_leverage_is_statsmodels_rlm(paper_paths) -> None:
+    rlm, tukey = _rlm_tukey()
+    cell = 0.03
+    compared = 0
+    for pts in paper_paths.values():
+        x, y = pts[:, 0], pts[:, 1]
+        for order in range(1, 11):
+            v = _chebyshev_design(x, order)
+            coef, _, _, conv = fits._bisquare(
+                v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
+            )
+            if not conv:  # a redescending M-estimate may cycle; RLM is then no reference
+                continue
+            ref = rlm(y, v, M=tukey).fit(
+                scale_est=_our_scale_rule(order + 1), conv="coefs", tol=1e-13, maxiter=500
+            )
+            np.testing.assert_allclose(v @ coef[:, 0], ref.fittedvalues, atol=1e-6 * cell)
+            compared += 1
+    assert compared >= 36  # of 40 (target, order) pairs
+
+
+@pytest.mark.parametrize(
+    ("target", "order"),
+    # every (target, order) of A-C at orders 2, 5, 8, 10 except C at order 2, where the
+    # iteration cycles between two weight patterns (reported as converged=False)
+    [(t, m) for t in "ABC" for m in (2, 5, 8, 10) if (t, m) != ("C", 2)],
+)
+def test_bisquare_on_paper_paths_is_a_fixed_point_of_the_documented_irls(
+    paper_paths, target: str, order: int
+) -> None:
+    """Weights recomputed from the returned fit by the documented rule (leverage-adjusted
+    residuals, MAD about zero after dropping the p - 1 smallest, c = 4.685) and a plain
+    ``lstsq`` reproduce the fit."""
+    pts = paper_paths[target]
+    x, y = pts[:, 0], pts[:, 1]
+    fit = fits.fit_polynomial(pts, order, method="bisquare", tol=1e-12, max_iter=1000)
+    assert fit.converged
+    v = _chebyshev_design(x, order)
+    h = np.diag(v @ np.linalg.pinv(v))  # hat matrix diagonal, computed another way
+    r_adj = (y - fit.curve(x)[:, 1]) / np.sqrt(1.0 - np.minimum(h, 0.9999))
+    s = np.median(np.sort(np.abs(r_adj))[order:]) / 0.6745
+    u = r_adj / (4.685 * s)
+    w = np.where(np.abs(u) < 1, (1 - u**2) ** 2, 0.0)
+    np.testing.assert_allclose(w, fit.weights, atol=1e-6)
+    c, *_ = np.linalg.lstsq(np.sqrt(w)[:, None] * v, np.sqrt(w) * y, rcond=None)
+    np.testing.assert_allclose(v @ c, fit.curve(x)[:, 1], atol=1e-6 * 0.03)
+
+
 def test_bisquare_on_clean_data_equals_least_squares() -> None:
     p = _staircase(45)
     ls = fits.fit_polynomial(p, 4)
