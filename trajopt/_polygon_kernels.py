@@ -1,0 +1,975 @@
+"""Compiled geometry kernels of :mod:`trajopt.polygon_corridor`.
+
+Everything here works in *cell units*: the map's cell ``(ix, iy)`` is the unit square
+``[ix, ix + 1] x [iy, iy + 1]`` and the map is ``[0, nx] x [0, ny]``. Obstacles are
+axis-aligned rectangles ``(x0, y0, x1, y1)`` (unions of occupied cells, see
+:func:`merge_rects`) plus the outside of the map. Rectangles are looked up through a
+bucket grid (:func:`build_buckets`, :func:`gather`).
+
+The *index* passed to the queries is the tuple of arrays
+``(rects, meta, bstart, bids, stamp, buf)``: ``meta`` holds
+``[gx0, gy0, bucket, nbx, nby, nx, ny]`` (ints), ``stamp`` (length ``R + 1``, its last
+entry the current tick) de-duplicates rectangles listed in several buckets and ``buf``
+(length ``R``) receives the gathered ids.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# ---------------------------------------------------------------- obstacles
+
+
+@njit(cache=True)
+def merge_rects(occ, x_off, y_off):  # pragma: no cover - compiled
+    """Occupied cells of ``occ`` (window of the map, ``occ[iy, ix]``) as rectangles.
+
+    Runs of occupied cells along each row are merged with the identical run of the row
+    below when there is one. Returns ``(R, 4)`` float64 ``(x0, y0, x1, y1)``, offset by
+    ``(x_off, y_off)`` cells.
+    """
+    h, w = occ.shape
+    runs = 0  # an upper bound of the rectangle count (growing arrays in the loop is slow)
+    for y in range(h):
+        inside = False
+        for x in range(w):
+            if occ[y, x] and not inside:
+                runs += 1
+            inside = occ[y, x]
+    rx0 = np.empty(runs, np.int64)
+    ry0 = np.empty(runs, np.int64)
+    rx1 = np.empty(runs, np.int64)
+    ry1 = np.empty(runs, np.int64)
+    n = 0
+    prev = np.full(w + 1, -1, np.int64)
+    cur = np.full(w + 1, -1, np.int64)
+    for y in range(h):
+        x = 0
+        while x < w:
+            if not occ[y, x]:
+                x += 1
+                continue
+            x0 = x
+            while x < w and occ[y, x]:
+                x += 1
+            rid = prev[x0]
+            if rid >= 0 and rx1[rid] == x and ry1[rid] == y:
+                ry1[rid] = y + 1
+            else:
+                rx0[n] = x0
+                ry0[n] = y
+                rx1[n] = x
+                ry1[n] = y + 1
+                rid = n
+                n += 1
+            cur[x0] = rid
+        tmp = prev
+        prev = cur
+        cur = tmp
+        cur[:] = -1
+    out = np.empty((n, 4), np.float64)
+    for i in range(n):
+        out[i, 0] = rx0[i] + x_off
+        out[i, 1] = ry0[i] + y_off
+        out[i, 2] = rx1[i] + x_off
+        out[i, 3] = ry1[i] + y_off
+    return out
+
+
+@njit(cache=True)
+def build_buckets(rects, gx0, gy0, bsize, nbx, nby):  # pragma: no cover - compiled
+    """CSR lists ``(bstart, bids)`` of the rectangles meeting each ``bsize`` bucket."""
+    nb = nbx * nby
+    counts = np.zeros(nb + 1, np.int64)
+    nr = rects.shape[0]
+    for i in range(nr):
+        bx0 = max(0, int(math.floor((rects[i, 0] - gx0) / bsize)))
+        bx1 = min(nbx - 1, int(math.floor((rects[i, 2] - gx0) / bsize)))
+        by0 = max(0, int(math.floor((rects[i, 1] - gy0) / bsize)))
+        by1 = min(nby - 1, int(math.floor((rects[i, 3] - gy0) / bsize)))
+        for by in range(by0, by1 + 1):
+            for bx in range(bx0, bx1 + 1):
+                counts[by * nbx + bx + 1] += 1
+    for b in range(nb):
+        counts[b + 1] += counts[b]
+    bids = np.empty(counts[nb], np.int64)
+    fill = counts[:nb].copy()
+    for i in range(nr):
+        bx0 = max(0, int(math.floor((rects[i, 0] - gx0) / bsize)))
+        bx1 = min(nbx - 1, int(math.floor((rects[i, 2] - gx0) / bsize)))
+        by0 = max(0, int(math.floor((rects[i, 1] - gy0) / bsize)))
+        by1 = min(nby - 1, int(math.floor((rects[i, 3] - gy0) / bsize)))
+        for by in range(by0, by1 + 1):
+            for bx in range(bx0, bx1 + 1):
+                b = by * nbx + bx
+                bids[fill[b]] = i
+                fill[b] += 1
+    return counts, bids
+
+
+@njit(cache=True)
+def gather(qx0, qx1, qy0, qy1, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Ids of the rectangles meeting the closed box ``[qx0, qx1] x [qy0, qy1]`` into
+    ``buf``; returns their count."""
+    gx0 = meta[0]
+    gy0 = meta[1]
+    bs = meta[2]
+    nbx = meta[3]
+    nby = meta[4]
+    bx0 = max(0, int(math.floor((qx0 - gx0) / bs)))
+    bx1 = min(nbx - 1, int(math.floor((qx1 - gx0) / bs)))
+    by0 = max(0, int(math.floor((qy0 - gy0) / bs)))
+    by1 = min(nby - 1, int(math.floor((qy1 - gy0) / bs)))
+    if bx0 > bx1 or by0 > by1:
+        return 0
+    nt = stamp.shape[0] - 1
+    stamp[nt] += 1
+    tick = stamp[nt]
+    n = 0
+    for by in range(by0, by1 + 1):
+        for bx in range(bx0, bx1 + 1):
+            b = by * nbx + bx
+            for k in range(bstart[b], bstart[b + 1]):
+                i = bids[k]
+                if stamp[i] == tick:
+                    continue
+                stamp[i] = tick
+                if (
+                    rects[i, 0] <= qx1
+                    and rects[i, 2] >= qx0
+                    and rects[i, 1] <= qy1
+                    and rects[i, 3] >= qy0
+                ):
+                    buf[n] = i
+                    n += 1
+    return n
+
+
+# ---------------------------------------------------------------- distances
+
+
+@njit(cache=True, inline="always")
+def pt_rect(px, py, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Distance from a point to a closed axis-aligned rectangle (0 inside)."""
+    gx = max(x0 - px, 0.0, px - x1)
+    gy = max(y0 - py, 0.0, py - y1)
+    return math.sqrt(gx * gx + gy * gy)
+
+
+@njit(cache=True, inline="always")
+def pt_seg(px, py, ax, ay, bx, by):  # pragma: no cover - compiled
+    """Distance from a point to a segment, and the parameter of the closest point."""
+    dx = bx - ax
+    dy = by - ay
+    ll = dx * dx + dy * dy
+    t = 0.0
+    if ll > 0.0:
+        t = ((px - ax) * dx + (py - ay) * dy) / ll
+        t = min(1.0, max(0.0, t))
+    cx = ax + t * dx - px
+    cy = ay + t * dy - py
+    return math.sqrt(cx * cx + cy * cy), t
+
+
+@njit(cache=True)
+def seg_meets_rect(ax, ay, bx, by, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Whether a closed segment meets a closed rectangle (Liang-Barsky)."""
+    dx = bx - ax
+    dy = by - ay
+    t0 = 0.0
+    t1 = 1.0
+    for k in range(4):
+        if k == 0:
+            p, q = -dx, ax - x0
+        elif k == 1:
+            p, q = dx, x1 - ax
+        elif k == 2:
+            p, q = -dy, ay - y0
+        else:
+            p, q = dy, y1 - ay
+        if p == 0.0:
+            if q < 0.0:
+                return False
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = max(t0, t)
+            else:
+                t1 = min(t1, t)
+    return t0 <= t1
+
+
+@njit(cache=True)
+def seg_rect(ax, ay, bx, by, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Exact distance between a segment and a rectangle (0 when they meet)."""
+    if seg_meets_rect(ax, ay, bx, by, x0, y0, x1, y1):
+        return 0.0
+    d = min(pt_rect(ax, ay, x0, y0, x1, y1), pt_rect(bx, by, x0, y0, x1, y1))
+    for c in range(4):
+        cx = x0 if (c == 0 or c == 3) else x1
+        cy = y0 if c < 2 else y1
+        e, _ = pt_seg(cx, cy, ax, ay, bx, by)
+        d = min(d, e)
+    return d
+
+
+@njit(cache=True)
+def poly_rect_closest(v, nv, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Exact distance between a convex polygon (``v[:nv]``, any orientation; 1 or 2
+    vertices for a point or a segment) and a rectangle, with a closest pair.
+
+    Returns ``(d, px, py, qx, qy)``: ``p`` on the polygon, ``q`` on the rectangle; ``d = 0``
+    (and ``p = q = nan``) when they meet, decided by the separating-axis theorem over the
+    polygon's edge normals and the two coordinate axes.
+    """
+    nan = np.nan
+    vxmin = v[0, 0]
+    vxmax = v[0, 0]
+    vymin = v[0, 1]
+    vymax = v[0, 1]
+    for i in range(1, nv):
+        vxmin = min(vxmin, v[i, 0])
+        vxmax = max(vxmax, v[i, 0])
+        vymin = min(vymin, v[i, 1])
+        vymax = max(vymax, v[i, 1])
+    sep = vxmax < x0 or vxmin > x1 or vymax < y0 or vymin > y1
+    if not sep and nv >= 2:
+        for i in range(nv):
+            j = (i + 1) % nv
+            ex = v[j, 0] - v[i, 0]
+            ey = v[j, 1] - v[i, 1]
+            if ex == 0.0 and ey == 0.0:
+                continue
+            nx_ = ey
+            ny_ = -ex
+            pmax = -np.inf
+            pmin = np.inf
+            for k in range(nv):
+                s = nx_ * v[k, 0] + ny_ * v[k, 1]
+                pmax = max(pmax, s)
+                pmin = min(pmin, s)
+            rmin = np.inf
+            rmax = -np.inf
+            for c in range(4):
+                cx = x0 if (c == 0 or c == 3) else x1
+                cy = y0 if c < 2 else y1
+                s = nx_ * cx + ny_ * cy
+                rmin = min(rmin, s)
+                rmax = max(rmax, s)
+            if rmin > pmax or rmax < pmin:
+                sep = True
+                break
+    if not sep:
+        return 0.0, nan, nan, nan, nan
+    best = np.inf
+    bpx = bpy = bqx = bqy = nan
+    for i in range(nv):
+        px = v[i, 0]
+        py = v[i, 1]
+        qx = min(max(px, x0), x1)
+        qy = min(max(py, y0), y1)
+        d = math.sqrt((px - qx) ** 2 + (py - qy) ** 2)
+        if d < best:
+            best = d
+            bpx, bpy, bqx, bqy = px, py, qx, qy
+    if nv >= 2:
+        for c in range(4):
+            cx = x0 if (c == 0 or c == 3) else x1
+            cy = y0 if c < 2 else y1
+            for i in range(nv):
+                j = (i + 1) % nv
+                d, t = pt_seg(cx, cy, v[i, 0], v[i, 1], v[j, 0], v[j, 1])
+                if d < best:
+                    best = d
+                    bpx = v[i, 0] + t * (v[j, 0] - v[i, 0])
+                    bpy = v[i, 1] + t * (v[j, 1] - v[i, 1])
+                    bqx, bqy = cx, cy
+    return best, bpx, bpy, bqx, bqy
+
+
+@njit(cache=True, inline="always")
+def _border(px, py, nx, ny):  # pragma: no cover - compiled
+    return max(0.0, min(px, nx - px, py, ny - py))
+
+
+@njit(cache=True)
+def point_nearest(px, py, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Distance (capped at ``cap``) from a point to the nearest obstacle (rectangle or
+    the outside of the map) and the nearest obstacle point (``nan`` when none is within
+    ``cap``)."""
+    nx = meta[5]
+    ny = meta[6]
+    best = cap
+    qx = np.nan
+    qy = np.nan
+    for k in range(4):
+        if k == 0:
+            d, cx, cy = px, 0.0, py
+        elif k == 1:
+            d, cx, cy = nx - px, float(nx), py
+        elif k == 2:
+            d, cx, cy = py, px, 0.0
+        else:
+            d, cx, cy = ny - py, px, float(ny)
+        d = max(d, 0.0)
+        if d < best:
+            best, qx, qy = d, cx, cy
+    n = gather(px - cap, px + cap, py - cap, py + cap, rects, meta, bstart, bids, stamp, buf)
+    for k in range(n):
+        i = buf[k]
+        cx = min(max(px, rects[i, 0]), rects[i, 2])
+        cy = min(max(py, rects[i, 1]), rects[i, 3])
+        d = math.sqrt((px - cx) ** 2 + (py - cy) ** 2)
+        if d < best:
+            best, qx, qy = d, cx, cy
+    return best, qx, qy
+
+
+@njit(cache=True)
+def seg_clearance(ax, ay, bx, by, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Exact distance (capped at ``cap``) from a segment to every obstacle."""
+    nx = meta[5]
+    ny = meta[6]
+    best = min(cap, _border(ax, ay, nx, ny), _border(bx, by, nx, ny))
+    n = gather(
+        min(ax, bx) - best, max(ax, bx) + best, min(ay, by) - best, max(ay, by) + best,
+        rects, meta, bstart, bids, stamp, buf,
+    )
+    for k in range(n):
+        i = buf[k]
+        d = seg_rect(ax, ay, bx, by, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
+        if d < best:
+            best = d
+    return best
+
+
+@njit(cache=True)
+def poly_clearance(v, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Exact distance (capped at ``cap``) from a convex polygon ``v[:nv]`` to every
+    obstacle: the outside of the map (nearest vertex) and every rectangle."""
+    nx = meta[5]
+    ny = meta[6]
+    best = cap
+    xmin = ymin = np.inf
+    xmax = ymax = -np.inf
+    for i in range(nv):
+        best = min(best, _border(v[i, 0], v[i, 1], nx, ny))
+        xmin = min(xmin, v[i, 0])
+        xmax = max(xmax, v[i, 0])
+        ymin = min(ymin, v[i, 1])
+        ymax = max(ymax, v[i, 1])
+    n = gather(xmin - best, xmax + best, ymin - best, ymax + best,
+               rects, meta, bstart, bids, stamp, buf)
+    for k in range(n):
+        i = buf[k]
+        d, _, _, _, _ = poly_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
+        if d < best:
+            best = d
+    return best
+
+
+@njit(cache=True)
+def hull4(pts, n, out):  # pragma: no cover - compiled
+    """Convex hull (counter-clockwise, no collinear points) of ``pts[:n]`` (n <= 8) into
+    ``out``; returns its vertex count (1 for a point, 2 for a segment)."""
+    p = np.empty((n, 2))
+    for i in range(n):
+        p[i, 0] = pts[i, 0]
+        p[i, 1] = pts[i, 1]
+    for i in range(1, n):  # lexicographic insertion sort (n is tiny)
+        x = p[i, 0]
+        y = p[i, 1]
+        j = i - 1
+        while j >= 0 and (p[j, 0] > x or (p[j, 0] == x and p[j, 1] > y)):
+            p[j + 1, 0] = p[j, 0]
+            p[j + 1, 1] = p[j, 1]
+            j -= 1
+        p[j + 1, 0] = x
+        p[j + 1, 1] = y
+    h = np.empty((2 * n + 1, 2))
+    k = 0
+    for i in range(n):
+        while k >= 2 and (
+            (h[k - 1, 0] - h[k - 2, 0]) * (p[i, 1] - h[k - 2, 1])
+            - (h[k - 1, 1] - h[k - 2, 1]) * (p[i, 0] - h[k - 2, 0])
+        ) <= 1e-12:
+            k -= 1
+        h[k] = p[i]
+        k += 1
+    lo = k + 1
+    for i in range(n - 2, -1, -1):
+        while k >= lo and (
+            (h[k - 1, 0] - h[k - 2, 0]) * (p[i, 1] - h[k - 2, 1])
+            - (h[k - 1, 1] - h[k - 2, 1]) * (p[i, 0] - h[k - 2, 0])
+        ) <= 1e-12:
+            k -= 1
+        h[k] = p[i]
+        k += 1
+    k -= 1  # the last point repeats the first
+    # drop duplicates (a point or a segment)
+    m = 0
+    for i in range(max(k, 1)):
+        if m > 0 and abs(h[i, 0] - out[m - 1, 0]) <= 1e-12 and abs(h[i, 1] - out[m - 1, 1]) <= 1e-12:
+            continue
+        out[m] = h[i]
+        m += 1
+    if m > 1 and abs(out[m - 1, 0] - out[0, 0]) <= 1e-12 and abs(out[m - 1, 1] - out[0, 1]) <= 1e-12:
+        m -= 1
+    return m
+
+
+# ---------------------------------------------------------------- path preparation
+
+
+@njit(cache=True)
+def path_clearances(p, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Clearance (capped) of every path point and every segment ``p[i] -> p[i + 1]``."""
+    n = p.shape[0]
+    pc = np.empty(n)
+    sc = np.empty(max(n - 1, 0))
+    for i in range(n):
+        pc[i], _, _ = point_nearest(p[i, 0], p[i, 1], cap, rects, meta, bstart, bids, stamp, buf)
+    for i in range(n - 1):
+        sc[i] = seg_clearance(p[i, 0], p[i, 1], p[i + 1, 0], p[i + 1, 1], cap,
+                              rects, meta, bstart, bids, stamp, buf)
+    return pc, sc
+
+
+@njit(cache=True)
+def centre_path(p, r, push, trigger, passes, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Push interior path points away from their nearest obstacle (at most ``push``).
+
+    A point whose clearance is below ``r + trigger`` moves along the direction away from
+    its nearest obstacle point by the step in ``(push, push/2, push/4)`` that raises its
+    clearance most, provided both segments to its neighbours keep at least
+    ``min(r, their clearance before)``. The end points never move.
+    """
+    q = p.copy()
+    n = q.shape[0]
+    cap = r + trigger + push + 1.0
+    for _ in range(passes):
+        for i in range(1, n - 1):
+            d0, ox, oy = point_nearest(q[i, 0], q[i, 1], r + trigger,
+                                       rects, meta, bstart, bids, stamp, buf)
+            if d0 >= r + trigger or d0 <= 0.0:
+                continue
+            gx = (q[i, 0] - ox) / d0
+            gy = (q[i, 1] - oy) / d0
+            s_prev = seg_clearance(q[i - 1, 0], q[i - 1, 1], q[i, 0], q[i, 1], r + 1.0,
+                                   rects, meta, bstart, bids, stamp, buf)
+            s_next = seg_clearance(q[i, 0], q[i, 1], q[i + 1, 0], q[i + 1, 1], r + 1.0,
+                                   rects, meta, bstart, bids, stamp, buf)
+            need_prev = min(r, s_prev)
+            need_next = min(r, s_next)
+            best = d0 + 1e-6
+            bx = q[i, 0]
+            by = q[i, 1]
+            moved = False
+            step = push
+            for _k in range(3):
+                cx = q[i, 0] + step * gx
+                cy = q[i, 1] + step * gy
+                step *= 0.5
+                dc, _, _ = point_nearest(cx, cy, cap, rects, meta, bstart, bids, stamp, buf)
+                if dc <= best:
+                    continue
+                if seg_clearance(q[i - 1, 0], q[i - 1, 1], cx, cy, need_prev + 1e-3,
+                                 rects, meta, bstart, bids, stamp, buf) < need_prev:
+                    continue
+                if seg_clearance(cx, cy, q[i + 1, 0], q[i + 1, 1], need_next + 1e-3,
+                                 rects, meta, bstart, bids, stamp, buf) < need_next:
+                    continue
+                best = dc
+                bx = cx
+                by = cy
+                moved = True
+            if moved:
+                q[i, 0] = bx
+                q[i, 1] = by
+    return q
+
+
+@njit(cache=True)
+def simplify_path(p, pc, sc, r, slack, open_c, max_len, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Greedy simplification: indices of the kept points (first and last included).
+
+    From each kept point the segment is extended to the farthest later point such that the
+    direct segment keeps a clearance of at least
+    ``max(min(floor, r + open_c) - slack, min(floor, r))``, where ``floor`` is the smallest
+    clearance of the points and segments it replaces, and is at most ``max_len`` long.
+    """
+    n = p.shape[0]
+    keep = np.empty(n, np.int64)
+    m = 0
+    keep[m] = 0
+    m += 1
+    i = 0
+    while i < n - 1:
+        j = i + 1
+        floor = min(pc[i], pc[j], sc[i])
+        while j + 1 < n:
+            dx = p[j + 1, 0] - p[i, 0]
+            dy = p[j + 1, 1] - p[i, 1]
+            if dx * dx + dy * dy > max_len * max_len:
+                break
+            f2 = min(floor, pc[j + 1], sc[j])
+            thr = max(min(f2, r + open_c) - slack, min(f2, r))
+            c = seg_clearance(p[i, 0], p[i, 1], p[j + 1, 0], p[j + 1, 1], thr + 1e-3,
+                              rects, meta, bstart, bids, stamp, buf)
+            if c < thr:
+                break
+            j += 1
+            floor = f2
+        keep[m] = j
+        m += 1
+        i = j
+    return keep[:m].copy()
+
+
+@njit(cache=True)
+def _seed(p, e, k, out):  # pragma: no cover - compiled
+    """Seed points of region ``k``: its segment plus ``e[k]`` of the previous segment and
+    ``e[k + 1]`` of the next one; returns the hull's vertex count (into ``out``)."""
+    pts = np.empty((4, 2))
+    n = 0
+    ax, ay = p[k, 0], p[k, 1]
+    bx, by = p[k + 1, 0], p[k + 1, 1]
+    if e[k] > 0.0:
+        dx = p[k - 1, 0] - ax
+        dy = p[k - 1, 1] - ay
+        ll = math.sqrt(dx * dx + dy * dy)
+        pts[n, 0] = ax + e[k] * dx / ll
+        pts[n, 1] = ay + e[k] * dy / ll
+        n += 1
+    pts[n, 0] = ax
+    pts[n, 1] = ay
+    n += 1
+    pts[n, 0] = bx
+    pts[n, 1] = by
+    n += 1
+    if e[k + 1] > 0.0:
+        dx = p[k + 2, 0] - bx
+        dy = p[k + 2, 1] - by
+        ll = math.sqrt(dx * dx + dy * dy)
+        pts[n, 0] = bx + e[k + 1] * dx / ll
+        pts[n, 1] = by + e[k + 1] * dy / ll
+        n += 1
+    return hull4(pts, n, out)
+
+
+@njit(cache=True)
+def junction_extensions(p, ext, r, tol, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """How far (cells) each region's seed reaches into its neighbours' segments.
+
+    ``e[j]`` (``j`` = interior vertex) starts at ``min(ext, 0.45 * both segment lengths)``
+    and is halved (then zeroed) while a seed hull that uses it comes closer than
+    ``min(r, segment clearance) - tol`` to an obstacle.
+    """
+    m = p.shape[0] - 1
+    e = np.zeros(m + 1)
+    seglen = np.empty(m)
+    for k in range(m):
+        seglen[k] = math.sqrt((p[k + 1, 0] - p[k, 0]) ** 2 + (p[k + 1, 1] - p[k, 1]) ** 2)
+    for j in range(1, m):
+        e[j] = min(ext, 0.45 * seglen[j - 1], 0.45 * seglen[j])
+    hull = np.empty((8, 2))
+    for k in range(m):
+        need = min(r, seg_clearance(p[k, 0], p[k, 1], p[k + 1, 0], p[k + 1, 1], r + 1.0,
+                                    rects, meta, bstart, bids, stamp, buf)) - tol
+        for attempt in range(6):
+            if e[k] == 0.0 and e[k + 1] == 0.0:
+                break
+            nh = _seed(p, e, k, hull)
+            if poly_clearance(hull, nh, r + 1.0, rects, meta, bstart, bids, stamp, buf) >= need:
+                break
+            if attempt == 4:
+                e[k] = 0.0
+                e[k + 1] = 0.0
+            else:
+                e[k] *= 0.5
+                e[k + 1] *= 0.5
+    return e
+
+
+# ---------------------------------------------------------------- polygons
+
+
+@njit(cache=True)
+def _clip(v, lab, nv, a0, a1, b, label, ov, olab):  # pragma: no cover - compiled
+    """Clip the labelled convex polygon ``v[:nv]`` (``lab[i]`` = row of edge i -> i + 1)
+    by ``a . p <= b``; the new edge gets ``label``. Returns the new vertex count."""
+    m = 0
+    for i in range(nv):
+        j = (i + 1) % nv
+        si = a0 * v[i, 0] + a1 * v[i, 1] - b
+        sj = a0 * v[j, 0] + a1 * v[j, 1] - b
+        if si <= 0.0:
+            ov[m, 0] = v[i, 0]
+            ov[m, 1] = v[i, 1]
+            olab[m] = lab[i]
+            m += 1
+            if sj > 0.0:
+                t = si / (si - sj)
+                ov[m, 0] = v[i, 0] + t * (v[j, 0] - v[i, 0])
+                ov[m, 1] = v[i, 1] + t * (v[j, 1] - v[i, 1])
+                olab[m] = label
+                m += 1
+        elif sj <= 0.0:
+            t = si / (si - sj)
+            ov[m, 0] = v[i, 0] + t * (v[j, 0] - v[i, 0])
+            ov[m, 1] = v[i, 1] + t * (v[j, 1] - v[i, 1])
+            olab[m] = lab[i]
+            m += 1
+    return m
+
+
+@njit(cache=True)
+def _tidy(v, lab, nv):  # pragma: no cover - compiled
+    """Drop repeated vertices and straight-angle vertices in place; returns the count."""
+    changed = True
+    while changed and nv >= 2:
+        changed = False
+        for i in range(nv):
+            j = (i + 1) % nv
+            if abs(v[i, 0] - v[j, 0]) <= 1e-12 and abs(v[i, 1] - v[j, 1]) <= 1e-12:
+                # zero-length edge i: remove vertex i (vertex j keeps its own edge)
+                for k in range(i, nv - 1):
+                    v[k] = v[k + 1]
+                    lab[k] = lab[k + 1]
+                nv -= 1
+                changed = True
+                break
+        if changed or nv < 3:
+            continue
+        for i in range(nv):
+            h = (i - 1) % nv
+            j = (i + 1) % nv
+            cr = (v[i, 0] - v[h, 0]) * (v[j, 1] - v[i, 1]) - (v[i, 1] - v[h, 1]) * (v[j, 0] - v[i, 0])
+            if abs(cr) <= 1e-14:
+                # straight angle at i: the merged edge h -> j keeps edge h's row
+                for k in range(i, nv - 1):
+                    v[k] = v[k + 1]
+                    lab[k] = lab[k + 1]
+                nv -= 1
+                changed = True
+                break
+    return nv
+
+
+@njit(cache=True)
+def _area(v, nv):  # pragma: no cover - compiled
+    s = 0.0
+    for i in range(nv):
+        j = (i + 1) % nv
+        s += v[i, 0] * v[j, 1] - v[j, 0] * v[i, 1]
+    return 0.5 * s
+
+
+@njit(cache=True)
+def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
+                rects, meta, bstart, bids, stamp, buf, out_h, out_v):  # pragma: no cover
+    """Grow one convex region around a seed hull (segment-ellipse method).
+
+    Obstacle rectangles near the window (the seed's bounding box plus ``margin``, inside
+    the map shrunk by ``r``) are taken in order of their distance to the seed segment's
+    midpoint in the metric of an ellipse around the segment; each one not yet excluded adds
+    the half-plane tangent to its ``r``-dilation, with the normal of the ellipse's level
+    set at the rectangle's nearest point, or, when that cuts the seed, the direction of the
+    closest pair between the seed hull and the rectangle. Every rectangle the new
+    half-plane keeps ``r`` away is dropped. The window's rows close the region.
+
+    Returns ``(nv, status)``: ``status`` 0 = a polygon of ``nv`` vertices
+    (``out_v``, counter-clockwise, ``out_h[i] = (a_x, a_y, b)`` the row of edge
+    ``i -> i + 1``), 1 = degenerate (no interior), 2 = the seed meets an obstacle's
+    dilation (no half-plane can separate them), 3 = the region lost a seed point.
+    """
+    nx = meta[5]
+    ny = meta[6]
+    sx0 = sy0 = np.inf
+    sx1 = sy1 = -np.inf
+    for i in range(ns):
+        sx0 = min(sx0, seed[i, 0])
+        sx1 = max(sx1, seed[i, 0])
+        sy0 = min(sy0, seed[i, 1])
+        sy1 = max(sy1, seed[i, 1])
+    wx0 = min(max(sx0 - margin, r), sx0)
+    wx1 = max(min(sx1 + margin, nx - r), sx1)
+    wy0 = min(max(sy0 - margin, r), sy0)
+    wy1 = max(min(sy1 + margin, ny - r), sy1)
+    n = gather(wx0 - r, wx1 + r, wy0 - r, wy1 + r, rects, meta, bstart, bids, stamp, buf)
+    cand = np.empty(n, np.int64)
+    m = 0
+    for k in range(n):
+        i = buf[k]
+        gx = max(rects[i, 0] - wx1, 0.0, wx0 - rects[i, 2])
+        gy = max(rects[i, 1] - wy1, 0.0, wy0 - rects[i, 3])
+        if gx * gx + gy * gy < r * r:
+            cand[m] = i
+            m += 1
+    # the ellipse around the seed segment
+    cx = 0.5 * (p0x + p1x)
+    cy = 0.5 * (p0y + p1y)
+    ll = math.sqrt((p1x - p0x) ** 2 + (p1y - p0y) ** 2)
+    if ll > 0.0:
+        ux = (p1x - p0x) / ll
+        uy = (p1y - p0y) / ll
+    else:
+        ux = 1.0
+        uy = 0.0
+    vx = -uy
+    vy = ux
+    cseed = np.inf
+    for k in range(m):
+        i = cand[k]
+        cseed = min(cseed, seg_rect(p0x, p0y, p1x, p1y, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3]))
+    a1 = 0.5 * ll + ext + 0.5
+    a2 = min(a1, max(0.5, cseed))
+    md = np.empty(m)
+    qq = np.empty((m, 2))
+    quad = np.empty((4, 2))
+    for k in range(m):
+        i = cand[k]
+        for c in range(4):
+            xx = rects[i, 0] if (c == 0 or c == 3) else rects[i, 2]
+            yy = rects[i, 1] if c < 2 else rects[i, 3]
+            quad[c, 0] = ((xx - cx) * ux + (yy - cy) * uy) / a1
+            quad[c, 1] = ((xx - cx) * vx + (yy - cy) * vy) / a2
+        # origin inside the (convex, consistently oriented) quadrilateral?
+        pos = 0
+        neg = 0
+        for c in range(4):
+            d = (c + 1) % 4
+            cr = quad[c, 0] * quad[d, 1] - quad[c, 1] * quad[d, 0]
+            if cr > 0:
+                pos += 1
+            elif cr < 0:
+                neg += 1
+        if pos == 0 or neg == 0:
+            md[k] = 0.0
+            qq[k, 0] = 0.0
+            qq[k, 1] = 0.0
+            continue
+        best = np.inf
+        for c in range(4):
+            d = (c + 1) % 4
+            e, t = pt_seg(0.0, 0.0, quad[c, 0], quad[c, 1], quad[d, 0], quad[d, 1])
+            if e < best:
+                best = e
+                qq[k, 0] = quad[c, 0] + t * (quad[d, 0] - quad[c, 0])
+                qq[k, 1] = quad[c, 1] + t * (quad[d, 1] - quad[c, 1])
+        md[k] = best
+    order = np.argsort(md)
+    active = np.ones(m, np.bool_)
+    h = np.empty((4 + m, 3))
+    h[0, 0], h[0, 1], h[0, 2] = 0.0, -1.0, -wy0
+    h[1, 0], h[1, 1], h[1, 2] = 1.0, 0.0, wx1
+    h[2, 0], h[2, 1], h[2, 2] = 0.0, 1.0, wy1
+    h[3, 0], h[3, 1], h[3, 2] = -1.0, 0.0, -wx0
+    nh = 4
+    for oi in range(m):
+        k = order[oi]
+        if not active[k]:
+            continue
+        i = cand[k]
+        x0, y0, x1, y1 = rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3]
+        ok = False
+        ax = ay = b = 0.0
+        if md[k] > 0.0:
+            gx = qq[k, 0] / a1 * ux + qq[k, 1] / a2 * vx
+            gy = qq[k, 0] / a1 * uy + qq[k, 1] / a2 * vy
+            gn = math.sqrt(gx * gx + gy * gy)
+            if gn > 0.0:
+                ax = gx / gn
+                ay = gy / gn
+                b = min(ax * x0, ax * x1) + min(ay * y0, ay * y1) - r
+                ok = True
+                for s in range(ns):
+                    if ax * seed[s, 0] + ay * seed[s, 1] > b:
+                        ok = False
+                        break
+        if not ok:
+            d, px, py, qx, qy = poly_rect_closest(seed, ns, x0, y0, x1, y1)
+            if not d > 0.0:
+                return 0, 2
+            ax = (qx - px) / d
+            ay = (qy - py) / d
+            b = min(ax * x0, ax * x1) + min(ay * y0, ay * y1) - r
+        h[nh, 0] = ax
+        h[nh, 1] = ay
+        h[nh, 2] = b
+        nh += 1
+        active[k] = False
+        for oj in range(oi + 1, m):
+            kk = order[oj]
+            if not active[kk]:
+                continue
+            j = cand[kk]
+            lo = min(ax * rects[j, 0], ax * rects[j, 2]) + min(ay * rects[j, 1], ay * rects[j, 3]) - r
+            if lo >= b:
+                active[kk] = False
+    # clip the window box by the obstacle rows
+    cap = nh + 8
+    va = np.empty((cap, 2))
+    la = np.empty(cap, np.int64)
+    vb = np.empty((cap, 2))
+    lb = np.empty(cap, np.int64)
+    va[0, 0], va[0, 1] = wx0, wy0
+    va[1, 0], va[1, 1] = wx1, wy0
+    va[2, 0], va[2, 1] = wx1, wy1
+    va[3, 0], va[3, 1] = wx0, wy1
+    la[0], la[1], la[2], la[3] = 0, 1, 2, 3
+    nv = 4
+    for row in range(4, nh):
+        nv = _clip(va, la, nv, h[row, 0], h[row, 1], h[row, 2], row, vb, lb)
+        va, vb = vb, va
+        la, lb = lb, la
+        if nv == 0:
+            break
+    nv = _tidy(va, la, nv)
+    if nv < 3 or _area(va, nv) <= 1e-9:
+        return 0, 1
+    for i in range(nv):
+        out_v[i, 0] = va[i, 0]
+        out_v[i, 1] = va[i, 1]
+        out_h[i, 0] = h[la[i], 0]
+        out_h[i, 1] = h[la[i], 1]
+        out_h[i, 2] = h[la[i], 2]
+    # the seed must lie in the region (it does by construction, up to rounding)
+    for s in range(ns):
+        for i in range(nv):
+            if out_h[i, 0] * seed[s, 0] + out_h[i, 1] * seed[s, 1] - out_h[i, 2] > 1e-9:
+                return nv, 3
+    return nv, 0
+
+
+@njit(cache=True)
+def grow_all(p, e, r, margin, kmax, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Grow the region of every segment ``p[k] -> p[k + 1]`` of the seed polyline.
+
+    Returns ``(H, V, nv, status)``: rows ``H[k, :nv[k]]`` and vertices ``V[k, :nv[k]]``
+    (``kmax`` slots each; status as :func:`grow_region`, 4 = more than ``kmax`` sides).
+    """
+    m = p.shape[0] - 1
+    hh = np.zeros((m, kmax, 3))
+    vv = np.zeros((m, kmax, 2))
+    nvs = np.zeros(m, np.int64)
+    status = np.zeros(m, np.int64)
+    seed = np.empty((8, 2))
+    oh = np.empty((4 + rects.shape[0] + 8, 3))
+    ov = np.empty((4 + rects.shape[0] + 8, 2))
+    for k in range(m):
+        ns = _seed(p, e, k, seed)
+        ext = max(e[k], e[k + 1])
+        nv, st = grow_region(seed, ns, p[k, 0], p[k, 1], p[k + 1, 0], p[k + 1, 1], ext, r,
+                             margin, rects, meta, bstart, bids, stamp, buf, oh, ov)
+        if st == 0 and nv > kmax:
+            st = 4
+        status[k] = st
+        if st == 0:
+            nvs[k] = nv
+            hh[k, :nv] = oh[:nv]
+            vv[k, :nv] = ov[:nv]
+    return hh, vv, nvs, status
+
+
+@njit(cache=True)
+def clip_convex(v, nv, rows, nrows, tol):  # pragma: no cover - compiled
+    """Vertices of the convex polygon ``v[:nv]`` (or segment, point) clipped by
+    ``rows[i] = (a_x, a_y, b)`` with ``a . p <= b + tol``, and for each vertex the row its
+    outgoing edge lies on (``-1`` = an edge of ``v``). Returns ``(V, labels, count)``."""
+    cap = nv + nrows + 4
+    va = np.empty((cap, 2))
+    la = np.full(cap, -1, np.int64)
+    vb = np.empty((cap, 2))
+    lb = np.empty(cap, np.int64)
+    va[:nv] = v[:nv]
+    n = nv
+    for i in range(nrows):
+        n = _clip(va, la, n, rows[i, 0], rows[i, 1], rows[i, 2] + tol, i, vb, lb)
+        va, vb = vb, va
+        la, lb = lb, la
+        if n == 0:
+            break
+    n = _tidy(va, la, n)
+    return va[:n].copy(), la[:n].copy(), n
+
+
+@njit(cache=True)
+def _seg_inside(rows, nrows, p, i, tol):  # pragma: no cover - compiled
+    """Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows
+    (``t0 > t1`` when empty)."""
+    ax, ay = p[i, 0], p[i, 1]
+    dx = p[i + 1, 0] - ax
+    dy = p[i + 1, 1] - ay
+    t0 = 0.0
+    t1 = 1.0
+    for j in range(nrows):
+        num = rows[j, 2] + tol - rows[j, 0] * ax - rows[j, 1] * ay
+        den = rows[j, 0] * dx + rows[j, 1] * dy
+        if den == 0.0:
+            if num < 0.0:
+                return 1.0, 0.0
+        elif den > 0.0:
+            t1 = min(t1, num / den)
+        else:
+            t0 = max(t0, num / den)
+    return t0, t1
+
+
+@njit(cache=True)
+def polyline_interval(rows, nrows, p, s, s_lo, s_hi, tol):  # pragma: no cover - compiled
+    """The largest arc-length interval ``[lo, hi]`` of the polyline ``p`` (vertex arc
+    lengths ``s``) that contains ``[s_lo, s_hi]`` and stays in ``{a . x <= b + tol}``;
+    ``(nan, nan)`` when ``[s_lo, s_hi]`` itself is not inside."""
+    n = p.shape[0]
+    eps = 1e-12 * max(1.0, s[n - 1])
+    i_lo = 0
+    while i_lo < n - 2 and s[i_lo + 1] <= s_lo:
+        i_lo += 1
+    i_hi = i_lo
+    while i_hi < n - 2 and s[i_hi + 1] < s_hi:
+        i_hi += 1
+    for i in range(i_lo, i_hi + 1):
+        t0, t1 = _seg_inside(rows, nrows, p, i, tol)
+        if t0 > t1:
+            return np.nan, np.nan
+        a = s[i] + t0 * (s[i + 1] - s[i])
+        b = s[i] + t1 * (s[i + 1] - s[i])
+        if a > max(s_lo, s[i]) + eps or b < min(s_hi, s[i + 1]) - eps:
+            return np.nan, np.nan
+    t0, t1 = _seg_inside(rows, nrows, p, i_lo, tol)
+    lo = s[i_lo] + t0 * (s[i_lo + 1] - s[i_lo])
+    i = i_lo - 1
+    while t0 <= 0.0 and i >= 0:
+        t0, t1 = _seg_inside(rows, nrows, p, i, tol)
+        if t1 < 1.0 or t0 > t1:
+            break
+        lo = s[i] + t0 * (s[i + 1] - s[i])
+        i -= 1
+    t0, t1 = _seg_inside(rows, nrows, p, i_hi, tol)
+    hi = s[i_hi] + t1 * (s[i_hi + 1] - s[i_hi])
+    i = i_hi + 1
+    while t1 >= 1.0 and i < n - 1:
+        t0, t1 = _seg_inside(rows, nrows, p, i, tol)
+        if t0 > 0.0 or t0 > t1:
+            break
+        hi = s[i] + t1 * (s[i + 1] - s[i])
+        i += 1
+    return lo, hi
+
+
+@njit(cache=True)
+def poly_rects_min(v, nv, rects):  # pragma: no cover - compiled
+    """Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects``
+    (``inf`` for none)."""
+    best = np.inf
+    for i in range(rects.shape[0]):
+        d, _, _, _, _ = poly_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
+        if d < best:
+            best = d
+            if best == 0.0:
+                break
+    return best
