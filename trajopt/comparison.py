@@ -11,7 +11,11 @@ Built-in methods (the chapter's four, in this order):
 * ``'A*'``: traditional A* on the raw grid (cell centres as a polyline);
 * ``'A* + avoidance area'``: A* on :func:`astar.avoidance_area` (``W = w_cells``);
 * ``'polynomial fit'``: :func:`trajopt.fits.fit_polynomial` ``y = f(x)`` of the latter;
-* ``'B-spline fit'``: :func:`trajopt.fits.fit_bspline` of the latter;
+* ``'B-spline fit'``: :func:`trajopt.fits.fit_bspline` of the latter (a least-squares
+  fit: as in the chapter's Table 2 its end points are not exact, see the
+  ``start_error_x_m`` ... ``end_error_y_m`` columns; parameters the data cannot support,
+  where the Schoenberg-Whitney condition fails or the system is numerically singular, give
+  a row with ``valid=False``, no curve and the reason as ``note``);
 
 and the proposed method, ``'proposed'``: :func:`trajopt.plan` (certified corridor smoother
 and ruckig timing; its own clearance-aware A* path), with the timed metrics as extra
@@ -296,7 +300,7 @@ def _method_polynomial_parametric(ctx: ComparisonContext) -> MethodResult:
 
 
 def _method_bspline(ctx: ComparisonContext) -> MethodResult:
-    from trajopt.fits import fit_bspline
+    from trajopt.fits import _IllPosedFitError, fit_bspline
 
     opts = {**DEFAULT_BSPLINE, **ctx.options_for("B-spline fit")}
     ref = ctx.reference
@@ -309,8 +313,14 @@ def _method_bspline(ctx: ComparisonContext) -> MethodResult:
         note = f"n_ctrl reduced from {n_ctrl} to {opts['n_ctrl']} (path has {n_distinct} points); "
     if n_distinct < 2:
         return MethodResult(None, False, "path has a single point")
-    curve = fit_bspline(ref, **opts)
-    note += f"{curve.parameterization}, degree {curve.k}, {curve.c.shape[0]} control points"
+    try:
+        curve = fit_bspline(ref, **opts)
+    except _IllPosedFitError as exc:  # the data cannot determine this fit: no curve to rank
+        return MethodResult(None, False, note + str(exc))
+    note += (
+        f"{curve.parameterization}, degree {curve.k}, {curve.c.shape[0]} control points; "
+        "end points not exact (start_error_*/end_error_* columns)"
+    )
     return MethodResult(curve, True, note, extras={"fit_mse_m2": curve.mse})
 
 
@@ -552,7 +562,11 @@ def compare(
     bspline : Mapping, optional
         Keyword arguments of :func:`trajopt.fits.fit_bspline` (``degree``, ``n_ctrl``,
         ``parameterization``); missing keys from :data:`DEFAULT_BSPLINE`. ``n_ctrl`` is
-        reduced to the number of path points when the path is shorter.
+        reduced to the number of path points when the path is shorter; when the data cannot
+        determine the fit (Schoenberg-Whitney fails or the collocation matrix is
+        numerically singular, typically for such a square system) the row is
+        ``valid=False`` without a curve, and its note says how many control points the
+        data allow.
     methods : sequence of str or Mapping[str, callable], optional
         Registered method names to run (default: every registered default method), or a
         mapping name -> method callable for one-off methods.

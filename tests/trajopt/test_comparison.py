@@ -106,6 +106,27 @@ def test_to_dataframe(room_table: cmp.ComparisonTable, monkeypatch) -> None:
     assert isinstance(df, pd.DataFrame) and list(df.index) == list(DEFAULT_METHODS)
 
 
+def test_bspline_row_is_invalid_when_the_data_cannot_determine_the_fit() -> None:
+    """Issue 23: n_ctrl beyond the path is cut to the number of points, a square system
+    where the Schoenberg-Whitney condition fails; the row has no curve and says why."""
+    chapter = ["A* + avoidance area", "B-spline fit"]
+    query = (_room(), (0.5, 0.5), (2.5, 2.3))
+    table = cmp.compare(*query, robot_radius=0.15, bspline={"n_ctrl": 80}, methods=chapter)
+    row = table.row("B-spline fit")
+    n = len(table.paths["A* + avoidance area"])
+    assert not row["valid"] and table.paths["B-spline fit"] is None
+    assert math.isnan(row["mse_m2"]) and math.isnan(row["end_error_x_m"])
+    assert f"n_ctrl reduced from 80 to {n}" in row["note"]
+    assert "Schoenberg-Whitney" in row["note"] and "degree 2" in row["note"]
+    allowed = int(row["note"].rsplit("allow at most ", 1)[1].split()[0])
+    assert allowed < n
+    ok = cmp.compare(*query, robot_radius=0.15, bspline={"n_ctrl": allowed}, methods=chapter)
+    good = ok.row("B-spline fit")
+    assert good["valid"] and "end points not exact" in good["note"]
+    errors = [good[f"{end}_error_{ax}_m"] for end in ("start", "end") for ax in "xy"]
+    assert all(math.isfinite(e) and e >= 0.0 for e in errors)
+
+
 # ------------------------------------------------------------------------- registry
 def test_one_off_methods_by_mapping() -> None:
     def failing(ctx):

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, event, example, given, settings
+from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
 from trajopt import fits
@@ -321,8 +323,163 @@ def test_curve_parameters_hand_case() -> None:
 
 def test_bspline_with_many_control_points_interpolates_data() -> None:
     p = _staircase(20)
-    curve = fits.fit_bspline(p, degree=3, n_ctrl=len(p))
+    # uniform parameters: the square system is well conditioned (cond ~ 41), an interpolant
+    curve = fits.fit_bspline(p, degree=3, n_ctrl=len(p), parameterization="uniform")
     assert curve.mse < 1e-20
+    assert np.max(np.abs(curve.c)) < 2.0 * np.max(np.abs(p))
+    # chord parameters of the same staircase: cond ~ 3e4, the interpolant's control points
+    # lie 50 m from a 0.6 m path; that is refused, naming how many control points work
+    with pytest.raises(InvalidInputError, match=r"numerically singular.*allow at most 20"):
+        fits.fit_bspline(p, degree=3, n_ctrl=len(p), parameterization="chord")
+
+
+# ----------------------------------------- B-spline: Schoenberg-Whitney and conditioning
+_STEP = {"x": (1, 0), "y": (0, 1), "d": (1, 1)}
+
+
+def _steps_to_points(steps: str, cell: float = 0.03) -> np.ndarray:
+    """An A*-like staircase: unit steps in x ('x') or y ('y') and diagonal steps ('d')."""
+    st = np.array([_STEP[c] for c in steps], dtype=float).reshape(-1, 2)
+    return cell * np.vstack([[0.0, 0.0], np.cumsum(st, axis=0)])
+
+
+#: Random 38-40-point staircases whose square chord-parameter fits diverged before the
+#: checks (issue 23; found by seeding numpy's default_rng 0..299 and keeping the fits with
+#: |C| > 1e4 m): (steps, degree, |C| the fit used to return, what is wrong).
+_DIVERGED = [
+    ("dxdddyxddyxyxxdyyydyyxxyyxxxdyyxxydydxx", 2, 1.95e14, "Schoenberg-Whitney"),
+    ("dddddyxxdxdxxyydxdddyyyxxxydyxyxydyyydx", 2, 2.48e24, "numerically singular"),
+    ("yxdxdyyyddyyyxyyddyxyyxxdydxddydyddddd", 3, 3.59e22, "numerically singular"),
+    ("xxxdxydydxxxxyyyddyxyydxyxddxxxdxyxddx", 3, 1.01e4, "numerically singular"),
+]
+
+
+def _reference_design(p: np.ndarray, k: int, n_ctrl: int, kind: str):
+    """The full collocation matrix (scipy's B-spline values) and the sites."""
+    u = fits.curve_parameters(p, kind)
+    t = clamped_uniform_knots(n_ctrl, k)
+    return BSpline.design_matrix(u, t, k).toarray(), u, t
+
+
+@pytest.mark.parametrize(("steps", "k", "c_before", "condition"), _DIVERGED)
+def test_square_staircase_fits_that_diverged_now_raise(
+    steps: str, k: int, c_before: float, condition: str
+) -> None:
+    p = _steps_to_points(steps)
+    n = len(p)
+    a, _, _ = _reference_design(p, k, n, "chord")
+    # independent reference: at the data's accuracy (rcond = 1 / BSPLINE_COND_MAX) lstsq
+    # finds the square system rank deficient
+    rank = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)[2]
+    assert rank < n
+    with pytest.raises(InvalidInputError) as info:
+        fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization="chord")
+    msg = str(info.value)
+    assert condition in msg
+    assert f"degree {k}" in msg and f"n_ctrl {n}" in msg and "chord" in msg
+    assert f"{n} distinct points" in msg
+    allowed = int(msg.rsplit("allow at most ", 1)[1].split()[0])
+    assert k + 1 <= allowed < n
+    curve = fits.fit_bspline(p, degree=k, n_ctrl=allowed, parameterization="chord")
+    a_ok, _, _ = _reference_design(p, k, allowed, "chord")
+    c_ref, _, rank_ok, _ = np.linalg.lstsq(a_ok, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
+    assert rank_ok == allowed
+    np.testing.assert_allclose(curve.c, c_ref, atol=1e-9)
+    assert np.max(np.abs(curve.c)) < 1e-3 * c_before
+
+
+def test_schoenberg_whitney_failure_is_exact_rank_deficiency() -> None:
+    steps, k, _, _ = _DIVERGED[0]
+    p = _steps_to_points(steps)
+    a, u, t = _reference_design(p, k, len(p), "chord")
+    assert fits._schoenberg_whitney_matches(u, t, k) < len(p)
+    assert np.linalg.matrix_rank(a) < len(p)  # numpy's default tolerance: singular
+
+
+def _brute_force_schoenberg_whitney(a: np.ndarray, u: np.ndarray) -> bool:
+    """Some strictly increasing sites u_(j_0) < ... with B_i(u_(j_i)) != 0 (by enumeration)."""
+    m, n = a.shape
+    for rows in itertools.combinations(range(m), n):
+        if np.all(np.diff(u[list(rows)]) > 0) and all(a[j, i] != 0 for i, j in enumerate(rows)):
+            return True
+    return False
+
+
+@given(
+    k=st.integers(1, 4),
+    extra=st.integers(0, 3),
+    # dyadic sites: they hit the knots 0, 0.25, 0.5, 0.75, 1 exactly and never underflow a
+    # B-spline value to 0 (a site like 1e-311 does: then only the conditioning check sees it)
+    sites=st.lists(st.integers(0, 2**16).map(lambda i: i / 2**16), min_size=3, max_size=9),
+)
+@example(k=1, extra=3, sites=[0.0, 0.25, 0.5, 0.75, 1.0])  # linear: every site on a knot
+@example(k=2, extra=3, sites=[0.0, 0.25, 0.25, 0.5, 0.75, 1.0])
+@example(k=2, extra=2, sites=[0.0, 0.25, 0.5, 0.75, 1.0])
+@example(k=3, extra=0, sites=[0.0, 0.0, 1.0, 1.0])  # two distinct sites for four functions
+@settings(max_examples=300, deadline=None)
+def test_schoenberg_whitney_greedy_equals_enumeration(k: int, extra: int, sites) -> None:
+    # clamped uniform knots (interior knots at 0.25, 0.5, 0.75 for n = k + 4) and sorted
+    # sites that may sit on knots, repeat, or sit on the clamped ends
+    n = k + 1 + extra
+    u = np.sort(np.asarray(sites, dtype=float))
+    t = clamped_uniform_knots(n, k)
+    a = BSpline.design_matrix(u, t, k).toarray() if n <= len(u) else None
+    ours = fits._schoenberg_whitney_matches(u, t, k) == n
+    event(f"schoenberg-whitney holds: {ours}")
+    assert ours == (a is not None and _brute_force_schoenberg_whitney(a, u))
+
+
+@given(
+    steps=st.text(alphabet="xyd", min_size=37, max_size=39),
+    k=st.sampled_from([2, 3]),
+    fewer=st.integers(0, 3),
+    kind=st.sampled_from(fits.PARAMETERIZATIONS),
+)
+@example(steps=_DIVERGED[0][0], k=2, fewer=0, kind="chord")
+@example(steps=_DIVERGED[1][0], k=2, fewer=0, kind="chord")
+@example(steps=_DIVERGED[2][0], k=3, fewer=0, kind="chord")
+@example(steps=_DIVERGED[3][0], k=3, fewer=0, kind="chord")
+@settings(max_examples=200, deadline=None)
+def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
+    steps: str, k: int, fewer: int, kind: str
+) -> None:
+    """Staircases (A*-like) against the full least-squares matrix and numpy's lstsq: the fit
+    raises iff the matrix is rank deficient at rcond = 1 / BSPLINE_COND_MAX (or the exact
+    Schoenberg-Whitney condition fails), and otherwise returns lstsq's control points."""
+    p = _steps_to_points(steps)
+    n = len(p) - fewer
+    assume(n >= k + 1)
+    a, u, t = _reference_design(p, k, n, kind)
+    sv = np.linalg.svd(a, compute_uv=False)
+    cond = sv[0] / sv[-1] if sv[-1] > 0 else math.inf
+    assume(abs(math.log(cond / fits.BSPLINE_COND_MAX)) > 1e-3)  # not at the threshold
+    c_ref, _, rank, _ = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
+    if rank < n or fits._schoenberg_whitney_matches(u, t, k) < n:
+        event("ill-posed")
+        with pytest.raises(InvalidInputError, match="Schoenberg-Whitney|numerically singular"):
+            fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
+    else:
+        event("fitted")
+        curve = fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
+        np.testing.assert_allclose(curve.c, c_ref, atol=1e-9)
+
+
+def test_sweep_records_ill_posed_combinations_with_the_reason() -> None:
+    steps, k, _, _ = _DIVERGED[1]
+    p = _steps_to_points(steps)
+    n = len(p)
+    recs = fits.sweep_bspline(p, parameterizations=("chord",), degrees=(k,), n_ctrls=(8, n))
+    by_n = {r.params["n_ctrl"]: r for r in recs}
+    assert by_n[8].valid and by_n[8].rank == 1
+    bad = by_n[n]
+    assert not bad.valid and math.isinf(bad.mse) and bad.rank == 2
+    assert "numerically singular" in bad.reason and "allow at most" in bad.reason
+
+
+def test_bspline_too_many_control_points_says_how_many_the_data_allow() -> None:
+    p = _staircase(60)
+    with pytest.raises(InvalidInputError, match=r"distinct points \(61\).*allow at most \d+"):
+        fits.fit_bspline(p, degree=3, n_ctrl=70)
 
 
 @pytest.mark.parametrize(
