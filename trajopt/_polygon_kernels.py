@@ -706,7 +706,7 @@ def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
         i = buf[k]
         gx = max(rects[i, 0] - wx1, 0.0, wx0 - rects[i, 2])
         gy = max(rects[i, 1] - wy1, 0.0, wy0 - rects[i, 3])
-        if gx * gx + gy * gy < r * r:
+        if gx * gx + gy * gy <= r * r:
             cand[m] = i
             m += 1
     # the ellipse around the seed segment

@@ -210,15 +210,15 @@ class ConvexPolygon:
         s = p @ self.A.T - self.b
         return np.all(s <= tol, axis=-1)
 
-    def intersection(self, other: ConvexPolygon, tol: float = CLEARANCE_TOL_M) -> ConvexPolygon:
+    def intersection(self, other: ConvexPolygon, tol: float = 0.0) -> ConvexPolygon:
         """The intersection of two regions (a region; degenerate when it has no interior).
 
         Parameters
         ----------
         other : ConvexPolygon
         tol : float, optional
-            Slack (m) of ``other``'s rows when clipping, so that regions that only touch
-            give a degenerate intersection rather than none.
+            Slack (m) added to ``other``'s rows when clipping (default 0: the exact
+            intersection; regions that touch give a degenerate one).
 
         Returns
         -------
@@ -527,7 +527,8 @@ def build_polygon_corridor(
         path on ``astar.inflate(raw_grid, radius, metric="square", outside_occupied=True)``
         does.
     radius : float
-        Clearance (m) every region keeps from the raw map (finite, ``>= 0``).
+        Clearance (m) every region keeps from the raw map (finite, ``> 0``: at 0 the
+        certificate could not tell touching an obstacle from overlapping it).
     margin_cells : float, optional
         How far (cells) a region may reach beyond its seed's bounding box (> 0). Default 10.
     max_segment_cells : float, optional
@@ -573,7 +574,7 @@ def build_polygon_corridor(
     rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
     """
     occ, res, ox, oy = _grid_parts(raw_grid)
-    r = _check_option(radius, "radius", 0.0, strict=False)
+    r = _check_option(radius, "radius", 0.0, strict=True)
     margin = _check_option(margin_cells, "margin_cells", 0.0, strict=True)
     max_len = _check_option(max_segment_cells, "max_segment_cells", 0.0, strict=True)
     ext = _check_option(overlap_cells, "overlap_cells", 0.0, strict=False)
@@ -613,7 +614,7 @@ def build_polygon_corridor(
     args = idx.args
     cap = r_c + open_c + 2.0
     pcl, scl = _k.path_clearances(p, cap, *args)
-    _check_path_clearance(p, src, pcl, scl, r_c, tol_c, res, ox, oy, n_in)
+    _check_path_clearance(pts_m, src, pcl, scl, r_c, tol_c, res)
     # centre, then simplify
     if push > 0.0 and len(p) > 2:
         p = _k.centre_path(p, r_c, push, trigger, 2, *args)
@@ -671,7 +672,7 @@ def build_polygon_corridor(
     region_s = np.empty((m, 2))
     for k, reg in enumerate(regions):
         rows = np.column_stack([reg.A, reg.b])
-        lo, hi = _k.polyline_interval(rows, len(rows), path_m, s, s[k], s[k + 1], CLEARANCE_TOL_M)
+        lo, hi = _k.polyline_interval(rows, len(rows), path_m, s, s[k], s[k + 1], 0.0)
         if not np.isfinite(lo):
             raise SmoothingError(f"region {k} does not contain its path segment", {"region": k})
         region_s[k] = lo, hi
@@ -683,7 +684,7 @@ def build_polygon_corridor(
     overlap_s = np.empty((m - 1, 2))
     trans = np.empty(m - 1)
     for k in range(m - 1):
-        ov = _intersect(regions[k], regions[k + 1], CLEARANCE_TOL_M)
+        ov = _intersect(regions[k], regions[k + 1], 0.0)
         if ov is None:  # they share path vertex k + 1 (within the tolerance)
             ov = _point_region(path_m[k + 1])
         overlaps.append(ov)
@@ -692,7 +693,7 @@ def build_polygon_corridor(
              np.column_stack([regions[k + 1].A, regions[k + 1].b])]
         )
         lo, hi = _k.polyline_interval(
-            rows, len(rows), path_m, s, s[k + 1], s[k + 1], CLEARANCE_TOL_M
+            rows, len(rows), path_m, s, s[k + 1], s[k + 1], 0.0
         )
         if not np.isfinite(lo):
             raise SmoothingError(
@@ -730,42 +731,39 @@ def build_polygon_corridor(
 
 
 def _check_path_clearance(
-    p: np.ndarray,
+    pts_m: np.ndarray,
     src: np.ndarray,
     pcl: np.ndarray,
     scl: np.ndarray,
     r_c: float,
     tol_c: float,
     res: float,
-    ox: float,
-    oy: float,
-    n_in: int,
 ) -> None:
-    """Raise for the first point, then segment, closer than ``r`` to the raw map."""
-    rule_pt = (
-        "every path point must keep the radius from every occupied cell (a square) and from "
-        "the outside of the map"
-    )
+    """Raise for the first point, then segment, closer than ``r`` to the raw map (``src``
+    maps the de-duplicated points, whose clearances ``pcl``/``scl`` are in cells, to the
+    input points ``pts_m``)."""
+    n_in = len(pts_m)
     bad = np.nonzero(pcl < r_c - tol_c)[0]
     if len(bad):
         # the end points first: a radius larger than the free space there
-        order = sorted(bad.tolist(), key=lambda i: (i not in (0, len(p) - 1), i))
-        i = order[0]
-        xy = [ox + res * p[i, 0], oy + res * p[i, 1]]
+        last = len(pcl) - 1
+        i = sorted(bad.tolist(), key=lambda j: (j not in (0, last), j))[0]
+        j = int(src[i])
         raise InvalidInputError(
-            f"{_point_name(int(src[i]), n_in)} {xy} m has clearance {pcl[i] * res:.6g} m, less "
-            f"than the radius {r_c * res:.6g} m: {rule_pt}"
+            f"{_point_name(j, n_in)} {pts_m[j].tolist()} m has clearance {pcl[i] * res:.6g} m, "
+            f"less than the radius {r_c * res:.6g} m: every path point must keep the radius "
+            "from every occupied cell (a square) and from the outside of the map"
         )
     bad = np.nonzero(scl < r_c - tol_c)[0]
     if len(bad):
         i = int(bad[0])
-        a = [ox + res * p[i, 0], oy + res * p[i, 1]]
-        b = [ox + res * p[i + 1, 0], oy + res * p[i + 1, 1]]
+        a, b = int(src[i]), int(src[i + 1])
         raise InvalidInputError(
-            f"path segment from point {int(src[i])} {a} m to point {int(src[i + 1])} {b} m "
-            f"has clearance {scl[i] * res:.6g} m, less than the radius {r_c * res:.6g} m: it "
-            f"passes a gap narrower than 2 * radius = {2 * r_c * res:.6g} m; search the path "
-            "on astar.inflate(raw_grid, radius, metric='square', outside_occupied=True)"
+            f"path segment from point {a} {pts_m[a].tolist()} m to point {b} "
+            f"{pts_m[b].tolist()} m has clearance {scl[i] * res:.6g} m, less than the radius "
+            f"{r_c * res:.6g} m: it passes a gap narrower than 2 * radius = "
+            f"{2 * r_c * res:.6g} m; search the path on "
+            "astar.inflate(raw_grid, radius, metric='square', outside_occupied=True)"
         )
 
 
