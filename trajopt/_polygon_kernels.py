@@ -973,3 +973,76 @@ def poly_rects_min(v, nv, rects):  # pragma: no cover - compiled
             if best == 0.0:
                 break
     return best
+
+
+@njit(cache=True)
+def chain_geometry(hm, vm, nrow, nvert, degen, p, s, tol):  # pragma: no cover - compiled
+    """Path intervals and overlaps of a chain of regions (world units).
+
+    ``hm[k, :nrow[k]]`` are region ``k``'s rows ``(a_x, a_y, b)`` (for a polygon with
+    interior, row ``i`` is the edge ``vm[k, i] -> vm[k, i + 1]``), ``vm[k, :nvert[k]]`` its
+    vertices. Returns ``(region_s, overlap_s, ov_v, ov_h, ov_n)``: each region's largest
+    interval of the polyline ``p`` (arc lengths ``s``) around its own segment ``k``; each
+    consecutive pair's largest interval around their shared vertex ``k + 1`` (``nan`` when
+    a required piece is outside); and the pair's intersection, clipped exactly: ``ov_n[k]``
+    vertices ``ov_v[k]`` with the row of each outgoing edge ``ov_h[k]`` (rows only
+    meaningful when both regions have interior).
+    """
+    m = hm.shape[0]
+    kmax = hm.shape[1]
+    region_s = np.empty((m, 2))
+    overlap_s = np.empty((max(m - 1, 0), 2))
+    cap = 2 * kmax + 4
+    ov_v = np.zeros((max(m - 1, 0), cap, 2))
+    ov_h = np.zeros((max(m - 1, 0), cap, 3))
+    ov_n = np.zeros(max(m - 1, 0), np.int64)
+    both = np.empty((2 * kmax, 3))
+    for k in range(m):
+        lo, hi = polyline_interval(hm[k], nrow[k], p, s, s[k], s[k + 1], tol)
+        region_s[k, 0] = lo
+        region_s[k, 1] = hi
+    va = np.empty((cap, 2))
+    la = np.empty(cap, np.int64)
+    vb = np.empty((cap, 2))
+    lb = np.empty(cap, np.int64)
+    for k in range(m - 1):
+        n1 = nrow[k]
+        n2 = nrow[k + 1]
+        for i in range(n1):
+            both[i] = hm[k, i]
+        for i in range(n2):
+            both[n1 + i] = hm[k + 1, i]
+        lo, hi = polyline_interval(both, n1 + n2, p, s, s[k + 1], s[k + 1], tol)
+        overlap_s[k, 0] = lo
+        overlap_s[k, 1] = hi
+        nv = nvert[k]
+        for i in range(nv):
+            va[i] = vm[k, i]
+            la[i] = -(i + 1)
+        for j in range(n2):
+            nv = _clip(va, la, nv, hm[k + 1, j, 0], hm[k + 1, j, 1], hm[k + 1, j, 2], j, vb, lb)
+            va, vb = vb, va
+            la, lb = lb, la
+            if nv == 0:
+                break
+        nv = _tidy(va, la, nv)
+        ov_n[k] = nv
+        for i in range(nv):
+            ov_v[k, i] = va[i]
+            if degen[k] or degen[k + 1]:
+                continue
+            if la[i] >= 0:
+                ov_h[k, i] = hm[k + 1, la[i]]
+            else:
+                ov_h[k, i] = hm[k, -la[i] - 1]
+    return region_s, overlap_s, ov_v, ov_h, ov_n
+
+
+@njit(cache=True)
+def certify_all(vv, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
+    """Exact clearance (capped at ``cap``) of every region ``vv[k, :nv[k]]``."""
+    m = vv.shape[0]
+    out = np.empty(m)
+    for k in range(m):
+        out[k] = poly_clearance(vv[k], nv[k], cap, rects, meta, bstart, bids, stamp, buf)
+    return out

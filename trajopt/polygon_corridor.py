@@ -86,6 +86,9 @@ logger = logging.getLogger(__name__)
 #: thousand cells).
 CLEARANCE_TOL_M = 1e-9
 
+#: Slack (m) of the path-in-region tests: absorbs the rounding of points that lie on a
+#: region's boundary (a seed touching a dilated obstacle, a segment along a row).
+_ROUND_M = 1e-2 * CLEARANCE_TOL_M
 _BUCKET_CELLS = 8
 _MAX_SIDES = 256
 
@@ -237,7 +240,9 @@ class ConvexPolygon:
 
 def _shoelace(v: np.ndarray) -> float:
     x, y = v[:, 0], v[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    return 0.5 * float(
+        x[:-1] @ y[1:] - x[1:] @ y[:-1] + x[-1] * y[0] - x[0] * y[-1]
+    )
 
 
 def _point_region(p: np.ndarray) -> ConvexPolygon:
@@ -259,6 +264,18 @@ def _segment_region(p: np.ndarray, q: np.ndarray) -> ConvexPolygon:
     return ConvexPolygon._construct_fast(a, b, np.array([p, q], dtype=float), True)
 
 
+def _degenerate_from(v: np.ndarray) -> ConvexPolygon:
+    """A point or segment region spanning vertices ``v`` (shape (n, 2), n >= 1) that lie
+    on one line (or at one point)."""
+    if len(v) == 1:
+        return _point_region(v[0])
+    d = np.hypot(*(v[:, None, :] - v[None, :, :]).transpose(2, 0, 1))
+    i, j = np.unravel_index(int(np.argmax(d)), d.shape)
+    if d[i, j] == 0.0:
+        return _point_region(v[0])
+    return _segment_region(v[min(i, j)], v[max(i, j)])
+
+
 def _intersect(p1: ConvexPolygon, p2: ConvexPolygon, tol: float) -> ConvexPolygon | None:
     rows = np.column_stack([p2.A, p2.b])
     v, lab, n = _k.clip_convex(
@@ -278,14 +295,7 @@ def _intersect(p1: ConvexPolygon, p2: ConvexPolygon, tol: float) -> ConvexPolygo
                 j = int(np.argmin(res))
                 a[i], b[i] = p1.A[j], p1.b[j]
         return ConvexPolygon._construct_fast(a, b, v, False)
-    if n == 1:
-        return _point_region(v[0])
-    # a segment: its two farthest vertices
-    d = np.hypot(*(v[:, None, :] - v[None, :, :]).transpose(2, 0, 1))
-    i, j = np.unravel_index(int(np.argmax(d)), d.shape)
-    if d[i, j] == 0.0:
-        return _point_region(v[0])
-    return _segment_region(v[min(i, j)], v[max(i, j)])
+    return _degenerate_from(v)
 
 
 # ---------------------------------------------------------------- the corridor value
@@ -506,9 +516,9 @@ def build_polygon_corridor(
     path: Any,
     radius: float,
     *,
-    margin_cells: float = 10.0,
+    margin_cells: float = 16.0,
     max_segment_cells: float = 20.0,
-    overlap_cells: float = 2.0,
+    overlap_cells: float = 4.0,
     centre_cells: float = 1.0,
     centre_trigger_cells: float = 2.0,
     simplify_slack_cells: float = 0.3,
@@ -530,14 +540,14 @@ def build_polygon_corridor(
         Clearance (m) every region keeps from the raw map (finite, ``> 0``: at 0 the
         certificate could not tell touching an obstacle from overlapping it).
     margin_cells : float, optional
-        How far (cells) a region may reach beyond its seed's bounding box (> 0). Default 10.
+        How far (cells) a region may reach beyond its seed's bounding box (> 0). Default 16.
     max_segment_cells : float, optional
         Longest segment (cells) of the simplified path, hence of a region's seed (> 0).
         Default 20.
     overlap_cells : float, optional
         How far (cells) each seed reaches into the neighbouring segments, so that
         consecutive regions share at least twice this much path where obstacles allow
-        (>= 0). Default 2.
+        (>= 0). Default 4.
     centre_cells : float, optional
         Largest push (cells) of an interior path point away from its nearest obstacle
         (>= 0; 0 disables centring). Default 1.
@@ -626,84 +636,88 @@ def build_polygon_corridor(
     kmax = int(min(4 + len(idx.rects), _MAX_SIDES))
     hh, vv, nvs, status = _k.grow_all(seed, e, r_c, margin, kmax, *args)
     m = len(seed) - 1
-    regions_c: list[tuple[np.ndarray, np.ndarray, bool]] = []  # (rows, vertices, degenerate)
-    clear = np.empty(m)
-    for k in range(m):
-        st = int(status[k])
-        if st == 0:
-            rows, verts, degen = hh[k, : nvs[k]], vv[k, : nvs[k]], False
-        elif st == 1:
-            verts = seed[k : k + 2].copy()
-            rows, degen = np.empty((0, 3)), True
-        else:
-            why = {
-                2: "its seed meets an obstacle's dilation",
-                3: "it lost a seed point",
-                4: f"it needs more than {kmax} sides",
-            }[st]
-            raise SmoothingError(
-                f"region {k} around path segment {seed_src[k]}..{seed_src[k + 1]} "
-                f"could not be grown: {why}",
-                {"region": k, "status": st},
-            )
-        c = _k.poly_clearance(np.ascontiguousarray(verts), len(verts), r_c + 1.0, *args)
-        if c < r_c - tol_c:
-            raise SmoothingError(
-                f"region {k} failed its certificate: clearance {c * res:.9g} m < radius "
-                f"{r} m - {CLEARANCE_TOL_M:g} m",
-                {"region": k, "clearance_m": c * res},
-            )
-        clear[k] = c * res
-        regions_c.append((rows, verts, degen))
+    bad = np.nonzero(status >= 2)[0]
+    if len(bad):
+        k, st = int(bad[0]), int(status[bad[0]])
+        why = {
+            2: "its seed meets an obstacle's dilation",
+            3: "it lost a seed point",
+            4: f"it needs more than {kmax} sides",
+        }[st]
+        raise SmoothingError(
+            f"region {k} around path segment {seed_src[k]}..{seed_src[k + 1]} could not be "
+            f"grown: {why}",
+            {"region": k, "status": st},
+        )
+    degen = status == 1
+    for k in np.nonzero(degen)[0]:  # no interior: the seed segment itself
+        vv[k, :2] = seed[k : k + 2]
+        nvs[k] = 2
+    # the certificate: exact clearance of every region (cell units)
+    clear_c = _k.certify_all(vv, nvs, r_c + 1.0, *args)
+    bad = np.nonzero(clear_c < r_c - tol_c)[0]
+    if len(bad):
+        k = int(bad[0])
+        raise SmoothingError(
+            f"region {k} failed its certificate: clearance {clear_c[k] * res:.9g} m < radius "
+            f"{r} m - {CLEARANCE_TOL_M:g} m",
+            {"region": k, "clearance_m": float(clear_c[k] * res)},
+        )
+    clear = clear_c * res
     # to world metres
     o = np.array([ox, oy])
+    vm = o + res * vv
+    hm = hh.copy()
+    hm[:, :, 2] = res * hh[:, :, 2] + hh[:, :, :2] @ o
+    nrow = nvs.copy()
     regions: list[ConvexPolygon] = []
-    for rows, verts, degen in regions_c:
-        vm = o + res * verts
-        if degen:
-            regions.append(_segment_region(vm[0], vm[1]))
+    for k in range(m):
+        if degen[k]:
+            reg = _segment_region(vm[k, 0], vm[k, 1])
+            nrow[k] = reg.n_sides
+            hm[k, : nrow[k], :2] = reg.A
+            hm[k, : nrow[k], 2] = reg.b
         else:
-            a = np.ascontiguousarray(rows[:, :2])
-            b = res * rows[:, 2] + a @ o
-            regions.append(ConvexPolygon._construct_fast(a, b, vm, False))
+            n = nvs[k]
+            reg = ConvexPolygon._construct_fast(hm[k, :n, :2], hm[k, :n, 2], vm[k, :n], False)
+        regions.append(reg)
     path_m = o + res * seed
     path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path_m, axis=0).T))])
-    region_s = np.empty((m, 2))
-    for k, reg in enumerate(regions):
-        rows = np.column_stack([reg.A, reg.b])
-        lo, hi = _k.polyline_interval(rows, len(rows), path_m, s, s[k], s[k + 1], 0.0)
-        if not np.isfinite(lo):
-            raise SmoothingError(f"region {k} does not contain its path segment", {"region": k})
-        region_s[k] = lo, hi
+    region_s, overlap_s, ov_v, ov_h, ov_n = _k.chain_geometry(
+        hm, vm, nrow, nvs, degen, path_m, s, _ROUND_M
+    )
+    bad = np.nonzero(~np.isfinite(region_s[:, 0]))[0]
+    if len(bad):
+        raise SmoothingError(
+            f"region {int(bad[0])} does not contain its path segment", {"region": int(bad[0])}
+        )
+    bad = np.nonzero(~np.isfinite(overlap_s[:, 0]))[0]
+    if len(bad):
+        k = int(bad[0])
+        raise SmoothingError(
+            f"regions {k} and {k + 1} do not both contain their shared path vertex",
+            {"region": k},
+        )
     region_index = np.column_stack(
         [np.searchsorted(s, region_s[:, 0] - 1e-12, side="left"),
          np.searchsorted(s, region_s[:, 1] + 1e-12, side="right") - 1]
     )
     overlaps: list[ConvexPolygon] = []
-    overlap_s = np.empty((m - 1, 2))
-    trans = np.empty(m - 1)
     for k in range(m - 1):
-        ov = _intersect(regions[k], regions[k + 1], 0.0)
-        if ov is None:  # they share path vertex k + 1 (within the tolerance)
+        n = int(ov_n[k])
+        v = ov_v[k, :n]
+        if n >= 3 and not (degen[k] or degen[k + 1]) and _shoelace(v) > 0.0:
+            ov = ConvexPolygon._construct_fast(ov_h[k, :n, :2], ov_h[k, :n, 2], v, False)
+        elif n == 0:  # only touching at their shared path vertex (within rounding)
             ov = _point_region(path_m[k + 1])
+        else:
+            ov = _degenerate_from(v)
         overlaps.append(ov)
-        rows = np.vstack(
-            [np.column_stack([regions[k].A, regions[k].b]),
-             np.column_stack([regions[k + 1].A, regions[k + 1].b])]
-        )
-        lo, hi = _k.polyline_interval(
-            rows, len(rows), path_m, s, s[k + 1], s[k + 1], 0.0
-        )
-        if not np.isfinite(lo):
-            raise SmoothingError(
-                f"regions {k} and {k + 1} do not both contain their shared path vertex",
-                {"region": k},
-            )
-        overlap_s[k] = lo, hi
-        a = max(lo, 0.5 * (s[k] + s[k + 1]))
-        b = min(hi, 0.5 * (s[k + 1] + s[k + 2]))
-        trans[k] = 0.5 * (a + b)
+    lo, hi = overlap_s[:, 0], overlap_s[:, 1]
+    trans = 0.5 * (
+        np.maximum(lo, 0.5 * (s[:-2] + s[1:-1])) + np.minimum(hi, 0.5 * (s[1:-1] + s[2:]))
+    )
     trans_pts = np.column_stack(
         [np.interp(trans, s, path_m[:, 0]), np.interp(trans, s, path_m[:, 1])]
     ).reshape(-1, 2)

@@ -169,13 +169,13 @@ def random_scene(draw):
     res = draw(st.sampled_from([0.05, 0.1, 0.25]))
     origin = (draw(st.sampled_from([0.0, -1.3, 2.75])), draw(st.sampled_from([0.0, 0.6, -3.1])))
     radius = draw(st.sampled_from([0.1, 0.5, 1.0, 1.5, 2.0, 2.5])) * res
-    return OccupancyGrid(occ, res, origin), radius, seed
+    return OccupancyGrid(occ, res, origin), radius, seed, draw(st.booleans())
 
 
 @settings(derandomize=True, deadline=None, max_examples=40)
 @given(random_scene())
 def test_random_grids_certified_against_brute_force(scene) -> None:
-    grid, radius, seed = scene
+    grid, radius, seed, as_points = scene
     infl = square_inflated(grid, radius)
     ys, xs = np.nonzero(~infl.occupied)
     assume(len(xs) >= 2)
@@ -185,7 +185,8 @@ def test_random_grids_certified_against_brute_force(scene) -> None:
         path = astar.find_path(infl, (int(xs[i]), int(ys[i])), (int(xs[j]), int(ys[j])))
     except astar.NoPathError:
         assume(False)
-    corr = build_polygon_corridor(grid, path, radius)
+    # the cells, or their centres as world points (m)
+    corr = build_polygon_corridor(grid, path.to_world(grid) if as_points else path, radius)
     assert_corridor_certified(corr, grid, radius)
     # the polygon certificate agrees with the public clearance function
     for k, reg in enumerate(corr.regions):
