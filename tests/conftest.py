@@ -1,4 +1,12 @@
-"""Shared fixtures: where the real maps live (``TRAJOPT_DATA``, default ``../shared/data``)."""
+"""Shared fixtures and settings.
+
+* Where the real maps live (``TRAJOPT_DATA``, default ``../shared/data``).
+* Hypothesis profiles: ``deterministic`` (the default, and what CI runs: every run draws the
+  same examples, so the README's test command cannot pass one run and fail the next) and
+  ``explore`` (fresh random examples each run, for looking for new failures:
+  ``HYPOTHESIS_PROFILE=explore python -m pytest``). Cases an exploration finds are pinned
+  in their test with ``@example``.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +14,11 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("deterministic", derandomize=True, database=None, print_blob=True)
+settings.register_profile("explore", derandomize=False, print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 _REPO = Path(__file__).resolve().parents[1]
 

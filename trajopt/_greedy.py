@@ -18,6 +18,7 @@ MAX_STEPS = 4
 
 _NEG_V_TOL = 1e-9  # a piece whose speed dips below -1e-9 m/s reverses
 _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
+_REST_V = 1e-12  # m/s: a speed this low with a = 0 is rest (round-off of a stop)
 
 
 @njit(cache=True)
@@ -252,8 +253,12 @@ def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin,
         chosen = np.nan
         safe = np.nan
         safe_noend = False
+        # at rest, a jerk <= 0 makes no progress (or reverses): taking it would idle forever
+        at_rest = v <= _REST_V and a == 0.0
         for ic in range(nc):
             u = cands[ic]
+            if at_rest and u <= 0.0:
+                continue
             # exact step with clamping at +-amax
             ta = dt
             if u > 0.0 and a + u * dt > amax:
@@ -323,6 +328,8 @@ def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin,
                 t += dt - ta
             if u == uz or abs(a) < 1e-9:
                 a = 0.0
+            if a == 0.0 and v < _REST_V:
+                v = 0.0  # round-off of a stop: rest exactly
             bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
             continue
         if safe_noend:
@@ -344,7 +351,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin,
                 t += tp
                 rem -= tp
         if rem > 0.0:  # stopped inside the step
-            v = 0.0 if v < 1e-12 else v
+            v = 0.0 if v < _REST_V else v
             a = 0.0
         if abs(a) < 1e-9:
             a = 0.0

@@ -81,6 +81,10 @@ class BSplineCurve(ParametricCurve):
         n = self.c.shape[0]
         return np.unique(self.t[self.k : n + 1])
 
+    @property
+    def polynomial_degree(self) -> int:
+        return self.k
+
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
         """Position or ``nu``-th derivative at ``u``; shape ``u.shape + (2,)``."""
         lo, hi = self.domain

@@ -17,6 +17,7 @@ from numpy.polynomial.legendre import leggauss
 __all__ = ["ParametricCurve", "CurveSamples", "PolylineCurve"]
 
 _GL_X, _GL_W = leggauss(5)
+_STILL = 1e-9  # |c'| below this fraction of the mean parametric speed counts as zero
 
 
 class CurveSamples(NamedTuple):
@@ -62,11 +63,55 @@ class ParametricCurve(ABC):
         """Parameter values where the curve may lose smoothness (default: the ends)."""
         return np.asarray(self.domain, dtype=float)
 
+    @property
+    def polynomial_degree(self) -> int | None:
+        """Degree ``p`` when the curve is a polynomial of degree ``<= p`` between consecutive
+        :meth:`breakpoints`, else ``None`` (the default for a subclass).
+
+        The timing bounds the curvature of such curves exactly (:mod:`trajopt.curvature_bound`)
+        and samples any other curve.
+        """
+        return None
+
     # --------------------------------------------------------------- geometry
     def heading(self, u: np.ndarray | float) -> np.ndarray:
-        """Tangent direction ``atan2(y', x')`` in (-pi, pi] (rad), shape of ``u``."""
-        d = self(u, 1)
-        return np.arctan2(d[..., 1], d[..., 0])
+        """Tangent direction ``atan2(y', x')`` in (-pi, pi] (rad), shape of ``u``.
+
+        Where the parametric speed vanishes (``|c'|`` below ``1e-9`` of the mean parametric
+        speed ``length / (u1 - u0)``, e.g. at the ends of a Bezier chain whose first two
+        control points coincide) the heading is the limit of the tangent direction: the
+        direction of the first non-vanishing derivative ``c^(k)`` (``k = 2 .. 6``), taken
+        towards larger ``u`` and, at the end of the domain, from below (``(-1)^(k-1) c^(k)``).
+        """
+        uu = np.asarray(u, dtype=float)
+        d = self(uu, 1)
+        theta = np.arctan2(d[..., 1], d[..., 0])
+        still = np.hypot(d[..., 0], d[..., 1]) <= _STILL * self._mean_speed()
+        if np.any(still):
+            theta = np.where(still, self._limit_heading(uu, theta), theta)
+        return theta
+
+    def _mean_speed(self) -> float:
+        lo, hi = self.domain
+        return self.length / (hi - lo) if hi > lo else 0.0
+
+    def _limit_heading(self, u: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        """Tangent direction at zero-speed parameters ``u`` from higher derivatives."""
+        lo, hi = self.domain
+        uu = np.clip(u, lo, hi)
+        span = hi - lo
+        floor = _STILL * self._mean_speed()
+        out = np.array(theta, dtype=float, copy=True)
+        todo = np.ones(uu.shape, dtype=bool)
+        for k in range(2, 7):
+            dk = np.asarray(self(uu, k), dtype=float)
+            sign = np.where(uu >= hi, (-1.0) ** (k - 1), 1.0)
+            big = todo & (np.hypot(dk[..., 0], dk[..., 1]) * span ** (k - 1) > floor)
+            out = np.where(big, np.arctan2(sign * dk[..., 1], sign * dk[..., 0]), out)
+            todo &= ~big
+            if not np.any(todo):
+                break
+        return out
 
     def speed(self, u: np.ndarray | float) -> np.ndarray:
         """Parametric speed ``|c'(u)|`` (m per unit of ``u``)."""
@@ -252,6 +297,10 @@ class PolylineCurve(ParametricCurve):
 
     def breakpoints(self) -> np.ndarray:
         return self._s.copy()
+
+    @property
+    def polynomial_degree(self) -> int:
+        return 1
 
     @property
     def length(self) -> float:

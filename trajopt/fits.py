@@ -139,6 +139,10 @@ class PolynomialCurve(ParametricCurve):
         return int(self.series.degree())
 
     @property
+    def polynomial_degree(self) -> int:
+        return max(self.order, 1)
+
+    @property
     def domain(self) -> tuple[float, float]:
         return (self.direction * self.x_start, self.direction * self.x_end)
 
@@ -187,6 +191,10 @@ class ParametricPolynomialCurve(ParametricCurve):
     def order(self) -> int:
         """Polynomial order ``m``."""
         return int(self.coef.shape[0] - 1)
+
+    @property
+    def polynomial_degree(self) -> int:
+        return max(self.order, 1)
 
     @property
     def domain(self) -> tuple[float, float]:

@@ -167,6 +167,10 @@ class SmoothPath(ParametricCurve):
     def degree(self) -> int:
         return self.curve.k
 
+    @property
+    def polynomial_degree(self) -> int:
+        return self.curve.k
+
 
 # --------------------------------------------------------------------- smoother
 @dataclass(frozen=True, slots=True)

@@ -12,18 +12,19 @@ problem to a cloud service) holds the first group; the cap is held by the design
 
 Method
 ------
-1. **Cap table.** ``kappa`` is sampled on a uniform arc-length grid (spacing <= 2.5 mm); each
-   grid interval gets the cap ``min(cap at its ends) - max(0, second differences)/8`` (a
-   bound on the dip of a convex minimum inside the interval) times ``1 - 1e-4``; speeds up to
-   ``max(v_start, v_end)`` may use the cap without that factor so that boundary speeds equal
-   to the cap are allowed. Where that dip bound is large (a sharp curvature peak) the interval
-   is resampled at 16 inner points, and a golden-section search next to the lowest of them
-   finds a peak narrower than that spacing (a near-cusp of the curve). An interval is also
-   resampled where the curvature may peak inside it while both ends are capped by ``v_max``
-   alone (flat cap, no second difference): when the heading turned across it, or a
-   second-difference bound on ``|kappa|``, exceeds the curvature at both ends. (The
-   10 000-example property runs found both kinds of peak, missed by 0.1-0.8 %.) A sparse
-   table answers "minimum cap over ``[s_a, s_b]``" in O(1).
+1. **Cap table.** One value per interval of a uniform arc-length grid (spacing <= 2.5 mm):
+   a lower bound of the cap over the interval, times ``1 - 1e-4``; speeds up to
+   ``max(v_start, v_end)`` may use the cap without that factor so that boundary speeds
+   equal to the cap are allowed. For a curve with a ``polynomial_degree`` (every curve of
+   the library) the bound is rigorous whatever the width of a curvature peak:
+   :func:`trajopt.curvature_bound.interval_kappa_max` bounds ``|kappa|`` on the curve's
+   polynomial pieces by Bernstein coefficients, bisects them until the bound is tight
+   (0.1 % of the cap) or harmless, and maps each piece to the intervals its exact arc-length
+   range touches. Any other curve is sampled: an interval gets the smaller cap at its ends
+   minus a second-difference bound on a convex dip, and is resampled at 16 inner points
+   (with a golden-section search next to the lowest) where that dip is large, or where the
+   heading turned across it or a second-difference bound on ``|kappa|`` says the curvature
+   may peak inside. A sparse table answers "minimum cap over ``[s_a, s_b]``" in O(1).
 2. **Forward greedy** (compiled with numba). Steps of ``dt`` (20 ms) with a constant jerk
    ``u`` from ``{j, 0.75 j, ..., -j}`` plus the ``u`` that zeroes ``a`` (clamped at
    ``+-a_max``). A step is *safe* when the step and its **stop profile** (the time-optimal
@@ -35,8 +36,10 @@ Method
    also passes the *target* test when, for every local minimum of the cap within its stop
    distance, the time-optimal slow-down to that speed (with ``a = 0``) ends before it. The
    greedy takes the largest ``u`` passing both, else the largest safe one, else follows its
-   own (safe) stop profile. When only the end condition blocks it, one ruckig position call
-   to ``(L, v_end, 0)`` finishes the motion.
+   own (safe) stop profile; at rest it only considers ``u > 0`` (a zero jerk there would idle
+   forever). When only the end condition blocks it, one ruckig position call to
+   ``(L, v_end, 0)`` finishes the motion, its ``max_velocity`` the lowest cap ahead (or the
+   state's own peak speed when that call breaks the cap).
 3. **Compress.** Knots at the greedy's speed minima (states with ``a = 0``); between two
    knots one ruckig position call with ``max_velocity`` = the greedy's peak speed there
    (the greedy is feasible for that problem, so ruckig's time-optimal answer is never
@@ -45,8 +48,8 @@ Method
 
 The result is a chain of constant-jerk phases (:class:`trajopt.Trajectory`). Limits hold on
 dense samples: ``a`` and ``jerk`` exactly (ruckig and the greedy both clamp), the speed cap
-up to the grid resolution (relative 1e-4 margin, well inside the 0.1% tolerance the tests
-use). On the benchmark paths the durations are within a few percent of TOPP-RA's
+by construction of the table for polynomial curves (relative 1e-4 margin), and up to the
+sampling's resolution for other curves. On the benchmark paths the durations are within a few percent of TOPP-RA's
 jerk-free time-optimal answer (``benchmarks/bench_timing.py``).
 """
 
@@ -59,7 +62,8 @@ from typing import Any
 
 import numpy as np
 
-from trajopt.curve import ParametricCurve, _signed_curvature
+from trajopt.curvature_bound import interval_kappa_max
+from trajopt.curve import _STILL, ParametricCurve, _signed_curvature
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
 from trajopt.trajectory import Trajectory
@@ -163,7 +167,19 @@ def time_parameterize(
             f"v_end={v_end:.6g} m/s exceeds the speed cap {cap1:.6g} m/s at s=L={length:.6g} m "
             f"(curvature {kappa[-1]:.6g} 1/m)"
         )
-    ci = _interval_caps(raw, curve, robot, s_nodes, kappa, theta)
+    degree = getattr(curve, "polynomial_degree", None)
+    if degree is not None:
+        kmax = interval_kappa_max(curve, h, n_int, int(degree), robot.speed_cap)
+        ci = np.asarray(robot.speed_cap(kmax), dtype=float)
+        if not np.all(np.isfinite(kmax)):
+            i_inf = int(np.flatnonzero(~np.isfinite(kmax))[0])
+            raise TimingError(
+                f"the curvature is unbounded at s={i_inf * h:.6g} m (the parametric speed "
+                f"vanishes there: a cusp, or a zero-speed end where the curve turns): the "
+                f"speed cap is 0"
+            )
+    else:
+        ci = _interval_caps(raw, curve, robot, s_nodes, kappa, theta)
     v_bound = max(v_start, v_end)
     ci = np.maximum(ci * (1.0 - _CAP_MARGIN), np.minimum(ci, v_bound))
     ci[0] = max(ci[0], min(v_start, raw[0], raw[1]))
@@ -295,7 +311,11 @@ def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarra
     if type(curve).curvature is base.curvature and type(curve).heading is base.heading:
         d1 = np.asarray(curve(u, 1), dtype=float)
         kappa = _signed_curvature(d1, np.asarray(curve(u, 2), dtype=float))
-        return kappa, np.arctan2(d1[:, 1], d1[:, 0])
+        theta = np.arctan2(d1[:, 1], d1[:, 0])
+        still = np.hypot(d1[:, 0], d1[:, 1]) <= _STILL * curve._mean_speed()
+        if np.any(still):  # zero parametric speed: the limit of the tangent direction
+            theta[still] = curve.heading(u[still])
+        return kappa, theta
     return (
         np.asarray(curve.curvature(u), dtype=float),
         np.asarray(curve.heading(u), dtype=float),
@@ -495,8 +515,16 @@ def _finish(rk, g, st, lg, h, length, phases, bounds, v_end, jmax, amax):
         if s_b > length:
             continue
         v_pk = v_b + (a_b * a_b / (2.0 * jmax) if a_b > 0 else 0.0)
-        rows = rk.solve((s_b, v_b, a_b), target, max(v_pk, v_end))
-        if rows is None or not _rows_ok(g, st, lg, h, length, rows):
+        # the lowest cap ahead bounds a profile that holds the cap everywhere; the state's
+        # own peak speed is the fallback (from rest that peak is 0: never the only bound)
+        v_room = float(g.range_min(st, lg, h, s_b, length))
+        rows = None
+        for vmax in dict.fromkeys((max(v_room, v_pk, v_end), max(v_pk, v_end))):
+            rows = rk.solve((s_b, v_b, a_b), target, vmax)
+            if rows is not None and _rows_ok(g, st, lg, h, length, rows):
+                break
+            rows = None
+        if rows is None:
             continue
         rows = rows.copy()
         rows[:, 0] += t_b

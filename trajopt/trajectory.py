@@ -279,18 +279,24 @@ class Trajectory(_SampledExport):
         return s, v, a, j
 
     def _u_at_s(self, s: np.ndarray) -> np.ndarray:
-        """Curve parameter at arc length ``s``: the dense ``u_grid`` table plus one Newton
-        step on ``path.s_at_u`` (falls back to ``path.u_at_s`` without a table)."""
+        """Curve parameter at arc length ``s``: the dense ``u_grid`` table, then Newton steps
+        on ``path.s_at_u`` until they move ``u`` by less than 1e-12 of the domain (at most
+        6; near a sharp curvature peak the table's first guess can be 1e-5 of the domain
+        off). Falls back to ``path.u_at_s`` without a table."""
         path = self.path
         if self.u_grid.shape[0] < 2:
             return np.asarray(path.u_at_s(s))
         u = np.interp(s, self.theta_grid_s, self.u_grid)
-        sp = np.asarray(path.speed(u))
-        err = np.asarray(path.s_at_u(u)) - s
-        with np.errstate(divide="ignore", invalid="ignore"):
-            step = np.where(sp > 0, err / sp, 0.0)
         lo, hi = path.domain
-        return np.clip(u - step, lo, hi)
+        for _ in range(6):
+            sp = np.asarray(path.speed(u))
+            err = np.asarray(path.s_at_u(u)) - s
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = np.where(sp > 0, err / sp, 0.0)
+            u = np.clip(u - step, lo, hi)
+            if not np.any(np.abs(step) > 1e-12 * (hi - lo)):
+                break
+        return u
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample:
         """Evaluate the trajectory at times ``t`` (vectorised).

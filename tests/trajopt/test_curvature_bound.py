@@ -1,0 +1,113 @@
+"""Tests of trajopt.curvature_bound against hand derivations and dense sampling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+from scipy.integrate import cumulative_trapezoid
+
+from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.curvature_bound import interval_kappa_max, kappa_bound
+from trajopt.robot import Robot
+
+ROBOT = Robot(v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
+              wheel_v_max=None)  # fmt: skip
+
+
+def parabola() -> BSplineCurve:
+    """``c(u) = (u, u^2)`` on ``[-1, 1]``: a quadratic Bezier, ``kappa = 2 / (1 + 4u^2)^1.5``."""
+    t = np.array([-1.0, -1.0, -1.0, 1.0, 1.0, 1.0])
+    return BSplineCurve(t, np.array([[-1.0, 1.0], [0.0, -1.0], [1.0, 1.0]]), 2)
+
+
+def parabola_kappa(u):
+    return 2.0 / (1.0 + 4.0 * np.asarray(u) ** 2) ** 1.5
+
+
+@pytest.mark.parametrize("a,b", [(-0.1, 0.1), (0.2, 0.3), (-1.0, -0.5), (0.0, 1.0)])
+def test_parabola_bound_holds_and_tightens(a, b):
+    # |kappa| peaks at u = 0 (2 1/m) and falls off monotonically in |u|
+    exact = parabola_kappa(0.0 if a <= 0.0 <= b else min(abs(a), abs(b)))
+    c = parabola()
+    k = float(kappa_bound(c, np.array([a]), np.array([b]), 2)[0])
+    assert k >= exact * (1 - 1e-12)
+    # on 2^10 pieces the largest bound is within 1e-4 of the exact maximum
+    e = np.linspace(a, b, 1025)
+    kk = kappa_bound(c, e[:-1], e[1:], 2)
+    assert np.all(kk >= parabola_kappa(np.where(e[:-1] * e[1:] <= 0, 0.0,
+                                                 np.minimum(abs(e[:-1]), abs(e[1:])))) * (1 - 1e-12))  # fmt: skip
+    assert kk.max() == pytest.approx(exact, rel=1e-4)
+
+
+def _dense_max_per_interval(c: BSplineCurve, h: float, n: int) -> np.ndarray:
+    """Largest |kappa| per arc-length interval from 100 001 samples, arc length by the
+    trapezoid rule on the same samples (independent of the library's quadrature)."""
+    u = np.linspace(*c.domain, 100_001)
+    s = cumulative_trapezoid(c.speed(u), u, initial=0.0)
+    k = np.abs(c.curvature(u))
+    i = np.clip((s / h).astype(int), 0, n - 1)
+    out = np.zeros(n)
+    np.maximum.at(out, i, k)
+    return out
+
+
+@settings(max_examples=12, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])  # fmt: skip
+@given(
+    pts=st.lists(st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=9,
+                 unique=True),
+    degree=st.sampled_from([2, 3, 5]),
+)  # fmt: skip
+def test_grid_bounds_cover_dense_samples(pts, degree):
+    p = np.asarray(pts, dtype=float)
+    assume(len(p) > degree and np.min(np.hypot(*np.diff(p, axis=0).T)) > 0.2)
+    c = BSplineCurve(clamped_uniform_knots(len(p), degree), p, degree)
+    sp = c.speed(np.linspace(*c.domain, 2001))
+    assume(np.min(sp) > 0.05 * np.max(sp))
+    n = 400
+    h = c.length / n
+    kmax = interval_kappa_max(c, h, n, degree, ROBOT.speed_cap)
+    dense = _dense_max_per_interval(c, h, n)
+    # a rigorous bound: never below a sample (up to the trapezoid rule's arc-length error,
+    # which can move a sample into the neighbouring interval)
+    nb = np.maximum(kmax, np.maximum(np.r_[kmax[1:], 0.0], np.r_[0.0, kmax[:-1]]))
+    assert np.all(dense <= nb * (1 + 1e-9) + 1e-12)
+    # and a tight one where it matters: the cap of the bound within 0.2 % of the sampled cap
+    cap_b = ROBOT.speed_cap(kmax)
+    cap_d = ROBOT.speed_cap(
+        np.maximum(dense, np.maximum(np.r_[dense[1:], 0.0], np.r_[0.0, dense[:-1]]))
+    )
+    assert np.all(cap_b >= cap_d * (1 - 2e-3) - 1e-12)
+
+
+def test_zero_speed_end_with_collinear_points_has_its_finite_limit():
+    # P0 = P1, P2 and P3 on one line through P0: the curvature tends to a finite limit
+    p = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 1.0], [4.0, 1.0]])
+    c = BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
+    n = 200
+    kmax = interval_kappa_max(c, c.length / n, n, 3, ROBOT.speed_cap)
+    assert np.all(np.isfinite(kmax))
+    u = np.linspace(*c.domain, 200_001)[1:]
+    assert kmax.max() >= np.abs(c.curvature(u)).max() * (1 - 1e-9)
+
+
+def test_zero_speed_end_that_turns_is_unbounded():
+    p = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [2.0, 2.0]])
+    c = BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
+    n = 100
+    kmax = interval_kappa_max(c, c.length / n, n, 3, ROBOT.speed_cap)
+    assert np.isinf(kmax[0]) and np.all(np.isfinite(kmax[1:]))
+
+
+def test_a_cusp_is_unbounded():
+    # x = u^2, y = u^3 on [-1, 1]: c'(0) = 0 and the curve turns back on itself
+    t = np.array([-1.0] * 4 + [1.0] * 4)
+    # power basis (u^2, u^3) as a cubic Bezier on [-1, 1]
+    ctrl = np.array([[1.0, -1.0], [-1.0 / 3.0, 1.0], [-1.0 / 3.0, -1.0], [1.0, 1.0]])
+    c = BSplineCurve(t, ctrl, 3)
+    assert np.allclose(c(np.array([0.5]))[0], [0.25, 0.125])
+    n = 100
+    kmax = interval_kappa_max(c, c.length / n, n, 3, ROBOT.speed_cap)
+    assert np.isinf(kmax).sum() >= 1
