@@ -162,8 +162,11 @@ def main() -> None:
         return
     tb = np.array([x["boxes_s"] for x in rows]) * 1e3
     tp = np.array([x["poly_s"] for x in rows]) * 1e3
-    print(f"{len(rows)} paths of 100-300 cells on {len(maps)} maps (search={args.search}, "
-          f"best of {args.repeats}); {len(failures)} polygon failures")
+    used = list(dict.fromkeys(x["map"] for x in rows))
+    unused = [name for name, _, _ in maps if name not in used]
+    print(f"{len(rows)} paths of 100-300 cells on {len(used)} maps (search={args.search}, "
+          f"best of {args.repeats}); {len(failures)} polygon failures"
+          + (f"; no such path drawn on {', '.join(unused)}" if unused else ""))
     print(f"{'':28}{'boxes':>10}{'polygons':>10}{'ratio':>8}")
     for q, label in ((50, "build median (ms)"), (95, "build p95 (ms)"), (100, "build max (ms)")):
         a, b = np.percentile(tb, q), np.percentile(tp, q)
