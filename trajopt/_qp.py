@@ -183,11 +183,14 @@ def h_nonzeros(band: np.ndarray, nb: int, p: int) -> np.ndarray:
 class ConstraintLayout:
     """Rows of the linear constraints ``lba <= A z <= uba`` for ``nb`` padded control
     points (``z = [x_0..x_{nb-1}, y_0..y_{nb-1}]``, then with ``m > 0`` one slack per
-    curvature sample) and ``m`` curvature samples per span.
+    curvature sample), ``m`` curvature samples per span and ``k`` region rows per control
+    point.
 
     Rows, in order: the :data:`N_HEADING_ROWS` heading rows (dense); for every control
-    point ``i`` the rows ``x_i + y_i`` and ``x_i - y_i`` (the 45-degree bounds of bridge
-    regions); then, for every sample ``r`` (``S = (nb - p) * m``, span ``r // m``), the
+    point ``i`` its ``k`` region rows ``a_x x_i + a_y y_i`` (box corridors: ``k = 2``, the
+    rows ``x_i + y_i`` and ``x_i - y_i`` of the 45-degree bounds of bridge regions;
+    polygon corridors: the half-planes of the regions of the point's spans, unused rows
+    with zero coefficients and infinite bounds); then, for every sample ``r`` (``S = (nb - p) * m``, span ``r // m``), the
     rows ``curvature+``, ``curvature-`` and ``speed`` of the sequential convex programme
     (each over the ``2 (p + 1)`` coordinates of the span's control points and the sample's
     slack, with coefficients -1, -1 and +1: an exact l1 penalty keeps every QP feasible).
@@ -196,6 +199,7 @@ class ConstraintLayout:
     nb: int
     p: int
     m: int
+    k: int
     n_rows: int
     sparsity: object
     #: CCS non-zero k takes triplet value ``nz_from_triplet[k]``
@@ -211,22 +215,28 @@ class ConstraintLayout:
 
     @property
     def sample_row0(self) -> int:
-        return N_HEADING_ROWS + 2 * self.nb
+        return N_HEADING_ROWS + self.k * self.nb
 
     def values(
-        self, heading: np.ndarray, sample_vals: np.ndarray | None = None
+        self,
+        heading: np.ndarray,
+        sample_vals: np.ndarray | None = None,
+        region_coef: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Triplet values of ``A`` from the dense heading rows (4, 2nb) and the sample
-        rows' coefficients (S, 3, 2 (p + 1)): ``[x_j..x_{j+p}, y_j..y_{j+p}]`` per row."""
+        """Triplet values of ``A`` from the dense heading rows (4, 2nb), the sample rows'
+        coefficients (S, 3, 2 (p + 1)): ``[x_j..x_{j+p}, y_j..y_{j+p}]`` per row, and the
+        region rows' coefficients ``(a_x, a_y)`` (nb, k, 2) (default, for ``k = 2``: the
+        rows ``x + y`` and ``x - y``)."""
         nb = self.nb
         trip = np.empty(self.n_triplets)
         k = N_HEADING_ROWS * 2 * nb
         trip[:k] = heading.ravel()
-        diag = np.empty((nb, 4))
-        diag[:, 0] = diag[:, 1] = diag[:, 2] = 1.0
-        diag[:, 3] = -1.0
-        trip[k : k + 4 * nb] = diag.ravel()
-        k += 4 * nb
+        if region_coef is None:
+            if self.k != 2:
+                raise ValueError(f"region_coef is required for k = {self.k} region rows")
+            region_coef = np.broadcast_to(np.array([[1.0, 1.0], [1.0, -1.0]]), (nb, 2, 2))
+        trip[k : k + 2 * self.k * nb] = np.asarray(region_coef, dtype=float).ravel()
+        k += 2 * self.k * nb
         if self.m:
             rows = trip[k:].reshape(self.n_samples, 3, 2 * (self.p + 1) + 1)
             rows[:, :, :-1] = 0.0 if sample_vals is None else sample_vals
@@ -258,9 +268,9 @@ class ConstraintLayout:
 
 
 @functools.lru_cache(maxsize=128)
-def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
-    """The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p`` and
-    ``m`` curvature samples per span (0: no sample rows)."""
+def constraint_layout(nb: int, p: int, m: int, k: int = 2) -> ConstraintLayout:
+    """The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p``, ``m``
+    curvature samples per span (0: no sample rows) and ``k`` region rows per control point."""
     import casadi as ca
 
     rows: list[np.ndarray] = []
@@ -270,10 +280,11 @@ def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
         rows.append(np.full(2 * nb, r))
         cols.append(cols2)
     i = np.arange(nb)
-    r0 = N_HEADING_ROWS + 2 * i
-    rows.append(np.column_stack([r0, r0, r0 + 1, r0 + 1]).ravel())
-    cols.append(np.column_stack([i, nb + i, i, nb + i]).ravel())
-    n_rows = N_HEADING_ROWS + 2 * nb
+    # region row j of point i: row N_HEADING_ROWS + k i + j, columns x_i and y_i
+    r0 = N_HEADING_ROWS + k * i[:, None] + np.arange(k)[None, :]
+    rows.append(np.repeat(r0.ravel(), 2))
+    cols.append(np.column_stack([np.repeat(i, k), np.repeat(nb + i, k)]).ravel())
+    n_rows = N_HEADING_ROWS + k * nb
     n_cols = 2 * nb
     if m:
         S = (nb - p) * m
@@ -298,6 +309,7 @@ def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
         nb=nb,
         p=p,
         m=m,
+        k=k,
         n_rows=n_rows,
         sparsity=sp,
         nz_from_triplet=np.asarray(mapping, dtype=np.int64),
@@ -308,14 +320,14 @@ def constraint_layout(nb: int, p: int, m: int) -> ConstraintLayout:
 
 
 @functools.lru_cache(maxsize=128)
-def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool):
+def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool, k: int = 2):
     """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
-    with the banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m)``; built
-    once per ``(nb, p, solver, m)``."""
+    with the banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m, k)``;
+    built once per ``(nb, p, solver, m, k)``."""
     import casadi as ca
 
     sp_h = qp_layout(nb, p)[0]
-    layout = constraint_layout(nb, p, m)
+    layout = constraint_layout(nb, p, m, k)
     sp_a = layout.sparsity
     if m:  # slack columns: no Hessian entries
         extra = layout.n_samples
@@ -341,7 +353,7 @@ def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool):
         opts["print_time"] = False
         opts["print_problem"] = False
     with _LOCK:
-        return ca.conic(f"smoother_qp_{m}", solver, {"h": sp_h, "a": sp_a}, opts)
+        return ca.conic(f"smoother_qp_{m}_{k}", solver, {"h": sp_h, "a": sp_a}, opts)
 
 
 @functools.lru_cache(maxsize=32)

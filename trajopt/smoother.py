@@ -50,6 +50,7 @@ from trajopt.bspline import BSplineCurve
 from trajopt.corridor import Corridor
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.polygon_corridor import CLEARANCE_TOL_M, PolygonCorridor
 
 __all__ = ["Smoother", "SmoothPath", "Certificate"]
 
@@ -59,6 +60,8 @@ QPSolver = Literal["osqp", "piqp", "ipopt"]
 _QP_SOLVERS = ("osqp", "piqp", "ipopt")
 CurvatureSolver = Literal["scp", "ipopt"]
 _CURVATURE_SOLVERS = ("scp", "ipopt")
+_OBJECTIVES = ("auto", "fidelity", "taut")
+Objective = Literal["auto", "fidelity", "taut"]
 
 
 # ----------------------------------------------------------------------- values
@@ -220,6 +223,18 @@ class Smoother:
         the sampled bound tightened by the excess found.
     samples_per_cell : int, optional
         Certificate sampling density along ``u`` (samples per cell). Default 8.
+    objective : {"auto", "fidelity", "taut"}, optional
+        ``"fidelity"``: least squares to the path points plus the smoothness term (the
+        chapter's fit, regularised). ``"taut"``: the smoothness term plus a length term
+        ``taut_length_weight * integral |C'|^2`` (shortest at constant speed: a straight,
+        evenly paced line) with the path points only as a weak regulariser
+        (``taut_fidelity_weight`` each), so the curve is pulled taut inside the corridor
+        instead of towards a staircase of cells. ``"auto"`` (default): ``"taut"`` in a
+        polygon corridor, ``"fidelity"`` in a box corridor.
+    taut_fidelity_weight : float, optional
+        Weight of each path point in the taut objective (>= 0). Default 0.02.
+    taut_length_weight : float, optional
+        Weight of the length term in the taut objective (>= 0), in cell units. Default 2.
     verbose : bool, optional
         Let the solvers print. Default False.
     """
@@ -237,6 +252,9 @@ class Smoother:
     time_budget_s: float = 5.0
     max_attempts: int = 3
     samples_per_cell: int = 8
+    objective: Objective = "auto"
+    taut_fidelity_weight: float = 0.02
+    taut_length_weight: float = 2.0
     verbose: bool = False
 
     def __post_init__(self) -> None:
@@ -280,6 +298,12 @@ class Smoother:
             raise InvalidInputError(
                 f"samples_per_cell must be an integer >= 2, got {self.samples_per_cell!r}"
             )
+        if self.objective not in _OBJECTIVES:
+            raise InvalidInputError(
+                f"objective must be one of {_OBJECTIVES}, got {self.objective!r}"
+            )
+        _check_float("taut_fidelity_weight", self.taut_fidelity_weight, lo=0.0)
+        _check_float("taut_length_weight", self.taut_length_weight, lo=0.0)
 
     # ----------------------------------------------------------------- public
     def fit(
@@ -329,43 +353,82 @@ class Smoother:
         """
         _warm_imports()  # one-off module imports do not count against the time budget
         t_call = time.perf_counter()
-        if not isinstance(corridor, Corridor):
-            raise InvalidInputError(f"corridor must be a Corridor, got {type(corridor).__name__}")
+        polygons = isinstance(corridor, PolygonCorridor)
+        if not (polygons or isinstance(corridor, Corridor)):
+            raise InvalidInputError(
+                f"corridor must be a Corridor or a PolygonCorridor, got {type(corridor).__name__}"
+            )
+        if polygons and "ipopt" in (self.qp_solver, self.curvature_solver):
+            raise InvalidInputError(
+                "qp_solver='ipopt' and curvature_solver='ipopt' take box corridors only; a "
+                "PolygonCorridor is solved by piqp or osqp (and the SCP)"
+            )
         res = corridor.resolution
         origin = np.asarray(corridor.origin, dtype=float)
-        targets = _targets(grid_path_or_points, corridor)
         rad = corridor.radius if radius is None else float(radius)
         if radius is not None and not (math.isfinite(rad) and rad >= 0):
             raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
         if raw_grid is not None and rad is None:
             raise InvalidInputError("radius is required (or corridor.radius) with raw_grid")
-        p0 = _point("start", start, targets[0])
-        p1 = _point("goal", goal, targets[-1])
-        b0, b1 = corridor.boxes[0], corridor.boxes[-1]
-        if not b0.contains(p0):
-            raise InvalidInputError(f"start {p0.tolist()} m must lie in the first box {b0}")
-        if not b1.contains(p1):
-            raise InvalidInputError(f"goal {p1.tolist()} m must lie in the last box {b1}")
         hs = _heading("start_heading", start_heading)
         hg = _heading("goal_heading", goal_heading)
         if corridor.length_m <= 0:
             raise InvalidInputError("the corridor's path has zero length (start == goal)")
-
-        prob = _Problem(
-            targets=(targets - origin) / res,
-            u=corridor.path_s / res,
-            lo=(corridor.lower - origin) / res,
-            hi=(corridor.upper - origin) / res,
-            dlo=(corridor.diag_lower - _sd(origin)) / res,
-            dhi=(corridor.diag_upper - _sd(origin)) / res,
-            trans=corridor.transitions_m / res,
-            overlap=(corridor.overlap_end_m - corridor.overlap_start_m) / res,
-            start=(p0 - origin) / res,
-            goal=(p1 - origin) / res,
-            start_dir=None if hs is None else np.array([math.cos(hs), math.sin(hs)]),
-            goal_dir=None if hg is None else np.array([math.cos(hg), math.sin(hg)]),
-            res=res,
-        )
+        taut = self.objective == "taut" or (self.objective == "auto" and polygons)
+        if polygons:
+            targets, u_m = _polygon_targets(corridor)
+            p0 = _point("start", start, corridor.path[0])
+            p1 = _point("goal", goal, corridor.path[-1])
+            for name, pt, k in (("start", p0, 0), ("goal", p1, len(corridor.regions) - 1)):
+                reg = corridor.regions[k]
+                if not bool(reg.contains(pt[None, :], tol=CLEARANCE_TOL_M)[0]):
+                    raise InvalidInputError(
+                        f"{name} {pt.tolist()} m must lie in the corridor's region {k} "
+                        f"(vertices {np.round(reg.vertices, 6).tolist()} m)"
+                    )
+            rows, lo_r, hi_r = _region_rows(corridor, origin, res)
+            prob = _Problem(
+                targets=(targets - origin) / res,
+                u=u_m / res,
+                lo=lo_r,
+                hi=hi_r,
+                dlo=np.full((len(rows), 2), -np.inf),
+                dhi=np.full((len(rows), 2), np.inf),
+                trans=corridor.transitions_m / res,
+                overlap=(corridor.overlap_s[:, 1] - corridor.overlap_s[:, 0]) / res,
+                start=(p0 - origin) / res,
+                goal=(p1 - origin) / res,
+                start_dir=None if hs is None else np.array([math.cos(hs), math.sin(hs)]),
+                goal_dir=None if hg is None else np.array([math.cos(hg), math.sin(hg)]),
+                res=res,
+                rows=rows,
+                taut=taut,
+            )
+        else:
+            targets = _targets(grid_path_or_points, corridor)
+            p0 = _point("start", start, targets[0])
+            p1 = _point("goal", goal, targets[-1])
+            b0, b1 = corridor.boxes[0], corridor.boxes[-1]
+            if not b0.contains(p0):
+                raise InvalidInputError(f"start {p0.tolist()} m must lie in the first box {b0}")
+            if not b1.contains(p1):
+                raise InvalidInputError(f"goal {p1.tolist()} m must lie in the last box {b1}")
+            prob = _Problem(
+                targets=(targets - origin) / res,
+                u=corridor.path_s / res,
+                lo=(corridor.lower - origin) / res,
+                hi=(corridor.upper - origin) / res,
+                dlo=(corridor.diag_lower - _sd(origin)) / res,
+                dhi=(corridor.diag_upper - _sd(origin)) / res,
+                trans=corridor.transitions_m / res,
+                overlap=(corridor.overlap_end_m - corridor.overlap_start_m) / res,
+                start=(p0 - origin) / res,
+                goal=(p1 - origin) / res,
+                start_dir=None if hs is None else np.array([math.cos(hs), math.sin(hs)]),
+                goal_dir=None if hg is None else np.array([math.cos(hg), math.sin(hg)]),
+                res=res,
+                taut=taut,
+            )
         attempts: list[dict[str, Any]] = []
         h = float(self.span_cells)
         margin = self.kappa_margin
@@ -507,9 +570,15 @@ class Smoother:
         lo[-1] = hi[-1] = prob.goal
         dlo[[0, -1]] = -np.inf  # the fixed ends were checked against their regions
         dhi[[0, -1]] = np.inf
-        band, g, const = _objective(
-            prob.targets, prob.u, t, p, n, self.smoothness_weight, self.smoothness_order
-        )
+        if prob.taut:
+            band, g, const = _objective(
+                prob.targets, prob.u, t, p, n, self.smoothness_weight, self.smoothness_order,
+                fidelity=self.taut_fidelity_weight, length=self.taut_length_weight,
+            )  # fmt: skip
+        else:
+            band, g, const = _objective(
+                prob.targets, prob.u, t, p, n, self.smoothness_weight, self.smoothness_order
+            )
         band[0] += 1e-9 * (1.0 + band[0].max())  # keeps the Hessian definite
         full = np.zeros((p + 1, nb))
         full[:, :n] = band[:, :n]
@@ -519,7 +588,13 @@ class Smoother:
         lbx[:n], lbx[nb : nb + n] = lo[:, 0], lo[:, 1]
         ubx[:n], ubx[nb : nb + n] = hi[:, 0], hi[:, 1]
         heading, lba, uba = _heading_rows(prob, n, nb)
-        rlb, rub = _diag_row_bounds(dlo, dhi, nb)
+        point_rows = None
+        if prob.rows is None:
+            k_rows, coef = 2, None
+            rlb, rub = _diag_row_bounds(dlo, dhi, nb)
+        else:
+            point_rows = _point_rows(prob.rows, span_box, n, p)
+            k_rows, coef, rlb, rub = _pack_point_rows(point_rows, nb)
         lba = np.concatenate([lba, rlb])
         uba = np.concatenate([uba, rub])
         x0 = np.zeros(2 * nb)
@@ -531,7 +606,7 @@ class Smoother:
                 guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n]
             )
         qp = _QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx, heading=heading,
-                     lba=lba, uba=uba)
+                     lba=lba, uba=uba, k=k_rows, region_coef=coef)
         if warm is None:
             z, info = self._solve_qp(qp, remaining, x0=x0)
         else:
@@ -575,7 +650,7 @@ class Smoother:
                 )
             z = np.clip(z, lbx, ubx)
         c = np.column_stack([z[:n], z[nb : nb + n]])
-        _project_heading(c, prob, lo, hi)
+        _project_heading(c, prob, lo, hi, point_rows)
         zx, zy = c[:, 0], c[:, 1]
         cost = 0.0
         for d in range(p + 1):
@@ -594,11 +669,11 @@ class Smoother:
         if x0 is None:
             x0 = np.zeros(2 * nb)
         tb = time.perf_counter()
-        built = _is_cached(f"{solver_name}-0", nb, p, self.verbose)
+        built = _is_cached(f"{solver_name}-0-{qp.k}", nb, p, self.verbose)
         if solver_name == "ipopt":
             solver = _qp.qp_ipopt(nb, p, self.verbose)
         else:
-            solver = _qp.qp_solver(nb, p, solver_name, 0, self.verbose)
+            solver = _qp.qp_solver(nb, p, solver_name, 0, self.verbose, qp.k)
         build = 0.0 if built else time.perf_counter() - tb
         ts = time.perf_counter()
         tc = time.process_time()
@@ -608,9 +683,9 @@ class Smoother:
         else:
             import casadi as ca
 
-            layout = _qp.constraint_layout(nb, p, 0)
+            layout = _qp.constraint_layout(nb, p, 0, qp.k)
             hnz = _qp.h_nonzeros(qp.full, nb, p)
-            trip = layout.values(qp.heading)
+            trip = layout.values(qp.heading, None, qp.region_coef)
             if solver_name == "piqp":
                 # piqp warns about (and drops) infinite rows, and large finite ones hurt
                 # its conditioning: bound every row by its range over the variable bounds
@@ -641,7 +716,7 @@ class Smoother:
         """One SCP QP over the working set ``work`` (bool per sample) of curvature samples,
         by :func:`_qp.solve_working_set`; ``vals`` holds every sample's row coefficients."""
         S = layout.n_samples
-        trip = layout.values(qp.heading, vals)
+        trip = layout.values(qp.heading, vals, qp.region_coef)
         lbx_s = np.concatenate([lbx, np.zeros(S)])
         ubx_s = np.concatenate([ubx, np.full(S, _SLACK_MAX)])
         ts = time.perf_counter()
@@ -720,8 +795,8 @@ class Smoother:
         idx = span[:, None] + np.arange(p + 1)[None, :]
         kb = margin * kmax
         floor = self.speed_floor
-        layout = _qp.constraint_layout(nb, p, ms)
-        n_fixed = _qp.N_HEADING_ROWS + 2 * nb
+        layout = _qp.constraint_layout(nb, p, ms, qp.k)
+        n_fixed = layout.sample_row0
         lba = np.full(n_fixed + 3 * S, -np.inf)
         uba = np.full(n_fixed + 3 * S, np.inf)
         lba[:n_fixed] = qp.lba
@@ -948,6 +1023,11 @@ class _AttemptFailed(Exception):
 
 @dataclass(slots=True)
 class _Problem:
+    """One fit in cell units: targets at parameters ``u``, per-region bounds (``lo``,
+    ``hi``: the box, or a polygon's bounding box; ``dlo``, ``dhi``: the bounds of ``x + y``
+    and ``x - y``) and, for polygon corridors, each region's half-planes ``rows``
+    (``(A, b)`` with ``A @ c <= b``, cells)."""
+
     targets: np.ndarray
     u: np.ndarray
     lo: np.ndarray
@@ -961,6 +1041,8 @@ class _Problem:
     start_dir: np.ndarray | None
     goal_dir: np.ndarray | None
     res: float = 1.0
+    rows: list[tuple[np.ndarray, np.ndarray]] | None = None
+    taut: bool = False
 
 
 @dataclass(slots=True)
@@ -974,8 +1056,10 @@ class _QPData:
     lbx: np.ndarray
     ubx: np.ndarray
     heading: np.ndarray  # heading rows, shape (4, 2 nb)
-    lba: np.ndarray  # bounds of the heading and diagonal rows, shape (4 + 2 nb,)
+    lba: np.ndarray  # bounds of the heading and region rows, shape (4 + k nb,)
     uba: np.ndarray
+    k: int = 2  # region rows per control point
+    region_coef: np.ndarray | None = None  # their (a_x, a_y), shape (nb, k, 2); None: x +- y
 
 
 def _sd(xy: np.ndarray) -> np.ndarray:
@@ -1050,6 +1134,82 @@ def _diag_row_bounds(dlo: np.ndarray, dhi: np.ndarray, nb: int):
     hi[thin] = mid
     lb[:n], ub[:n] = lo, hi
     return lb.ravel(), ub.ravel()
+
+
+#: polygon rows are imposed this far (cells) inside their half-planes, so that solver
+#: tolerances never put a control point outside its region
+_POLY_MARGIN = 1e-6
+#: region rows per control point are padded to one of these counts (cached solvers)
+_K_SIZES = (4, 8, 12, 16, 24, 32, 48, 64)
+
+
+def _polygon_targets(corridor: PolygonCorridor) -> tuple[np.ndarray, np.ndarray]:
+    """The corridor's path sampled about once per cell: points (m) and their arc lengths."""
+    res = corridor.resolution
+    s_v = np.asarray(corridor.path_s, dtype=float)
+    pts = np.asarray(corridor.path, dtype=float)
+    s = np.unique(np.concatenate([np.arange(0.0, s_v[-1], res), s_v]))
+    xy = np.column_stack([np.interp(s, s_v, pts[:, 0]), np.interp(s, s_v, pts[:, 1])])
+    return xy, s
+
+
+def _region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
+    """Each region's rows ``lo <= A c <= hi`` in cells (``A`` (q, 2), ``lo``, ``hi``
+    (q,)), ``_POLY_MARGIN`` inside, and the regions' bounding boxes (cells, (m, 2) each).
+
+    A degenerate region's line (its first two, opposite rows) becomes one two-sided row."""
+    out = []
+    lo_b = np.empty((len(corridor.regions), 2))
+    hi_b = np.empty((len(corridor.regions), 2))
+    for k, reg in enumerate(corridor.regions):
+        A = np.asarray(reg.A, dtype=float)
+        b = (np.asarray(reg.b, dtype=float) - A @ origin) / res
+        v = (np.asarray(reg.vertices, dtype=float) - origin) / res
+        lo_b[k], hi_b[k] = v.min(axis=0), v.max(axis=0)
+        if reg.degenerate:
+            mid = 0.5 * (b[0] - b[1])
+            rows_a = np.vstack([A[:1], A[2:]])
+            rlo = np.concatenate([[mid], np.full(len(A) - 2, -np.inf)])
+            rhi = np.concatenate([[mid], b[2:] - _POLY_MARGIN])
+        else:
+            rows_a = A
+            rlo = np.full(len(A), -np.inf)
+            rhi = b - _POLY_MARGIN
+        out.append((rows_a, rlo, rhi))
+    return out, lo_b, hi_b
+
+
+def _point_rows(rows, span_box: np.ndarray, n: int, p: int):
+    """Rows ``(A, lo, hi)`` of every control point: those of the regions of the spans it
+    touches (the fixed end points get none: they were checked against their regions)."""
+    ns = len(span_box)
+    empty = (np.zeros((0, 2)), np.zeros(0), np.zeros(0))
+    out = [empty] * n
+    for i in range(1, n - 1):
+        regs = np.unique(span_box[max(0, i - p) : min(ns - 1, i) + 1])
+        parts = [rows[r] for r in regs]
+        out[i] = (
+            np.vstack([q[0] for q in parts]),
+            np.concatenate([q[1] for q in parts]),
+            np.concatenate([q[2] for q in parts]),
+        )
+    return out
+
+
+def _pack_point_rows(point_rows, nb: int):
+    """Region rows padded to ``k`` per point: ``(k, coef (nb, k, 2), lb, ub)`` (flat, in
+    the layout's order); unused rows have zero coefficients and infinite bounds."""
+    most = max((len(r[1]) for r in point_rows), default=0)
+    k = next((s for s in _K_SIZES if s >= most), int(8 * math.ceil(most / 8)))
+    coef = np.zeros((nb, k, 2))
+    lb = np.full((nb, k), -np.inf)
+    ub = np.full((nb, k), np.inf)
+    for i, (A, rlo, rhi) in enumerate(point_rows):
+        q = len(rlo)
+        coef[i, :q] = A
+        lb[i, :q] = rlo
+        ub[i, :q] = rhi
+    return k, coef, lb.ravel(), ub.ravel()
 
 
 _BUILT: set[tuple] = set()
@@ -1176,22 +1336,25 @@ def graded_knots(
     return t, np.concatenate(boxes).astype(np.int64)
 
 
-def _objective(pts, u, t, p, n, weight, order):
+def _objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
     """Upper band of ``H`` (one coordinate block), ``g`` (2n: x then y, padded layout
     resolved later) and the constant, for ``1/2 z'Hz + g'z + const`` =
-    ``sum |C(u_r) - p_r|^2 + weight * integral |C^(order)|^2``."""
+    ``fidelity * sum |C(u_r) - p_r|^2 + weight * integral |C^(order)|^2
+    + length * integral |C'|^2``."""
     span = _qp.find_spans(t, p, n, u)
     vals = _qp.basis_derivs(t, p, span, u, 0)
-    band = 2.0 * _qp.band_gram(span, vals, np.ones(len(u)), n)
+    band = 2.0 * fidelity * _qp.band_gram(span, vals, np.ones(len(u)), n)
     if weight > 0:
         band += 2.0 * weight * _qp.smoothness_band(t, p, n, order)
-    rhs = _qp.band_rhs(span, vals, pts, n)
+    if length > 0:
+        band += 2.0 * length * _qp.smoothness_band(t, p, n, 1)
+    rhs = fidelity * _qp.band_rhs(span, vals, pts, n)
     g = np.zeros(2 * n)
     nb = _qp.bucket_size(n)
     g = np.zeros(2 * nb)
     g[:n] = -2.0 * rhs[:, 0]
     g[nb : nb + n] = -2.0 * rhs[:, 1]
-    const = float(np.sum(pts * pts))
+    const = fidelity * float(np.sum(pts * pts))
     return band, g, const
 
 
@@ -1218,9 +1381,12 @@ def _heading_rows(prob: _Problem, n: int, nb: int):
     return amat, lba, uba
 
 
-def _project_heading(c: np.ndarray, prob: _Problem, lo: np.ndarray, hi: np.ndarray) -> None:
+def _project_heading(
+    c: np.ndarray, prob: _Problem, lo: np.ndarray, hi: np.ndarray, point_rows=None
+) -> None:
     """Put ``c_1`` (``c_{n-2}``) exactly on the start (reversed goal) heading ray, inside
-    its bounds, at least ``1e-3`` cells from the end point when the bounds allow it."""
+    its bounds (and its region rows ``lo <= A c <= hi`` in a polygon corridor), at least
+    ``1e-3`` cells from the end point when the bounds allow it."""
     ends = []
     if prob.start_dir is not None:
         ends.append((1, prob.start, prob.start_dir))
@@ -1234,6 +1400,16 @@ def _project_heading(c: np.ndarray, prob: _Problem, lo: np.ndarray, hi: np.ndarr
                 t2 = (hi[idx, ax] - end[ax]) / d[ax]
                 a_lo = max(a_lo, min(t1, t2))
                 a_hi = min(a_hi, max(t1, t2))
+        if point_rows is not None:  # A (end + a d) in [rlo, rhi]
+            A, rlo, rhi = point_rows[idx]
+            ad = A @ d
+            ae = A @ end
+            for q in range(len(ad)):
+                if abs(ad[q]) > 1e-15:
+                    t1 = (rlo[q] - ae[q]) / ad[q]
+                    t2 = (rhi[q] - ae[q]) / ad[q]
+                    a_lo = max(a_lo, min(t1, t2))
+                    a_hi = min(a_hi, max(t1, t2))
         a = float(np.dot(c[idx] - end, d))
         a = min(max(a, a_lo, min(1e-3, a_hi)), a_hi)
         c[idx] = np.clip(end + a * d, lo[idx], hi[idx])
@@ -1326,15 +1502,21 @@ def certify(
     k = curve.k
     c = curve.c
     ns = len(c) - k
-    lo = corridor.lower[span_box]
-    hi = corridor.upper[span_box]
-    dlo = corridor.diag_lower[span_box]
-    dhi = corridor.diag_upper[span_box]
     inside = True
-    for off in range(k + 1):
-        cp = c[off : off + ns]
-        sd = np.column_stack([cp[:, 0] + cp[:, 1], cp[:, 0] - cp[:, 1]])
-        inside &= bool(np.all((cp >= lo) & (cp <= hi) & (sd >= dlo) & (sd <= dhi)))
+    if isinstance(corridor, PolygonCorridor):
+        # span j lies in the convex hull of c_j .. c_{j+k}: all of them in its polygon
+        for j in range(ns):
+            reg = corridor.regions[int(span_box[j])]
+            inside &= bool(np.all(reg.contains(c[j : j + k + 1], tol=CLEARANCE_TOL_M)))
+    else:
+        lo = corridor.lower[span_box]
+        hi = corridor.upper[span_box]
+        dlo = corridor.diag_lower[span_box]
+        dhi = corridor.diag_upper[span_box]
+        for off in range(k + 1):
+            cp = c[off : off + ns]
+            sd = np.column_stack([cp[:, 0] + cp[:, 1], cp[:, 0] - cp[:, 1]])
+            inside &= bool(np.all((cp >= lo) & (cp <= hi) & (sd >= dlo) & (sd <= dhi)))
     if not inside:
         failures.append("control_points_in_boxes")
     u0, u1 = curve.domain

@@ -237,6 +237,7 @@ MAPS = (
     "random512-40-5",
     "maze512-1-0",
     "Boston_0_1024",
+    "AR0046SR",
 )
 LARGE_CELLS = 50_000  # maps with more cells are sampled (256^2, 512^2 and 1024^2 here)
 FAST_SAMPLE = 24  # per large map in the default run
@@ -292,7 +293,7 @@ def test_movingai_optimal_lengths(shared_data, name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    "name", [m for m in MAPS if m.startswith(("Berlin", "random", "maze", "Boston"))]
+    "name", [m for m in MAPS if m.startswith(("Berlin", "random", "maze", "Boston", "AR"))]
 )
 def test_movingai_optimal_lengths_full_sample(shared_data, name):
     """At least 200 scenarios per large map, the longest bucket included (slow: ~10 s/map)."""
