@@ -106,7 +106,7 @@ def interval_kappa_max(
 
     k_free = _free_curvature(speed_cap)
     k_b = kappa_bound(curve, a, b, degree, flip, k_free)
-    k_s = _sampled_kappa(curve, a, b, flip)
+    k_s = _sampled_kappa(curve, a, b)
     split = _to_split(k_b, k_s, sb - sa, h, k_free, speed_cap, rtol)
     work = a.size
     done = [(a[~split], b[~split], sa[~split], sb[~split], np.maximum(k_b, k_s)[~split])]
@@ -122,7 +122,7 @@ def interval_kappa_max(
         sb = np.concatenate([smid, lsb])
         flip = np.concatenate([np.where(lf == 1, 1, 0), np.where(lf == -1, -1, 0)]).astype(np.int8)
         k_b = kappa_bound(curve, a, b, degree, flip, k_free)
-        k_s = _sampled_kappa(curve, a, b, flip)
+        k_s = _sampled_kappa(curve, a, b)
         work += a.size
         split = _to_split(k_b, k_s, sb - sa, h, k_free, speed_cap, rtol)
         done.append((a[~split], b[~split], sa[~split], sb[~split], np.maximum(k_b, k_s)[~split]))
@@ -167,12 +167,12 @@ def _loose(bound, ref, speed_cap, rtol) -> np.ndarray:
     return cap_b < cap_r * (1.0 - rtol)
 
 
-def _sampled_kappa(curve, a, b, flip) -> np.ndarray:
-    """``|kappa|`` at both ends and the middle of each interval (the zero-speed end of a
-    flipped interval is replaced by a point a hundredth of the way in)."""
-    ua = np.where(flip == 1, a + 0.01 * (b - a), a)
-    ub = np.where(flip == -1, b - 0.01 * (b - a), b)
-    u = np.stack([ua, 0.5 * (a + b), ub])
+def _sampled_kappa(curve, a, b) -> np.ndarray:
+    """``|kappa|`` at three interior points of each interval (a hundredth of the way in from
+    either end, and the middle): a lower bound of its maximum there. Interior points keep
+    every sample on the interval's own polynomial piece (at a knot a curve reports the next
+    piece's curvature, and a zero-speed end has none)."""
+    u = np.stack([a + 0.01 * (b - a), 0.5 * (a + b), b - 0.01 * (b - a)])
     d1 = np.asarray(curve(u, 1), dtype=float)
     d2 = np.asarray(curve(u, 2), dtype=float)
     cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]

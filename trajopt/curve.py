@@ -44,8 +44,9 @@ class ParametricCurve(ABC):
 
     Subclasses implement :attr:`domain` and :meth:`__call__`. Arc-length quantities are
     computed once, lazily, by 5-point Gauss-Legendre quadrature on a fine partition of
-    the domain (``breakpoints`` refined ``_ARC_SUBDIVISIONS`` times) and a cubic Hermite
-    model of ``s(u)`` between the nodes.
+    the domain (``breakpoints`` refined ``_ARC_SUBDIVISIONS`` times, and bisected further
+    where the quadrature has not converged, next to near-cusps) and a cubic Hermite model of
+    ``s(u)`` between the nodes.
     """
 
     _ARC_SUBDIVISIONS = 16
@@ -132,16 +133,39 @@ class ParametricCurve(ABC):
                 [np.linspace(a, b, m, endpoint=False) for a, b in zip(bp[:-1], bp[1:], strict=True)]
                 + [bp[-1:]]
             )
-            a, b = fine[:-1], fine[1:]
-            half = 0.5 * (b - a)
-            mid = 0.5 * (a + b)
-            q = mid[:, None] + half[:, None] * _GL_X[None, :]
-            seg = half * (self.speed(q) @ _GL_W)
+            fine, seg = self._refined_partition(fine)
             s_nodes = np.concatenate([[0.0], np.cumsum(seg)])
             v_nodes = self.speed(fine)
             table = (fine, s_nodes, v_nodes)
             object.__setattr__(self, "_arc_cache", table)
         return table
+
+    def _refined_partition(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Bisect the intervals of ``nodes`` where the quadrature of ``|c'|`` on the two
+        halves differs from that on the whole by more than ``1e-13`` of the curve's length
+        (a near-cusp, where the speed has a sharp minimum), up to 12 times; returns the
+        nodes and the length of every interval."""
+        a, b = nodes[:-1], nodes[1:]
+        seg = self._gl(a, b)
+        total = max(float(seg.sum()), 1e-300)
+        for _ in range(12):
+            mid = 0.5 * (a + b)
+            left, right = self._gl(a, mid), self._gl(mid, b)
+            bad = np.abs(left + right - seg) > 1e-13 * total
+            if not np.any(bad):
+                break
+            # replace every bad interval by its halves (kept in order)
+            a = np.concatenate([a[~bad], a[bad], mid[bad]])
+            b = np.concatenate([b[~bad], mid[bad], b[bad]])
+            seg = np.concatenate([seg[~bad], left[bad], right[bad]])
+            order = np.argsort(a, kind="stable")
+            a, b, seg = a[order], b[order], seg[order]
+        return np.concatenate([a, b[-1:]]), seg
+
+    def _gl(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        half = 0.5 * (b - a)
+        q = (0.5 * (a + b))[:, None] + half[:, None] * _GL_X[None, :]
+        return half * (self.speed(q) @ _GL_W)
 
     @property
     def length(self) -> float:
