@@ -96,6 +96,13 @@ def build_parser() -> argparse.ArgumentParser:
         default="clearance",
         help="A* cost (default clearance-aware)",
     )
+    p.add_argument(
+        "--corridor",
+        choices=("polygons", "boxes"),
+        default="polygons",
+        help="convex polygons grown around the path (default; boxes where they fail) or "
+        "axis-aligned boxes of free cells only",
+    )
     p.add_argument("--kappa-max", type=float, help="curvature bound [1/m] for the smoother")
     p.add_argument("--start-heading", type=float, help="exact start heading [rad]")
     p.add_argument("--goal-heading", type=float, help="exact goal heading [rad]")
@@ -238,6 +245,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         search=args.search,
         smoother=smoother,
         fallback="stop_and_turn" if args.fallback else None,
+        corridor=args.corridor,
     )
     traj = planner.plan(
         args.start, args.goal, start_heading=args.start_heading, goal_heading=args.goal_heading
@@ -247,6 +255,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         f"duration {traj.duration:.3f} s, length {traj.path.length:.3f} m, "
         f"planned in {1e3 * stages.get('total', float('nan')):.1f} ms"
     )
+    if traj.stats.get("corridor"):
+        line += f", corridor {traj.stats['corridor']}"
     if traj.stats.get("fallback"):
         reason = str(traj.stats.get("fallback_reason", "")).splitlines()[0][:120]
         line += (

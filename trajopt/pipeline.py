@@ -62,6 +62,7 @@ from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
 from trajopt.feasibility import curvature_witness, witness_grid_path
+from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.robot import Robot
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.timing import time_parameterize
@@ -74,11 +75,13 @@ logger = logging.getLogger(__name__)
 Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest"]
 Fallback = Literal["stop_and_turn"]
+CorridorKind = Literal["polygons", "boxes"]
 #: What :meth:`Planner.plan` returns: a smooth trajectory, or the stop-and-turn fallback.
 PlanResult = Trajectory | StopAndTurnTrajectory
 _INFLATIONS = ("exact", "paper")
 _SEARCHES = ("clearance", "shortest")
 _FALLBACKS = (None, "stop_and_turn")
+_CORRIDORS = ("polygons", "boxes")
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,8 +97,10 @@ class PlanSteps:
     grid_path : astar.GridPath
         The A* path on ``inflated_grid`` (after a witness rescue, the grid path along the
         witness: ``expanded`` 0, ``cost`` its length).
-    corridor : Corridor
-        The free boxes around the path (end boxes widened to the exact start/goal).
+    corridor : PolygonCorridor or Corridor
+        The corridor the smooth path was fitted in: convex polygons around the path
+        (``corridor="polygons"``), or free boxes (end boxes widened to the exact
+        start/goal) with ``corridor="boxes"`` or where the polygons failed.
     smooth_path : SmoothPath or None
         The certified B-spline; ``None`` when the planner returned the stop-and-turn
         fallback (the trajectory's ``path`` is then the polyline it drives).
@@ -111,7 +116,7 @@ class PlanSteps:
     raw_grid: OccupancyGrid
     inflated_grid: OccupancyGrid
     grid_path: Any
-    corridor: Corridor
+    corridor: PolygonCorridor | Corridor
     smooth_path: SmoothPath | None
     start: tuple[float, float]
     goal: tuple[float, float]
@@ -147,6 +152,14 @@ class Planner:
         they fail and both end speeds are 0, return a
         :class:`~trajopt.fallback.StopAndTurnTrajectory` along the A* polyline, checked
         against the raw map (module docstring); ``stats["fallback"]`` says so.
+    corridor : {"polygons", "boxes"}
+        ``"polygons"`` (default): convex polygons grown around the A* path in continuous
+        space (:func:`~trajopt.polygon_corridor.build_polygon_corridor`), with the taut
+        objective; where the polygon corridor cannot be built or the fit in it fails, the
+        box corridor is tried next (``stats["corridor"]`` names the one used).
+        ``"boxes"``: axis-aligned boxes of free cells only (:func:`build_corridor`). With
+        ``inflation="paper"`` the corridor is always boxes (the polygons keep the radius
+        from the raw map, not from the chapter's avoidance area).
 
     Notes
     -----
@@ -165,6 +178,7 @@ class Planner:
         smoother: Smoother | None = None,
         timing_dt: float = 0.02,
         fallback: Fallback | None = None,
+        corridor: CorridorKind = "polygons",
     ) -> None:
         if not isinstance(grid, OccupancyGrid):
             raise InvalidInputError(
@@ -179,6 +193,8 @@ class Planner:
             raise InvalidInputError(f"search must be one of {_SEARCHES}, got {search!r}")
         if not (fallback is None or (isinstance(fallback, str) and fallback in _FALLBACKS)):
             raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
+        if not (isinstance(corridor, str) and corridor in _CORRIDORS):
+            raise InvalidInputError(f"corridor must be one of {_CORRIDORS}, got {corridor!r}")
         if w_cells is None:
             w_cells = max(1, round(robot.width / grid.resolution))
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
@@ -202,6 +218,7 @@ class Planner:
         self.smoother = smoother
         self.timing_dt = float(timing_dt)
         self.fallback: Fallback | None = fallback
+        self.corridor: CorridorKind = corridor
         self._lock = threading.RLock()
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
@@ -313,21 +330,21 @@ class Planner:
             ) from exc
         stages["search"] = time.perf_counter() - t
         t = time.perf_counter()
-        corridor = self._corridor(inflated, path, p0, p1)
-        stages["corridor"] = time.perf_counter() - t
-        t = time.perf_counter()
         smooth = None
         rescue = None
+        corridor = None
         try:
             try:
-                smooth = self._fit(self.smoother, path, corridor, p0, p1, start_heading, goal_heading)
+                corridor, smooth = self._corridor_fit(
+                    self.smoother, inflated, path, p0, p1, start_heading, goal_heading, stages
+                )
             except SmoothingError as exc:
                 found = self._witness_rescue(exc, inflated, p0, p1, start_heading, goal_heading, t)
                 if found is None:
                     raise
                 path, corridor, smooth = found
                 rescue = "witness"
-            stages["smooth"] = time.perf_counter() - t
+            stages["smooth"] = time.perf_counter() - t - stages.get("corridor", 0.0)
             t = time.perf_counter()
             traj = time_parameterize(
                 smooth, self.robot, v_start=v_start, v_end=v_end, dt=self.timing_dt
@@ -337,6 +354,8 @@ class Planner:
             stages["smooth" if smooth is None else "timing"] = time.perf_counter() - t
             if self.fallback is None or v_start != 0.0 or v_end != 0.0:
                 raise
+            if corridor is None:
+                corridor = self._box_corridor(inflated, path, p0, p1)
             return self._fallback(
                 exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
             )
@@ -357,9 +376,57 @@ class Planner:
         stats["search"] = self.search
         stats["smoother"] = dict(smooth.stats)
         stats["smoother"]["rescue"] = rescue
+        stats["corridor"] = "polygons" if isinstance(corridor, PolygonCorridor) else "boxes"
         return dataclasses.replace(traj, stats=stats, steps=steps)
 
-    def _corridor(self, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray):
+    def _corridor_fit(self, smoother, inflated, path, p0, p1, start_heading, goal_heading,
+                      stages=None):
+        """Build the corridor and fit in it: polygons first (when chosen), then boxes.
+
+        Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
+        ``InvalidInputError``) when every corridor failed. ``stages["corridor"]`` adds up
+        the corridor builds (s)."""
+        t_start = time.perf_counter()
+        kinds = ["boxes"]
+        if self.corridor == "polygons" and self.inflation == "exact":
+            kinds.insert(0, "polygons")
+        for i, kind in enumerate(kinds):
+            last = i == len(kinds) - 1
+            t = time.perf_counter()
+            try:
+                if kind == "polygons":
+                    corridor = self._polygon_corridor(path, p0, p1)
+                else:
+                    corridor = self._box_corridor(inflated, path, p0, p1)
+            except InvalidInputError as exc:
+                if last:
+                    raise
+                logger.debug("%s corridor not built (%s); trying the next kind", kind, exc)
+                continue
+            finally:
+                if stages is not None:
+                    stages["corridor"] = stages.get("corridor", 0.0) + time.perf_counter() - t
+            left = smoother.time_budget_s - (time.perf_counter() - t_start)
+            try:
+                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
+                if left <= 0:
+                    raise SmoothingError("time budget exhausted before the box corridor", {})
+                return corridor, self._fit(sm, path, corridor, p0, p1, start_heading,
+                                           goal_heading)
+            except SmoothingError as exc:
+                if last:
+                    raise
+                logger.debug("fit in the %s corridor failed (%s); trying the next kind",
+                             kind, exc)
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def _polygon_corridor(self, path: Any, p0: np.ndarray, p1: np.ndarray) -> PolygonCorridor:
+        """Polygons around the A* path, from the exact start to the exact goal."""
+        centres = np.asarray(self.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
+        points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
+        return build_polygon_corridor(self.grid, points, self.robot.radius)
+
+    def _box_corridor(self, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray):
         # bridges (45-degree regions certified against the raw map) across diagonal gaps;
         # not with the chapter's avoidance area, which the curve must not enter either
         bridge_map = self.grid if self.inflation == "exact" else None
@@ -406,10 +473,9 @@ class Planner:
             if left <= 0:
                 return None
             try:
-                corridor = self._corridor(inflated, path, p0, p1)
-                smooth = self._fit(
+                corridor, smooth = self._corridor_fit(
                     dataclasses.replace(sm, time_budget_s=left),
-                    path, corridor, p0, p1, start_heading, goal_heading,
+                    inflated, path, p0, p1, start_heading, goal_heading,
                 )
             except (SmoothingError, InvalidInputError) as exc2:
                 logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
@@ -500,6 +566,7 @@ def plan(
     smoother: Smoother | None = None,
     w_cells: int | None = None,
     fallback: Fallback | None = None,
+    corridor: CorridorKind = "polygons",
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
@@ -518,7 +585,7 @@ def plan(
         Exact headings at the ends (rad).
     v_start, v_end : float
         Speeds at the ends (m/s).
-    inflation, search, smoother, w_cells
+    inflation, search, smoother, w_cells, corridor
         See :class:`Planner`.
     fallback : {None, "stop_and_turn"}
         Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
@@ -545,6 +612,7 @@ def plan(
         smoother=smoother,
         w_cells=w_cells,
         fallback=fallback,
+        corridor=corridor,
     )
     return planner.plan(
         start,

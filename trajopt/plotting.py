@@ -53,8 +53,10 @@ def plot_map(
         Raw map.
     inflated : OccupancyGrid, optional
         Inflated grid of the same shape; cells blocked only by inflation are shaded grey.
-    corridor : Corridor, optional
-        Anything with ``boxes`` whose items have ``xmin, xmax, ymin, ymax`` (m).
+    corridor : PolygonCorridor or Corridor, optional
+        Drawn as outlines: a polygon corridor's ``regions`` (each with ``vertices``, m), or
+        a box corridor's ``boxes`` (each with ``xmin, xmax, ymin, ymax``, m; a 45-degree
+        bridge by its ``vertices``).
     ax : matplotlib Axes, optional
 
     Returns
@@ -62,7 +64,7 @@ def plot_map(
     (Figure, Axes)
     """
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Rectangle
+    from matplotlib.patches import Polygon, Rectangle
 
     if ax is None:
         fig, ax = plt.subplots(figsize=(6, 6))
@@ -81,11 +83,14 @@ def plot_map(
     ax.imshow(img, origin="lower", extent=extent, cmap="Greys", vmin=0, vmax=1,
               interpolation="nearest")
     if corridor is not None:
-        for box in corridor.boxes:
-            ax.add_patch(
-                Rectangle((box.xmin, box.ymin), box.xmax - box.xmin, box.ymax - box.ymin,
-                          fill=False, lw=0.7, ec="tab:cyan", alpha=0.8)
-            )
+        style = dict(fill=False, lw=0.7, ec="tab:cyan", alpha=0.8)
+        regions = getattr(corridor, "regions", None)
+        for reg in regions if regions is not None else corridor.boxes:
+            if regions is None and not getattr(reg, "is_diagonal", False):
+                ax.add_patch(Rectangle((reg.xmin, reg.ymin), reg.xmax - reg.xmin,
+                                       reg.ymax - reg.ymin, **style))
+            else:
+                ax.add_patch(Polygon(np.asarray(reg.vertices), closed=True, **style))
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal")

@@ -327,9 +327,20 @@ def zigzag():
 
 
 def test_without_fallback_the_zigzag_raises(zigzag):
+    # the box corridor of the one-cell staircase squeezes the control points together
     grid, start, goal = zigzag
     with pytest.raises(SmoothingError):
-        trajopt.plan(grid, start, goal, ZZ_ROBOT)
+        trajopt.plan(grid, start, goal, ZZ_ROBOT, corridor="boxes")
+
+
+def test_polygon_corridor_smooths_the_zigzag(zigzag):
+    # the polygons are rotated regions with real overlaps: a certified curve, no fallback
+    grid, start, goal = zigzag
+    traj = trajopt.plan(grid, start, goal, ZZ_ROBOT)
+    assert traj.stats["corridor"] == "polygons" and traj.steps.smooth_path.certificate.ok
+    smp = traj.sample(np.linspace(0.0, traj.duration, 4000))
+    assert brute_points_clearance(grid, np.c_[smp.x, smp.y]) >= ZZ_ROBOT.radius - 1e-9
+    assert trajectory_metrics(traj, ZZ_ROBOT)["within_limits"]
 
 
 def test_planner_fallback_is_safe_exact_and_deterministic(zigzag):
@@ -368,7 +379,7 @@ def test_planner_fallback_is_safe_exact_and_deterministic(zigzag):
 
 def test_fallback_needs_rest_at_both_ends(zigzag):
     grid, start, goal = zigzag
-    planner = trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn")
+    planner = trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn", corridor="boxes")
     with pytest.raises(SmoothingError):
         planner.plan(start, goal, v_end=0.1)
 
@@ -379,7 +390,9 @@ def test_failed_clearance_check_reraises_the_original_error(zigzag, monkeypatch)
     monkeypatch.setattr(pipeline, "polyline_clearance", lambda *a, **k: 0.0)
     grid, start, goal = zigzag
     with pytest.raises(SmoothingError, match="certified"):
-        trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn").plan(start, goal)
+        trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn", corridor="boxes").plan(
+            start, goal
+        )
 
 
 def test_fallback_unused_when_the_smoother_succeeds():
@@ -403,6 +416,8 @@ def test_cli_plan_fallback(zigzag, tmp_path, capsys):
         *map(str, goal),
         "--radius",
         "0.12",
+        "--corridor",
+        "boxes",
     ]
     assert main(args) == 2
     assert "SmoothingError" in capsys.readouterr().err

@@ -161,7 +161,8 @@ def test_planner_rescues_a_curvature_bounded_query_along_the_witness(shared_data
     # space between them, and the fit along it is certified
     raw = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     radius, kmax = 0.2, 1.0 / 0.4
-    planner = Planner(raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10))
+    planner = Planner(raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10),
+                      corridor="boxes")  # fmt: skip
     p0, p1 = raw.cell_to_world(np.array([169, 205])), raw.cell_to_world(np.array([197, 230]))
     path = astar.find_path(planner.inflated_grid, (169, 205), (197, 230), cost=planner.search_cost)
     corr = build_corridor(planner.inflated_grid, path, radius=radius, raw_grid=raw)
@@ -180,6 +181,21 @@ def test_planner_rescues_a_curvature_bounded_query_along_the_witness(shared_data
     assert brute_clearance(raw, xy).min() >= radius - 1e-9
     np.testing.assert_allclose(xy[[0, -1]], [p0, p1], atol=1e-9)
     _check_grid_path(traj.steps.grid_path.cells, planner.inflated_grid.occupied)
+
+
+def test_polygon_corridor_plans_the_curvature_bounded_pillar_query(shared_data):
+    # the query above, in the default polygon corridor: a certified curve that holds the
+    # bound, found along the A* path or through the rescue
+    raw = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
+    radius, kmax = 0.2, 1.0 / 0.4
+    planner = Planner(raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10))
+    p0, p1 = raw.cell_to_world(np.array([169, 205])), raw.cell_to_world(np.array([197, 230]))
+    traj = planner.plan(p0, p1)
+    sp = traj.steps.smooth_path
+    assert sp.certificate.ok and traj.stats["corridor"] in ("polygons", "boxes")
+    u = np.linspace(*sp.domain, 4000)
+    assert brute_clearance(raw, sp(u)).min() >= radius - 1e-9
+    assert np.abs(sp.curvature(u)).max() <= kmax * (1 + 1e-6)
 
 
 def test_planner_without_a_witness_raises_the_smoothers_error():
