@@ -1,0 +1,153 @@
+"""The smoother and the planner in polygon corridors: certified against brute force, hand
+cases that box corridors fail, the taut objective, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import astar
+import trajopt
+from astar import OccupancyGrid
+from tests.trajopt.test_pipeline import brute_clearance
+from tests.trajopt.test_polygon_corridor import square_inflated, staircase_passage
+from trajopt import scenes
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.metrics import trajectory_metrics
+from trajopt.polygon_corridor import build_polygon_corridor
+from trajopt.smoother import Smoother
+
+
+def passage(angle: float, extra: float):
+    """A staircase passage of free width ``2 r + extra`` cells (5 cm cells, r = 2.5 cells)
+    and two free cells on its axis 2 m apart."""
+    res, r_cells = 0.05, 2.5
+    radius = r_cells * res
+    grid = OccupancyGrid(staircase_passage(angle, 2 * r_cells + extra), res)
+    infl = square_inflated(grid, radius)
+    th = math.radians(angle)
+    ys, xs = np.nonzero(~infl.occupied)
+    proj = (xs + 0.5 - 30) * math.cos(th) + (ys + 0.5 - 30) * math.sin(th)
+    ia, ib = int(np.argmin(np.abs(proj + 20))), int(np.argmin(np.abs(proj - 20)))
+    p0 = grid.cell_to_world(np.array([xs[ia], ys[ia]]))
+    p1 = grid.cell_to_world(np.array([xs[ib], ys[ib]]))
+    return grid, radius, p0, p1
+
+
+def check_trajectory(grid, traj, robot, p0, p1):
+    """Dense brute-force clearance, exact ends, every limit, control points in regions."""
+    sp = traj.steps.smooth_path
+    u = np.linspace(*sp.domain, 6000)
+    xy = sp(u)
+    assert brute_clearance(grid, xy).min() >= robot.radius - 1e-9
+    np.testing.assert_allclose(xy[[0, -1]], [p0, p1], atol=1e-9)
+    assert trajectory_metrics(traj, robot)["within_limits"]
+    corr = traj.steps.corridor
+    c = sp.control_points
+    k = sp.degree
+    for j, r in enumerate(sp.certificate.span_box):
+        reg = corr.regions[int(r)]
+        # independent of ConvexPolygon.contains: the half-planes themselves
+        assert np.all(c[j : j + k + 1] @ reg.A.T - reg.b <= 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("angle", "extra", "kappa"),
+    [(30, 1.0, False), (45, 2.0, True), (30, 3.0, True)],
+)
+def test_staircase_passages_that_boxes_fail_are_smoothed_in_polygons(angle, extra, kappa):
+    grid, radius, p0, p1 = passage(angle, extra)
+    robot = trajopt.Robot(radius=radius)
+    sm = Smoother(kappa_max=1 / (2 * radius)) if kappa else None
+    with pytest.raises(SmoothingError):
+        trajopt.plan(grid, p0, p1, robot, smoother=sm, corridor="boxes")
+    traj = trajopt.plan(grid, p0, p1, robot, smoother=sm)
+    assert traj.stats["corridor"] == "polygons"
+    check_trajectory(grid, traj, robot, p0, p1)
+    if kappa:
+        sp = traj.steps.smooth_path
+        u = np.linspace(*sp.domain, 6000)
+        assert np.abs(sp.curvature(u)).max() <= sm.kappa_max * (1 + 1e-6)
+
+
+def test_diagonal_door_is_crossed_smoothly():
+    res, r_cells, n = 0.1, 2.5, 50
+    iy, ix = np.mgrid[0:n, 0:n]
+    occ = (np.abs(ix - iy) <= 1) & ~(np.abs(ix + iy - n) <= 5)  # 45-degree wall with a door
+    grid = OccupancyGrid(occ, res)
+    robot = trajopt.Robot(radius=r_cells * res)
+    p0, p1 = grid.cell_to_world(np.array([32, 18])), grid.cell_to_world(np.array([18, 32]))
+    traj = trajopt.plan(grid, p0, p1, robot)
+    assert traj.stats["corridor"] == "polygons"
+    check_trajectory(grid, traj, robot, p0, p1)
+
+
+@pytest.mark.parametrize("target", ["A", "B", "C", "D"])
+def test_paper_scene_in_polygons_is_certified_and_turns_less(target):
+    scene = scenes.paper()
+    robot = trajopt.Robot(radius=scene.robot_radius)
+    goal = scene.goal(target)
+    poly = trajopt.plan(scene.grid, scene.start, goal, robot)
+    boxes = trajopt.plan(scene.grid, scene.start, goal, robot, corridor="boxes")
+    assert poly.stats["corridor"] == "polygons"
+    check_trajectory(scene.grid, poly, robot, scene.start, goal)
+
+    def bending(traj):
+        s = traj.sample_uniform(0.01)
+        return float(np.trapezoid(s.kappa**2, s.s))
+
+    def yaw_sign_changes(traj):
+        om = traj.sample_uniform(0.01).omega
+        sg = np.sign(om[np.abs(om) > 1e-3])
+        return int(np.sum(sg[1:] != sg[:-1]))
+
+    assert bending(poly) < bending(boxes)
+    assert yaw_sign_changes(poly) <= yaw_sign_changes(boxes)
+    assert poly.duration < boxes.duration
+
+
+def test_taut_objective_is_shorter_than_fidelity_in_the_same_corridor():
+    scene = scenes.paper()
+    planner = trajopt.Planner(scene.grid, trajopt.Robot(radius=scene.robot_radius))
+    traj = planner.plan(scene.start, scene.goal("C"))
+    corr = traj.steps.corridor
+    kw = dict(raw_grid=scene.grid, radius=scene.robot_radius)
+    taut = Smoother(objective="taut").fit(None, corr, **kw)
+    fid = Smoother(objective="fidelity").fit(None, corr, **kw)
+    assert taut.certificate.ok and fid.certificate.ok
+    assert taut.length < fid.length
+
+
+def test_end_headings_in_polygons():
+    scene = scenes.paper()
+    robot = trajopt.Robot(radius=scene.robot_radius)
+    traj = trajopt.plan(scene.grid, scene.start, scene.goal("B"), robot, start_heading=1.2,
+                        goal_heading=0.5)  # fmt: skip
+    assert traj.stats["corridor"] == "polygons"
+    sp = traj.steps.smooth_path
+    h = sp.heading(np.array(sp.domain))
+    np.testing.assert_allclose(np.angle(np.exp(1j * (h - [1.2, 0.5]))), 0.0, atol=1e-9)
+
+
+def test_polygon_corridor_bad_input():
+    scene = scenes.paper()
+    grid, r = scene.grid, scene.robot_radius
+    infl = square_inflated(grid, r)
+    path = astar.find_path(infl, scene.start_cell, scene.goal_cell("A"))
+    corr = build_polygon_corridor(grid, path, r)
+    with pytest.raises(InvalidInputError, match="ipopt"):
+        Smoother(qp_solver="ipopt").fit(None, corr)
+    with pytest.raises(InvalidInputError, match="ipopt"):
+        Smoother(kappa_max=1.0, curvature_solver="ipopt").fit(None, corr)
+    with pytest.raises(InvalidInputError, match="start .* must lie in the corridor's region 0"):
+        Smoother().fit(None, corr, start=(0.0, 0.0))
+    with pytest.raises(InvalidInputError, match="objective must be one of"):
+        Smoother(objective="short")
+    with pytest.raises(InvalidInputError, match="taut_length_weight"):
+        Smoother(taut_length_weight=-1.0)
+    with pytest.raises(InvalidInputError, match="corridor must be one of"):
+        trajopt.Planner(grid, corridor="triangles")
+    with pytest.raises(InvalidInputError, match="corridor must be a Corridor or a PolygonCorridor"):
+        Smoother().fit(None, object())
