@@ -31,6 +31,9 @@ _EXPORTS: dict[str, str] = {
     "Box": "trajopt.corridor",
     "Corridor": "trajopt.corridor",
     "build_corridor": "trajopt.corridor",
+    "ConvexPolygon": "trajopt.polygon_corridor",
+    "PolygonCorridor": "trajopt.polygon_corridor",
+    "build_polygon_corridor": "trajopt.polygon_corridor",
     "Smoother": "trajopt.smoother",
     "SmoothPath": "trajopt.smoother",
     # timing

@@ -9,11 +9,16 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 2. **search**: octile A* on the inflated grid; by default (``search="clearance"``) with
    the soft clearance cost of :func:`astar.clearance_cost`, which keeps paths off the walls;
    ``search="shortest"`` is the plain shortest path.
-3. **corridor**: :func:`trajopt.build_corridor`. When the exact start or goal is not a cell
-   centre, the end box is widened to contain it after an exact box-to-obstacle clearance
-   check.
+3. **corridor**: with ``corridor="polygons"`` (default, exact inflation)
+   :func:`trajopt.polygon_corridor.build_polygon_corridor` around the polyline *exact start
+   -> A* cell centres -> exact goal*; otherwise, and wherever the polygon corridor cannot be
+   built or the fit in it fails, :func:`trajopt.build_corridor` (boxes). When the exact
+   start or goal is not a cell centre, the end box is widened to contain it after an exact
+   box-to-obstacle clearance check. ``stats["corridor"]`` names the corridor of the result;
+   ``stages_s["corridor"]`` adds up the corridors built.
 4. **smooth**: :class:`trajopt.Smoother` (certified clearance ``>= radius`` from the raw
-   map, exact endpoints, continuous heading). **Witness rescue**: when the smoother has a
+   map, exact endpoints, continuous heading; the taut objective in polygons, the fidelity
+   objective in boxes). **Witness rescue**: when the smoother has a
    curvature bound and fails along the A* path, the planner looks for a curvature-bounded
    path with :func:`trajopt.feasibility.curvature_witness` (first one keeping a cell more
    than the radius, then one with the exact radius), rebuilds the corridor around

@@ -90,7 +90,8 @@ def plot_map(
                 ax.add_patch(Rectangle((reg.xmin, reg.ymin), reg.xmax - reg.xmin,
                                        reg.ymax - reg.ymin, **style))
             else:
-                ax.add_patch(Polygon(np.asarray(reg.vertices), closed=True, **style))
+                v = reg.vertices() if callable(reg.vertices) else reg.vertices
+                ax.add_patch(Polygon(np.asarray(v), closed=True, **style))
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal")

@@ -1,18 +1,22 @@
 """The proposed smoother: a corridor-constrained B-spline fit, certified collision-free.
 
 :class:`Smoother` fits a clamped B-spline ``C(u) = sum_i c_i B_i(u)`` (parameter ``u`` =
-arc length along the A* polyline) to the A* points ``p_r`` at their arc lengths ``u_r``:
+arc length along the path) to path points ``p_r`` at their arc lengths ``u_r``:
 
-    minimise   sum_r |C(u_r) - p_r|^2  +  w * integral |C^(m)(u)|^2 du          (cell units)
+    minimise   lam * sum_r |C(u_r) - p_r|^2  +  w * integral |C^(m)(u)|^2 du
+               + ell * integral |C'(u)|^2 du                                     (cell units)
     subject to c_0 = start, c_{n-1} = goal,
                c_i in the intersection of the corridor regions of every span it touches,
                optional: c_1 on the start-heading ray, c_{n-2} on the reverse goal ray,
                optional: |kappa| <= kappa_max at dense samples (with a speed floor).
 
-The first term is the chapter's least-squares fidelity (equation (3)); the second is the
+With the *fidelity* objective (default in a box corridor) ``p_r`` are the A* cell centres,
+``lam = 1`` and ``ell = 0``: the chapter's least-squares fidelity (equation (3)) plus the
 knot-aware integrated squared ``m``-th derivative (exact Gram matrix of the derivative
-basis). Positions and parameters are divided by the grid resolution first, so the default
-weights work on every map.
+basis). With the *taut* objective (default in a :class:`~trajopt.polygon_corridor.
+PolygonCorridor`) ``p_r`` are the corridor's path sampled once per cell, ``lam`` is small
+and the length term pulls the curve taut. Positions and parameters are divided by the grid
+resolution first, so the default weights work on every map.
 
 The corridor constraint uses the convex-hull property: span ``j`` lies in the convex hull
 of ``c_j .. c_{j+p}``; with all of them inside the span's region the whole continuous span
@@ -20,7 +24,7 @@ is inside it. Knots are graded so that every region holds at least ``p`` spans (
 control point touches more than two consecutive regions, which always intersect), so each
 control point is bounded by one intersection: variable bounds for the axis-aligned boxes
 plus two rows ``x + y`` and ``x - y`` for the 45-degree *bridges* the corridor places in
-diagonal gaps. The convex problem is a sparse banded QP solved by ``casadi.conic`` (piqp by
+diagonal gaps, or the half-planes of its (at most two) polygons in a polygon corridor. The convex problem is a sparse banded QP solved by ``casadi.conic`` (piqp by
 default). The curvature-bounded problem is solved by sequential convex programming (a few
 QPs with the bound linearised at the current iterate, l1-penalised slacks and a trust
 region, solved by piqp directly over a working set of the samples near the bound;
@@ -29,7 +33,7 @@ problem, warm-started from the QP (``curvature_solver="ipopt"``). Solvers are bu
 per padded size and cached.
 
 Every result is verified (:class:`Certificate`) before it is returned: control points in
-their boxes, exact endpoints, dense-sample clearance against the raw map, no cusp, and the
+their regions, exact endpoints, dense-sample clearance against the raw map, no cusp, and the
 curvature bound. On failure the knots are refined; when that is exhausted
 :class:`~trajopt.errors.SmoothingError` is raised with the solver statistics.
 """
@@ -74,7 +78,8 @@ class Certificate:
     span_box : ndarray of int, shape (n_spans,)
         Corridor box holding each span's control points.
     control_points_in_boxes : bool
-        Every span's control points lie in its box (exact comparison).
+        Every span's control points lie in its corridor region: its box (exact comparison)
+        or its polygon (``A @ c <= b + CLEARANCE_TOL_M``).
     endpoint_error_m : float
         ``max(|C(u0) - start|, |C(u1) - goal|)`` (m).
     radius_m : float or None
@@ -309,7 +314,7 @@ class Smoother:
     def fit(
         self,
         grid_path_or_points: Any,
-        corridor: Corridor,
+        corridor: Corridor | PolygonCorridor,
         *,
         raw_grid: Any = None,
         radius: float | None = None,
@@ -325,17 +330,19 @@ class Smoother:
         grid_path_or_points : astar.GridPath or array_like, shape (n, 2)
             The A* path (a GridPath or an *integer* array of cells ``(ix, iy)``: the cell
             centres are the fidelity targets) or float target points in world metres, one
-            per path cell of ``corridor`` (``None``: the corridor's path).
-        corridor : Corridor
-            From :func:`~trajopt.corridor.build_corridor` on the same path.
+            per path cell of ``corridor`` (``None``: the corridor's path). Not used with a
+            polygon corridor, whose own (centred, simplified) path gives the targets.
+        corridor : Corridor or PolygonCorridor
+            From :func:`~trajopt.corridor.build_corridor` on the same path, or from
+            :func:`~trajopt.polygon_corridor.build_polygon_corridor`.
         raw_grid : astar.OccupancyGrid, optional
             The raw (not inflated) map; when given, the certificate checks the clearance by
             dense sampling (point-to-square distance, outside the map counts as occupied).
         radius : float, optional
             Clearance to certify (m); default ``corridor.radius``.
         start, goal : array_like, shape (2,), optional
-            Exact end points (m); default the first and last path cell centres. Each must lie
-            in its end box.
+            Exact end points (m); default the first and last path points. Each must lie in
+            its end region.
         start_heading, goal_heading : float, optional
             Exact tangent directions (rad) at the ends.
 
