@@ -24,6 +24,7 @@ _EXPORTS: dict[str, str] = {
     "NoPathError": "trajopt.errors",
     "SmoothingError": "trajopt.errors",
     "TimingError": "trajopt.errors",
+    "IllPosedFitError": "trajopt.errors",
     # curves
     "ParametricCurve": "trajopt.curve",
     "BSplineCurve": "trajopt.bspline",

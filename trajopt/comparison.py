@@ -300,7 +300,8 @@ def _method_polynomial_parametric(ctx: ComparisonContext) -> MethodResult:
 
 
 def _method_bspline(ctx: ComparisonContext) -> MethodResult:
-    from trajopt.fits import _IllPosedFitError, fit_bspline
+    from trajopt.errors import IllPosedFitError
+    from trajopt.fits import fit_bspline
 
     opts = {**DEFAULT_BSPLINE, **ctx.options_for("B-spline fit")}
     ref = ctx.reference
@@ -315,7 +316,7 @@ def _method_bspline(ctx: ComparisonContext) -> MethodResult:
         return MethodResult(None, False, "path has a single point")
     try:
         curve = fit_bspline(ref, **opts)
-    except _IllPosedFitError as exc:  # the data cannot determine this fit: no curve to rank
+    except IllPosedFitError as exc:  # the data cannot determine this fit: no curve to rank
         return MethodResult(None, False, note + str(exc))
     note += (
         f"{curve.parameterization}, degree {curve.k}, {curve.c.shape[0]} control points; "

@@ -15,6 +15,7 @@ import astar.errors as _astar_errors
 __all__ = [
     "TrajoptError",
     "InvalidInputError",
+    "IllPosedFitError",
     "NoPathError",
     "SmoothingError",
     "TimingError",
@@ -27,6 +28,12 @@ class TrajoptError(Exception):
 
 class InvalidInputError(TrajoptError, _astar_errors.InvalidInputError):
     """An argument breaks a documented rule (the message names the field, value and rule)."""
+
+
+class IllPosedFitError(InvalidInputError):
+    """The data cannot determine the requested plain fit (the Schoenberg-Whitney condition
+    fails, or the collocation matrix is numerically singular); :func:`trajopt.compare`
+    records such a fit as invalid with this message."""
 
 
 class NoPathError(TrajoptError, _astar_errors.NoPathError):

@@ -45,7 +45,7 @@ from numpy.polynomial import chebyshev as _cheb
 
 from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.curve import ParametricCurve
-from trajopt.errors import InvalidInputError
+from trajopt.errors import IllPosedFitError, InvalidInputError
 
 __all__ = [
     "FIT_METHODS",
@@ -65,11 +65,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-
-class _IllPosedFitError(InvalidInputError):
-    """The data cannot determine the requested fit (Schoenberg-Whitney fails, or the
-    collocation matrix is numerically singular); :func:`trajopt.compare` records it."""
 
 
 FitMethod = Literal["least_squares", "lar", "bisquare"]
@@ -893,14 +888,14 @@ def fit_bspline(
     n_c = _check_int(n_ctrl, "n_ctrl", k + 1)
     u = curve_parameters(p, parameterization)
     if n_c > len(p):
-        raise _IllPosedFitError(
+        raise IllPosedFitError(
             f"n_ctrl must be <= the number of distinct points ({len(p)}), got {n_c}; "
             f"{_allowed(u, k, len(p) + 1)} ({parameterization} parameters)"
         )
     t = clamped_uniform_knots(n_c, k)
     problem = _design_problem(u, t, k)
     if problem:
-        raise _IllPosedFitError(_ill_posed_message(problem, k, n_c, parameterization, u))
+        raise IllPosedFitError(_ill_posed_message(problem, k, n_c, parameterization, u))
     return _lsq(p, u, t, k, w, parameterization)
 
 
@@ -912,13 +907,13 @@ def _lsq(
     try:
         spl = make_lsq_spline(u, p, t, k=k, w=np.sqrt(w), check_finite=False)
     except (ValueError, np.linalg.LinAlgError) as exc:
-        raise _IllPosedFitError(
+        raise IllPosedFitError(
             f"least-squares B-spline with degree {k} and {len(t) - k - 1} control points "
             f"is not defined for these {len(p)} points ({parameterization} parameters): {exc}"
         ) from exc
     c = np.asarray(spl.c)
     if not np.all(np.isfinite(c)):  # not expected after the checks of fit_bspline
-        raise _IllPosedFitError(
+        raise IllPosedFitError(
             f"least-squares B-spline with degree {k} and {len(c)} control points is singular "
             f"for these {len(p)} points (Schoenberg-Whitney condition)"
         )
