@@ -15,8 +15,12 @@ code; the narrow ones that leave no grid path after inflation are skipped and na
   (numpy here, not the library's kernel);
 * median trajectory duration ratio polygons / boxes on the queries both solved, median
   min-clearance / radius, median integral of squared curvature ``int kappa^2 ds``;
+* *touching* failures apart: queries whose start and goal are joined only through free
+  space of zero width (no grid path for a radius a millionth of a cell larger: an end point
+  or a gap exactly at the radius from the walls), where no curve has room;
 * warm times (best of ``--repeats`` calls after an untimed first): corridor build,
-  smoothing stage, whole ``plan``.
+  smoothing stage, whole ``plan`` (also per map, with willow at 5 cm cells, 1216 x 1132, as
+  a warehouse-size map).
 
 With a curvature bound a failure is a failure on a *feasible* query only when
 :func:`trajopt.feasibility.curvature_witness` finds a witness (``--witness``).
@@ -108,6 +112,25 @@ def dense_clearance(raw, xy: np.ndarray, window: float) -> float:
     return float(out)
 
 
+_TOUCH: dict = {}
+
+
+def touching(raw, radius: float, a, b) -> bool:
+    """Whether start and goal are joined only through free space of zero width: no grid
+    path for a radius one millionth of a cell larger (an end point, or a gap, at exactly the
+    radius from the walls)."""
+    key = (id(raw), radius, a, b)
+    if key not in _TOUCH:
+        g = astar.inflate(raw, radius + 1e-6 * raw.resolution, metric="square",
+                          outside_occupied=True)  # fmt: skip
+        try:
+            astar.find_path(g, a, b)
+            _TOUCH[key] = False
+        except (astar.NoPathError, astar.InvalidInputError):
+            _TOUCH[key] = True
+    return _TOUCH[key]
+
+
 def run(planner: Planner, p0, p1, repeats: int):
     """Plan once (untimed), then ``repeats`` times: the result and the best stage times."""
     try:
@@ -156,6 +179,15 @@ def queries(per_map: int, seed: int):
         _, pairs = draw_pairs(raw, radius, per_map, rng)
         for a, b in pairs:
             yield name, raw, radius, a, b
+    # a warehouse-size map: willow at 5 cm cells (each 10 cm cell split in four), 1216 x 1132
+    f = d / "ros" / "willow-2010-02-18-0.10.yaml"
+    if f.exists():
+        w = astar.load_map(f)
+        occ = np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1)
+        big = astar.OccupancyGrid(occ, w.resolution / 2, w.origin)
+        _, pairs = draw_pairs(big, 0.25, per_map, rng)
+        for a, b in pairs:
+            yield "willow-5cm", big, 0.25, a, b
     for angle in (30.0, 45.0):
         for width in (1.0, 2.0, 3.0, 4.0):
             grid, r_cells, a, b = staircase(angle, width)
@@ -198,7 +230,8 @@ def main(argv: list[str] | None = None) -> int:
                 planners[key] = Planner(raw, Robot(radius=radius), search=search, smoother=sm,
                                         corridor=corr)  # fmt: skip
             traj, err, times = run(planners[key], p0, p1, args.repeats)
-            rec = {"map": name, "query": (a, b), "error": err, "times": times}
+            rec = {"map": name, "query": (a, b), "error": err, "times": times,
+                   "touching": touching(raw, radius, a, b)}  # fmt: skip
             if traj is not None:
                 rec.update(measure(traj, raw, radius))
             elif kap and args.witness:
@@ -223,6 +256,9 @@ def main(argv: list[str] | None = None) -> int:
             v = [r["times"][key] * 1e3 for r in src if key in r["times"]]
             return float(np.percentile(v, q)) if v else math.nan
 
+        n_touch = sum(1 for r in fails if r["touching"])
+        if n_touch:
+            feas += f" ({n_touch} touching)"
         print(
             f"| {'1/(2r)' if kap else 'none'} | {search} | {corr} | {len(ok)}/{len(rs)}{feas} | "
             f"{sum(r['in_polygons'] for r in ok) if corr == 'polygons' else '-'} | "
@@ -234,7 +270,25 @@ def main(argv: list[str] | None = None) -> int:
         )
         for r in fails:
             print(f"    failed: {r['map']} {r['query']} {r['error']}"
-                  + (f" feasible={r.get('feasible')}" if 'feasible' in r else ""))
+                  + (f" feasible={r.get('feasible')}" if 'feasible' in r else "")
+                  + (" touching" if r["touching"] else ""))
+        if corr == "polygons":
+            for r in ok:
+                if not r["in_polygons"]:
+                    print(f"    fitted in boxes: {r['map']} {r['query']}")
+    print()
+    print("Whole plan (warm, best of repeats), no bound, clearance search, median ms per map:")
+    print("| map | queries | boxes | polygons | ratio |")
+    print("|---|---|---|---|---|")
+    b_rows, p_rows = rows[("boxes", "clearance", False)], rows[("polygons", "clearance", False)]
+    for name in dict.fromkeys(r["map"] for r in b_rows):
+        pairs_ = [(x, y) for x, y in zip(b_rows, p_rows, strict=True)
+                  if x["map"] == name and not x["error"] and not y["error"]]  # fmt: skip
+        if not pairs_:
+            continue
+        tb = np.median([x["times"]["plan"] for x, _ in pairs_]) * 1e3
+        tp = np.median([y["times"]["plan"] for _, y in pairs_]) * 1e3
+        print(f"| {name} | {len(pairs_)} | {tb:.1f} | {tp:.1f} | {tp / tb:.2f} |")
     print()
     print("| bound | search | queries both solved | median duration polygons / boxes | "
           "p10 / p90 | median int k^2 polygons / boxes |")

@@ -606,7 +606,8 @@ class Smoother:
         uba = np.concatenate([uba, rub])
         x0 = np.zeros(2 * nb)
         # warm start: the targets projected to the bounds, by parameter
-        greville = np.array([t[i + 1 : i + p + 1].mean() for i in range(n)])
+        cs = np.concatenate([[0.0], np.cumsum(t)])
+        greville = (cs[p + 1 : n + p + 1] - cs[1 : n + 1]) / p  # mean of t[i+1 .. i+p]
         for d in range(2):
             guess = np.interp(greville, prob.u, prob.targets[:, d])
             x0[d * nb : d * nb + n] = np.clip(
@@ -1188,18 +1189,27 @@ def _region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
 
 def _point_rows(rows, span_box: np.ndarray, n: int, p: int):
     """Rows ``(A, lo, hi)`` of every control point: those of the regions of the spans it
-    touches (the fixed end points get none: they were checked against their regions)."""
+    touches (the fixed end points get none: they were checked against their regions).
+
+    Span regions never decrease along the curve and a control point touches at most two
+    of them (the knots give every region at least ``p`` spans), so the regions of point
+    ``i`` are those of its first and last span."""
     ns = len(span_box)
     empty = (np.zeros((0, 2)), np.zeros(0), np.zeros(0))
     out = [empty] * n
+    both: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     for i in range(1, n - 1):
-        regs = np.unique(span_box[max(0, i - p) : min(ns - 1, i) + 1])
-        parts = [rows[r] for r in regs]
-        out[i] = (
-            np.vstack([q[0] for q in parts]),
-            np.concatenate([q[1] for q in parts]),
-            np.concatenate([q[2] for q in parts]),
-        )
+        r0 = int(span_box[max(0, i - p)])
+        r1 = int(span_box[min(ns - 1, i)])
+        if r0 == r1:
+            out[i] = rows[r0]
+            continue
+        key = (r0, r1)
+        if key not in both:
+            a, b = rows[r0], rows[r1]
+            both[key] = (np.vstack([a[0], b[0]]), np.concatenate([a[1], b[1]]),
+                         np.concatenate([a[2], b[2]]))  # fmt: skip
+        out[i] = both[key]
     return out
 
 
@@ -1213,9 +1223,10 @@ def _pack_point_rows(point_rows, nb: int):
     ub = np.full((nb, k), np.inf)
     for i, (A, rlo, rhi) in enumerate(point_rows):
         q = len(rlo)
-        coef[i, :q] = A
-        lb[i, :q] = rlo
-        ub[i, :q] = rhi
+        if q:
+            coef[i, :q] = A
+            lb[i, :q] = rlo
+            ub[i, :q] = rhi
     return k, coef, lb.ravel(), ub.ravel()
 
 
@@ -1512,9 +1523,13 @@ def certify(
     inside = True
     if isinstance(corridor, PolygonCorridor):
         # span j lies in the convex hull of c_j .. c_{j+k}: all of them in its polygon
-        for j in range(ns):
-            reg = corridor.regions[int(span_box[j])]
-            inside &= bool(np.all(reg.contains(c[j : j + k + 1], tol=CLEARANCE_TOL_M)))
+        # (the spans of a region are consecutive: check its points once)
+        sb = np.asarray(span_box)
+        for r in np.unique(sb):
+            js = np.flatnonzero(sb == r)
+            reg = corridor.regions[int(r)]
+            pts = c[int(js[0]) : int(js[-1]) + k + 1]
+            inside &= bool(np.all(reg.contains(pts, tol=CLEARANCE_TOL_M)))
     else:
         lo = corridor.lower[span_box]
         hi = corridor.upper[span_box]
