@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import time
 from pathlib import Path
@@ -37,6 +36,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from bench_curvature import data_dir  # noqa: E402
 
 import astar  # noqa: E402
 from trajopt.corridor import build_corridor  # noqa: E402
@@ -46,11 +48,6 @@ from trajopt.polygon_corridor import build_polygon_corridor  # noqa: E402
 MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5", "AR0046SR",
             "Boston_0_1024"]
 ROS = ["turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10"]
-
-
-def data_dir() -> Path:
-    env = os.environ.get("TRAJOPT_DATA")
-    return Path(env) if env else ROOT.parent / "shared" / "data"
 
 
 def load_maps() -> list[tuple[str, object, float]]:

@@ -80,16 +80,23 @@ def merge_rects(occ, x_off, y_off):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _bucket_range(rect, gx0, gy0, bsize, nbx, nby):  # pragma: no cover - compiled
+    """Bucket index ranges ``(bx0, bx1, by0, by1)`` (inclusive) that a rectangle meets."""
+    bx0 = max(0, int(math.floor((rect[0] - gx0) / bsize)))
+    bx1 = min(nbx - 1, int(math.floor((rect[2] - gx0) / bsize)))
+    by0 = max(0, int(math.floor((rect[1] - gy0) / bsize)))
+    by1 = min(nby - 1, int(math.floor((rect[3] - gy0) / bsize)))
+    return bx0, bx1, by0, by1
+
+
+@njit(cache=True)
 def build_buckets(rects, gx0, gy0, bsize, nbx, nby):  # pragma: no cover - compiled
     """CSR lists ``(bstart, bids)`` of the rectangles meeting each ``bsize`` bucket."""
     nb = nbx * nby
     counts = np.zeros(nb + 1, np.int64)
     nr = rects.shape[0]
     for i in range(nr):
-        bx0 = max(0, int(math.floor((rects[i, 0] - gx0) / bsize)))
-        bx1 = min(nbx - 1, int(math.floor((rects[i, 2] - gx0) / bsize)))
-        by0 = max(0, int(math.floor((rects[i, 1] - gy0) / bsize)))
-        by1 = min(nby - 1, int(math.floor((rects[i, 3] - gy0) / bsize)))
+        bx0, bx1, by0, by1 = _bucket_range(rects[i], gx0, gy0, bsize, nbx, nby)
         for by in range(by0, by1 + 1):
             for bx in range(bx0, bx1 + 1):
                 counts[by * nbx + bx + 1] += 1
@@ -98,10 +105,7 @@ def build_buckets(rects, gx0, gy0, bsize, nbx, nby):  # pragma: no cover - compi
     bids = np.empty(counts[nb], np.int64)
     fill = counts[:nb].copy()
     for i in range(nr):
-        bx0 = max(0, int(math.floor((rects[i, 0] - gx0) / bsize)))
-        bx1 = min(nbx - 1, int(math.floor((rects[i, 2] - gx0) / bsize)))
-        by0 = max(0, int(math.floor((rects[i, 1] - gy0) / bsize)))
-        by1 = min(nby - 1, int(math.floor((rects[i, 3] - gy0) / bsize)))
+        bx0, bx1, by0, by1 = _bucket_range(rects[i], gx0, gy0, bsize, nbx, nby)
         for by in range(by0, by1 + 1):
             for bx in range(bx0, bx1 + 1):
                 b = by * nbx + bx
