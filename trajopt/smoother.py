@@ -600,8 +600,8 @@ class Smoother:
             k_rows, coef = 2, None
             rlb, rub = _diag_row_bounds(dlo, dhi, nb)
         else:
-            point_rows = _point_rows(prob.rows, span_box, n, p)
-            k_rows, coef, rlb, rub = _pack_point_rows(point_rows, nb)
+            k_rows, coef, rlb, rub = _point_rows(prob.rows, span_box, n, p, lo, hi, nb)
+            point_rows = (coef, rlb.reshape(nb, k_rows), rub.reshape(nb, k_rows))
         lba = np.concatenate([lba, rlb])
         uba = np.concatenate([uba, rub])
         x0 = np.zeros(2 * nb)
@@ -1187,46 +1187,53 @@ def _region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
     return out, lo_b, hi_b
 
 
-def _point_rows(rows, span_box: np.ndarray, n: int, p: int):
-    """Rows ``(A, lo, hi)`` of every control point: those of the regions of the spans it
-    touches (the fixed end points get none: they were checked against their regions).
+def _point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, nb: int):
+    """The region rows of every control point, padded to ``k`` per point.
 
-    Span regions never decrease along the curve and a control point touches at most two
-    of them (the knots give every region at least ``p`` spans), so the regions of point
-    ``i`` are those of its first and last span."""
+    A point gets the rows of the regions of the spans it touches, less those that its
+    variable bounds ``lo``, ``hi`` (cells, shape (n, 2)) already imply (the row's largest
+    value over that box is within its bound); the fixed end points get none (they were
+    checked against their regions). Span regions never decrease along the curve and a point
+    touches at most two of them (the knots give every region at least ``p`` spans), so the
+    regions of point ``i`` are those of its first and last span.
+
+    Returns ``(k, coef (nb, k, 2), lb (nb k,), ub (nb k,))`` in the layout's order; unused
+    rows have zero coefficients and infinite bounds.
+    """
+    m = len(rows)
+    q = max(len(r[1]) for r in rows)
+    A = np.zeros((m + 1, q, 2))  # region m: no rows (the fixed end points)
+    rlo = np.full((m + 1, q), -np.inf)
+    rhi = np.full((m + 1, q), np.inf)
+    for r, (a, lo_r, hi_r) in enumerate(rows):
+        A[r, : len(lo_r)] = a
+        rlo[r, : len(lo_r)] = lo_r
+        rhi[r, : len(lo_r)] = hi_r
     ns = len(span_box)
-    empty = (np.zeros((0, 2)), np.zeros(0), np.zeros(0))
-    out = [empty] * n
-    both: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-    for i in range(1, n - 1):
-        r0 = int(span_box[max(0, i - p)])
-        r1 = int(span_box[min(ns - 1, i)])
-        if r0 == r1:
-            out[i] = rows[r0]
-            continue
-        key = (r0, r1)
-        if key not in both:
-            a, b = rows[r0], rows[r1]
-            both[key] = (np.vstack([a[0], b[0]]), np.concatenate([a[1], b[1]]),
-                         np.concatenate([a[2], b[2]]))  # fmt: skip
-        out[i] = both[key]
-    return out
-
-
-def _pack_point_rows(point_rows, nb: int):
-    """Region rows padded to ``k`` per point: ``(k, coef (nb, k, 2), lb, ub)`` (flat, in
-    the layout's order); unused rows have zero coefficients and infinite bounds."""
-    most = max((len(r[1]) for r in point_rows), default=0)
+    i = np.arange(n)
+    r0 = np.asarray(span_box)[np.clip(i - p, 0, ns - 1)]
+    r1 = np.asarray(span_box)[np.clip(i, 0, ns - 1)]
+    r1 = np.where(r1 == r0, m, r1)
+    r0[[0, -1]] = m
+    r1[[0, -1]] = m
+    ca = np.concatenate([A[r0], A[r1]], axis=1)  # (n, 2q, 2)
+    clo = np.concatenate([rlo[r0], rlo[r1]], axis=1)
+    chi = np.concatenate([rhi[r0], rhi[r1]], axis=1)
+    top = np.maximum(ca[..., 0] * lo[:, :1], ca[..., 0] * hi[:, :1]) + np.maximum(
+        ca[..., 1] * lo[:, 1:], ca[..., 1] * hi[:, 1:]
+    )
+    keep = ((top > chi) | np.isfinite(clo)) & (np.isfinite(chi) | np.isfinite(clo))
+    most = int(keep.sum(axis=1).max(initial=0))
     k = next((s for s in _K_SIZES if s >= most), int(8 * math.ceil(most / 8)))
+    w = min(k, 2 * q)
+    order = np.argsort(~keep, axis=1, kind="stable")[:, :w]  # kept rows first
+    kept = np.take_along_axis(keep, order, axis=1)
     coef = np.zeros((nb, k, 2))
     lb = np.full((nb, k), -np.inf)
     ub = np.full((nb, k), np.inf)
-    for i, (A, rlo, rhi) in enumerate(point_rows):
-        q = len(rlo)
-        if q:
-            coef[i, :q] = A
-            lb[i, :q] = rlo
-            ub[i, :q] = rhi
+    coef[:n, :w] = np.where(kept[..., None], np.take_along_axis(ca, order[..., None], axis=1), 0.0)
+    lb[:n, :w] = np.where(kept, np.take_along_axis(clo, order, axis=1), -np.inf)
+    ub[:n, :w] = np.where(kept, np.take_along_axis(chi, order, axis=1), np.inf)
     return k, coef, lb.ravel(), ub.ravel()
 
 
@@ -1419,7 +1426,7 @@ def _project_heading(
                 a_lo = max(a_lo, min(t1, t2))
                 a_hi = min(a_hi, max(t1, t2))
         if point_rows is not None:  # A (end + a d) in [rlo, rhi]
-            A, rlo, rhi = point_rows[idx]
+            A, rlo, rhi = (x[idx] for x in point_rows)
             ad = A @ d
             ae = A @ end
             for q in range(len(ad)):
