@@ -494,7 +494,9 @@ def solve_working_set(
     """One QP of the sequential convex programme with only the ``active`` curvature
     samples, solved by piqp directly (the rows of the other samples and their slacks are
     left out: the problem's sparsity changes with the working set, which a
-    ``casadi.conic`` fixes at build time).
+    ``casadi.conic`` fixes at build time). With ``m = 0`` (no samples) it is the corridor
+    QP itself; rows with only zero coefficients or no finite bound are left out too (the
+    padded region rows of a polygon corridor).
 
     Parameters
     ----------

@@ -24,8 +24,10 @@ is inside it. Knots are graded so that every region holds at least ``p`` spans (
 control point touches more than two consecutive regions, which always intersect), so each
 control point is bounded by one intersection: variable bounds for the axis-aligned boxes
 plus two rows ``x + y`` and ``x - y`` for the 45-degree *bridges* the corridor places in
-diagonal gaps, or the half-planes of its (at most two) polygons in a polygon corridor. The convex problem is a sparse banded QP solved by ``casadi.conic`` (piqp by
-default). The curvature-bounded problem is solved by sequential convex programming (a few
+diagonal gaps, or the half-planes of its (at most two) polygons in a polygon corridor.
+The convex problem is a sparse banded QP solved by piqp (by default): through
+``casadi.conic`` in a box corridor, directly in a polygon corridor (its rows per point
+vary). The curvature-bounded problem is solved by sequential convex programming (a few
 QPs with the bound linearised at the current iterate, l1-penalised slacks and a trust
 region, solved by piqp directly over a working set of the samples near the bound;
 ``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex
@@ -676,6 +678,26 @@ class Smoother:
         lbx, ubx, lba, uba = qp.lbx, qp.ubx, qp.lba, qp.uba
         if x0 is None:
             x0 = np.zeros(2 * nb)
+        ts = time.perf_counter()
+        tc = time.process_time()
+        if solver_name == "piqp" and qp.region_coef is not None:
+            # polygon rows: piqp directly, without the rows a point does not use (a
+            # casadi.conic keeps every padded row of its fixed sparsity)
+            layout = _qp.constraint_layout(nb, p, 0, qp.k)
+            trip = layout.values(qp.heading, None, qp.region_coef)
+            z, cost, success, status, iters = _qp.solve_working_set(
+                qp.full, qp.g, layout, trip, lbx, ubx, lba, uba, np.zeros(0, bool), 0.0
+            )
+            return z, {
+                "solver": solver_name,
+                "cost": cost,
+                "success": success,
+                "status": status,
+                "iterations": iters,
+                "solve_time_s": time.perf_counter() - ts,
+                "solve_cpu_s": time.process_time() - tc,
+                "build_time_s": 0.0,
+            }
         tb = time.perf_counter()
         built = _is_cached(f"{solver_name}-0-{qp.k}", nb, p, self.verbose)
         if solver_name == "ipopt":
