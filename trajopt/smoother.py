@@ -685,19 +685,10 @@ class Smoother:
             # casadi.conic keeps every padded row of its fixed sparsity)
             layout = _qp.constraint_layout(nb, p, 0, qp.k)
             trip = layout.values(qp.heading, None, qp.region_coef)
-            z, cost, success, status, iters = _qp.solve_working_set(
+            z, *result = _qp.solve_working_set(
                 qp.full, qp.g, layout, trip, lbx, ubx, lba, uba, np.zeros(0, bool), 0.0
             )
-            return z, {
-                "solver": solver_name,
-                "cost": cost,
-                "success": success,
-                "status": status,
-                "iterations": iters,
-                "solve_time_s": time.perf_counter() - ts,
-                "solve_cpu_s": time.process_time() - tc,
-                "build_time_s": 0.0,
-            }
+            return z, _piqp_info(result, ts, tc)
         tb = time.perf_counter()
         built = _is_cached(f"{solver_name}-0-{qp.k}", nb, p, self.verbose)
         if solver_name == "ipopt":
@@ -751,20 +742,11 @@ class Smoother:
         ubx_s = np.concatenate([ubx, np.full(S, _SLACK_MAX)])
         ts = time.perf_counter()
         tc = time.process_time()
-        z, cost, success, status, iters = _qp.solve_working_set(
+        z, *result = _qp.solve_working_set(
             qp.full, qp.g, layout, trip, lbx_s, ubx_s, lba, uba, work, _SLACK_PENALTY
         )
-        info = {
-            "solver": "piqp",
-            "cost": cost,
-            "success": success,
-            "status": status,
-            "iterations": iters,
-            "solve_time_s": time.perf_counter() - ts,
-            "solve_cpu_s": time.process_time() - tc,
-            "build_time_s": 0.0,
-            "n_samples": int(work.sum()),
-        }
+        info = _piqp_info(result, ts, tc)
+        info["n_samples"] = int(work.sum())
         return z, info
 
     def _curvature_samples(self, t: np.ndarray, n: int, nb: int):
@@ -1257,6 +1239,22 @@ def _point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, 
     lb[:n, :w] = np.where(kept, np.take_along_axis(clo, order, axis=1), -np.inf)
     ub[:n, :w] = np.where(kept, np.take_along_axis(chi, order, axis=1), np.inf)
     return k, coef, lb.ravel(), ub.ravel()
+
+
+def _piqp_info(result, t_wall: float, t_cpu: float) -> dict[str, Any]:
+    """Statistics of a direct piqp solve from :func:`_qp.solve_working_set`'s
+    ``(cost, success, status, iterations)`` and the wall and CPU clocks at its start."""
+    cost, success, status, iters = result
+    return {
+        "solver": "piqp",
+        "cost": cost,
+        "success": success,
+        "status": status,
+        "iterations": iters,
+        "solve_time_s": time.perf_counter() - t_wall,
+        "solve_cpu_s": time.process_time() - t_cpu,
+        "build_time_s": 0.0,
+    }
 
 
 _BUILT: set[tuple] = set()
