@@ -26,6 +26,11 @@ _EXPORTS: dict[str, str] = {
     "save_map": "astar.io",
     "from_intensity": "astar.io",
     "read_scenarios": "astar.io",
+    "read_map_values": "astar.io",
+    # costmaps
+    "Costmap": "astar.costmap",
+    "from_costmap": "astar.costmap",
+    "load_costmap": "astar.costmap",
     "Scenario": "astar.io",
     # inflation
     "inflate": "astar.inflation",
@@ -54,8 +59,16 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
+    from astar.costmap import Costmap, from_costmap, load_costmap
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
-    from astar.io import Scenario, from_intensity, load_map, read_scenarios, save_map
+    from astar.io import (
+        Scenario,
+        from_intensity,
+        load_map,
+        read_map_values,
+        read_scenarios,
+        save_map,
+    )
     from astar.search import GridPath, find_path

@@ -46,6 +46,7 @@ __all__ = [
     "Scenario",
     "from_intensity",
     "load_map",
+    "read_map_values",
     "read_scenarios",
     "save_map",
 ]
@@ -227,6 +228,62 @@ def load_map(
         grid = _make_grid(p, occ[::-1], resolution, origin_xy)
     logger.debug("loaded %s: %r", p, grid)
     return grid
+
+
+def read_map_values(
+    yaml_path: str | os.PathLike[str],
+) -> tuple[np.ndarray, float, tuple[float, float], str]:
+    """map_server's cell values of a ROS map YAML + image, before any thresholding to bool.
+
+    The values are those a ``nav_msgs/OccupancyGrid`` published by map_server holds
+    (``-1`` unknown, ``0..100``), computed with the rules of :func:`load_map` for the file's
+    ``mode``; ``raw`` mode keeps ``0..100`` as written and anything above 100 as ``-1``.
+    Costmaps and Nav2 filter masks are read through this function
+    (:func:`astar.load_costmap`, :func:`trajopt.load_speed_mask`).
+
+    Parameters
+    ----------
+    yaml_path : str or os.PathLike
+        The ``.yaml`` / ``.yml`` metadata file (same keys as :func:`load_map`).
+
+    Returns
+    -------
+    values : ndarray of int16, shape (ny, nx)
+        Row 0 at the bottom (the last image row), like ``OccupancyGrid.occupied``.
+    resolution : float
+        Cell size (m).
+    origin : tuple of float
+        World ``(x, y)`` (m) of the lower-left corner of cell ``(0, 0)``.
+    mode : str
+        The file's ``mode`` (``trinary``, ``scale`` or ``raw``).
+
+    Raises
+    ------
+    MapFormatError
+        Missing or malformed files (the message names the file, the field and the rule).
+    """
+    p = Path(yaml_path)
+    if p.suffix.lower() not in _YAML_SUFFIXES:
+        raise MapFormatError(
+            f"{p}: expected a map_server YAML file ({', '.join(_YAML_SUFFIXES)}), "
+            f"got suffix {p.suffix!r}"
+        )
+    if not p.is_file():
+        raise MapFormatError(f"{p}: map file does not exist (or is not a regular file)")
+    meta = _read_ros_yaml(p)
+    if not meta.image.is_file():
+        raise MapFormatError(
+            f"{p}: field image: image file {str(meta.image)!r} does not exist "
+            "(relative paths are resolved against the YAML file's folder)"
+        )
+    values = _map_server_values(
+        _read_pixels(meta.image, p),
+        mode=meta.mode,
+        negate=meta.negate,
+        occupied_thresh=meta.occupied_thresh,
+        free_thresh=meta.free_thresh,
+    )
+    return np.ascontiguousarray(values[::-1]), meta.resolution, meta.origin, meta.mode
 
 
 def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike[str]) -> Path:

@@ -41,6 +41,8 @@ _EXPORTS: dict[str, str] = {
     "Robot": "trajopt.robot",
     "time_parameterize": "trajopt.timing",
     "Trajectory": "trajopt.trajectory",
+    "SpeedLimits": "trajopt.speed_limits",
+    "load_speed_mask": "trajopt.speed_limits",
     # the opt-in stop-and-turn fallback
     "StopAndTurnTrajectory": "trajopt.fallback",
     "stop_and_turn": "trajopt.fallback",
@@ -89,5 +91,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.pipeline import Planner, plan
     from trajopt.robot import Robot
     from trajopt.smoother import Smoother, SmoothPath
+    from trajopt.speed_limits import SpeedLimits, load_speed_mask
     from trajopt.timing import time_parameterize
     from trajopt.trajectory import Trajectory

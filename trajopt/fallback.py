@@ -45,6 +45,7 @@ import numpy as np
 from trajopt.curve import PolylineCurve
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
+from trajopt.speed_limits import SpeedLimits
 from trajopt.trajectory import TrajectorySample, _export_dict, _readonly, _SampledExport
 
 __all__ = ["StopAndTurnTrajectory", "stop_and_turn", "turn_limits", "polyline_clearance"]
@@ -355,6 +356,7 @@ def stop_and_turn(
     *,
     start_heading: float | None = None,
     goal_heading: float | None = None,
+    speed_limits: SpeedLimits | None = None,
 ) -> StopAndTurnTrajectory:
     """Drive a polyline with rest-to-rest straight moves and turns in place.
 
@@ -370,6 +372,9 @@ def stop_and_turn(
         place from ``start_heading`` to the first segment's direction, and at the end from
         the last segment's direction to ``goal_heading`` (shortest signed angles). Without
         them the motion starts and ends along the first and last segment.
+    speed_limits : SpeedLimits, optional
+        Speed-limit zones (:mod:`trajopt.speed_limits`): each straight move keeps under the
+        lowest limit of the mask cells meeting its segment's bounding box.
 
     Returns
     -------
@@ -417,7 +422,17 @@ def stop_and_turn(
     if h1 is not None:
         theta_end = theta_end + math.remainder(h1 - theta_end, 2.0 * math.pi)
 
-    drive = _RestToRest(float(robot.speed_cap(0.0)), robot.a_max, robot.j_max)
+    if speed_limits is not None and not isinstance(speed_limits, SpeedLimits):
+        raise InvalidInputError(
+            f"speed_limits must be a trajopt.SpeedLimits, got {type(speed_limits).__name__}"
+        )
+    v_straight = float(robot.speed_cap(0.0))
+    seg_vmax = np.full(n_seg, v_straight)
+    if speed_limits is not None:
+        lo = np.minimum(pts[:-1], pts[1:])
+        hi = np.maximum(pts[:-1], pts[1:])
+        seg_vmax = np.minimum(seg_vmax, speed_limits.box_caps(lo, hi, robot.v_max))
+    drives: dict[float, _RestToRest] = {}
     w_lim, al_lim, z_lim = turn_limits(robot)
     turn = _RestToRest(w_lim, al_lim, z_lim)
 
@@ -447,7 +462,10 @@ def stop_and_turn(
     for k in range(n_seg):
         if k > 0:
             add_turn(float(seg_theta[k - 1]), float(seg_theta[k]), k, 0.0)
-        rows = drive.solve(float(seg_len[k]))
+        vk = float(seg_vmax[k])
+        if vk not in drives:
+            drives[vk] = _RestToRest(vk, robot.a_max, robot.j_max)
+        rows = drives[vk].solve(float(seg_len[k]))
         out = np.zeros((len(rows), 10))
         out[:, 0] = rows[:, 0]
         out[:, 1] = k

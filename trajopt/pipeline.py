@@ -8,7 +8,9 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
    on top, so the result is never less safe than the certified inflation.
 2. **search**: octile A* on the inflated grid; by default (``search="clearance"``) with
    the soft clearance cost of :func:`astar.clearance_cost`, which keeps paths off the walls;
-   ``search="shortest"`` is the plain shortest path.
+   ``search="shortest"`` is the plain shortest path. A costmap given as the map
+   (:class:`astar.Costmap`) is searched with its graded cost (``search="costmap"``, or
+   ``"costmap+clearance"`` for both); its obstacle cells are what is inflated above.
 3. **corridor**: with ``corridor="polygons"`` (default, exact inflation)
    :func:`trajopt.polygon_corridor.build_polygon_corridor` around the polyline *exact start
    -> A* cell centres -> exact goal*; otherwise, and wherever the polygon corridor cannot be
@@ -26,7 +28,8 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
    again. Both tries share the smoother's ``time_budget_s``; ``stats["smoother"]["rescue"]``
    is ``"witness"`` when the second try gave the curve (``None`` otherwise), and
    ``steps.grid_path`` / ``steps.corridor`` are then the ones along the witness.
-5. **timing**: :func:`trajopt.time_parameterize`.
+5. **timing**: :func:`trajopt.time_parameterize`, with the planner's speed-limit zones
+   (:class:`~trajopt.speed_limits.SpeedLimits`) when it has them.
 
 The returned :class:`~trajopt.trajectory.Trajectory` carries every intermediate result in
 ``trajectory.steps`` (a :class:`PlanSteps`).
@@ -62,6 +65,7 @@ from typing import Any, Literal
 import numpy as np
 
 import astar
+from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
@@ -70,6 +74,7 @@ from trajopt.feasibility import curvature_witness, witness_grid_path
 from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.robot import Robot
 from trajopt.smoother import Smoother, SmoothPath
+from trajopt.speed_limits import SpeedLimits
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
 
@@ -78,13 +83,13 @@ __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "P
 logger = logging.getLogger(__name__)
 
 Inflation = Literal["exact", "paper"]
-Search = Literal["clearance", "shortest"]
+Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]
 Fallback = Literal["stop_and_turn"]
 CorridorKind = Literal["polygons", "boxes"]
 #: What :meth:`Planner.plan` returns: a smooth trajectory, or the stop-and-turn fallback.
 PlanResult = Trajectory | StopAndTurnTrajectory
 _INFLATIONS = ("exact", "paper")
-_SEARCHES = ("clearance", "shortest")
+_SEARCHES = ("clearance", "shortest", "costmap", "costmap+clearance")
 _FALLBACKS = (None, "stop_and_turn")
 _CORRIDORS = ("polygons", "boxes")
 
@@ -136,8 +141,10 @@ class Planner:
 
     Parameters
     ----------
-    grid : astar.OccupancyGrid
-        The raw map.
+    grid : astar.OccupancyGrid or astar.Costmap
+        The raw map, or a costmap (:func:`astar.load_costmap`, :func:`astar.from_costmap`):
+        its obstacle cells are the map (inflated and certified against as any map) and its
+        graded cost feeds the search (``search="costmap"``, the default for a costmap).
     robot : Robot, optional
         Size and limits; default ``Robot()`` (the chapter's robot).
     inflation : {"exact", "paper"}
@@ -146,8 +153,19 @@ class Planner:
     w_cells : int, optional
         ``W`` for ``inflation="paper"``; default ``round(robot.width / resolution)`` (11 on
         the paper scene).
-    search : {"clearance", "shortest"}
-        A* cost: clearance-aware (default) or plain shortest path.
+    search : {"clearance", "shortest", "costmap", "costmap+clearance"}, optional
+        A* cost: clearance-aware (:func:`astar.clearance_cost`; the default for an
+        occupancy grid), plain shortest path, the costmap's graded cost
+        (:meth:`astar.Costmap.search_cost` with ``costmap_weight``; the default for a
+        costmap) or the sum of both. The costmap modes need ``grid`` to be a costmap.
+    costmap_weight : float, optional
+        ``weight`` of :meth:`astar.Costmap.search_cost` (default 2: a step through the
+        costliest graded cells costs three times its length).
+    speed_limits : SpeedLimits, optional
+        Speed-limit zones (:func:`trajopt.load_speed_mask`): the timing caps the speed by the
+        zone under the robot's centre (and the stop-and-turn fallback by the zones its
+        segments cross). The mask is looked up in world coordinates with its own resolution
+        and origin; a mask that does not overlap the map at all is refused.
     smoother : Smoother, optional
         Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
     timing_dt : float
@@ -179,16 +197,23 @@ class Planner:
         *,
         inflation: Inflation = "exact",
         w_cells: int | None = None,
-        search: Search = "clearance",
+        search: Search | None = None,
         smoother: Smoother | None = None,
         timing_dt: float = 0.02,
         fallback: Fallback | None = None,
         corridor: CorridorKind = "polygons",
+        costmap_weight: float = 2.0,
+        speed_limits: SpeedLimits | None = None,
     ) -> None:
+        costmap: Costmap | None = None
+        if isinstance(grid, Costmap):
+            costmap, grid = grid, grid.grid
         if not isinstance(grid, OccupancyGrid):
             raise InvalidInputError(
-                f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}"
+                f"grid must be an astar.OccupancyGrid or astar.Costmap, got {type(grid).__name__}"
             )
+        if search is None:
+            search = "clearance" if costmap is None else "costmap"
         robot = Robot() if robot is None else robot
         if not isinstance(robot, Robot):
             raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
@@ -196,6 +221,15 @@ class Planner:
             raise InvalidInputError(f"inflation must be one of {_INFLATIONS}, got {inflation!r}")
         if search not in _SEARCHES:
             raise InvalidInputError(f"search must be one of {_SEARCHES}, got {search!r}")
+        if search.startswith("costmap") and costmap is None:
+            raise InvalidInputError(
+                f"search={search!r} needs the grid to be an astar.Costmap "
+                "(astar.load_costmap / astar.from_costmap), got an OccupancyGrid"
+            )
+        if costmap is not None:
+            costmap.search_cost(costmap_weight)  # validates the weight
+        if speed_limits is not None:
+            _check_speed_limits(speed_limits, grid)
         if not (fallback is None or (isinstance(fallback, str) and fallback in _FALLBACKS)):
             raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
         if not (isinstance(corridor, str) and corridor in _CORRIDORS):
@@ -224,6 +258,9 @@ class Planner:
         self.timing_dt = float(timing_dt)
         self.fallback: Fallback | None = fallback
         self.corridor: CorridorKind = corridor
+        self.costmap = costmap
+        self.costmap_weight = float(costmap_weight)
+        self.speed_limits = speed_limits
         self._lock = threading.RLock()
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
@@ -250,9 +287,14 @@ class Planner:
             return None
         with self._lock:
             if self._cost is None:
-                self._cost = astar.clearance_cost(
-                    self.grid, self.robot.radius, outside_occupied=True
-                )
+                cost = np.zeros(self.grid.shape)
+                if self.search in ("clearance", "costmap+clearance"):
+                    cost += astar.clearance_cost(
+                        self.grid, self.robot.radius, outside_occupied=True
+                    )
+                if self.costmap is not None and self.search.startswith("costmap"):
+                    cost += self.costmap.search_cost(self.costmap_weight)
+                self._cost = cost
             return self._cost
 
     # ---------------------------------------------------------------- query
@@ -352,7 +394,12 @@ class Planner:
             stages["smooth"] = time.perf_counter() - t - stages.get("corridor", 0.0)
             t = time.perf_counter()
             traj = time_parameterize(
-                smooth, self.robot, v_start=v_start, v_end=v_end, dt=self.timing_dt
+                smooth,
+                self.robot,
+                v_start=v_start,
+                v_end=v_end,
+                dt=self.timing_dt,
+                speed_limits=self.speed_limits,
             )
             stages["timing"] = time.perf_counter() - t
         except (SmoothingError, TimingError) as exc:
@@ -508,7 +555,11 @@ class Planner:
             )
             raise exc
         traj = stop_and_turn(
-            points, self.robot, start_heading=start_heading, goal_heading=goal_heading
+            points,
+            self.robot,
+            start_heading=start_heading,
+            goal_heading=goal_heading,
+            speed_limits=self.speed_limits,
         )
         stages["fallback"] = time.perf_counter() - t
         stages["total"] = time.perf_counter() - t0
@@ -557,7 +608,7 @@ class Planner:
 
 
 def plan(
-    grid: OccupancyGrid,
+    grid: OccupancyGrid | Costmap,
     start: Sequence[float],
     goal: Sequence[float],
     robot: Robot | None = None,
@@ -567,11 +618,13 @@ def plan(
     v_start: float = 0.0,
     v_end: float = 0.0,
     inflation: Inflation = "exact",
-    search: Search = "clearance",
+    search: Search | None = None,
     smoother: Smoother | None = None,
     w_cells: int | None = None,
     fallback: Fallback | None = None,
     corridor: CorridorKind = "polygons",
+    costmap_weight: float = 2.0,
+    speed_limits: SpeedLimits | None = None,
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
@@ -580,8 +633,8 @@ def plan(
 
     Parameters
     ----------
-    grid : astar.OccupancyGrid
-        Raw map.
+    grid : astar.OccupancyGrid or astar.Costmap
+        Raw map, or a costmap (see :class:`Planner`).
     start, goal : sequence of float, shape (2,)
         End points ``(x, y)`` in world metres.
     robot : Robot, optional
@@ -590,7 +643,7 @@ def plan(
         Exact headings at the ends (rad).
     v_start, v_end : float
         Speeds at the ends (m/s).
-    inflation, search, smoother, w_cells, corridor
+    inflation, search, smoother, w_cells, corridor, costmap_weight, speed_limits
         See :class:`Planner`.
     fallback : {None, "stop_and_turn"}
         Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
@@ -618,6 +671,8 @@ def plan(
         w_cells=w_cells,
         fallback=fallback,
         corridor=corridor,
+        costmap_weight=costmap_weight,
+        speed_limits=speed_limits,
     )
     return planner.plan(
         start,
@@ -630,6 +685,23 @@ def plan(
 
 
 # ------------------------------------------------------------------ helpers
+def _check_speed_limits(limits: object, grid: OccupancyGrid) -> None:
+    if not isinstance(limits, SpeedLimits):
+        raise InvalidInputError(
+            f"speed_limits must be a trajopt.SpeedLimits (trajopt.load_speed_mask), "
+            f"got {type(limits).__name__}"
+        )
+    x0, x1, y0, y1 = limits.extent
+    gx0, gy0 = grid.origin
+    gx1, gy1 = gx0 + grid.width, gy0 + grid.height
+    if x1 <= gx0 or x0 >= gx1 or y1 <= gy0 or y0 >= gy1:
+        raise InvalidInputError(
+            f"speed_limits: the mask covers x in [{x0:.6g}, {x1:.6g}] m, y in [{y0:.6g}, "
+            f"{y1:.6g}] m, which does not overlap the map (x in [{gx0:.6g}, {gx1:.6g}] m, "
+            f"y in [{gy0:.6g}, {gy1:.6g}] m); masks are looked up in world coordinates"
+        )
+
+
 def _point(name: str, value: Any) -> np.ndarray:
     try:
         p = np.asarray(value, dtype=float)

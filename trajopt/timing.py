@@ -66,6 +66,7 @@ from trajopt.curvature_bound import interval_kappa_max
 from trajopt.curve import _STILL, ParametricCurve, _signed_curvature
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
+from trajopt.speed_limits import SpeedLimits
 from trajopt.trajectory import Trajectory
 
 __all__ = ["time_parameterize"]
@@ -92,6 +93,7 @@ def time_parameterize(
     v_start: float = 0.0,
     v_end: float = 0.0,
     dt: float = 0.02,
+    speed_limits: SpeedLimits | None = None,
 ) -> Trajectory:
     """Time a curve with a near time-optimal, jerk-limited speed profile.
 
@@ -105,6 +107,10 @@ def time_parameterize(
         Speed at ``s = 0`` and at ``s = L`` (m/s), >= 0; the acceleration is 0 at both ends.
     dt : float
         Step of the forward greedy (s), in ``(0, 0.5]``.
+    speed_limits : SpeedLimits, optional
+        Speed-limit zones (:mod:`trajopt.speed_limits`): the speed is capped by the limit of
+        the zone under the robot's centre, one more cap in the cap table (each interval
+        takes the lowest limit of the mask cells the curve can touch in it).
 
     Returns
     -------
@@ -136,6 +142,10 @@ def time_parameterize(
     v_end = _speed("v_end", v_end)
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0.0 < dt <= 0.5):
         raise InvalidInputError(f"dt must be a number in (0, 0.5] s, got {dt!r}")
+    if speed_limits is not None and not isinstance(speed_limits, SpeedLimits):
+        raise InvalidInputError(
+            f"speed_limits must be a trajopt.SpeedLimits, got {type(speed_limits).__name__}"
+        )
     length = float(curve.length)
     if not (math.isfinite(length) and length > 0.0):
         raise InvalidInputError(f"curve.length must be finite and > 0 m, got {length!r}")
@@ -154,18 +164,23 @@ def time_parameterize(
     u_nodes[0], u_nodes[-1] = curve.domain
     kappa, theta = _curvature_heading(curve, u_nodes)
     theta = np.unwrap(theta)
-    raw = np.asarray(robot.speed_cap(kappa), dtype=float)
-    cap0 = float(robot.speed_cap(kappa[0]))
-    cap1 = float(robot.speed_cap(kappa[-1]))
+    raw_kappa = np.asarray(robot.speed_cap(kappa), dtype=float)
+    raw = raw_kappa
+    zone = None
+    if speed_limits is not None:
+        zone = _zone_caps(curve, u_nodes, h, speed_limits, robot.v_max)
+        raw = np.minimum(raw, np.minimum(np.r_[zone[0], zone], np.r_[zone, zone[-1]]))
+    cap0 = float(raw[0])
+    cap1 = float(raw[-1])
     if v_start > cap0 * (1.0 + 1e-12):
         raise TimingError(
             f"v_start={v_start:.6g} m/s exceeds the speed cap {cap0:.6g} m/s at s=0 "
-            f"(curvature {kappa[0]:.6g} 1/m)"
+            f"(curvature {kappa[0]:.6g} 1/m{_zone_note(zone, 0)})"
         )
     if v_end > cap1 * (1.0 + 1e-12):
         raise TimingError(
             f"v_end={v_end:.6g} m/s exceeds the speed cap {cap1:.6g} m/s at s=L={length:.6g} m "
-            f"(curvature {kappa[-1]:.6g} 1/m)"
+            f"(curvature {kappa[-1]:.6g} 1/m{_zone_note(zone, -1)})"
         )
     degree = getattr(curve, "polynomial_degree", None)
     if degree is not None:
@@ -179,7 +194,9 @@ def time_parameterize(
                 f"speed cap is 0"
             )
     else:
-        ci = _interval_caps(raw, curve, robot, s_nodes, kappa, theta)
+        ci = _interval_caps(raw_kappa, curve, robot, s_nodes, kappa, theta)
+    if zone is not None:
+        ci = np.minimum(ci, zone)
     v_bound = max(v_start, v_end)
     ci = np.maximum(ci * (1.0 - _CAP_MARGIN), np.minimum(ci, v_bound))
     ci[0] = max(ci[0], min(v_start, raw[0], raw[1]))
@@ -290,6 +307,29 @@ def _speed(name: str, value: Any) -> float:
     if not math.isfinite(x) or x < 0.0:
         raise InvalidInputError(f"{name} must be finite and >= 0 m/s, got {value!r}")
     return x
+
+
+def _zone_caps(
+    curve: ParametricCurve, u_nodes: np.ndarray, h: float, limits: SpeedLimits, v_max: float
+) -> np.ndarray:
+    """Lowest zone limit (m/s) per cap-table interval, shape ``(n,)``.
+
+    The piece of the curve between two nodes ``h`` apart in arc length lies within ``h/2``
+    of one of them, so it lies in the box around the two nodes grown by ``h/2`` (plus 1e-6 m
+    for the table's ``u(s)`` error); the interval takes the lowest limit of every mask cell
+    meeting that box.
+    """
+    xy = np.asarray(curve(u_nodes), dtype=float)
+    grow = 0.5 * h + 1e-6
+    lo = np.minimum(xy[:-1], xy[1:]) - grow
+    hi = np.maximum(xy[:-1], xy[1:]) + grow
+    return limits.box_caps(lo, hi, v_max)
+
+
+def _zone_note(zone: np.ndarray | None, i: int) -> str:
+    if zone is None or not np.isfinite(zone[i]):
+        return ""
+    return f"; speed-limit zone {float(zone[i]):.6g} m/s"
 
 
 def _table_u_at_s(curve: ParametricCurve, s: np.ndarray) -> np.ndarray:
