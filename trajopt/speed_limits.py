@@ -116,7 +116,7 @@ class SpeedLimits:
         if np.any(bad):
             iy, ix = (int(i) for i in np.argwhere(bad)[0])
             raise InvalidInputError(
-                f"speed mask values[{iy}, {ix}] = {v[iy, ix]!r} is not an OccupancyGrid value "
+                f"speed mask values[{iy}, {ix}] = {v[iy, ix].item()!r} is not an OccupancyGrid value "
                 "(integers -1..100)"
             )
         v = v.astype(np.int64)
