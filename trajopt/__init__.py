@@ -43,6 +43,9 @@ _EXPORTS: dict[str, str] = {
     "Trajectory": "trajopt.trajectory",
     "SpeedLimits": "trajopt.speed_limits",
     "load_speed_mask": "trajopt.speed_limits",
+    # ROS 2 files
+    "read_mcap": "trajopt.ros_mcap",
+    "write_mcap": "trajopt.ros_mcap",
     # the opt-in stop-and-turn fallback
     "StopAndTurnTrajectory": "trajopt.fallback",
     "stop_and_turn": "trajopt.fallback",
@@ -90,6 +93,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
     from trajopt.pipeline import Planner, plan
     from trajopt.robot import Robot
+    from trajopt.ros_mcap import read_mcap, write_mcap
     from trajopt.smoother import Smoother, SmoothPath
     from trajopt.speed_limits import SpeedLimits, load_speed_mask
     from trajopt.timing import time_parameterize

@@ -92,10 +92,31 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--search",
-        choices=("clearance", "shortest"),
-        default="clearance",
-        help="A* cost (default clearance-aware)",
+        choices=("clearance", "shortest", "costmap", "costmap+clearance"),
+        default=None,
+        help="A* cost (default clearance-aware; with --costmap the costmap's graded cost)",
     )
+    g = p.add_argument_group("ROS 2 / Nav2 inputs")
+    g.add_argument(
+        "--costmap",
+        action="store_true",
+        help="MAP is a costmap saved by Nav2's map saver (OccupancyGrid values, best in "
+        "mode raw): lethal cells are obstacles, the graded cost steers the search",
+    )
+    g.add_argument(
+        "--costmap-weight", type=float, default=2.0,
+        help="weight of the costmap's normalised cost in the search (default 2)",
+    )  # fmt: skip
+    g.add_argument("--speed-mask", metavar="YAML", help="Nav2 speed filter mask (map_server YAML)")
+    g.add_argument(
+        "--speed-mask-type", choices=("percentage", "absolute"), default="percentage",
+        help="limit in percent of --v-max or in m/s (Nav2 filter type 1 or 2; default percentage)",
+    )  # fmt: skip
+    g.add_argument("--speed-mask-base", type=float, default=0.0,
+                   help="Nav2 'base': limit = value * multiplier + base (default 0)")  # fmt: skip
+    g.add_argument("--speed-mask-multiplier", type=float, default=1.0,
+                   help="Nav2 'multiplier' (default 1)")  # fmt: skip
+    g.add_argument("--frame-id", default="map", help="frame of the written poses (default map)")
     p.add_argument(
         "--corridor",
         choices=("polygons", "boxes"),
@@ -113,7 +134,9 @@ def build_parser() -> argparse.ArgumentParser:
         "with stops and turns in place at the corners (differential drive; "
         "checked against the map) instead of an error",
     )
-    p.add_argument("--out", help="write the trajectory (.csv or .json)")
+    p.add_argument(
+        "--out", help="write the trajectory (.csv, .json, or .mcap for ROS 2 / Foxglove)"
+    )
     p.add_argument("--dt", type=float, default=0.01, help="sample step of --out [s]")
     p.add_argument("--plot", help="write a figure (.png/.pdf/.svg)")
     p.set_defaults(func=_cmd_plan)
@@ -231,12 +254,32 @@ def _require_matplotlib() -> None:
 
 
 # -------------------------------------------------------------------- commands
+_OUT_SUFFIXES = (".csv", ".json", ".mcap")
+
+
 def _cmd_plan(args: argparse.Namespace) -> int:
     from trajopt.pipeline import Planner
     from trajopt.smoother import Smoother
 
-    grid = _load(args)
+    if args.out and Path(args.out).suffix.lower() not in _OUT_SUFFIXES:
+        raise CliError(f"--out must end in .csv, .json or .mcap, got {args.out!r}")
+    if args.costmap:
+        import astar
+
+        grid = astar.load_costmap(args.map)
+    else:
+        grid = _load(args)
     robot = _robot(args)
+    speed_limits = None
+    if args.speed_mask:
+        from trajopt.speed_limits import load_speed_mask
+
+        speed_limits = load_speed_mask(
+            args.speed_mask,
+            type=args.speed_mask_type,
+            base=args.speed_mask_base,
+            multiplier=args.speed_mask_multiplier,
+        )
     smoother = Smoother(kappa_max=args.kappa_max) if args.kappa_max is not None else None
     planner = Planner(
         grid,
@@ -246,6 +289,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         smoother=smoother,
         fallback="stop_and_turn" if args.fallback else None,
         corridor=args.corridor,
+        costmap_weight=args.costmap_weight,
+        speed_limits=speed_limits,
     )
     traj = planner.plan(
         args.start, args.goal, start_heading=args.start_heading, goal_heading=args.goal_heading
@@ -267,11 +312,11 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.out:
         suffix = Path(args.out).suffix.lower()
         if suffix == ".csv":
-            traj.to_csv(args.out, dt=args.dt)
+            traj.to_csv(args.out, dt=args.dt, frame_id=args.frame_id)
         elif suffix == ".json":
-            traj.to_json(args.out, dt=args.dt)
+            traj.to_json(args.out, dt=args.dt, frame_id=args.frame_id)
         else:
-            raise CliError(f"--out must end in .csv or .json, got {args.out!r}")
+            traj.to_mcap(args.out, dt=args.dt, frame_id=args.frame_id)
         print(f"wrote {args.out}")
     if args.plot:
         _require_matplotlib()

@@ -93,7 +93,8 @@ class _SampledExport:
 
     A subclass provides ``duration`` (s), ``sample(t)`` returning a
     :class:`TrajectorySample` and ``to_dict(dt)``; the helpers below give it
-    ``sample_uniform``, ``to_json`` and ``to_csv`` (atomic writes).
+    ``sample_uniform``, ``to_poses`` and the writers ``to_json``, ``to_csv`` and
+    ``to_mcap`` (atomic writes, each naming the frame of its poses).
     """
 
     __slots__ = ()
@@ -117,27 +118,93 @@ class _SampledExport:
             t[-1] = min(t[-1], duration)
         return self.sample(t)  # type: ignore[attr-defined]
 
-    def to_json(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
-        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path."""
-        text = json.dumps(self.to_dict(dt), indent=1)  # type: ignore[attr-defined]
-        return _atomic_write(Path(path), text)
+    def to_json(
+        self, path: str | os.PathLike, dt: float = 0.01, *, frame_id: str = "map"
+    ) -> Path:
+        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path.
 
-    def to_csv(self, path: str | os.PathLike, dt: float = 0.01) -> Path:
+        The top-level ``frame_id`` names the frame of ``x``, ``y`` and ``theta``.
+        """
+        frame = _frame_id(frame_id)
+        out = {"frame_id": frame, **self.to_dict(dt)}  # type: ignore[attr-defined]
+        return _atomic_write(Path(path), json.dumps(out, indent=1))
+
+    def to_csv(
+        self, path: str | os.PathLike, dt: float = 0.01, *, frame_id: str = "map"
+    ) -> Path:
         """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
 
-        The header names each column with its unit, e.g. ``t [s]``, ``v [m/s]``.
+        The first line is a comment naming the frame of the poses
+        (``# frame_id: map; ...``; ``pandas.read_csv(path, comment="#")`` and
+        ``numpy.loadtxt`` skip it); the header then names each column with its unit, e.g.
+        ``t [s]``, ``v [m/s]``.
         """
+        frame = _frame_id(frame_id)
         smp = self.sample_uniform(dt).as_dict()
         names = list(smp)
         import io
 
         buf = io.StringIO()
+        buf.write(f"# frame_id: {frame}; x, y and theta are in this frame\n")
         w = csv.writer(buf, lineterminator="\n")
         w.writerow([f"{n} [{SAMPLE_UNITS[n]}]" for n in names])
         cols = np.column_stack([np.asarray(smp[n]) for n in names])
         for row in cols:
             w.writerow([repr(float(x)) for x in row])
         return _atomic_write(Path(path), buf.getvalue())
+
+
+    def to_poses(self, dt: float = 0.01) -> np.ndarray:
+        """Poses every ``dt`` seconds in the shape of ``nav_msgs/Path``, without ROS.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), > 0; the end time is always included.
+
+        Returns
+        -------
+        ndarray, structured, shape (n,)
+            Records ``(t, x, y, qz, qw)`` of float64: time (s), position (m) and the
+            heading as a unit quaternion about z (``qz = sin(theta/2)``,
+            ``qw = cos(theta/2)``).
+        """
+        smp = self.sample_uniform(dt)
+        out = np.empty(len(smp.t), dtype=POSE_DTYPE)
+        half = 0.5 * np.asarray(smp.theta)
+        out["t"], out["x"], out["y"] = smp.t, smp.x, smp.y
+        out["qz"], out["qw"] = np.sin(half), np.cos(half)
+        return out
+
+    def to_mcap(
+        self,
+        path: str | os.PathLike,
+        dt: float = 0.01,
+        *,
+        frame_id: str = "map",
+        child_frame_id: str = "base_link",
+        start_time: float = 0.0,
+    ) -> Path:
+        """Write a ROS 2 MCAP file: maps, path, corridor, stamped poses and twists.
+
+        See :func:`trajopt.ros_mcap.write_mcap` (topics, types, frames and stamps).
+        """
+        from trajopt.ros_mcap import write_mcap
+
+        return write_mcap(
+            self, path, dt=dt, frame_id=frame_id, child_frame_id=child_frame_id,
+            start_time=start_time,
+        )  # fmt: skip
+
+
+#: The record of :meth:`Trajectory.to_poses`.
+POSE_DTYPE = np.dtype([("t", "f8"), ("x", "f8"), ("y", "f8"), ("qz", "f8"), ("qw", "f8")])
+
+
+def _frame_id(value: object) -> str:
+    if not isinstance(value, str) or not value or "\n" in value:
+        raise InvalidInputError(f"frame_id must be a non-empty one-line string, got {value!r}")
+    return value
 
 
 def _export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:

@@ -55,7 +55,7 @@ def run(argv) -> int:
         (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "-1"],
          "v_max"),
         (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--out", "x.txt"],
-         "--out must end in .csv or .json"),
+         "--out must end in .csv, .json or .mcap"),
         (["plan", "{map}", "--start", "0.4"], "expected 2 arguments"),
         (["bench", "{map}", "--limit", "0"], "--limit must be >= 1"),
         (["nonsense"], "invalid choice"),
@@ -138,3 +138,39 @@ def test_bench_serial_equals_parallel(shared_data, capsys):
 
     assert strip_times(serial) == strip_times(parallel)
     assert "scenarios                      3" in serial
+
+
+def test_plan_on_a_costmap_with_a_speed_mask_to_mcap(tmp_path, capsys):
+    from PIL import Image
+
+    from trajopt.ros_mcap import read_mcap
+
+    # a 3 x 2 m room at 5 cm with a wall stub; costmap in raw mode (OccupancyGrid values)
+    og = np.zeros((40, 60), np.int64)
+    og[:, 0] = og[:, -1] = og[0, :] = og[-1, :] = 100
+    og[:25, 30] = 100
+    og[:28, 28:33] = np.maximum(og[:28, 28:33], 60)  # graded cost around the stub
+    Image.fromarray(og.astype(np.uint8)[::-1], mode="L").save(tmp_path / "cm.pgm")
+    (tmp_path / "cm.yaml").write_text(
+        "image: cm.pgm\nmode: raw\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.25\n"
+    )
+    mask = np.zeros((40, 60), np.uint8)
+    mask[:, 40:] = 50  # 50 % of v_max for x >= 2 m (scale mode: grey 50 % -> value 50)
+    Image.fromarray(np.rint(255 * (1 - mask / 100)).astype(np.uint8)[::-1], mode="L").save(
+        tmp_path / "mask.pgm"
+    )
+    (tmp_path / "mask.yaml").write_text(
+        "image: mask.pgm\nmode: scale\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+        "negate: 0\noccupied_thresh: 1.0\nfree_thresh: 0.0\n"
+    )
+    out = tmp_path / "traj.mcap"
+    rc = main(["plan", str(tmp_path / "cm.yaml"), "--costmap", "--start", "0.5", "0.5",
+               "--goal", "2.6", "0.5", "--radius", "0.12", "--speed-mask",
+               str(tmp_path / "mask.yaml"), "--out", str(out), "--dt", "0.01"])  # fmt: skip
+    assert rc == 0, capsys.readouterr().err
+    back = read_mcap(out)
+    zone = back.x >= 2.0 + 1e-9
+    assert zone.any() and np.all(back.v[zone] <= 0.5 * 0.5 + 1e-9)
+    assert back.v[~zone].max() > 0.3
+    assert back.y.max() > 25 * 0.05  # around the stub, not through it

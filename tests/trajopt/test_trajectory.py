@@ -163,7 +163,10 @@ def test_exports(tmp_path):
     assert np.allclose(loaded["phases"]["t"], traj.phase_t)
     q = traj.to_csv(tmp_path / "traj.csv", dt=0.05)
     with open(q, newline="") as f:
+        first = f.readline()
         rows = list(csv.reader(f))
+    assert first.startswith("# frame_id: map;")
+    assert loaded["frame_id"] == "map"
     assert rows[0][0] == "t [s]" and "v [m/s]" in rows[0] and "theta [rad]" in rows[0]
     table = np.array(rows[1:], dtype=float)
     assert table.shape == (len(smp.t), len(rows[0]))
