@@ -76,7 +76,7 @@ def test_wrong_dtype_maps(occ, match) -> None:
 @pytest.mark.parametrize(
     ("grid", "robot", "kwargs", "match"),
     [
-        (np.zeros((4, 4), bool), None, {}, "grid must be an astar.OccupancyGrid, got ndarray"),
+        (np.zeros((4, 4), bool), None, {}, "grid must be an astar.OccupancyGrid or astar.Costmap, got ndarray"),
         ("door", {"radius": 0.1}, {}, "robot must be a trajopt.Robot, got dict"),
         ("door", None, {"timing_dt": 0.0}, r"timing_dt must be a number in \(0, 0.5\]"),
         ("door", None, {"timing_dt": math.nan}, "timing_dt"),
