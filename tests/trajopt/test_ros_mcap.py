@@ -157,3 +157,13 @@ def test_atomic_and_typed_failures(planned, tmp_path, monkeypatch):
         planned.to_mcap(tmp_path / "x.mcap", start_time=-1.0)
     with pytest.raises(McapExportError, match="not a readable MCAP"):
         read_mcap(blocker)
+
+
+def test_box_corridor_markers(tmp_path):
+    sc = trajopt.scenes.paper()
+    traj = trajopt.plan(sc.grid, sc.start, sc.goal("A"), corridor="boxes")
+    back = read_mcap(traj.to_mcap(tmp_path / "b.mcap", dt=0.1))
+    boxes = traj.steps.corridor.boxes
+    assert len(back.corridor) == len(boxes)
+    for outline, box in zip(back.corridor, boxes, strict=True):
+        np.testing.assert_allclose(outline[:-1], box.vertices())
