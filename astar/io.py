@@ -36,8 +36,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from astar._files import atomic_write
 from astar.errors import InvalidInputError, MapFormatError
+from astar.files import atomic_write
 from astar.grid import OccupancyGrid
 
 __all__ = [
@@ -1091,5 +1091,5 @@ def _nonneg_int(value: object, name: str) -> int:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (:func:`astar._files.atomic_write`)."""
+    """Write ``data`` to ``path`` atomically (:func:`astar.files.atomic_write`)."""
     atomic_write(path, lambda tmp: tmp.write_bytes(data))

@@ -16,7 +16,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from astar._files import atomic_write
+from astar.files import atomic_write
 
 __all__ = ["main", "build_parser"]
 

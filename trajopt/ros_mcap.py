@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from astar._files import atomic_write
+from astar.files import atomic_write
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, TrajoptError
 

@@ -19,7 +19,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from astar._files import atomic_write
+from astar.files import atomic_write
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
 from trajopt.robot import Robot

@@ -1,4 +1,4 @@
-"""Tests of the shared atomic file write (:mod:`astar._files`)."""
+"""Tests of the shared atomic file write (:mod:`astar.files`)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import stat
 
 import pytest
 
-from astar._files import atomic_write
+from astar.files import atomic_write
 
 
 def test_new_file_gets_umask_permissions_not_private_ones(tmp_path):

@@ -1,4 +1,4 @@
-"""Private: atomic file writes shared by the loaders, the trajectory exporters and the CLI."""
+"""Atomic file writes, shared by the map writers, the trajectory exporters and the CLI."""
 
 from __future__ import annotations
 
