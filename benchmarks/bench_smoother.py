@@ -30,9 +30,10 @@ sys.path.insert(0, str(ROOT))
 import astar  # noqa: E402
 from trajopt import _qp  # noqa: E402
 from trajopt.bspline import clamped_uniform_knots  # noqa: E402
+from trajopt.clearance import points_clearance  # noqa: E402
 from trajopt.corridor import build_corridor  # noqa: E402
 from trajopt.errors import SmoothingError  # noqa: E402
-from trajopt.smoother import Smoother, point_square_clearance  # noqa: E402
+from trajopt.smoother import Smoother  # noqa: E402
 
 
 def data_dir() -> Path:
@@ -145,7 +146,7 @@ def peer(cases, n_ctrl_by_case):
         xy = spl(u)
         if (
             not np.all(np.isfinite(xy))
-            or point_square_clearance(xy, raw, r + raw.resolution).min() < r - 1e-9
+            or points_clearance(xy, raw, r + raw.resolution).min() < r - 1e-9
         ):
             viol += 1
     return times, viol

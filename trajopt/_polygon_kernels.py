@@ -3,7 +3,7 @@
 Everything here works in *cell units*: the map's cell ``(ix, iy)`` is the unit square
 ``[ix, ix + 1] x [iy, iy + 1]`` and the map is ``[0, nx] x [0, ny]``. Obstacles are
 axis-aligned rectangles ``(x0, y0, x1, y1)`` (unions of occupied cells, see
-:func:`merge_rects`) plus the outside of the map. Rectangles are looked up through a
+:func:`trajopt.clearance.merge_rects`) plus the outside of the map. Rectangles are looked up through a
 bucket grid (:func:`build_buckets`, :func:`gather`).
 
 The *index* passed to the queries is the tuple of arrays
@@ -20,63 +20,14 @@ import math
 import numpy as np
 from numba import njit
 
+from trajopt.clearance import (
+    border_distance,
+    point_segment_distance,
+    polygon_rect_closest,
+    segment_rect_distance,
+)
+
 # ---------------------------------------------------------------- obstacles
-
-
-@njit(cache=True)
-def merge_rects(occ, x_off, y_off):  # pragma: no cover - compiled
-    """Occupied cells of ``occ`` (window of the map, ``occ[iy, ix]``) as rectangles.
-
-    Runs of occupied cells along each row are merged with the identical run of the row
-    below when there is one. Returns ``(R, 4)`` float64 ``(x0, y0, x1, y1)``, offset by
-    ``(x_off, y_off)`` cells.
-    """
-    h, w = occ.shape
-    runs = 0  # an upper bound of the rectangle count (growing arrays in the loop is slow)
-    for y in range(h):
-        inside = False
-        for x in range(w):
-            if occ[y, x] and not inside:
-                runs += 1
-            inside = occ[y, x]
-    rx0 = np.empty(runs, np.int64)
-    ry0 = np.empty(runs, np.int64)
-    rx1 = np.empty(runs, np.int64)
-    ry1 = np.empty(runs, np.int64)
-    n = 0
-    prev = np.full(w + 1, -1, np.int64)
-    cur = np.full(w + 1, -1, np.int64)
-    for y in range(h):
-        x = 0
-        while x < w:
-            if not occ[y, x]:
-                x += 1
-                continue
-            x0 = x
-            while x < w and occ[y, x]:
-                x += 1
-            rid = prev[x0]
-            if rid >= 0 and rx1[rid] == x and ry1[rid] == y:
-                ry1[rid] = y + 1
-            else:
-                rx0[n] = x0
-                ry0[n] = y
-                rx1[n] = x
-                ry1[n] = y + 1
-                rid = n
-                n += 1
-            cur[x0] = rid
-        tmp = prev
-        prev = cur
-        cur = tmp
-        cur[:] = -1
-    out = np.empty((n, 4), np.float64)
-    for i in range(n):
-        out[i, 0] = rx0[i] + x_off
-        out[i, 1] = ry0[i] + y_off
-        out[i, 2] = rx1[i] + x_off
-        out[i, 3] = ry1[i] + y_off
-    return out
 
 
 @njit(cache=True)
@@ -155,150 +106,6 @@ def gather(qx0, qx1, qy0, qy1, rects, meta, bstart, bids, stamp, buf):  # pragma
 # ---------------------------------------------------------------- distances
 
 
-@njit(cache=True, inline="always")
-def pt_rect(px, py, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """Distance from a point to a closed axis-aligned rectangle (0 inside)."""
-    gx = max(x0 - px, 0.0, px - x1)
-    gy = max(y0 - py, 0.0, py - y1)
-    return math.sqrt(gx * gx + gy * gy)
-
-
-@njit(cache=True, inline="always")
-def pt_seg(px, py, ax, ay, bx, by):  # pragma: no cover - compiled
-    """Distance from a point to a segment, and the parameter of the closest point."""
-    dx = bx - ax
-    dy = by - ay
-    ll = dx * dx + dy * dy
-    t = 0.0
-    if ll > 0.0:
-        t = ((px - ax) * dx + (py - ay) * dy) / ll
-        t = min(1.0, max(0.0, t))
-    cx = ax + t * dx - px
-    cy = ay + t * dy - py
-    return math.sqrt(cx * cx + cy * cy), t
-
-
-@njit(cache=True)
-def seg_meets_rect(ax, ay, bx, by, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """Whether a closed segment meets a closed rectangle (Liang-Barsky)."""
-    dx = bx - ax
-    dy = by - ay
-    t0 = 0.0
-    t1 = 1.0
-    for k in range(4):
-        if k == 0:
-            p, q = -dx, ax - x0
-        elif k == 1:
-            p, q = dx, x1 - ax
-        elif k == 2:
-            p, q = -dy, ay - y0
-        else:
-            p, q = dy, y1 - ay
-        if p == 0.0:
-            if q < 0.0:
-                return False
-        else:
-            t = q / p
-            if p < 0.0:
-                t0 = max(t0, t)
-            else:
-                t1 = min(t1, t)
-    return t0 <= t1
-
-
-@njit(cache=True)
-def seg_rect(ax, ay, bx, by, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """Exact distance between a segment and a rectangle (0 when they meet)."""
-    if seg_meets_rect(ax, ay, bx, by, x0, y0, x1, y1):
-        return 0.0
-    d = min(pt_rect(ax, ay, x0, y0, x1, y1), pt_rect(bx, by, x0, y0, x1, y1))
-    for c in range(4):
-        cx = x0 if (c == 0 or c == 3) else x1
-        cy = y0 if c < 2 else y1
-        e, _ = pt_seg(cx, cy, ax, ay, bx, by)
-        d = min(d, e)
-    return d
-
-
-@njit(cache=True)
-def poly_rect_closest(v, nv, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """Exact distance between a convex polygon (``v[:nv]``, any orientation; 1 or 2
-    vertices for a point or a segment) and a rectangle, with a closest pair.
-
-    Returns ``(d, px, py, qx, qy)``: ``p`` on the polygon, ``q`` on the rectangle; ``d = 0``
-    (and ``p = q = nan``) when they meet, decided by the separating-axis theorem over the
-    polygon's edge normals and the two coordinate axes.
-    """
-    nan = np.nan
-    vxmin = v[0, 0]
-    vxmax = v[0, 0]
-    vymin = v[0, 1]
-    vymax = v[0, 1]
-    for i in range(1, nv):
-        vxmin = min(vxmin, v[i, 0])
-        vxmax = max(vxmax, v[i, 0])
-        vymin = min(vymin, v[i, 1])
-        vymax = max(vymax, v[i, 1])
-    sep = vxmax < x0 or vxmin > x1 or vymax < y0 or vymin > y1
-    if not sep and nv >= 2:
-        for i in range(nv):
-            j = (i + 1) % nv
-            ex = v[j, 0] - v[i, 0]
-            ey = v[j, 1] - v[i, 1]
-            if ex == 0.0 and ey == 0.0:
-                continue
-            nx_ = ey
-            ny_ = -ex
-            pmax = -np.inf
-            pmin = np.inf
-            for k in range(nv):
-                s = nx_ * v[k, 0] + ny_ * v[k, 1]
-                pmax = max(pmax, s)
-                pmin = min(pmin, s)
-            rmin = np.inf
-            rmax = -np.inf
-            for c in range(4):
-                cx = x0 if (c == 0 or c == 3) else x1
-                cy = y0 if c < 2 else y1
-                s = nx_ * cx + ny_ * cy
-                rmin = min(rmin, s)
-                rmax = max(rmax, s)
-            if rmin > pmax or rmax < pmin:
-                sep = True
-                break
-    if not sep:
-        return 0.0, nan, nan, nan, nan
-    best = np.inf
-    bpx = bpy = bqx = bqy = nan
-    for i in range(nv):
-        px = v[i, 0]
-        py = v[i, 1]
-        qx = min(max(px, x0), x1)
-        qy = min(max(py, y0), y1)
-        d = math.sqrt((px - qx) ** 2 + (py - qy) ** 2)
-        if d < best:
-            best = d
-            bpx, bpy, bqx, bqy = px, py, qx, qy
-    if nv >= 2:
-        for c in range(4):
-            cx = x0 if (c == 0 or c == 3) else x1
-            cy = y0 if c < 2 else y1
-            for i in range(nv):
-                j = (i + 1) % nv
-                d, t = pt_seg(cx, cy, v[i, 0], v[i, 1], v[j, 0], v[j, 1])
-                if d < best:
-                    best = d
-                    bpx = v[i, 0] + t * (v[j, 0] - v[i, 0])
-                    bpy = v[i, 1] + t * (v[j, 1] - v[i, 1])
-                    bqx, bqy = cx, cy
-    return best, bpx, bpy, bqx, bqy
-
-
-@njit(cache=True, inline="always")
-def _border(px, py, nx, ny):  # pragma: no cover - compiled
-    return max(0.0, min(px, nx - px, py, ny - py))
-
-
 @njit(cache=True)
 def point_nearest(px, py, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
     """Distance (capped at ``cap``) from a point to the nearest obstacle (rectangle or
@@ -337,14 +144,14 @@ def seg_clearance(ax, ay, bx, by, cap, rects, meta, bstart, bids, stamp, buf):  
     """Exact distance (capped at ``cap``) from a segment to every obstacle."""
     nx = meta[5]
     ny = meta[6]
-    best = min(cap, _border(ax, ay, nx, ny), _border(bx, by, nx, ny))
+    best = min(cap, border_distance(ax, ay, nx, ny), border_distance(bx, by, nx, ny))
     n = gather(
         min(ax, bx) - best, max(ax, bx) + best, min(ay, by) - best, max(ay, by) + best,
         rects, meta, bstart, bids, stamp, buf,
     )
     for k in range(n):
         i = buf[k]
-        d = seg_rect(ax, ay, bx, by, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
+        d = segment_rect_distance(ax, ay, bx, by, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
         if d < best:
             best = d
     return best
@@ -360,7 +167,7 @@ def poly_clearance(v, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma
     xmin = ymin = np.inf
     xmax = ymax = -np.inf
     for i in range(nv):
-        best = min(best, _border(v[i, 0], v[i, 1], nx, ny))
+        best = min(best, border_distance(v[i, 0], v[i, 1], nx, ny))
         xmin = min(xmin, v[i, 0])
         xmax = max(xmax, v[i, 0])
         ymin = min(ymin, v[i, 1])
@@ -369,7 +176,7 @@ def poly_clearance(v, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma
                rects, meta, bstart, bids, stamp, buf)
     for k in range(n):
         i = buf[k]
-        d, _, _, _, _ = poly_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
+        d, _, _, _, _ = polygon_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
         if d < best:
             best = d
     return best
@@ -728,7 +535,7 @@ def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
     cseed = np.inf
     for k in range(m):
         i = cand[k]
-        cseed = min(cseed, seg_rect(p0x, p0y, p1x, p1y, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3]))
+        cseed = min(cseed, segment_rect_distance(p0x, p0y, p1x, p1y, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3]))
     a1 = 0.5 * ll + ext + 0.5
     a2 = min(a1, max(0.5, cseed))
     md = np.empty(m)
@@ -759,7 +566,7 @@ def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
         best = np.inf
         for c in range(4):
             d = (c + 1) % 4
-            e, t = pt_seg(0.0, 0.0, quad[c, 0], quad[c, 1], quad[d, 0], quad[d, 1])
+            e, t = point_segment_distance(0.0, 0.0, quad[c, 0], quad[c, 1], quad[d, 0], quad[d, 1])
             if e < best:
                 best = e
                 qq[k, 0] = quad[c, 0] + t * (quad[d, 0] - quad[c, 0])
@@ -795,7 +602,7 @@ def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
                         ok = False
                         break
         if not ok:
-            d, px, py, qx, qy = poly_rect_closest(seed, ns, x0, y0, x1, y1)
+            d, px, py, qx, qy = polygon_rect_closest(seed, ns, x0, y0, x1, y1)
             if not d > 0.0:
                 return 0, 2
             ax = (qx - px) / d
@@ -963,20 +770,6 @@ def polyline_interval(rows, nrows, p, s, s_lo, s_hi, tol):  # pragma: no cover -
         hi = s[i] + t1 * (s[i + 1] - s[i])
         i += 1
     return lo, hi
-
-
-@njit(cache=True)
-def poly_rects_min(v, nv, rects):  # pragma: no cover - compiled
-    """Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects``
-    (``inf`` for none)."""
-    best = np.inf
-    for i in range(rects.shape[0]):
-        d, _, _, _, _ = poly_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
-        if d < best:
-            best = d
-            if best == 0.0:
-                break
-    return best
 
 
 @njit(cache=True)

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from trajopt.clearance import polygon_rects_distance
 from trajopt.errors import InvalidInputError
 
 __all__ = ["Box", "Corridor", "build_corridor"]
@@ -565,7 +566,6 @@ def _place_transitions(
 
 
 # ------------------------------------------------------------------ bridges
-_SQRT2 = float(np.sqrt(2.0))
 
 
 def _occupied_squares(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
@@ -603,34 +603,12 @@ def rotated_rect_clearance(sd: tuple[float, float, float, float], squares: np.nd
     if len(squares) == 0:
         return float("inf")
     smin, smax, dmin, dmax = sd
-    qx = squares[:, 0]
-    qy = squares[:, 1]
-    separated = (
-        (qx > 0.5 * (smax + dmax))
-        | (qx + 1 < 0.5 * (smin + dmin))
-        | (qy > 0.5 * (smax - dmin))
-        | (qy + 1 < 0.5 * (smin - dmax))
-        | (qx + qy > smax)
-        | (qx + qy + 2 < smin)
-        | (qx - qy - 1 > dmax)
-        | (qx - qy + 1 < dmin)
-    )
-    if not separated.all():
-        return 0.0
-    vs = np.array([smin, smin, smax, smax])
-    vd = np.array([dmin, dmax, dmin, dmax])
-    vx = (0.5 * (vs + vd))[:, None]
-    vy = (0.5 * (vs - vd))[:, None]
-    gx = np.maximum(0.0, np.maximum(qx[None] - vx, vx - (qx[None] + 1)))
-    gy = np.maximum(0.0, np.maximum(qy[None] - vy, vy - (qy[None] + 1)))
-    best = float(np.hypot(gx, gy).min())
-    for cx, cy in ((0, 0), (1, 0), (0, 1), (1, 1)):
-        s = qx + cx + qy + cy
-        d = qx + cx - qy - cy
-        gs = np.maximum(0.0, np.maximum(smin - s, s - smax))
-        gd = np.maximum(0.0, np.maximum(dmin - d, d - dmax))
-        best = min(best, float(np.hypot(gs, gd).min()) / _SQRT2)
-    return best
+    vs = np.array([smin, smax, smax, smin])
+    vd = np.array([dmin, dmin, dmax, dmax])
+    corners = np.ascontiguousarray(np.column_stack([0.5 * (vs + vd), 0.5 * (vs - vd)]))
+    sq = np.asarray(squares, dtype=float)
+    rects = np.ascontiguousarray(np.column_stack([sq, sq + 1.0]))
+    return float(polygon_rects_distance(corners, 4, rects))
 
 
 def _diagonal_bridge(

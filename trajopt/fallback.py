@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from trajopt.clearance import polyline_clearance
 from trajopt.curve import PolylineCurve
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
@@ -569,109 +570,3 @@ def _heading_arg(name: str, value: Any) -> float | None:
 def _short(value: Any) -> str:
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
-
-
-# ====================================================================== clearance
-def polyline_clearance(
-    points: Any, raw_grid: Any, *, window_m: float, outside_occupied: bool = True
-) -> float:
-    """Exact distance (m) from a polyline to the nearest occupied square of a grid.
-
-    Every segment is cut into pieces no longer than one cell; for each piece the exact
-    segment-to-square distance (0 when they intersect; else the least distance between a
-    vertex of one and the other) is taken over the occupied cells (and, with
-    ``outside_occupied``, the cells outside the map) within ``window_m`` of it.
-
-    Parameters
-    ----------
-    points : array_like, shape (n, 2)
-        Vertices (m), n >= 1.
-    raw_grid : astar.OccupancyGrid
-        The map, obstacles as closed squares of side ``resolution``.
-    window_m : float
-        Search distance (m); the result is capped at it (nothing occupied that close).
-    outside_occupied : bool
-        Count the cells outside the map as occupied.
-
-    Returns
-    -------
-    float
-        ``min(clearance, window_m)`` (m).
-    """
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
-    res = float(raw_grid.resolution)
-    ox, oy = (float(v) for v in raw_grid.origin)
-    q = (p - [ox, oy]) / res  # cell units
-    if len(q) == 1:
-        q = np.vstack([q, q])
-    a_list, b_list = [], []
-    for i in range(len(q) - 1):
-        n = max(1, int(math.ceil(math.hypot(*(q[i + 1] - q[i])))))
-        f = np.arange(n + 1) / n
-        seg = q[i] + f[:, None] * (q[i + 1] - q[i])
-        a_list.append(seg[:-1])
-        b_list.append(seg[1:])
-    pa = np.vstack(a_list)
-    pb = np.vstack(b_list)
-    cap = float(window_m) / res
-    w = int(math.ceil(cap)) + 2
-    offs = np.arange(-w, w + 1)
-    ox_, oy_ = np.meshgrid(offs, offs)
-    ox_, oy_ = ox_.ravel(), oy_.ravel()
-    occ = np.asarray(raw_grid.occupied, dtype=bool)
-    ny, nx = occ.shape
-    best = cap
-    chunk = max(1, 400_000 // len(ox_))  # pieces per vectorised batch (bounded memory)
-    for c0 in range(0, len(pa), chunk):
-        a = pa[c0 : c0 + chunk]
-        b = pb[c0 : c0 + chunk]
-        mid = np.floor(0.5 * (a + b)).astype(np.int64)
-        gx = mid[:, 0:1] + ox_[None, :]
-        gy = mid[:, 1:2] + oy_[None, :]
-        inside = (gx >= 0) & (gx < nx) & (gy >= 0) & (gy < ny)
-        blocked = np.zeros(gx.shape, bool)
-        blocked[inside] = occ[gy[inside], gx[inside]]
-        if outside_occupied:
-            blocked |= ~inside
-        r, c = np.nonzero(blocked)
-        if r.size == 0:
-            continue
-        dist = _segment_square_distance(a[r], b[r], gx[r, c].astype(float), gy[r, c].astype(float))
-        best = min(best, float(dist.min()))
-    return min(best, cap) * res
-
-
-def _segment_square_distance(a, b, x0, y0) -> np.ndarray:
-    """Exact distance between segments ``a -> b`` (shape (m, 2)) and unit squares
-    ``[x0, x0 + 1] x [y0, y0 + 1]`` (shape (m,)), all in cell units."""
-    x1, y1 = x0 + 1.0, y0 + 1.0
-    d = b - a
-    # Liang-Barsky clip: the segment meets the square when the parameter interval survives
-    t_lo = np.zeros(len(a))
-    t_hi = np.ones(len(a))
-    hit = np.ones(len(a), bool)
-    for ax, lo, hi in ((0, x0, x1), (1, y0, y1)):
-        da = d[:, ax]
-        pa = a[:, ax]
-        flat = da == 0.0
-        hit &= ~flat | ((pa >= lo) & (pa <= hi))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ta = (lo - pa) / da
-            tb = (hi - pa) / da
-        t_lo = np.where(flat, t_lo, np.maximum(t_lo, np.minimum(ta, tb)))
-        t_hi = np.where(flat, t_hi, np.minimum(t_hi, np.maximum(ta, tb)))
-    hit &= t_lo <= t_hi
-
-    def point_box(px, py):
-        dx = np.maximum(0.0, np.maximum(x0 - px, px - x1))
-        dy = np.maximum(0.0, np.maximum(y0 - py, py - y1))
-        return np.hypot(dx, dy)
-
-    dist = np.minimum(point_box(a[:, 0], a[:, 1]), point_box(b[:, 0], b[:, 1]))
-    dd = np.einsum("ij,ij->i", d, d)
-    for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = ((cx - a[:, 0]) * d[:, 0] + (cy - a[:, 1]) * d[:, 1]) / dd
-        t = np.where(dd > 0, np.clip(t, 0.0, 1.0), 0.0)
-        dist = np.minimum(dist, np.hypot(a[:, 0] + t * d[:, 0] - cx, a[:, 1] + t * d[:, 1] - cy))
-    return np.where(hit, 0.0, dist)

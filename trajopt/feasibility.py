@@ -33,8 +33,8 @@ import numpy as np
 from numba import njit
 
 import astar
+from trajopt.clearance import point_square_dist2
 from trajopt.errors import InvalidInputError
-from trajopt.smoother import square_dist2
 
 __all__ = ["curvature_witness", "witness_grid_path"]
 
@@ -182,7 +182,7 @@ def _sample_finish(x, y, th, goal, turn_r, psi, side) -> np.ndarray:
 def _clear(px, py, occ, w, r):
     """Distance from ``(px, py)`` (cells) to the nearest occupied square is >= ``r``."""
     r2 = r * r - 1e-9
-    return square_dist2(px, py, occ, w, r2) >= r2
+    return point_square_dist2(px, py, occ, w, r2) >= r2
 
 
 @njit(cache=True)

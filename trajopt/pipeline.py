@@ -67,9 +67,10 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
+from trajopt.clearance import box_clearance, polygon_clearance, polyline_clearance
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
+from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
 from trajopt.feasibility import curvature_witness, witness_grid_path
 from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.robot import Robot
@@ -359,7 +360,7 @@ class Planner:
                     f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
                     f"inflation={self.inflation!r} avoidance area (robot radius "
                     f"{self.robot.radius} m); clearance of the cell centre "
-                    f"{_clearance_of(self.grid, self.grid.cell_to_world(c)):.4g} m"
+                    f"{_point_clearance(self.grid, self.grid.cell_to_world(c)):.4g} m"
                 )
         if tuple(c0) == tuple(c1):
             raise InvalidInputError(
@@ -460,9 +461,9 @@ class Planner:
                     stages["corridor"] = stages.get("corridor", 0.0) + time.perf_counter() - t
             left = smoother.time_budget_s - (time.perf_counter() - t_start)
             try:
-                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
                 if left <= 0:
                     raise SmoothingError("time budget exhausted before the box corridor", {})
+                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
                 return corridor, self._fit(sm, path, corridor, p0, p1, start_heading,
                                            goal_heading)
             except SmoothingError as exc:
@@ -598,7 +599,7 @@ class Planner:
             raise InvalidInputError(
                 f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
             )
-        clr = _clearance_of(grid, p)
+        clr = _point_clearance(grid, p)
         if clr < self.robot.radius:
             raise InvalidInputError(
                 f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
@@ -721,32 +722,9 @@ def _cell(c: np.ndarray) -> tuple[int, int]:
     return (int(c[0]), int(c[1]))
 
 
-def _box_clearance(grid: OccupancyGrid, lo: np.ndarray, hi: np.ndarray) -> float:
-    """Exact distance (m) from the box ``[lo, hi]`` to the nearest occupied square or the
-    map's outside (which counts as occupied)."""
-    ox, oy = grid.origin
-    res = grid.resolution
-    edge = min(lo[0] - ox, lo[1] - oy, ox + grid.width - hi[0], oy + grid.height - hi[1])
-    if edge <= 0:
-        return 0.0
-    reach = edge  # nothing farther than the map edge matters
-    c_lo = np.floor((lo - reach - (ox, oy)) / res).astype(int)
-    c_hi = np.floor((hi + reach - (ox, oy)) / res).astype(int)
-    x0, y0 = max(c_lo[0], 0), max(c_lo[1], 0)
-    x1, y1 = min(c_hi[0], grid.nx - 1), min(c_hi[1], grid.ny - 1)
-    iy, ix = np.nonzero(grid.occupied[y0 : y1 + 1, x0 : x1 + 1])
-    if ix.size == 0:
-        return float(edge)
-    sx0 = ox + (ix + x0) * res
-    sy0 = oy + (iy + y0) * res
-    dx = np.maximum(0.0, np.maximum(sx0 - hi[0], lo[0] - (sx0 + res)))
-    dy = np.maximum(0.0, np.maximum(sy0 - hi[1], lo[1] - (sy0 + res)))
-    return float(min(edge, np.hypot(dx, dy).min()))
-
-
-def _clearance_of(grid: OccupancyGrid, p: np.ndarray) -> float:
-    p = np.asarray(p, dtype=float)
-    return _box_clearance(grid, p, p)
+def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
+    """Exact clearance (m) of a world point from the raw map (outside occupied)."""
+    return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)
 
 
 def _widen_end_boxes(
@@ -761,7 +739,7 @@ def _widen_end_boxes(
             continue
         lo = np.minimum([b.xmin, b.ymin], p)
         hi = np.maximum([b.xmax, b.ymax], p)
-        clr = _box_clearance(raw, lo, hi)
+        clr = box_clearance(raw, lo, hi)
         if clr < radius:
             raise InvalidInputError(
                 f"{name} {p.tolist()} m cannot join the corridor with clearance {radius} m: "

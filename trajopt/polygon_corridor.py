@@ -72,6 +72,7 @@ from typing import Any
 import numpy as np
 
 from trajopt import _polygon_kernels as _k
+from trajopt.clearance import grid_cells, merge_rects, polygon_clearance
 from trajopt.errors import InvalidInputError, SmoothingError
 
 __all__ = [
@@ -450,7 +451,7 @@ class _Index:
             rects = np.zeros((0, 4))
             x0, y0, x1, y1 = 0, 0, 1, 1
         else:
-            rects = _k.merge_rects(np.ascontiguousarray(occ[y0:y1, x0:x1]), x0, y0)
+            rects = merge_rects(np.ascontiguousarray(occ[y0:y1, x0:x1]), x0, y0)
         bs = _BUCKET_CELLS
         nbx = max(1, -(-(x1 - x0) // bs))
         nby = max(1, -(-(y1 - y0) // bs))
@@ -466,20 +467,6 @@ class _Index:
 
 
 # ---------------------------------------------------------------- helpers
-def _grid_parts(raw_grid: Any) -> tuple[np.ndarray, float, float, float]:
-    try:
-        occ = np.asarray(raw_grid.occupied, dtype=bool)
-        res = float(raw_grid.resolution)
-        ox, oy = (float(v) for v in raw_grid.origin)
-    except (AttributeError, TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"raw_grid must be an astar.OccupancyGrid, got {type(raw_grid).__name__}"
-        ) from exc
-    if occ.ndim != 2:
-        raise InvalidInputError(f"raw_grid.occupied must be 2-D, got shape {occ.shape}")
-    return occ, res, ox, oy
-
-
 def _path_points(path: Any, res: float, ox: float, oy: float) -> np.ndarray:
     """World points (m) of a GridPath / integer cells (cell centres) or float points."""
     cells = getattr(path, "cells", None)
@@ -588,7 +575,7 @@ def build_polygon_corridor(
     Deterministic. Costs grow with the path length and the number of obstacle
     rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
     """
-    occ, res, ox, oy = _grid_parts(raw_grid)
+    occ, res, ox, oy = grid_cells(raw_grid)
     r = _check_option(radius, "radius", 0.0, strict=True)
     margin = _check_option(margin_cells, "margin_cells", 0.0, strict=True)
     max_len = _check_option(max_segment_cells, "max_segment_cells", 0.0, strict=True)
@@ -784,50 +771,3 @@ def _check_path_clearance(
             f"{2 * r_c * res:.6g} m; search the path on "
             "astar.inflate(raw_grid, radius, metric='square', outside_occupied=True)"
         )
-
-
-# ---------------------------------------------------------------- public clearance
-def polygon_clearance(polygon: ConvexPolygon | Any, raw_grid: Any) -> float:
-    """Exact distance (m) from a convex polygon to a raw map's obstacles.
-
-    Parameters
-    ----------
-    polygon : ConvexPolygon or array_like, shape (k, 2)
-        The region, or its vertices (m) in order around it (``k = 1`` a point, ``k = 2`` a
-        segment).
-    raw_grid : astar.OccupancyGrid
-        The raw map: occupied cells are closed squares; the outside of the map counts as
-        occupied.
-
-    Returns
-    -------
-    float
-        ``0`` when the polygon meets an occupied square or leaves the map; otherwise the
-        smallest distance to an occupied square or to the map's boundary: for each square
-        decided by the separating-axis theorem and measured as the minimum of the
-        vertex-to-edge distances both ways (two disjoint convex polygons are closest at a
-        vertex of one of them).
-    """
-    occ, res, ox, oy = _grid_parts(raw_grid)
-    v = np.asarray(getattr(polygon, "vertices", polygon), dtype=float)
-    if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 1 or not np.all(np.isfinite(v)):
-        raise InvalidInputError(f"polygon vertices must be finite, shape (k, 2); got {v.shape}")
-    vc = np.ascontiguousarray((v - np.array([ox, oy])) / res)
-    ny, nx = occ.shape
-    border = float(
-        max(0.0, min(vc[:, 0].min(), nx - vc[:, 0].max(), vc[:, 1].min(), ny - vc[:, 1].max()))
-    )
-    if border == 0.0:
-        return 0.0
-    x0, x1 = vc[:, 0].min(), vc[:, 0].max()
-    y0, y1 = vc[:, 1].min(), vc[:, 1].max()
-    pad = 2.0
-    while True:
-        wx0, wx1 = max(0, int(math.floor(x0 - pad))), min(nx, int(math.ceil(x1 + pad)))
-        wy0, wy1 = max(0, int(math.floor(y0 - pad))), min(ny, int(math.ceil(y1 + pad)))
-        rects = _k.merge_rects(np.ascontiguousarray(occ[wy0:wy1, wx0:wx1]), wx0, wy0)
-        best = min(border, _k.poly_rects_min(vc, len(vc), rects) if len(rects) else math.inf)
-        whole = wx0 == 0 and wy0 == 0 and wx1 == nx and wy1 == ny
-        if best <= pad or whole:
-            return best * res
-        pad = max(4.0 * pad, best)

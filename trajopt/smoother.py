@@ -49,10 +49,10 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from numba import njit
 
 from trajopt import _qp
 from trajopt.bspline import BSplineCurve
+from trajopt.clearance import points_clearance
 from trajopt.corridor import Corridor
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError, SmoothingError
@@ -1479,57 +1479,6 @@ def _summary(attempts: list[dict[str, Any]], total: float, *, success: bool) -> 
 
 
 # -------------------------------------------------------------------- certify
-def point_square_clearance(points: np.ndarray, raw_grid: Any, window_m: float) -> np.ndarray:
-    """Distance (m) from each world point to the nearest occupied square of ``raw_grid``
-    (cells outside the grid count as occupied), searched within ``window_m``; points with
-    nothing occupied inside the window get ``window_m``.
-
-    Parameters
-    ----------
-    points : ndarray, shape (M, 2)
-    raw_grid : astar.OccupancyGrid
-    window_m : float
-    """
-    occ = np.ascontiguousarray(raw_grid.occupied, dtype=np.bool_)
-    res = float(raw_grid.resolution)
-    ox, oy = (float(v) for v in raw_grid.origin)
-    q = (np.asarray(points, dtype=float).reshape(-1, 2) - [ox, oy]) / res
-    w = int(math.ceil(window_m / res)) + 1
-    out = _square_clearance_kernel(np.ascontiguousarray(q), occ, w, float(window_m) / res)
-    return np.minimum(out * res, window_m)
-
-
-@njit(cache=True)
-def _square_clearance_kernel(q, occ, w, cap):
-    """Per point (cell units): exact distance to the nearest occupied unit square among the
-    cells within ``w`` of the point's cell (outside the grid counts as occupied), capped."""
-    out = np.empty(q.shape[0])
-    for k in range(q.shape[0]):
-        out[k] = math.sqrt(square_dist2(q[k, 0], q[k, 1], occ, w, cap * cap))
-    return out
-
-
-@njit(cache=True)
-def square_dist2(px, py, occ, w, best):
-    """``min(best, d^2)``: ``d`` the distance (cells) from ``(px, py)`` to the nearest
-    occupied unit square within ``w`` cells of its cell (outside the grid is occupied)."""
-    ny, nx = occ.shape
-    cx = int(math.floor(px))
-    cy = int(math.floor(py))
-    for gy in range(cy - w, cy + w + 1):
-        dy = max(0.0, max(gy - py, py - (gy + 1)))
-        if dy * dy >= best:
-            continue
-        for gx in range(cx - w, cx + w + 1):
-            if 0 <= gx < nx and 0 <= gy < ny and not occ[gy, gx]:
-                continue
-            dx = max(0.0, max(gx - px, px - (gx + 1)))
-            d2 = dx * dx + dy * dy
-            if d2 < best:
-                best = d2
-    return best
-
-
 def certify(
     curve: BSplineCurve,
     corridor: Corridor,
@@ -1596,7 +1545,7 @@ def certify(
     min_clear = None
     if raw_grid is not None and radius is not None:
         window = radius + 2 * float(raw_grid.resolution)
-        min_clear = float(point_square_clearance(xy, raw_grid, window).min())
+        min_clear = float(points_clearance(xy, raw_grid, window).min())
         if min_clear < radius - 1e-9:
             failures.append("clearance")
     return Certificate(
