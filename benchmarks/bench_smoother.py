@@ -28,12 +28,13 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
-from trajopt import _qp  # noqa: E402
 from trajopt.bspline import clamped_uniform_knots  # noqa: E402
 from trajopt.clearance import points_clearance  # noqa: E402
 from trajopt.corridor import build_corridor  # noqa: E402
 from trajopt.errors import SmoothingError  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
+from trajopt.smoother import qp as smoother_qp  # noqa: E402
+from trajopt.smoother.basis import CURV_SAMPLES  # noqa: E402
 
 
 def data_dir() -> Path:
@@ -226,15 +227,15 @@ def main() -> None:
     rows += krows
     # cold build of fresh sizes (cache cleared): the QP's conic and the layout of the SCP's
     # sample rows (the SCP's QPs go to piqp directly: nothing else to build)
-    _qp.qp_solver.cache_clear()
-    _qp.constraint_layout.cache_clear()
+    smoother_qp.qp_solver.cache_clear()
+    smoother_qp.constraint_layout.cache_clear()
     tb = []
     for nb in (64, 128):
         t0 = time.perf_counter()
-        _qp.qp_solver(nb, 3, "piqp", 0, False)
+        smoother_qp.qp_solver(nb, 3, "piqp", 0, False)
         tq = time.perf_counter() - t0
         t0 = time.perf_counter()
-        _qp.constraint_layout(nb, 3, _qp.CURV_SAMPLES)
+        smoother_qp.constraint_layout(nb, 3, CURV_SAMPLES)
         tb.append((nb, tq, time.perf_counter() - t0))
         print(
             f"cold build nb={nb}: piqp conic {tq * 1e3:.1f} ms, SCP row layout "

@@ -20,11 +20,12 @@ from scipy.spatial import cKDTree
 
 from astar.grid import OccupancyGrid
 from tests.trajopt.test_corridor import brute_inflate_square, dijkstra_path, l_shaped_grid
-from trajopt import _qp
 from trajopt.bspline import clamped_uniform_knots
 from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.smoother import Smoother, SmoothPath
+from trajopt.smoother import basis as _basis
+from trajopt.smoother import qp as _qp
 
 # ----------------------------------------------------------------- references
 _TREES: dict[int, tuple] = {}
@@ -134,9 +135,9 @@ def test_basis_derivatives_match_scipy():
         inner = np.sort(rng.uniform(0, 10, n - p - 1))
         t = np.concatenate([np.zeros(p + 1), inner, np.full(p + 1, 10.0)])
         u = np.concatenate([rng.uniform(0, 10, 40), [0.0, 10.0]])
-        span = _qp.find_spans(t, p, n, u)
+        span = _basis.find_spans(t, p, n, u)
         for nu in range(p + 1):
-            vals = _qp.basis_derivs(t, p, span, u, nu)
+            vals = _basis.basis_derivs(t, p, span, u, nu)
             dense = np.zeros((len(u), n))
             for a in range(p + 1):
                 dense[np.arange(len(u)), span + a] = vals[:, a]
@@ -218,7 +219,7 @@ def test_smoothness_gram_matches_quadrature_of_scipy_derivative():
         [np.zeros(p + 1), np.sort(rng.uniform(0, 5, n - p - 1)), np.full(p + 1, 5.0)]
     )
     c = rng.normal(size=n)
-    band = _qp.smoothness_band(t, p, n, 2)
+    band = _basis.smoothness_band(t, p, n, 2)
     quad = band[0] @ (c * c) + 2 * sum(
         band[d, : n - d] @ (c[: n - d] * c[d:]) for d in range(1, p + 1)
     )

@@ -1,9 +1,8 @@
-"""Private: B-spline basis evaluation, the banded least-squares/smoothness QP data, and
-cached CasADi solvers (a ``casadi.conic`` QP and an IPOPT curvature-bounded NLP) built once
-per padded problem size.
+"""The convex corridor QP of the smoother: constraint layouts, cached ``casadi.conic``
+builds, the direct piqp solve over a working set, and one call that solves the QP.
 
-Everything here works in *cell units* (positions and parameters divided by the grid
-resolution), so one set of weights and tolerances serves every map.
+Everything works in cell units on ``nb`` padded control points (solvers are built once per
+padded size and cached for the process).
 """
 
 from __future__ import annotations
@@ -11,133 +10,34 @@ from __future__ import annotations
 import functools
 import logging
 import threading
+import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from trajopt.smoother.problem import QPData
+from trajopt.smoother.status import SolveInfo, SolveStatus
+
+__all__ = [
+    "LOCK",
+    "N_HEADING_ROWS",
+    "ConstraintLayout",
+    "constraint_layout",
+    "h_nonzeros",
+    "is_built",
+    "piqp_info",
+    "qp_layout",
+    "qp_solver",
+    "solve_qp",
+    "solve_working_set",
+    "upper_band_triplets",
+    "warm_imports",
+]
+
 logger = logging.getLogger(__name__)
 
-#: padded problem sizes, about 12 % apart (the padded variables and sample rows cost solver
-#: time, each new size costs a solver build of a few ms)
-_SIZES = (16, 20, 24, 28, 32, 36, 40, 44, 48, 56, 64, 72, 80, 88, 96, 104, 112, 128, 144, 160,
-          176, 192, 216, 240, 272, 304, 336, 376, 416, 464, 512, 576, 640, 720, 800, 896, 1024)
-
-
-def bucket_size(n: int) -> int:
-    """Padded number of control points for ``n`` (sizes repeat so solvers can be cached)."""
-    for s in _SIZES:
-        if n <= s:
-            return s
-    return int(256 * np.ceil(n / 256))
-
-
-# ---------------------------------------------------------------------- basis
-def basis_derivs(t: np.ndarray, p: int, span: np.ndarray, u: np.ndarray, nu: int) -> np.ndarray:
-    """``nu``-th derivatives of the ``p + 1`` B-splines of degree ``p`` that are non-zero on
-    span ``span`` (control points ``span .. span + p``), evaluated at ``u``.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n + p + 1,)
-        Clamped knots.
-    p : int
-        Degree.
-    span : ndarray of int, shape (M,)
-        Span index ``j`` (knot interval ``[t[j + p], t[j + p + 1]]``) of each point.
-    u : ndarray, shape (M,)
-        Parameters (inside or on the boundary of their spans).
-    nu : int
-        Derivative order (0 .. p).
-
-    Returns
-    -------
-    ndarray, shape (M, p + 1)
-    """
-    k = np.asarray(span, dtype=np.int64) + p  # knot interval index
-    u = np.asarray(u, dtype=float)
-    m = len(u)
-    q0 = p - nu
-    # degree-q0 non-zero basis values N_{k-q0 .. k, q0}(u) by Cox-de Boor
-    vals = np.ones((m, 1))
-    for q in range(1, q0 + 1):
-        new = np.zeros((m, q + 1))
-        for a in range(q + 1):
-            i = k - q + a  # basis index
-            if a >= 1:  # N_{i, q-1} is vals[:, a-1]
-                den = t[i + q] - t[i]
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    w = np.where(den > 0, (u - t[i]) / np.where(den > 0, den, 1.0), 0.0)
-                new[:, a] += w * vals[:, a - 1]
-            if a <= q - 1:  # N_{i+1, q-1} is vals[:, a]
-                den = t[i + q + 1] - t[i + 1]
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    w = np.where(den > 0, (t[i + q + 1] - u) / np.where(den > 0, den, 1.0), 0.0)
-                new[:, a] += w * vals[:, a]
-        vals = new
-    # raise to degree p through the derivative recurrence
-    for q in range(q0 + 1, p + 1):
-        new = np.zeros((m, q + 1))
-        for a in range(q + 1):
-            i = k - q + a
-            if a >= 1:
-                den = t[i + q] - t[i]
-                new[:, a] += (
-                    np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a - 1]
-                )
-            if a <= q - 1:
-                den = t[i + q + 1] - t[i + 1]
-                new[:, a] -= np.where(den > 0, q / np.where(den > 0, den, 1.0), 0.0) * vals[:, a]
-        vals = new
-    return vals
-
-
-def find_spans(t: np.ndarray, p: int, n: int, u: np.ndarray) -> np.ndarray:
-    """Span index (0 .. n - p - 1) holding each parameter ``u``."""
-    j = np.searchsorted(t, u, side="right") - 1
-    return np.clip(j, p, n - 1) - p
-
-
-def band_gram(span: np.ndarray, vals: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
-    """Upper band of ``sum_r w_r b_r b_r^T`` for rows ``b_r`` with ``p + 1`` consecutive
-    non-zeros ``vals[r]`` starting at column ``span[r]``: ``band[d, i] = M[i, i + d]``."""
-    p = vals.shape[1] - 1
-    band = np.zeros((p + 1, n))
-    for a in range(p + 1):
-        for b in range(a, p + 1):
-            band[b - a] += np.bincount(
-                span + a, weights=weights * vals[:, a] * vals[:, b], minlength=n
-            )
-    return band
-
-
-def band_rhs(span: np.ndarray, vals: np.ndarray, rhs: np.ndarray, n: int) -> np.ndarray:
-    """``B^T rhs`` for the row-banded matrix of :func:`band_gram`; ``rhs`` shape (M, d)."""
-    out = np.zeros((n, rhs.shape[1]))
-    for a in range(vals.shape[1]):
-        for dim in range(rhs.shape[1]):
-            out[:, dim] += np.bincount(span + a, weights=vals[:, a] * rhs[:, dim], minlength=n)
-    return out
-
-
-def smoothness_band(t: np.ndarray, p: int, n: int, order: int) -> np.ndarray:
-    """Upper band of ``S[i, j] = integral B_i^(order)(u) B_j^(order)(u) du`` (exact, by
-    Gauss-Legendre quadrature on every non-empty span)."""
-    nq = max(1, p - order + 1)
-    gx, gw = np.polynomial.legendre.leggauss(nq)
-    a = t[p:n]
-    b = t[p + 1 : n + 1]
-    half = 0.5 * (b - a)
-    keep = half > 0
-    spans = np.nonzero(keep)[0]
-    uq = (0.5 * (a + b))[keep][:, None] + half[keep][:, None] * gx[None, :]
-    wq = half[keep][:, None] * gw[None, :]
-    span_q = np.repeat(spans, nq)
-    vals = basis_derivs(t, p, span_q, uq.ravel(), order)
-    return band_gram(span_q, vals, wq.ravel(), n)
-
-
-# -------------------------------------------------------------------- solvers
-_LOCK = threading.Lock()
+LOCK = threading.Lock()
 
 
 def _band_pattern(nb: int, p: int):
@@ -352,119 +252,8 @@ def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool, k: int = 2):
     if not verbose:
         opts["print_time"] = False
         opts["print_problem"] = False
-    with _LOCK:
+    with LOCK:
         return ca.conic(f"smoother_qp_{m}_{k}", solver, {"h": sp_h, "a": sp_a}, opts)
-
-
-@functools.lru_cache(maxsize=32)
-def qp_ipopt(nb: int, p: int, verbose: bool):
-    """The same convex problem (no sample rows) solved by IPOPT (fallback / reference);
-    parameters ``[h band (p+1)*nb, g (2nb), heading rows (4*2nb)]``."""
-    import casadi as ca
-
-    z = ca.SX.sym("z", 2 * nb)
-    hb = ca.SX.sym("hb", (p + 1) * nb)
-    g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
-    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
-    nlp = {"x": z, "p": ca.vertcat(hb, g, a), "f": f,
-           "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb))}
-    with _LOCK:
-        return ca.nlpsol("smoother_qp_ipopt", "ipopt", nlp, _ipopt_opts(verbose))
-
-
-def _diag_rows(z, nb: int):
-    """``[x_0 + y_0, x_0 - y_0, x_1 + y_1, ...]`` (the layout's diagonal rows)."""
-    import casadi as ca
-
-    x, y = z[:nb], z[nb:]
-    return ca.reshape(ca.horzcat(x + y, x - y).T, 2 * nb, 1)
-
-
-def _band_quadratic(z, hb, nb: int, p: int):
-    import casadi as ca
-
-    x, y = z[:nb], z[nb:]
-    f = 0
-    for d in range(p + 1):
-        w = 0.5 if d == 0 else 1.0
-        h = hb[d * nb : d * nb + nb - d]
-        f = f + w * (ca.dot(h, x[: nb - d] * x[d:]) + ca.dot(h, y[: nb - d] * y[d:]))
-    return f
-
-
-def _ipopt_opts(verbose: bool) -> dict:
-    return {
-        "ipopt": {
-            "print_level": 5 if verbose else 0,
-            "sb": "yes",
-            "max_iter": 300,
-            "tol": 1e-8,
-            "acceptable_tol": 1e-6,
-            "mu_strategy": "adaptive",
-            "bound_relax_factor": 0.0,
-            "honor_original_bounds": "yes",
-        },
-        "print_time": verbose,
-        "error_on_fail": False,
-    }
-
-
-#: curvature samples per span (its start and interior points; the last span also its end)
-CURV_SAMPLES = 4
-
-
-@functools.lru_cache(maxsize=16)
-def curvature_nlp(nb: int, p: int, verbose: bool):
-    """IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``
-    (``CURV_SAMPLES`` per span, span ``j`` touching control points ``j .. j + p``)
-
-    ``cross_r^2 - kmax^2 * speed2_r^3 <= 0`` and ``speed2_r >= floor_r^2`` (via ``lbg``),
-
-    with ``cross = x'y'' - y'x''`` and ``speed2 = x'^2 + y'^2`` from basis-derivative values
-    passed as parameters. Parameters: ``[hb, g, a, b1 (S*(p+1)), b2 (S*(p+1)), kmax^2]``.
-    Constraint order: 4 heading rows, ``2 nb`` diagonal rows, then ``S`` curvature rows,
-    then ``S`` speed rows.
-    """
-    import casadi as ca
-
-    ns = nb - p
-    S = ns * CURV_SAMPLES
-    z = ca.SX.sym("z", 2 * nb)
-    hb = ca.SX.sym("hb", (p + 1) * nb)
-    g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
-    b1 = ca.SX.sym("b1", S * (p + 1))
-    b2 = ca.SX.sym("b2", S * (p + 1))
-    k2 = ca.SX.sym("k2")
-    x, y = z[:nb], z[nb:]
-    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
-    span = np.repeat(np.arange(ns), CURV_SAMPLES)
-    B1 = ca.reshape(b1, S, p + 1)
-    B2 = ca.reshape(b2, S, p + 1)
-    dx = 0
-    dy = 0
-    ddx = 0
-    ddy = 0
-    for c in range(p + 1):
-        idx = (span + c).tolist()
-        dx = dx + B1[:, c] * x[idx]
-        dy = dy + B1[:, c] * y[idx]
-        ddx = ddx + B2[:, c] * x[idx]
-        ddy = ddy + B2[:, c] * y[idx]
-    cross = dx * ddy - dy * ddx
-    sp2 = dx * dx + dy * dy
-    gcurv = cross * cross - k2 * sp2 * sp2 * sp2
-    nlp = {
-        "x": z,
-        "p": ca.vertcat(hb, g, a, b1, b2, k2),
-        "f": f,
-        "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb), gcurv, sp2),
-    }
-    with _LOCK:
-        return ca.nlpsol("smoother_curv", "ipopt", nlp, _ipopt_opts(verbose))
 
 
 @functools.lru_cache(maxsize=64)
@@ -561,3 +350,122 @@ def solve_working_set(
     z = x[: 2 * nb] if success else np.zeros(2 * nb)
     cost = float(solver.result.info.primal_obj) if success else float("nan")
     return z, cost, success, str(status), int(solver.result.info.iter)
+
+
+def piqp_info(z: np.ndarray, result: tuple, t_wall: float, t_cpu: float) -> SolveInfo:
+    """The :class:`SolveInfo` of a direct piqp solve from :func:`solve_working_set`'s
+    ``(cost, success, status, iterations)`` and the wall and CPU clocks at its start."""
+    cost, success, status, iters = result
+    return SolveInfo(
+        solver="piqp",
+        status=SolveStatus.SOLVED if success else SolveStatus.SOLVER_FAILED,
+        detail=status,
+        iterations=iters,
+        solve_time_s=time.perf_counter() - t_wall,
+        solve_cpu_s=time.process_time() - t_cpu,
+        build_time_s=0.0,
+        cost=cost,
+        z=z,
+    )
+
+
+_BUILT: set[tuple] = set()
+
+
+def warm_imports() -> None:
+    """Import the lazily loaded heavy modules (casadi, piqp, scipy) once."""
+    import casadi  # noqa: F401
+    import piqp  # noqa: F401
+    import scipy.interpolate  # noqa: F401
+    import scipy.sparse  # noqa: F401
+
+
+def is_built(kind: str, nb: int, p: int, verbose: bool) -> bool:
+    """Whether the solver ``(kind, nb, p, verbose)`` was built before in this process
+    (and mark it built): its build time is then not counted again."""
+    key = (kind, nb, p, verbose)
+    if key in _BUILT:
+        return True
+    _BUILT.add(key)
+    return False
+
+
+def solve_qp(options: Any, qp: QPData, x0: np.ndarray | None = None) -> SolveInfo:
+    """One solve of the corridor QP (no curvature rows) by ``options.qp_solver``.
+
+    Parameters
+    ----------
+    options : Smoother
+        ``degree``, ``qp_solver`` and ``verbose`` are used.
+    qp : QPData
+        The problem (cell units, padded).
+    x0 : ndarray, shape (2 nb,), optional
+        Starting point of solvers that take one.
+
+    Returns
+    -------
+    SolveInfo
+        With the solution ``z`` (shape (2 nb,)).
+    """
+    p = options.degree
+    nb = qp.nb
+    solver_name = options.qp_solver
+    lbx, ubx, lba, uba = qp.lbx, qp.ubx, qp.lba, qp.uba
+    if x0 is None:
+        x0 = np.zeros(2 * nb)
+    ts = time.perf_counter()
+    tc = time.process_time()
+    if solver_name == "piqp" and qp.region_coef is not None:
+        # polygon rows: piqp directly, without the rows a point does not use (a
+        # casadi.conic keeps every padded row of its fixed sparsity)
+        layout = constraint_layout(nb, p, 0, qp.k)
+        trip = layout.values(qp.heading, None, qp.region_coef)
+        z, *result = solve_working_set(
+            qp.full, qp.g, layout, trip, lbx, ubx, lba, uba, np.zeros(0, bool), 0.0
+        )
+        return piqp_info(z, result, ts, tc)
+    tb = time.perf_counter()
+    built = is_built(f"{solver_name}-0-{qp.k}", nb, p, options.verbose)
+    if solver_name == "ipopt":
+        from trajopt.smoother.nlp import qp_ipopt
+
+        solver = qp_ipopt(nb, p, options.verbose)
+    else:
+        solver = qp_solver(nb, p, solver_name, 0, options.verbose, qp.k)
+    build = 0.0 if built else time.perf_counter() - tb
+    ts = time.perf_counter()
+    tc = time.process_time()
+    if solver_name == "ipopt":
+        par = np.concatenate([qp.full.ravel(), qp.g, qp.heading.ravel(order="F")])
+        out = solver(x0=x0, p=par, lbx=lbx, ubx=ubx, lbg=lba, ubg=uba)
+    else:
+        import casadi as ca
+
+        layout = constraint_layout(nb, p, 0, qp.k)
+        hnz = h_nonzeros(qp.full, nb, p)
+        trip = layout.values(qp.heading, None, qp.region_coef)
+        if solver_name == "piqp":
+            # piqp warns about (and drops) infinite rows, and large finite ones hurt
+            # its conditioning: bound every row by its range over the variable bounds
+            lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
+            lba = np.maximum(lba, lo_r - 1.0)
+            uba = np.minimum(uba, hi_r + 1.0)
+        hval = ca.DM(solver.sparsity_in("h"), hnz)
+        aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
+        out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+    solve = time.perf_counter() - ts
+    cpu = time.process_time() - tc
+    st = solver.stats()
+    z = np.asarray(out["x"], dtype=float).ravel()[: 2 * nb]
+    success = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
+    return SolveInfo(
+        solver=solver_name,
+        status=SolveStatus.SOLVED if success else SolveStatus.SOLVER_FAILED,
+        detail=str(st.get("return_status", st.get("unified_return_status", ""))),
+        iterations=int(st.get("iter_count", st.get("iter", 0)) or 0),
+        solve_time_s=solve,
+        solve_cpu_s=cpu,
+        build_time_s=build,
+        cost=float(out["cost"]) if "cost" in out else float("nan"),
+        z=z,
+    )

@@ -1,0 +1,69 @@
+"""The smoother's result: a certified B-spline that is a :class:`~trajopt.curve.ParametricCurve`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from trajopt.bspline import BSplineCurve
+from trajopt.curve import ParametricCurve
+from trajopt.smoother.certificate import Certificate
+
+__all__ = ["SmoothPath"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SmoothPath(ParametricCurve):
+    """A certified smooth path: a :class:`~trajopt.bspline.BSplineCurve` plus evidence.
+
+    The :class:`~trajopt.curve.ParametricCurve` interface (``__call__(u, nu)``, ``heading``,
+    ``curvature``, ``length``, ``u_at_s``, ``sample``) delegates to :attr:`curve`; ``u`` is
+    in metres (arc length of the A* polyline) and positions are world metres.
+
+    Attributes
+    ----------
+    curve : BSplineCurve
+        The clamped B-spline in world coordinates.
+    stats : dict
+        Solver statistics: ``status``, ``success``, ``solver``, ``iterations``,
+        ``solve_time_s`` (solver calls), ``build_time_s`` (solvers built in this call),
+        ``total_time_s``, ``cost``, ``attempts``, ``n_control_points``, ``padded_size``.
+    certificate : Certificate
+    """
+
+    curve: BSplineCurve
+    stats: dict[str, Any] = field(default_factory=dict)
+    certificate: Certificate | None = None
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        return self.curve.domain
+
+    def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        return self.curve(u, nu)
+
+    def breakpoints(self) -> np.ndarray:
+        return self.curve.breakpoints()
+
+    def _arc_table(self):
+        return self.curve._arc_table()
+
+    @property
+    def control_points(self) -> np.ndarray:
+        """Control points, shape (n, 2) (m, read-only)."""
+        return self.curve.c
+
+    @property
+    def knots(self) -> np.ndarray:
+        """Knot vector, shape (n + k + 1,) (m, read-only)."""
+        return self.curve.t
+
+    @property
+    def degree(self) -> int:
+        return self.curve.k
+
+    @property
+    def polynomial_degree(self) -> int:
+        return self.curve.k
