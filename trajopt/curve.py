@@ -17,7 +17,7 @@ from numpy.polynomial.legendre import leggauss
 __all__ = ["ParametricCurve", "CurveSamples", "PolylineCurve"]
 
 _GL_X, _GL_W = leggauss(5)
-_STILL = 1e-9  # |c'| below this fraction of the mean parametric speed counts as zero
+STILL_SPEED_RATIO = 1e-9  # |c'| below this fraction of the mean parametric speed counts as zero
 
 
 class CurveSamples(NamedTuple):
@@ -87,7 +87,7 @@ class ParametricCurve(ABC):
         uu = np.asarray(u, dtype=float)
         d = self(uu, 1)
         theta = np.arctan2(d[..., 1], d[..., 0])
-        still = np.hypot(d[..., 0], d[..., 1]) <= _STILL * self._mean_speed()
+        still = np.hypot(d[..., 0], d[..., 1]) <= STILL_SPEED_RATIO * self._mean_speed()
         if np.any(still):
             theta = np.where(still, self._limit_heading(uu, theta), theta)
         return theta
@@ -101,7 +101,7 @@ class ParametricCurve(ABC):
         lo, hi = self.domain
         uu = np.clip(u, lo, hi)
         span = hi - lo
-        floor = _STILL * self._mean_speed()
+        floor = STILL_SPEED_RATIO * self._mean_speed()
         out = np.array(theta, dtype=float, copy=True)
         todo = np.ones(uu.shape, dtype=bool)
         for k in range(2, 7):
@@ -121,7 +121,7 @@ class ParametricCurve(ABC):
 
     def curvature(self, u: np.ndarray | float) -> np.ndarray:
         """Signed curvature ``(x'y'' - y'x'') / |c'|^3`` (1/m); ``inf`` where ``c' = 0``."""
-        return _signed_curvature(self(u, 1), self(u, 2))
+        return signed_curvature(self(u, 1), self(u, 2))
 
     # ------------------------------------------------------------- arc length
     def _arc_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -251,7 +251,7 @@ class ParametricCurve(ABC):
         )
 
 
-def _signed_curvature(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+def signed_curvature(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
     """``(x'y'' - y'x'') / |c'|^3`` from first and second derivatives (..., 2); inf at c' = 0."""
     cross = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
     sp3 = np.hypot(d1[..., 0], d1[..., 1]) ** 3

@@ -88,10 +88,10 @@ class _RestToRest:
     (the timing's ruckig wrapper, without its velocity margin)."""
 
     def __init__(self, vmax: float, amax: float, jmax: float) -> None:
-        from trajopt.timing import _Ruckig
+        from trajopt.timing.ruckig_profile import RuckigProfile
 
         self.vmax = vmax
-        self.rk = _Ruckig(amax, jmax)
+        self.rk = RuckigProfile(amax, jmax)
 
     def solve(self, d: float) -> np.ndarray:
         """Rows ``(duration, q0, dq0, ddq0, jerk)`` of the profile's non-empty phases."""

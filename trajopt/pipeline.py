@@ -4,7 +4,8 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 
 1. **inflate**: ``astar.inflate(grid, r, metric="square", outside_occupied=True)`` (the
    grid the corridor certifies against; GUIDE section 6). ``inflation="paper"`` adds the
-   chapter's avoidance area (``W`` rounds of 8-neighbour marking, ``W = round(width/res)``)
+   chapter's avoidance area (``W`` rounds of 8-neighbour marking, ``W`` from
+   :func:`trajopt.robot.avoidance_width`)
    on top, so the result is never less safe than the certified inflation.
 2. **search**: octile A* on the inflated grid; by default (``search="clearance"``) with
    the soft clearance cost of :func:`astar.clearance_cost`, which keeps paths off the walls;
@@ -55,11 +56,9 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import math
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -67,13 +66,13 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.clearance import box_clearance, polygon_clearance, polyline_clearance
-from trajopt.corridor import Box, Corridor, build_corridor
+from trajopt.clearance import polygon_clearance, polyline_clearance
+from trajopt.corridor_fit import box_corridor, fit_in_corridor, witness_rescue
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
-from trajopt.feasibility import curvature_witness, witness_grid_path
-from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
-from trajopt.robot import Robot
+from trajopt.plan_query import PlanQuery, PlanSteps
+from trajopt.polygon_corridor import PolygonCorridor
+from trajopt.robot import Robot, avoidance_width
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.speed_limits import SpeedLimits
 from trajopt.timing import time_parameterize
@@ -95,45 +94,6 @@ _FALLBACKS = (None, "stop_and_turn")
 _CORRIDORS = ("polygons", "boxes")
 
 
-@dataclass(frozen=True, slots=True)
-class PlanSteps:
-    """Every intermediate result of one :meth:`Planner.plan` query.
-
-    Attributes
-    ----------
-    raw_grid : astar.OccupancyGrid
-        The map as given.
-    inflated_grid : astar.OccupancyGrid
-        The grid the robot centre moves in.
-    grid_path : astar.GridPath
-        The A* path on ``inflated_grid`` (after a witness rescue, the grid path along the
-        witness: ``expanded`` 0, ``cost`` its length).
-    corridor : PolygonCorridor or Corridor
-        The corridor the smooth path was fitted in: convex polygons around the path
-        (``corridor="polygons"``), or free boxes (end boxes widened to the exact
-        start/goal) with ``corridor="boxes"`` or where the polygons failed.
-    smooth_path : SmoothPath or None
-        The certified B-spline; ``None`` when the planner returned the stop-and-turn
-        fallback (the trajectory's ``path`` is then the polyline it drives).
-    start, goal : tuple of float
-        The query's end points (m).
-    stages_s : dict of str to float
-        Wall time of each stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
-        ``timing``, ``total``. ``inflate`` is ~0 when the planner's cache served it. With
-        the fallback: ``fallback`` (checking and timing the polyline) and no ``timing``
-        unless the timing was the stage that failed.
-    """
-
-    raw_grid: OccupancyGrid
-    inflated_grid: OccupancyGrid
-    grid_path: Any
-    corridor: PolygonCorridor | Corridor
-    smooth_path: SmoothPath | None
-    start: tuple[float, float]
-    goal: tuple[float, float]
-    stages_s: dict[str, float]
-
-
 class Planner:
     """Plans timed trajectories on one map, caching what repeated queries share.
 
@@ -152,8 +112,8 @@ class Planner:
         ``"exact"``: obstacles grown by ``robot.radius`` (square metric, certified).
         ``"paper"``: the chapter's avoidance area of ``w_cells`` rounds on top of it.
     w_cells : int, optional
-        ``W`` for ``inflation="paper"``; default ``round(robot.width / resolution)`` (11 on
-        the paper scene).
+        ``W`` for ``inflation="paper"``; default :func:`~trajopt.robot.avoidance_width`
+        (11 on the paper scene).
     search : {"clearance", "shortest", "costmap", "costmap+clearance"}, optional
         A* cost: clearance-aware (:func:`astar.clearance_cost`; the default for an
         occupancy grid), plain shortest path, the costmap's graded cost
@@ -236,7 +196,7 @@ class Planner:
         if not (isinstance(corridor, str) and corridor in _CORRIDORS):
             raise InvalidInputError(f"corridor must be one of {_CORRIDORS}, got {corridor!r}")
         if w_cells is None:
-            w_cells = max(1, round(robot.width / grid.resolution))
+            w_cells = avoidance_width(robot.width, grid.resolution)
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
             raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
         if (
@@ -345,246 +305,126 @@ class Planner:
             return self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
-        t0 = time.perf_counter()
-        stages: dict[str, float] = {}
         p0 = _point("start", start)
         p1 = _point("goal", goal)
-        c0 = self._check_endpoint("start", p0)
-        c1 = self._check_endpoint("goal", p1)
-        t = time.perf_counter()
-        inflated = self.inflated_grid
-        stages["inflate"] = time.perf_counter() - t
-        for name, p, c in (("start", p0, c0), ("goal", p1, c1)):
-            if inflated.occupied[c[1], c[0]]:
+        q = PlanQuery(
+            start=p0,
+            goal=p1,
+            start_cell=self._check_endpoint("start", p0),
+            goal_cell=self._check_endpoint("goal", p1),
+            start_heading=start_heading,
+            goal_heading=goal_heading,
+            v_start=v_start,
+            v_end=v_end,
+        )
+        with q.timer.stage("inflate"):
+            q.inflated = self.inflated_grid
+        self._check_reachable_ends(q)
+        with q.timer.stage("search"):
+            try:
+                q.path = astar.find_path(
+                    q.inflated, _cell(q.start_cell), _cell(q.goal_cell), cost=self.search_cost
+                )
+            except astar.NoPathError as exc:
+                raise NoPathError(
+                    f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot "
+                    f"of radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
+                ) from exc
+        smooth = None
+        try:
+            smooth = self._smooth(q)
+            with q.timer.stage("timing"):
+                traj = time_parameterize(smooth, self.robot, v_start=v_start, v_end=v_end,
+                                         dt=self.timing_dt, speed_limits=self.speed_limits)  # fmt: skip
+        except (SmoothingError, TimingError) as exc:
+            if self.fallback is None or v_start != 0.0 or v_end != 0.0:
+                raise
+            return self._fallback(q, exc)
+        smoother_stats = dict(smooth.stats)
+        smoother_stats["rescue"] = q.rescue
+        kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
+        return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind)
+
+    def _smooth(self, q: PlanQuery) -> SmoothPath:
+        """The corridor and the certified curve (``q.path``, ``q.corridor``), with the
+        witness rescue of a curvature-bounded fit."""
+        t_start = time.perf_counter()
+        try:
+            q.corridor, smooth = fit_in_corridor(self, q, q.path, self.smoother)
+        except SmoothingError as exc:
+            found = witness_rescue(self, q, exc, t_start)
+            if found is None:
+                raise
+            q.path, q.corridor, smooth = found
+            q.rescue = "witness"
+        return smooth
+
+    def _check_reachable_ends(self, q: PlanQuery) -> None:
+        for name, p, c in (("start", q.start, q.start_cell), ("goal", q.goal, q.goal_cell)):
+            if q.inflated.occupied[c[1], c[0]]:
                 raise InvalidInputError(
                     f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
                     f"inflation={self.inflation!r} avoidance area (robot radius "
                     f"{self.robot.radius} m); clearance of the cell centre "
                     f"{_point_clearance(self.grid, self.grid.cell_to_world(c)):.4g} m"
                 )
-        if tuple(c0) == tuple(c1):
+        if tuple(q.start_cell) == tuple(q.goal_cell):
             raise InvalidInputError(
-                f"start {p0.tolist()} m and goal {p1.tolist()} m lie in the same cell "
-                f"{_cell(c0)}; the planner needs them at least one cell apart"
+                f"start {q.start.tolist()} m and goal {q.goal.tolist()} m lie in the same cell "
+                f"{_cell(q.start_cell)}; the planner needs them at least one cell apart"
             )
-        t = time.perf_counter()
-        cost = self.search_cost
-        try:
-            path = astar.find_path(inflated, tuple(c0), tuple(c1), cost=cost)
-        except astar.NoPathError as exc:
-            raise NoPathError(
-                f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot of "
-                f"radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
-            ) from exc
-        stages["search"] = time.perf_counter() - t
-        t = time.perf_counter()
-        smooth = None
-        rescue = None
-        corridor = None
-        try:
-            try:
-                corridor, smooth = self._corridor_fit(
-                    self.smoother, inflated, path, p0, p1, start_heading, goal_heading, stages
-                )
-            except SmoothingError as exc:
-                found = self._witness_rescue(exc, inflated, p0, p1, start_heading, goal_heading, t)
-                if found is None:
-                    raise
-                path, corridor, smooth = found
-                rescue = "witness"
-            stages["smooth"] = time.perf_counter() - t - stages.get("corridor", 0.0)
-            t = time.perf_counter()
-            traj = time_parameterize(
-                smooth,
-                self.robot,
-                v_start=v_start,
-                v_end=v_end,
-                dt=self.timing_dt,
-                speed_limits=self.speed_limits,
-            )
-            stages["timing"] = time.perf_counter() - t
-        except (SmoothingError, TimingError) as exc:
-            stages["smooth" if smooth is None else "timing"] = time.perf_counter() - t
-            if self.fallback is None or v_start != 0.0 or v_end != 0.0:
-                raise
-            if corridor is None:
-                corridor = self._box_corridor(inflated, path, p0, p1)
-            return self._fallback(
-                exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
-            )
-        stages["total"] = time.perf_counter() - t0
+
+    def _result(self, q: PlanQuery, traj: Any, smooth: SmoothPath | None, **extra: Any) -> Any:
+        """The one place that attaches :class:`PlanSteps` and the planner's statistics."""
+        stages = q.timer.finish()
         steps = PlanSteps(
             raw_grid=self.grid,
-            inflated_grid=inflated,
-            grid_path=path,
-            corridor=corridor,
+            inflated_grid=q.inflated,
+            grid_path=q.path,
+            corridor=q.corridor,
             smooth_path=smooth,
-            start=(float(p0[0]), float(p0[1])),
-            goal=(float(p1[0]), float(p1[1])),
+            start=(float(q.start[0]), float(q.start[1])),
+            goal=(float(q.goal[0]), float(q.goal[1])),
             stages_s=stages,
         )
         stats = dict(traj.stats)
+        stats.update(extra)
         stats["stages_s"] = dict(stages)
         stats["inflation"] = self.inflation
         stats["search"] = self.search
-        stats["smoother"] = dict(smooth.stats)
-        stats["smoother"]["rescue"] = rescue
-        stats["corridor"] = "polygons" if isinstance(corridor, PolygonCorridor) else "boxes"
         return dataclasses.replace(traj, stats=stats, steps=steps)
 
-    def _corridor_fit(self, smoother, inflated, path, p0, p1, start_heading, goal_heading,
-                      stages=None):
-        """Build the corridor and fit in it: polygons first (when chosen), then boxes.
-
-        Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
-        ``InvalidInputError``) when every corridor failed. ``stages["corridor"]`` adds up
-        the corridor builds (s)."""
-        t_start = time.perf_counter()
-        kinds = ["boxes"]
-        if self.corridor == "polygons" and self.inflation == "exact":
-            kinds.insert(0, "polygons")
-        for i, kind in enumerate(kinds):
-            last = i == len(kinds) - 1
-            t = time.perf_counter()
-            try:
-                if kind == "polygons":
-                    corridor = self._polygon_corridor(path, p0, p1)
-                else:
-                    corridor = self._box_corridor(inflated, path, p0, p1)
-            except InvalidInputError as exc:
-                if last:
-                    raise
-                logger.debug("%s corridor not built (%s); trying the next kind", kind, exc)
-                continue
-            finally:
-                if stages is not None:
-                    stages["corridor"] = stages.get("corridor", 0.0) + time.perf_counter() - t
-            left = smoother.time_budget_s - (time.perf_counter() - t_start)
-            try:
-                if left <= 0:
-                    raise SmoothingError("time budget exhausted before the box corridor", {})
-                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
-                return corridor, self._fit(sm, path, corridor, p0, p1, start_heading,
-                                           goal_heading)
-            except SmoothingError as exc:
-                if last:
-                    raise
-                logger.debug("fit in the %s corridor failed (%s); trying the next kind",
-                             kind, exc)
-        raise AssertionError("unreachable")  # pragma: no cover
-
-    def _polygon_corridor(self, path: Any, p0: np.ndarray, p1: np.ndarray) -> PolygonCorridor:
-        """Polygons around the A* path, from the exact start to the exact goal."""
-        centres = np.asarray(self.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
-        points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
-        return build_polygon_corridor(self.grid, points, self.robot.radius)
-
-    def _box_corridor(self, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray):
-        # bridges (45-degree regions certified against the raw map) across diagonal gaps;
-        # not with the chapter's avoidance area, which the curve must not enter either
-        bridge_map = self.grid if self.inflation == "exact" else None
-        corridor = build_corridor(inflated, path, radius=self.robot.radius, raw_grid=bridge_map)
-        return _widen_end_boxes(corridor, self.grid, p0, p1, self.robot.radius)
-
-    def _fit(self, smoother: Smoother, path, corridor, p0, p1, start_heading, goal_heading):
-        return smoother.fit(
-            path,
-            corridor,
-            raw_grid=self.grid,
-            radius=self.robot.radius,
-            start=p0,
-            goal=p1,
-            start_heading=start_heading,
-            goal_heading=goal_heading,
-        )
-
-    def _witness_rescue(self, exc, inflated, p0, p1, start_heading, goal_heading, t_start):
-        """The second try of a curvature-bounded fit, along a witness; ``None`` if none.
-
-        A witness that keeps one cell more than the radius is tried first (its grid path
-        stays off the inflated grid's edges, so the corridor has room to turn; its search
-        is capped at 1 s), then one with the exact radius.
-        """
-        sm = self.smoother
-        if sm.kappa_max is None:
-            return None
-        radius = self.robot.radius
-        for margin, cap_s in ((self.grid.resolution, 1.0), (0.0, math.inf)):
-            left = sm.time_budget_s - (time.perf_counter() - t_start)
-            if left <= 0:
-                return None
-            witness = curvature_witness(
-                self.grid, radius + margin, p0, p1, sm.kappa_max, time_limit_s=min(left, cap_s)
-            )
-            cells = None if witness is None else witness_grid_path(witness, inflated)
-            if cells is None or len(cells) < 2:
-                continue
-            steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
-            length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
-            path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
-            left = sm.time_budget_s - (time.perf_counter() - t_start)
-            if left <= 0:
-                return None
-            try:
-                corridor, smooth = self._corridor_fit(
-                    dataclasses.replace(sm, time_budget_s=left),
-                    inflated, path, p0, p1, start_heading, goal_heading,
-                )
-            except (SmoothingError, InvalidInputError) as exc2:
-                logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
-                continue
-            return path, corridor, smooth
-        return None
-
-    def _fallback(
-        self, exc, path, inflated, corridor, p0, p1, start_heading, goal_heading, stages, t0
-    ) -> StopAndTurnTrajectory:
+    def _fallback(self, q: PlanQuery, exc: Exception) -> StopAndTurnTrajectory:
         """The stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
-        t = time.perf_counter()
-        grid = self.grid
-        centres = np.asarray(grid.cell_to_world(np.asarray(path.cells)), dtype=float)
-        points = np.vstack([p0, centres.reshape(-1, 2), p1])
-        radius = self.robot.radius
-        window = radius + 2.0 * float(grid.resolution)
-        clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
-        if clearance < radius - 1e-9:
-            logger.warning(
-                "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an "
-                "obstacle (radius %.6g m)",
-                clearance,
-                radius,
-            )
-            raise exc
-        traj = stop_and_turn(
-            points,
-            self.robot,
-            start_heading=start_heading,
-            goal_heading=goal_heading,
-            speed_limits=self.speed_limits,
-        )
-        stages["fallback"] = time.perf_counter() - t
-        stages["total"] = time.perf_counter() - t0
+        with q.timer.stage("fallback"):
+            grid = self.grid
+            if q.corridor is None:
+                with q.timer.stage("corridor"):
+                    q.corridor = box_corridor(self, q.inflated, q.path, q.start, q.goal)
+            centres = np.asarray(grid.cell_to_world(np.asarray(q.path.cells)), dtype=float)
+            points = np.vstack([q.start, centres.reshape(-1, 2), q.goal])
+            radius = self.robot.radius
+            window = radius + 2.0 * float(grid.resolution)
+            clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
+            if clearance < radius - 1e-9:
+                logger.warning(
+                    "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an "
+                    "obstacle (radius %.6g m)",
+                    clearance,
+                    radius,
+                )
+                raise exc
+            traj = stop_and_turn(points, self.robot, start_heading=q.start_heading,
+                                 goal_heading=q.goal_heading, speed_limits=self.speed_limits)  # fmt: skip
         logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
-        steps = PlanSteps(
-            raw_grid=grid,
-            inflated_grid=inflated,
-            grid_path=path,
-            corridor=corridor,
-            smooth_path=None,
-            start=(float(p0[0]), float(p0[1])),
-            goal=(float(p1[0]), float(p1[1])),
-            stages_s=stages,
-        )
-        stats = dict(traj.stats)
-        stats["fallback_error"] = type(exc).__name__
-        stats["fallback_reason"] = str(exc)
-        stats["fallback_min_clearance_m"] = float(clearance)
-        stats["stages_s"] = dict(stages)
-        stats["inflation"] = self.inflation
-        stats["search"] = self.search
+        extra: dict[str, Any] = {
+            "fallback_error": type(exc).__name__,
+            "fallback_reason": str(exc),
+            "fallback_min_clearance_m": float(clearance),
+        }
         if isinstance(exc, SmoothingError):
-            stats["smoother"] = dict(exc.stats)
-        return dataclasses.replace(traj, stats=stats, steps=steps)
+            extra["smoother"] = dict(exc.stats)
+        return self._result(q, traj, None, **extra)
 
     def _check_endpoint(self, name: str, p: np.ndarray) -> np.ndarray:
         grid = self.grid
@@ -725,41 +565,6 @@ def _cell(c: np.ndarray) -> tuple[int, int]:
 def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
     """Exact clearance (m) of a world point from the raw map (outside occupied)."""
     return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)
-
-
-def _widen_end_boxes(
-    corridor: Corridor, raw: OccupancyGrid, p0: np.ndarray, p1: np.ndarray, radius: float
-) -> Corridor:
-    """Widen the first/last box to hold the exact start/goal, after an exact clearance check."""
-    boxes = list(corridor.boxes)
-    changed = False
-    for name, idx, p in (("start", 0, p0), ("goal", len(boxes) - 1, p1)):
-        b = boxes[idx]
-        if b.contains(p):
-            continue
-        lo = np.minimum([b.xmin, b.ymin], p)
-        hi = np.maximum([b.xmax, b.ymax], p)
-        clr = box_clearance(raw, lo, hi)
-        if clr < radius:
-            raise InvalidInputError(
-                f"{name} {p.tolist()} m cannot join the corridor with clearance {radius} m: "
-                f"the box joining it to the path comes {clr:.4g} m from an obstacle; move it "
-                "towards free space or onto the centre of its cell"
-            )
-        boxes[idx] = Box(
-            xmin=float(lo[0]),
-            xmax=float(hi[0]),
-            ymin=float(lo[1]),
-            ymax=float(hi[1]),
-            ix0=b.ix0,
-            ix1=b.ix1,
-            iy0=b.iy0,
-            iy1=b.iy1,
-        )
-        changed = True
-    if not changed:
-        return corridor
-    return dataclasses.replace(corridor, boxes=tuple(boxes))
 
 
 def compare_method(ctx: Any) -> Any:

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.validation import positive
 
 __all__ = ["Robot"]
 
@@ -124,12 +125,21 @@ class Robot:
 
 
 def _positive(name: str, value: Any) -> float:
-    if isinstance(value, (bool, np.bool_)):
-        raise InvalidInputError(f"Robot.{name} must be a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"Robot.{name} must be a number, got {value!r}") from None
-    if not math.isfinite(x) or x <= 0.0:
-        raise InvalidInputError(f"Robot.{name} must be finite and > 0, got {value!r}")
-    return x
+    return positive(f"Robot.{name}", value)
+
+
+def avoidance_width(width_m: float, resolution_m: float) -> int:
+    """The chapter's avoidance-area width ``W`` in cells: the fewest whole cells that cover
+    the robot's width (``ceil(width / resolution)``, with a 1e-9 tolerance for round-off so
+    that 0.33 m on 0.03 m cells is 11), and at least 1.
+
+    Parameters
+    ----------
+    width_m : float
+        Robot width (m), > 0.
+    resolution_m : float
+        Cell size (m), > 0.
+    """
+    w = positive("width_m", width_m, "m")
+    res = positive("resolution_m", resolution_m, "m")
+    return max(1, math.ceil(w / res - 1e-9))

@@ -95,8 +95,8 @@ def integer(name: str, value: Any, lo: int, hi: int | None = None) -> int:
         raise InvalidInputError(f"{name} must be an integer, got {short_repr(value)}")
     v = int(value)
     if v < lo or (hi is not None and v > hi):
-        rule = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
-        raise InvalidInputError(f"{name} must be {rule}, got {v}")
+        rule = f">= {lo}" if hi is None else f"in {lo}..{hi}"
+        raise InvalidInputError(f"{name} must be an integer {rule}, got {v}")
     return v
 
 

@@ -108,7 +108,7 @@ class Smoother:
     def __post_init__(self) -> None:
         integer("degree", self.degree, 3, 5)
         number("smoothness_weight", self.smoothness_weight, lo=0.0)
-        integer("smoothness_order (1 .. degree - 1)", self.smoothness_order, 1, self.degree - 1)
+        integer("smoothness_order", self.smoothness_order, 1, self.degree - 1)
         number("span_cells", self.span_cells, lo=0.5)
         if self.kappa_max is not None:
             number("kappa_max", self.kappa_max, unit="1/m", lo=0.0, strict=True)

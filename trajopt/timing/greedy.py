@@ -1,4 +1,4 @@
-"""Compiled kernels of the jerk-limited timing along arc length (private to :mod:`trajopt.timing`).
+"""Compiled kernels of the jerk-limited timing along arc length (numba).
 
 All kernels work on a 1-DoF motion ``s(t)`` made of constant-jerk pieces and on a speed cap
 given as one value per interval of a uniform arc-length grid (spacing ``h``), stored as a

@@ -1,0 +1,174 @@
+"""The planner's corridor-and-fit stage: polygons first, boxes where they fail, and the
+witness rescue of a curvature-bounded fit.
+
+Functions take the :class:`~trajopt.pipeline.Planner` (its raw map, robot, inflation,
+corridor kind and smoother) and the query record (:class:`~trajopt.plan_query.PlanQuery`),
+whose timer gets the corridor builds under ``corridor`` and the fits (and the witness
+search) under ``smooth``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt.clearance import box_clearance
+from trajopt.corridor import Box, Corridor, build_corridor
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.feasibility import curvature_witness, witness_grid_path
+from trajopt.plan_query import PlanQuery
+from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
+from trajopt.smoother import Smoother, SmoothPath
+
+__all__ = ["box_corridor", "fit_in_corridor", "polygon_corridor", "witness_rescue"]
+
+logger = logging.getLogger("trajopt.pipeline")
+
+
+def fit_in_corridor(
+    planner: Any, q: PlanQuery, path: Any, smoother: Smoother
+) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
+    """Build the corridor around ``path`` and fit in it: polygons first (when chosen),
+    then boxes, sharing ``smoother.time_budget_s``.
+
+    Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
+    ``InvalidInputError``) when every corridor failed.
+    """
+    t_start = time.perf_counter()
+    kinds = ["boxes"]
+    if planner.corridor == "polygons" and planner.inflation == "exact":
+        kinds.insert(0, "polygons")
+    for i, kind in enumerate(kinds):
+        last = i == len(kinds) - 1
+        try:
+            with q.timer.stage("corridor"):
+                if kind == "polygons":
+                    corridor = polygon_corridor(planner, path, q.start, q.goal)
+                else:
+                    corridor = box_corridor(planner, q.inflated, path, q.start, q.goal)
+        except InvalidInputError as exc:
+            if last:
+                raise
+            logger.debug("%s corridor not built (%s); trying the next kind", kind, exc)
+            continue
+        left = smoother.time_budget_s - (time.perf_counter() - t_start)
+        try:
+            if left <= 0:
+                raise SmoothingError("time budget exhausted before the box corridor", {})
+            sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
+            with q.timer.stage("smooth"):
+                smooth = sm.fit(path, corridor, raw_grid=planner.grid,
+                                radius=planner.robot.radius, start=q.start, goal=q.goal,
+                                start_heading=q.start_heading, goal_heading=q.goal_heading)  # fmt: skip
+            return corridor, smooth
+        except SmoothingError as exc:
+            if last:
+                raise
+            logger.debug("fit in the %s corridor failed (%s); trying the next kind", kind, exc)
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def witness_rescue(
+    planner: Any, q: PlanQuery, exc: Exception, t_start: float
+) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath] | None:
+    """The second try of a curvature-bounded fit, along a witness; ``None`` if none.
+
+    A witness that keeps one cell more than the radius is tried first (its grid path
+    stays off the inflated grid's edges, so the corridor has room to turn; its search
+    is capped at 1 s), then one with the exact radius. Both tries share the smoother's
+    time budget, counted from ``t_start``.
+    """
+    sm = planner.smoother
+    if sm.kappa_max is None:
+        return None
+    radius = planner.robot.radius
+    grid = planner.grid
+    for margin, cap_s in ((grid.resolution, 1.0), (0.0, math.inf)):
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            return None
+        with q.timer.stage("smooth"):
+            witness = curvature_witness(
+                grid, radius + margin, q.start, q.goal, sm.kappa_max,
+                time_limit_s=min(left, cap_s),
+            )  # fmt: skip
+            cells = None if witness is None else witness_grid_path(witness, q.inflated)
+        if cells is None or len(cells) < 2:
+            continue
+        steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+        length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
+        path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            return None
+        try:
+            corridor, smooth = fit_in_corridor(
+                planner, q, path, dataclasses.replace(sm, time_budget_s=left)
+            )
+        except (SmoothingError, InvalidInputError) as exc2:
+            logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
+            continue
+        return path, corridor, smooth
+    return None
+
+
+def polygon_corridor(planner: Any, path: Any, p0: np.ndarray, p1: np.ndarray) -> PolygonCorridor:
+    """Polygons around the A* path, from the exact start to the exact goal."""
+    centres = np.asarray(planner.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
+    points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
+    return build_polygon_corridor(planner.grid, points, planner.robot.radius)
+
+
+def box_corridor(
+    planner: Any, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray
+) -> Corridor:
+    """Boxes of free cells around the A* path, the end boxes widened to the exact ends.
+
+    Bridges (45-degree regions certified against the raw map) cross diagonal gaps; not
+    with the chapter's avoidance area, which the curve must not enter either.
+    """
+    bridge_map = planner.grid if planner.inflation == "exact" else None
+    corridor = build_corridor(inflated, path, radius=planner.robot.radius, raw_grid=bridge_map)
+    return widen_end_boxes(corridor, planner.grid, p0, p1, planner.robot.radius)
+
+
+def widen_end_boxes(
+    corridor: Corridor, raw: OccupancyGrid, p0: np.ndarray, p1: np.ndarray, radius: float
+) -> Corridor:
+    """Widen the first/last box to hold the exact start/goal, after an exact clearance check."""
+    boxes = list(corridor.boxes)
+    changed = False
+    for name, idx, p in (("start", 0, p0), ("goal", len(boxes) - 1, p1)):
+        b = boxes[idx]
+        if b.contains(p):
+            continue
+        lo = np.minimum([b.xmin, b.ymin], p)
+        hi = np.maximum([b.xmax, b.ymax], p)
+        clr = box_clearance(raw, lo, hi)
+        if clr < radius:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m cannot join the corridor with clearance {radius} m: "
+                f"the box joining it to the path comes {clr:.4g} m from an obstacle; move it "
+                "towards free space or onto the centre of its cell"
+            )
+        boxes[idx] = Box(
+            xmin=float(lo[0]),
+            xmax=float(hi[0]),
+            ymin=float(lo[1]),
+            ymax=float(hi[1]),
+            ix0=b.ix0,
+            ix1=b.ix1,
+            iy0=b.iy0,
+            iy1=b.iy1,
+        )
+        changed = True
+    if not changed:
+        return corridor
+    return dataclasses.replace(corridor, boxes=tuple(boxes))

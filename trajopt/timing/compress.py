@@ -1,0 +1,126 @@
+"""The timing's last stages on the greedy's answer: finish at ``(L, v_end, 0)`` with one
+ruckig call, then compress the sections between speed minima into ruckig's time-optimal
+profiles where they stay under the cap."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trajopt.timing import greedy
+from trajopt.timing.cap_table import CapTable
+from trajopt.timing.ruckig_profile import RuckigProfile
+
+__all__ = ["compress", "finish", "rows_from_greedy"]
+
+MAX_SPLIT_DEPTH = 6
+MIN_SPLIT_STEPS = 6  # split a failed section only when it spans at least this many steps
+
+
+def rows_from_greedy(phases: np.ndarray, i0: int, i1: int, t_end: float) -> np.ndarray:
+    """Greedy phases ``i0:i1`` as rows ``(t0, s0, v0, a0, jerk, duration)``."""
+    ph = phases[i0:i1]
+    t_next = np.append(ph[1:, 0], t_end)
+    return np.column_stack([ph[:, :5], t_next - ph[:, 0]])
+
+
+def finish(
+    rk: RuckigProfile, table: CapTable, phases: np.ndarray, bounds: np.ndarray, v_end: float,
+    jmax: float,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Append one ruckig position call to ``(L, v_end, 0)``; back off a few steps if needed.
+
+    Returns ``(phases, bounds)`` with ``phases`` rows ``(t0, s0, v0, a0, jerk)`` and ``bounds``
+    rows ``(t, s, v, a, phase_index)``, the last bound being the end state; or None.
+    """
+    length = table.length
+    target = (length, v_end, 0.0)
+    nb = bounds.shape[0]
+    for back in range(min(nb, 25)):
+        ib = nb - 1 - back
+        t_b, s_b, v_b, a_b, p_b = bounds[ib]
+        if s_b > length:
+            continue
+        v_pk = v_b + (a_b * a_b / (2.0 * jmax) if a_b > 0 else 0.0)
+        # the lowest cap ahead bounds a profile that holds the cap everywhere; the state's
+        # own peak speed is the fallback (from rest that peak is 0: never the only bound)
+        v_room = table.range_min(s_b, length)
+        rows = None
+        for vmax in dict.fromkeys((max(v_room, v_pk, v_end), max(v_pk, v_end))):
+            rows = rk.solve((s_b, v_b, a_b), target, vmax)
+            if rows is not None and table.rows_ok(rows):
+                break
+            rows = None
+        if rows is None:
+            continue
+        rows = rows.copy()
+        rows[:, 0] += t_b
+        new_ph = np.vstack([phases[: int(p_b)], rows[:, :5]])
+        t_end = t_b + float(rows[:, 5].sum())
+        new_b = np.vstack([bounds[: ib + 1], [[t_end, length, v_end, 0.0, new_ph.shape[0]]]])
+        return new_ph, new_b
+    return None
+
+
+def compress(
+    rk: RuckigProfile, table: CapTable, phases: np.ndarray, bounds: np.ndarray
+) -> list[np.ndarray]:
+    """Replace the greedy between its speed minima by ruckig's time-optimal sections."""
+    nb = bounds.shape[0]
+    v, a = bounds[:, 2], bounds[:, 3]
+    vm, vc, vp = v[:-2], v[1:-1], v[2:]
+    inner = (a[1:-1] == 0.0) & (vc <= vm) & (vc <= vp) & ~((vm == vc) & (vc == vp))
+    knots = [0, *(np.flatnonzero(inner) + 1).tolist(), nb - 1]
+    t_next = np.append(phases[1:, 0], bounds[-1, 0])
+    peaks = greedy.phase_peaks(phases, t_next)
+    ph_index = bounds[:, 4].astype(np.int64)
+    ci, h = table.ci, table.h
+    n_ci = ci.shape[0]
+    chain: list[np.ndarray] = []
+    t_out = 0.0
+    budget = [3 * len(knots) + 32]  # ruckig calls; the greedy answer is kept beyond it
+
+    def greedy_rows(i0: int, i1: int) -> np.ndarray:
+        return rows_from_greedy(phases, ph_index[i0], ph_index[i1], float(bounds[i1, 0]))
+
+    def fits(rows, g_dur: float) -> bool:
+        return (
+            rows is not None
+            and float(rows[:, 5].sum()) <= g_dur
+            and table.rows_ok(rows)
+        )
+
+    def solve(i0: int, i1: int, depth: int) -> list[np.ndarray]:
+        p0, p1 = ph_index[i0], ph_index[i1]
+        if p1 <= p0:
+            return []
+        if i1 - i0 < 2 or budget[0] <= 0:
+            return [greedy_rows(i0, i1)]
+        budget[0] -= 1
+        g_dur = float(bounds[i1, 0] - bounds[i0, 0])
+        st0 = (bounds[i0, 1], bounds[i0, 2], bounds[i0, 3])
+        st1 = (bounds[i1, 1], bounds[i1, 2], bounds[i1, 3])
+        peak = float(peaks[p0:p1].max())
+        i_a = min(int(st0[0] / h), n_ci - 1)
+        i_b = min(int(st1[0] / h), n_ci - 1)
+        top = float(ci[i_a : i_b + 1].max())
+        if top > peak * (1.0 + 1e-6):
+            # first try the highest cap in the section: better than the greedy's peak if it fits
+            rows = rk.solve(st0, st1, top)
+            if fits(rows, g_dur):
+                return [rows]
+        rows = rk.solve(st0, st1, peak)
+        if fits(rows, g_dur):
+            return [rows]
+        if i1 - i0 >= MIN_SPLIT_STEPS and depth < MAX_SPLIT_DEPTH:
+            t_mid = 0.5 * (bounds[i0, 0] + bounds[i1, 0])
+            im = int(np.clip(np.searchsorted(bounds[:, 0], t_mid), i0 + 1, i1 - 1))
+            return solve(i0, im, depth + 1) + solve(im, i1, depth + 1)
+        return [greedy_rows(i0, i1)]
+
+    for k0, k1 in zip(knots[:-1], knots[1:], strict=True):
+        for rows in solve(k0, k1, 0):
+            r = rows.copy()
+            r[:, 0] = r[:, 0] - r[0, 0] + t_out
+            t_out = float(r[-1, 0] + r[-1, 5])
+            chain.append(r)
+    return chain

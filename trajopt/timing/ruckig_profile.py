@@ -1,0 +1,81 @@
+"""A reusable 1-DoF ruckig position problem: the time-optimal jerk-limited profile between
+two states, as constant-jerk rows."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["RUCKIG_V_MARGIN", "RuckigProfile"]
+
+RUCKIG_V_MARGIN = 1e-9  # m/s added to ruckig's max_velocity
+
+
+class RuckigProfile:
+    """One reusable 1-DoF ruckig position problem (no intermediate_positions, ever).
+
+    Used by the timing (finish and compress stages) and by the stop-and-turn fallback
+    (rest-to-rest moves and turns).
+
+    Parameters
+    ----------
+    amax : float
+        Acceleration limit (units of the motion per s^2).
+    jmax : float
+        Jerk limit (per s^3).
+    """
+
+    def __init__(self, amax: float, jmax: float) -> None:
+        from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+
+        self.inp = InputParameter(1)
+        self.otg = Ruckig(1)
+        self.traj = Trajectory(1)
+        self.ok = (Result.Working, Result.Finished)
+        self.errors = (RuntimeError, RuckigError)
+        self.inp.max_acceleration = [amax]
+        self.inp.max_jerk = [jmax]
+        self.inp.min_velocity = [0.0]
+
+    def solve(
+        self, state0, state1, vmax: float, *, v_margin: float = RUCKIG_V_MARGIN
+    ) -> np.ndarray | None:
+        """Rows ``(t0, s0, v0, a0, jerk, duration)`` from ``state0`` to ``state1`` or None.
+
+        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s)."""
+        inp = self.inp
+        s0, v0, a0 = state0
+        s1, v1, a1 = state1
+        inp.current_position = [s0]
+        inp.current_velocity = [v0]
+        inp.current_acceleration = [a0]
+        inp.target_position = [s1]
+        inp.target_velocity = [v1]
+        inp.target_acceleration = [a1]
+        inp.max_velocity = [max(vmax, v0, v1) + v_margin]
+        try:
+            res = self.otg.calculate(inp, self.traj)
+        except self.errors:  # ruckig rejects some target states (e.g. a != 0 near v limit)
+            return None
+        if res not in self.ok:
+            return None
+        prof = self.traj.profiles[0][0]
+        if prof.accel.duration > 1e-15:
+            return None
+        rows = []
+        t = 0.0
+        b = prof.brake
+        if b.duration > 0.0:
+            for i in range(2):
+                if b.t[i] > 0.0:
+                    rows.append((t, b.p[i], b.v[i], b.a[i], b.j[i], b.t[i]))
+                    t += b.t[i]
+        pt, pj, pp, pv, pa = prof.t, prof.j, prof.p, prof.v, prof.a
+        for i in range(7):
+            if pt[i] > 0.0:
+                rows.append((t, pp[i], pv[i], pa[i], pj[i], pt[i]))
+                t += pt[i]
+        if not rows:
+            return None
+        out = np.array(rows)
+        out[:, 0] = np.concatenate([[0.0], np.cumsum(out[:-1, 5])])
+        return out
