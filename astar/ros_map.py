@@ -89,18 +89,7 @@ def read_map_values(
     if not p.is_file():
         raise MapFormatError(f"{p}: map file does not exist (or is not a regular file)")
     meta = read_ros_yaml(p)
-    if not meta.image.is_file():
-        raise MapFormatError(
-            f"{p}: field image: image file {str(meta.image)!r} does not exist "
-            "(relative paths are resolved against the YAML file's folder)"
-        )
-    values = map_server_values(
-        read_pixels(meta.image, p),
-        mode=meta.mode,
-        negate=meta.negate,
-        occupied_thresh=meta.occupied_thresh,
-        free_thresh=meta.free_thresh,
-    )
+    values = _image_values(p, meta)
     return np.ascontiguousarray(values[::-1]), meta.resolution, meta.origin, meta.mode
 
 
@@ -115,6 +104,22 @@ class RosMeta:
     occupied_thresh: float
     free_thresh: float
     mode: str
+
+
+def _image_values(p: Path, meta: RosMeta) -> np.ndarray:
+    """map_server's values (int16, top image row first) of the image that ``p`` names."""
+    if not meta.image.is_file():
+        raise MapFormatError(
+            f"{p}: field image: image file {str(meta.image)!r} does not exist "
+            "(relative paths are resolved against the YAML file's folder)"
+        )
+    return map_server_values(
+        read_pixels(meta.image, p),
+        mode=meta.mode,
+        negate=meta.negate,
+        occupied_thresh=meta.occupied_thresh,
+        free_thresh=meta.free_thresh,
+    )
 
 
 def load_ros(
@@ -136,18 +141,7 @@ def load_ros(
             f"{p}: origin={origin!r} given, but the YAML file sets origin {meta.origin!r}; "
             "leave origin at its default for YAML maps"
         )
-    if not meta.image.is_file():
-        raise MapFormatError(
-            f"{p}: field image: image file {str(meta.image)!r} does not exist "
-            "(relative paths are resolved against the YAML file's folder)"
-        )
-    values = map_server_values(
-        read_pixels(meta.image, p),
-        mode=meta.mode,
-        negate=meta.negate,
-        occupied_thresh=meta.occupied_thresh,
-        free_thresh=meta.free_thresh,
-    )
+    values = _image_values(p, meta)
     occ = values_to_occupied(
         values,
         mode=meta.mode,

@@ -12,6 +12,7 @@ import numpy as np
 
 import astar.errors as _astar_errors
 from astar.grid import OccupancyGrid
+from trajopt import validation
 from trajopt.comparison.records import ComparisonContext, MethodFn, MethodResult
 from trajopt.comparison.registry import resolve_methods
 from trajopt.comparison.table import ComparisonTable
@@ -84,18 +85,6 @@ def _run_method(
         "note": out.note,
     }
     return out.path, row
-
-
-def _xy(value: object, name: str) -> tuple[float, float]:
-    try:
-        x, y = (float(v) for v in value)  # type: ignore[union-attr]
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"{name} must be two numbers (x, y) in metres, got {value!r}"
-        ) from exc
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise InvalidInputError(f"{name} must be finite, got ({x}, {y})")
-    return x, y
 
 
 def _search(grid: OccupancyGrid, s: tuple[int, int], g: tuple[int, int], what: str) -> Any:
@@ -173,13 +162,9 @@ def compare(
     """
     if not isinstance(grid, OccupancyGrid):
         raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}")
-    s_xy, g_xy = _xy(start, "start"), _xy(goal, "goal")
-    try:
-        radius = float(robot_radius)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"robot_radius must be a number, got {robot_radius!r}") from exc
-    if not (math.isfinite(radius) and radius > 0):
-        raise InvalidInputError(f"robot_radius must be finite and > 0 m, got {radius!r}")
+    s_xy = tuple(float(v) for v in validation.point("start", start))
+    g_xy = tuple(float(v) for v in validation.point("goal", goal))
+    radius = validation.positive("robot_radius", robot_radius, "m")
     if w_cells is None:
         w = _paper_w_cells(radius, grid.resolution)
     elif isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
