@@ -25,13 +25,13 @@ _EXPORTS: dict[str, str] = {
     "load_map": "astar.io",
     "save_map": "astar.io",
     "from_intensity": "astar.io",
-    "read_scenarios": "astar.io",
-    "read_map_values": "astar.io",
+    "read_scenarios": "astar.movingai",
+    "read_map_values": "astar.ros_map",
     # costmaps
     "Costmap": "astar.costmap",
     "from_costmap": "astar.costmap",
     "load_costmap": "astar.costmap",
-    "Scenario": "astar.io",
+    "Scenario": "astar.movingai",
     # inflation
     "inflate": "astar.inflation",
     "clearance": "astar.inflation",
@@ -63,12 +63,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
-    from astar.io import (
-        Scenario,
-        from_intensity,
-        load_map,
-        read_map_values,
-        read_scenarios,
-        save_map,
-    )
+    from astar.io import from_intensity, load_map, save_map
+    from astar.movingai import Scenario, read_scenarios
+    from astar.ros_map import read_map_values
     from astar.search import GridPath, find_path

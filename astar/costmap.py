@@ -42,9 +42,10 @@ from typing import Literal
 
 import numpy as np
 
+from astar import validation
 from astar.errors import InvalidInputError, MapFormatError
 from astar.grid import OccupancyGrid
-from astar.io import read_map_values
+from astar.ros_map import read_map_values
 
 __all__ = ["Costmap", "CostmapConvention", "from_costmap", "load_costmap"]
 
@@ -167,7 +168,7 @@ def from_costmap(
                        ("unknown_occupied", unknown_occupied)):  # fmt: skip
         if not isinstance(flag, bool | np.bool_):
             raise InvalidInputError(f"{name} must be a bool, got {flag!r}")
-    v = _integer_values(values)
+    v = validation.integer_values(values)
     if convention == "costmap_2d":
         lo, hi, rule = 0, 255, "0..255 (0 free, 1..252 graded, 253 inscribed, 254 lethal, 255 unknown)"
     else:
@@ -253,25 +254,3 @@ def load_costmap(
         )
     except InvalidInputError as exc:
         raise MapFormatError(f"{p}: {exc}") from None
-
-
-def _integer_values(values: object) -> np.ndarray:
-    try:
-        arr = np.asarray(values)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"values must be a 2-D array of integers, got {exc}") from None
-    if arr.ndim != 2 or arr.size == 0:
-        raise InvalidInputError(
-            f"values must be a non-empty 2-D array (ny, nx), got shape {arr.shape}"
-        )
-    if arr.dtype.kind in "iu":
-        return arr.astype(np.int64)
-    if arr.dtype.kind == "f":
-        finite = np.isfinite(arr)
-        if not np.all(finite) or np.any(arr != np.round(arr)):
-            iy, ix = (int(i) for i in np.argwhere(~finite | (arr != np.round(arr)))[0])
-            raise InvalidInputError(
-                f"values must hold integers, got values[{iy}, {ix}] = {arr[iy, ix]!r}"
-            )
-        return arr.astype(np.int64)
-    raise InvalidInputError(f"values must be an integer array, got dtype {arr.dtype}")

@@ -11,11 +11,11 @@ Conventions (as ROS ``nav_msgs/OccupancyGrid`` and Nav2):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from astar import validation
 from astar.errors import InvalidInputError
 
 __all__ = ["OccupancyGrid"]
@@ -50,16 +50,9 @@ class OccupancyGrid:
     origin: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        occ = _as_bool_grid(self.occupied)
-        res = _as_positive_float(self.resolution, "resolution")
-        try:
-            ox, oy = (float(v) for v in self.origin)
-        except (TypeError, ValueError) as exc:
-            raise InvalidInputError(
-                f"origin must be two numbers (x, y) in metres, got {self.origin!r}"
-            ) from exc
-        if not (math.isfinite(ox) and math.isfinite(oy)):
-            raise InvalidInputError(f"origin must be finite, got ({ox}, {oy})")
+        occ = validation.bool_grid(self.occupied)
+        res = validation.positive_float("resolution", self.resolution, allow_bool=True)
+        ox, oy = validation.origin(self.origin)
         object.__setattr__(self, "occupied", occ)
         object.__setattr__(self, "resolution", res)
         object.__setattr__(self, "origin", (ox, oy))
@@ -189,34 +182,3 @@ class OccupancyGrid:
         )
 
     __hash__ = None  # type: ignore[assignment]
-
-
-def _as_positive_float(value: object, name: str) -> float:
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be a number, got {value!r}") from exc
-    if not math.isfinite(v) or v <= 0.0:
-        raise InvalidInputError(f"{name} must be finite and > 0, got {v!r}")
-    return v
-
-
-def _as_bool_grid(occupied: object) -> np.ndarray:
-    a = np.asarray(occupied)
-    if a.ndim != 2:
-        raise InvalidInputError(f"occupied must be a 2-D array [ny, nx], got shape {a.shape}")
-    if a.shape[0] == 0 or a.shape[1] == 0:
-        raise InvalidInputError(f"occupied must not be empty, got shape {a.shape}")
-    if a.dtype != bool:
-        if a.dtype.kind not in "iuf":
-            raise InvalidInputError(f"occupied must be bool or 0/1 numbers, got dtype {a.dtype}")
-        if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
-            raise InvalidInputError("occupied must not contain NaN or infinity")
-        if not np.all((a == 0) | (a == 1)):
-            bad = a[(a != 0) & (a != 1)].ravel()[0].item()
-            raise InvalidInputError(
-                f"occupied must hold only 0/1 (or bool) values, found {bad!r}"
-            )
-    out = np.array(a, dtype=bool, order="C", copy=True)
-    out.flags.writeable = False
-    return out

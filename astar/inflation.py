@@ -45,6 +45,7 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
+from astar import validation
 from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
 
@@ -57,31 +58,6 @@ _METRICS = ("centre", "square")
 
 #: Relative tolerance under which a distance counts as equal to the radius.
 _REL_TOL = 1e-9
-
-
-# --------------------------------------------------------------------------- validation
-def _check_grid(grid: object) -> OccupancyGrid:
-    if not isinstance(grid, OccupancyGrid):
-        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}")
-    return grid
-
-
-def _check_metric(metric: object) -> str:
-    if not isinstance(metric, str) or metric not in _METRICS:
-        raise InvalidInputError(f"metric must be one of {_METRICS}, got {metric!r}")
-    return metric
-
-
-def _check_nonneg(value: object, name: str, unit: str) -> float:
-    if isinstance(value, bool):
-        raise InvalidInputError(f"{name} must be a number ({unit}), got {value!r}")
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be a number ({unit}), got {value!r}") from exc
-    if not math.isfinite(v) or v < 0.0:
-        raise InvalidInputError(f"{name} must be finite and >= 0 ({unit}), got {v!r}")
-    return v
 
 
 def _padded(occupied: np.ndarray, outside_occupied: bool) -> tuple[np.ndarray, int]:
@@ -243,9 +219,9 @@ def inflate(
     >>> inflate(g, 0.1).occupied.sum()  # the cell and its 4 edge neighbours
     5
     """
-    grid = _check_grid(grid)
-    r = _check_nonneg(radius, "radius", "metres")
-    metric = _check_metric(metric)  # type: ignore[assignment]
+    grid = validation.grid(grid)
+    r = validation.nonnegative_float("radius", radius, "metres")
+    metric = validation.choice("metric", metric, _METRICS)  # type: ignore[assignment]
     occ, pad = _padded(grid.occupied, bool(outside_occupied))
     if not occ.any():
         return grid
@@ -304,8 +280,8 @@ def clearance(
     half-cell lattice, so the transform of the refined grid is exact too (at four times the
     cost).
     """
-    grid = _check_grid(grid)
-    metric = _check_metric(metric)  # type: ignore[assignment]
+    grid = validation.grid(grid)
+    metric = validation.choice("metric", metric, _METRICS)  # type: ignore[assignment]
     occ, pad = _padded(grid.occupied, bool(outside_occupied))
     if not occ.any():
         return np.full(grid.shape, np.inf)
@@ -351,7 +327,7 @@ def avoidance_area(grid: OccupancyGrid, w_cells: int, *, border: bool = True) ->
     InvalidInputError
         ``grid`` is not an :class:`OccupancyGrid` or ``w_cells`` is not an integer ``>= 0``.
     """
-    grid = _check_grid(grid)
+    grid = validation.grid(grid)
     if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)):
         raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
     w = int(w_cells)
@@ -413,12 +389,12 @@ def clearance_cost(
     InvalidInputError
         A parameter breaks the rules above.
     """
-    grid = _check_grid(grid)
-    r = _check_nonneg(radius, "radius", "metres")
-    falloff = _check_nonneg(falloff_cells, "falloff_cells", "cells")
+    grid = validation.grid(grid)
+    r = validation.nonnegative_float("radius", radius, "metres")
+    falloff = validation.nonnegative_float("falloff_cells", falloff_cells, "cells")
     if falloff == 0.0:
         raise InvalidInputError(f"falloff_cells must be finite and > 0 (cells), got {falloff!r}")
-    wgt = _check_nonneg(weight, "weight", "dimensionless")
+    wgt = validation.nonnegative_float("weight", weight, "dimensionless")
     d = clearance(grid, metric="square", outside_occupied=outside_occupied) / grid.resolution
     with np.errstate(invalid="ignore"):
         cost = wgt * np.maximum(0.0, 1.0 - (d - r / grid.resolution) / falloff)

@@ -40,6 +40,7 @@ from typing import Literal
 import numpy as np
 from numba import njit
 
+from astar import validation
 from astar.errors import InvalidInputError, NoPathError
 from astar.grid import OccupancyGrid
 
@@ -390,58 +391,6 @@ def _padded_free(occupied: np.ndarray) -> np.ndarray:
     return flat
 
 
-# --------------------------------------------------------------------------- validation
-def _check_cell(value: object, name: str, grid: OccupancyGrid) -> tuple[int, int]:
-    bad = InvalidInputError(f"{name} must be a cell (ix, iy) of two integers, got {value!r}")
-    if isinstance(value, (str, bytes)) or (
-        isinstance(value, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in value)
-    ):
-        raise bad
-    try:
-        arr = np.asarray(value)
-    except (TypeError, ValueError) as exc:
-        raise bad from exc
-    if arr.shape != (2,):
-        raise bad
-    if arr.dtype.kind not in "iu" and not (arr.dtype == object and all(_is_int(v) for v in arr)):
-        raise bad
-    ix, iy = int(arr[0]), int(arr[1])
-    if not (0 <= ix < grid.nx and 0 <= iy < grid.ny):
-        raise InvalidInputError(
-            f"{name} cell ({ix}, {iy}) is outside the grid: need 0 <= ix < {grid.nx} "
-            f"and 0 <= iy < {grid.ny}"
-        )
-    if grid.occupied[iy, ix]:
-        raise InvalidInputError(
-            f"{name} cell ({ix}, {iy}) is blocked: it is occupied in the grid given to "
-            "find_path (an obstacle, or inside the inflated avoidance area)"
-        )
-    return ix, iy
-
-
-def _is_int(v: object) -> bool:
-    return isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
-
-
-def _check_cost(cost: object, grid: OccupancyGrid) -> np.ndarray:
-    try:
-        c = np.asarray(cost, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"cost must be a float array of shape {grid.shape} (per-cell cost >= 0), "
-            f"got {type(cost).__name__}"
-        ) from exc
-    if c.shape != grid.shape:
-        raise InvalidInputError(
-            f"cost must have the grid's shape (ny, nx) = {grid.shape}, got {c.shape}"
-        )
-    if not np.all(np.isfinite(c)):
-        raise InvalidInputError("cost must be finite everywhere (found NaN or infinity)")
-    if c.size and c.min() < 0.0:
-        raise InvalidInputError(f"cost must be >= 0 everywhere, found {float(c.min())!r}")
-    return c
-
-
 # --------------------------------------------------------------------------- public API
 def find_path(
     grid: OccupancyGrid,
@@ -504,15 +453,14 @@ def find_path(
     >>> p.cells.tolist(), round(p.length, 6)
     ([[0, 0], [1, 1], [2, 2], [3, 2]], 3.828427)
     """
-    if not isinstance(grid, OccupancyGrid):
-        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}")
+    grid = validation.grid(grid)
     if isinstance(connectivity, bool) or connectivity not in (4, 8):
         raise InvalidInputError(f"connectivity must be 4 or 8, got {connectivity!r}")
-    sx, sy = _check_cell(start, "start", grid)
-    gx, gy = _check_cell(goal, "goal", grid)
+    sx, sy = validation.cell("start", start, grid)
+    gx, gy = validation.cell("goal", goal, grid)
     weighted = cost is not None
     if weighted:
-        c = _check_cost(cost, grid)
+        c = validation.cell_costs(cost, grid)
         cpad = np.zeros((grid.ny + 2, grid.nx + 2), dtype=np.float64)
         cpad[1:-1, 1:-1] = c
         cflat = cpad.ravel()

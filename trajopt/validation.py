@@ -26,6 +26,7 @@ __all__ = [
     "points",
     "positive",
     "short_repr",
+    "weights",
 ]
 
 _REPR = reprlib.Repr()
@@ -159,3 +160,24 @@ def points(
         i = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(f"{name} must be finite, got {name}[{i}] = {p[i].tolist()}")
     return p
+
+
+def weights(name: str, value: Any, n: int, *, positive: bool = False) -> np.ndarray:
+    """Per-point weights, a float array of shape ``(n,)``: ones when ``value`` is None.
+
+    Finite, ``> 0`` with ``positive`` or else ``>= 0``, and not all zero.
+    """
+    if value is None:
+        return np.ones(n)
+    w = np.asarray(value, dtype=float)
+    if w.shape != (n,):
+        raise InvalidInputError(f"{name} must have shape ({n},) (one per point), got {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise InvalidInputError(f"{name} must be finite")
+    if positive and np.any(w <= 0):
+        raise InvalidInputError(f"{name} must be > 0, got min {w.min()!r}")
+    if np.any(w < 0):
+        raise InvalidInputError(f"{name} must be >= 0, got min {w.min()!r}")
+    if not np.any(w > 0):
+        raise InvalidInputError(f"{name} must not all be zero")
+    return w

@@ -6,7 +6,6 @@ The helpers here (brute-force square inflation and an octile Dijkstra) are indep
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
@@ -15,63 +14,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from astar.grid import OccupancyGrid
+from tests.cases import l_shaped_grid
+from tests.reference import brute_inflate_square, dijkstra_path
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError
 
 
 # ---------------------------------------------------------------- references
-def brute_inflate_square(occ: np.ndarray, radius_cells: float) -> np.ndarray:
-    """Blocked where the cell centre is closer than ``radius_cells`` to an occupied cell
-    taken as a unit square, or to the outside of the map (brute force over all pairs)."""
-    ny, nx = occ.shape
-    pad = int(math.ceil(radius_cells)) + 1
-    big = np.ones((ny + 2 * pad, nx + 2 * pad), bool)
-    big[pad:-pad, pad:-pad] = occ
-    oy, ox = np.nonzero(big)
-    oy = oy - pad
-    ox = ox - pad
-    out = np.zeros_like(occ)
-    for iy in range(ny):
-        for ix in range(nx):
-            cx, cy = ix + 0.5, iy + 0.5
-            dx = np.maximum(0, np.maximum(ox - cx, cx - (ox + 1)))
-            dy = np.maximum(0, np.maximum(oy - cy, cy - (oy + 1)))
-            out[iy, ix] = bool(np.any(np.hypot(dx, dy) < radius_cells))
-    return out
-
-
-def dijkstra_path(free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]) -> np.ndarray:
-    """Octile shortest path (no corner cutting) by plain Dijkstra; cells ``(ix, iy)``."""
-    ny, nx = free.shape
-    dist = {start: 0.0}
-    prev: dict = {}
-    pq = [(0.0, start)]
-    moves = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1) if dx or dy]
-    while pq:
-        d, c = heapq.heappop(pq)
-        if c == goal:
-            break
-        if d > dist.get(c, math.inf):
-            continue
-        for dx, dy in moves:
-            x, y = c[0] + dx, c[1] + dy
-            if not (0 <= x < nx and 0 <= y < ny) or not free[y, x]:
-                continue
-            if dx and dy and not (free[c[1], x] and free[y, c[0]]):
-                continue
-            nd = d + (math.sqrt(2) if dx and dy else 1.0)
-            if nd < dist.get((x, y), math.inf) - 1e-12:
-                dist[(x, y)] = nd
-                prev[(x, y)] = c
-                heapq.heappush(pq, (nd, (x, y)))
-    if goal not in dist:
-        raise ValueError("unreachable")
-    out = [goal]
-    while out[-1] != start:
-        out.append(prev[out[-1]])
-    return np.array(out[::-1], dtype=np.int64)
-
-
 def assert_corridor_valid(corr: Corridor, free: np.ndarray, cells: np.ndarray, res: float, origin):
     """Every box free (brute force), consecutive boxes overlap, the path is covered."""
     ox, oy = origin
@@ -93,13 +42,6 @@ def assert_corridor_valid(corr: Corridor, free: np.ndarray, cells: np.ndarray, r
     assert np.all(np.diff(corr.transitions_m) > 0)
     assert np.all(corr.transitions_m >= corr.overlap_start_m - 1e-12)
     assert np.all(corr.transitions_m <= corr.overlap_end_m + 1e-12)
-
-
-def l_shaped_grid() -> np.ndarray:
-    occ = np.ones((30, 30), bool)
-    occ[3:10, 3:27] = False  # horizontal hall
-    occ[3:27, 19:27] = False  # vertical hall
-    return occ
 
 
 # --------------------------------------------------------------------- tests

@@ -14,7 +14,7 @@ import pytest
 
 import astar
 import trajopt
-from tests.trajopt.test_pipeline import door_grid
+from tests.cases import door_grid
 
 ROBOT = trajopt.Robot(radius=0.12)
 START, GOAL = (0.4, 0.3), (2.6, 1.6)

@@ -15,6 +15,7 @@ import pytest
 
 import astar
 import trajopt
+from tests.reference import polyline_samples, square_clearance
 from trajopt.cli import main
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
@@ -254,32 +255,6 @@ def test_sampling_is_vectorised():
 
 
 # ------------------------------------------------------------------ clearance
-def brute_points_clearance(grid, q):
-    """Least distance (m) from points ``q`` (shape (m, 2)) to the occupied squares and the
-    map's outside: vectorised brute force over every occupied cell."""
-    res, (ox, oy) = grid.resolution, grid.origin
-    iy, ix = np.nonzero(grid.occupied)
-    x0, y0 = ox + ix * res, oy + iy * res
-    best = np.min(
-        [q[:, 0] - ox, q[:, 1] - oy, ox + grid.width - q[:, 0], oy + grid.height - q[:, 1]]
-    )
-    for k in range(0, len(q), 2048):
-        px, py = q[k : k + 2048, 0:1], q[k : k + 2048, 1:2]
-        dx = np.maximum(0.0, np.maximum(x0 - px, px - (x0 + res)))
-        dy = np.maximum(0.0, np.maximum(y0 - py, py - (y0 + res)))
-        best = min(best, float(np.hypot(dx, dy).min()))
-    return best
-
-
-def brute_segment_clearance(grid, pts, spacing):
-    """:func:`brute_points_clearance` of points every ``spacing`` m along a polyline."""
-    dense = [pts[:1]]
-    for a, b in zip(pts[:-1], pts[1:], strict=True):
-        n = max(1, int(np.ceil(np.hypot(*(b - a)) / spacing)))
-        dense.append(a + (b - a) * (np.arange(1, n + 1) / n)[:, None])
-    return brute_points_clearance(grid, np.vstack(dense))
-
-
 def test_polyline_clearance_is_exact():
     rng = np.random.default_rng(0)
     occ = rng.random((30, 40)) < 0.03
@@ -290,7 +265,7 @@ def test_polyline_clearance_is_exact():
         p0 = rng.uniform([-0.8, 2.2], [2.8, 4.8])
         pts = np.clip(p0 + np.cumsum(rng.normal(0, 0.25, (3, 2)), axis=0), [-1, 2], [3, 5])
         exact = polyline_clearance(pts, grid, window_m=1.0)
-        dense = min(brute_segment_clearance(grid, pts, spacing), 1.0)
+        dense = min(square_clearance(grid, polyline_samples(pts, spacing)).min(), 1.0)
         assert exact <= dense + 1e-12  # never more optimistic than any sample
         assert dense - exact <= spacing  # and within the sample spacing of the true minimum
         positive += exact > 0
@@ -340,7 +315,7 @@ def test_polygon_corridor_smooths_the_zigzag(zigzag):
     traj = trajopt.plan(grid, start, goal, ZZ_ROBOT)
     assert traj.stats["corridor"] == "polygons" and traj.steps.smooth_path.certificate.ok
     smp = traj.sample(np.linspace(0.0, traj.duration, 4000))
-    assert brute_points_clearance(grid, np.c_[smp.x, smp.y]) >= ZZ_ROBOT.radius - 1e-9
+    assert square_clearance(grid, np.c_[smp.x, smp.y]).min() >= ZZ_ROBOT.radius - 1e-9
     assert trajectory_metrics(traj, ZZ_ROBOT)["within_limits"]
 
 
@@ -364,8 +339,8 @@ def test_planner_fallback_is_safe_exact_and_deterministic(zigzag):
     # dense samples keep the clearance from the raw map (brute force, outside = occupied)
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
     pts = np.vstack([np.c_[smp.x, smp.y], verts])
-    assert brute_points_clearance(grid, pts) >= ZZ_ROBOT.radius - 1e-9
-    assert brute_segment_clearance(grid, verts, 0.002) >= ZZ_ROBOT.radius - 1e-9
+    assert square_clearance(grid, pts).min() >= ZZ_ROBOT.radius - 1e-9
+    assert square_clearance(grid, polyline_samples(verts, 0.002)).min() >= ZZ_ROBOT.radius - 1e-9
     assert st["fallback_min_clearance_m"] >= ZZ_ROBOT.radius - 1e-9
     assert (float(smp.x[-1]), float(smp.y[-1])) == goal
     assert math.remainder(float(smp.theta[-1]), 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
@@ -397,7 +372,7 @@ def test_failed_clearance_check_reraises_the_original_error(zigzag, monkeypatch)
 
 
 def test_fallback_unused_when_the_smoother_succeeds():
-    from tests.trajopt.test_pipeline import door_grid
+    from tests.cases import door_grid
 
     grid = door_grid()
     a = trajopt.plan(grid, (0.4, 0.3), (2.6, 1.6), ZZ_ROBOT, fallback="stop_and_turn")

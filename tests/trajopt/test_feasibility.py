@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import astar
-from tests.trajopt.test_pipeline import brute_clearance
+from tests.reference import square_clearance
 from trajopt import Planner, Robot, Smoother, build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.feasibility import curvature_witness, witness_grid_path
@@ -35,7 +35,7 @@ def test_open_room_witness_holds_every_promise():
     np.testing.assert_array_equal(w[-1], goal)
     step = np.hypot(*np.diff(w, axis=0).T)
     assert step.max() <= 0.1 / 8 + 1e-12
-    assert brute_clearance(grid, w).min() >= radius - 1e-9
+    assert square_clearance(grid, w).min() >= radius - 1e-9
     keep = np.concatenate([[True], step > 1e-12])  # drop the repeated junction points
     kappa = _three_point_curvature(w[keep])
     assert np.nanmax(kappa) <= kmax * (1 + 1e-6)
@@ -67,13 +67,13 @@ def test_narrow_l_bend_has_no_witness_and_the_smoother_agrees():
         )
     # a tighter turn fits in the same channel: the witness finds it
     w = curvature_witness(grid, radius, start, goal, 1.0)
-    assert w is not None and brute_clearance(grid, w).min() >= radius - 1e-9
+    assert w is not None and square_clearance(grid, w).min() >= radius - 1e-9
 
 
 def test_wide_l_bend_is_feasible():
     grid = _l_bend(16)  # 11-cell wide centre band: room for a 5-cell turning radius
     w = curvature_witness(grid, 2.5, np.array([8.5, 11.0]), np.array([21.0, 24.5]), 0.2)
-    assert w is not None and brute_clearance(grid, w).min() >= 2.5 - 1e-9
+    assert w is not None and square_clearance(grid, w).min() >= 2.5 - 1e-9
 
 
 @pytest.mark.parametrize(
@@ -178,7 +178,7 @@ def test_planner_rescues_a_curvature_bounded_query_along_the_witness(shared_data
     assert sp.certificate.ok
     u = np.linspace(*sp.domain, 2000)
     xy = sp(u)
-    assert brute_clearance(raw, xy).min() >= radius - 1e-9
+    assert square_clearance(raw, xy).min() >= radius - 1e-9
     np.testing.assert_allclose(xy[[0, -1]], [p0, p1], atol=1e-9)
     _check_grid_path(traj.steps.grid_path.cells, planner.inflated_grid.occupied)
 
@@ -194,7 +194,7 @@ def test_polygon_corridor_plans_the_curvature_bounded_pillar_query(shared_data):
     sp = traj.steps.smooth_path
     assert sp.certificate.ok and traj.stats["corridor"] in ("polygons", "boxes")
     u = np.linspace(*sp.domain, 4000)
-    assert brute_clearance(raw, sp(u)).min() >= radius - 1e-9
+    assert square_clearance(raw, sp(u)).min() >= radius - 1e-9
     assert np.abs(sp.curvature(u)).max() <= kmax * (1 + 1e-6)
 
 

@@ -16,6 +16,8 @@ from trajopt import fits
 from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
+from trajopt.fits.bspline_fit import schoenberg_whitney_matches
+from trajopt.fits.robust import bisquare
 
 
 def _staircase(n: int = 60) -> np.ndarray:
@@ -109,7 +111,7 @@ def test_bisquare_without_leverage_is_statsmodels_rlm(seed: int, share: float) -
     rlm, tukey = _rlm_tukey()
     x, y, _, _ = _noisy_quadratic(seed, share)
     v = _chebyshev_design(x, 2)
-    coef, robust, _, conv = fits._bisquare(
+    coef, robust, _, conv = bisquare(
         v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
     )
     ref = rlm(y, v, M=tukey).fit(scale_est=_our_scale_rule(3), conv="coefs", tol=1e-13, maxiter=500)
@@ -178,7 +180,7 @@ def test_bisquare_on_paper_paths_without_leverage_is_statsmodels_rlm(paper_paths
         x, y = pts[:, 0], pts[:, 1]
         for order in range(1, 11):
             v = _chebyshev_design(x, order)
-            coef, _, _, conv = fits._bisquare(
+            coef, _, _, conv = bisquare(
                 v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
             )
             if not conv:  # a redescending M-estimate may cycle; RLM is then no reference
@@ -392,7 +394,7 @@ def test_schoenberg_whitney_failure_is_exact_rank_deficiency() -> None:
     steps, k, _, _ = _DIVERGED[0]
     p = _steps_to_points(steps)
     a, u, t = _reference_design(p, k, len(p), "chord")
-    assert fits._schoenberg_whitney_matches(u, t, k) < len(p)
+    assert schoenberg_whitney_matches(u, t, k) < len(p)
     assert np.linalg.matrix_rank(a) < len(p)  # numpy's default tolerance: singular
 
 
@@ -424,7 +426,7 @@ def test_schoenberg_whitney_greedy_equals_enumeration(k: int, extra: int, sites)
     u = np.sort(np.asarray(sites, dtype=float))
     t = clamped_uniform_knots(n, k)
     a = BSpline.design_matrix(u, t, k).toarray() if n <= len(u) else None
-    ours = fits._schoenberg_whitney_matches(u, t, k) == n
+    ours = schoenberg_whitney_matches(u, t, k) == n
     event(f"schoenberg-whitney holds: {ours}")
     assert ours == (a is not None and _brute_force_schoenberg_whitney(a, u))
 
@@ -454,7 +456,7 @@ def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
     cond = sv[0] / sv[-1] if sv[-1] > 0 else math.inf
     assume(abs(math.log(cond / fits.BSPLINE_COND_MAX)) > 1e-3)  # not at the threshold
     c_ref, _, rank, _ = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
-    if rank < n or fits._schoenberg_whitney_matches(u, t, k) < n:
+    if rank < n or schoenberg_whitney_matches(u, t, k) < n:
         event("ill-posed")
         with pytest.raises(InvalidInputError, match="Schoenberg-Whitney|numerically singular"):
             fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)

@@ -9,34 +9,9 @@ import pytest
 
 import astar
 import trajopt
+from tests.cases import door_grid
+from tests.reference import square_clearance
 from trajopt.errors import InvalidInputError, NoPathError
-
-
-def brute_clearance(grid: astar.OccupancyGrid, pts: np.ndarray) -> np.ndarray:
-    """Distance (m) from each point to the nearest occupied square or the map's outside."""
-    res = grid.resolution
-    ox, oy = grid.origin
-    iy, ix = np.nonzero(grid.occupied)
-    x0 = ox + ix * res
-    y0 = oy + iy * res
-    out = np.empty(len(pts))
-    for k, (px, py) in enumerate(pts):
-        dx = np.maximum(0.0, np.maximum(x0 - px, px - (x0 + res)))
-        dy = np.maximum(0.0, np.maximum(y0 - py, py - (y0 + res)))
-        d = np.hypot(dx, dy).min() if len(x0) else np.inf
-        edge = min(px - ox, py - oy, ox + grid.width - px, oy + grid.height - py)
-        out[k] = min(d, edge)
-    return out
-
-
-def door_grid() -> astar.OccupancyGrid:
-    """60 x 40 cells of 5 cm: a wall at x = 1.5 m with a 0.6 m door, a block below."""
-    occ = np.zeros((40, 60), bool)
-    occ[:, 30] = True
-    occ[16:28, 30] = False
-    occ[5:12, 40:50] = True
-    return astar.OccupancyGrid(occ, 0.05, (0.0, 0.0))
-
 
 ROBOT = trajopt.Robot(radius=0.12)
 
@@ -45,7 +20,7 @@ def check_guarantees(grid, traj, robot, start, goal):
     t = np.linspace(0.0, traj.duration, 4000)
     smp = traj.sample(t)
     pts = np.c_[smp.x, smp.y]
-    assert brute_clearance(grid, pts).min() >= robot.radius - 1e-9
+    assert square_clearance(grid, pts).min() >= robot.radius - 1e-9
     np.testing.assert_allclose(pts[0], start, atol=1e-9)
     np.testing.assert_allclose(pts[-1], goal, atol=1e-9)
     assert np.all(np.diff(smp.s) >= -1e-12)

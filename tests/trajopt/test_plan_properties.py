@@ -37,6 +37,7 @@ from scipy import ndimage
 
 import astar
 import trajopt
+from tests.reference import square_clearance
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 
 #: The documented failures of :func:`trajopt.plan`.
@@ -196,51 +197,6 @@ def build_case(p: CaseParams) -> Case:
 
 
 # ------------------------------------------------------------------ the checks
-def brute_clearance(
-    grid: astar.OccupancyGrid, pts: np.ndarray, reach: float = math.inf
-) -> np.ndarray:
-    """Distance (m) from each point to the nearest occupied square or the map's outside.
-
-    Brute force over the occupied cells that touch a free cell (the nearest point of the
-    occupied set to a point in free space lies on such a cell); a point inside an occupied
-    cell has clearance 0. With a finite ``reach`` (m), each chunk of points only looks at
-    the cells within ``reach`` of the chunk's bounding box: values ``<= reach`` are exact,
-    larger ones are only known to exceed ``reach``.
-    """
-    res = grid.resolution
-    ox, oy = grid.origin
-    occ = grid.occupied
-    padded = np.pad(occ, 1, constant_values=True)
-    free_nb = np.zeros_like(occ)
-    for dy, dx in ((0, 1), (2, 1), (1, 0), (1, 2)):
-        free_nb |= ~padded[dy : dy + occ.shape[0], dx : dx + occ.shape[1]]
-    iy, ix = np.nonzero(occ & free_nb)
-    x0, y0 = ox + ix * res, oy + iy * res
-    px, py = pts[:, 0], pts[:, 1]
-    edge = np.minimum.reduce([px - ox, py - oy, ox + grid.width - px, oy + grid.height - py])
-    out = np.maximum(edge, 0.0)
-    chunk = 256
-    for k in range(0, len(pts), chunk):
-        qx, qy = px[k : k + chunk], py[k : k + chunk]
-        near = (
-            (x0 + res >= qx.min() - reach) & (x0 <= qx.max() + reach)
-            & (y0 + res >= qy.min() - reach) & (y0 <= qy.max() + reach)
-        )  # fmt: skip
-        if not near.any():
-            continue
-        cx, cy = x0[near], y0[near]
-        dx = np.maximum(0.0, np.maximum(cx - qx[:, None], qx[:, None] - (cx + res)))
-        dy = np.maximum(0.0, np.maximum(cy - qy[:, None], qy[:, None] - (cy + res)))
-        out[k : k + chunk] = np.minimum(out[k : k + chunk], np.hypot(dx, dy).min(axis=1))
-    cx = np.floor((px - ox) / res).astype(np.int64)
-    cy = np.floor((py - oy) / res).astype(np.int64)
-    inside = (cx >= 0) & (cx < grid.nx) & (cy >= 0) & (cy < grid.ny)
-    on_obstacle = np.zeros(len(pts), bool)
-    on_obstacle[inside] = occ[cy[inside], cx[inside]]
-    out[on_obstacle] = 0.0
-    return out
-
-
 def check_trajectory(case: Case, traj: trajopt.Trajectory) -> None:
     """Every guarantee of a returned trajectory, on dense samples."""
     robot, grid = case.robot, case.grid
@@ -257,7 +213,7 @@ def check_trajectory(case: Case, traj: trajopt.Trajectory) -> None:
     assert abs(smp.y[-1] - case.goal[1]) <= ENDPOINT_TOL, (smp.y[-1], case.goal)
     # clearance from the raw map (absolute slack for rounding at |coordinates| ~ 1e2 m)
     pts = np.c_[smp.x, smp.y]
-    clr = brute_clearance(grid, pts, reach=2.0 * robot.radius + grid.resolution)
+    clr = square_clearance(grid, pts, reach=2.0 * robot.radius + grid.resolution)
     k = int(np.argmin(clr))
     assert clr[k] >= robot.radius - 1e-9, (
         f"clearance {clr[k]!r} m < radius {robot.radius!r} m at t={t[k]!r} s, "
@@ -406,9 +362,9 @@ def test_brute_clearance_reference() -> None:
         [0.0, 0.0],  # outside the map
     ])
     expected = [0.0, 0.5, 0.5, 0.1, 0.0]
-    np.testing.assert_allclose(brute_clearance(grid, pts), expected)
+    np.testing.assert_allclose(square_clearance(grid, pts), expected)
     # a finite reach changes nothing below it
-    got = brute_clearance(grid, pts, reach=0.3)
+    got = square_clearance(grid, pts, reach=0.3)
     np.testing.assert_allclose(got[[0, 3, 4]], [0.0, 0.1, 0.0])
     assert np.all(got[[1, 2]] > 0.3)
 

@@ -16,6 +16,8 @@ from hypothesis import strategies as st
 
 import astar
 from astar.grid import OccupancyGrid
+from tests.cases import square_inflated, staircase_passage
+from tests.reference import square_clearance
 from trajopt import scenes
 from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError
@@ -29,33 +31,6 @@ from trajopt.polygon_corridor import (
 
 
 # ---------------------------------------------------------------- references
-def brute_clearance(points: np.ndarray, grid: OccupancyGrid, reach: float = math.inf) -> np.ndarray:
-    """Exact distance (m) from each point (shape (N, 2), m) to the nearest occupied square
-    or to the outside of the map, naively over every occupied cell (0 inside either).
-
-    With ``reach``, only cells within ``reach`` of the points' bounding box are visited:
-    the result is then exact where it is below ``reach`` and ``>= reach`` elsewhere."""
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
-    res = grid.resolution
-    ox, oy = grid.origin
-    ny, nx = grid.occupied.shape
-    border = np.minimum.reduce(
-        [p[:, 0] - ox, ox + nx * res - p[:, 0], p[:, 1] - oy, oy + ny * res - p[:, 1]]
-    )
-    out = np.maximum(border, 0.0)
-    iy, ix = np.nonzero(grid.occupied)
-    x0 = ox + ix * res
-    y0 = oy + iy * res
-    lo, hi = p.min(axis=0) - reach, p.max(axis=0) + reach
-    near = (x0 + res >= lo[0]) & (x0 <= hi[0]) & (y0 + res >= lo[1]) & (y0 <= hi[1])
-    x0, y0 = x0[near], y0[near]
-    if len(x0):
-        gx = np.maximum(0.0, np.maximum(x0[None] - p[:, :1], p[:, :1] - (x0[None] + res)))
-        gy = np.maximum(0.0, np.maximum(y0[None] - p[:, 1:], p[:, 1:] - (y0[None] + res)))
-        out = np.minimum(out, np.hypot(gx, gy).min(axis=1))
-    return out
-
-
 def boundary_samples(v: np.ndarray, spacing: float) -> np.ndarray:
     """Vertices and points every ``spacing`` (at most) along the closed boundary."""
     out = [v]
@@ -82,13 +57,13 @@ def brute_polygon_clearance(v: np.ndarray, grid: OccupancyGrid, spacing: float) 
     """Dense-sampling estimate of a convex polygon's clearance: the boundary sampled every
     ``spacing`` (the nearest point of a disjoint square lies on the boundary), 0 when an
     interior sample falls in an occupied square or outside the map."""
-    d = float(brute_clearance(boundary_samples(v, spacing), grid).min())
+    d = float(square_clearance(grid, boundary_samples(v, spacing)).min())
     if len(v) >= 3:
         poly = ConvexPolygon(
             A=_edge_normals(v), b=np.einsum("ij,ij->i", _edge_normals(v), v), vertices=v
         )
         inner = interior_samples(poly, spacing)
-        if np.any(brute_clearance(inner, grid) == 0.0):
+        if np.any(square_clearance(grid, inner) == 0.0):
             return 0.0
     return d
 
@@ -111,7 +86,7 @@ def assert_corridor_certified(corr: PolygonCorridor, grid: OccupancyGrid, radius
         # inside (its centre would)
         samples = boundary_samples(reg.vertices, res / 8)
         assert reg.contains(samples, tol=1e-9).all()
-        c = brute_clearance(samples, grid, reach=radius + 2 * res)
+        c = square_clearance(grid, samples, reach=radius + 2 * res)
         assert c.min() >= radius - tol, (k, c.min(), radius)
         assert not reg.contains(centres).any()
         assert corr.clearance_m[k] >= radius - tol
@@ -147,10 +122,6 @@ def assert_corridor_certified(corr: PolygonCorridor, grid: OccupancyGrid, radius
     # end points are the input's
     np.testing.assert_array_equal(corr.path[0], corr.input_path[0])
     np.testing.assert_array_equal(corr.path[-1], corr.input_path[-1])
-
-
-def square_inflated(grid: OccupancyGrid, radius: float) -> OccupancyGrid:
-    return astar.inflate(grid, radius, metric="square", outside_occupied=True)
 
 
 # ---------------------------------------------------------------- random grids
@@ -228,21 +199,6 @@ def test_polygon_clearance_matches_dense_sampling(seed, k, density) -> None:
 
 
 # ---------------------------------------------------------------- hand cases
-def staircase_passage(angle_deg: float, width_cells: float, n: int = 60) -> np.ndarray:
-    """Occupied: cells whose square lies entirely outside the open strip of
-    ``width_cells`` around the line through the map centre at ``angle_deg``."""
-    th = math.radians(angle_deg)
-    iy, ix = np.mgrid[0:n, 0:n]
-    ds = np.array(
-        [
-            -math.sin(th) * (ix + cx - n / 2) + math.cos(th) * (iy + cy - n / 2)
-            for cx, cy in ((0, 0), (1, 0), (0, 1), (1, 1))
-        ]
-    )
-    h = width_cells / 2
-    return np.all(ds >= h, axis=0) | np.all(ds <= -h, axis=0)
-
-
 def wall_gap_cells(occ: np.ndarray, angle_deg: float) -> float:
     """Smallest distance (cells) between an occupied square on one side of the strip and
     one on the other (brute force)."""

@@ -16,10 +16,10 @@ import time
 import numpy as np
 import pytest
 from scipy.interpolate import BSpline, make_lsq_spline
-from scipy.spatial import cKDTree
 
 from astar.grid import OccupancyGrid
-from tests.trajopt.test_corridor import brute_inflate_square, dijkstra_path, l_shaped_grid
+from tests.cases import l_shaped_grid
+from tests.reference import brute_inflate_square, dijkstra_path, square_clearance
 from trajopt.bspline import clamped_uniform_knots
 from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
@@ -27,57 +27,15 @@ from trajopt.smoother import Smoother, SmoothPath
 from trajopt.smoother import basis as _basis
 from trajopt.smoother import qp as _qp
 
+
 # ----------------------------------------------------------------- references
-_TREES: dict[int, tuple] = {}
-
-
-def brute_clearance(points: np.ndarray, raw: OccupancyGrid) -> np.ndarray:
-    """Distance (m) from each point to the nearest occupied square of ``raw`` or to the
-    outside of the map: exact point-to-square distances to every occupied cell whose centre
-    could hold the nearest square, found with a KD-tree (independent of the library's
-    window search). The nearest square's centre is within ``d0 + sqrt(2)/2`` cells, with
-    ``d0`` the nearest centre distance."""
-    res = raw.resolution
-    ox, oy = raw.origin
-    q = (np.asarray(points, dtype=float) - [ox, oy]) / res
-    ny, nx = raw.occupied.shape
-    border = np.minimum.reduce([q[:, 0], nx - q[:, 0], q[:, 1], ny - q[:, 1]])
-    out = np.maximum(border, 0.0)
-    if id(raw) not in _TREES:
-        oyi, oxi = np.nonzero(raw.occupied)
-        centres = np.column_stack([oxi + 0.5, oyi + 0.5])
-        _TREES[id(raw)] = (raw, centres, cKDTree(centres) if len(centres) else None)
-    _, centres, tree = _TREES[id(raw)]
-    if tree is None:
-        return out * res
-    k = min(12, len(centres))
-    dist, idx = tree.query(q, k=k)
-    dist = dist.reshape(len(q), k)
-    idx = idx.reshape(len(q), k)
-    reach = dist[:, :1] + 0.7072
-    sq = centres[np.minimum(idx, len(centres) - 1)] - 0.5
-    dx = np.maximum(0, np.maximum(sq[..., 0] - q[:, None, 0], q[:, None, 0] - (sq[..., 0] + 1)))
-    dy = np.maximum(0, np.maximum(sq[..., 1] - q[:, None, 1], q[:, None, 1] - (sq[..., 1] + 1)))
-    dsq = np.where(dist <= reach, np.hypot(dx, dy), np.inf).min(axis=1)
-    # every candidate in reach was among the k nearest, or the k-th is already in reach
-    incomplete = (dist[:, -1] <= reach[:, 0]) & (k < len(centres))
-    for i in np.nonzero(incomplete)[0]:
-        sq_i = centres[tree.query_ball_point(q[i], reach[i, 0] + 1e-9)] - 0.5
-        if len(sq_i) == 0:
-            continue
-        ddx = np.maximum(0, np.maximum(sq_i[:, 0] - q[i, 0], q[i, 0] - (sq_i[:, 0] + 1)))
-        ddy = np.maximum(0, np.maximum(sq_i[:, 1] - q[i, 1], q[i, 1] - (sq_i[:, 1] + 1)))
-        dsq[i] = np.hypot(ddx, ddy).min()
-    return np.minimum(out, dsq) * res
-
-
 def check_guarantees(sp: SmoothPath, raw: OccupancyGrid, radius: float, start, goal, kappa=None):
     """Brute-force checks of every guarantee; returns the sampled minimum clearance."""
     u0, u1 = sp.domain
     assert np.abs(sp(u0) - start).max() <= 1e-9
     assert np.abs(sp(u1) - goal).max() <= 1e-9
     u = np.linspace(u0, u1, int((u1 - u0) / raw.resolution * 6) + 2)
-    clear = brute_clearance(sp(u), raw)
+    clear = square_clearance(raw, sp(u))
     assert clear.min() >= radius - 1e-9, f"clearance {clear.min()} < radius {radius}"
     d1 = sp(u, 1)
     speed = np.hypot(d1[:, 0], d1[:, 1])
@@ -380,7 +338,7 @@ def test_shared_maps_zero_guarantee_violations(shared_data):
         plain = make_lsq_spline(corr.path_s, corr.path_points, t, k=3)
         uu = np.linspace(0, corr.length_m, int(corr.length_m / raw.resolution * 4) + 2)
         xy = plain(uu)
-        if not np.all(np.isfinite(xy)) or brute_clearance(xy, raw).min() < r - 1e-9:
+        if not np.all(np.isfinite(xy)) or square_clearance(raw, xy).min() < r - 1e-9:
             violations_plain += 1
     print(
         f"\nshared maps: {len(cases)} cases, {done} certified, {errors} SmoothingError, plain "

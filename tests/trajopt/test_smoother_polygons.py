@@ -11,8 +11,8 @@ import pytest
 import astar
 import trajopt
 from astar import OccupancyGrid
-from tests.trajopt.test_pipeline import brute_clearance
-from tests.trajopt.test_polygon_corridor import square_inflated, staircase_passage
+from tests.cases import square_inflated, staircase_passage
+from tests.reference import square_clearance
 from trajopt import scenes
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.metrics import trajectory_metrics
@@ -41,7 +41,7 @@ def check_trajectory(grid, traj, robot, p0, p1):
     sp = traj.steps.smooth_path
     u = np.linspace(*sp.domain, 6000)
     xy = sp(u)
-    assert brute_clearance(grid, xy).min() >= robot.radius - 1e-9
+    assert square_clearance(grid, xy).min() >= robot.radius - 1e-9
     np.testing.assert_allclose(xy[[0, -1]], [p0, p1], atol=1e-9)
     assert trajectory_metrics(traj, robot)["within_limits"]
     corr = traj.steps.corridor

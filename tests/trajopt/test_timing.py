@@ -9,6 +9,7 @@ import pytest
 from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
+from tests.cases import Arc, line
 from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError, TimingError
@@ -20,47 +21,6 @@ TOL = 1e-3  # relative tolerance of the curvature-dependent limits on dense samp
 
 
 # ------------------------------------------------------------------ test curves
-class Arc(ParametricCurve):
-    """An exact circular arc of radius r (counter-clockwise), parameter = angle (rad)."""
-
-    def __init__(self, r: float, angle: float) -> None:
-        self.r, self.angle = r, angle
-
-    @property
-    def domain(self):
-        return (0.0, self.angle)
-
-    def __call__(self, u, nu=0):
-        u = np.clip(np.asarray(u, dtype=float), 0.0, self.angle)
-        c, s = np.cos(u), np.sin(u)
-        r = self.r
-        out = {
-            0: (r * c, r * s),
-            1: (-r * s, r * c),
-            2: (-r * c, -r * s),
-            3: (r * s, -r * c),
-        }[nu]
-        return np.stack(out, axis=-1)
-
-    @property
-    def length(self):
-        return self.r * self.angle
-
-    def s_at_u(self, u):
-        return self.r * np.clip(np.asarray(u, dtype=float), 0.0, self.angle)
-
-    def u_at_s(self, s):
-        return np.clip(np.asarray(s, dtype=float), 0.0, self.length) / self.r
-
-
-def line(length: float, direction: float = 0.3) -> BSplineCurve:
-    """A straight segment as a cubic B-spline with uniformly spaced control points."""
-    t = clamped_uniform_knots(5, 3)
-    d = np.array([math.cos(direction), math.sin(direction)])
-    c = np.linspace(0.0, length, 5)[:, None] * d[None, :]
-    return BSplineCurve(t, c, 3)
-
-
 def hairpin() -> BSplineCurve:
     """Up 2 m, a tight U-turn of about 0.3 m radius, back down."""
     p = np.array(

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.trajopt.test_timing import Arc, line
+from tests.cases import Arc, line
 from trajopt.errors import InvalidInputError
 from trajopt.robot import Robot
 from trajopt.timing import time_parameterize
