@@ -69,6 +69,7 @@ __all__ = [
     "register_method",
     "unregister_method",
     "registered_methods",
+    "resolve_method",
     "DEFAULT_POLY",
     "DEFAULT_BSPLINE",
 ]
@@ -260,6 +261,19 @@ def unregister_method(name: str) -> None:
 def registered_methods(*, default_only: bool = False) -> tuple[str, ...]:
     """Names of the registered methods in registration order."""
     return tuple(n for n, s in _REGISTRY.items() if s.default or not default_only)
+
+
+def resolve_method(name: str) -> MethodFn:
+    """The callable of a registered method (imported now if registered as "module:attr").
+
+    Raises
+    ------
+    InvalidInputError
+        ``name`` is not registered.
+    """
+    if name not in _REGISTRY:
+        raise InvalidInputError(f"method {name!r} is not registered; known: {list(_REGISTRY)}")
+    return _REGISTRY[name].resolve()
 
 
 # ============================================================================ built-ins

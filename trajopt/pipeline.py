@@ -413,9 +413,9 @@ class Planner:
                     stages["corridor"] = stages.get("corridor", 0.0) + time.perf_counter() - t
             left = smoother.time_budget_s - (time.perf_counter() - t_start)
             try:
-                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
                 if left <= 0:
                     raise SmoothingError("time budget exhausted before the box corridor", {})
+                sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
                 return corridor, self._fit(sm, path, corridor, p0, p1, start_heading,
                                            goal_heading)
             except SmoothingError as exc:
