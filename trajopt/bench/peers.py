@@ -11,8 +11,9 @@
   the reference A* path.
 
 The outputs are sampled polylines (metres) that :func:`trajopt.bench.methods.evaluate_query`
-scores like every other method. A peer that finds no solution raises :class:`PeerFailure`
-(a row with ``failure = "PeerFailure"``). A peer whose package is missing raises
+scores like every other method. A peer that finds no solution, or raises any exception of its own
+(e.g. python-motion-planning's interpolation on a singular system), raises
+:class:`PeerFailure` (a row with ``failure = "PeerFailure"``, the reason in ``note``). A peer whose package is missing raises
 :class:`~trajopt.errors.PeerUnavailableError` when the run is checked, before any work.
 """
 
@@ -152,12 +153,17 @@ def run(name: str, q: Any) -> Any:
     for mod in METHODS[name].requires:
         require(mod, name)
     t0 = time.perf_counter()
-    if name.startswith("ompl-"):
-        pts = _ompl(name.removeprefix("ompl-"), q)
-        note = f"{name.removeprefix('ompl-')}, {OMPL_TIME_LIMIT_S} s, simplifyMax + smoothBSpline"
-    else:
-        pts = _pmp(name.removeprefix("pmp-"), q)
-        note = f"{name.removeprefix('pmp-')} through the reference's corner points"
+    try:
+        if name.startswith("ompl-"):
+            pts = _ompl(name.removeprefix("ompl-"), q)
+            note = f"{name.removeprefix('ompl-')}, {OMPL_TIME_LIMIT_S} s, simplifyMax + smoothBSpline"
+        else:
+            pts = _pmp(name.removeprefix("pmp-"), q)
+            note = f"{name.removeprefix('pmp-')} through the reference's corner points"
+    except PeerFailure:
+        raise
+    except Exception as exc:  # the peer's own crash is its row's failure, not the run's
+        raise PeerFailure(f"{name} raised {type(exc).__name__}: {exc}") from exc
     runtime = time.perf_counter() - t0
     # drop repeated vertices (a polyline needs distinct consecutive points)
     keep = np.concatenate([[True], np.any(np.diff(pts, axis=0) != 0.0, axis=1)])

@@ -153,7 +153,7 @@ def figures(data: Any, out_dir: str | os.PathLike[str]) -> list[Path]:
             v = values[ok["method"] == m].to_numpy(dtype=float)
             v = v[np.isfinite(v) & ((v > 0) if log else True)]
             data_m.append(v if len(v) else np.array([np.nan]))
-        ax.boxplot(data_m, vert=False, showfliers=True, flierprops={"markersize": 2})
+        ax.boxplot(data_m, orientation="horizontal", showfliers=True, flierprops={"markersize": 2})
         ax.set_yticks(range(1, len(methods) + 1), methods if ax is axes[0] else [""] * len(methods))
         ax.set_title(title)
         if log:
@@ -166,9 +166,10 @@ def figures(data: Any, out_dir: str | os.PathLike[str]) -> list[Path]:
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(7, 0.45 * len(methods) + 1.5))
-    g = df.groupby("method", sort=False)
-    succ = (g["ok"].sum() - g.apply(lambda x: int((x["ok"] & x["collision"]).sum()))).reindex(methods)
-    coll = g.apply(lambda x: int((x["ok"] & x["collision"]).sum())).reindex(methods)
+    flags = df[["method", "ok"]].assign(hit=df["ok"] & df["collision"])
+    g = flags.groupby("method", sort=False)
+    coll = g["hit"].sum().reindex(methods)
+    succ = g["ok"].sum().reindex(methods) - coll
     fail = (g.size() - g["ok"].sum()).reindex(methods)
     y = np.arange(len(methods))
     ax.barh(y, succ, color="tab:green", label="path, no collision")

@@ -192,8 +192,9 @@ def movingai_queries(
         Robot radius in cells (> 0); the radius in metres is ``radius_cells * resolution``.
     feasible_only : bool
         Keep only the scenarios whose start and goal cells are free on the grid inflated by
-        the radius (``astar.inflate(..., metric="square", outside_occupied=True)``), before
-        ``limit`` picks among them. Most Moving AI scenarios start or end next to a wall,
+        the radius (``astar.inflate(..., metric="square", outside_occupied=True)``) and in
+        the same 4-connected free region of it (then an octile path without corner cutting
+        exists), before ``limit`` picks among them. Most Moving AI scenarios start or end next to a wall,
         where a robot wider than a cell cannot stand.
 
     Raises
@@ -230,8 +231,20 @@ def movingai_queries(
     if feasible_only:
         inflated = astar.inflate(grid, r_cells * float(grid.resolution), metric="square",
                                  outside_occupied=True)
-        indexed = [(i, s) for i, s in indexed
-                   if inflated.is_free(s.start) and inflated.is_free(s.goal)]
+        import scipy.ndimage as ndi
+
+        labels, _ = ndi.label(~np.asarray(inflated.occupied))  # 4-connected free regions
+
+        def connected(s: astar.Scenario) -> bool:
+            a = labels[s.start[1], s.start[0]]
+            return bool(a > 0 and a == labels[s.goal[1], s.goal[0]])
+
+        indexed = [(i, s) for i, s in indexed if connected(s)]
+        if not indexed:
+            raise BenchmarkError(
+                f"no scenario of {str(scen)!r} has both end cells free and connected for the radius "
+                f"{r_cells} cells (feasible_only=True)"
+            )
     indexed = select_evenly(indexed, limit)
     name = mp.name
     queries = tuple(
@@ -333,14 +346,14 @@ def random_queries(
 #: the number of seeded random queries (seed 0).
 SUITES: dict[str, dict[str, dict[str, int | None]]] = {
     "shared-small": {
-        "movingai": {"arena": 4, "den312d": 4, "rmtst01": 4},
+        "movingai": {"den312d": 4, "rmtst01": 4, "Berlin_0_256": 4},
         "ros": {"turtlebot3_world": 4, "smoothers_world": 4},
     },
     "shared-full": {
         "movingai": {
             name: None
             for name in (
-                "arena", "den312d", "rmtst01", "Berlin_0_256", "AR0046SR",
+                "den312d", "rmtst01", "Berlin_0_256", "AR0046SR",
                 "random512-40-5", "maze512-1-0", "Boston_0_1024",
             )
         },
@@ -363,9 +376,9 @@ def suite(
 ) -> list[MapQueries]:
     """A named suite of the shared maps (:data:`SUITES`).
 
-    ``shared-small``: a few scenarios of the three small Moving AI maps and a few random
-    queries on two ROS maps (a minute on one core); ``shared-full``: every scenario of the
-    eight shared Moving AI maps and 100 random queries on each of the four ROS maps (hours
+    ``shared-small``: a few scenarios of three Moving AI maps and a few random
+    queries on two ROS maps (a minute on one core); ``shared-full``: every scenario of seven
+    shared Moving AI maps (not ``arena``: none of its scenarios is feasible for 2.5 cells) and 100 random queries on each of the four ROS maps (hours
     of CPU: a cluster job). The Moving AI scenarios are those feasible for the radius
     (``movingai_queries(..., feasible_only=True)``).
 
