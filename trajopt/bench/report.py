@@ -102,15 +102,17 @@ def format_summary(table: Any) -> str:
         "duration_s": "duration s",
     }
 
-    def fmt(v: Any) -> str:
-        if isinstance(v, (int, np.integer)):
-            return str(int(v))
+    counts = ("queries", "feasible", "success", "collisions")
+
+    def fmt(c: str, v: Any) -> str:
         v = float(v)
-        return "-" if not np.isfinite(v) else f"{v:.4g}"
+        if not np.isfinite(v):
+            return "-"
+        return str(int(v)) if c in counts else f"{v:.4g}"
 
     rows = [["method", *heads.values()]]
     for method, r in table.iterrows():
-        rows.append([str(method), *(fmt(r[c]) for c in heads)])
+        rows.append([str(method), *(fmt(c, r[c]) for c in heads)])
     widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
     lines = [
         "  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in
