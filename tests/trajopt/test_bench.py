@@ -22,7 +22,7 @@ from trajopt import bench  # noqa: E402
 from trajopt.errors import BenchmarkError, PeerUnavailableError  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
-METHODS = ("trajopt", "trajopt-shortest", "astar", "bspline-fit")
+METHODS = ("trajopt", "astar", "bspline-fit")
 
 
 @pytest.fixture(scope="module")
@@ -108,7 +108,7 @@ def test_a_worker_killed_mid_task_has_its_chunk_retried(client, sources, serial,
     out = tmp_path / "killed"
     result: dict = {}
     run = threading.Thread(target=lambda: result.update(res=bench.run(
-        sources, out, methods=METHODS, client=client, chunk_size=1, progress=False)))
+        sources[:1], out, methods=METHODS, client=client, chunk_size=1, progress=False)))
     run.start()
     killed = None
     deadline = time.monotonic() + 30
@@ -122,8 +122,9 @@ def test_a_worker_killed_mid_task_has_its_chunk_retried(client, sources, serial,
         time.sleep(0.01)
     run.join(timeout=120)
     assert killed is not None and not run.is_alive()
-    assert result["res"].rows_written == len(serial)
-    assert_same_rows(bench.read_dataset(out), serial)
+    expected = serial[serial["map"] == "den312d.map"]
+    assert result["res"].rows_written == len(expected)
+    assert_same_rows(bench.read_dataset(out), expected)
 
 
 def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources, tmp_path):
@@ -177,7 +178,7 @@ def test_bad_input_is_a_typed_error_before_any_work(shared_data, sources, tmp_pa
     with pytest.raises(BenchmarkError, match="method 'rrt' is unknown"):
         bench.run(sources, out, methods=["trajopt", "rrt"], progress=False)
     with pytest.raises(BenchmarkError, match="'tcp://127.0.0.1:9' is unreachable"):
-        bench.run(sources, out, scheduler="tcp://127.0.0.1:9", connect_timeout_s=1.0,
+        bench.run(sources, out, scheduler="tcp://127.0.0.1:9", connect_timeout_s=0.5,
                   progress=False)
     with pytest.raises(BenchmarkError, match="scheduler must be"):
         bench.run(sources, out, scheduler="localhost:8786", progress=False)
