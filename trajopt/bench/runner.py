@@ -153,6 +153,16 @@ def _worker_env() -> dict[str, str]:
     }
 
 
+def _quiet_dask() -> None:
+    """Keep the in-process scheduler's INFO lines off the terminal unless the root logger
+    is at INFO or below (``trajopt -v``): dask gives its loggers their own levels."""
+    if logging.getLogger().getEffectiveLevel() <= logging.INFO:
+        return
+    names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed")]
+    for name in ["distributed", *names]:
+        logging.getLogger(name).setLevel(logging.WARNING)
+
+
 def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10.0) -> Any:
     """A :class:`distributed.Client` for ``scheduler`` (``"local"`` or an address).
 
@@ -168,6 +178,7 @@ def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10
     from distributed import Client, LocalCluster
 
     if scheduler == "local":
+        _quiet_dask()
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
