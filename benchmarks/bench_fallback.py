@@ -52,7 +52,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
-from trajopt._bench import select_scenarios  # noqa: E402
+from trajopt.bench.suites import select_evenly as select_scenarios  # noqa: E402
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError  # noqa: E402
 from trajopt.fallback import StopAndTurnTrajectory  # noqa: E402
 from trajopt.metrics import path_metrics  # noqa: E402

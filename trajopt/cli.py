@@ -1,4 +1,4 @@
-"""The ``trajopt`` command line: ``plan``, ``compare``, ``demo`` and ``bench``.
+"""The ``trajopt`` command line: ``plan``, ``compare``, ``demo`` and ``bench`` (``run``, ``report``).
 
 Every failure the user can fix (bad arguments, unreadable maps, blocked or unreachable
 start/goal, infeasible limits) exits with code 2 and one line on stderr, no traceback.
@@ -171,27 +171,51 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "bench",
-        help="run the methods on a Moving AI scenario file",
-        description="Proposed method and plain B-spline fit on the scenarios of "
-        "a Moving AI .scen; prints aggregate metrics.",
+        help="benchmark methods on maps and scenarios (Dask, Parquet dataset)",
+        description="Run maps x queries x methods on Dask distributed into a Parquet "
+        "dataset (bench run), and summarise a dataset (bench report).",
     )
-    p.add_argument("scen", metavar="SCEN_FILE", help="Moving AI .scen file")
-    p.add_argument("--map", help="the .map file (default: found beside the .scen or in ../maps)")
-    p.add_argument("--limit", type=int, default=20, help="number of scenarios (default 20)")
-    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
-    p.add_argument(
-        "--radius-cells",
-        type=float,
-        default=2.5,
-        help="robot radius in cells (default 2.5; the map has 1 m cells)",
+    bsub = p.add_subparsers(dest="bench_command", metavar="{run,report}", required=True)
+    r = bsub.add_parser(
+        "run",
+        help="run methods on scenario files, maps or a named suite",
+        description="Each INPUT is a Moving AI .scen file (its map found beside it or in "
+        "../maps, or given with --map) or a map file (.yaml, .map) for seeded random "
+        "queries (--queries, --seed). Rows, one per (query, method), go to the Parquet "
+        "dataset --out; the summary table is printed at the end.",
     )
-    p.add_argument(
-        "--fallback",
-        action="store_true",
-        help="plan with the stop-and-turn fallback (as plan --fallback) and count "
-        "how often it was used",
+    r.add_argument("inputs", metavar="INPUT", nargs="*", help=".scen or map files")
+    r.add_argument("--suite", help="a named suite: shared-small or shared-full")
+    r.add_argument("--data", help="shared data folder for --suite (default $TRAJOPT_DATA)")
+    r.add_argument("--map", help="the .map of a single .scen INPUT")
+    r.add_argument("--out", required=True, help="dataset folder (Parquet files)")
+    r.add_argument("--resume", action="store_true", help="skip rows the dataset already holds")
+    r.add_argument("--methods", help="comma-separated methods (default: all but the peers)")
+    r.add_argument("--limit", type=int, help="scenarios (or random queries) per map")
+    r.add_argument("--queries", type=int, default=20,
+                   help="random queries per map INPUT (default 20)")
+    r.add_argument("--seed", type=int, default=0, help="seed of the random queries (default 0)")
+    r.add_argument("--radius-cells", type=float, default=2.5,
+                   help="robot radius on Moving AI maps, in cells (default 2.5)")
+    r.add_argument("--radius", type=float, default=0.165,
+                   help="robot radius on other maps [m] (default 0.165)")
+    r.add_argument("--feasible-only", action="store_true",
+                   help="keep only scenarios whose end cells are free for the radius")
+    r.add_argument("--scheduler", default="local",
+                   help="'local' (LocalCluster, default), 'serial', or tcp://host:8786")
+    r.add_argument("--workers", type=int, help="local worker processes (default: cores)")
+    r.add_argument("--chunk-size", type=int, default=4, help="queries per task (default 4)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.set_defaults(func=_cmd_bench_run)
+    r = bsub.add_parser(
+        "report",
+        help="summary table and figures of a dataset",
+        description="Prints the per-method summary of a dataset written by bench run and "
+        "writes distribution figures with --figures.",
     )
-    p.set_defaults(func=_cmd_bench)
+    r.add_argument("dataset", metavar="DATASET", help="dataset folder (or .parquet file)")
+    r.add_argument("--figures", help="folder for the figures (PNG)")
+    r.set_defaults(func=_cmd_bench_report)
     return parser
 
 
@@ -448,71 +472,52 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _find_map(scen: Path, explicit: str | None, map_name: str) -> Path:
-    if explicit:
-        return Path(explicit)
-    for cand in (
-        scen.parent / map_name,
-        scen.parent.parent / "maps" / map_name,
-        scen.with_suffix(""),
-    ):
-        if cand.is_file() and cand.suffix == ".map":
-            return cand
-    raise CliError(
-        f"map {map_name!r} of {str(scen)!r} not found beside it or in ../maps; give --map"
-    )
+def _bench_sources(args: argparse.Namespace) -> list[Any]:
+    from trajopt import bench
 
-
-def _bench_one(job: tuple[str, float, Any, str | None]) -> dict[str, Any]:
-    from trajopt._bench import run_scenario
-
-    map_path, radius_cells, scenario, fallback = job
-    return run_scenario(map_path, radius_cells, scenario, fallback=fallback)
-
-
-def _cmd_bench(args: argparse.Namespace) -> int:
-    import astar
-    from trajopt._bench import select_scenarios, summarize
-
-    if args.limit < 1:
+    if args.limit is not None and args.limit < 1:
         raise CliError(f"--limit must be >= 1, got {args.limit}")
-    if args.jobs < 1:
-        raise CliError(f"--jobs must be >= 1, got {args.jobs}")
-    if not args.radius_cells > 0:
-        raise CliError(f"--radius-cells must be > 0, got {args.radius_cells}")
-    scen = Path(args.scen)
-    scenarios = astar.read_scenarios(scen)
-    if not scenarios:
-        raise CliError(f"{str(scen)!r} holds no scenarios")
-    map_path = _find_map(scen, args.map, scenarios[0].map_name)
-    astar.load_map(map_path)  # fail early, with one line, on a bad map
-    chosen = select_scenarios(scenarios, args.limit)
-    fallback = "stop_and_turn" if args.fallback else None
-    jobs = [(str(map_path), args.radius_cells, s, fallback) for s in chosen]
-    results: list[dict[str, Any]] = []
-    t0 = time.perf_counter()
-    if args.jobs == 1:
-        for i, job in enumerate(jobs):
-            results.append(_bench_one(job))
-            _progress(i + 1, len(jobs), t0)
-    else:
-        from concurrent.futures import ProcessPoolExecutor
+    if not args.inputs and not args.suite:
+        raise CliError("give INPUT files or --suite")
+    if args.map and len(args.inputs) != 1:
+        raise CliError(f"--map needs exactly one .scen INPUT, got {len(args.inputs)}")
+    sources = []
+    if args.suite:
+        sources += bench.suite(args.suite, args.data, limit=args.limit,
+                               radius_cells=args.radius_cells, radius_m=args.radius,
+                               seed=args.seed)
+    for item in args.inputs:
+        if item.endswith(".scen"):
+            sources.append(bench.movingai_queries(
+                item, args.map, limit=args.limit, radius_cells=args.radius_cells,
+                feasible_only=args.feasible_only))
+        else:
+            n = args.queries if args.limit is None else min(args.queries, args.limit)
+            sources.append(bench.random_queries(item, n, seed=args.seed, radius_m=args.radius))
+    return sources
 
-        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            for i, res in enumerate(pool.map(_bench_one, jobs)):
-                results.append(res)
-                _progress(i + 1, len(jobs), t0)
-    print(file=sys.stderr)
-    print(summarize(results))
+
+def _cmd_bench_run(args: argparse.Namespace) -> int:
+    from trajopt import bench
+
+    sources = _bench_sources(args)
+    res = bench.run(sources, args.out, methods=args.methods, scheduler=args.scheduler,
+                    workers=args.workers, chunk_size=args.chunk_size, resume=args.resume,
+                    progress=not args.no_progress)
+    print(f"{res.rows_written} rows written, {res.rows_skipped} already held, "
+          f"{res.rows_expected} in all ({res.chunks} chunks, {res.workers} workers, "
+          f"{res.elapsed_s:.1f} s) -> {res.out}")
+    print(bench.report(res.out))
     return 0
 
 
-def _progress(done: int, total: int, t0: float) -> None:
-    width = 30
-    filled = int(width * done / total)
-    bar = "#" * filled + "-" * (width - filled)
-    sys.stderr.write(f"\r[{bar}] {done}/{total} {time.perf_counter() - t0:.1f} s")
-    sys.stderr.flush()
+def _cmd_bench_report(args: argparse.Namespace) -> int:
+    from trajopt import bench
+
+    print(bench.report(args.dataset, figures_dir=args.figures))
+    if args.figures:
+        print(f"wrote figures to {args.figures}/")
+    return 0
 
 
 # ------------------------------------------------------------------------ main

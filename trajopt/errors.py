@@ -19,6 +19,8 @@ __all__ = [
     "NoPathError",
     "SmoothingError",
     "TimingError",
+    "BenchmarkError",
+    "PeerUnavailableError",
 ]
 
 
@@ -56,3 +58,16 @@ class SmoothingError(TrajoptError):
 
 class TimingError(TrajoptError):
     """The time parameterisation cannot meet the requested boundary speeds or limits."""
+
+
+class BenchmarkError(InvalidInputError):
+    """A benchmark run cannot start: a missing map or scenario file, a scenario file for
+    another map size, an unknown method or suite, an unreachable Dask scheduler, or an
+    output dataset that does not match the run. Raised before any query is planned; the
+    message names the input, its value and the rule."""
+
+
+class PeerUnavailableError(BenchmarkError):
+    """A peer method (OMPL, python-motion-planning) was requested but its package is not
+    installed; the message says to install the ``peers`` extra
+    (``pip install 'trajopt[peers]'``)."""

@@ -57,7 +57,7 @@ def run(argv) -> int:
         (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--out", "x.txt"],
          "--out must end in .csv, .json or .mcap"),
         (["plan", "{map}", "--start", "0.4"], "expected 2 arguments"),
-        (["bench", "{map}", "--limit", "0"], "--limit must be >= 1"),
+        (["bench", "run", "{map}", "--limit", "0", "--out", "o"], "--limit must be >= 1"),
         (["nonsense"], "invalid choice"),
         # issue 7: bad values reach the library's typed errors, still one line and exit 2
         (["plan", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
@@ -82,9 +82,14 @@ def run(argv) -> int:
           "--radius", "-1"], "robot_radius must be finite and > 0"),
         (["compare", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
          "start must be finite"),
-        (["bench", "{badscen}"], "field start_y must be an integer >= 0"),
-        (["bench", "{map}", "--jobs", "0"], "--jobs must be >= 1"),
-        (["bench", "{map}", "--radius-cells", "nan"], "--radius-cells must be > 0"),
+        (["bench", "run", "{badscen}", "--out", "o"], "field start_y must be an integer >= 0"),
+        (["bench", "run", "{map}", "--chunk-size", "0", "--out", "o"],
+         "chunk_size must be an integer >= 1"),
+        (["bench", "run", "{map}", "--radius", "nan", "--out", "o"],
+         "radius_m must be a finite number > 0"),
+        (["bench", "run", "{map}", "--methods", "rrt", "--out", "o"], "method 'rrt' is unknown"),
+        (["bench", "run", "--out", "o"], "give INPUT files or --suite"),
+        (["bench", "report", "missing"], "dataset 'missing' does not exist"),
     ],
 )
 def test_errors_are_one_line_exit_2(argv, match, door_map, capsys, tmp_path, monkeypatch):
@@ -100,9 +105,9 @@ def test_errors_are_one_line_exit_2(argv, match, door_map, capsys, tmp_path, mon
 
 
 def test_help_for_every_command(capsys):
-    for cmd in ("plan", "compare", "demo", "bench"):
+    for cmd in ("plan", "compare", "demo", "bench", "bench run", "bench report"):
         with pytest.raises(SystemExit) as exc:
-            main([cmd, "--help"])
+            main([*cmd.split(), "--help"])
         assert exc.value.code == 0
         assert "usage: trajopt " + cmd in capsys.readouterr().out
 
@@ -123,21 +128,6 @@ def test_compare_markdown(door_map, capsys):
     assert rc == 0
     out = capsys.readouterr().out
     assert out.count("|") > 20 and "proposed" in out
-
-
-def test_bench_serial_equals_parallel(shared_data, capsys):
-    scen = shared_data / "movingai" / "scen" / "arena.map.scen"
-    args = ["bench", str(scen), "--limit", "3"]
-    assert main(args + ["--jobs", "1"]) == 0
-    serial = capsys.readouterr().out
-    assert main(args + ["--jobs", "2"]) == 0
-    parallel = capsys.readouterr().out
-
-    def strip_times(text):
-        return [ln for ln in text.splitlines() if "time" not in ln]
-
-    assert strip_times(serial) == strip_times(parallel)
-    assert "scenarios                      3" in serial
 
 
 def test_plan_on_a_costmap_with_a_speed_mask_to_mcap(tmp_path, capsys):

@@ -12,7 +12,6 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-import astar
 import trajopt
 from tests.cases import door_grid
 
@@ -83,9 +82,11 @@ def test_fresh_process_gives_the_same_answer() -> None:
 
 
 def _records_equal(a: dict, b: dict) -> bool:
-    """Exact equality of two ``run_scenario`` records, wall times left out."""
-    ka = {k for k in a if not k.endswith("time_s") and k != "smooth_s"}
-    kb = {k for k in b if not k.endswith("time_s") and k != "smooth_s"}
+    """Exact equality of two benchmark rows, wall times and the worker left out."""
+    from trajopt.bench import TIMING_COLUMNS
+
+    ka = {k for k in a if k not in TIMING_COLUMNS}
+    kb = {k for k in b if k not in TIMING_COLUMNS}
     if ka != kb:
         return False
     for k in ka:
@@ -98,18 +99,16 @@ def _records_equal(a: dict, b: dict) -> bool:
 
 
 def test_bench_records_serial_equal_parallel_exactly(shared_data) -> None:
-    # `trajopt bench --jobs N` prints medians rounded to 4 digits; compare the raw records
-    # (every metric of every scenario) of a serial run and a 2-process run exactly
-    from trajopt._bench import select_scenarios
-    from trajopt.cli import _bench_one
+    # the benchmark's rows (every metric of every scenario) of a serial run and of a
+    # 2-process run are equal exactly (tests/trajopt/test_bench.py does the same on Dask)
+    from trajopt import bench
 
-    scen = shared_data / "movingai" / "scen" / "arena.map.scen"
-    map_path = shared_data / "movingai" / "maps" / "arena.map"
-    chosen = select_scenarios(astar.read_scenarios(scen), 4)
-    jobs = [(str(map_path), 2.5, s, None) for s in chosen]  # (map, radius, scenario, fallback)
-    serial = [_bench_one(j) for j in jobs]
+    src = bench.movingai_queries(shared_data / "movingai" / "scen" / "den312d.map.scen",
+                                 limit=4, feasible_only=True)
+    chunks = bench.make_chunks([src], ["trajopt", "bspline-fit"], set(), 1)
+    serial = [r for ch in chunks for r in bench.run_chunk(ch)]
     with ProcessPoolExecutor(max_workers=2) as pool:
-        parallel = list(pool.map(_bench_one, jobs))
-    assert len(serial) == len(parallel) == len(jobs)
+        parallel = [r for rows in pool.map(bench.run_chunk, chunks) for r in rows]
+    assert len(serial) == len(parallel) == 8
     for i, (a, b) in enumerate(zip(serial, parallel, strict=True)):
-        assert _records_equal(a, b), f"scenario {i}: serial {a} != parallel {b}"
+        assert _records_equal(a, b), f"row {i}: serial {a} != parallel {b}"

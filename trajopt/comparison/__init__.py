@@ -48,7 +48,12 @@ registration order. A method that raises :class:`~trajopt.errors.NoPathError`,
 
 from trajopt.comparison.builtin_methods import DEFAULT_BSPLINE, DEFAULT_POLY
 from trajopt.comparison.records import ComparisonContext, MethodFn, MethodResult
-from trajopt.comparison.registry import register_method, registered_methods, unregister_method
+from trajopt.comparison.registry import (
+    register_method,
+    registered_methods,
+    resolve_method,
+    unregister_method,
+)
 from trajopt.comparison.run import compare
 from trajopt.comparison.table import ComparisonTable
 
@@ -61,6 +66,7 @@ __all__ = [
     "register_method",
     "unregister_method",
     "registered_methods",
+    "resolve_method",
     "DEFAULT_POLY",
     "DEFAULT_BSPLINE",
 ]

@@ -15,6 +15,7 @@ __all__ = [
     "MethodSpec",
     "register_method",
     "registered_methods",
+    "resolve_method",
     "resolve_methods",
     "unregister_method",
 ]
@@ -98,6 +99,17 @@ def unregister_method(name: str) -> None:
 def registered_methods(*, default_only: bool = False) -> tuple[str, ...]:
     """Names of the registered methods in registration order."""
     return tuple(n for n, s in _METHODS.items() if s.default or not default_only)
+
+
+def resolve_method(name: str) -> MethodFn:
+    """The callable of a registered method (imported now if registered as "module:attr").
+
+    Raises
+    ------
+    InvalidInputError
+        ``name`` is not registered.
+    """
+    return resolve_methods([name])[0][1]
 
 
 def resolve_methods(

@@ -1,0 +1,332 @@
+"""Running a benchmark: chunks of queries on Dask distributed, rows into the dataset.
+
+:func:`run` checks everything first (maps and scenario files were checked when the
+:class:`~trajopt.bench.suites.MapQueries` were made; here the methods, the scheduler
+address and the dataset folder), then cuts the (query, method) pairs the dataset does not
+hold yet into :class:`Chunk` tasks of ``chunk_size`` queries of one map, and submits them:
+
+* ``scheduler="local"`` (default): a :class:`distributed.LocalCluster` of ``workers``
+  processes (default one per core, one thread each) started for the run and closed after;
+  the workers get this process's ``sys.path`` entry of :mod:`trajopt` on their
+  ``PYTHONPATH``, so they import the same code;
+* ``scheduler="tcp://host:8786"`` (any Dask address): an existing scheduler (its workers
+  need ``trajopt`` installed and the map files at the same paths);
+* ``scheduler="serial"``: in this process, no Dask (the reference for the tests).
+
+A worker runs a chunk with :func:`run_chunk` (the map is loaded and inflated once per
+worker, :func:`~trajopt.bench.methods.map_context`); the client writes each finished
+chunk to its own Parquet file (:func:`~trajopt.bench.dataset.write_chunk`, atomic) as it
+arrives, with a ``tqdm`` progress bar counting rows. A chunk whose worker dies is
+rescheduled by Dask and also retried ``retries`` times on an exception; as files are
+named by chunk, a retried chunk replaces its own file and never duplicates rows.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import math
+import os
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from trajopt.bench.dataset import existing_keys, prepare, write_chunk
+from trajopt.bench.methods import check_methods, evaluate_query, map_context
+from trajopt.bench.suites import MapQueries, Query
+from trajopt.errors import BenchmarkError
+
+__all__ = ["Chunk", "RunSummary", "run", "run_chunk", "make_chunks", "connect"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True)
+class Chunk:
+    """One task: some queries of one map, each with the methods still to run.
+
+    Attributes
+    ----------
+    chunk_id : str
+        ``<map stem>-<12 hex digits of a hash of the work>``; names the Parquet file.
+    maps : MapQueries
+        The map (its ``queries`` are not used here).
+    work : tuple of (Query, tuple of str)
+        The queries and their methods.
+    """
+
+    chunk_id: str
+    maps: MapQueries
+    work: tuple[tuple[Query, tuple[str, ...]], ...]
+
+    @property
+    def n_rows(self) -> int:
+        """Rows this chunk writes."""
+        return sum(len(m) for _, m in self.work)
+
+
+@dataclass(frozen=True, slots=True)
+class RunSummary:
+    """What :func:`run` did.
+
+    Attributes
+    ----------
+    out : Path
+        The dataset folder.
+    rows_expected : int
+        Queries x methods of the run.
+    rows_skipped : int
+        Pairs the dataset already held (``resume``).
+    rows_written : int
+        Rows written by this call.
+    chunks : int
+        Chunks run by this call.
+    elapsed_s : float
+        Wall time of the computation (s), from the first submission to the last file.
+    workers : int
+        Worker processes (1 for ``"serial"``).
+    """
+
+    out: Path
+    rows_expected: int
+    rows_skipped: int
+    rows_written: int
+    chunks: int
+    elapsed_s: float
+    workers: int
+
+
+def make_chunks(sources: Sequence[MapQueries], methods: Sequence[str],
+                done: set[tuple[str, str]], chunk_size: int) -> list[Chunk]:
+    """Cut the (query, method) pairs not in ``done`` into chunks of ``chunk_size`` queries
+    of one map (in map order, then query order)."""
+    chunks: list[Chunk] = []
+    for mq in sources:
+        todo = []
+        for q in mq.queries:
+            ms = tuple(m for m in methods if (q.query_id, m) not in done)
+            if ms:
+                todo.append((q, ms))
+        for i in range(0, len(todo), chunk_size):
+            work = tuple(todo[i:i + chunk_size])
+            h = hashlib.sha1(repr([(q.query_id, ms) for q, ms in work]).encode()).hexdigest()
+            stem = Path(mq.map_name).stem.replace(" ", "_")
+            chunks.append(Chunk(f"{stem}-{h[:12]}", mq, work))
+    return chunks
+
+
+def run_chunk(chunk: Chunk) -> list[dict[str, Any]]:
+    """Plan and score every (query, method) of a chunk; the rows (plain dicts).
+
+    Runs in a worker process (or in this one for ``scheduler="serial"``).
+    """
+    mq = chunk.maps
+    mctx = map_context(mq.map_path, mq.radius_m)
+    worker = f"{os.uname().nodename}:{os.getpid()}"
+    rows: list[dict[str, Any]] = []
+    for q, methods in chunk.work:
+        base = {
+            "map": mq.map_name, "source": mq.source, "query_id": q.query_id,
+            "query_index": q.index, "bucket": q.bucket, "start_ix": q.start[0],
+            "start_iy": q.start[1], "goal_ix": q.goal[0], "goal_iy": q.goal[1],
+            "optimal_length_cells": q.optimal_length_cells, "radius_m": mq.radius_m,
+            "resolution_m": mq.resolution_m, "worker": worker,
+        }
+        for r in evaluate_query(mctx, q.start, q.goal, methods):
+            rows.append({**base, **r})
+    return rows
+
+
+def _worker_env() -> dict[str, str]:
+    import trajopt
+
+    root = str(Path(trajopt.__file__).resolve().parents[1])
+    paths = [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    return {
+        "PYTHONPATH": os.pathsep.join(dict.fromkeys(paths)),
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+    }
+
+
+def _quiet_dask() -> None:
+    """Keep the in-process scheduler's INFO lines off the terminal unless the root logger
+    is at INFO or below (``trajopt -v``): dask gives its loggers their own levels."""
+    if logging.getLogger().getEffectiveLevel() <= logging.INFO:
+        return
+    names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed")]
+    for name in ["distributed", *names]:
+        logging.getLogger(name).setLevel(logging.WARNING)
+
+
+def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10.0) -> Any:
+    """A :class:`distributed.Client` for ``scheduler`` (``"local"`` or an address).
+
+    With ``"local"`` the client owns a new :class:`distributed.LocalCluster` of
+    ``workers`` processes (default ``os.cpu_count()``), closed with the client
+    (``client.close(); client.cluster.close()``).
+
+    Raises
+    ------
+    BenchmarkError
+        Malformed address, or no scheduler answering at it within ``timeout_s``.
+    """
+    from distributed import Client, LocalCluster
+
+    if scheduler == "local":
+        _quiet_dask()
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+            silence_logs=logging.ERROR, env=_worker_env(),
+        )
+        return Client(cluster)
+    if "://" not in scheduler or not scheduler.split("://", 1)[1]:
+        raise BenchmarkError(
+            f"scheduler must be 'local', 'serial' or a Dask address like "
+            f"'tcp://host:8786', got {scheduler!r}"
+        )
+    try:
+        return Client(scheduler, timeout=timeout_s)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise BenchmarkError(
+            f"scheduler {scheduler!r} is unreachable (no answer within {timeout_s} s): {exc}"
+        ) from exc
+
+
+def run(
+    sources: Sequence[MapQueries],
+    out: str | os.PathLike[str],
+    *,
+    methods: Sequence[str] | str | None = None,
+    scheduler: str = "local",
+    workers: int | None = None,
+    chunk_size: int = 4,
+    resume: bool = False,
+    retries: int = 2,
+    progress: bool = True,
+    client: Any = None,
+    connect_timeout_s: float = 10.0,
+) -> RunSummary:
+    """Run ``methods`` on every query of ``sources`` and write the rows to ``out``.
+
+    Parameters
+    ----------
+    sources : sequence of MapQueries
+        Maps and queries (:func:`~trajopt.bench.suites.suite`,
+        :func:`~trajopt.bench.suites.movingai_queries`, ...).
+    out : path
+        Dataset folder (created; must be new or empty unless ``resume``).
+    methods : sequence of str or comma-separated str, optional
+        Method names (:data:`~trajopt.bench.methods.METHODS`); default
+        :data:`~trajopt.bench.methods.DEFAULT_METHODS`.
+    scheduler : str
+        ``"local"``, ``"serial"`` or a Dask scheduler address (module docstring).
+    workers : int, optional
+        Worker processes of the local cluster (default one per core).
+    chunk_size : int
+        Queries per task (>= 1).
+    resume : bool
+        Skip the (query, method) pairs ``out`` already holds.
+    retries : int
+        Extra attempts of a chunk that raised (worker deaths are rescheduled anyway).
+    progress : bool
+        Show a tqdm progress bar on stderr.
+    client : distributed.Client, optional
+        Use this client instead of ``scheduler`` (not closed).
+    connect_timeout_s : float
+        How long to wait for a remote scheduler (s).
+
+    Returns
+    -------
+    RunSummary
+
+    Raises
+    ------
+    BenchmarkError
+        No queries, an unknown method, a bad option, an unreachable scheduler, a dataset
+        folder holding another run: all before any query is planned.
+    PeerUnavailableError
+        A peer method whose package is missing.
+    """
+    from trajopt.bench.methods import DEFAULT_METHODS
+
+    names = check_methods(DEFAULT_METHODS if methods is None else methods)
+    srcs = list(sources)
+    if not srcs or not any(mq.queries for mq in srcs):
+        raise BenchmarkError("sources must hold at least one query")
+    ids = [q.query_id for mq in srcs for q in mq.queries]
+    if len(set(ids)) != len(ids):
+        raise BenchmarkError("query ids must be unique: a map and source appear twice")
+    for nm, v, lo in (("chunk_size", chunk_size, 1), ("retries", retries, 0),
+                      ("workers", 1 if workers is None else workers, 1)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise BenchmarkError(f"{nm} must be an integer >= {lo}, got {v!r}")
+    if client is None and scheduler != "serial" and scheduler != "local" and "://" not in scheduler:
+        raise BenchmarkError(
+            f"scheduler must be 'local', 'serial' or a Dask address like 'tcp://host:8786', "
+            f"got {scheduler!r}"
+        )
+    own_client = None
+    if client is None and scheduler not in ("serial", "local"):
+        own_client = connect(scheduler, timeout_s=connect_timeout_s)  # fail before writing
+    try:
+        d = prepare(out, {"radius_m": {mq.map_name: mq.radius_m for mq in srcs}}, resume=resume)
+        done = existing_keys(d) if resume else set()
+        expected = len(ids) * len(names)
+        skipped = sum(1 for i in ids for m in names if (i, m) in done)
+        chunks = make_chunks(srcs, names, done, chunk_size)
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=expected, initial=skipped, unit="row", desc="bench",
+                   disable=not progress, file=sys.stderr, dynamic_ncols=True)
+        written = 0
+        n_workers = 1
+        t0 = time.perf_counter()
+        try:
+            if client is None and scheduler == "serial":
+                for ch in chunks:
+                    rows = run_chunk(ch)
+                    write_chunk(d, ch.chunk_id, rows)
+                    written += len(rows)
+                    bar.update(len(rows))
+            elif chunks:
+                if client is None and own_client is None:
+                    own_client = connect("local", workers=workers)
+                cl = client if client is not None else own_client
+                from distributed import as_completed
+
+                n_workers = max(1, len(cl.scheduler_info()["workers"]))
+                t0 = time.perf_counter()
+                futures = {
+                    cl.submit(run_chunk, ch, key=f"trajopt-bench-{ch.chunk_id}",
+                              retries=retries, pure=False): ch
+                    for ch in chunks
+                }
+                for fut in as_completed(futures):
+                    ch = futures[fut]
+                    rows = fut.result()
+                    write_chunk(d, ch.chunk_id, rows)
+                    written += len(rows)
+                    bar.update(len(rows))
+                    fut.release()
+        finally:
+            bar.close()
+        elapsed = time.perf_counter() - t0
+    finally:
+        if own_client is not None:
+            cluster = getattr(own_client, "cluster", None)  # the local cluster, else None
+            own_client.close()
+            if cluster is not None:
+                cluster.close()
+    if written + skipped != expected:  # a chunk returned a wrong number of rows
+        raise BenchmarkError(
+            f"wrote {written} rows and skipped {skipped}, expected {expected} "
+            f"(queries x methods)"
+        )
+    return RunSummary(Path(d), expected, skipped, written, len(chunks),
+                      elapsed if math.isfinite(elapsed) else 0.0, n_workers)
