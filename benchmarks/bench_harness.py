@@ -57,10 +57,10 @@ def sources(data: Path, limit: int) -> list[bench.MapQueries]:
 def timed_run(srcs, methods, workers: int, out: Path, chunk_size: int) -> tuple[float, int]:
     from distributed import Client, LocalCluster
 
-    from trajopt.bench.runner import _worker_env
+    from trajopt.bench.runner import worker_env
 
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None, env=_worker_env())
+                           dashboard_address=None, env=worker_env())
     client = Client(cluster)
     try:
         for src in srcs:  # every worker loads every map and plans one query of it, once

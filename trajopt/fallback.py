@@ -47,7 +47,8 @@ from trajopt.curve import PolylineCurve
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
 from trajopt.speed_limits import SpeedLimits
-from trajopt.trajectory import TrajectorySample, _export_dict, _readonly, _SampledExport
+from trajopt.trajectory import SampledExport, TrajectorySample, export_dict
+from trajopt.validation import heading, readonly, short_repr
 
 __all__ = ["StopAndTurnTrajectory", "stop_and_turn", "turn_limits", "polyline_clearance"]
 
@@ -103,7 +104,7 @@ class _RestToRest:
 
 # ====================================================================== trajectory
 @dataclass(frozen=True, slots=True)
-class StopAndTurnTrajectory(_SampledExport):
+class StopAndTurnTrajectory(SampledExport):
     """A polyline driven with stops and turns in place (see the module docstring).
 
     Built by :func:`stop_and_turn` (or by :class:`trajopt.Planner` with
@@ -167,7 +168,7 @@ class StopAndTurnTrajectory(_SampledExport):
         )  # fmt: skip
         shape = np.shape(self.phase_t)
         for n in names:
-            arr = _readonly(getattr(self, n))
+            arr = readonly(getattr(self, n))
             if arr.ndim != 1 or arr.shape != shape or arr.shape[0] < 1:
                 raise InvalidInputError(
                     f"{n} must have shape (p,) with p >= 1 like phase_t {shape}, got {arr.shape}"
@@ -185,8 +186,8 @@ class StopAndTurnTrajectory(_SampledExport):
         object.__setattr__(self, "theta_end", float(self.theta_end))
         seg_len = np.hypot(*np.diff(pts, axis=0).T)
         seg_s = np.concatenate([[0.0], np.cumsum(seg_len)])
-        object.__setattr__(self, "_seg_s", _readonly(seg_s))
-        object.__setattr__(self, "_seg_len", _readonly(seg_len))
+        object.__setattr__(self, "_seg_s", readonly(seg_s))
+        object.__setattr__(self, "_seg_len", readonly(seg_len))
 
     # ------------------------------------------------------------------ basic
     @property
@@ -308,7 +309,7 @@ class StopAndTurnTrajectory(_SampledExport):
             half = 0.5 * self.robot.track_width
             out["v_left"] = v - omega * half
             out["v_right"] = v + omega * half
-        return TrajectorySample(**{n: _readonly(x) for n, x in out.items()})
+        return TrajectorySample(**{n: readonly(x) for n, x in out.items()})
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
@@ -341,7 +342,7 @@ class StopAndTurnTrajectory(_SampledExport):
             "theta_end": self.theta_end,
             "phases": phases,
         }
-        return _export_dict(self, "trajopt.StopAndTurnTrajectory", dt, extra)
+        return export_dict(self, "trajopt.StopAndTurnTrajectory", dt, extra)
 
     def __repr__(self) -> str:
         return (
@@ -404,8 +405,8 @@ def stop_and_turn(
     if not isinstance(robot, Robot):
         raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
     pts = _clean_points(points)
-    h0 = _heading_arg("start_heading", start_heading)
-    h1 = _heading_arg("goal_heading", goal_heading)
+    h0 = heading("start_heading", start_heading)
+    h1 = heading("goal_heading", goal_heading)
 
     d = np.diff(pts, axis=0)
     seg_len = np.hypot(d[:, 0], d[:, 1])
@@ -515,7 +516,7 @@ def _clean_points(points: Any) -> np.ndarray:
         p = np.array(points, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(
-            f"points must be an array of shape (n, 2) in metres, got {_short(points)}"
+            f"points must be an array of shape (n, 2) in metres, got {short_repr(points)}"
         ) from exc
     if p.ndim != 2 or p.shape[1] != 2 or not 2 <= p.shape[0] <= _MAX_POINTS:
         raise InvalidInputError(
@@ -549,24 +550,3 @@ def _clean_points(points: Any) -> np.ndarray:
             out.append(q[i])
     out.append(q[-1])
     return np.array(out)
-
-
-def _heading_arg(name: str, value: Any) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, (bool, np.bool_)):
-        raise InvalidInputError(f"{name} must be a number (rad) or None, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(
-            f"{name} must be a number (rad) or None, got {_short(value)}"
-        ) from None
-    if not math.isfinite(x):
-        raise InvalidInputError(f"{name} must be finite (rad), got {value!r}")
-    return x
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."

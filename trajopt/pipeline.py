@@ -77,6 +77,7 @@ from trajopt.smoother import Smoother, SmoothPath
 from trajopt.speed_limits import SpeedLimits
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
+from trajopt.validation import point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
 
@@ -305,8 +306,8 @@ class Planner:
             return self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
-        p0 = _point("start", start)
-        p1 = _point("goal", goal)
+        p0 = point("start", start)
+        p1 = point("goal", goal)
         q = PlanQuery(
             start=p0,
             goal=p1,
@@ -541,20 +542,6 @@ def _check_speed_limits(limits: object, grid: OccupancyGrid) -> None:
             f"{y1:.6g}] m, which does not overlap the map (x in [{gx0:.6g}, {gx1:.6g}] m, "
             f"y in [{gy0:.6g}, {gy1:.6g}] m); masks are looked up in world coordinates"
         )
-
-
-def _point(name: str, value: Any) -> np.ndarray:
-    try:
-        p = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"{name} must be two numbers (x, y) in metres, got {value!r}"
-        ) from exc
-    if p.shape != (2,):
-        raise InvalidInputError(f"{name} must be two numbers (x, y) in metres, got {value!r}")
-    if not np.all(np.isfinite(p)):
-        raise InvalidInputError(f"{name} must be finite, got {p.tolist()}")
-    return p
 
 
 def _cell(c: np.ndarray) -> tuple[int, int]:

@@ -35,6 +35,7 @@ from typing import Literal
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.validation import number, point, positive
 
 __all__ = ["SpeedLimits", "SpeedLimitType", "load_speed_mask"]
 
@@ -99,9 +100,9 @@ class SpeedLimits:
             resolution or origin.
         """
         kind = _limit_type(type)
-        b = _finite("base", base)
-        m = _finite("multiplier", multiplier)
-        res = _positive("resolution", resolution)
+        b = number("base", base)
+        m = number("multiplier", multiplier)
+        res = positive("resolution", resolution, "m")
         org = _origin(origin)
         try:
             v = np.asarray(values)
@@ -304,27 +305,6 @@ def _limit_type(value: object) -> str:
     )
 
 
-def _finite(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.number):
-        raise InvalidInputError(f"{name} must be a number, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise InvalidInputError(f"{name} must be finite, got {v!r}")
-    return v
-
-
-def _positive(name: str, value: object) -> float:
-    v = _finite(name, value)
-    if v <= 0.0:
-        raise InvalidInputError(f"{name} must be > 0 (m), got {v!r}")
-    return v
-
-
 def _origin(value: object) -> tuple[float, float]:
-    try:
-        ox, oy = (float(v) for v in value)  # type: ignore[union-attr]
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"origin must be two numbers (x, y) in metres, got {value!r}") from None
-    if not (math.isfinite(ox) and math.isfinite(oy)):
-        raise InvalidInputError(f"origin must be finite, got ({ox}, {oy})")
-    return ox, oy
+    ox, oy = point("origin", value)
+    return float(ox), float(oy)

@@ -23,6 +23,7 @@ from astar.files import atomic_write
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
 from trajopt.robot import Robot
+from trajopt.validation import readonly
 
 __all__ = ["Trajectory", "TrajectorySample", "SAMPLE_UNITS"]
 
@@ -82,13 +83,7 @@ class TrajectorySample(NamedTuple):
         return {k: v for k, v in self._asdict().items() if v is not None}
 
 
-def _readonly(x: Any) -> np.ndarray:
-    arr = np.array(x, dtype=float)
-    arr.flags.writeable = False
-    return arr
-
-
-class _SampledExport:
+class SampledExport:
     """The sampling and file export shared by every timed trajectory of :mod:`trajopt`.
 
     A subclass provides ``duration`` (s), ``sample(t)`` returning a
@@ -207,7 +202,7 @@ def _frame_id(value: object) -> str:
     return value
 
 
-def _export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:
+def export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:
     """The ``to_dict`` layout shared by the trajectory classes: a header (format, units,
     duration, length, end speeds, robot, stats), then ``extra``, then the ``samples``."""
     smp = traj.sample_uniform(dt).as_dict()
@@ -230,7 +225,7 @@ def _export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[
 
 
 @dataclass(frozen=True, slots=True)
-class Trajectory(_SampledExport):
+class Trajectory(SampledExport):
     """A jerk-limited timed motion along a curve.
 
     Built by :func:`trajopt.time_parameterize`; the constructor checks shapes only.
@@ -274,14 +269,14 @@ class Trajectory(_SampledExport):
     v_start: float
     v_end: float
     stats: dict[str, Any] = field(default_factory=dict)
-    theta_grid_s: np.ndarray = field(default_factory=lambda: _readonly([]))
-    theta_grid: np.ndarray = field(default_factory=lambda: _readonly([]))
-    u_grid: np.ndarray = field(default_factory=lambda: _readonly([]))
+    theta_grid_s: np.ndarray = field(default_factory=lambda: readonly([]))
+    theta_grid: np.ndarray = field(default_factory=lambda: readonly([]))
+    u_grid: np.ndarray = field(default_factory=lambda: readonly([]))
     steps: Any = None
 
     def __post_init__(self) -> None:
         names = ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j")
-        arrays = [_readonly(getattr(self, n)) for n in names]
+        arrays = [readonly(getattr(self, n)) for n in names]
         p = arrays[0].shape
         for n, arr in zip(names, arrays, strict=True):
             if arr.ndim != 1 or arr.shape != p or p[0] < 1:
@@ -295,7 +290,7 @@ class Trajectory(_SampledExport):
                 f"got {self.duration!r}"
             )
         object.__setattr__(self, "duration", float(self.duration))
-        gs, gt = _readonly(self.theta_grid_s), _readonly(self.theta_grid)
+        gs, gt = readonly(self.theta_grid_s), readonly(self.theta_grid)
         if gs.shape != gt.shape or gs.ndim != 1:
             raise InvalidInputError(
                 f"theta_grid_s and theta_grid must have equal shapes (g,), got {gs.shape}, "
@@ -303,7 +298,7 @@ class Trajectory(_SampledExport):
             )
         object.__setattr__(self, "theta_grid_s", gs)
         object.__setattr__(self, "theta_grid", gt)
-        ug = _readonly(self.u_grid)
+        ug = readonly(self.u_grid)
         if ug.shape[0] and ug.shape != gs.shape:
             raise InvalidInputError(
                 f"u_grid must be empty or have the shape of theta_grid_s {gs.shape}, got {ug.shape}"
@@ -415,7 +410,7 @@ class Trajectory(_SampledExport):
             half = 0.5 * self.robot.track_width
             out["v_left"] = v - omega * half
             out["v_right"] = v + omega * half
-        return TrajectorySample(**{k: _readonly(x) for k, x in out.items()})
+        return TrajectorySample(**{k: readonly(x) for k, x in out.items()})
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
@@ -434,7 +429,7 @@ class Trajectory(_SampledExport):
             "a": self.phase_a.tolist(),
             "jerk": self.phase_j.tolist(),
         }
-        return _export_dict(self, "trajopt.Trajectory", dt, {"phases": phases})
+        return export_dict(self, "trajopt.Trajectory", dt, {"phases": phases})
 
     def __repr__(self) -> str:
         return (

@@ -17,6 +17,7 @@ import numpy as np
 from trajopt.errors import InvalidInputError
 
 __all__ = [
+    "readonly",
     "choice",
     "heading",
     "integer",
@@ -55,8 +56,8 @@ def number(
     hi: float | None = None,
 ) -> float:
     """A finite float, optionally bounded below (``> lo`` if ``strict``, else ``>= lo``)
-    and above (``<= hi``). Booleans are not numbers."""
-    if isinstance(value, bool | np.bool_):
+    and above (``<= hi``). Booleans and strings are not numbers."""
+    if isinstance(value, bool | np.bool_ | str | bytes):
         raise InvalidInputError(f"{name} must be a number{_unit(unit)}, got {value!r}")
     try:
         x = float(value)
@@ -181,3 +182,10 @@ def weights(name: str, value: Any, n: int, *, positive: bool = False) -> np.ndar
     if not np.any(w > 0):
         raise InvalidInputError(f"{name} must not all be zero")
     return w
+
+
+def readonly(value: Any, dtype: Any = float) -> np.ndarray:
+    """A read-only copy of ``value`` as an array of ``dtype`` (the values' stored arrays)."""
+    out = np.array(value, dtype=dtype, copy=True)
+    out.flags.writeable = False
+    return out

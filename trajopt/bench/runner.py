@@ -140,7 +140,7 @@ def run_chunk(chunk: Chunk) -> list[dict[str, Any]]:
     return rows
 
 
-def _worker_env() -> dict[str, str]:
+def worker_env() -> dict[str, str]:
     import trajopt
 
     root = str(Path(trajopt.__file__).resolve().parents[1])
@@ -182,7 +182,7 @@ def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-            silence_logs=logging.ERROR, env=_worker_env(),
+            silence_logs=logging.ERROR, env=worker_env(),
         )
         return Client(cluster)
     if "://" not in scheduler or not scheduler.split("://", 1)[1]:

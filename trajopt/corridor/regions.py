@@ -4,17 +4,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
+from trajopt.validation import readonly
+
 __all__ = ["Box", "Corridor"]
-
-
-def _readonly(a: np.ndarray, dtype: Any) -> np.ndarray:
-    out = np.array(a, dtype=dtype, copy=True)
-    out.flags.writeable = False
-    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -155,10 +150,10 @@ class Corridor:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "boxes", tuple(self.boxes))
-        object.__setattr__(self, "path_ranges", _readonly(self.path_ranges, np.int64))
+        object.__setattr__(self, "path_ranges", readonly(self.path_ranges, np.int64))
         for name in ("transitions_m", "overlap_start_m", "overlap_end_m", "path_s"):
-            object.__setattr__(self, name, _readonly(getattr(self, name), float))
-        object.__setattr__(self, "path_points", _readonly(self.path_points, float))
+            object.__setattr__(self, name, readonly(getattr(self, name), float))
+        object.__setattr__(self, "path_points", readonly(self.path_points, float))
         lo = np.array([[b.xmin, b.ymin] for b in self.boxes], dtype=float).reshape(-1, 2)
         hi = np.array([[b.xmax, b.ymax] for b in self.boxes], dtype=float).reshape(-1, 2)
         inf = np.inf

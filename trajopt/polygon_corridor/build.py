@@ -28,6 +28,7 @@ from trajopt.polygon_corridor.regions import (
     segment_region,
     shoelace,
 )
+from trajopt.validation import nonnegative, positive
 
 __all__ = ["build_polygon_corridor"]
 
@@ -61,14 +62,6 @@ def _point_name(i: int, n: int) -> str:
     if i == n - 1:
         return "goal"
     return f"path point {i}"
-
-
-def _check_option(value: float, name: str, lo: float, strict: bool) -> float:
-    v = float(value)
-    ok = math.isfinite(v) and (v > lo if strict else v >= lo)
-    if not ok:
-        raise InvalidInputError(f"{name} must be finite and {'>' if strict else '>='} {lo}, got {value!r}")
-    return v
 
 
 def build_polygon_corridor(
@@ -144,14 +137,14 @@ def build_polygon_corridor(
     rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
     """
     occ, res, ox, oy = grid_cells(raw_grid)
-    r = _check_option(radius, "radius", 0.0, strict=True)
-    margin = _check_option(margin_cells, "margin_cells", 0.0, strict=True)
-    max_len = _check_option(max_segment_cells, "max_segment_cells", 0.0, strict=True)
-    ext = _check_option(overlap_cells, "overlap_cells", 0.0, strict=False)
-    push = _check_option(centre_cells, "centre_cells", 0.0, strict=False)
-    trigger = _check_option(centre_trigger_cells, "centre_trigger_cells", 0.0, strict=False)
-    slack = _check_option(simplify_slack_cells, "simplify_slack_cells", 0.0, strict=False)
-    open_c = _check_option(open_cells, "open_cells", 0.0, strict=False)
+    r = positive("radius", radius)
+    margin = positive("margin_cells", margin_cells)
+    max_len = positive("max_segment_cells", max_segment_cells)
+    ext = nonnegative("overlap_cells", overlap_cells)
+    push = nonnegative("centre_cells", centre_cells)
+    trigger = nonnegative("centre_trigger_cells", centre_trigger_cells)
+    slack = nonnegative("simplify_slack_cells", simplify_slack_cells)
+    open_c = nonnegative("open_cells", open_cells)
     ny, nx = occ.shape
     pts_m = _path_points(path, res, ox, oy)
     n_in = len(pts_m)

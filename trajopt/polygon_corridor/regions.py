@@ -10,6 +10,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.polygon_corridor.region_kernels import clip_convex
+from trajopt.validation import readonly
 
 __all__ = [
     "CLEARANCE_TOL_M",
@@ -32,12 +33,6 @@ CLEARANCE_TOL_M = 1e-9
 #: Slack (m) of the path-in-region tests: absorbs the rounding of points that lie on a
 #: region's boundary (a seed touching a dilated obstacle, a segment along a row).
 ROUND_M = 1e-2 * CLEARANCE_TOL_M
-
-
-def _readonly(a: Any, dtype: Any) -> np.ndarray:
-    out = np.array(a, dtype=dtype, copy=True)
-    out.flags.writeable = False
-    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -315,14 +310,14 @@ class PolygonCorridor:
         if len(self.overlaps) != m - 1:
             raise InvalidInputError(f"need {m - 1} overlaps for {m} regions, got {len(self.overlaps)}")
         for name in ("path", "input_path", "transition_points"):
-            object.__setattr__(self, name, _readonly(getattr(self, name), float).reshape(-1, 2))
+            object.__setattr__(self, name, readonly(getattr(self, name), float).reshape(-1, 2))
         for name in ("path_s", "transitions_m", "clearance_m"):
-            object.__setattr__(self, name, _readonly(getattr(self, name), float).reshape(-1))
-        object.__setattr__(self, "region_s", _readonly(self.region_s, float).reshape(-1, 2))
-        object.__setattr__(self, "overlap_s", _readonly(self.overlap_s, float).reshape(-1, 2))
-        object.__setattr__(self, "source_index", _readonly(self.source_index, np.int64).reshape(-1))
+            object.__setattr__(self, name, readonly(getattr(self, name), float).reshape(-1))
+        object.__setattr__(self, "region_s", readonly(self.region_s, float).reshape(-1, 2))
+        object.__setattr__(self, "overlap_s", readonly(self.overlap_s, float).reshape(-1, 2))
+        object.__setattr__(self, "source_index", readonly(self.source_index, np.int64).reshape(-1))
         object.__setattr__(
-            self, "region_index", _readonly(self.region_index, np.int64).reshape(-1, 2)
+            self, "region_index", readonly(self.region_index, np.int64).reshape(-1, 2)
         )
         object.__setattr__(self, "radius", float(self.radius))
         object.__setattr__(self, "resolution", float(self.resolution))

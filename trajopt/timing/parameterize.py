@@ -19,6 +19,7 @@ from trajopt.timing.cap_table import T_MIN, CapTable, build_cap_table
 from trajopt.timing.compress import compress, finish
 from trajopt.timing.ruckig_profile import RuckigProfile
 from trajopt.trajectory import Trajectory
+from trajopt.validation import nonnegative
 
 __all__ = ["time_parameterize"]
 
@@ -79,8 +80,8 @@ def time_parameterize(
                 f"curve must be a ParametricCurve (needs {name!r} and __call__), "
                 f"got {type(curve).__name__}"
             )
-    v_start = _speed("v_start", v_start)
-    v_end = _speed("v_end", v_end)
+    v_start = nonnegative("v_start", v_start, "m/s")
+    v_end = nonnegative("v_end", v_end, "m/s")
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0.0 < dt <= 0.5):
         raise InvalidInputError(f"dt must be a number in (0, 0.5] s, got {dt!r}")
     if speed_limits is not None and not isinstance(speed_limits, SpeedLimits):
@@ -188,16 +189,6 @@ def _run_greedy(
     if status != greedy.OK_FINISH:
         raise TimingError(f"the greedy timing did not finish within {max_steps} steps")
     return phases, bounds
-
-
-def _speed(name: str, value: Any) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"{name} must be a number (m/s), got {value!r}") from None
-    if not math.isfinite(x) or x < 0.0:
-        raise InvalidInputError(f"{name} must be finite and >= 0 m/s, got {value!r}")
-    return x
 
 
 def _change_distance(v0: float, v1: float, j: float, amax: float) -> float:
