@@ -8,16 +8,15 @@ so that every public function reports bad input the same way.
 from __future__ import annotations
 
 import math
-import reprlib
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from astar.validation import short_repr
 from trajopt.errors import InvalidInputError
 
 __all__ = [
-    "readonly",
     "choice",
     "heading",
     "integer",
@@ -26,21 +25,10 @@ __all__ = [
     "point",
     "points",
     "positive",
+    "readonly",
     "short_repr",
     "weights",
 ]
-
-_REPR = reprlib.Repr()
-_REPR.maxlevel = 2
-_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = 4
-_REPR.maxstring = 60
-_REPR.maxother = 80
-
-
-def short_repr(value: Any) -> str:
-    """A repr of at most about 80 characters, for error messages."""
-    return _REPR.repr(value)
-
 
 def _unit(unit: str) -> str:
     return f" ({unit})" if unit else ""
