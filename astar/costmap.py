@@ -128,7 +128,7 @@ def from_costmap(
     inscribed_occupied: bool = False,
     unknown_occupied: bool = True,
 ) -> Costmap:
-    """A :class:`Costmap` from an array of costmap cell values.
+    """Return a :class:`Costmap` from an array of costmap cell values.
 
     Parameters
     ----------

@@ -67,7 +67,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path
 
 
 def read_bytes(p: Path) -> bytes:
-    """The content of ``p``; an :class:`OSError` becomes a :class:`MapFormatError`."""
+    """Return the content of ``p``; an :class:`OSError` becomes a :class:`MapFormatError`."""
     try:
         return p.read_bytes()
     except OSError as exc:
@@ -75,7 +75,7 @@ def read_bytes(p: Path) -> bytes:
 
 
 def read_text(p: Path) -> str:
-    """The content of ``p`` decoded as UTF-8 (:class:`MapFormatError` when it is not)."""
+    """Return the content of ``p`` decoded as UTF-8 (:class:`MapFormatError` when it is not)."""
     data = read_bytes(p)
     try:
         return data.decode("utf-8")

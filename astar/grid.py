@@ -104,7 +104,7 @@ class OccupancyGrid:
         return out
 
     def with_occupied(self, occupied: np.ndarray) -> OccupancyGrid:
-        """A grid with the same resolution and origin and new occupancy (validated)."""
+        """Return a grid with the same resolution and origin and new occupancy (validated)."""
         return OccupancyGrid(occupied, self.resolution, self.origin)
 
     # ------------------------------------------------------- conversions

@@ -41,8 +41,11 @@ MAX_IMAGE_PIXELS = 89_478_485
 
 @dataclass(frozen=True, slots=True)
 class Pixels:
-    """Image pixels, top row first: ``rgb_sum`` = R + G + B (float ``[h, w]``), ``alpha``
-    (float ``[h, w]``, ``maxval`` = opaque) or None, both on the scale 0..``maxval``."""
+    """Image pixels, top row first.
+
+    ``rgb_sum`` = R + G + B (float ``[h, w]``), ``alpha`` (float ``[h, w]``, ``maxval`` =
+    opaque) or None, both on the scale 0..``maxval``.
+    """
 
     rgb_sum: np.ndarray
     alpha: np.ndarray | None

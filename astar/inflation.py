@@ -61,7 +61,7 @@ _REL_TOL = 1e-9
 
 
 def _padded(occupied: np.ndarray, outside_occupied: bool) -> tuple[np.ndarray, int]:
-    """The occupancy, with a ring of occupied cells around it when ``outside_occupied``.
+    """Return the occupancy, with a ring of occupied cells around it when ``outside_occupied``.
 
     One ring is enough: the nearest cell outside the map (centre or square) always lies in the
     ring next to the border.
@@ -117,8 +117,11 @@ def _half_widths(radius_cells: float, metric: str) -> np.ndarray:
 
 @njit(cache=True)
 def _row_distance(occ: np.ndarray, h: np.ndarray, cap: int) -> None:  # pragma: no cover
-    """``h[iy, ix]`` = distance along row ``iy`` from ``ix`` to the nearest occupied cell,
-    capped at ``cap`` (``occ`` uint8 [ny, nx]; ``h`` unsigned ints of the same shape)."""
+    """``h[iy, ix]`` = distance along row ``iy`` from ``ix`` to the nearest occupied cell.
+
+    ``h[iy, ix]`` = distance along row ``iy`` from ``ix`` to the nearest occupied cell, capped
+    at ``cap`` (``occ`` uint8 [ny, nx]; ``h`` unsigned ints of the same shape).
+    """
     ny, nx = occ.shape
     for iy in range(ny):
         last = -cap
@@ -299,7 +302,7 @@ def clearance(
 
 
 def avoidance_area(grid: OccupancyGrid, w_cells: int, *, border: bool = True) -> OccupancyGrid:
-    """The chapter's avoidance area: mark the 8 neighbours of full cells as full, ``w_cells`` times.
+    """Return the chapter's avoidance area: mark the 8 neighbours of full cells as full, ``w_cells`` times.
 
     Each round marks every free cell next to (8-neighbourhood) an occupied cell -- or to the map
     border when ``border`` is true -- as full. After ``W`` rounds a cell is full exactly when an

@@ -125,7 +125,7 @@ def _image_values(p: Path, meta: RosMeta) -> np.ndarray:
 def load_ros(
     p: Path, resolution: float | None, origin: tuple[float, float], unknown_occupied: bool
 ) -> OccupancyGrid:
-    """The grid of a map_server YAML file and its image (the rules of :func:`astar.load_map`).
+    """Return the grid of a map_server YAML file and its image (the rules of :func:`astar.load_map`).
 
     ``resolution`` and ``origin`` are the caller's (already checked) arguments: a value that
     differs from the file's is an :class:`InvalidInputError`.

@@ -86,7 +86,7 @@ class GridPath:
         object.__setattr__(self, "expanded", int(self.expanded))
 
     def __len__(self) -> int:
-        """Number of cells ``n``."""
+        """Return the number of cells ``n``."""
         return int(self.cells.shape[0])
 
     def to_world(self, grid: OccupancyGrid) -> np.ndarray:

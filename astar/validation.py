@@ -42,7 +42,7 @@ _REPR.maxother = 80
 
 
 def short_repr(value: object) -> str:
-    """A bounded repr for error messages.
+    """Return a bounded repr for error messages.
 
     YAML aliases can make a tiny file describe a structure with billions of elements (a
     "billion laughs" document), whose full repr would never finish.
@@ -51,7 +51,7 @@ def short_repr(value: object) -> str:
 
 
 def positive_float(name: str, value: object, *, allow_bool: bool = False) -> float:
-    """A finite float ``> 0``.
+    """Return a finite float ``> 0``.
 
     Booleans are not numbers, except with ``allow_bool`` (the rule of
     :class:`~astar.grid.OccupancyGrid`'s ``resolution``, which has always taken ``True``
@@ -69,7 +69,7 @@ def positive_float(name: str, value: object, *, allow_bool: bool = False) -> flo
 
 
 def nonnegative_float(name: str, value: object, unit: str) -> float:
-    """A finite float ``>= 0``; ``unit`` (e.g. ``"metres"``) is named in the message."""
+    """Return a finite float ``>= 0``; ``unit`` (e.g. ``"metres"``) is named in the message."""
     if isinstance(value, bool):
         raise InvalidInputError(f"{name} must be a number ({unit}), got {value!r}")
     try:
@@ -82,7 +82,7 @@ def nonnegative_float(name: str, value: object, unit: str) -> float:
 
 
 def nonnegative_int(name: str, value: object) -> int:
-    """An ``int`` (or NumPy integer, not a bool) ``>= 0``."""
+    """Return an ``int`` (or NumPy integer, not a bool) ``>= 0``."""
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
         raise InvalidInputError(f"{name} must be an int, got {value!r}")
     v = int(value)
@@ -92,7 +92,7 @@ def nonnegative_int(name: str, value: object) -> int:
 
 
 def origin(value: object) -> tuple[float, float]:
-    """A finite world point ``(x, y)`` in metres (the ``origin`` of a grid)."""
+    """Return a finite world point ``(x, y)`` in metres (the ``origin`` of a grid)."""
     try:
         ox, oy = (float(v) for v in value)  # type: ignore[union-attr]
     except (TypeError, ValueError):
@@ -112,7 +112,7 @@ def choice(name: str, value: object, choices: Sequence[str]) -> str:
 
 
 def grid(value: object) -> OccupancyGrid:
-    """An :class:`~astar.grid.OccupancyGrid` (the ``grid`` argument)."""
+    """Return an :class:`~astar.grid.OccupancyGrid` (the ``grid`` argument)."""
     from astar.grid import OccupancyGrid
 
     if not isinstance(value, OccupancyGrid):
@@ -121,7 +121,7 @@ def grid(value: object) -> OccupancyGrid:
 
 
 def bool_grid(occupied: object) -> np.ndarray:
-    """A non-empty 2-D occupancy, bool or 0/1 numbers, as a new read-only bool array.
+    """Return a non-empty 2-D occupancy, bool or 0/1 numbers, as a new read-only bool array.
 
     Returns
     -------
@@ -147,7 +147,7 @@ def bool_grid(occupied: object) -> np.ndarray:
 
 
 def integer_values(values: object) -> np.ndarray:
-    """A non-empty 2-D array of integers (integer dtype, or floats holding integers).
+    """Return a non-empty 2-D array of integers (integer dtype, or floats holding integers).
 
     Returns
     -------
@@ -179,7 +179,7 @@ def _is_int(v: object) -> bool:
 
 
 def cell(name: str, value: object, grid: OccupancyGrid) -> tuple[int, int]:
-    """A free cell ``(ix, iy)`` of ``grid`` (two integers, inside the grid, not occupied)."""
+    """Return a free cell ``(ix, iy)`` of ``grid`` (two integers, inside the grid, not occupied)."""
     bad = InvalidInputError(f"{name} must be a cell (ix, iy) of two integers, got {value!r}")
     if isinstance(value, (str, bytes)) or (
         isinstance(value, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in value)
@@ -208,7 +208,7 @@ def cell(name: str, value: object, grid: OccupancyGrid) -> tuple[int, int]:
 
 
 def cell_costs(cost: object, grid: OccupancyGrid) -> np.ndarray:
-    """A per-cell cost of the grid's shape, finite and ``>= 0``, as float64.
+    """Return a per-cell cost of the grid's shape, finite and ``>= 0``, as float64.
 
     Returns
     -------

@@ -74,15 +74,18 @@ class BSplineCurve(ParametricCurve):
 
     @property
     def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
         n = self.c.shape[0]
         return (float(self.t[self.k]), float(self.t[n]))
 
     def breakpoints(self) -> np.ndarray:
+        """Return the parameters where the polynomial pieces meet (with the ends)."""
         n = self.c.shape[0]
         return np.unique(self.t[self.k : n + 1])
 
     @property
     def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
         return self.k
 
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
@@ -94,7 +97,7 @@ class BSplineCurve(ParametricCurve):
         return self._spline(uu, nu)
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
-        """The ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
+        """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
         if not 1 <= nu < self.k:
             raise InvalidInputError(f"nu must be in [1, k-1] = [1, {self.k - 1}], got {nu}")
         return BSplineCurve.from_scipy(self._spline.derivative(nu))

@@ -122,8 +122,10 @@ def segment_rect_distance(ax, ay, bx, by, x0, y0, x1, y1):  # pragma: no cover -
 
 @njit(cache=True)
 def polygon_rect_closest(v, nv, x0, y0, x1, y1):  # pragma: no cover - compiled
-    """Exact distance between a convex polygon (``v[:nv]``, any orientation; 1 or 2
-    vertices for a point or a segment) and a rectangle, with a closest pair.
+    """Exact distance between a convex polygon.
+
+    Exact distance between a convex polygon (``v[:nv]``, any orientation; 1 or 2 vertices for a
+    point or a segment) and a rectangle, with a closest pair.
 
     Returns ``(d, px, py, qx, qy)``: ``p`` on the polygon, ``q`` on the rectangle; ``d = 0``
     (and ``p = q = nan``) when they meet, decided by the separating-axis theorem over the
@@ -258,8 +260,11 @@ def merge_rects(occ, x_off, y_off):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def polygon_rects_distance(v, nv, rects):  # pragma: no cover - compiled
-    """Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects``
-    (``inf`` for none)."""
+    """Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects``.
+
+    Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects`` (``inf`` for
+    none).
+    """
     best = np.inf
     for i in range(rects.shape[0]):
         d, _, _, _, _ = polygon_rect_closest(v, nv, rects[i, 0], rects[i, 1], rects[i, 2], rects[i, 3])
@@ -272,8 +277,11 @@ def polygon_rects_distance(v, nv, rects):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def point_square_dist2(px, py, occ, w, best):  # pragma: no cover - compiled
-    """``min(best, d^2)``: ``d`` the distance (cells) from ``(px, py)`` to the nearest
-    occupied unit square within ``w`` cells of its cell (outside the grid is occupied)."""
+    """``min(best, d^2)``.
+
+    ``d`` the distance (cells) from ``(px, py)`` to the nearest occupied unit square within
+    ``w`` cells of its cell (outside the grid is occupied).
+    """
     ny, nx = occ.shape
     cx = int(math.floor(px))
     cy = int(math.floor(py))
@@ -301,9 +309,12 @@ def _points_clearance_kernel(q, occ, w, cap):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def segment_squares_distance(ax, ay, bx, by, occ, w, cap, outside_occupied):  # pragma: no cover
-    """Exact distance (cells, capped at ``cap``) from a segment to the occupied unit
-    squares among the cells within ``w`` of the cell of its midpoint (and, with
-    ``outside_occupied``, the cells outside the grid)."""
+    """Exact distance (cells, capped at ``cap``).
+
+    Exact distance (cells, capped at ``cap``) from a segment to the occupied unit squares among
+    the cells within ``w`` of the cell of its midpoint (and, with ``outside_occupied``, the
+    cells outside the grid).
+    """
     ny, nx = occ.shape
     mx = int(math.floor(0.5 * (ax + bx)))
     my = int(math.floor(0.5 * (ay + by)))
@@ -324,8 +335,11 @@ def segment_squares_distance(ax, ay, bx, by, occ, w, cap, outside_occupied):  # 
 
 @njit(cache=True)
 def _polyline_kernel(q, occ, cap, outside_occupied):  # pragma: no cover - compiled
-    """Least :func:`segment_squares_distance` over the pieces (at most one cell long) of
-    the polyline ``q`` (cells)."""
+    """Least :func:`segment_squares_distance` over the pieces.
+
+    Least :func:`segment_squares_distance` over the pieces (at most one cell long) of the
+    polyline ``q`` (cells).
+    """
     w = int(math.ceil(cap)) + 2
     best = cap
     for i in range(q.shape[0] - 1):
@@ -345,8 +359,9 @@ def _polyline_kernel(q, occ, cap, outside_occupied):  # pragma: no cover - compi
 
 # ================================================================= metres
 def grid_cells(grid: Any) -> tuple[np.ndarray, float, float, float]:
-    """``(occupied, resolution, ox, oy)`` of a grid: the one place that reads a map's cell
-    geometry for the distances here.
+    """``(occupied, resolution, ox, oy)`` of a grid.
+
+    The one place that reads a map's cell geometry for the distances here.
 
     Raises
     ------
@@ -367,9 +382,11 @@ def grid_cells(grid: Any) -> tuple[np.ndarray, float, float, float]:
 
 
 def points_clearance(points: np.ndarray, grid: Any, window_m: float) -> np.ndarray:
-    """Distance (m) from each point to the nearest occupied square of ``grid`` (the outside
-    of the map counts as occupied), searched within ``window_m``: points with nothing
-    occupied that close get ``window_m``.
+    """Distance (m) from each point to the nearest occupied square of ``grid``.
+
+    Distance (m) from each point to the nearest occupied square of ``grid`` (the outside of the
+    map counts as occupied), searched within ``window_m``: points with nothing occupied that
+    close get ``window_m``.
 
     Parameters
     ----------
@@ -472,8 +489,11 @@ def polygon_clearance(polygon: Any, raw_grid: Any) -> float:
 
 
 def box_clearance(grid: Any, lo: np.ndarray, hi: np.ndarray) -> float:
-    """Exact distance (m) from the axis-aligned box ``[lo, hi]`` (a point when
-    ``lo == hi``) to the nearest occupied square or the outside of the map."""
+    """Exact distance (m) from the axis-aligned box ``[lo, hi]``.
+
+    Exact distance (m) from the axis-aligned box ``[lo, hi]`` (a point when ``lo == hi``) to the
+    nearest occupied square or the outside of the map.
+    """
     lo = np.asarray(lo, dtype=float)
     hi = np.asarray(hi, dtype=float)
     if np.array_equal(lo, hi):

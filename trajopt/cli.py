@@ -68,7 +68,7 @@ def _map_args(p: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``trajopt`` command."""
+    """Return the argument parser of the ``trajopt`` command."""
     parser = _Parser(
         prog="trajopt",
         description="Occupancy grid + start + goal -> timed, collision-free, smooth trajectory.",

@@ -1,5 +1,6 @@
-"""The planner's corridor-and-fit stage: polygons first, boxes where they fail, and the
-witness rescue of a curvature-bounded fit.
+"""The planner's corridor-and-fit stage.
+
+Polygons first, boxes where they fail, and the witness rescue of a curvature-bounded fit.
 
 Functions take the :class:`~trajopt.pipeline.Planner` (its raw map, robot, inflation,
 corridor kind and smoother) and the query record (:class:`~trajopt.plan_query.PlanQuery`),
@@ -35,8 +36,9 @@ logger = logging.getLogger("trajopt.pipeline")
 def fit_in_corridor(
     planner: Any, q: PlanQuery, path: Any, smoother: Smoother
 ) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
-    """Build the corridor around ``path`` and fit in it: polygons first (when chosen),
-    then boxes, sharing ``smoother.time_budget_s``.
+    """Build the corridor around ``path`` and fit in it.
+
+    Polygons first (when chosen), then boxes, sharing ``smoother.time_budget_s``.
 
     Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
     ``InvalidInputError``) when every corridor failed.
@@ -78,7 +80,7 @@ def fit_in_corridor(
 def witness_rescue(
     planner: Any, q: PlanQuery, exc: Exception, t_start: float
 ) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath] | None:
-    """The second try of a curvature-bounded fit, along a witness; ``None`` if none.
+    """Return the second try of a curvature-bounded fit, along a witness; ``None`` if none.
 
     A witness that keeps one cell more than the radius is tried first (its grid path
     stays off the inflated grid's edges, so the corridor has room to turn; its search

@@ -147,8 +147,11 @@ def _s_at(curve, u: np.ndarray) -> np.ndarray:
 
 
 def _to_split(k_b, k_s, ds, h, k_free, speed_cap, rtol) -> np.ndarray:
-    """Pieces to bisect: the cap binds somewhere, and the piece spans more than one grid
-    interval or its bound is loose."""
+    """Pieces to bisect.
+
+    The cap binds somewhere, and the piece spans more than one grid interval or its bound is
+    loose.
+    """
     binds = k_b > k_free
     return binds & ((ds > h) | _loose(k_b, k_s, speed_cap, rtol))
 
@@ -168,10 +171,13 @@ def _loose(bound, ref, speed_cap, rtol) -> np.ndarray:
 
 
 def _sampled_kappa(curve, a, b) -> np.ndarray:
-    """``|kappa|`` at three interior points of each interval (a hundredth of the way in from
-    either end, and the middle): a lower bound of its maximum there. Interior points keep
-    every sample on the interval's own polynomial piece (at a knot a curve reports the next
-    piece's curvature, and a zero-speed end has none)."""
+    """``|kappa|`` at three interior points of each interval.
+
+    ``|kappa|`` at three interior points of each interval (a hundredth of the way in from either
+    end, and the middle): a lower bound of its maximum there. Interior points keep every sample
+    on the interval's own polynomial piece (at a knot a curve reports the next piece's
+    curvature, and a zero-speed end has none).
+    """
     u = np.stack([a + 0.01 * (b - a), 0.5 * (a + b), b - 0.01 * (b - a)])
     d1 = np.asarray(curve(u, 1), dtype=float)
     d2 = np.asarray(curve(u, 2), dtype=float)
@@ -295,7 +301,7 @@ def _ratio_bound(X: np.ndarray, S: np.ndarray) -> np.ndarray:
 
 
 def _deriv(P: np.ndarray) -> np.ndarray:
-    """Derivative of power-basis polynomials ``P[:, i, ...]`` (coefficient of ``t^i``)."""
+    """Return the derivative of power-basis polynomials ``P[:, i, ...]`` (coefficient of ``t^i``)."""
     n = P.shape[1]
     if n == 1:
         return np.zeros_like(P)
@@ -335,7 +341,7 @@ def _power_to_bernstein(n: int) -> np.ndarray:
 
 
 def _shift_matrices(p: int) -> tuple[np.ndarray, np.ndarray]:
-    """Maps of coefficients in ``tau = t - 1/2`` to powers of ``t`` and of ``1 - t``."""
+    """Map of coefficients in ``tau = t - 1/2`` to powers of ``t`` and of ``1 - t``."""
     key = ("shift", p)
     M = _CACHE.get(key)
     if M is None:

@@ -66,7 +66,9 @@ class ParametricCurve(ABC):
 
     @property
     def polynomial_degree(self) -> int | None:
-        """Degree ``p`` when the curve is a polynomial of degree ``<= p`` between consecutive
+        """Degree ``p`` when the curve is a polynomial.
+
+        Degree ``p`` when the curve is a polynomial of degree ``<= p`` between consecutive
         :meth:`breakpoints`, else ``None`` (the default for a subclass).
 
         The timing bounds the curvature of such curves exactly (:mod:`trajopt.curvature_bound`)
@@ -141,10 +143,13 @@ class ParametricCurve(ABC):
         return table
 
     def _refined_partition(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Bisect the intervals of ``nodes`` where the quadrature of ``|c'|`` on the two
-        halves differs from that on the whole by more than ``1e-13`` of the curve's length
-        (a near-cusp, where the speed has a sharp minimum), up to 12 times; returns the
-        nodes and the length of every interval."""
+        """Bisect the intervals.
+
+        Bisect the intervals of ``nodes`` where the quadrature of ``|c'|`` on the two halves
+        differs from that on the whole by more than ``1e-13`` of the curve's length (a
+        near-cusp, where the speed has a sharp minimum), up to 12 times; returns the nodes and
+        the length of every interval.
+        """
         a, b = nodes[:-1], nodes[1:]
         seg = self._gl(a, b)
         total = max(float(seg.sum()), 1e-300)
@@ -222,7 +227,7 @@ class ParametricCurve(ABC):
 
     # ---------------------------------------------------------------- sampling
     def sample(self, n: int | None = None, *, ds: float | None = None) -> CurveSamples:
-        """Samples equally spaced in arc length.
+        """Sample equally spaced in arc length.
 
         Parameters
         ----------
@@ -317,26 +322,33 @@ class PolylineCurve(ParametricCurve):
 
     @property
     def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
         return (0.0, float(self._s[-1]))
 
     def breakpoints(self) -> np.ndarray:
+        """Return the parameters where the polynomial pieces meet (with the ends)."""
         return self._s.copy()
 
     @property
     def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
         return 1
 
     @property
     def length(self) -> float:
+        """Arc length (m)."""
         return float(self._s[-1])
 
     def s_at_u(self, u):
+        """Return the arc length (m) at parameters ``u``."""
         return np.clip(np.asarray(u, dtype=float), 0.0, self.length)
 
     def u_at_s(self, s):
+        """Return the parameters at arc lengths ``s`` (m)."""
         return np.clip(np.asarray(s, dtype=float), 0.0, self.length)
 
     def __call__(self, u, nu: int = 0) -> np.ndarray:
+        """Evaluate the ``nu``-th derivative at ``u``, shape ``(..., 2)``."""
         uu = np.clip(np.asarray(u, dtype=float), 0.0, self.length)
         seg = np.clip(np.searchsorted(self._s, uu, side="right") - 1, 0, len(self.points) - 2)
         d = self.points[seg + 1] - self.points[seg]

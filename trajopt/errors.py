@@ -33,9 +33,12 @@ class InvalidInputError(TrajoptError, _astar_errors.InvalidInputError):
 
 
 class IllPosedFitError(InvalidInputError):
-    """The data cannot determine the requested plain fit (the Schoenberg-Whitney condition
-    fails, or the collocation matrix is numerically singular); :func:`trajopt.compare`
-    records such a fit as invalid with this message."""
+    """The data cannot determine the requested plain fit.
+
+    The data cannot determine the requested plain fit (the Schoenberg-Whitney condition fails,
+    or the collocation matrix is numerically singular); :func:`trajopt.compare` records such a
+    fit as invalid with this message.
+    """
 
 
 class NoPathError(TrajoptError, _astar_errors.NoPathError):
@@ -61,13 +64,17 @@ class TimingError(TrajoptError):
 
 
 class BenchmarkError(InvalidInputError):
-    """A benchmark run cannot start: a missing map or scenario file, a scenario file for
-    another map size, an unknown method or suite, an unreachable Dask scheduler, or an
-    output dataset that does not match the run. Raised before any query is planned; the
-    message names the input, its value and the rule."""
+    """A benchmark run cannot start.
+
+    A missing map or scenario file, a scenario file for another map size, an unknown method or
+    suite, an unreachable Dask scheduler, or an output dataset that does not match the run.
+    Raised before any query is planned; the message names the input, its value and the rule.
+    """
 
 
 class PeerUnavailableError(BenchmarkError):
-    """A peer method (OMPL, python-motion-planning) was requested but its package is not
-    installed; the message says to install the ``peers`` extra
-    (``pip install 'trajopt[peers]'``)."""
+    """A peer method was requested but its package is not installed.
+
+    A peer method (OMPL, python-motion-planning) was requested but its package is not installed;
+    the message says to install the ``peers`` extra (``pip install 'trajopt[peers]'``).
+    """

@@ -85,8 +85,11 @@ def turn_limits(robot: Robot) -> tuple[float, float, float]:
 
 # ====================================================================== ruckig
 class _RestToRest:
-    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits
-    (the timing's ruckig wrapper, without its velocity margin)."""
+    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d``.
+
+    Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits (the
+    timing's ruckig wrapper, without its velocity margin).
+    """
 
     def __init__(self, vmax: float, amax: float, jmax: float) -> None:
         from trajopt.timing.ruckig_profile import RuckigProfile
@@ -237,7 +240,7 @@ class StopAndTurnTrajectory(SampledExport):
         return seg, sig, v, a, j
 
     def motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
-        """The motion along the path: ``(s, v, a, jerk)`` at times ``t`` (s).
+        """Return the motion along the path: ``(s, v, a, jerk)`` at times ``t`` (s).
 
         Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
         ``(length, 0, 0, 0)``. During a turn ``v = a = jerk = 0``.
@@ -248,7 +251,7 @@ class StopAndTurnTrajectory(SampledExport):
         return self._seg_s[seg] + sig, v, a, j
 
     def heading_motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
-        """The heading: ``(theta, omega, alpha, zeta)`` at times ``t`` (s).
+        """Return the heading: ``(theta, omega, alpha, zeta)`` at times ``t`` (s).
 
         Heading (rad, unwrapped), yaw rate (rad/s), yaw acceleration (rad/s^2) and yaw jerk
         (rad/s^3); ``omega = alpha = zeta = 0`` while driving. At and after ``duration``:
@@ -313,7 +316,7 @@ class StopAndTurnTrajectory(SampledExport):
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
-        """A JSON-ready description: units, robot, stats, vertices, exact phases, samples.
+        """Return a JSON-ready description: units, robot, stats, vertices, exact phases, samples.
 
         Parameters
         ----------
@@ -511,7 +514,7 @@ def stop_and_turn(
 
 
 def _clean_points(points: Any) -> np.ndarray:
-    """Validated ``(n, 2)`` float vertices without short segments and straight-on vertices."""
+    """Return validated ``(n, 2)`` float vertices without short segments and straight-on vertices."""
     try:
         p = np.array(points, dtype=float)
     except (TypeError, ValueError) as exc:

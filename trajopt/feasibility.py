@@ -52,7 +52,7 @@ def curvature_witness(
     max_expansions: int = 200_000,
     time_limit_s: float = 30.0,
 ) -> np.ndarray | None:
-    """A curvature-bounded, collision-free path from ``start`` to ``goal``, or ``None``.
+    """Return a curvature-bounded, collision-free path from ``start`` to ``goal``, or ``None``.
 
     Parameters
     ----------
@@ -208,10 +208,11 @@ def _primitive(x, y, th, kind, step, turn_r, occ, w, r):
 
 @njit(cache=True)
 def _finish(x, y, th, gx, gy, turn_r, occ, w, r):
-    """An arc (radius ``turn_r``, either side) then a straight line to ``(gx, gy)``, checked.
+    """Return an arc (radius ``turn_r``, either side) then a straight line to ``(gx, gy)``, checked.
 
     Returns ``(psi, side)``: the arc's turning angle and side (+1 left, -1 right), or side 0
-    when neither is free."""
+    when neither is free.
+    """
     for side in (1, -1):
         cx = x - side * turn_r * math.sin(th)
         cy = y + side * turn_r * math.cos(th)
@@ -257,8 +258,11 @@ def _finish(x, y, th, gx, gy, turn_r, occ, w, r):
 
 @njit(cache=True)
 def _distance_field(occ, w, r, gx, gy):
-    """8-connected step counts from the goal cell over cells that may hold a free point
-    (centre clearance >= ``r - sqrt(2)/2``); a heuristic in cells (inf elsewhere)."""
+    """8-connected step counts from the goal cell over cells that may hold a free point.
+
+    8-connected step counts from the goal cell over cells that may hold a free point (centre
+    clearance >= ``r - sqrt(2)/2``); a heuristic in cells (inf elsewhere).
+    """
     ny, nx = occ.shape
     relax = max(0.0, r - 0.7072)
     free = np.zeros((ny, nx), dtype=np.bool_)
@@ -290,7 +294,7 @@ def _distance_field(occ, w, r, gx, gy):
 
 
 def witness_grid_path(witness: np.ndarray, inflated_grid: Any) -> np.ndarray | None:
-    """A grid path of ``inflated_grid`` that follows ``witness`` (for the witness rescue).
+    """Return a grid path of ``inflated_grid`` that follows ``witness`` (for the witness rescue).
 
     The cells the witness passes through are taken in order; those blocked in the inflated
     grid (a witness point may keep the exact clearance where its cell centre does not) are

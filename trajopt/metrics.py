@@ -113,12 +113,12 @@ class PathMetrics:
     n_samples: int
 
     def as_dict(self) -> dict[str, Any]:
-        """The metrics as a plain ``dict`` (field order)."""
+        """Return the metrics as a plain ``dict`` (field order)."""
         return asdict(self)
 
     @classmethod
     def nan(cls, sample_spacing: float = math.nan) -> PathMetrics:
-        """A record of NaNs (``collision=False``): for a method that produced no path."""
+        """Return a record of NaNs (``collision=False``): for a method that produced no path."""
         vals: dict[str, Any] = {f: math.nan for f in cls.__dataclass_fields__}
         vals.update(collision=False, sample_spacing_m=sample_spacing, n_samples=0)
         return cls(**vals)

@@ -347,8 +347,11 @@ class Planner:
         return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind)
 
     def _smooth(self, q: PlanQuery) -> SmoothPath:
-        """The corridor and the certified curve (``q.path``, ``q.corridor``), with the
-        witness rescue of a curvature-bounded fit."""
+        """Return the corridor and the certified curve.
+
+        The corridor and the certified curve (``q.path``, ``q.corridor``), with the witness
+        rescue of a curvature-bounded fit.
+        """
         t_start = time.perf_counter()
         try:
             q.corridor, smooth = fit_in_corridor(self, q, q.path, self.smoother)
@@ -376,7 +379,7 @@ class Planner:
             )
 
     def _result(self, q: PlanQuery, traj: Any, smooth: SmoothPath | None, **extra: Any) -> Any:
-        """The one place that attaches :class:`PlanSteps` and the planner's statistics."""
+        """Return the one place that attaches :class:`PlanSteps` and the planner's statistics."""
         stages = q.timer.finish()
         steps = PlanSteps(
             raw_grid=self.grid,
@@ -396,7 +399,7 @@ class Planner:
         return dataclasses.replace(traj, stats=stats, steps=steps)
 
     def _fallback(self, q: PlanQuery, exc: Exception) -> StopAndTurnTrajectory:
-        """The stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
+        """Return the stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
         with q.timer.stage("fallback"):
             grid = self.grid
             if q.corridor is None:
@@ -545,7 +548,7 @@ def _check_speed_limits(limits: object, grid: OccupancyGrid) -> None:
 
 
 def _cell(c: np.ndarray) -> tuple[int, int]:
-    """A cell ``(ix, iy)`` as plain ints (for messages)."""
+    """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
     return (int(c[0]), int(c[1]))
 
 
@@ -555,7 +558,7 @@ def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
 
 
 def compare_method(ctx: Any) -> Any:
-    """The proposed method as a :func:`trajopt.compare` row (registered as ``"proposed"``).
+    """Return the proposed method as a :func:`trajopt.compare` row (registered as ``"proposed"``).
 
     Plans with :class:`Planner` on ``ctx.grid`` for a :class:`Robot` of radius
     ``ctx.robot_radius`` (default limits; options ``robot``, ``inflation``, ``search`` and

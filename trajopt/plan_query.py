@@ -1,5 +1,8 @@
-"""One planning query as a record: what was asked, what each stage produced, how long each
-stage took; and :class:`PlanSteps`, the intermediate results a trajectory carries."""
+"""One planning query as a record.
+
+What was asked, what each stage produced, how long each stage took; and :class:`PlanSteps`, the
+intermediate results a trajectory carries.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,7 @@
-"""Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11),
-and time plots of a trajectory with its limits.
+"""Figures: the map with avoidance area, corridor and paths.
+
+Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11), and time
+plots of a trajectory with its limits.
 
 matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
 Every function returns the matplotlib objects it drew on, for further styling.
@@ -109,7 +111,7 @@ def plot_paths(
     zoom: tuple[float, float, float, float] | None = None,
     ax: Any = None,
 ) -> tuple[Any, Any]:
-    """The map with every method's path (the chapter's Figures 7-10; with ``zoom``, 11).
+    """Return the map with every method's path (the chapter's Figures 7-10; with ``zoom``, 11).
 
     Parameters
     ----------

@@ -120,7 +120,7 @@ class Robot:
         return cap
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
+        """Return the fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
         return asdict(self)
 
 
@@ -129,9 +129,10 @@ def _positive(name: str, value: Any) -> float:
 
 
 def avoidance_width(width_m: float, resolution_m: float) -> int:
-    """The chapter's avoidance-area width ``W`` in cells: the fewest whole cells that cover
-    the robot's width (``ceil(width / resolution)``, with a 1e-9 tolerance for round-off so
-    that 0.33 m on 0.03 m cells is 11), and at least 1.
+    """Return the chapter's avoidance-area width ``W`` in cells.
+
+    The fewest whole cells that cover the robot's width (``ceil(width / resolution)``, with a
+    1e-9 tolerance for round-off so that 0.33 m on 0.03 m cells is 11), and at least 1.
 
     Parameters
     ----------

@@ -119,7 +119,7 @@ def _uses(name: str) -> list[str]:
 
 
 def message_definition(datatype: str) -> str:
-    """The ``ros2msg`` schema text of ``datatype`` (e.g. ``"nav_msgs/msg/Path"``)."""
+    """Return the ``ros2msg`` schema text of ``datatype`` (e.g. ``"nav_msgs/msg/Path"``)."""
     short = datatype.replace("/msg/", "/")
     parts = [_DEFS[short]]
     for dep in _uses(short):
@@ -129,8 +129,11 @@ def message_definition(datatype: str) -> str:
 
 # ============================================================== CDR encoding
 class _Cdr:
-    """Little-endian CDR (XCDR1) writer: primitives aligned to their size from the start
-    of the payload (after the 4-byte encapsulation header)."""
+    """Little-endian CDR (XCDR1) writer.
+
+    Primitives aligned to their size from the start of the payload (after the 4-byte
+    encapsulation header).
+    """
 
     __slots__ = ("buf",)
 

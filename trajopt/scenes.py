@@ -130,7 +130,7 @@ def _xy(value: object, name: str) -> tuple[float, float]:
 
 
 def paper() -> Scene:
-    """The chapter's setting, reconstructed: 4.5 m x 4.5 m room, square obstacles, SP, A-D.
+    """Return the chapter's setting, reconstructed: 4.5 m x 4.5 m room, square obstacles, SP, A-D.
 
     The chapter gives the grid (150 x 150 cells of 0.03 m, origin (0, 0)), the robot
     (width 0.33 m, so ``W = 0.33 / 0.03 = 11`` cells of avoidance area), a start point SP

@@ -146,7 +146,7 @@ class SpeedLimits:
         return ox, ox + nx * self.resolution, oy, oy + ny * self.resolution
 
     def speed_caps(self, v_max: float) -> np.ndarray:
-        """The limit per cell in m/s (shape ``(ny, nx)``), ``inf`` where there is none.
+        """Return the limit per cell in m/s (shape ``(ny, nx)``), ``inf`` where there is none.
 
         Parameters
         ----------

@@ -79,7 +79,7 @@ class TrajectorySample(NamedTuple):
     v_right: np.ndarray | None = None
 
     def as_dict(self) -> dict[str, np.ndarray]:
-        """The arrays by name (``v_left``/``v_right`` only when present)."""
+        """Return the arrays by name (``v_left``/``v_right`` only when present)."""
         return {k: v for k, v in self._asdict().items() if v is not None}
 
 
@@ -95,7 +95,7 @@ class SampledExport:
     __slots__ = ()
 
     def sample_uniform(self, dt: float) -> TrajectorySample:
-        """Samples every ``dt`` seconds from 0, plus the end time ``duration``.
+        """Sample every ``dt`` seconds from 0, plus the end time ``duration``.
 
         Parameters
         ----------
@@ -203,8 +203,11 @@ def _frame_id(value: object) -> str:
 
 
 def export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:
-    """The ``to_dict`` layout shared by the trajectory classes: a header (format, units,
-    duration, length, end speeds, robot, stats), then ``extra``, then the ``samples``."""
+    """Return the ``to_dict`` layout shared by the trajectory classes.
+
+    A header (format, units, duration, length, end speeds, robot, stats), then ``extra``, then
+    the ``samples``.
+    """
     smp = traj.sample_uniform(dt).as_dict()
     units = {k: u for k, u in SAMPLE_UNITS.items() if k in smp}
     out: dict[str, Any] = {
@@ -317,7 +320,7 @@ class Trajectory(SampledExport):
         return int(self.phase_t.shape[0])
 
     def motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
-        """The motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
+        """Return the motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
 
         Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
         ``(length, v_end, 0, 0)``.
@@ -341,10 +344,13 @@ class Trajectory(SampledExport):
         return s, v, a, j
 
     def _u_at_s(self, s: np.ndarray) -> np.ndarray:
-        """Curve parameter at arc length ``s``: the dense ``u_grid`` table, then Newton steps
-        on ``path.s_at_u``, repeated (at most 6) where a step moved ``u`` by more than 1e-9
-        of the domain (near a sharp curvature peak the table's first guess can be 1e-5 of
-        the domain off). Falls back to ``path.u_at_s`` without a table."""
+        """Curve parameter at arc length ``s``.
+
+        The dense ``u_grid`` table, then Newton steps on ``path.s_at_u``, repeated (at most 6)
+        where a step moved ``u`` by more than 1e-9 of the domain (near a sharp curvature peak
+        the table's first guess can be 1e-5 of the domain off). Falls back to ``path.u_at_s``
+        without a table.
+        """
         path = self.path
         if self.u_grid.shape[0] < 2:
             return np.asarray(path.u_at_s(s))
@@ -414,7 +420,7 @@ class Trajectory(SampledExport):
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
-        """A JSON-ready description: units, robot, stats, the exact phases and samples.
+        """Return a JSON-ready description: units, robot, stats, the exact phases and samples.
 
         Parameters
         ----------

@@ -43,8 +43,11 @@ def number(
     strict: bool = False,
     hi: float | None = None,
 ) -> float:
-    """A finite float, optionally bounded below (``> lo`` if ``strict``, else ``>= lo``)
-    and above (``<= hi``). Booleans and strings are not numbers."""
+    """Return a finite float, optionally bounded below.
+
+    A finite float, optionally bounded below (``> lo`` if ``strict``, else ``>= lo``) and above
+    (``<= hi``). Booleans and strings are not numbers.
+    """
     if isinstance(value, bool | np.bool_ | str | bytes):
         raise InvalidInputError(f"{name} must be a number{_unit(unit)}, got {value!r}")
     try:
@@ -70,17 +73,17 @@ def number(
 
 
 def positive(name: str, value: Any, unit: str = "") -> float:
-    """A finite float ``> 0``."""
+    """Return a finite float ``> 0``."""
     return number(name, value, unit=unit, lo=0.0, strict=True)
 
 
 def nonnegative(name: str, value: Any, unit: str = "") -> float:
-    """A finite float ``>= 0``."""
+    """Return a finite float ``>= 0``."""
     return number(name, value, unit=unit, lo=0.0)
 
 
 def integer(name: str, value: Any, lo: int, hi: int | None = None) -> int:
-    """An integer (not a bool) in ``[lo, hi]`` (``hi`` open when None)."""
+    """Return an integer (not a bool) in ``[lo, hi]`` (``hi`` open when None)."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, int | np.integer):
         raise InvalidInputError(f"{name} must be an integer, got {short_repr(value)}")
     v = int(value)
@@ -99,14 +102,14 @@ def choice(name: str, value: Any, choices: Sequence[Any]) -> Any:
 
 
 def heading(name: str, value: Any) -> float | None:
-    """An angle in radians (finite float) or None."""
+    """Return an angle in radians (finite float) or None."""
     if value is None:
         return None
     return number(name, value, unit="rad")
 
 
 def point(name: str, value: Any) -> np.ndarray:
-    """A finite ``(x, y)`` in metres, as a new float array of shape (2,)."""
+    """Return a finite ``(x, y)`` in metres, as a new float array of shape (2,)."""
     try:
         p = np.array(value, dtype=float)
     except (TypeError, ValueError):
@@ -125,8 +128,11 @@ def point(name: str, value: Any) -> np.ndarray:
 def points(
     name: str, value: Any, *, min_points: int = 2, max_points: int | None = None
 ) -> np.ndarray:
-    """Finite world points (m), a new float array of shape ``(n, 2)`` with
-    ``min_points <= n <= max_points``."""
+    """Finite world points.
+
+    Finite world points (m), a new float array of shape ``(n, 2)`` with ``min_points <= n <=
+    max_points``.
+    """
     if hasattr(value, "cells"):
         raise InvalidInputError(
             f"{name} must be world coordinates (m), shape (n, 2); convert a GridPath with "
@@ -173,7 +179,7 @@ def weights(name: str, value: Any, n: int, *, positive: bool = False) -> np.ndar
 
 
 def readonly(value: Any, dtype: Any = float) -> np.ndarray:
-    """A read-only copy of ``value`` as an array of ``dtype`` (the values' stored arrays)."""
+    """Return a read-only copy of ``value`` as an array of ``dtype`` (the values' stored arrays)."""
     out = np.array(value, dtype=dtype, copy=True)
     out.flags.writeable = False
     return out

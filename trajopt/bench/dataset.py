@@ -70,7 +70,7 @@ _DEFAULTS = {_STR: "", _INT: -1, _FLT: float("nan"), _BOOL: False}
 
 
 def schema() -> Any:
-    """The dataset's :class:`pyarrow.Schema` (:data:`COLUMNS`)."""
+    """Return the dataset's :class:`pyarrow.Schema` (:data:`COLUMNS`)."""
     import pyarrow as pa
 
     types = {_STR: pa.string(), _INT: pa.int64(), _FLT: pa.float64(), _BOOL: pa.bool_()}
@@ -98,7 +98,7 @@ def _normalize(row: Mapping[str, Any], worker: str) -> dict[str, Any]:
 
 
 def part_files(out: str | os.PathLike[str]) -> list[Path]:
-    """The finished chunk files of a dataset folder, sorted by name."""
+    """Return the finished chunk files of a dataset folder, sorted by name."""
     d = Path(out)
     return sorted(p for p in d.glob("part-*.parquet") if p.is_file()) if d.is_dir() else []
 
@@ -144,7 +144,7 @@ def write_chunk(out: str | os.PathLike[str], chunk_id: str,
 
 
 def existing_keys(out: str | os.PathLike[str]) -> set[tuple[str, str]]:
-    """The ``(query_id, method)`` pairs a dataset folder already holds."""
+    """Return the ``(query_id, method)`` pairs a dataset folder already holds."""
     files = part_files(out)
     if not files:
         return set()

@@ -110,7 +110,7 @@ class MapContext:
         return 0.05 * float(self.grid.resolution)
 
     def planner(self, variant: str) -> Any:
-        """The planner of a trajopt variant (built once per map)."""
+        """Return the planner of a trajopt variant (built once per map)."""
         if variant not in self.planners:
             from trajopt.pipeline import Planner
             from trajopt.robot import Robot
@@ -163,8 +163,11 @@ class QueryContext:
     reference: np.ndarray
 
     def comparison_context(self) -> Any:
-        """A :class:`trajopt.comparison.ComparisonContext` whose avoidance area is the
-        inflated grid and whose reference is this query's reference (for the plain fits)."""
+        """Return the context of one query for the plain fits.
+
+        A :class:`trajopt.comparison.ComparisonContext` whose avoidance area is the inflated
+        grid and whose reference is this query's reference (for the plain fits).
+        """
         from trajopt.comparison import ComparisonContext
 
         m = self.map

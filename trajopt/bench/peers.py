@@ -51,7 +51,7 @@ def require(module: str, method: str) -> None:
 
 
 def corner_points(points: np.ndarray) -> np.ndarray:
-    """The vertices of a polyline where its direction changes, ends included.
+    """Return the vertices of a polyline where its direction changes, ends included.
 
     Parameters
     ----------

@@ -92,7 +92,7 @@ def summary(data: Any) -> Any:
 
 
 def format_summary(table: Any) -> str:
-    """The summary as a fixed-width text table (one line per method)."""
+    """Return the summary as a fixed-width text table (one line per method)."""
     heads = {
         "queries": "queries", "feasible": "feasible", "success": "success",
         "success_pct": "success %", "collisions": "collisions",
@@ -123,9 +123,11 @@ def format_summary(table: Any) -> str:
 
 
 def figures(data: Any, out_dir: str | os.PathLike[str]) -> list[Path]:
-    """Distribution plots per method (successful rows): compute time, length ratio,
-    clearance / radius, max curvature x radius. Writes ``distributions.png`` and
-    ``outcomes.png`` (success, collision and failure counts) into ``out_dir``.
+    """Distribution plots per method (successful rows).
+
+    Compute time, length ratio, clearance / radius, max curvature x radius. Writes
+    ``distributions.png`` and ``outcomes.png`` (success, collision and failure counts) into
+    ``out_dir``.
 
     Returns
     -------
@@ -190,8 +192,11 @@ def figures(data: Any, out_dir: str | os.PathLike[str]) -> list[Path]:
 
 def report(dataset: str | os.PathLike[str], figures_dir: str | os.PathLike[str] | None = None
            ) -> str:
-    """Read a dataset, return the summary table as text, and write the figures when
-    ``figures_dir`` is given."""
+    """Read a dataset, return the summary table as text.
+
+    Read a dataset, return the summary table as text, and write the figures when ``figures_dir``
+    is given.
+    """
     df = _frame(dataset)
     text = format_summary(summary(df))
     if figures_dir is not None:

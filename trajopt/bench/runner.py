@@ -101,8 +101,11 @@ class RunSummary:
 
 def make_chunks(sources: Sequence[MapQueries], methods: Sequence[str],
                 done: set[tuple[str, str]], chunk_size: int) -> list[Chunk]:
-    """Cut the (query, method) pairs not in ``done`` into chunks of ``chunk_size`` queries
-    of one map (in map order, then query order)."""
+    """Cut the (query, method) pairs not in ``done`` into chunks.
+
+    Cut the (query, method) pairs not in ``done`` into chunks of ``chunk_size`` queries of one
+    map (in map order, then query order).
+    """
     chunks: list[Chunk] = []
     for mq in sources:
         todo = []
@@ -154,8 +157,11 @@ def worker_env() -> dict[str, str]:
 
 
 def _quiet_dask() -> None:
-    """Keep the in-process scheduler's INFO lines off the terminal unless the root logger
-    is at INFO or below (``trajopt -v``): dask gives its loggers their own levels."""
+    """Keep the in-process scheduler's INFO lines off the terminal.
+
+    Keep the in-process scheduler's INFO lines off the terminal unless the root logger is at
+    INFO or below (``trajopt -v``): dask gives its loggers their own levels.
+    """
     if logging.getLogger().getEffectiveLevel() <= logging.INFO:
         return
     names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed")]
@@ -164,7 +170,7 @@ def _quiet_dask() -> None:
 
 
 def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10.0) -> Any:
-    """A :class:`distributed.Client` for ``scheduler`` (``"local"`` or an address).
+    """Return a :class:`distributed.Client` for ``scheduler`` (``"local"`` or an address).
 
     With ``"local"`` the client owns a new :class:`distributed.LocalCluster` of
     ``workers`` processes (default ``os.cpu_count()``), closed with the client

@@ -104,8 +104,10 @@ class MapQueries:
 
 
 def data_dir(path: str | os.PathLike[str] | None = None) -> Path:
-    """The shared data folder: ``path``, else ``$TRAJOPT_DATA``, else ``shared/data`` beside
-    the repository checkout that holds this package.
+    """Return the shared data folder.
+
+    ``path``, else ``$TRAJOPT_DATA``, else ``shared/data`` beside the repository checkout that
+    holds this package.
 
     Raises
     ------
@@ -127,8 +129,11 @@ def data_dir(path: str | os.PathLike[str] | None = None) -> Path:
 
 
 def select_evenly(items: Sequence, limit: int | None) -> list:
-    """``limit`` items spread evenly over ``items`` (the first and the last always included;
-    all when ``limit`` is None or >= the length). Deterministic."""
+    """``limit`` items spread evenly over ``items``.
+
+    ``limit`` items spread evenly over ``items`` (the first and the last always included; all
+    when ``limit`` is None or >= the length). Deterministic.
+    """
     n = len(items)
     if limit is None or limit >= n:
         return list(items)
@@ -177,7 +182,7 @@ def movingai_queries(
     radius_cells: float = DEFAULT_RADIUS_CELLS,
     feasible_only: bool = False,
 ) -> MapQueries:
-    """The scenarios of a Moving AI ``.scen`` file as a :class:`MapQueries`.
+    """Return the scenarios of a Moving AI ``.scen`` file as a :class:`MapQueries`.
 
     Parameters
     ----------
@@ -374,7 +379,7 @@ def suite(
     radius_m: float = DEFAULT_RADIUS_M,
     seed: int = 0,
 ) -> list[MapQueries]:
-    """A named suite of the shared maps (:data:`SUITES`).
+    """Return a named suite of the shared maps (:data:`SUITES`).
 
     ``shared-small``: a few scenarios of three Moving AI maps and a few random
     queries on two ROS maps (a minute on one core); ``shared-full``: every scenario of seven

@@ -1,5 +1,8 @@
-"""The chapter's comparison methods (A*, A* + avoidance area, the polynomial and B-spline
-fits) and the proposed method, registered in the order the table shows them."""
+"""The chapter's comparison methods.
+
+The chapter's comparison methods (A*, A* + avoidance area, the polynomial and B-spline fits) and
+the proposed method, registered in the order the table shows them.
+"""
 
 from __future__ import annotations
 

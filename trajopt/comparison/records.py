@@ -1,5 +1,8 @@
-"""What the comparison methods share and return: :class:`ComparisonContext` (built once
-per :func:`trajopt.compare` call) and :class:`MethodResult`."""
+"""What the comparison methods share and return.
+
+:class:`ComparisonContext` (built once per :func:`trajopt.compare` call) and
+:class:`MethodResult`.
+"""
 
 from __future__ import annotations
 
@@ -98,7 +101,7 @@ class ComparisonContext:
         object.__setattr__(self, "timings", MappingProxyType(dict(self.timings)))
 
     def options_for(self, name: str) -> dict[str, Any]:
-        """A fresh dict of the options given for method ``name`` (empty when none)."""
+        """Return a fresh dict of the options given for method ``name`` (empty when none)."""
         return dict(self.options.get(name, {}))
 
     def points(self, grid_path: Any) -> np.ndarray:

@@ -1,5 +1,8 @@
-"""The registry of comparison methods: names, callables (or lazy ``"module:attr"``
-targets) and whether :func:`trajopt.compare` runs them by default."""
+"""The registry of comparison methods.
+
+Names, callables (or lazy ``"module:attr"`` targets) and whether :func:`trajopt.compare` runs
+them by default.
+"""
 
 from __future__ import annotations
 
@@ -23,14 +26,16 @@ __all__ = [
 
 @dataclass(frozen=True, slots=True)
 class MethodSpec:
-    """A registered method: its callable or ``"module:attr"`` target, and whether it runs
-    by default."""
+    """A registered method.
+
+    Its callable or ``"module:attr"`` target, and whether it runs by default.
+    """
 
     target: MethodFn | str
     default: bool
 
     def resolve(self) -> MethodFn:
-        """The callable (a ``"module:attr"`` target is imported now)."""
+        """Return the callable (a ``"module:attr"`` target is imported now)."""
         if callable(self.target):
             return self.target
         module, _, attr = self.target.partition(":")
@@ -102,7 +107,7 @@ def registered_methods(*, default_only: bool = False) -> tuple[str, ...]:
 
 
 def resolve_method(name: str) -> MethodFn:
-    """The callable of a registered method (imported now if registered as "module:attr").
+    """Return the callable of a registered method (imported now if registered as "module:attr").
 
     Raises
     ------

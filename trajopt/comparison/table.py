@@ -70,7 +70,7 @@ class ComparisonTable:
         return tuple(str(r["method"]) for r in self.rows)
 
     def row(self, method: str) -> Mapping[str, Any]:
-        """The row of ``method`` (:class:`InvalidInputError` when absent)."""
+        """Return the row of ``method`` (:class:`InvalidInputError` when absent)."""
         for r in self.rows:
             if r["method"] == method:
                 return r
@@ -80,11 +80,11 @@ class ComparisonTable:
         return len(self.rows)
 
     def to_records(self) -> list[dict[str, Any]]:
-        """A list of plain dicts, one per method (fresh copies)."""
+        """Return a list of plain dicts, one per method (fresh copies)."""
         return [dict(r) for r in self.rows]
 
     def to_text(self, *, transpose: bool = True, columns: Sequence[str] | None = None) -> str:
-        """An aligned plain-text table.
+        """Return an aligned plain-text table.
 
         Parameters
         ----------
@@ -127,7 +127,7 @@ class ComparisonTable:
         return self.to_text()
 
     def to_markdown(self) -> str:
-        """A GitHub-flavoured Markdown table, one row per method."""
+        """Return a GitHub-flavoured Markdown table, one row per method."""
         cols = list(self.columns)
 
         def esc(s: str) -> str:
@@ -150,7 +150,7 @@ class ComparisonTable:
         return p
 
     def to_dataframe(self) -> Any:
-        """A :class:`pandas.DataFrame` indexed by method (pandas imported here)."""
+        """Return a :class:`pandas.DataFrame` indexed by method (pandas imported here)."""
         try:
             import pandas as pd
         except ImportError as exc:

@@ -1,5 +1,7 @@
-"""45-degree *bridges* of the box corridor: certified rotated rectangles where the path
-crosses diagonally between two boxes that meet only at a point or along a line.
+"""45-degree *bridges* of the box corridor.
+
+Certified rotated rectangles where the path crosses diagonally between two boxes that meet only
+at a point or along a line.
 
 A bridge is grown around the path while its exact distance to every occupied square of
 the raw map (and to the outside of the map) stays at least the radius
@@ -18,8 +20,11 @@ __all__ = ["bridge_box", "diagonal_bridge", "insert_bridges", "rotated_rect_clea
 
 
 def occupied_squares(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
-    """Lower-left corners (cells) of the occupied unit squares among cells ``x0..x1`` by
-    ``y0..y1``; cells outside the map count as occupied. Shape (M, 2)."""
+    """Lower-left corners.
+
+    Lower-left corners (cells) of the occupied unit squares among cells ``x0..x1`` by
+    ``y0..y1``; cells outside the map count as occupied. Shape (M, 2).
+    """
     ny, nx = occ.shape
     xs = np.arange(x0, x1 + 1)
     ys = np.arange(y0, y1 + 1)
@@ -72,8 +77,10 @@ def diagonal_bridge(
     max_width: float = 4.0,
     min_width: float = 0.5,
 ) -> tuple[float, float, float, float] | None:
-    """A certified 45-degree rectangle (cell units, ``(smin, smax, dmin, dmax)``) around the
-    path near cell ``t`` when the path runs diagonally there, else ``None``.
+    """Return a certified 45-degree rectangle.
+
+    A certified 45-degree rectangle (cell units, ``(smin, smax, dmin, dmax)``) around the path
+    near cell ``t`` when the path runs diagonally there, else ``None``.
 
     Seeded with the path cell centres ``t - k .. t + k`` (``k <= reach``, reduced until
     the seed is certified), then grown ``step`` at a time, round-robin across and along the
@@ -168,8 +175,11 @@ def in_bridge(dg: tuple[float, float, float, float], cell: np.ndarray) -> bool:
 
 
 def insert_bridges(rects, runs, cells, raw_occ, radius_cells):
-    """Insert a certified 45-degree bridge between consecutive boxes whose shrunk boxes
-    meet only at a point or along a line, where the path crosses them diagonally."""
+    """Insert certified 45-degree bridges between boxes that meet only at a point or line.
+
+    Insert a certified 45-degree bridge between consecutive boxes whose shrunk boxes meet only
+    at a point or along a line, where the path crosses them diagonally.
+    """
     out_r = [rects[0]]
     out_run = [runs[0]]
     out_d: list = [None]

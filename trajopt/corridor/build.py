@@ -208,8 +208,11 @@ def build_corridor(
 def _place_transitions(
     lo: np.ndarray, hi: np.ndarray, length: float, min_share: float
 ) -> np.ndarray:
-    """Transitions at the overlap midpoints, then nudged (inside their overlaps) so that
-    every box's share is at least ``min_share`` where the overlaps allow it."""
+    """Transitions at the overlap midpoints, then nudged.
+
+    Transitions at the overlap midpoints, then nudged (inside their overlaps) so that every
+    box's share is at least ``min_share`` where the overlaps allow it.
+    """
     t = 0.5 * (lo + hi)
     m = len(t)
     if m == 0:

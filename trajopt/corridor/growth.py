@@ -25,6 +25,7 @@ class RectTester:
         self.x_off, self.y_off = x0, y0
 
     def free(self, x0: int, x1: int, y0: int, y1: int) -> bool:
+        """Return whether the cell rectangle ``[x0, x1] x [y0, y1]`` is all free."""
         x0 -= self.x_off
         x1 -= self.x_off
         y0 -= self.y_off
@@ -38,8 +39,11 @@ class RectTester:
 def grow_boxes(
     cells: np.ndarray, tester: RectTester, cap: int, seed_back: int
 ) -> tuple[list[tuple[int, int, int, int]], list[tuple[int, int]]]:
-    """Boxes ``(x0, x1, y0, y1)`` (inclusive cells) covering the path ``cells`` in order,
-    and the run of path cells ``(a, b)`` each one holds (see :func:`build_corridor`)."""
+    """Boxes ``(x0, x1, y0, y1)``.
+
+    Boxes ``(x0, x1, y0, y1)`` (inclusive cells) covering the path ``cells`` in order, and the
+    run of path cells ``(a, b)`` each one holds (see :func:`build_corridor`).
+    """
     n = len(cells)
     rects: list[tuple[int, int, int, int]] = []
     runs: list[tuple[int, int]] = []

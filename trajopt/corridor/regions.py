@@ -1,5 +1,8 @@
-"""The box corridor's values: :class:`Box` (an axis-aligned box of free cells, or a
-45-degree bridge) and :class:`Corridor` (the chain of boxes around a path)."""
+"""The box corridor's values.
+
+:class:`Box` (an axis-aligned box of free cells, or a 45-degree bridge) and :class:`Corridor`
+(the chain of boxes around a path).
+"""
 
 from __future__ import annotations
 
@@ -187,14 +190,18 @@ class Corridor:
 
     @property
     def diag_lower(self) -> np.ndarray:
-        """Lower bounds ``(smin, dmin)`` on ``x + y`` and ``x - y`` (m), shape (m, 2);
-        ``-inf`` for axis-aligned boxes."""
+        """Lower bounds ``(smin, dmin)`` on ``x + y`` and ``x - y`` (m), shape (m, 2).
+
+        ``-inf`` for axis-aligned boxes.
+        """
         return self._dlo
 
     @property
     def diag_upper(self) -> np.ndarray:
-        """Upper bounds ``(smax, dmax)`` on ``x + y`` and ``x - y`` (m), shape (m, 2);
-        ``+inf`` for axis-aligned boxes."""
+        """Upper bounds ``(smax, dmax)`` on ``x + y`` and ``x - y`` (m), shape (m, 2).
+
+        ``+inf`` for axis-aligned boxes.
+        """
         return self._dhi
 
     @property

@@ -1,5 +1,8 @@
-"""Least-squares B-spline fits of path points (the chapter's equation (3)), with the
-checks that refuse a system the data cannot determine (Schoenberg-Whitney, conditioning)."""
+"""Least-squares B-spline fits of path points.
+
+Least-squares B-spline fits of path points (the chapter's equation (3)), with the checks that
+refuse a system the data cannot determine (Schoenberg-Whitney, conditioning).
+"""
 
 from __future__ import annotations
 
@@ -46,7 +49,7 @@ BSPLINE_COND_MAX = 1e4
 
 
 def curve_parameters(points: np.ndarray, parameterization: Parameterization) -> np.ndarray:
-    """Data parameters ``u_i`` in [0, 1] for a point sequence.
+    """Return the data parameters ``u_i`` in [0, 1] for a point sequence.
 
     Parameters
     ----------
@@ -176,7 +179,7 @@ def allowed_message(u: np.ndarray, k: int, below: int) -> str:
 def ill_posed_message(
     reason: str, k: int, n_ctrl: int, parameterization: str, u: np.ndarray
 ) -> str:
-    """The message of an ill-posed fit: the design, the ``reason`` and what the data allow."""
+    """Return the message of an ill-posed fit: the design, the ``reason`` and what the data allow."""
     return (
         f"least-squares B-spline with degree {k}, n_ctrl {n_ctrl} (clamped uniform knots) "
         f"and {parameterization} parameters of {len(u)} distinct points: {reason}; "

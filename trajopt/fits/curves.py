@@ -53,10 +53,12 @@ class PolynomialCurve(ParametricCurve):
 
     @property
     def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
         return max(self.order, 1)
 
     @property
     def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
         return (self.direction * self.x_start, self.direction * self.x_end)
 
     def f(self, x: np.ndarray | float, nu: int = 0) -> np.ndarray:
@@ -107,13 +109,16 @@ class ParametricPolynomialCurve(ParametricCurve):
 
     @property
     def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
         return max(self.order, 1)
 
     @property
     def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
         return (0.0, 1.0)
 
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        """Evaluate the ``nu``-th derivative at ``u``, shape ``(..., 2)``."""
         uu = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
         c = self._derivs.get(nu)
         if c is None:

@@ -1,5 +1,8 @@
-"""Polynomial fits of path points: ``y = f(x)`` as the chapter fits them, and the
-parametric ``x(u), y(u)`` that handles any path shape."""
+"""Polynomial fits of path points.
+
+``y = f(x)`` as the chapter fits them, and the parametric ``x(u), y(u)`` that handles any path
+shape.
+"""
 
 from __future__ import annotations
 

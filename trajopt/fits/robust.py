@@ -1,6 +1,7 @@
-"""The regression solvers behind the polynomial fits: weighted least squares, least
-absolute residual (a linear programme) and Tukey bisquare (robust IRLS, as MATLAB's
-``robustfit``).
+"""The regression solvers behind the polynomial fits.
+
+Weighted least squares, least absolute residual (a linear programme) and Tukey bisquare (robust
+IRLS, as MATLAB's ``robustfit``).
 
 Each takes a design matrix ``V`` of shape ``(n, p)``, data ``y`` of shape ``(n, d)`` and
 weights ``w`` of shape ``(n,)``, and returns coefficients of shape ``(p, d)``.

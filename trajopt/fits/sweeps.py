@@ -1,5 +1,7 @@
-"""Parameter sweeps of the plain fits, as the chapter's Tables 1 and 2: every combination
-ranked by the MSE of equation (3) at the fitted parameters."""
+"""Parameter sweeps of the plain fits, as the chapter's Tables 1 and 2.
+
+Every combination ranked by the MSE of equation (3) at the fitted parameters.
+"""
 
 from __future__ import annotations
 

@@ -188,7 +188,7 @@ def build_polygon_corridor(
 
 
 def _distinct_points(pc_: np.ndarray, n_in: int) -> tuple[np.ndarray, np.ndarray]:
-    """The path without repeated points (cell units) and where each kept one came from."""
+    """Return the path without repeated points (cell units) and where each kept one came from."""
     keep_in = np.concatenate([[True], np.any(np.diff(pc_, axis=0) != 0.0, axis=1)])
     src = np.nonzero(keep_in)[0]
     p = np.ascontiguousarray(pc_[src])
@@ -203,8 +203,11 @@ def _grow_regions(
     idx: ObstacleIndex, p: np.ndarray, src: np.ndarray, pts_m: np.ndarray, r_c: float,
     tol_c: float, res: float, opts: tuple,
 ) -> tuple:
-    """Check, centre and simplify the path, then grow one region per simplified segment
-    (cell units). Returns ``(seed, seed_src, hh, vv, nvs, degen)``."""
+    """Check, centre and simplify the path, then grow one region per simplified segment.
+
+    Check, centre and simplify the path, then grow one region per simplified segment (cell
+    units). Returns ``(seed, seed_src, hh, vv, nvs, degen)``.
+    """
     margin, max_len, ext, push, trigger, slack, open_c = opts
     args = idx.args
     cap = r_c + open_c + 2.0
@@ -245,7 +248,7 @@ def _corridor(
     degen: np.ndarray, pts_m: np.ndarray, src: np.ndarray, clear: np.ndarray, r: float,
     res: float, origin: tuple[float, float],
 ) -> PolygonCorridor:
-    """The :class:`PolygonCorridor` in world metres from the grown regions (cells)."""
+    """Return the :class:`PolygonCorridor` in world metres from the grown regions (cells)."""
     ox, oy = origin
     m = len(seed) - 1
     # to world metres
@@ -335,9 +338,12 @@ def _check_path_clearance(
     tol_c: float,
     res: float,
 ) -> None:
-    """Raise for the first point, then segment, closer than ``r`` to the raw map (``src``
-    maps the de-duplicated points, whose clearances ``pcl``/``scl`` are in cells, to the
-    input points ``pts_m``)."""
+    """Raise for the first point, then segment, closer than ``r`` to the raw map.
+
+    Raise for the first point, then segment, closer than ``r`` to the raw map (``src`` maps the
+    de-duplicated points, whose clearances ``pcl``/``scl`` are in cells, to the input points
+    ``pts_m``).
+    """
     n_in = len(pts_m)
     bad = np.nonzero(pcl < r_c - tol_c)[0]
     if len(bad):

@@ -1,7 +1,8 @@
-"""The polygon corridor's obstacle index: the occupied cells of a map window merged into
-rectangles (cell units), a bucket grid over them, and the exact distance queries of a
-point, a segment or a polygon to every obstacle (the rectangles and the outside of the
-map).
+"""The polygon corridor's obstacle index.
+
+The occupied cells of a map window merged into rectangles (cell units), a bucket grid over them,
+and the exact distance queries of a point, a segment or a polygon to every obstacle (the
+rectangles and the outside of the map).
 
 The *index* passed to the kernels is the tuple ``(rects, meta, bstart, bids, stamp,
 buf)`` of :attr:`ObstacleIndex.args`: ``meta`` holds ``[gx0, gy0, bucket, nbx, nby, nx,
@@ -66,8 +67,10 @@ def build_buckets(rects, gx0, gy0, bsize, nbx, nby):  # pragma: no cover - compi
 
 @njit(cache=True)
 def gather(qx0, qx1, qy0, qy1, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
-    """Ids of the rectangles meeting the closed box ``[qx0, qx1] x [qy0, qy1]`` into
-    ``buf``; returns their count."""
+    """Ids of the rectangles meeting the closed box ``[qx0, qx1] x [qy0, qy1]`` into ``buf``.
+
+    Returns their count.
+    """
     gx0 = meta[0]
     gy0 = meta[1]
     bs = meta[2]
@@ -106,9 +109,11 @@ def gather(qx0, qx1, qy0, qy1, rects, meta, bstart, bids, stamp, buf):  # pragma
 
 @njit(cache=True)
 def point_nearest(px, py, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
-    """Distance (capped at ``cap``) from a point to the nearest obstacle (rectangle or
-    the outside of the map) and the nearest obstacle point (``nan`` when none is within
-    ``cap``)."""
+    """Distance (capped at ``cap``) from a point to the nearest obstacle.
+
+    Distance (capped at ``cap``) from a point to the nearest obstacle (rectangle or the outside
+    of the map) and the nearest obstacle point (``nan`` when none is within ``cap``).
+    """
     nx = meta[5]
     ny = meta[6]
     best = cap
@@ -157,8 +162,10 @@ def seg_clearance(ax, ay, bx, by, cap, rects, meta, bstart, bids, stamp, buf):  
 
 @njit(cache=True)
 def poly_clearance(v, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma: no cover
-    """Exact distance (capped at ``cap``) from a convex polygon ``v[:nv]`` to every
-    obstacle: the outside of the map (nearest vertex) and every rectangle."""
+    """Exact distance (capped at ``cap``) from a convex polygon ``v[:nv]`` to every obstacle.
+
+    The outside of the map (nearest vertex) and every rectangle.
+    """
     nx = meta[5]
     ny = meta[6]
     best = cap

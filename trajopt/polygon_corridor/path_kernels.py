@@ -1,6 +1,8 @@
-"""Compiled kernels that prepare the polygon corridor's path (cell units): clearances
-of its points and segments, centring it away from walls, simplifying it, and the
-extensions of its junctions."""
+"""Compiled kernels that prepare the polygon corridor's path (cell units).
+
+Clearances of its points and segments, centring it away from walls, simplifying it, and the
+extensions of its junctions.
+"""
 
 from __future__ import annotations
 
@@ -23,8 +25,11 @@ __all__ = [
 
 @njit(cache=True)
 def hull4(pts, n, out):  # pragma: no cover - compiled
-    """Convex hull (counter-clockwise, no collinear points) of ``pts[:n]`` (n <= 8) into
-    ``out``; returns its vertex count (1 for a point, 2 for a segment)."""
+    """Convex hull (counter-clockwise, no collinear points) of ``pts[:n]``.
+
+    Convex hull (counter-clockwise, no collinear points) of ``pts[:n]`` (n <= 8) into ``out``;
+    returns its vertex count (1 for a point, 2 for a segment).
+    """
     p = np.empty((n, 2))
     for i in range(n):
         p[i, 0] = pts[i, 0]
@@ -180,8 +185,11 @@ def simplify_path(p, pc, sc, r, slack, open_c, max_len, rects, meta, bstart, bid
 
 @njit(cache=True)
 def seed_points(p, e, k, out):  # pragma: no cover - compiled
-    """Seed points of region ``k``: its segment plus ``e[k]`` of the previous segment and
-    ``e[k + 1]`` of the next one; returns the hull's vertex count (into ``out``)."""
+    """Seed points of region ``k``.
+
+    Its segment plus ``e[k]`` of the previous segment and ``e[k + 1]`` of the next one; returns
+    the hull's vertex count (into ``out``).
+    """
     pts = np.empty((4, 2))
     n = 0
     ax, ay = p[k, 0], p[k, 1]

@@ -1,6 +1,9 @@
-"""Compiled kernels that grow the polygon corridor's regions (cell units) and compute
-the chain's geometry: clipping, region growth around each path segment, the path
-interval inside each region, the overlaps, and the regions' exact clearance."""
+"""Compiled kernels that grow the polygon corridor's regions.
+
+Compiled kernels that grow the polygon corridor's regions (cell units) and compute the chain's
+geometry: clipping, region growth around each path segment, the path interval inside each
+region, the overlaps, and the regions' exact clearance.
+"""
 
 from __future__ import annotations
 
@@ -25,8 +28,11 @@ __all__ = ["certify_all", "chain_geometry", "clip_convex", "grow_all", "grow_reg
 
 @njit(cache=True)
 def _clip(v, lab, nv, a0, a1, b, label, ov, olab):  # pragma: no cover - compiled
-    """Clip the labelled convex polygon ``v[:nv]`` (``lab[i]`` = row of edge i -> i + 1)
-    by ``a . p <= b``; the new edge gets ``label``. Returns the new vertex count."""
+    """Clip the labelled convex polygon ``v[:nv]``.
+
+    Clip the labelled convex polygon ``v[:nv]`` (``lab[i]`` = row of edge i -> i + 1) by ``a . p
+    <= b``; the new edge gets ``label``. Returns the new vertex count.
+    """
     m = 0
     for i in range(nv):
         j = (i + 1) % nv
@@ -303,9 +309,12 @@ def grow_all(p, e, r, margin, kmax, rects, meta, bstart, bids, stamp, buf):  # p
 
 @njit(cache=True)
 def clip_convex(v, nv, rows, nrows, tol):  # pragma: no cover - compiled
-    """Vertices of the convex polygon ``v[:nv]`` (or segment, point) clipped by
-    ``rows[i] = (a_x, a_y, b)`` with ``a . p <= b + tol``, and for each vertex the row its
-    outgoing edge lies on (``-1`` = an edge of ``v``). Returns ``(V, labels, count)``."""
+    """Vertices of the convex polygon ``v[:nv]``.
+
+    Vertices of the convex polygon ``v[:nv]`` (or segment, point) clipped by ``rows[i] = (a_x,
+    a_y, b)`` with ``a . p <= b + tol``, and for each vertex the row its outgoing edge lies on
+    (``-1`` = an edge of ``v``). Returns ``(V, labels, count)``.
+    """
     cap = nv + nrows + 4
     va = np.empty((cap, 2))
     la = np.full(cap, -1, np.int64)
@@ -325,8 +334,11 @@ def clip_convex(v, nv, rows, nrows, tol):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _seg_inside(rows, nrows, p, i, tol):  # pragma: no cover - compiled
-    """Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows
-    (``t0 > t1`` when empty)."""
+    """Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows.
+
+    Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows (``t0 > t1``
+    when empty).
+    """
     ax, ay = p[i, 0], p[i, 1]
     dx = p[i + 1, 0] - ax
     dy = p[i + 1, 1] - ay
@@ -347,9 +359,12 @@ def _seg_inside(rows, nrows, p, i, tol):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def polyline_interval(rows, nrows, p, s, s_lo, s_hi, tol):  # pragma: no cover - compiled
-    """The largest arc-length interval ``[lo, hi]`` of the polyline ``p`` (vertex arc
-    lengths ``s``) that contains ``[s_lo, s_hi]`` and stays in ``{a . x <= b + tol}``;
-    ``(nan, nan)`` when ``[s_lo, s_hi]`` itself is not inside."""
+    """Return the largest arc-length interval ``[lo, hi]`` of the polyline ``p``.
+
+    The largest arc-length interval ``[lo, hi]`` of the polyline ``p`` (vertex arc lengths
+    ``s``) that contains ``[s_lo, s_hi]`` and stays in ``{a . x <= b + tol}``; ``(nan, nan)``
+    when ``[s_lo, s_hi]`` itself is not inside.
+    """
     n = p.shape[0]
     eps = 1e-12 * max(1.0, s[n - 1])
     i_lo = 0

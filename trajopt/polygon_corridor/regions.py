@@ -124,8 +124,10 @@ class ConvexPolygon:
 
     @property
     def line(self) -> tuple[np.ndarray, float] | None:
-        """For a degenerate segment, its line as ``(a, c)``: the region lies on
-        ``a @ p == c`` (``a`` = ``A[0]``, shape (2,)); ``None`` otherwise."""
+        """For a degenerate segment, its line as ``(a, c)``.
+
+        The region lies on ``a @ p == c`` (``a`` = ``A[0]``, shape (2,)); ``None`` otherwise.
+        """
         if not self.degenerate or self.vertices.shape[0] != 2:
             return None
         return self.A[0].copy(), float(self.b[0])
@@ -149,7 +151,7 @@ class ConvexPolygon:
         return np.all(s <= tol, axis=-1)
 
     def intersection(self, other: ConvexPolygon, tol: float = 0.0) -> ConvexPolygon:
-        """The intersection of two regions (a region; degenerate when it has no interior).
+        """Return the intersection of two regions (a region; degenerate when it has no interior).
 
         Parameters
         ----------
@@ -174,6 +176,7 @@ class ConvexPolygon:
 
 
 def shoelace(v: np.ndarray) -> float:
+    """Return the signed area of the polygon ``v`` (counter-clockwise positive)."""
     x, y = v[:, 0], v[:, 1]
     return 0.5 * float(
         x[:-1] @ y[1:] - x[1:] @ y[:-1] + x[-1] * y[0] - x[0] * y[-1]
@@ -181,6 +184,7 @@ def shoelace(v: np.ndarray) -> float:
 
 
 def point_region(p: np.ndarray) -> ConvexPolygon:
+    """Return the degenerate region holding only the point ``p``."""
     a = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
     b = np.array([p[0], -p[0], p[1], -p[1]])
     return ConvexPolygon._construct_fast(a, b, np.array([p], dtype=float), True)
@@ -200,8 +204,11 @@ def segment_region(p: np.ndarray, q: np.ndarray) -> ConvexPolygon:
 
 
 def degenerate_from(v: np.ndarray) -> ConvexPolygon:
-    """A point or segment region spanning vertices ``v`` (shape (n, 2), n >= 1) that lie
-    on one line (or at one point)."""
+    """Return a point or segment region spanning vertices ``v``.
+
+    A point or segment region spanning vertices ``v`` (shape (n, 2), n >= 1) that lie on one
+    line (or at one point).
+    """
     if len(v) == 1:
         return point_region(v[0])
     d = np.hypot(*(v[:, None, :] - v[None, :, :]).transpose(2, 0, 1))
@@ -350,8 +357,11 @@ class PolygonCorridor:
         return self.overlap_s[:, 1] - self.overlap_s[:, 0]
 
     def contains(self, points: Any, tol: float = 0.0) -> np.ndarray:
-        """Whether each world point (shape ``(..., 2)``, m) lies in at least one region
-        (``tol`` m of slack on every row)."""
+        """Whether each world point.
+
+        Whether each world point (shape ``(..., 2)``, m) lies in at least one region (``tol`` m
+        of slack on every row).
+        """
         p = np.asarray(points, dtype=float)
         flat = p.reshape(-1, 2)
         viol = flat @ self._all_a.T - self._all_b > tol  # (n, rows)

@@ -167,11 +167,12 @@ def solve_attempt(
     warm: np.ndarray | None,
     rec: AttemptRecord,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One attempt on the knots of span ``h`` (cells): the QP, then with a curvature bound
-    the SCP or IPOPT (sampled bound ``margin * kappa_max``). ``warm``: control points
-    (cells) of an earlier attempt on the same knots; the curvature solver then starts from
-    them instead of the QP solution. Fills ``rec``; returns the control points (cells,
-    shape (n, 2)), the knots (cells) and every span's region.
+    """One attempt on the knots of span ``h`` (cells).
+
+    The QP, then with a curvature bound the SCP or IPOPT (sampled bound ``margin * kappa_max``).
+    ``warm``: control points (cells) of an earlier attempt on the same knots; the curvature
+    solver then starts from them instead of the QP solution. Fills ``rec``; returns the control
+    points (cells, shape (n, 2)), the knots (cells) and every span's region.
 
     Raises
     ------

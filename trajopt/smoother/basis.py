@@ -1,5 +1,7 @@
-"""B-spline basis maths of the smoother, in cell units: basis derivatives, the banded Gram
-and smoothness matrices, the padded problem sizes, and the value of the banded quadratic.
+"""B-spline basis maths of the smoother, in cell units.
+
+Basis derivatives, the banded Gram and smoothness matrices, the padded problem sizes, and the
+value of the banded quadratic.
 
 Everything here is NumPy; the solvers that use these arrays are in
 :mod:`trajopt.smoother.qp`, :mod:`trajopt.smoother.scp` and :mod:`trajopt.smoother.nlp`.
@@ -31,7 +33,7 @@ _SIZES = (16, 20, 24, 28, 32, 36, 40, 44, 48, 56, 64, 72, 80, 88, 96, 104, 112, 
 
 
 def bucket_size(n: int) -> int:
-    """Padded number of control points for ``n`` (sizes repeat so solvers can be cached)."""
+    """Return the padded number of control points for ``n`` (sizes repeat so solvers can be cached)."""
     for s in _SIZES:
         if n <= s:
             return s
@@ -39,8 +41,10 @@ def bucket_size(n: int) -> int:
 
 
 def basis_derivs(t: np.ndarray, p: int, span: np.ndarray, u: np.ndarray, nu: int) -> np.ndarray:
-    """``nu``-th derivatives of the ``p + 1`` B-splines of degree ``p`` that are non-zero on
-    span ``span`` (control points ``span .. span + p``), evaluated at ``u``.
+    """``nu``-th derivatives.
+
+    ``nu``-th derivatives of the ``p + 1`` B-splines of degree ``p`` that are non-zero on span
+    ``span`` (control points ``span .. span + p``), evaluated at ``u``.
 
     Parameters
     ----------
@@ -104,8 +108,11 @@ def find_spans(t: np.ndarray, p: int, n: int, u: np.ndarray) -> np.ndarray:
 
 
 def band_gram(span: np.ndarray, vals: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
-    """Upper band of ``sum_r w_r b_r b_r^T`` for rows ``b_r`` with ``p + 1`` consecutive
-    non-zeros ``vals[r]`` starting at column ``span[r]``: ``band[d, i] = M[i, i + d]``."""
+    """Upper band of ``sum_r w_r b_r b_r^T`` for rows ``b_r``.
+
+    Upper band of ``sum_r w_r b_r b_r^T`` for rows ``b_r`` with ``p + 1`` consecutive non-zeros
+    ``vals[r]`` starting at column ``span[r]``: ``band[d, i] = M[i, i + d]``.
+    """
     p = vals.shape[1] - 1
     band = np.zeros((p + 1, n))
     for a in range(p + 1):
@@ -126,8 +133,11 @@ def band_rhs(span: np.ndarray, vals: np.ndarray, rhs: np.ndarray, n: int) -> np.
 
 
 def smoothness_band(t: np.ndarray, p: int, n: int, order: int) -> np.ndarray:
-    """Upper band of ``S[i, j] = integral B_i^(order)(u) B_j^(order)(u) du`` (exact, by
-    Gauss-Legendre quadrature on every non-empty span)."""
+    """Upper band of ``S[i, j] = integral B_i^(order)(u) B_j^(order)(u) du``.
+
+    Upper band of ``S[i, j] = integral B_i^(order)(u) B_j^(order)(u) du`` (exact, by
+    Gauss-Legendre quadrature on every non-empty span).
+    """
     nq = max(1, p - order + 1)
     gx, gw = np.polynomial.legendre.leggauss(nq)
     a = t[p:n]
@@ -168,8 +178,10 @@ def band_quadratic(full: np.ndarray, g: np.ndarray, z: np.ndarray, const: float 
 def curvature_samples(
     t: np.ndarray, p: int, n: int, nb: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per
-    span, padded to ``nb - p`` spans.
+    """Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per span.
+
+    Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per span, padded to
+    ``nb - p`` spans.
 
     A span is sampled at its start and at evenly spaced interior points; its end is the
     next span's start (``C'`` and ``C''`` are continuous at the simple interior knots, so

@@ -1,5 +1,6 @@
-"""The smoother's certificate: every guarantee of a fitted curve, checked independently
-of the optimiser that produced it.
+"""The smoother's certificate.
+
+Every guarantee of a fitted curve, checked independently of the optimiser that produced it.
 """
 
 from __future__ import annotations

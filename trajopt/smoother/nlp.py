@@ -1,5 +1,6 @@
-"""IPOPT problems of the smoother (``qp_solver="ipopt"``, ``curvature_solver="ipopt"``):
-the convex QP and the exact curvature-bounded NLP, built with CasADi once per padded size.
+"""IPOPT problems of the smoother (``qp_solver="ipopt"``, ``curvature_solver="ipopt"``).
+
+The convex QP and the exact curvature-bounded NLP, built with CasADi once per padded size.
 """
 
 from __future__ import annotations
@@ -20,8 +21,10 @@ __all__ = ["curvature_nlp", "qp_ipopt", "solve_curvature_ipopt"]
 
 @functools.lru_cache(maxsize=32)
 def qp_ipopt(nb: int, p: int, verbose: bool):
-    """The same convex problem (no sample rows) solved by IPOPT (fallback / reference);
-    parameters ``[h band (p+1)*nb, g (2nb), heading rows (4*2nb)]``."""
+    """Return the same convex problem (no sample rows) solved by IPOPT (fallback / reference).
+
+    Parameters ``[h band (p+1)*nb, g (2nb), heading rows (4*2nb)]``.
+    """
     import casadi as ca
 
     z = ca.SX.sym("z", 2 * nb)
@@ -75,7 +78,9 @@ def _ipopt_opts(verbose: bool) -> dict:
 
 @functools.lru_cache(maxsize=16)
 def curvature_nlp(nb: int, p: int, verbose: bool):
-    """IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``
+    """IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``.
+
+    IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``
     (``CURV_SAMPLES`` per span, span ``j`` touching control points ``j .. j + p``)
 
     ``cross_r^2 - kmax^2 * speed2_r^3 <= 0`` and ``speed2_r >= floor_r^2`` (via ``lbg``),
@@ -129,7 +134,7 @@ def solve_curvature_ipopt(
     options: Any, qp: QPData, t: np.ndarray, z0: np.ndarray, kmax: float, remaining: float,
     margin: float,
 ) -> SolveInfo:
-    """The curvature-bounded problem by IPOPT, warm started at ``z0`` (cells).
+    """Return the curvature-bounded problem by IPOPT, warm started at ``z0`` (cells).
 
     ``|kappa| <= margin * kmax`` (1/cell) and ``|C'| >= options.speed_floor`` at
     :data:`~trajopt.smoother.basis.CURV_SAMPLES` samples per span; a solve longer than the

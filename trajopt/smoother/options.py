@@ -1,5 +1,8 @@
-"""The :class:`Smoother` options (a frozen dataclass, validated on construction) and its
-two entry points; the work is done by :mod:`trajopt.smoother.attempts`."""
+"""The :class:`Smoother` options.
+
+The :class:`Smoother` options (a frozen dataclass, validated on construction) and its two entry
+points; the work is done by :mod:`trajopt.smoother.attempts`.
+"""
 
 from __future__ import annotations
 
@@ -186,7 +189,7 @@ class Smoother:
         )
 
     def fit_free(self, points: np.ndarray, u: np.ndarray, knots: np.ndarray) -> BSplineCurve:
-        """The same objective with *no* constraints (no corridor, free ends, no bound).
+        """Return the same objective with *no* constraints (no corridor, free ends, no bound).
 
         A reference and test hook: with ``smoothness_weight = 0`` it is the least-squares
         spline of ``points`` at parameters ``u`` on ``knots`` (as

@@ -39,12 +39,15 @@ class SmoothPath(ParametricCurve):
 
     @property
     def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
         return self.curve.domain
 
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        """Evaluate the ``nu``-th derivative at ``u``, shape ``(..., 2)``."""
         return self.curve(u, nu)
 
     def breakpoints(self) -> np.ndarray:
+        """Return the parameters where the polynomial pieces meet (with the ends)."""
         return self.curve.breakpoints()
 
     def _arc_table(self):
@@ -62,8 +65,10 @@ class SmoothPath(ParametricCurve):
 
     @property
     def degree(self) -> int:
+        """Spline degree."""
         return self.curve.k
 
     @property
     def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
         return self.curve.k

@@ -1,5 +1,7 @@
-"""The smoother's problem in cell units: targets, knots, the objective's band, the
-control-point bounds and region rows, and one attempt's QP.
+"""The smoother's problem in cell units.
+
+Targets, knots, the objective's band, the control-point bounds and region rows, and one
+attempt's QP.
 
 Positions and parameters are divided by the grid resolution, so one set of weights and
 tolerances serves every map.
@@ -56,10 +58,12 @@ def _end_point(name: str, value: Any, default: np.ndarray) -> np.ndarray:
 
 @dataclass(slots=True)
 class Problem:
-    """One fit in cell units: targets at parameters ``u``, per-region bounds (``lo``,
-    ``hi``: the box, or a polygon's bounding box; ``dlo``, ``dhi``: the bounds of ``x + y``
-    and ``x - y``) and, for polygon corridors, each region's half-planes ``rows``
-    (``(A, b)`` with ``A @ c <= b``, cells)."""
+    """One fit in cell units.
+
+    Targets at parameters ``u``, per-region bounds (``lo``, ``hi``: the box, or a polygon's
+    bounding box; ``dlo``, ``dhi``: the bounds of ``x + y`` and ``x - y``) and, for polygon
+    corridors, each region's half-planes ``rows`` (``(A, b)`` with ``A @ c <= b``, cells).
+    """
 
     targets: np.ndarray
     u: np.ndarray
@@ -160,7 +164,7 @@ _K_SIZES = (4, 8, 12, 16, 24, 32, 48, 64)
 
 
 def polygon_targets(corridor: PolygonCorridor) -> tuple[np.ndarray, np.ndarray]:
-    """The corridor's path sampled about once per cell: points (m) and their arc lengths."""
+    """Return the corridor's path sampled about once per cell: points (m) and their arc lengths."""
     res = corridor.resolution
     s_v = np.asarray(corridor.path_s, dtype=float)
     pts = np.asarray(corridor.path, dtype=float)
@@ -170,10 +174,13 @@ def polygon_targets(corridor: PolygonCorridor) -> tuple[np.ndarray, np.ndarray]:
 
 
 def region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
-    """Each region's rows ``lo <= A c <= hi`` in cells (``A`` (q, 2), ``lo``, ``hi``
-    (q,)), ``_POLY_MARGIN`` inside, and the regions' bounding boxes (cells, (m, 2) each).
+    """Each region's rows ``lo <= A c <= hi`` in cells.
 
-    A degenerate region's line (its first two, opposite rows) becomes one two-sided row."""
+    Each region's rows ``lo <= A c <= hi`` in cells (``A`` (q, 2), ``lo``, ``hi`` (q,)),
+    ``_POLY_MARGIN`` inside, and the regions' bounding boxes (cells, (m, 2) each).
+
+    A degenerate region's line (its first two, opposite rows) becomes one two-sided row.
+    """
     out = []
     lo_b = np.empty((len(corridor.regions), 2))
     hi_b = np.empty((len(corridor.regions), 2))
@@ -196,7 +203,7 @@ def region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
 
 
 def point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, nb: int):
-    """The region rows of every control point, padded to ``k`` per point.
+    """Return the region rows of every control point, padded to ``k`` per point.
 
     A point gets the rows of the regions of the spans it touches, less those that its
     variable bounds ``lo``, ``hi`` (cells, shape (n, 2)) already imply (the row's largest
@@ -246,6 +253,7 @@ def point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, n
 
 
 def box_targets(src: Any, corridor: Corridor) -> np.ndarray:
+    """Return the fidelity targets (m) of a box corridor: ``src`` cells' centres or points."""
     if src is None:
         return np.array(corridor.path_points)
     cells = getattr(src, "cells", None)
@@ -320,10 +328,12 @@ def graded_knots(
 
 
 def objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
-    """Upper band of ``H`` (one coordinate block), ``g`` (2n: x then y, padded layout
-    resolved later) and the constant, for ``1/2 z'Hz + g'z + const`` =
-    ``fidelity * sum |C(u_r) - p_r|^2 + weight * integral |C^(order)|^2
-    + length * integral |C'|^2``."""
+    """Upper band of ``H``.
+
+    Upper band of ``H`` (one coordinate block), ``g`` (2n: x then y, padded layout resolved
+    later) and the constant, for ``1/2 z'Hz + g'z + const`` = ``fidelity * sum |C(u_r) - p_r|^2
+    + weight * integral |C^(order)|^2 + length * integral |C'|^2``.
+    """
     span = find_spans(t, p, n, u)
     vals = basis_derivs(t, p, span, u, 0)
     band = 2.0 * fidelity * band_gram(span, vals, np.ones(len(u)), n)
@@ -342,6 +352,7 @@ def objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
 
 
 def heading_rows(prob: Problem, n: int, nb: int):
+    """Return the heading rows ``(A (4, 2 nb), lba, uba)`` of the start and goal tangents."""
     amat = np.zeros((4, 2 * nb))
     lba = np.full(4, -np.inf)
     uba = np.full(4, np.inf)
@@ -367,9 +378,12 @@ def heading_rows(prob: Problem, n: int, nb: int):
 def project_heading(
     c: np.ndarray, prob: Problem, lo: np.ndarray, hi: np.ndarray, point_rows=None
 ) -> None:
-    """Put ``c_1`` (``c_{n-2}``) exactly on the start (reversed goal) heading ray, inside
-    its bounds (and its region rows ``lo <= A c <= hi`` in a polygon corridor), at least
-    ``1e-3`` cells from the end point when the bounds allow it."""
+    """Put ``c_1`` (``c_{n-2}``) exactly on the start.
+
+    Put ``c_1`` (``c_{n-2}``) exactly on the start (reversed goal) heading ray, inside its
+    bounds (and its region rows ``lo <= A c <= hi`` in a polygon corridor), at least ``1e-3``
+    cells from the end point when the bounds allow it.
+    """
     ends = []
     if prob.start_dir is not None:
         ends.append((1, prob.start, prob.start_dir))
@@ -408,7 +422,7 @@ def build_problem(
     hs: float | None,
     hg: float | None,
 ) -> tuple[Problem, np.ndarray, np.ndarray]:
-    """The fit in cell units, and the exact end points (m).
+    """Return the fit in cell units, and the exact end points (m).
 
     Parameters
     ----------
@@ -486,7 +500,7 @@ def build_problem(
 
 
 def assemble(options: Any, prob: Problem, h: float) -> Assembly:
-    """The QP of one attempt on the knots of longest span ``h`` (cells).
+    """Return the QP of one attempt on the knots of longest span ``h`` (cells).
 
     Control-point bounds are the intersection of the regions of the spans each point
     touches; the fixed end points get theirs from the exact ends.

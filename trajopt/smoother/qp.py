@@ -1,5 +1,7 @@
-"""The convex corridor QP of the smoother: constraint layouts, cached ``casadi.conic``
-builds, the direct piqp solve over a working set, and one call that solves the QP.
+"""The convex corridor QP of the smoother.
+
+Constraint layouts, cached ``casadi.conic`` builds, the direct piqp solve over a working set,
+and one call that solves the QP.
 
 Everything works in cell units on ``nb`` padded control points (solvers are built once per
 padded size and cached for the process).
@@ -56,8 +58,11 @@ N_HEADING_ROWS = 4
 
 @functools.lru_cache(maxsize=64)
 def qp_layout(nb: int, p: int):
-    """Sparsity of the two-block banded Hessian (x block then y block) and the index map
-    from CCS non-zeros to ``(band offset, band column)``."""
+    """Sparsity of the two-block banded Hessian.
+
+    Sparsity of the two-block banded Hessian (x block then y block) and the index map from CCS
+    non-zeros to ``(band offset, band column)``.
+    """
     import casadi as ca
 
     r, c = _band_pattern(nb, p)
@@ -81,10 +86,11 @@ def h_nonzeros(band: np.ndarray, nb: int, p: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ConstraintLayout:
-    """Rows of the linear constraints ``lba <= A z <= uba`` for ``nb`` padded control
-    points (``z = [x_0..x_{nb-1}, y_0..y_{nb-1}]``, then with ``m > 0`` one slack per
-    curvature sample), ``m`` curvature samples per span and ``k`` region rows per control
-    point.
+    """Rows of the linear constraints ``lba <= A z <= uba`` for ``nb`` padded control points.
+
+    Rows of the linear constraints ``lba <= A z <= uba`` for ``nb`` padded control points (``z =
+    [x_0..x_{nb-1}, y_0..y_{nb-1}]``, then with ``m > 0`` one slack per curvature sample), ``m``
+    curvature samples per span and ``k`` region rows per control point.
 
     Rows, in order: the :data:`N_HEADING_ROWS` heading rows (dense); for every control
     point ``i`` its ``k`` region rows ``a_x x_i + a_y y_i`` (box corridors: ``k = 2``, the
@@ -111,10 +117,12 @@ class ConstraintLayout:
 
     @property
     def n_samples(self) -> int:
+        """Number of curvature samples ``S``."""
         return (self.nb - self.p) * self.m
 
     @property
     def sample_row0(self) -> int:
+        """Index of the first sample row."""
         return N_HEADING_ROWS + self.k * self.nb
 
     def values(
@@ -123,10 +131,13 @@ class ConstraintLayout:
         sample_vals: np.ndarray | None = None,
         region_coef: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Triplet values of ``A`` from the dense heading rows (4, 2nb), the sample rows'
-        coefficients (S, 3, 2 (p + 1)): ``[x_j..x_{j+p}, y_j..y_{j+p}]`` per row, and the
-        region rows' coefficients ``(a_x, a_y)`` (nb, k, 2) (default, for ``k = 2``: the
-        rows ``x + y`` and ``x - y``)."""
+        """Triplet values of ``A`` from the dense heading rows.
+
+        Triplet values of ``A`` from the dense heading rows (4, 2nb), the sample rows'
+        coefficients (S, 3, 2 (p + 1)): ``[x_j..x_{j+p}, y_j..y_{j+p}]`` per row, and the region
+        rows' coefficients ``(a_x, a_y)`` (nb, k, 2) (default, for ``k = 2``: the rows ``x + y``
+        and ``x - y``).
+        """
         nb = self.nb
         trip = np.empty(self.n_triplets)
         k = N_HEADING_ROWS * 2 * nb
@@ -150,8 +161,10 @@ class ConstraintLayout:
     def implied_range(
         self, trip: np.ndarray, lbx: np.ndarray, ubx: np.ndarray, select: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Range of every row ``A z`` over the variable bounds (interval arithmetic);
-        ``select`` (bool per triplet): only those triplets (rows with none get 0)."""
+        """Range of every row ``A z`` over the variable bounds (interval arithmetic).
+
+        ``select`` (bool per triplet): only those triplets (rows with none get 0).
+        """
         rows, cols = self.trip_rows, self.trip_cols
         if select is not None:
             trip, rows, cols = trip[select], rows[select], cols[select]
@@ -169,8 +182,11 @@ class ConstraintLayout:
 
 @functools.lru_cache(maxsize=128)
 def constraint_layout(nb: int, p: int, m: int, k: int = 2) -> ConstraintLayout:
-    """The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p``, ``m``
-    curvature samples per span (0: no sample rows) and ``k`` region rows per control point."""
+    """Return the :class:`ConstraintLayout` for ``nb`` padded control points.
+
+    The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p``, ``m``
+    curvature samples per span (0: no sample rows) and ``k`` region rows per control point.
+    """
     import casadi as ca
 
     rows: list[np.ndarray] = []
@@ -221,9 +237,12 @@ def constraint_layout(nb: int, p: int, m: int, k: int = 2) -> ConstraintLayout:
 
 @functools.lru_cache(maxsize=128)
 def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool, k: int = 2):
-    """A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``
-    with the banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m, k)``;
-    built once per ``(nb, p, solver, m, k)``."""
+    """Return a ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba``.
+
+    A ``casadi.conic`` QP ``min 1/2 z'Hz + g'z, lbx <= z <= ubx, lba <= A z <= uba`` with the
+    banded two-block Hessian and :func:`constraint_layout` ``(nb, p, m, k)``; built once per
+    ``(nb, p, solver, m, k)``.
+    """
     import casadi as ca
 
     sp_h = qp_layout(nb, p)[0]
@@ -258,8 +277,10 @@ def qp_solver(nb: int, p: int, solver: str, m: int, verbose: bool, k: int = 2):
 
 @functools.lru_cache(maxsize=64)
 def upper_band_triplets(nb: int, p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Upper triangle of the two-block banded Hessian: rows, columns, and the ``(band
-    offset, band column)`` of each entry's value."""
+    """Upper triangle of the two-block banded Hessian.
+
+    Rows, columns, and the ``(band offset, band column)`` of each entry's value.
+    """
     r, c = _band_pattern(nb, p)
     up = r <= c
     r, c = r[up], c[up]
@@ -280,12 +301,13 @@ def solve_working_set(
     active: np.ndarray,
     slack_penalty: float,
 ) -> tuple[np.ndarray, float, bool, str, int]:
-    """One QP of the sequential convex programme with only the ``active`` curvature
-    samples, solved by piqp directly (the rows of the other samples and their slacks are
-    left out: the problem's sparsity changes with the working set, which a
-    ``casadi.conic`` fixes at build time). With ``m = 0`` (no samples) it is the corridor
-    QP itself; rows with only zero coefficients or no finite bound are left out too (the
-    padded region rows of a polygon corridor).
+    """One QP of the sequential convex programme with only the ``active`` curvature samples.
+
+    One QP of the sequential convex programme with only the ``active`` curvature samples, solved
+    by piqp directly (the rows of the other samples and their slacks are left out: the problem's
+    sparsity changes with the working set, which a ``casadi.conic`` fixes at build time). With
+    ``m = 0`` (no samples) it is the corridor QP itself; rows with only zero coefficients or no
+    finite bound are left out too (the padded region rows of a polygon corridor).
 
     Parameters
     ----------
@@ -353,8 +375,11 @@ def solve_working_set(
 
 
 def piqp_info(z: np.ndarray, result: tuple, t_wall: float, t_cpu: float) -> SolveInfo:
-    """The :class:`SolveInfo` of a direct piqp solve from :func:`solve_working_set`'s
-    ``(cost, success, status, iterations)`` and the wall and CPU clocks at its start."""
+    """Return the :class:`SolveInfo` of a direct piqp solve.
+
+    The :class:`SolveInfo` of a direct piqp solve from :func:`solve_working_set`'s ``(cost,
+    success, status, iterations)`` and the wall and CPU clocks at its start.
+    """
     cost, success, status, iters = result
     return SolveInfo(
         solver="piqp",
@@ -381,8 +406,11 @@ def warm_imports() -> None:
 
 
 def is_built(kind: str, nb: int, p: int, verbose: bool) -> bool:
-    """Whether the solver ``(kind, nb, p, verbose)`` was built before in this process
-    (and mark it built): its build time is then not counted again."""
+    """Whether the solver ``(kind, nb, p, verbose)`` was built before in this process.
+
+    Whether the solver ``(kind, nb, p, verbose)`` was built before in this process (and mark it
+    built): its build time is then not counted again.
+    """
     key = (kind, nb, p, verbose)
     if key in _BUILT:
         return True

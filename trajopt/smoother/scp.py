@@ -152,11 +152,11 @@ class CurvatureSCP:
 
     # ------------------------------------------------------------------ pieces
     def objective(self, z: np.ndarray) -> float:
-        """The QP objective (>= 0), constant included."""
+        """Return the QP objective (>= 0), constant included."""
         return band_quadratic(self.qp.full, self.qp.g, z, self.const)
 
     def measure(self, z: np.ndarray) -> _Iterate:
-        """Derivatives, speeds, curvatures, feasibility and merit at the samples."""
+        """Return the derivatives, speeds, curvatures, feasibility and merit at the samples."""
         nb = self.qp.nb
         X = z[:nb][self.idx]
         Y = z[nb:][self.idx]
@@ -174,7 +174,7 @@ class CurvatureSCP:
         return _Iterate(z, d1, d2, sp, kap, ok, merit)
 
     def near_active(self, it: _Iterate) -> np.ndarray:
-        """Samples near either bound, with their neighbouring spans' samples."""
+        """Sample near either bound, with their neighbouring spans' samples."""
         near = (it.kap > self.set.ws_kappa * self.kb) | (it.sp < self.set.ws_speed * self.floor)
         return np.convolve(near, self.kernel, mode="same") > 0
 
@@ -228,8 +228,11 @@ class CurvatureSCP:
 
     # ------------------------------------------------------------------- solve
     def run(self, z0: np.ndarray, remaining: float, trust: float = 1.0) -> SolveInfo:
-        """Iterate from ``z0`` (cells) within ``remaining`` seconds, trust region ``trust``
-        cells at first; the returned info's ``z`` is the last accepted iterate."""
+        """Iterate from ``z0``.
+
+        Iterate from ``z0`` (cells) within ``remaining`` seconds, trust region ``trust`` cells
+        at first; the returned info's ``z`` is the last accepted iterate.
+        """
         st = self.set
         ns = self.ns_real
         delta = float(trust)  # trust region (cells)

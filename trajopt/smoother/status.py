@@ -1,5 +1,7 @@
-"""What a smoother solve reports: a typed status, one record per solver call and per
-attempt, and the ``stats`` dictionary derived from them in one place.
+"""What a smoother solve reports.
+
+A typed status, one record per solver call and per attempt, and the ``stats`` dictionary derived
+from them in one place.
 """
 
 from __future__ import annotations
@@ -91,7 +93,7 @@ class SolveInfo:
         return self.status.ok
 
     def to_stats(self) -> dict[str, Any]:
-        """The call's statistics as a plain dict (no arrays)."""
+        """Return the call's statistics as a plain dict (no arrays)."""
         out: dict[str, Any] = {
             "solver": self.solver,
             "cost": self.cost,
@@ -128,7 +130,7 @@ class AttemptRecord:
         return self.nlp if self.nlp is not None else self.qp
 
     def to_stats(self) -> dict[str, Any]:
-        """The attempt as a plain dict (``attempt_log`` entries of ``stats``)."""
+        """Return the attempt as a plain dict (``attempt_log`` entries of ``stats``)."""
         out: dict[str, Any] = {"attempt": self.attempt, "span_cells": self.span_cells}
         if self.kappa_margin is not None:
             out["kappa_margin"] = self.kappa_margin

@@ -82,8 +82,11 @@ class CapTable:
         return float(greedy.range_min(self.st, self.lg, self.h, s_a, s_b))
 
     def rows_ok(self, rows: np.ndarray) -> bool:
-        """Whether constant-jerk rows ``(t0, s0, v0, a0, jerk, duration)`` stay under the
-        cap (exact on the grid)."""
+        """Whether constant-jerk rows ``(t0, s0, v0, a0, jerk, duration)`` stay under the cap.
+
+        Whether constant-jerk rows ``(t0, s0, v0, a0, jerk, duration)`` stay under the cap
+        (exact on the grid).
+        """
         return bool(greedy.rows_ok(self.st, self.lg, self.h, self.length,
                                    np.ascontiguousarray(rows), T_MIN))  # fmt: skip
 
@@ -96,7 +99,7 @@ def build_cap_table(
     v_end: float,
     speed_limits: SpeedLimits | None = None,
 ) -> CapTable:
-    """The :class:`CapTable` of ``curve`` for ``robot``.
+    """Return the :class:`CapTable` of ``curve`` for ``robot``.
 
     Raises
     ------
@@ -202,8 +205,11 @@ def _table_u_at_s(curve: ParametricCurve, s: np.ndarray) -> np.ndarray:
 
 
 def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Signed curvature (1/m) and heading (rad) at ``u``, sharing one first-derivative
-    evaluation when the curve uses the base class's formulas."""
+    """Signed curvature.
+
+    Signed curvature (1/m) and heading (rad) at ``u``, sharing one first-derivative evaluation
+    when the curve uses the base class's formulas.
+    """
     base = ParametricCurve
     if type(curve).curvature is base.curvature and type(curve).heading is base.heading:
         d1 = np.asarray(curve(u, 1), dtype=float)
@@ -277,8 +283,11 @@ def _interval_caps(
 
 
 def _golden_min_cap(curve, robot: Robot, s_sub: np.ndarray, cap_sub: np.ndarray) -> np.ndarray:
-    """Lowest cap found by golden-section search in the two fine steps around each row's
-    lowest sample (shape (k,)); all rows are searched at once."""
+    """Lowest cap found by golden-section search next to each row's lowest sample.
+
+    Lowest cap found by golden-section search in the two fine steps around each row's lowest
+    sample (shape (k,)); all rows are searched at once.
+    """
     k = np.argmin(cap_sub, axis=1)
     rows = np.arange(len(k))
     last = s_sub.shape[1] - 1

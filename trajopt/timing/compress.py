@@ -1,6 +1,8 @@
-"""The timing's last stages on the greedy's answer: finish at ``(L, v_end, 0)`` with one
-ruckig call, then compress the sections between speed minima into ruckig's time-optimal
-profiles where they stay under the cap."""
+"""The timing's last stages on the greedy's answer.
+
+Finish at ``(L, v_end, 0)`` with one ruckig call, then compress the sections between speed
+minima into ruckig's time-optimal profiles where they stay under the cap.
+"""
 
 from __future__ import annotations
 

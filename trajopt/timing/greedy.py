@@ -76,7 +76,7 @@ def range_min(st, lg, h, sa, sb):
 
 @njit(cache=True)
 def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
-    """True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
+    """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
     Conservative and exact on the grid: a piece passes when its speed maximum is below the
     minimum cap over the arc-length range it covers; otherwise it is bisected in time down

@@ -1,5 +1,8 @@
-"""The timing's entry point, :func:`time_parameterize`: validate, then the cap table, the
-forward greedy, the finish and the compress stages (method in :mod:`trajopt.timing`)."""
+"""The timing's entry point, :func:`time_parameterize`.
+
+Validate, then the cap table, the forward greedy, the finish and the compress stages (method in
+:mod:`trajopt.timing`).
+"""
 
 from __future__ import annotations
 
@@ -166,7 +169,7 @@ def time_parameterize(
 def _run_greedy(
     table: CapTable, v_start: float, v_end: float, amax: float, jmax: float, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The forward greedy's phases and bounds; its failures as :class:`TimingError`."""
+    """Return the forward greedy's phases and bounds; its failures as :class:`TimingError`."""
     length, h, ci = table.length, table.h, table.ci
     vtop = table.vtop
     t_lower = length / vtop

@@ -1,5 +1,7 @@
-"""A reusable 1-DoF ruckig position problem: the time-optimal jerk-limited profile between
-two states, as constant-jerk rows."""
+"""A reusable 1-DoF ruckig position problem.
+
+The time-optimal jerk-limited profile between two states, as constant-jerk rows.
+"""
 
 from __future__ import annotations
 
@@ -41,7 +43,8 @@ class RuckigProfile:
     ) -> np.ndarray | None:
         """Rows ``(t0, s0, v0, a0, jerk, duration)`` from ``state0`` to ``state1`` or None.
 
-        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s)."""
+        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s).
+        """
         inp = self.inp
         s0, v0, a0 = state0
         s1, v1, a1 = state1

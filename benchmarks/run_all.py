@@ -1,0 +1,191 @@
+"""Run every benchmark and write ``docs/benchmarks.md`` from what they print.
+
+Each benchmark script measures one thing against a reference in the same run (a peer
+library or a textbook method) and prints its table; this script runs them one after the
+other in fresh processes, with the quick or the full settings, and writes one section per
+benchmark: what it measures, the exact command, the wall time of the run and the printed
+figures. The page header records the machine, the library versions and the date, so the
+page always states one run of the present code.
+
+Run from the repository root (the benchmarks on real maps need the shared data,
+``$TRAJOPT_DATA`` or ``../shared/data``)::
+
+    python benchmarks/run_all.py --quick            # about 10-20 min on 2 cores
+    python benchmarks/run_all.py --full             # the settings quoted in the scripts
+    python benchmarks/run_all.py --quick --only inflate astar --out /tmp/b.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import os
+import platform
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Bench:
+    """One benchmark script and its two settings."""
+
+    name: str
+    title: str
+    script: str
+    what: str
+    quick: tuple[str, ...]
+    full: tuple[str, ...] = ()
+
+
+BENCHES: tuple[Bench, ...] = (
+    Bench("inflate", "Inflation: `astar.inflate` vs a distance-transform threshold",
+          "bench_inflate.py",
+          "Median time to inflate a random grid by 10 cells with both metrics, against "
+          "thresholding `scipy.ndimage.distance_transform_edt`; the results must agree.",
+          ("--size", "2000", "--repeat", "3")),
+    Bench("astar", "A*: `astar.find_path` vs `pyastar2d`", "bench_astar.py",
+          "Median search time on Moving AI scenarios of the shared maps, against pyastar2d "
+          "on the same queries (path costs must agree).",
+          ("--n", "10", "--repeat", "3")),
+    Bench("timing", "Timing: jerk-limited timing vs TOPP-RA", "bench_timing.py",
+          "Compute time and duration of `time_parameterize` against TOPP-RA's jerk-free "
+          "time-optimal profile on the same paths.",
+          ("--limit", "20", "--repeat", "3")),
+    Bench("smoother", "Smoother: corridor-constrained B-spline", "bench_smoother.py",
+          "Warm solve and first-build times, success and clearance of the smoother, "
+          "against a plain least-squares B-spline on the same paths.",
+          ("--n", "15", "--kappa-n", "6", "--reps", "2")),
+    Bench("plan", "Whole pipeline: warm per-query latency", "bench_plan.py",
+          "Per-stage wall time of `Planner.plan` on the paper scene and the shared ROS "
+          "maps.",
+          ("--repeat", "3", "--ros-queries", "5")),
+    Bench("polygon_corridor", "Corridors: convex polygons vs boxes",
+          "bench_polygon_corridor.py",
+          "Build time, area and overlap of the polygon corridor against the box corridor "
+          "on the same A* paths.",
+          ("--per-map", "8", "--repeats", "2")),
+    Bench("corridor", "Planner: polygon corridors vs box corridors", "bench_corridor.py",
+          "Success, smoothing time and path quality of `plan` with polygons against boxes "
+          "on held-out queries.",
+          ("--per-map", "6", "--repeats", "1")),
+    Bench("curvature", "Curvature-bounded smoothing", "bench_curvature.py",
+          "The SCP curvature bound against IPOPT on the same problems.",
+          ("--per-map", "8", "--repeats", "2")),
+    Bench("budget", "Smoother time budget", "bench_budget.py",
+          "Success rate of curvature-bounded plans for several time budgets.",
+          ("--per-map", "4", "--repeats", "1")),
+    Bench("fallback", "Robustness: smoother, stop-and-turn fallback, failures",
+          "bench_fallback.py",
+          "Outcome of every query on the shared maps with and without the fallback.",
+          ("--limit-per-map", "10")),
+    Bench("timing_property", "Timing: the speed cap on sharp curvature peaks",
+          "timing_property_run.py",
+          "Random curves with sharp curvature peaks: worst ratio of the sampled speed to "
+          "its cap.",
+          ("--examples", "100")),
+    Bench("mcap", "ROS 2 export: MCAP writing speed", "bench_mcap.py",
+          "Writing a 60 s trajectory at 100 Hz to MCAP, against mcap_ros2's generic "
+          "writer in the same run.",
+          ("--repeat", "3")),
+    Bench("harness", "Benchmark harness: Dask scaling", "bench_harness.py",
+          "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
+          "and the report on 10^5 rows.",
+          ("--limit", "6")),
+)
+
+
+def machine() -> str:
+    """One line describing this machine and the library versions."""
+    import numpy
+
+    try:
+        import casadi
+
+        casadi_v = casadi.__version__
+    except ImportError:  # pragma: no cover
+        casadi_v = "missing"
+    try:
+        import ruckig
+
+        ruckig_v = getattr(ruckig, "__version__", "installed")
+    except ImportError:  # pragma: no cover
+        ruckig_v = "missing"
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    return (
+        f"{platform.platform()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+        f"numpy {numpy.__version__}, casadi {casadi_v}, ruckig {ruckig_v}; "
+        f"load average {load:.2f} at the start"
+    )
+
+
+def run_one(bench: Bench, full: bool) -> tuple[str, float, int]:
+    """Run one benchmark; returns (its output, wall time in s, exit code)."""
+    args = bench.full if full else bench.quick
+    cmd = [sys.executable, str(ROOT / "benchmarks" / bench.script), *args]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    out = proc.stdout.rstrip()
+    if proc.returncode != 0:
+        tail = "\n".join(proc.stderr.rstrip().splitlines()[-15:])
+        out = f"{out}\n\n[exit code {proc.returncode}]\n{tail}".strip()
+    return out, wall, proc.returncode
+
+
+def section(bench: Bench, full: bool, out: str, wall: float, code: int) -> str:
+    """The markdown section of one benchmark."""
+    args = bench.full if full else bench.quick
+    cmd = " ".join(["python", f"benchmarks/{bench.script}", *args])
+    status = "" if code == 0 else f" **(failed, exit code {code})**"
+    return (
+        f"## {bench.title}\n\n{bench.what}\n\n"
+        f"`{cmd}`: {wall:.0f} s{status}\n\n```text\n{out}\n```\n"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    mode = ap.add_mutually_exclusive_group()
+    mode.add_argument("--quick", action="store_true", help="small settings (default)")
+    mode.add_argument("--full", action="store_true", help="the scripts' own defaults")
+    ap.add_argument("--only", nargs="+", choices=[b.name for b in BENCHES],
+                    help="run these benchmarks only")  # fmt: skip
+    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
+    args = ap.parse_args(argv)
+    chosen = [b for b in BENCHES if args.only is None or b.name in args.only]
+    when = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    head = (
+        "# Benchmarks\n\n"
+        "Every figure on this page comes from one run of "
+        f"`python benchmarks/run_all.py {'--full' if args.full else '--quick'}`, which "
+        "runs each script of `benchmarks/` in a fresh process and writes this page from "
+        "what it prints. Each benchmark measures against a reference in the same run; "
+        "absolute times depend on the machine and its load, ratios much less.\n\n"
+        f"- **Date**: {when}\n- **Machine**: {machine()}\n"
+        f"- **Settings**: {'full' if args.full else 'quick'} "
+        "(`--full` uses each script's own defaults)\n\n"
+        "Regenerate with the same command; rerun one section with `--only NAME`.\n"
+    )
+    parts = [head]
+    failed = 0
+    for bench in chosen:
+        print(f"running {bench.name} ...", flush=True)
+        out, wall, code = run_one(bench, args.full)
+        failed += code != 0
+        print(f"  {wall:.0f} s, exit code {code}", flush=True)
+        parts.append(section(bench, args.full, out, wall, code))
+    text = "\n".join(parts)
+    tmp = args.out.with_suffix(".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, args.out)
+    print(f"wrote {args.out} ({len(chosen)} benchmarks, {failed} failed)")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
