@@ -7,7 +7,7 @@ Three ways to grow obstacles by a robot radius, plus the distance field they der
   - ``"centre"`` (default): a cell is blocked when its centre lies within ``radius`` (``<=``)
     of the *centre* of an occupied cell;
   - ``"square"``: a cell is blocked when its centre is closer than ``radius`` (``<``) to an
-    occupied cell taken as a *square* (GUIDE.md section 6; the inflation a corridor can certify).
+    occupied cell taken as a *square* (``docs/concepts.md``, stage 1: the inflation a corridor can certify).
 
 * :func:`clearance` -- the distance in metres from every cell centre to the nearest occupied
   cell (centre or square, as above).
@@ -192,7 +192,7 @@ def inflate(
         centre is closer than ``radius`` (``<``) to an occupied cell taken as a square, i.e.
         the offset ``(dx, dy)`` in cells satisfies
         ``hypot(max(0, |dx| - 1/2), max(0, |dy| - 1/2)) < radius / resolution``
-        (GUIDE.md section 6: the inflation whose free boxes certify clearance).
+        (``docs/concepts.md``, stage 1: the inflation whose free boxes certify clearance).
     outside_occupied : bool, optional
         Treat everything outside the map as occupied (as the chapter does), so cells near the
         border are blocked too. Default ``False``.
@@ -363,7 +363,7 @@ def clearance_cost(
     cells from the cell centre to the nearest occupied cell *square* (``clearance(...,
     metric="square") / resolution``) and ``r = radius / resolution``: ``weight`` at the edge of
     the avoidance area (``d = r``), falling linearly to zero ``falloff_cells`` further out, zero
-    beyond (GUIDE.md section 6: ``weight=2``, ``falloff_cells=3``). Cells inside the avoidance
+    beyond (defaults ``weight=2``, ``falloff_cells=3``). Cells inside the avoidance
     area (``d < r``) get more than ``weight``; they are blocked in the inflated grid anyway.
     Pass the result as ``cost=`` to :func:`astar.find_path`, where a step costs its length
     times ``1 + mean cost of its two cells``.

@@ -3,7 +3,7 @@
 Stages (each timed in ``Trajectory.stats["stages_s"]``):
 
 1. **inflate**: ``astar.inflate(grid, r, metric="square", outside_occupied=True)`` (the
-   grid the corridor certifies against; GUIDE section 6). ``inflation="paper"`` adds the
+   grid the corridor certifies against; ``docs/concepts.md``). ``inflation="paper"`` adds the
    chapter's avoidance area (``W`` rounds of 8-neighbour marking, ``W`` from
    :func:`trajopt.robot.avoidance_width`)
    on top, so the result is never less safe than the certified inflation.
