@@ -47,7 +47,7 @@ from trajopt.curve import PolylineCurve
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.robot import Robot
 from trajopt.speed_limits import SpeedLimits
-from trajopt.trajectory import SampledExport, TrajectorySample, export_dict
+from trajopt.trajectory import SampledExport, TrajectorySample, export_dict, make_sample
 from trajopt.validation import heading, readonly, short_repr
 
 __all__ = ["StopAndTurnTrajectory", "stop_and_turn", "turn_limits", "polyline_clearance"]
@@ -295,24 +295,9 @@ class StopAndTurnTrajectory(SampledExport):
         f = (sig / self._seg_len[seg])[..., None]
         xy = (1.0 - f) * pts[seg] + f * pts[seg + 1]
         zero = np.zeros_like(tt)
-        out: dict[str, Any] = dict(
-            t=tt,
-            x=xy[..., 0],
-            y=xy[..., 1],
-            theta=theta,
-            v=v,
-            omega=omega,
-            a=a,
-            jerk=j,
-            a_lat=zero,
-            kappa=zero,
-            s=self._seg_s[seg] + sig,
-        )
-        if self.robot.track_width is not None:
-            half = 0.5 * self.robot.track_width
-            out["v_left"] = v - omega * half
-            out["v_right"] = v + omega * half
-        return TrajectorySample(**{n: readonly(x) for n, x in out.items()})
+        return make_sample(self.robot, t=tt, x=xy[..., 0], y=xy[..., 1], theta=theta, v=v,
+                           omega=omega, a=a, jerk=j, a_lat=zero, kappa=zero,
+                           s=self._seg_s[seg] + sig)  # fmt: skip
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:

@@ -83,6 +83,20 @@ class TrajectorySample(NamedTuple):
         return {k: v for k, v in self._asdict().items() if v is not None}
 
 
+def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample:
+    """Return a :class:`TrajectorySample` of read-only copies of ``arrays``.
+
+    ``arrays`` holds ``t``, ``x``, ``y``, ``theta``, ``v``, ``omega``, ``a``, ``jerk``,
+    ``a_lat``, ``kappa`` and ``s``; the wheel speeds ``v -+ omega * track_width / 2`` are
+    added when the robot has a track width.
+    """
+    if robot.track_width is not None:
+        half = 0.5 * robot.track_width
+        arrays["v_left"] = arrays["v"] - arrays["omega"] * half
+        arrays["v_right"] = arrays["v"] + arrays["omega"] * half
+    return TrajectorySample(**{k: readonly(x) for k, x in arrays.items()})
+
+
 class SampledExport:
     """The sampling and file export shared by every timed trajectory of :mod:`trajopt`.
 
@@ -399,24 +413,8 @@ class Trajectory(SampledExport):
         else:
             theta = raw
         omega = kappa * v
-        out: dict[str, Any] = dict(
-            t=tt,
-            x=xy[..., 0],
-            y=xy[..., 1],
-            theta=theta,
-            v=v,
-            omega=omega,
-            a=a,
-            jerk=j,
-            a_lat=omega * v,
-            kappa=kappa,
-            s=s,
-        )
-        if self.robot.track_width is not None:
-            half = 0.5 * self.robot.track_width
-            out["v_left"] = v - omega * half
-            out["v_right"] = v + omega * half
-        return TrajectorySample(**{k: readonly(x) for k, x in out.items()})
+        return make_sample(self.robot, t=tt, x=xy[..., 0], y=xy[..., 1], theta=theta, v=v,
+                           omega=omega, a=a, jerk=j, a_lat=omega * v, kappa=kappa, s=s)  # fmt: skip
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
