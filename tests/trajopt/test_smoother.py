@@ -24,8 +24,8 @@ from trajopt.bspline import clamped_uniform_knots
 from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.smoother import Smoother, SmoothPath
-from trajopt.smoother import basis as _basis
-from trajopt.smoother import qp as _qp
+from trajopt.smoother import basis as smoother_basis
+from trajopt.smoother import qp as smoother_qp
 
 
 # ----------------------------------------------------------------- references
@@ -93,9 +93,9 @@ def test_basis_derivatives_match_scipy():
         inner = np.sort(rng.uniform(0, 10, n - p - 1))
         t = np.concatenate([np.zeros(p + 1), inner, np.full(p + 1, 10.0)])
         u = np.concatenate([rng.uniform(0, 10, 40), [0.0, 10.0]])
-        span = _basis.find_spans(t, p, n, u)
+        span = smoother_basis.find_spans(t, p, n, u)
         for nu in range(p + 1):
-            vals = _basis.basis_derivs(t, p, span, u, nu)
+            vals = smoother_basis.basis_derivs(t, p, span, u, nu)
             dense = np.zeros((len(u), n))
             for a in range(p + 1):
                 dense[np.arange(len(u)), span + a] = vals[:, a]
@@ -110,17 +110,17 @@ def _random_scp_qp(rng, nb=20, p=3, m=4):
     full[0] = 4.0 + rng.uniform(0, 1, nb)
     full[1:] = rng.uniform(-0.5, 0.5, (p, nb))  # diagonally dominant: positive definite
     g = rng.normal(0, 3, 2 * nb)
-    layout = _qp.constraint_layout(nb, p, m)
+    layout = smoother_qp.constraint_layout(nb, p, m)
     S = layout.n_samples
-    heading = np.zeros((_qp.N_HEADING_ROWS, 2 * nb))
+    heading = np.zeros((smoother_qp.N_HEADING_ROWS, 2 * nb))
     heading[0, :4] = rng.normal(0, 1, 4)
     vals = rng.normal(0, 1, (S, 3, 2 * (p + 1)))
     lba = np.full(layout.n_rows, -np.inf)
     uba = np.full(layout.n_rows, np.inf)
     lba[0], uba[0] = -1.0, 1.0
     r0 = layout.sample_row0
-    lba[_qp.N_HEADING_ROWS : r0] = -3.0
-    uba[_qp.N_HEADING_ROWS : r0] = 3.0
+    lba[smoother_qp.N_HEADING_ROWS : r0] = -3.0
+    uba[smoother_qp.N_HEADING_ROWS : r0] = 3.0
     rows = r0 + 3 * np.arange(S)
     uba[rows] = rng.uniform(-1, 1, S)
     uba[rows + 1] = rng.uniform(-1, 1, S)
@@ -143,7 +143,7 @@ def test_working_set_qp_matches_a_reference_solver(fraction):
     active = rng.uniform(0, 1, S) < fraction
     penalty = 50.0
     trip = layout.values(heading, vals)
-    z, cost, ok, status, _ = _qp.solve_working_set(
+    z, cost, ok, status, _ = smoother_qp.solve_working_set(
         full, g, layout, trip, lbx, ubx, lba, uba, active, penalty
     )
     assert ok, status
@@ -155,13 +155,13 @@ def test_working_set_qp_matches_a_reference_solver(fraction):
     ubx_r[2 * nb :][~active] = 0.0
     ref = ca.conic(
         "ref", "osqp",
-        {"h": _qp.qp_solver(nb, p, "osqp", layout.m, False).sparsity_in("h"),
+        {"h": smoother_qp.qp_solver(nb, p, "osqp", layout.m, False).sparsity_in("h"),
          "a": layout.sparsity},
         {"osqp": {"verbose": False, "eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 200000,
                   "polish": True}, "print_time": False, "error_on_fail": True},
     )
     gg = np.concatenate([g, np.full(S, penalty)])
-    out = ref(h=ca.DM(ref.sparsity_in("h"), _qp.h_nonzeros(full, nb, p)), g=gg,
+    out = ref(h=ca.DM(ref.sparsity_in("h"), smoother_qp.h_nonzeros(full, nb, p)), g=gg,
               a=ca.DM(layout.sparsity, layout.nonzeros(trip)),
               lbx=lbx, ubx=ubx_r, lba=lba_r, uba=uba_r)
     x_ref = np.asarray(out["x"]).ravel()
@@ -177,7 +177,7 @@ def test_smoothness_gram_matches_quadrature_of_scipy_derivative():
         [np.zeros(p + 1), np.sort(rng.uniform(0, 5, n - p - 1)), np.full(p + 1, 5.0)]
     )
     c = rng.normal(size=n)
-    band = _basis.smoothness_band(t, p, n, 2)
+    band = smoother_basis.smoothness_band(t, p, n, 2)
     quad = band[0] @ (c * c) + 2 * sum(
         band[d, : n - d] @ (c[: n - d] * c[d:]) for d in range(1, p + 1)
     )
