@@ -134,7 +134,7 @@ def _astar_kernel(
     conn8,  # bool
     cut,  # corner cutting allowed
     weighted,  # bool: use `cost`
-    cost,  # float64 [H*W] (ignored unless weighted)
+    cost,  # float64 [ny*nx], unpadded (ignored unless weighted)
     rec,  # int32 [4*H*W] per-cell record: stamp, straight steps, diagonal steps, parent
     gf,  # float64 [H*W]: cost so far (weighted)
     gen,  # this search's stamp; gen + 1 marks closed
@@ -226,7 +226,8 @@ def _astar_kernel(
         ux = u % w
         uy = u // w
         gu = gf[u]
-        cu = cost[u] if weighted else 0.0
+        # unpadded cell index of a padded index v in row vy: v - 2 * vy - (w - 1)
+        cu = cost[u - 2 * uy - (w - 1)] if weighted else 0.0
         gau = rec[4 * u + 1]
         gbu = rec[4 * u + 2]
         for k in range(4):
@@ -255,7 +256,7 @@ def _astar_kernel(
             ay = abs(vy - gy)
             if weighted:
                 step = 1.0 if k < 4 else sqrt2
-                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v]))
+                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v - 2 * vy - (w - 1)]))
                 if sv == gen and gnew >= gf[v]:
                     continue
                 gf[v] = gnew
@@ -732,10 +733,7 @@ def find_path(
     gx, gy = validation.cell("goal", goal, grid)
     weighted = cost is not None
     if weighted:
-        c = validation.cell_costs(cost, grid)
-        cpad = np.zeros((grid.ny + 2, grid.nx + 2), dtype=np.float64)
-        cpad[1:-1, 1:-1] = c
-        cflat = cpad.ravel()
+        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel()
     else:
         cflat = _EMPTY_COST
     width = grid.nx + 2
