@@ -135,8 +135,8 @@ def _astar_kernel(
     cut,  # corner cutting allowed
     weighted,  # bool: use `cost`
     cost,  # float64 [ny*nx], unpadded (ignored unless weighted)
-    rec,  # int32 [4*H*W] per-cell record: stamp, straight steps, diagonal steps, parent
-    gf,  # float64 [H*W]: cost so far (weighted)
+    rec,  # int32 [4*H*W] per-cell record: stamp, parent, straight steps, diagonal steps
+    recf,  # float64 view of rec: recf[2 * v + 1] is the cost so far (weighted)
     gen,  # this search's stamp; gen + 1 marks closed
 ):  # pragma: no cover - numba
     sqrt2 = 1.4142135623730951
@@ -157,10 +157,10 @@ def _astar_kernel(
 
     closed = gen + 1
     rec[4 * start] = gen
-    rec[4 * start + 1] = 0
     rec[4 * start + 2] = 0
-    rec[4 * start + 3] = -1
-    gf[start] = 0.0
+    rec[4 * start + 3] = 0
+    rec[4 * start + 1] = -1
+    recf[2 * start + 1] = 0.0
     sx = start % w
     sy = start // w
     ax = abs(sx - gx)
@@ -225,11 +225,11 @@ def _astar_kernel(
             break
         ux = u % w
         uy = u // w
-        gu = gf[u]
+        gu = recf[2 * u + 1]
         # unpadded cell index of a padded index v in row vy: v - 2 * vy - (w - 1)
         cu = cost[u - 2 * uy - (w - 1)] if weighted else 0.0
-        gau = rec[4 * u + 1]
-        gbu = rec[4 * u + 2]
+        gau = rec[4 * u + 2]
+        gbu = rec[4 * u + 3]
         for k in range(4):
             fr[k] = free[u + ddy[k] * w + ddx[k]] != 0
         for k in range(ndir):
@@ -257,9 +257,9 @@ def _astar_kernel(
             if weighted:
                 step = 1.0 if k < 4 else sqrt2
                 gnew = gu + step * (1.0 + 0.5 * (cu + cost[v - 2 * vy - (w - 1)]))
-                if sv == gen and gnew >= gf[v]:
+                if sv == gen and gnew >= recf[2 * v + 1]:
                     continue
-                gf[v] = gnew
+                recf[2 * v + 1] = gnew
                 if conn8:
                     hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
                 else:
@@ -269,17 +269,17 @@ def _astar_kernel(
                 na = gau + (1 if k < 4 else 0)
                 nb = gbu + (0 if k < 4 else 1)
                 gnew = na + nb * sqrt2
-                if sv == gen and gnew >= rec[r4 + 1] + rec[r4 + 2] * sqrt2:
+                if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
                     continue
-                rec[r4 + 1] = na
-                rec[r4 + 2] = nb
+                rec[r4 + 2] = na
+                rec[r4 + 3] = nb
                 if conn8:
                     mn = min(ax, ay)
                     fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
                 else:
                     fnew = (na + ax + ay) + nb * sqrt2
             rec[r4] = gen
-            rec[r4 + 3] = u
+            rec[r4 + 1] = u
             if fnew == fcur:
                 if ssize == scap:
                     scap *= 2
@@ -321,17 +321,17 @@ def _astar_kernel(
     n = 1
     v = goal
     while v != start:
-        v = rec[4 * v + 3]
+        v = rec[4 * v + 1]
         n += 1
     path = np.empty(n, dtype=np.int64)
     v = goal
     for i in range(n - 1, -1, -1):
         path[i] = v
         if i > 0:
-            v = rec[4 * v + 3]
+            v = rec[4 * v + 1]
     if weighted:
-        return True, path, expanded, gf[goal], 0, 0
-    return True, path, expanded, 0.0, rec[4 * goal + 1], rec[4 * goal + 2]
+        return True, path, expanded, recf[2 * goal + 1], 0, 0
+    return True, path, expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
 
 
 # --------------------------------------------------------------------------- jump point search
@@ -386,9 +386,9 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
 
     closed = gen + 1
     rec[4 * start] = gen
-    rec[4 * start + 1] = 0
     rec[4 * start + 2] = 0
-    rec[4 * start + 3] = -1
+    rec[4 * start + 3] = 0
+    rec[4 * start + 1] = -1
     ax = abs(start % w - gx)
     ay = abs(start // w - gy)
     h0 = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
@@ -449,9 +449,9 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
             break
         ux = u % w
         uy = u // w
-        gau = rec[4 * u + 1]
-        gbu = rec[4 * u + 2]
-        pu = rec[4 * u + 3]
+        gau = rec[4 * u + 2]
+        gbu = rec[4 * u + 3]
+        pu = rec[4 * u + 1]
 
         # ---- successors: jump points in the pruned directions
         ns = 0
@@ -532,12 +532,12 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
                 na = gau + ddx + ddy
                 nb = gbu
             gnew = na + nb * sqrt2
-            if sv == gen and gnew >= rec[r4 + 1] + rec[r4 + 2] * sqrt2:
+            if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
                 continue
             rec[r4] = gen
-            rec[r4 + 1] = na
-            rec[r4 + 2] = nb
-            rec[r4 + 3] = u
+            rec[r4 + 2] = na
+            rec[r4 + 3] = nb
+            rec[r4 + 1] = u
             ax = abs(vx - gx)
             ay = abs(vy - gy)
             mn = min(ax, ay)
@@ -583,7 +583,7 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
     n = 1
     v = goal
     while v != start:
-        pv = rec[4 * v + 3]
+        pv = rec[4 * v + 1]
         n += max(abs(v % w - pv % w), abs(v // w - pv // w))
         v = pv
     path = np.empty(n, dtype=np.int64)
@@ -591,7 +591,7 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
     path[i] = goal
     v = goal
     while v != start:
-        pv = rec[4 * v + 3]
+        pv = rec[4 * v + 1]
         vx = v % w
         vy = v // w
         sx = 1 if pv % w > vx else (-1 if pv % w < vx else 0)
@@ -603,19 +603,20 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
             i -= 1
             path[i] = c
         v = pv
-    return True, path, expanded, 0.0, rec[4 * goal + 1], rec[4 * goal + 2]
+    return True, path, expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
 
 
 # --------------------------------------------------------------------------- caches
 class _Workspace:
     """Work buffers of one padded size, reused between searches (guarded by a lock)."""
 
-    __slots__ = ("gen", "gf", "rec")
+    __slots__ = ("gen", "rec", "recf")
 
     def __init__(self, n: int) -> None:
-        # one cache line touch per cell: [stamp, straight steps, diagonal steps, parent]
+        # one cache line touch per cell: [stamp, parent, straight steps, diagonal steps]; the
+        # two step counts double as the float64 cost so far of the weighted search (recf)
         self.rec = np.zeros(4 * n, dtype=np.int32)
-        self.gf = np.empty(n, dtype=np.float64)
+        self.recf = self.rec.view(np.float64)
         self.gen = 1
 
     def next_gen(self) -> int:
@@ -758,7 +759,7 @@ def find_path(
                 weighted,
                 cflat,
                 ws.rec,
-                ws.gf,
+                ws.recf,
                 gen,
             )
     if not found:
