@@ -26,6 +26,13 @@ so equal costs compare exactly equal and ties are broken exactly: among equal ``
 deeper node (larger ``g``) is expanded first, then the earlier pushed one. The search is
 therefore deterministic. The padded grid of the last few grids searched is cached (grids are
 immutable).
+
+The plain shortest path under the Moving AI rules (``connectivity=8``, no corner cutting, no
+``cost``) runs jump point search (Harabor and Grastien's pruning for grids without corner
+cutting: straight jumps stop at forced neighbours, diagonal jumps stop where a straight jump
+from them finds a jump point, diagonal moves have no forced neighbours) on the same exact
+integer-pair costs and tie-breaking; only jump points enter the open list (``expanded`` counts
+them) and the segments between them are unrolled into cells. The other modes run plain A*.
 """
 
 from __future__ import annotations
