@@ -26,6 +26,13 @@ so equal costs compare exactly equal and ties are broken exactly: among equal ``
 deeper node (larger ``g``) is expanded first, then the earlier pushed one. The search is
 therefore deterministic. The padded grid of the last few grids searched is cached (grids are
 immutable).
+
+The plain shortest path under the Moving AI rules (``connectivity=8``, no corner cutting, no
+``cost``) runs jump point search (Harabor and Grastien's pruning for grids without corner
+cutting: straight jumps stop at forced neighbours, diagonal jumps stop where a straight jump
+from them finds a jump point, diagonal moves have no forced neighbours) on the same exact
+integer-pair costs and tie-breaking; only jump points enter the open list (``expanded`` counts
+them) and the segments between them are unrolled into cells. The other modes run plain A*.
 """
 
 from __future__ import annotations
@@ -134,9 +141,9 @@ def _astar_kernel(
     conn8,  # bool
     cut,  # corner cutting allowed
     weighted,  # bool: use `cost`
-    cost,  # float64 [H*W] (ignored unless weighted)
-    rec,  # int32 [4*H*W] per-cell record: stamp, straight steps, diagonal steps, parent
-    gf,  # float64 [H*W]: cost so far (weighted)
+    cost,  # float64 [ny*nx], unpadded (ignored unless weighted)
+    rec,  # int32 [4*H*W] per-cell record: stamp, parent, straight steps, diagonal steps
+    recf,  # float64 view of rec: recf[2 * v + 1] is the cost so far (weighted)
     gen,  # this search's stamp; gen + 1 marks closed
 ):  # pragma: no cover - numba
     sqrt2 = 1.4142135623730951
@@ -157,10 +164,10 @@ def _astar_kernel(
 
     closed = gen + 1
     rec[4 * start] = gen
-    rec[4 * start + 1] = 0
     rec[4 * start + 2] = 0
-    rec[4 * start + 3] = -1
-    gf[start] = 0.0
+    rec[4 * start + 3] = 0
+    rec[4 * start + 1] = -1
+    recf[2 * start + 1] = 0.0
     sx = start % w
     sy = start // w
     ax = abs(sx - gx)
@@ -225,10 +232,11 @@ def _astar_kernel(
             break
         ux = u % w
         uy = u // w
-        gu = gf[u]
-        cu = cost[u] if weighted else 0.0
-        gau = rec[4 * u + 1]
-        gbu = rec[4 * u + 2]
+        gu = recf[2 * u + 1]
+        # unpadded cell index of a padded index v in row vy: v - 2 * vy - (w - 1)
+        cu = cost[u - 2 * uy - (w - 1)] if weighted else 0.0
+        gau = rec[4 * u + 2]
+        gbu = rec[4 * u + 3]
         for k in range(4):
             fr[k] = free[u + ddy[k] * w + ddx[k]] != 0
         for k in range(ndir):
@@ -255,10 +263,10 @@ def _astar_kernel(
             ay = abs(vy - gy)
             if weighted:
                 step = 1.0 if k < 4 else sqrt2
-                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v]))
-                if sv == gen and gnew >= gf[v]:
+                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v - 2 * vy - (w - 1)]))
+                if sv == gen and gnew >= recf[2 * v + 1]:
                     continue
-                gf[v] = gnew
+                recf[2 * v + 1] = gnew
                 if conn8:
                     hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
                 else:
@@ -268,17 +276,17 @@ def _astar_kernel(
                 na = gau + (1 if k < 4 else 0)
                 nb = gbu + (0 if k < 4 else 1)
                 gnew = na + nb * sqrt2
-                if sv == gen and gnew >= rec[r4 + 1] + rec[r4 + 2] * sqrt2:
+                if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
                     continue
-                rec[r4 + 1] = na
-                rec[r4 + 2] = nb
+                rec[r4 + 2] = na
+                rec[r4 + 3] = nb
                 if conn8:
                     mn = min(ax, ay)
                     fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
                 else:
                     fnew = (na + ax + ay) + nb * sqrt2
             rec[r4] = gen
-            rec[r4 + 3] = u
+            rec[r4 + 1] = u
             if fnew == fcur:
                 if ssize == scap:
                     scap *= 2
@@ -320,29 +328,302 @@ def _astar_kernel(
     n = 1
     v = goal
     while v != start:
-        v = rec[4 * v + 3]
+        v = rec[4 * v + 1]
         n += 1
     path = np.empty(n, dtype=np.int64)
     v = goal
     for i in range(n - 1, -1, -1):
         path[i] = v
         if i > 0:
-            v = rec[4 * v + 3]
+            v = rec[4 * v + 1]
     if weighted:
-        return True, path, expanded, gf[goal], 0, 0
-    return True, path, expanded, 0.0, rec[4 * goal + 1], rec[4 * goal + 2]
+        return True, path, expanded, recf[2 * goal + 1], 0, 0
+    return True, path, expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
+
+
+# --------------------------------------------------------------------------- jump point search
+@njit(cache=True)
+def _jump_straight(free, n, d, p, goal):  # pragma: no cover - numba
+    """Walk from ``n`` by ``d`` to the next jump point (``-1`` if blocked first)."""
+    # p is the perpendicular offset (1 or the row width); a cell is a jump point when a side
+    # cell is free while the side cell one step back is blocked (a forced neighbour)
+    while True:
+        n += d
+        if free[n] == 0:
+            return -1
+        if n == goal:
+            return n
+        b = n - d
+        if (free[n + p] != 0 and free[b + p] == 0) or (free[n - p] != 0 and free[b - p] == 0):
+            return n
+
+
+@njit(cache=True)
+def _jump_diag(free, n, dh, dv, w, goal):  # pragma: no cover - numba
+    """Walk diagonally from ``n`` by ``dh + dv`` to the next jump point (``-1`` if none)."""
+    while True:
+        # no corner cutting: both orthogonal cells of the step must be free
+        if free[n + dh] == 0 or free[n + dv] == 0:
+            return -1
+        n += dh + dv
+        if free[n] == 0:
+            return -1
+        if n == goal:
+            return n
+        if _jump_straight(free, n, dh, w, goal) >= 0 or _jump_straight(free, n, dv, 1, goal) >= 0:
+            return n
+
+
+@njit(cache=True)
+def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
+    """Jump point search: 8-connected, no corner cutting, octile costs (exact, integer pairs).
+
+    Same record layout and result tuple as :func:`_astar_kernel` (``rec`` holds the jump
+    points only; the path between two jump points is a straight or diagonal segment).
+    """
+    sqrt2 = 1.4142135623730951
+    w = width
+    gx = goal % w
+    gy = goal // w
+
+    cap = 256
+    hf = np.empty(cap, dtype=np.float64)
+    hg = np.empty(cap, dtype=np.float64)
+    hn = np.empty(cap, dtype=np.int32)
+
+    closed = gen + 1
+    rec[4 * start] = gen
+    rec[4 * start + 2] = 0
+    rec[4 * start + 3] = 0
+    rec[4 * start + 1] = -1
+    ax = abs(start % w - gx)
+    ay = abs(start // w - gy)
+    h0 = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
+    hf[0] = h0
+    hg[0] = 0.0
+    hn[0] = start
+    size = 1
+
+    scap = 64
+    stk = np.empty(scap, dtype=np.int32)
+    ssize = 0
+    fcur = h0
+
+    succ = np.empty(8, dtype=np.int64)
+    # the 8 directions as (horizontal offset, vertical offset), straight ones first
+    sdh = np.array([1, -1, 0, 0, 1, -1, 1, -1], dtype=np.int64)
+    sdv = np.array([0, 0, w, -w, w, w, -w, -w], dtype=np.int64)
+
+    expanded = 0
+    found = False
+    while size > 0 or ssize > 0:
+        if ssize > 0:
+            ssize -= 1
+            u = stk[ssize]
+        else:
+            u = hn[0]
+            fcur = hf[0]
+            size -= 1
+            if size > 0:
+                lf = hf[size]
+                lg = hg[size]
+                ln = hn[size]
+                i = 0
+                while True:
+                    c = 2 * i + 1
+                    if c >= size:
+                        break
+                    if c + 1 < size and (
+                        hf[c + 1] < hf[c] or (hf[c + 1] == hf[c] and hg[c + 1] > hg[c])
+                    ):
+                        c += 1
+                    if hf[c] < lf or (hf[c] == lf and hg[c] > lg):
+                        hf[i] = hf[c]
+                        hg[i] = hg[c]
+                        hn[i] = hn[c]
+                        i = c
+                    else:
+                        break
+                hf[i] = lf
+                hg[i] = lg
+                hn[i] = ln
+        if rec[4 * u] == closed:
+            continue
+        rec[4 * u] = closed
+        expanded += 1
+        if u == goal:
+            found = True
+            break
+        ux = u % w
+        uy = u // w
+        gau = rec[4 * u + 2]
+        gbu = rec[4 * u + 3]
+        pu = rec[4 * u + 1]
+
+        # ---- successors: jump points in the pruned directions
+        ns = 0
+        if pu < 0:
+            for k in range(8):
+                dh = sdh[k]
+                dv = sdv[k]
+                if k < 4:
+                    if free[u + dh + dv] != 0:
+                        v = _jump_straight(free, u, dh + dv, 1 if dh == 0 else w, goal)
+                        if v >= 0:
+                            succ[ns] = v
+                            ns += 1
+                else:
+                    v = _jump_diag(free, u, dh, dv, w, goal)
+                    if v >= 0:
+                        succ[ns] = v
+                        ns += 1
+        else:
+            px = pu % w
+            py = pu // w
+            sx = 1 if ux > px else (-1 if ux < px else 0)
+            sy = 1 if uy > py else (-1 if uy < py else 0)
+            dh = sx
+            dv = sy * w
+            if sx != 0 and sy != 0:
+                if free[u + dh] != 0:
+                    v = _jump_straight(free, u, dh, w, goal)
+                    if v >= 0:
+                        succ[ns] = v
+                        ns += 1
+                if free[u + dv] != 0:
+                    v = _jump_straight(free, u, dv, 1, goal)
+                    if v >= 0:
+                        succ[ns] = v
+                        ns += 1
+                v = _jump_diag(free, u, dh, dv, w, goal)
+                if v >= 0:
+                    succ[ns] = v
+                    ns += 1
+            else:
+                d = dh + dv  # the direction of travel
+                p = w if sy == 0 else 1  # perpendicular offset
+                if free[u + d] != 0:
+                    v = _jump_straight(free, u, d, p, goal)
+                    if v >= 0:
+                        succ[ns] = v
+                        ns += 1
+                for q in (p, -p):
+                    if free[u + q] != 0 and free[u - d + q] == 0:
+                        # forced: turn to the side, straight or diagonally forward
+                        v = _jump_straight(free, u, q, w + 1 - p, goal)
+                        if v >= 0:
+                            succ[ns] = v
+                            ns += 1
+                        if sy == 0:
+                            v = _jump_diag(free, u, d, q, w, goal)
+                        else:
+                            v = _jump_diag(free, u, q, d, w, goal)
+                        if v >= 0:
+                            succ[ns] = v
+                            ns += 1
+
+        for j in range(ns):
+            v = succ[j]
+            r4 = 4 * v
+            sv = rec[r4]
+            if sv == closed:
+                continue
+            vx = v % w
+            vy = v // w
+            ddx = abs(vx - ux)
+            ddy = abs(vy - uy)
+            if ddx != 0 and ddy != 0:
+                na = gau
+                nb = gbu + ddx
+            else:
+                na = gau + ddx + ddy
+                nb = gbu
+            gnew = na + nb * sqrt2
+            if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
+                continue
+            rec[r4] = gen
+            rec[r4 + 2] = na
+            rec[r4 + 3] = nb
+            rec[r4 + 1] = u
+            ax = abs(vx - gx)
+            ay = abs(vy - gy)
+            mn = min(ax, ay)
+            fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
+            if fnew == fcur:
+                if ssize == scap:
+                    scap *= 2
+                    nst = np.empty(scap, dtype=np.int32)
+                    nst[:ssize] = stk[:ssize]
+                    stk = nst
+                stk[ssize] = v
+                ssize += 1
+                continue
+            if size == cap:
+                cap *= 2
+                nf = np.empty(cap, dtype=np.float64)
+                ng = np.empty(cap, dtype=np.float64)
+                nn = np.empty(cap, dtype=np.int32)
+                nf[:size] = hf[:size]
+                ng[:size] = hg[:size]
+                nn[:size] = hn[:size]
+                hf = nf
+                hg = ng
+                hn = nn
+            i = size
+            size += 1
+            while i > 0:
+                pp = (i - 1) >> 1
+                if fnew < hf[pp] or (fnew == hf[pp] and gnew > hg[pp]):
+                    hf[i] = hf[pp]
+                    hg[i] = hg[pp]
+                    hn[i] = hn[pp]
+                    i = pp
+                else:
+                    break
+            hf[i] = fnew
+            hg[i] = gnew
+            hn[i] = v
+
+    if not found:
+        return False, np.empty(0, dtype=np.int64), expanded, 0.0, 0, 0
+    # ---- unroll the jump points into cells (each hop is a straight or diagonal segment)
+    n = 1
+    v = goal
+    while v != start:
+        pv = rec[4 * v + 1]
+        n += max(abs(v % w - pv % w), abs(v // w - pv // w))
+        v = pv
+    path = np.empty(n, dtype=np.int64)
+    i = n - 1
+    path[i] = goal
+    v = goal
+    while v != start:
+        pv = rec[4 * v + 1]
+        vx = v % w
+        vy = v // w
+        sx = 1 if pv % w > vx else (-1 if pv % w < vx else 0)
+        sy = 1 if pv // w > vy else (-1 if pv // w < vy else 0)
+        step = sx + sy * w
+        c = v
+        while c != pv:
+            c += step
+            i -= 1
+            path[i] = c
+        v = pv
+    return True, path, expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
 
 
 # --------------------------------------------------------------------------- caches
 class _Workspace:
     """Work buffers of one padded size, reused between searches (guarded by a lock)."""
 
-    __slots__ = ("gen", "gf", "rec")
+    __slots__ = ("gen", "rec", "recf")
 
     def __init__(self, n: int) -> None:
-        # one cache line touch per cell: [stamp, straight steps, diagonal steps, parent]
+        # one cache line touch per cell: [stamp, parent, straight steps, diagonal steps]; the
+        # two step counts double as the float64 cost so far of the weighted search (recf)
         self.rec = np.zeros(4 * n, dtype=np.int32)
-        self.gf = np.empty(n, dtype=np.float64)
+        self.recf = self.rec.view(np.float64)
         self.gen = 1
 
     def next_gen(self) -> int:
@@ -460,37 +741,40 @@ def find_path(
     gx, gy = validation.cell("goal", goal, grid)
     weighted = cost is not None
     if weighted:
-        c = validation.cell_costs(cost, grid)
-        cpad = np.zeros((grid.ny + 2, grid.nx + 2), dtype=np.float64)
-        cpad[1:-1, 1:-1] = c
-        cflat = cpad.ravel()
+        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel()
     else:
         cflat = _EMPTY_COST
     width = grid.nx + 2
     s = (sy + 1) * width + sx + 1
     t = (gy + 1) * width + gx + 1
+    # jump point search for the plain shortest path under the Moving AI rules
+    jps = connectivity == 8 and not corner_cutting and not weighted
     with _LOCK:
         free = _padded_free(grid.occupied)
         ws = _workspace(free.shape[0])
         gen = ws.next_gen()
-        found, path, expanded, gcost, na, nb = _astar_kernel(
-            free,
-            width,
-            s,
-            t,
-            connectivity == 8,
-            bool(corner_cutting),
-            weighted,
-            cflat,
-            ws.rec,
-            ws.gf,
-            gen,
-        )
+        if jps:
+            found, path, expanded, gcost, na, nb = _jps_kernel(free, width, s, t, ws.rec, gen)
+        else:
+            found, path, expanded, gcost, na, nb = _astar_kernel(
+                free,
+                width,
+                s,
+                t,
+                connectivity == 8,
+                bool(corner_cutting),
+                weighted,
+                cflat,
+                ws.rec,
+                ws.recf,
+                gen,
+            )
     if not found:
         raise NoPathError(
             f"no path from start ({sx}, {sy}) to goal ({gx}, {gy}) on the "
             f"{grid.nx} x {grid.ny} grid (connectivity={connectivity}, "
-            f"corner_cutting={bool(corner_cutting)}); {expanded} cells reachable from start"
+            f"corner_cutting={bool(corner_cutting)}); the search exhausted every cell reachable "
+            f"from start ({expanded} {'jump points' if jps else 'cells'} expanded)"
         )
     iy, ix = np.divmod(path, width)
     cells = np.stack([ix - 1, iy - 1], axis=1)

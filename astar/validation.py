@@ -225,8 +225,11 @@ def cell_costs(cost: object, grid: OccupancyGrid) -> np.ndarray:
         raise InvalidInputError(
             f"cost must have the grid's shape (ny, nx) = {grid.shape}, got {c.shape}"
         )
-    if not np.all(np.isfinite(c)):
-        raise InvalidInputError("cost must be finite everywhere (found NaN or infinity)")
-    if c.size and c.min() < 0.0:
-        raise InvalidInputError(f"cost must be >= 0 everywhere, found {float(c.min())!r}")
+    if c.size:
+        # two reductions, no temporary: NaN propagates through min, +-inf shows in min or max
+        lo = float(c.min())
+        if not (math.isfinite(lo) and math.isfinite(float(c.max()))):
+            raise InvalidInputError("cost must be finite everywhere (found NaN or infinity)")
+        if lo < 0.0:
+            raise InvalidInputError(f"cost must be >= 0 everywhere, found {lo!r}")
     return c
