@@ -41,6 +41,7 @@ _EXPORTS: dict[str, str] = {
     "Robot": "trajopt.robot",
     "time_parameterize": "trajopt.timing",
     "Trajectory": "trajopt.trajectory",
+    "State": "trajopt.state",
     "SpeedLimits": "trajopt.speed_limits",
     "load_speed_mask": "trajopt.speed_limits",
     # ROS 2 files
@@ -96,5 +97,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.ros_mcap import read_mcap, write_mcap
     from trajopt.smoother import Smoother, SmoothPath
     from trajopt.speed_limits import SpeedLimits, load_speed_mask
+    from trajopt.state import State
     from trajopt.timing import time_parameterize
     from trajopt.trajectory import Trajectory

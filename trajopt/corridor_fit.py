@@ -49,6 +49,7 @@ def fit_in_corridor(
     kinds = ["boxes"]
     if planner.corridor == "polygons" and planner.inflation == "exact":
         kinds.insert(0, "polygons")
+    first_failure: SmoothingError | None = None
     for i, kind in enumerate(kinds):
         last = i == len(kinds) - 1
         try:
@@ -58,6 +59,9 @@ def fit_in_corridor(
                 else:
                     corridor = box_corridor(planner, q.inflated, path, q.start, q.goal)
         except InvalidInputError as exc:
+            if last and first_failure is not None:
+                # the polygons were built but the fit in them failed: that is the failure
+                raise first_failure from exc
             if last:
                 raise
             logger.debug("%s corridor not built (%s); trying the next kind", kind, exc)
@@ -71,12 +75,14 @@ def fit_in_corridor(
             with q.timer.stage("smooth"):
                 smooth = sm.fit(path, corridor, raw_grid=planner.grid,
                                 radius=planner.robot.radius, start=q.start, goal=q.goal,
-                                start_heading=q.start_heading, goal_heading=q.goal_heading)  # fmt: skip
+                                start_heading=q.start_heading, goal_heading=q.goal_heading,
+                                start_curvature=q.start_curvature)  # fmt: skip
             return corridor, smooth
         except SmoothingError as exc:
             spent += time.perf_counter() - t_fit
             if last:
                 raise
+            first_failure = first_failure or exc
             logger.debug("fit in the %s corridor failed (%s); trying the next kind", kind, exc)
     raise AssertionError("unreachable")  # pragma: no cover
 

@@ -54,8 +54,10 @@ stop-and-turn motion starts and ends at rest, so it could not honour those speed
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import logging
+import math
 import threading
 import time
 from collections.abc import Sequence
@@ -75,9 +77,10 @@ from trajopt.polygon_corridor import PolygonCorridor
 from trajopt.robot import Robot, avoidance_width
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.speed_limits import SpeedLimits
+from trajopt.state import State
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
-from trajopt.validation import point
+from trajopt.validation import nonnegative, number, point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
 
@@ -224,45 +227,115 @@ class Planner:
         self.costmap_weight = float(costmap_weight)
         self.speed_limits = speed_limits
         self._lock = threading.RLock()
+        self._latencies: collections.deque[float] = collections.deque(maxlen=32)
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
 
     # -------------------------------------------------------------- caches
     @property
     def inflated_grid(self) -> OccupancyGrid:
-        """The grid the robot centre moves in (computed once)."""
+        """The grid the robot centre moves in (computed once per map)."""
         with self._lock:
             if self._inflated is None:
-                g = astar.inflate(
-                    self.grid, self.robot.radius, metric="square", outside_occupied=True
-                )
-                if self.inflation == "paper":
-                    area = astar.avoidance_area(self.grid, self.w_cells, border=True)
-                    g = self.grid.with_occupied(g.occupied | area.occupied)
-                self._inflated = g
+                self._inflated = self.grid.with_occupied(self._inflate(self.grid))
             return self._inflated
 
     @property
     def search_cost(self) -> np.ndarray | None:
-        """Per-cell A* cost (``None`` for ``search="shortest"``), computed once."""
+        """Per-cell A* cost (``None`` for ``search="shortest"``), computed once per map."""
         if self.search == "shortest":
             return None
         with self._lock:
             if self._cost is None:
-                cost = np.zeros(self.grid.shape)
-                if self.search in ("clearance", "costmap+clearance"):
-                    cost += astar.clearance_cost(
-                        self.grid, self.robot.radius, outside_occupied=True
-                    )
+                cost = self._clearance_cost(self.grid)
                 if self.costmap is not None and self.search.startswith("costmap"):
                     cost += self.costmap.search_cost(self.costmap_weight)
                 self._cost = cost
             return self._cost
 
+    def _inflate(self, grid: OccupancyGrid) -> np.ndarray:
+        occ = astar.inflate(grid, self.robot.radius, metric="square", outside_occupied=True)
+        out = occ.occupied
+        if self.inflation == "paper":
+            out = out | astar.avoidance_area(grid, self.w_cells, border=True).occupied
+        return out
+
+    def _clearance_cost(self, grid: OccupancyGrid) -> np.ndarray:
+        cost = np.zeros(grid.shape)
+        if self.search in ("clearance", "costmap+clearance"):
+            cost += astar.clearance_cost(grid, self.robot.radius, outside_occupied=True)
+        return cost
+
+    def update_map(self, grid: OccupancyGrid) -> dict[str, Any]:
+        """Replace the raw map, recomputing the caches only where the change reaches.
+
+        The inflated grid and the clearance cost depend on the map only within the robot
+        radius (plus the avoidance area and the cost's fall-off) of each cell, so they are
+        recomputed in the box around the changed cells grown by that reach (on a window
+        grown once more, whose made-up outside then cannot reach the box); everything else
+        is kept. A map of another shape, resolution or origin resets the caches.
+
+        Parameters
+        ----------
+        grid : astar.OccupancyGrid
+            The updated raw map.
+
+        Returns
+        -------
+        dict
+            ``changed_cells`` and ``window`` (``(x0, x1, y0, y1)`` cells, inclusive, or
+            ``None``) of the recomputed box; ``reset`` when the caches were dropped.
+
+        Raises
+        ------
+        InvalidInputError
+            ``grid`` is not an OccupancyGrid, or the planner plans on a costmap (make a new
+            :class:`Planner` from the new costmap).
+        """
+        if not isinstance(grid, OccupancyGrid):
+            raise InvalidInputError(
+                f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}"
+            )
+        if self.costmap is not None:
+            raise InvalidInputError(
+                "this planner plans on a costmap: build a new Planner from the updated costmap"
+            )
+        with self._lock:
+            old = self.grid
+            same = (
+                grid.shape == old.shape
+                and grid.resolution == old.resolution
+                and grid.origin == old.origin
+            )
+            if not same:
+                self.grid, self._inflated, self._cost = grid, None, None
+                return {"changed_cells": None, "window": None, "reset": True}
+            changed = grid.occupied != old.occupied
+            n_changed = int(changed.sum())
+            self.grid = grid
+            if n_changed == 0:
+                return {"changed_cells": 0, "window": None, "reset": False}
+            iy, ix = np.nonzero(changed)
+            box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
+            r_cells = int(math.ceil(self.robot.radius / grid.resolution)) + 2
+            if self.inflation == "paper":
+                r_cells += self.w_cells + 1
+            reach_cost = r_cells + 5  # + the clearance cost's 3-cell fall-off, rounded up
+            window = _grow(box, max(r_cells, reach_cost), grid.shape)
+            if self._inflated is not None:
+                occ = np.array(self._inflated.occupied)
+                _patch(occ, grid, window, r_cells, self._inflate)
+                self._inflated = grid.with_occupied(occ)
+            if self._cost is not None:
+                cost = np.array(self._cost)
+                _patch(cost, grid, window, reach_cost, self._clearance_cost)
+                self._cost = cost
+            return {"changed_cells": n_changed, "window": window, "reset": False}
+
     # ---------------------------------------------------------------- query
     def plan(
         self,
-        start: Sequence[float],
+        start: Sequence[float] | State,
         goal: Sequence[float],
         *,
         start_heading: float | None = None,
@@ -274,8 +347,13 @@ class Planner:
 
         Parameters
         ----------
-        start, goal : sequence of float, shape (2,)
-            End points ``(x, y)`` in metres.
+        start : sequence of float, shape (2,), or State
+            Start point ``(x, y)`` in metres, or a moving robot's :class:`~trajopt.state.State`:
+            the curve then starts at its position with its heading and curvature (C2 at the
+            splice) and the timing at its speed and acceleration (``start_heading`` and
+            ``v_start`` must then be left at their defaults).
+        goal : sequence of float, shape (2,)
+            End point ``(x, y)`` in metres.
         start_heading, goal_heading : float, optional
             Exact headings at the ends (rad).
         v_start, v_end : float
@@ -303,9 +381,99 @@ class Planner:
             its clearance check.
         """
         with self._lock:
-            return self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
+            t0 = time.perf_counter()
+            out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
+            self._latencies.append(time.perf_counter() - t0)
+            return out
+
+    @property
+    def latency_s(self) -> float:
+        """Median wall time (s) of this planner's recent queries (0 before the first)."""
+        with self._lock:
+            return float(np.median(self._latencies)) if self._latencies else 0.0
+
+    def replan(
+        self,
+        trajectory: PlanResult,
+        t: float,
+        goal: Sequence[float] | None = None,
+        grid: OccupancyGrid | None = None,
+        *,
+        latency: float | None = None,
+        goal_heading: float | None = None,
+        v_end: float = 0.0,
+    ) -> PlanResult:
+        """Re-plan from a trajectory being driven, splicing at ``t + latency``.
+
+        The new trajectory starts at ``trajectory.state_at(t + latency)``: the same
+        position, heading, curvature, speed and acceleration (a C2 splice), so a robot can
+        switch to it at that time without a jump. Its ``stats["splice_time_s"]`` is the
+        splice time on the old trajectory's clock, ``stats["latency_s"]`` the latency used.
+
+        Parameters
+        ----------
+        trajectory : Trajectory or StopAndTurnTrajectory
+            The trajectory being driven.
+        t : float
+            Its current time (s).
+        goal : sequence of float, shape (2,), optional
+            A new goal (m); default the old one (``trajectory.steps.goal``).
+        grid : astar.OccupancyGrid, optional
+            An updated map (:meth:`update_map`: the caches are recomputed only where the
+            change reaches).
+        latency : float, optional
+            Time (s) the re-plan is expected to take: the splice is that far ahead. Default
+            :attr:`latency_s`, the median of this planner's recent queries.
+        goal_heading : float, optional
+            Exact heading at the goal (rad).
+        v_end : float, optional
+            Speed at the goal (m/s).
+
+        Raises
+        ------
+        InvalidInputError
+            ``t + latency`` outside ``[0, duration]``, a negative latency, no goal given
+            for a trajectory without ``steps``.
+        TimingError, SmoothingError, NoPathError
+            As :meth:`plan`; a state too fast for any curve found says so.
+        """
+        lat = self.latency_s if latency is None else nonnegative("latency", latency, "s")
+        t_now = number("t", t, unit="s", lo=0.0, hi=float(trajectory.duration))
+        ts = t_now + lat
+        if ts > trajectory.duration:
+            raise InvalidInputError(
+                f"t + latency = {t_now:.6g} + {lat:.6g} s is past the trajectory's end "
+                f"({trajectory.duration:.6g} s): nothing is left to splice onto"
+            )
+        if goal is None:
+            steps = getattr(trajectory, "steps", None)
+            if steps is None:
+                raise InvalidInputError(
+                    "goal is required: the trajectory has no steps (it was not planned by a "
+                    "Planner)"
+                )
+            goal = steps.goal
+        if grid is not None:
+            self.update_map(grid)
+        state = trajectory.state_at(ts)
+        out = self.plan(state, goal, goal_heading=goal_heading, v_end=v_end)
+        stats = dict(out.stats)
+        stats["splice_time_s"] = ts
+        stats["latency_s"] = lat
+        return dataclasses.replace(out, stats=stats)
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
+        kappa0 = None
+        a0 = 0.0
+        if isinstance(start, State):
+            if start_heading is not None or v_start != 0.0:
+                raise InvalidInputError(
+                    "start is a State: its theta and v are the start heading and speed; "
+                    f"leave start_heading (got {start_heading!r}) and v_start (got "
+                    f"{v_start!r}) at their defaults"
+                )
+            start_heading, kappa0, v_start, a0 = start.theta, start.kappa, start.v, start.a
+            start = start.position
         p0 = point("start", start)
         p1 = point("goal", goal)
         q = PlanQuery(
@@ -315,8 +483,10 @@ class Planner:
             goal_cell=self._check_endpoint("goal", p1),
             start_heading=start_heading,
             goal_heading=goal_heading,
+            start_curvature=kappa0,
             v_start=v_start,
             v_end=v_end,
+            a_start=a0,
         )
         with q.timer.stage("inflate"):
             q.inflated = self.inflated_grid
@@ -334,17 +504,68 @@ class Planner:
         smooth = None
         try:
             smooth = self._smooth(q)
-            with q.timer.stage("timing"):
-                traj = time_parameterize(smooth, self.robot, v_start=v_start, v_end=v_end,
-                                         dt=self.timing_dt, speed_limits=self.speed_limits)  # fmt: skip
+            try:
+                traj = self._time(q, smooth)
+            except TimingError:
+                if v_start <= 0.0:
+                    raise
+                smooth = self._smooth_for_speed(q)
+                traj = self._time(q, smooth)
         except (SmoothingError, TimingError) as exc:
-            if self.fallback is None or v_start != 0.0 or v_end != 0.0:
+            if self.fallback is None or v_start != 0.0 or v_end != 0.0 or q.a_start != 0.0:
                 raise
             return self._fallback(q, exc)
         smoother_stats = dict(smooth.stats)
         smoother_stats["rescue"] = q.rescue
         kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
         return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind)
+
+    def _time(self, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
+        with q.timer.stage("timing"):
+            return time_parameterize(smooth, self.robot, v_start=q.v_start, v_end=q.v_end,
+                                     dt=self.timing_dt, speed_limits=self.speed_limits,
+                                     a_start=q.a_start)  # fmt: skip
+
+    def _smooth_for_speed(self, q: PlanQuery) -> SmoothPath:
+        """Fit again with a curvature bound the start speed can follow.
+
+        A moving start whose speed cannot be brought under the cap of the first curve
+        (too sharp a turn too soon) gets a second fit bounded by the curvature whose cap
+        is that speed (``Robot.speed_cap``), a little tighter; the state's own curvature
+        must already be within it.
+
+        Raises
+        ------
+        TimingError
+            The state is above the cap at its own curvature.
+        SmoothingError
+            No curve within that bound (the message says why the bound was imposed).
+        """
+        r = self.robot
+        # the speed rises by a^2 / (2 j) before a positive acceleration can be undone
+        v = q.v_start + max(q.a_start, 0.0) ** 2 / (2.0 * r.j_max)
+        bounds = [r.a_lat_max / (v * v), r.omega_max / v]
+        if r.track_width is not None and r.wheel_v_max is not None and v < r.wheel_v_max:
+            bounds.append((r.wheel_v_max / v - 1.0) * 2.0 / r.track_width)
+        k_speed = 0.95 * min(bounds)
+        k0 = abs(q.start_curvature or 0.0)
+        if k0 > k_speed:
+            raise TimingError(
+                f"the start state moves at {v:.6g} m/s on curvature {k0:.6g} 1/m: above the "
+                f"speed cap there ({float(r.speed_cap(k0)):.6g} m/s)"
+            )
+        kmax = k_speed if self.smoother.kappa_max is None else min(k_speed, self.smoother.kappa_max)
+        sm = dataclasses.replace(self.smoother, kappa_max=kmax)
+        try:
+            q.corridor, smooth = fit_in_corridor(self, q, q.path, sm)
+        except SmoothingError as exc:
+            raise SmoothingError(
+                f"the start state moves at {v:.6g} m/s: no curve from it turns gently enough "
+                f"(curvature <= {kmax:.6g} 1/m) to slow down under the speed cap in time: {exc}",
+                exc.stats,
+            ) from exc
+        q.rescue = "speed"
+        return smooth
 
     def _smooth(self, q: PlanQuery) -> SmoothPath:
         """Return the corridor and the certified curve.
@@ -550,6 +771,30 @@ def _check_speed_limits(limits: object, grid: OccupancyGrid) -> None:
 def _cell(c: np.ndarray) -> tuple[int, int]:
     """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
     return (int(c[0]), int(c[1]))
+
+
+def _grow(box: tuple[int, int, int, int], k: int, shape: tuple[int, int]):
+    """Grow the cell box ``(x0, x1, y0, y1)`` (inclusive) by ``k`` cells, inside ``shape``."""
+    ny, nx = shape
+    return (max(0, box[0] - k), min(nx - 1, box[1] + k), max(0, box[2] - k), min(ny - 1, box[3] + k))
+
+
+def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute) -> None:
+    """Recompute ``target`` (a per-cell array of ``grid``) inside ``window``.
+
+    ``compute`` runs on the map cut to ``window`` grown by ``reach`` more cells; cells of
+    ``window`` are at least ``reach`` from that cut's made-up outside (where it is not the
+    map's own edge), so they get exactly the values of a whole-map computation.
+    """
+    x0, x1, y0, y1 = window
+    cx0, cx1, cy0, cy1 = _grow(window, reach, grid.shape)
+    res = grid.resolution
+    ox, oy = grid.origin
+    sub = OccupancyGrid(
+        grid.occupied[cy0 : cy1 + 1, cx0 : cx1 + 1], res, (ox + cx0 * res, oy + cy0 * res)
+    )
+    vals = compute(sub)
+    target[y0 : y1 + 1, x0 : x1 + 1] = vals[y0 - cy0 : y1 - cy0 + 1, x0 - cx0 : x1 - cx0 + 1]
 
 
 def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:

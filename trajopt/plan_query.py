@@ -59,8 +59,12 @@ class PlanQuery:
         Their cells ``(ix, iy)``.
     start_heading, goal_heading : float or None
         Exact end headings (rad).
+    start_curvature : float or None
+        Exact start curvature (1/m), from a :class:`~trajopt.state.State`.
     v_start, v_end : float
         End speeds (m/s).
+    a_start : float
+        Start acceleration (m/s^2), from a :class:`~trajopt.state.State`.
     inflated : OccupancyGrid or None
         The grid the robot centre moves in.
     path : astar.GridPath or None
@@ -79,8 +83,10 @@ class PlanQuery:
     goal_cell: np.ndarray
     start_heading: float | None = None
     goal_heading: float | None = None
+    start_curvature: float | None = None
     v_start: float = 0.0
     v_end: float = 0.0
+    a_start: float = 0.0
     inflated: OccupancyGrid | None = None
     path: Any = None
     corridor: PolygonCorridor | Corridor | None = None

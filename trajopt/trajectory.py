@@ -23,7 +23,8 @@ from astar.files import atomic_write
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
 from trajopt.robot import Robot
-from trajopt.validation import readonly
+from trajopt.state import State
+from trajopt.validation import number, readonly
 
 __all__ = ["Trajectory", "TrajectorySample", "SAMPLE_UNITS"]
 
@@ -162,6 +163,30 @@ class SampledExport:
             w.writerow([repr(float(x)) for x in row])
         return _atomic_write(Path(path), buf.getvalue())
 
+
+    def state_at(self, t: float) -> State:
+        """Return the robot's :class:`~trajopt.state.State` at time ``t`` (s).
+
+        Position, heading, signed curvature, speed and tangential acceleration of the
+        trajectory at ``t``, which must lie in ``[0, duration]``: the start of a re-plan
+        (:meth:`trajopt.Planner.replan`).
+
+        Raises
+        ------
+        InvalidInputError
+            ``t`` is not a number in ``[0, duration]``.
+        """
+        duration = float(self.duration)  # type: ignore[attr-defined]
+        tt = number("t", t, unit="s", lo=0.0, hi=duration)
+        smp = self.sample(np.array([tt]))  # type: ignore[attr-defined]
+        return State(
+            x=float(smp.x[0]),
+            y=float(smp.y[0]),
+            theta=float(smp.theta[0]),
+            kappa=float(smp.kappa[0]),
+            v=max(0.0, float(smp.v[0])),
+            a=float(smp.a[0]),
+        )
 
     def to_poses(self, dt: float = 0.01) -> np.ndarray:
         """Poses every ``dt`` seconds in the shape of ``nav_msgs/Path``, without ROS.

@@ -37,7 +37,7 @@ from trajopt.smoother.problem import (
 from trajopt.smoother.qp import N_HEADING_ROWS, solve_qp, warm_imports
 from trajopt.smoother.scp import CurvatureSCP
 from trajopt.smoother.status import AttemptRecord, SolveInfo, SolveStatus, summarize
-from trajopt.validation import heading
+from trajopt.validation import heading, number
 
 __all__ = ["fit", "fit_free"]
 
@@ -69,6 +69,7 @@ def fit(
     goal: Any = None,
     start_heading: float | None = None,
     goal_heading: float | None = None,
+    start_curvature: float | None = None,
 ) -> SmoothPath:
     """:meth:`Smoother.fit` (see there)."""
     warm_imports()  # one-off module imports do not count against the time budget
@@ -92,10 +93,16 @@ def fit(
         raise InvalidInputError("radius is required (or corridor.radius) with raw_grid")
     hs = heading("start_heading", start_heading)
     hg = heading("goal_heading", goal_heading)
+    ks = None
+    if start_curvature is not None:
+        ks = number("start_curvature", start_curvature, unit="1/m")
+        if hs is None:
+            raise InvalidInputError("start_curvature needs start_heading (the tangent it bends)")
     if corridor.length_m <= 0:
         raise InvalidInputError("the corridor's path has zero length (start == goal)")
     prob, p0, p1 = build_problem(
-        options, grid_path_or_points, corridor, start=start, goal=goal, hs=hs, hg=hg
+        options, grid_path_or_points, corridor, start=start, goal=goal, hs=hs, hg=hg,
+        start_kappa=ks,
     )
     attempts: list[AttemptRecord] = []
     h = float(options.span_cells)
@@ -210,7 +217,7 @@ def solve_attempt(
             raise AttemptFailed(f"curvature bound ({cinfo.solver}): {cinfo.detail}")
         z = np.clip(cinfo.z, qp.lbx, qp.ubx)
     c = np.column_stack([z[:n], z[nb : nb + n]])
-    project_heading(c, prob, asm.lo, asm.hi, asm.point_rows)
+    project_heading(c, prob, asm.lo, asm.hi, asm.point_rows, asm.start_alpha)
     zc = np.zeros(2 * nb)
     zc[:n], zc[nb : nb + n] = c[:, 0], c[:, 1]
     rec.cost = band_quadratic(qp.full, qp.g, zc, const)

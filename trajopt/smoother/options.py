@@ -138,6 +138,7 @@ class Smoother:
         goal: np.ndarray | tuple[float, float] | None = None,
         start_heading: float | None = None,
         goal_heading: float | None = None,
+        start_curvature: float | None = None,
     ) -> SmoothPath:
         """Fit a certified smooth path inside ``corridor``.
 
@@ -161,6 +162,11 @@ class Smoother:
             its end region.
         start_heading, goal_heading : float, optional
             Exact tangent directions (rad) at the ends.
+        start_curvature : float, optional
+            Exact signed curvature (1/m) at the start, with ``start_heading`` (a re-plan
+            from a moving robot continues its curvature). ``|c_1 - c_0|`` is then fixed
+            (module :mod:`trajopt.smoother.problem`, :func:`start_alpha`), which makes the
+            curvature linear in ``c_2``.
 
         Returns
         -------
@@ -186,6 +192,7 @@ class Smoother:
             goal=goal,
             start_heading=start_heading,
             goal_heading=goal_heading,
+            start_curvature=start_curvature,
         )
 
     def fit_free(self, points: np.ndarray, u: np.ndarray, knots: np.ndarray) -> BSplineCurve:

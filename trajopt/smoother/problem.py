@@ -44,6 +44,8 @@ __all__ = [
     "polygon_targets",
     "project_heading",
     "region_rows",
+    "start_alpha",
+    "start_curvature_row",
 ]
 
 class EmptyBoundsError(Exception):
@@ -80,6 +82,7 @@ class Problem:
     res: float = 1.0
     rows: list[tuple[np.ndarray, np.ndarray]] | None = None
     taut: bool = False
+    start_kappa: float | None = None  # curvature at the start (1/cell), with start_dir
 
 
 @dataclass(slots=True)
@@ -119,6 +122,8 @@ class Assembly:
         Starting point: the targets projected to the bounds, by parameter.
     const : float
         Constant term of the objective (its value at ``z = 0``).
+    start_alpha : float or None
+        With a start curvature, the fixed ``|c_1 - c_0|`` (cells).
     """
 
     qp: QPData
@@ -129,6 +134,7 @@ class Assembly:
     point_rows: tuple | None
     x0: np.ndarray
     const: float
+    start_alpha: float | None = None
 
 
 def _sd(xy: np.ndarray) -> np.ndarray:
@@ -351,19 +357,27 @@ def objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
     return band, g, const
 
 
-def heading_rows(prob: Problem, n: int, nb: int):
-    """Return the heading rows ``(A (4, 2 nb), lba, uba)`` of the start and goal tangents."""
-    amat = np.zeros((4, 2 * nb))
-    lba = np.full(4, -np.inf)
-    uba = np.full(4, np.inf)
+def heading_rows(prob: Problem, n: int, nb: int, alpha: float | None = None):
+    """Return the end-condition rows ``(A (5, 2 nb), lba, uba)``.
+
+    Rows 0-1: ``c_1`` on the start-heading ray (``cross(d, c_1 - c_0) = 0``,
+    ``dot(d, c_1 - c_0) >= 1e-3``, or ``= alpha`` with a start curvature); rows 2-3: the
+    same for ``c_{n-2}`` and the goal heading; row 4: the start curvature
+    (:func:`start_curvature_row`), unused rows with infinite bounds.
+    """
+    amat = np.zeros((5, 2 * nb))
+    lba = np.full(5, -np.inf)
+    uba = np.full(5, np.inf)
     eps = 1e-3  # cells: keeps c_1 != c_0 so the end heading is defined
     if prob.start_dir is not None:
         dx, dy = prob.start_dir
-        # cross(d, c1 - c0) = 0 ; dot(d, c1 - c0) >= eps
+        # cross(d, c1 - c0) = 0 ; dot(d, c1 - c0) >= eps (= alpha with a start curvature)
         amat[0, 1], amat[0, nb + 1] = -dy, dx
         lba[0] = uba[0] = -dy * prob.start[0] + dx * prob.start[1]
         amat[1, 1], amat[1, nb + 1] = dx, dy
         lba[1] = dx * prob.start[0] + dy * prob.start[1] + eps
+        if alpha is not None:
+            lba[1] = uba[1] = dx * prob.start[0] + dy * prob.start[1] + alpha
     if prob.goal_dir is not None:
         dx, dy = prob.goal_dir
         j = n - 2
@@ -375,14 +389,64 @@ def heading_rows(prob: Problem, n: int, nb: int):
     return amat, lba, uba
 
 
-def project_heading(
-    c: np.ndarray, prob: Problem, lo: np.ndarray, hi: np.ndarray, point_rows=None
-) -> None:
-    """Put ``c_1`` (``c_{n-2}``) exactly on the start.
+def start_alpha(prob: Problem, t: np.ndarray, p: int, lo: np.ndarray, hi: np.ndarray,
+                rows: tuple | None) -> float | None:
+    """Return the fixed ``|c_1 - c_0|`` (cells) of a fit with a start curvature, else None.
 
-    Put ``c_1`` (``c_{n-2}``) exactly on the start (reversed goal) heading ray, inside its
-    bounds (and its region rows ``lo <= A c <= hi`` in a polygon corridor), at least ``1e-3``
-    cells from the end point when the bounds allow it.
+    ``t[p + 1] / p``: the parametric speed ``|C'(0)| = p |c_1 - c_0| / t[p + 1]`` is then 1,
+    as for the arc-length parameter; at most half the room along the heading ray inside
+    ``c_1``'s bounds (and region rows).
+    """
+    if prob.start_kappa is None or prob.start_dir is None:
+        return None
+    d = prob.start_dir
+    room = np.inf
+    for ax in range(2):
+        if d[ax] > 1e-15:
+            room = min(room, (hi[1, ax] - prob.start[ax]) / d[ax])
+        elif d[ax] < -1e-15:
+            room = min(room, (lo[1, ax] - prob.start[ax]) / d[ax])
+    if rows is not None:
+        A, _, rhi = (x[1] for x in rows)
+        ad = A @ d
+        slack = rhi - A @ prob.start
+        pos = ad > 1e-15
+        if np.any(pos):
+            room = min(room, float(np.min(slack[pos] / ad[pos])))
+    alpha = float(t[p + 1]) / p
+    if np.isfinite(room) and room > 0.0:
+        alpha = min(alpha, 0.5 * room)
+    return alpha
+
+
+def start_curvature_row(prob: Problem, t: np.ndarray, p: int, nb: int, alpha: float,
+                        amat: np.ndarray, lba: np.ndarray, uba: np.ndarray) -> None:
+    """Fill row 4: the curvature at ``u = 0`` equals ``prob.start_kappa`` (1/cell).
+
+    For clamped knots ``C'(0) = p (c_1 - c_0) / t_{p+1}`` and ``C''(0) =
+    p (p - 1) / t_{p+1} ((c_2 - c_1) / t_{p+2} - (c_1 - c_0) / t_{p+1})``, so with
+    ``c_1 - c_0 = alpha d`` (``|d| = 1``) the curvature is ``(p - 1) t_{p+1} /
+    (p t_{p+2}) cross(d, c_2 - c_1) / alpha^2``: fixing ``alpha`` makes it linear in
+    ``c_2``.
+    """
+    dx, dy = prob.start_dir
+    k_rhs = prob.start_kappa * alpha * alpha * p * float(t[p + 2]) / ((p - 1) * float(t[p + 1]))
+    # cross(d, c2 - c1) = -dy (x2 - x1) + dx (y2 - y1)
+    amat[4, 2], amat[4, nb + 2] = -dy, dx
+    amat[4, 1], amat[4, nb + 1] = dy, -dx
+    lba[4] = uba[4] = k_rhs
+
+
+def project_heading(
+    c: np.ndarray, prob: Problem, lo: np.ndarray, hi: np.ndarray, point_rows=None,
+    alpha: float | None = None,
+) -> None:
+    """Put ``c_1`` and ``c_{n-2}`` exactly on their heading rays.
+
+    ``c_1`` (``c_{n-2}``) goes on the start (reversed goal) heading ray, inside its bounds
+    (and its region rows ``lo <= A c <= hi`` in a polygon corridor), at least ``1e-3`` cells
+    from the end point when the bounds allow it; with a start curvature ``c_1`` is exactly
+    ``alpha`` cells along the start ray.
     """
     ends = []
     if prob.start_dir is not None:
@@ -390,6 +454,9 @@ def project_heading(
     if prob.goal_dir is not None:
         ends.append((len(c) - 2, prob.goal, -prob.goal_dir))
     for idx, end, d in ends:
+        if idx == 1 and alpha is not None:
+            c[idx] = end + alpha * d
+            continue
         a_lo, a_hi = 0.0, np.inf
         for ax in range(2):
             if abs(d[ax]) > 1e-15:
@@ -421,6 +488,7 @@ def build_problem(
     goal: Any,
     hs: float | None,
     hg: float | None,
+    start_kappa: float | None = None,
 ) -> tuple[Problem, np.ndarray, np.ndarray]:
     """Return the fit in cell units, and the exact end points (m).
 
@@ -432,6 +500,8 @@ def build_problem(
         As in :meth:`Smoother.fit`.
     hs, hg : float or None
         Validated start and goal headings (rad).
+    start_kappa : float or None
+        Validated start curvature (1/m), with ``hs``.
 
     Raises
     ------
@@ -470,6 +540,7 @@ def build_problem(
             res=res,
             rows=rows,
             taut=taut,
+            start_kappa=None if start_kappa is None else start_kappa * res,
         )
     else:
         targets = box_targets(grid_path_or_points, corridor)
@@ -495,6 +566,7 @@ def build_problem(
             goal_dir=None if hg is None else np.array([math.cos(hg), math.sin(hg)]),
             res=res,
             taut=taut,
+            start_kappa=None if start_kappa is None else start_kappa * res,
         )
     return prob, p0, p1
 
@@ -548,7 +620,6 @@ def assemble(options: Any, prob: Problem, h: float) -> Assembly:
     ubx = np.zeros(2 * nb)
     lbx[:n], lbx[nb : nb + n] = lo[:, 0], lo[:, 1]
     ubx[:n], ubx[nb : nb + n] = hi[:, 0], hi[:, 1]
-    heading, lba, uba = heading_rows(prob, n, nb)
     rows_of_points = None
     if prob.rows is None:
         k_rows, coef = 2, None
@@ -556,6 +627,10 @@ def assemble(options: Any, prob: Problem, h: float) -> Assembly:
     else:
         k_rows, coef, rlb, rub = point_rows(prob.rows, span_box, n, p, lo, hi, nb)
         rows_of_points = (coef, rlb.reshape(nb, k_rows), rub.reshape(nb, k_rows))
+    alpha = start_alpha(prob, t, p, lo, hi, rows_of_points)
+    heading, lba, uba = heading_rows(prob, n, nb, alpha)
+    if alpha is not None:
+        start_curvature_row(prob, t, p, nb, alpha, heading, lba, uba)
     lba = np.concatenate([lba, rlb])
     uba = np.concatenate([uba, rub])
     x0 = np.zeros(2 * nb)
@@ -570,4 +645,4 @@ def assemble(options: Any, prob: Problem, h: float) -> Assembly:
     qp = QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx, heading=heading,
                 lba=lba, uba=uba, k=k_rows, region_coef=coef)  # fmt: skip
     return Assembly(qp=qp, knots=t, span_box=span_box, lo=lo, hi=hi, point_rows=rows_of_points,
-                    x0=x0, const=const)  # fmt: skip
+                    x0=x0, const=const, start_alpha=alpha)  # fmt: skip

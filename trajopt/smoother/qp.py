@@ -53,7 +53,7 @@ def _band_pattern(nb: int, p: int):
 
 
 #: heading rows at the top of every constraint matrix (start/goal tangent; see smoother)
-N_HEADING_ROWS = 4
+N_HEADING_ROWS = 5
 
 
 @functools.lru_cache(maxsize=64)

@@ -206,8 +206,10 @@ def _push(buf, n, t, s, v, a, j):
 
 
 @njit(cache=True)
-def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin, max_steps):
-    """Forward greedy over piecewise-constant jerk with an exact stop-profile safety test.
+def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps):
+    """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
+
+    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``.
 
     Returns
     -------
@@ -224,7 +226,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, v_end, amax, j, dt, ncand, tmin,
     n_b = 0
     s = 0.0
     v = v0
-    a = 0.0
+    a = a0
     t = 0.0
     bounds, n_b = _push(bounds, n_b, t, s, v, a, 0.0)
     ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin)

@@ -22,7 +22,7 @@ from trajopt.timing.cap_table import T_MIN, CapTable, build_cap_table
 from trajopt.timing.compress import compress, finish
 from trajopt.timing.ruckig_profile import RuckigProfile
 from trajopt.trajectory import Trajectory
-from trajopt.validation import nonnegative
+from trajopt.validation import nonnegative, number
 
 __all__ = ["time_parameterize"]
 
@@ -39,6 +39,7 @@ def time_parameterize(
     v_end: float = 0.0,
     dt: float = 0.02,
     speed_limits: SpeedLimits | None = None,
+    a_start: float = 0.0,
 ) -> Trajectory:
     """Time a curve with a near time-optimal, jerk-limited speed profile.
 
@@ -49,13 +50,18 @@ def time_parameterize(
     robot : Robot, optional
         Limits; default ``Robot()`` (the chapter's robot).
     v_start, v_end : float
-        Speed at ``s = 0`` and at ``s = L`` (m/s), >= 0; the acceleration is 0 at both ends.
+        Speed at ``s = 0`` and at ``s = L`` (m/s), >= 0.
     dt : float
         Step of the forward greedy (s), in ``(0, 0.5]``.
     speed_limits : SpeedLimits, optional
         Speed-limit zones (:mod:`trajopt.speed_limits`): the speed is capped by the limit of
         the zone under the robot's centre, one more cap in the cap table (each interval
         takes the lowest limit of the mask cells the curve can touch in it).
+    a_start : float
+        Tangential acceleration at ``s = 0`` (m/s^2), ``|a_start| <= a_max`` (a moving
+        robot's state); the acceleration at ``s = L`` is 0. The profile starts from
+        ``(v_start, a_start)`` under the jerk limit and brakes first where the cap ahead
+        requires it.
 
     Returns
     -------
@@ -84,6 +90,7 @@ def time_parameterize(
                 f"got {type(curve).__name__}"
             )
     v_start = nonnegative("v_start", v_start, "m/s")
+    a_start = number("a_start", a_start, unit="m/s^2", lo=-robot.a_max, hi=robot.a_max)
     v_end = nonnegative("v_end", v_end, "m/s")
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0.0 < dt <= 0.5):
         raise InvalidInputError(f"dt must be a number in (0, 0.5] s, got {dt!r}")
@@ -101,7 +108,7 @@ def time_parameterize(
     # ---------------------------------------------------------------- 1. cap table
     t0 = time.perf_counter()
     table = build_cap_table(curve, robot, length, v_start, v_end, speed_limits)
-    d_change = _change_distance(v_start, v_end, jmax, amax)
+    d_change = _change_distance(v_start, v_end, jmax, amax) if a_start == 0.0 else 0.0
     if d_change > length * (1.0 + 1e-9):
         raise TimingError(
             f"cannot change speed from v_start={v_start:.6g} m/s to v_end={v_end:.6g} m/s "
@@ -112,7 +119,7 @@ def time_parameterize(
 
     # ---------------------------------------------------------------- 2. greedy
     t0 = time.perf_counter()
-    phases, bounds = _run_greedy(table, v_start, v_end, amax, jmax, float(dt))
+    phases, bounds = _run_greedy(table, v_start, a_start, v_end, amax, jmax, float(dt))
     stats["timing_greedy_s"] = time.perf_counter() - t0
 
     # ---------------------------------------------------------------- 3. finish
@@ -167,7 +174,8 @@ def time_parameterize(
 
 
 def _run_greedy(
-    table: CapTable, v_start: float, v_end: float, amax: float, jmax: float, dt: float
+    table: CapTable, v_start: float, a_start: float, v_end: float, amax: float, jmax: float,
+    dt: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Return the forward greedy's phases and bounds; its failures as :class:`TimingError`."""
     length, h, ci = table.length, table.h, table.ci
@@ -175,12 +183,13 @@ def _run_greedy(
     t_lower = length / vtop
     max_steps = int(min(5e6, 100.0 * (t_lower + 10.0 * (vtop / amax + amax / jmax)) / dt + 1000))
     phases, bounds, status = greedy.greedy(
-        table.st, table.lg, h, length, table.min_s, table.min_v, v_start, v_end, amax, jmax,
-        dt, N_CAND, T_MIN, max_steps,
+        table.st, table.lg, h, length, table.min_s, table.min_v, v_start, a_start, v_end, amax,
+        jmax, dt, N_CAND, T_MIN, max_steps,
     )  # fmt: skip
     if status == greedy.START_INFEASIBLE:
         raise TimingError(
-            f"v_start={v_start:.6g} m/s cannot be brought under the speed cap ahead (minimum "
+            f"v_start={v_start:.6g} m/s, a_start={a_start:.6g} m/s^2 cannot be brought under "
+            f"the speed cap ahead (minimum "
             f"{ci[: max(1, int(v_start**2 / amax / h) + 2)].min():.6g} m/s near the start) "
             f"with a_max={amax:.6g} m/s^2, j_max={jmax:.6g} m/s^3"
         )
