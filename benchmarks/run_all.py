@@ -92,6 +92,11 @@ BENCHES: tuple[Bench, ...] = (
           "Writing a 60 s trajectory at 100 Hz to MCAP, against mcap_ros2's generic "
           "writer in the same run.",
           ("--repeat", "3")),
+    Bench("replan", "Re-planning from a moving robot", "bench_replan.py",
+          "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal, "
+          "then one new goal), the jump at the splice and the limits of the new "
+          "trajectory, against a fresh plan from rest at the same point.",
+          ("--queries", "4")),
     Bench("harness", "Benchmark harness: Dask scaling", "bench_harness.py",
           "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
           "and the report on 10^5 rows.",
@@ -148,6 +153,32 @@ def section(bench: Bench, full: bool, out: str, wall: float, code: int) -> str:
     )
 
 
+def _merge(existing: str, parts: list[str]) -> list[str]:
+    """Put the new sections (``parts[1:]``) into an existing page in the benchmarks' order,
+    keeping the other sections; the header notes which sections were rerun."""
+    head_lines: list[str] = []
+    old: dict[str, list[str]] = {}
+    current: list[str] = head_lines
+    in_code = False
+    for line in existing.split("\n"):
+        if line.startswith("```"):
+            in_code = not in_code
+        if not in_code and line.startswith("## "):
+            current = old.setdefault(line[3:], [])
+        current.append(line)
+    old = {k: "\n".join(v).rstrip() + "\n" for k, v in old.items()}
+    new = {p.split("\n", 1)[0][3:]: p for p in parts[1:]}
+    titles = [b.title for b in BENCHES]
+    merged = {**old, **new}
+    ordered = [merged[t] for t in titles if t in merged]
+    ordered += [v for k, v in merged.items() if k not in titles]
+    rerun = ", ".join(new)
+    head = "\n".join(head_lines).rstrip()
+    head = head.split("\n\nSections rerun since")[0]
+    head += f"\n\nSections rerun since with `--only`: {rerun}.\n"
+    return [head, *ordered]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     mode = ap.add_mutually_exclusive_group()
@@ -179,6 +210,8 @@ def main(argv: list[str] | None = None) -> int:
         failed += code != 0
         print(f"  {wall:.0f} s, exit code {code}", flush=True)
         parts.append(section(bench, args.full, out, wall, code))
+    if args.only is not None and args.out.is_file():
+        parts = _merge(args.out.read_text(), parts)
     text = "\n".join(parts)
     tmp = args.out.with_suffix(".tmp")
     tmp.write_text(text)

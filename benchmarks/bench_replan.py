@@ -1,0 +1,146 @@
+"""Re-planning from a moving robot: latency, splice continuity and limits, same run.
+
+For each query on the shared ROS maps (seeded random start/goal pairs that a warm
+:class:`trajopt.Planner` solves), the robot drives the trajectory and re-plans every
+``--every`` seconds of trajectory time to the same goal (``Planner.replan`` with the
+latency set to 0, so the splice is at the re-plan time), then once to a new goal. For every
+re-plan it records the wall time, the jump of position, heading, curvature, speed and
+acceleration between the old trajectory at the splice and the new one at its start, and
+whether the new trajectory holds every limit on 1 ms samples (``trajectory_metrics``). A
+re-plan that raises a typed error (a state too fast for any curve found, a goal behind
+the robot) is counted as refused, with its type. The reference is a fresh ``plan`` from
+rest at the same point, timed in the same run.
+
+Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
+``../shared/data``)::
+
+    python benchmarks/bench_replan.py
+    python benchmarks/bench_replan.py --queries 8 --every 0.5
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import astar  # noqa: E402
+import trajopt  # noqa: E402
+from trajopt.errors import TrajoptError  # noqa: E402
+from trajopt.metrics import trajectory_metrics  # noqa: E402
+
+MAPS = ("turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10")
+
+
+def data_dir() -> Path:
+    env = os.environ.get("TRAJOPT_DATA")
+    return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+def queries(grid, robot, n, rng):
+    """``n`` random (start, goal) pairs at least 2 m apart in free space."""
+    free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
+                                      outside_occupied=True).occupied)  # fmt: skip
+    out = []
+    for _ in range(50 * n):
+        if len(out) == n or len(free) == 0:
+            break
+        a, b = free[rng.integers(len(free), size=2)]
+        p0 = grid.cell_to_world(a[::-1])
+        p1 = grid.cell_to_world(b[::-1])
+        if math.dist(p0, p1) >= 2.0:
+            out.append((tuple(p0), tuple(p1)))
+    return out
+
+
+def jump(a, b) -> float:
+    return max(
+        math.hypot(a.x - b.x, a.y - b.y),
+        abs(math.remainder(a.theta - b.theta, 2 * math.pi)),
+        abs(a.kappa - b.kappa),
+        abs(a.v - b.v),
+        abs(a.a - b.a),
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--queries", type=int, default=6, help="queries per map")
+    ap.add_argument("--every", type=float, default=0.5, help="re-plan period (s)")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    d = data_dir() / "ros"
+    if not d.is_dir():
+        print(f"shared data not found at {d} (set TRAJOPT_DATA)")
+        return 1
+    rng = np.random.default_rng(args.seed)
+    robot = trajopt.Robot(radius=0.2)
+    print(f"robot radius {robot.radius} m, v_max {robot.v_max} m/s; re-plan every "
+          f"{args.every} s of trajectory time, latency 0")  # fmt: skip
+    print(f"{'map':26s} {'replans':>7s} {'ok':>4s} {'refused':>7s} {'median ms':>9s} "
+          f"{'p95 ms':>7s} {'fresh ms':>8s} {'max jump':>9s} {'limits':>6s} {'new goal':>10s}")
+    all_ms: list[float] = []
+    for name in MAPS:
+        grid = astar.load_map(d / f"{name}.yaml")
+        planner = trajopt.Planner(grid, robot)
+        times, fresh, worst, refused, ok_limits, n_ok = [], [], 0.0, {}, True, 0
+        new_goal = {"ok": 0, "refused": 0}
+        qs = queries(grid, robot, args.queries, rng)
+        for k, (p0, p1) in enumerate(qs):
+            try:
+                traj = planner.plan(p0, p1)
+            except TrajoptError:
+                continue
+            t = args.every
+            while t < traj.duration - 0.5:
+                t0 = time.perf_counter()
+                try:
+                    new = planner.replan(traj, t, latency=0.0)
+                except TrajoptError as exc:
+                    refused[type(exc).__name__] = refused.get(type(exc).__name__, 0) + 1
+                    t += args.every
+                    continue
+                times.append(1e3 * (time.perf_counter() - t0))
+                n_ok += 1
+                worst = max(worst, jump(traj.state_at(t), new.state_at(0.0)))
+                ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
+                s = traj.state_at(t)
+                t1 = time.perf_counter()
+                try:
+                    planner.plan(s.position, p1)
+                    fresh.append(1e3 * (time.perf_counter() - t1))
+                except TrajoptError:
+                    pass
+                t += args.every
+            other = qs[(k + 1) % len(qs)][1]
+            try:
+                new = planner.replan(traj, min(1.0, traj.duration / 2), goal=other, latency=0.0)
+                worst = max(worst, jump(traj.state_at(min(1.0, traj.duration / 2)),
+                                        new.state_at(0.0)))  # fmt: skip
+                new_goal["ok"] += 1
+            except TrajoptError:
+                new_goal["refused"] += 1
+        all_ms += times
+        med = statistics.median(times) if times else float("nan")
+        p95 = float(np.percentile(times, 95)) if times else float("nan")
+        fr = statistics.median(fresh) if fresh else float("nan")
+        ref = ", ".join(f"{v} {k}" for k, v in refused.items()) or "0"
+        print(f"{name:26s} {n_ok + sum(refused.values()):7d} {n_ok:4d} {ref:>7s} {med:9.1f} "
+              f"{p95:7.1f} {fr:8.1f} {worst:9.1e} {str(ok_limits):>6s} "
+              f"{new_goal['ok']}/{new_goal['ok'] + new_goal['refused']:<8d}")  # fmt: skip
+    if all_ms:
+        print(f"all maps: re-plan median {statistics.median(all_ms):.1f} ms, p95 "
+              f"{np.percentile(all_ms, 95):.1f} ms over {len(all_ms)} re-plans")  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
