@@ -132,6 +132,49 @@ class GridPath:
 
 
 # --------------------------------------------------------------------------- the kernel
+@njit(cache=True, inline="always")
+def _stack_push(stk, ssize, scap, v):  # pragma: no cover - compiled
+    """Push ``v`` on the stack of nodes whose f equals the current minimum (grown x2)."""
+    if ssize == scap:
+        scap *= 2
+        ns = np.empty(scap, dtype=np.int32)
+        ns[:ssize] = stk[:ssize]
+        stk = ns
+    stk[ssize] = v
+    return stk, ssize + 1, scap
+
+
+@njit(cache=True, inline="always")
+def _heap_push(hf, hg, hn, size, cap, fnew, gnew, v):  # pragma: no cover - compiled
+    """Push ``(f, g, node)`` on the binary heap (ties: larger ``g`` first; grown x2)."""
+    if size == cap:
+        cap *= 2
+        nf = np.empty(cap, dtype=np.float64)
+        ng = np.empty(cap, dtype=np.float64)
+        nn = np.empty(cap, dtype=np.int32)
+        nf[:size] = hf[:size]
+        ng[:size] = hg[:size]
+        nn[:size] = hn[:size]
+        hf = nf
+        hg = ng
+        hn = nn
+    i = size
+    size += 1
+    while i > 0:
+        p = (i - 1) >> 1
+        if fnew < hf[p] or (fnew == hf[p] and gnew > hg[p]):
+            hf[i] = hf[p]
+            hg[i] = hg[p]
+            hn[i] = hn[p]
+            i = p
+        else:
+            break
+    hf[i] = fnew
+    hg[i] = gnew
+    hn[i] = v
+    return hf, hg, hn, size, cap
+
+
 @njit(cache=True)
 def _astar_kernel(
     free,  # uint8 [H*W], padded with a blocked ring
@@ -288,40 +331,10 @@ def _astar_kernel(
             rec[r4] = gen
             rec[r4 + 1] = u
             if fnew == fcur:
-                if ssize == scap:
-                    scap *= 2
-                    ns = np.empty(scap, dtype=np.int32)
-                    ns[:ssize] = stk[:ssize]
-                    stk = ns
-                stk[ssize] = v
-                ssize += 1
+                stk, ssize, scap = _stack_push(stk, ssize, scap, v)
                 continue
             # ---- push (sift up)
-            if size == cap:
-                cap *= 2
-                nf = np.empty(cap, dtype=np.float64)
-                ng = np.empty(cap, dtype=np.float64)
-                nn = np.empty(cap, dtype=np.int32)
-                nf[:size] = hf[:size]
-                ng[:size] = hg[:size]
-                nn[:size] = hn[:size]
-                hf = nf
-                hg = ng
-                hn = nn
-            i = size
-            size += 1
-            while i > 0:
-                p = (i - 1) >> 1
-                if fnew < hf[p] or (fnew == hf[p] and gnew > hg[p]):
-                    hf[i] = hf[p]
-                    hg[i] = hg[p]
-                    hn[i] = hn[p]
-                    i = p
-                else:
-                    break
-            hf[i] = fnew
-            hg[i] = gnew
-            hn[i] = v
+            hf, hg, hn, size, cap = _heap_push(hf, hg, hn, size, cap, fnew, gnew, v)
 
     if not found:
         return False, np.empty(0, dtype=np.int64), expanded, 0.0, 0, 0
@@ -550,39 +563,9 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
             mn = min(ax, ay)
             fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
             if fnew == fcur:
-                if ssize == scap:
-                    scap *= 2
-                    nst = np.empty(scap, dtype=np.int32)
-                    nst[:ssize] = stk[:ssize]
-                    stk = nst
-                stk[ssize] = v
-                ssize += 1
+                stk, ssize, scap = _stack_push(stk, ssize, scap, v)
                 continue
-            if size == cap:
-                cap *= 2
-                nf = np.empty(cap, dtype=np.float64)
-                ng = np.empty(cap, dtype=np.float64)
-                nn = np.empty(cap, dtype=np.int32)
-                nf[:size] = hf[:size]
-                ng[:size] = hg[:size]
-                nn[:size] = hn[:size]
-                hf = nf
-                hg = ng
-                hn = nn
-            i = size
-            size += 1
-            while i > 0:
-                pp = (i - 1) >> 1
-                if fnew < hf[pp] or (fnew == hf[pp] and gnew > hg[pp]):
-                    hf[i] = hf[pp]
-                    hg[i] = hg[pp]
-                    hn[i] = hn[pp]
-                    i = pp
-                else:
-                    break
-            hf[i] = fnew
-            hg[i] = gnew
-            hn[i] = v
+            hf, hg, hn, size, cap = _heap_push(hf, hg, hn, size, cap, fnew, gnew, v)
 
     if not found:
         return False, np.empty(0, dtype=np.int64), expanded, 0.0, 0, 0
