@@ -133,6 +133,36 @@ class GridPath:
 
 # --------------------------------------------------------------------------- the kernel
 @njit(cache=True, inline="always")
+def _heap_pop(hf, hg, hn, size):  # pragma: no cover - compiled
+    """Pop the heap's root: returns ``(node, f, new size)``."""
+    u = hn[0]
+    fcur = hf[0]
+    size -= 1
+    if size > 0:
+        lf = hf[size]
+        lg = hg[size]
+        ln = hn[size]
+        i = 0
+        while True:
+            c = 2 * i + 1
+            if c >= size:
+                break
+            if c + 1 < size and (hf[c + 1] < hf[c] or (hf[c + 1] == hf[c] and hg[c + 1] > hg[c])):
+                c += 1
+            if hf[c] < lf or (hf[c] == lf and hg[c] > lg):
+                hf[i] = hf[c]
+                hg[i] = hg[c]
+                hn[i] = hn[c]
+                i = c
+            else:
+                break
+        hf[i] = lf
+        hg[i] = lg
+        hn[i] = ln
+    return u, fcur, size
+
+
+@njit(cache=True, inline="always")
 def _stack_push(stk, ssize, scap, v):  # pragma: no cover - compiled
     """Push ``v`` on the stack of nodes whose f equals the current minimum (grown x2)."""
     if ssize == scap:
@@ -240,32 +270,7 @@ def _astar_kernel(
             u = stk[ssize]
         else:
             # ---- pop the heap's root
-            u = hn[0]
-            fcur = hf[0]
-            size -= 1
-            if size > 0:
-                lf = hf[size]
-                lg = hg[size]
-                ln = hn[size]
-                i = 0
-                while True:
-                    c = 2 * i + 1
-                    if c >= size:
-                        break
-                    if c + 1 < size and (
-                        hf[c + 1] < hf[c] or (hf[c + 1] == hf[c] and hg[c + 1] > hg[c])
-                    ):
-                        c += 1
-                    if hf[c] < lf or (hf[c] == lf and hg[c] > lg):
-                        hf[i] = hf[c]
-                        hg[i] = hg[c]
-                        hn[i] = hn[c]
-                        i = c
-                    else:
-                        break
-                hf[i] = lf
-                hg[i] = lg
-                hn[i] = ln
+            u, fcur, size = _heap_pop(hf, hg, hn, size)
         if rec[4 * u] == closed:
             continue  # stale entry (lazy deletion)
         rec[4 * u] = closed
@@ -434,32 +439,7 @@ def _jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
             ssize -= 1
             u = stk[ssize]
         else:
-            u = hn[0]
-            fcur = hf[0]
-            size -= 1
-            if size > 0:
-                lf = hf[size]
-                lg = hg[size]
-                ln = hn[size]
-                i = 0
-                while True:
-                    c = 2 * i + 1
-                    if c >= size:
-                        break
-                    if c + 1 < size and (
-                        hf[c + 1] < hf[c] or (hf[c + 1] == hf[c] and hg[c + 1] > hg[c])
-                    ):
-                        c += 1
-                    if hf[c] < lf or (hf[c] == lf and hg[c] > lg):
-                        hf[i] = hf[c]
-                        hg[i] = hg[c]
-                        hn[i] = hn[c]
-                        i = c
-                    else:
-                        break
-                hf[i] = lf
-                hg[i] = lg
-                hn[i] = ln
+            u, fcur, size = _heap_pop(hf, hg, hn, size)
         if rec[4 * u] == closed:
             continue
         rec[4 * u] = closed
