@@ -23,15 +23,19 @@ field                     default    meaning
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.footprint import Footprint
 from trajopt.validation import positive
 
-__all__ = ["Robot"]
+__all__ = ["DEFAULT_RADIUS", "Robot", "avoidance_width"]
+
+#: The chapter robot's footprint radius (m): half of its 0.33 m width.
+DEFAULT_RADIUS = 0.165
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,8 +44,11 @@ class Robot:
 
     Parameters
     ----------
-    radius : float
-        Footprint radius (m), used to inflate obstacles.
+    radius : float, optional
+        Footprint radius (m) of a disc robot, used to inflate obstacles; default 0.165. With
+        a ``footprint`` it becomes the footprint's circumscribed radius (leave it at its
+        default; another value is an error): every stage that models the robot as a disc
+        then keeps the whole footprint clear.
     v_max : float
         Maximum forward speed (m/s).
     a_max : float
@@ -57,12 +64,16 @@ class Robot:
         with ``wheel_v_max`` or leave both ``None``.
     wheel_v_max : float or None
         Maximum speed of either wheel (m/s).
+    footprint : Footprint or array_like, shape (k, 2), optional
+        A convex footprint in the robot frame (x forward, metres, the rotation centre at
+        the origin, strictly inside); see :meth:`rectangle`.
 
     Raises
     ------
     InvalidInputError
-        A limit is not a finite number > 0, or only one of ``track_width`` and
-        ``wheel_v_max`` is given.
+        A limit is not a finite number > 0, only one of ``track_width`` and
+        ``wheel_v_max`` is given, a bad footprint (non-convex, self-intersecting, fewer than
+        3 vertices, the origin not inside, NaN), or a radius contradicting it.
     """
 
     radius: float = 0.165
@@ -73,8 +84,25 @@ class Robot:
     omega_max: float = 1.5
     track_width: float | None = 0.28
     wheel_v_max: float | None = 0.6
+    footprint: Footprint | None = None
 
     def __post_init__(self) -> None:
+        fp = self.footprint
+        if fp is not None and not isinstance(fp, Footprint):
+            try:
+                fp = Footprint(np.asarray(fp, dtype=float))
+            except (TypeError, ValueError) as exc:
+                raise InvalidInputError(f"Robot.footprint: {exc}") from None
+            object.__setattr__(self, "footprint", fp)
+        if fp is not None:
+            r_c = fp.circumscribed_radius
+            given = self.radius != DEFAULT_RADIUS  # the default stands for "unset"
+            if given and abs(float(self.radius) - r_c) > 1e-12 * max(1.0, r_c):
+                raise InvalidInputError(
+                    f"Robot.radius={self.radius!r} contradicts the footprint, whose "
+                    f"circumscribed radius is {r_c:.6g} m; leave radius unset with a footprint"
+                )
+            object.__setattr__(self, "radius", r_c)
         for name in ("radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max"):
             object.__setattr__(self, name, _positive(name, getattr(self, name)))
         if (self.track_width is None) != (self.wheel_v_max is None):
@@ -86,10 +114,31 @@ class Robot:
             object.__setattr__(self, "track_width", _positive("track_width", self.track_width))
             object.__setattr__(self, "wheel_v_max", _positive("wheel_v_max", self.wheel_v_max))
 
+    @classmethod
+    def rectangle(
+        cls, length: float, width: float, rear_offset: float | None = None, **limits: Any
+    ) -> Robot:
+        """Return a robot with a rectangular footprint (:meth:`Footprint.rectangle`).
+
+        ``rear_offset`` is the distance (m) from the rotation centre back to the rear edge
+        (default ``length / 2``); ``limits`` are the other fields (``v_max``, ...).
+        """
+        return cls(footprint=Footprint.rectangle(length, width, rear_offset), **limits)
+
     @property
     def width(self) -> float:
-        """Footprint diameter ``2 * radius`` (m)."""
+        """Footprint diameter ``2 * radius`` (m): the disc every planner stage keeps clear."""
         return 2.0 * self.radius
+
+    @property
+    def inscribed_radius(self) -> float:
+        """Largest disc about the rotation centre inside the footprint (m)."""
+        return self.radius if self.footprint is None else self.footprint.inscribed_radius
+
+    @property
+    def circumscribed_radius(self) -> float:
+        """Smallest disc about the rotation centre containing the footprint (m)."""
+        return self.radius if self.footprint is None else self.footprint.circumscribed_radius
 
     def speed_cap(self, kappa: np.ndarray | float) -> np.ndarray | float:
         """Curvature-dependent speed limit (m/s).
@@ -121,7 +170,9 @@ class Robot:
 
     def to_dict(self) -> dict[str, Any]:
         """Return the fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
-        return asdict(self)
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        out["footprint"] = None if self.footprint is None else self.footprint.to_list()
+        return out
 
 
 def _positive(name: str, value: Any) -> float:

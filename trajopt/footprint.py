@@ -1,0 +1,257 @@
+"""Oriented robot footprints: a convex polygon in the robot frame and what it sweeps.
+
+A :class:`Footprint` is a convex polygon in the robot frame (x forward, y left, metres),
+the rotation centre at the origin, which must lie strictly inside it. Its
+:attr:`~Footprint.inscribed_radius` (the largest disc about the origin inside it) and
+:attr:`~Footprint.circumscribed_radius` (the smallest disc about the origin containing it)
+bracket the disc models of the robot.
+
+The certificate of a footprint robot needs the set the footprint covers while its heading
+stays in an interval ``[theta_lo, theta_hi]``: :meth:`Footprint.swept_hull` returns a
+convex polygon containing it, exactly, by bounding each vertex's arc by its outer tangent
+polygon (arc endpoints and the tangent intersections of pieces of at most 45 degrees):
+every rotated footprint is the convex hull of its rotated vertices, which lie on those arcs.
+:func:`span_heading_intervals` bounds the tangent direction of every span of a B-spline by
+its hodograph (the derivative's control points span a cone that holds the tangent).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import InvalidInputError
+from trajopt.validation import positive, short_repr
+
+__all__ = ["Footprint", "convex_hull", "minkowski_sum", "span_heading_intervals"]
+
+_MAX_ARC = math.pi / 4  # arc pieces of at most 45 degrees: apex at 1 / cos(22.5 deg) = 1.082 r
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """A convex robot footprint (robot frame, metres).
+
+    Parameters
+    ----------
+    vertices : array_like, shape (k, 2)
+        Corners in order around the polygon (either direction; stored counter-clockwise),
+        ``k >= 3``; the rotation centre (origin) strictly inside.
+
+    Raises
+    ------
+    InvalidInputError
+        Fewer than 3 vertices, non-finite values, repeated or collinear corners, a
+        non-convex or self-intersecting polygon, the origin not strictly inside.
+    """
+
+    vertices: np.ndarray
+
+    def __post_init__(self) -> None:
+        try:
+            v = np.array(self.vertices, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidInputError(
+                f"footprint vertices must be an array of shape (k, 2) in metres, got "
+                f"{short_repr(self.vertices)}"
+            ) from None
+        if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3:
+            raise InvalidInputError(
+                f"footprint must have at least 3 vertices, shape (k, 2), got {v.shape}"
+            )
+        if not np.all(np.isfinite(v)):
+            raise InvalidInputError("footprint vertices must be finite (found NaN or inf)")
+        area = _signed_area(v)
+        if area < 0:
+            v = v[::-1].copy()
+        e = np.roll(v, -1, axis=0) - v
+        cross = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+        scale = max(float(np.max(np.abs(v))), 1e-12)
+        if np.any(np.hypot(e[:, 0], e[:, 1]) <= 1e-12 * scale):
+            raise InvalidInputError("footprint has repeated vertices")
+        if np.any(cross <= 1e-12 * scale * scale):
+            raise InvalidInputError(
+                "footprint must be a convex polygon without collinear corners (every turn "
+                "the same way); got a non-convex or self-intersecting one"
+            )
+        turning = np.sum(np.arctan2(cross, np.einsum("ij,ij->i", e, np.roll(e, -1, axis=0))))
+        if abs(turning - 2 * math.pi) > 1e-6:
+            raise InvalidInputError(
+                "footprint must be a simple convex polygon; its edges wind "
+                f"{turning / (2 * math.pi):.3g} times around (self-intersecting)"
+            )
+        d = _edge_distances(v)
+        if np.any(d <= 0.0):
+            raise InvalidInputError(
+                "footprint must contain the rotation centre (0, 0) strictly inside; "
+                f"it is {'on' if np.min(d) == 0 else 'outside'} edge {int(np.argmin(d))}"
+            )
+        v.flags.writeable = False
+        object.__setattr__(self, "vertices", v)
+
+    # ------------------------------------------------------------- constructors
+    @classmethod
+    def rectangle(cls, length: float, width: float, rear_offset: float | None = None) -> Footprint:
+        """Return a ``length`` x ``width`` rectangle (m), x forward.
+
+        ``rear_offset`` is the distance (m) from the rotation centre back to the rear edge,
+        so the body spans x in ``[-rear_offset, length - rear_offset]`` and y in
+        ``[-width / 2, width / 2]``; default ``length / 2`` (centred).
+        """
+        ln = positive("length", length, "m")
+        wd = positive("width", width, "m")
+        rear = 0.5 * ln if rear_offset is None else float(rear_offset)
+        if not (math.isfinite(rear) and 0.0 < rear < ln):
+            raise InvalidInputError(
+                f"rear_offset must be in (0, length) = (0, {ln:g}) m so that the rotation "
+                f"centre is inside the body, got {rear_offset!r}"
+            )
+        x0, x1, y = -rear, ln - rear, 0.5 * wd
+        return cls(np.array([[x0, -y], [x1, -y], [x1, y], [x0, y]]))
+
+    # --------------------------------------------------------------- geometry
+    @property
+    def inscribed_radius(self) -> float:
+        """Largest disc about the rotation centre inside the footprint (m)."""
+        return float(np.min(_edge_distances(self.vertices)))
+
+    @property
+    def circumscribed_radius(self) -> float:
+        """Smallest disc about the rotation centre containing the footprint (m)."""
+        return float(np.max(np.hypot(self.vertices[:, 0], self.vertices[:, 1])))
+
+    def at(self, x: float, y: float, theta: float) -> np.ndarray:
+        """Return the corners in the world at pose ``(x, y, theta)``, shape (k, 2) (m)."""
+        c, s = math.cos(theta), math.sin(theta)
+        v = self.vertices
+        return np.column_stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]])
+
+    def swept_hull(self, theta_lo: float, theta_hi: float) -> np.ndarray:
+        """Return a convex polygon containing the footprint swept over a heading interval.
+
+        Every rotation of the footprint about the origin by an angle in ``[theta_lo,
+        theta_hi]`` (rad) lies inside the returned polygon, shape (m, 2), counter-clockwise.
+        A span of ``2 pi`` or more gives a polygon around the circumscribed disc.
+        """
+        lo, hi = float(theta_lo), float(theta_hi)
+        if not (math.isfinite(lo) and math.isfinite(hi)) or hi < lo:
+            raise InvalidInputError(
+                f"need finite theta_lo <= theta_hi (rad), got {theta_lo!r}, {theta_hi!r}"
+            )
+        span = min(hi - lo, 2 * math.pi)
+        n = max(1, math.ceil(span / _MAX_ARC - 1e-12))
+        step = span / n
+        ang = lo + step * np.arange(n + 1)
+        mid = lo + step * (np.arange(n) + 0.5)
+        grow = 1.0 / math.cos(0.5 * step) if n > 0 and step > 0 else 1.0
+        rho = np.hypot(self.vertices[:, 0], self.vertices[:, 1])
+        phi = np.arctan2(self.vertices[:, 1], self.vertices[:, 0])
+        pts = [
+            np.column_stack([np.cos(phi[i] + ang), np.sin(phi[i] + ang)]) * rho[i]
+            for i in range(len(rho))
+        ]
+        if step > 0:  # the tangent intersections between consecutive arc points
+            pts += [
+                np.column_stack([np.cos(phi[i] + mid), np.sin(phi[i] + mid)]) * rho[i] * grow
+                for i in range(len(rho))
+            ]
+        return convex_hull(np.vstack(pts))
+
+    def to_list(self) -> list[list[float]]:
+        """Return the vertices as a list of ``[x, y]`` (m)."""
+        return self.vertices.tolist()
+
+
+def span_heading_intervals(knots: np.ndarray, control_points: np.ndarray, degree: int):
+    """Bound the tangent direction of every span of a clamped B-spline.
+
+    The derivative is a B-spline of degree ``p - 1`` with control points
+    ``Q_i = p (c_{i+1} - c_i) / (t_{i+p+1} - t_{i+1})``; on span ``j`` it is a convex
+    combination of ``Q_j .. Q_{j+p-1}``, so the tangent direction lies in the cone those
+    span. When the cone's directions all lie within a half-plane the interval is tight
+    around them; otherwise the span gets the whole circle (``hi - lo = 2 pi``).
+
+    Parameters
+    ----------
+    knots : ndarray, shape (n + p + 1,)
+    control_points : ndarray, shape (n, 2)
+    degree : int
+
+    Returns
+    -------
+    ndarray, shape (n - p, 2)
+        ``(theta_lo, theta_hi)`` per span (rad), ``theta_lo <= theta_hi``.
+    """
+    t = np.asarray(knots, dtype=float)
+    c = np.asarray(control_points, dtype=float)
+    p = int(degree)
+    n = len(c)
+    den = t[p + 1 : n + p] - t[1:n]
+    q = np.zeros((n - 1, 2))
+    ok = den > 0
+    q[ok] = p * np.diff(c, axis=0)[ok] / den[ok, None]
+    out = np.empty((n - p, 2))
+    for j in range(n - p):
+        qs = q[j : j + p]
+        qs = qs[np.hypot(qs[:, 0], qs[:, 1]) > 1e-15]
+        if len(qs) == 0:
+            out[j] = (-math.pi, math.pi)
+            continue
+        ang = np.arctan2(qs[:, 1], qs[:, 0])
+        ref = ang[0]
+        rel = np.remainder(ang - ref + math.pi, 2 * math.pi) - math.pi
+        lo, hi = float(rel.min()), float(rel.max())
+        # the cone holds the tangent only if it is less than a half-turn wide
+        if hi - lo >= math.pi - 1e-12:
+            out[j] = (ref - math.pi, ref + math.pi)
+        else:
+            out[j] = (ref + lo, ref + hi)
+    return out
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Return the convex hull of ``points`` (shape (m, 2)), counter-clockwise."""
+    p = np.unique(np.asarray(points, dtype=float), axis=0)
+    if len(p) <= 2:
+        return p
+    order = np.lexsort((p[:, 1], p[:, 0]))
+    p = p[order]
+
+    def half(pts: Any) -> list:
+        h: list = []
+        for q in pts:
+            while len(h) >= 2 and _cross(h[-2], h[-1], q) <= 0.0:
+                h.pop()
+            h.append(q)
+        return h
+
+    lower = half(p)
+    upper = half(p[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def minkowski_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Return the convex hull of ``{x + y : x in a, y in b}`` for point sets ``a`` and ``b``."""
+    a = np.asarray(a, dtype=float).reshape(-1, 2)
+    b = np.asarray(b, dtype=float).reshape(-1, 2)
+    return convex_hull((a[:, None, :] + b[None, :, :]).reshape(-1, 2))
+
+
+def _cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+
+def _signed_area(v: np.ndarray) -> float:
+    x, y = v[:, 0], v[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def _edge_distances(v: np.ndarray) -> np.ndarray:
+    """Signed distance from the origin to each edge's line (positive inside, CCW ``v``)."""
+    e = np.roll(v, -1, axis=0) - v
+    length = np.hypot(e[:, 0], e[:, 1])
+    # inward normal of a CCW edge is (-ey, ex); distance of the origin = n . (0 - v)
+    return (-e[:, 1] * (-v[:, 0]) + e[:, 0] * (-v[:, 1])) / length
