@@ -57,7 +57,6 @@ from __future__ import annotations
 import collections
 import dataclasses
 import logging
-import math
 import threading
 import time
 from collections.abc import Sequence
@@ -72,15 +71,17 @@ from trajopt.clearance import polygon_clearance, polyline_clearance
 from trajopt.corridor_fit import box_corridor, fit_in_corridor, witness_rescue
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
+from trajopt.map_update import update_caches
 from trajopt.plan_query import PlanQuery, PlanSteps
 from trajopt.polygon_corridor import PolygonCorridor
+from trajopt.replanning import replan_from, smooth_for_speed
 from trajopt.robot import Robot, avoidance_width
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.speed_limits import SpeedLimits
 from trajopt.state import State
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
-from trajopt.validation import nonnegative, number, point
+from trajopt.validation import point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
 
@@ -292,45 +293,7 @@ class Planner:
             ``grid`` is not an OccupancyGrid, or the planner plans on a costmap (make a new
             :class:`Planner` from the new costmap).
         """
-        if not isinstance(grid, OccupancyGrid):
-            raise InvalidInputError(
-                f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}"
-            )
-        if self.costmap is not None:
-            raise InvalidInputError(
-                "this planner plans on a costmap: build a new Planner from the updated costmap"
-            )
-        with self._lock:
-            old = self.grid
-            same = (
-                grid.shape == old.shape
-                and grid.resolution == old.resolution
-                and grid.origin == old.origin
-            )
-            if not same:
-                self.grid, self._inflated, self._cost = grid, None, None
-                return {"changed_cells": None, "window": None, "reset": True}
-            changed = grid.occupied != old.occupied
-            n_changed = int(changed.sum())
-            self.grid = grid
-            if n_changed == 0:
-                return {"changed_cells": 0, "window": None, "reset": False}
-            iy, ix = np.nonzero(changed)
-            box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
-            r_cells = int(math.ceil(self.robot.radius / grid.resolution)) + 2
-            if self.inflation == "paper":
-                r_cells += self.w_cells + 1
-            reach_cost = r_cells + 5  # + the clearance cost's 3-cell fall-off, rounded up
-            window = _grow(box, max(r_cells, reach_cost), grid.shape)
-            if self._inflated is not None:
-                occ = np.array(self._inflated.occupied)
-                _patch(occ, grid, window, r_cells, self._inflate)
-                self._inflated = grid.with_occupied(occ)
-            if self._cost is not None:
-                cost = np.array(self._cost)
-                _patch(cost, grid, window, reach_cost, self._clearance_cost)
-                self._cost = cost
-            return {"changed_cells": n_changed, "window": window, "reset": False}
+        return update_caches(self, grid)
 
     # ---------------------------------------------------------------- query
     def plan(
@@ -437,30 +400,8 @@ class Planner:
         TimingError, SmoothingError, NoPathError
             As :meth:`plan`; a state too fast for any curve found says so.
         """
-        lat = self.latency_s if latency is None else nonnegative("latency", latency, "s")
-        t_now = number("t", t, unit="s", lo=0.0, hi=float(trajectory.duration))
-        ts = t_now + lat
-        if ts > trajectory.duration:
-            raise InvalidInputError(
-                f"t + latency = {t_now:.6g} + {lat:.6g} s is past the trajectory's end "
-                f"({trajectory.duration:.6g} s): nothing is left to splice onto"
-            )
-        if goal is None:
-            steps = getattr(trajectory, "steps", None)
-            if steps is None:
-                raise InvalidInputError(
-                    "goal is required: the trajectory has no steps (it was not planned by a "
-                    "Planner)"
-                )
-            goal = steps.goal
-        if grid is not None:
-            self.update_map(grid)
-        state = trajectory.state_at(ts)
-        out = self.plan(state, goal, goal_heading=goal_heading, v_end=v_end)
-        stats = dict(out.stats)
-        stats["splice_time_s"] = ts
-        stats["latency_s"] = lat
-        return dataclasses.replace(out, stats=stats)
+        return replan_from(self, trajectory, t, goal, grid, latency=latency,
+                           goal_heading=goal_heading, v_end=v_end)  # fmt: skip
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
         kappa0 = None
@@ -509,7 +450,7 @@ class Planner:
             except TimingError:
                 if v_start <= 0.0:
                     raise
-                smooth = self._smooth_for_speed(q)
+                smooth = smooth_for_speed(self, q)
                 traj = self._time(q, smooth)
         except (SmoothingError, TimingError) as exc:
             if self.fallback is None or v_start != 0.0 or v_end != 0.0 or q.a_start != 0.0:
@@ -525,47 +466,6 @@ class Planner:
             return time_parameterize(smooth, self.robot, v_start=q.v_start, v_end=q.v_end,
                                      dt=self.timing_dt, speed_limits=self.speed_limits,
                                      a_start=q.a_start)  # fmt: skip
-
-    def _smooth_for_speed(self, q: PlanQuery) -> SmoothPath:
-        """Fit again with a curvature bound the start speed can follow.
-
-        A moving start whose speed cannot be brought under the cap of the first curve
-        (too sharp a turn too soon) gets a second fit bounded by the curvature whose cap
-        is that speed (``Robot.speed_cap``), a little tighter; the state's own curvature
-        must already be within it.
-
-        Raises
-        ------
-        TimingError
-            The state is above the cap at its own curvature.
-        SmoothingError
-            No curve within that bound (the message says why the bound was imposed).
-        """
-        r = self.robot
-        # the speed rises by a^2 / (2 j) before a positive acceleration can be undone
-        v = q.v_start + max(q.a_start, 0.0) ** 2 / (2.0 * r.j_max)
-        bounds = [r.a_lat_max / (v * v), r.omega_max / v]
-        if r.track_width is not None and r.wheel_v_max is not None and v < r.wheel_v_max:
-            bounds.append((r.wheel_v_max / v - 1.0) * 2.0 / r.track_width)
-        k_speed = 0.95 * min(bounds)
-        k0 = abs(q.start_curvature or 0.0)
-        if k0 > k_speed:
-            raise TimingError(
-                f"the start state moves at {v:.6g} m/s on curvature {k0:.6g} 1/m: above the "
-                f"speed cap there ({float(r.speed_cap(k0)):.6g} m/s)"
-            )
-        kmax = k_speed if self.smoother.kappa_max is None else min(k_speed, self.smoother.kappa_max)
-        sm = dataclasses.replace(self.smoother, kappa_max=kmax)
-        try:
-            q.corridor, smooth = fit_in_corridor(self, q, q.path, sm)
-        except SmoothingError as exc:
-            raise SmoothingError(
-                f"the start state moves at {v:.6g} m/s: no curve from it turns gently enough "
-                f"(curvature <= {kmax:.6g} 1/m) to slow down under the speed cap in time: {exc}",
-                exc.stats,
-            ) from exc
-        q.rescue = "speed"
-        return smooth
 
     def _smooth(self, q: PlanQuery) -> SmoothPath:
         """Return the corridor and the certified curve.
@@ -773,59 +673,6 @@ def _cell(c: np.ndarray) -> tuple[int, int]:
     return (int(c[0]), int(c[1]))
 
 
-def _grow(box: tuple[int, int, int, int], k: int, shape: tuple[int, int]):
-    """Grow the cell box ``(x0, x1, y0, y1)`` (inclusive) by ``k`` cells, inside ``shape``."""
-    ny, nx = shape
-    return (max(0, box[0] - k), min(nx - 1, box[1] + k), max(0, box[2] - k), min(ny - 1, box[3] + k))
-
-
-def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute) -> None:
-    """Recompute ``target`` (a per-cell array of ``grid``) inside ``window``.
-
-    ``compute`` runs on the map cut to ``window`` grown by ``reach`` more cells; cells of
-    ``window`` are at least ``reach`` from that cut's made-up outside (where it is not the
-    map's own edge), so they get exactly the values of a whole-map computation.
-    """
-    x0, x1, y0, y1 = window
-    cx0, cx1, cy0, cy1 = _grow(window, reach, grid.shape)
-    res = grid.resolution
-    ox, oy = grid.origin
-    sub = OccupancyGrid(
-        grid.occupied[cy0 : cy1 + 1, cx0 : cx1 + 1], res, (ox + cx0 * res, oy + cy0 * res)
-    )
-    vals = compute(sub)
-    target[y0 : y1 + 1, x0 : x1 + 1] = vals[y0 - cy0 : y1 - cy0 + 1, x0 - cx0 : x1 - cx0 + 1]
-
-
 def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
     """Exact clearance (m) of a world point from the raw map (outside occupied)."""
     return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)
-
-
-def compare_method(ctx: Any) -> Any:
-    """Return the proposed method as a :func:`trajopt.compare` row (registered as ``"proposed"``).
-
-    Plans with :class:`Planner` on ``ctx.grid`` for a :class:`Robot` of radius
-    ``ctx.robot_radius`` (default limits; options ``robot``, ``inflation``, ``search`` and
-    ``smoother`` may be given through ``compare(..., options={"proposed": {...}})``) and
-    adds the timed metrics of :func:`trajopt.metrics.trajectory_metrics` as extra columns.
-    """
-    from trajopt.comparison import MethodResult
-    from trajopt.metrics import trajectory_metrics
-
-    opts = ctx.options_for("proposed")
-    robot = opts.pop("robot", None) or Robot(radius=ctx.robot_radius)
-    t0 = time.perf_counter()
-    traj = Planner(ctx.grid, robot, **opts).plan(ctx.start, ctx.goal)
-    runtime = time.perf_counter() - t0
-    timed = trajectory_metrics(traj, robot)
-    extras = {
-        k: timed[k]
-        for k in ("duration_s", "ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat")
-        if k in timed
-    }
-    attempts = traj.stats.get("smoother", {}).get("attempts")
-    note = f"duration {traj.duration:.3g} s"
-    if attempts:
-        note += f", smoother attempts {attempts if isinstance(attempts, int) else len(attempts)}"
-    return MethodResult(traj.path, True, note, runtime_s=runtime, extras=extras)

@@ -36,7 +36,7 @@ metres (scored as a polyline), or a :class:`MethodResult` to also set ``valid``/
 Its options arrive as ``ctx.options_for(name)`` (from ``compare(..., options={name: {...}})``).
 Register it with one line, without touching the other methods::
 
-    register_method("proposed", "trajopt.pipeline:compare_method")   # lazy "module:attr"
+    register_method("proposed", "trajopt.comparison.proposed:proposed_method")   # lazy "module:attr"
     # or, in any module:  @register_method("proposed")  def _run(ctx): ...
 
 Registered methods with ``default=True`` (the default) run when ``methods`` is ``None``, in

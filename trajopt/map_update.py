@@ -1,0 +1,84 @@
+"""Map updates of a :class:`~trajopt.pipeline.Planner`.
+
+The inflated grid and the clearance cost are recomputed only where the change reaches.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from astar.grid import OccupancyGrid
+from trajopt.errors import InvalidInputError
+
+__all__ = ["update_caches"]
+
+
+def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
+    """Return what :meth:`~trajopt.pipeline.Planner.update_map` reports, after doing it."""
+    if not isinstance(grid, OccupancyGrid):
+        raise InvalidInputError(
+            f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}"
+        )
+    if planner.costmap is not None:
+        raise InvalidInputError(
+            "this planner plans on a costmap: build a new Planner from the updated costmap"
+        )
+    with planner._lock:
+        old = planner.grid
+        same = (
+            grid.shape == old.shape
+            and grid.resolution == old.resolution
+            and grid.origin == old.origin
+        )
+        if not same:
+            planner.grid, planner._inflated, planner._cost = grid, None, None
+            return {"changed_cells": None, "window": None, "reset": True}
+        changed = grid.occupied != old.occupied
+        n_changed = int(changed.sum())
+        planner.grid = grid
+        if n_changed == 0:
+            return {"changed_cells": 0, "window": None, "reset": False}
+        iy, ix = np.nonzero(changed)
+        box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
+        r_cells = int(math.ceil(planner.robot.radius / grid.resolution)) + 2
+        if planner.inflation == "paper":
+            r_cells += planner.w_cells + 1
+        reach_cost = r_cells + 5  # + the clearance cost's 3-cell fall-off, rounded up
+        window = _grow(box, max(r_cells, reach_cost), grid.shape)
+        if planner._inflated is not None:
+            occ = np.array(planner._inflated.occupied)
+            _patch(occ, grid, window, r_cells, planner._inflate)
+            planner._inflated = grid.with_occupied(occ)
+        if planner._cost is not None:
+            cost = np.array(planner._cost)
+            _patch(cost, grid, window, reach_cost, planner._clearance_cost)
+            planner._cost = cost
+        return {"changed_cells": n_changed, "window": window, "reset": False}
+
+
+
+def _grow(box: tuple[int, int, int, int], k: int, shape: tuple[int, int]):
+    """Grow the cell box ``(x0, x1, y0, y1)`` (inclusive) by ``k`` cells, inside ``shape``."""
+    ny, nx = shape
+    return (max(0, box[0] - k), min(nx - 1, box[1] + k), max(0, box[2] - k), min(ny - 1, box[3] + k))
+
+
+def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute) -> None:
+    """Recompute ``target`` (a per-cell array of ``grid``) inside ``window``.
+
+    ``compute`` runs on the map cut to ``window`` grown by ``reach`` more cells; cells of
+    ``window`` are at least ``reach`` from that cut's made-up outside (where it is not the
+    map's own edge), so they get exactly the values of a whole-map computation.
+    """
+    x0, x1, y0, y1 = window
+    cx0, cx1, cy0, cy1 = _grow(window, reach, grid.shape)
+    res = grid.resolution
+    ox, oy = grid.origin
+    sub = OccupancyGrid(
+        grid.occupied[cy0 : cy1 + 1, cx0 : cx1 + 1], res, (ox + cx0 * res, oy + cy0 * res)
+    )
+    vals = compute(sub)
+    target[y0 : y1 + 1, x0 : x1 + 1] = vals[y0 - cy0 : y1 - cy0 + 1, x0 - cx0 : x1 - cx0 + 1]
