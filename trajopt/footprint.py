@@ -203,20 +203,7 @@ def span_heading_intervals(knots: np.ndarray, control_points: np.ndarray, degree
     q[ok] = p * np.diff(c, axis=0)[ok] / den[ok, None]
     out = np.empty((n - p, 2))
     for j in range(n - p):
-        qs = q[j : j + p]
-        qs = qs[np.hypot(qs[:, 0], qs[:, 1]) > 1e-15]
-        if len(qs) == 0:
-            out[j] = (-math.pi, math.pi)
-            continue
-        ang = np.arctan2(qs[:, 1], qs[:, 0])
-        ref = ang[0]
-        rel = np.remainder(ang - ref + math.pi, 2 * math.pi) - math.pi
-        lo, hi = float(rel.min()), float(rel.max())
-        # the cone holds the tangent only if it is less than a half-turn wide
-        if hi - lo >= math.pi - 1e-12:
-            out[j] = (ref - math.pi, ref + math.pi)
-        else:
-            out[j] = (ref + lo, ref + hi)
+        out[j] = _cone(q[j : j + p])
     return out
 
 
@@ -302,64 +289,139 @@ class FootprintCertificate:
 
 
 def certify_footprint(curve: Any, footprint: Footprint, raw_grid: Any, *,
-                      tol_m: float = 1e-9) -> FootprintCertificate:
+                      tol_m: float = 1e-9, max_depth: int = 4) -> FootprintCertificate:
     """Check that ``footprint``, oriented along ``curve``, never meets an obstacle.
 
-    Span ``j`` of the clamped B-spline lies in the convex hull of its control points
-    ``c_j .. c_{j+p}`` and its tangent direction in the interval of
-    :func:`span_heading_intervals`, so the footprint over the span lies in the Minkowski
-    sum of that hull and :meth:`Footprint.swept_hull` of the interval; the span passes when
-    that polygon's exact distance to the raw map's occupied squares and to the outside of
-    the map (the polygon corridor's obstacle index, exact convex-polygon-to-rectangle
-    distances) exceeds ``tol_m``; margins are reported up to the circumscribed radius plus
-    two cells. The check is
-    independent of the optimiser that produced the curve.
+    Each polynomial piece (span) of the curve is written in Bezier form; a Bezier piece lies
+    in the convex hull of its control points, and its tangent direction in the cone of its
+    hodograph's control points (the differences of consecutive control points), so the
+    footprint over the piece lies in the Minkowski sum of that hull and
+    :meth:`Footprint.swept_hull` of the cone's heading interval. The piece passes when that
+    polygon's exact distance to the raw map's occupied squares and to the outside of the
+    map (the polygon corridor's obstacle index: exact convex-polygon-to-rectangle
+    distances) exceeds ``tol_m``; a piece that does not is split in two (de Casteljau), up
+    to ``max_depth`` times, which tightens both bounds. The check is independent of the
+    optimiser that produced the curve; margins are reported up to the circumscribed radius
+    plus two cells.
 
     Parameters
     ----------
     curve : BSplineCurve or SmoothPath
-        Anything with knots ``t``, control points ``c`` and degree ``k`` (a
-        :class:`~trajopt.smoother.SmoothPath` is unwrapped), in world metres.
+        Anything with ``domain``, ``breakpoints()``, ``k`` (or ``degree``) and derivatives
+        ``curve(u, nu)`` (a :class:`~trajopt.smoother.SmoothPath` is unwrapped), in world
+        metres.
     footprint : Footprint
     raw_grid : astar.OccupancyGrid
     tol_m : float, optional
         Smallest clearance counted as clear (m).
+    max_depth : int, optional
+        Most halvings of a span.
 
     Returns
     -------
     FootprintCertificate
+        Per span: the smallest margin over its final pieces, and the heading interval of
+        its whole hodograph.
     """
     from trajopt.clearance import grid_cells
     from trajopt.polygon_corridor.obstacle_index import ObstacleIndex, poly_clearance
 
     spline = getattr(curve, "curve", curve)
-    t, c, k = np.asarray(spline.t), np.asarray(spline.c), int(spline.k)
-    heads = span_heading_intervals(t, c, k)
+    pieces = _bezier_spans(spline)
     occ, res, ox, oy = grid_cells(raw_grid)
     origin = np.array([ox, oy])
-    polys = [
-        (minkowski_sum(c[j : j + k + 1], footprint.swept_hull(lo, hi)) - origin) / res
-        for j, (lo, hi) in enumerate(heads)
-    ]
     cap = footprint.circumscribed_radius / res + 2.0  # beyond it the exact value is moot
-    margins = np.empty(len(polys))
-    if polys:
-        allp = np.vstack(polys)
-        reach = int(math.ceil(cap)) + 2
-        idx = ObstacleIndex(
-            occ,
-            int(math.floor(allp[:, 0].min())) - reach,
-            int(math.ceil(allp[:, 0].max())) + reach,
-            int(math.floor(allp[:, 1].min())) - reach,
-            int(math.ceil(allp[:, 1].max())) + reach,
-        )
-        for j, poly in enumerate(polys):
-            v = np.ascontiguousarray(poly)
-            margins[j] = poly_clearance(v, len(v), cap, *idx.args) * res
-    worst = int(np.argmin(margins)) if margins.size else 0
+    allp = np.vstack(pieces) if pieces else np.zeros((1, 2))
+    reach = int(math.ceil(cap + footprint.circumscribed_radius / res)) + 2
+    q = (allp - origin) / res
+    idx = ObstacleIndex(
+        occ,
+        int(math.floor(q[:, 0].min())) - reach,
+        int(math.ceil(q[:, 0].max())) + reach,
+        int(math.floor(q[:, 1].min())) - reach,
+        int(math.ceil(q[:, 1].max())) + reach,
+    )
+
+    def margin(bez: np.ndarray) -> float:
+        lo, hi = _cone(np.diff(bez, axis=0))
+        poly = (minkowski_sum(bez, footprint.swept_hull(lo, hi)) - origin) / res
+        v = np.ascontiguousarray(poly)
+        return float(poly_clearance(v, len(v), cap, *idx.args)) * res
+
+    margins = np.empty(len(pieces))
+    heads = np.empty((len(pieces), 2))
+    for j, bez in enumerate(pieces):
+        heads[j] = _cone(np.diff(bez, axis=0))
+        todo = [bez]
+        worst = math.inf
+        for depth in range(max_depth + 1):
+            nxt = []
+            for b in todo:
+                m = margin(b)
+                if m > tol_m or depth == max_depth:
+                    worst = min(worst, m)
+                else:
+                    nxt.extend(_split(b))
+            todo = nxt
+            if not todo:
+                break
+        margins[j] = worst
+    worst_span = int(np.argmin(margins)) if margins.size else 0
     return FootprintCertificate(
         ok=bool(np.all(margins > tol_m)),
         margins_m=margins,
         heading_intervals=heads,
-        worst_span=worst,
+        worst_span=worst_span,
     )
+
+
+def _bezier_spans(spline: Any) -> list[np.ndarray]:
+    """Return the Bezier control points (shape (p + 1, 2)) of each polynomial piece.
+
+    From the derivatives at the piece's start: the power-basis coefficients
+    ``f^(j)(a) (b - a)^j / j!`` give ``b_i = sum_{j <= i} C(i, j) / C(p, j) coef_j``.
+    """
+    p = int(getattr(spline, "k", getattr(spline, "degree", 3)))
+    lo, hi = (float(x) for x in spline.domain)
+    bp = np.asarray(spline.breakpoints(), dtype=float)
+    w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
+    out = []
+    for a, b in zip(w[:-1], w[1:], strict=True):
+        if b <= a:
+            continue
+        der = np.array([np.asarray(spline(np.array([a]), nu), dtype=float)[0] for nu in range(p + 1)])
+        coef = np.array([der[j] * (b - a) ** j / math.factorial(j) for j in range(p + 1)])
+        bez = np.zeros((p + 1, 2))
+        for i in range(p + 1):
+            for j in range(i + 1):
+                bez[i] += math.comb(i, j) / math.comb(p, j) * coef[j]
+        out.append(bez)
+    return out
+
+
+def _split(bez: np.ndarray) -> list[np.ndarray]:
+    """Return the two halves of a Bezier piece (de Casteljau at 1/2)."""
+    left, right = [bez[0]], [bez[-1]]
+    cur = bez
+    while len(cur) > 1:
+        cur = 0.5 * (cur[:-1] + cur[1:])
+        left.append(cur[0])
+        right.append(cur[-1])
+    return [np.array(left), np.array(right[::-1])]
+
+
+def _cone(d: np.ndarray) -> tuple[float, float]:
+    """Return the heading interval (rad) spanned by the direction vectors ``d``.
+
+    The whole circle when they do not fit in an open half-plane, or all vanish.
+    """
+    d = d[np.hypot(d[:, 0], d[:, 1]) > 1e-15]
+    if len(d) == 0:
+        return (-math.pi, math.pi)
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    ref = float(ang[0])
+    rel = np.remainder(ang - ref + math.pi, 2 * math.pi) - math.pi
+    lo, hi = float(rel.min()), float(rel.max())
+    if hi - lo >= math.pi - 1e-12:
+        return (ref - math.pi, ref + math.pi)
+    return (ref + lo, ref + hi)

@@ -27,6 +27,8 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
             "this planner plans on a costmap: build a new Planner from the updated costmap"
         )
     with planner._lock:
+        for disc in planner._disc_planners.values():  # a footprint robot's disc models
+            update_caches(disc, grid)
         old = planner.grid
         same = (
             grid.shape == old.shape

@@ -71,6 +71,7 @@ from trajopt.clearance import polygon_clearance, polyline_clearance
 from trajopt.corridor_fit import box_corridor, fit_in_corridor, witness_rescue
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
+from trajopt.footprint_planning import plan_with_footprint
 from trajopt.map_update import update_caches
 from trajopt.plan_query import PlanQuery, PlanSteps
 from trajopt.polygon_corridor import PolygonCorridor
@@ -231,6 +232,7 @@ class Planner:
         self._latencies: collections.deque[float] = collections.deque(maxlen=32)
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
+        self._disc_planners: dict[float, Planner] = {}  # footprint robots: the disc models
 
     # -------------------------------------------------------------- caches
     @property
@@ -345,7 +347,12 @@ class Planner:
         """
         with self._lock:
             t0 = time.perf_counter()
-            out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
+            if self.robot.footprint is not None:
+                out = plan_with_footprint(self, start, goal, start_heading=start_heading,
+                                          goal_heading=goal_heading, v_start=v_start,
+                                          v_end=v_end)  # fmt: skip
+            else:
+                out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
             self._latencies.append(time.perf_counter() - t0)
             return out
 

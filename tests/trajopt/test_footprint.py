@@ -1,0 +1,212 @@
+"""Oriented footprints: the polygon, its swept bound, the certificate, and whole plans.
+
+References are brute force and independent of :mod:`trajopt.footprint`: dense rotations
+of the footprint for the swept bound, dense tangent samples for the heading intervals,
+and a point-sampling collision check (points inside the posed footprint against the
+occupied squares) for the certificate and the plans.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import astar
+import trajopt
+from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.errors import InvalidInputError
+from trajopt.footprint import Footprint, certify_footprint, convex_hull, span_heading_intervals
+
+
+def inside_convex(poly: np.ndarray, pts: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+    e = np.roll(poly, -1, axis=0) - poly
+    c = e[None, :, 0] * (pts[:, None, 1] - poly[None, :, 1]) - e[None, :, 1] * (
+        pts[:, None, 0] - poly[None, :, 0]
+    )
+    return np.all(c >= -tol, axis=1)
+
+
+def footprint_points(fp: Footprint, n: int = 12) -> np.ndarray:
+    """Points filling the footprint (robot frame): its boundary and a grid inside."""
+    v = fp.vertices
+    edges = [v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i])
+             for i in range(len(v))]  # fmt: skip
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n))
+    grid = np.column_stack([gx.ravel(), gy.ravel()])
+    return np.vstack(edges + [grid[inside_convex(v, grid)]])
+
+
+def collides(grid: astar.OccupancyGrid, fp: Footprint, x, y, theta) -> bool:
+    """Brute force: does any sampled point of the posed footprint lie in an occupied square
+    or outside the map?"""
+    pts = footprint_points(fp)
+    out = []
+    for xi, yi, ti in zip(np.atleast_1d(x), np.atleast_1d(y), np.atleast_1d(theta), strict=True):
+        c, s = math.cos(ti), math.sin(ti)
+        w = np.column_stack([xi + c * pts[:, 0] - s * pts[:, 1], yi + s * pts[:, 0] + c * pts[:, 1]])
+        out.append(w)
+    w = np.vstack(out)
+    q = (w - np.asarray(grid.origin)) / grid.resolution
+    ix, iy = np.floor(q[:, 0]).astype(int), np.floor(q[:, 1]).astype(int)
+    ny, nx = grid.shape
+    outside = (ix < 0) | (iy < 0) | (ix >= nx) | (iy >= ny)
+    if outside.any():
+        return True
+    return bool(grid.occupied[iy, ix].any())
+
+
+# ------------------------------------------------------------------ the polygon
+def test_rectangle_by_hand():
+    fp = Footprint.rectangle(0.6, 0.4, rear_offset=0.15)
+    np.testing.assert_allclose(fp.vertices, [[-0.15, -0.2], [0.45, -0.2], [0.45, 0.2], [-0.15, 0.2]])
+    assert fp.inscribed_radius == pytest.approx(0.15)  # the rear edge
+    assert fp.circumscribed_radius == pytest.approx(math.hypot(0.45, 0.2))
+    np.testing.assert_allclose(fp.at(1.0, 2.0, math.pi / 2)[1], [1.2, 2.45])
+    r = trajopt.Robot.rectangle(0.6, 0.4, 0.15, v_max=0.8)
+    assert r.radius == pytest.approx(fp.circumscribed_radius) and r.v_max == 0.8
+    assert r.inscribed_radius == pytest.approx(0.15)
+    assert r.to_dict()["footprint"] == fp.to_list()
+
+
+@pytest.mark.parametrize(
+    ("vertices", "match"),
+    [
+        ([[0.1, 0.1], [0.2, 0.1]], "at least 3 vertices"),
+        ([[1, 0], [0, 1], [-1, 0], [0.2, 0.1], [0, -1]], "convex"),  # a dent
+        ([[1, 1], [-1, -1], [1, -1], [-1, 1]], "convex|self-intersecting"),  # a bow-tie
+        ([[0.2, 0.1], [0.5, 0.1], [0.5, 0.4], [0.2, 0.4]], "rotation centre"),
+        ([[-0.2, 0.0], [0.2, 0.0], [0.2, 0.3], [-0.2, 0.3]], "rotation centre"),  # on an edge
+        ([[-0.2, -0.1], [0.2, -0.1], [math.nan, 0.1]], "finite"),
+        ([[-0.2, -0.1], [0.0, -0.1], [0.2, -0.1], [0.0, 0.2]], "collinear|convex"),
+    ],
+)
+def test_bad_footprints(vertices, match):
+    with pytest.raises(InvalidInputError, match=match):
+        Footprint(np.array(vertices, dtype=float))
+
+
+def test_robot_footprint_rules():
+    with pytest.raises(InvalidInputError, match="contradicts the footprint"):
+        trajopt.Robot(radius=0.3, footprint=Footprint.rectangle(0.6, 0.4))
+    with pytest.raises(InvalidInputError, match="rear_offset"):
+        trajopt.Robot.rectangle(0.6, 0.4, rear_offset=0.7)
+    r = trajopt.Robot(footprint=[[-0.1, -0.1], [0.3, -0.1], [0.3, 0.1], [-0.1, 0.1]])
+    assert isinstance(r.footprint, Footprint) and r.radius == pytest.approx(math.hypot(0.3, 0.1))
+
+
+# ------------------------------------------------------------------ swept bound
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-4.0, 4.0), st.floats(0.0, 7.0), st.integers(0, 2))
+def test_swept_hull_contains_every_rotation(lo, span, which):
+    fp = [Footprint.rectangle(0.6, 0.4, 0.15), Footprint.rectangle(0.3, 0.3),
+          Footprint(np.array([[0.4, 0.0], [-0.1, 0.25], [-0.2, -0.2]]))][which]  # fmt: skip
+    hull = fp.swept_hull(lo, lo + span)
+    pts = np.vstack([fp.at(0.0, 0.0, t) for t in np.linspace(lo, lo + span, 721)])
+    assert inside_convex(hull, pts, tol=1e-12).all()
+    # and not loose: within 10 % of the brute-force hull's area for spans up to 45 degrees
+    if span <= math.pi / 4:
+        def area(p):
+            return 0.5 * abs(np.dot(p[:, 0], np.roll(p[:, 1], -1)) - np.dot(np.roll(p[:, 0], -1), p[:, 1]))
+        assert area(hull) <= 1.1 * area(convex_hull(pts)) + 1e-12
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_span_heading_intervals_hold_the_tangent(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 12))
+    c = np.cumsum(rng.normal(size=(n, 2)) * [1.0, 0.4] + [1.0, 0.0], axis=0)
+    curve = BSplineCurve(clamped_uniform_knots(n, 3), c, 3)
+    heads = span_heading_intervals(curve.t, curve.c, 3)
+    for j, (lo, hi) in enumerate(heads):
+        a, b = curve.t[3 + j], curve.t[4 + j]
+        if b <= a:
+            continue
+        d = curve(np.linspace(a, b, 200), 1)
+        th = np.arctan2(d[:, 1], d[:, 0])
+        rel = np.remainder(th - lo + 1e-9, 2 * math.pi) - 1e-9  # the tight ends: round-off
+        assert np.all(rel <= (hi - lo) + 1e-9) or hi - lo >= 2 * math.pi - 1e-9
+
+
+# ------------------------------------------------------------------ certificate
+@pytest.fixture(scope="module")
+def door():
+    res = 0.02
+    occ = np.zeros((150, 200), bool)
+    occ[:, 100:104] = True
+    occ[60:85, 100:104] = False  # a 0.5 m door in a 8 cm wall
+    return astar.OccupancyGrid(occ, res)
+
+
+def test_certificate_is_sound_and_catches_a_collision(door):
+    fp = Footprint.rectangle(0.7, 0.4)
+    straight = np.column_stack([np.linspace(0.8, 3.2, 8), np.full(8, 1.45)])
+    good = BSplineCurve(clamped_uniform_knots(8, 3, (0.0, 2.4)), straight, 3)
+    cert = certify_footprint(good, fp, door)
+    assert cert.ok and cert.min_margin_m == pytest.approx(0.05, abs=1e-6)
+    u = np.linspace(0.0, 2.4, 500)
+    xy = good(u)
+    assert not collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
+    low = straight + [0.0, -0.12]  # 12 cm off the door's axis: the body hits the jamb
+    bad = BSplineCurve(clamped_uniform_knots(8, 3, (0.0, 2.4)), low, 3)
+    cert = certify_footprint(bad, fp, door)
+    assert not cert.ok and cert.min_margin_m == 0.0
+    xy = bad(u)
+    assert collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
+
+
+# ------------------------------------------------------------------ plans
+def test_rectangle_through_a_door_its_circumscribed_disc_cannot_pass(door):
+    robot = trajopt.Robot.rectangle(0.7, 0.4, track_width=0.3, wheel_v_max=0.6)
+    assert 2 * robot.circumscribed_radius > 0.5 > 0.4 + 2 * door.resolution
+    with pytest.raises(trajopt.NoPathError):
+        trajopt.plan(door, (0.8, 1.45), (3.2, 1.45), trajopt.Robot(radius=robot.radius))
+    traj = trajopt.plan(door, (0.8, 1.45), (3.2, 1.45), robot)
+    assert traj.robot is robot
+    fpst = traj.stats["footprint"]
+    assert fpst["disc_radius_m"] == pytest.approx(robot.inscribed_radius)
+    assert fpst["min_margin_m"] > 0.0
+    smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
+    assert not collides(door, robot.footprint, smp.x, smp.y, smp.theta)
+    from trajopt.metrics import trajectory_metrics
+
+    assert trajectory_metrics(traj, robot)["within_limits"]
+
+
+def test_footprint_replan_splices(door):
+    robot = trajopt.Robot.rectangle(0.7, 0.4, track_width=0.3, wheel_v_max=0.6)
+    planner = trajopt.Planner(door, robot)
+    traj = planner.plan((0.8, 1.45), (3.2, 1.45))
+    new = planner.replan(traj, 1.0, latency=0.0)
+    a, b = traj.state_at(1.0), new.state_at(0.0)
+    assert max(abs(a.x - b.x), abs(a.y - b.y), abs(a.theta - b.theta), abs(a.v - b.v)) < 1e-6
+    smp = new.sample(np.linspace(0.0, new.duration, 2000))
+    assert not collides(door, robot.footprint, smp.x, smp.y, smp.theta)
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_random_scenes_never_collide(seed):
+    rng = np.random.default_rng(seed)
+    occ = rng.random((60, 90)) < 0.03
+    occ = np.asarray(astar.inflate(astar.OccupancyGrid(occ, 0.05), 0.05).occupied)
+    grid = astar.OccupancyGrid(occ, 0.05)
+    robot = trajopt.Robot.rectangle(float(rng.uniform(0.3, 0.5)), 0.24)
+    free = np.argwhere(~astar.inflate(grid, robot.circumscribed_radius + 0.05,
+                                      metric="square", outside_occupied=True).occupied)  # fmt: skip
+    if len(free) < 2:
+        return
+    a, b = free[0], free[-1]
+    try:
+        traj = trajopt.plan(grid, grid.cell_to_world(a[::-1]), grid.cell_to_world(b[::-1]), robot)
+    except (trajopt.NoPathError, trajopt.SmoothingError, trajopt.TimingError):
+        return  # a typed refusal is allowed; a collision is not
+    if traj.stats.get("fallback"):
+        return
+    smp = traj.sample(np.linspace(0.0, traj.duration, 1500))
+    assert not collides(grid, robot.footprint, smp.x, smp.y, smp.theta)

@@ -1,0 +1,136 @@
+"""Planning for a robot with an oriented footprint.
+
+A :class:`~trajopt.pipeline.Planner` whose robot has a
+:class:`~trajopt.footprint.Footprint` plans with disc models of growing radius and keeps
+the first result whose footprint certificate passes:
+
+1. the **inscribed** radius first: the centre keeps at least it from every obstacle, so
+   the search accepts every passage at least as wide as the footprint's narrowest
+   extent through the rotation centre, and the corridor and the smoother certify that
+   disc clearance;
+2. the curve is then checked for the whole footprint, oriented along its tangent
+   (:func:`~trajopt.footprint.certify_footprint`: per span, the Minkowski sum of the
+   control-point hull and the footprint swept over the span's heading interval, exactly
+   clear of the raw map);
+3. when that check fails, the next radius of the ladder (halfway to the circumscribed
+   radius, then the circumscribed radius, whose disc holds the footprint in every heading)
+   is tried.
+
+What is exact and what is conservative: every returned smooth trajectory passes the
+footprint certificate, which bounds the footprint over each span rigorously (the swept
+hull and the control-point hull both contain what they stand for), so the footprint never
+meets an obstacle. The search is conservative towards feasibility only through the
+ladder: the grid path is searched for a disc, not in SE(2), so a passage that a footprint
+can only pass at a heading the disc path does not take is found only if the curve happens
+to take it. The stop-and-turn fallback is used only on the circumscribed rung: it turns in
+place, where only the circumscribed disc is free in every heading.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
+from trajopt.fallback import StopAndTurnTrajectory
+from trajopt.footprint import certify_footprint
+from trajopt.robot import Robot
+
+__all__ = ["disc_planner", "plan_with_footprint", "radius_ladder"]
+
+
+def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:
+    """Return the disc radii tried in order (m): inscribed, halfway, circumscribed."""
+    out = [inscribed, 0.5 * (inscribed + circumscribed), circumscribed]
+    return [r for i, r in enumerate(out) if i == 0 or r > out[i - 1] * (1 + 1e-9)]
+
+
+def disc_planner(planner: Any, radius: float) -> Any:
+    """Return (and cache) the planner's disc model of ``radius`` (m), same options."""
+    from trajopt.pipeline import Planner
+
+    cache = planner._disc_planners
+    if radius not in cache:
+        r = planner.robot
+        disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
+                     a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
+                     wheel_v_max=r.wheel_v_max)  # fmt: skip
+        last = radius >= r.circumscribed_radius * (1 - 1e-9)
+        cache[radius] = Planner(
+            planner.costmap if planner.costmap is not None else planner.grid,
+            disc,
+            inflation=planner.inflation,
+            w_cells=planner.w_cells,
+            search=planner.search,
+            smoother=planner.smoother,
+            timing_dt=planner.timing_dt,
+            fallback=planner.fallback if last else None,
+            corridor=planner.corridor,
+            costmap_weight=planner.costmap_weight,
+            speed_limits=planner.speed_limits,
+        )
+    return cache[radius]
+
+
+def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> Any:
+    """Return :meth:`~trajopt.pipeline.Planner.plan`'s result for a footprint robot.
+
+    Raises
+    ------
+    InvalidInputError
+        The start or goal is invalid even for the inscribed disc.
+    NoPathError
+        No disc of the ladder finds a path.
+    SmoothingError
+        No rung gives a curve whose footprint certificate passes (the message lists why
+        each radius failed).
+    """
+    robot = planner.robot
+    fp = robot.footprint
+    ladder = radius_ladder(fp.inscribed_radius, fp.circumscribed_radius)
+    failures: list[str] = []
+    errors: list[Exception] = []
+    for i, r in enumerate(ladder):
+        disc = disc_planner(planner, r)
+        try:
+            traj = disc.plan(start, goal, **kwargs)
+        except InvalidInputError as exc:
+            if i == 0:
+                raise
+            failures.append(f"radius {r:.4g} m: {type(exc).__name__}: {exc}")
+            errors.append(exc)
+            continue
+        except (NoPathError, SmoothingError, TimingError) as exc:
+            failures.append(f"radius {r:.4g} m: {type(exc).__name__}: {exc}")
+            errors.append(exc)
+            continue
+        if isinstance(traj, StopAndTurnTrajectory):
+            cert = None  # only on the circumscribed rung: its disc holds every heading
+        else:
+            cert = certify_footprint(traj.path, fp, planner.grid)
+            if not cert.ok:
+                failures.append(
+                    f"radius {r:.4g} m: footprint certificate failed at span "
+                    f"{cert.worst_span} (margin {cert.min_margin_m:.4g} m)"
+                )
+                errors.append(SmoothingError(failures[-1], {}))
+                continue
+        stats = dict(traj.stats)
+        stats["footprint"] = {
+            "disc_radius_m": r,
+            "ladder_m": ladder,
+            "rejected": list(failures),
+            "min_margin_m": None if cert is None else cert.min_margin_m,
+            "spans": None if cert is None else int(cert.margins_m.size),
+        }
+        return dataclasses.replace(traj, robot=robot, stats=stats)
+    if errors and all(isinstance(e, NoPathError) for e in errors):
+        raise NoPathError("no path for any disc of the footprint's ladder: " + "; ".join(failures))
+    stats: dict[str, Any] = {"footprint_failures": failures}
+    for e in reversed(errors):
+        if isinstance(e, SmoothingError) and e.stats:
+            stats.update(e.stats)
+            break
+    raise SmoothingError(
+        "no footprint-certified trajectory: " + "; ".join(failures), stats
+    )
