@@ -29,6 +29,7 @@ place, where only the circumscribed disc is free in every heading.
 from __future__ import annotations
 
 import dataclasses
+import time
 from typing import Any
 
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
@@ -104,10 +105,13 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             failures.append(f"radius {r:.4g} m: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
+        cert_s = 0.0
         if isinstance(traj, StopAndTurnTrajectory):
             cert = None  # only on the circumscribed rung: its disc holds every heading
         else:
+            t_cert = time.perf_counter()
             cert = certify_footprint(traj.path, fp, planner.grid)
+            cert_s = time.perf_counter() - t_cert
             if not cert.ok:
                 failures.append(
                     f"radius {r:.4g} m: footprint certificate failed at span "
@@ -122,6 +126,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             "rejected": list(failures),
             "min_margin_m": None if cert is None else cert.min_margin_m,
             "spans": None if cert is None else int(cert.margins_m.size),
+            "certificate_s": cert_s,
         }
         return dataclasses.replace(traj, robot=robot, stats=stats)
     if errors and all(isinstance(e, NoPathError) for e in errors):
