@@ -416,6 +416,7 @@ def _require_matplotlib() -> None:
 
 # -------------------------------------------------------------------- commands
 _OUT_SUFFIXES = (".csv", ".json", ".mcap")
+_PLOT_POSES = (5, 40)  # least and most footprints drawn along the trajectory by plan --plot
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -482,8 +483,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.plot:
         _require_matplotlib()
         import matplotlib.pyplot as plt
+        import numpy as np
 
-        from trajopt.plotting import plot_paths
+        from trajopt.plotting import plot_footprints, plot_paths
 
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
@@ -497,6 +499,12 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             goals={"goal": steps.goal},
             ax=ax,
         )
+        if robot.footprint is not None:
+            # evenly spaced in time, about one circumscribed diameter apart on average
+            poses = int(np.clip(round(traj.path.length / robot.width) + 1, *_PLOT_POSES))
+            every_s = max(traj.duration, 1e-6) / (poses - 1)
+            plot_footprints(ax, traj, robot, every_s=every_s)
+            ax.legend(loc="best", fontsize="small")
         print(f"wrote {_save_figure(fig, args.plot)}")
     return 0
 
