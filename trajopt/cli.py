@@ -25,11 +25,43 @@ logger = logging.getLogger(__name__)
 EXIT_USAGE = 2
 
 
+class _Formatter(argparse.HelpFormatter):
+    """Help formatter that shows an action's ``usage_metavar`` verbatim when it has one."""
+
+    def _format_args(self, action: argparse.Action, default_metavar: str) -> str:
+        fixed = getattr(action, "usage_metavar", None)
+        return fixed if fixed is not None else super()._format_args(action, default_metavar)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse that reports errors as one line and exit code 2."""
 
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+class _FootprintAction(argparse.Action):
+    """``--footprint L W [REAR]``: 2 or 3 numbers (m), else a usage error (exit code 2)."""
+
+    usage_metavar = "L W [REAR]"
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        if len(values) not in (2, 3):
+            parser.error(
+                f"argument {option_string}: expected 2 or 3 numbers (length, width and "
+                f"optionally the rear offset, m), got {len(values)}"
+            )
+        setattr(namespace, self.dest, list(values))
 
 
 class CliError(Exception):
@@ -37,9 +69,26 @@ class CliError(Exception):
 
 
 # ----------------------------------------------------------------- arguments
+def _shape_args(g: Any, radius_help: str) -> None:
+    """Add ``--radius``, ``--footprint`` and ``--footprint-file``, mutually exclusive."""
+    shape = g.add_mutually_exclusive_group()
+    shape.add_argument("--radius", type=float, help=radius_help)
+    shape.add_argument(
+        "--footprint", nargs="+", type=float, action=_FootprintAction,
+        help="rectangular footprint [m]: length L (x forward), width W and the rear offset "
+        "REAR from the rotation centre back to the rear edge (default L/2); the disc-model "
+        "stages keep its circumscribed radius clear",
+    )  # fmt: skip
+    shape.add_argument(
+        "--footprint-file", metavar="PATH",
+        help="convex footprint polygon [m, robot frame, x forward]: JSON (a list of [x, y] "
+        "or {\"vertices\": [[x, y], ...]}) or CSV/text rows 'x, y'",
+    )  # fmt: skip
+
+
 def _robot_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("robot and limits (SI units; defaults: trajopt.Robot())")
-    g.add_argument("--radius", type=float, help="footprint radius [m]")
+    _shape_args(g, "disc robot radius [m]")
     g.add_argument("--v-max", type=float, help="max speed [m/s]")
     g.add_argument("--a-max", type=float, help="max tangential acceleration [m/s^2]")
     g.add_argument("--j-max", type=float, help="max jerk [m/s^3]")
@@ -148,7 +197,9 @@ def build_parser() -> argparse.ArgumentParser:
         "area, polynomial fit, B-spline fit and the proposed smoother.",
     )
     _map_args(p)
-    p.add_argument("--radius", type=float, help="robot radius [m] (default trajopt.Robot())")
+    _shape_args(
+        p.add_argument_group("robot (SI units; default trajopt.Robot())"), "robot radius [m]"
+    )
     p.add_argument(
         "--format",
         choices=("text", "markdown", "csv"),
@@ -248,23 +299,109 @@ def _load(args: argparse.Namespace):
     return astar.load_map(args.map, **kwargs)
 
 
+def _read_footprint_file(path: str) -> Any:
+    """Return the footprint of a ``--footprint-file`` (JSON or CSV/text rows ``x, y``).
+
+    Parameters
+    ----------
+    path : str
+        A JSON file holding a list of ``[x, y]`` vertices (m) or an object with the key
+        ``"vertices"``, or a text file of rows ``x, y`` (m; commas or spaces between the
+        numbers, ``#`` comments, blank lines and one header line such as ``x,y`` allowed).
+
+    Returns
+    -------
+    Footprint
+
+    Raises
+    ------
+    CliError
+        The file is missing, unreadable or does not follow the format.
+    InvalidInputError
+        The vertices do not form a valid footprint (the rule is named, with the file).
+    """
+    import json
+    import math
+
+    from trajopt.errors import InvalidInputError
+    from trajopt.footprint import Footprint
+
+    where = f"--footprint-file {path!r}"
+    file = Path(path)
+    if not file.is_file():
+        raise CliError(f"{where} does not exist or is not a file")
+    try:
+        text = file.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CliError(f"{where} cannot be read: {exc}") from None
+    rule_json = 'a JSON list of [x, y] vertices (m) or an object {"vertices": [[x, y], ...]}'
+    rule_rows = "rows of two numbers 'x, y' (m)"
+    if file.suffix.lower() == ".json" or text.lstrip()[:1] in ("[", "{"):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise CliError(f"{where} is not valid JSON ({exc}); expected {rule_json}") from None
+        if isinstance(data, dict):
+            if "vertices" not in data:
+                raise CliError(f"{where} has no key 'vertices'; expected {rule_json}")
+            data = data["vertices"]
+        ok = isinstance(data, list) and all(
+            isinstance(v, list)
+            and len(v) == 2
+            and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in v)
+            for v in data
+        )
+        if not ok:
+            raise CliError(f"{where} must hold {rule_json}; got {json.dumps(data)[:60]}")
+        vertices = [[float(x), float(y)] for x, y in data]
+    else:
+        vertices = []
+        header_allowed = True
+        for lineno, raw in enumerate(text.splitlines(), 1):
+            line = raw.split("#", 1)[0].strip()
+            if not line:
+                continue
+            cells = line.replace(",", " ").replace(";", " ").split()
+            try:
+                row = [float(c) for c in cells]
+            except ValueError:
+                if header_allowed:
+                    header_allowed = False
+                    continue  # one header line such as "x, y"
+                row = []
+            header_allowed = False
+            if len(row) != 2 or not all(math.isfinite(c) for c in row):
+                raise CliError(f"{where} line {lineno}: {raw.strip()!r} is not {rule_rows}")
+            vertices.append(row)
+    try:
+        return Footprint(vertices)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{where}: {exc}") from None
+
+
+def _numbers(values: Sequence[float]) -> str:
+    return " ".join(f"{v:g}" for v in values)
+
+
 def _robot(args: argparse.Namespace):
+    from trajopt.errors import InvalidInputError
+    from trajopt.footprint import Footprint
     from trajopt.robot import Robot
 
-    fields = {
-        "radius": args.radius,
-        "v_max": args.v_max,
-        "a_max": args.a_max,
-        "j_max": args.j_max,
-        "a_lat_max": args.a_lat_max,
-        "omega_max": args.omega_max,
-        "track_width": args.track_width,
-        "wheel_v_max": args.wheel_v_max,
-    }
-    kwargs = {k: v for k, v in fields.items() if v is not None}
+    names = ("radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max", "track_width",
+             "wheel_v_max")  # fmt: skip
+    kwargs = {k: getattr(args, k, None) for k in names}
+    kwargs = {k: v for k, v in kwargs.items() if v is not None}
     if getattr(args, "no_wheels", False):
         kwargs["track_width"] = None
         kwargs["wheel_v_max"] = None
+    if args.footprint is not None:
+        try:
+            kwargs["footprint"] = Footprint.rectangle(*args.footprint)
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"--footprint {_numbers(args.footprint)}: {exc}") from None
+    elif args.footprint_file is not None:
+        kwargs["footprint"] = _read_footprint_file(args.footprint_file)
     return Robot(**kwargs)
 
 
@@ -279,6 +416,7 @@ def _require_matplotlib() -> None:
 
 # -------------------------------------------------------------------- commands
 _OUT_SUFFIXES = (".csv", ".json", ".mcap")
+_PLOT_POSES = (5, 40)  # least and most footprints drawn along the trajectory by plan --plot
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -345,8 +483,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if args.plot:
         _require_matplotlib()
         import matplotlib.pyplot as plt
+        import numpy as np
 
-        from trajopt.plotting import plot_paths
+        from trajopt.plotting import plot_footprints, plot_paths
 
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
@@ -360,6 +499,12 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             goals={"goal": steps.goal},
             ax=ax,
         )
+        if robot.footprint is not None:
+            # evenly spaced in time, about one circumscribed diameter apart on average
+            poses = int(np.clip(round(traj.path.length / robot.width) + 1, *_PLOT_POSES))
+            every_s = max(traj.duration, 1e-6) / (poses - 1)
+            plot_footprints(ax, traj, robot, every_s=every_s)
+            ax.legend(loc="best", fontsize="small")
         print(f"wrote {_save_figure(fig, args.plot)}")
     return 0
 
@@ -391,10 +536,10 @@ def _avoidance(grid: Any, table: Any) -> Any:
 
 def _cmd_compare(args: argparse.Namespace) -> int:
     from trajopt.comparison import compare
-    from trajopt.robot import Robot
 
     grid = _load(args)
-    radius = Robot().radius if args.radius is None else args.radius
+    # the comparison's methods are disc models: a footprint enters by its circumscribed radius
+    radius = args.radius if args.radius is not None else _robot(args).radius
     table = compare(grid, tuple(args.start), tuple(args.goal), robot_radius=radius)
     print(_table_text(table, args.format))
     if args.out:

@@ -1,7 +1,8 @@
 """Figures: the map with avoidance area, corridor and paths.
 
-Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11), and time
-plots of a trajectory with its limits.
+Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11), the
+robot's footprint (or disc) at regular times along a timed trajectory, and time plots of a
+trajectory with its limits.
 
 matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
 Every function returns the matplotlib objects it drew on, for further styling.
@@ -17,7 +18,10 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.curve import ParametricCurve
 
-__all__ = ["plot_map", "plot_paths", "plot_profiles", "path_points"]
+__all__ = ["plot_map", "plot_paths", "plot_footprints", "plot_profiles", "path_points"]
+
+#: Most poses :func:`plot_footprints` draws; a smaller ``every_s`` is refused.
+MAX_FOOTPRINTS = 10_000
 
 _COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
 
@@ -148,6 +152,89 @@ def plot_paths(
         ax.set_ylim(zoom[2], zoom[3])
     ax.legend(loc="best", fontsize="small")
     return fig, ax
+
+
+def plot_footprints(
+    ax: Any,
+    trajectory: Any,
+    robot: Any = None,
+    *,
+    every_s: float = 1.0,
+    color: str = "tab:purple",
+    label: str | None = None,
+) -> list[Any]:
+    """Draw the robot's outline at regular times along a timed trajectory.
+
+    A robot with a footprint is drawn as its polygon at the sampled pose ``(x, y, theta)``;
+    a disc robot as a circle of ``robot.radius``. Outlines only, thin and light, so the
+    path and the map stay visible. The poses are at ``t = 0, every_s, 2 every_s, ...``
+    and at the end time ``duration``.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        Axes in metres (e.g. from :func:`plot_paths`).
+    trajectory : Trajectory or StopAndTurnTrajectory
+        Anything with ``duration`` (s) and ``sample(t)`` returning named arrays ``x, y``
+        (m) and ``theta`` (rad).
+    robot : Robot, optional
+        Shape to draw: its ``footprint`` (robot frame, m) when set, else a disc of its
+        ``radius`` (m). Default: ``trajectory.robot``.
+    every_s : float
+        Time between drawn poses (s, finite, > 0).
+    color : str
+        Outline colour (any matplotlib colour).
+    label : str, optional
+        Legend label of the first outline (default ``"footprint"`` or ``"robot disc"``).
+
+    Returns
+    -------
+    list of matplotlib patches
+        One ``Polygon`` or ``Circle`` per pose, in time order.
+
+    Raises
+    ------
+    ValueError
+        ``every_s`` not finite and > 0, or giving more than :data:`MAX_FOOTPRINTS` poses;
+        no robot given and the trajectory has none; a non-finite duration.
+    """
+    from matplotlib.patches import Circle, Polygon
+
+    robot = robot if robot is not None else getattr(trajectory, "robot", None)
+    if robot is None:
+        raise ValueError("robot is required when the trajectory has no robot attribute")
+    try:
+        step = float(every_s)
+    except (TypeError, ValueError):
+        raise ValueError(f"every_s must be a number of seconds > 0, got {every_s!r}") from None
+    if not (np.isfinite(step) and step > 0.0):
+        raise ValueError(f"every_s must be finite and > 0 (s), got {every_s!r}")
+    duration = float(trajectory.duration)
+    if not (np.isfinite(duration) and duration >= 0.0):
+        raise ValueError(f"trajectory duration must be finite and >= 0 (s), got {duration!r}")
+    if duration / step + 1 > MAX_FOOTPRINTS:
+        raise ValueError(
+            f"every_s={every_s!r} s gives {int(duration / step) + 2} poses over "
+            f"{duration:.3g} s, more than {MAX_FOOTPRINTS}; use a larger every_s"
+        )
+    t = step * np.arange(int(np.floor(duration / step + 1e-9)) + 1)
+    t = t[t < duration - 1e-9 * max(1.0, duration)]
+    t = np.append(t, duration)
+    smp = trajectory.sample(t)
+    x, y, theta = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (smp.x, smp.y, smp.theta))
+    footprint = getattr(robot, "footprint", None)
+    if label is None:
+        label = "footprint" if footprint is not None else "robot disc"
+    style = dict(fill=False, lw=0.6, ec=color, alpha=0.55, zorder=2)
+    patches = []
+    for i in range(t.shape[0]):
+        kw = dict(style, label=label if i == 0 else None)
+        if footprint is not None:
+            patch = Polygon(footprint.at(x[i], y[i], theta[i]), closed=True, **kw)
+        else:
+            patch = Circle((x[i], y[i]), float(robot.radius), **kw)
+        patches.append(ax.add_patch(patch))
+    return patches
 
 
 def plot_profiles(trajectory: Any, robot: Any = None, *, n: int = 1000) -> tuple[Any, Any]:

@@ -164,3 +164,123 @@ def test_plan_on_a_costmap_with_a_speed_mask_to_mcap(tmp_path, capsys):
     assert zone.any() and np.all(back.v[zone] <= 0.5 * 0.5 + 1e-9)
     assert back.v[~zone].max() > 0.3
     assert back.y.max() > 25 * 0.05  # around the stub, not through it
+
+
+# ------------------------------------------------------------ footprints (issue 18, item 6)
+PLAN = ["--start", "0.4", "0.3", "--goal", "2.6", "1.6"]
+
+
+def _figures(monkeypatch) -> list:
+    """Record the figures the CLI saves (then save them as usual)."""
+    import trajopt.cli as cli
+
+    saved, original = [], cli._save_figure
+
+    def record(fig, path):
+        saved.append(fig)
+        return original(fig, path)
+
+    monkeypatch.setattr(cli, "_save_figure", record)
+    return saved
+
+
+def test_plan_with_a_rectangle_footprint_writes_it_and_plots_it(
+    door_map, tmp_path, capsys, monkeypatch
+):
+    from matplotlib.patches import Polygon
+
+    saved = _figures(monkeypatch)
+    out, fig = tmp_path / "traj.json", tmp_path / "fig.png"
+    # 0.2 x 0.12 m, rotation centre 0.05 m ahead of the rear edge: circumscribed radius
+    # hypot(0.15, 0.06) = 0.1616 m, below the 0.3 m clearance of start and goal
+    rc = main(["plan", str(door_map), *PLAN, "--footprint", "0.2", "0.12", "0.05",
+               "--out", str(out), "--plot", str(fig)])  # fmt: skip
+    assert rc == 0, capsys.readouterr().err
+    robot = json.loads(out.read_text())["robot"]
+    np.testing.assert_allclose(
+        robot["footprint"], [[-0.05, -0.06], [0.15, -0.06], [0.15, 0.06], [-0.05, 0.06]]
+    )
+    assert robot["radius"] == pytest.approx(np.hypot(0.15, 0.06))
+    assert fig.stat().st_size > 0
+    (ax,) = saved[0].axes
+    outlines = [p for p in ax.patches if isinstance(p, Polygon) and len(p.get_xy()) == 5]
+    assert 5 <= len(outlines) <= 40  # closed quadrilaterals: 4 corners + the first again
+    assert "footprint" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_plan_footprint_files(door_map, tmp_path, capsys):
+    square = [[-0.08, -0.08], [0.08, -0.08], [0.08, 0.08], [-0.08, 0.08]]
+    files = {
+        "list.json": json.dumps(square),
+        "object.json": json.dumps({"vertices": square[::-1]}),  # clockwise is fine
+        "rows.csv": "# a square\nx, y\n" + "".join(f"{x}, {y}\n" for x, y in square),
+        "rows.txt": "\n".join(f"{x} {y}" for x, y in square) + "\n\n",
+    }
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+        out = tmp_path / f"{name}.json"
+        rc = main(["plan", str(door_map), *PLAN, "--footprint-file", str(tmp_path / name),
+                   "--out", str(out)])  # fmt: skip
+        assert rc == 0, (name, capsys.readouterr().err)
+        robot = json.loads(out.read_text())["robot"]
+        assert len(robot["footprint"]) == 4
+        assert robot["radius"] == pytest.approx(0.08 * np.sqrt(2)), name
+
+
+def test_compare_takes_the_footprint_circumscribed_radius(door_map, capsys, monkeypatch):
+    import trajopt.comparison
+
+    seen = {}
+    real = trajopt.comparison.compare
+
+    def spy(*args, **kwargs):
+        seen.update(kwargs)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(trajopt.comparison, "compare", spy)
+    rc = main(["compare", str(door_map), *PLAN, "--footprint", "0.2", "0.12"])
+    assert rc == 0, capsys.readouterr().err
+    assert seen["robot_radius"] == pytest.approx(np.hypot(0.1, 0.06))
+
+
+@pytest.mark.parametrize(
+    ("extra", "files", "match"),
+    [
+        (["--footprint", "0.2"], {}, "--footprint: expected 2 or 3 numbers"),
+        (["--footprint", "0.2", "0.1", "0.05", "0.3"], {}, "expected 2 or 3 numbers"),
+        (["--footprint", "0.2", "0.1", "0.3"], {}, "--footprint 0.2 0.1 0.3: rear_offset"),
+        (["--footprint", "0.2", "-0.1"], {}, "--footprint 0.2 -0.1: width must be finite"),
+        (["--radius", "0.1", "--footprint", "0.2", "0.1"], {},
+         "argument --footprint: not allowed with argument --radius"),
+        (["--footprint", "0.2", "0.1", "--footprint-file", "fp.json"], {},
+         "not allowed with argument --footprint"),
+        (["--footprint-file", "missing.json"], {},
+         "--footprint-file 'missing.json' does not exist"),
+        (["--footprint-file", "star.json"],
+         {"star.json": "[[0.2, 0], [0.02, 0.02], [0, 0.2], [-0.2, 0], [0, -0.2]]"},
+         "--footprint-file 'star.json': footprint must be a convex polygon"),
+        (["--footprint-file", "out.csv"], {"out.csv": "0.1,0.1\n0.2,0.1\n0.2,0.2\n"},
+         "must contain the rotation centre (0, 0) strictly inside"),
+        (["--footprint-file", "bad.json"], {"bad.json": '{"corners": [[0, 1]]}'},
+         "--footprint-file 'bad.json' has no key 'vertices'"),
+        (["--footprint-file", "bad.json"], {"bad.json": "[[0.1, 0.1, 0], [1, 2]]"},
+         "--footprint-file 'bad.json' must hold a JSON list of [x, y] vertices"),
+        (["--footprint-file", "bad.json"], {"bad.json": "[[0.1, 0.1],"},
+         "--footprint-file 'bad.json' is not valid JSON"),
+        (["--footprint-file", "bad.csv"], {"bad.csv": "x,y\n0.1,0.1\n0.1;oops\n"},
+         "--footprint-file 'bad.csv' line 3: '0.1;oops' is not rows of two numbers"),
+        (["--footprint-file", "bad.csv"], {"bad.csv": "-0.1 -0.1 0\n0.1 -0.1\n0 0.1\n"},
+         "line 1: '-0.1 -0.1 0' is not rows of two numbers 'x, y' (m)"),
+    ],
+)
+def test_bad_footprints_are_one_line_exit_2(
+    extra, files, match, door_map, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    for cmd in ("plan", "compare"):
+        assert run([cmd, str(door_map), *PLAN, *extra]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1, err
+        assert match in err, err
