@@ -97,6 +97,11 @@ BENCHES: tuple[Bench, ...] = (
           "then one new goal), the jump at the splice and the limits of the new "
           "trajectory, against a fresh plan from rest at the same point.",
           ("--queries", "4")),
+    Bench("footprint", "Rectangular robots: collisions and doors", "bench_footprint.py",
+          "Rectangles (1.6 x 1.0 and 2:1 of the disc's diameter) on the shared maps, checked "
+          "by an independent collision test, and door passages narrower than the "
+          "circumscribed disc, against that disc in the same run.",
+          ("--per-map", "5")),
     Bench("harness", "Benchmark harness: Dask scaling", "bench_harness.py",
           "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
           "and the report on 10^5 rows.",
