@@ -33,6 +33,7 @@ __all__ = [
     "certify_footprint",
     "convex_hull",
     "minkowski_sum",
+    "polygons_clearance",
     "span_heading_intervals",
 ]
 
@@ -373,6 +374,49 @@ def certify_footprint(curve: Any, footprint: Footprint, raw_grid: Any, *,
         heading_intervals=heads,
         worst_span=worst_span,
     )
+
+
+def polygons_clearance(polygons: list[np.ndarray], raw_grid: Any, cap_m: float) -> np.ndarray:
+    """Return the exact clearance (m, capped at ``cap_m``) of convex polygons from a map.
+
+    One obstacle index (the polygon corridor's: occupied cells merged into rectangles,
+    bucketed) serves all the polygons; the outside of the map counts as occupied.
+
+    Parameters
+    ----------
+    polygons : list of ndarray, shape (k, 2) each
+        Convex polygons in world metres.
+    raw_grid : astar.OccupancyGrid
+    cap_m : float
+        Distances beyond this are reported as ``cap_m`` (m).
+
+    Returns
+    -------
+    ndarray, shape (len(polygons),)
+    """
+    from trajopt.clearance import grid_cells
+    from trajopt.polygon_corridor.obstacle_index import ObstacleIndex, poly_clearance
+
+    out = np.empty(len(polygons))
+    if not polygons:
+        return out
+    occ, res, ox, oy = grid_cells(raw_grid)
+    origin = np.array([ox, oy])
+    cells = [(np.asarray(p, dtype=float) - origin) / res for p in polygons]
+    allp = np.vstack(cells)
+    cap = float(cap_m) / res
+    reach = int(math.ceil(cap)) + 2
+    idx = ObstacleIndex(
+        occ,
+        int(math.floor(allp[:, 0].min())) - reach,
+        int(math.ceil(allp[:, 0].max())) + reach,
+        int(math.floor(allp[:, 1].min())) - reach,
+        int(math.ceil(allp[:, 1].max())) + reach,
+    )
+    for j, poly in enumerate(cells):
+        v = np.ascontiguousarray(poly)
+        out[j] = poly_clearance(v, len(v), cap, *idx.args) * res
+    return out
 
 
 def _bezier_spans(spline: Any) -> list[np.ndarray]:

@@ -17,13 +17,14 @@ the first result whose footprint certificate passes:
    is tried.
 
 What is exact and what is conservative: every returned smooth trajectory passes the
-footprint certificate, which bounds the footprint over each span rigorously (the swept
+footprint certificate, which bounds the footprint over each piece rigorously (the swept
 hull and the control-point hull both contain what they stand for), so the footprint never
-meets an obstacle. The search is conservative towards feasibility only through the
-ladder: the grid path is searched for a disc, not in SE(2), so a passage that a footprint
-can only pass at a heading the disc path does not take is found only if the curve happens
-to take it. The stop-and-turn fallback is used only on the circumscribed rung: it turns in
-place, where only the circumscribed disc is free in every heading.
+meets an obstacle. The search is a disc search with an oriented check of its grid path
+(:func:`oriented_path_check`: the footprint at the path's own heading at every cell,
+re-searching around the cells where it collides), not a search over positions and
+headings: a passage the footprint can only take at a heading the grid path does not
+suggest may be missed. The stop-and-turn fallback is used only on the circumscribed rung:
+it turns in place, where only the circumscribed disc is free in every heading.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ import dataclasses
 import time
 from typing import Any
 
+import numpy as np
+
+import astar
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.fallback import StopAndTurnTrajectory
 from trajopt.footprint import certify_footprint
@@ -57,7 +61,7 @@ def disc_planner(planner: Any, radius: float) -> Any:
                      a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
                      wheel_v_max=r.wheel_v_max)  # fmt: skip
         last = radius >= r.circumscribed_radius * (1 - 1e-9)
-        cache[radius] = Planner(
+        disc_planner_ = Planner(
             planner.costmap if planner.costmap is not None else planner.grid,
             disc,
             inflation=planner.inflation,
@@ -70,7 +74,58 @@ def disc_planner(planner: Any, radius: float) -> Any:
             costmap_weight=planner.costmap_weight,
             speed_limits=planner.speed_limits,
         )
+        if not last:  # the circumscribed disc holds the footprint at every heading
+            footprint = r.footprint
+            raw = planner.grid
+            disc_planner_.path_check = lambda p, q: oriented_path_check(p, q, footprint, raw)
+        cache[radius] = disc_planner_
     return cache[radius]
+
+
+#: most re-searches of the oriented grid-path check
+MAX_RESEARCHES = 4
+
+
+def oriented_path_check(disc: Any, q: Any, footprint: Any, raw: Any) -> tuple[Any, Any]:
+    """Check the footprint along a disc model's grid path; re-search around collisions.
+
+    At every interior path cell the footprint is placed at the heading of the path there
+    (the direction from two cells back to two cells ahead) and its exact clearance from
+    the raw map is computed (:func:`trajopt.footprint.polygons_clearance`). Cells where it
+    meets an obstacle are blocked and the search is run again, up to
+    :data:`MAX_RESEARCHES` times; a re-search that finds no path keeps the last path
+    found (the certificate of the curve decides). Returns the grid path and the inflated
+    grid it was found on.
+    """
+    from trajopt.footprint import polygons_clearance
+
+    path, grid = q.path, q.inflated
+    for _ in range(MAX_RESEARCHES):
+        cells = np.asarray(path.cells)
+        n = len(cells)
+        if n < 5:
+            return path, grid
+        centres = raw.cell_to_world(cells)
+        ahead = centres[np.minimum(np.arange(n) + 2, n - 1)]
+        back = centres[np.maximum(np.arange(n) - 2, 0)]
+        d = ahead - back
+        theta = np.arctan2(d[:, 1], d[:, 0])
+        inner = np.arange(2, n - 2)
+        clr = polygons_clearance([footprint.at(*centres[i], theta[i]) for i in inner], raw,
+                                 raw.resolution)  # fmt: skip
+        bad = inner[clr <= 0.0]
+        if bad.size == 0:
+            return path, grid
+        occ = np.array(grid.occupied)
+        occ[cells[bad, 1], cells[bad, 0]] = True
+        trial = grid.with_occupied(occ)
+        try:
+            path = astar.find_path(trial, tuple(cells[0]), tuple(cells[-1]),
+                                   cost=disc.search_cost)  # fmt: skip
+        except astar.NoPathError:
+            return path, grid
+        grid = trial
+    return path, grid
 
 
 def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> Any:

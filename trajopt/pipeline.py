@@ -233,6 +233,9 @@ class Planner:
         self._inflated: OccupancyGrid | None = None
         self._cost: np.ndarray | None = None
         self._disc_planners: dict[float, Planner] = {}  # footprint robots: the disc models
+        #: optional ``(planner, query) -> (grid path, inflated grid)`` run after the search
+        #: (a footprint robot's oriented check of the grid path)
+        self.path_check: Any = None
 
     # -------------------------------------------------------------- caches
     @property
@@ -449,6 +452,8 @@ class Planner:
                     f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot "
                     f"of radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
                 ) from exc
+            if self.path_check is not None:
+                q.path, q.inflated = self.path_check(self, q)
         smooth = None
         try:
             smooth = self._smooth(q)
