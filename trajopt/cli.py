@@ -116,6 +116,31 @@ def _map_args(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _ros_args(p: argparse.ArgumentParser) -> None:
+    """Add ``plan``'s ROS 2 / Nav2 options: costmap, speed mask, frame."""
+    g = p.add_argument_group("ROS 2 / Nav2 inputs")
+    g.add_argument(
+        "--costmap",
+        action="store_true",
+        help="MAP is a costmap saved by Nav2's map saver (OccupancyGrid values, best in "
+        "mode raw): lethal cells are obstacles, the graded cost steers the search",
+    )
+    g.add_argument(
+        "--costmap-weight", type=float, default=2.0,
+        help="weight of the costmap's normalised cost in the search (default 2)",
+    )  # fmt: skip
+    g.add_argument("--speed-mask", metavar="YAML", help="Nav2 speed filter mask (map_server YAML)")
+    g.add_argument(
+        "--speed-mask-type", choices=("percentage", "absolute"), default="percentage",
+        help="limit in percent of --v-max or in m/s (Nav2 filter type 1 or 2; default percentage)",
+    )  # fmt: skip
+    g.add_argument("--speed-mask-base", type=float, default=0.0,
+                   help="Nav2 'base': limit = value * multiplier + base (default 0)")  # fmt: skip
+    g.add_argument("--speed-mask-multiplier", type=float, default=1.0,
+                   help="Nav2 'multiplier' (default 1)")  # fmt: skip
+    g.add_argument("--frame-id", default="map", help="frame of the written poses (default map)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``trajopt`` command."""
     parser = _Parser(
@@ -145,27 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="A* cost (default clearance-aware; with --costmap the costmap's graded cost)",
     )
-    g = p.add_argument_group("ROS 2 / Nav2 inputs")
-    g.add_argument(
-        "--costmap",
-        action="store_true",
-        help="MAP is a costmap saved by Nav2's map saver (OccupancyGrid values, best in "
-        "mode raw): lethal cells are obstacles, the graded cost steers the search",
-    )
-    g.add_argument(
-        "--costmap-weight", type=float, default=2.0,
-        help="weight of the costmap's normalised cost in the search (default 2)",
-    )  # fmt: skip
-    g.add_argument("--speed-mask", metavar="YAML", help="Nav2 speed filter mask (map_server YAML)")
-    g.add_argument(
-        "--speed-mask-type", choices=("percentage", "absolute"), default="percentage",
-        help="limit in percent of --v-max or in m/s (Nav2 filter type 1 or 2; default percentage)",
-    )  # fmt: skip
-    g.add_argument("--speed-mask-base", type=float, default=0.0,
-                   help="Nav2 'base': limit = value * multiplier + base (default 0)")  # fmt: skip
-    g.add_argument("--speed-mask-multiplier", type=float, default=1.0,
-                   help="Nav2 'multiplier' (default 1)")  # fmt: skip
-    g.add_argument("--frame-id", default="map", help="frame of the written poses (default map)")
+    _ros_args(p)
     p.add_argument(
         "--corridor",
         choices=("polygons", "boxes"),
