@@ -12,9 +12,10 @@ the first result whose footprint certificate passes:
    (:func:`~trajopt.footprint.certify_footprint`: per span, the Minkowski sum of the
    control-point hull and the footprint swept over the span's heading interval, exactly
    clear of the raw map);
-3. when that check fails, the next radius of the ladder (halfway to the circumscribed
-   radius, then the circumscribed radius, whose disc holds the footprint in every heading)
-   is tried.
+3. when that check fails, the same disc is tried again with the footprint's oriented
+   check of its grid path (:func:`oriented_path_check`), then the next radius of the
+   ladder (halfway to the circumscribed radius, then the circumscribed radius, whose disc
+   holds the footprint in every heading).
 
 What is exact and what is conservative: every returned smooth trajectory passes the
 footprint certificate, which bounds the footprint over each piece rigorously (the swept
@@ -50,36 +51,51 @@ def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:
     return [r for i, r in enumerate(out) if i == 0 or r > out[i - 1] * (1 + 1e-9)]
 
 
-def disc_planner(planner: Any, radius: float) -> Any:
-    """Return (and cache) the planner's disc model of ``radius`` (m), same options."""
+def _new_disc(planner: Any, radius: float) -> Any:
+    """Return a new disc model of ``radius`` (m) with the planner's options."""
     from trajopt.pipeline import Planner
 
+    r = planner.robot
+    disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
+                 a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
+                 wheel_v_max=r.wheel_v_max)  # fmt: skip
+    last = radius >= r.circumscribed_radius * (1 - 1e-9)
+    return Planner(
+        planner.costmap if planner.costmap is not None else planner.grid,
+        disc,
+        inflation=planner.inflation,
+        w_cells=planner.w_cells,
+        search=planner.search,
+        smoother=planner.smoother,
+        timing_dt=planner.timing_dt,
+        fallback=planner.fallback if last else None,
+        corridor=planner.corridor,
+        costmap_weight=planner.costmap_weight,
+        speed_limits=planner.speed_limits,
+    )
+
+
+def disc_planner(planner: Any, radius: float) -> Any:
+    """Return (and cache) the planner's disc model of ``radius`` (m), same options."""
     cache = planner._disc_planners
     if radius not in cache:
-        r = planner.robot
-        disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
-                     a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
-                     wheel_v_max=r.wheel_v_max)  # fmt: skip
-        last = radius >= r.circumscribed_radius * (1 - 1e-9)
-        disc_planner_ = Planner(
-            planner.costmap if planner.costmap is not None else planner.grid,
-            disc,
-            inflation=planner.inflation,
-            w_cells=planner.w_cells,
-            search=planner.search,
-            smoother=planner.smoother,
-            timing_dt=planner.timing_dt,
-            fallback=planner.fallback if last else None,
-            corridor=planner.corridor,
-            costmap_weight=planner.costmap_weight,
-            speed_limits=planner.speed_limits,
-        )
-        if not last:  # the circumscribed disc holds the footprint at every heading
-            footprint = r.footprint
-            raw = planner.grid
-            disc_planner_.path_check = lambda p, q: oriented_path_check(p, q, footprint, raw)
-        cache[radius] = disc_planner_
+        cache[radius] = _new_disc(planner, radius)
     return cache[radius]
+
+
+def checked_planner(planner: Any, radius: float) -> Any:
+    """Return (and cache) the disc model of ``radius`` with an oriented path check.
+
+    Its grid path gets the footprint's oriented check (:func:`oriented_path_check`).
+    """
+    key = ("checked", radius)
+    cache = planner._disc_planners
+    if key not in cache:
+        checked = _new_disc(planner, radius)
+        footprint, raw = planner.robot.footprint, planner.grid
+        checked.path_check = lambda p, q: oriented_path_check(p, q, footprint, raw)
+        cache[key] = checked
+    return cache[key]
 
 
 #: most re-searches of the oriented grid-path check
@@ -146,18 +162,23 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
     ladder = radius_ladder(fp.inscribed_radius, fp.circumscribed_radius)
     failures: list[str] = []
     errors: list[Exception] = []
-    for i, r in enumerate(ladder):
-        disc = disc_planner(planner, r)
+    attempts = []
+    for r in ladder:
+        attempts.append((r, disc_planner))
+        if r < ladder[-1]:  # a second try with the oriented check of the grid path
+            attempts.append((r, checked_planner))
+    for i, (r, make) in enumerate(attempts):
+        disc = make(planner, r)
         try:
             traj = disc.plan(start, goal, **kwargs)
         except InvalidInputError as exc:
             if i == 0:
                 raise
-            failures.append(f"radius {r:.4g} m: {type(exc).__name__}: {exc}")
+            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
         except (NoPathError, SmoothingError, TimingError) as exc:
-            failures.append(f"radius {r:.4g} m: {type(exc).__name__}: {exc}")
+            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
         cert_s = 0.0
@@ -169,7 +190,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             cert_s = time.perf_counter() - t_cert
             if not cert.ok:
                 failures.append(
-                    f"radius {r:.4g} m: footprint certificate failed at span "
+                    f"{_label(r, make)}: footprint certificate failed at span "
                     f"{cert.worst_span} (margin {cert.min_margin_m:.4g} m)"
                 )
                 errors.append(SmoothingError(failures[-1], {}))
@@ -194,3 +215,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
     raise SmoothingError(
         "no footprint-certified trajectory: " + "; ".join(failures), stats
     )
+
+
+def _label(radius: float, make: Any) -> str:
+    return f"radius {radius:.4g} m" + (", oriented check" if make is checked_planner else "")
