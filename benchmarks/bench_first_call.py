@@ -1,0 +1,125 @@
+"""Latency of the first ``plan`` in a fresh process, and where its time goes.
+
+Each run is a new Python process that imports ``trajopt`` and then plans SP -> A on the
+paper scene, with numba's on-disk cache already warm (one untimed process runs first to
+fill it). The scene (its grid, which needs numpy) is built before the clock starts. The child splits the first call's wall time into
+
+* ``imports``: modules first imported during the call (numba, scipy, casadi, ...),
+  counted once at the outermost ``import`` statement;
+* ``numba cache``: loading compiled kernels from numba's disk cache, with the modules
+  numba imports for itself while it loads them (its typing and lowering registries);
+* ``solver build``: the smoother's first CasADi/piqp solver build (its own stat);
+* ``rest``: everything else (search, corridor, QP solves, timing).
+
+The second plan in the same process (SP -> B) shows the warm latency. Reported: the
+median over ``--runs`` processes of each part, and of ``import trajopt`` itself.
+
+Run::
+
+    python benchmarks/bench_first_call.py            # 5 fresh processes
+    python benchmarks/bench_first_call.py --runs 9
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+CHILD = r"""
+import builtins, json, sys, time
+
+t0 = time.perf_counter()
+import trajopt
+t_import = time.perf_counter() - t0
+
+state = {"depth": 0, "imports": 0.0, "numba": 0.0, "patched": False}
+real_import = builtins.__import__
+
+
+def patch_numba():
+    caching = sys.modules.get("numba.core.caching")
+    if state["patched"] or caching is None:
+        return
+    state["patched"] = True
+    real_load = caching.Cache.load_overload
+
+    def load_overload(self, *args, **kwargs):
+        if state["depth"]:
+            return real_load(self, *args, **kwargs)
+        state["depth"] += 1
+        t = time.perf_counter()
+        try:
+            return real_load(self, *args, **kwargs)
+        finally:
+            state["numba"] += time.perf_counter() - t
+            state["depth"] -= 1
+
+    caching.Cache.load_overload = load_overload
+
+
+def timed_import(name, *args, **kwargs):
+    if state["depth"]:
+        return real_import(name, *args, **kwargs)
+    state["depth"] += 1
+    t = time.perf_counter()
+    try:
+        return real_import(name, *args, **kwargs)
+    finally:
+        state["imports"] += time.perf_counter() - t
+        state["depth"] -= 1
+        patch_numba()
+
+
+scene = trajopt.scenes.paper()
+robot = trajopt.Robot(radius=scene.robot_radius)
+builtins.__import__ = timed_import
+t1 = time.perf_counter()
+first = trajopt.plan(scene.grid, scene.start, scene.goal("A"), robot=robot)
+t_first = time.perf_counter() - t1
+builtins.__import__ = real_import
+t2 = time.perf_counter()
+trajopt.plan(scene.grid, scene.start, scene.goal("B"), robot=robot)
+t_second = time.perf_counter() - t2
+build = float(first.stats.get("smoother", {}).get("build_time_s", 0.0) or 0.0)
+print(json.dumps({"import_trajopt": t_import, "first": t_first, "imports": state["imports"],
+                  "numba": state["numba"], "build": build, "second": t_second}))
+"""
+
+
+def run_child(root: Path) -> dict:
+    """Run one fresh process and return its timings in seconds."""
+    out = subprocess.run([sys.executable, "-c", CHILD], cwd=root, check=True,
+                         capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    """Print the median first-call breakdown over fresh processes."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=5, help="fresh processes (default 5)")
+    args = ap.parse_args()
+    root = Path(__file__).resolve().parents[1]
+    run_child(root)  # fills numba's disk cache; not counted
+    runs = [run_child(root) for _ in range(args.runs)]
+
+    def med(key: str) -> float:
+        return 1e3 * statistics.median(r[key] for r in runs)
+
+    rest = [1e3 * (r["first"] - r["imports"] - r["numba"] - r["build"]) for r in runs]
+    print(f"first plan in a fresh process, paper scene SP -> A, median of {args.runs} processes")
+    print(f"  import trajopt            {med('import_trajopt'):7.1f} ms")
+    print(f"  first plan (wall)         {med('first'):7.1f} ms   target <= 500 ms")
+    print(f"    imports during the call {med('imports'):7.1f} ms")
+    print(f"    numba cache loads       {med('numba'):7.1f} ms")
+    print(f"    first solver build      {med('build'):7.1f} ms")
+    print(f"    rest                    {statistics.median(rest):7.1f} ms")
+    print(f"  second plan (SP -> B)     {med('second'):7.1f} ms")
+    print(f"  import trajopt + first plan {1e3 * statistics.median(r['import_trajopt'] + r['first'] for r in runs):7.1f} ms")
+
+
+if __name__ == "__main__":
+    main()
