@@ -12,7 +12,9 @@ fill it). The scene (its grid, which needs numpy) is built before the clock star
 * ``rest``: everything else (search, corridor, QP solves, timing).
 
 The second plan in the same process (SP -> B) shows the warm latency. Reported: the
-median over ``--runs`` processes of each part, and of ``import trajopt`` itself.
+median over ``--runs`` processes of each part, and of ``import trajopt`` itself; then, in
+as many other fresh processes, the time of ``trajopt.warm_up()`` called at start-up and of
+the first plan after it.
 
 Run::
 
@@ -74,6 +76,7 @@ def timed_import(name, *args, **kwargs):
         patch_numba()
 
 
+t_warm = trajopt.warm_up() if WARM else 0.0
 scene = trajopt.scenes.paper()
 robot = trajopt.Robot(radius=scene.robot_radius)
 builtins.__import__ = timed_import
@@ -85,14 +88,15 @@ t2 = time.perf_counter()
 trajopt.plan(scene.grid, scene.start, scene.goal("B"), robot=robot)
 t_second = time.perf_counter() - t2
 build = float(first.stats.get("smoother", {}).get("build_time_s", 0.0) or 0.0)
-print(json.dumps({"import_trajopt": t_import, "first": t_first, "imports": state["imports"],
+print(json.dumps({"import_trajopt": t_import, "warm_up": t_warm, "first": t_first, "imports": state["imports"],
                   "numba": state["numba"], "build": build, "second": t_second}))
 """
 
 
-def run_child(root: Path) -> dict:
-    """Run one fresh process and return its timings in seconds."""
-    out = subprocess.run([sys.executable, "-c", CHILD], cwd=root, check=True,
+def run_child(root: Path, warm: bool = False) -> dict:
+    """Run one fresh process (after ``trajopt.warm_up()`` if ``warm``); timings in seconds."""
+    code = f"WARM = {warm}\n" + CHILD
+    out = subprocess.run([sys.executable, "-c", code], cwd=root, check=True,
                          capture_output=True, text=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -105,6 +109,7 @@ def main() -> None:
     root = Path(__file__).resolve().parents[1]
     run_child(root)  # fills numba's disk cache; not counted
     runs = [run_child(root) for _ in range(args.runs)]
+    warm = [run_child(root, warm=True) for _ in range(args.runs)]
 
     def med(key: str) -> float:
         return 1e3 * statistics.median(r[key] for r in runs)
@@ -118,7 +123,11 @@ def main() -> None:
     print(f"    first solver build      {med('build'):7.1f} ms")
     print(f"    rest                    {statistics.median(rest):7.1f} ms")
     print(f"  second plan (SP -> B)     {med('second'):7.1f} ms")
-    print(f"  import trajopt + first plan {1e3 * statistics.median(r['import_trajopt'] + r['first'] for r in runs):7.1f} ms")
+    total = 1e3 * statistics.median(r["import_trajopt"] + r["first"] for r in runs)
+    print(f"  import trajopt + first plan {total:7.1f} ms")
+    print(f"after trajopt.warm_up() at start-up, median of {args.runs} processes")
+    print(f"  warm_up()                 {1e3 * statistics.median(r['warm_up'] for r in warm):7.1f} ms")
+    print(f"  first plan (wall)         {1e3 * statistics.median(r['first'] for r in warm):7.1f} ms")
 
 
 if __name__ == "__main__":

@@ -97,6 +97,11 @@ BENCHES: tuple[Bench, ...] = (
           "then one new goal), the jump at the splice and the limits of the new "
           "trajectory, against a fresh plan from rest at the same point.",
           ("--queries", "4")),
+    Bench("first_call", "First plan in a fresh process", "bench_first_call.py",
+          "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
+          "warm on disk), split into imports, numba cache loads, solver build and the "
+          "rest, and of the first plan after `trajopt.warm_up()` at start-up.",
+          ("--runs", "5")),
     Bench("footprint", "Rectangular robots: collisions and doors", "bench_footprint.py",
           "Rectangles (1.6 x 1.0 and 2:1 of the disc's diameter) on the shared maps, checked "
           "by an independent collision test, and door passages narrower than the "
@@ -160,7 +165,8 @@ def section(bench: Bench, full: bool, out: str, wall: float, code: int) -> str:
 
 def _merge(existing: str, parts: list[str]) -> list[str]:
     """Put the new sections (``parts[1:]``) into an existing page in the benchmarks' order,
-    keeping the other sections; the header notes which sections were rerun."""
+    keeping the other sections; the header lists every section rerun since the whole page
+    was written."""
     head_lines: list[str] = []
     old: dict[str, list[str]] = {}
     current: list[str] = head_lines
@@ -177,9 +183,10 @@ def _merge(existing: str, parts: list[str]) -> list[str]:
     merged = {**old, **new}
     ordered = [merged[t] for t in titles if t in merged]
     ordered += [v for k, v in merged.items() if k not in titles]
-    rerun = ", ".join(new)
     head = "\n".join(head_lines).rstrip()
-    head = head.split("\n\nSections rerun since")[0]
+    head, _, before = head.partition("\n\nSections rerun since with `--only`: ")
+    earlier = [t for t in before.rstrip(".").split("; ") if t and t not in new]
+    rerun = "; ".join([*earlier, *new])
     head += f"\n\nSections rerun since with `--only`: {rerun}.\n"
     return [head, *ordered]
 

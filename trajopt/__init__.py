@@ -53,6 +53,7 @@ _EXPORTS: dict[str, str] = {
     # pipeline and analysis
     "plan": "trajopt.pipeline",
     "Planner": "trajopt.pipeline",
+    "warm_up": "trajopt.warm_up",
     "compare": "trajopt.comparison",
     "ComparisonTable": "trajopt.comparison",
 }
@@ -100,3 +101,4 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.state import State
     from trajopt.timing import time_parameterize
     from trajopt.trajectory import Trajectory
+    from trajopt.warm_up import warm_up

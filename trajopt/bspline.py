@@ -1,8 +1,9 @@
-"""Planar B-spline curves ``(t, c, k)`` evaluated through :class:`scipy.interpolate.BSpline`."""
+"""Planar B-spline curves ``(t, c, k)`` evaluated with de Boor's algorithm."""
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
@@ -30,11 +31,9 @@ class BSplineCurve(ParametricCurve):
     convex hull of ``c[j:j+k+1]``.
     """
 
-    __slots__ = ("t", "c", "k", "_spline", "_arc_cache")
+    __slots__ = ("t", "c", "k", "_derivatives", "_arc_cache")
 
     def __init__(self, t: np.ndarray, c: np.ndarray, k: int) -> None:
-        from scipy.interpolate import BSpline
-
         t = np.array(t, dtype=float)
         c = np.array(c, dtype=float)
         k = int(k)
@@ -59,7 +58,7 @@ class BSplineCurve(ParametricCurve):
         t.flags.writeable = False
         c.flags.writeable = False
         self.t, self.c, self.k = t, c, k
-        self._spline = BSpline(t, c, k, extrapolate=True)
+        self._derivatives: dict[int, tuple[np.ndarray, np.ndarray]] = {0: (t, c)}
 
     @classmethod
     def from_scipy(cls, spline) -> BSplineCurve:
@@ -94,13 +93,27 @@ class BSplineCurve(ParametricCurve):
         uu = np.clip(np.asarray(u, dtype=float), lo, hi)
         if nu > self.k:
             return np.zeros(uu.shape + (2,))
-        return self._spline(uu, nu)
+        t, c = self._derivative_coefficients(nu)
+        flat = uu.reshape(-1)
+        return de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
         """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
         if not 1 <= nu < self.k:
             raise InvalidInputError(f"nu must be in [1, k-1] = [1, {self.k - 1}], got {nu}")
-        return BSplineCurve.from_scipy(self._spline.derivative(nu))
+        t, c = self._derivative_coefficients(nu)
+        return BSplineCurve(t, c, self.k - nu)
+
+    def _derivative_coefficients(self, nu: int) -> tuple[np.ndarray, np.ndarray]:
+        """Knots and control points of the ``nu``-th derivative (cached)."""
+        if nu not in self._derivatives:
+            t, c = self._derivative_coefficients(nu - 1)
+            p = self.k - nu + 1
+            dt = t[p + 1 : -1] - t[1 : -p - 1]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                scale = np.where(dt > 0, p / dt, 0.0)
+            self._derivatives[nu] = (t[1:-1], scale[:, None] * np.diff(c, axis=0))
+        return self._derivatives[nu]
 
     def span_of(self, u: np.ndarray | float) -> np.ndarray:
         """Index ``j`` of the non-empty span holding ``u`` (control points ``c[j:j+k+1]``)."""
@@ -111,6 +124,55 @@ class BSplineCurve(ParametricCurve):
 
     def __repr__(self) -> str:
         return f"BSplineCurve(k={self.k}, n={self.c.shape[0]}, domain={self.domain})"
+
+
+def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:
+    """Evaluate the spline ``(t, c, k)`` at parameters inside its domain (de Boor's algorithm).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n + k + 1,)
+        Non-decreasing knots.
+    c : ndarray, shape (n, d)
+        Control points.
+    k : int
+        Degree (>= 0).
+    u : ndarray, shape (m,)
+        Parameters in ``[t[k], t[n]]``; the last span is closed on the right.
+
+    Returns
+    -------
+    ndarray, shape (m, d)
+    """
+    return _de_boor(
+        np.ascontiguousarray(t, dtype=np.float64),
+        np.ascontiguousarray(c, dtype=np.float64),
+        int(k),
+        np.ascontiguousarray(u, dtype=np.float64),
+    )
+
+
+@njit(cache=True)
+def _de_boor(t, c, k, u):  # pragma: no cover - compiled
+    n, dim = c.shape
+    out = np.empty((u.shape[0], dim))
+    d = np.empty((k + 1, dim))
+    for q in range(u.shape[0]):
+        x = u[q]
+        j = np.searchsorted(t, x, side="right") - 1
+        j = min(max(j, k), n - 1)
+        for i in range(k + 1):
+            for a in range(dim):
+                d[i, a] = c[j - k + i, a]
+        for r in range(1, k + 1):
+            for i in range(k, r - 1, -1):
+                left = t[j - k + i]
+                alpha = (x - left) / (t[j + 1 + i - r] - left)
+                for a in range(dim):
+                    d[i, a] = (1.0 - alpha) * d[i - 1, a] + alpha * d[i, a]
+        for a in range(dim):
+            out[q, a] = d[k, a]
+    return out
 
 
 def clamped_uniform_knots(n: int, k: int, domain: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:

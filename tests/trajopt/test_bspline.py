@@ -24,6 +24,25 @@ def test_matches_scipy_per_axis():
             np.testing.assert_allclose(c(u, nu)[:, axis], ref, atol=1e-12)
 
 
+@pytest.mark.parametrize("k", range(1, 7))
+def test_de_boor_matches_scipy_with_repeated_knots(k):
+    # degrees 1-6, a doubled interior knot, every derivative order up to k + 1, at random
+    # parameters and at every knot (where the k-th derivative jumps: both take the right limit)
+    rng = np.random.default_rng(k)
+    n = k + 6
+    t = clamped_uniform_knots(n, k, (0.3, 2.0))
+    t[k + 2] = t[k + 1]
+    c = BSplineCurve(t, rng.normal(size=(n, 2)), k)
+    u = np.concatenate([rng.uniform(0.3, 2.0, 200), t[k : n + 1]])
+    for nu in range(k + 2):
+        ref = np.stack([BSpline(t, c.c[:, a], k)(u, nu) for a in range(2)], axis=1) if nu <= k else 0.0
+        np.testing.assert_allclose(c(u, nu), np.broadcast_to(ref, (u.size, 2)), rtol=1e-12, atol=1e-10)
+    for nu in range(1, k):
+        ref = BSpline(t, c.c, k).derivative(nu)
+        np.testing.assert_allclose(c.derivative(nu)(u), ref(u), rtol=1e-12, atol=1e-10)
+    assert c(1.0).shape == (2,) and c(np.ones((3, 4)), 1).shape == (3, 4, 2)
+
+
 def test_clamped_endpoints_and_derivative():
     c = _curve()
     np.testing.assert_allclose(c(0.0), c.c[0], atol=1e-14)

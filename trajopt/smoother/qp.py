@@ -410,7 +410,6 @@ def warm_imports() -> None:
         return
     import casadi  # noqa: F401
     import piqp  # noqa: F401
-    import scipy.interpolate  # noqa: F401
     import scipy.sparse  # noqa: F401
 
     from astar.grid import OccupancyGrid

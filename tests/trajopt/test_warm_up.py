@@ -1,0 +1,103 @@
+"""trajopt.warm_up: the first plan after it loads no compiled kernel, for every planner kind."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import astar
+from trajopt import Planner, Robot, Smoother, warm_up
+from trajopt.errors import InvalidInputError
+from trajopt.warm_up import warm_up_map
+
+
+def _square_distance(p: np.ndarray, grid: astar.OccupancyGrid) -> float:
+    """Brute force: distance (m) from a point to every occupied square and to the map edge."""
+    res = grid.resolution
+    iy, ix = np.nonzero(grid.occupied)
+    lo = np.stack([ix, iy], axis=1) * res
+    d = np.maximum(np.maximum(lo - p, p - (lo + res)), 0.0)
+    edge = min(p[0], p[1], grid.occupied.shape[1] * res - p[0], grid.occupied.shape[0] * res - p[1])
+    return float(min(np.sqrt((d**2).sum(axis=1)).min(), edge))
+
+
+def _free_grid() -> astar.OccupancyGrid:
+    return astar.OccupancyGrid(np.zeros((50, 50), dtype=bool), 0.05)
+
+
+def _costmap() -> astar.Costmap:
+    values = np.zeros((50, 50), dtype=np.uint8)
+    values[20:30, 20:30] = 254
+    return astar.from_costmap(values, 0.05, convention="costmap_2d")
+
+
+PLANNERS = {
+    "default": lambda: Planner(_free_grid()),
+    "rectangle": lambda: Planner(_free_grid(), Robot.rectangle(0.6, 0.3, 0.15)),
+    "kappa": lambda: Planner(_free_grid(), Robot(radius=0.1), smoother=Smoother(kappa_max=2.0)),
+    "boxes": lambda: Planner(_free_grid(), corridor="boxes"),
+    "paper": lambda: Planner(_free_grid(), Robot(radius=0.1), inflation="paper"),
+    "shortest": lambda: Planner(_free_grid(), search="shortest"),
+    "fallback": lambda: Planner(_free_grid(), fallback="stop_and_turn"),
+    "costmap": lambda: Planner(_costmap(), Robot(radius=0.1)),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(PLANNERS))
+def test_warm_up_plans_with_the_planners_settings(kind):
+    planner = PLANNERS[kind]()
+    seconds = warm_up(planner)
+    assert seconds > 0.0
+    assert planner.latency_s == 0.0  # the planner itself ran no query
+
+
+@pytest.mark.parametrize("kind", ["default", "rectangle", "kappa", "paper"])
+def test_warm_up_map_leaves_room_for_the_robot(kind):
+    planner = PLANNERS[kind]()
+    grid, start, goal = warm_up_map(planner)
+    need = planner.robot.radius * (3.0 if planner.inflation == "paper" else 1.0)
+    for p in (start, goal):
+        assert _square_distance(np.asarray(p), grid) >= need
+    assert grid.occupied[:, grid.occupied.shape[1] // 2].any()  # a wall between them
+
+
+def test_first_plan_after_warm_up_loads_no_kernel():
+    # a fresh process: after warm_up(), planning the paper scene loads or compiles no numba
+    # kernel (counted at numba's own cache and dispatcher entry points)
+    script = textwrap.dedent(
+        """
+        import numba.core.caching as caching
+        from numba.core.dispatcher import Dispatcher
+        import trajopt
+        trajopt.warm_up()
+        events = []
+        load, compile_ = caching.Cache.load_overload, Dispatcher.compile
+        def counting_load(self, *a, **k):
+            events.append("load")
+            return load(self, *a, **k)
+        def counting_compile(self, sig):
+            n = len(self.overloads)
+            out = compile_(self, sig)
+            if len(self.overloads) > n:
+                events.append(self.py_func.__name__)
+            return out
+        caching.Cache.load_overload = counting_load
+        Dispatcher.compile = counting_compile
+        scene = trajopt.scenes.paper()
+        for name in scene.target_names:
+            trajopt.plan(scene.grid, scene.start, scene.goal(name),
+                         robot=trajopt.Robot(radius=scene.robot_radius))
+        print("EVENTS", events)
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert "EVENTS []" in out.stdout, out.stdout + out.stderr
+
+
+def test_warm_up_rejects_a_non_planner():
+    with pytest.raises(InvalidInputError, match="planner must be a trajopt.Planner"):
+        warm_up("planner")
