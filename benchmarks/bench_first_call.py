@@ -42,38 +42,33 @@ state = {"depth": 0, "imports": 0.0, "numba": 0.0, "patched": False}
 real_import = builtins.__import__
 
 
-def patch_numba():
-    caching = sys.modules.get("numba.core.caching")
-    if state["patched"] or caching is None:
-        return
-    state["patched"] = True
-    real_load = caching.Cache.load_overload
+def outermost(fn, key):
+    # fn, whose outermost calls add their wall time to state[key]
 
-    def load_overload(self, *args, **kwargs):
+    def wrapped(*args, **kwargs):
         if state["depth"]:
-            return real_load(self, *args, **kwargs)
+            return fn(*args, **kwargs)
         state["depth"] += 1
         t = time.perf_counter()
         try:
-            return real_load(self, *args, **kwargs)
+            return fn(*args, **kwargs)
         finally:
-            state["numba"] += time.perf_counter() - t
+            state[key] += time.perf_counter() - t
             state["depth"] -= 1
+            if key == "imports":
+                patch_numba()
 
-    caching.Cache.load_overload = load_overload
+    return wrapped
 
 
-def timed_import(name, *args, **kwargs):
-    if state["depth"]:
-        return real_import(name, *args, **kwargs)
-    state["depth"] += 1
-    t = time.perf_counter()
-    try:
-        return real_import(name, *args, **kwargs)
-    finally:
-        state["imports"] += time.perf_counter() - t
-        state["depth"] -= 1
-        patch_numba()
+def patch_numba():
+    caching = sys.modules.get("numba.core.caching")
+    if not state["patched"] and caching is not None:
+        state["patched"] = True
+        caching.Cache.load_overload = outermost(caching.Cache.load_overload, "numba")
+
+
+timed_import = outermost(real_import, "imports")
 
 
 t_warm = trajopt.warm_up() if WARM else 0.0
