@@ -89,12 +89,17 @@ class ParametricCurve(ABC):
         uu = np.asarray(u, dtype=float)
         d = self(uu, 1)
         theta = np.arctan2(d[..., 1], d[..., 0])
-        still = np.hypot(d[..., 0], d[..., 1]) <= STILL_SPEED_RATIO * self._mean_speed()
+        still = np.hypot(d[..., 0], d[..., 1]) <= STILL_SPEED_RATIO * self.mean_speed()
         if np.any(still):
             theta = np.where(still, self._limit_heading(uu, theta), theta)
         return theta
 
-    def _mean_speed(self) -> float:
+    def mean_speed(self) -> float:
+        """Return the mean parametric speed ``length / (u1 - u0)`` (m per unit of ``u``; 0 for an empty domain).
+
+        A tangent shorter than ``STILL_SPEED_RATIO`` times it counts as zero speed (where
+        :meth:`heading` takes the limit direction).
+        """
         lo, hi = self.domain
         return self.length / (hi - lo) if hi > lo else 0.0
 
@@ -103,7 +108,7 @@ class ParametricCurve(ABC):
         lo, hi = self.domain
         uu = np.clip(u, lo, hi)
         span = hi - lo
-        floor = STILL_SPEED_RATIO * self._mean_speed()
+        floor = STILL_SPEED_RATIO * self.mean_speed()
         out = np.array(theta, dtype=float, copy=True)
         todo = np.ones(uu.shape, dtype=bool)
         for k in range(2, 7):

@@ -62,6 +62,8 @@ def test_arc_length_curvature_heading():
     samples = arc.sample(50)
     np.testing.assert_allclose(samples.heading, samples.u + np.pi / 2, atol=1e-9)
     np.testing.assert_allclose(samples.s, samples.u * 1.7, atol=1e-9)
+    assert arc.mean_speed() == pytest.approx(1.7, rel=1e-12)  # |c'(u)| = r everywhere
+    assert Parabola().mean_speed() == pytest.approx(_parabola_length(1.0), rel=1e-9)
 
 
 @settings(max_examples=50, deadline=None)

@@ -215,7 +215,7 @@ def _curvature_heading(curve: ParametricCurve, u: np.ndarray) -> tuple[np.ndarra
         d1 = np.asarray(curve(u, 1), dtype=float)
         kappa = signed_curvature(d1, np.asarray(curve(u, 2), dtype=float))
         theta = np.arctan2(d1[:, 1], d1[:, 0])
-        still = np.hypot(d1[:, 0], d1[:, 1]) <= STILL_SPEED_RATIO * curve._mean_speed()
+        still = np.hypot(d1[:, 0], d1[:, 1]) <= STILL_SPEED_RATIO * curve.mean_speed()
         if np.any(still):  # zero parametric speed: the limit of the tangent direction
             theta[still] = curve.heading(u[still])
         return kappa, theta
