@@ -8,7 +8,8 @@ fill it). The scene (its grid, which needs numpy) is built before the clock star
   counted once at the outermost ``import`` statement;
 * ``numba cache``: loading compiled kernels from numba's disk cache, with the modules
   numba imports for itself while it loads them (its typing and lowering registries);
-* ``solver build``: the smoother's first CasADi/piqp solver build (its own stat);
+* ``solver build``: the smoother's CasADi solver builds (its own stat; 0 on the default
+  path, whose QPs go to piqp directly and build no CasADi solver);
 * ``rest``: everything else (search, corridor, QP solves, timing).
 
 The second plan in the same process (SP -> B) shows the warm latency. Reported: the
