@@ -89,13 +89,12 @@ class BSplineCurve(ParametricCurve):
 
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
         """Position or ``nu``-th derivative at ``u``; shape ``u.shape + (2,)``."""
-        lo, hi = self.domain
-        uu = np.clip(np.asarray(u, dtype=float), lo, hi)
+        uu = np.asarray(u, dtype=np.float64)
         if nu > self.k:
             return np.zeros(uu.shape + (2,))
-        t, c = self._derivative_coefficients(nu)
-        flat = uu.reshape(-1)
-        return de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
+        t, c = self._derivative_coefficients(nu)  # float64, contiguous
+        flat = np.ascontiguousarray(uu.reshape(-1))
+        return _de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
         """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
@@ -127,7 +126,7 @@ class BSplineCurve(ParametricCurve):
 
 
 def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:
-    """Evaluate the spline ``(t, c, k)`` at parameters inside its domain (de Boor's algorithm).
+    """Evaluate the spline ``(t, c, k)`` with de Boor's algorithm.
 
     Parameters
     ----------
@@ -138,11 +137,13 @@ def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:
     k : int
         Degree (>= 0).
     u : ndarray, shape (m,)
-        Parameters in ``[t[k], t[n]]``; the last span is closed on the right.
+        Parameters; those outside the domain ``[t[k], t[n]]`` are clamped to it (the last
+        span is closed on the right).
 
     Returns
     -------
     ndarray, shape (m, d)
+        NaN rows where ``u`` is NaN.
     """
     return _de_boor(
         np.ascontiguousarray(t, dtype=np.float64),
@@ -157,8 +158,14 @@ def _de_boor(t, c, k, u):  # pragma: no cover - compiled
     n, dim = c.shape
     out = np.empty((u.shape[0], dim))
     d = np.empty((k + 1, dim))
+    lo = t[k]
+    hi = t[n]
     for q in range(u.shape[0]):
         x = u[q]
+        if not x == x:
+            out[q, :] = np.nan
+            continue
+        x = min(max(x, lo), hi)
         j = np.searchsorted(t, x, side="right") - 1
         j = min(max(j, k), n - 1)
         for i in range(k + 1):

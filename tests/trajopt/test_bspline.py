@@ -41,6 +41,10 @@ def test_de_boor_matches_scipy_with_repeated_knots(k):
         ref = BSpline(t, c.c, k).derivative(nu)
         np.testing.assert_allclose(c.derivative(nu)(u), ref(u), rtol=1e-12, atol=1e-10)
     assert c(1.0).shape == (2,) and c(np.ones((3, 4)), 1).shape == (3, 4, 2)
+    outside = np.array([-5.0, 0.29, 2.01, 7.0])  # clamped to the domain, as np.clip would
+    ref = np.stack([BSpline(t, c.c[:, a], k)(np.clip(outside, 0.3, 2.0)) for a in range(2)], 1)
+    np.testing.assert_allclose(c(outside), ref, rtol=1e-12, atol=1e-12)
+    assert np.all(np.isnan(c(np.array([np.nan]), 1)))
 
 
 def test_clamped_endpoints_and_derivative():
