@@ -97,8 +97,9 @@ def warm_up(planner: Planner | None = None) -> float:
     grid, start, goal = warm_up_map(planner)
     search_map: OccupancyGrid | object = grid
     if planner.costmap is not None:
-        values = np.where(grid.occupied, 254, 0).astype(np.uint8)
+        values = np.zeros(grid.occupied.shape, dtype=np.uint8)
         values[:, : WARM_UP_CELLS // 4] = 100  # a graded band for the costmap's cost term
+        values[grid.occupied] = 254  # lethal
         search_map = from_costmap(values, grid.resolution, grid.origin, convention="costmap_2d")
     copy = Planner(
         search_map,

@@ -65,15 +65,28 @@ def test_warm_up_map_leaves_room_for_the_robot(kind):
     assert grid.occupied[:, grid.occupied.shape[1] // 2].any()  # a wall between them
 
 
-def test_first_plan_after_warm_up_loads_no_kernel():
-    # a fresh process: after warm_up(), planning the paper scene loads or compiles no numba
-    # kernel (counted at numba's own cache and dispatcher entry points)
+@pytest.mark.parametrize("kind", ["disc", "costmap", "rectangle"])
+def test_first_plans_after_warm_up_load_no_kernel(kind):
+    # a fresh process: after warm_up(planner), the paper scene's four queries load or compile
+    # no numba kernel (counted at numba's own cache and dispatcher entry points)
     script = textwrap.dedent(
         """
+        import sys
+        import numpy as np
         import numba.core.caching as caching
         from numba.core.dispatcher import Dispatcher
-        import trajopt
-        trajopt.warm_up()
+        import astar, trajopt
+        kind = sys.argv[1]
+        scene = trajopt.scenes.paper()
+        grid, robot = scene.grid, trajopt.Robot(radius=scene.robot_radius)
+        if kind == "costmap":
+            values = np.where(grid.occupied, 254, 0).astype(np.uint8)
+            grid = astar.from_costmap(values, grid.resolution, grid.origin,
+                                      convention="costmap_2d")
+        elif kind == "rectangle":
+            robot = trajopt.Robot.rectangle(2.2 * scene.robot_radius, 1.4 * scene.robot_radius)
+        planner = trajopt.Planner(grid, robot)
+        trajopt.warm_up(planner)
         events = []
         load, compile_ = caching.Cache.load_overload, Dispatcher.compile
         def counting_load(self, *a, **k):
@@ -87,15 +100,16 @@ def test_first_plan_after_warm_up_loads_no_kernel():
             return out
         caching.Cache.load_overload = counting_load
         Dispatcher.compile = counting_compile
-        scene = trajopt.scenes.paper()
         for name in scene.target_names:
-            trajopt.plan(scene.grid, scene.start, scene.goal(name),
-                         robot=trajopt.Robot(radius=scene.robot_radius))
+            planner.plan(scene.start, scene.goal(name))
         print("EVENTS", events)
         """
     )
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
-    assert "EVENTS []" in out.stdout, out.stdout + out.stderr
+    out = subprocess.run(
+        [sys.executable, "-c", script, kind], capture_output=True, text=True, check=False
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "EVENTS []" in out.stdout, out.stdout + out.stderr[-2000:]
 
 
 def test_warm_up_rejects_a_non_planner():
