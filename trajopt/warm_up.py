@@ -12,7 +12,9 @@ the corridor, the smoother and the timing all run) with the planner's own settin
 robot (or footprint), search mode, corridor kind, smoother options, timing step and
 fallback, so the kernels loaded are the ones its queries use. The map and its
 resolution are scaled to the robot, so the warm-up takes the same short time for any
-robot size.
+robot size. Two paths stay cold: the stop-and-turn fallback, which only a failed smoother
+or timing runs, loads its kernels the first time it is used; and speed-limit zones are not
+copied (their lookup is plain NumPy).
 """
 
 from __future__ import annotations
