@@ -13,7 +13,7 @@ robot (or footprint), search mode, corridor kind, smoother options, timing step 
 fallback, so the kernels loaded are the ones its queries use. The map and its
 resolution are scaled to the robot, so the warm-up takes the same short time for any
 robot size. Two paths stay cold: the stop-and-turn fallback, which only a failed smoother
-or timing runs, loads its kernels the first time it is used; and speed-limit zones are not
+or timing runs, may load kernels of its own the first time it is used; and speed-limit zones are not
 copied (their lookup is plain NumPy).
 """
 
