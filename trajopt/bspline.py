@@ -107,11 +107,7 @@ class BSplineCurve(ParametricCurve):
         """Knots and control points of the ``nu``-th derivative (cached)."""
         if nu not in self._derivatives:
             t, c = self._derivative_coefficients(nu - 1)
-            p = self.k - nu + 1
-            dt = t[p + 1 : -1] - t[1 : -p - 1]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                scale = np.where(dt > 0, p / dt, 0.0)
-            self._derivatives[nu] = (t[1:-1], scale[:, None] * np.diff(c, axis=0))
+            self._derivatives[nu] = derivative_control_points(t, c, self.k - nu + 1)
         return self._derivatives[nu]
 
     def span_of(self, u: np.ndarray | float) -> np.ndarray:
@@ -123,6 +119,33 @@ class BSplineCurve(ParametricCurve):
 
     def __repr__(self) -> str:
         return f"BSplineCurve(k={self.k}, n={self.c.shape[0]}, domain={self.domain})"
+
+
+def derivative_control_points(t: np.ndarray, c: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Return the knots and control points of the derivative of the spline ``(t, c, k)``.
+
+    The derivative is a B-spline of degree ``k - 1`` on the knots ``t[1:-1]`` with control
+    points ``Q_i = k (c_{i+1} - c_i) / (t_{i+k+1} - t_{i+1})`` (``0`` where that knot
+    interval is empty).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n + k + 1,)
+    c : ndarray, shape (n, d)
+    k : int
+        Degree (>= 1).
+
+    Returns
+    -------
+    knots : ndarray, shape (n + k - 1,)
+    control_points : ndarray, shape (n - 1, d)
+    """
+    n = len(c)
+    den = t[k + 1 : n + k] - t[1:n]
+    q = np.zeros((n - 1, c.shape[1]))
+    ok = den > 0
+    q[ok] = k * np.diff(c, axis=0)[ok] / den[ok, None]
+    return t[1:-1], q
 
 
 def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:

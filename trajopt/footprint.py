@@ -22,8 +22,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from trajopt.bspline import derivative_control_points
+from trajopt.convex_hull import convex_hull
 from trajopt.errors import InvalidInputError
 from trajopt.validation import positive, short_repr
 
@@ -198,48 +199,11 @@ def span_heading_intervals(knots: np.ndarray, control_points: np.ndarray, degree
     c = np.asarray(control_points, dtype=float)
     p = int(degree)
     n = len(c)
-    den = t[p + 1 : n + p] - t[1:n]
-    q = np.zeros((n - 1, 2))
-    ok = den > 0
-    q[ok] = p * np.diff(c, axis=0)[ok] / den[ok, None]
+    q = derivative_control_points(t, c, p)[1]
     out = np.empty((n - p, 2))
     for j in range(n - p):
         out[j] = _cone(q[j : j + p])
     return out
-
-
-def convex_hull(points: np.ndarray) -> np.ndarray:
-    """Return the convex hull of ``points`` (shape (m, 2)), counter-clockwise."""
-    p = np.unique(np.asarray(points, dtype=float).reshape(-1, 2), axis=0)  # sorted by x, y
-    if len(p) <= 2:
-        return p
-    return p[_monotone_chain(np.ascontiguousarray(p))]
-
-
-@njit(cache=True)
-def _monotone_chain(p):  # pragma: no cover - compiled
-    """Hull vertex indices of points sorted by ``(x, y)``, counter-clockwise."""
-    n = p.shape[0]
-    h = np.empty(2 * n, dtype=np.int64)
-    k = 0
-    for i in range(n):
-        while k >= 2 and (
-            (p[h[k - 1], 0] - p[h[k - 2], 0]) * (p[i, 1] - p[h[k - 2], 1])
-            - (p[h[k - 1], 1] - p[h[k - 2], 1]) * (p[i, 0] - p[h[k - 2], 0])
-        ) <= 0.0:
-            k -= 1
-        h[k] = i
-        k += 1
-    lo = k + 1
-    for i in range(n - 2, -1, -1):
-        while k >= lo and (
-            (p[h[k - 1], 0] - p[h[k - 2], 0]) * (p[i, 1] - p[h[k - 2], 1])
-            - (p[h[k - 1], 1] - p[h[k - 2], 1]) * (p[i, 0] - p[h[k - 2], 0])
-        ) <= 0.0:
-            k -= 1
-        h[k] = i
-        k += 1
-    return h[: k - 1]
 
 
 def minkowski_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -11,6 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
+from trajopt.convex_hull import monotone_chain
 from trajopt.polygon_corridor.obstacle_index import point_nearest, poly_clearance, seg_clearance
 
 __all__ = [
@@ -44,32 +45,15 @@ def hull4(pts, n, out):  # pragma: no cover - compiled
             j -= 1
         p[j + 1, 0] = x
         p[j + 1, 1] = y
-    h = np.empty((2 * n + 1, 2))
-    k = 0
-    for i in range(n):
-        while k >= 2 and (
-            (h[k - 1, 0] - h[k - 2, 0]) * (p[i, 1] - h[k - 2, 1])
-            - (h[k - 1, 1] - h[k - 2, 1]) * (p[i, 0] - h[k - 2, 0])
-        ) <= 1e-12:
-            k -= 1
-        h[k] = p[i]
-        k += 1
-    lo = k + 1
-    for i in range(n - 2, -1, -1):
-        while k >= lo and (
-            (h[k - 1, 0] - h[k - 2, 0]) * (p[i, 1] - h[k - 2, 1])
-            - (h[k - 1, 1] - h[k - 2, 1]) * (p[i, 0] - h[k - 2, 0])
-        ) <= 1e-12:
-            k -= 1
-        h[k] = p[i]
-        k += 1
+    idx, k = monotone_chain(p, n, 1e-12)
     k -= 1  # the last point repeats the first
     # drop duplicates (a point or a segment)
     m = 0
     for i in range(max(k, 1)):
-        if m > 0 and abs(h[i, 0] - out[m - 1, 0]) <= 1e-12 and abs(h[i, 1] - out[m - 1, 1]) <= 1e-12:
+        q = p[idx[i]]
+        if m > 0 and abs(q[0] - out[m - 1, 0]) <= 1e-12 and abs(q[1] - out[m - 1, 1]) <= 1e-12:
             continue
-        out[m] = h[i]
+        out[m] = q
         m += 1
     if m > 1 and abs(out[m - 1, 0] - out[0, 0]) <= 1e-12 and abs(out[m - 1, 1] - out[0, 1]) <= 1e-12:
         m -= 1
