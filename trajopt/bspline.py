@@ -94,7 +94,7 @@ class BSplineCurve(ParametricCurve):
             return np.zeros(uu.shape + (2,))
         t, c = self._derivative_coefficients(nu)  # float64, contiguous
         flat = np.ascontiguousarray(uu.reshape(-1))
-        return _de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
+        return de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
         """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
@@ -148,13 +148,14 @@ def derivative_control_points(t: np.ndarray, c: np.ndarray, k: int) -> tuple[np.
     return t[1:-1], q
 
 
-def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:
+@njit(cache=True)
+def de_boor(t, c, k, u):  # pragma: no cover - compiled
     """Evaluate the spline ``(t, c, k)`` with de Boor's algorithm.
 
     Parameters
     ----------
-    t : ndarray, shape (n + k + 1,)
-        Non-decreasing knots.
+    t : ndarray of float64, shape (n + k + 1,)
+        Non-decreasing knots (contiguous, as every array here: the function is compiled).
     c : ndarray, shape (n, d)
         Control points.
     k : int
@@ -168,16 +169,6 @@ def de_boor(t: np.ndarray, c: np.ndarray, k: int, u: np.ndarray) -> np.ndarray:
     ndarray, shape (m, d)
         NaN rows where ``u`` is NaN.
     """
-    return _de_boor(
-        np.ascontiguousarray(t, dtype=np.float64),
-        np.ascontiguousarray(c, dtype=np.float64),
-        int(k),
-        np.ascontiguousarray(u, dtype=np.float64),
-    )
-
-
-@njit(cache=True)
-def _de_boor(t, c, k, u):  # pragma: no cover - compiled
     n, dim = c.shape
     out = np.empty((u.shape[0], dim))
     d = np.empty((k + 1, dim))
