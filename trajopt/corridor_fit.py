@@ -76,7 +76,8 @@ def fit_in_corridor(
                 smooth = sm.fit(path, corridor, raw_grid=planner.grid,
                                 radius=planner.robot.radius, start=q.start, goal=q.goal,
                                 start_heading=q.start_heading, goal_heading=q.goal_heading,
-                                start_curvature=q.start_curvature)  # fmt: skip
+                                start_curvature=q.start_curvature,
+                                footprint=planner.smoothing_footprint)  # fmt: skip
             return corridor, smooth
         except SmoothingError as exc:
             spent += time.perf_counter() - t_fit

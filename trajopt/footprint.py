@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from trajopt import footprint_kernels
 from trajopt.bspline import derivative_control_points
 from trajopt.convex_hull import convex_hull
 from trajopt.errors import InvalidInputError
@@ -38,7 +39,7 @@ __all__ = [
     "span_heading_intervals",
 ]
 
-_MAX_ARC = math.pi / 4  # arc pieces of at most 45 degrees: apex at 1 / cos(22.5 deg) = 1.082 r
+MAX_ARC_RAD = math.pi / 4  # arc pieces of at most 45 degrees: apex at 1 / cos(22.5 deg) = 1.082 r
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,12 @@ class Footprint:
         """Smallest disc about the rotation centre containing the footprint (m)."""
         return float(np.max(np.hypot(self.vertices[:, 0], self.vertices[:, 1])))
 
+    @property
+    def polar(self) -> tuple[np.ndarray, np.ndarray]:
+        """The vertices in polar form: distances (m) and angles (rad), shape (k,) each."""
+        v = self.vertices
+        return np.hypot(v[:, 0], v[:, 1]), np.arctan2(v[:, 1], v[:, 0])
+
     def at(self, x: float, y: float, theta: float) -> np.ndarray:
         """Return the corners in the world at pose ``(x, y, theta)``, shape (k, 2) (m)."""
         c, s = math.cos(theta), math.sin(theta)
@@ -151,24 +158,8 @@ class Footprint:
             raise InvalidInputError(
                 f"need finite theta_lo <= theta_hi (rad), got {theta_lo!r}, {theta_hi!r}"
             )
-        span = min(hi - lo, 2 * math.pi)
-        n = max(1, math.ceil(span / _MAX_ARC - 1e-12))
-        step = span / n
-        ang = lo + step * np.arange(n + 1)
-        mid = lo + step * (np.arange(n) + 0.5)
-        grow = 1.0 / math.cos(0.5 * step) if n > 0 and step > 0 else 1.0
-        rho = np.hypot(self.vertices[:, 0], self.vertices[:, 1])
-        phi = np.arctan2(self.vertices[:, 1], self.vertices[:, 0])
-        pts = [
-            np.column_stack([np.cos(phi[i] + ang), np.sin(phi[i] + ang)]) * rho[i]
-            for i in range(len(rho))
-        ]
-        if step > 0:  # the tangent intersections between consecutive arc points
-            pts += [
-                np.column_stack([np.cos(phi[i] + mid), np.sin(phi[i] + mid)]) * rho[i] * grow
-                for i in range(len(rho))
-            ]
-        return convex_hull(np.vstack(pts))
+        rho, phi = self.polar
+        return footprint_kernels.swept_hull(rho, phi, lo, hi, MAX_ARC_RAD)
 
     def to_list(self) -> list[list[float]]:
         """Return the vertices as a list of ``[x, y]`` (m)."""
@@ -202,7 +193,7 @@ def span_heading_intervals(knots: np.ndarray, control_points: np.ndarray, degree
     q = derivative_control_points(t, c, p)[1]
     out = np.empty((n - p, 2))
     for j in range(n - p):
-        out[j] = _cone(q[j : j + p])
+        out[j] = footprint_kernels.cone(np.ascontiguousarray(q[j : j + p]))
     return out
 
 
@@ -289,14 +280,14 @@ def certify_footprint(curve: Any, footprint: Footprint, raw_grid: Any, *,
         its whole hodograph.
     """
     from trajopt.clearance import grid_cells
-    from trajopt.polygon_corridor.obstacle_index import ObstacleIndex, poly_clearance
+    from trajopt.polygon_corridor.obstacle_index import ObstacleIndex
 
     spline = getattr(curve, "curve", curve)
     pieces = _bezier_spans(spline)
     occ, res, ox, oy = grid_cells(raw_grid)
     origin = np.array([ox, oy])
     cap = footprint.circumscribed_radius / res + 2.0  # beyond it the exact value is moot
-    allp = np.vstack(pieces) if pieces else np.zeros((1, 2))
+    allp = pieces.reshape(-1, 2) if len(pieces) else np.zeros((1, 2))
     reach = int(math.ceil(cap + footprint.circumscribed_radius / res)) + 2
     q = (allp - origin) / res
     idx = ObstacleIndex(
@@ -307,30 +298,13 @@ def certify_footprint(curve: Any, footprint: Footprint, raw_grid: Any, *,
         int(math.ceil(q[:, 1].max())) + reach,
     )
 
-    def margin(bez: np.ndarray) -> float:
-        lo, hi = _cone(np.diff(bez, axis=0))
-        poly = (minkowski_sum(bez, footprint.swept_hull(lo, hi)) - origin) / res
-        v = np.ascontiguousarray(poly)
-        return float(poly_clearance(v, len(v), cap, *idx.args)) * res
-
-    margins = np.empty(len(pieces))
-    heads = np.empty((len(pieces), 2))
-    for j, bez in enumerate(pieces):
-        heads[j] = _cone(np.diff(bez, axis=0))
-        todo = [bez]
-        worst = math.inf
-        for depth in range(max_depth + 1):
-            nxt = []
-            for b in todo:
-                m = margin(b)
-                if m > tol_m or depth == max_depth:
-                    worst = min(worst, m)
-                else:
-                    nxt.extend(_split(b))
-            todo = nxt
-            if not todo:
-                break
-        margins[j] = worst
+    rho, phi = footprint.polar
+    bez = (pieces - origin) / res
+    m_cells, heads = footprint_kernels.span_margins(
+        np.ascontiguousarray(bez), rho / res, phi, MAX_ARC_RAD, cap, tol_m / res, int(max_depth),
+        *idx.args,
+    )
+    margins = m_cells * res
     worst_span = int(np.argmin(margins)) if margins.size else 0
     return FootprintCertificate(
         ok=bool(np.all(margins > tol_m)),
@@ -383,53 +357,21 @@ def polygons_clearance(polygons: list[np.ndarray], raw_grid: Any, cap_m: float) 
     return out
 
 
-def _bezier_spans(spline: Any) -> list[np.ndarray]:
-    """Return the Bezier control points (shape (p + 1, 2)) of each polynomial piece.
+def _bezier_spans(spline: Any) -> np.ndarray:
+    """Return the Bezier control points of each polynomial piece, shape (m, p + 1, 2).
 
-    From the derivatives at the piece's start: the power-basis coefficients
+    From the derivatives at the pieces' starts: the power-basis coefficients
     ``f^(j)(a) (b - a)^j / j!`` give ``b_i = sum_{j <= i} C(i, j) / C(p, j) coef_j``.
     """
     p = int(getattr(spline, "k", getattr(spline, "degree", 3)))
     lo, hi = (float(x) for x in spline.domain)
     bp = np.asarray(spline.breakpoints(), dtype=float)
     w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
-    out = []
-    for a, b in zip(w[:-1], w[1:], strict=True):
-        if b <= a:
-            continue
-        der = np.array([np.asarray(spline(np.array([a]), nu), dtype=float)[0] for nu in range(p + 1)])
-        coef = np.array([der[j] * (b - a) ** j / math.factorial(j) for j in range(p + 1)])
-        bez = np.zeros((p + 1, 2))
-        for i in range(p + 1):
-            for j in range(i + 1):
-                bez[i] += math.comb(i, j) / math.comb(p, j) * coef[j]
-        out.append(bez)
-    return out
-
-
-def _split(bez: np.ndarray) -> list[np.ndarray]:
-    """Return the two halves of a Bezier piece (de Casteljau at 1/2)."""
-    left, right = [bez[0]], [bez[-1]]
-    cur = bez
-    while len(cur) > 1:
-        cur = 0.5 * (cur[:-1] + cur[1:])
-        left.append(cur[0])
-        right.append(cur[-1])
-    return [np.array(left), np.array(right[::-1])]
-
-
-def _cone(d: np.ndarray) -> tuple[float, float]:
-    """Return the heading interval (rad) spanned by the direction vectors ``d``.
-
-    The whole circle when they do not fit in an open half-plane, or all vanish.
-    """
-    d = d[np.hypot(d[:, 0], d[:, 1]) > 1e-15]
-    if len(d) == 0:
-        return (-math.pi, math.pi)
-    ang = np.arctan2(d[:, 1], d[:, 0])
-    ref = float(ang[0])
-    rel = np.remainder(ang - ref + math.pi, 2 * math.pi) - math.pi
-    lo, hi = float(rel.min()), float(rel.max())
-    if hi - lo >= math.pi - 1e-12:
-        return (ref - math.pi, ref + math.pi)
-    return (ref + lo, ref + hi)
+    a, h = w[:-1], np.diff(w)
+    a, h = a[h > 0], h[h > 0]
+    coef = np.stack([np.asarray(spline(a, j), dtype=float).reshape(len(a), 2)
+                     * (h ** j / math.factorial(j))[:, None] for j in range(p + 1)],
+                    axis=1)  # fmt: skip
+    mix = np.array([[math.comb(i, j) / math.comb(p, j) if j <= i else 0.0
+                     for j in range(p + 1)] for i in range(p + 1)])  # fmt: skip
+    return np.einsum("ij,mjd->mid", mix, coef)

@@ -31,6 +31,7 @@ it turns in place, where only the circumscribed disc is free in every heading.
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from typing import Any
 
@@ -60,7 +61,7 @@ def _new_disc(planner: Any, radius: float) -> Any:
                  a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
                  wheel_v_max=r.wheel_v_max)  # fmt: skip
     last = radius >= r.circumscribed_radius * (1 - 1e-9)
-    return Planner(
+    disc_model = Planner(
         planner.costmap if planner.costmap is not None else planner.grid,
         disc,
         inflation=planner.inflation,
@@ -73,6 +74,8 @@ def _new_disc(planner: Any, radius: float) -> Any:
         costmap_weight=planner.costmap_weight,
         speed_limits=planner.speed_limits,
     )
+    disc_model.smoothing_footprint = r.footprint
+    return disc_model
 
 
 def disc_planner(planner: Any, radius: float) -> Any:
@@ -159,6 +162,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
     """
     robot = planner.robot
     fp = robot.footprint
+    check_end_poses(planner, start, goal, kwargs.get("start_heading"), kwargs.get("goal_heading"))
     ladder = radius_ladder(fp.inscribed_radius, fp.circumscribed_radius)
     failures: list[str] = []
     errors: list[Exception] = []
@@ -177,7 +181,13 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
-        except (NoPathError, SmoothingError, TimingError) as exc:
+        except NoPathError as exc:
+            if i == 0:  # no path for the inscribed disc: none for any footprint pose either
+                raise NoPathError(f"no path for the footprint's inscribed disc: {exc}") from None
+            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
+            errors.append(exc)
+            continue
+        except (SmoothingError, TimingError) as exc:
             failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
@@ -185,9 +195,13 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
         if isinstance(traj, StopAndTurnTrajectory):
             cert = None  # only on the circumscribed rung: its disc holds every heading
         else:
-            t_cert = time.perf_counter()
-            cert = certify_footprint(traj.path, fp, planner.grid)
-            cert_s = time.perf_counter() - t_cert
+            cert = getattr(traj.path, "footprint_certificate", None)  # the smoother's
+            smoother_stats = getattr(traj.path, "stats", {})
+            cert_s = smoother_stats.get("footprint_certificate_s", 0.0)
+            if cert is None:  # a box corridor's fit, or a curve from elsewhere
+                t_cert = time.perf_counter()
+                cert = certify_footprint(traj.path, fp, planner.grid)
+                cert_s = time.perf_counter() - t_cert
             if not cert.ok:
                 failures.append(
                     f"{_label(r, make)}: footprint certificate failed at span "
@@ -203,6 +217,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             "min_margin_m": None if cert is None else cert.min_margin_m,
             "spans": None if cert is None else int(cert.margins_m.size),
             "certificate_s": cert_s,
+            "rounds": 0 if cert is None else int(smoother_stats.get("footprint_rounds", 0)),
         }
         return dataclasses.replace(traj, robot=robot, stats=stats)
     if errors and all(isinstance(e, NoPathError) for e in errors):
@@ -215,6 +230,48 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
     raise SmoothingError(
         "no footprint-certified trajectory: " + "; ".join(failures), stats
     )
+
+
+def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | None,
+                    goal_heading: float | None) -> None:  # fmt: skip
+    """Raise when the footprint cannot stand at the start or the goal.
+
+    With a heading (given, or a :class:`~trajopt.state.State`'s ``theta``) the footprint at
+    that pose must be clear of the raw map; without one, at least one of
+    :data:`~trajopt.smoother.footprint_rounds.END_HEADINGS` sampled headings must be.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the end, its position and heading (or the sampled headings), and the
+        clearance found.
+    """
+    from trajopt.footprint import polygons_clearance
+    from trajopt.smoother.footprint_rounds import END_HEADINGS, clear_headings
+
+    fp, raw = planner.robot.footprint, planner.grid
+    for name, end, heading in (("start", start, start_heading), ("goal", goal, goal_heading)):
+        theta = getattr(end, "theta", None) if heading is None else heading
+        xy = np.array([getattr(end, "x", None), getattr(end, "y", None)], dtype=float)
+        if not np.all(np.isfinite(xy)):
+            try:
+                xy = np.asarray(end, dtype=float).reshape(2)
+            except (TypeError, ValueError):
+                return  # malformed: the disc planner's validation names it
+        if not np.all(np.isfinite(xy)):
+            return
+        if theta is not None and math.isfinite(float(theta)):
+            clr = float(polygons_clearance([fp.at(*xy, float(theta))], raw, raw.resolution)[0])
+            if clr <= 0.0:
+                raise InvalidInputError(
+                    f"{name} pose ({xy[0]:.4g}, {xy[1]:.4g}) m, heading {float(theta):.4g} rad: "
+                    "the footprint meets an obstacle or the map edge there (clearance 0 m)"
+                )
+        elif len(clear_headings(fp, raw, xy, 0.0)) == 0:
+            raise InvalidInputError(
+                f"{name} ({xy[0]:.4g}, {xy[1]:.4g}) m: the footprint meets an obstacle or the "
+                f"map edge at each of {END_HEADINGS} sampled headings; it cannot stand there"
+            )
 
 
 def _label(radius: float, make: Any) -> str:

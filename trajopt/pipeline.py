@@ -236,6 +236,8 @@ class Planner:
         #: optional ``(planner, query) -> (grid path, inflated grid)`` run after the search
         #: (a footprint robot's oriented check of the grid path)
         self.path_check: Any = None
+        #: a footprint robot's disc model: the footprint its smoother must also certify
+        self.smoothing_footprint: Any = None
 
     # -------------------------------------------------------------- caches
     @property

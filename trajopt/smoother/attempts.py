@@ -5,11 +5,15 @@ the SCP or IPOPT), puts the end control points exactly on their heading rays, an
 the curve with :func:`~trajopt.smoother.certificate.certify`. A failed certificate halves
 ``h`` (at most ``max_attempts`` knot vectors); when only the curvature bound broke, between
 the samples and by at most ``retry_max_excess``, the same knots are solved once more, warm
-started, with the sampled bound tightened by the excess found.
+started, with the sampled bound tightened by the excess found. With a robot footprint the
+curve must also pass :func:`~trajopt.footprint.certify_footprint`; when only that fails, an
+end heading may be pinned or the same knots solved again by the footprint SCP
+(:mod:`~trajopt.smoother.footprint_rounds`) before refining.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -20,9 +24,11 @@ import numpy as np
 from trajopt.bspline import BSplineCurve
 from trajopt.corridor import Corridor
 from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.footprint import Footprint
 from trajopt.polygon_corridor import PolygonCorridor
 from trajopt.smoother.basis import band_quadratic, bucket_size
 from trajopt.smoother.certificate import certify
+from trajopt.smoother.footprint_rounds import FootprintRounds, footprint_scp
 from trajopt.smoother.nlp import solve_curvature_ipopt
 from trajopt.smoother.path import SmoothPath
 from trajopt.smoother.problem import (
@@ -70,6 +76,7 @@ def fit(
     start_heading: float | None = None,
     goal_heading: float | None = None,
     start_curvature: float | None = None,
+    footprint: Footprint | None = None,
 ) -> SmoothPath:
     """:meth:`Smoother.fit` (see there)."""
     warm_imports()  # one-off module imports do not count against the time budget
@@ -85,12 +92,15 @@ def fit(
             "PolygonCorridor is solved by piqp or osqp (and the SCP)"
         )
     res = corridor.resolution
-    origin = np.asarray(corridor.origin, dtype=float)
     rad = corridor.radius if radius is None else float(radius)
     if radius is not None and not (math.isfinite(rad) and rad >= 0):
         raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
     if raw_grid is not None and rad is None:
         raise InvalidInputError("radius is required (or corridor.radius) with raw_grid")
+    if footprint is not None and not isinstance(footprint, Footprint):
+        raise InvalidInputError(f"footprint must be a Footprint, got {type(footprint).__name__}")
+    if footprint is not None and raw_grid is None:
+        raise InvalidInputError("footprint needs raw_grid (its certificate checks the raw map)")
     hs = heading("start_heading", start_heading)
     hg = heading("goal_heading", goal_heading)
     ks = None
@@ -108,6 +118,7 @@ def fit(
     h = float(options.span_cells)
     margin = options.kappa_margin
     warm = None  # control points (cells) of a retry on the same knots
+    fp = None if footprint is None else FootprintRounds(footprint, raw_grid, res, hs, hg)
     spans_tried = 0
     while spans_tried < int(options.max_attempts):
         remaining = options.time_budget_s - (time.perf_counter() - t_call)
@@ -124,17 +135,40 @@ def fit(
             h, margin, warm = max(0.5, h / 2), options.kappa_margin, None
             spans_tried += 1
             continue
-        c = origin + res * c_cells
-        c[0] = p0
-        c[-1] = p1
-        curve = BSplineCurve(t_cells * res, c, options.degree)
-        cert = certify(curve, corridor, span_box, start=p0, goal=p1, raw_grid=raw_grid,
-                       radius=rad, kappa_bound=options.kappa_max,
-                       samples_per_cell=options.samples_per_cell)  # fmt: skip
+        check = functools.partial(_check, options, corridor, raw_grid, rad, fp, (p0, p1))
+        curve, cert, fcert = check(c_cells, t_cells, span_box)
         rec.certificate_ok = cert.ok
-        if cert.ok:
+        if fcert is not None and not fcert.ok:  # the disc is clear, the footprint is not
+            rec.failure = (f"footprint certificate: span {fcert.worst_span}, margin "
+                           f"{fcert.min_margin_m:.3g} m")  # fmt: skip
+            if fp.pin(fcert, c_cells, (p0, p1)):
+                try:
+                    prob, p0, p1 = build_problem(
+                        options, grid_path_or_points, corridor, start=start, goal=goal,
+                        hs=fp.start_heading, hg=fp.goal_heading, start_kappa=ks,
+                    )  # fmt: skip
+                    margin, warm = options.kappa_margin, None
+                    continue
+                except InvalidInputError as exc:  # the pinned heading leaves its region
+                    logger.debug("footprint: end heading not pinned (%s)", exc)
+                    fp.unpin()
+            if polygons and options.kappa_max is None:
+                found = footprint_scp(options, prob, h, c_cells, fcert, fp, rad / res, check)
+                if found is not None:
+                    curve, cert, fcert = found
+                    rec.failure = None
+        if fcert is not None:
+            rec.footprint_margin_m = fcert.min_margin_m
+        if cert.ok and (fcert is None or fcert.ok):
             stats = summarize(attempts, time.perf_counter() - t_call, success=True)
-            return SmoothPath(curve=curve, stats=stats, certificate=cert)
+            if fp is not None:
+                stats.update(footprint_certificate_s=fp.time_s, footprint_rounds=fp.rounds)
+            return SmoothPath(curve=curve, stats=stats, certificate=cert,
+                              footprint_certificate=fcert)  # fmt: skip
+        if cert.ok:  # the footprint still fails: refine the knots
+            h, margin, warm = max(0.5, h / 2), options.kappa_margin, None
+            spans_tried += 1
+            continue
         rec.failure = "certificate: " + ", ".join(cert.failures)
         logger.debug("attempt %d failed its certificate: %s", len(attempts), cert.failures)
         kmax = options.kappa_max
@@ -163,6 +197,24 @@ def fit(
         f"(time_budget_s={options.time_budget_s}): {last}",
         stats,
     )
+
+
+def _check(options: Any, corridor: Any, raw_grid: Any, radius: float, fp: Any, ends: tuple,
+           c_cells: np.ndarray, t_cells: np.ndarray, span_box: np.ndarray) -> tuple:  # fmt: skip
+    """Return the curve of ``c_cells`` (cells) and its certificates.
+
+    ``(curve, certificate, footprint certificate)``: the last only with a footprint
+    (``fp``, :class:`~trajopt.smoother.footprint_rounds.FootprintRounds`) and when the first
+    passes, else ``None``. ``ends``: the exact end points (m).
+    """
+    res = corridor.resolution
+    c = np.asarray(corridor.origin, dtype=float) + res * c_cells
+    c[0], c[-1] = ends
+    curve = BSplineCurve(t_cells * res, c, options.degree)
+    cert = certify(curve, corridor, span_box, start=ends[0], goal=ends[1], raw_grid=raw_grid,
+                   radius=radius, kappa_bound=options.kappa_max,
+                   samples_per_cell=options.samples_per_cell)  # fmt: skip
+    return curve, cert, (fp.certify(curve) if (cert.ok and fp is not None) else None)
 
 
 def solve_attempt(

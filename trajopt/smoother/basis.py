@@ -20,6 +20,7 @@ __all__ = [
     "basis_derivs",
     "bucket_size",
     "find_spans",
+    "sample_bases",
     "smoothness_band",
 ]
 
@@ -180,13 +181,27 @@ def curvature_samples(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per span.
 
-    Span index and first/second basis derivatives at ``CURV_SAMPLES`` points per span, padded to
-    ``nb - p`` spans.
+    :func:`sample_bases` with orders 1 and 2.
+    """
+    span, (B1, B2) = sample_bases(t, p, n, nb, (1, 2))
+    return span, B1, B2
 
-    A span is sampled at its start and at evenly spaced interior points; its end is the
-    next span's start (``C'`` and ``C''`` are continuous at the simple interior knots, so
-    a sample there would repeat a row). The last span spreads its samples from its start
-    to its end, so the curve's end is sampled too.
+
+def sample_bases(
+    t: np.ndarray, p: int, n: int, nb: int, orders: tuple[int, ...]
+) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Span index and basis derivatives of ``orders`` at ``CURV_SAMPLES`` points per span.
+
+    Padded to ``nb - p`` spans (zero rows). A span is sampled at its start and at evenly
+    spaced interior points; its end is the next span's start (``C``, ``C'`` and ``C''`` are
+    continuous at the simple interior knots, so a sample there would repeat a row). The
+    last span spreads its samples from its start to its end, so the curve's end is sampled
+    too.
+
+    Returns
+    -------
+    span : ndarray of int, shape ((n - p) CURV_SAMPLES,)
+    bases : list of ndarray, shape ((nb - p) CURV_SAMPLES, p + 1) each
     """
     ms = CURV_SAMPLES
     ns = n - p
@@ -197,8 +212,9 @@ def curvature_samples(
     span = np.repeat(np.arange(ns), ms)
     uu = (a[:, None] + (b - a)[:, None] * fr).ravel()
     S = (nb - p) * ms
-    B1 = np.zeros((S, p + 1))
-    B2 = np.zeros((S, p + 1))
-    B1[: ns * ms] = basis_derivs(t, p, span, uu, 1)
-    B2[: ns * ms] = basis_derivs(t, p, span, uu, 2)
-    return span, B1, B2
+    out = []
+    for nu in orders:
+        B = np.zeros((S, p + 1))
+        B[: ns * ms] = basis_derivs(t, p, span, uu, nu)
+        out.append(B)
+    return span, out

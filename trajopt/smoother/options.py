@@ -13,6 +13,7 @@ import numpy as np
 
 from trajopt.bspline import BSplineCurve
 from trajopt.corridor import Corridor
+from trajopt.footprint import Footprint
 from trajopt.polygon_corridor import PolygonCorridor
 from trajopt.smoother.path import SmoothPath
 from trajopt.validation import choice, integer, number
@@ -139,6 +140,7 @@ class Smoother:
         start_heading: float | None = None,
         goal_heading: float | None = None,
         start_curvature: float | None = None,
+        footprint: Footprint | None = None,
     ) -> SmoothPath:
         """Fit a certified smooth path inside ``corridor``.
 
@@ -167,6 +169,13 @@ class Smoother:
             from a moving robot continues its curvature). ``|c_1 - c_0|`` is then fixed
             (module :mod:`trajopt.smoother.problem`, :func:`start_alpha`), which makes the
             curvature linear in ``c_2``.
+        footprint : Footprint, optional
+            The robot's oriented footprint (needs ``raw_grid``): the curve must also pass
+            :func:`~trajopt.footprint.certify_footprint` (the footprint along the tangent,
+            clear of the raw map). A curve that fails it gets the footprint rounds of
+            :mod:`~trajopt.smoother.footprint_rounds` (a pinned end heading; in a polygon
+            corridor without a curvature bound, the footprint SCP); then the knots are
+            refined.
 
         Returns
         -------
@@ -193,6 +202,7 @@ class Smoother:
             start_heading=start_heading,
             goal_heading=goal_heading,
             start_curvature=start_curvature,
+            footprint=footprint,
         )
 
     def fit_free(self, points: np.ndarray, u: np.ndarray, knots: np.ndarray) -> BSplineCurve:

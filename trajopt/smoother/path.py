@@ -31,11 +31,14 @@ class SmoothPath(ParametricCurve):
         ``solve_time_s`` (solver calls), ``build_time_s`` (solvers built in this call),
         ``total_time_s``, ``cost``, ``attempts``, ``n_control_points``, ``padded_size``.
     certificate : Certificate
+    footprint_certificate : FootprintCertificate or None
+        With a robot footprint (:meth:`Smoother.fit`'s ``footprint``): its certificate.
     """
 
     curve: BSplineCurve
     stats: dict[str, Any] = field(default_factory=dict)
     certificate: Certificate | None = None
+    footprint_certificate: Any = None
 
     @property
     def domain(self) -> tuple[float, float]:

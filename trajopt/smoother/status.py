@@ -123,6 +123,7 @@ class AttemptRecord:
     cost: float | None = None
     failure: str | None = None
     certificate_ok: bool | None = None
+    footprint_margin_m: float | None = None
 
     @property
     def last(self) -> SolveInfo | None:
@@ -156,6 +157,8 @@ class AttemptRecord:
             out["failure"] = self.failure
         if self.certificate_ok is not None:
             out["certificate_ok"] = self.certificate_ok
+        if self.footprint_margin_m is not None:
+            out["footprint_margin_m"] = self.footprint_margin_m
         return out
 
 
