@@ -7,8 +7,15 @@ Two parts:
    ``1.6 D x 1.0 D`` and ``2:1`` (``1.6 D x 0.8 D``), rotation centre in the middle. Every
    returned trajectory is checked for collisions by an independent test: points filling
    the footprint at 1500 poses along it, against the occupied squares and the outside of
-   the map. Reported: solved, collisions, the rung of the radius ladder used, the median
-   and p95 of the accepted rung's smoothing stage and of the footprint certificate.
+   the map. Reported: solved, why the others were refused (no path even for the inscribed
+   disc, an end where the footprint stands at no heading, no certified curve), collisions,
+   the rung of the radius ladder used, the share that needed footprint rounds (a pinned
+   end heading or the footprint SCP), and the median and p95 of the accepted rung's
+   smoothing stage (footprint certificates and rounds included) and of its footprint
+   certificates alone. One warm-up plan runs first (compilation is not measured).
+   The same queries are then planned again without the footprint rounds (the smoother
+   only certifies the footprint; the ladder of discs does the rest), as the previous
+   design, and the solved counts and smoothing p95 are printed side by side.
 2. **Doors.** A wall with one door whose width lies between the footprint's width plus two
    cells and its circumscribed diameter (so the circumscribed disc cannot pass), with
    several widths, wall thicknesses and offsets; the query crosses the door. Reported:
@@ -24,6 +31,7 @@ Run from the repository root (the shared maps: ``$TRAJOPT_DATA`` or ``../shared/
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import statistics
@@ -81,12 +89,33 @@ def queries(grid, r_free, n, rng):
     return out
 
 
-def run_maps(args, rng) -> None:
-    print(f"{'map':18s} {'shape':>9s} {'solved':>7s} {'collide':>7s} {'rungs':>9s} "
+@contextlib.contextmanager
+def without_footprint_rounds():
+    """The previous design, for comparison in the same run: the fit only certifies."""
+    import trajopt.smoother.attempts as attempts
+    from trajopt.smoother.footprint_rounds import FootprintRounds
+
+    saved = attempts.footprint_scp, FootprintRounds.pin
+    attempts.footprint_scp = lambda *a, **k: None
+    FootprintRounds.pin = lambda *a, **k: False
+    try:
+        yield
+    finally:
+        attempts.footprint_scp, FootprintRounds.pin = saved
+
+
+def run_maps(args, rng, quiet: bool = False) -> tuple[int, int, list[float]]:
+    """Plan the map queries; return (solved, queries, smoothing times in ms)."""
+    say = (lambda *a, **k: None) if quiet else print
+    say(f"{'map':18s} {'shape':>9s} {'solved':>7s} {'no path':>7s} {'no pose':>7s} "
+          f"{'no curve':>8s} {'collide':>7s} {'rungs':>9s} {'rounds':>6s} "
           f"{'smooth med/p95 ms':>18s} {'cert med/p95 ms':>16s}")  # fmt: skip
     d = data_dir()
     maps = [(n, d / "ros" / f"{n}.yaml", None) for n in ROS]
     maps += [(n, d / "movingai" / "maps" / f"{n}.map", 2.5) for n in MOVINGAI]
+    all_smooth: list[float] = []
+    total_solved = total_queries = 0
+    trajopt.warm_up(trajopt.Planner(astar.load_map(maps[0][1]), trajopt.Robot.rectangle(0.64, 0.4)))
     for name, path, r_cells in maps:
         grid = astar.load_map(path)
         diam = 2 * (0.2 if r_cells is None else r_cells * grid.resolution)
@@ -95,13 +124,21 @@ def run_maps(args, rng) -> None:
             robot = trajopt.Robot.rectangle(ln, wd)
             planner = trajopt.Planner(grid, robot)
             qs = queries(grid, robot.inscribed_radius + grid.resolution, args.per_map, rng)
-            solved = collided = 0
+            solved = collided = with_rounds = 0
+            refused = {"no path": 0, "no pose": 0, "no curve": 0}
             rungs: dict[int, int] = {}
             smooth, cert = [], []
             for p0, p1 in qs:
                 try:
                     traj = planner.plan(p0, p1)
+                except trajopt.NoPathError:
+                    refused["no path"] += 1
+                    continue
+                except trajopt.InvalidInputError:
+                    refused["no pose"] += 1
+                    continue
                 except TrajoptError:
+                    refused["no curve"] += 1
                     continue
                 solved += 1
                 smp = traj.sample(np.linspace(0.0, traj.duration, 1500))
@@ -109,6 +146,7 @@ def run_maps(args, rng) -> None:
                 fst = traj.stats["footprint"]
                 k = fst["ladder_m"].index(fst["disc_radius_m"])
                 rungs[k] = rungs.get(k, 0) + 1
+                with_rounds += fst["rounds"] > 0
                 smooth.append(1e3 * traj.stats["stages_s"].get("smooth", float("nan")))
                 cert.append(1e3 * fst["certificate_s"])
 
@@ -116,8 +154,17 @@ def run_maps(args, rng) -> None:
                 return (f"{statistics.median(v):.1f}/{np.percentile(v, 95):.1f}" if v else "-")
 
             rung_s = ",".join(f"{rungs.get(i, 0)}" for i in range(3))
-            print(f"{name:18s} {shape:>9s} {solved:3d}/{len(qs):<3d} {collided:7d} {rung_s:>9s} "
-                  f"{mp(smooth):>18s} {mp(cert):>16s}")  # fmt: skip
+            total_solved += solved
+            total_queries += len(qs)
+            say(f"{name:18s} {shape:>9s} {solved:3d}/{len(qs):<3d} {refused['no path']:7d} "
+                  f"{refused['no pose']:7d} {refused['no curve']:8d} {collided:7d} {rung_s:>9s} "
+                  f"{with_rounds:6d} {mp(smooth):>18s} {mp(cert):>16s}")  # fmt: skip
+            all_smooth.extend(smooth)
+    if all_smooth:
+        say(f"smoothing stage over all solved queries: median {statistics.median(all_smooth):.1f} "
+              f"ms, p95 {np.percentile(all_smooth, 95):.1f} ms, max {max(all_smooth):.1f} ms "
+              f"({len(all_smooth)} plans)")  # fmt: skip
+    return total_solved, total_queries, all_smooth
 
 
 def door_grid(width_m, wall_cells, offset_cells, res=0.02):
@@ -165,7 +212,13 @@ def main(argv: list[str] | None = None) -> int:
     if not (data_dir() / "ros").is_dir():
         print(f"shared data not found at {data_dir()} (set TRAJOPT_DATA)")
         return 1
-    run_maps(args, np.random.default_rng(args.seed))
+    ok, n, smooth = run_maps(args, np.random.default_rng(args.seed))
+    with without_footprint_rounds():
+        ok0, n0, smooth0 = run_maps(args, np.random.default_rng(args.seed), quiet=True)
+    print(f"the same queries without the footprint rounds (no pinned end heading, no footprint "
+          f"SCP; the ladder only): solved {ok0}/{n0}, smoothing p95 "
+          f"{np.percentile(smooth0, 95):.1f} ms; with them: {ok}/{n}, "
+          f"{np.percentile(smooth, 95):.1f} ms")  # fmt: skip
     run_doors(args)
     return 0
 

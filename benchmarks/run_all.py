@@ -104,9 +104,11 @@ BENCHES: tuple[Bench, ...] = (
           ("--runs", "5")),
     Bench("footprint", "Rectangular robots: collisions and doors", "bench_footprint.py",
           "Rectangles (1.6 x 1.0 and 2:1 of the disc's diameter) on the shared maps, checked "
-          "by an independent collision test, and door passages narrower than the "
-          "circumscribed disc, against that disc in the same run.",
-          ("--per-map", "5")),
+          "by an independent collision test, why refused queries were refused, the "
+          "smoothing stage with the footprint certificate and rounds, the same queries "
+          "without the footprint rounds (the previous design), and door passages narrower "
+          "than the circumscribed disc, against that disc in the same run.",
+          ("--per-map", "15")),
     Bench("harness", "Benchmark harness: Dask scaling", "bench_harness.py",
           "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
           "and the report on 10^5 rows.",

@@ -1,21 +1,24 @@
 """Planning for a robot with an oriented footprint.
 
 A :class:`~trajopt.pipeline.Planner` whose robot has a
-:class:`~trajopt.footprint.Footprint` plans with disc models of growing radius and keeps
+:class:`~trajopt.footprint.Footprint` first checks that the footprint can stand at both
+ends (:func:`check_end_poses`), then plans with disc models of growing radius and keeps
 the first result whose footprint certificate passes:
 
 1. the **inscribed** radius first: the centre keeps at least it from every obstacle, so
    the search accepts every passage at least as wide as the footprint's narrowest
    extent through the rotation centre, and the corridor and the smoother certify that
-   disc clearance;
-2. the curve is then checked for the whole footprint, oriented along its tangent
-   (:func:`~trajopt.footprint.certify_footprint`: per span, the Minkowski sum of the
-   control-point hull and the footprint swept over the span's heading interval, exactly
-   clear of the raw map);
-3. when that check fails, the same disc is tried again with the footprint's oriented
-   check of its grid path (:func:`oriented_path_check`), then the next radius of the
-   ladder (halfway to the circumscribed radius, then the circumscribed radius, whose disc
-   holds the footprint in every heading).
+   disc clearance (no path for it: :class:`~trajopt.errors.NoPathError` at once);
+2. the disc model's smoother is given the footprint
+   (:attr:`~trajopt.pipeline.Planner.smoothing_footprint`): it accepts a curve only when
+   :func:`~trajopt.footprint.certify_footprint` passes too (per span, the Minkowski sum of
+   the control-point hull and the footprint swept over the span's heading interval,
+   exactly clear of the raw map), and runs its footprint rounds (pinned end headings, the
+   footprint SCP: :mod:`trajopt.smoother.footprint_rounds`) before refining its knots;
+3. when that fails, the same disc is tried again with the footprint's oriented check of
+   its grid path (:func:`oriented_path_check`), then the next radius of the ladder
+   (halfway to the circumscribed radius, then the circumscribed radius, whose disc holds
+   the footprint in every heading).
 
 What is exact and what is conservative: every returned smooth trajectory passes the
 footprint certificate, which bounds the footprint over each piece rigorously (the swept
@@ -43,7 +46,7 @@ from trajopt.fallback import StopAndTurnTrajectory
 from trajopt.footprint import certify_footprint
 from trajopt.robot import Robot
 
-__all__ = ["disc_planner", "plan_with_footprint", "radius_ladder"]
+__all__ = ["check_end_poses", "disc_planner", "plan_with_footprint", "radius_ladder"]
 
 
 def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:

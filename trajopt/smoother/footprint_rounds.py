@@ -6,7 +6,8 @@ With a robot footprint, :meth:`~trajopt.smoother.Smoother.fit` accepts a curve o
 1. **End headings.** If an end span fails and that end's heading is free, the heading is
    pinned (once per end) to the one nearest the curve's own end tangent among
    :data:`END_HEADINGS` sampled headings at which the footprint on the fixed end point is
-   clear of the raw map, and the knots are solved again: no row can move a fixed end point.
+   well clear of the raw map (at least half the best clearance found, capped at a cell), and
+   the knots are solved again: no row can move a fixed end point.
 2. **SCP rounds** (polygon corridors, no curvature bound): :func:`footprint_scp` solves the
    same knots again with the corner rows of :class:`~trajopt.smoother.footprint_scp.
    FootprintSCP` on the failing spans, up to :data:`FOOTPRINT_ROUNDS` times, certifying
@@ -32,6 +33,7 @@ __all__ = [
     "FOOTPRINT_ROUNDS",
     "FootprintRounds",
     "clear_headings",
+    "end_headings",
     "footprint_scp",
     "spans_to_tighten",
 ]
@@ -94,8 +96,8 @@ class FootprintRounds:
                 continue
             self._free[end] = False  # one try per end
             d = c_cells[b] - c_cells[a]
-            headings = clear_headings(self.footprint, self.raw_grid, ends_m[end], 0.0)
-            theta = _nearest(headings, math.atan2(d[1], d[0]))
+            theta = _nearest(*end_headings(self.footprint, self.raw_grid, ends_m[end]),
+                             math.atan2(d[1], d[0]))  # fmt: skip
             if theta is None:
                 continue
             self._before = (self.start_heading, self.goal_heading)
@@ -164,6 +166,17 @@ def spans_to_tighten(margins_m: np.ndarray, n_spans: int, degree: int,
     return out
 
 
+def end_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray):
+    """Return :data:`END_HEADINGS` sampled headings (rad) and the footprint's clearance there (m).
+
+    The clearance of the footprint placed on ``point`` (m) at each heading, capped at one
+    cell.
+    """
+    ths = -math.pi + 2 * math.pi * np.arange(END_HEADINGS) / END_HEADINGS
+    polys = [footprint.at(float(point[0]), float(point[1]), float(t)) for t in ths]
+    return ths, polygons_clearance(polys, raw_grid, raw_grid.resolution)
+
+
 def clear_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray,
                    margin_m: float) -> np.ndarray:  # fmt: skip
     """Return the sampled headings (rad) at which the footprint on ``point`` (m) is clear.
@@ -177,9 +190,15 @@ def clear_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray,
     return ths[clr > margin_m]
 
 
-def _nearest(headings: np.ndarray, theta: float) -> float | None:
-    """Return the heading of ``headings`` nearest ``theta`` on the circle (``None``: empty)."""
-    if len(headings) == 0:
+def _nearest(headings: np.ndarray, clearance: np.ndarray, theta: float) -> float | None:
+    """Return the well-clear heading nearest ``theta`` on the circle (``None``: none clear).
+
+    Well clear: a clearance of at least half the best one found (at most a cell), so that
+    the curve leaving the end has room to turn.
+    """
+    best = float(clearance.max(initial=0.0))
+    if best <= 0.0:
         return None
-    diff = np.abs(np.remainder(headings - theta + math.pi, 2 * math.pi) - math.pi)
-    return float(headings[int(np.argmin(diff))])
+    ok = clearance >= 0.5 * best
+    diff = np.abs(np.remainder(headings[ok] - theta + math.pi, 2 * math.pi) - math.pi)
+    return float(headings[ok][int(np.argmin(diff))])

@@ -41,6 +41,9 @@ ROWS_PER_SAMPLE = 2
 SLACK_PENALTY = 1e4
 #: largest slack (cells): keeps every row's range finite for the interior-point solver
 SLACK_MAX = 1e3
+#: the corner rows keep this far (cells) inside the pushed-out half-planes: room for the
+#: certificate's bound (the control hull plus the swept footprint) around the samples
+ROW_MARGIN_CELLS = 0.5
 #: the speed row keeps ``T . C'`` at least this fraction of the current speed (hard row)
 SPEED_KEEP = 0.75
 
@@ -84,7 +87,7 @@ class FootprintSCP:
         for k, (a, lo_r, hi_r) in enumerate(prob.rows):
             one = np.flatnonzero(~np.isfinite(lo_r))
             A[k, one] = a[one]
-            hi[k, one] = hi_r[one] + r_cells
+            hi[k, one] = hi_r[one] + r_cells - ROW_MARGIN_CELLS
         region = np.asarray(asm.span_box)[span]
         self.A, self.hi = A[region], hi[region]  # (ns, q, 2), (ns, q)
         S = self.layout.n_samples
@@ -96,6 +99,8 @@ class FootprintSCP:
         self.rows = n_fixed + 3 * np.arange(ns)
         self.vals = np.zeros((S, 3, 2 * (p + 1)))
         self.work = np.zeros(S, dtype=bool)
+        #: per sample and row: the (region row, corner) pair of the last linearisation
+        self.pairs = np.zeros((ns, ROWS_PER_SAMPLE, 2), dtype=np.int64)
 
     def activate(self, spans: np.ndarray) -> None:
         """Add the samples of the spans marked in ``spans`` (bool, shape (n - p,))."""
@@ -122,6 +127,7 @@ class FootprintSCP:
         s = np.arange(ns)
         for j in range(ROWS_PER_SAMPLE):
             qi, ki = np.divmod(order[:, j], K)
+            self.pairs[:, j, 0], self.pairs[:, j, 1] = qi, ki
             a = self.A[s, qi]
             beta = np.einsum("sd,sd->s", a, RpF[s, ki]) / v
             self.vals[:ns, j, : p + 1] = self.B0 * a[:, :1] + self.B1 * (beta * N[:, 0])[:, None]
