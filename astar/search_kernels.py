@@ -1,5 +1,7 @@
 """Compiled kernels of :func:`astar.find_path`: octile A* and jump point search.
 
+(With a per-cell cost the search runs :mod:`astar.weighted_kernel` instead.)
+
 Both search a padded, flattened grid of free cells with a binary heap of ``(f, g, node)``
 (ties: larger ``g`` first) plus a stack of nodes whose ``f`` equals the current minimum;
 the shared open-list helpers are :func:`heap_push`, :func:`heap_pop` and
@@ -12,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["astar_kernel", "heap_pop", "heap_push", "jps_kernel", "stack_push"]
+__all__ = ["astar_kernel", "heap_pop", "heap_push", "jps_kernel", "stack_push", "unroll_path"]
 
 
 @njit(cache=True, inline="always")
@@ -96,17 +98,15 @@ def astar_kernel(
     goal,
     conn8,  # bool
     cut,  # corner cutting allowed
-    weighted,  # bool: use `cost`
-    cost,  # float64 [ny*nx], unpadded (ignored unless weighted)
     rec,  # int32 [4*H*W] per-cell record: stamp, parent, straight steps, diagonal steps
-    recf,  # float64 view of rec: recf[2 * v + 1] is the cost so far (weighted)
     gen,  # this search's stamp; gen + 1 marks closed
 ):  # pragma: no cover - numba
     """Run octile A* on the padded grid (the argument comments give each one's role).
 
-    Returns ``(found, path, expanded, cost, straight steps, diagonal steps)``: the padded
+    Returns ``(found, path, expanded, 0.0, straight steps, diagonal steps)``: the padded
     flat indices of the path from start to goal, the count of expanded cells, and the
-    path's cost (its length in cells when not ``weighted``).
+    path's numbers of straight and diagonal steps (its length is ``a + b sqrt(2)``).
+    (:func:`~astar.weighted_kernel.weighted_kernel` runs the search with a cell cost.)
     """
     sqrt2 = 1.4142135623730951
     w = width
@@ -129,7 +129,6 @@ def astar_kernel(
     rec[4 * start + 2] = 0
     rec[4 * start + 3] = 0
     rec[4 * start + 1] = -1
-    recf[2 * start + 1] = 0.0
     sx = start % w
     sy = start // w
     ax = abs(sx - gx)
@@ -169,9 +168,6 @@ def astar_kernel(
             break
         ux = u % w
         uy = u // w
-        gu = recf[2 * u + 1]
-        # unpadded cell index of a padded index v in row vy: v - 2 * vy - (w - 1)
-        cu = cost[u - 2 * uy - (w - 1)] if weighted else 0.0
         gau = rec[4 * u + 2]
         gbu = rec[4 * u + 3]
         for k in range(4):
@@ -198,30 +194,18 @@ def astar_kernel(
             vy = uy + dy
             ax = abs(vx - gx)
             ay = abs(vy - gy)
-            if weighted:
-                step = 1.0 if k < 4 else sqrt2
-                gnew = gu + step * (1.0 + 0.5 * (cu + cost[v - 2 * vy - (w - 1)]))
-                if sv == gen and gnew >= recf[2 * v + 1]:
-                    continue
-                recf[2 * v + 1] = gnew
-                if conn8:
-                    hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2
-                else:
-                    hv = float(ax + ay)
-                fnew = gnew + hv
+            na = gau + (1 if k < 4 else 0)
+            nb = gbu + (0 if k < 4 else 1)
+            gnew = na + nb * sqrt2
+            if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
+                continue
+            rec[r4 + 2] = na
+            rec[r4 + 3] = nb
+            if conn8:
+                mn = min(ax, ay)
+                fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
             else:
-                na = gau + (1 if k < 4 else 0)
-                nb = gbu + (0 if k < 4 else 1)
-                gnew = na + nb * sqrt2
-                if sv == gen and gnew >= rec[r4 + 2] + rec[r4 + 3] * sqrt2:
-                    continue
-                rec[r4 + 2] = na
-                rec[r4 + 3] = nb
-                if conn8:
-                    mn = min(ax, ay)
-                    fnew = (na + max(ax, ay) - mn) + (nb + mn) * sqrt2
-                else:
-                    fnew = (na + ax + ay) + nb * sqrt2
+                fnew = (na + ax + ay) + nb * sqrt2
             rec[r4] = gen
             rec[r4 + 1] = u
             if fnew == fcur:
@@ -232,6 +216,12 @@ def astar_kernel(
 
     if not found:
         return False, np.empty(0, dtype=np.int64), expanded, 0.0, 0, 0
+    return True, unroll_path(rec, start, goal), expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
+
+
+@njit(cache=True)
+def unroll_path(rec, start, goal):  # pragma: no cover - compiled
+    """Return the padded flat indices from ``start`` to ``goal`` along the parents in ``rec``."""
     n = 1
     v = goal
     while v != start:
@@ -243,9 +233,7 @@ def astar_kernel(
         path[i] = v
         if i > 0:
             v = rec[4 * v + 1]
-    if weighted:
-        return True, path, expanded, recf[2 * goal + 1], 0, 0
-    return True, path, expanded, 0.0, rec[4 * goal + 2], rec[4 * goal + 3]
+    return path
 
 
 # --------------------------------------------------------------------------- jump point search

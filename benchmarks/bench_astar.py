@@ -9,6 +9,12 @@ benchmark's optimal length, and pyastar2d's excess length (its paths measured wi
 metric: it charges a diagonal step like a straight one and cuts corners, so it is not
 octile-optimal and is only a speed reference).
 
+A second table times the clearance-cost search (``cost=astar.clearance_cost(...)``, the
+planner's default ``search="clearance"``) on a warehouse-size map, willow at 5 cm cells
+(each 10 cm cell split in four, 1132 x 1216 cells), robot radius 0.25 m: the ``--long`` longest
+of 3x as many random connected queries, best of ``--repeat``; the three longest are checked
+against scipy's Dijkstra on the same graph (costs must agree to 1e-9).
+
 Run from the repository root::
 
     python benchmarks/bench_astar.py            # Boston_0_1024 and maze512-1-0
@@ -111,6 +117,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--maps", nargs="+", default=list(DEFAULT_MAPS))
     ap.add_argument("--n", type=int, default=20, help="queries per map (whole longest buckets)")
     ap.add_argument("--repeat", type=int, default=3, help="timings per query (best kept)")
+    ap.add_argument("--long", type=int, default=20,
+                    help="clearance-cost queries timed on the warehouse-size map (0: none)")
     args = ap.parse_args(argv)
     print(
         f"{'map':<16}{'queries':>8}{'buckets':>10}{'ours ms':>10}{'pyastar2d ms':>14}"
@@ -128,7 +136,80 @@ def main(argv: list[str] | None = None) -> int:
         "ratio = median over queries of (our best time / pyastar2d's best time); "
         "len err = max relative error of our length vs the benchmark optimum"
     )
+    if args.long:
+        bench_clearance_search(args.long, args.repeat)
     return 0
+
+
+def step_graph(occ: np.ndarray, cost: np.ndarray):
+    """The 8-connected step graph without corner cutting, as a scipy CSR matrix."""
+    from scipy.sparse import csr_matrix
+
+    ny, nx = occ.shape
+    free = ~occ
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    rows, cols, w = [], [], []
+    for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)):
+        ok = free.copy()
+        ok &= np.roll(np.roll(free, -dy, axis=0), -dx, axis=1)
+        if dx and dy:  # both orthogonal neighbours free
+            ok &= np.roll(free, -dx, axis=1) & np.roll(free, -dy, axis=0)
+        ys, xs = np.nonzero(ok)
+        keep = (xs + dx >= 0) & (xs + dx < nx) & (ys + dy >= 0) & (ys + dy < ny)
+        ys, xs = ys[keep], xs[keep]
+        length = math.sqrt(2.0) if dx and dy else 1.0
+        rows.append(idx[ys, xs])
+        cols.append(idx[ys + dy, xs + dx])
+        w.append(length * (1.0 + 0.5 * (cost[ys, xs] + cost[ys + dy, xs + dx])))
+    n = ny * nx
+    return csr_matrix((np.concatenate(w), (np.concatenate(rows), np.concatenate(cols))), (n, n))
+
+
+def bench_clearance_search(n_long: int, repeat: int) -> None:
+    from scipy.sparse.csgraph import dijkstra
+
+    f = data_dir() / "ros" / "willow-2010-02-18-0.10.yaml"
+    if not f.exists():
+        print(f"clearance-cost search: skipped ({f} not found)")
+        return
+    w = astar.load_map(f)
+    big = astar.OccupancyGrid(np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1),
+                              w.resolution / 2, w.origin)  # fmt: skip
+    inflated = astar.inflate(big, 0.25)
+    cost = astar.clearance_cost(big, 0.25)
+    free = np.argwhere(~inflated.occupied)
+    rng = np.random.default_rng(0)
+    found = []
+    while len(found) < 3 * n_long:
+        a, b = free[rng.integers(len(free), size=2)]
+        try:
+            p = astar.find_path(inflated, (a[1], a[0]), (b[1], b[0]), cost=cost)
+        except astar.NoPathError:
+            continue
+        found.append((p.cost, (a[1], a[0]), (b[1], b[0])))
+    found.sort(reverse=True)
+    times, expanded = [], []
+    for _, s, g in found[:n_long]:
+        best = math.inf
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            p = astar.find_path(inflated, s, g, cost=cost)
+            best = min(best, time.perf_counter() - t0)
+        times.append(1e3 * best)
+        expanded.append(p.expanded)
+    graph = step_graph(np.asarray(inflated.occupied), cost)
+    worst = 0.0
+    for c, s, g in found[:3]:
+        d = dijkstra(graph, indices=s[1] * big.nx + s[0])[g[1] * big.nx + g[0]]
+        worst = max(worst, abs(d - c) / d)
+    t = np.array(times)
+    print(f"\nclearance-cost search, willow at 5 cm ({big.nx} x {big.ny}), radius 0.25 m, the "
+          f"{n_long} longest of {3 * n_long} queries (path cost {found[n_long - 1][0]:.0f}-"
+          f"{found[0][0]:.0f} cells)")  # fmt: skip
+    print(f"  time median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, max "
+          f"{t.max():.1f} ms (target <= 30 ms); expansions median {np.median(expanded):.0f}; "
+          f"{np.median(t * 1e6 / np.array(expanded)):.0f} ns per expansion")  # fmt: skip
+    print(f"  cost vs scipy's Dijkstra on the 3 longest: max relative error {worst:.1e}")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Tests of the fast search paths of astar.find_path: jump point search (8-connected, no corner
 cutting, no cost) against Dijkstra on structured grids, the unpadded cost array of the weighted
-search, and cost validation of single bad cells.
+search and its radix heap on long searches, and cost validation of single bad cells.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from astar import InvalidInputError, NoPathError, OccupancyGrid, find_path
+from astar import InvalidInputError, NoPathError, OccupancyGrid, clearance_cost, find_path
 from tests.astar.test_search import check_path, dijkstra_costs
 
 
@@ -99,3 +99,28 @@ def test_one_bad_cost_cell_rejected(bad, pattern):
     cost[2, 3] = bad
     with pytest.raises(InvalidInputError, match=pattern):
         find_path(grid, (0, 0), (4, 3), cost=cost)
+
+
+@pytest.mark.parametrize("x", [0, 1, 2, 3, 255, 256, 2**32 - 1, 2**32, 2**52 + 7, 2**63, 2**64 - 1])
+def test_radix_bit_length(x):
+    from astar.weighted_kernel import bit_length
+
+    assert bit_length(np.uint64(x)) == int(x).bit_length()
+
+
+@pytest.mark.parametrize("connectivity, corner_cutting", [(8, False), (8, True), (4, False)])
+def test_radix_heap_search_on_a_large_clearance_cost(connectivity, corner_cutting):
+    """Long searches (many bucket redistributions) stay optimal against scipy's Dijkstra."""
+    rng = np.random.default_rng(11)
+    occ = rng.random((70, 90)) < 0.12
+    occ[0, 0] = occ[69, 89] = False
+    grid = OccupancyGrid(occ, 0.05)
+    cost = clearance_cost(grid, 0.05)
+    ref = dijkstra_costs(occ, (0, 0), connectivity, corner_cutting, cost)
+    reach = np.argwhere(np.isfinite(ref))
+    goals = [tuple(c[::-1]) for c in reach[np.argsort(-ref[np.isfinite(ref)])[:3]]]
+    for goal in goals:
+        p = find_path(grid, (0, 0), goal, cost=cost, connectivity=connectivity,
+                      corner_cutting=corner_cutting)  # fmt: skip
+        assert p.cost == pytest.approx(ref[goal[1], goal[0]], rel=1e-12)
+        check_path(p, occ, (0, 0), goal, connectivity, corner_cutting, cost)
