@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["convex_hull", "monotone_chain"]
+__all__ = ["convex_hull", "monotone_chain", "sort_xy"]
 
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
@@ -40,6 +40,24 @@ def monotone_chain(p, n, tol):  # pragma: no cover - compiled
         h[k] = i
         k += 1
     return h, k
+
+
+@njit(cache=True)
+def sort_xy(p, n):  # pragma: no cover - compiled
+    """Sort the first ``n`` rows of ``p`` (m, 2) in place by ``(x, y)``.
+
+    Insertion sort: the point sets of the callers are a few hundred at most.
+    """
+    for i in range(1, n):
+        x = p[i, 0]
+        y = p[i, 1]
+        j = i - 1
+        while j >= 0 and (p[j, 0] > x or (p[j, 0] == x and p[j, 1] > y)):
+            p[j + 1, 0] = p[j, 0]
+            p[j + 1, 1] = p[j, 1]
+            j -= 1
+        p[j + 1, 0] = x
+        p[j + 1, 1] = y
 
 
 @njit(cache=True, inline="always")

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt.convex_hull import monotone_chain
+from trajopt.convex_hull import monotone_chain, sort_xy
 from trajopt.polygon_corridor.obstacle_index import poly_clearance
 
 __all__ = ["cone", "hull_of", "span_margins", "swept_hull"]
@@ -54,18 +54,9 @@ def cone(d):  # pragma: no cover - compiled
 def hull_of(pts, n):  # pragma: no cover - compiled
     """Return the convex hull of the first ``n`` rows of ``pts`` (m, 2), counter-clockwise.
 
-    ``pts[:n]`` is sorted in place by ``(x, y)`` (insertion sort: the point sets here are a
-    few hundred at most).
+    ``pts[:n]`` is sorted in place by ``(x, y)`` (:func:`~trajopt.convex_hull.sort_xy`).
     """
-    for i in range(1, n):
-        x, y = pts[i, 0], pts[i, 1]
-        j = i - 1
-        while j >= 0 and (pts[j, 0] > x or (pts[j, 0] == x and pts[j, 1] > y)):
-            pts[j + 1, 0] = pts[j, 0]
-            pts[j + 1, 1] = pts[j, 1]
-            j -= 1
-        pts[j + 1, 0] = x
-        pts[j + 1, 1] = y
+    sort_xy(pts, n)
     h, k = monotone_chain(pts, n, 0.0)
     m = max(k - 1, 1)
     out = np.empty((m, 2))

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt.convex_hull import monotone_chain
+from trajopt.convex_hull import monotone_chain, sort_xy
 from trajopt.polygon_corridor.obstacle_index import point_nearest, poly_clearance, seg_clearance
 
 __all__ = [
@@ -35,16 +35,7 @@ def hull4(pts, n, out):  # pragma: no cover - compiled
     for i in range(n):
         p[i, 0] = pts[i, 0]
         p[i, 1] = pts[i, 1]
-    for i in range(1, n):  # lexicographic insertion sort (n is tiny)
-        x = p[i, 0]
-        y = p[i, 1]
-        j = i - 1
-        while j >= 0 and (p[j, 0] > x or (p[j, 0] == x and p[j, 1] > y)):
-            p[j + 1, 0] = p[j, 0]
-            p[j + 1, 1] = p[j, 1]
-            j -= 1
-        p[j + 1, 0] = x
-        p[j + 1, 1] = y
+    sort_xy(p, n)
     idx, k = monotone_chain(p, n, 1e-12)
     k -= 1  # the last point repeats the first
     # drop duplicates (a point or a segment)
