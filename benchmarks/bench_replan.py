@@ -11,6 +11,12 @@ re-plan that raises a typed error (a state too fast for any curve found, a goal 
 the robot) is counted as refused, with its type. The reference is a fresh ``plan`` from
 rest at the same point, timed in the same run.
 
+A second part runs on a warehouse-size map, willow at 5 cm cells (each 10 cm cell split in
+four, 1132 x 1216 cells), robot radius 0.25 m, with a warm planner (``trajopt.warm_up``, one
+untimed plan): the whole ``plan`` of each query (start and goal at least 5 m apart: a new
+goal for the planner), and a re-plan to a new goal (the next query's) from the moving
+robot 2 s into each trajectory, with the stage split of the plans.
+
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
 
@@ -76,6 +82,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--queries", type=int, default=6, help="queries per map")
     ap.add_argument("--every", type=float, default=0.5, help="re-plan period (s)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--warehouse", type=int, default=12,
+                    help="queries on the warehouse-size map (0: skip that part)")
     args = ap.parse_args(argv)
     d = data_dir() / "ros"
     if not d.is_dir():
@@ -139,7 +147,55 @@ def main(argv: list[str] | None = None) -> int:
     if all_ms:
         print(f"all maps: re-plan median {statistics.median(all_ms):.1f} ms, p95 "
               f"{np.percentile(all_ms, 95):.1f} ms over {len(all_ms)} re-plans")  # fmt: skip
+    if args.warehouse:
+        warehouse(d, args.warehouse, np.random.default_rng(args.seed))
     return 0
+
+
+def warehouse(d: Path, n: int, rng) -> None:
+    """Whole plans and re-plans to a new goal on willow at 5 cm (module docstring)."""
+    w = astar.load_map(d / "willow-2010-02-18-0.10.yaml")
+    grid = astar.OccupancyGrid(np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1),
+                               w.resolution / 2, w.origin)  # fmt: skip
+    robot = trajopt.Robot(radius=0.25)
+    planner = trajopt.Planner(grid, robot)
+    trajopt.warm_up(planner)
+    free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
+                                      outside_occupied=True).occupied)  # fmt: skip
+    qs = []
+    while len(qs) < n + 1:
+        a, b = free[rng.integers(len(free), size=2)]
+        p0, p1 = grid.cell_to_world(a[::-1]), grid.cell_to_world(b[::-1])
+        if math.dist(p0, p1) < 5.0:
+            continue
+        try:
+            planner.plan(p0, p1)  # also the untimed first plan of this map
+        except TrajoptError:
+            continue
+        qs.append((tuple(p0), tuple(p1)))
+    plans, replans, stages, refused = [], [], {}, 0
+    for k, (p0, p1) in enumerate(qs[1:]):
+        t0 = time.perf_counter()
+        traj = planner.plan(p0, p1)
+        plans.append(1e3 * (time.perf_counter() - t0))
+        for key, v in traj.stats["stages_s"].items():
+            stages.setdefault(key, []).append(1e3 * v)
+        t0 = time.perf_counter()
+        try:
+            planner.replan(traj, min(2.0, traj.duration / 2), goal=qs[k][1], latency=0.0)
+            replans.append(1e3 * (time.perf_counter() - t0))
+        except TrajoptError:
+            refused += 1
+    print(f"\nwarehouse-size map: willow at 5 cm ({grid.nx} x {grid.ny} cells), radius 0.25 m, "
+          f"{len(plans)} queries 5 m or more apart, warm planner")  # fmt: skip
+    print(f"  whole plan (new goal): median {statistics.median(plans):.1f} ms, p95 "
+          f"{np.percentile(plans, 95):.1f} ms (target median <= 40 ms)")  # fmt: skip
+    split = ", ".join(f"{k} {statistics.median(v):.1f}" for k, v in stages.items() if k != "total")
+    print(f"  stage medians (ms): {split}")
+    if replans:
+        print(f"  re-plan to a new goal from the moving robot: median "
+              f"{statistics.median(replans):.1f} ms, p95 {np.percentile(replans, 95):.1f} ms "
+              f"({len(replans)} re-plans, {refused} refused; target median <= 40 ms)")  # fmt: skip
 
 
 if __name__ == "__main__":
