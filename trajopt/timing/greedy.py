@@ -75,49 +75,81 @@ def range_min(st, lg, h, sa, sb):
 
 
 @njit(cache=True)
+def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
+    """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
+    if s0 >= length:
+        return 0
+    s1, v1, a1 = advance(s0, v0, a0, j, t0)
+    vmax = v0 if v0 > v1 else v1
+    vmin = v0 if v0 < v1 else v1
+    peak = False
+    if a0 > 0.0 and a1 < 0.0:
+        pk = v0 - a0 * a0 / (2.0 * j)
+        if pk > vmax:
+            vmax = pk
+            peak = True
+    elif a0 < 0.0 and a1 > 0.0:
+        tr = v0 - a0 * a0 / (2.0 * j)
+        if tr < vmin:
+            vmin = tr
+    if vmin < -_NEG_V_TOL:
+        return 1
+    se = s1 if s1 < length else length
+    if se < s0:
+        se = s0
+    if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
+        return 0
+    # a point of the piece over the cap: the bisection would end there
+    if s1 < length and v1 > range_min(st, lg, h, s1, s1) + _CAP_TOL:
+        return 1
+    if v0 > range_min(st, lg, h, s0, s0) + _CAP_TOL:
+        return 1
+    if peak:
+        s_pk = advance(s0, v0, a0, j, -a0 / j)[0]
+        if s_pk < length and vmax > range_min(st, lg, h, s_pk, s_pk) + _CAP_TOL:
+            return 1
+    return 2
+
+
+@njit(cache=True)
 def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
     """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
     Conservative and exact on the grid: a piece passes when its speed maximum is below the
     minimum cap over the arc-length range it covers; otherwise it is bisected in time down
-    to ``tmin`` seconds.
+    to ``tmin`` seconds (the bisection stack is only allocated when the whole piece is
+    undecided).
     """
     if T <= 0.0:
         return True
+    res = _piece_test(st, lg, h, length, s, v, a, j, T)
+    if res != 2:
+        return res == 0
+    if T <= tmin:
+        return False
     stk = np.empty((96, 4))
-    stk[0, 0] = s
-    stk[0, 1] = v
-    stk[0, 2] = a
-    stk[0, 3] = T
-    top = 1
+    half = 0.5 * T
+    sm, vm, am = advance(s, v, a, j, half)
+    stk[0, 0] = sm
+    stk[0, 1] = vm
+    stk[0, 2] = am
+    stk[0, 3] = half
+    stk[1, 0] = s
+    stk[1, 1] = v
+    stk[1, 2] = a
+    stk[1, 3] = half
+    top = 2
     while top > 0:
         top -= 1
         s0 = stk[top, 0]
         v0 = stk[top, 1]
         a0 = stk[top, 2]
         t0 = stk[top, 3]
-        if s0 >= length:
+        res = _piece_test(st, lg, h, length, s0, v0, a0, j, t0)
+        if res == 0:
             continue
-        s1, v1, a1 = advance(s0, v0, a0, j, t0)
-        vmax = v0 if v0 > v1 else v1
-        vmin = v0 if v0 < v1 else v1
-        if a0 > 0.0 and a1 < 0.0:
-            pk = v0 - a0 * a0 / (2.0 * j)
-            if pk > vmax:
-                vmax = pk
-        elif a0 < 0.0 and a1 > 0.0:
-            tr = v0 - a0 * a0 / (2.0 * j)
-            if tr < vmin:
-                vmin = tr
-        if vmin < -_NEG_V_TOL:
+        if res == 1:
             return False
-        se = s1 if s1 < length else length
-        if se < s0:
-            se = s0
-        if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
-            continue
-        if s1 < length and v1 > range_min(st, lg, h, s1, s1) + _CAP_TOL:
-            return False  # the end of the piece is over the cap: bisection would end there
         if t0 <= tmin or top + 2 > stk.shape[0]:
             return False
         half = 0.5 * t0
@@ -192,6 +224,28 @@ def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin):
 
 
 @njit(cache=True)
+def cruise_reach(v, v_end, amax, j, dt):
+    """Farthest arc length (m) a greedy step from ``(s, v, a = 0)`` queries, less ``s``.
+
+    The largest jerk ``j`` gives the farthest step end and, from there, the longest brake to
+    rest and to ``v_end``: every query of the step (its pieces, the stop profile, the end
+    test) lies within that distance of ``s``.
+    """
+    ta = dt
+    if j * dt > amax:
+        ta = amax / j
+    s1, v1, a1 = advance(0.0, v, 0.0, j, ta)
+    if ta < dt:
+        s1, v1, a1 = advance(s1, v1, amax, 0.0, dt - ta)
+    t1, t2, t3, _ = brake_times(v1, a1, 0.0, j, amax)
+    far = brake_end(s1, v1, a1, t1, t2, t3, j)
+    t1, t2, t3, kind = brake_times(v1, a1, v_end, j, amax)
+    if kind != 1:
+        far = max(far, brake_end(s1, v1, a1, t1, t2, t3, j))
+    return max(far, s1)
+
+
+@njit(cache=True)
 def _push(buf, n, t, s, v, a, j):
     if n == buf.shape[0]:
         nb = np.empty((2 * n, buf.shape[1]))
@@ -236,7 +290,17 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     ptr = 0
     cands = np.empty(ncand + 1)
     status = MAX_STEPS
-    for _ in range(max_steps):
+    # last interval of the run of equal caps holding each interval (for cruise steps)
+    n_int = st.shape[1]
+    run_end = np.empty(n_int, np.int64)
+    run_end[n_int - 1] = n_int - 1
+    for i in range(n_int - 2, -1, -1):
+        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
+    reach = -1.0  # cruise reach of the speed held last (m); < 0: not computed
+    reach_v = -1.0
+    steps = 0
+    while steps < max_steps:
+        steps += 1
         while ptr < nmin and min_s[ptr] <= s:
             ptr += 1
         # candidate jerks, descending, plus the one that zeroes a at the step end
@@ -314,6 +378,8 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             chosen = safe
         if not np.isnan(chosen):
             u = chosen
+            s_prev = s
+            at_zero = a == 0.0
             ta = dt
             if u > 0.0 and a + u * dt > amax:
                 ta = max(0.0, (amax - a) / u)
@@ -333,6 +399,19 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
             bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+            if u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
+                # a cruise step: repeat it while every query lies on one run of equal caps
+                if v != reach_v:
+                    reach = cruise_reach(v, v_end, amax, j, dt) + 2.0 * h
+                    reach_v = v
+                i0 = min(max(int(s_prev / h), 0), n_int - 1)
+                lim = min(run_end[i0] * h, length - h) - reach
+                while s_prev <= lim and s <= lim and steps < max_steps:
+                    steps += 1
+                    phases, n_ph = _push(phases, n_ph, t, s, v, 0.0, u)
+                    s, v, a = advance(s, v, 0.0, u, dt)
+                    t += dt
+                    bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
             continue
         if safe_noend:
             status = OK_FINISH
