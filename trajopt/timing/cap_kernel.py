@@ -146,7 +146,7 @@ def speed_cap(k, limits):  # pragma: no cover - compiled
     return cap
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     """Velocity ``c'`` of piece ``i`` at ``x = (u - mid) / half``: ``(vx, vy)``."""
     p = coef.shape[1]
@@ -158,7 +158,7 @@ def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     return vx, vy
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     """Acceleration ``c''`` of piece ``i`` at ``x``: ``(ax, ay)``."""
     p = coef.shape[1]
@@ -199,18 +199,19 @@ def _binomials(n):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True)
-def _bernstein_range(P, n_coef, comb, want_max_abs):  # pragma: no cover - compiled
-    """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[:n_coef]``.
+@njit(cache=True, inline="always")
+def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - compiled
+    """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[off:off + n_coef]``.
 
-    ``b_i = sum_{k <= i} C(i, k) / C(n, k) P_k`` on ``[0, 1]``, ``n = n_coef - 1``.
+    ``b_i = sum_{k <= i} C(i, k) / C(n, k) P_k`` on ``[0, 1]``, ``n = n_coef - 1``
+    (``p2b[n, i, k]`` holds the factors).
     """
     n = n_coef - 1
     best = 0.0 if want_max_abs else np.inf
     for i in range(n + 1):
         b = 0.0
         for k in range(i + 1):
-            b += comb[i, k] / comb[n, k] * P[k]
+            b += p2b[n, i, k] * P[off + k]
         if want_max_abs:
             b = abs(b)
             if b > best:
@@ -220,39 +221,65 @@ def _bernstein_range(P, n_coef, comb, want_max_abs):  # pragma: no cover - compi
     return best
 
 
-@njit(cache=True)
-def _mul_into(out, P, Q, i, j, sign, tmp):  # pragma: no cover - compiled
-    """``out += sign * P[:i] Q[:j]`` (power basis), the product built first as in ``_mul``."""
+@njit(cache=True, inline="always")
+def _mul_into(out, wk, rp, rq, i, j, sign):  # pragma: no cover - compiled
+    """``out += sign * P Q`` for ``P = wk[rp, :i]``, ``Q = wk[rq, :j]`` (power basis).
+
+    The product is built first in ``wk[4]``, as ``curvature_bound._mul`` does.
+    """
     for r in range(i + j - 1):
-        tmp[r] = 0.0
+        wk[4, r] = 0.0
     for r in range(i):
         for q in range(j):
-            tmp[r + q] += P[r] * Q[q]
+            wk[4, r + q] += wk[rp, r] * wk[rq, q]
     for r in range(i + j - 1):
-        out[r] += sign * tmp[r]
+        out[r] += sign * wk[4, r]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _cross_and_norm(V, m, X, S, wk):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
     ``wk`` is a work array of 5 rows. Returns the numbers of coefficients of ``X`` and ``S``.
     """
-    X[:] = 0.0
-    S[:] = 0.0
-    v0, v1, d0, d1, tmp = wk[0], wk[1], wk[2], wk[3], wk[4]
+    for r in range(X.shape[0]):
+        X[r] = 0.0
+        S[r] = 0.0
     for q in range(m):
-        v0[q] = V[q, 0]
-        v1[q] = V[q, 1]
+        wk[0, q] = V[q, 0]
+        wk[1, q] = V[q, 1]
     if m >= 2:
         for q in range(m - 1):
-            d0[q] = v0[q + 1] * (q + 1)
-            d1[q] = v1[q + 1] * (q + 1)
-        _mul_into(X, v0, d1, m, m - 1, 1.0, tmp)
-        _mul_into(X, v1, d0, m, m - 1, -1.0, tmp)
-    _mul_into(S, v0, v0, m, m, 1.0, tmp)
-    _mul_into(S, v1, v1, m, m, 1.0, tmp)
+            wk[2, q] = V[q + 1, 0] * (q + 1)
+            wk[3, q] = V[q + 1, 1] * (q + 1)
+        _mul_into(X, wk, 0, 3, m, m - 1, 1.0)
+        _mul_into(X, wk, 1, 2, m, m - 1, -1.0)
+    _mul_into(S, wk, 0, 0, m, m, 1.0)
+    _mul_into(S, wk, 1, 1, m, m, 1.0)
     return max(2 * m - 2, 1), 2 * m - 1
+
+
+@njit(cache=True)
+def matrices(p):  # pragma: no cover - compiled
+    """Constant matrices of :func:`bound_from_taylor` for degree ``p``.
+
+    Bernstein factors ``p2b[n, i, k] = C(i, k) / C(n, k)`` (``n <= 2 p``) and the maps
+    ``shift[0, i, k]``, ``shift[1, i, k]`` of coefficients in ``tau = t - 1/2`` to powers of
+    ``t`` and of ``1 - t`` (``curvature_bound._shift_matrices``).
+    """
+    comb = _binomials(2 * p + 2)
+    nm = 2 * p + 1
+    p2b = np.zeros((nm, nm, nm))
+    for n in range(nm):
+        for i in range(n + 1):
+            for k in range(i + 1):
+                p2b[n, i, k] = comb[i, k] / comb[n, k]
+    shift = np.zeros((2, p, p))
+    for k in range(p):
+        for i in range(k + 1):
+            shift[0, i, k] = comb[k, i] * (-0.5) ** (k - i)
+            shift[1, i, k] = comb[k, i] * 0.5 ** (k - i) * (-1.0) ** i
+    return p2b, shift
 
 
 @njit(cache=True)
@@ -262,36 +289,33 @@ def workspace(p):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def bound_from_taylor(gam, flip, k_free, comb, X, S, V, wk):  # pragma: no cover - compiled
+def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover - compiled
     """Bernstein bound on ``|kappa|`` from the Taylor coefficients ``gam`` (p, 2) of ``c_t``.
 
     ``gam[k]`` multiplies ``(t - 1/2)^k`` on the local ``t`` in ``[0, 1]``; ``flip`` is 1
-    (zero speed at ``t = 0``), -1 (at ``t = 1``) or 0. ``X``, ``S``, ``V``, ``wk`` are work
-    arrays (``workspace(p)``).
+    (zero speed at ``t = 0``), -1 (at ``t = 1``) or 0. ``p2b``, ``shift`` come from
+    :func:`matrices`; ``X``, ``S``, ``V``, ``wk`` are work arrays (:func:`workspace`).
     The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`.
     """
     p = gam.shape[0]
     if p < 2:
         return 0.0
-    for i in range(p):  # tau^k = (t - 1/2)^k, or (1/2 - t')^k with t' = 1 - t
+    sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
+    for i in range(p):
         for d in range(2):
             acc = 0.0
             for k in range(i, p):
-                if flip == -1:
-                    c = comb[k, i] * 0.5 ** (k - i) * (-1.0) ** i
-                else:
-                    c = comb[k, i] * (-0.5) ** (k - i)
-                acc += c * gam[k, d]
+                acc += shift[sh, i, k] * gam[k, d]
             V[i, d] = acc
     if flip == 0 or not _zero_start(V, p):
         nx, ns = _cross_and_norm(V, p, X, S, wk)
-        bx = _bernstein_range(X, nx, comb, True)
-        bs = _bernstein_range(S, ns, comb, False)
+        bx = _bernstein_range(X, 0, nx, p2b, True)
+        bs = _bernstein_range(S, 0, ns, p2b, False)
         if bx == 0.0:
             return 0.0
         if not bs > 0.0:
             return np.inf
-        return bx / bs**1.5
+        return bx / (bs * math.sqrt(bs))
     # V = t g: bound on g (see curvature_bound._zero_speed_bound)
     m = p - 1
     if m < 2:
@@ -303,11 +327,11 @@ def bound_from_taylor(gam, flip, k_free, comb, X, S, V, wk):  # pragma: no cover
     for i in range(m):
         gsum += abs(V[i, 0]) + abs(V[i, 1])
     nx, ns = _cross_and_norm(V, m, X, S, wk)
-    s_min = _bernstein_range(S, ns, comb, False)
+    s_min = _bernstein_range(S, 0, ns, p2b, False)
     y0 = X[0]
-    base = _bernstein_range(X[1:], nx - 1, comb, True)
+    base = _bernstein_range(X, 1, nx - 1, p2b, True)
     if s_min > 0.0:
-        base = base / s_min**1.5
+        base = base / (s_min * math.sqrt(s_min))
     else:
         base = np.inf
     if y0 == 0.0:
@@ -315,13 +339,13 @@ def bound_from_taylor(gam, flip, k_free, comb, X, S, V, wk):  # pragma: no cover
     if not s_min > 0.0:
         return np.inf
     k_ref = max(base, k_free)
-    t0 = abs(y0) / (_RTOL_TIP * k_ref * s_min**1.5)
+    t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
     if t0 * t0 * gsum <= _TIP:
         return max(base, 0.0) * (1.0 + _RTOL_TIP)
     return np.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _zero_start(V, p):  # pragma: no cover - compiled
     """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
     scale = 0.0
@@ -368,7 +392,8 @@ def _sampled(gam):  # pragma: no cover - compiled
                 ay = ay * tau + k * gam[k, 1]
             vx = vx * tau + gam[k, 0]
             vy = vy * tau + gam[k, 1]
-        sp3 = math.hypot(vx, vy) ** 3
+        sp = math.sqrt(vx * vx + vy * vy)
+        sp3 = sp * sp * sp
         if not sp3 > 0.0:
             return np.inf
         best = max(best, abs(vx * ay - vy * ax) / sp3)
@@ -396,56 +421,55 @@ def _tables(
     n = s_grid.shape[0] - 1
     m = w.shape[0] - 1
     nn = nodes.shape[0]
-    # --- u(s) on the grid: the base class's Hermite model, three Newton steps
+    # --- u(s) on the grid: the base class's Hermite model of s(u) on each node interval
+    # (a cubic in t = (u - lo) / (hi - lo)), three Newton steps from linear interpolation
     u = np.empty(n + 1)
     i = 0
+    ic = -1
+    s0 = c1 = c2 = c3 = lo = hn = 0.0
     for q in range(n + 1):
         ss = min(max(s_grid[q], 0.0), s_nodes[nn - 1])
         while i + 1 < nn and s_nodes[i + 1] <= ss:
             i += 1
-        ic = min(i, nn - 2)
-        ds = s_nodes[ic + 1] - s_nodes[ic]
-        frac = (ss - s_nodes[ic]) / ds if ds > 0 else 0.0
-        lo = nodes[ic]
-        hi = nodes[ic + 1]
-        uq = lo + frac * (hi - lo)
-        hn = hi - lo
-        for _ in range(3):
-            t = (uq - lo) / hn if hn > 0 else 0.0
-            t2 = t * t
-            t3 = t * t * t
-            f = (
-                (2 * t3 - 3 * t2 + 1) * s_nodes[ic]
-                + (t3 - 2 * t2 + t) * hn * v_nodes[ic]
-                + (-2 * t3 + 3 * t2) * s_nodes[ic + 1]
-                + (t3 - t2) * hn * v_nodes[ic + 1]
-            ) - ss
-            hs = hn if hn > 0 else 1.0
-            df = (
-                (6 * t2 - 6 * t) * s_nodes[ic] / hs
-                + (3 * t2 - 4 * t + 1) * v_nodes[ic]
-                + (-6 * t2 + 6 * t) * s_nodes[ic + 1] / hs
-                + (3 * t2 - 2 * t) * v_nodes[ic + 1]
-            )
-            step = f / df if df > 0 else 0.0
-            uq = min(max(uq - step, lo), hi)
-        u[q] = uq
+        if min(i, nn - 2) != ic:
+            ic = min(i, nn - 2)
+            s0 = s_nodes[ic]
+            d = s_nodes[ic + 1] - s0
+            lo = nodes[ic]
+            hn = nodes[ic + 1] - lo
+            c1 = hn * v_nodes[ic]
+            e1 = hn * v_nodes[ic + 1]
+            c2 = 3.0 * d - 2.0 * c1 - e1
+            c3 = -2.0 * d + c1 + e1
+            inv_d = 1.0 / d if d > 0 else 0.0
+        t = (ss - s0) * inv_d
+        if hn > 0:
+            for _ in range(3):
+                f = (s0 - ss) + t * (c1 + t * (c2 + t * c3))
+                df = c1 + t * (2.0 * c2 + 3.0 * c3 * t)
+                if df > 0:
+                    t = min(max(t - f / df, 0.0), 1.0)
+        u[q] = lo + t * hn
     u[0] = w[0]
     u[n] = w[m]
-    # --- curvature and heading at the nodes
+    # --- curvature and heading at the nodes (u is non-decreasing: a moving piece index)
     kappa = np.empty(n + 1)
     theta = np.empty(n + 1)
     still = False
+    j = 0
     for q in range(n + 1):
-        j = np.searchsorted(w, u[q], side="right") - 1
-        j = min(max(j, 0), m - 1)
+        uq = u[q]
+        while j + 1 < m and w[j + 1] <= uq:
+            j += 1
+        while j > 0 and w[j] > uq:
+            j -= 1
         pm = 0.5 * (w[j] + w[j + 1])
         ph = 0.5 * (w[j + 1] - w[j])
-        x = (u[q] - pm) / ph
+        x = (uq - pm) / ph
         vx, vy = _poly_d1(coef, j, x)
         ax, ay = _poly_d2(coef, j, x, ph)
-        sp = math.hypot(vx, vy)
-        sp3 = sp**3
+        sp = math.sqrt(vx * vx + vy * vy)
+        sp3 = sp * sp * sp
         kappa[q] = (vx * ay - vy * ax) / sp3 if sp3 > 0 else np.inf
         theta[q] = math.atan2(vy, vx)
         if sp <= still_speed:
@@ -477,7 +501,7 @@ def _interval_bounds(
     """``interval_kappa_max`` on the pieces' polynomials: bound per grid interval (1/m)."""
     m = w.shape[0] - 1
     p = coef.shape[1]
-    comb = _binomials(2 * p + 2)
+    p2b, shift = matrices(p)
     X, S, V, wk = workspace(p)
     gam = np.empty((p, 2))
     cap0 = speed_cap(0.0, limits)
@@ -510,7 +534,7 @@ def _interval_bounds(
         n_split = 0
         for i in range(cnt):
             _taylor(coef, lpc[i], w, la[i], lb[i], gam)
-            k_b = bound_from_taylor(gam, flip[i], k_free, comb, X, S, V, wk)
+            k_b = bound_from_taylor(gam, flip[i], k_free, p2b, shift, X, S, V, wk)
             k_s = _sampled(gam)
             kb[i] = max(k_b, k_s)
             if k_b > k_free and (

@@ -21,7 +21,7 @@ _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
 _REST_V = 1e-12  # m/s: a speed this low with a = 0 is rest (round-off of a stop)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def advance(s, v, a, j, t):
     """State after ``t`` seconds of constant jerk ``j`` from ``(s, v, a)``."""
     return (
@@ -52,7 +52,7 @@ def build_table(ci):
     return st, lg
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
     n = st.shape[1]
@@ -74,7 +74,7 @@ def range_min(st, lg, h, sa, sb):
     return x if x < y else y
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
     if s0 >= length:
@@ -166,7 +166,7 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def brake_times(v, a, vt, j, amax):
     """Time-optimal jerk-limited change from ``(v, a)`` down to ``(vt, 0)``.
 
@@ -194,7 +194,7 @@ def brake_times(v, a, vt, j, amax):
     return t1, t2, amax / j, 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def brake_end(s, v, a, t1, t2, t3, j):
     """Arc length at the end of the ``brake_times`` phases."""
     s, v, a = advance(s, v, a, -j, t1)
@@ -331,34 +331,41 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                 ta = max(0.0, (amax - a) / u)
             elif u < 0.0 and a + u * dt < -amax:
                 ta = max(0.0, (-amax - a) / u)
-            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
-                continue
             sa, va, aa = advance(s, v, a, u, ta)
             if ta < dt:
                 aa = amax if u > 0.0 else -amax
-                if not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
-                    continue
                 s1, v1, a1 = advance(sa, va, aa, 0.0, dt - ta)
             else:
                 s1, v1, a1 = sa, va, aa
             if u == uz or abs(a1) < 1e-9:
                 a1 = 0.0
+            # the end test (closed form; the stop profile's end is stop_ok's) before the cap
+            # tests: a candidate that fails it can only set safe_noend
+            end_ok = s1 < length
+            s_stop = s1
+            if end_ok:
+                b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
+                s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
+                if v_end == 0.0:
+                    end_ok = s_stop <= length
+                else:
+                    b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
+                    if kind != 1:
+                        end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
+            if safe_noend and not end_ok:
+                continue
+            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
+                continue
+            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
+                continue
             if s1 >= length:
                 safe_noend = True
                 continue
-            ok, s_stop = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)
-            if not ok:
-                continue
-            if v_end == 0.0:
-                end_ok = s_stop <= length
-            else:
-                b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
-                if kind == 1:
-                    end_ok = s1 < length
-                else:
-                    end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
             if not end_ok:
-                safe_noend = True
+                if not safe_noend:
+                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]
+                continue
+            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]:
                 continue
             if np.isnan(safe):
                 safe = u
