@@ -128,7 +128,7 @@ def polynomial_tables(
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def speed_cap(k, limits):  # pragma: no cover - compiled
     """``Robot.speed_cap`` of ``|k|`` (1/m) for ``limits = (v_max, a_lat, omega, tw, wv)``.
 
@@ -170,7 +170,7 @@ def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     return ax / half, ay / half
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover - compiled
     """``ParametricCurve.s_at_u`` (m) at ``u`` inside polynomial piece ``piece``."""
     nn = nodes.shape[0]
@@ -297,7 +297,12 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no
     :func:`matrices`; ``X``, ``S``, ``V``, ``wk`` are work arrays (:func:`workspace`).
     The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`.
     """
-    p = gam.shape[0]
+    return _bound(gam, gam.shape[0], flip, k_free, p2b, shift, X, S, V, wk)
+
+
+@njit(cache=True, inline="always")
+def _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover - compiled
+    """:func:`bound_from_taylor` for ``p`` rows of ``gam`` (a constant where inlined)."""
     if p < 2:
         return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
@@ -355,10 +360,9 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True)
-def _taylor(coef, piece, w, a, b, gam):  # pragma: no cover - compiled
+@njit(cache=True, inline="always")
+def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
-    p = coef.shape[1]
     pm = 0.5 * (w[piece] + w[piece + 1])
     ph = 0.5 * (w[piece + 1] - w[piece])
     hh = b - a
@@ -376,10 +380,9 @@ def _taylor(coef, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True)
-def _sampled(gam):  # pragma: no cover - compiled
+@njit(cache=True, inline="always")
+def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
-    p = gam.shape[0]
     best = 0.0
     for tau in (-0.49, 0.0, 0.49):
         vx = 0.0
@@ -494,6 +497,13 @@ def _tables(
     return u, kappa, theta, still, kmax, cap
 
 
+@njit(cache=True, inline="always")
+def _evaluate(coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, wk, gam):  # pragma: no cover - compiled
+    """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``."""
+    _taylor(coef, p, piece, w, a, b, gam)
+    return _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk), _sampled(gam, p)
+
+
 @njit(cache=True)
 def _interval_bounds(
     w, coef, nodes, s_nodes, h, n, zero_speed, limits, k_grid, gl_x, gl_w, rtol
@@ -533,9 +543,16 @@ def _interval_bounds(
         kb = np.empty(cnt)
         n_split = 0
         for i in range(cnt):
-            _taylor(coef, lpc[i], w, la[i], lb[i], gam)
-            k_b = bound_from_taylor(gam, flip[i], k_free, p2b, shift, X, S, V, wk)
-            k_s = _sampled(gam)
+            # the degree as a constant in the common cases: loops of known length
+            if p == 3:
+                k_b, k_s = _evaluate(coef, 3, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
+                                     shift, X, S, V, wk, gam)  # fmt: skip
+            elif p == 5:
+                k_b, k_s = _evaluate(coef, 5, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
+                                     shift, X, S, V, wk, gam)  # fmt: skip
+            else:
+                k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
+                                     shift, X, S, V, wk, gam)  # fmt: skip
             kb[i] = max(k_b, k_s)
             if k_b > k_free and (
                 lsb[i] - lsa[i] > h
