@@ -498,7 +498,9 @@ def _tables(
 
 
 @njit(cache=True, inline="always")
-def _evaluate(coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, wk, gam):  # pragma: no cover - compiled
+def _evaluate(
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, wk, gam
+):  # pragma: no cover - compiled
     """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``."""
     _taylor(coef, p, piece, w, a, b, gam)
     return _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk), _sampled(gam, p)

@@ -260,10 +260,16 @@ def _push(buf, n, t, s, v, a, j):
 
 
 @njit(cache=True)
-def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps):
+def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
+           cruise=True):  # fmt: skip
     """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
 
-    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``.
+    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``. With ``cruise``, a
+    step that holds the speed (``a = 0`` before and after, jerk 0) is repeated without
+    re-testing while every query of the step (its pieces, its stop profile and the end test,
+    within :func:`cruise_reach` of the state) lies on one run of equal caps ahead: each
+    repeat would see the same caps and make the same choice, so the phases are the same as
+    with ``cruise=False``.
 
     Returns
     -------
@@ -406,7 +412,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
             bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
-            if u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
+            if cruise and u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
                 # a cruise step: repeat it while every query lies on one run of equal caps
                 if v != reach_v:
                     reach = cruise_reach(v, v_end, amax, j, dt) + 2.0 * h

@@ -200,7 +200,7 @@ def _run_greedy(
     max_steps = int(min(5e6, 100.0 * (t_lower + 10.0 * (vtop / amax + amax / jmax)) / dt + 1000))
     phases, bounds, status = greedy.greedy(
         table.st, table.lg, h, length, table.min_s, table.min_v, v_start, a_start, v_end, amax,
-        jmax, dt, N_CAND, T_MIN, max_steps,
+        jmax, dt, N_CAND, T_MIN, max_steps, True,
     )  # fmt: skip
     if status == greedy.START_INFEASIBLE:
         raise TimingError(
