@@ -545,12 +545,9 @@ def _interval_bounds(
         kb = np.empty(cnt)
         n_split = 0
         for i in range(cnt):
-            # the degree as a constant in the common cases: loops of known length
+            # the degree as a constant for cubic pieces (the smoother's): loops of known length
             if p == 3:
                 k_b, k_s = _evaluate(coef, 3, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
-                                     shift, X, S, V, wk, gam)  # fmt: skip
-            elif p == 5:
-                k_b, k_s = _evaluate(coef, 5, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
                                      shift, X, S, V, wk, gam)  # fmt: skip
             else:
                 k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
