@@ -246,6 +246,16 @@ def cruise_reach(v, v_end, amax, j, dt):
 
 
 @njit(cache=True)
+def _reserve(buf, need):
+    """``buf`` or a copy with room for at least ``need`` rows (doubling)."""
+    if need <= buf.shape[0]:
+        return buf
+    nb = np.empty((max(need, 2 * buf.shape[0]), buf.shape[1]))
+    nb[: buf.shape[0]] = buf
+    return nb
+
+
+@njit(cache=True)
 def _push(buf, n, t, s, v, a, j):
     if n == buf.shape[0]:
         nb = np.empty((2 * n, buf.shape[1]))
@@ -419,12 +429,29 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                     reach_v = v
                 i0 = min(max(int(s_prev / h), 0), n_int - 1)
                 lim = min(run_end[i0] * h, length - h) - reach
+                if s_prev <= lim and s <= lim:  # room for the repeats, then rows in place
+                    need = int((lim - s) / (v * dt)) + 2
+                    phases = _reserve(phases, n_ph + need)
+                    bounds = _reserve(bounds, n_b + need)
                 while s_prev <= lim and s <= lim and steps < max_steps:
+                    if n_ph == phases.shape[0] or n_b == bounds.shape[0]:
+                        phases = _reserve(phases, n_ph + 1)
+                        bounds = _reserve(bounds, n_b + 1)
                     steps += 1
-                    phases, n_ph = _push(phases, n_ph, t, s, v, 0.0, u)
+                    phases[n_ph, 0] = t
+                    phases[n_ph, 1] = s
+                    phases[n_ph, 2] = v
+                    phases[n_ph, 3] = 0.0
+                    phases[n_ph, 4] = u
+                    n_ph += 1
                     s, v, a = advance(s, v, 0.0, u, dt)
                     t += dt
-                    bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+                    bounds[n_b, 0] = t
+                    bounds[n_b, 1] = s
+                    bounds[n_b, 2] = v
+                    bounds[n_b, 3] = a
+                    bounds[n_b, 4] = float(n_ph)
+                    n_b += 1
             continue
         if safe_noend:
             status = OK_FINISH
