@@ -92,6 +92,7 @@ def test_compiled_tables_equal_the_reference_and_cover_samples(pts, degree):
     ref = interval_kappa_max(c, h, n, degree, ROBOT.speed_cap)
     np.testing.assert_allclose(tab.kmax, ref, rtol=1e-12, atol=0.0)
     np.testing.assert_array_equal(tab.cap, ROBOT.speed_cap(tab.kmax))
+    np.testing.assert_array_equal(tab.end_caps, ROBOT.speed_cap(tab.kappa[[0, 1, n - 1, n]]))
     u = c.u_at_s(s, exact=False)
     u[0], u[-1] = c.domain
     np.testing.assert_allclose(tab.u, u, rtol=0.0, atol=1e-12 * (c.domain[1] - c.domain[0]))

@@ -53,6 +53,8 @@ class PolynomialTables(NamedTuple):
         unbounded).
     cap : ndarray, shape (n,)
         ``Robot.speed_cap(kmax)`` (m/s).
+    end_caps : ndarray, shape (4,)
+        ``Robot.speed_cap(kappa)`` at the nodes ``0, 1, n - 1, n`` (m/s).
     """
 
     u: np.ndarray
@@ -60,6 +62,7 @@ class PolynomialTables(NamedTuple):
     theta: np.ndarray
     kmax: np.ndarray
     cap: np.ndarray
+    end_caps: np.ndarray
 
 
 def polynomial_tables(
@@ -114,7 +117,7 @@ def polynomial_tables(
     wv = math.inf if robot.wheel_v_max is None else float(robot.wheel_v_max)
     limits = np.array([robot.v_max, robot.a_lat_max, robot.omega_max, tw, wv], dtype=float)
     h = float(s_grid[-1]) / (s_grid.size - 1)
-    u, kappa, theta, still, kmax, cap = _tables(
+    u, kappa, theta, still, kmax, cap, end_caps = _tables(
         w, coef, nodes, s_nodes, v_nodes, np.ascontiguousarray(s_grid, dtype=float), h,
         STILL_SPEED_RATIO * curve.mean_speed(), _ZERO * curve.length / (hi - lo), limits,
         _K_GRID, _GL_X, _GL_W, float(rtol),
@@ -125,7 +128,7 @@ def polynomial_tables(
         mask = np.hypot(raw[:, 0], raw[:, 1]) <= STILL_SPEED_RATIO * curve.mean_speed()
         th[mask] = curve.heading(u[mask])
         theta = np.unwrap(th)
-    return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap)
+    return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
 
 
 @njit(cache=True, inline="always")
@@ -494,7 +497,10 @@ def _tables(
     cap = np.empty(n)
     for q in range(n):
         cap[q] = speed_cap(kmax[q], limits)
-    return u, kappa, theta, still, kmax, cap
+    end_caps = np.empty(4)  # the cap at the nodes 0, 1, n - 1 and n
+    for q, node in enumerate((0, 1, n - 1, n)):
+        end_caps[q] = speed_cap(kappa[node], limits)
+    return u, kappa, theta, still, kmax, cap, end_caps
 
 
 @njit(cache=True, inline="always")

@@ -114,7 +114,7 @@ def build_cap_table(
     degree = getattr(curve, "polynomial_degree", None)
     fast = None if degree is None else polynomial_tables(curve, robot, s_nodes, int(degree))
     if fast is not None:  # the compiled path: node tables and bounds in one call
-        u_nodes, kappa, theta, kmax, ci = fast
+        u_nodes, kappa, theta, kmax, ci, raw_kappa = fast
         ends = np.array([0, 1, n_int - 1, n_int])
     else:
         u_nodes = _table_u_at_s(curve, s_nodes)
@@ -122,7 +122,7 @@ def build_cap_table(
         kappa, theta = _curvature_heading(curve, u_nodes)
         theta = np.unwrap(theta)
         ends = np.arange(n_int + 1)
-    raw_kappa = np.asarray(robot.speed_cap(kappa[ends]), dtype=float)
+        raw_kappa = np.asarray(robot.speed_cap(kappa), dtype=float)
     raw = raw_kappa  # the cap at the nodes (all of them, or only the first and last two)
     zone = None
     if speed_limits is not None:
