@@ -3,8 +3,9 @@
 :func:`build_cap_table` tabulates ``cap(s) = Robot.speed_cap(kappa(s))`` (with speed-limit
 zones as one more cap) on a uniform arc-length grid of spacing at most 2.5 mm, each value a
 lower bound of the cap over its whole interval (rigorous for curves with a
-``polynomial_degree``, by :func:`trajopt.curvature_bound.interval_kappa_max`; sampled with
-refinement otherwise). The :class:`CapTable` record carries the values, their sparse table
+``polynomial_degree``: the method of :func:`trajopt.curvature_bound.interval_kappa_max`,
+compiled with the grid's ``u(s)`` and heading in :mod:`trajopt.timing.cap_kernel` for the
+library's curves; sampled with refinement otherwise). The :class:`CapTable` record carries the values, their sparse table
 for O(1) range minima, and the cap's local minima that the greedy slows down for.
 """
 
