@@ -131,7 +131,7 @@ def polynomial_tables(
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def speed_cap(k, limits):  # pragma: no cover - compiled
     """``Robot.speed_cap`` of ``|k|`` (1/m) for ``limits = (v_max, a_lat, omega, tw, wv)``.
 
@@ -173,7 +173,7 @@ def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     return ax / half, ay / half
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover - compiled
     """``ParametricCurve.s_at_u`` (m) at ``u`` inside polynomial piece ``piece``."""
     nn = nodes.shape[0]
@@ -303,9 +303,9 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no
     return _bound(gam, gam.shape[0], flip, k_free, p2b, shift, X, S, V, wk)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover - compiled
-    """:func:`bound_from_taylor` for ``p`` rows of ``gam`` (a constant where inlined)."""
+    """:func:`bound_from_taylor` for the ``p`` rows of ``gam``."""
     if p < 2:
         return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
@@ -363,7 +363,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -383,7 +383,7 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -503,7 +503,7 @@ def _tables(
     return u, kappa, theta, still, kmax, cap, end_caps
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _evaluate(
     coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, wk, gam
 ):  # pragma: no cover - compiled
@@ -551,13 +551,8 @@ def _interval_bounds(
         kb = np.empty(cnt)
         n_split = 0
         for i in range(cnt):
-            # the degree as a constant for cubic pieces (the smoother's): loops of known length
-            if p == 3:
-                k_b, k_s = _evaluate(coef, 3, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
-                                     shift, X, S, V, wk, gam)  # fmt: skip
-            else:
-                k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b,
-                                     shift, X, S, V, wk, gam)  # fmt: skip
+            k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                                 X, S, V, wk, gam)  # fmt: skip
             kb[i] = max(k_b, k_s)
             if k_b > k_free and (
                 lsb[i] - lsa[i] > h
