@@ -11,6 +11,9 @@ Run::
 
     python benchmarks/bench_timing.py            # ~60 Moving AI scenarios + paper scene
     python benchmarks/bench_timing.py --limit 20
+
+``benchmarks/compare_timing.py`` compares the compute time and the durations with an
+earlier commit's timing on the same curves.
 """
 
 from __future__ import annotations
@@ -190,6 +193,7 @@ def main() -> None:
         greedy = np.array([r["greedy"] / r["topp"] for r in sel])
         t_ours = np.array([r["t_ours"] for r in sel])
         per10 = np.array([r["t_min"] * 10.0 / r["length"] for r in sel])
+        per_s = np.array([r["t_min"] / r["ours"] for r in sel])  # per s of trajectory
         t_min = np.array([r["t_min"] for r in sel])
         print(
             f"\n{label} ({len(sel)} paths, median length "
@@ -210,6 +214,10 @@ def main() -> None:
         )
         print(f"  compute time ours, best of runs median {1e3 * np.median(t_min):.2f} ms")
         print(f"  best-of-runs time per 10 m      median {1e3 * np.median(per10):.2f} ms")
+        print(
+            f"  best-of-runs time per s of traj median {1e3 * np.median(per_s):.4f} ms  "
+            f"max {1e3 * per_s.max():.4f} ms"
+        )
         print(
             f"  compute time TOPP-RA            median "
             f"{1e3 * np.median([r['t_topp'] for r in sel]):.2f} ms"

@@ -56,6 +56,12 @@ BENCHES: tuple[Bench, ...] = (
           "Compute time and duration of `time_parameterize` against TOPP-RA's jerk-free "
           "time-optimal profile on the same paths.",
           ("--limit", "20", "--repeat", "3")),
+    Bench("timing_compare", "Timing: compute time against the timing before its speed-up",
+          "compare_timing.py",
+          "`time_parameterize` of this tree against commit 1510844 (before issue #19's faster "
+          "timing) on the same saved curves, alternating fresh processes: compute time per "
+          "second of trajectory and the relative difference of the durations.",
+          ("--limit", "20", "--repeat", "3", "--rounds", "2")),
     Bench("smoother", "Smoother: corridor-constrained B-spline", "bench_smoother.py",
           "Warm solve and first-build times, success and clearance of the smoother, "
           "against a plain least-squares B-spline on the same paths.",

@@ -20,8 +20,13 @@ Method
    :func:`trajopt.curvature_bound.interval_kappa_max` bounds ``|kappa|`` on the curve's
    polynomial pieces by Bernstein coefficients, bisects them until the bound is tight
    (0.1 % of the cap) or harmless, and maps each piece to the intervals its exact arc-length
-   range touches. Any other curve is sampled: an interval gets the smaller cap at its ends
-   minus a second-difference bound on a convex dip, and is resampled at 16 inner points
+   range touches. For the library's curves (the base class's arc length and geometry, a
+   ``Robot``'s own ``speed_cap``) one compiled call does this together with the grid's
+   ``u(s)``, heading and curvature (:func:`trajopt.timing.cap_kernel.polynomial_tables`,
+   from the Taylor coefficients of each piece's velocity; ``interval_kappa_max`` is the NumPy
+   form of the same method and the path for other curves). Any other curve is sampled: an
+   interval gets the smaller cap at its ends minus a second-difference bound on a convex
+   dip, and is resampled at 16 inner points
    (with a golden-section search next to the lowest) where that dip is large, or where the
    heading turned across it or a second-difference bound on ``|kappa|`` says the curvature
    may peak inside. A sparse table answers "minimum cap over ``[s_a, s_b]``" in O(1).
@@ -37,7 +42,9 @@ Method
    distance, the time-optimal slow-down to that speed (with ``a = 0``) ends before it. The
    greedy takes the largest ``u`` passing both, else the largest safe one, else follows its
    own (safe) stop profile; at rest it only considers ``u > 0`` (a zero jerk there would idle
-   forever). When only the end condition blocks it, one ruckig position call to
+   forever). A cruise step (``a = 0``, jerk 0) is repeated without re-testing while all
+   that its tests query lies on one run of equal caps (the same caps give the same choice:
+   the phases are those of testing every step). When only the end condition blocks it, one ruckig position call to
    ``(L, v_end, 0)`` finishes the motion, its ``max_velocity`` the lowest cap ahead (or the
    state's own peak speed when that call breaks the cap).
 3. **Compress.** Knots at the greedy's speed minima (states with ``a = 0``); between two
@@ -53,7 +60,8 @@ sampling's resolution for other curves. On the benchmark paths the durations are
 jerk-free time-optimal answer (``benchmarks/bench_timing.py``).
 
 Modules: :mod:`~trajopt.timing.parameterize` (the entry point),
-:mod:`~trajopt.timing.cap_table` (stage 1), :mod:`~trajopt.timing.greedy` (the compiled
+:mod:`~trajopt.timing.cap_table` (stage 1) with :mod:`~trajopt.timing.cap_kernel` (its
+compiled path), :mod:`~trajopt.timing.greedy` (the compiled
 kernels of stage 2), :mod:`~trajopt.timing.compress` (stages 3 and 4) and
 :mod:`~trajopt.timing.ruckig_profile` (the ruckig wrapper, also used by the stop-and-turn
 fallback).

@@ -3,8 +3,9 @@
 :func:`build_cap_table` tabulates ``cap(s) = Robot.speed_cap(kappa(s))`` (with speed-limit
 zones as one more cap) on a uniform arc-length grid of spacing at most 2.5 mm, each value a
 lower bound of the cap over its whole interval (rigorous for curves with a
-``polynomial_degree``, by :func:`trajopt.curvature_bound.interval_kappa_max`; sampled with
-refinement otherwise). The :class:`CapTable` record carries the values, their sparse table
+``polynomial_degree``: the method of :func:`trajopt.curvature_bound.interval_kappa_max`,
+compiled with the grid's ``u(s)`` and heading in :mod:`trajopt.timing.cap_kernel` for the
+library's curves; sampled with refinement otherwise). The :class:`CapTable` record carries the values, their sparse table
 for O(1) range minima, and the cap's local minima that the greedy slows down for.
 """
 
@@ -21,6 +22,7 @@ from trajopt.errors import TimingError
 from trajopt.robot import Robot
 from trajopt.speed_limits import SpeedLimits
 from trajopt.timing import greedy
+from trajopt.timing.cap_kernel import polynomial_tables
 
 __all__ = ["CapTable", "T_MIN", "build_cap_table"]
 
@@ -110,16 +112,23 @@ def build_cap_table(
     n_int = int(np.clip(math.ceil(length / GRID_SPACING), MIN_INTERVALS, MAX_INTERVALS))
     h = length / n_int
     s_nodes = np.linspace(0.0, length, n_int + 1)
-    u_nodes = _table_u_at_s(curve, s_nodes)
-    u_nodes[0], u_nodes[-1] = curve.domain
-    kappa, theta = _curvature_heading(curve, u_nodes)
-    theta = np.unwrap(theta)
-    raw_kappa = np.asarray(robot.speed_cap(kappa), dtype=float)
-    raw = raw_kappa
+    degree = getattr(curve, "polynomial_degree", None)
+    fast = None if degree is None else polynomial_tables(curve, robot, s_nodes, int(degree))
+    if fast is not None:  # the compiled path: node tables and bounds in one call
+        u_nodes, kappa, theta, kmax, ci, raw_kappa = fast
+        ends = np.array([0, 1, n_int - 1, n_int])
+    else:
+        u_nodes = _table_u_at_s(curve, s_nodes)
+        u_nodes[0], u_nodes[-1] = curve.domain
+        kappa, theta = _curvature_heading(curve, u_nodes)
+        theta = np.unwrap(theta)
+        ends = np.arange(n_int + 1)
+        raw_kappa = np.asarray(robot.speed_cap(kappa), dtype=float)
+    raw = raw_kappa  # the cap at the nodes (all of them, or only the first and last two)
     zone = None
     if speed_limits is not None:
         zone = _zone_caps(curve, u_nodes, h, speed_limits, robot.v_max)
-        raw = np.minimum(raw, np.minimum(np.r_[zone[0], zone], np.r_[zone, zone[-1]]))
+        raw = np.minimum(raw, np.minimum(np.r_[zone[0], zone], np.r_[zone, zone[-1]])[ends])
     cap0 = float(raw[0])
     cap1 = float(raw[-1])
     if v_start > cap0 * (1.0 + 1e-12):
@@ -132,19 +141,18 @@ def build_cap_table(
             f"v_end={v_end:.6g} m/s exceeds the speed cap {cap1:.6g} m/s at s=L={length:.6g} m "
             f"(curvature {kappa[-1]:.6g} 1/m{_zone_note(zone, -1)})"
         )
-    degree = getattr(curve, "polynomial_degree", None)
-    if degree is not None:
+    if fast is None and degree is not None:
         kmax = interval_kappa_max(curve, h, n_int, int(degree), robot.speed_cap)
         ci = np.asarray(robot.speed_cap(kmax), dtype=float)
-        if not np.all(np.isfinite(kmax)):
-            i_inf = int(np.flatnonzero(~np.isfinite(kmax))[0])
-            raise TimingError(
-                f"the curvature is unbounded at s={i_inf * h:.6g} m (the parametric speed "
-                f"vanishes there: a cusp, or a zero-speed end where the curve turns): the "
-                f"speed cap is 0"
-            )
-    else:
+    elif fast is None:
         ci = _interval_caps(raw_kappa, curve, robot, s_nodes, kappa, theta)
+    if degree is not None and not np.all(np.isfinite(kmax)):
+        i_inf = int(np.flatnonzero(~np.isfinite(kmax))[0])
+        raise TimingError(
+            f"the curvature is unbounded at s={i_inf * h:.6g} m (the parametric speed "
+            f"vanishes there: a cusp, or a zero-speed end where the curve turns): the "
+            f"speed cap is 0"
+        )
     if zone is not None:
         ci = np.minimum(ci, zone)
     v_bound = max(v_start, v_end)

@@ -21,7 +21,7 @@ _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
 _REST_V = 1e-12  # m/s: a speed this low with a = 0 is rest (round-off of a stop)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def advance(s, v, a, j, t):
     """State after ``t`` seconds of constant jerk ``j`` from ``(s, v, a)``."""
     return (
@@ -52,7 +52,7 @@ def build_table(ci):
     return st, lg
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
     n = st.shape[1]
@@ -74,50 +74,82 @@ def range_min(st, lg, h, sa, sb):
     return x if x < y else y
 
 
+@njit(cache=True, inline="always")
+def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
+    """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
+    if s0 >= length:
+        return 0
+    s1, v1, a1 = advance(s0, v0, a0, j, t0)
+    vmax = v0 if v0 > v1 else v1
+    vmin = v0 if v0 < v1 else v1
+    peak = False
+    if a0 > 0.0 and a1 < 0.0:
+        pk = v0 - a0 * a0 / (2.0 * j)
+        if pk > vmax:
+            vmax = pk
+            peak = True
+    elif a0 < 0.0 and a1 > 0.0:
+        tr = v0 - a0 * a0 / (2.0 * j)
+        if tr < vmin:
+            vmin = tr
+    if vmin < -_NEG_V_TOL:
+        return 1
+    se = s1 if s1 < length else length
+    if se < s0:
+        se = s0
+    if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
+        return 0
+    # a point of the piece over the cap: the bisection would end there
+    if s1 < length and v1 > range_min(st, lg, h, s1, s1) + _CAP_TOL:
+        return 1
+    if v0 > range_min(st, lg, h, s0, s0) + _CAP_TOL:
+        return 1
+    if peak:
+        s_pk = advance(s0, v0, a0, j, -a0 / j)[0]
+        if s_pk < length and vmax > range_min(st, lg, h, s_pk, s_pk) + _CAP_TOL:
+            return 1
+    return 2
+
+
 @njit(cache=True)
 def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
     """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
     Conservative and exact on the grid: a piece passes when its speed maximum is below the
     minimum cap over the arc-length range it covers; otherwise it is bisected in time down
-    to ``tmin`` seconds.
+    to ``tmin`` seconds (the bisection stack is only allocated when the whole piece is
+    undecided).
     """
     if T <= 0.0:
         return True
+    res = _piece_test(st, lg, h, length, s, v, a, j, T)
+    if res != 2:
+        return res == 0
+    if T <= tmin:
+        return False
     stk = np.empty((96, 4))
-    stk[0, 0] = s
-    stk[0, 1] = v
-    stk[0, 2] = a
-    stk[0, 3] = T
-    top = 1
+    half = 0.5 * T
+    sm, vm, am = advance(s, v, a, j, half)
+    stk[0, 0] = sm
+    stk[0, 1] = vm
+    stk[0, 2] = am
+    stk[0, 3] = half
+    stk[1, 0] = s
+    stk[1, 1] = v
+    stk[1, 2] = a
+    stk[1, 3] = half
+    top = 2
     while top > 0:
         top -= 1
         s0 = stk[top, 0]
         v0 = stk[top, 1]
         a0 = stk[top, 2]
         t0 = stk[top, 3]
-        if s0 >= length:
+        res = _piece_test(st, lg, h, length, s0, v0, a0, j, t0)
+        if res == 0:
             continue
-        s1, v1, a1 = advance(s0, v0, a0, j, t0)
-        vmax = v0 if v0 > v1 else v1
-        vmin = v0 if v0 < v1 else v1
-        if a0 > 0.0 and a1 < 0.0:
-            pk = v0 - a0 * a0 / (2.0 * j)
-            if pk > vmax:
-                vmax = pk
-        elif a0 < 0.0 and a1 > 0.0:
-            tr = v0 - a0 * a0 / (2.0 * j)
-            if tr < vmin:
-                vmin = tr
-        if vmin < -_NEG_V_TOL:
+        if res == 1:
             return False
-        se = s1 if s1 < length else length
-        if se < s0:
-            se = s0
-        if vmax <= range_min(st, lg, h, s0, se) + _CAP_TOL:
-            continue
-        if s1 < length and v1 > range_min(st, lg, h, s1, s1) + _CAP_TOL:
-            return False  # the end of the piece is over the cap: bisection would end there
         if t0 <= tmin or top + 2 > stk.shape[0]:
             return False
         half = 0.5 * t0
@@ -134,7 +166,7 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def brake_times(v, a, vt, j, amax):
     """Time-optimal jerk-limited change from ``(v, a)`` down to ``(vt, 0)``.
 
@@ -162,7 +194,7 @@ def brake_times(v, a, vt, j, amax):
     return t1, t2, amax / j, 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def brake_end(s, v, a, t1, t2, t3, j):
     """Arc length at the end of the ``brake_times`` phases."""
     s, v, a = advance(s, v, a, -j, t1)
@@ -192,6 +224,38 @@ def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin):
 
 
 @njit(cache=True)
+def cruise_reach(v, v_end, amax, j, dt):
+    """Farthest arc length (m) a greedy step from ``(s, v, a = 0)`` queries, less ``s``.
+
+    The largest jerk ``j`` gives the farthest step end and, from there, the longest brake to
+    rest and to ``v_end``: every query of the step (its pieces, the stop profile, the end
+    test) lies within that distance of ``s``.
+    """
+    ta = dt
+    if j * dt > amax:
+        ta = amax / j
+    s1, v1, a1 = advance(0.0, v, 0.0, j, ta)
+    if ta < dt:
+        s1, v1, a1 = advance(s1, v1, amax, 0.0, dt - ta)
+    t1, t2, t3, _ = brake_times(v1, a1, 0.0, j, amax)
+    far = brake_end(s1, v1, a1, t1, t2, t3, j)
+    t1, t2, t3, kind = brake_times(v1, a1, v_end, j, amax)
+    if kind != 1:
+        far = max(far, brake_end(s1, v1, a1, t1, t2, t3, j))
+    return max(far, s1)
+
+
+@njit(cache=True)
+def _reserve(buf, need):
+    """``buf`` or a copy with room for at least ``need`` rows (doubling)."""
+    if need <= buf.shape[0]:
+        return buf
+    nb = np.empty((max(need, 2 * buf.shape[0]), buf.shape[1]))
+    nb[: buf.shape[0]] = buf
+    return nb
+
+
+@njit(cache=True)
 def _push(buf, n, t, s, v, a, j):
     if n == buf.shape[0]:
         nb = np.empty((2 * n, buf.shape[1]))
@@ -206,10 +270,16 @@ def _push(buf, n, t, s, v, a, j):
 
 
 @njit(cache=True)
-def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps):
+def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
+           cruise=True):  # fmt: skip
     """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
 
-    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``.
+    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``. With ``cruise``, a
+    step that holds the speed (``a = 0`` before and after, jerk 0) is repeated without
+    re-testing while every query of the step (its pieces, its stop profile and the end test,
+    within :func:`cruise_reach` of the state) lies on one run of equal caps ahead: each
+    repeat would see the same caps and make the same choice, so the phases are the same as
+    with ``cruise=False``.
 
     Returns
     -------
@@ -236,7 +306,17 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     ptr = 0
     cands = np.empty(ncand + 1)
     status = MAX_STEPS
-    for _ in range(max_steps):
+    # last interval of the run of equal caps holding each interval (for cruise steps)
+    n_int = st.shape[1]
+    run_end = np.empty(n_int, np.int64)
+    run_end[n_int - 1] = n_int - 1
+    for i in range(n_int - 2, -1, -1):
+        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
+    reach = -1.0  # cruise reach of the speed held last (m); < 0: not computed
+    reach_v = -1.0
+    steps = 0
+    while steps < max_steps:
+        steps += 1
         while ptr < nmin and min_s[ptr] <= s:
             ptr += 1
         # candidate jerks, descending, plus the one that zeroes a at the step end
@@ -267,34 +347,41 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                 ta = max(0.0, (amax - a) / u)
             elif u < 0.0 and a + u * dt < -amax:
                 ta = max(0.0, (-amax - a) / u)
-            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
-                continue
             sa, va, aa = advance(s, v, a, u, ta)
             if ta < dt:
                 aa = amax if u > 0.0 else -amax
-                if not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
-                    continue
                 s1, v1, a1 = advance(sa, va, aa, 0.0, dt - ta)
             else:
                 s1, v1, a1 = sa, va, aa
             if u == uz or abs(a1) < 1e-9:
                 a1 = 0.0
+            # the end test (closed form; the stop profile's end is stop_ok's) before the cap
+            # tests: a candidate that fails it can only set safe_noend
+            end_ok = s1 < length
+            s_stop = s1
+            if end_ok:
+                b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
+                s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
+                if v_end == 0.0:
+                    end_ok = s_stop <= length
+                else:
+                    b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
+                    if kind != 1:
+                        end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
+            if safe_noend and not end_ok:
+                continue
+            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
+                continue
+            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
+                continue
             if s1 >= length:
                 safe_noend = True
                 continue
-            ok, s_stop = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)
-            if not ok:
-                continue
-            if v_end == 0.0:
-                end_ok = s_stop <= length
-            else:
-                b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
-                if kind == 1:
-                    end_ok = s1 < length
-                else:
-                    end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
             if not end_ok:
-                safe_noend = True
+                if not safe_noend:
+                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]
+                continue
+            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]:
                 continue
             if np.isnan(safe):
                 safe = u
@@ -314,6 +401,8 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             chosen = safe
         if not np.isnan(chosen):
             u = chosen
+            s_prev = s
+            at_zero = a == 0.0
             ta = dt
             if u > 0.0 and a + u * dt > amax:
                 ta = max(0.0, (amax - a) / u)
@@ -333,6 +422,36 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
             bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+            if cruise and u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
+                # a cruise step: repeat it while every query lies on one run of equal caps
+                if v != reach_v:
+                    reach = cruise_reach(v, v_end, amax, j, dt) + 2.0 * h
+                    reach_v = v
+                i0 = min(max(int(s_prev / h), 0), n_int - 1)
+                lim = min(run_end[i0] * h, length - h) - reach
+                if s_prev <= lim and s <= lim:  # room for the repeats, then rows in place
+                    need = int((lim - s) / (v * dt)) + 2
+                    phases = _reserve(phases, n_ph + need)
+                    bounds = _reserve(bounds, n_b + need)
+                while s_prev <= lim and s <= lim and steps < max_steps:
+                    if n_ph == phases.shape[0] or n_b == bounds.shape[0]:
+                        phases = _reserve(phases, n_ph + 1)
+                        bounds = _reserve(bounds, n_b + 1)
+                    steps += 1
+                    phases[n_ph, 0] = t
+                    phases[n_ph, 1] = s
+                    phases[n_ph, 2] = v
+                    phases[n_ph, 3] = 0.0
+                    phases[n_ph, 4] = u
+                    n_ph += 1
+                    s, v, a = advance(s, v, 0.0, u, dt)
+                    t += dt
+                    bounds[n_b, 0] = t
+                    bounds[n_b, 1] = s
+                    bounds[n_b, 2] = v
+                    bounds[n_b, 3] = a
+                    bounds[n_b, 4] = float(n_ph)
+                    n_b += 1
             continue
         if safe_noend:
             status = OK_FINISH

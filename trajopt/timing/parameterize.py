@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 import time
 from typing import Any
 
@@ -29,6 +30,21 @@ __all__ = ["time_parameterize"]
 _log = logging.getLogger("trajopt.timing")
 
 N_CAND = 9  # jerk candidates j, 0.75 j, ..., -j
+
+_RUCKIG = threading.local()  # one RuckigProfile per thread and (a_max, j_max)
+
+
+def _ruckig(amax: float, jmax: float) -> RuckigProfile:
+    """Return the calling thread's :class:`RuckigProfile` for these limits (built once)."""
+    cache = getattr(_RUCKIG, "profiles", None)
+    if cache is None:
+        cache = _RUCKIG.profiles = {}
+    rk = cache.get((amax, jmax))
+    if rk is None:
+        if len(cache) > 16:
+            cache.clear()
+        rk = cache[(amax, jmax)] = RuckigProfile(amax, jmax)
+    return rk
 
 
 def time_parameterize(
@@ -124,7 +140,7 @@ def time_parameterize(
 
     # ---------------------------------------------------------------- 3. finish
     t0 = time.perf_counter()
-    rk = RuckigProfile(amax, jmax)
+    rk = _ruckig(amax, jmax)
     fin = finish(rk, table, phases, bounds, v_end, jmax)
     if fin is None:
         raise TimingError(
@@ -184,7 +200,7 @@ def _run_greedy(
     max_steps = int(min(5e6, 100.0 * (t_lower + 10.0 * (vtop / amax + amax / jmax)) / dt + 1000))
     phases, bounds, status = greedy.greedy(
         table.st, table.lg, h, length, table.min_s, table.min_v, v_start, a_start, v_end, amax,
-        jmax, dt, N_CAND, T_MIN, max_steps,
+        jmax, dt, N_CAND, T_MIN, max_steps, True,
     )  # fmt: skip
     if status == greedy.START_INFEASIBLE:
         raise TimingError(

@@ -68,10 +68,11 @@ class RuckigProfile:
         t = 0.0
         b = prof.brake
         if b.duration > 0.0:
+            bt, bj, bp, bv, ba = b.t, b.j, b.p, b.v, b.a
             for i in range(2):
-                if b.t[i] > 0.0:
-                    rows.append((t, b.p[i], b.v[i], b.a[i], b.j[i], b.t[i]))
-                    t += b.t[i]
+                if bt[i] > 0.0:
+                    rows.append((t, bp[i], bv[i], ba[i], bj[i], bt[i]))
+                    t += bt[i]
         pt, pj, pp, pv, pa = prof.t, prof.j, prof.p, prof.v, prof.a
         for i in range(7):
             if pt[i] > 0.0:
@@ -79,6 +80,4 @@ class RuckigProfile:
                 t += pt[i]
         if not rows:
             return None
-        out = np.array(rows)
-        out[:, 0] = np.concatenate([[0.0], np.cumsum(out[:-1, 5])])
-        return out
+        return np.array(rows)  # the start times are the running sums of the durations
