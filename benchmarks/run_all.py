@@ -50,7 +50,8 @@ BENCHES: tuple[Bench, ...] = (
           ("--size", "2000", "--repeat", "3")),
     Bench("astar", "A*: `astar.find_path` vs `pyastar2d`", "bench_astar.py",
           "Median search time on Moving AI scenarios of the shared maps, against pyastar2d "
-          "on the same queries (path costs must agree).",
+          "on the same queries (path costs must agree); then the clearance-cost search on a "
+          "warehouse-size map (willow at 5 cm), checked against scipy's Dijkstra.",
           ("--n", "10", "--repeat", "3")),
     Bench("timing", "Timing: jerk-limited timing vs TOPP-RA", "bench_timing.py",
           "Compute time and duration of `time_parameterize` against TOPP-RA's jerk-free "
@@ -101,7 +102,8 @@ BENCHES: tuple[Bench, ...] = (
     Bench("replan", "Re-planning from a moving robot", "bench_replan.py",
           "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal, "
           "then one new goal), the jump at the splice and the limits of the new "
-          "trajectory, against a fresh plan from rest at the same point.",
+          "trajectory, against a fresh plan from rest at the same point; then whole plans "
+          "and re-plans to a new goal on a warehouse-size map (willow at 5 cm).",
           ("--queries", "4")),
     Bench("first_call", "First plan in a fresh process", "bench_first_call.py",
           "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
