@@ -136,9 +136,10 @@ class ParametricCurve(ABC):
         if table is None:
             bp = np.unique(np.clip(self.breakpoints(), *self.domain))
             m = self._ARC_SUBDIVISIONS
+            # m nodes per piece (as np.linspace(a, b, m, endpoint=False): i * step + a)
+            step = (bp[1:] - bp[:-1]) / m
             fine = np.concatenate(
-                [np.linspace(a, b, m, endpoint=False) for a, b in zip(bp[:-1], bp[1:], strict=True)]
-                + [bp[-1:]]
+                [(np.arange(m)[None, :] * step[:, None] + bp[:-1, None]).ravel(), bp[-1:]]
             )
             fine, seg = self._refined_partition(fine)
             s_nodes = np.concatenate([[0.0], np.cumsum(seg)])
