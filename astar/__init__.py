@@ -40,6 +40,8 @@ _EXPORTS: dict[str, str] = {
     # search
     "find_path": "astar.search",
     "GridPath": "astar.search",
+    "Landmarks": "astar.landmarks",
+    "build_landmarks": "astar.landmarks",
 }
 
 __all__ = sorted(_EXPORTS)
@@ -64,6 +66,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from astar.grid import OccupancyGrid
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
     from astar.io import from_intensity, load_map, save_map
+    from astar.landmarks import Landmarks, build_landmarks
     from astar.movingai import Scenario, read_scenarios
     from astar.ros_map import read_map_values
     from astar.search import GridPath, find_path

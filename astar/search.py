@@ -53,6 +53,7 @@ import numpy as np
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
 from astar.grid import OccupancyGrid
+from astar.landmarks import Landmarks
 from astar.search_kernels import astar_kernel, jps_kernel
 from astar.weighted_kernel import weighted_kernel
 
@@ -162,6 +163,32 @@ _WORKSPACES: OrderedDict[int, _Workspace] = OrderedDict()
 _PADDED: OrderedDict[int, tuple[np.ndarray, np.ndarray]] = OrderedDict()
 _CACHE_SIZE = 4
 _EMPTY_COST = np.zeros(1, dtype=np.float64)
+_NO_LANDMARKS = (np.zeros((0, 1)), np.zeros(0))
+
+
+def _check_landmarks(landmarks: object, grid: OccupancyGrid, cost: object, connectivity: int,
+                     corner_cutting: bool) -> np.ndarray:  # fmt: skip
+    """Return the landmarks' cost after checking that they serve this search."""
+    if not isinstance(landmarks, Landmarks):
+        raise InvalidInputError(
+            f"landmarks must be an astar.Landmarks (astar.build_landmarks), got "
+            f"{type(landmarks).__name__}"
+        )
+    if landmarks.grid is not grid and not (
+        landmarks.grid.shape == grid.shape
+        and np.array_equal(landmarks.grid.occupied, grid.occupied)
+    ):
+        raise InvalidInputError("landmarks were built for another grid (their bounds hold there only)")
+    if cost is not None and cost is not landmarks.cost:
+        raise InvalidInputError(
+            "with landmarks, pass no cost (or landmarks.cost): their bounds hold for that cost only"
+        )
+    if (connectivity, bool(corner_cutting)) != (landmarks.connectivity, landmarks.corner_cutting):
+        raise InvalidInputError(
+            f"landmarks were built for connectivity={landmarks.connectivity}, "
+            f"corner_cutting={landmarks.corner_cutting}; got {connectivity}, {bool(corner_cutting)}"
+        )
+    return landmarks.cost
 
 
 def _workspace(n: int) -> _Workspace:
@@ -204,6 +231,7 @@ def find_path(
     connectivity: Literal[4, 8] = 8,
     corner_cutting: bool = False,
     cost: np.ndarray | None = None,
+    landmarks: Landmarks | None = None,
 ) -> GridPath:
     """Shortest (or cheapest) path of free cells from ``start`` to ``goal`` by A*.
 
@@ -226,6 +254,11 @@ def find_path(
         :func:`astar.clearance_cost`. A step then costs its length times
         ``1 + (cost[a] + cost[b]) / 2`` for its two cells; the heuristic is unchanged (still
         admissible and consistent), so the path is optimal for that cost.
+    landmarks : Landmarks, optional
+        From :func:`astar.build_landmarks` on this ``grid``: the search uses their cost (pass
+        no ``cost``, or that same ``landmarks.cost``) and their lower bounds as well as the
+        octile distance (ALT), which is still exact and expands far fewer cells on long
+        searches. Refused for another grid, cost or step rule.
 
     Returns
     -------
@@ -263,14 +296,19 @@ def find_path(
         raise InvalidInputError(f"connectivity must be 4 or 8, got {connectivity!r}")
     sx, sy = validation.cell("start", start, grid)
     gx, gy = validation.cell("goal", goal, grid)
+    lm, lg = _NO_LANDMARKS
+    if landmarks is not None:
+        cost = _check_landmarks(landmarks, grid, cost, connectivity, corner_cutting)
+        cflat = cost.ravel()  # validated when the landmarks were built
     weighted = cost is not None
-    if weighted:
-        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel()
-    else:
-        cflat = _EMPTY_COST
+    if landmarks is None:
+        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel() if weighted else _EMPTY_COST
     width = grid.nx + 2
     s = (sy + 1) * width + sx + 1
     t = (gy + 1) * width + gx + 1
+    if landmarks is not None:
+        lm = landmarks.distances
+        lg = np.ascontiguousarray(lm[:, t])
     # jump point search for the plain shortest path under the Moving AI rules
     jps = connectivity == 8 and not corner_cutting and not weighted
     with _LOCK:
@@ -280,7 +318,7 @@ def find_path(
         if weighted:
             found, path, expanded, gcost, na, nb = weighted_kernel(
                 free, width, s, t, connectivity == 8, bool(corner_cutting), cflat, ws.rec,
-                ws.recf, gen,
+                ws.recf, gen, lm, lg,
             )  # fmt: skip
         elif jps:
             found, path, expanded, gcost, na, nb = jps_kernel(free, width, s, t, ws.rec, gen)

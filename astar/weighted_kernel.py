@@ -49,8 +49,15 @@ def weighted_kernel(
     rec,  # int32 [4*H*W] per-cell record: stamp, parent, (cost so far as float64)
     recf,  # float64 view of rec: recf[2 * v + 1] is the cost so far
     gen,  # this search's stamp; gen + 1 marks closed
+    lm,  # float64 [K, H*W]: landmark distances (ALT heuristic; K = 0: none)
+    lg,  # float64 [K]: the landmarks' distances to the goal
 ):  # pragma: no cover - numba
     """Run octile A* with step costs ``length (1 + (cost[a] + cost[b]) / 2)`` (module docstring).
+
+    The heuristic is the octile distance, or with landmarks the larger of it and
+    ``max_k |lg[k] - lm[k, v]|`` (both consistent, so their maximum is). ``goal < 0``: no
+    goal and no heuristic, every reachable cell is closed with its cost from ``start`` in
+    ``recf`` (a single-source shortest-path tree, as Dijkstra's algorithm).
 
     Returns ``(found, path, expanded, cost, 0, 0)``, as :func:`~astar.search_kernels.
     astar_kernel` does for a weighted search.
@@ -82,6 +89,8 @@ def weighted_kernel(
     ax = abs(start % w - gx)
     ay = abs(start // w - gy)
     fbits[0] = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2 if conn8 else float(ax + ay)
+    if goal < 0:
+        fbits[0] = 0.0
     last = ubits[0]
     pkey[0] = last
     pnode[0] = start
@@ -156,9 +165,15 @@ def weighted_kernel(
             recf[2 * v + 1] = gnew
             rec[r4] = gen
             rec[r4 + 1] = u
-            ax = abs(ux + dx - gx)
-            ay = abs(vy - gy)
-            hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2 if conn8 else float(ax + ay)
+            hv = 0.0
+            if goal >= 0:
+                ax = abs(ux + dx - gx)
+                ay = abs(vy - gy)
+                hv = max(ax, ay) - min(ax, ay) + min(ax, ay) * sqrt2 if conn8 else float(ax + ay)
+                for q in range(lm.shape[0]):
+                    d = abs(lg[q] - lm[q, v])
+                    if d > hv:  # NaN (both unreachable from the landmark) is no bound
+                        hv = d
             fbits[0] = gnew + hv
             key = max(ubits[0], last)
             if spare >= 0:

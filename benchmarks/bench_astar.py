@@ -12,8 +12,10 @@ octile-optimal and is only a speed reference).
 A second table times the clearance-cost search (``cost=astar.clearance_cost(...)``, the
 planner's default ``search="clearance"``) on a warehouse-size map, willow at 5 cm cells
 (each 10 cm cell split in four, 1132 x 1216 cells), robot radius 0.25 m: the ``--long`` longest
-of 3x as many random connected queries, best of ``--repeat``; the three longest are checked
-against scipy's Dijkstra on the same graph (costs must agree to 1e-9).
+of 3x as many random connected queries, best of ``--repeat``, without and with 6 ALT
+landmarks (:func:`astar.build_landmarks`, build time reported) in the same run; the three
+longest are checked against scipy's Dijkstra on the same graph (costs must agree to 1e-9),
+and the landmark searches against the plain ones.
 
 Run from the repository root::
 
@@ -188,15 +190,24 @@ def bench_clearance_search(n_long: int, repeat: int) -> None:
             continue
         found.append((p.cost, (a[1], a[0]), (b[1], b[0])))
     found.sort(reverse=True)
-    times, expanded = [], []
-    for _, s, g in found[:n_long]:
-        best = math.inf
+    t0 = time.perf_counter()
+    lms = astar.build_landmarks(inflated, cost, 6)
+    build_s = time.perf_counter() - t0
+    times, expanded, times_alt, expanded_alt, alt_err = [], [], [], [], 0.0
+    for c, s, g in found[:n_long]:
+        best = best_alt = math.inf
         for _ in range(repeat):
             t0 = time.perf_counter()
             p = astar.find_path(inflated, s, g, cost=cost)
-            best = min(best, time.perf_counter() - t0)
+            t1 = time.perf_counter()
+            q = astar.find_path(inflated, s, g, landmarks=lms)
+            best = min(best, t1 - t0)
+            best_alt = min(best_alt, time.perf_counter() - t1)
         times.append(1e3 * best)
         expanded.append(p.expanded)
+        times_alt.append(1e3 * best_alt)
+        expanded_alt.append(q.expanded)
+        alt_err = max(alt_err, abs(q.cost - c) / c)
     graph = step_graph(np.asarray(inflated.occupied), cost)
     worst = 0.0
     for c, s, g in found[:3]:
@@ -209,6 +220,12 @@ def bench_clearance_search(n_long: int, repeat: int) -> None:
     print(f"  time median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, max "
           f"{t.max():.1f} ms (target <= 30 ms); expansions median {np.median(expanded):.0f}; "
           f"{np.median(t * 1e6 / np.array(expanded)):.0f} ns per expansion")  # fmt: skip
+    ta = np.array(times_alt)
+    print(f"  with 6 landmarks (built once in {build_s:.2f} s): median {np.median(ta):.1f} ms, p95 "
+          f"{np.percentile(ta, 95):.1f} ms, max {ta.max():.1f} ms; expansions median "
+          f"{np.median(expanded_alt):.0f}; median time ratio landmarks / none "
+          f"{np.median(ta / t):.2f}; cost vs the plain search max relative error "
+          f"{alt_err:.1e}")  # fmt: skip
     print(f"  cost vs scipy's Dijkstra on the 3 longest: max relative error {worst:.1e}")
 
 

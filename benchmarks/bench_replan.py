@@ -12,10 +12,11 @@ the robot) is counted as refused, with its type. The reference is a fresh ``plan
 rest at the same point, timed in the same run.
 
 A second part runs on a warehouse-size map, willow at 5 cm cells (each 10 cm cell split in
-four, 1132 x 1216 cells), robot radius 0.25 m, with a warm planner (``trajopt.warm_up``, one
-untimed plan): the whole ``plan`` of each query (start and goal at least 5 m apart: a new
-goal for the planner), and a re-plan to a new goal (the next query's) from the moving
-robot 2 s into each trajectory, with the stage split of the plans.
+four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt.warm_up``, one
+untimed plan), one with 6 search landmarks (``Planner(landmarks=6)``) and one without, in
+the same run: the whole ``plan`` of each query (start and goal at least 5 m apart: a new
+goal for the planner), and, with the landmarks, a re-plan to a new goal (the next query's)
+from the moving robot 2 s into each trajectory, with the stage split of the plans.
 
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
@@ -158,7 +159,8 @@ def warehouse(d: Path, n: int, rng) -> None:
     grid = astar.OccupancyGrid(np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1),
                                w.resolution / 2, w.origin)  # fmt: skip
     robot = trajopt.Robot(radius=0.25)
-    planner = trajopt.Planner(grid, robot)
+    planner = trajopt.Planner(grid, robot, landmarks=6)
+    plain = trajopt.Planner(grid, robot)
     trajopt.warm_up(planner)
     free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
                                       outside_occupied=True).occupied)  # fmt: skip
@@ -169,12 +171,16 @@ def warehouse(d: Path, n: int, rng) -> None:
         if math.dist(p0, p1) < 5.0:
             continue
         try:
-            planner.plan(p0, p1)  # also the untimed first plan of this map
+            planner.plan(p0, p1)  # also the untimed first plans of this map
+            plain.plan(p0, p1)
         except TrajoptError:
             continue
         qs.append((tuple(p0), tuple(p1)))
-    plans, replans, stages, refused = [], [], {}, 0
+    plans, plain_ms, replans, stages, refused = [], [], [], {}, 0
     for k, (p0, p1) in enumerate(qs[1:]):
+        t0 = time.perf_counter()
+        plain.plan(p0, p1)
+        plain_ms.append(1e3 * (time.perf_counter() - t0))
         t0 = time.perf_counter()
         traj = planner.plan(p0, p1)
         plans.append(1e3 * (time.perf_counter() - t0))
@@ -188,8 +194,10 @@ def warehouse(d: Path, n: int, rng) -> None:
             refused += 1
     print(f"\nwarehouse-size map: willow at 5 cm ({grid.nx} x {grid.ny} cells), radius 0.25 m, "
           f"{len(plans)} queries 5 m or more apart, warm planner")  # fmt: skip
-    print(f"  whole plan (new goal): median {statistics.median(plans):.1f} ms, p95 "
-          f"{np.percentile(plans, 95):.1f} ms (target median <= 40 ms)")  # fmt: skip
+    print(f"  whole plan (new goal), landmarks=6: median {statistics.median(plans):.1f} ms, p95 "
+          f"{np.percentile(plans, 95):.1f} ms (target median <= 40 ms); without landmarks: "
+          f"median {statistics.median(plain_ms):.1f} ms, p95 {np.percentile(plain_ms, 95):.1f} "
+          f"ms")  # fmt: skip
     split = ", ".join(f"{k} {statistics.median(v):.1f}" for k, v in stages.items() if k != "total")
     print(f"  stage medians (ms): {split}")
     if replans:

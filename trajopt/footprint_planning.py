@@ -76,6 +76,7 @@ def _new_disc(planner: Any, radius: float) -> Any:
         corridor=planner.corridor,
         costmap_weight=planner.costmap_weight,
         speed_limits=planner.speed_limits,
+        landmarks=planner.landmarks,
     )
     disc_model.smoothing_footprint = r.footprint
     return disc_model

@@ -1,6 +1,8 @@
 """Map updates of a :class:`~trajopt.pipeline.Planner`.
 
-The inflated grid and the clearance cost are recomputed only where the change reaches.
+The inflated grid and the clearance cost are recomputed only where the change reaches. The
+search landmarks (``Planner(landmarks=k)``), whose distances span the whole map, are
+dropped on any change and built again by the next search.
 """
 
 from __future__ import annotations
@@ -37,12 +39,14 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
         )
         if not same:
             planner.grid, planner._inflated, planner._cost = grid, None, None
+            planner._landmarks = None
             return {"changed_cells": None, "window": None, "reset": True}
         changed = grid.occupied != old.occupied
         n_changed = int(changed.sum())
         planner.grid = grid
         if n_changed == 0:
             return {"changed_cells": 0, "window": None, "reset": False}
+        planner._landmarks = None
         iy, ix = np.nonzero(changed)
         box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
         r_cells = int(math.ceil(planner.robot.radius / grid.resolution)) + 2

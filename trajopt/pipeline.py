@@ -78,7 +78,7 @@ from trajopt.polygon_corridor import PolygonCorridor
 from trajopt.replanning import replan_from, smooth_for_speed
 from trajopt.robot import Robot, avoidance_width
 from trajopt.smoother import Smoother, SmoothPath
-from trajopt.speed_limits import SpeedLimits
+from trajopt.speed_limits import SpeedLimits, check_overlap
 from trajopt.state import State
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
@@ -133,6 +133,11 @@ class Planner:
         zone under the robot's centre (and the stop-and-turn fallback by the zones its
         segments cross). The mask is looked up in world coordinates with its own resolution
         and origin; a mask that does not overlap the map at all is refused.
+    landmarks : int, optional
+        ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`; 0, the
+        default: none). Exact either way; on large maps they cut a long search several
+        times, for a one-time cost on the first query after each map (about 0.1 s per
+        landmark per million cells) and ``8 landmarks`` bytes per cell.
     smoother : Smoother, optional
         Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
     timing_dt : float
@@ -171,6 +176,7 @@ class Planner:
         corridor: CorridorKind = "polygons",
         costmap_weight: float = 2.0,
         speed_limits: SpeedLimits | None = None,
+        landmarks: int = 0,
     ) -> None:
         costmap: Costmap | None = None
         if isinstance(grid, Costmap):
@@ -196,11 +202,15 @@ class Planner:
         if costmap is not None:
             costmap.search_cost(costmap_weight)  # validates the weight
         if speed_limits is not None:
-            _check_speed_limits(speed_limits, grid)
+            check_overlap(speed_limits, grid)
         if not (fallback is None or (isinstance(fallback, str) and fallback in _FALLBACKS)):
             raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
         if not (isinstance(corridor, str) and corridor in _CORRIDORS):
             raise InvalidInputError(f"corridor must be one of {_CORRIDORS}, got {corridor!r}")
+        if isinstance(landmarks, bool) or not isinstance(landmarks, (int, np.integer)) or not (
+            0 <= landmarks <= 64
+        ):
+            raise InvalidInputError(f"landmarks must be an integer in [0, 64], got {landmarks!r}")
         if w_cells is None:
             w_cells = avoidance_width(robot.width, grid.resolution)
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
@@ -228,6 +238,8 @@ class Planner:
         self.costmap = costmap
         self.costmap_weight = float(costmap_weight)
         self.speed_limits = speed_limits
+        self.landmarks = int(landmarks)
+        self._landmarks: astar.Landmarks | None = None  # built on the first search that uses them
         self._lock = threading.RLock()
         self._latencies: collections.deque[float] = collections.deque(maxlen=32)
         self._inflated: OccupancyGrid | None = None
@@ -261,6 +273,16 @@ class Planner:
                 self._cost = cost
             return self._cost
 
+    def search_landmarks(self) -> astar.Landmarks | None:
+        """ALT landmarks of the inflated grid and search cost (``None`` without), built once."""
+        if self.landmarks == 0 or self.search == "shortest":
+            return None
+        with self._lock:
+            if self._landmarks is None:
+                self._landmarks = astar.build_landmarks(self.inflated_grid, self.search_cost,
+                                                        self.landmarks)  # fmt: skip
+            return self._landmarks
+
     def _inflate(self, grid: OccupancyGrid) -> np.ndarray:
         occ = astar.inflate(grid, self.robot.radius, metric="square", outside_occupied=True)
         out = occ.occupied
@@ -281,7 +303,8 @@ class Planner:
         radius (plus the avoidance area and the cost's fall-off) of each cell, so they are
         recomputed in the box around the changed cells grown by that reach (on a window
         grown once more, whose made-up outside then cannot reach the box); everything else
-        is kept. A map of another shape, resolution or origin resets the caches.
+        is kept. A map of another shape, resolution or origin resets the caches. Search
+        landmarks, if any, are dropped on any change (the next search builds them again).
 
         Parameters
         ----------
@@ -446,9 +469,11 @@ class Planner:
         self._check_reachable_ends(q)
         with q.timer.stage("search"):
             try:
+                lms = self.search_landmarks()
                 q.path = astar.find_path(
-                    q.inflated, _cell(q.start_cell), _cell(q.goal_cell), cost=self.search_cost
-                )
+                    q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
+                    cost=self.search_cost if lms is None else None, landmarks=lms,
+                )  # fmt: skip
             except astar.NoPathError as exc:
                 raise NoPathError(
                     f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot "
@@ -665,23 +690,6 @@ def plan(
 
 
 # ------------------------------------------------------------------ helpers
-def _check_speed_limits(limits: object, grid: OccupancyGrid) -> None:
-    if not isinstance(limits, SpeedLimits):
-        raise InvalidInputError(
-            f"speed_limits must be a trajopt.SpeedLimits (trajopt.load_speed_mask), "
-            f"got {type(limits).__name__}"
-        )
-    x0, x1, y0, y1 = limits.extent
-    gx0, gy0 = grid.origin
-    gx1, gy1 = gx0 + grid.width, gy0 + grid.height
-    if x1 <= gx0 or x0 >= gx1 or y1 <= gy0 or y0 >= gy1:
-        raise InvalidInputError(
-            f"speed_limits: the mask covers x in [{x0:.6g}, {x1:.6g}] m, y in [{y0:.6g}, "
-            f"{y1:.6g}] m, which does not overlap the map (x in [{gx0:.6g}, {gx1:.6g}] m, "
-            f"y in [{gy0:.6g}, {gy1:.6g}] m); masks are looked up in world coordinates"
-        )
-
-
 def _cell(c: np.ndarray) -> tuple[int, int]:
     """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
     return (int(c[0]), int(c[1]))

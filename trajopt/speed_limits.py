@@ -30,14 +30,14 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.validation import number, point, positive
 
-__all__ = ["SpeedLimits", "SpeedLimitType", "load_speed_mask"]
+__all__ = ["SpeedLimits", "SpeedLimitType", "check_overlap", "load_speed_mask"]
 
 SpeedLimitType = Literal["percentage", "absolute"]
 _TYPES: tuple[str, ...] = ("percentage", "absolute")
@@ -308,3 +308,21 @@ def _limit_type(value: object) -> str:
 def _origin(value: object) -> tuple[float, float]:
     ox, oy = point("origin", value)
     return float(ox), float(oy)
+
+
+def check_overlap(limits: object, grid: Any) -> None:
+    """Raise unless ``limits`` is a :class:`SpeedLimits` whose mask overlaps ``grid``'s extent."""
+    if not isinstance(limits, SpeedLimits):
+        raise InvalidInputError(
+            f"speed_limits must be a trajopt.SpeedLimits (trajopt.load_speed_mask), "
+            f"got {type(limits).__name__}"
+        )
+    x0, x1, y0, y1 = limits.extent
+    gx0, gy0 = grid.origin
+    gx1, gy1 = gx0 + grid.width, gy0 + grid.height
+    if x1 <= gx0 or x0 >= gx1 or y1 <= gy0 or y0 >= gy1:
+        raise InvalidInputError(
+            f"speed_limits: the mask covers x in [{x0:.6g}, {x1:.6g}] m, y in [{y0:.6g}, "
+            f"{y1:.6g}] m, which does not overlap the map (x in [{gx0:.6g}, {gx1:.6g}] m, "
+            f"y in [{gy0:.6g}, {gy1:.6g}] m); masks are looked up in world coordinates"
+        )

@@ -113,6 +113,7 @@ def warm_up(planner: Planner | None = None) -> float:
         fallback=planner.fallback,
         corridor=planner.corridor,
         costmap_weight=planner.costmap_weight,
+        landmarks=planner.landmarks,
     )
     copy.plan(start, goal)
     return time.perf_counter() - t0
