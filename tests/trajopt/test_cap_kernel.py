@@ -15,8 +15,8 @@ import math
 import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-from scipy.integrate import cumulative_trapezoid
 
+from tests.trajopt.test_curvature_bound import _dense_max_per_interval
 from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.curvature_bound import interval_kappa_max, kappa_bound
 from trajopt.robot import Robot
@@ -67,17 +67,6 @@ def test_compiled_bound_equals_the_numpy_reference(pts, degree, seed):
         # and it bounds |kappa| sampled densely on the interval
         u = np.linspace(a[i], b[i], 201)
         assert np.abs(c.curvature(u)).max() <= got * (1 + 1e-9)
-
-
-def _dense_max_per_interval(c: BSplineCurve, h: float, n: int) -> np.ndarray:
-    """Largest |kappa| per arc-length interval from 100 001 samples (trapezoid arc length)."""
-    u = np.linspace(*c.domain, 100_001)
-    s = cumulative_trapezoid(c.speed(u), u, initial=0.0)
-    k = np.abs(c.curvature(u))
-    i = np.clip((s / h).astype(int), 0, n - 1)
-    out = np.zeros(n)
-    np.maximum.at(out, i, k)
-    return out
 
 
 @SETTINGS
