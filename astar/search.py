@@ -300,9 +300,11 @@ def find_path(
     if landmarks is not None:
         cost = _check_landmarks(landmarks, grid, cost, connectivity, corner_cutting)
         cflat = cost.ravel()  # validated when the landmarks were built
+    elif cost is not None:
+        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel()
+    else:
+        cflat = _EMPTY_COST
     weighted = cost is not None
-    if landmarks is None:
-        cflat = np.ascontiguousarray(validation.cell_costs(cost, grid)).ravel() if weighted else _EMPTY_COST
     width = grid.nx + 2
     s = (sy + 1) * width + sx + 1
     t = (gy + 1) * width + gx + 1

@@ -196,11 +196,11 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             errors.append(exc)
             continue
         cert_s = 0.0
+        smoother_stats = getattr(getattr(traj, "path", None), "stats", None) or {}
         if isinstance(traj, StopAndTurnTrajectory):
             cert = None  # only on the circumscribed rung: its disc holds every heading
         else:
             cert = getattr(traj.path, "footprint_certificate", None)  # the smoother's
-            smoother_stats = getattr(traj.path, "stats", {})
             cert_s = smoother_stats.get("footprint_certificate_s", 0.0)
             if cert is None:  # a box corridor's fit, or a curve from elsewhere
                 t_cert = time.perf_counter()
@@ -221,7 +221,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             "min_margin_m": None if cert is None else cert.min_margin_m,
             "spans": None if cert is None else int(cert.margins_m.size),
             "certificate_s": cert_s,
-            "rounds": 0 if cert is None else int(smoother_stats.get("footprint_rounds", 0)),
+            "rounds": int(smoother_stats.get("footprint_rounds", 0)),
         }
         return dataclasses.replace(traj, robot=robot, stats=stats)
     if errors and all(isinstance(e, NoPathError) for e in errors):
@@ -251,7 +251,7 @@ def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | 
         clearance found.
     """
     from trajopt.footprint import polygons_clearance
-    from trajopt.smoother.footprint_rounds import END_HEADINGS, clear_headings
+    from trajopt.smoother.footprint_rounds import END_HEADINGS, end_headings
 
     fp, raw = planner.robot.footprint, planner.grid
     for name, end, heading in (("start", start, start_heading), ("goal", goal, goal_heading)):
@@ -271,7 +271,7 @@ def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | 
                     f"{name} pose ({xy[0]:.4g}, {xy[1]:.4g}) m, heading {float(theta):.4g} rad: "
                     "the footprint meets an obstacle or the map edge there (clearance 0 m)"
                 )
-        elif len(clear_headings(fp, raw, xy, 0.0)) == 0:
+        elif not np.any(end_headings(fp, raw, xy)[1] > 0.0):
             raise InvalidInputError(
                 f"{name} ({xy[0]:.4g}, {xy[1]:.4g}) m: the footprint meets an obstacle or the "
                 f"map edge at each of {END_HEADINGS} sampled headings; it cannot stand there"

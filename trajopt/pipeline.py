@@ -82,7 +82,7 @@ from trajopt.speed_limits import SpeedLimits, check_overlap
 from trajopt.state import State
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
-from trajopt.validation import point
+from trajopt.validation import integer, point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
 
@@ -207,10 +207,7 @@ class Planner:
             raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
         if not (isinstance(corridor, str) and corridor in _CORRIDORS):
             raise InvalidInputError(f"corridor must be one of {_CORRIDORS}, got {corridor!r}")
-        if isinstance(landmarks, bool) or not isinstance(landmarks, (int, np.integer)) or not (
-            0 <= landmarks <= 64
-        ):
-            raise InvalidInputError(f"landmarks must be an integer in [0, 64], got {landmarks!r}")
+        landmarks = integer("landmarks", landmarks, 0, 64)
         if w_cells is None:
             w_cells = avoidance_width(robot.width, grid.resolution)
         if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
@@ -273,6 +270,7 @@ class Planner:
                 self._cost = cost
             return self._cost
 
+    @property
     def search_landmarks(self) -> astar.Landmarks | None:
         """ALT landmarks of the inflated grid and search cost (``None`` without), built once."""
         if self.landmarks == 0 or self.search == "shortest":
@@ -469,7 +467,7 @@ class Planner:
         self._check_reachable_ends(q)
         with q.timer.stage("search"):
             try:
-                lms = self.search_landmarks()
+                lms = self.search_landmarks
                 q.path = astar.find_path(
                     q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
                     cost=self.search_cost if lms is None else None, landmarks=lms,

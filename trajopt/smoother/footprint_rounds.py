@@ -32,7 +32,6 @@ __all__ = [
     "END_HEADINGS",
     "FOOTPRINT_ROUNDS",
     "FootprintRounds",
-    "clear_headings",
     "end_headings",
     "footprint_scp",
     "spans_to_tighten",
@@ -166,28 +165,17 @@ def spans_to_tighten(margins_m: np.ndarray, n_spans: int, degree: int,
     return out
 
 
-def end_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray):
+def end_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray,
+                 cap_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Return :data:`END_HEADINGS` sampled headings (rad) and the footprint's clearance there (m).
 
-    The clearance of the footprint placed on ``point`` (m) at each heading, capped at one
-    cell.
+    The exact clearance of the footprint placed on ``point`` (m) at each heading in
+    ``[-pi, pi)``, capped at ``cap_m`` (default one cell).
     """
     ths = -math.pi + 2 * math.pi * np.arange(END_HEADINGS) / END_HEADINGS
     polys = [footprint.at(float(point[0]), float(point[1]), float(t)) for t in ths]
-    return ths, polygons_clearance(polys, raw_grid, raw_grid.resolution)
-
-
-def clear_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray,
-                   margin_m: float) -> np.ndarray:  # fmt: skip
-    """Return the sampled headings (rad) at which the footprint on ``point`` (m) is clear.
-
-    :data:`END_HEADINGS` headings in ``[-pi, pi)``; clear means an exact clearance above
-    ``margin_m`` (m) from the raw map.
-    """
-    ths = -math.pi + 2 * math.pi * np.arange(END_HEADINGS) / END_HEADINGS
-    polys = [footprint.at(float(point[0]), float(point[1]), float(t)) for t in ths]
-    clr = polygons_clearance(polys, raw_grid, 2.0 * margin_m + raw_grid.resolution)
-    return ths[clr > margin_m]
+    cap = raw_grid.resolution if cap_m is None else cap_m
+    return ths, polygons_clearance(polys, raw_grid, cap)
 
 
 def _nearest(headings: np.ndarray, clearance: np.ndarray, theta: float) -> float | None:
