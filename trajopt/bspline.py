@@ -110,6 +110,40 @@ class BSplineCurve(ParametricCurve):
             self._derivatives[nu] = derivative_control_points(t, c, self.k - nu + 1)
         return self._derivatives[nu]
 
+    def tail(self, u0: float) -> BSplineCurve:
+        """Return the curve on ``[u0, t[n]]`` as a clamped B-spline of its own (exact).
+
+        ``u0`` is inserted as a knot until it has multiplicity ``k`` (Boehm's insertion,
+        which leaves the curve unchanged); the control points from the one at ``C(u0)`` on
+        are the tail's. Each new control point is a convex combination of the control
+        points of the span holding ``u0``, so it lies in every convex set holding them. The
+        derivatives' coefficients are cut the same way from this curve's own, so they stay
+        accurate when ``u0`` lies a hair before a knot (differences of the tail's control
+        points over so short a first span would not).
+
+        Parameters
+        ----------
+        u0 : float
+            Start of the tail, in ``[t[k], t[n])`` (the curve's parameter, unchanged).
+
+        Raises
+        ------
+        InvalidInputError
+            ``u0`` outside ``[t[k], t[n])``.
+        """
+        lo, hi = self.domain
+        u0 = float(u0)
+        if not lo <= u0 < hi:
+            raise InvalidInputError(f"u0 must lie in the domain [{lo}, {hi}), got {u0!r}")
+        if u0 == lo:
+            return self
+        out = BSplineCurve(*_tail_coefficients(self.t, self.c, self.k, u0), self.k)
+        for nu in range(1, self.k + 1):
+            out._derivatives[nu] = _tail_coefficients(
+                *self._derivative_coefficients(nu), self.k - nu, u0
+            )
+        return out
+
     def span_of(self, u: np.ndarray | float) -> np.ndarray:
         """Index ``j`` of the non-empty span holding ``u`` (control points ``c[j:j+k+1]``)."""
         n = self.c.shape[0]
@@ -119,6 +153,24 @@ class BSplineCurve(ParametricCurve):
 
     def __repr__(self) -> str:
         return f"BSplineCurve(k={self.k}, n={self.c.shape[0]}, domain={self.domain})"
+
+
+def _tail_coefficients(t: np.ndarray, c: np.ndarray, k: int, u0: float):
+    """Knots and control points of the spline ``(t, c, k)`` (``k >= 0``) cut to ``[u0, ...]``.
+
+    Boehm's insertion of ``u0`` up to multiplicity ``k``; the tail starts with ``u0``
+    repeated ``k + 1`` times.
+    """
+    t, c = np.array(t, dtype=float), np.array(c, dtype=float)
+    for _ in range(max(0, k - int(np.count_nonzero(t == u0)))):
+        m = int(np.searchsorted(t, u0, side="right")) - 1  # t[m] <= u0 < t[m + 1]
+        i = np.arange(m - k + 1, m + 1)
+        alpha = ((u0 - t[i]) / (t[i + k] - t[i]))[:, None]
+        mixed = (1.0 - alpha) * c[i - 1] + alpha * c[i]
+        c = np.concatenate([c[: m - k + 1], mixed, c[m:]])
+        t = np.insert(t, m + 1, u0)
+    m = int(np.searchsorted(t, u0, side="right")) - 1  # the span [u0, next knot)
+    return np.concatenate([[u0], t[m - k + 1 :]]), np.ascontiguousarray(c[m - k :])
 
 
 def derivative_control_points(t: np.ndarray, c: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:

@@ -35,6 +35,7 @@ straight between its vertices, and at a vertex the robot turns at rest, where th
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -43,14 +44,23 @@ from typing import Any
 import numpy as np
 
 from trajopt.clearance import polyline_clearance
+from trajopt.corridor_fit import box_corridor
 from trajopt.curve import PolylineCurve
-from trajopt.errors import InvalidInputError, TimingError
+from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.robot import Robot
 from trajopt.speed_limits import SpeedLimits
 from trajopt.trajectory import SampledExport, TrajectorySample, export_dict, make_sample
 from trajopt.validation import heading, readonly, short_repr
 
-__all__ = ["StopAndTurnTrajectory", "stop_and_turn", "turn_limits", "polyline_clearance"]
+__all__ = [
+    "StopAndTurnTrajectory",
+    "stop_and_turn",
+    "turn_limits",
+    "polyline_clearance",
+    "polyline_fallback",
+]
+
+logger = logging.getLogger(__name__)
 
 #: Consecutive points closer than this are merged (m).
 MIN_SEGMENT_M = 1e-9
@@ -496,6 +506,45 @@ def stop_and_turn(
         theta_end=theta_end,
         stats=stats,
     )
+
+
+def polyline_fallback(planner: Any, q: Any, exc: Exception) -> tuple[StopAndTurnTrajectory, dict]:
+    """Return a planner's stop-and-turn trajectory along the A* polyline, or re-raise ``exc``.
+
+    The polyline *exact start -> A* path cell centres -> exact goal* of the query ``q``
+    (:class:`~trajopt.plan_query.PlanQuery`) must keep ``planner.robot.radius`` from the raw
+    map (exact distance to the obstacle squares); otherwise ``exc``, the smoother's or the
+    timing's error, is raised again. Also returns the statistics the trajectory gets
+    (``fallback_error``, ``fallback_reason``, ``fallback_min_clearance_m``, ``smoother``).
+    """
+    grid = planner.grid
+    if q.corridor is None:
+        with q.timer.stage("corridor"):
+            q.corridor = box_corridor(planner, q.inflated, q.path, q.start, q.goal)
+    centres = np.asarray(grid.cell_to_world(np.asarray(q.path.cells)), dtype=float)
+    points = np.vstack([q.start, centres.reshape(-1, 2), q.goal])
+    radius = planner.robot.radius
+    window = radius + 2.0 * float(grid.resolution)
+    clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
+    if clearance < radius - 1e-9:
+        logger.warning(
+            "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an obstacle "
+            "(radius %.6g m)",
+            clearance,
+            radius,
+        )
+        raise exc
+    traj = stop_and_turn(points, planner.robot, start_heading=q.start_heading,
+                         goal_heading=q.goal_heading, speed_limits=planner.speed_limits)  # fmt: skip
+    logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
+    extra: dict[str, Any] = {
+        "fallback_error": type(exc).__name__,
+        "fallback_reason": str(exc),
+        "fallback_min_clearance_m": float(clearance),
+    }
+    if isinstance(exc, SmoothingError):
+        extra["smoother"] = dict(exc.stats)
+    return traj, extra
 
 
 def _clean_points(points: Any) -> np.ndarray:

@@ -56,7 +56,6 @@ from __future__ import annotations
 
 import collections
 import dataclasses
-import logging
 import threading
 import time
 from collections.abc import Sequence
@@ -67,10 +66,10 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.clearance import polygon_clearance, polyline_clearance
-from trajopt.corridor_fit import box_corridor, fit_in_corridor, witness_rescue
+from trajopt.clearance import polygon_clearance
+from trajopt.corridor_fit import fit_in_corridor, witness_rescue
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
+from trajopt.fallback import StopAndTurnTrajectory, polyline_fallback
 from trajopt.footprint_planning import plan_with_footprint
 from trajopt.map_update import update_caches
 from trajopt.plan_query import PlanQuery, PlanSteps
@@ -85,8 +84,6 @@ from trajopt.trajectory import Trajectory
 from trajopt.validation import integer, point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
-
-logger = logging.getLogger(__name__)
 
 Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]
@@ -398,13 +395,20 @@ class Planner:
         latency: float | None = None,
         goal_heading: float | None = None,
         v_end: float = 0.0,
+        reuse: bool = True,
     ) -> PlanResult:
         """Re-plan from a trajectory being driven, splicing at ``t + latency``.
 
         The new trajectory starts at ``trajectory.state_at(t + latency)``: the same
         position, heading, curvature, speed and acceleration (a C2 splice), so a robot can
         switch to it at that time without a jump. Its ``stats["splice_time_s"]`` is the
-        splice time on the old trajectory's clock, ``stats["latency_s"]`` the latency used.
+        splice time on the old trajectory's clock, ``stats["latency_s"]`` the latency used,
+        ``stats["replan"]`` ``"kept"`` or ``"planned: <why the rest was not kept>"``.
+
+        With ``reuse`` (the default) the rest of the old trajectory is kept, cut at the
+        splice and certified again, when the goal, goal heading and end speed are the old
+        ones and the map changed nowhere near it (:mod:`trajopt.replan_keep`); otherwise a
+        new trajectory is planned from the state (:meth:`plan`).
 
         Parameters
         ----------
@@ -424,6 +428,8 @@ class Planner:
             Exact heading at the goal (rad).
         v_end : float, optional
             Speed at the goal (m/s).
+        reuse : bool, optional
+            ``False``: always plan anew from the state.
 
         Raises
         ------
@@ -433,8 +439,9 @@ class Planner:
         TimingError, SmoothingError, NoPathError
             As :meth:`plan`; a state too fast for any curve found says so.
         """
-        return replan_from(self, trajectory, t, goal, grid, latency=latency,
-                           goal_heading=goal_heading, v_end=v_end)  # fmt: skip
+        with self._lock:
+            return replan_from(self, trajectory, t, goal, grid, latency=latency,
+                               goal_heading=goal_heading, v_end=v_end, reuse=reuse)  # fmt: skip
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
         kappa0 = None
@@ -559,33 +566,7 @@ class Planner:
     def _fallback(self, q: PlanQuery, exc: Exception) -> StopAndTurnTrajectory:
         """Return the stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
         with q.timer.stage("fallback"):
-            grid = self.grid
-            if q.corridor is None:
-                with q.timer.stage("corridor"):
-                    q.corridor = box_corridor(self, q.inflated, q.path, q.start, q.goal)
-            centres = np.asarray(grid.cell_to_world(np.asarray(q.path.cells)), dtype=float)
-            points = np.vstack([q.start, centres.reshape(-1, 2), q.goal])
-            radius = self.robot.radius
-            window = radius + 2.0 * float(grid.resolution)
-            clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
-            if clearance < radius - 1e-9:
-                logger.warning(
-                    "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an "
-                    "obstacle (radius %.6g m)",
-                    clearance,
-                    radius,
-                )
-                raise exc
-            traj = stop_and_turn(points, self.robot, start_heading=q.start_heading,
-                                 goal_heading=q.goal_heading, speed_limits=self.speed_limits)  # fmt: skip
-        logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
-        extra: dict[str, Any] = {
-            "fallback_error": type(exc).__name__,
-            "fallback_reason": str(exc),
-            "fallback_min_clearance_m": float(clearance),
-        }
-        if isinstance(exc, SmoothingError):
-            extra["smoother"] = dict(exc.stats)
+            traj, extra = polyline_fallback(self, q, exc)
         return self._result(q, traj, None, **extra)
 
     def _check_endpoint(self, name: str, p: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ from astar.grid import OccupancyGrid
 from trajopt.corridor_fit import fit_in_corridor
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.plan_query import PlanQuery
+from trajopt.replan_keep import keep_rest
 from trajopt.smoother import SmoothPath
 from trajopt.validation import nonnegative, number
 
@@ -30,6 +31,7 @@ def replan_from(
     latency: float | None,
     goal_heading: float | None,
     v_end: float,
+    reuse: bool = True,
 ) -> Any:
     """Return :meth:`~trajopt.pipeline.Planner.replan`'s trajectory (see there)."""
     lat = planner.latency_s if latency is None else nonnegative("latency", latency, "s")
@@ -50,9 +52,15 @@ def replan_from(
         goal = steps.goal
     if grid is not None:
         planner.update_map(grid)
-    state = trajectory.state_at(ts)
-    out = planner.plan(state, goal, goal_heading=goal_heading, v_end=v_end)
+    out, why = None, "reuse=False"
+    if reuse:
+        out, why = keep_rest(planner, trajectory, ts, goal, goal_heading=goal_heading,
+                             v_end=v_end)  # fmt: skip
+    if out is None:
+        state = trajectory.state_at(ts)
+        out = planner.plan(state, goal, goal_heading=goal_heading, v_end=v_end)
     stats = dict(out.stats)
+    stats["replan"] = "kept" if why == "kept" else f"planned: {why}"
     stats["splice_time_s"] = ts
     stats["latency_s"] = lat
     return dataclasses.replace(out, stats=stats)

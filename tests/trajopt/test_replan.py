@@ -112,11 +112,13 @@ def _check_splice(old, new) -> None:
     assert trajectory_metrics(new, ROBOT)["within_limits"]
 
 
+@pytest.mark.parametrize("reuse", [True, False])
 @pytest.mark.parametrize("t", [0.0, 0.7, 2.0, 4.5, 6.5])
-def test_replan_same_goal_splices_c2(driven, t):
+def test_replan_same_goal_splices_c2(driven, t, reuse):
     planner, traj = driven
-    new = planner.replan(traj, t, latency=0.05)
+    new = planner.replan(traj, t, latency=0.05, reuse=reuse)
     assert new.stats["splice_time_s"] == pytest.approx(t + 0.05)
+    assert new.stats["replan"] == ("kept" if reuse else "planned: reuse=False")
     _check_splice(traj, new)
     assert new.steps.goal == traj.steps.goal
 
@@ -127,7 +129,7 @@ def test_replan_splice_property(driven, frac):
     planner, traj = driven
     t = frac * (traj.duration - 1.0)
     try:
-        new = planner.replan(traj, t, latency=0.0)
+        new = planner.replan(traj, t, latency=0.0, reuse=False)
     except (SmoothingError, TimingError):  # a typed refusal is allowed, a jump is not
         return
     _check_splice(traj, new)
@@ -187,7 +189,7 @@ def test_replan_is_deterministic(scene):
     for _ in range(2):
         planner = trajopt.Planner(scene.grid, ROBOT)
         traj = planner.plan(scene.start, scene.goal("C"))
-        new = planner.replan(traj, 2.5, latency=0.1)
+        new = planner.replan(traj, 2.5, latency=0.1, reuse=False)
         outs.append((np.asarray(new.path.control_points), new.phase_t, new.phase_v))
     for a, b in zip(outs[0], outs[1], strict=True):
         assert np.array_equal(a, b)

@@ -1,0 +1,176 @@
+"""What a re-plan keeps: the rest of the trajectory being driven, when nothing it relies on changed.
+
+:meth:`~trajopt.pipeline.Planner.replan` first asks :func:`keep_rest` whether the old
+trajectory's rest is still the answer. It is when the goal, the goal heading and the end
+speed are the old ones and the map has not changed where the rest depends on it: no cell
+was freed anywhere (a freed cell may open a better route), and no cell became occupied
+within the robot's reach of the corridor regions the rest of the curve lies in (the
+regions the certificate holds it to). Then nothing is searched, fitted or timed again: the
+curve is cut at the splice (:meth:`~trajopt.bspline.BSplineCurve.tail`, exact), the timing's
+constant-jerk phases from the splice on are kept as they are, shifted in time and arc
+length, and the cut curve is certified again against the corridor and the current map.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from trajopt.polygon_corridor import PolygonCorridor
+from trajopt.smoother import SmoothPath
+from trajopt.smoother.certificate import certify
+from trajopt.trajectory import Trajectory
+from trajopt.validation import point
+
+__all__ = ["keep_rest", "trajectory_after"]
+
+
+def keep_rest(
+    planner: Any,
+    trajectory: Any,
+    ts: float,
+    goal: Sequence[float] | None,
+    *,
+    goal_heading: float | None,
+    v_end: float,
+) -> tuple[Trajectory | None, str]:
+    """Return the rest of ``trajectory`` from ``ts`` if a re-plan may keep it.
+
+    Parameters
+    ----------
+    planner : Planner
+        The planner re-planning, with its current map.
+    trajectory : Trajectory or StopAndTurnTrajectory
+        The trajectory being driven.
+    ts : float
+        The splice time on its clock (s), in ``[0, duration]``.
+    goal : sequence of float, shape (2,), or None
+        The re-plan's goal (m); ``None``: the old one.
+    goal_heading : float or None
+        The re-plan's goal heading (rad).
+    v_end : float
+        The re-plan's end speed (m/s).
+
+    Returns
+    -------
+    (Trajectory or None, str)
+        The kept trajectory (time 0 at the splice; ``stats["replan"] == "kept"``) and
+        ``"kept"``, or ``None`` and why the rest cannot be kept.
+    """
+    t0 = time.perf_counter()
+    steps = getattr(trajectory, "steps", None)
+    smooth = getattr(steps, "smooth_path", None)
+    if not isinstance(trajectory, Trajectory) or not isinstance(smooth, SmoothPath):
+        return None, "not a smoothed trajectory of a Planner"
+    if planner.robot.footprint is not None:
+        return None, "footprint robot"
+    if trajectory.robot != planner.robot:
+        return None, "planned for another robot"
+    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
+        return None, "new goal"
+    if v_end != trajectory.v_end:
+        return None, "new end speed"
+    u_end = trajectory.path.domain[1]
+    if goal_heading is not None:
+        old = float(trajectory.path.heading(u_end))
+        if abs(math.remainder(float(goal_heading) - old, 2.0 * math.pi)) > 1e-9:
+            return None, "new goal heading"
+    s0 = float(trajectory.motion(ts)[0])
+    u0 = float(trajectory._u_at_s(np.array(s0)))
+    if not u0 < u_end or s0 >= trajectory.length:
+        return None, "at the end"
+    if trajectory.path is not smooth:
+        return None, "the trajectory does not drive its smooth path"
+    span_box = smooth.certificate.span_box[int(smooth.curve.span_of(u0)):]
+    corridor = steps.corridor
+    regions = corridor.regions if isinstance(corridor, PolygonCorridor) else corridor.boxes
+    why = _map_change(planner, steps, [regions[i] for i in np.unique(span_box)])
+    if why:
+        return None, why
+    tail = smooth.curve.tail(u0)
+    start = tail.c[0]
+    cert = certify(tail, corridor, span_box, start=start, goal=np.asarray(steps.goal),
+                   raw_grid=planner.grid, radius=smooth.certificate.radius_m,
+                   kappa_bound=smooth.certificate.kappa_bound)  # fmt: skip
+    if not cert.ok:
+        return None, f"the rest fails its certificate ({', '.join(cert.failures)})"
+    path = dataclasses.replace(smooth, curve=tail, certificate=cert, footprint_certificate=None)
+    out = trajectory_after(trajectory, ts, path, u0)
+    elapsed = time.perf_counter() - t0
+    stages = {"keep": elapsed, "total": elapsed}
+    new_steps = dataclasses.replace(steps, raw_grid=planner.grid,
+                                    inflated_grid=planner.inflated_grid, smooth_path=path,
+                                    start=(float(start[0]), float(start[1])), stages_s=stages)  # fmt: skip
+    stats = dict(out.stats)
+    stats["stages_s"] = stages
+    stats["replan"] = "kept"
+    return dataclasses.replace(out, steps=new_steps, stats=stats), "kept"
+
+
+def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
+    """Return why the map change breaks the rest of the old curve ('' when it does not)."""
+    old, new = steps.raw_grid, planner.grid
+    if old is new:
+        return ""
+    if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
+        return "map of another shape"
+    if np.any(old.occupied & ~new.occupied):
+        return "cells freed"
+    iy, ix = np.nonzero(new.occupied & ~old.occupied)
+    if ix.size == 0:
+        return ""
+    centres = np.asarray(new.cell_to_world(np.column_stack([ix, iy])), dtype=float)
+    res = float(new.resolution)
+    # a region keeps the radius (plus the avoidance area with inflation="paper") from every
+    # occupied square; a new square whose centre is farther than that plus its half-diagonal
+    # from the region's bounding box cannot come closer
+    reach = planner.robot.radius + res * (math.sqrt(0.5) + 1e-9)
+    if planner.inflation == "paper":
+        reach += planner.w_cells * res
+    for reg in regions:
+        v = np.asarray(reg.vertices if isinstance(reg.vertices, np.ndarray) else reg.vertices())
+        lo, hi = v.min(axis=0) - reach, v.max(axis=0) + reach
+        if np.any(np.all((centres >= lo) & (centres <= hi), axis=1)):
+            return "cells blocked near the rest of the path"
+    return ""
+
+
+def trajectory_after(traj: Trajectory, ts: float, path: Any, u0: float) -> Trajectory:
+    """Return ``traj`` from time ``ts`` on, along ``path`` (its curve cut at ``u0``).
+
+    The constant-jerk phases after ``ts`` are kept as they are, shifted by ``ts`` in time
+    and by the arc length ``s(ts)``; the phase holding ``ts`` starts at ``ts`` with the
+    motion's state there. ``path`` must be ``traj.path`` from ``u0 = u(s(ts))`` on, with
+    the same parameter.
+    """
+    s0, v0, a0, _ = (float(x) for x in traj.motion(ts))
+    k = int(np.searchsorted(traj.phase_t, ts, side="right")) - 1
+    later = slice(k + 1, None)
+    gs = traj.theta_grid_s
+    ahead = gs > s0
+    theta0 = float(traj.state_at(ts).theta)
+    u_grid = traj.u_grid
+    if u_grid.shape[0]:
+        u_grid = np.concatenate([[u0], u_grid[ahead]])
+    return Trajectory(
+        path=path,
+        robot=traj.robot,
+        phase_t=np.concatenate([[0.0], traj.phase_t[later] - ts]),
+        phase_s=np.concatenate([[0.0], traj.phase_s[later] - s0]),
+        phase_v=np.concatenate([[v0], traj.phase_v[later]]),
+        phase_a=np.concatenate([[a0], traj.phase_a[later]]),
+        phase_j=np.concatenate([traj.phase_j[k : k + 1], traj.phase_j[later]]),
+        duration=traj.duration - ts,
+        v_start=v0,
+        v_end=traj.v_end,
+        stats=dict(traj.stats),
+        theta_grid_s=np.concatenate([[0.0], gs[ahead] - s0]),
+        theta_grid=np.concatenate([[theta0], traj.theta_grid[ahead]]),
+        u_grid=u_grid,
+        steps=traj.steps,
+    )
