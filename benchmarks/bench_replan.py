@@ -94,13 +94,15 @@ def main(argv: list[str] | None = None) -> int:
     robot = trajopt.Robot(radius=0.2)
     print(f"robot radius {robot.radius} m, v_max {robot.v_max} m/s; re-plan every "
           f"{args.every} s of trajectory time, latency 0")  # fmt: skip
-    print(f"{'map':26s} {'replans':>7s} {'ok':>4s} {'refused':>7s} {'median ms':>9s} "
-          f"{'p95 ms':>7s} {'fresh ms':>8s} {'max jump':>9s} {'limits':>6s} {'new goal':>10s}")
-    all_ms: list[float] = []
+    print(f"{'map':26s} {'replans':>7s} {'ok':>4s} {'refused':>7s} {'kept':>4s} "
+          f"{'kept ms':>7s} {'full ms':>7s} {'full p95':>8s} {'fresh ms':>8s} {'max jump':>9s} "
+          f"{'limits':>6s} {'new goal':>8s}")  # fmt: skip
+    all_kept: list[float] = []
+    all_full: list[float] = []
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
         planner = trajopt.Planner(grid, robot)
-        times, fresh, worst, refused, ok_limits, n_ok = [], [], 0.0, {}, True, 0
+        kept, full, fresh, worst, refused, ok_limits, n_ok, n_kept = [], [], [], 0.0, {}, True, 0, 0
         new_goal = {"ok": 0, "refused": 0}
         qs = queries(grid, robot, args.queries, rng)
         for k, (p0, p1) in enumerate(qs):
@@ -110,17 +112,18 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             t = args.every
             while t < traj.duration - 0.5:
-                t0 = time.perf_counter()
-                try:
-                    new = planner.replan(traj, t, latency=0.0)
-                except TrajoptError as exc:
-                    refused[type(exc).__name__] = refused.get(type(exc).__name__, 0) + 1
-                    t += args.every
-                    continue
-                times.append(1e3 * (time.perf_counter() - t0))
-                n_ok += 1
-                worst = max(worst, jump(traj.state_at(t), new.state_at(0.0)))
-                ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
+                for reuse, times in ((True, kept), (False, full)):
+                    t0 = time.perf_counter()
+                    try:
+                        new = planner.replan(traj, t, latency=0.0, reuse=reuse)
+                    except TrajoptError as exc:
+                        refused[type(exc).__name__] = refused.get(type(exc).__name__, 0) + 1
+                        continue
+                    times.append(1e3 * (time.perf_counter() - t0))
+                    n_ok += 1
+                    n_kept += new.stats["replan"] == "kept"
+                    worst = max(worst, jump(traj.state_at(t), new.state_at(0.0)))
+                    ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
                 s = traj.state_at(t)
                 t1 = time.perf_counter()
                 try:
@@ -137,20 +140,73 @@ def main(argv: list[str] | None = None) -> int:
                 new_goal["ok"] += 1
             except TrajoptError:
                 new_goal["refused"] += 1
-        all_ms += times
-        med = statistics.median(times) if times else float("nan")
-        p95 = float(np.percentile(times, 95)) if times else float("nan")
-        fr = statistics.median(fresh) if fresh else float("nan")
+        all_kept += kept
+        all_full += full
         ref = ", ".join(f"{v} {k}" for k, v in refused.items()) or "0"
-        print(f"{name:26s} {n_ok + sum(refused.values()):7d} {n_ok:4d} {ref:>7s} {med:9.1f} "
-              f"{p95:7.1f} {fr:8.1f} {worst:9.1e} {str(ok_limits):>6s} "
-              f"{new_goal['ok']}/{new_goal['ok'] + new_goal['refused']:<8d}")  # fmt: skip
-    if all_ms:
-        print(f"all maps: re-plan median {statistics.median(all_ms):.1f} ms, p95 "
-              f"{np.percentile(all_ms, 95):.1f} ms over {len(all_ms)} re-plans")  # fmt: skip
+        print(f"{name:26s} {n_ok + sum(refused.values()):7d} {n_ok:4d} {ref:>7s} {n_kept:4d} "
+              f"{_med(kept):7.1f} {_med(full):7.1f} {_p95(full):8.1f} {_med(fresh):8.1f} "
+              f"{worst:9.1e} {str(ok_limits):>6s} "
+              f"{new_goal['ok']}/{new_goal['ok'] + new_goal['refused']:<6d}")  # fmt: skip
+    if all_full:
+        print(f"all maps, same goal and map: kept re-plans median {_med(all_kept):.2f} ms, p95 "
+              f"{_p95(all_kept):.2f} ms ({len(all_kept)}); full re-plans (reuse=False) median "
+              f"{_med(all_full):.1f} ms, p95 {_p95(all_full):.1f} ms ({len(all_full)})")  # fmt: skip
+    appearing(d, robot, args, np.random.default_rng(args.seed))
     if args.warehouse:
         warehouse(d, args.warehouse, np.random.default_rng(args.seed))
     return 0
+
+
+def _med(x) -> float:
+    return statistics.median(x) if x else float("nan")
+
+
+def _p95(x) -> float:
+    return float(np.percentile(x, 95)) if x else float("nan")
+
+
+def appearing(d: Path, robot, args, rng) -> None:
+    """Drive each query re-planning every ``args.every`` s while obstacles appear."""
+    print(f"\nobstacles appearing: before every re-plan a 2 x 2 cell block turns occupied at "
+          f"a random free place at least {robot.radius + 0.3:.2f} m from the robot; the robot "
+          f"drives each new trajectory")  # fmt: skip
+    print(f"{'map':26s} {'replans':>7s} {'kept':>5s} {'planned':>7s} {'refused':>7s} "
+          f"{'median ms':>9s} {'p95 ms':>7s} {'max jump':>9s} {'limits':>6s}")  # fmt: skip
+    for name in MAPS:
+        grid = astar.load_map(d / f"{name}.yaml")
+        planner = trajopt.Planner(grid, robot)
+        times, kept, planned, refused, worst, ok_limits = [], 0, 0, 0, 0.0, True
+        for p0, p1 in queries(grid, robot, args.queries, rng):
+            planner.update_map(grid)
+            try:
+                traj = planner.plan(p0, p1)
+            except TrajoptError:
+                continue
+            occ = np.array(grid.occupied)
+            while traj.duration > args.every + 0.5:
+                here = np.asarray(traj.state_at(args.every).position)
+                free = np.argwhere(~occ[:-1, :-1])
+                for _ in range(100):
+                    iy, ix = free[rng.integers(len(free))]
+                    c = np.asarray(grid.cell_to_world((ix, iy)))
+                    if np.hypot(*(c - here)) > robot.radius + 0.3:
+                        occ[iy : iy + 2, ix : ix + 2] = True
+                        break
+                t0 = time.perf_counter()
+                try:
+                    new = planner.replan(traj, args.every, grid=grid.with_occupied(occ.copy()),
+                                         latency=0.0)  # fmt: skip
+                except TrajoptError:
+                    refused += 1
+                    break
+                times.append(1e3 * (time.perf_counter() - t0))
+                kept += new.stats["replan"] == "kept"
+                planned += new.stats["replan"] != "kept"
+                worst = max(worst, jump(traj.state_at(args.every), new.state_at(0.0)))
+                ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
+                traj = new
+        print(f"{name:26s} {kept + planned + refused:7d} {kept:5d} {planned:7d} {refused:7d} "
+              f"{_med(times):9.1f} {_p95(times):7.1f} {worst:9.1e} {str(ok_limits):>6s}")  # fmt: skip
 
 
 def warehouse(d: Path, n: int, rng) -> None:
