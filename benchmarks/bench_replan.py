@@ -3,13 +3,20 @@
 For each query on the shared ROS maps (seeded random start/goal pairs that a warm
 :class:`trajopt.Planner` solves), the robot drives the trajectory and re-plans every
 ``--every`` seconds of trajectory time to the same goal (``Planner.replan`` with the
-latency set to 0, so the splice is at the re-plan time), then once to a new goal. For every
+latency set to 0, so the splice is at the re-plan time), twice: as a user calls it (the
+map and goal are unchanged, so the rest of the trajectory is kept) and with
+``reuse=False`` (a full plan from the moving state); then once to a new goal. For every
 re-plan it records the wall time, the jump of position, heading, curvature, speed and
 acceleration between the old trajectory at the splice and the new one at its start, and
 whether the new trajectory holds every limit on 1 ms samples (``trajectory_metrics``). A
 re-plan that raises a typed error (a state too fast for any curve found, a goal behind
 the robot) is counted as refused, with its type. The reference is a fresh ``plan`` from
 rest at the same point, timed in the same run.
+
+Then the robot drives each query while obstacles appear: before every re-plan a 2 x 2
+block of free cells turns occupied at a random place away from the robot, and the robot
+re-plans on the updated map and drives the new trajectory (kept when the block is far from
+its rest, planned anew otherwise).
 
 A second part runs on a warehouse-size map, willow at 5 cm cells (each 10 cm cell split in
 four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt.warm_up``, one

@@ -100,10 +100,12 @@ BENCHES: tuple[Bench, ...] = (
           "writer in the same run.",
           ("--repeat", "3")),
     Bench("replan", "Re-planning from a moving robot", "bench_replan.py",
-          "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal, "
-          "then one new goal), the jump at the splice and the limits of the new "
-          "trajectory, against a fresh plan from rest at the same point; then whole plans "
-          "and re-plans to a new goal on a warehouse-size map (willow at 5 cm).",
+          "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal: "
+          "the rest kept, and with `reuse=False` a full plan; then one new goal), the jump "
+          "at the splice and the limits of the new trajectory, against a fresh plan from "
+          "rest at the same point; a drive with obstacles appearing before every re-plan; "
+          "then whole plans and re-plans to a new goal on a warehouse-size map (willow at "
+          "5 cm).",
           ("--queries", "4")),
     Bench("first_call", "First plan in a fresh process", "bench_first_call.py",
           "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
