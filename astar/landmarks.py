@@ -11,7 +11,8 @@ by farthest-point selection (each the cell farthest, by cost, from those chosen 
 first the one farthest from that region's first cell in row-major order), one
 single-source search each; cells of other regions get no bound from them. The result is
 tied to the grid, cost and step rule it was built for: :func:`astar.find_path` refuses it
-for any other.
+for any other. After a map update that only adds obstacles and raises costs,
+:meth:`Landmarks.rebase` carries it over without a new search.
 """
 
 from __future__ import annotations
@@ -57,6 +58,46 @@ class Landmarks:
     def k(self) -> int:
         """Number of landmarks."""
         return int(self.cells.shape[0])
+
+    def rebase(self, grid: OccupancyGrid, cost: object) -> Landmarks:
+        """Return these landmarks for a grid and cost that only got harder to cross.
+
+        When every cell occupied in :attr:`grid` is still occupied in ``grid`` and no cell's
+        cost fell, every path of the new graph is a path of the old one at no lower cost, so
+        the old distances ``d`` are lower bounds of the new ones ``d'``; then
+        ``|d(L, goal) - d(L, v)| <= d(v, goal) <= d'(v, goal)`` and the bound stays
+        admissible and consistent: the search stays exact, only less sharp. The distances
+        are shared, not copied (no new search runs).
+
+        Parameters
+        ----------
+        grid : OccupancyGrid
+            The updated grid (same shape).
+        cost : array_like of float, shape (ny, nx)
+            Its per-cell cost, ``>= self.cost`` everywhere.
+
+        Raises
+        ------
+        InvalidInputError
+            Another shape, a cell freed or a cost lowered (the message counts them): the
+            bounds may then overestimate, so build new landmarks.
+        """
+        grid = validation.grid(grid)
+        if grid.shape != self.grid.shape:
+            raise InvalidInputError(
+                f"grid has shape {grid.shape}, the landmarks' grid {self.grid.shape}"
+            )
+        c = np.array(validation.cell_costs(cost, grid), dtype=np.float64, order="C")
+        freed = int(np.count_nonzero(np.asarray(self.grid.occupied) & ~np.asarray(grid.occupied)))
+        lowered = int(np.count_nonzero(c < self.cost))
+        if freed or lowered:
+            raise InvalidInputError(
+                f"the landmarks' bounds hold only where no cell was freed and no cost fell: "
+                f"{freed} cells freed, {lowered} costs lowered; build new landmarks"
+            )
+        c.flags.writeable = False
+        return Landmarks(grid=grid, cost=c, cells=self.cells, distances=self.distances,
+                         connectivity=self.connectivity, corner_cutting=self.corner_cutting)  # fmt: skip
 
 
 def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivity: int = 8,

@@ -1,8 +1,10 @@
 """Map updates of a :class:`~trajopt.pipeline.Planner`.
 
 The inflated grid and the clearance cost are recomputed only where the change reaches. The
-search landmarks (``Planner(landmarks=k)``), whose distances span the whole map, are
-dropped on any change and built again by the next search.
+search landmarks (``Planner(landmarks=k)``), whose distances span the whole map, are kept
+(:meth:`astar.Landmarks.rebase`: still exact lower bounds) when the change only adds
+obstacles, so that no inflated cell is freed and no cost falls; otherwise they are dropped
+and built again by the next search.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 
@@ -39,13 +42,17 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
         )
         if not same:
             planner.grid, planner._inflated, planner._cost = grid, None, None
+            had = planner._landmarks is not None
             planner._landmarks = None
-            return {"changed_cells": None, "window": None, "reset": True}
+            return {"changed_cells": None, "window": None, "reset": True,
+                    "landmarks": "dropped" if had else None}  # fmt: skip
         changed = grid.occupied != old.occupied
         n_changed = int(changed.sum())
         planner.grid = grid
+        lms = planner._landmarks
         if n_changed == 0:
-            return {"changed_cells": 0, "window": None, "reset": False}
+            return {"changed_cells": 0, "window": None, "reset": False,
+                    "landmarks": None if lms is None else "kept"}  # fmt: skip
         planner._landmarks = None
         iy, ix = np.nonzero(changed)
         box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
@@ -62,7 +69,15 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
             cost = np.array(planner._cost)
             _patch(cost, grid, window, reach_cost, planner._clearance_cost)
             planner._cost = cost
-        return {"changed_cells": n_changed, "window": window, "reset": False}
+        state = None
+        if lms is not None:
+            try:
+                planner._landmarks = lms.rebase(planner._inflated, planner._cost)
+                state = "rebased"
+            except AstarInputError:  # a cell freed or a cost lowered
+                state = "dropped"
+        return {"changed_cells": n_changed, "window": window, "reset": False,
+                "landmarks": state}  # fmt: skip
 
 
 

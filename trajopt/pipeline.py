@@ -134,7 +134,8 @@ class Planner:
         ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`; 0, the
         default: none). Exact either way; on large maps they cut a long search several
         times, for a one-time cost on the first query after each map (about 0.1 s per
-        landmark per million cells) and ``8 landmarks`` bytes per cell.
+        landmark per million cells; :meth:`update_map` keeps them through changes that only
+        add obstacles) and ``8 landmarks`` bytes per cell.
     smoother : Smoother, optional
         Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
     timing_dt : float
@@ -299,7 +300,9 @@ class Planner:
         recomputed in the box around the changed cells grown by that reach (on a window
         grown once more, whose made-up outside then cannot reach the box); everything else
         is kept. A map of another shape, resolution or origin resets the caches. Search
-        landmarks, if any, are dropped on any change (the next search builds them again).
+        landmarks, if any, are kept when the change only adds obstacles (their bounds stay
+        exact lower bounds, :meth:`astar.Landmarks.rebase`) and dropped otherwise (the next
+        search builds them again).
 
         Parameters
         ----------
@@ -310,7 +313,8 @@ class Planner:
         -------
         dict
             ``changed_cells`` and ``window`` (``(x0, x1, y0, y1)`` cells, inclusive, or
-            ``None``) of the recomputed box; ``reset`` when the caches were dropped.
+            ``None``) of the recomputed box; ``reset`` when the caches were dropped;
+            ``landmarks``: ``"kept"``, ``"rebased"``, ``"dropped"`` or ``None`` (none built).
 
         Raises
         ------

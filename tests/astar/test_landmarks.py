@@ -103,7 +103,52 @@ def test_refusals():
         trajopt.Planner(grid, trajopt.Robot(radius=0.05), landmarks=-1)
 
 
-def test_planner_with_landmarks_plans_the_same_and_rebuilds_after_a_map_update():
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_rebased_landmarks_stay_exact_after_obstacles_are_added(seed):
+    occ = rooms(seed)
+    grid = OccupancyGrid(occ, 0.05)
+    lms = build_landmarks(grid, clearance_cost(grid, 0.05), 4)
+    rng = np.random.default_rng(seed + 20)
+    occ2 = occ.copy()
+    for _ in range(6):  # blocks that cut paths and raise the clearance cost around them
+        y, x = rng.integers(0, 44), rng.integers(0, 60)
+        occ2[y : y + 4, x : x + 4] = True
+    grid2 = OccupancyGrid(occ2, 0.05)
+    cost2 = clearance_cost(grid2, 0.05)
+    moved = lms.rebase(grid2, cost2)
+    assert moved.distances is lms.distances and moved.grid is grid2
+    free = np.argwhere(~occ2)
+    for _ in range(15):
+        a, b = free[rng.integers(len(free), size=2)]
+        s, g = (int(a[1]), int(a[0])), (int(b[1]), int(b[0]))
+        ref = dijkstra_costs(occ2, s, 8, False, cost2)[g[1], g[0]]
+        if not np.isfinite(ref):
+            with pytest.raises(astar.NoPathError):
+                find_path(grid2, s, g, landmarks=moved)
+            continue
+        p = find_path(grid2, s, g, landmarks=moved)
+        assert p.cost == pytest.approx(ref, rel=1e-12)
+        check_path(p, occ2, s, g, 8, False, cost2)
+
+
+def test_rebase_refuses_freed_cells_and_lowered_costs():
+    occ = rooms(0)
+    grid = OccupancyGrid(occ, 0.05)
+    cost = clearance_cost(grid, 0.05)
+    lms = build_landmarks(grid, cost, 2)
+    opened = occ.copy()
+    opened[:, 10] = False
+    with pytest.raises(InvalidInputError, match=r"\d+ cells freed, 0 costs lowered"):
+        lms.rebase(OccupancyGrid(opened, 0.05), cost)
+    cheaper = cost.copy()
+    cheaper[cheaper > 0] *= 0.5
+    with pytest.raises(InvalidInputError, match=r"0 cells freed, \d+ costs lowered"):
+        lms.rebase(grid, cheaper)
+    with pytest.raises(InvalidInputError, match="shape"):
+        lms.rebase(OccupancyGrid(occ[:-1], 0.05), cost[:-1])
+
+
+def test_planner_with_landmarks_plans_the_same_through_map_updates():
     occ = np.zeros((60, 90), bool)
     occ[:, 40:42] = True
     occ[20:26, 40:42] = False
@@ -116,11 +161,19 @@ def test_planner_with_landmarks_plans_the_same_and_rebuilds_after_a_map_update()
     with_lm = planner.plan(a, b)
     assert planner._landmarks is not None and planner._landmarks.k == 4
     assert with_lm.steps.grid_path.cost == pytest.approx(plain.steps.grid_path.cost, rel=1e-12)
+    built = planner._landmarks.distances
+    # obstacles added: the landmarks are carried over, the search stays exact
     occ2 = occ.copy()
     occ2[40:50, 10:20] = True
-    planner.update_map(OccupancyGrid(occ2, 0.05))
-    assert planner._landmarks is None
+    occ2[18:22, 30:34] = True  # near the door: the path's clearance cost rises
+    assert planner.update_map(OccupancyGrid(occ2, 0.05))["landmarks"] == "rebased"
+    assert planner._landmarks.distances is built
     again = planner.plan(a, b)
     fresh = trajopt.Planner(OccupancyGrid(occ2, 0.05), robot).plan(a, b)
     assert again.steps.grid_path.cost == pytest.approx(fresh.steps.grid_path.cost, rel=1e-12)
-    assert planner._landmarks is not None
+    # a cell freed: dropped, and built again by the next search
+    assert planner.update_map(OccupancyGrid(occ, 0.05))["landmarks"] == "dropped"
+    assert planner._landmarks is None
+    back = planner.plan(a, b)
+    assert back.steps.grid_path.cost == pytest.approx(plain.steps.grid_path.cost, rel=1e-12)
+    assert planner._landmarks is not None and planner._landmarks.distances is not built

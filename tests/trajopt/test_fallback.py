@@ -361,9 +361,9 @@ def test_fallback_needs_rest_at_both_ends(zigzag):
 
 
 def test_failed_clearance_check_reraises_the_original_error(zigzag, monkeypatch):
-    import trajopt.pipeline as pipeline
+    import trajopt.fallback as fallback
 
-    monkeypatch.setattr(pipeline, "polyline_clearance", lambda *a, **k: 0.0)
+    monkeypatch.setattr(fallback, "polyline_clearance", lambda *a, **k: 0.0)
     grid, start, goal = zigzag
     with pytest.raises(SmoothingError, match="certified"):
         trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn", corridor="boxes").plan(
