@@ -17,6 +17,7 @@ for any other. After a map update that only adds obstacles and raises costs,
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,7 +60,8 @@ class Landmarks:
         """Number of landmarks."""
         return int(self.cells.shape[0])
 
-    def rebase(self, grid: OccupancyGrid, cost: object) -> Landmarks:
+    def rebase(self, grid: OccupancyGrid, cost: object,
+               window: tuple[int, int, int, int] | None = None) -> Landmarks:  # fmt: skip
         """Return these landmarks for a grid and cost that only got harder to cross.
 
         When every cell occupied in :attr:`grid` is still occupied in ``grid`` and no cell's
@@ -74,28 +76,46 @@ class Landmarks:
         grid : OccupancyGrid
             The updated grid (same shape).
         cost : array_like of float, shape (ny, nx)
-            Its per-cell cost, ``>= self.cost`` everywhere.
+            Its per-cell cost, finite and ``>= self.cost`` everywhere. A read-only
+            C-contiguous float64 array is kept as it is (the caller must not change it).
+        window : tuple of int, optional
+            ``(x0, x1, y0, y1)`` cells, inclusive: the caller knows that outside it ``grid``
+            and ``cost`` equal the landmarks' (as :meth:`trajopt.Planner.update_map`
+            reports), so only the window is checked. Default: the whole grid.
 
         Raises
         ------
         InvalidInputError
-            Another shape, a cell freed or a cost lowered (the message counts them): the
-            bounds may then overestimate, so build new landmarks.
+            Another shape, a cost not finite and ``>= 0``, a cell freed or a cost lowered
+            (the message counts them): the bounds may then overestimate, so build new
+            landmarks.
         """
         grid = validation.grid(grid)
         if grid.shape != self.grid.shape:
             raise InvalidInputError(
                 f"grid has shape {grid.shape}, the landmarks' grid {self.grid.shape}"
             )
-        c = np.array(validation.cell_costs(cost, grid), dtype=np.float64, order="C")
-        freed = int(np.count_nonzero(np.asarray(self.grid.occupied) & ~np.asarray(grid.occupied)))
-        lowered = int(np.count_nonzero(c < self.cost))
+        c = np.asarray(cost, dtype=np.float64)
+        if c.shape != grid.shape:
+            raise InvalidInputError(f"cost must have the grid's shape {grid.shape}, got {c.shape}")
+        win = np.s_[:, :]
+        if window is not None:
+            x0, x1, y0, y1 = (int(v) for v in window)
+            win = np.s_[y0 : y1 + 1, x0 : x1 + 1]
+        part = c[win]
+        if part.size and not (math.isfinite(float(part.max())) and float(part.min()) >= 0.0):
+            raise InvalidInputError("cost must be finite and >= 0 everywhere")
+        old_occ, new_occ = np.asarray(self.grid.occupied)[win], np.asarray(grid.occupied)[win]
+        freed = int(np.count_nonzero(old_occ & ~new_occ))
+        lowered = int(np.count_nonzero(part < self.cost[win]))
         if freed or lowered:
             raise InvalidInputError(
                 f"the landmarks' bounds hold only where no cell was freed and no cost fell: "
                 f"{freed} cells freed, {lowered} costs lowered; build new landmarks"
             )
-        c.flags.writeable = False
+        if c.flags.writeable or not c.flags.c_contiguous:
+            c = np.array(c, order="C")
+            c.flags.writeable = False
         return Landmarks(grid=grid, cost=c, cells=self.cells, distances=self.distances,
                          connectivity=self.connectivity, corner_cutting=self.corner_cutting)  # fmt: skip
 

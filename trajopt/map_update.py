@@ -46,15 +46,15 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
             planner._landmarks = None
             return {"changed_cells": None, "window": None, "reset": True,
                     "landmarks": "dropped" if had else None}  # fmt: skip
-        changed = grid.occupied != old.occupied
-        n_changed = int(changed.sum())
+        changed = np.flatnonzero(np.asarray(grid.occupied) != np.asarray(old.occupied))
+        n_changed = int(changed.size)
         planner.grid = grid
         lms = planner._landmarks
         if n_changed == 0:
             return {"changed_cells": 0, "window": None, "reset": False,
                     "landmarks": None if lms is None else "kept"}  # fmt: skip
         planner._landmarks = None
-        iy, ix = np.nonzero(changed)
+        iy, ix = np.divmod(changed, grid.nx)  # flatnonzero: far faster than a 2-D nonzero
         box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
         r_cells = int(math.ceil(planner.robot.radius / grid.resolution)) + 2
         if planner.inflation == "paper":
@@ -68,11 +68,12 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
         if planner._cost is not None:
             cost = np.array(planner._cost)
             _patch(cost, grid, window, reach_cost, planner._clearance_cost)
+            cost.flags.writeable = False  # shared with the landmarks
             planner._cost = cost
         state = None
         if lms is not None:
             try:
-                planner._landmarks = lms.rebase(planner._inflated, planner._cost)
+                planner._landmarks = lms.rebase(planner._inflated, planner._cost, window)
                 state = "rebased"
             except AstarInputError:  # a cell freed or a cost lowered
                 state = "dropped"

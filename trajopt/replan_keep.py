@@ -121,7 +121,7 @@ def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
         return "map of another shape"
     if np.any(old.occupied & ~new.occupied):
         return "cells freed"
-    iy, ix = np.nonzero(new.occupied & ~old.occupied)
+    iy, ix = np.divmod(np.flatnonzero(new.occupied & ~old.occupied), new.nx)
     if ix.size == 0:
         return ""
     centres = np.asarray(new.cell_to_world(np.column_stack([ix, iy])), dtype=float)

@@ -146,6 +146,13 @@ def test_rebase_refuses_freed_cells_and_lowered_costs():
         lms.rebase(grid, cheaper)
     with pytest.raises(InvalidInputError, match="shape"):
         lms.rebase(OccupancyGrid(occ[:-1], 0.05), cost[:-1])
+    # a window holding the freed column still sees it; NaN costs in it are refused
+    with pytest.raises(InvalidInputError, match=r"\d+ cells freed"):
+        lms.rebase(OccupancyGrid(opened, 0.05), cost, window=(8, 12, 0, 47))
+    bad = cost.copy()
+    bad[5, 9] = np.nan
+    with pytest.raises(InvalidInputError, match="finite and >= 0"):
+        lms.rebase(grid, bad, window=(8, 12, 0, 47))
 
 
 def test_planner_with_landmarks_plans_the_same_through_map_updates():
