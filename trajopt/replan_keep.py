@@ -3,9 +3,10 @@
 :meth:`~trajopt.pipeline.Planner.replan` first asks :func:`keep_rest` whether the old
 trajectory's rest is still the answer. It is when the goal, the goal heading and the end
 speed are the old ones and the map has not changed where the rest depends on it: no cell
-was freed anywhere (a freed cell may open a better route), and no cell became occupied
-within the robot's reach of the corridor regions the rest of the curve lies in (the
-regions the certificate holds it to). Then nothing is searched, fitted or timed again: the
+of the inflated grid (the search's graph) was freed anywhere, since a freed cell may open a
+better route, and no cell became occupied within the robot's reach of the corridor regions
+the rest of the curve lies in (the regions the certificate holds it to). The trajectory is
+taken to come from this planner (its speed limits and smoother options). Then nothing is searched, fitted or timed again: the
 curve is cut at the splice (:meth:`~trajopt.bspline.BSplineCurve.tail`, exact), the timing's
 constant-jerk phases from the splice on are kept as they are, shifted in time and arc
 length, and the cut curve is certified again against the corridor and the current map.
@@ -119,7 +120,9 @@ def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
         return ""
     if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
         return "map of another shape"
-    if np.any(old.occupied & ~new.occupied):
+    # a cell the search could not enter before and can now may open a better route; a raw
+    # cell freed inside what stays inflated adds nothing to the search's graph
+    if np.any(steps.inflated_grid.occupied & ~planner.inflated_grid.occupied):
         return "cells freed"
     iy, ix = np.divmod(np.flatnonzero(new.occupied & ~old.occupied), new.nx)
     if ix.size == 0:

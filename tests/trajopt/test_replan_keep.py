@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy import ndimage
 from scipy.interpolate import BSpline
 from scipy.spatial import Delaunay
 
@@ -162,9 +163,17 @@ def test_map_updates_far_from_the_rest_keep_it_near_ones_do_not(scene):
     new = planner.replan(kept, 0.5, grid=near, latency=0.0)
     assert new.stats["replan"] == "planned: cells blocked near the rest of the path"
 
-    # a cell freed anywhere may open a better route: re-planned
-    ix, iy = np.argwhere(np.asarray(near.occupied))[0][::-1]
-    again = planner.replan(new, 0.5, grid=_edit(near, [(ix, iy)], False), latency=0.0)
+    # a raw cell freed inside an obstacle (still inflated) adds nothing: kept
+    labels, _ = ndimage.label(np.asarray(near.occupied))
+    biggest = np.argwhere(labels == np.argmax(np.bincount(labels.ravel())[1:]) + 1)
+    inside = tuple(np.median(biggest, axis=0).astype(int)[::-1])  # (ix, iy) in its middle
+    assert near.occupied[inside[1], inside[0]]
+    hollow = _edit(near, [inside], False)
+    same = planner.replan(new, 0.5, grid=hollow, latency=0.0)
+    assert same.stats["replan"] == "kept"
+    # a whole obstacle removed opens cells to the search: re-planned
+    opened = _edit(hollow, [tuple(c[::-1]) for c in biggest], False)
+    again = planner.replan(same, 0.5, grid=opened, latency=0.0)
     assert again.stats["replan"] == "planned: cells freed"
 
 
