@@ -24,17 +24,6 @@ from trajopt.state import State
 ROBOT = trajopt.Robot()
 
 
-@pytest.fixture(scope="module")
-def scene():
-    return trajopt.scenes.paper()
-
-
-@pytest.fixture(scope="module")
-def driven(scene):
-    planner = trajopt.Planner(scene.grid, ROBOT)
-    return planner, planner.plan(scene.start, scene.goal("A"))
-
-
 def jumps(a: State, b: State) -> dict[str, float]:
     """Absolute differences of two states, per field (heading wrapped)."""
     return {

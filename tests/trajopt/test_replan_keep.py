@@ -69,17 +69,6 @@ def test_tail_refuses_a_start_outside_the_domain():
             curve.tail(u0)
 
 
-@pytest.fixture(scope="module")
-def scene():
-    return trajopt.scenes.paper()
-
-
-@pytest.fixture(scope="module")
-def driven(scene):
-    planner = trajopt.Planner(scene.grid, ROBOT)
-    return planner, planner.plan(scene.start, scene.goal("B"))
-
-
 def _same_motion(old, new, ts: float) -> None:
     """``new`` is ``old`` from ``ts`` on: on 1 ms samples, every quantity agrees."""
     assert new.duration == pytest.approx(old.duration - ts, abs=1e-12)
