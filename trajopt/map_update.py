@@ -18,7 +18,7 @@ from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 
-__all__ = ["update_caches"]
+__all__ = ["change_reach", "update_caches"]
 
 
 def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
@@ -56,10 +56,7 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
         planner._landmarks = None
         iy, ix = np.divmod(changed, grid.nx)  # flatnonzero: far faster than a 2-D nonzero
         box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
-        r_cells = int(math.ceil(planner.robot.radius / grid.resolution)) + 2
-        if planner.inflation == "paper":
-            r_cells += planner.w_cells + 1
-        reach_cost = r_cells + 5  # + the clearance cost's 3-cell fall-off, rounded up
+        r_cells, reach_cost = change_reach(planner, grid.resolution)
         window = _grow(box, max(r_cells, reach_cost), grid.shape)
         if planner._inflated is not None:
             occ = np.array(planner._inflated.occupied)
@@ -80,6 +77,19 @@ def update_caches(planner: Any, grid: OccupancyGrid) -> dict[str, Any]:
         return {"changed_cells": n_changed, "window": window, "reset": False,
                 "landmarks": state}  # fmt: skip
 
+
+
+def change_reach(planner: Any, resolution: float) -> tuple[int, int]:
+    """Cells a changed cell can reach: ``(inflated grid, search cost)``.
+
+    The inflated grid changes within the robot radius (plus the avoidance area with
+    ``inflation="paper"``) of a changed cell, plus 2 cells of rounding; the search cost
+    within that plus the clearance cost's 3-cell fall-off, rounded up.
+    """
+    r_cells = int(math.ceil(planner.robot.radius / resolution)) + 2
+    if planner.inflation == "paper":
+        r_cells += planner.w_cells + 1
+    return r_cells, r_cells + 5
 
 
 def _grow(box: tuple[int, int, int, int], k: int, shape: tuple[int, int]):

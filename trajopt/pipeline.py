@@ -372,6 +372,10 @@ class Planner:
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
         """
+        return self._query(start, goal, start_heading, goal_heading, v_start, v_end, None)
+
+    def _query(self, start, goal, start_heading, goal_heading, v_start, v_end, grid_path):
+        """:meth:`plan`, with a grid path to use instead of a search (a re-plan's warm start)."""
         with self._lock:
             t0 = time.perf_counter()
             if self.robot.footprint is not None:
@@ -379,7 +383,8 @@ class Planner:
                                           goal_heading=goal_heading, v_start=v_start,
                                           v_end=v_end)  # fmt: skip
             else:
-                out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end)
+                out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end,
+                                 grid_path)  # fmt: skip
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -412,7 +417,10 @@ class Planner:
         With ``reuse`` (the default) the rest of the old trajectory is kept, cut at the
         splice and certified again, when the goal, goal heading and end speed are the old
         ones and the map changed nowhere near it (:mod:`trajopt.replan_keep`); otherwise a
-        new trajectory is planned from the state (:meth:`plan`).
+        new trajectory is planned from the state (:meth:`plan`). When the map changed near
+        the rest but beyond the search cost's reach of its grid path, that plan takes the
+        rest of the old grid path, joined from the state's cell, instead of searching
+        (``stats["grid_path"] == "reused"``; ``"searched"`` otherwise).
 
         Parameters
         ----------
@@ -447,7 +455,8 @@ class Planner:
             return replan_from(self, trajectory, t, goal, grid, latency=latency,
                                goal_heading=goal_heading, v_end=v_end, reuse=reuse)  # fmt: skip
 
-    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end) -> PlanResult:
+    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end,
+              grid_path=None) -> PlanResult:  # fmt: skip
         kappa0 = None
         a0 = 0.0
         if isinstance(start, State):
@@ -476,18 +485,10 @@ class Planner:
         with q.timer.stage("inflate"):
             q.inflated = self.inflated_grid
         self._check_reachable_ends(q)
+        ends = [q.start_cell, q.goal_cell]
+        reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
         with q.timer.stage("search"):
-            try:
-                lms = self.search_landmarks
-                q.path = astar.find_path(
-                    q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
-                    cost=self.search_cost if lms is None else None, landmarks=lms,
-                )  # fmt: skip
-            except astar.NoPathError as exc:
-                raise NoPathError(
-                    f"no path from start {p0.tolist()} m to goal {p1.tolist()} m for a robot "
-                    f"of radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
-                ) from exc
+            q.path = grid_path if reused else self._search(q)
             if self.path_check is not None:
                 q.path, q.inflated = self.path_check(self, q)
         smooth = None
@@ -507,7 +508,22 @@ class Planner:
         smoother_stats = dict(smooth.stats)
         smoother_stats["rescue"] = q.rescue
         kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
-        return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind)
+        return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind,
+                            grid_path="reused" if reused else "searched")  # fmt: skip
+
+    def _search(self, q: PlanQuery) -> astar.GridPath:
+        """Return the A* path of the query on the inflated grid (typed error without one)."""
+        try:
+            lms = self.search_landmarks
+            return astar.find_path(
+                q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
+                cost=self.search_cost if lms is None else None, landmarks=lms,
+            )  # fmt: skip
+        except astar.NoPathError as exc:
+            raise NoPathError(
+                f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
+                f"robot of radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
+            ) from exc
 
     def _time(self, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
         with q.timer.stage("timing"):

@@ -10,6 +10,9 @@ taken to come from this planner (its speed limits and smoother options). Then no
 curve is cut at the splice (:meth:`~trajopt.bspline.BSplineCurve.tail`, exact), the timing's
 constant-jerk phases from the splice on are kept as they are, shifted in time and arc
 length, and the cut curve is certified again against the corridor and the current map.
+
+When the rest cannot be kept because new obstacles came near it, :func:`remaining_grid_path`
+may still hand the re-plan the rest of the old grid path, so that it skips the search.
 """
 
 from __future__ import annotations
@@ -22,13 +25,20 @@ from typing import Any
 
 import numpy as np
 
+from astar.search import GridPath
+from trajopt.map_update import change_reach
 from trajopt.polygon_corridor import PolygonCorridor
 from trajopt.smoother import SmoothPath
 from trajopt.smoother.certificate import certify
 from trajopt.trajectory import Trajectory
 from trajopt.validation import point
 
-__all__ = ["keep_rest", "trajectory_after"]
+__all__ = ["BLOCKED_NEAR", "keep_rest", "remaining_grid_path", "trajectory_after"]
+
+#: why :func:`keep_rest` refuses when new obstacles come near the rest of the path
+BLOCKED_NEAR = "cells blocked near the rest of the path"
+#: changed cells near the grid path compared pairwise with its cells, at most this many
+_MAX_NEAR_CHANGES = 20_000
 
 
 def keep_rest(
@@ -139,8 +149,79 @@ def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
         v = np.asarray(reg.vertices if isinstance(reg.vertices, np.ndarray) else reg.vertices())
         lo, hi = v.min(axis=0) - reach, v.max(axis=0) + reach
         if np.any(np.all((centres >= lo) & (centres <= hi), axis=1)):
-            return "cells blocked near the rest of the path"
+            return BLOCKED_NEAR
     return ""
+
+
+def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> GridPath | None:
+    """Return the rest of the old grid path joined from ``start_cell``, if the map allows.
+
+    The join is the straight line of king moves from ``start_cell`` to the nearest cell of
+    the old path (the last one at that distance), then the old path from there. It is
+    returned when every cell of it is free on the current inflated grid (diagonal moves
+    without cutting corners, as the search moves), no inflated cell was freed anywhere, and
+    no raw cell changed within the search cost's reach of it
+    (:func:`~trajopt.map_update.change_reach`). Then the costs along the old part are the
+    old ones and no other path got cheaper, so that part is still a least-cost path from its
+    first cell to the goal; only the short join is not searched.
+
+    Parameters
+    ----------
+    planner : Planner
+        The re-planning planner, with its current map.
+    steps : PlanSteps
+        The old trajectory's steps (its grid path, raw and inflated grids).
+    start_cell : ndarray of int, shape (2,)
+        The new start's cell ``(ix, iy)``.
+
+    Returns
+    -------
+    astar.GridPath or None
+        ``expanded`` 0, ``length`` and ``cost`` recomputed on the current search cost.
+    """
+    old, new = steps.raw_grid, planner.grid
+    if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
+        return None
+    start = np.asarray(start_cell, dtype=np.int64)
+    if not new.in_bounds(start):
+        return None
+    free = ~np.asarray(planner.inflated_grid.occupied)
+    if np.any(np.asarray(steps.inflated_grid.occupied) & free):
+        return None  # cells freed: another route may be cheaper now
+    cells = np.asarray(steps.grid_path.cells)
+    d2 = np.sum((cells - start) ** 2, axis=1)
+    i = int(len(d2) - 1 - np.argmin(d2[::-1]))
+    n = int(np.max(np.abs(cells[i] - start)))
+    k = np.arange(n + 1)[:, None] / max(n, 1)
+    join = np.rint(start + (cells[i] - start) * k).astype(np.int64)
+    path = np.vstack([join[:-1], cells[i:]])
+    if not np.all(free[path[:, 1], path[:, 0]]):
+        return None
+    step = np.diff(path, axis=0)
+    diag = np.all(step != 0, axis=1)
+    a = path[:-1][diag]
+    if not (np.all(free[a[:, 1], a[:, 0] + step[diag, 0]])
+            and np.all(free[a[:, 1] + step[diag, 1], a[:, 0]])):  # fmt: skip
+        return None
+    _, reach = change_reach(planner, new.resolution)
+    iy, ix = np.divmod(np.flatnonzero(new.occupied != old.occupied), new.nx)
+    lo, hi = path.min(axis=0) - reach, path.max(axis=0) + reach
+    near = (ix >= lo[0]) & (ix <= hi[0]) & (iy >= lo[1]) & (iy <= hi[1])
+    if np.count_nonzero(near) > _MAX_NEAR_CHANGES:
+        return None
+    changed = np.column_stack([ix[near], iy[near]])
+    for chunk in np.array_split(changed, max(1, len(changed) // 256)):
+        if len(chunk) and np.min(np.max(np.abs(chunk[:, None, :] - path[None]), axis=2)) <= reach:
+            return None
+    length_steps = np.where(diag, math.sqrt(2.0), 1.0)
+    cost = planner.search_cost
+    if cost is None:
+        step_costs = length_steps
+    else:
+        c = cost[path[:, 1], path[:, 0]]
+        step_costs = length_steps * (1.0 + 0.5 * (c[:-1] + c[1:]))
+    return GridPath(cells=path, length=float(length_steps.sum()), cost=float(step_costs.sum()),
+                    expanded=0)  # fmt: skip
 
 
 def trajectory_after(traj: Trajectory, ts: float, path: Any, u0: float) -> Trajectory:

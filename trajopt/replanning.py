@@ -14,7 +14,7 @@ from astar.grid import OccupancyGrid
 from trajopt.corridor_fit import fit_in_corridor
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.plan_query import PlanQuery
-from trajopt.replan_keep import keep_rest
+from trajopt.replan_keep import BLOCKED_NEAR, keep_rest, remaining_grid_path
 from trajopt.smoother import SmoothPath
 from trajopt.validation import nonnegative, number
 
@@ -58,7 +58,11 @@ def replan_from(
                              v_end=v_end)  # fmt: skip
     if out is None:
         state = trajectory.state_at(ts)
-        out = planner.plan(state, goal, goal_heading=goal_heading, v_end=v_end)
+        path = None
+        if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
+            path = remaining_grid_path(planner, trajectory.steps,
+                                       planner.grid.world_to_cell(state.position))  # fmt: skip
+        out = planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
     stats = dict(out.stats)
     stats["replan"] = "kept" if why == "kept" else f"planned: {why}"
     stats["splice_time_s"] = ts

@@ -172,3 +172,55 @@ def test_footprint_robots_and_fallbacks_are_planned_anew(scene):
     traj = planner.plan(scene.start, scene.goal("A"))
     new = planner.replan(traj, 1.0, latency=0.0)
     assert new.stats["replan"] == "planned: footprint robot"
+
+
+def _step_costs(cells: np.ndarray, cost: np.ndarray) -> float:
+    """The search's cost of a path of cells: step length times one plus the mean cell cost."""
+    d = np.diff(cells, axis=0)
+    length = np.where(np.all(d != 0, axis=1), math.sqrt(2.0), 1.0)
+    c = cost[cells[:, 1], cells[:, 0]]
+    return float(np.sum(length * (1.0 + 0.5 * (c[:-1] + c[1:]))))
+
+
+def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
+    from tests.astar.test_search import dijkstra_costs
+    from trajopt.map_update import change_reach
+
+    grid = scene.grid
+    planner = trajopt.Planner(grid, ROBOT)
+    traj = planner.plan(scene.start, scene.goal("B"))
+    old_cells = np.asarray(traj.steps.grid_path.cells)
+    _, reach = change_reach(planner, grid.resolution)
+    # a free cell just beyond the cost's reach of every path cell, but near the corridor
+    free = np.argwhere(~np.asarray(grid.occupied))[:, ::-1]
+    cheb = np.max(np.abs(free[:, None, :] - old_cells[None]), axis=2).min(axis=1)
+    candidates = free[(cheb > reach + 1) & (cheb <= reach + 3)]
+    for cell in candidates:
+        updated = _edit(grid, [tuple(cell)], True)
+        new = planner.replan(traj, 1.0, grid=updated, latency=0.0)
+        planner.update_map(grid)
+        if new.stats["replan"] == "planned: cells blocked near the rest of the path":
+            break
+    else:
+        pytest.fail("no candidate cell near the corridor")
+    assert new.stats["grid_path"] == "reused"
+    cells = np.asarray(new.steps.grid_path.cells)
+    # the old path's rest, joined from the new start: and still a least-cost path from its
+    # first cell on the updated map (scipy's Dijkstra on the inflated grid)
+    k = next(j for j in range(len(cells)) if tuple(cells[j]) in {tuple(c) for c in old_cells})
+    rest = cells[k:]
+    assert np.array_equal(rest, old_cells[-len(rest):])
+    planner.update_map(updated)
+    occ = np.asarray(planner.inflated_grid.occupied)
+    ref = dijkstra_costs(occ, tuple(rest[0]), 8, False, planner.search_cost)
+    goal = tuple(rest[-1])
+    assert _step_costs(rest, planner.search_cost) == pytest.approx(ref[goal[1], goal[0]], rel=1e-9)
+    assert new.steps.grid_path.cost == pytest.approx(_step_costs(cells, planner.search_cost))
+    smp = new.sample_uniform(0.005)
+    clr = point_clearance(np.column_stack([smp.x, smp.y]), updated, border_occupied=True)
+    assert clr.min() >= ROBOT.radius - 1e-6
+    # a block on the path ahead: searched again
+    ahead = old_cells[int(0.8 * len(old_cells))]
+    blocked = _edit(updated, [tuple(ahead)], True)
+    again = planner.replan(traj, 1.0, grid=blocked, latency=0.0)
+    assert again.stats["grid_path"] == "searched"
