@@ -1,4 +1,4 @@
-"""What a re-plan keeps: the rest of the trajectory being driven, when nothing it relies on changed.
+"""What a re-plan keeps of the trajectory being driven, when nothing it relies on changed.
 
 :meth:`~trajopt.pipeline.Planner.replan` first asks :func:`keep_rest` whether the old
 trajectory's rest is still the answer. It is when the goal, the goal heading and the end
@@ -6,10 +6,11 @@ speed are the old ones and the map has not changed where the rest depends on it:
 of the inflated grid (the search's graph) was freed anywhere, since a freed cell may open a
 better route, and no cell became occupied within the robot's reach of the corridor regions
 the rest of the curve lies in (the regions the certificate holds it to). The trajectory is
-taken to come from this planner (its speed limits and smoother options). Then nothing is searched, fitted or timed again: the
-curve is cut at the splice (:meth:`~trajopt.bspline.BSplineCurve.tail`, exact), the timing's
-constant-jerk phases from the splice on are kept as they are, shifted in time and arc
-length, and the cut curve is certified again against the corridor and the current map.
+taken to come from this planner (its speed limits and smoother options). Then nothing is
+searched, fitted or timed again: the curve is cut at the splice
+(:meth:`~trajopt.bspline.BSplineCurve.tail`, exact), the timing's constant-jerk phases from
+the splice on are kept as they are, shifted in time and arc length, and the cut curve is
+certified again against the corridor and the current map.
 
 When the rest cannot be kept because new obstacles came near it, :func:`remaining_grid_path`
 may still hand the re-plan the rest of the old grid path, so that it skips the search.
