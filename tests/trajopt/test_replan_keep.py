@@ -224,3 +224,13 @@ def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
     blocked = _edit(updated, [tuple(ahead)], True)
     again = planner.replan(traj, 1.0, grid=blocked, latency=0.0)
     assert again.stats["grid_path"] == "searched"
+
+
+def test_box_corridors_keep_the_rest_too(scene):
+    planner = trajopt.Planner(scene.grid, ROBOT, corridor="boxes")
+    traj = planner.plan(scene.start, scene.goal("C"))
+    assert traj.stats["corridor"] == "boxes"
+    new = planner.replan(traj, 2.0, latency=0.0)
+    assert new.stats["replan"] == "kept"
+    assert new.steps.smooth_path.certificate.ok
+    _same_motion(traj, new, 2.0)
