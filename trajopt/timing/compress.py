@@ -89,9 +89,7 @@ def compress(
     peaks = greedy.phase_peaks(phases, t_next)
     ph_index = bounds[:, 4].astype(np.int64).tolist()
     b_t = bounds[:, 0].tolist()
-    states = bounds[:, 1:4].tolist()  # (s, v, a) per bound
     ci, h = table.ci, table.h
-    n_ci = ci.shape[0]
     st, lg, length = table.st, table.lg, table.length
     chain: list[np.ndarray] = []
     t_out = 0.0
@@ -115,11 +113,8 @@ def compress(
             return [greedy_rows(i0, i1)]
         budget[0] -= 1
         g_dur = b_t[i1] - b_t[i0]
-        st0, st1 = states[i0], states[i1]
-        peak = float(peaks[p0:p1].max())
-        i_a = min(int(st0[0] / h), n_ci - 1)
-        i_b = min(int(st1[0] / h), n_ci - 1)
-        top = float(ci[i_a : i_b + 1].max())
+        st0, st1 = bounds[i0, 1:4].tolist(), bounds[i1, 1:4].tolist()  # (s, v, a)
+        peak, top = greedy.section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
         tried_top = top > peak * (1.0 + 1e-6)
         if tried_top:
             # first try the highest cap in the section: better than the greedy's peak if it fits
