@@ -18,7 +18,6 @@ __all__ = ["compress", "finish", "rows_from_greedy"]
 
 MAX_SPLIT_DEPTH = 6
 MIN_SPLIT_STEPS = 6  # split a failed section only when it spans at least this many steps
-PEAK_REL = 1e-3  # the peak is tried after the top cap only when below it by more than this
 
 
 def rows_from_greedy(phases: np.ndarray, i0: int, i1: int, t_end: float) -> np.ndarray:
@@ -74,11 +73,12 @@ def compress(
 ) -> list[np.ndarray]:
     """Replace the greedy between its speed minima by ruckig's time-optimal sections.
 
-    A section is tried with ruckig at the highest cap over it (when above the greedy's peak
-    speed there by more than ``PEAK_REL``), then at the greedy's peak; a profile is kept when
-    it is no slower than the greedy and under the cap. A failed section is split at its
-    middle time step (down to ``MAX_SPLIT_DEPTH`` levels, ``MIN_SPLIT_STEPS`` steps); the
-    greedy's own rows stand where nothing fits.
+    A section is tried with ruckig at the highest cap over it when that is above the
+    greedy's peak speed there, else (or when ruckig gives no profile for it) at the greedy's
+    peak; a profile is kept when it is no slower than the greedy and under the cap. A
+    failed section is split at the greedy step nearest its mid-time (down to
+    ``MAX_SPLIT_DEPTH`` levels and ``MIN_SPLIT_STEPS`` steps); the greedy's own phases stand
+    where nothing fits.
     """
     nb = bounds.shape[0]
     v, a = bounds[:, 2], bounds[:, 3]
@@ -115,13 +115,13 @@ def compress(
         g_dur = b_t[i1] - b_t[i0]
         st0, st1 = bounds[i0, 1:4].tolist(), bounds[i1, 1:4].tolist()  # (s, v, a)
         peak, top = greedy.section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
-        tried_top = top > peak * (1.0 + 1e-6)
-        if tried_top:
+        rows = None
+        if top > peak * (1.0 + 1e-6):
             # first try the highest cap in the section: better than the greedy's peak if it fits
             rows = rk.solve(st0, st1, top)
             if fits(rows, g_dur):
                 return [rows]
-        if not tried_top or top > peak * (1.0 + PEAK_REL):
+        if rows is None:  # no top attempt, or ruckig gave no profile for it
             rows = rk.solve(st0, st1, peak)
             if fits(rows, g_dur):
                 return [rows]
