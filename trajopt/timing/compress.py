@@ -87,16 +87,12 @@ def compress(
     knots = [0, *(np.flatnonzero(inner) + 1).tolist(), nb - 1]
     t_next = np.append(phases[1:, 0], bounds[-1, 0])
     peaks = greedy.phase_peaks(phases, t_next)
-    ph_index = bounds[:, 4].astype(np.int64).tolist()
-    b_t = bounds[:, 0].tolist()
+    b_t = bounds[:, 0]  # bound times, non-decreasing
     ci, h = table.ci, table.h
     st, lg, length = table.st, table.lg, table.length
     chain: list[np.ndarray] = []
     t_out = 0.0
     budget = [3 * len(knots) + 32]  # ruckig calls; the greedy answer is kept beyond it
-
-    def greedy_rows(i0: int, i1: int) -> np.ndarray:
-        return rows_from_greedy(phases, ph_index[i0], ph_index[i1], b_t[i1])
 
     def fits(rows, g_dur: float) -> bool:
         return (
@@ -106,14 +102,15 @@ def compress(
         )
 
     def solve(i0: int, i1: int, depth: int) -> list[np.ndarray]:
-        p0, p1 = ph_index[i0], ph_index[i1]
+        b0, b1 = bounds[i0].tolist(), bounds[i1].tolist()  # (t, s, v, a, phase_index)
+        p0, p1 = int(b0[4]), int(b1[4])
         if p1 <= p0:
             return []
         if i1 - i0 < 2 or budget[0] <= 0:
-            return [greedy_rows(i0, i1)]
+            return [rows_from_greedy(phases, p0, p1, b1[0])]
         budget[0] -= 1
-        g_dur = b_t[i1] - b_t[i0]
-        st0, st1 = bounds[i0, 1:4].tolist(), bounds[i1, 1:4].tolist()  # (s, v, a)
+        g_dur = b1[0] - b0[0]
+        st0, st1 = b0[1:4], b1[1:4]
         peak, top = greedy.section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
         rows = None
         if top > peak * (1.0 + 1e-6):
@@ -126,10 +123,9 @@ def compress(
             if fits(rows, g_dur):
                 return [rows]
         if i1 - i0 >= MIN_SPLIT_STEPS and depth < MAX_SPLIT_DEPTH:
-            t_mid = 0.5 * (b_t[i0] + b_t[i1])
-            im = min(max(bisect_left(b_t, t_mid), i0 + 1), i1 - 1)
+            im = min(bisect_left(b_t, 0.5 * (b0[0] + b1[0]), i0 + 1, i1), i1 - 1)
             return solve(i0, im, depth + 1) + solve(im, i1, depth + 1)
-        return [greedy_rows(i0, i1)]
+        return [rows_from_greedy(phases, p0, p1, b1[0])]
 
     for k0, k1 in zip(knots[:-1], knots[1:], strict=True):
         for rows in solve(k0, k1, 0):
