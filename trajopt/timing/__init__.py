@@ -48,10 +48,12 @@ Method
    ``(L, v_end, 0)`` finishes the motion, its ``max_velocity`` the lowest cap ahead (or the
    state's own peak speed when that call breaks the cap).
 3. **Compress.** Knots at the greedy's speed minima (states with ``a = 0``); between two
-   knots one ruckig position call with ``max_velocity`` = the greedy's peak speed there
-   (the greedy is feasible for that problem, so ruckig's time-optimal answer is never
-   slower). A section whose ruckig profile breaks the cap is split at the greedy step
-   nearest its mid-time (up to 6 levels), else the greedy's own phases are kept.
+   knots one ruckig position call with ``max_velocity`` = the highest cap over the section
+   when that is above the greedy's peak speed there, else the greedy's peak speed (the
+   greedy is feasible for that problem, so ruckig's time-optimal answer is never slower).
+   A section whose ruckig profile breaks the cap or is slower than the greedy is split at
+   the greedy step nearest its mid-time (up to 6 levels), else the greedy's own phases are
+   kept.
 
 The result is a chain of constant-jerk phases (:class:`trajopt.Trajectory`). Limits hold on
 dense samples: ``a`` and ``jerk`` exactly (ruckig and the greedy both clamp), the speed cap

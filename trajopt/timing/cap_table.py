@@ -109,7 +109,7 @@ def build_cap_table(
         A boundary speed above the cap there, an unbounded curvature (cusp) or a cap of
         about 0 somewhere.
     """
-    n_int = int(np.clip(math.ceil(length / GRID_SPACING), MIN_INTERVALS, MAX_INTERVALS))
+    n_int = min(max(math.ceil(length / GRID_SPACING), MIN_INTERVALS), MAX_INTERVALS)
     h = length / n_int
     s_nodes = np.linspace(0.0, length, n_int + 1)
     degree = getattr(curve, "polynomial_degree", None)

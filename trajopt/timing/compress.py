@@ -6,10 +6,12 @@ minima into ruckig's time-optimal profiles where they stay under the cap.
 
 from __future__ import annotations
 
+from bisect import bisect_left
+
 import numpy as np
 
 from trajopt.timing import greedy
-from trajopt.timing.cap_table import CapTable
+from trajopt.timing.cap_table import T_MIN, CapTable
 from trajopt.timing.ruckig_profile import RuckigProfile
 
 __all__ = ["compress", "finish", "rows_from_greedy"]
@@ -21,8 +23,11 @@ MIN_SPLIT_STEPS = 6  # split a failed section only when it spans at least this m
 def rows_from_greedy(phases: np.ndarray, i0: int, i1: int, t_end: float) -> np.ndarray:
     """Greedy phases ``i0:i1`` as rows ``(t0, s0, v0, a0, jerk, duration)``."""
     ph = phases[i0:i1]
-    t_next = np.append(ph[1:, 0], t_end)
-    return np.column_stack([ph[:, :5], t_next - ph[:, 0]])
+    rows = np.empty((ph.shape[0], 6))
+    rows[:, :5] = ph
+    rows[:-1, 5] = ph[1:, 0] - ph[:-1, 0]
+    rows[-1, 5] = t_end - ph[-1, 0]
+    return rows
 
 
 def finish(
@@ -66,7 +71,15 @@ def finish(
 def compress(
     rk: RuckigProfile, table: CapTable, phases: np.ndarray, bounds: np.ndarray
 ) -> list[np.ndarray]:
-    """Replace the greedy between its speed minima by ruckig's time-optimal sections."""
+    """Replace the greedy between its speed minima by ruckig's time-optimal sections.
+
+    A section is tried with ruckig at the highest cap over it when that is above the
+    greedy's peak speed there, else (or when ruckig gives no profile for it) at the greedy's
+    peak; a profile is kept when it is no slower than the greedy and under the cap. A
+    failed section is split at the greedy step nearest its mid-time (down to
+    ``MAX_SPLIT_DEPTH`` levels and ``MIN_SPLIT_STEPS`` steps); the greedy's own phases stand
+    where nothing fits.
+    """
     nb = bounds.shape[0]
     v, a = bounds[:, 2], bounds[:, 3]
     vm, vc, vp = v[:-2], v[1:-1], v[2:]
@@ -74,50 +87,45 @@ def compress(
     knots = [0, *(np.flatnonzero(inner) + 1).tolist(), nb - 1]
     t_next = np.append(phases[1:, 0], bounds[-1, 0])
     peaks = greedy.phase_peaks(phases, t_next)
-    ph_index = bounds[:, 4].astype(np.int64)
+    b_t = bounds[:, 0]  # bound times, non-decreasing
     ci, h = table.ci, table.h
-    n_ci = ci.shape[0]
+    st, lg, length = table.st, table.lg, table.length
     chain: list[np.ndarray] = []
     t_out = 0.0
     budget = [3 * len(knots) + 32]  # ruckig calls; the greedy answer is kept beyond it
 
-    def greedy_rows(i0: int, i1: int) -> np.ndarray:
-        return rows_from_greedy(phases, ph_index[i0], ph_index[i1], float(bounds[i1, 0]))
-
     def fits(rows, g_dur: float) -> bool:
         return (
             rows is not None
-            and float(rows[:, 5].sum()) <= g_dur
-            and table.rows_ok(rows)
+            and rows[-1, 0] + rows[-1, 5] <= g_dur
+            and greedy.rows_ok(st, lg, h, length, rows, T_MIN)
         )
 
     def solve(i0: int, i1: int, depth: int) -> list[np.ndarray]:
-        p0, p1 = ph_index[i0], ph_index[i1]
+        b0, b1 = bounds[i0].tolist(), bounds[i1].tolist()  # (t, s, v, a, phase_index)
+        p0, p1 = int(b0[4]), int(b1[4])
         if p1 <= p0:
             return []
         if i1 - i0 < 2 or budget[0] <= 0:
-            return [greedy_rows(i0, i1)]
+            return [rows_from_greedy(phases, p0, p1, b1[0])]
         budget[0] -= 1
-        g_dur = float(bounds[i1, 0] - bounds[i0, 0])
-        st0 = (bounds[i0, 1], bounds[i0, 2], bounds[i0, 3])
-        st1 = (bounds[i1, 1], bounds[i1, 2], bounds[i1, 3])
-        peak = float(peaks[p0:p1].max())
-        i_a = min(int(st0[0] / h), n_ci - 1)
-        i_b = min(int(st1[0] / h), n_ci - 1)
-        top = float(ci[i_a : i_b + 1].max())
+        g_dur = b1[0] - b0[0]
+        st0, st1 = b0[1:4], b1[1:4]
+        peak, top = greedy.section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
+        rows = None
         if top > peak * (1.0 + 1e-6):
             # first try the highest cap in the section: better than the greedy's peak if it fits
             rows = rk.solve(st0, st1, top)
             if fits(rows, g_dur):
                 return [rows]
-        rows = rk.solve(st0, st1, peak)
-        if fits(rows, g_dur):
-            return [rows]
+        if rows is None:  # no top attempt, or ruckig gave no profile for it
+            rows = rk.solve(st0, st1, peak)
+            if fits(rows, g_dur):
+                return [rows]
         if i1 - i0 >= MIN_SPLIT_STEPS and depth < MAX_SPLIT_DEPTH:
-            t_mid = 0.5 * (bounds[i0, 0] + bounds[i1, 0])
-            im = int(np.clip(np.searchsorted(bounds[:, 0], t_mid), i0 + 1, i1 - 1))
+            im = min(bisect_left(b_t, 0.5 * (b0[0] + b1[0]), i0 + 1, i1), i1 - 1)
             return solve(i0, im, depth + 1) + solve(im, i1, depth + 1)
-        return [greedy_rows(i0, i1)]
+        return [rows_from_greedy(phases, p0, p1, b1[0])]
 
     for k0, k1 in zip(knots[:-1], knots[1:], strict=True):
         for rows in solve(k0, k1, 0):

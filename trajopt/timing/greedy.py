@@ -517,3 +517,25 @@ def phase_peaks(phases, t_next):
             pk = max(pk, v0 - a0 * a0 / (2.0 * j))
         out[i] = pk
     return out
+
+
+@njit(cache=True)
+def section_speeds(peaks, ci, p0, p1, s0, s1, h):
+    """Highest greedy speed and highest cap of a compress section.
+
+    Returns ``(peak, top)``: the largest of ``peaks[p0:p1]`` (the phases' highest speeds,
+    :func:`phase_peaks`) and the largest cap ``ci`` over the grid intervals from the one
+    holding ``s0`` to the one holding ``s1`` (m; spacing ``h``).
+    """
+    peak = -np.inf
+    for i in range(p0, p1):
+        if peaks[i] > peak:
+            peak = peaks[i]
+    n = ci.shape[0]
+    i_a = min(int(s0 / h), n - 1)
+    i_b = min(int(s1 / h), n - 1)
+    top = -np.inf
+    for i in range(i_a, i_b + 1):
+        if ci[i] > top:
+            top = ci[i]
+    return peak, top

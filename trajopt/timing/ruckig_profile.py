@@ -31,6 +31,7 @@ class RuckigProfile:
 
         self.inp = InputParameter(1)
         self.otg = Ruckig(1)
+        self.calculate = self.otg.calculate
         self.traj = Trajectory(1)
         self.ok = (Result.Working, Result.Finished)
         self.errors = (RuntimeError, RuckigError)
@@ -56,7 +57,7 @@ class RuckigProfile:
         inp.target_acceleration = [a1]
         inp.max_velocity = [max(vmax, v0, v1) + v_margin]
         try:
-            res = self.otg.calculate(inp, self.traj)
+            res = self.calculate(inp, self.traj)
         except self.errors:  # ruckig rejects some target states (e.g. a != 0 near v limit)
             return None
         if res not in self.ok:
@@ -64,20 +65,23 @@ class RuckigProfile:
         prof = self.traj.profiles[0][0]
         if prof.accel.duration > 1e-15:
             return None
-        rows = []
+        flat: list[float] = []  # rows laid end to end
         t = 0.0
         b = prof.brake
         if b.duration > 0.0:
             bt, bj, bp, bv, ba = b.t, b.j, b.p, b.v, b.a
             for i in range(2):
-                if bt[i] > 0.0:
-                    rows.append((t, bp[i], bv[i], ba[i], bj[i], bt[i]))
-                    t += bt[i]
+                ti = bt[i]
+                if ti > 0.0:
+                    flat += (t, bp[i], bv[i], ba[i], bj[i], ti)
+                    t += ti
         pt, pj, pp, pv, pa = prof.t, prof.j, prof.p, prof.v, prof.a
         for i in range(7):
-            if pt[i] > 0.0:
-                rows.append((t, pp[i], pv[i], pa[i], pj[i], pt[i]))
-                t += pt[i]
-        if not rows:
+            ti = pt[i]
+            if ti > 0.0:
+                flat += (t, pp[i], pv[i], pa[i], pj[i], ti)
+                t += ti
+        if not flat:
             return None
-        return np.array(rows)  # the start times are the running sums of the durations
+        # the start times are the running sums of the durations
+        return np.array(flat).reshape(-1, 6)
