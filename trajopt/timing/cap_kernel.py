@@ -225,40 +225,31 @@ def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - c
 
 
 @njit(cache=True, inline="always")
-def _mul_into(out, wk, rp, rq, i, j, sign):  # pragma: no cover - compiled
-    """``out += sign * P Q`` for ``P = wk[rp, :i]``, ``Q = wk[rq, :j]`` (power basis).
-
-    The product is built first in ``wk[4]``, as ``curvature_bound._mul`` does.
-    """
-    for r in range(i + j - 1):
-        wk[4, r] = 0.0
-    for r in range(i):
-        for q in range(j):
-            wk[4, r + q] += wk[rp, r] * wk[rq, q]
-    for r in range(i + j - 1):
-        out[r] += sign * wk[4, r]
-
-
-@njit(cache=True, inline="always")
-def _cross_and_norm(V, m, X, S, wk):  # pragma: no cover - compiled
+def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
-    ``wk`` is a work array of 5 rows. Returns the numbers of coefficients of ``X`` and ``S``.
+    Each coefficient is summed in the order of ``curvature_bound._mul`` (products of
+    ascending index of the left factor; ``X`` the difference and ``S`` the sum of the two
+    products). Returns the numbers of coefficients of ``X`` and ``S``.
     """
     for r in range(X.shape[0]):
         X[r] = 0.0
         S[r] = 0.0
-    for q in range(m):
-        wk[0, q] = V[q, 0]
-        wk[1, q] = V[q, 1]
-    if m >= 2:
-        for q in range(m - 1):
-            wk[2, q] = V[q + 1, 0] * (q + 1)
-            wk[3, q] = V[q + 1, 1] * (q + 1)
-        _mul_into(X, wk, 0, 3, m, m - 1, 1.0)
-        _mul_into(X, wk, 1, 2, m, m - 1, -1.0)
-    _mul_into(S, wk, 0, 0, m, m, 1.0)
-    _mul_into(S, wk, 1, 1, m, m, 1.0)
+    for k in range(2 * m - 1):
+        s0 = 0.0
+        s1 = 0.0
+        for r in range(max(0, k - m + 1), min(m - 1, k) + 1):
+            s0 += V[r, 0] * V[k - r, 0]
+            s1 += V[r, 1] * V[k - r, 1]
+        S[k] = s0 + s1
+    for k in range(2 * m - 2):  # V' has the m - 1 coefficients (q + 1) V[q + 1]
+        t0 = 0.0
+        t1 = 0.0
+        for r in range(max(0, k - m + 2), min(m - 1, k) + 1):
+            q = k - r
+            t0 += V[r, 0] * (V[q + 1, 1] * (q + 1))
+            t1 += V[r, 1] * (V[q + 1, 0] * (q + 1))
+        X[k] = t0 - t1
     return max(2 * m - 2, 1), 2 * m - 1
 
 
@@ -287,24 +278,24 @@ def matrices(p):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def workspace(p):  # pragma: no cover - compiled
-    """Work arrays ``X``, ``S``, ``V``, ``wk`` of :func:`bound_from_taylor` for degree ``p``."""
-    return np.empty(2 * p + 2), np.empty(2 * p + 2), np.empty((p, 2)), np.empty((5, 2 * p + 2))
+    """Work arrays ``X``, ``S``, ``V`` of :func:`bound_from_taylor` for degree ``p``."""
+    return np.empty(2 * p + 2), np.empty(2 * p + 2), np.empty((p, 2))
 
 
 @njit(cache=True)
-def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover - compiled
+def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cover - compiled
     """Bernstein bound on ``|kappa|`` from the Taylor coefficients ``gam`` (p, 2) of ``c_t``.
 
     ``gam[k]`` multiplies ``(t - 1/2)^k`` on the local ``t`` in ``[0, 1]``; ``flip`` is 1
     (zero speed at ``t = 0``), -1 (at ``t = 1``) or 0. ``p2b``, ``shift`` come from
-    :func:`matrices`; ``X``, ``S``, ``V``, ``wk`` are work arrays (:func:`workspace`).
+    :func:`matrices`; ``X``, ``S``, ``V`` are work arrays (:func:`workspace`).
     The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`.
     """
-    return _bound(gam, gam.shape[0], flip, k_free, p2b, shift, X, S, V, wk)
+    return _bound(gam, gam.shape[0], flip, k_free, p2b, shift, X, S, V)
 
 
 @njit(cache=True)
-def _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover - compiled
+def _bound(gam, p, flip, k_free, p2b, shift, X, S, V):  # pragma: no cover - compiled
     """:func:`bound_from_taylor` for the ``p`` rows of ``gam``."""
     if p < 2:
         return 0.0
@@ -316,7 +307,7 @@ def _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover -
                 acc += shift[sh, i, k] * gam[k, d]
             V[i, d] = acc
     if flip == 0 or not _zero_start(V, p):
-        nx, ns = _cross_and_norm(V, p, X, S, wk)
+        nx, ns = _cross_and_norm(V, p, X, S)
         bx = _bernstein_range(X, 0, nx, p2b, True)
         bs = _bernstein_range(S, 0, ns, p2b, False)
         if bx == 0.0:
@@ -334,7 +325,7 @@ def _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk):  # pragma: no cover -
     gsum = 0.0
     for i in range(m):
         gsum += abs(V[i, 0]) + abs(V[i, 1])
-    nx, ns = _cross_and_norm(V, m, X, S, wk)
+    nx, ns = _cross_and_norm(V, m, X, S)
     s_min = _bernstein_range(S, 0, ns, p2b, False)
     y0 = X[0]
     base = _bernstein_range(X, 1, nx - 1, p2b, True)
@@ -505,11 +496,11 @@ def _tables(
 
 @njit(cache=True)
 def _evaluate(
-    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, wk, gam
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
 ):  # pragma: no cover - compiled
     """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``."""
     _taylor(coef, p, piece, w, a, b, gam)
-    return _bound(gam, p, flip, k_free, p2b, shift, X, S, V, wk), _sampled(gam, p)
+    return _bound(gam, p, flip, k_free, p2b, shift, X, S, V), _sampled(gam, p)
 
 
 @njit(cache=True)
@@ -520,7 +511,7 @@ def _interval_bounds(
     m = w.shape[0] - 1
     p = coef.shape[1]
     p2b, shift = matrices(p)
-    X, S, V, wk = workspace(p)
+    X, S, V = workspace(p)
     gam = np.empty((p, 2))
     cap0 = speed_cap(0.0, limits)
     k_free = 0.0
@@ -552,7 +543,7 @@ def _interval_bounds(
         n_split = 0
         for i in range(cnt):
             k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                                 X, S, V, wk, gam)  # fmt: skip
+                                 X, S, V, gam)  # fmt: skip
             kb[i] = max(k_b, k_s)
             if k_b > k_free and (
                 lsb[i] - lsa[i] > h
