@@ -291,57 +291,12 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cov
     :func:`matrices`; ``X``, ``S``, ``V`` are work arrays (:func:`workspace`).
     The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`.
     """
-    return _bound(gam, gam.shape[0], flip, k_free, p2b, shift, X, S, V)
-
-
-@njit(cache=True)
-def _bound(gam, p, flip, k_free, p2b, shift, X, S, V):  # pragma: no cover - compiled
-    """:func:`bound_from_taylor` for the ``p`` rows of ``gam``."""
-    if p < 2:
-        return 0.0
-    sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
-    for i in range(p):
-        for d in range(2):
-            acc = 0.0
-            for k in range(i, p):
-                acc += shift[sh, i, k] * gam[k, d]
-            V[i, d] = acc
-    if flip == 0 or not _zero_start(V, p):
-        nx, ns = _cross_and_norm(V, p, X, S)
-        bx = _bernstein_range(X, 0, nx, p2b, True)
-        bs = _bernstein_range(S, 0, ns, p2b, False)
-        if bx == 0.0:
-            return 0.0
-        if not bs > 0.0:
-            return np.inf
-        return bx / (bs * math.sqrt(bs))
-    # V = t g: bound on g (see curvature_bound._zero_speed_bound)
-    m = p - 1
-    if m < 2:
-        return 0.0
-    for i in range(m):
-        V[i, 0] = V[i + 1, 0]
-        V[i, 1] = V[i + 1, 1]
-    gsum = 0.0
-    for i in range(m):
-        gsum += abs(V[i, 0]) + abs(V[i, 1])
-    nx, ns = _cross_and_norm(V, m, X, S)
-    s_min = _bernstein_range(S, 0, ns, p2b, False)
-    y0 = X[0]
-    base = _bernstein_range(X, 1, nx - 1, p2b, True)
-    if s_min > 0.0:
-        base = base / (s_min * math.sqrt(s_min))
-    else:
-        base = np.inf
-    if y0 == 0.0:
-        return base
-    if not s_min > 0.0:
-        return np.inf
-    k_ref = max(base, k_free)
-    t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
-    if t0 * t0 * gsum <= _TIP:
-        return max(base, 0.0) * (1.0 + _RTOL_TIP)
-    return np.inf
+    p = gam.shape[0]
+    coef = np.empty((1, p, 2))  # one piece on [-1, 1]: the interval [-1/2, 1/2] keeps gam as is
+    coef[0] = gam
+    work = np.empty((p, 2))
+    w = np.array([-1.0, 1.0])
+    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)[0]
 
 
 @njit(cache=True, inline="always")
@@ -354,7 +309,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -374,7 +329,7 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -498,9 +453,58 @@ def _tables(
 def _evaluate(
     coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
 ):  # pragma: no cover - compiled
-    """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``."""
+    """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
+
+    ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`); the bound is that
+    of :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
+    """
     _taylor(coef, p, piece, w, a, b, gam)
-    return _bound(gam, p, flip, k_free, p2b, shift, X, S, V), _sampled(gam, p)
+    k_s = _sampled(gam, p)
+    if p < 2:
+        return 0.0, k_s
+    sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
+    for i in range(p):
+        for d in range(2):
+            acc = 0.0
+            for k in range(i, p):
+                acc += shift[sh, i, k] * gam[k, d]
+            V[i, d] = acc
+    if flip == 0 or not _zero_start(V, p):
+        nx, ns = _cross_and_norm(V, p, X, S)
+        bx = _bernstein_range(X, 0, nx, p2b, True)
+        bs = _bernstein_range(S, 0, ns, p2b, False)
+        if bx == 0.0:
+            return 0.0, k_s
+        if not bs > 0.0:
+            return np.inf, k_s
+        return bx / (bs * math.sqrt(bs)), k_s
+    # V = t g: bound on g (see curvature_bound._zero_speed_bound)
+    m = p - 1
+    if m < 2:
+        return 0.0, k_s
+    for i in range(m):
+        V[i, 0] = V[i + 1, 0]
+        V[i, 1] = V[i + 1, 1]
+    gsum = 0.0
+    for i in range(m):
+        gsum += abs(V[i, 0]) + abs(V[i, 1])
+    nx, ns = _cross_and_norm(V, m, X, S)
+    s_min = _bernstein_range(S, 0, ns, p2b, False)
+    y0 = X[0]
+    base = _bernstein_range(X, 1, nx - 1, p2b, True)
+    if s_min > 0.0:
+        base = base / (s_min * math.sqrt(s_min))
+    else:
+        base = np.inf
+    if y0 == 0.0:
+        return base, k_s
+    if not s_min > 0.0:
+        return np.inf, k_s
+    k_ref = max(base, k_free)
+    t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
+    if t0 * t0 * gsum <= _TIP:
+        return max(base, 0.0) * (1.0 + _RTOL_TIP), k_s
+    return np.inf, k_s
 
 
 @njit(cache=True)
