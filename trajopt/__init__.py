@@ -41,6 +41,8 @@ _EXPORTS: dict[str, str] = {
     "Robot": "trajopt.robot",
     "time_parameterize": "trajopt.timing",
     "Trajectory": "trajopt.trajectory",
+    "TrajectoryChain": "trajopt.trajectory_chain",
+    "TurnInPlace": "trajopt.trajectory_chain",
     "State": "trajopt.state",
     "SpeedLimits": "trajopt.speed_limits",
     "load_speed_mask": "trajopt.speed_limits",
@@ -101,4 +103,5 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.state import State
     from trajopt.timing import time_parameterize
     from trajopt.trajectory import Trajectory
+    from trajopt.trajectory_chain import TrajectoryChain, TurnInPlace
     from trajopt.warm_up import warm_up

@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial.legendre import leggauss
 
-__all__ = ["ParametricCurve", "CurveSamples", "PolylineCurve"]
+__all__ = ["ParametricCurve", "CurveSamples", "CurveSegment", "PolylineCurve"]
 
 _GL_X, _GL_W = leggauss(5)
 STILL_SPEED_RATIO = 1e-9  # |c'| below this fraction of the mean parametric speed counts as zero
@@ -365,3 +365,50 @@ class PolylineCurve(ParametricCurve):
         if nu == 1:
             return unit
         return np.zeros(uu.shape + (2,))
+
+
+class CurveSegment(ParametricCurve):
+    """The part of a curve between two of its parameters, evaluated exactly.
+
+    Nothing is refitted or cut: the segment evaluates ``curve`` itself (same parameter,
+    same derivatives) on ``[u0, u1]``, so its points are the curve's to the last bit. The
+    re-plan's braking piece follows the old path this way
+    (:mod:`trajopt.replan_brake`).
+
+    Parameters
+    ----------
+    curve : ParametricCurve
+        The whole curve.
+    u0, u1 : float
+        The segment's parameter interval, ``curve.domain[0] <= u0 < u1 <= curve.domain[1]``.
+    """
+
+    __slots__ = ("curve", "_domain", "_arc_cache")
+
+    def __init__(self, curve: ParametricCurve, u0: float, u1: float) -> None:
+        lo, hi = curve.domain
+        u0, u1 = float(u0), float(u1)
+        if not lo <= u0 < u1 <= hi:
+            raise ValueError(f"need {lo} <= u0 < u1 <= {hi}, got u0={u0!r}, u1={u1!r}")
+        self.curve = curve
+        self._domain = (u0, u1)
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """``(u0, u1)``: the segment's interval of the curve's parameter."""
+        return self._domain
+
+    def breakpoints(self) -> np.ndarray:
+        """Return the curve's breakpoints inside the segment, with its ends."""
+        u0, u1 = self._domain
+        bp = np.asarray(self.curve.breakpoints(), dtype=float)
+        return np.unique(np.concatenate([[u0, u1], bp[(bp > u0) & (bp < u1)]]))
+
+    @property
+    def polynomial_degree(self) -> int | None:
+        """The curve's own (:attr:`ParametricCurve.polynomial_degree`)."""
+        return self.curve.polynomial_degree
+
+    def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        """Evaluate the curve's ``nu``-th derivative at ``u`` clipped to the segment."""
+        return self.curve(np.clip(np.asarray(u, dtype=float), *self._domain), nu)

@@ -56,6 +56,7 @@ __all__ = [
     "StopAndTurnTrajectory",
     "stop_and_turn",
     "turn_limits",
+    "RestToRest",
     "polyline_clearance",
     "polyline_fallback",
 ]
@@ -94,11 +95,16 @@ def turn_limits(robot: Robot) -> tuple[float, float, float]:
 
 
 # ====================================================================== ruckig
-class _RestToRest:
-    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d``.
+class RestToRest:
+    """Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits.
 
-    Rest-to-rest 1-DoF ruckig position problems ``0 -> d`` (d > 0) under fixed limits (the
-    timing's ruckig wrapper, without its velocity margin).
+    The timing's ruckig wrapper without its velocity margin; the straight moves and turns
+    of :func:`stop_and_turn` and the turns of :class:`trajopt.trajectory_chain.TurnInPlace`.
+
+    Parameters
+    ----------
+    vmax, amax, jmax : float
+        Limits of the motion's speed, acceleration and jerk (its units per s, s^2, s^3).
     """
 
     def __init__(self, vmax: float, amax: float, jmax: float) -> None:
@@ -432,9 +438,9 @@ def stop_and_turn(
         lo = np.minimum(pts[:-1], pts[1:])
         hi = np.maximum(pts[:-1], pts[1:])
         seg_vmax = np.minimum(seg_vmax, speed_limits.box_caps(lo, hi, robot.v_max))
-    drives: dict[float, _RestToRest] = {}
+    drives: dict[float, RestToRest] = {}
     w_lim, al_lim, z_lim = turn_limits(robot)
-    turn = _RestToRest(w_lim, al_lim, z_lim)
+    turn = RestToRest(w_lim, al_lim, z_lim)
 
     blocks: list[np.ndarray] = []  # rows (dur, seg, sigma, v, a, j, theta, omega, alpha, zeta)
     n_turns = 0
@@ -464,7 +470,7 @@ def stop_and_turn(
             add_turn(float(seg_theta[k - 1]), float(seg_theta[k]), k, 0.0)
         vk = float(seg_vmax[k])
         if vk not in drives:
-            drives[vk] = _RestToRest(vk, robot.a_max, robot.j_max)
+            drives[vk] = RestToRest(vk, robot.a_max, robot.j_max)
         rows = drives[vk].solve(float(seg_len[k]))
         out = np.zeros((len(rows), 10))
         out[:, 0] = rows[:, 0]

@@ -74,13 +74,14 @@ from trajopt.footprint_planning import plan_with_footprint
 from trajopt.map_update import update_caches
 from trajopt.plan_query import PlanQuery, PlanSteps
 from trajopt.polygon_corridor import PolygonCorridor
-from trajopt.replanning import replan_from, smooth_for_speed
+from trajopt.replanning import BRAKE_AFTER_S, replan_from, smooth_for_speed
 from trajopt.robot import Robot, avoidance_width
 from trajopt.smoother import Smoother, SmoothPath
 from trajopt.speed_limits import SpeedLimits, check_overlap
 from trajopt.state import State
 from trajopt.timing import time_parameterize
 from trajopt.trajectory import Trajectory
+from trajopt.trajectory_chain import TrajectoryChain
 from trajopt.validation import integer, point
 
 __all__ = ["plan", "Planner", "PlanSteps", "Inflation", "Search", "Fallback", "PlanResult"]
@@ -405,26 +406,23 @@ class Planner:
         goal_heading: float | None = None,
         v_end: float = 0.0,
         reuse: bool = True,
-    ) -> PlanResult:
+        brake_after_s: float | None = BRAKE_AFTER_S,
+    ) -> PlanResult | TrajectoryChain:
         """Re-plan from a trajectory being driven, splicing at ``t + latency``.
 
         The new trajectory starts at ``trajectory.state_at(t + latency)``: the same
         position, heading, curvature, speed and acceleration (a C2 splice), so a robot can
         switch to it at that time without a jump. Its ``stats["splice_time_s"]`` is the
         splice time on the old trajectory's clock, ``stats["latency_s"]`` the latency used,
-        ``stats["replan"]`` ``"kept"`` or ``"planned: <why the rest was not kept>"``.
+        ``stats["replan"]`` ``"kept"``, ``"planned: <why the rest was not kept>"`` or
+        ``"braked: <why no smooth plan>"``.
 
-        With ``reuse`` (the default) the rest of the old trajectory is kept, cut at the
-        splice and certified again, when the goal, goal heading and end speed are the old
-        ones and the map changed nowhere near it (:mod:`trajopt.replan_keep`); otherwise a
-        new trajectory is planned from the state (:meth:`plan`). When the map changed near
-        the rest but beyond the search cost's reach of its grid path, that plan takes the
-        rest of the old grid path, joined from the state's cell, instead of searching
-        (``stats["grid_path"] == "reused"``; ``"searched"`` otherwise).
+        What it keeps of the old trajectory, what it reuses and when it brakes instead:
+        :mod:`trajopt.replanning`.
 
         Parameters
         ----------
-        trajectory : Trajectory or StopAndTurnTrajectory
+        trajectory : Trajectory, StopAndTurnTrajectory or TrajectoryChain
             The trajectory being driven.
         t : float
             Its current time (s).
@@ -442,6 +440,8 @@ class Planner:
             Speed at the goal (m/s).
         reuse : bool, optional
             ``False``: always plan anew from the state.
+        brake_after_s : float or None, optional
+            Smoothing time (s) before the robot brakes instead; ``None``: never brake.
 
         Raises
         ------
@@ -449,11 +449,12 @@ class Planner:
             ``t + latency`` outside ``[0, duration]``, a negative latency, no goal given
             for a trajectory without ``steps``.
         TimingError, SmoothingError, NoPathError
-            As :meth:`plan`; a state too fast for any curve found says so.
+            As :meth:`plan`; ``TimingError``: it must brake and cannot stop in time.
         """
         with self._lock:
             return replan_from(self, trajectory, t, goal, grid, latency=latency,
-                               goal_heading=goal_heading, v_end=v_end, reuse=reuse)  # fmt: skip
+                               goal_heading=goal_heading, v_end=v_end, reuse=reuse,
+                               brake_after_s=brake_after_s)  # fmt: skip
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end,
               grid_path=None) -> PlanResult:  # fmt: skip

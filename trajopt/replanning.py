@@ -1,7 +1,23 @@
-"""Re-planning from a moving robot.
+"""Re-planning from a moving robot: :meth:`~trajopt.pipeline.Planner.replan`.
 
-The splice of :meth:`~trajopt.pipeline.Planner.replan`, and the second fit a fast start
-needs.
+A re-plan starts at the old trajectory's state at the splice time (position, heading,
+curvature, speed and acceleration: a C2 splice) and takes the first of these that applies:
+
+* **Keep** (``reuse=True``, the default): the rest of the old trajectory, cut at the splice
+  and certified again, when the goal, goal heading and end speed are the old ones and the
+  map changed nowhere near it (:mod:`trajopt.replan_keep`). ``stats["replan"] == "kept"``.
+* **Plan** from the moving state (:meth:`~trajopt.pipeline.Planner.plan`), with the
+  smoother's time budget capped at ``brake_after_s``. When the map changed near the rest
+  but beyond the search cost's reach of its grid path, the plan takes the rest of the old
+  grid path, joined from the state's cell, instead of searching (``stats["grid_path"]``
+  ``"reused"``, else ``"searched"``). ``stats["replan"] == "planned: <why not kept>"``.
+* **Brake, turn in place and go** when that plan fails (:mod:`trajopt.replan_brake`): a
+  :class:`~trajopt.trajectory_chain.TrajectoryChain`, ``stats["replan"] == "braked: ..."``.
+
+A chain is re-planned like any trajectory: while its last piece (the plan from rest) plays,
+that piece is; before, the chain's rest is kept when the map, goal, goal heading and end
+speed are unchanged, and a turn in place playing at the splice is finished first.
+:func:`smooth_for_speed` is the second fit a fast start needs.
 """
 
 from __future__ import annotations
@@ -14,11 +30,16 @@ from astar.grid import OccupancyGrid
 from trajopt.corridor_fit import fit_in_corridor
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.plan_query import PlanQuery
+from trajopt.replan_brake import brake_turn_go
 from trajopt.replan_keep import BLOCKED_NEAR, keep_rest, remaining_grid_path
 from trajopt.smoother import SmoothPath
-from trajopt.validation import nonnegative, number
+from trajopt.trajectory_chain import TrajectoryChain, TurnInPlace
+from trajopt.validation import nonnegative, number, point
 
-__all__ = ["replan_from", "smooth_for_speed"]
+__all__ = ["BRAKE_AFTER_S", "replan_from", "smooth_for_speed"]
+
+#: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
+BRAKE_AFTER_S = 0.25
 
 
 def replan_from(
@@ -32,6 +53,7 @@ def replan_from(
     goal_heading: float | None,
     v_end: float,
     reuse: bool = True,
+    brake_after_s: float | None = BRAKE_AFTER_S,
 ) -> Any:
     """Return :meth:`~trajopt.pipeline.Planner.replan`'s trajectory (see there)."""
     lat = planner.latency_s if latency is None else nonnegative("latency", latency, "s")
@@ -50,25 +72,85 @@ def replan_from(
                 "Planner)"
             )
         goal = steps.goal
+    if brake_after_s is not None:
+        brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
         planner.update_map(grid)
     out, why = None, "reuse=False"
-    if reuse:
-        out, why = keep_rest(planner, trajectory, ts, goal, goal_heading=goal_heading,
+    piece, t_piece = trajectory, ts
+    if isinstance(trajectory, TrajectoryChain):
+        i, t_piece = trajectory.piece_at(ts)
+        if i == len(trajectory.pieces) - 1:  # driving the chain's last plan: re-plan that
+            piece = trajectory.pieces[i]
+    if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
+        out, why = _keep_chain(planner, trajectory, ts, goal, goal_heading, v_end)
+    elif reuse:
+        out, why = keep_rest(planner, piece, t_piece, goal, goal_heading=goal_heading,
                              v_end=v_end)  # fmt: skip
     if out is None:
-        state = trajectory.state_at(ts)
-        path = None
-        if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
-            path = remaining_grid_path(planner, trajectory.steps,
-                                       planner.grid.world_to_cell(state.position))  # fmt: skip
-        out = planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
+        out = _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading,
+                             v_end, why, brake_after_s)  # fmt: skip
     stats = dict(out.stats)
-    stats["replan"] = "kept" if why == "kept" else f"planned: {why}"
+    if why == "kept":
+        stats["replan"] = "kept"
+    elif not str(stats.get("replan", "")).startswith("braked"):
+        stats["replan"] = f"planned: {why}"
     stats["splice_time_s"] = ts
     stats["latency_s"] = lat
     return dataclasses.replace(out, stats=stats)
 
+
+
+def _keep_chain(planner, chain, ts, goal, goal_heading, v_end) -> tuple[Any, str]:
+    """Return the rest of a brake-turn-go chain from ``ts`` if nothing it relies on changed."""
+    steps = chain.steps
+    if steps is None or planner.grid is not steps.raw_grid:
+        return None, "the map changed"
+    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
+        return None, "new goal"
+    if goal_heading is not None or v_end != chain.v_end:
+        return None, "new goal heading or end speed"
+    return chain.after(ts), "kept"
+
+
+def _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading, v_end, why,
+                   brake_after_s):  # fmt: skip
+    """Plan from the state at ``ts``; brake, turn and go when that fails (:func:`replan_from`).
+
+    The plan from the moving state gets the smoother's time budget capped at
+    ``brake_after_s``: a re-plan must be quick, and a state no curve can leave smoothly
+    exhausts the whole budget before it fails. Its smoothing and timing errors, and the
+    input errors of its start (e.g. a state already in the goal's cell), lead to braking;
+    an invalid goal is raised as such.
+    """
+    if isinstance(piece, TrajectoryChain):
+        i, tau = piece.piece_at(ts)
+        if isinstance(piece.pieces[i], TurnInPlace) and tau < piece.pieces[i].duration:
+            error = TimingError("the robot is turning in place at the splice")
+            return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
+                                 v_end=v_end, error=error)  # fmt: skip
+    state = trajectory.state_at(ts)
+    path = None
+    if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
+        path = remaining_grid_path(planner, piece.steps,
+                                   planner.grid.world_to_cell(state.position))  # fmt: skip
+    if brake_after_s is None:
+        return planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
+    smoother = planner.smoother
+    planner.smoother = dataclasses.replace(
+        smoother, time_budget_s=min(smoother.time_budget_s, brake_after_s)
+    )
+    try:
+        return planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
+    except (SmoothingError, TimingError) as exc:
+        error = exc
+    except InvalidInputError as exc:  # the goal's own error, else the moving start's
+        planner._check_endpoint("goal", point("goal", goal))
+        error = exc
+    finally:
+        planner.smoother = smoother
+    return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
+                         v_end=v_end, error=error)  # fmt: skip
 
 
 def smooth_for_speed(planner: Any, q: PlanQuery) -> SmoothPath:
@@ -76,13 +158,14 @@ def smooth_for_speed(planner: Any, q: PlanQuery) -> SmoothPath:
 
     A moving start whose speed cannot be brought under the cap of the first curve
     (too sharp a turn too soon) gets a second fit bounded by the curvature whose cap
-    is that speed (``Robot.speed_cap``), a little tighter; the state's own curvature
-    must already be within it.
+    is that speed (``Robot.speed_cap``), 5 % tighter but never below the state's own
+    curvature, which must already be within it.
 
     Raises
     ------
     TimingError
-        The state is above the cap at its own curvature.
+        The state's speed plus ``a^2 / (2 j)`` (its peak before a positive acceleration
+        can be undone) is above the cap at its own curvature.
     SmoothingError
         No curve within that bound (the message says why the bound was imposed).
     """
@@ -92,13 +175,15 @@ def smooth_for_speed(planner: Any, q: PlanQuery) -> SmoothPath:
     bounds = [r.a_lat_max / (v * v), r.omega_max / v]
     if r.track_width is not None and r.wheel_v_max is not None and v < r.wheel_v_max:
         bounds.append((r.wheel_v_max / v - 1.0) * 2.0 / r.track_width)
-    k_speed = 0.95 * min(bounds)
     k0 = abs(q.start_curvature or 0.0)
-    if k0 > k_speed:
+    if k0 > min(bounds):
         raise TimingError(
-            f"the start state moves at {v:.6g} m/s on curvature {k0:.6g} 1/m: above the "
-            f"speed cap there ({float(r.speed_cap(k0)):.6g} m/s)"
+            f"the start state reaches {v:.6g} m/s on curvature {k0:.6g} 1/m (its speed "
+            f"{q.v_start:.6g} m/s plus a^2 / (2 j)): above the speed cap there "
+            f"({float(r.speed_cap(k0)):.6g} m/s)"
         )
+    # a little below the cap, but never below the state's own curvature
+    k_speed = max(0.95 * min(bounds), k0)
     kmax = k_speed if planner.smoother.kappa_max is None else min(k_speed, planner.smoother.kappa_max)
     sm = dataclasses.replace(planner.smoother, kappa_max=kmax)
     try:
