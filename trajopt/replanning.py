@@ -39,7 +39,7 @@ from trajopt.validation import nonnegative, number, point
 __all__ = ["BRAKE_AFTER_S", "replan_from", "smooth_for_speed"]
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
-BRAKE_AFTER_S = 0.25
+BRAKE_AFTER_S = 0.1
 
 
 def replan_from(

@@ -183,3 +183,17 @@ def test_chain_rejects_pieces_that_do_not_join(driven):
         TrajectoryChain((traj,), ROBOT, starts=(0.0, 1.0))
     with pytest.raises(InvalidInputError, match=r"starts\[0\]"):
         TrajectoryChain((traj,), ROBOT, starts=(traj.duration + 1.0,))
+
+
+def test_a_box_qp_out_of_reach_is_a_typed_failure(shared_data):
+    # a moving start whose heading row the boxes' variable bounds cannot reach: piqp through
+    # casadi.conic rejected the clipped rows (lower above upper) with a RuntimeError
+    import astar
+    from trajopt.state import State
+
+    grid = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
+    planner = trajopt.Planner(grid, trajopt.Robot(radius=0.2),
+                              smoother=trajopt.Smoother(time_budget_s=0.5))  # fmt: skip
+    s = State(x=0.527907, y=-0.326162, theta=-1.62805, kappa=-0.112344, v=0.218226, a=-0.5)
+    with pytest.raises(SmoothingError, match="primal infeasible"):
+        planner.plan(s, (0.675, 1.525))

@@ -492,6 +492,14 @@ def solve_qp(options: Any, qp: QPData, x0: np.ndarray | None = None) -> SolveInf
             lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
             lba = np.maximum(lba, lo_r - 1.0)
             uba = np.minimum(uba, hi_r + 1.0)
+            gap = lba - uba
+            if np.any(gap > 0.0):  # a row out of reach of the variable bounds
+                i = int(np.argmax(gap))
+                return SolveInfo(
+                    solver=solver_name, status=SolveStatus.SOLVER_FAILED,
+                    detail=f"primal infeasible: row {i} is out of reach of the variable bounds",
+                    build_time_s=build, z=np.full(2 * nb, np.nan),
+                )  # fmt: skip
         hval = ca.DM(solver.sparsity_in("h"), hnz)
         aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
         out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
