@@ -429,8 +429,8 @@ class Planner:
         goal : sequence of float, shape (2,), optional
             A new goal (m); default the old one (``trajectory.steps.goal``).
         grid : astar.OccupancyGrid, optional
-            An updated map (:meth:`update_map`: the caches are recomputed only where the
-            change reaches).
+            An updated map; it becomes the planner's map (:meth:`update_map`, which
+            recomputes the caches only where the change reaches).
         latency : float, optional
             Time (s) the re-plan is expected to take: the splice is that far ahead. Default
             :attr:`latency_s`, the median of this planner's recent queries.
