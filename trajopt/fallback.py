@@ -49,7 +49,7 @@ from trajopt.curve import PolylineCurve
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.robot import Robot
 from trajopt.speed_limits import SpeedLimits
-from trajopt.trajectory import SampledExport, TrajectorySample, export_dict, make_sample
+from trajopt.trajectory import AtRestEnds, TrajectorySample, export_dict, make_sample
 from trajopt.validation import heading, readonly, short_repr
 
 __all__ = [
@@ -123,7 +123,7 @@ class RestToRest:
 
 # ====================================================================== trajectory
 @dataclass(frozen=True, slots=True)
-class StopAndTurnTrajectory(SampledExport):
+class StopAndTurnTrajectory(AtRestEnds):
     """A polyline driven with stops and turns in place (see the module docstring).
 
     Built by :func:`stop_and_turn` (or by :class:`trajopt.Planner` with
@@ -218,16 +218,6 @@ class StopAndTurnTrajectory(SampledExport):
     def length(self) -> float:
         """Length of the polyline (m)."""
         return float(self._seg_s[-1])
-
-    @property
-    def v_start(self) -> float:
-        """Speed at the start: always 0 (m/s)."""
-        return 0.0
-
-    @property
-    def v_end(self) -> float:
-        """Speed at the end: always 0 (m/s)."""
-        return 0.0
 
     @property
     def n_phases(self) -> int:

@@ -231,6 +231,22 @@ class SampledExport:
         )  # fmt: skip
 
 
+class AtRestEnds(SampledExport):
+    """A :class:`SampledExport` that starts and ends at rest (stop-and-turn moves, turns)."""
+
+    __slots__ = ()
+
+    @property
+    def v_start(self) -> float:
+        """Speed at the start: always 0 (m/s)."""
+        return 0.0
+
+    @property
+    def v_end(self) -> float:
+        """Speed at the end: always 0 (m/s)."""
+        return 0.0
+
+
 #: The record of :meth:`Trajectory.to_poses`.
 POSE_DTYPE = np.dtype([("t", "f8"), ("x", "f8"), ("y", "f8"), ("qz", "f8"), ("qw", "f8")])
 

@@ -23,7 +23,7 @@ import numpy as np
 from trajopt.errors import InvalidInputError
 from trajopt.fallback import RestToRest, turn_limits
 from trajopt.robot import Robot
-from trajopt.trajectory import SampledExport, TrajectorySample, export_dict, make_sample
+from trajopt.trajectory import AtRestEnds, SampledExport, TrajectorySample, export_dict, make_sample
 from trajopt.validation import readonly
 
 __all__ = ["TrajectoryChain", "TurnInPlace", "turn_in_place"]
@@ -34,7 +34,7 @@ _BASE = ("t", "x", "y", "theta", "v", "omega", "a", "jerk", "a_lat", "kappa", "s
 
 
 @dataclass(frozen=True, slots=True)
-class TurnInPlace(SampledExport):
+class TurnInPlace(AtRestEnds):
     """A rest-to-rest turn about the robot's centre (built by :func:`turn_in_place`).
 
     Parameters
@@ -74,16 +74,6 @@ class TurnInPlace(SampledExport):
     @property
     def length(self) -> float:
         """Distance travelled: 0 (m)."""
-        return 0.0
-
-    @property
-    def v_start(self) -> float:
-        """Speed at the start: 0 (m/s)."""
-        return 0.0
-
-    @property
-    def v_end(self) -> float:
-        """Speed at the end: 0 (m/s)."""
         return 0.0
 
     @property
