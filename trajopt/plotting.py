@@ -27,17 +27,21 @@ _COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:
 
 
 def path_points(path: Any, spacing: float | None = None) -> np.ndarray:
-    """Points (m), shape (m, 2), of a curve, a GridPath-like polyline or an (m, 2) array.
+    """Points (m), shape (m, 2), of a curve, a timed trajectory or an (m, 2) array.
 
     Parameters
     ----------
-    path : ParametricCurve or array_like, shape (m, 2)
-        Curves are sampled every ``spacing`` metres (default: 400 samples).
+    path : ParametricCurve, timed trajectory or array_like, shape (m, 2)
+        Curves are sampled every ``spacing`` metres (default: 400 samples); timed
+        trajectories (``Trajectory``, ``TrajectoryChain``, ...) every 10 ms.
     spacing : float, optional
         Sample spacing in metres for curves.
     """
     if isinstance(path, ParametricCurve):
         return path.sample(ds=spacing).xy if spacing else path.sample(400).xy
+    if hasattr(path, "sample_uniform"):
+        smp = path.sample_uniform(0.01)
+        return np.column_stack([smp.x, smp.y])
     pts = np.asarray(path, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"path must be a curve or an (m, 2) array, got shape {pts.shape}")

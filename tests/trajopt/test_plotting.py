@@ -74,3 +74,15 @@ def test_array_footprint_and_bad_arguments(ax):
         plot_footprints(ax, _Line(robot), every_s=1e-4)
     with pytest.raises(ValueError, match="robot is required"):
         plot_footprints(ax, SimpleNamespace(duration=1.0, sample=None), every_s=1.0)
+
+
+def test_path_points_of_a_timed_trajectory():
+    from trajopt.plotting import path_points
+    from trajopt.trajectory import SampledExport
+
+    class Timed(SampledExport, _Line):  # sample_uniform from SampledExport, motion from _Line
+        pass
+
+    pts = path_points(Timed())
+    assert pts.shape == (401, 2)  # every 10 ms of 4 s, both ends
+    assert np.allclose(pts[:, 0], pts[:, 1]) and pts[-1, 0] == pytest.approx(2.0 / np.sqrt(2.0))
