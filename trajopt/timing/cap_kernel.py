@@ -296,7 +296,7 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cov
     coef[0] = gam
     work = np.empty((p, 2))
     w = np.array([-1.0, 1.0])
-    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)[0]
+    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)
 
 
 @njit(cache=True, inline="always")
@@ -453,15 +453,15 @@ def _tables(
 def _evaluate(
     coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
 ):  # pragma: no cover - compiled
-    """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
+    """Bound on ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
 
-    ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`); the bound is that
-    of :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
+    ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`; the caller samples
+    ``|kappa|`` from them with :func:`_sampled` where it needs that); the bound is that of
+    :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
     """
     _taylor(coef, p, piece, w, a, b, gam)
-    k_s = _sampled(gam, p)
     if p < 2:
-        return 0.0, k_s
+        return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
     for i in range(p):
         for d in range(2):
@@ -474,14 +474,14 @@ def _evaluate(
         bx = _bernstein_range(X, 0, nx, p2b, True)
         bs = _bernstein_range(S, 0, ns, p2b, False)
         if bx == 0.0:
-            return 0.0, k_s
+            return 0.0
         if not bs > 0.0:
-            return np.inf, k_s
-        return bx / (bs * math.sqrt(bs)), k_s
+            return np.inf
+        return bx / (bs * math.sqrt(bs))
     # V = t g: bound on g (see curvature_bound._zero_speed_bound)
     m = p - 1
     if m < 2:
-        return 0.0, k_s
+        return 0.0
     for i in range(m):
         V[i, 0] = V[i + 1, 0]
         V[i, 1] = V[i + 1, 1]
@@ -497,14 +497,14 @@ def _evaluate(
     else:
         base = np.inf
     if y0 == 0.0:
-        return base, k_s
+        return base
     if not s_min > 0.0:
-        return np.inf, k_s
+        return np.inf
     k_ref = max(base, k_free)
     t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
     if t0 * t0 * gsum <= _TIP:
-        return max(base, 0.0) * (1.0 + _RTOL_TIP), k_s
-    return np.inf, k_s
+        return max(base, 0.0) * (1.0 + _RTOL_TIP)
+    return np.inf
 
 
 @njit(cache=True)
@@ -545,17 +545,20 @@ def _interval_bounds(
         split = np.zeros(cnt, np.bool_)
         kb = np.empty(cnt)
         n_split = 0
+        final = work >= _MAX_WORK or depth == _MAX_DEPTH  # every bound is kept as it is
         for i in range(cnt):
-            k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                                 X, S, V, gam)  # fmt: skip
-            kb[i] = max(k_b, k_s)
-            if k_b > k_free and (
-                lsb[i] - lsa[i] > h
-                or speed_cap(k_b, limits) < speed_cap(k_s, limits) * (1.0 - rtol)
-            ):
+            k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                            X, S, V, gam)  # fmt: skip
+            if k_b > k_free and lsb[i] - lsa[i] > h and not final:  # split: no sample needed
                 split[i] = True
                 n_split += 1
-        last = n_split == 0 or work >= _MAX_WORK or depth == _MAX_DEPTH
+                continue
+            k_s = _sampled(gam, p)  # the Taylor coefficients _evaluate left in gam
+            kb[i] = max(k_b, k_s)
+            if k_b > k_free and speed_cap(k_b, limits) < speed_cap(k_s, limits) * (1.0 - rtol):
+                split[i] = True
+                n_split += 1
+        last = n_split == 0 or final
         for i in range(cnt):
             if split[i] and not last:
                 continue
