@@ -19,6 +19,13 @@ MAX_STEPS = 4
 _NEG_V_TOL = 1e-9  # a piece whose speed dips below -1e-9 m/s reverses
 _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
 _REST_V = 1e-12  # m/s: a speed this low with a = 0 is rest (round-off of a stop)
+STACK = 96  # rows of piece_ok's bisection stack
+
+# The kernels that take the cap table and run inside the greedy's loops (range_min,
+# _piece_test, piece_ok, stop_ok, _put) are compiled without numba's reference counting
+# (``_nrt=False``): they allocate nothing, and the atomic increments and decrements of the
+# arrays passed to them otherwise take most of the greedy's time. Their callers allocate
+# (the bisection stack ``stk`` included).
 
 
 @njit(cache=True, inline="always")
@@ -52,7 +59,7 @@ def build_table(ci):
     return st, lg
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
     n = st.shape[1]
@@ -74,7 +81,7 @@ def range_min(st, lg, h, sa, sb):
     return x if x < y else y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
     if s0 >= length:
@@ -111,14 +118,13 @@ def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     return 2
 
 
-@njit(cache=True)
-def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
+@njit(cache=True, _nrt=False)
+def piece_ok(st, lg, h, length, s, v, a, j, T, tmin, stk):
     """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
     Conservative and exact on the grid: a piece passes when its speed maximum is below the
     minimum cap over the arc-length range it covers; otherwise it is bisected in time down
-    to ``tmin`` seconds (the bisection stack is only allocated when the whole piece is
-    undecided).
+    to ``tmin`` seconds on the caller's stack ``stk`` (shape ``(STACK, 4)``).
     """
     if T <= 0.0:
         return True
@@ -127,7 +133,6 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
         return res == 0
     if T <= tmin:
         return False
-    stk = np.empty((96, 4))
     half = 0.5 * T
     sm, vm, am = advance(s, v, a, j, half)
     stk[0, 0] = sm
@@ -203,21 +208,21 @@ def brake_end(s, v, a, t1, t2, t3, j):
     return s
 
 
-@njit(cache=True)
-def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin):
+@njit(cache=True, _nrt=False)
+def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk):
     """Is the stop profile from ``(s, v, a)`` under the cap? Returns ``(ok, s_stop)``."""
     t1, t2, t3, kind = brake_times(v, a, 0.0, j, amax)
     if kind == 2 and a < -1e-12:
         # cannot stop without reversing unless the undershoot is round-off
         if v - a * a / (2.0 * j) < -_NEG_V_TOL:
             return False, s
-    if not piece_ok(st, lg, h, length, s, v, a, -j, t1, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, -j, t1, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, -j, t1)
-    if not piece_ok(st, lg, h, length, s, v, a, 0.0, t2, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, 0.0, t2, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, 0.0, t2)
-    if not piece_ok(st, lg, h, length, s, v, a, j, t3, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, j, t3, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, j, t3)
     return True, s
@@ -255,18 +260,14 @@ def _reserve(buf, need):
     return nb
 
 
-@njit(cache=True)
-def _push(buf, n, t, s, v, a, j):
-    if n == buf.shape[0]:
-        nb = np.empty((2 * n, buf.shape[1]))
-        nb[:n] = buf
-        buf = nb
+@njit(cache=True, _nrt=False)
+def _put(buf, n, t, s, v, a, j):
+    """Write row ``n`` of ``buf`` (the caller made room: :func:`_reserve`)."""
     buf[n, 0] = t
     buf[n, 1] = s
     buf[n, 2] = v
     buf[n, 3] = a
     buf[n, 4] = j
-    return buf, n + 1
 
 
 @njit(cache=True)
@@ -291,6 +292,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
         One of the exit codes of this module.
     """
     phases = np.empty((1024, 5))
+    stk = np.empty((STACK, 4))  # piece_ok's bisection stack
     n_ph = 0
     bounds = np.empty((256, 5))
     n_b = 0
@@ -298,8 +300,11 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     v = v0
     a = a0
     t = 0.0
-    bounds, n_b = _push(bounds, n_b, t, s, v, a, 0.0)
-    ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin)
+    if n_b == bounds.shape[0]:
+        bounds = _reserve(bounds, n_b + 1)
+    _put(bounds, n_b, t, s, v, a, 0.0)
+    n_b += 1
+    ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk)
     if not ok0:
         return phases[:n_ph], bounds[:n_b], START_INFEASIBLE
     nmin = min_s.shape[0]
@@ -370,18 +375,18 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                         end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
             if safe_noend and not end_ok:
                 continue
-            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
+            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin, stk):
                 continue
-            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
+            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin, stk):
                 continue
             if s1 >= length:
                 safe_noend = True
                 continue
             if not end_ok:
                 if not safe_noend:
-                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]
+                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin, stk)[0]
                 continue
-            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]:
+            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin, stk)[0]:
                 continue
             if np.isnan(safe):
                 safe = u
@@ -409,19 +414,28 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             elif u < 0.0 and a + u * dt < -amax:
                 ta = max(0.0, (-amax - a) / u)
             if ta > 0.0:
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, u)
+                if n_ph == phases.shape[0]:
+                    phases = _reserve(phases, n_ph + 1)
+                _put(phases, n_ph, t, s, v, a, u)
+                n_ph += 1
                 s, v, a = advance(s, v, a, u, ta)
                 t += ta
             if ta < dt:
                 a = amax if u > 0.0 else -amax
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, 0.0)
+                if n_ph == phases.shape[0]:
+                    phases = _reserve(phases, n_ph + 1)
+                _put(phases, n_ph, t, s, v, a, 0.0)
+                n_ph += 1
                 s, v, a = advance(s, v, a, 0.0, dt - ta)
                 t += dt - ta
             if u == uz or abs(a) < 1e-9:
                 a = 0.0
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
-            bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+            if n_b == bounds.shape[0]:
+                bounds = _reserve(bounds, n_b + 1)
+            _put(bounds, n_b, t, s, v, a, float(n_ph))
+            n_b += 1
             if cruise and u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
                 # a cruise step: repeat it while every query lies on one run of equal caps
                 if v != reach_v:
@@ -467,7 +481,10 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             jp = -j if p == 0 else (0.0 if p == 1 else j)
             tp = min(tp, rem)
             if tp > 0.0:
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, jp)
+                if n_ph == phases.shape[0]:
+                    phases = _reserve(phases, n_ph + 1)
+                _put(phases, n_ph, t, s, v, a, jp)
+                n_ph += 1
                 s, v, a = advance(s, v, a, jp, tp)
                 t += tp
                 rem -= tp
@@ -476,7 +493,10 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             a = 0.0
         if abs(a) < 1e-9:
             a = 0.0
-        bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+        if n_b == bounds.shape[0]:
+            bounds = _reserve(bounds, n_b + 1)
+        _put(bounds, n_b, t, s, v, a, float(n_ph))
+        n_b += 1
     return phases[:n_ph], bounds[:n_b], status
 
 
@@ -484,9 +504,12 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
 def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
     """Every phase (rows of start states and jerks, ending at ``t_end``) under the cap."""
     n = ph_t.shape[0]
+    stk = np.empty((STACK, 4))
     for i in range(n):
         te = ph_t[i + 1] if i + 1 < n else t_end
-        if not piece_ok(st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin):
+        if not piece_ok(
+            st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin, stk
+        ):
             return False
     return True
 
@@ -494,9 +517,11 @@ def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
 @njit(cache=True)
 def rows_ok(st, lg, h, length, rows, tmin):
     """Rows ``(t0, s0, v0, a0, jerk, duration)`` (shape (k, 6)) all under the cap."""
+    stk = np.empty((STACK, 4))
     for i in range(rows.shape[0]):
         if not piece_ok(
-            st, lg, h, length, rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4], rows[i, 5], tmin
+            st, lg, h, length, rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4], rows[i, 5], tmin,
+            stk,
         ):
             return False
     return True
