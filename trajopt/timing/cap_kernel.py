@@ -131,7 +131,7 @@ def polynomial_tables(
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def speed_cap(k, limits):  # pragma: no cover - compiled
     """``Robot.speed_cap`` of ``|k|`` (1/m) for ``limits = (v_max, a_lat, omega, tw, wv)``.
 
@@ -149,7 +149,7 @@ def speed_cap(k, limits):  # pragma: no cover - compiled
     return cap
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     """Velocity ``c'`` of piece ``i`` at ``x = (u - mid) / half``: ``(vx, vy)``."""
     p = coef.shape[1]
@@ -161,7 +161,7 @@ def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     return vx, vy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     """Acceleration ``c''`` of piece ``i`` at ``x``: ``(ax, ay)``."""
     p = coef.shape[1]
@@ -173,7 +173,7 @@ def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     return ax / half, ay / half
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover - compiled
     """``ParametricCurve.s_at_u`` (m) at ``u`` inside polynomial piece ``piece``."""
     nn = nodes.shape[0]
@@ -202,7 +202,7 @@ def _binomials(n):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - compiled
     """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[off:off + n_coef]``.
 
@@ -224,7 +224,7 @@ def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - c
     return best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
@@ -299,7 +299,7 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cov
     return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _zero_start(V, p):  # pragma: no cover - compiled
     """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
     scale = 0.0
@@ -309,7 +309,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -329,7 +329,7 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -449,7 +449,7 @@ def _tables(
     return u, kappa, theta, still, kmax, cap, end_caps
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _evaluate(
     coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
 ):  # pragma: no cover - compiled
