@@ -564,3 +564,21 @@ def section_speeds(peaks, ci, p0, p1, s0, s1, h):
         if ci[i] > top:
             top = ci[i]
     return peak, top
+
+
+@njit(cache=True)
+def chain_times(rows, sizes):
+    """Lay sections of rows ``(t0, s0, v0, a0, jerk, duration)`` end to end in time, in place.
+
+    ``rows`` holds the sections one after the other (``sizes`` rows each); a section's start
+    times become ``t0 - t0[0] + t_out``, ``t_out`` the end (``t0 + duration``) of the last
+    row before it (0 for the first).
+    """
+    t_out = 0.0
+    i = 0
+    for k in range(sizes.shape[0]):
+        r0 = rows[i, 0]
+        for q in range(i, i + sizes[k]):
+            rows[q, 0] = rows[q, 0] - r0 + t_out
+        i += sizes[k]
+        t_out = rows[i - 1, 0] + rows[i - 1, 5]
