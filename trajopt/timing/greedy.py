@@ -59,6 +59,43 @@ def build_table(ci):
     return st, lg
 
 
+@njit(cache=True)
+def finish_caps(ci, scale, v_bound, lo0, lo1):
+    """Finish the cap table on the interval caps ``ci`` (changed in place).
+
+    ``ci = max(ci * scale, min(ci, v_bound))``, then ``ci[0] = max(ci[0], lo0)`` and
+    ``ci[-1] = max(ci[-1], lo1)``. Returns ``(i_low, vtop, st, lg, minima)``: the first
+    lowest interval, the highest cap, the sparse table (:func:`build_table`) and the
+    intervals of the cap's local minima (strictly below the interval before, not above the
+    one after, below ``vtop``; not the first or last).
+    """
+    n = ci.shape[0]
+    for i in range(n):
+        c = ci[i]
+        x = c * scale
+        y = c if c < v_bound else v_bound
+        ci[i] = x if x >= y else y
+    if lo0 > ci[0]:
+        ci[0] = lo0
+    if lo1 > ci[n - 1]:
+        ci[n - 1] = lo1
+    i_low = 0
+    vtop = ci[0]
+    for i in range(1, n):
+        if ci[i] < ci[i_low]:
+            i_low = i
+        if ci[i] > vtop:
+            vtop = ci[i]
+    st, lg = build_table(ci)
+    minima = np.empty(n, np.int64)
+    k = 0
+    for i in range(1, n - 1):
+        if ci[i] < ci[i - 1] and ci[i] <= ci[i + 1] and ci[i] < vtop:
+            minima[k] = i
+            k += 1
+    return i_low, vtop, st, lg, minima[:k]
+
+
 @njit(cache=True, _nrt=False)
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
