@@ -45,7 +45,8 @@ class PolynomialTables(NamedTuple):
     u : ndarray, shape (n + 1,)
         Curve parameter at the grid nodes (the ends are the domain's).
     kappa : ndarray, shape (n + 1,)
-        Signed curvature at the nodes (1/m; ``inf`` where the parametric speed is 0).
+        Signed curvature at the nodes (1/m; ``inf`` where the parametric speed is 0; nan
+        except at the nodes ``0, 1, n - 1, n`` when asked without ``node_kappa``).
     theta : ndarray, shape (n + 1,)
         Unwrapped heading at the nodes (rad).
     kmax : ndarray, shape (n,)
@@ -66,7 +67,8 @@ class PolynomialTables(NamedTuple):
 
 
 def polynomial_tables(
-    curve: ParametricCurve, robot: Robot, s_grid: np.ndarray, degree: int, *, rtol: float = 1e-3
+    curve: ParametricCurve, robot: Robot, s_grid: np.ndarray, degree: int, *, rtol: float = 1e-3,
+    node_kappa: bool = True,
 ) -> PolynomialTables | None:
     """Grid tables and curvature bounds of ``curve`` on the arc-length grid ``s_grid``.
 
@@ -82,6 +84,9 @@ def polynomial_tables(
         Polynomial degree of the pieces.
     rtol : float
         Relative tightness asked of the cap (``interval_kappa_max``'s ``rtol``).
+    node_kappa : bool
+        Whether ``kappa`` holds the curvature at every node; if False, only at the nodes
+        ``0, 1, n - 1, n`` (the others are nan), which is all that ``end_caps`` needs.
 
     Returns
     -------
@@ -120,7 +125,7 @@ def polynomial_tables(
     u, kappa, theta, still, kmax, cap, end_caps = _tables(
         w, coef, nodes, s_nodes, v_nodes, np.ascontiguousarray(s_grid, dtype=float), h,
         STILL_SPEED_RATIO * curve.mean_speed(), _ZERO * curve.length / (hi - lo), limits,
-        _K_GRID, _GL_X, _GL_W, float(rtol),
+        _K_GRID, _GL_X, _GL_W, float(rtol), bool(node_kappa),
     )  # fmt: skip
     if still:  # zero parametric speed at a node: the limit of the tangent direction
         raw = np.asarray(curve(u, 1), dtype=float)
@@ -368,6 +373,7 @@ def _tables(
     gl_x,
     gl_w,
     rtol,
+    node_kappa,
 ):  # pragma: no cover - compiled
     """Node tables and interval bounds (see :func:`polynomial_tables`)."""
     n = s_grid.shape[0] - 1
@@ -419,10 +425,13 @@ def _tables(
         ph = 0.5 * (w[j + 1] - w[j])
         x = (uq - pm) / ph
         vx, vy = _poly_d1(coef, j, x)
-        ax, ay = _poly_d2(coef, j, x, ph)
         sp = math.sqrt(vx * vx + vy * vy)
-        sp3 = sp * sp * sp
-        kappa[q] = (vx * ay - vy * ax) / sp3 if sp3 > 0 else np.inf
+        if node_kappa or q <= 1 or q >= n - 1:
+            ax, ay = _poly_d2(coef, j, x, ph)
+            sp3 = sp * sp * sp
+            kappa[q] = (vx * ay - vy * ax) / sp3 if sp3 > 0 else np.inf
+        else:
+            kappa[q] = np.nan
         theta[q] = math.atan2(vy, vx)
         if sp <= still_speed:
             still = True

@@ -114,7 +114,10 @@ def build_cap_table(
     s_nodes = np.arange(n_int + 1, dtype=float) * h  # np.linspace(0.0, length, n_int + 1)
     s_nodes[-1] = length
     degree = getattr(curve, "polynomial_degree", None)
-    fast = None if degree is None else polynomial_tables(curve, robot, s_nodes, int(degree))
+    fast = (
+        None if degree is None
+        else polynomial_tables(curve, robot, s_nodes, int(degree), node_kappa=False)
+    )  # fmt: skip
     if fast is not None:  # the compiled path: node tables and bounds in one call
         u_nodes, kappa, theta, kmax, ci, raw_kappa = fast
         ends = np.array([0, 1, n_int - 1, n_int])
@@ -164,6 +167,8 @@ def build_cap_table(
         min(v_end, raw[-1], raw[-2]),
     )  # fmt: skip
     if not ci[i_low] > 1e-6:
+        if np.isnan(kappa[i_low]):  # the compiled path keeps the end nodes only
+            kappa = np.asarray(curve.curvature(u_nodes), dtype=float)
         raise TimingError(
             f"the speed cap is {ci[i_low]:.3g} m/s at s={i_low * h:.6g} m (curvature "
             f"{kappa[i_low]:.6g} 1/m): the curve has a cusp or a turn the robot cannot follow"
