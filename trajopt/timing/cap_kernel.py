@@ -109,7 +109,7 @@ def polynomial_tables(
         return None
     lo, hi = (float(x) for x in curve.domain)
     bp = np.asarray(curve.breakpoints(), dtype=float)
-    w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
+    w = _piece_ends(bp, lo, hi)  # np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
     mid = 0.5 * (w[:-1] + w[1:])
     half = 0.5 * (w[1:] - w[:-1])
     coef = np.empty((mid.size, degree, 2))
@@ -134,6 +134,28 @@ def polynomial_tables(
         th[mask] = curve.heading(u[mask])
         theta = np.unwrap(th)
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
+
+
+@njit(cache=True)
+def _piece_ends(bp, lo, hi):  # pragma: no cover - compiled
+    """``np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])``: sorted, without repeats."""
+    buf = np.empty(bp.shape[0] + 2)
+    buf[0] = lo
+    buf[1] = hi
+    k = 2
+    for x in bp:
+        if lo < x < hi:
+            buf[k] = x
+            k += 1
+    buf = np.sort(buf[:k])
+    out = np.empty(k)
+    out[0] = buf[0]
+    m = 1
+    for i in range(1, k):
+        if buf[i] != buf[i - 1]:
+            out[m] = buf[i]
+            m += 1
+    return out[:m]
 
 
 @njit(cache=True, _nrt=False)

@@ -44,7 +44,7 @@ def finish(
     nb = bounds.shape[0]
     for back in range(min(nb, 25)):
         ib = nb - 1 - back
-        t_b, s_b, v_b, a_b, p_b = bounds[ib]
+        t_b, s_b, v_b, a_b, p_b = bounds[ib].tolist()
         if s_b > length:
             continue
         v_pk = v_b + (a_b * a_b / (2.0 * jmax) if a_b > 0 else 0.0)
@@ -59,12 +59,11 @@ def finish(
             rows = None
         if rows is None:
             continue
-        rows = rows.copy()
-        rows[:, 0] += t_b
-        new_ph = np.vstack([phases[: int(p_b)], rows[:, :5]])
+        rows[:, 0] += t_b  # rows: a fresh array from rk.solve
+        new_ph = np.concatenate((phases[: int(p_b)], rows[:, :5]))
         t_end = t_b + float(rows[:, 5].sum())
-        new_b = np.vstack([bounds[: ib + 1], [[t_end, length, v_end, 0.0, new_ph.shape[0]]]])
-        return new_ph, new_b
+        end = np.array([[t_end, length, v_end, 0.0, new_ph.shape[0]]], dtype=float)
+        return new_ph, np.concatenate((bounds[: ib + 1], end))
     return None
 
 
