@@ -147,3 +147,9 @@ def test_cruise_steps_give_the_same_phases(levels, widths, v_end):
     assert fast[2] == slow[2]
     np.testing.assert_array_equal(fast[0], slow[0])
     np.testing.assert_array_equal(fast[1], slow[1])
+    # buffers too small at first: the greedy runs again with more room, same phases
+    for cruise, ref in ((True, fast), (False, slow)):
+        small = greedy.greedy(*args, cruise, 8)
+        assert small[2] == ref[2]
+        np.testing.assert_array_equal(small[0], ref[0])
+        np.testing.assert_array_equal(small[1], ref[1])

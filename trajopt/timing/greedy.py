@@ -15,6 +15,7 @@ OK_FINISH = 1  # the end condition binds: finish with one position call to (L, v
 STUCK = 2  # at rest and no step is safe (speed cap ~0 ahead)
 START_INFEASIBLE = 3  # the initial state cannot stay under the cap
 MAX_STEPS = 4
+_NEED_ROOM = 5  # internal: the buffers filled up (greedy runs again with more room)
 
 _NEG_V_TOL = 1e-9  # a piece whose speed dips below -1e-9 m/s reverses
 _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
@@ -287,19 +288,9 @@ def cruise_reach(v, v_end, amax, j, dt):
     return max(far, s1)
 
 
-@njit(cache=True)
-def _reserve(buf, need):
-    """``buf`` or a copy with room for at least ``need`` rows (doubling)."""
-    if need <= buf.shape[0]:
-        return buf
-    nb = np.empty((max(need, 2 * buf.shape[0]), buf.shape[1]))
-    nb[: buf.shape[0]] = buf
-    return nb
-
-
 @njit(cache=True, _nrt=False)
 def _put(buf, n, t, s, v, a, j):
-    """Write row ``n`` of ``buf`` (the caller made room: :func:`_reserve`)."""
+    """Write row ``n`` of ``buf`` (the caller checked the room)."""
     buf[n, 0] = t
     buf[n, 1] = s
     buf[n, 2] = v
@@ -309,7 +300,7 @@ def _put(buf, n, t, s, v, a, j):
 
 @njit(cache=True)
 def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
-           cruise=True):  # fmt: skip
+           cruise=True, rows=0):  # fmt: skip
     """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
 
     It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``. With ``cruise``, a
@@ -317,7 +308,9 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     re-testing while every query of the step (its pieces, its stop profile and the end test,
     within :func:`cruise_reach` of the state) lies on one run of equal caps ahead: each
     repeat would see the same caps and make the same choice, so the phases are the same as
-    with ``cruise=False``.
+    with ``cruise=False``. The phase and bound buffers start with ``rows`` rows (0: twice
+    the time at the cap everywhere, in steps, plus 1024); a run that fills them runs again
+    with twice the room.
 
     Returns
     -------
@@ -328,32 +321,57 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     status : int
         One of the exit codes of this module.
     """
-    phases = np.empty((1024, 5))
+    n_int = st.shape[1]
+    # last interval of the run of equal caps holding each interval (for cruise steps)
+    run_end = np.empty(n_int, np.int64)
+    run_end[n_int - 1] = n_int - 1
+    for i in range(n_int - 2, -1, -1):
+        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
+    if rows <= 0:  # buffers sized by the time at the cap everywhere
+        t_cap = 0.0
+        for i in range(n_int):
+            t_cap += h / st[0, i]
+        rows = int(min(2.0 * t_cap / dt, 4.0 * max_steps)) + 1024
     stk = np.empty((STACK, 4))  # piece_ok's bisection stack
+    cands = np.empty(ncand + 1)
+    counts = np.zeros(2, np.int64)
+    while True:
+        phases = np.empty((rows, 5))
+        bounds = np.empty((rows, 5))
+        status = _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin,
+                      max_steps, cruise, run_end, phases, bounds, stk, cands, counts)  # fmt: skip
+        if status != _NEED_ROOM:
+            return phases[: counts[0]], bounds[: counts[1]], status
+        rows *= 2
+
+
+@njit(cache=True, _nrt=False)
+def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
+         cruise, run_end, phases, bounds, stk, cands, counts):  # fmt: skip
+    """Run the loop of :func:`greedy` on buffers it does not grow; return the status.
+
+    ``counts`` receives the numbers of phase and bound rows written; the status
+    ``_NEED_ROOM`` means the buffers filled up (nothing is kept).
+    """
     n_ph = 0
-    bounds = np.empty((256, 5))
     n_b = 0
     s = 0.0
     v = v0
     a = a0
     t = 0.0
     if n_b == bounds.shape[0]:
-        bounds = _reserve(bounds, n_b + 1)
+        return _NEED_ROOM
     _put(bounds, n_b, t, s, v, a, 0.0)
     n_b += 1
     ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk)
     if not ok0:
-        return phases[:n_ph], bounds[:n_b], START_INFEASIBLE
+        counts[0] = n_ph
+        counts[1] = n_b
+        return START_INFEASIBLE
     nmin = min_s.shape[0]
     ptr = 0
-    cands = np.empty(ncand + 1)
     status = MAX_STEPS
-    # last interval of the run of equal caps holding each interval (for cruise steps)
     n_int = st.shape[1]
-    run_end = np.empty(n_int, np.int64)
-    run_end[n_int - 1] = n_int - 1
-    for i in range(n_int - 2, -1, -1):
-        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
     reach = -1.0  # cruise reach of the speed held last (m); < 0: not computed
     reach_v = -1.0
     steps = 0
@@ -452,7 +470,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                 ta = max(0.0, (-amax - a) / u)
             if ta > 0.0:
                 if n_ph == phases.shape[0]:
-                    phases = _reserve(phases, n_ph + 1)
+                    return _NEED_ROOM
                 _put(phases, n_ph, t, s, v, a, u)
                 n_ph += 1
                 s, v, a = advance(s, v, a, u, ta)
@@ -460,7 +478,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             if ta < dt:
                 a = amax if u > 0.0 else -amax
                 if n_ph == phases.shape[0]:
-                    phases = _reserve(phases, n_ph + 1)
+                    return _NEED_ROOM
                 _put(phases, n_ph, t, s, v, a, 0.0)
                 n_ph += 1
                 s, v, a = advance(s, v, a, 0.0, dt - ta)
@@ -470,7 +488,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
             if n_b == bounds.shape[0]:
-                bounds = _reserve(bounds, n_b + 1)
+                return _NEED_ROOM
             _put(bounds, n_b, t, s, v, a, float(n_ph))
             n_b += 1
             if cruise and u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
@@ -480,14 +498,9 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                     reach_v = v
                 i0 = min(max(int(s_prev / h), 0), n_int - 1)
                 lim = min(run_end[i0] * h, length - h) - reach
-                if s_prev <= lim and s <= lim:  # room for the repeats, then rows in place
-                    need = int((lim - s) / (v * dt)) + 2
-                    phases = _reserve(phases, n_ph + need)
-                    bounds = _reserve(bounds, n_b + need)
                 while s_prev <= lim and s <= lim and steps < max_steps:
                     if n_ph == phases.shape[0] or n_b == bounds.shape[0]:
-                        phases = _reserve(phases, n_ph + 1)
-                        bounds = _reserve(bounds, n_b + 1)
+                        return _NEED_ROOM
                     steps += 1
                     phases[n_ph, 0] = t
                     phases[n_ph, 1] = s
@@ -519,7 +532,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             tp = min(tp, rem)
             if tp > 0.0:
                 if n_ph == phases.shape[0]:
-                    phases = _reserve(phases, n_ph + 1)
+                    return _NEED_ROOM
                 _put(phases, n_ph, t, s, v, a, jp)
                 n_ph += 1
                 s, v, a = advance(s, v, a, jp, tp)
@@ -531,10 +544,12 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
         if abs(a) < 1e-9:
             a = 0.0
         if n_b == bounds.shape[0]:
-            bounds = _reserve(bounds, n_b + 1)
+            return _NEED_ROOM
         _put(bounds, n_b, t, s, v, a, float(n_ph))
         n_b += 1
-    return phases[:n_ph], bounds[:n_b], status
+    counts[0] = n_ph
+    counts[1] = n_b
+    return status
 
 
 @njit(cache=True)
