@@ -357,6 +357,12 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
 
 
 @njit(cache=True, _nrt=False)
+def _taylor_at(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
+    """:func:`_taylor` as a call of its own (for callers with reference counting)."""
+    _taylor(coef, p, piece, w, a, b, gam)
+
+
+@njit(cache=True, _nrt=False)
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -482,15 +488,17 @@ def _tables(
 
 @njit(cache=True, _nrt=False)
 def _evaluate(
-    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True
 ):  # pragma: no cover - compiled
     """Bound on ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
 
     ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`; the caller samples
-    ``|kappa|`` from them with :func:`_sampled` where it needs that); the bound is that of
+    ``|kappa|`` from them with :func:`_sampled` where it needs that; ``taylor=False``: the
+    caller filled ``gam`` for this interval already); the bound is that of
     :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
     """
-    _taylor(coef, p, piece, w, a, b, gam)
+    if taylor:
+        _taylor(coef, p, piece, w, a, b, gam)
     if p < 2:
         return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
@@ -578,9 +586,21 @@ def _interval_bounds(
         n_split = 0
         final = work >= _MAX_WORK or depth == _MAX_DEPTH  # every bound is kept as it is
         for i in range(cnt):
-            k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                            X, S, V, gam)  # fmt: skip
-            if k_b > k_free and lsb[i] - lsa[i] > h and not final:  # split: no sample needed
+            wide = lsb[i] - lsa[i] > h and not final
+            if wide and flip[i] == 0:
+                # a sampled curvature above k_free: the bound (>= every value) binds as
+                # well, and a wide piece binding is split whatever its bound
+                _taylor_at(coef, p, lpc[i], w, la[i], lb[i], gam)
+                if _sampled(gam, p) > k_free * (1.0 + 1e-9):
+                    split[i] = True
+                    n_split += 1
+                    continue
+                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                                X, S, V, gam, False)  # fmt: skip
+            else:
+                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                                X, S, V, gam)  # fmt: skip
+            if k_b > k_free and wide:  # split: no sample needed
                 split[i] = True
                 n_split += 1
                 continue
