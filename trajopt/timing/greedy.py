@@ -73,17 +73,20 @@ def finish_caps(ci, scale, v_bound, lo0, lo1):
     n = ci.shape[0]
     for i in range(n):
         c = ci[i]
-        x = c * scale
-        y = c if c < v_bound else v_bound
-        ci[i] = x if x >= y else y
+        if c == c:  # a nan stays (as with np.maximum)
+            x = c * scale
+            y = c if c < v_bound else v_bound
+            ci[i] = x if x >= y else y
     if lo0 > ci[0]:
         ci[0] = lo0
     if lo1 > ci[n - 1]:
         ci[n - 1] = lo1
-    i_low = 0
+    i_low = 0  # np.argmin: the first nan if any, else the first lowest
     vtop = ci[0]
     for i in range(1, n):
-        if ci[i] < ci[i_low]:
+        if ci[i_low] != ci[i_low]:
+            break
+        if ci[i] < ci[i_low] or ci[i] != ci[i]:
             i_low = i
         if ci[i] > vtop:
             vtop = ci[i]
