@@ -269,6 +269,28 @@ def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk):
     return True, s
 
 
+@njit(cache=True, inline="always")
+def _end_test(s1, v1, a1, v_end, length, j, amax):
+    """Return whether ``(s1, v1, a1)`` can still end at ``length`` with ``v_end``, and ``s_stop``.
+
+    ``ok``: ``s1 < length``, its stop profile ends at or before ``length`` and so does its
+    slow-down to ``v_end``; ``s_stop`` is the end of the stop profile (``s1`` if
+    ``s1 >= length``).
+    """
+    end_ok = s1 < length
+    s_stop = s1
+    if end_ok:
+        b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
+        s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
+        if v_end == 0.0:
+            end_ok = s_stop <= length
+        else:
+            b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
+            if kind != 1:
+                end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
+    return end_ok, s_stop
+
+
 @njit(cache=True)
 def cruise_reach(v, v_end, amax, j, dt):
     """Farthest arc length (m) a greedy step from ``(s, v, a = 0)`` queries, less ``s``.
@@ -418,25 +440,19 @@ def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmi
                 s1, v1, a1 = sa, va, aa
             if u == uz or abs(a1) < 1e-9:
                 a1 = 0.0
-            # the end test (closed form; the stop profile's end is stop_ok's) before the cap
-            # tests: a candidate that fails it can only set safe_noend
-            end_ok = s1 < length
-            s_stop = s1
-            if end_ok:
-                b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
-                s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
-                if v_end == 0.0:
-                    end_ok = s_stop <= length
-                else:
-                    b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
-                    if kind != 1:
-                        end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
-            if safe_noend and not end_ok:
-                continue
+            # the end test (closed form; the stop profile's end is stop_ok's): a candidate
+            # that fails it can only set safe_noend, so once that is set it goes first and
+            # spares the cap tests; before, the step's cap tests go first (the same outcome)
+            if safe_noend:
+                end_ok, s_stop = _end_test(s1, v1, a1, v_end, length, j, amax)
+                if not end_ok:
+                    continue
             if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin, stk):
                 continue
             if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin, stk):
                 continue
+            if not safe_noend:
+                end_ok, s_stop = _end_test(s1, v1, a1, v_end, length, j, amax)
             if s1 >= length:
                 safe_noend = True
                 continue
