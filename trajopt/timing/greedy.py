@@ -653,3 +653,39 @@ def chain_times(rows, sizes):
             rows[q, 0] = rows[q, 0] - r0 + t_out
         i += sizes[k]
         t_out = rows[i - 1, 0] + rows[i - 1, 5]
+
+
+@njit(cache=True)
+def profile_rows(s, v, a, brake_t, brake_j, phase_t, phase_j):
+    """Rows ``(t0, s0, v0, a0, jerk, duration)`` of a ruckig profile from ``(s, v, a)``.
+
+    The brake phases (``brake_t``, ``brake_j``), then the profile's phases (``phase_t``,
+    ``phase_j``); phases of zero duration are left out, start times are the running sums of
+    the durations and start states come from :func:`advance` (shape ``(0, 6)`` if none).
+    """
+    n = 0
+    for x in brake_t:
+        if x > 0.0:
+            n += 1
+    for x in phase_t:
+        if x > 0.0:
+            n += 1
+    rows = np.empty((n, 6))
+    t = 0.0
+    k = 0
+    for q in range(len(brake_t) + len(phase_t)):
+        if q < len(brake_t):
+            ti, jq = brake_t[q], brake_j[q]
+        else:
+            ti, jq = phase_t[q - len(brake_t)], phase_j[q - len(brake_t)]
+        if ti > 0.0:
+            rows[k, 0] = t
+            rows[k, 1] = s
+            rows[k, 2] = v
+            rows[k, 3] = a
+            rows[k, 4] = jq
+            rows[k, 5] = ti
+            s, v, a = advance(s, v, a, jq, ti)
+            t += ti
+            k += 1
+    return rows
