@@ -631,7 +631,13 @@ def _interval_bounds(
             if not split[i]:
                 continue
             mid = 0.5 * (la[i] + lb[i])
-            smid = _s_at_u(mid, lpc[i], w, coef, nodes, s_nodes, gl_x, gl_w)
+            ia = min(max(int(lsa[i] / h), 0), n - 1)
+            if lsb[i] - lsa[i] <= h and ia == min(max(int(lsb[i] / h), 0), n - 1):
+                # within one grid interval and no wider than h: every value in
+                # [lsa, lsb] maps the halves (and their halves) as the exact one would
+                smid = 0.5 * (lsa[i] + lsb[i])
+            else:
+                smid = _s_at_u(mid, lpc[i], w, coef, nodes, s_nodes, gl_x, gl_w)
             na[r], nb[r], nsa[r], nsb[r], npc[r] = la[i], mid, lsa[i], smid, lpc[i]
             nfl[r] = 1 if flip[i] == 1 else 0
             q = n_split + r
