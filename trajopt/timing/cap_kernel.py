@@ -30,6 +30,7 @@ from numba import njit
 from trajopt.curvature_bound import _MAX_DEPTH, _MAX_WORK, _RTOL_TIP, _TIP, _ZERO
 from trajopt.curve import STILL_SPEED_RATIO, ParametricCurve
 from trajopt.robot import Robot
+from trajopt.timing.cap_cubic import bound_cubic
 
 __all__ = ["PolynomialTables", "polynomial_tables"]
 
@@ -487,122 +488,20 @@ def _tables(
 
 
 @njit(cache=True, _nrt=False)
-def _bound_cubic(coef, piece, w, a, b, gam):  # pragma: no cover - compiled
-    """:func:`_evaluate` for a cubic piece without a zero-speed end (``p = 3``, ``flip = 0``).
-
-    The same operations in the same order as the general loops (:func:`_taylor`, the shift
-    to powers of ``t``, :func:`_cross_and_norm`, :func:`_bernstein_range` with the factors
-    of :func:`matrices` as literals), unrolled; generated, see the general code for the
-    meaning of each line.
-    """
-    pm = 0.5 * (w[piece] + w[piece + 1])
-    ph = 0.5 * (w[piece + 1] - w[piece])
-    hh = b - a
-    x0 = (0.5 * (a + b) - pm) / ph
-    r = hh / ph
-    g00 = coef[piece, 0, 0]
-    g10 = coef[piece, 1, 0]
-    g20 = coef[piece, 2, 0]
-    g10 = g10 + x0 * g20
-    g00 = g00 + x0 * g10
-    g10 = g10 + x0 * g20
-    f = hh
-    g00 = g00 * f
-    f = f * r
-    g10 = g10 * f
-    f = f * r
-    g20 = g20 * f
-    f = f * r
-    g01 = coef[piece, 0, 1]
-    g11 = coef[piece, 1, 1]
-    g21 = coef[piece, 2, 1]
-    g11 = g11 + x0 * g21
-    g01 = g01 + x0 * g11
-    g11 = g11 + x0 * g21
-    f = hh
-    g01 = g01 * f
-    f = f * r
-    g11 = g11 * f
-    f = f * r
-    g21 = g21 * f
-    f = f * r
-    gam[0, 0] = g00
-    gam[1, 0] = g10
-    gam[2, 0] = g20
-    gam[0, 1] = g01
-    gam[1, 1] = g11
-    gam[2, 1] = g21
-    v00 = (((0.0 + 1.0 * g00) + -0.5 * g10) + 0.25 * g20)
-    v01 = (((0.0 + 1.0 * g01) + -0.5 * g11) + 0.25 * g21)
-    v10 = ((0.0 + 1.0 * g10) + -1.0 * g20)
-    v11 = ((0.0 + 1.0 * g11) + -1.0 * g21)
-    v20 = (0.0 + 1.0 * g20)
-    v21 = (0.0 + 1.0 * g21)
-    S0 = (0.0 + v00 * v00) + (0.0 + v01 * v01)
-    S1 = ((0.0 + v00 * v10) + v10 * v00) + ((0.0 + v01 * v11) + v11 * v01)
-    S2 = (((0.0 + v00 * v20) + v10 * v10) + v20 * v00) + (((0.0 + v01 * v21) + v11 * v11) + v21 * v01)
-    S3 = ((0.0 + v10 * v20) + v20 * v10) + ((0.0 + v11 * v21) + v21 * v11)
-    S4 = (0.0 + v20 * v20) + (0.0 + v21 * v21)
-    X0 = (0.0 + v00 * (v11 * 1.0)) - (0.0 + v01 * (v10 * 1.0))
-    X1 = ((0.0 + v00 * (v21 * 2.0)) + v10 * (v11 * 1.0)) - ((0.0 + v01 * (v20 * 2.0)) + v11 * (v10 * 1.0))
-    X2 = ((0.0 + v10 * (v21 * 2.0)) + v20 * (v11 * 1.0)) - ((0.0 + v11 * (v20 * 2.0)) + v21 * (v10 * 1.0))
-    X3 = (0.0 + v20 * (v21 * 2.0)) - (0.0 + v21 * (v20 * 2.0))
-    best = 0.0
-    bb = (0.0 + 1.0 * X0)
-    bb = abs(bb)
-    if bb > best:
-        best = bb
-    bb = ((0.0 + 1.0 * X0) + 0.3333333333333333 * X1)
-    bb = abs(bb)
-    if bb > best:
-        best = bb
-    bb = (((0.0 + 1.0 * X0) + 0.6666666666666666 * X1) + 0.3333333333333333 * X2)
-    bb = abs(bb)
-    if bb > best:
-        best = bb
-    bb = ((((0.0 + 1.0 * X0) + 1.0 * X1) + 1.0 * X2) + 1.0 * X3)
-    bb = abs(bb)
-    if bb > best:
-        best = bb
-    bx = best
-    best = np.inf
-    bb = (0.0 + 1.0 * S0)
-    if bb < best:
-        best = bb
-    bb = ((0.0 + 1.0 * S0) + 0.25 * S1)
-    if bb < best:
-        best = bb
-    bb = (((0.0 + 1.0 * S0) + 0.5 * S1) + 0.16666666666666666 * S2)
-    if bb < best:
-        best = bb
-    bb = ((((0.0 + 1.0 * S0) + 0.75 * S1) + 0.5 * S2) + 0.25 * S3)
-    if bb < best:
-        best = bb
-    bb = (((((0.0 + 1.0 * S0) + 1.0 * S1) + 1.0 * S2) + 1.0 * S3) + 1.0 * S4)
-    if bb < best:
-        best = bb
-    bs = best
-    if bx == 0.0:
-        return 0.0
-    if not bs > 0.0:
-        return np.inf
-    return bx / (bs * math.sqrt(bs))
-
-
-
-@njit(cache=True, _nrt=False)
 def _evaluate(
-    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True, unrolled=True
 ):  # pragma: no cover - compiled
     """Bound on ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
 
     ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`; the caller samples
     ``|kappa|`` from them with :func:`_sampled` where it needs that; ``taylor=False``: the
     caller filled ``gam`` for this interval already); the bound is that of
-    :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
+    :func:`bound_from_taylor` (one compiled function per interval: no inner calls). A cubic
+    piece without a zero-speed end goes to :func:`trajopt.timing.cap_cubic.bound_cubic`
+    (the same operations unrolled) unless ``unrolled`` is False.
     """
-    if p == 3 and flip == 0:  # the common case, unrolled (same operations)
-        return _bound_cubic(coef, piece, w, a, b, gam)
+    if p == 3 and flip == 0 and unrolled:  # the common case, unrolled (same operations)
+        return bound_cubic(coef, piece, w, a, b, gam)
     if taylor:
         _taylor(coef, p, piece, w, a, b, gam)
     if p < 2:
