@@ -4,8 +4,10 @@
   ``curvature_bound.kappa_bound`` (the NumPy reference) within 1e-12, the grid bounds equal
   ``interval_kappa_max`` and cover densely sampled ``|kappa|``, and the node tables equal the
   curve's own ``u_at_s``, curvature and heading.
+  The unrolled bound of a cubic piece (``cap_cubic.bound_cubic``) equals the general loops
+  bit for bit.
 * ``trajopt.timing.greedy``: repeating cruise steps gives the same phases as testing every
-  step.
+  step, also when its buffers fill up.
 """
 
 from __future__ import annotations
@@ -113,6 +115,28 @@ def test_compiled_tables_at_zero_speed_ends():
                             abs_tol=1e-12)  # fmt: skip
 
 
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), scale=st.sampled_from([1e-3, 1.0, 1e3]))
+def test_unrolled_cubic_bound_equals_the_general_loops(seed, scale):
+    rng = np.random.default_rng(seed)
+    p2b, shift = cap_kernel.matrices(3)
+    X, S, V = cap_kernel.workspace(3)
+    for _ in range(50):
+        w = np.sort(rng.uniform(0.0, 5.0, 4))
+        coef = rng.normal(size=(3, 3, 2)) * scale
+        if rng.random() < 0.2:
+            coef[:, 2, :] = 0.0  # a quadratic
+        piece = int(rng.integers(0, 3))
+        a = w[piece] + (w[piece + 1] - w[piece]) * rng.uniform(0.0, 0.5)
+        b = a + (w[piece + 1] - a) * rng.uniform(0.01, 1.0)
+        got_gam, ref_gam = np.empty((3, 2)), np.empty((3, 2))
+        args = (coef, 3, piece, w, a, b, 0, 1.0, p2b, shift, X, S, V)
+        got = cap_kernel._evaluate(*args, got_gam, True, True)
+        ref = cap_kernel._evaluate(*args, ref_gam, True, False)
+        assert got == ref
+        np.testing.assert_array_equal(got_gam, ref_gam)
+
+
 def test_compiled_speed_cap_is_robots():
     k = np.r_[0.0, np.logspace(-6, 4, 200), -3.0, np.inf, np.nan]
     for robot in (ROBOT, Robot(track_width=None, wheel_v_max=None)):
@@ -147,3 +171,9 @@ def test_cruise_steps_give_the_same_phases(levels, widths, v_end):
     assert fast[2] == slow[2]
     np.testing.assert_array_equal(fast[0], slow[0])
     np.testing.assert_array_equal(fast[1], slow[1])
+    # buffers too small at first: the greedy runs again with more room, same phases
+    for cruise, ref in ((True, fast), (False, slow)):
+        small = greedy.greedy(*args, cruise, 8)
+        assert small[2] == ref[2]
+        np.testing.assert_array_equal(small[0], ref[0])
+        np.testing.assert_array_equal(small[1], ref[1])

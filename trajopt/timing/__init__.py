@@ -63,7 +63,8 @@ jerk-free time-optimal answer (``benchmarks/bench_timing.py``).
 
 Modules: :mod:`~trajopt.timing.parameterize` (the entry point),
 :mod:`~trajopt.timing.cap_table` (stage 1) with :mod:`~trajopt.timing.cap_kernel` (its
-compiled path), :mod:`~trajopt.timing.greedy` (the compiled
+compiled path; :mod:`~trajopt.timing.cap_cubic` its bound on cubic pieces, unrolled),
+:mod:`~trajopt.timing.greedy` (the compiled
 kernels of stage 2), :mod:`~trajopt.timing.compress` (stages 3 and 4) and
 :mod:`~trajopt.timing.ruckig_profile` (the ruckig wrapper, also used by the stop-and-turn
 fallback).

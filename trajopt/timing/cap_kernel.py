@@ -30,6 +30,7 @@ from numba import njit
 from trajopt.curvature_bound import _MAX_DEPTH, _MAX_WORK, _RTOL_TIP, _TIP, _ZERO
 from trajopt.curve import STILL_SPEED_RATIO, ParametricCurve
 from trajopt.robot import Robot
+from trajopt.timing.cap_cubic import bound_cubic
 
 __all__ = ["PolynomialTables", "polynomial_tables"]
 
@@ -45,7 +46,8 @@ class PolynomialTables(NamedTuple):
     u : ndarray, shape (n + 1,)
         Curve parameter at the grid nodes (the ends are the domain's).
     kappa : ndarray, shape (n + 1,)
-        Signed curvature at the nodes (1/m; ``inf`` where the parametric speed is 0).
+        Signed curvature at the nodes (1/m; ``inf`` where the parametric speed is 0; nan
+        except at the nodes ``0, 1, n - 1, n`` when asked without ``node_kappa``).
     theta : ndarray, shape (n + 1,)
         Unwrapped heading at the nodes (rad).
     kmax : ndarray, shape (n,)
@@ -66,7 +68,8 @@ class PolynomialTables(NamedTuple):
 
 
 def polynomial_tables(
-    curve: ParametricCurve, robot: Robot, s_grid: np.ndarray, degree: int, *, rtol: float = 1e-3
+    curve: ParametricCurve, robot: Robot, s_grid: np.ndarray, degree: int, *, rtol: float = 1e-3,
+    node_kappa: bool = True,
 ) -> PolynomialTables | None:
     """Grid tables and curvature bounds of ``curve`` on the arc-length grid ``s_grid``.
 
@@ -82,6 +85,9 @@ def polynomial_tables(
         Polynomial degree of the pieces.
     rtol : float
         Relative tightness asked of the cap (``interval_kappa_max``'s ``rtol``).
+    node_kappa : bool
+        Whether ``kappa`` holds the curvature at every node; if False, only at the nodes
+        ``0, 1, n - 1, n`` (the others are nan), which is all that ``end_caps`` needs.
 
     Returns
     -------
@@ -104,7 +110,7 @@ def polynomial_tables(
         return None
     lo, hi = (float(x) for x in curve.domain)
     bp = np.asarray(curve.breakpoints(), dtype=float)
-    w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
+    w = _piece_ends(bp, lo, hi)  # np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
     mid = 0.5 * (w[:-1] + w[1:])
     half = 0.5 * (w[1:] - w[:-1])
     coef = np.empty((mid.size, degree, 2))
@@ -120,7 +126,7 @@ def polynomial_tables(
     u, kappa, theta, still, kmax, cap, end_caps = _tables(
         w, coef, nodes, s_nodes, v_nodes, np.ascontiguousarray(s_grid, dtype=float), h,
         STILL_SPEED_RATIO * curve.mean_speed(), _ZERO * curve.length / (hi - lo), limits,
-        _K_GRID, _GL_X, _GL_W, float(rtol),
+        _K_GRID, _GL_X, _GL_W, float(rtol), bool(node_kappa),
     )  # fmt: skip
     if still:  # zero parametric speed at a node: the limit of the tangent direction
         raw = np.asarray(curve(u, 1), dtype=float)
@@ -132,6 +138,28 @@ def polynomial_tables(
 
 
 @njit(cache=True)
+def _piece_ends(bp, lo, hi):  # pragma: no cover - compiled
+    """``np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])``: sorted, without repeats."""
+    buf = np.empty(bp.shape[0] + 2)
+    buf[0] = lo
+    buf[1] = hi
+    k = 2
+    for x in bp:
+        if lo < x < hi:
+            buf[k] = x
+            k += 1
+    buf = np.sort(buf[:k])
+    out = np.empty(k)
+    out[0] = buf[0]
+    m = 1
+    for i in range(1, k):
+        if buf[i] != buf[i - 1]:
+            out[m] = buf[i]
+            m += 1
+    return out[:m]
+
+
+@njit(cache=True, _nrt=False)
 def speed_cap(k, limits):  # pragma: no cover - compiled
     """``Robot.speed_cap`` of ``|k|`` (1/m) for ``limits = (v_max, a_lat, omega, tw, wv)``.
 
@@ -149,7 +177,7 @@ def speed_cap(k, limits):  # pragma: no cover - compiled
     return cap
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     """Velocity ``c'`` of piece ``i`` at ``x = (u - mid) / half``: ``(vx, vy)``."""
     p = coef.shape[1]
@@ -161,7 +189,7 @@ def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     return vx, vy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     """Acceleration ``c''`` of piece ``i`` at ``x``: ``(ax, ay)``."""
     p = coef.shape[1]
@@ -173,7 +201,7 @@ def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     return ax / half, ay / half
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover - compiled
     """``ParametricCurve.s_at_u`` (m) at ``u`` inside polynomial piece ``piece``."""
     nn = nodes.shape[0]
@@ -202,7 +230,7 @@ def _binomials(n):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - compiled
     """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[off:off + n_coef]``.
 
@@ -224,7 +252,7 @@ def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - c
     return best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
@@ -296,10 +324,10 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cov
     coef[0] = gam
     work = np.empty((p, 2))
     w = np.array([-1.0, 1.0])
-    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)[0]
+    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _zero_start(V, p):  # pragma: no cover - compiled
     """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
     scale = 0.0
@@ -309,7 +337,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -329,7 +357,13 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
+def _taylor_at(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
+    """:func:`_taylor` as a call of its own (for callers with reference counting)."""
+    _taylor(coef, p, piece, w, a, b, gam)
+
+
+@njit(cache=True, _nrt=False)
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -368,6 +402,7 @@ def _tables(
     gl_x,
     gl_w,
     rtol,
+    node_kappa,
 ):  # pragma: no cover - compiled
     """Node tables and interval bounds (see :func:`polynomial_tables`)."""
     n = s_grid.shape[0] - 1
@@ -419,10 +454,13 @@ def _tables(
         ph = 0.5 * (w[j + 1] - w[j])
         x = (uq - pm) / ph
         vx, vy = _poly_d1(coef, j, x)
-        ax, ay = _poly_d2(coef, j, x, ph)
         sp = math.sqrt(vx * vx + vy * vy)
-        sp3 = sp * sp * sp
-        kappa[q] = (vx * ay - vy * ax) / sp3 if sp3 > 0 else np.inf
+        if node_kappa or q <= 1 or q >= n - 1:
+            ax, ay = _poly_d2(coef, j, x, ph)
+            sp3 = sp * sp * sp
+            kappa[q] = (vx * ay - vy * ax) / sp3 if sp3 > 0 else np.inf
+        else:
+            kappa[q] = np.nan
         theta[q] = math.atan2(vy, vx)
         if sp <= still_speed:
             still = True
@@ -449,19 +487,25 @@ def _tables(
     return u, kappa, theta, still, kmax, cap, end_caps
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _evaluate(
-    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True, unrolled=True
 ):  # pragma: no cover - compiled
-    """Bound and sampled ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
+    """Bound on ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
 
-    ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`); the bound is that
-    of :func:`bound_from_taylor` (one compiled function per interval: no inner calls).
+    ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`; the caller samples
+    ``|kappa|`` from them with :func:`_sampled` where it needs that; ``taylor=False``: the
+    caller filled ``gam`` for this interval already); the bound is that of
+    :func:`bound_from_taylor` (one compiled function per interval: no inner calls). A cubic
+    piece without a zero-speed end goes to :func:`trajopt.timing.cap_cubic.bound_cubic`
+    (the same operations unrolled) unless ``unrolled`` is False.
     """
-    _taylor(coef, p, piece, w, a, b, gam)
-    k_s = _sampled(gam, p)
+    if p == 3 and flip == 0 and unrolled:  # the common case, unrolled (same operations)
+        return bound_cubic(coef, piece, w, a, b, gam)
+    if taylor:
+        _taylor(coef, p, piece, w, a, b, gam)
     if p < 2:
-        return 0.0, k_s
+        return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
     for i in range(p):
         for d in range(2):
@@ -474,14 +518,14 @@ def _evaluate(
         bx = _bernstein_range(X, 0, nx, p2b, True)
         bs = _bernstein_range(S, 0, ns, p2b, False)
         if bx == 0.0:
-            return 0.0, k_s
+            return 0.0
         if not bs > 0.0:
-            return np.inf, k_s
-        return bx / (bs * math.sqrt(bs)), k_s
+            return np.inf
+        return bx / (bs * math.sqrt(bs))
     # V = t g: bound on g (see curvature_bound._zero_speed_bound)
     m = p - 1
     if m < 2:
-        return 0.0, k_s
+        return 0.0
     for i in range(m):
         V[i, 0] = V[i + 1, 0]
         V[i, 1] = V[i + 1, 1]
@@ -497,14 +541,14 @@ def _evaluate(
     else:
         base = np.inf
     if y0 == 0.0:
-        return base, k_s
+        return base
     if not s_min > 0.0:
-        return np.inf, k_s
+        return np.inf
     k_ref = max(base, k_free)
     t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
     if t0 * t0 * gsum <= _TIP:
-        return max(base, 0.0) * (1.0 + _RTOL_TIP), k_s
-    return np.inf, k_s
+        return max(base, 0.0) * (1.0 + _RTOL_TIP)
+    return np.inf
 
 
 @njit(cache=True)
@@ -545,17 +589,32 @@ def _interval_bounds(
         split = np.zeros(cnt, np.bool_)
         kb = np.empty(cnt)
         n_split = 0
+        final = work >= _MAX_WORK or depth == _MAX_DEPTH  # every bound is kept as it is
         for i in range(cnt):
-            k_b, k_s = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                                 X, S, V, gam)  # fmt: skip
-            kb[i] = max(k_b, k_s)
-            if k_b > k_free and (
-                lsb[i] - lsa[i] > h
-                or speed_cap(k_b, limits) < speed_cap(k_s, limits) * (1.0 - rtol)
-            ):
+            wide = lsb[i] - lsa[i] > h and not final
+            if wide and flip[i] == 0:
+                # a sampled curvature above k_free: the bound (>= every value) binds as
+                # well, and a wide piece binding is split whatever its bound
+                _taylor_at(coef, p, lpc[i], w, la[i], lb[i], gam)
+                if _sampled(gam, p) > k_free * (1.0 + 1e-9):
+                    split[i] = True
+                    n_split += 1
+                    continue
+                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                                X, S, V, gam, False)  # fmt: skip
+            else:
+                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                                X, S, V, gam)  # fmt: skip
+            if k_b > k_free and wide:  # split: no sample needed
                 split[i] = True
                 n_split += 1
-        last = n_split == 0 or work >= _MAX_WORK or depth == _MAX_DEPTH
+                continue
+            k_s = _sampled(gam, p)  # the Taylor coefficients _evaluate left in gam
+            kb[i] = max(k_b, k_s)
+            if k_b > k_free and speed_cap(k_b, limits) < speed_cap(k_s, limits) * (1.0 - rtol):
+                split[i] = True
+                n_split += 1
+        last = n_split == 0 or final
         for i in range(cnt):
             if split[i] and not last:
                 continue
@@ -577,7 +636,13 @@ def _interval_bounds(
             if not split[i]:
                 continue
             mid = 0.5 * (la[i] + lb[i])
-            smid = _s_at_u(mid, lpc[i], w, coef, nodes, s_nodes, gl_x, gl_w)
+            ia = min(max(int(lsa[i] / h), 0), n - 1)
+            if lsb[i] - lsa[i] <= h and ia == min(max(int(lsb[i] / h), 0), n - 1):
+                # within one grid interval and no wider than h: every value in
+                # [lsa, lsb] maps the halves (and their halves) as the exact one would
+                smid = 0.5 * (lsa[i] + lsb[i])
+            else:
+                smid = _s_at_u(mid, lpc[i], w, coef, nodes, s_nodes, gl_x, gl_w)
             na[r], nb[r], nsa[r], nsb[r], npc[r] = la[i], mid, lsa[i], smid, lpc[i]
             nfl[r] = 1 if flip[i] == 1 else 0
             q = n_split + r

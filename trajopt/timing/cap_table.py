@@ -111,9 +111,13 @@ def build_cap_table(
     """
     n_int = min(max(math.ceil(length / GRID_SPACING), MIN_INTERVALS), MAX_INTERVALS)
     h = length / n_int
-    s_nodes = np.linspace(0.0, length, n_int + 1)
+    s_nodes = np.arange(n_int + 1, dtype=float) * h  # np.linspace(0.0, length, n_int + 1)
+    s_nodes[-1] = length
     degree = getattr(curve, "polynomial_degree", None)
-    fast = None if degree is None else polynomial_tables(curve, robot, s_nodes, int(degree))
+    fast = (
+        None if degree is None
+        else polynomial_tables(curve, robot, s_nodes, int(degree), node_kappa=False)
+    )  # fmt: skip
     if fast is not None:  # the compiled path: node tables and bounds in one call
         u_nodes, kappa, theta, kmax, ci, raw_kappa = fast
         ends = np.array([0, 1, n_int - 1, n_int])
@@ -155,22 +159,20 @@ def build_cap_table(
         )
     if zone is not None:
         ci = np.minimum(ci, zone)
-    v_bound = max(v_start, v_end)
-    ci = np.maximum(ci * (1.0 - CAP_MARGIN), np.minimum(ci, v_bound))
-    ci[0] = max(ci[0], min(v_start, raw[0], raw[1]))
-    ci[-1] = max(ci[-1], min(v_end, raw[-1], raw[-2]))
-    i_low = int(np.argmin(ci))
+    # ci = max(ci (1 - margin), min(ci, max(v_start, v_end))), the ends at least the
+    # boundary speeds (up to the cap at the end nodes), its sparse table and local minima
+    ci = np.array(ci, dtype=float)  # a fresh array: changed in place
+    i_low, _, st, lg, idx = greedy.finish_caps(
+        ci, 1.0 - CAP_MARGIN, max(v_start, v_end), min(v_start, raw[0], raw[1]),
+        min(v_end, raw[-1], raw[-2]),
+    )  # fmt: skip
     if not ci[i_low] > 1e-6:
+        if np.isnan(kappa[i_low]):  # the compiled path keeps the end nodes only
+            kappa = np.asarray(curve.curvature(u_nodes), dtype=float)
         raise TimingError(
             f"the speed cap is {ci[i_low]:.3g} m/s at s={i_low * h:.6g} m (curvature "
             f"{kappa[i_low]:.6g} 1/m): the curve has a cusp or a turn the robot cannot follow"
         )
-    st, lg = greedy.build_table(ci)
-    vtop = float(ci.max())
-    is_min = np.zeros(n_int, bool)
-    if n_int > 2:
-        is_min[1:-1] = (ci[1:-1] < ci[:-2]) & (ci[1:-1] <= ci[2:]) & (ci[1:-1] < vtop)
-    idx = np.flatnonzero(is_min)
     min_s = idx * h
     min_v = ci[idx]
     return CapTable(ci=ci, h=h, length=length, st=st, lg=lg, min_s=min_s, min_v=min_v,

@@ -44,7 +44,7 @@ def finish(
     nb = bounds.shape[0]
     for back in range(min(nb, 25)):
         ib = nb - 1 - back
-        t_b, s_b, v_b, a_b, p_b = bounds[ib]
+        t_b, s_b, v_b, a_b, p_b = bounds[ib].tolist()
         if s_b > length:
             continue
         v_pk = v_b + (a_b * a_b / (2.0 * jmax) if a_b > 0 else 0.0)
@@ -59,18 +59,17 @@ def finish(
             rows = None
         if rows is None:
             continue
-        rows = rows.copy()
-        rows[:, 0] += t_b
-        new_ph = np.vstack([phases[: int(p_b)], rows[:, :5]])
+        rows[:, 0] += t_b  # rows: a fresh array from rk.solve
+        new_ph = np.concatenate((phases[: int(p_b)], rows[:, :5]))
         t_end = t_b + float(rows[:, 5].sum())
-        new_b = np.vstack([bounds[: ib + 1], [[t_end, length, v_end, 0.0, new_ph.shape[0]]]])
-        return new_ph, new_b
+        end = np.array([[t_end, length, v_end, 0.0, new_ph.shape[0]]], dtype=float)
+        return new_ph, np.concatenate((bounds[: ib + 1], end))
     return None
 
 
 def compress(
     rk: RuckigProfile, table: CapTable, phases: np.ndarray, bounds: np.ndarray
-) -> list[np.ndarray]:
+) -> tuple[np.ndarray, int]:
     """Replace the greedy between its speed minima by ruckig's time-optimal sections.
 
     A section is tried with ruckig at the highest cap over it when that is above the
@@ -79,6 +78,14 @@ def compress(
     failed section is split at the greedy step nearest its mid-time (down to
     ``MAX_SPLIT_DEPTH`` levels and ``MIN_SPLIT_STEPS`` steps); the greedy's own phases stand
     where nothing fits.
+
+    Returns
+    -------
+    rows : ndarray, shape (k, 6)
+        The sections' rows ``(t0, s0, v0, a0, jerk, duration)`` laid end to end in time
+        (:func:`greedy.chain_times`).
+    sections : int
+        Number of sections.
     """
     nb = bounds.shape[0]
     v, a = bounds[:, 2], bounds[:, 3]
@@ -87,19 +94,12 @@ def compress(
     knots = [0, *(np.flatnonzero(inner) + 1).tolist(), nb - 1]
     t_next = np.append(phases[1:, 0], bounds[-1, 0])
     peaks = greedy.phase_peaks(phases, t_next)
-    b_t = bounds[:, 0]  # bound times, non-decreasing
+    b_t: list[float] = []  # bound times, non-decreasing (listed at the first split)
     ci, h = table.ci, table.h
     st, lg, length = table.st, table.lg, table.length
-    chain: list[np.ndarray] = []
-    t_out = 0.0
+    rows_ok, section_speeds = greedy.rows_ok, greedy.section_speeds
+    solve_rk = rk.solve
     budget = [3 * len(knots) + 32]  # ruckig calls; the greedy answer is kept beyond it
-
-    def fits(rows, g_dur: float) -> bool:
-        return (
-            rows is not None
-            and rows[-1, 0] + rows[-1, 5] <= g_dur
-            and greedy.rows_ok(st, lg, h, length, rows, T_MIN)
-        )
 
     def solve(i0: int, i1: int, depth: int) -> list[np.ndarray]:
         b0, b1 = bounds[i0].tolist(), bounds[i1].tolist()  # (t, s, v, a, phase_index)
@@ -111,26 +111,34 @@ def compress(
         budget[0] -= 1
         g_dur = b1[0] - b0[0]
         st0, st1 = b0[1:4], b1[1:4]
-        peak, top = greedy.section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
+        peak, top = section_speeds(peaks, ci, p0, p1, st0[0], st1[0], h)
         rows = None
+        # first try the highest cap in the section (better than the greedy's peak if it
+        # fits), then the peak when there was no top attempt or ruckig gave no profile;
+        # a profile fits when it is no slower than the greedy and under the cap
         if top > peak * (1.0 + 1e-6):
-            # first try the highest cap in the section: better than the greedy's peak if it fits
-            rows = rk.solve(st0, st1, top)
-            if fits(rows, g_dur):
+            rows = solve_rk(st0, st1, top)
+            if rows is not None and rows[-1, 0] + rows[-1, 5] <= g_dur and rows_ok(
+                st, lg, h, length, rows, T_MIN
+            ):
                 return [rows]
-        if rows is None:  # no top attempt, or ruckig gave no profile for it
-            rows = rk.solve(st0, st1, peak)
-            if fits(rows, g_dur):
+        if rows is None:
+            rows = solve_rk(st0, st1, peak)
+            if rows is not None and rows[-1, 0] + rows[-1, 5] <= g_dur and rows_ok(
+                st, lg, h, length, rows, T_MIN
+            ):
                 return [rows]
         if i1 - i0 >= MIN_SPLIT_STEPS and depth < MAX_SPLIT_DEPTH:
+            if not b_t:
+                b_t.extend(bounds[:, 0].tolist())
             im = min(bisect_left(b_t, 0.5 * (b0[0] + b1[0]), i0 + 1, i1), i1 - 1)
             return solve(i0, im, depth + 1) + solve(im, i1, depth + 1)
         return [rows_from_greedy(phases, p0, p1, b1[0])]
 
+    chain: list[np.ndarray] = []
     for k0, k1 in zip(knots[:-1], knots[1:], strict=True):
-        for rows in solve(k0, k1, 0):
-            r = rows.copy()
-            r[:, 0] = r[:, 0] - r[0, 0] + t_out
-            t_out = float(r[-1, 0] + r[-1, 5])
-            chain.append(r)
-    return chain
+        chain += solve(k0, k1, 0)
+    sizes = np.array([r.shape[0] for r in chain], dtype=np.int64)
+    rows = np.concatenate(chain) if len(chain) > 1 else chain[0].copy()
+    greedy.chain_times(rows, sizes)
+    return rows, len(chain)

@@ -15,10 +15,18 @@ OK_FINISH = 1  # the end condition binds: finish with one position call to (L, v
 STUCK = 2  # at rest and no step is safe (speed cap ~0 ahead)
 START_INFEASIBLE = 3  # the initial state cannot stay under the cap
 MAX_STEPS = 4
+_NEED_ROOM = 5  # internal: the buffers filled up (greedy runs again with more room)
 
 _NEG_V_TOL = 1e-9  # a piece whose speed dips below -1e-9 m/s reverses
 _CAP_TOL = 2e-9  # m/s: absorbs the 1e-9 margin given to ruckig's max_velocity
 _REST_V = 1e-12  # m/s: a speed this low with a = 0 is rest (round-off of a stop)
+STACK = 96  # rows of piece_ok's bisection stack
+
+# The kernels that take the cap table and run inside the greedy's loops (range_min,
+# _piece_test, piece_ok, stop_ok, _put) are compiled without numba's reference counting
+# (``_nrt=False``): they allocate nothing, and the atomic increments and decrements of the
+# arrays passed to them otherwise take most of the greedy's time. Their callers allocate
+# (the bisection stack ``stk`` included).
 
 
 @njit(cache=True, inline="always")
@@ -52,7 +60,47 @@ def build_table(ci):
     return st, lg
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
+def finish_caps(ci, scale, v_bound, lo0, lo1):
+    """Finish the cap table on the interval caps ``ci`` (changed in place).
+
+    ``ci = max(ci * scale, min(ci, v_bound))``, then ``ci[0] = max(ci[0], lo0)`` and
+    ``ci[-1] = max(ci[-1], lo1)``. Returns ``(i_low, vtop, st, lg, minima)``: the first
+    lowest interval, the highest cap, the sparse table (:func:`build_table`) and the
+    intervals of the cap's local minima (strictly below the interval before, not above the
+    one after, below ``vtop``; not the first or last).
+    """
+    n = ci.shape[0]
+    for i in range(n):
+        c = ci[i]
+        if c == c:  # a nan stays (as with np.maximum)
+            x = c * scale
+            y = c if c < v_bound else v_bound
+            ci[i] = x if x >= y else y
+    if lo0 > ci[0]:
+        ci[0] = lo0
+    if lo1 > ci[n - 1]:
+        ci[n - 1] = lo1
+    i_low = 0  # np.argmin: the first nan if any, else the first lowest
+    vtop = ci[0]
+    for i in range(1, n):
+        if ci[i_low] != ci[i_low]:
+            break
+        if ci[i] < ci[i_low] or ci[i] != ci[i]:
+            i_low = i
+        if ci[i] > vtop:
+            vtop = ci[i]
+    st, lg = build_table(ci)
+    minima = np.empty(n, np.int64)
+    k = 0
+    for i in range(1, n - 1):
+        if ci[i] < ci[i - 1] and ci[i] <= ci[i + 1] and ci[i] < vtop:
+            minima[k] = i
+            k += 1
+    return i_low, vtop, st, lg, minima[:k]
+
+
+@njit(cache=True, _nrt=False)
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
     n = st.shape[1]
@@ -74,7 +122,7 @@ def range_min(st, lg, h, sa, sb):
     return x if x < y else y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
     if s0 >= length:
@@ -111,14 +159,13 @@ def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     return 2
 
 
-@njit(cache=True)
-def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
+@njit(cache=True, _nrt=False)
+def piece_ok(st, lg, h, length, s, v, a, j, T, tmin, stk):
     """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
     Conservative and exact on the grid: a piece passes when its speed maximum is below the
     minimum cap over the arc-length range it covers; otherwise it is bisected in time down
-    to ``tmin`` seconds (the bisection stack is only allocated when the whole piece is
-    undecided).
+    to ``tmin`` seconds on the caller's stack ``stk`` (shape ``(STACK, 4)``).
     """
     if T <= 0.0:
         return True
@@ -127,7 +174,6 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin):
         return res == 0
     if T <= tmin:
         return False
-    stk = np.empty((96, 4))
     half = 0.5 * T
     sm, vm, am = advance(s, v, a, j, half)
     stk[0, 0] = sm
@@ -203,24 +249,46 @@ def brake_end(s, v, a, t1, t2, t3, j):
     return s
 
 
-@njit(cache=True)
-def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin):
+@njit(cache=True, _nrt=False)
+def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk):
     """Is the stop profile from ``(s, v, a)`` under the cap? Returns ``(ok, s_stop)``."""
     t1, t2, t3, kind = brake_times(v, a, 0.0, j, amax)
     if kind == 2 and a < -1e-12:
         # cannot stop without reversing unless the undershoot is round-off
         if v - a * a / (2.0 * j) < -_NEG_V_TOL:
             return False, s
-    if not piece_ok(st, lg, h, length, s, v, a, -j, t1, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, -j, t1, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, -j, t1)
-    if not piece_ok(st, lg, h, length, s, v, a, 0.0, t2, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, 0.0, t2, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, 0.0, t2)
-    if not piece_ok(st, lg, h, length, s, v, a, j, t3, tmin):
+    if not piece_ok(st, lg, h, length, s, v, a, j, t3, tmin, stk):
         return False, s
     s, v, a = advance(s, v, a, j, t3)
     return True, s
+
+
+@njit(cache=True, inline="always")
+def _end_test(s1, v1, a1, v_end, length, j, amax):
+    """Return whether ``(s1, v1, a1)`` can still end at ``length`` with ``v_end``, and ``s_stop``.
+
+    ``ok``: ``s1 < length``, its stop profile ends at or before ``length`` and so does its
+    slow-down to ``v_end``; ``s_stop`` is the end of the stop profile (``s1`` if
+    ``s1 >= length``).
+    """
+    end_ok = s1 < length
+    s_stop = s1
+    if end_ok:
+        b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
+        s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
+        if v_end == 0.0:
+            end_ok = s_stop <= length
+        else:
+            b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
+            if kind != 1:
+                end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
+    return end_ok, s_stop
 
 
 @njit(cache=True)
@@ -245,33 +313,19 @@ def cruise_reach(v, v_end, amax, j, dt):
     return max(far, s1)
 
 
-@njit(cache=True)
-def _reserve(buf, need):
-    """``buf`` or a copy with room for at least ``need`` rows (doubling)."""
-    if need <= buf.shape[0]:
-        return buf
-    nb = np.empty((max(need, 2 * buf.shape[0]), buf.shape[1]))
-    nb[: buf.shape[0]] = buf
-    return nb
-
-
-@njit(cache=True)
-def _push(buf, n, t, s, v, a, j):
-    if n == buf.shape[0]:
-        nb = np.empty((2 * n, buf.shape[1]))
-        nb[:n] = buf
-        buf = nb
+@njit(cache=True, _nrt=False)
+def _put(buf, n, t, s, v, a, j):
+    """Write row ``n`` of ``buf`` (the caller checked the room)."""
     buf[n, 0] = t
     buf[n, 1] = s
     buf[n, 2] = v
     buf[n, 3] = a
     buf[n, 4] = j
-    return buf, n + 1
 
 
 @njit(cache=True)
 def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
-           cruise=True):  # fmt: skip
+           cruise=True, rows=0):  # fmt: skip
     """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
 
     It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``. With ``cruise``, a
@@ -279,7 +333,9 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     re-testing while every query of the step (its pieces, its stop profile and the end test,
     within :func:`cruise_reach` of the state) lies on one run of equal caps ahead: each
     repeat would see the same caps and make the same choice, so the phases are the same as
-    with ``cruise=False``.
+    with ``cruise=False``. The phase and bound buffers start with ``rows`` rows (0: twice
+    the time at the cap everywhere, in steps, plus 1024); a run that fills them runs again
+    with twice the room.
 
     Returns
     -------
@@ -290,28 +346,57 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     status : int
         One of the exit codes of this module.
     """
-    phases = np.empty((1024, 5))
+    n_int = st.shape[1]
+    # last interval of the run of equal caps holding each interval (for cruise steps)
+    run_end = np.empty(n_int, np.int64)
+    run_end[n_int - 1] = n_int - 1
+    for i in range(n_int - 2, -1, -1):
+        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
+    if rows <= 0:  # buffers sized by the time at the cap everywhere
+        t_cap = 0.0
+        for i in range(n_int):
+            t_cap += h / st[0, i]
+        rows = int(min(2.0 * t_cap / dt, 4.0 * max_steps)) + 1024
+    stk = np.empty((STACK, 4))  # piece_ok's bisection stack
+    cands = np.empty(ncand + 1)
+    counts = np.zeros(2, np.int64)
+    while True:
+        phases = np.empty((rows, 5))
+        bounds = np.empty((rows, 5))
+        status = _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin,
+                      max_steps, cruise, run_end, phases, bounds, stk, cands, counts)  # fmt: skip
+        if status != _NEED_ROOM:
+            return phases[: counts[0]], bounds[: counts[1]], status
+        rows *= 2
+
+
+@njit(cache=True, _nrt=False)
+def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
+         cruise, run_end, phases, bounds, stk, cands, counts):  # fmt: skip
+    """Run the loop of :func:`greedy` on buffers it does not grow; return the status.
+
+    ``counts`` receives the numbers of phase and bound rows written; the status
+    ``_NEED_ROOM`` means the buffers filled up (nothing is kept).
+    """
     n_ph = 0
-    bounds = np.empty((256, 5))
     n_b = 0
     s = 0.0
     v = v0
     a = a0
     t = 0.0
-    bounds, n_b = _push(bounds, n_b, t, s, v, a, 0.0)
-    ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin)
+    if n_b == bounds.shape[0]:
+        return _NEED_ROOM
+    _put(bounds, n_b, t, s, v, a, 0.0)
+    n_b += 1
+    ok0, _ = stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk)
     if not ok0:
-        return phases[:n_ph], bounds[:n_b], START_INFEASIBLE
+        counts[0] = n_ph
+        counts[1] = n_b
+        return START_INFEASIBLE
     nmin = min_s.shape[0]
     ptr = 0
-    cands = np.empty(ncand + 1)
     status = MAX_STEPS
-    # last interval of the run of equal caps holding each interval (for cruise steps)
     n_int = st.shape[1]
-    run_end = np.empty(n_int, np.int64)
-    run_end[n_int - 1] = n_int - 1
-    for i in range(n_int - 2, -1, -1):
-        run_end[i] = run_end[i + 1] if st[0, i] == st[0, i + 1] else i
     reach = -1.0  # cruise reach of the speed held last (m); < 0: not computed
     reach_v = -1.0
     steps = 0
@@ -355,33 +440,27 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                 s1, v1, a1 = sa, va, aa
             if u == uz or abs(a1) < 1e-9:
                 a1 = 0.0
-            # the end test (closed form; the stop profile's end is stop_ok's) before the cap
-            # tests: a candidate that fails it can only set safe_noend
-            end_ok = s1 < length
-            s_stop = s1
-            if end_ok:
-                b1, b2, b3, _ = brake_times(v1, a1, 0.0, j, amax)
-                s_stop = brake_end(s1, v1, a1, b1, b2, b3, j)
-                if v_end == 0.0:
-                    end_ok = s_stop <= length
-                else:
-                    b1, b2, b3, kind = brake_times(v1, a1, v_end, j, amax)
-                    if kind != 1:
-                        end_ok = brake_end(s1, v1, a1, b1, b2, b3, j) <= length
-            if safe_noend and not end_ok:
+            # the end test (closed form; the stop profile's end is stop_ok's): a candidate
+            # that fails it can only set safe_noend, so once that is set it goes first and
+            # spares the cap tests; before, the step's cap tests go first (the same outcome)
+            if safe_noend:
+                end_ok, s_stop = _end_test(s1, v1, a1, v_end, length, j, amax)
+                if not end_ok:
+                    continue
+            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin, stk):
                 continue
-            if not piece_ok(st, lg, h, length, s, v, a, u, ta, tmin):
+            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin, stk):
                 continue
-            if ta < dt and not piece_ok(st, lg, h, length, sa, va, aa, 0.0, dt - ta, tmin):
-                continue
+            if not safe_noend:
+                end_ok, s_stop = _end_test(s1, v1, a1, v_end, length, j, amax)
             if s1 >= length:
                 safe_noend = True
                 continue
             if not end_ok:
                 if not safe_noend:
-                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]
+                    safe_noend = stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin, stk)[0]
                 continue
-            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin)[0]:
+            if not stop_ok(st, lg, h, length, s1, v1, a1, j, amax, tmin, stk)[0]:
                 continue
             if np.isnan(safe):
                 safe = u
@@ -409,19 +488,28 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             elif u < 0.0 and a + u * dt < -amax:
                 ta = max(0.0, (-amax - a) / u)
             if ta > 0.0:
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, u)
+                if n_ph == phases.shape[0]:
+                    return _NEED_ROOM
+                _put(phases, n_ph, t, s, v, a, u)
+                n_ph += 1
                 s, v, a = advance(s, v, a, u, ta)
                 t += ta
             if ta < dt:
                 a = amax if u > 0.0 else -amax
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, 0.0)
+                if n_ph == phases.shape[0]:
+                    return _NEED_ROOM
+                _put(phases, n_ph, t, s, v, a, 0.0)
+                n_ph += 1
                 s, v, a = advance(s, v, a, 0.0, dt - ta)
                 t += dt - ta
             if u == uz or abs(a) < 1e-9:
                 a = 0.0
             if a == 0.0 and v < _REST_V:
                 v = 0.0  # round-off of a stop: rest exactly
-            bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
+            if n_b == bounds.shape[0]:
+                return _NEED_ROOM
+            _put(bounds, n_b, t, s, v, a, float(n_ph))
+            n_b += 1
             if cruise and u == 0.0 and a == 0.0 and at_zero and v > _REST_V:
                 # a cruise step: repeat it while every query lies on one run of equal caps
                 if v != reach_v:
@@ -429,14 +517,9 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
                     reach_v = v
                 i0 = min(max(int(s_prev / h), 0), n_int - 1)
                 lim = min(run_end[i0] * h, length - h) - reach
-                if s_prev <= lim and s <= lim:  # room for the repeats, then rows in place
-                    need = int((lim - s) / (v * dt)) + 2
-                    phases = _reserve(phases, n_ph + need)
-                    bounds = _reserve(bounds, n_b + need)
                 while s_prev <= lim and s <= lim and steps < max_steps:
                     if n_ph == phases.shape[0] or n_b == bounds.shape[0]:
-                        phases = _reserve(phases, n_ph + 1)
-                        bounds = _reserve(bounds, n_b + 1)
+                        return _NEED_ROOM
                     steps += 1
                     phases[n_ph, 0] = t
                     phases[n_ph, 1] = s
@@ -467,7 +550,10 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             jp = -j if p == 0 else (0.0 if p == 1 else j)
             tp = min(tp, rem)
             if tp > 0.0:
-                phases, n_ph = _push(phases, n_ph, t, s, v, a, jp)
+                if n_ph == phases.shape[0]:
+                    return _NEED_ROOM
+                _put(phases, n_ph, t, s, v, a, jp)
+                n_ph += 1
                 s, v, a = advance(s, v, a, jp, tp)
                 t += tp
                 rem -= tp
@@ -476,17 +562,25 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
             a = 0.0
         if abs(a) < 1e-9:
             a = 0.0
-        bounds, n_b = _push(bounds, n_b, t, s, v, a, float(n_ph))
-    return phases[:n_ph], bounds[:n_b], status
+        if n_b == bounds.shape[0]:
+            return _NEED_ROOM
+        _put(bounds, n_b, t, s, v, a, float(n_ph))
+        n_b += 1
+    counts[0] = n_ph
+    counts[1] = n_b
+    return status
 
 
 @njit(cache=True)
 def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
     """Every phase (rows of start states and jerks, ending at ``t_end``) under the cap."""
     n = ph_t.shape[0]
+    stk = np.empty((STACK, 4))
     for i in range(n):
         te = ph_t[i + 1] if i + 1 < n else t_end
-        if not piece_ok(st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin):
+        if not piece_ok(
+            st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin, stk
+        ):
             return False
     return True
 
@@ -494,9 +588,11 @@ def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
 @njit(cache=True)
 def rows_ok(st, lg, h, length, rows, tmin):
     """Rows ``(t0, s0, v0, a0, jerk, duration)`` (shape (k, 6)) all under the cap."""
+    stk = np.empty((STACK, 4))
     for i in range(rows.shape[0]):
         if not piece_ok(
-            st, lg, h, length, rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4], rows[i, 5], tmin
+            st, lg, h, length, rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4], rows[i, 5], tmin,
+            stk,
         ):
             return False
     return True
@@ -539,3 +635,57 @@ def section_speeds(peaks, ci, p0, p1, s0, s1, h):
         if ci[i] > top:
             top = ci[i]
     return peak, top
+
+
+@njit(cache=True)
+def chain_times(rows, sizes):
+    """Lay sections of rows ``(t0, s0, v0, a0, jerk, duration)`` end to end in time, in place.
+
+    ``rows`` holds the sections one after the other (``sizes`` rows each); a section's start
+    times become ``t0 - t0[0] + t_out``, ``t_out`` the end (``t0 + duration``) of the last
+    row before it (0 for the first).
+    """
+    t_out = 0.0
+    i = 0
+    for k in range(sizes.shape[0]):
+        r0 = rows[i, 0]
+        for q in range(i, i + sizes[k]):
+            rows[q, 0] = rows[q, 0] - r0 + t_out
+        i += sizes[k]
+        t_out = rows[i - 1, 0] + rows[i - 1, 5]
+
+
+@njit(cache=True)
+def profile_rows(s, v, a, brake_t, brake_j, phase_t, phase_j):
+    """Rows ``(t0, s0, v0, a0, jerk, duration)`` of a ruckig profile from ``(s, v, a)``.
+
+    The brake phases (``brake_t``, ``brake_j``), then the profile's phases (``phase_t``,
+    ``phase_j``); phases of zero duration are left out, start times are the running sums of
+    the durations and start states come from :func:`advance` (shape ``(0, 6)`` if none).
+    """
+    n = 0
+    for x in brake_t:
+        if x > 0.0:
+            n += 1
+    for x in phase_t:
+        if x > 0.0:
+            n += 1
+    rows = np.empty((n, 6))
+    t = 0.0
+    k = 0
+    for q in range(len(brake_t) + len(phase_t)):
+        if q < len(brake_t):
+            ti, jq = brake_t[q], brake_j[q]
+        else:
+            ti, jq = phase_t[q - len(brake_t)], phase_j[q - len(brake_t)]
+        if ti > 0.0:
+            rows[k, 0] = t
+            rows[k, 1] = s
+            rows[k, 2] = v
+            rows[k, 3] = a
+            rows[k, 4] = jq
+            rows[k, 5] = ti
+            s, v, a = advance(s, v, a, jq, ti)
+            t += ti
+            k += 1
+    return rows

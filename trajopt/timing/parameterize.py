@@ -153,10 +153,9 @@ def time_parameterize(
 
     # ---------------------------------------------------------------- 4. compress
     t0 = time.perf_counter()
-    chain = compress(rk, table, phases, bounds)
+    rows, n_sections = compress(rk, table, phases, bounds)  # (t0, s0, v0, a0, jerk, duration)
     stats["timing_compress_s"] = time.perf_counter() - t0
 
-    rows = np.vstack(chain)  # (t0, s0, v0, a0, jerk, duration)
     duration = float(rows[-1, 0] + rows[-1, 5])
     keep = rows[:, 5] > 0.0
     keep[0] = True
@@ -167,7 +166,7 @@ def time_parameterize(
         timing_greedy_duration=greedy_duration,
         timing_duration=duration,
         timing_phases=int(rows.shape[0]),
-        timing_sections=len(chain),
+        timing_sections=n_sections,
         timing_grid_intervals=table.n,
     )
     _log.debug("time_parameterize: %s", stats)

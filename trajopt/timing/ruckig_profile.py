@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from trajopt.timing.greedy import profile_rows
+
 __all__ = ["RUCKIG_V_MARGIN", "RuckigProfile"]
 
 RUCKIG_V_MARGIN = 1e-9  # m/s added to ruckig's max_velocity
+_NO_BRAKE = (0.0, 0.0)  # durations and jerks of an absent brake
 
 
 class RuckigProfile:
@@ -44,7 +47,10 @@ class RuckigProfile:
     ) -> np.ndarray | None:
         """Rows ``(t0, s0, v0, a0, jerk, duration)`` from ``state0`` to ``state1`` or None.
 
-        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s).
+        ``max_velocity`` is ``max(vmax, v0, v1) + v_margin`` (m/s). The rows are ruckig's
+        phases of positive duration (its brake first); their start states are integrated
+        from ``state0`` over those phases (:func:`trajopt.timing.greedy.profile_rows`; within
+        a few 1e-15 of ruckig's own).
         """
         inp = self.inp
         s0, v0, a0 = state0
@@ -65,23 +71,8 @@ class RuckigProfile:
         prof = self.traj.profiles[0][0]
         if prof.accel.duration > 1e-15:
             return None
-        flat: list[float] = []  # rows laid end to end
-        t = 0.0
         b = prof.brake
-        if b.duration > 0.0:
-            bt, bj, bp, bv, ba = b.t, b.j, b.p, b.v, b.a
-            for i in range(2):
-                ti = bt[i]
-                if ti > 0.0:
-                    flat += (t, bp[i], bv[i], ba[i], bj[i], ti)
-                    t += ti
-        pt, pj, pp, pv, pa = prof.t, prof.j, prof.p, prof.v, prof.a
-        for i in range(7):
-            ti = pt[i]
-            if ti > 0.0:
-                flat += (t, pp[i], pv[i], pa[i], pj[i], ti)
-                t += ti
-        if not flat:
-            return None
-        # the start times are the running sums of the durations
-        return np.array(flat).reshape(-1, 6)
+        brake = (tuple(b.t), tuple(b.j)) if b.duration > 0.0 else (_NO_BRAKE, _NO_BRAKE)
+        rows = profile_rows(float(s0), float(v0), float(a0), *brake, tuple(prof.t),
+                            tuple(prof.j))  # fmt: skip
+        return rows if rows.shape[0] else None
