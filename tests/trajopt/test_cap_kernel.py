@@ -177,3 +177,13 @@ def test_cruise_steps_give_the_same_phases(levels, widths, v_end):
         assert small[2] == ref[2]
         np.testing.assert_array_equal(small[0], ref[0])
         np.testing.assert_array_equal(small[1], ref[1])
+
+
+def test_kernel_options_follow_what_numba_knows(monkeypatch):
+    from numba.core import cpu
+
+    from trajopt.timing import kernel_options
+
+    assert kernel_options._no_refcount() == {"_nrt": False}  # this numba knows the option
+    monkeypatch.delattr(cpu.CPUTargetOptions, "_nrt")
+    assert kernel_options._no_refcount() == {}  # a numba without it: plain kernels

@@ -12,10 +12,12 @@ import math
 import numpy as np
 from numba import njit
 
+from trajopt.timing.kernel_options import NO_REFCOUNT
+
 __all__ = ["bound_cubic"]
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def bound_cubic(coef, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Bound on ``|kappa|`` over ``[a, b]`` in cubic piece ``piece``, no zero-speed end (1/m).
 

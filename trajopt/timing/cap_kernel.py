@@ -31,6 +31,7 @@ from trajopt.curvature_bound import _MAX_DEPTH, _MAX_WORK, _RTOL_TIP, _TIP, _ZER
 from trajopt.curve import STILL_SPEED_RATIO, ParametricCurve
 from trajopt.robot import Robot
 from trajopt.timing.cap_cubic import bound_cubic
+from trajopt.timing.kernel_options import NO_REFCOUNT
 
 __all__ = ["PolynomialTables", "polynomial_tables"]
 
@@ -159,7 +160,7 @@ def _piece_ends(bp, lo, hi):  # pragma: no cover - compiled
     return out[:m]
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def speed_cap(k, limits):  # pragma: no cover - compiled
     """``Robot.speed_cap`` of ``|k|`` (1/m) for ``limits = (v_max, a_lat, omega, tw, wv)``.
 
@@ -177,7 +178,7 @@ def speed_cap(k, limits):  # pragma: no cover - compiled
     return cap
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     """Velocity ``c'`` of piece ``i`` at ``x = (u - mid) / half``: ``(vx, vy)``."""
     p = coef.shape[1]
@@ -189,7 +190,7 @@ def _poly_d1(coef, i, x):  # pragma: no cover - compiled
     return vx, vy
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     """Acceleration ``c''`` of piece ``i`` at ``x``: ``(ax, ay)``."""
     p = coef.shape[1]
@@ -201,7 +202,7 @@ def _poly_d2(coef, i, x, half):  # pragma: no cover - compiled
     return ax / half, ay / half
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover - compiled
     """``ParametricCurve.s_at_u`` (m) at ``u`` inside polynomial piece ``piece``."""
     nn = nodes.shape[0]
@@ -230,7 +231,7 @@ def _binomials(n):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - compiled
     """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[off:off + n_coef]``.
 
@@ -252,7 +253,7 @@ def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - c
     return best
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
@@ -327,7 +328,7 @@ def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cov
     return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def _zero_start(V, p):  # pragma: no cover - compiled
     """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
     scale = 0.0
@@ -337,7 +338,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -357,13 +358,13 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
             f *= r
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _taylor_at(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """:func:`_taylor` as a call of its own (for callers with reference counting)."""
     _taylor(coef, p, piece, w, a, b, gam)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _sampled(gam, p):  # pragma: no cover - compiled
     """``|kappa|`` at ``t = 0.01, 0.5, 0.99`` from ``gam`` (their largest; inf at zero speed)."""
     best = 0.0
@@ -487,7 +488,7 @@ def _tables(
     return u, kappa, theta, still, kmax, cap, end_caps
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _evaluate(
     coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True, unrolled=True
 ):  # pragma: no cover - compiled

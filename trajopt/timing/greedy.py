@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from trajopt.timing.kernel_options import NO_REFCOUNT
+
 #: greedy exit codes
 OK_FINISH = 1  # the end condition binds: finish with one position call to (L, v_end, 0)
 STUCK = 2  # at rest and no step is safe (speed cap ~0 ahead)
@@ -24,9 +26,9 @@ STACK = 96  # rows of piece_ok's bisection stack
 
 # The kernels that take the cap table and run inside the greedy's loops (range_min,
 # _piece_test, piece_ok, stop_ok, _put) are compiled without numba's reference counting
-# (``_nrt=False``): they allocate nothing, and the atomic increments and decrements of the
-# arrays passed to them otherwise take most of the greedy's time. Their callers allocate
-# (the bisection stack ``stk`` included).
+# (``NO_REFCOUNT``, :mod:`trajopt.timing.kernel_options`): they allocate nothing, and the
+# atomic increments and decrements of the arrays passed to them otherwise take most of the
+# greedy's time. Their callers allocate (the bisection stack ``stk`` included).
 
 
 @njit(cache=True, inline="always")
@@ -100,7 +102,7 @@ def finish_caps(ci, scale, v_bound, lo0, lo1):
     return i_low, vtop, st, lg, minima[:k]
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def range_min(st, lg, h, sa, sb):
     """Minimum cap over the grid intervals touched by ``[sa, sb]`` (m, ``sa <= sb``)."""
     n = st.shape[1]
@@ -122,7 +124,7 @@ def range_min(st, lg, h, sa, sb):
     return x if x < y else y
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     """One level of :func:`piece_ok`: 0 under the cap, 1 over it (or reversing), 2 undecided."""
     if s0 >= length:
@@ -159,7 +161,7 @@ def _piece_test(st, lg, h, length, s0, v0, a0, j, t0):
     return 2
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def piece_ok(st, lg, h, length, s, v, a, j, T, tmin, stk):
     """Return True when the constant-jerk piece keeps ``v >= 0`` and ``v <= cap(s)`` up to ``length``.
 
@@ -249,7 +251,7 @@ def brake_end(s, v, a, t1, t2, t3, j):
     return s
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk):
     """Is the stop profile from ``(s, v, a)`` under the cap? Returns ``(ok, s_stop)``."""
     t1, t2, t3, kind = brake_times(v, a, 0.0, j, amax)
@@ -313,7 +315,7 @@ def cruise_reach(v, v_end, amax, j, dt):
     return max(far, s1)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _put(buf, n, t, s, v, a, j):
     """Write row ``n`` of ``buf`` (the caller checked the room)."""
     buf[n, 0] = t
@@ -370,7 +372,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
         rows *= 2
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
          cruise, run_end, phases, bounds, stk, cands, counts):  # fmt: skip
     """Run the loop of :func:`greedy` on buffers it does not grow; return the status.
