@@ -4,8 +4,8 @@ A re-plan that cannot continue smoothly from a moving robot brakes along the old
 in place and drives a plan from rest (:mod:`trajopt.replan_brake`). Its result is a
 :class:`TrajectoryChain` of those pieces: one timed motion with the interface of
 :class:`trajopt.Trajectory` (``duration``, ``length``, ``sample``, ``state_at``,
-``to_dict`` and the writers), whose pieces join without a jump in position, heading, speed
-or acceleration (checked when the chain is built).
+``to_dict`` and the writers), whose pieces join without a jump in position, heading, speed,
+acceleration or yaw rate (checked when the chain is built).
 
 :class:`TurnInPlace` is a rest-to-rest rotation about the robot's centre under the limits of
 :func:`trajopt.fallback.turn_limits`, sampled with the conventions of the stop-and-turn
@@ -169,7 +169,8 @@ class TrajectoryChain(SampledExport):
     ------
     InvalidInputError
         No piece, a start outside its piece, or two pieces that do not join (position,
-        heading modulo ``2 pi``, speed or acceleration differ by more than ``JOIN_TOL``).
+        heading modulo ``2 pi``, speed, acceleration or yaw rate differ by more than
+        ``JOIN_TOL``).
     """
 
     pieces: tuple
@@ -282,7 +283,7 @@ class TrajectoryChain(SampledExport):
 
 
 def _at(smp: TrajectorySample, i: int) -> dict[str, float]:
-    return {n: float(getattr(smp, n)[i]) for n in ("x", "y", "theta", "v", "a", "s")}
+    return {n: float(getattr(smp, n)[i]) for n in ("x", "y", "theta", "v", "a", "omega", "s")}
 
 
 def _check_join(i: int, end: dict[str, float], start: dict[str, float], shift: float) -> None:
@@ -291,6 +292,7 @@ def _check_join(i: int, end: dict[str, float], start: dict[str, float], shift: f
         "heading (rad)": abs(end["theta"] - start["theta"] - shift),
         "speed (m/s)": abs(end["v"] - start["v"]),
         "acceleration (m/s^2)": abs(end["a"] - start["a"]),
+        "yaw rate (rad/s)": abs(end["omega"] - start["omega"]),
     }
     bad = {k: v for k, v in jumps.items() if not v <= JOIN_TOL}
     if bad:
