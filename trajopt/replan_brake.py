@@ -67,7 +67,8 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
     Raises
     ------
     TimingError
-        The stop does not end on the path (the trajectory ends moving).
+        The stop does not end on the path (the trajectory ends moving), or the state
+        decelerates too hard to end at rest without reversing.
     """
     robot = traj.robot
     s0, v0, a0, _ = (float(x) for x in traj.motion(ts))
@@ -81,6 +82,11 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
             rows.append((t, s, v, a, jerk))
             s, v, a = advance(s, v, a, jerk, d)
             t += d
+    if v < -1e-9:  # a state decelerating too hard to end at rest without reversing
+        raise TimingError(
+            f"the robot at {v0:.6g} m/s with a = {a0:.6g} m/s^2 cannot stop without reversing "
+            f"under the jerk limit {j} m/s^3"
+        )
     if s0 + s > traj.length + 1e-9:
         raise TimingError(
             f"the robot at {v0:.6g} m/s cannot stop on the path: it needs {s:.6g} m, "
