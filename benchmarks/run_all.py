@@ -107,6 +107,13 @@ BENCHES: tuple[Bench, ...] = (
           "then whole plans and re-plans to a new goal on a warehouse-size map (willow at "
           "5 cm).",
           ("--queries", "4")),
+    Bench("replan_robustness", "Re-planning: every guarantee on many re-plans",
+          "replan_robustness.py",
+          "Re-plans with `reuse=False` from moving robots on the shared ROS maps to the same "
+          "goal and to two other goals, and braked results re-planned again mid-brake: "
+          "outcomes (planned, braked, refused by type), latency, and every violation of the "
+          "splice continuity, the limits, the clearance, or an untyped error.",
+          ("--queries", "3")),
     Bench("first_call", "First plan in a fresh process", "bench_first_call.py",
           "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
           "warm on disk), split into imports, numba cache loads, solver build and the "
