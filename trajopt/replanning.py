@@ -121,7 +121,8 @@ def _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading, 
     ``brake_after_s``: a re-plan must be quick, and a state no curve can leave smoothly
     exhausts the whole budget before it fails. Its smoothing and timing errors, and the
     input errors of its start (e.g. a state already in the goal's cell), lead to braking;
-    an invalid goal is raised as such.
+    an invalid goal is raised as such. A footprint robot, which does not brake this way,
+    keeps the whole budget.
     """
     if isinstance(piece, TrajectoryChain):
         i, tau = piece.piece_at(ts)
@@ -134,7 +135,7 @@ def _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading, 
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
         path = remaining_grid_path(planner, piece.steps,
                                    planner.grid.world_to_cell(state.position))  # fmt: skip
-    if brake_after_s is None:
+    if brake_after_s is None or planner.robot.footprint is not None:  # no brake to fall on
         return planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
     smoother = planner.smoother
     planner.smoother = dataclasses.replace(

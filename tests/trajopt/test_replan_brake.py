@@ -208,3 +208,21 @@ def test_a_state_that_would_reverse_to_stop_is_refused():
                       phase_a=[-0.5], phase_j=[0.0], duration=0.01, v_start=0.01, v_end=0.0)  # fmt: skip
     with pytest.raises(TimingError, match="without reversing"):
         brake_on_path(traj, 0.0)
+
+
+@pytest.mark.parametrize("footprint", [False, True])
+def test_the_smoothing_cap_applies_only_to_robots_that_brake(scene, monkeypatch, footprint):
+    robot = trajopt.Robot.rectangle(length=0.3, width=0.2) if footprint else ROBOT
+    planner = trajopt.Planner(scene.grid, robot)
+    traj = planner.plan(scene.start, scene.goal("A"))
+    budgets = []
+    query = planner._query
+
+    def spy(*args):
+        budgets.append(planner.smoother.time_budget_s)
+        return query(*args)
+
+    monkeypatch.setattr(planner, "_query", spy)
+    planner.replan(traj, 1.0, goal=scene.goal("B"), latency=0.0, brake_after_s=0.05)
+    assert budgets[0] == (planner.smoother.time_budget_s if footprint else 0.05)
+    assert planner.smoother.time_budget_s == trajopt.Smoother().time_budget_s  # restored
