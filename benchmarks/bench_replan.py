@@ -66,6 +66,15 @@ def data_dir() -> Path:
     return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "data"
 
 
+def ros_dir() -> Path | None:
+    """The shared ROS maps' folder, or ``None`` (said on stdout) when it is absent."""
+    d = data_dir() / "ros"
+    if not d.is_dir():
+        print(f"shared data not found at {d} (set TRAJOPT_DATA)")
+        return None
+    return d
+
+
 def queries(grid, robot, n, rng):
     """``n`` random (start, goal) pairs at least 2 m apart in free space."""
     free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
@@ -100,9 +109,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--warehouse", type=int, default=12,
                     help="queries on the warehouse-size map (0: skip that part)")
     args = ap.parse_args(argv)
-    d = data_dir() / "ros"
-    if not d.is_dir():
-        print(f"shared data not found at {d} (set TRAJOPT_DATA)")
+    d = ros_dir()
+    if d is None:
         return 1
     rng = np.random.default_rng(args.seed)
     robot = trajopt.Robot(radius=0.2)

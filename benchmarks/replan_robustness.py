@@ -38,7 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_replan import MAPS, data_dir, jump, queries  # noqa: E402
+from bench_replan import MAPS, jump, queries, ros_dir  # noqa: E402
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
@@ -90,9 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--every", type=float, default=1.5, help="re-plan period (s)")
     ap.add_argument("--seed", type=int, default=7)
     args = ap.parse_args(argv)
-    d = data_dir() / "ros"
-    if not d.is_dir():
-        print(f"shared data not found at {d} (set TRAJOPT_DATA)")
+    d = ros_dir()
+    if d is None:
         return 1
     rng = np.random.default_rng(args.seed)
     robot = trajopt.Robot(radius=0.2)
