@@ -88,8 +88,8 @@ def replan_from(
         out, why = keep_rest(planner, piece, t_piece, goal, goal_heading=goal_heading,
                              v_end=v_end)  # fmt: skip
     if out is None:
-        out = _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading,
-                             v_end, why, brake_after_s)  # fmt: skip
+        out = _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, why,
+                             brake_after_s)  # fmt: skip
     stats = dict(out.stats)
     if why == "kept":
         stats["replan"] = "kept"
@@ -113,7 +113,7 @@ def _keep_chain(planner, chain, ts, goal, goal_heading, v_end) -> tuple[Any, str
     return chain.after(ts), "kept"
 
 
-def _plan_or_brake(planner, trajectory, ts, piece, t_piece, goal, goal_heading, v_end, why,
+def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, why,
                    brake_after_s):  # fmt: skip
     """Plan from the state at ``ts``; brake, turn and go when that fails (:func:`replan_from`).
 
