@@ -40,6 +40,7 @@ from astar.grid import OccupancyGrid
 from trajopt.clearance import points_clearance
 from trajopt.curve import CurveSegment
 from trajopt.errors import TimingError, TrajoptError
+from trajopt.replan_keep import target_change
 from trajopt.timing import time_parameterize
 from trajopt.timing.greedy import advance, brake_times
 from trajopt.trajectory import Trajectory
@@ -223,15 +224,9 @@ def _resume(planner, traj, brake, goal, goal_heading, v_end) -> list[Trajectory]
     speed differ from the old trajectory's. A map change is checked as for the braking.
     """
     steps = traj.steps
-    old_goal = None if steps is None else np.asarray(steps.goal, dtype=float)
-    if old_goal is None or not np.allclose(np.asarray(goal, dtype=float), old_goal,
-                                           rtol=0.0, atol=1e-9) or v_end != traj.v_end:  # fmt: skip
+    if steps is None or target_change(traj, goal, goal_heading, v_end):
         return None
     u_stop, u_end = brake.path.domain[1], traj.path.domain[1]
-    if goal_heading is not None:
-        old = float(traj.path.heading(u_end))
-        if abs(math.remainder(float(goal_heading) - old, 2.0 * math.pi)) > 1e-9:
-            return None
     if not u_stop < u_end:
         return []
     rest = time_parameterize(CurveSegment(traj.path, u_stop, u_end), planner.robot,

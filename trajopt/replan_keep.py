@@ -34,7 +34,7 @@ from trajopt.smoother.certificate import certify
 from trajopt.trajectory import Trajectory
 from trajopt.validation import point
 
-__all__ = ["BLOCKED_NEAR", "keep_rest", "remaining_grid_path", "trajectory_after"]
+__all__ = ["BLOCKED_NEAR", "keep_rest", "remaining_grid_path", "target_change", "trajectory_after"]
 
 #: why :func:`keep_rest` refuses when new obstacles come near the rest of the path
 BLOCKED_NEAR = "cells blocked near the rest of the path"
@@ -83,15 +83,10 @@ def keep_rest(
         return None, "footprint robot"
     if trajectory.robot != planner.robot:
         return None, "planned for another robot"
-    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
-        return None, "new goal"
-    if v_end != trajectory.v_end:
-        return None, "new end speed"
+    why = target_change(trajectory, goal, goal_heading, v_end)
+    if why:
+        return None, why
     u_end = trajectory.path.domain[1]
-    if goal_heading is not None:
-        old = float(trajectory.path.heading(u_end))
-        if abs(math.remainder(float(goal_heading) - old, 2.0 * math.pi)) > 1e-9:
-            return None, "new goal heading"
     s0 = float(trajectory.motion(ts)[0])
     u0 = float(trajectory._u_at_s(np.array(s0)))
     if not u0 < u_end or s0 >= trajectory.length:
@@ -122,6 +117,29 @@ def keep_rest(
     stats["stages_s"] = stages
     stats["replan"] = "kept"
     return dataclasses.replace(out, steps=new_steps, stats=stats), "kept"
+
+
+def target_change(
+    trajectory: Any, goal: Sequence[float] | None, goal_heading: float | None, v_end: float
+) -> str:
+    """Why a re-plan's goal, goal heading or end speed differ from ``trajectory``'s.
+
+    ``""`` when they do not. ``goal`` ``None`` is the old goal; a goal heading counts as
+    new unless ``trajectory`` has a ``path`` that ends with it (within 1e-9 rad).
+    """
+    steps = trajectory.steps
+    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
+        return "new goal"
+    if v_end != trajectory.v_end:
+        return "new end speed"
+    if goal_heading is not None:
+        path = getattr(trajectory, "path", None)
+        if path is None:
+            return "new goal heading"
+        old = float(path.heading(path.domain[1]))
+        if abs(math.remainder(float(goal_heading) - old, 2.0 * math.pi)) > 1e-9:
+            return "new goal heading"
+    return ""
 
 
 def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:

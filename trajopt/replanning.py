@@ -31,7 +31,7 @@ from trajopt.corridor_fit import fit_in_corridor
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.plan_query import PlanQuery
 from trajopt.replan_brake import brake_turn_go
-from trajopt.replan_keep import BLOCKED_NEAR, keep_rest, remaining_grid_path
+from trajopt.replan_keep import BLOCKED_NEAR, keep_rest, remaining_grid_path, target_change
 from trajopt.smoother import SmoothPath
 from trajopt.trajectory_chain import TrajectoryChain, TurnInPlace
 from trajopt.validation import nonnegative, number, point
@@ -106,11 +106,8 @@ def _keep_chain(planner, chain, ts, goal, goal_heading, v_end) -> tuple[Any, str
     steps = chain.steps
     if steps is None or planner.grid is not steps.raw_grid:
         return None, "the map changed"
-    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
-        return None, "new goal"
-    if goal_heading is not None or v_end != chain.v_end:
-        return None, "new goal heading or end speed"
-    return chain.after(ts), "kept"
+    why = target_change(chain, goal, goal_heading, v_end)  # a chain has no path: no heading
+    return (None, why) if why else (chain.after(ts), "kept")
 
 
 def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, why,
