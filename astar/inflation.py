@@ -10,7 +10,8 @@ Three ways to grow obstacles by a robot radius, plus the distance field they der
     occupied cell taken as a *square* (``docs/concepts.md``, stage 1: the inflation a corridor can certify).
 
 * :func:`clearance` -- the distance in metres from every cell centre to the nearest occupied
-  cell (centre or square, as above).
+  cell (centre or square, as above), from the exact transform of
+  :mod:`astar.distance_transform`.
 * :func:`avoidance_area` -- the chapter's own method: mark every cell next to an obstacle or the
   map border as full, ``W`` times. This is a Chebyshev (square) dilation, reproduced as such.
 * :func:`clearance_cost` -- a soft per-cell cost for clearance-aware search
@@ -43,9 +44,9 @@ from typing import Literal
 
 import numpy as np
 from numba import njit
-from scipy import ndimage
 
 from astar import validation
+from astar.distance_transform import squared_distances
 from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
 
@@ -277,25 +278,17 @@ def clearance(
 
     Notes
     -----
-    Uses :func:`scipy.ndimage.distance_transform_edt`, which is exact on the integer lattice.
-    For ``"square"`` the lattice is refined by two: the point of an occupied square nearest to
-    a cell centre is always a corner or an edge midpoint of that square, i.e. a point of the
-    half-cell lattice, so the transform of the refined grid is exact too (at four times the
-    cost).
+    Exact: :func:`astar.distance_transform.squared_distances` computes every squared distance
+    as an integer (cells squared, or quarter cells squared for ``"square"``); only the final
+    square root rounds.
     """
     grid = validation.grid(grid)
     metric = validation.choice("metric", metric, _METRICS)  # type: ignore[assignment]
     occ, pad = _padded(grid.occupied, bool(outside_occupied))
     if not occ.any():
         return np.full(grid.shape, np.inf)
-    if metric == "centre":
-        d = ndimage.distance_transform_edt(~occ)
-    else:
-        ny, nx = occ.shape
-        fine = np.zeros((2 * ny + 1, 2 * nx + 1), dtype=bool)
-        fine[1::2, 1::2] = occ
-        fine = ndimage.maximum_filter(fine, size=3, mode="constant", cval=False)
-        d = ndimage.distance_transform_edt(~fine)[1::2, 1::2] * 0.5
+    d2 = squared_distances(occ, metric)
+    d = np.sqrt(d2) if metric == "centre" else np.sqrt(d2) * 0.5
     if pad:
         d = d[pad:-pad, pad:-pad]
     return np.ascontiguousarray(d * grid.resolution, dtype=np.float64)
@@ -342,6 +335,8 @@ def avoidance_area(grid: OccupancyGrid, w_cells: int, *, border: bool = True) ->
     if border:
         occ = np.pad(occ, w, mode="constant", constant_values=True)
     size = 2 * w + 1
+    from scipy import ndimage
+
     out = ndimage.maximum_filter1d(occ, size, axis=0, mode="constant", cval=False)
     out = ndimage.maximum_filter1d(out, size, axis=1, mode="constant", cval=False)
     if border:
