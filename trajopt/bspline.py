@@ -107,7 +107,11 @@ class BSplineCurve(ParametricCurve):
         """Knots and control points of the ``nu``-th derivative (cached)."""
         if nu not in self._derivatives:
             t, c = self._derivative_coefficients(nu - 1)
-            self._derivatives[nu] = derivative_control_points(t, c, self.k - nu + 1)
+            td, cd = derivative_control_points(t, c, self.k - nu + 1)
+            # read-only like the curve's own: one compiled signature of the evaluator for all
+            td.flags.writeable = False
+            cd.flags.writeable = False
+            self._derivatives[nu] = td, cd
         return self._derivatives[nu]
 
     def tail(self, u0: float) -> BSplineCurve:
@@ -170,7 +174,10 @@ def _tail_coefficients(t: np.ndarray, c: np.ndarray, k: int, u0: float):
         c = np.concatenate([c[: m - k + 1], mixed, c[m:]])
         t = np.insert(t, m + 1, u0)
     m = int(np.searchsorted(t, u0, side="right")) - 1  # the span [u0, next knot)
-    return np.concatenate([[u0], t[m - k + 1 :]]), np.ascontiguousarray(c[m - k :])
+    tt, cc = np.concatenate([[u0], t[m - k + 1 :]]), np.ascontiguousarray(c[m - k :])
+    tt.flags.writeable = False
+    cc.flags.writeable = False
+    return tt, cc
 
 
 def derivative_control_points(t: np.ndarray, c: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:

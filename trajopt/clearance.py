@@ -11,7 +11,8 @@ Layers:
 * **kernels** (numba, cell units): :func:`point_rect_distance`,
   :func:`point_segment_distance`, :func:`segment_meets_rect`,
   :func:`segment_rect_distance`, :func:`polygon_rect_closest`, :func:`border_distance`,
-  :func:`merge_rects` (occupied cells as rectangles), :func:`polygon_rects_distance`,
+  :func:`merge_rects` (occupied cells as rectangles; :func:`window_rects` calls it on a
+  window of the map), :func:`polygon_rects_distance`,
   :func:`point_square_dist2` and :func:`segment_squares_distance` (scans of the cells
   around a point or a segment);
 * **metres** (NumPy in, float out): :func:`points_clearance` (the smoother's certificate),
@@ -51,6 +52,7 @@ __all__ = [
     "segment_meets_rect",
     "segment_rect_distance",
     "segment_squares_distance",
+    "window_rects",
 ]
 
 
@@ -256,6 +258,20 @@ def merge_rects(occ, x_off, y_off):  # pragma: no cover - compiled
         out[i, 2] = rx1[i] + x_off
         out[i, 3] = ry1[i] + y_off
     return out
+
+
+def window_rects(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
+    """Occupied cells of the window ``occ[y0:y1, x0:x1]`` as rectangles, in map cells.
+
+    Returns :func:`merge_rects`'s ``(R, 4)`` float64 ``(x0, y0, x1, y1)``. The window is
+    passed read-only whether or not it had to be copied, so the kernel has one compiled
+    signature (each signature is a cache load in a fresh process).
+    """
+    window = np.ascontiguousarray(occ[y0:y1, x0:x1], dtype=np.bool_)
+    if window.flags.writeable:
+        window = window.view()
+        window.flags.writeable = False
+    return merge_rects(window, x0, y0)
 
 
 @njit(cache=True)
@@ -480,7 +496,7 @@ def polygon_clearance(polygon: Any, raw_grid: Any) -> float:
     while True:
         wx0, wx1 = max(0, int(math.floor(x0 - pad))), min(nx, int(math.ceil(x1 + pad)))
         wy0, wy1 = max(0, int(math.floor(y0 - pad))), min(ny, int(math.ceil(y1 + pad)))
-        rects = merge_rects(np.ascontiguousarray(occ[wy0:wy1, wx0:wx1]), wx0, wy0)
+        rects = window_rects(occ, wx0, wx1, wy0, wy1)
         best = min(border, polygon_rects_distance(vc, len(vc), rects) if len(rects) else math.inf)
         whole = wx0 == 0 and wy0 == 0 and wx1 == nx and wy1 == ny
         if best <= pad or whole:

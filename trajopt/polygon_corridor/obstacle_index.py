@@ -19,9 +19,9 @@ from numba import njit
 
 from trajopt.clearance import (
     border_distance,
-    merge_rects,
     polygon_rect_closest,
     segment_rect_distance,
+    window_rects,
 )
 
 __all__ = ["BUCKET_CELLS", "ObstacleIndex", "gather", "point_nearest", "poly_clearance",
@@ -201,7 +201,7 @@ class ObstacleIndex:
             rects = np.zeros((0, 4))
             x0, y0, x1, y1 = 0, 0, 1, 1
         else:
-            rects = merge_rects(np.ascontiguousarray(occ[y0:y1, x0:x1]), x0, y0)
+            rects = window_rects(occ, x0, x1, y0, y1)
         bs = BUCKET_CELLS
         nbx = max(1, -(-(x1 - x0) // bs))
         nby = max(1, -(-(y1 - y0) // bs))
