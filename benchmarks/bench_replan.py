@@ -206,6 +206,7 @@ def appearing(d: Path, robot, args, rng) -> None:
     print(f"{'map':26s} {'replans':>7s} {'kept':>5s} {'planned':>7s} {'path kept':>9s} "
           f"{'braked':>6s} {'refused':>7s} {'median ms':>9s} {'p95 ms':>7s} {'max jump':>9s} "
           f"{'limits':>6s} {'min clear m':>11s}")  # fmt: skip
+    corridor_share: list[tuple[float, float]] = []  # (corridor, total) s, grid path reused
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
         planner = trajopt.Planner(grid, robot)
@@ -240,7 +241,10 @@ def appearing(d: Path, robot, args, rng) -> None:
                 kept += how == "kept"
                 braked += how.startswith("braked")
                 planned += how.startswith("planned")
-                reused += how.startswith("planned") and new.stats["grid_path"] == "reused"
+                if how.startswith("planned") and new.stats["grid_path"] == "reused":
+                    reused += 1
+                    st = new.stats["stages_s"]
+                    corridor_share.append((st["corridor"], st["total"]))
                 worst = max(worst, jump(traj.state_at(args.every), new.state_at(0.0)))
                 ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
                 smp = new.sample_uniform(0.01)
@@ -253,6 +257,12 @@ def appearing(d: Path, robot, args, rng) -> None:
     print(f"(min clear: the smallest distance from a 10 ms sample of any new trajectory to an "
           f"occupied cell of its updated map, by trajopt.metrics.point_clearance; the robot "
           f"radius is {robot.radius} m)")  # fmt: skip
+    if corridor_share:
+        cor = [1e3 * c for c, _ in corridor_share]
+        tot = [1e3 * t for _, t in corridor_share]
+        print(f"planned re-plans on a reused grid path ({len(cor)}): corridor stage median "
+              f"{_med(cor):.2f} ms (max {max(cor):.2f}) of a median {_med(tot):.1f} ms per "
+              f"re-plan: the most that reusing the old corridor's regions could save")  # fmt: skip
 
 
 def warehouse(d: Path, n: int, rng) -> None:
