@@ -23,6 +23,7 @@ Run::
 
     python benchmarks/bench_first_call.py            # 5 fresh processes
     python benchmarks/bench_first_call.py --runs 9
+    python benchmarks/bench_first_call.py --python /tmp/venv/bin/python   # an installed copy
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 CHILD = r"""
@@ -88,16 +90,17 @@ trajopt.plan(scene.grid, scene.start, scene.goal("B"), robot=robot)
 t_second = time.perf_counter() - t2
 build = float(first.stats.get("smoother", {}).get("build_time_s", 0.0) or 0.0)
 print(json.dumps({"import_trajopt": t_import, "warm_up": t_warm, "first": t_first, "imports": state["imports"],
-                  "numba": state["numba"], "build": build, "second": t_second}))
+                  "numba": state["numba"], "build": build, "second": t_second,
+                  "cffi": "cffi" in sys.modules}))
 """
 
 
-def run_child(root: Path, warm: bool = False) -> dict:
+def run_child(cwd: Path, python: str, warm: bool = False) -> dict:
     """Run one fresh process (after ``trajopt.warm_up()`` if ``warm``); timings in seconds."""
     code = f"WARM = {warm}\n" + CHILD
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    out = subprocess.run([sys.executable, "-c", code], cwd=root, check=True,
-                         capture_output=True, text=True, env=env)
+    out = subprocess.run([python, "-c", code], cwd=cwd, check=True,
+                         capture_output=True, text=True, env=env)  # fmt: skip
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -105,17 +108,24 @@ def main() -> None:
     """Print the median first-call breakdown over fresh processes."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5, help="fresh processes (default 5)")
+    ap.add_argument("--python", default=None,
+                    help="interpreter of another environment with trajopt installed, e.g. a "
+                         "clean virtual environment's (default: this one, on this checkout)")
     args = ap.parse_args()
-    root = Path(__file__).resolve().parents[1]
-    run_child(root)  # fills numba's disk cache and the bytecode cache; not counted
-    runs = [run_child(root) for _ in range(args.runs)]
-    warm = [run_child(root, warm=True) for _ in range(args.runs)]
+    if args.python is None:  # this checkout, from its root
+        python, cwd = sys.executable, Path(__file__).resolve().parents[1]
+    else:  # the other environment's own trajopt: not this checkout's from the working dir
+        python, cwd = args.python, Path(tempfile.gettempdir())
+    run_child(cwd, python)  # fills numba's disk cache and the bytecode cache; not counted
+    runs = [run_child(cwd, python) for _ in range(args.runs)]
+    warm = [run_child(cwd, python, warm=True) for _ in range(args.runs)]
 
     def med(key: str) -> float:
         return 1e3 * statistics.median(r[key] for r in runs)
 
     rest = [1e3 * (r["first"] - r["imports"] - r["numba"] - r["build"]) for r in runs]
     print(f"first plan in a fresh process, paper scene SP -> A, median of {args.runs} processes")
+    print(f"  interpreter {python}; cffi imported by numba: {runs[0]['cffi']}")
     print(f"  import trajopt            {med('import_trajopt'):7.1f} ms")
     print(f"  first plan (wall)         {med('first'):7.1f} ms   target <= 500 ms")
     print(f"    imports during the call {med('imports'):7.1f} ms")
