@@ -24,8 +24,9 @@ from trajopt.clearance import box_clearance
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.feasibility import curvature_witness, witness_grid_path
-from trajopt.plan_query import PlanQuery
+from trajopt.plan_query import PlanQuery, PlanSteps
 from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
+from trajopt.polygon_corridor.reuse import corridor_with_rest
 from trajopt.smoother import Smoother, SmoothPath
 
 __all__ = ["box_corridor", "fit_in_corridor", "polygon_corridor", "witness_rescue"]
@@ -55,7 +56,8 @@ def fit_in_corridor(
         try:
             with q.timer.stage("corridor"):
                 if kind == "polygons":
-                    corridor = polygon_corridor(planner, path, q.start, q.goal)
+                    corridor, q.regions_kept = polygon_corridor(planner, path, q.start, q.goal,
+                                                                q.previous)  # fmt: skip
                 else:
                     corridor = box_corridor(planner, q.inflated, path, q.start, q.goal)
         except InvalidInputError as exc:
@@ -132,11 +134,25 @@ def witness_rescue(
     return None
 
 
-def polygon_corridor(planner: Any, path: Any, p0: np.ndarray, p1: np.ndarray) -> PolygonCorridor:
-    """Polygons around the A* path, from the exact start to the exact goal."""
+def polygon_corridor(
+    planner: Any, path: Any, p0: np.ndarray, p1: np.ndarray, previous: PlanSteps | None = None
+) -> tuple[PolygonCorridor, int]:
+    """Polygons around the A* path, from the exact start to the exact goal.
+
+    With a re-plan's ``previous`` steps, their polygon corridor's regions along the rest
+    of the path the two share are kept when still certified
+    (:func:`~trajopt.polygon_corridor.reuse.corridor_with_rest`). Returns the corridor and
+    the number of regions kept.
+    """
     centres = np.asarray(planner.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
     points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
-    return build_polygon_corridor(planner.grid, points, planner.robot.radius)
+    radius = planner.robot.radius
+    if previous is not None and isinstance(previous.corridor, PolygonCorridor):
+        out = corridor_with_rest(planner.grid, points, radius, previous.corridor,
+                                 previous.raw_grid)  # fmt: skip
+        if out is not None:
+            return out
+    return build_polygon_corridor(planner.grid, points, radius), 0
 
 
 def box_corridor(

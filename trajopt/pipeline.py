@@ -14,11 +14,11 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
    ``"costmap+clearance"`` for both); its obstacle cells are what is inflated above.
 3. **corridor**: with ``corridor="polygons"`` (default, exact inflation)
    :func:`trajopt.polygon_corridor.build_polygon_corridor` around the polyline *exact start
-   -> A* cell centres -> exact goal*; otherwise, and wherever the polygon corridor cannot be
-   built or the fit in it fails, :func:`trajopt.build_corridor` (boxes). When the exact
-   start or goal is not a cell centre, the end box is widened to contain it after an exact
-   box-to-obstacle clearance check. ``stats["corridor"]`` names the corridor of the result;
-   ``stages_s["corridor"]`` adds up the corridors built.
+   -> A* cell centres -> exact goal* (a re-plan keeps the old corridor's regions along the
+   rest of the path the two share: ``stats["corridor_regions_kept"]``); otherwise, and
+   wherever the polygon corridor cannot be built or the fit in it fails,
+   :func:`trajopt.build_corridor` (boxes), its end boxes widened to the exact start and
+   goal after an exact clearance check. ``stats["corridor"]`` names the result's corridor.
 4. **smooth**: :class:`trajopt.Smoother` (certified clearance ``>= radius`` from the raw
    map, exact endpoints, continuous heading; the taut objective in polygons, the fidelity
    objective in boxes). **Witness rescue**: when the smoother has a
@@ -32,8 +32,7 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 5. **timing**: :func:`trajopt.time_parameterize`, with the planner's speed-limit zones
    (:class:`~trajopt.speed_limits.SpeedLimits`) when it has them.
 
-The returned :class:`~trajopt.trajectory.Trajectory` carries every intermediate result in
-``trajectory.steps`` (a :class:`PlanSteps`).
+The :class:`~trajopt.trajectory.Trajectory` carries every stage's result in ``.steps``.
 
 **Fallback** (opt-in, ``fallback="stop_and_turn"``). When the smoother raises
 :class:`~trajopt.errors.SmoothingError` (after its own refinements), or the timing raises
@@ -43,13 +42,10 @@ planner returns a :class:`~trajopt.fallback.StopAndTurnTrajectory` instead: the 
 rest-to-rest profile per segment and turning in place at rest at every corner (a
 differential drive can do this; see :mod:`trajopt.fallback`). The A* moves between
 adjacent free cells of the square-metric inflated grid without corner cutting keep the
-centre at clearance ``>= radius``; the planner does not rely on that argument but checks the
-polyline's exact distance to the raw map's obstacle squares (cells outside the map count
-as occupied) and re-raises the original error if it is below the radius. The trajectory's
-``stats`` hold ``fallback = "stop_and_turn"``, ``fallback_error`` (the exception's type),
-``fallback_reason`` (its message) and ``fallback_min_clearance_m``; ``steps.smooth_path``
-is ``None``. With ``v_start`` or ``v_end`` not 0 the original error is raised: a
-stop-and-turn motion starts and ends at rest, so it could not honour those speeds.
+centre at clearance ``>= radius``; the planner still checks the polyline's exact distance to
+the raw map (the outside counts as occupied) and re-raises the error below the radius.
+``stats``: ``fallback = "stop_and_turn"``, ``fallback_error`` (the exception's type),
+``fallback_reason`` (its message), ``fallback_min_clearance_m``; no ``steps.smooth_path``. With an end speed not 0 the error is raised (the fallback is rest to rest).
 """
 
 from __future__ import annotations
@@ -375,8 +371,8 @@ class Planner:
         """
         return self._query(start, goal, start_heading, goal_heading, v_start, v_end, None)
 
-    def _query(self, start, goal, start_heading, goal_heading, v_start, v_end, grid_path):
-        """:meth:`plan`, with a grid path to use instead of a search (a re-plan's warm start)."""
+    def _query(self, start, goal, start_heading, goal_heading, v_start, v_end, warm):
+        """:meth:`plan`, with a re-plan's :class:`~trajopt.plan_query.WarmStart` (or ``None``)."""
         with self._lock:
             t0 = time.perf_counter()
             if self.robot.footprint is not None:
@@ -385,7 +381,7 @@ class Planner:
                                           v_end=v_end)  # fmt: skip
             else:
                 out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end,
-                                 grid_path)  # fmt: skip
+                                 warm)  # fmt: skip
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -439,7 +435,7 @@ class Planner:
         v_end : float, optional
             Speed at the goal (m/s).
         reuse : bool, optional
-            ``False``: always plan anew from the state.
+            ``False``: plan anew from the state, keeping nothing of the old plan.
         brake_after_s : float or None, optional
             Smoothing time (s) before the robot brakes instead; ``None``: never brake.
 
@@ -457,7 +453,7 @@ class Planner:
                                brake_after_s=brake_after_s)  # fmt: skip
 
     def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end,
-              grid_path=None) -> PlanResult:  # fmt: skip
+              warm=None) -> PlanResult:  # fmt: skip
         kappa0 = None
         a0 = 0.0
         if isinstance(start, State):
@@ -482,11 +478,13 @@ class Planner:
             v_start=v_start,
             v_end=v_end,
             a_start=a0,
+            previous=None if warm is None else warm.previous,
         )
         with q.timer.stage("inflate"):
             q.inflated = self.inflated_grid
         self._check_reachable_ends(q)
         ends = [q.start_cell, q.goal_cell]
+        grid_path = None if warm is None else warm.grid_path
         reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
         with q.timer.stage("search"):
             q.path = grid_path if reused else self._search(q)
@@ -510,7 +508,8 @@ class Planner:
         smoother_stats["rescue"] = q.rescue
         kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
         return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind,
-                            grid_path="reused" if reused else "searched")  # fmt: skip
+                            grid_path="reused" if reused else "searched",
+                            corridor_regions_kept=q.regions_kept)  # fmt: skip
 
     def _search(self, q: PlanQuery) -> astar.GridPath:
         """Return the A* path of the query on the inflated grid (typed error without one)."""

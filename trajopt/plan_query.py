@@ -18,7 +18,7 @@ from astar.grid import OccupancyGrid
 from trajopt.corridor import Corridor
 from trajopt.polygon_corridor import PolygonCorridor
 
-__all__ = ["PlanQuery", "PlanSteps", "StageTimer"]
+__all__ = ["PlanQuery", "PlanSteps", "StageTimer", "WarmStart"]
 
 
 class StageTimer:
@@ -74,6 +74,11 @@ class PlanQuery:
         The corridor of the smooth path (or of the fallback's polyline).
     rescue : str or None
         ``"witness"`` when the curve came from the witness rescue.
+    previous : PlanSteps or None
+        A re-plan's old steps: the polygon corridor may keep their regions along the rest
+        of the path it shares with them (:mod:`trajopt.polygon_corridor.reuse`).
+    regions_kept : int
+        How many regions of the result's polygon corridor are ``previous``'s.
     timer : StageTimer
     """
 
@@ -91,7 +96,25 @@ class PlanQuery:
     path: Any = None
     corridor: PolygonCorridor | Corridor | None = None
     rescue: str | None = None
+    previous: PlanSteps | None = None
+    regions_kept: int = 0
     timer: StageTimer = field(default_factory=StageTimer)
+
+
+@dataclass(frozen=True, slots=True)
+class WarmStart:
+    """What a re-plan hands the plan from the moving state (:mod:`trajopt.replanning`).
+
+    Attributes
+    ----------
+    grid_path : astar.GridPath or None
+        Used instead of a search when its end cells are the query's.
+    previous : PlanSteps or None
+        The re-planned trajectory's steps (:attr:`PlanQuery.previous`).
+    """
+
+    grid_path: Any = None
+    previous: PlanSteps | None = None
 
 
 @dataclass(frozen=True, slots=True)

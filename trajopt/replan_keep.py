@@ -116,6 +116,7 @@ def keep_rest(
     stats = dict(out.stats)
     stats["stages_s"] = stages
     stats["replan"] = "kept"
+    stats["corridor_regions_kept"] = len(regions) if isinstance(corridor, PolygonCorridor) else 0
     return dataclasses.replace(out, steps=new_steps, stats=stats), "kept"
 
 

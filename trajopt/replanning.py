@@ -10,7 +10,9 @@ curvature, speed and acceleration: a C2 splice) and takes the first of these tha
   smoother's time budget capped at ``brake_after_s``. When the map changed near the rest
   but beyond the search cost's reach of its grid path, the plan takes the rest of the old
   grid path, joined from the state's cell, instead of searching (``stats["grid_path"]``
-  ``"reused"``, else ``"searched"``). ``stats["replan"] == "planned: <why not kept>"``.
+  ``"reused"``, else ``"searched"``). The polygon corridor keeps the old regions along the
+  rest of the path the two share, unless ``reuse=False`` (:mod:`trajopt.polygon_corridor.reuse`;
+  ``stats["corridor_regions_kept"]``). ``stats["replan"] == "planned: <why not kept>"``.
 * **Brake, turn in place and go** when that plan fails (:mod:`trajopt.replan_brake`): a
   :class:`~trajopt.trajectory_chain.TrajectoryChain`, ``stats["replan"] == "braked: ..."``.
 
@@ -29,7 +31,7 @@ from typing import Any
 from astar.grid import OccupancyGrid
 from trajopt.corridor_fit import fit_in_corridor
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
-from trajopt.plan_query import PlanQuery
+from trajopt.plan_query import PlanQuery, WarmStart
 from trajopt.replan_brake import brake_turn_go
 from trajopt.replan_keep import BLOCKED_NEAR, keep_rest, remaining_grid_path, target_change
 from trajopt.smoother import SmoothPath
@@ -40,6 +42,8 @@ __all__ = ["BRAKE_AFTER_S", "replan_from", "smooth_for_speed"]
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
 BRAKE_AFTER_S = 0.1
+#: Why a re-plan planned anew when the caller asked for no reuse.
+NO_REUSE = "reuse=False"
 
 
 def replan_from(
@@ -76,7 +80,7 @@ def replan_from(
         brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
         planner.update_map(grid)
-    out, why = None, "reuse=False"
+    out, why = None, NO_REUSE
     piece, t_piece = trajectory, ts
     if isinstance(trajectory, TrajectoryChain):
         i, t_piece = trajectory.piece_at(ts)
@@ -132,14 +136,15 @@ def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, wh
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
         path = remaining_grid_path(planner, piece.steps,
                                    planner.grid.world_to_cell(state.position))  # fmt: skip
+    warm = WarmStart(path, None if why == NO_REUSE else getattr(piece, "steps", None))
     if brake_after_s is None or planner.robot.footprint is not None:  # no brake to fall on
-        return planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
+        return planner._query(state, goal, None, goal_heading, 0.0, v_end, warm)
     smoother = planner.smoother
     planner.smoother = dataclasses.replace(
         smoother, time_budget_s=min(smoother.time_budget_s, brake_after_s)
     )
     try:
-        return planner._query(state, goal, None, goal_heading, 0.0, v_end, path)
+        return planner._query(state, goal, None, goal_heading, 0.0, v_end, warm)
     except (SmoothingError, TimingError) as exc:
         error = exc
     except InvalidInputError as exc:  # the goal's own error, else the moving start's

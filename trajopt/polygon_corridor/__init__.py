@@ -63,6 +63,8 @@ may be a single point (the shared path vertex).
 
 Modules: :mod:`~trajopt.polygon_corridor.regions` (the values),
 :mod:`~trajopt.polygon_corridor.build` (:func:`build_polygon_corridor`),
+:mod:`~trajopt.polygon_corridor.reuse` (a re-plan's corridor that keeps a previous
+corridor's regions along the path the two share),
 :mod:`~trajopt.polygon_corridor.obstacle_index` (obstacles as rectangles, with exact
 distance queries), and the compiled kernels :mod:`~trajopt.polygon_corridor.path_kernels`
 and :mod:`~trajopt.polygon_corridor.region_kernels`. :func:`polygon_clearance` is

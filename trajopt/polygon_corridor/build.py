@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -30,7 +30,13 @@ from trajopt.polygon_corridor.regions import (
 )
 from trajopt.validation import nonnegative, positive
 
-__all__ = ["build_polygon_corridor"]
+__all__ = [
+    "GrownRegions",
+    "assemble_corridor",
+    "build_polygon_corridor",
+    "grow_regions",
+    "metric_regions",
+]
 
 logger = logging.getLogger("trajopt.polygon_corridor")
 
@@ -136,6 +142,52 @@ def build_polygon_corridor(
     Deterministic. Costs grow with the path length and the number of obstacle
     rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
     """
+    g = grow_regions(raw_grid, path, radius, margin_cells=margin_cells,
+                     max_segment_cells=max_segment_cells, overlap_cells=overlap_cells,
+                     centre_cells=centre_cells, centre_trigger_cells=centre_trigger_cells,
+                     simplify_slack_cells=simplify_slack_cells, open_cells=open_cells)  # fmt: skip
+    return assemble_corridor(*g)
+
+
+class GrownRegions(NamedTuple):
+    """Certified regions around a path, before the chain geometry (:func:`grow_regions`).
+
+    The first arguments of :func:`assemble_corridor`, in its order.
+    """
+
+    regions: list[ConvexPolygon]
+    hm: np.ndarray
+    vm: np.ndarray
+    nrow: np.ndarray
+    nvs: np.ndarray
+    degen: np.ndarray
+    path_m: np.ndarray
+    seed_src: np.ndarray
+    pts_m: np.ndarray
+    clear_m: np.ndarray
+    radius: float
+    resolution: float
+    origin: tuple[float, float]
+
+
+def grow_regions(
+    raw_grid: Any,
+    path: Any,
+    radius: float,
+    *,
+    margin_cells: float = 16.0,
+    max_segment_cells: float = 20.0,
+    overlap_cells: float = 4.0,
+    centre_cells: float = 1.0,
+    centre_trigger_cells: float = 2.0,
+    simplify_slack_cells: float = 0.3,
+    open_cells: float = 2.0,
+) -> GrownRegions:
+    """Grow and certify the regions of :func:`build_polygon_corridor` (same parameters).
+
+    Raises what :func:`build_polygon_corridor` raises, but does not compute the chain's
+    intervals and overlaps (:func:`assemble_corridor` does).
+    """
     occ, res, ox, oy = grid_cells(raw_grid)
     r = positive("radius", radius)
     margin = positive("margin_cells", margin_cells)
@@ -183,8 +235,14 @@ def build_polygon_corridor(
         "polygon corridor: %d regions for %d path points (%d obstacle rectangles)",
         len(seed) - 1, n_in, len(idx.rects),
     )
-    return _corridor(seed, seed_src, hh, vv, nvs, degen, pts_m, src, clear_c * res, r, res,
-                     (ox, oy))  # fmt: skip
+    regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
+    path_m = np.array([ox, oy]) + res * seed
+    path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
+    regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
+    path_m = np.array([ox, oy]) + res * seed
+    path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
+    return GrownRegions(regions, hm, vm, nrow, nvs, degen, path_m, seed_src, pts_m,
+                        clear_c * res, r, res, (ox, oy))  # fmt: skip
 
 
 def _distinct_points(pc_: np.ndarray, n_in: int) -> tuple[np.ndarray, np.ndarray]:
@@ -243,22 +301,22 @@ def _grow_regions(
     return seed, seed_src, hh, vv, nvs, degen
 
 
-def _corridor(
-    seed: np.ndarray, seed_src: np.ndarray, hh: np.ndarray, vv: np.ndarray, nvs: np.ndarray,
-    degen: np.ndarray, pts_m: np.ndarray, src: np.ndarray, clear: np.ndarray, r: float,
+def metric_regions(
+    seed: np.ndarray, hh: np.ndarray, vv: np.ndarray, nvs: np.ndarray, degen: np.ndarray,
     res: float, origin: tuple[float, float],
-) -> PolygonCorridor:
-    """Return the :class:`PolygonCorridor` in world metres from the grown regions (cells)."""
-    ox, oy = origin
-    m = len(seed) - 1
-    # to world metres
-    o = np.array([ox, oy])
+) -> tuple[list[ConvexPolygon], np.ndarray, np.ndarray, np.ndarray]:
+    """Return grown regions (cell units) in world metres: ``(regions, hm, vm, nrow)``.
+
+    ``hm[k, :nrow[k]]`` are region ``k``'s rows ``(a_x, a_y, b)`` (m), ``vm[k, :nvs[k]]``
+    its vertices (m); a degenerate region becomes its seed segment's region.
+    """
+    o = np.array(origin, dtype=float)
     vm = o + res * vv
     hm = hh.copy()
     hm[:, :, 2] = res * hh[:, :, 2] + hh[:, :, :2] @ o
     nrow = nvs.copy()
     regions: list[ConvexPolygon] = []
-    for k in range(m):
+    for k in range(len(seed) - 1):
         if degen[k]:
             reg = segment_region(vm[k, 0], vm[k, 1])
             nrow[k] = reg.n_sides
@@ -268,8 +326,23 @@ def _corridor(
             n = nvs[k]
             reg = ConvexPolygon._construct_fast(hm[k, :n, :2], hm[k, :n, 2], vm[k, :n], False)
         regions.append(reg)
-    path_m = o + res * seed
-    path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
+    return regions, hm, vm, nrow
+
+
+def assemble_corridor(
+    regions: list[ConvexPolygon], hm: np.ndarray, vm: np.ndarray, nrow: np.ndarray,
+    nvs: np.ndarray, degen: np.ndarray, path_m: np.ndarray, seed_src: np.ndarray,
+    pts_m: np.ndarray, clear: np.ndarray, r: float, res: float, origin: tuple[float, float],
+) -> PolygonCorridor:
+    """Return the :class:`PolygonCorridor` of certified regions around the polyline ``path_m``.
+
+    Region ``k`` (world metres: ``regions[k]``, rows ``hm[k, :nrow[k]]``, vertices
+    ``vm[k, :nvs[k]]``) contains segment ``k`` of ``path_m`` (shape (m + 1, 2)); ``seed_src``
+    maps each vertex to the input path ``pts_m``; ``clear`` (m) is each region's certified
+    clearance. Computes the chain's path intervals, overlaps and transitions.
+    """
+    ox, oy = origin
+    m = len(path_m) - 1
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path_m, axis=0).T))])
     region_s, overlap_s, ov_v, ov_h, ov_n = chain_geometry(
         hm, vm, nrow, nvs, degen, path_m, s, ROUND_M
