@@ -29,6 +29,7 @@ from scipy import ndimage
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import astar  # noqa: E402
+from tests.reference import scipy_distance_cells  # noqa: E402
 
 
 def timed(fn, repeat: int) -> tuple[float, object]:
@@ -72,24 +73,13 @@ def main(argv: list[str] | None = None) -> int:
     print("clearance field (metres, every cell)")
     for metric in ("centre", "square"):
         t_ours, field = timed(lambda m=metric: astar.clearance(grid, metric=m), args.repeat)
-        t_ref, ref_field = timed(lambda m=metric: _scipy_clearance(occ, m) * args.resolution,
+        t_ref, ref_field = timed(lambda m=metric: scipy_distance_cells(occ, m) * args.resolution,
                                  args.repeat)  # fmt: skip
         equal = bool(np.array_equal(field, ref_field))
         same &= equal
         print(f"  astar.clearance ({metric}) {1e3 * t_ours:9.1f} ms   scipy {1e3 * t_ref:9.1f} ms"
               f"   ratio scipy / ours {t_ref / t_ours:6.2f}x   identical: {equal}")
     return 0 if same else 1
-
-
-def _scipy_clearance(occ: np.ndarray, metric: str) -> np.ndarray:
-    """Distance in cells by scipy's transform (refined by two for the square metric)."""
-    if metric == "centre":
-        return ndimage.distance_transform_edt(~occ)
-    ny, nx = occ.shape
-    fine = np.zeros((2 * ny + 1, 2 * nx + 1), dtype=bool)
-    fine[1::2, 1::2] = occ
-    fine = ndimage.maximum_filter(fine, size=3, mode="constant", cval=False)
-    return ndimage.distance_transform_edt(~fine)[1::2, 1::2] * 0.5
 
 
 if __name__ == "__main__":

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy import ndimage
 
 from astar.distance_transform import UNREACHED, squared_distances
+from tests.reference import scipy_distance_cells
 
 
 def brute_squared(occ: np.ndarray, metric: str) -> np.ndarray:
@@ -31,17 +31,6 @@ def brute_squared(occ: np.ndarray, metric: str) -> np.ndarray:
         ay = np.maximum(2 * dy - 1, 0)
         d2 = ax * ax + ay * ay
     return d2.min(axis=1).reshape(occ.shape)
-
-
-def scipy_distance(occ: np.ndarray, metric: str) -> np.ndarray:
-    """Distance in cells from scipy's transform (refined by two for the square metric)."""
-    if metric == "centre":
-        return ndimage.distance_transform_edt(~occ)
-    ny, nx = occ.shape
-    fine = np.zeros((2 * ny + 1, 2 * nx + 1), dtype=bool)
-    fine[1::2, 1::2] = occ
-    fine = ndimage.maximum_filter(fine, size=3, mode="constant", cval=False)
-    return ndimage.distance_transform_edt(~fine)[1::2, 1::2] * 0.5
 
 
 def _random_grids(seed: int, count: int, max_side: int):
@@ -64,7 +53,7 @@ def test_matches_scipy_on_larger_grids(metric):
     for occ in _random_grids(2, 12, 160):
         d2 = squared_distances(occ, metric)
         d = np.sqrt(d2) if metric == "centre" else np.sqrt(d2) * 0.5
-        np.testing.assert_array_equal(d, scipy_distance(occ, metric))
+        np.testing.assert_array_equal(d, scipy_distance_cells(occ, metric))
 
 
 @pytest.mark.parametrize("metric", ["centre", "square"])

@@ -170,33 +170,25 @@ class GrownRegions(NamedTuple):
     origin: tuple[float, float]
 
 
-def grow_regions(
-    raw_grid: Any,
-    path: Any,
-    radius: float,
-    *,
-    margin_cells: float = 16.0,
-    max_segment_cells: float = 20.0,
-    overlap_cells: float = 4.0,
-    centre_cells: float = 1.0,
-    centre_trigger_cells: float = 2.0,
-    simplify_slack_cells: float = 0.3,
-    open_cells: float = 2.0,
-) -> GrownRegions:
+def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> GrownRegions:
     """Grow and certify the regions of :func:`build_polygon_corridor` (same parameters).
 
-    Raises what :func:`build_polygon_corridor` raises, but does not compute the chain's
-    intervals and overlaps (:func:`assemble_corridor` does).
+    ``options`` are its keyword options, with its defaults. Raises what it raises, but does
+    not compute the chain's intervals and overlaps (:func:`assemble_corridor` does).
     """
+    unknown = sorted(set(options) - set(build_polygon_corridor.__kwdefaults__))
+    if unknown:
+        raise InvalidInputError(f"unknown corridor options {unknown}")
+    opt = {**build_polygon_corridor.__kwdefaults__, **options}
     occ, res, ox, oy = grid_cells(raw_grid)
     r = positive("radius", radius)
-    margin = positive("margin_cells", margin_cells)
-    max_len = positive("max_segment_cells", max_segment_cells)
-    ext = nonnegative("overlap_cells", overlap_cells)
-    push = nonnegative("centre_cells", centre_cells)
-    trigger = nonnegative("centre_trigger_cells", centre_trigger_cells)
-    slack = nonnegative("simplify_slack_cells", simplify_slack_cells)
-    open_c = nonnegative("open_cells", open_cells)
+    margin = positive("margin_cells", opt["margin_cells"])
+    max_len = positive("max_segment_cells", opt["max_segment_cells"])
+    ext = nonnegative("overlap_cells", opt["overlap_cells"])
+    push = nonnegative("centre_cells", opt["centre_cells"])
+    trigger = nonnegative("centre_trigger_cells", opt["centre_trigger_cells"])
+    slack = nonnegative("simplify_slack_cells", opt["simplify_slack_cells"])
+    open_c = nonnegative("open_cells", opt["open_cells"])
     ny, nx = occ.shape
     pts_m = _path_points(path, res, ox, oy)
     n_in = len(pts_m)
