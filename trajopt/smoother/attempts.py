@@ -79,9 +79,11 @@ def fit(
     footprint: Footprint | None = None,
 ) -> SmoothPath:
     """:meth:`Smoother.fit` (see there)."""
-    warm_imports()  # one-off module imports do not count against the time budget
-    t_call = time.perf_counter()
     polygons = isinstance(corridor, PolygonCorridor)
+    # one-off module imports do not count against the time budget; polygon QPs go to piqp
+    # directly, the others through casadi
+    warm_imports(casadi=not polygons or options.qp_solver != "piqp")
+    t_call = time.perf_counter()
     if not (polygons or isinstance(corridor, Corridor)):
         raise InvalidInputError(
             f"corridor must be a Corridor or a PolygonCorridor, got {type(corridor).__name__}"

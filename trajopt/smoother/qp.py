@@ -107,7 +107,7 @@ class ConstraintLayout:
     m: int
     k: int
     n_rows: int
-    sparsity: object
+    n_cols: int
     #: CCS non-zero k takes triplet value ``nz_from_triplet[k]``
     nz_from_triplet: np.ndarray
     n_triplets: int
@@ -119,6 +119,11 @@ class ConstraintLayout:
     def n_samples(self) -> int:
         """Number of curvature samples ``S``."""
         return (self.nb - self.p) * self.m
+
+    @property
+    def sparsity(self) -> Any:
+        """The ``casadi.Sparsity`` of ``A`` (for the ``casadi.conic`` solves; built once)."""
+        return _casadi_sparsity(self.nb, self.p, self.m, self.k)
 
     @property
     def sample_row0(self) -> int:
@@ -187,8 +192,6 @@ def constraint_layout(nb: int, p: int, m: int, k: int = 2) -> ConstraintLayout:
     The :class:`ConstraintLayout` for ``nb`` padded control points, degree ``p``, ``m``
     curvature samples per span (0: no sample rows) and ``k`` region rows per control point.
     """
-    import casadi as ca
-
     rows: list[np.ndarray] = []
     cols: list[np.ndarray] = []
     cols2 = np.arange(2 * nb)
@@ -220,19 +223,32 @@ def constraint_layout(nb: int, p: int, m: int, k: int = 2) -> ConstraintLayout:
         n_cols += S
     rows_a = np.concatenate(rows).astype(np.int64)
     cols_a = np.concatenate(cols).astype(np.int64)
-    sp, mapping = ca.Sparsity.triplet(n_rows, n_cols, rows_a.tolist(), cols_a.tolist(), False)
+    # compressed column storage: the triplets (all distinct) by column, then row
     return ConstraintLayout(
         nb=nb,
         p=p,
         m=m,
         k=k,
         n_rows=n_rows,
-        sparsity=sp,
-        nz_from_triplet=np.asarray(mapping, dtype=np.int64),
+        n_cols=n_cols,
+        nz_from_triplet=np.lexsort((rows_a, cols_a)).astype(np.int64),
         n_triplets=len(rows_a),
         trip_rows=rows_a,
         trip_cols=cols_a,
     )
+
+
+@functools.lru_cache(maxsize=128)
+def _casadi_sparsity(nb: int, p: int, m: int, k: int) -> Any:
+    """Return the ``casadi.Sparsity`` of :func:`constraint_layout` ``(nb, p, m, k)``'s ``A``."""
+    import casadi as ca
+
+    layout = constraint_layout(nb, p, m, k)
+    sp, mapping = ca.Sparsity.triplet(layout.n_rows, layout.n_cols, layout.trip_rows.tolist(),
+                                      layout.trip_cols.tolist(), False)  # fmt: skip
+    if not np.array_equal(np.asarray(mapping), layout.nz_from_triplet):  # pragma: no cover
+        raise AssertionError("casadi's CCS order differs from the layout's")
+    return sp
 
 
 @functools.lru_cache(maxsize=128)
@@ -397,18 +413,22 @@ def piqp_info(z: np.ndarray, result: tuple, t_wall: float, t_cpu: float) -> Solv
 _BUILT: set[tuple] = set()
 
 
-_WARM: list[bool] = []
+_WARM: list[str] = []  # what warm_imports has loaded: "casadi", "piqp"
 
 
-def warm_imports() -> None:
+def warm_imports(casadi: bool = True) -> None:
     """Load the heavy modules and the certificate's compiled kernel once per process.
 
-    casadi, piqp and scipy are imported and the clearance kernel is loaded (or compiled)
-    before a fit starts its clock, so that neither counts against its budget.
+    piqp and scipy (and casadi when ``casadi``: the fits that go through ``casadi.conic`` or
+    IPOPT) are imported and the clearance kernel is loaded (or compiled) before a fit starts
+    its clock, so that neither counts against its budget.
     """
-    if _WARM:
+    if casadi and "casadi" not in _WARM:
+        import casadi as ca  # noqa: F401
+
+        _WARM.append("casadi")
+    if "piqp" in _WARM:
         return
-    import casadi  # noqa: F401
     import piqp  # noqa: F401
     import scipy.sparse  # noqa: F401
 
@@ -416,7 +436,7 @@ def warm_imports() -> None:
     from trajopt.clearance import points_clearance
 
     points_clearance(np.zeros((1, 2)), OccupancyGrid(np.zeros((2, 2), bool), 1.0), 1.0)
-    _WARM.append(True)
+    _WARM.append("piqp")
 
 
 def is_built(kind: str, nb: int, p: int, verbose: bool) -> bool:
