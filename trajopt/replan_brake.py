@@ -40,6 +40,7 @@ from astar.grid import OccupancyGrid
 from trajopt.clearance import points_clearance
 from trajopt.curve import CurveSegment
 from trajopt.errors import TimingError, TrajoptError
+from trajopt.plan_query import WarmStart
 from trajopt.replan_keep import target_change
 from trajopt.timing import time_parameterize
 from trajopt.timing.greedy import advance, brake_times
@@ -132,6 +133,7 @@ def brake_turn_go(
     goal_heading: float | None,
     v_end: float,
     error: TrajoptError,
+    previous: Any = None,
 ) -> TrajectoryChain:
     """Return the re-plan that brakes, turns in place and goes (module docstring).
 
@@ -153,6 +155,9 @@ def brake_turn_go(
     error : TrajoptError
         Why the smooth re-plan failed: re-raised when braking cannot apply (a footprint
         robot, a trajectory that is not a smooth :class:`~trajopt.Trajectory`).
+    previous : PlanSteps or None, optional
+        The old plan's steps: the plan from rest keeps their polygon corridor's regions
+        along the rest of the path the two share (:mod:`trajopt.polygon_corridor.reuse`).
 
     Raises
     ------
@@ -187,7 +192,8 @@ def brake_turn_go(
             stop = traj.sample(np.array([t_in]))
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     try:
-        out = planner._query(p_stop, goal, None, goal_heading, 0.0, v_end, None)
+        out = planner._query(p_stop, goal, None, goal_heading, 0.0, v_end,
+                             WarmStart(None, previous))  # fmt: skip
     except TrajoptError as exc:
         rest = None if brake is None else _resume(planner, traj, brake, goal, goal_heading, v_end)
         if rest is None:

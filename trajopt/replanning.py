@@ -14,7 +14,8 @@ curvature, speed and acceleration: a C2 splice) and takes the first of these tha
   rest of the path the two share, unless ``reuse=False`` (:mod:`trajopt.polygon_corridor.reuse`;
   ``stats["corridor_regions_kept"]``). ``stats["replan"] == "planned: <why not kept>"``.
 * **Brake, turn in place and go** when that plan fails (:mod:`trajopt.replan_brake`): a
-  :class:`~trajopt.trajectory_chain.TrajectoryChain`, ``stats["replan"] == "braked: ..."``.
+  :class:`~trajopt.trajectory_chain.TrajectoryChain`, ``stats["replan"] == "braked: ..."``;
+  its plan from rest keeps corridor regions the same way.
 
 A chain is re-planned like any trajectory: while its last piece (the plan from rest) plays,
 that piece is; before, the chain's rest is kept when the map, goal, goal heading and end
@@ -125,18 +126,19 @@ def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, wh
     an invalid goal is raised as such. A footprint robot, which does not brake this way,
     keeps the whole budget.
     """
+    previous = None if why == NO_REUSE else getattr(piece, "steps", None)
     if isinstance(piece, TrajectoryChain):
         i, tau = piece.piece_at(ts)
         if isinstance(piece.pieces[i], TurnInPlace) and tau < piece.pieces[i].duration:
             error = TimingError("the robot is turning in place at the splice")
             return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
-                                 v_end=v_end, error=error)  # fmt: skip
+                                 v_end=v_end, error=error, previous=previous)  # fmt: skip
     state = trajectory.state_at(ts)
     path = None
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
         path = remaining_grid_path(planner, piece.steps,
                                    planner.grid.world_to_cell(state.position))  # fmt: skip
-    warm = WarmStart(path, None if why == NO_REUSE else getattr(piece, "steps", None))
+    warm = WarmStart(path, previous)
     if brake_after_s is None or planner.robot.footprint is not None:  # no brake to fall on
         return planner._query(state, goal, None, goal_heading, 0.0, v_end, warm)
     smoother = planner.smoother
@@ -153,7 +155,7 @@ def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, wh
     finally:
         planner.smoother = smoother
     return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
-                         v_end=v_end, error=error)  # fmt: skip
+                         v_end=v_end, error=error, previous=previous)  # fmt: skip
 
 
 def smooth_for_speed(planner: Any, q: PlanQuery) -> SmoothPath:

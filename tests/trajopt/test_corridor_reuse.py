@@ -158,3 +158,29 @@ def test_replans_keep_regions_and_stay_clear(scene):
         fresh = build_polygon_corridor(updated, cor.input_path, ROBOT.radius)
         assert abs(len(fresh.regions) - len(cor.regions)) <= 2
     assert kept_any >= 2
+
+
+def test_the_plan_from_rest_after_braking_keeps_regions_too(scene):
+    planner = trajopt.Planner(scene.grid, ROBOT)
+    traj = planner.plan(scene.start, scene.goal("C"))
+    # a 3 x 3 block on the path 15 cells ahead of the robot at 2 s: no smooth curve leaves
+    # the moving state, so the robot brakes, turns and goes along a path that meets the
+    # old one again behind the block
+    cells = np.asarray(traj.steps.grid_path.cells)
+    here = np.asarray(scene.grid.world_to_cell(traj.state_at(2.0).position))
+    c = cells[int(np.argmin(np.hypot(*(cells - here).T))) + 15]
+    occ = np.array(scene.grid.occupied)
+    occ[c[1] - 1 : c[1] + 2, c[0] - 1 : c[0] + 2] = True
+    updated = scene.grid.with_occupied(occ)
+    for reuse in (True, False):
+        planner.update_map(scene.grid)
+        new = planner.replan(traj, 2.0, grid=updated, latency=0.0, reuse=reuse)
+        assert new.stats["replan"].startswith("braked")
+        go = new.pieces[-1]
+        assert new.stats["corridor_regions_kept"] == go.stats["corridor_regions_kept"]
+        assert (go.stats["corridor_regions_kept"] > 0) == reuse
+        for k, reg in enumerate(go.steps.corridor.regions):
+            assert polygon_clearance(reg, updated) >= ROBOT.radius - CLEARANCE_TOL_M, k
+        smp = new.sample_uniform(0.005)
+        clr = point_clearance(np.column_stack([smp.x, smp.y]), updated, border_occupied=True)
+        assert clr.min() >= ROBOT.radius - 1e-6
