@@ -127,6 +127,12 @@ def _row_pass(f: np.ndarray, square: bool) -> np.ndarray:  # pragma: no cover
     return out
 
 
+@njit(cache=True)
+def _transform(occ: np.ndarray, square: bool) -> np.ndarray:  # pragma: no cover
+    """Both passes in one compiled call (one kernel to load in a fresh process)."""
+    return _row_pass(_column_pass(occ, square), square)
+
+
 def squared_distances(occupied: np.ndarray, metric: Literal["centre", "square"]) -> np.ndarray:
     """Exact squared distance from every cell centre to the nearest occupied cell.
 
@@ -149,5 +155,4 @@ def squared_distances(occupied: np.ndarray, metric: Literal["centre", "square"])
         raise ValueError(f"occupied must be 2-D, got shape {occ.shape}")
     if metric not in ("centre", "square"):
         raise ValueError(f"metric must be 'centre' or 'square', got {metric!r}")
-    square = metric == "square"
-    return _row_pass(_column_pass(occ, square), square)
+    return _transform(occ, metric == "square")

@@ -156,6 +156,13 @@ def _or_rows(h: np.ndarray, w: np.ndarray, out: np.ndarray) -> None:  # pragma: 
                 orow[ix] |= hrow[ix] <= wd
 
 
+@njit(cache=True)
+def _dilate_rows(occ, h, cap, w, out) -> None:  # pragma: no cover
+    """:func:`_row_distance`, then :func:`_or_rows`, in one compiled call (one kernel to load)."""
+    _row_distance(occ, h, cap)
+    _or_rows(h, w, out)
+
+
 def _dilate_disk(occ: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Exact dilation of bool ``occ`` [ny, nx] by the disk with row half-widths ``w``."""
     wmax = int(w.max())
@@ -165,9 +172,9 @@ def _dilate_disk(occ: np.ndarray, w: np.ndarray) -> np.ndarray:
     dtype = np.uint8 if wmax < 255 else (np.uint16 if wmax < 65535 else np.uint32)
     cap = wmax + 1
     h = np.empty(occ.shape, dtype=dtype)
-    _row_distance(np.ascontiguousarray(occ, dtype=np.uint8), h, cap)
     out = np.zeros(occ.shape, dtype=np.uint8)
-    _or_rows(h, w.astype(h.dtype), out)  # all w >= 0 here (rows are contiguous from dy = 0)
+    # all w >= 0 here (rows are contiguous from dy = 0)
+    _dilate_rows(np.ascontiguousarray(occ, dtype=np.uint8), h, cap, w.astype(dtype), out)
     return out.view(bool)
 
 
