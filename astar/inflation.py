@@ -342,7 +342,7 @@ def avoidance_area(grid: OccupancyGrid, w_cells: int, *, border: bool = True) ->
     if border:
         occ = np.pad(occ, w, mode="constant", constant_values=True)
     size = 2 * w + 1
-    from scipy import ndimage
+    from scipy import ndimage  # only here: a plan with exact inflation does not import it
 
     out = ndimage.maximum_filter1d(occ, size, axis=0, mode="constant", cval=False)
     out = ndimage.maximum_filter1d(out, size, axis=1, mode="constant", cval=False)

@@ -40,7 +40,7 @@ from astar.grid import OccupancyGrid
 from trajopt.clearance import points_clearance
 from trajopt.curve import CurveSegment
 from trajopt.errors import TimingError, TrajoptError
-from trajopt.plan_query import WarmStart
+from trajopt.plan_query import PlanSteps, WarmStart
 from trajopt.replan_keep import target_change
 from trajopt.timing import time_parameterize
 from trajopt.timing.greedy import advance, brake_times
@@ -133,7 +133,7 @@ def brake_turn_go(
     goal_heading: float | None,
     v_end: float,
     error: TrajoptError,
-    previous: Any = None,
+    previous: PlanSteps | None = None,
 ) -> TrajectoryChain:
     """Return the re-plan that brakes, turns in place and goes (module docstring).
 
