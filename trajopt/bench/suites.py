@@ -18,6 +18,7 @@ scenario file written for another map size, ...). :func:`suite` returns the name
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import zlib
@@ -29,6 +30,8 @@ from typing import Literal
 import numpy as np
 
 from trajopt.errors import BenchmarkError
+
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "Query",
@@ -181,6 +184,7 @@ def movingai_queries(
     limit: int | None = None,
     radius_cells: float = DEFAULT_RADIUS_CELLS,
     feasible_only: bool = False,
+    allow_empty: bool = False,
 ) -> MapQueries:
     """Return the scenarios of a Moving AI ``.scen`` file as a :class:`MapQueries`.
 
@@ -201,12 +205,16 @@ def movingai_queries(
         the same 4-connected free region of it (then an octile path without corner cutting
         exists), before ``limit`` picks among them. Most Moving AI scenarios start or end next to a wall,
         where a robot wider than a cell cannot stand.
+    allow_empty : bool
+        Return a :class:`MapQueries` without queries when ``feasible_only`` leaves none
+        (instead of raising).
 
     Raises
     ------
     BenchmarkError
         Missing or unreadable files, an empty or malformed scenario file, scenarios naming
-        several maps, or a scenario file whose map size is not the map's.
+        several maps, a scenario file whose map size is not the map's, or no feasible
+        scenario (``feasible_only`` without ``allow_empty``).
     """
     import astar
 
@@ -245,12 +253,12 @@ def movingai_queries(
             return bool(a > 0 and a == labels[s.goal[1], s.goal[0]])
 
         indexed = [(i, s) for i, s in indexed if connected(s)]
-        if not indexed:
+        if not indexed and not allow_empty:
             raise BenchmarkError(
                 f"no scenario of {str(scen)!r} has both end cells free and connected for the radius "
                 f"{r_cells} cells (feasible_only=True)"
             )
-    indexed = select_evenly(indexed, limit)
+    indexed = select_evenly(indexed, limit) if indexed else []
     name = mp.name
     queries = tuple(
         Query(
@@ -383,9 +391,11 @@ def suite(
 
     ``shared-small``: a few scenarios of three Moving AI maps and a few random
     queries on two ROS maps (a minute on one core); ``shared-full``: every scenario of seven
-    shared Moving AI maps (not ``arena``: none of its scenarios is feasible for 2.5 cells) and 100 random queries on each of the four ROS maps (hours
-    of CPU: a cluster job). The Moving AI scenarios are those feasible for the radius
-    (``movingai_queries(..., feasible_only=True)``).
+    shared Moving AI maps (not ``arena``: none of its scenarios is feasible for 2.5 cells) and
+    100 random queries on each of the four ROS maps (hours of CPU: a cluster job). The Moving
+    AI scenarios are those feasible for the radius (``movingai_queries(..., feasible_only=True)``);
+    a map with none (``random512-40-5`` and ``maze512-1-0`` at 2.5 cells: their passages are
+    narrower than the robot) is left out with a logged warning.
 
     Parameters
     ----------
@@ -404,7 +414,7 @@ def suite(
     Raises
     ------
     BenchmarkError
-        Unknown suite name, missing data folder or files.
+        Unknown suite name, missing data folder or files, or no feasible query on any map.
     """
     if name not in SUITES:
         raise BenchmarkError(f"suite must be one of {sorted(SUITES)}, got {name!r}")
@@ -413,16 +423,23 @@ def suite(
     out: list[MapQueries] = []
     for m, k in spec["movingai"].items():
         lim = k if limit is None else (limit if k is None else min(k, limit))
-        out.append(
-            movingai_queries(
-                root / "movingai" / "scen" / f"{m}.map.scen",
-                root / "movingai" / "maps" / f"{m}.map",
-                limit=lim,
-                radius_cells=radius_cells,
-                feasible_only=True,
-            )
+        mq = movingai_queries(
+            root / "movingai" / "scen" / f"{m}.map.scen",
+            root / "movingai" / "maps" / f"{m}.map",
+            limit=lim,
+            radius_cells=radius_cells,
+            feasible_only=True,
+            allow_empty=True,
         )
+        if mq.queries:
+            out.append(mq)
+        else:
+            logger.warning("suite %s: no scenario of %s is feasible for the radius %g cells; "
+                           "map left out", name, m, radius_cells)
     for m, k in spec["ros"].items():
         n = int(k if limit is None else min(int(k or 0), limit))
         out.append(random_queries(root / "ros" / f"{m}.yaml", n, seed=seed, radius_m=radius_m))
+    if not any(mq.queries for mq in out):
+        raise BenchmarkError(f"suite {name!r} has no feasible query for radius_cells="
+                             f"{radius_cells} and radius_m={radius_m}")
     return out
