@@ -144,25 +144,45 @@ class SampledExport:
     ) -> Path:
         """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
 
-        The first line is a comment naming the frame of the poses
-        (``# frame_id: map; ...``; ``pandas.read_csv(path, comment="#")`` and
-        ``numpy.loadtxt`` skip it); the header then names each column with its unit, e.g.
-        ``t [s]``, ``v [m/s]``.
+        The first line is the header: one column per sampled quantity (``t``, ``x``, ``y``,
+        ``theta``, ``v``, ``omega``, ``a``, ``jerk``, ``a_lat``, ``kappa``, ``s``, and
+        ``v_left``, ``v_right`` when the robot has a track width), each named with its unit
+        in brackets, e.g. ``t [s]``, ``v [m/s]``. The pose columns also name their frame in
+        parentheses: ``x [m] (map)``, ``y [m] (map)``, ``theta [rad] (map)``. Every other
+        line is one sample, all numbers, so the file reads with no options:
+        ``pandas.read_csv(path)`` keeps these column names, and
+        ``numpy.genfromtxt(path, delimiter=",", names=True)`` gives a structured array whose
+        field names drop the brackets and other punctuation and put ``_`` for spaces
+        (``t_s``, ``x_m_map``, ``theta_rad_map``, ``v_ms``, ``a_ms2``).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file; missing parent folders are created.
+        dt : float
+            Time step (s), > 0; the end time ``duration`` is always the last row.
+        frame_id : str
+            Frame of ``x``, ``y`` and ``theta`` (default ``"map"``). It goes into the header,
+            so it may not contain ``,``, ``"``, ``#``, ``(``, ``)`` or control characters.
+
+        Raises
+        ------
+        InvalidInputError
+            ``dt`` is not a finite number > 0, or ``frame_id`` is not a non-empty one-line
+            string that a CSV header can carry.
         """
-        frame = _frame_id(frame_id)
+        frame = _csv_frame_id(frame_id)
         smp = self.sample_uniform(dt).as_dict()
         names = list(smp)
         import io
 
         buf = io.StringIO()
-        buf.write(f"# frame_id: {frame}; x, y and theta are in this frame\n")
         w = csv.writer(buf, lineterminator="\n")
-        w.writerow([f"{n} [{SAMPLE_UNITS[n]}]" for n in names])
+        w.writerow([_csv_column(n, frame) for n in names])
         cols = np.column_stack([np.asarray(smp[n]) for n in names])
         for row in cols:
             w.writerow([repr(float(x)) for x in row])
         return _atomic_write(Path(path), buf.getvalue())
-
 
     def state_at(self, t: float) -> State:
         """Return the robot's :class:`~trajopt.state.State` at time ``t`` (s).
@@ -255,6 +275,35 @@ def _frame_id(value: object) -> str:
     if not isinstance(value, str) or not value or "\n" in value:
         raise InvalidInputError(f"frame_id must be a non-empty one-line string, got {value!r}")
     return value
+
+
+# Sampled quantities whose CSV column names the frame (the pose in that frame).
+_CSV_POSE_COLUMNS: tuple[str, ...] = ("x", "y", "theta")
+
+# Characters a ``frame_id`` may not contain in a CSV header: the delimiter, the quote,
+# numpy's comment mark, the parentheses around the frame.
+_CSV_FRAME_FORBIDDEN = frozenset(',"#()')
+
+
+def _csv_column(name: str, frame_id: str) -> str:
+    """Return the CSV header of the sampled quantity ``name``.
+
+    ``"<name> [<unit>]"`` with the unit from :data:`SAMPLE_UNITS`, followed by
+    ``" (<frame_id>)"`` for the pose columns ``x``, ``y`` and ``theta``.
+    """
+    head = f"{name} [{SAMPLE_UNITS[name]}]"
+    return f"{head} ({frame_id})" if name in _CSV_POSE_COLUMNS else head
+
+
+def _csv_frame_id(value: object) -> str:
+    frame = _frame_id(value)
+    bad = sorted({c for c in frame if c in _CSV_FRAME_FORBIDDEN or not c.isprintable()})
+    if bad:
+        raise InvalidInputError(
+            f"frame_id {frame!r} contains {''.join(bad)!r}: a CSV header's frame may not "
+            "contain ',', '\"', '#', '(', ')' or control characters"
+        )
+    return frame
 
 
 def export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:

@@ -236,8 +236,7 @@ def test_interface_exports_and_metrics(tmp_path):
     assert js["vertices"]["xy"] == SQUARE.tolist()
     assert js["samples"]["kappa"] == [0.0] * len(js["samples"]["t"])
     lines = traj.to_csv(tmp_path / "t.csv", dt=0.05, frame_id="odom").read_text().splitlines()
-    assert lines.pop(0).startswith("# frame_id: odom;")
-    assert lines[0].startswith("t [s],x [m],y [m],theta [rad]")
+    assert lines[0].startswith("t [s],x [m] (odom),y [m] (odom),theta [rad] (odom),v [m/s]")
     body = np.array([r.split(",") for r in lines[1:]], float)
     assert np.all(np.isfinite(body)) and body[-1, 0] == traj.duration
     assert "StopAndTurnTrajectory(" in repr(traj)

@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -163,16 +164,75 @@ def test_exports(tmp_path):
     assert np.allclose(loaded["phases"]["t"], traj.phase_t)
     q = traj.to_csv(tmp_path / "traj.csv", dt=0.05)
     with open(q, newline="") as f:
-        first = f.readline()
         rows = list(csv.reader(f))
-    assert first.startswith("# frame_id: map;")
     assert loaded["frame_id"] == "map"
-    assert rows[0][0] == "t [s]" and "v [m/s]" in rows[0] and "theta [rad]" in rows[0]
+    assert rows[0][0] == "t [s]" and "v [m/s]" in rows[0] and "theta [rad] (map)" in rows[0]
     table = np.array(rows[1:], dtype=float)
     assert table.shape == (len(smp.t), len(rows[0]))
-    assert np.allclose(table[:, rows[0].index("theta [rad]")], smp.theta)
+    assert np.allclose(table[:, rows[0].index("theta [rad] (map)")], smp.theta)
     assert sorted(x.name for x in tmp_path.iterdir()) == ["sub", "traj.csv"]  # no temp files
     assert [x.name for x in (tmp_path / "sub").iterdir()] == ["traj.json"]
+
+
+def _csv_references(traj, dt, frame):
+    """Column name (header text) -> reference samples from ``traj.sample_uniform(dt)``."""
+    smp = traj.sample_uniform(dt).as_dict()
+    pose = {"x", "y", "theta"}
+    return {
+        f"{k} [{SAMPLE_UNITS[k]}]" + (f" ({frame})" if k in pose else ""): np.asarray(v)
+        for k, v in smp.items()
+    }
+
+
+@pytest.fixture(scope="module")
+def exported(driven):
+    """A planned trajectory (SP -> A), a chain (a turn in place, then it) and a stop-and-turn."""
+    from trajopt.fallback import stop_and_turn
+    from trajopt.trajectory_chain import TrajectoryChain, turn_in_place
+
+    planner, traj = driven
+    x0, y0, th0 = (float(v) for v in traj.sample(0.0)[1:4])
+    turn = turn_in_place((x0, y0), th0 - 1.0, th0, traj.robot)
+    chain = TrajectoryChain((turn, traj), traj.robot)
+    square = np.array([[0.5, 0.5], [1.5, 0.5], [1.5, 1.5]])
+    return {"planned": traj, "chain": chain, "stop_and_turn": stop_and_turn(square, traj.robot)}
+
+
+@pytest.mark.parametrize("kind", ["planned", "chain", "stop_and_turn"])
+@pytest.mark.parametrize("frame", ["map", "robot1/odom"])
+def test_csv_reads_with_pandas_and_numpy_without_options(exported, kind, frame, tmp_path):
+    pd = pytest.importorskip("pandas")
+    traj, dt = exported[kind], 0.05
+    path = traj.to_csv(tmp_path / "traj.csv", dt=dt, frame_id=frame)
+    ref = _csv_references(traj, dt, frame)
+    n = len(ref["t [s]"])
+    assert n > 10 and ref["t [s]"][-1] == traj.duration
+
+    df = pd.read_csv(path)
+    assert list(df.columns) == list(ref)
+    assert len(df) == n and all(df.dtypes == np.float64)
+    for name, want in ref.items():
+        np.testing.assert_array_equal(df[name].to_numpy(), want, err_msg=name)  # repr round-trips
+
+    arr = np.genfromtxt(path, delimiter=",", names=True)
+    assert arr.shape == (n,) and len(arr.dtype.names) == len(ref)
+    for field_name, want in zip(arr.dtype.names, ref.values(), strict=True):
+        np.testing.assert_array_equal(arr[field_name], want, err_msg=field_name)
+    mangled = "".join(c for c in frame if c.isalnum() or c == "_")
+    assert arr.dtype.names[:4] == ("t_s", f"x_m_{mangled}", f"y_m_{mangled}", f"theta_rad_{mangled}")
+    assert "v_ms" in arr.dtype.names and "a_ms2" in arr.dtype.names
+
+    # the frame is recoverable from the header alone
+    frames = {re.fullmatch(r"(\w+) \[[^]]+\] \((.+)\)", c).groups() for c in df.columns[1:4]}
+    assert frames == {("x", frame), ("y", frame), ("theta", frame)}
+    assert not any("(" in c for c in df.columns if c.split()[0] not in {"x", "y", "theta"})
+
+
+@pytest.mark.parametrize("frame", ["a,b", 'a"b', "map#1", "map(2)", "ta\tb", "a\rb", "", 7])
+def test_csv_refuses_a_frame_its_header_cannot_carry(exported, frame, tmp_path):
+    with pytest.raises(InvalidInputError, match="frame_id"):
+        exported["planned"].to_csv(tmp_path / "t.csv", dt=0.1, frame_id=frame)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_invalid_construction():
