@@ -15,8 +15,8 @@ from scipy.interpolate import BSpline
 from trajopt import fits
 from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.curve import ParametricCurve
-from trajopt.errors import InvalidInputError
-from trajopt.fits.bspline_fit import schoenberg_whitney_matches
+from trajopt.errors import IllPosedFitError, InvalidInputError
+from trajopt.fits.bspline_fit import BSPLINE_SWING_MAX, schoenberg_whitney_matches
 from trajopt.fits.robust import bisquare
 
 
@@ -447,7 +447,8 @@ def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
 ) -> None:
     """Staircases (A*-like) against the full least-squares matrix and numpy's lstsq: the fit
     raises iff the matrix is rank deficient at rcond = 1 / BSPLINE_COND_MAX (or the exact
-    Schoenberg-Whitney condition fails), and otherwise returns lstsq's control points."""
+    Schoenberg-Whitney condition fails) or lstsq's control points leave the data's box by
+    more than BSPLINE_SWING_MAX extents, and otherwise returns lstsq's control points."""
     p = _steps_to_points(steps)
     n = len(p) - fewer
     assume(n >= k + 1)
@@ -458,12 +459,107 @@ def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
     c_ref, _, rank, _ = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
     if rank < n or schoenberg_whitney_matches(u, t, k) < n:
         event("ill-posed")
-        with pytest.raises(InvalidInputError, match="Schoenberg-Whitney|numerically singular"):
+        with pytest.raises(IllPosedFitError, match="Schoenberg-Whitney|numerically singular"):
+            fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
+        return
+    swing = _reference_swing(p, c_ref)
+    assume(abs(swing - BSPLINE_SWING_MAX) > 1e-6)  # not at the threshold
+    if swing > BSPLINE_SWING_MAX:
+        event("swings")
+        with pytest.raises(IllPosedFitError, match="swings away from the data"):
             fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
     else:
         event("fitted")
         curve = fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
         np.testing.assert_allclose(curve.c, c_ref, atol=1e-9)
+
+
+def _reference_swing(p: np.ndarray, c: np.ndarray) -> float:
+    """Largest distance of a control point from the data's bounding box over its longer side
+    (the nearest point of the box by clipping)."""
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    return float(np.linalg.norm(c - np.clip(c, lo, hi), axis=1).max() / np.max(hi - lo))
+
+
+_DIRS8 = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)]
+
+
+def _random_walk(rng: np.random.Generator, cell: float = 0.05) -> np.ndarray:
+    """Cell centres of an 8-connected walk of 20-43 cells that never steps straight back."""
+    d = int(rng.integers(8))
+    cells = [(0, 0)]
+    for _ in range(int(rng.integers(20, 44)) - 1):
+        d = int(rng.choice([e for e in range(8) if e != (d + 4) % 8]))
+        cells.append((cells[-1][0] + _DIRS8[d][0], cells[-1][1] + _DIRS8[d][1]))
+    return cell * (np.array(cells, dtype=float) + 0.5)
+
+
+def test_square_fits_of_random_staircases_never_swing() -> None:
+    """Square and nearly square chord fits (degrees 2, 3) of seeded random walks: every fit
+    returned keeps its control points within BSPLINE_SWING_MAX extents of the data's box;
+    every fit refused is ill-posed by the design checks or by lstsq's own swing. Without the
+    swing check, 123 of these 600 square fits had control points beyond 10 extents."""
+    rng = np.random.default_rng(0)
+    returned = refused_swing = 0
+    for _ in range(150):
+        p = _random_walk(rng)
+        for k, fewer in itertools.product((2, 3), (0, 1)):
+            n = len(p) - fewer
+            a, u, t = _reference_design(p, k, n, "chord")
+            try:
+                curve = fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization="chord")
+            except IllPosedFitError as exc:
+                msg = str(exc)
+                assert f"degree {k}, n_ctrl {n}" in msg and "chord" in msg
+                if "swings away" in msg:
+                    refused_swing += 1
+                    c_ref = np.linalg.lstsq(a, p, rcond=None)[0]
+                    assert _reference_swing(p, c_ref) > BSPLINE_SWING_MAX
+                    ratio = float(msg.split(" times the data's extent")[0].rsplit(", ", 1)[1])
+                    assert ratio == pytest.approx(_reference_swing(p, c_ref), rel=1e-2)
+                else:
+                    assert "Schoenberg-Whitney" in msg or "numerically singular" in msg
+                continue
+            returned += 1
+            assert _reference_swing(p, curve.c) <= BSPLINE_SWING_MAX
+            np.testing.assert_allclose(a @ curve.c, curve(u), atol=1e-9)
+    assert returned > 50 and refused_swing > 50  # both branches are exercised
+
+
+def test_a_fit_that_swings_raises_naming_the_fit_the_value_and_the_rule() -> None:
+    # an 11-point staircase (diagonals, then x-y steps), chord parameters, degree 3, one
+    # control point per point: the interpolant passes every cell centre, but a control
+    # point lies about 8.8 extents outside the path's box (independent reference: lstsq)
+    steps = "ddxxyxyxxx"
+    p = _steps_to_points(steps)
+    k, n = 3, len(p)
+    a, _, _ = _reference_design(p, k, n, "chord")
+    c_ref, _, rank, _ = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
+    assert rank == n  # well conditioned enough for the design checks
+    swing = _reference_swing(p, c_ref)
+    assert swing > BSPLINE_SWING_MAX
+    with pytest.raises(IllPosedFitError) as info:
+        fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization="chord")
+    msg = str(info.value)
+    assert f"degree {k}, n_ctrl {n}" in msg and "chord" in msg and f"{n} distinct points" in msg
+    assert f"{swing:.3g} times the data's extent" in msg
+    assert f"BSPLINE_SWING_MAX = {BSPLINE_SWING_MAX:g}" in msg
+    allowed = int(msg.rsplit("allow at most ", 1)[1].split()[0])
+    assert k + 1 <= allowed < n  # and that count does fit, inside the bound
+    ok = fits.fit_bspline(p, degree=k, n_ctrl=allowed, parameterization="chord")
+    assert _reference_swing(p, ok.c) <= BSPLINE_SWING_MAX
+    # the comparison records the refused fit as invalid, with the reason
+    from trajopt.comparison.builtin_methods import _method_bspline
+
+    class Ctx:
+        reference = p
+
+        @staticmethod
+        def options_for(name: str) -> dict:
+            return {"parameterization": "chord", "degree": k, "n_ctrl": n}
+
+    res = _method_bspline(Ctx())
+    assert res.path is None and not res.valid and "swings away from the data" in res.note
 
 
 def test_sweep_records_ill_posed_combinations_with_the_reason() -> None:

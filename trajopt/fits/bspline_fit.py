@@ -18,6 +18,7 @@ from trajopt.fits.curves import FittedBSpline
 
 __all__ = [
     "BSPLINE_COND_MAX",
+    "BSPLINE_SWING_MAX",
     "PARAMETERIZATIONS",
     "Parameterization",
     "allowed_message",
@@ -27,6 +28,7 @@ __all__ = [
     "fit_bspline",
     "ill_posed_message",
     "schoenberg_whitney_matches",
+    "swing_problem",
 ]
 
 Parameterization = Literal["uniform", "chord", "centripetal"]
@@ -42,10 +44,25 @@ PARAMETERIZATIONS: tuple[str, ...] = ("uniform", "chord", "centripetal")
 #: :func:`numpy.linalg.lstsq` counts it, is below ``n_ctrl``). Well-posed designs of every
 #: allowed degree stay far below (dense uniform sites: about 2 for degree 1, 5 for degree
 #: 3, 100-850 for degree 9; the paper scene's sweeps at most 21). Below the threshold a
-#: near-interpolating fit can still swing away from the data between the points (on random
-#: 38-40-point staircases the largest excursion was roughly 0.1-0.3 cond cells); the
-#: comparison's Hausdorff and clearance metrics show that.
+#: near-interpolating fit can still swing far from the data between the points: the
+#: solution's check, :data:`BSPLINE_SWING_MAX`, refuses those.
 BSPLINE_COND_MAX = 1e4
+
+#: Largest distance of a control point from the data's bounding box, in units of the data's
+#: extent (the longer side of that box), that :func:`fit_bspline` accepts in its solution.
+#: Each span of the curve lies in the convex hull of its ``k + 1`` control points, so a
+#: control polygon that leaves the box by more than the path's own size lets the curve
+#: leave it too. Measured on 300 random 8-connected staircases of 20-43 cells (chord
+#: parameters, degrees 2 and 3, ``n_ctrl`` from ``n`` down to ``n - 12``): the curve left
+#: the box by about half its control points' excursion, and where the control points
+#: were 1-2 extents out the curve's farthest point was a median 0.65 extents from every
+#: data point (up to 300 extents for the fits beyond 10): it interpolates the points and
+#: swings between them, and no longer approximates the path. Well-posed least-squares
+#: fits stay inside the bound: with ``n_ctrl = n - 8``, 1 fit of 600 exceeded it, with
+#: ``n - 12`` none exceeded half of it. The swing appears when a square or nearly square
+#: system passes the conditioning check (:data:`BSPLINE_COND_MAX`) yet turns the
+#: staircase's corners into alternating control points.
+BSPLINE_SWING_MAX = 1.0
 
 
 def curve_parameters(points: np.ndarray, parameterization: Parameterization) -> np.ndarray:
@@ -160,30 +177,103 @@ def design_problem(u: np.ndarray, t: np.ndarray, k: int) -> str:
     return ""
 
 
-def _supported_n_ctrl(u: np.ndarray, k: int, below: int) -> int:
-    """Largest ``n_ctrl < below`` (clamped uniform knots) the sites support; 0 if none."""
+def swing_problem(points: np.ndarray, c: np.ndarray) -> str:
+    """Why the control points ``c`` swing too far from ``points`` ('' if they do not).
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 2)
+        The fitted data (m).
+    c : ndarray, shape (n_ctrl, 2)
+        Control points of a fit of ``points`` (m).
+
+    Returns
+    -------
+    str
+        Empty when every control point lies within :data:`BSPLINE_SWING_MAX` times the data's
+        extent (the longer side of its bounding box) of that box; otherwise the farthest
+        control point, its distance, the ratio and the rule. Non-finite control points fail.
+    """
+    p = np.asarray(points, dtype=float)
+    cc = np.asarray(c, dtype=float)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    extent = float(np.max(hi - lo))
+    outside = np.maximum(0.0, np.maximum(lo - cc, cc - hi))
+    dist = np.hypot(outside[:, 0], outside[:, 1])
+    dist[~np.all(np.isfinite(cc), axis=1)] = math.inf
+    i = int(np.argmax(dist))
+    ratio = float(dist[i]) / extent if extent > 0 else (0.0 if dist[i] == 0 else math.inf)
+    if ratio <= BSPLINE_SWING_MAX:
+        return ""
+    return (
+        f"the solution swings away from the data: control point {i} lies {dist[i]:.3g} m "
+        f"outside the data's bounding box, {ratio:.3g} times the data's extent "
+        f"{extent:.3g} m > BSPLINE_SWING_MAX = {BSPLINE_SWING_MAX:g}, so the curve swings "
+        f"between the points instead of following them"
+    )
+
+
+def _supported_n_ctrl(
+    u: np.ndarray, k: int, below: int, points: np.ndarray | None, w: np.ndarray | None
+) -> int:
+    """Largest ``n_ctrl < below`` (clamped uniform knots) the sites support; 0 if none.
+
+    With ``points`` (and their weights ``w``) the fit must also pass :func:`swing_problem`.
+    """
     for n in range(min(below - 1, len(u)), k, -1):
-        if not design_problem(u, clamped_uniform_knots(n, k), k):
+        t = clamped_uniform_knots(n, k)
+        if design_problem(u, t, k):
+            continue
+        if points is None:
+            return n
+        ww = np.ones(len(points)) if w is None else w
+        try:
+            c = _lsq(points, u, t, k, ww, "").c
+        except IllPosedFitError:
+            continue
+        if not swing_problem(points, c):
             return n
     return 0
 
 
-def allowed_message(u: np.ndarray, k: int, below: int) -> str:
-    """How many control points (``< below``) the sites ``u`` allow for degree ``k``, in words."""
-    best = _supported_n_ctrl(u, k, below)
+def allowed_message(
+    u: np.ndarray,
+    k: int,
+    below: int,
+    *,
+    points: np.ndarray | None = None,
+    weights: np.ndarray | None = None,
+) -> str:
+    """How many control points (``< below``) the sites ``u`` allow for degree ``k``, in words.
+
+    Without ``points`` the count passes the design checks (:func:`design_problem`); with the
+    data ``points`` (shape ``(len(u), 2)``, optional ``weights``) its fit also passes
+    :func:`swing_problem`.
+    """
+    best = _supported_n_ctrl(u, k, below, points, weights)
     if best:
         return f"these data allow at most {best} control points for degree {k}"
     return f"these data allow no control-point count for degree {k} (tried {k + 1}-{below - 1})"
 
 
 def ill_posed_message(
-    reason: str, k: int, n_ctrl: int, parameterization: str, u: np.ndarray
+    reason: str,
+    k: int,
+    n_ctrl: int,
+    parameterization: str,
+    u: np.ndarray,
+    *,
+    points: np.ndarray | None = None,
+    weights: np.ndarray | None = None,
 ) -> str:
-    """Return the message of an ill-posed fit: the design, the ``reason`` and what the data allow."""
+    """Return the message of an ill-posed fit: the design, the ``reason`` and what the data allow.
+
+    ``points`` and ``weights`` go to :func:`allowed_message`.
+    """
+    allowed = allowed_message(u, k, n_ctrl, points=points, weights=weights)
     return (
         f"least-squares B-spline with degree {k}, n_ctrl {n_ctrl} (clamped uniform knots) "
-        f"and {parameterization} parameters of {len(u)} distinct points: {reason}; "
-        f"{allowed_message(u, k, n_ctrl)}"
+        f"and {parameterization} parameters of {len(u)} distinct points: {reason}; {allowed}"
     )
 
 
@@ -222,9 +312,17 @@ def fit_bspline(
       :data:`BSPLINE_COND_MAX` (``1e4``); above it ``A`` is numerically singular at the
       accuracy of A* points and the control points would diverge.
 
-    Both fail typically when ``n_ctrl`` is close to the number of points (a square or
+    After solving, the solution is checked too:
+
+    * **Swing**: every control point must lie within :data:`BSPLINE_SWING_MAX` (``1``)
+      times the data's extent (the longer side of the data's bounding box) of that box
+      (:func:`swing_problem`); farther out, the curve interpolates the points and swings
+      between them instead of approximating the path.
+
+    All three fail typically when ``n_ctrl`` is close to the number of points (a square or
     nearly square system whose data parameters fall outside or near the ends of the basis
-    functions' supports).
+    functions' supports, or that turns a staircase's corners into alternating control
+    points).
 
     Parameters
     ----------
@@ -248,11 +346,15 @@ def fit_bspline(
     Raises
     ------
     InvalidInputError
-        Bad arguments; or the data cannot determine the fit: more control points than
-        distinct points, the Schoenberg-Whitney condition fails, or ``cond(A) >
-        BSPLINE_COND_MAX``. The message names the condition, the degree, ``n_ctrl``, the
+        Bad arguments.
+    IllPosedFitError
+        The data cannot determine the fit (a subclass of :class:`InvalidInputError`): more
+        control points than distinct points, the Schoenberg-Whitney condition fails,
+        ``cond(A) > BSPLINE_COND_MAX``, or a control point lies more than
+        ``BSPLINE_SWING_MAX`` extents outside the data's bounding box. The message names the
+        condition (with the offending value and the bound), the degree, ``n_ctrl``, the
         parameterisation and the number of points, and says how many control points the
-        data allow (the largest count below ``n_ctrl`` that passes both checks).
+        data allow (the largest count below ``n_ctrl`` that passes every check).
     """
     p = validation.points("points", points)
     k = validation.integer("degree", degree, 1, 9)
@@ -264,13 +366,22 @@ def fit_bspline(
     if n_c > len(p):
         raise IllPosedFitError(
             f"n_ctrl must be <= the number of distinct points ({len(p)}), got {n_c}; "
-            f"{allowed_message(u, k, len(p) + 1)} ({parameterization} parameters)"
+            f"{allowed_message(u, k, len(p) + 1, points=p, weights=w)} "
+            f"({parameterization} parameters)"
         )
     t = clamped_uniform_knots(n_c, k)
     problem = design_problem(u, t, k)
     if problem:
-        raise IllPosedFitError(ill_posed_message(problem, k, n_c, parameterization, u))
-    return _lsq(p, u, t, k, w, parameterization)
+        raise IllPosedFitError(
+            ill_posed_message(problem, k, n_c, parameterization, u, points=p, weights=w)
+        )
+    curve = _lsq(p, u, t, k, w, parameterization)
+    problem = swing_problem(p, curve.c)
+    if problem:
+        raise IllPosedFitError(
+            ill_posed_message(problem, k, n_c, parameterization, u, points=p, weights=w)
+        )
+    return curve
 
 
 def _lsq(
