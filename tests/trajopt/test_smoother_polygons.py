@@ -84,6 +84,57 @@ def test_diagonal_door_is_crossed_smoothly():
     check_trajectory(grid, traj, robot, p0, p1)
 
 
+def passage_into_room(top_wall_cells: int) -> OccupancyGrid:
+    """1 m cells: a passage exactly 2 r = 5 cells wide (its free centres are the line
+    y = 10.5) opening into a room whose left part lies below the line: the passage's top
+    wall reaches ``top_wall_cells`` into the room."""
+    occ = np.ones((20, 56), bool)
+    occ[8:13, 3:40] = False
+    occ[4:16, 40:54] = False
+    occ[13:16, 40 : 40 + top_wall_cells] = True
+    return OccupancyGrid(occ, 1.0)
+
+
+@pytest.mark.parametrize("top_wall_cells", [4, 8])
+@pytest.mark.parametrize("start", [(43.5, 9.5), (45.5, 9.5), (44.5, 8.5), (47.5, 8.5)])
+def test_entering_a_passage_exactly_2r_wide_at_an_angle(top_wall_cells, start):
+    # the room's region meets the passage's degenerate region (a segment of the line
+    # y = 10.5) at the tip of a wedge; with the segment only its seed and the wedge's
+    # edge on that line shrunk inside, the two had no common point and every fit failed
+    # (the held-out "narrow room" failures: certificate heading_continuity)
+    grid = passage_into_room(top_wall_cells)
+    robot = trajopt.Robot(radius=2.5)
+    goal = (8.5, 10.5)
+    traj = trajopt.plan(grid, start, goal, robot)
+    assert traj.stats["corridor"] == "polygons"
+    check_trajectory(grid, traj, robot, start, goal)
+    corr = traj.steps.corridor
+    line = [k for k, reg in enumerate(corr.regions) if reg.degenerate]
+    assert line
+    for k in line:  # the degenerate regions lie on the line, clear of the walls
+        v = corr.regions[k].vertices
+        np.testing.assert_allclose(v[:, 1], 10.5, atol=1e-9)
+        xs = np.linspace(v[:, 0].min(), v[:, 0].max(), 200)
+        pts = np.column_stack([xs, np.full_like(xs, 10.5)])
+        assert square_clearance(grid, pts).min() >= 2.5 - 1e-9
+
+
+def test_degenerate_regions_extend_along_their_line():
+    # a straight passage exactly 2 r wide: the segment regions reach past their seed
+    # segments along the line (so that consecutive ones overlap in a segment, not a point)
+    grid = passage_into_room(4)
+    pts = np.array([[38.5, 10.5], [30.5, 10.5], [20.5, 10.5], [10.5, 10.5]])
+    corr = build_polygon_corridor(grid, pts, 2.5)
+    deg = [reg for reg in corr.regions if reg.degenerate]
+    assert deg
+    lengths = [np.ptp(reg.vertices[:, 0]) for reg in deg]
+    seeds = np.abs(np.diff(corr.path[:, 0]))
+    assert max(lengths) > max(seeds) + 1.0
+    for ov in corr.overlaps:
+        if ov.degenerate:
+            assert np.ptp(ov.vertices[:, 0]) > 1.0
+
+
 @pytest.mark.parametrize("target", ["A", "B", "C", "D"])
 def test_paper_scene_in_polygons_is_certified_and_turns_less(target):
     scene = scenes.paper()
@@ -151,3 +202,15 @@ def test_polygon_corridor_bad_input():
         trajopt.Planner(grid, corridor="triangles")
     with pytest.raises(InvalidInputError, match="corridor must be a Corridor or a PolygonCorridor"):
         Smoother().fit(None, object())
+
+
+@pytest.mark.parametrize(("start", "goal"), [((49.5, 39.5), (30.5, 42.5)),
+                                             ((21.5, 43.5), (49.5, 37.5))])
+def test_den312d_passage_mouth_queries(shared_data, start, goal):
+    # random queries on den312d (radius 2.5 cells) that failed with heading_continuity:
+    # a passage exactly 2 r wide entered from the corner of a room
+    grid = astar.load_map(shared_data / "movingai" / "maps" / "den312d.map")
+    robot = trajopt.Robot(radius=2.5)
+    traj = trajopt.plan(grid, start, goal, robot)
+    assert traj.stats["corridor"] == "polygons"
+    check_trajectory(grid, traj, robot, start, goal)

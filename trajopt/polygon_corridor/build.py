@@ -287,10 +287,42 @@ def _grow_regions(
             {"region": k, "status": st},
         )
     degen = status == 1
-    for k in np.nonzero(degen)[0]:  # no interior: the seed segment itself
-        vv[k, :2] = seed[k : k + 2]
+    for k in np.nonzero(degen)[0]:  # no interior: the seed segment, extended along its line
+        vv[k, :2] = _line_extension(seed[k], seed[k + 1], ext, r_c, tol_c, args)
         nvs[k] = 2
     return seed, seed_src, hh, vv, nvs, degen
+
+
+def _line_extension(
+    a: np.ndarray, b: np.ndarray, ext: float, r_c: float, tol_c: float, args: tuple
+) -> np.ndarray:
+    """Return the ends of segment ``a -> b`` extended along its line (cell units).
+
+    A degenerate region (a passage exactly ``2 r`` wide) is a segment of the line its
+    free space lies on. Its neighbours meet it where the path enters that line, often at
+    the tip of a wedge (the path reaches the line at an angle); a region holding only its
+    seed segment then overlaps the wedge in a sliver, and the control points shared by the
+    two regions are squeezed into it (the QP stalls or the curve nearly stops there).
+    Each end is therefore extended along the line by the largest of ``ext``, ``ext / 2``,
+    ``ext / 4`` (cells) whose added piece keeps ``r_c - tol_c`` from every obstacle, as
+    the seed extensions of the other regions are (the region is certified afterwards
+    like every other).
+    """
+    d = b - a
+    u = d / math.hypot(d[0], d[1])
+    cap = r_c + 1.0
+    out = np.array([a, b], dtype=float)
+    for end, sign in ((0, -1.0), (1, 1.0)):
+        p = out[end]
+        for e in (ext, 0.5 * ext, 0.25 * ext):
+            if e <= 0.0:
+                break
+            q = p + sign * e * u
+            _, sc = path_clearances(np.ascontiguousarray(np.array([p, q])), cap, *args)
+            if sc[0] >= r_c - tol_c:
+                out[end] = q
+                break
+    return out
 
 
 def metric_regions(

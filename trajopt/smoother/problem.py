@@ -216,7 +216,10 @@ def point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, n
     value over that box is within its bound); the fixed end points get none (they were
     checked against their regions). Span regions never decrease along the curve and a point
     touches at most two of them (the knots give every region at least ``p`` spans), so the
-    regions of point ``i`` are those of its first and last span.
+    regions of point ``i`` are those of its first and last span. A point held on a
+    degenerate region's line (its two-sided row) gets its one-sided rows without the
+    ``_POLY_MARGIN`` shrink: a neighbouring polygon's edge often lies on that very line,
+    and shrunk it would leave the two regions no common point.
 
     Returns ``(k, coef (nb, k, 2), lb (nb k,), ub (nb k,))`` in the layout's order; unused
     rows have zero coefficients and infinite bounds.
@@ -240,6 +243,11 @@ def point_rows(rows, span_box, n: int, p: int, lo: np.ndarray, hi: np.ndarray, n
     ca = np.concatenate([A[r0], A[r1]], axis=1)  # (n, 2q, 2)
     clo = np.concatenate([rlo[r0], rlo[r1]], axis=1)
     chi = np.concatenate([rhi[r0], rhi[r1]], axis=1)
+    # a point on a degenerate region's line: its other region's edge along that line
+    # (tangent to the same obstacles) must not be moved inside, or the two never meet
+    degenerate = np.isfinite(rlo).any(axis=1)
+    on_line = (degenerate[r0] | degenerate[r1])[:, None] & np.isinf(clo) & np.isfinite(chi)
+    chi = np.where(on_line, chi + _POLY_MARGIN, chi)
     top = np.maximum(ca[..., 0] * lo[:, :1], ca[..., 0] * hi[:, :1]) + np.maximum(
         ca[..., 1] * lo[:, 1:], ca[..., 1] * hi[:, 1:]
     )
