@@ -629,6 +629,8 @@ def plan(
     corridor: CorridorKind = "polygons",
     costmap_weight: float = 2.0,
     speed_limits: SpeedLimits | None = None,
+    timing_dt: float = 0.02,
+    landmarks: int = 0,
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
@@ -649,6 +651,15 @@ def plan(
         Speeds at the ends (m/s).
     inflation, search, smoother, w_cells, corridor, costmap_weight, speed_limits
         See :class:`Planner`.
+    timing_dt : float
+        Step of the timing's forward greedy (s), in (0, 0.5]; default 0.02 (see
+        :class:`Planner`).
+    landmarks : int, optional
+        ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`), 0-64;
+        0, the default: none (see :class:`Planner`). Exact either way. Each call builds
+        them for its one query (``landmarks + 1`` searches of the whole map), which costs
+        more than the search they shorten; they pay off across the queries of one
+        :class:`Planner`.
     fallback : {None, "stop_and_turn"}
         Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
         module docstring); default ``None``: the failure raises.
@@ -677,6 +688,8 @@ def plan(
         corridor=corridor,
         costmap_weight=costmap_weight,
         speed_limits=speed_limits,
+        timing_dt=timing_dt,
+        landmarks=landmarks,
     )
     return planner.plan(
         start,
