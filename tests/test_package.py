@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import ast
+import importlib
+import inspect
 import subprocess
 import sys
+
+import pytest
 
 import astar
 import trajopt
@@ -22,6 +27,34 @@ def test_all_exports_resolve():
     for mod in (astar, trajopt):
         for name in mod.__all__:
             assert getattr(mod, name) is not None, name
+
+
+def _type_checking_imports(module) -> dict[str, str]:
+    """Name -> module of every ``from M import name`` under ``if TYPE_CHECKING:``."""
+    tree = ast.parse(inspect.getsource(module))
+    out: dict[str, str] = {}
+    for block in tree.body:
+        if isinstance(block, ast.If) and ast.unparse(block.test) == "TYPE_CHECKING":
+            for node in ast.walk(block):
+                if isinstance(node, ast.ImportFrom):
+                    out.update({a.asname or a.name: node.module for a in node.names})
+    return out
+
+
+@pytest.mark.parametrize("package", ["astar", "trajopt"])
+def test_type_checking_block_imports_every_lazy_export(package):
+    """Static type checkers see the lazy exports (PEP 562) only through the TYPE_CHECKING
+    imports: each must name the module ``__getattr__`` loads it from, and the block must
+    hold nothing that is not exported."""
+    mod = importlib.import_module(package)
+    seen = _type_checking_imports(mod)
+    want = dict(mod._EXPORTS)
+    want.update({name: package for name in getattr(mod, "_SUBMODULES", ())})
+    wrong = {name: (where, seen.get(name)) for name, where in want.items() if seen.get(name) != where}
+    assert not wrong, f"{package}: TYPE_CHECKING imports missing or from another module: {wrong}"
+    assert set(seen) == set(mod.__all__) == set(want)
+    for name, where in seen.items():  # and each names the very object __getattr__ returns
+        assert getattr(importlib.import_module(where), name) is getattr(mod, name), name
 
 
 def test_import_is_light():

@@ -83,11 +83,13 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
+    from trajopt import cli, fallback, fits, metrics, plotting, scenes
     from trajopt.bspline import BSplineCurve
     from trajopt.comparison import ComparisonTable, compare
     from trajopt.corridor import Box, Corridor, build_corridor
     from trajopt.curve import ParametricCurve
     from trajopt.errors import (
+        IllPosedFitError,
         InvalidInputError,
         NoPathError,
         SmoothingError,
@@ -96,6 +98,7 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
     from trajopt.pipeline import Planner, plan
+    from trajopt.polygon_corridor import ConvexPolygon, PolygonCorridor, build_polygon_corridor
     from trajopt.robot import Robot
     from trajopt.ros_mcap import read_mcap, write_mcap
     from trajopt.smoother import Smoother, SmoothPath
