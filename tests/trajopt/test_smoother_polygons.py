@@ -214,3 +214,39 @@ def test_den312d_passage_mouth_queries(shared_data, start, goal):
     traj = trajopt.plan(grid, start, goal, robot)
     assert traj.stats["corridor"] == "polygons"
     check_trajectory(grid, traj, robot, start, goal)
+
+
+def test_polygon_box_a_rounding_error_short_of_a_degenerate_line():
+    # a polygon's vertices are computed: when the one beside a degenerate region ends a
+    # rounding error short of the region's line, its bounding box must still meet the line
+    import dataclasses
+
+    from trajopt.polygon_corridor import ConvexPolygon
+
+    grid = passage_into_room(4)
+    start, goal = np.array([45.5, 9.5]), np.array([8.5, 10.5])
+    traj = trajopt.plan(grid, start, goal, trajopt.Robot(radius=2.5))
+    corr = traj.steps.corridor
+    regions = list(corr.regions)
+    k = next(i for i in range(len(regions) - 1)
+             if regions[i + 1].degenerate and not regions[i].degenerate)
+    reg = regions[k]
+    v = reg.vertices.copy()
+    top = v[:, 1] >= 10.5 - 1e-12
+    assert top.any()  # its edge lies on the line
+    v[top, 1] = 10.5 - 4e-15
+    regions[k] = ConvexPolygon(reg.A, reg.b, v)
+    shifted = dataclasses.replace(corr, regions=tuple(regions))
+    sp = Smoother().fit(None, shifted, raw_grid=grid, radius=2.5, start=start, goal=goal)
+    assert sp.certificate.ok
+
+
+def test_den312d_small_robot_degenerate_line_beside_a_polygon(shared_data):
+    # radius 1.5 cells: the polygon beside a degenerate region ended 3.6e-15 cells short of
+    # its line, and every attempt stopped at "empty control-point bound"
+    grid = astar.load_map(shared_data / "movingai" / "maps" / "den312d.map")
+    robot = trajopt.Robot(radius=1.5)
+    start, goal = (44.5, 13.5), (11.5, 23.5)
+    traj = trajopt.plan(grid, start, goal, robot)
+    assert traj.stats["corridor"] == "polygons"
+    check_trajectory(grid, traj, robot, start, goal)

@@ -165,6 +165,10 @@ def diag_row_bounds(dlo: np.ndarray, dhi: np.ndarray, nb: int):
 #: polygon rows are imposed this far (cells) inside their half-planes, so that solver
 #: tolerances never put a control point outside its region
 _POLY_MARGIN = 1e-6
+#: a polygon's bounding box (a redundant bound on its control points; its rows are exact)
+#: is widened by this much (cells): its vertices are computed, and a box that ends a
+#: rounding error short of a degenerate neighbour's line would leave the two no common point
+_BOX_PAD = 1e-9
 #: region rows per control point are padded to one of these counts (cached solvers)
 _K_SIZES = (4, 8, 12, 16, 24, 32, 48, 64)
 
@@ -183,7 +187,8 @@ def region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
     """Each region's rows ``lo <= A c <= hi`` in cells.
 
     Each region's rows ``lo <= A c <= hi`` in cells (``A`` (q, 2), ``lo``, ``hi`` (q,)),
-    ``_POLY_MARGIN`` inside, and the regions' bounding boxes (cells, (m, 2) each).
+    ``_POLY_MARGIN`` inside, and the regions' bounding boxes (cells, (m, 2) each; a
+    polygon's widened by ``_BOX_PAD``).
 
     A degenerate region's line (its first two, opposite rows) becomes one two-sided row.
     """
@@ -194,7 +199,8 @@ def region_rows(corridor: PolygonCorridor, origin: np.ndarray, res: float):
         A = np.asarray(reg.A, dtype=float)
         b = (np.asarray(reg.b, dtype=float) - A @ origin) / res
         v = (np.asarray(reg.vertices, dtype=float) - origin) / res
-        lo_b[k], hi_b[k] = v.min(axis=0), v.max(axis=0)
+        pad = 0.0 if reg.degenerate else _BOX_PAD
+        lo_b[k], hi_b[k] = v.min(axis=0) - pad, v.max(axis=0) + pad
         if reg.degenerate:
             mid = 0.5 * (b[0] - b[1])
             rows_a = np.vstack([A[:1], A[2:]])
