@@ -35,9 +35,13 @@ class InvalidInputError(TrajoptError, _astar_errors.InvalidInputError):
 class IllPosedFitError(InvalidInputError):
     """The data cannot determine the requested plain fit.
 
-    The data cannot determine the requested plain fit (the Schoenberg-Whitney condition fails,
-    or the collocation matrix is numerically singular); :func:`trajopt.compare` records such a
-    fit as invalid with this message.
+    Raised by :func:`trajopt.fits.fit_bspline` when there are more control points than
+    distinct points, the Schoenberg-Whitney condition fails, the collocation matrix is
+    numerically singular (condition number above :data:`trajopt.fits.BSPLINE_COND_MAX`), or
+    the solution swings: a control point lies more than :data:`trajopt.fits.BSPLINE_SWING_MAX`
+    times the data's extent outside the data's bounding box. :func:`trajopt.compare` records
+    such a fit as invalid with this message, and :func:`trajopt.fits.sweep_bspline` lists it
+    as an invalid record with the message as its reason.
     """
 
 

@@ -14,8 +14,10 @@ Built-in methods (the chapter's four, in this order):
 * ``'B-spline fit'``: :func:`trajopt.fits.fit_bspline` of the latter (a least-squares
   fit: as in the chapter's Table 2 its end points are not exact, see the
   ``start_error_x_m`` ... ``end_error_y_m`` columns; parameters the data cannot support,
-  where the Schoenberg-Whitney condition fails or the system is numerically singular, give
-  a row with ``valid=False``, no curve and the reason as ``note``);
+  where the Schoenberg-Whitney condition fails, the system is numerically singular or the
+  solution swings more than :data:`~trajopt.fits.BSPLINE_SWING_MAX` data extents outside
+  the data's bounding box, give a row with ``valid=False``, no curve and the reason as
+  ``note``);
 
 and the proposed method, ``'proposed'``: :func:`trajopt.plan` (certified corridor smoother
 and ruckig timing; its own clearance-aware A* path), with the timed metrics as extra

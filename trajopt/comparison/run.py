@@ -124,10 +124,11 @@ def compare(
         Keyword arguments of :func:`trajopt.fits.fit_bspline` (``degree``, ``n_ctrl``,
         ``parameterization``); missing keys from :data:`DEFAULT_BSPLINE`. ``n_ctrl`` is
         reduced to the number of path points when the path is shorter; when the data cannot
-        determine the fit (Schoenberg-Whitney fails or the collocation matrix is
-        numerically singular, typically for such a square system) the row is
-        ``valid=False`` without a curve, and its note says how many control points the
-        data allow.
+        determine the fit (Schoenberg-Whitney fails, the collocation matrix is numerically
+        singular, or the solution swings: a control point more than
+        :data:`~trajopt.fits.BSPLINE_SWING_MAX` data extents outside the data's bounding
+        box; typically for such a square system) the row is ``valid=False`` without a
+        curve, and its note says how many control points the data allow.
     methods : sequence of str or Mapping[str, callable], optional
         Registered method names to run (default: every registered default method), or a
         mapping name -> method callable for one-off methods.

@@ -2,8 +2,9 @@
 
 Modules: :mod:`~trajopt.fits.curves` (the returned curves), :mod:`~trajopt.fits.records`,
 :mod:`~trajopt.fits.robust` (least squares, LAR, bisquare), :mod:`~trajopt.fits.polynomial`,
-:mod:`~trajopt.fits.bspline_fit` and :mod:`~trajopt.fits.sweeps`; every public name is
-imported here.
+:mod:`~trajopt.fits.bspline_fit` and :mod:`~trajopt.fits.sweeps`; the names listed in
+``__all__`` here are imported from them (the building blocks of the checks and messages,
+such as :func:`~trajopt.fits.bspline_fit.design_problem`, stay in their modules).
 
 Two families, both returning objects that follow :class:`trajopt.curve.ParametricCurve`
 (position, derivatives, heading, curvature, arc length, dense sampling):
@@ -28,21 +29,28 @@ Two families, both returning objects that follow :class:`trajopt.curve.Parametri
   chapter's equation (3), ``sum_i w_i |C(u_i) - Q_i|^2``; the end points are *not* forced
   onto the data (as in the chapter's Table 2). A system the data cannot determine (the
   Schoenberg-Whitney condition fails, or the collocation matrix is numerically singular,
-  condition number above :data:`BSPLINE_COND_MAX`) raises :class:`InvalidInputError`
-  instead of returning a diverged curve.
+  condition number above :data:`BSPLINE_COND_MAX`) raises
+  :class:`~trajopt.errors.IllPosedFitError` (an :class:`~trajopt.errors.InvalidInputError`)
+  instead of returning a diverged curve, and so does a solution that swings: a control
+  point more than :data:`BSPLINE_SWING_MAX` times the data's extent outside the data's
+  bounding box (:func:`swing_problem`), where the curve interpolates the points and swings
+  between them.
 
 Parameter sweeps as the chapter's Tables 1 and 2 (:func:`sweep_polynomial`: 3 methods x 10
 orders; :func:`sweep_bspline`: 3 parameterisations x 4 degrees x 42 control-point counts =
-504) rank every combination by the MSE of equation (3) at the fitted parameters; the
-``kwargs`` of the best record are reused unchanged on other targets.
+504) rank every combination by the MSE of equation (3) at the fitted parameters, the
+combinations that fail a check of :func:`fit_bspline` last as invalid; the ``kwargs`` of
+the best record are reused unchanged on other targets.
 """
 
 from trajopt.fits.bspline_fit import (
     BSPLINE_COND_MAX,
+    BSPLINE_SWING_MAX,
     PARAMETERIZATIONS,
     Parameterization,
     curve_parameters,
     fit_bspline,
+    swing_problem,
 )
 from trajopt.fits.curves import FittedBSpline, ParametricPolynomialCurve, PolynomialCurve
 from trajopt.fits.polynomial import fit_polynomial, fit_polynomial_parametric
@@ -59,6 +67,7 @@ from trajopt.fits.sweeps import (
 __all__ = [
     "BISQUARE_C",
     "BSPLINE_COND_MAX",
+    "BSPLINE_SWING_MAX",
     "FIT_METHODS",
     "PARAMETERIZATIONS",
     "SWEEP_DEGREES",
@@ -77,4 +86,5 @@ __all__ = [
     "fit_polynomial_parametric",
     "sweep_bspline",
     "sweep_polynomial",
+    "swing_problem",
 ]

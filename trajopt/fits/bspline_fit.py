@@ -1,7 +1,8 @@
 """Least-squares B-spline fits of path points.
 
 Least-squares B-spline fits of path points (the chapter's equation (3)), with the checks that
-refuse a system the data cannot determine (Schoenberg-Whitney, conditioning).
+refuse a system the data cannot determine (Schoenberg-Whitney, conditioning) and a solution
+that swings away from the data (:func:`swing_problem`).
 """
 
 from __future__ import annotations
@@ -214,26 +215,44 @@ def swing_problem(points: np.ndarray, c: np.ndarray) -> str:
 
 
 def _supported_n_ctrl(
-    u: np.ndarray, k: int, below: int, points: np.ndarray | None, w: np.ndarray | None
+    u: np.ndarray,
+    k: int,
+    below: int,
+    points: np.ndarray | None,
+    w: np.ndarray | None,
+    memo: dict[int, bool] | None,
 ) -> int:
     """Largest ``n_ctrl < below`` (clamped uniform knots) the sites support; 0 if none.
 
     With ``points`` (and their weights ``w``) the fit must also pass :func:`swing_problem`.
+    ``memo`` maps counts already checked to their outcome and is filled in place.
     """
     for n in range(min(below - 1, len(u)), k, -1):
-        t = clamped_uniform_knots(n, k)
-        if design_problem(u, t, k):
-            continue
-        if points is None:
-            return n
-        ww = np.ones(len(points)) if w is None else w
-        try:
-            c = _lsq(points, u, t, k, ww, "").c
-        except IllPosedFitError:
-            continue
-        if not swing_problem(points, c):
+        ok = memo.get(n) if memo is not None else None
+        if ok is None:
+            ok = _passes(u, k, n, points, w)
+            if memo is not None:
+                memo[n] = ok
+        if ok:
             return n
     return 0
+
+
+def _passes(
+    u: np.ndarray, k: int, n: int, points: np.ndarray | None, w: np.ndarray | None
+) -> bool:
+    """Whether ``n`` control points pass the design checks (and, with ``points``, the swing)."""
+    t = clamped_uniform_knots(n, k)
+    if design_problem(u, t, k):
+        return False
+    if points is None:
+        return True
+    ww = np.ones(len(points)) if w is None else w
+    try:
+        c = _lsq(points, u, t, k, ww, "").c
+    except IllPosedFitError:
+        return False
+    return not swing_problem(points, c)
 
 
 def allowed_message(
@@ -243,14 +262,18 @@ def allowed_message(
     *,
     points: np.ndarray | None = None,
     weights: np.ndarray | None = None,
+    memo: dict[int, bool] | None = None,
 ) -> str:
     """How many control points (``< below``) the sites ``u`` allow for degree ``k``, in words.
 
     Without ``points`` the count passes the design checks (:func:`design_problem`); with the
     data ``points`` (shape ``(len(u), 2)``, optional ``weights``) its fit also passes
-    :func:`swing_problem`.
+    :func:`swing_problem`. ``memo``, when given, maps control-point counts already checked
+    for these ``u``, ``k``, ``points`` and ``weights`` to whether they pass; the counts
+    checked here are added to it (:func:`~trajopt.fits.sweep_bspline` shares one per
+    parameterisation and degree).
     """
-    best = _supported_n_ctrl(u, k, below, points, weights)
+    best = _supported_n_ctrl(u, k, below, points, weights, memo)
     if best:
         return f"these data allow at most {best} control points for degree {k}"
     return f"these data allow no control-point count for degree {k} (tried {k + 1}-{below - 1})"
@@ -265,12 +288,13 @@ def ill_posed_message(
     *,
     points: np.ndarray | None = None,
     weights: np.ndarray | None = None,
+    memo: dict[int, bool] | None = None,
 ) -> str:
     """Return the message of an ill-posed fit: the design, the ``reason`` and what the data allow.
 
-    ``points`` and ``weights`` go to :func:`allowed_message`.
+    ``points``, ``weights`` and ``memo`` go to :func:`allowed_message`.
     """
-    allowed = allowed_message(u, k, n_ctrl, points=points, weights=weights)
+    allowed = allowed_message(u, k, n_ctrl, points=points, weights=weights, memo=memo)
     return (
         f"least-squares B-spline with degree {k}, n_ctrl {n_ctrl} (clamped uniform knots) "
         f"and {parameterization} parameters of {len(u)} distinct points: {reason}; {allowed}"

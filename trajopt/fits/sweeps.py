@@ -20,6 +20,7 @@ from trajopt.fits.bspline_fit import (
     dedup,
     design_problem,
     ill_posed_message,
+    swing_problem,
 )
 from trajopt.fits.polynomial import fit_polynomial
 from trajopt.fits.records import SweepRecord
@@ -89,12 +90,16 @@ def sweep_bspline(
     """Every ``(parameterization, degree, n_ctrl)`` of :func:`fit_bspline`, ranked by MSE.
 
     The default grid is 3 x 4 x 42 = 504 combinations (Table 2). Data parameters are
-    computed once per parameterisation and the fits reuse them; combinations the data
-    cannot support (``n_ctrl < degree + 1``, more control points than points, the
-    Schoenberg-Whitney condition failing or a numerically singular collocation matrix, as
-    :func:`fit_bspline` checks) appear last, ``valid=False`` with ``mse = inf`` and the
-    reason (which says how many control points the data allow), instead of being ranked
-    by the MSE of a diverged curve.
+    computed once per parameterisation and the fits reuse them. Combinations the data
+    cannot support appear last, ``valid=False`` with ``mse = inf`` and the reason, instead
+    of being ranked by the MSE of a diverged or swinging curve: ``n_ctrl < degree + 1``,
+    more control points than points, and every check of :func:`fit_bspline` (the
+    Schoenberg-Whitney condition, a numerically singular collocation matrix, and a solution
+    with a control point more than :data:`~trajopt.fits.BSPLINE_SWING_MAX` data extents
+    outside the data's bounding box). For those checks the reason is the message
+    :func:`fit_bspline` raises, including how many control points the data allow (the
+    largest count below ``n_ctrl`` that passes every check), so the ``kwargs`` of every
+    valid record, the best one included, fit with :func:`fit_bspline` without raising.
 
     Returns
     -------
@@ -116,17 +121,24 @@ def sweep_bspline(
     for kind in kinds:
         u = curve_parameters(p, kind)
         for k in degs:
+            # control-point count -> passes every check of fit_bspline, shared by the
+            # records' "allow at most" counts
+            memo: dict[int, bool] = {}
             for nc in ncs:
                 params = {"parameterization": kind, "degree": k, "n_ctrl": nc}
                 if nc < k + 1 or nc > len(p):
                     why = f"n_ctrl {nc} outside [degree + 1, points] = [{k + 1}, {len(p)}]"
                     if nc > len(p):
-                        why += f"; {allowed_message(u, k, len(p) + 1)}"
+                        allowed = allowed_message(
+                            u, k, len(p) + 1, points=p, weights=w, memo=memo
+                        )
+                        why += f"; {allowed}"
                     out.append(SweepRecord("bspline", params, math.inf, False, why))
                     continue
+                memo[nc] = False  # until every check below has passed
                 problem = design_problem(u, knots[k, nc], k)
                 if problem:
-                    why = ill_posed_message(problem, k, nc, kind, u)
+                    why = ill_posed_message(problem, k, nc, kind, u, points=p, weights=w, memo=memo)
                     out.append(SweepRecord("bspline", params, math.inf, False, why))
                     continue
                 try:
@@ -140,5 +152,11 @@ def sweep_bspline(
                     why = "singular least-squares system (Schoenberg-Whitney condition)"
                     out.append(SweepRecord("bspline", params, math.inf, False, why))
                     continue
+                problem = swing_problem(p, spl.c)
+                if problem:
+                    why = ill_posed_message(problem, k, nc, kind, u, points=p, weights=w, memo=memo)
+                    out.append(SweepRecord("bspline", params, math.inf, False, why))
+                    continue
+                memo[nc] = True
                 out.append(SweepRecord("bspline", params, mse, True, ""))
     return _rank(out)
