@@ -89,6 +89,26 @@ def test_table_conversions(room_table: cmp.ComparisonTable, tmp_path) -> None:
     assert float(rows[2]["hausdorff_m"]) == pytest.approx(room_table.rows[2]["hausdorff_m"])
 
 
+def test_to_csv_is_atomic(tmp_path) -> None:
+    """A write that fails midway keeps the old file and leaves no temporary file."""
+
+    class Unprintable:
+        def __str__(self) -> str:
+            raise RuntimeError("cannot format")
+
+    target = tmp_path / "t.csv"
+    good = cmp.ComparisonTable(rows=({"method": "a", "x": 1.5},))
+    assert good.to_csv(target) == target
+    before = target.read_bytes()
+    bad = cmp.ComparisonTable(rows=({"method": "a", "x": 2.5}, {"method": "b", "x": Unprintable()}))
+    with pytest.raises(RuntimeError, match="cannot format"):
+        bad.to_csv(target)
+    assert target.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["t.csv"]
+    with target.open(newline="") as fh:
+        assert list(csv.DictReader(fh)) == [{"method": "a", "x": "1.5"}]
+
+
 def test_table_is_frozen(room_table: cmp.ComparisonTable) -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         room_table.rows = ()  # type: ignore[misc]

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from astar.files import atomic_write
 from trajopt.errors import InvalidInputError
 
 __all__ = ["ComparisonTable"]
@@ -140,14 +141,22 @@ class ComparisonTable:
         return "\n".join(out)
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write the records as CSV (header = columns); returns the path written."""
-        p = Path(path)
-        with p.open("w", newline="", encoding="utf-8") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(self.columns))
-            writer.writeheader()
-            for r in self.rows:
-                writer.writerow(dict(r))
-        return p
+        """Write the records as CSV (header = columns), atomically; returns the path written.
+
+        The file is written beside ``path`` under a temporary name and moved into place
+        (:func:`astar.files.atomic_write`): readers see the old file or the new one, and a
+        failed write keeps the old file. The folder of ``path`` must exist.
+        """
+        cols = list(self.columns)
+
+        def write(tmp: Path) -> None:
+            with tmp.open("w", newline="", encoding="utf-8") as fh:
+                writer = csv.DictWriter(fh, fieldnames=cols)
+                writer.writeheader()
+                for r in self.rows:
+                    writer.writerow(dict(r))
+
+        return atomic_write(Path(path), write)
 
     def to_dataframe(self) -> Any:
         """Return a :class:`pandas.DataFrame` indexed by method (pandas imported here)."""
