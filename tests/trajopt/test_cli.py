@@ -26,10 +26,16 @@ def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     rc = main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
                "--radius", "0.12", "--out", str(out), "--dt", "0.05"])
     assert rc == 0
-    with open(out) as fh:
-        rows = [r for r in csv.reader(fh) if r and not r[0].startswith("#")]
-    header, body = rows[0], np.array(rows[1:], float)
-    t = body[:, header.index(next(h for h in header if h.startswith("t")))]
+    # read as a user would, with no options: the first line is the header
+    with open(out, newline="") as fh:
+        reader = csv.DictReader(fh)
+        header = list(reader.fieldnames or ())
+        rows = list(reader)
+    assert header[:3] == ["t [s]", "x [m] (map)", "y [m] (map)"]
+    body = np.array([[float(r[h]) for h in header] for r in rows])
+    assert body.shape == (len(rows), len(header)) and len(rows) > 2
+    assert np.all(np.isfinite(body))
+    t = body[:, 0]
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     assert "duration" in capsys.readouterr().out
     js = tmp_path / "traj.json"
