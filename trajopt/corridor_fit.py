@@ -29,18 +29,22 @@ from trajopt.polygon_corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.polygon_corridor.reuse import corridor_with_rest
 from trajopt.smoother import Smoother, SmoothPath
 
-__all__ = ["box_corridor", "fit_in_corridor", "polygon_corridor", "witness_rescue"]
+__all__ = [
+    "box_corridor", "fit_in_corridor", "polygon_corridor", "witness_corridor", "witness_rescue",
+]
 
 logger = logging.getLogger("trajopt.pipeline")
 
 
 def fit_in_corridor(
-    planner: Any, q: PlanQuery, path: Any, smoother: Smoother
+    planner: Any, q: PlanQuery, path: Any, smoother: Smoother, witness: np.ndarray | None = None
 ) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
     """Build the corridor around ``path`` and fit in it.
 
     Polygons first (when chosen), then boxes; the fits share ``smoother.time_budget_s``
-    (the corridor builds do not count against it).
+    (the corridor builds do not count against it). With a curvature ``witness`` (points, m,
+    from :func:`~trajopt.feasibility.curvature_witness`), the polygons are grown around the
+    witness itself (:func:`witness_corridor`), the boxes around ``path``.
 
     Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
     ``InvalidInputError``) when every corridor failed.
@@ -55,7 +59,9 @@ def fit_in_corridor(
         last = i == len(kinds) - 1
         try:
             with q.timer.stage("corridor"):
-                if kind == "polygons":
+                if kind == "polygons" and witness is not None:
+                    corridor, q.regions_kept = witness_corridor(planner, witness), 0
+                elif kind == "polygons":
                     corridor, q.regions_kept = polygon_corridor(planner, path, q.start, q.goal,
                                                                 q.previous)  # fmt: skip
                 else:
@@ -97,14 +103,17 @@ def witness_rescue(
 
     A witness that keeps one cell more than the radius is tried first (its grid path
     stays off the inflated grid's edges, so the corridor has room to turn; its search
-    is capped at 1 s), then one with the exact radius. Both tries share the smoother's
-    time budget, counted from ``t_start``.
+    is capped at 1 s), then one with the exact radius. The polygons of each try are grown
+    around the witness (:func:`witness_corridor`), the boxes around the grid path that
+    follows it. Both tries share the smoother's time budget, counted from ``t_start``.
+    When none gives a curve, ``q.witness_note`` says whether a witness was found.
     """
     sm = planner.smoother
     if sm.kappa_max is None:
         return None
     radius = planner.robot.radius
     grid = planner.grid
+    q.witness_note = "no curvature-bounded path found by the witness search"
     for margin, cap_s in ((grid.resolution, 1.0), (0.0, math.inf)):
         left = sm.time_budget_s - (time.perf_counter() - t_start)
         if left <= 0:
@@ -117,6 +126,7 @@ def witness_rescue(
             cells = None if witness is None else witness_grid_path(witness, q.inflated)
         if cells is None or len(cells) < 2:
             continue
+        q.witness_note = "a curvature-bounded path exists, but no certified curve was fitted along it"
         steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
         length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
         path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
@@ -125,13 +135,31 @@ def witness_rescue(
             return None
         try:
             corridor, smooth = fit_in_corridor(
-                planner, q, path, dataclasses.replace(sm, time_budget_s=left)
+                planner, q, path, dataclasses.replace(sm, time_budget_s=left), witness
             )
         except (SmoothingError, InvalidInputError) as exc2:
             logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
             continue
         return path, corridor, smooth
     return None
+
+
+#: the polygons of a witness rescue are grown around every this-many-th witness point (the
+#: witness is sampled at most an eighth of a cell apart: about every half cell)
+WITNESS_STRIDE = 4
+
+
+def witness_corridor(planner: Any, witness: np.ndarray) -> PolygonCorridor:
+    """Polygons around a curvature witness's own points (m), not centred.
+
+    A witness keeps the exact radius and bends at the curvature bound, often along a wall;
+    the corridor of the grid path that follows it is centred away from the walls and
+    simplified into long segments, and can leave the witness's arcs outside every region
+    (no curvature-bounded curve in it). Grown around about every half cell of the witness,
+    without centring (``centre_cells=0``), the regions follow its arcs.
+    """
+    pts = np.vstack([witness[::WITNESS_STRIDE][:-1], witness[-1:]])
+    return build_polygon_corridor(planner.grid, pts, planner.robot.radius, centre_cells=0.0)
 
 
 def polygon_corridor(

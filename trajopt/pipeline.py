@@ -543,7 +543,10 @@ class Planner:
         except SmoothingError as exc:
             found = witness_rescue(self, q, exc, t_start)
             if found is None:
-                raise
+                if q.witness_note is None:
+                    raise
+                stats = dict(exc.stats, witness=q.witness_note)
+                raise SmoothingError(f"{exc}; witness rescue: {q.witness_note}", stats) from exc
             q.path, q.corridor, smooth = found
             q.rescue = "witness"
         return smooth

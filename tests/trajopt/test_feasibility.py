@@ -203,3 +203,37 @@ def test_planner_without_a_witness_raises_the_smoothers_error():
     planner = Planner(grid, Robot(radius=2.5), smoother=Smoother(kappa_max=0.15, time_budget_s=5))
     with pytest.raises(SmoothingError, match="no certified curve"):
         planner.plan((8.5, 6.0), (26.0, 22.5))
+
+
+# ------------------------------------------------------------------ the planner's rescue
+def test_planner_failure_says_whether_a_witness_exists():
+    # the narrow L-bend: no curvature-bounded path; the planner's error says the witness
+    # search found none (and its stats carry it)
+    grid = _l_bend(6)
+    planner = Planner(grid, Robot(radius=2.5), smoother=Smoother(kappa_max=0.15))
+    with pytest.raises(SmoothingError, match="witness rescue: no curvature-bounded path") as ei:
+        planner.plan((8.5, 6.0), (26.0, 22.5))
+    assert ei.value.stats["witness"].startswith("no curvature-bounded path")
+
+
+@pytest.mark.parametrize(("radius", "start", "goal"), [
+    (2.5, (32.5, 41.5), (27.5, 68.5)),
+    (1.5, (6.5, 58.5), (8.5, 70.5)),
+])
+def test_witness_rescue_grows_its_polygons_around_the_witness(shared_data, radius, start,
+                                                                goal):
+    # den312d, kappa_max = 1 / (2 r): the fit along the A* path fails; the witness hugs the
+    # walls at the exact radius and the corridor of its (centred, simplified) grid path left
+    # its arcs outside every region; polygons grown around the witness itself hold a curve
+    grid = astar.load_map(shared_data / "movingai" / "maps" / "den312d.map")
+    kmax = 1.0 / (2.0 * radius)
+    planner = Planner(grid, Robot(radius=radius), smoother=Smoother(kappa_max=kmax))
+    traj = planner.plan(start, goal)
+    assert traj.stats["smoother"]["rescue"] == "witness"
+    assert traj.stats["corridor"] == "polygons"
+    sp = traj.steps.smooth_path
+    u = np.linspace(*sp.domain, 8000)
+    assert square_clearance(grid, sp(u)).min() >= radius - 1e-9
+    p = sp(u)
+    assert _three_point_curvature(p[::4]).max() <= kmax * 1.01
+    np.testing.assert_allclose(p[[0, -1]], [start, goal], atol=1e-9)
