@@ -91,6 +91,13 @@ BENCHES: tuple[Bench, ...] = (
           "bench_fallback.py",
           "Outcome of every query on the shared maps with and without the fallback.",
           ("--limit-per-map", "10")),
+    Bench("failures", "Failures at scale: default and curvature-bounded planner",
+          "bench_failures.py",
+          "Failures of the default and the curvature-bounded (1/(2r)) planner on the "
+          "shared-full suite and on random queries at several radii; curvature-bounded "
+          "failures classified by a curvature witness; median time of a failing query.",
+          ("--limit", "40", "--random", "40", "--radii", "1.5,2.5"),
+          ("--limit", "400", "--random", "250", "--radii", "1.5,2.5,3.5")),
     Bench("timing_property", "Timing: the speed cap on sharp curvature peaks",
           "timing_property_run.py",
           "Random curves with sharp curvature peaks: worst ratio of the sampled speed to "
