@@ -60,7 +60,8 @@ def fit_in_corridor(
         try:
             with q.timer.stage("corridor"):
                 if kind == "polygons" and witness is not None:
-                    corridor, q.regions_kept = witness_corridor(planner, witness), 0
+                    corridor = witness_corridor(planner.grid, planner.robot.radius, witness)
+                    q.regions_kept = 0
                 elif kind == "polygons":
                     corridor, q.regions_kept = polygon_corridor(planner, path, q.start, q.goal,
                                                                 q.previous)  # fmt: skip
@@ -97,27 +98,33 @@ def fit_in_corridor(
 
 
 def witness_rescue(
-    planner: Any, q: PlanQuery, exc: Exception, t_start: float
-) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath] | None:
-    """Return the second try of a curvature-bounded fit, along a witness; ``None`` if none.
+    planner: Any, q: PlanQuery, exc: SmoothingError, t_start: float
+) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath]:
+    """Return the second try of a curvature-bounded fit, along a witness.
 
     A witness that keeps one cell more than the radius is tried first (its grid path
     stays off the inflated grid's edges, so the corridor has room to turn; its search
     is capped at 1 s), then one with the exact radius. The polygons of each try are grown
     around the witness (:func:`witness_corridor`), the boxes around the grid path that
     follows it. Both tries share the smoother's time budget, counted from ``t_start``.
-    When none gives a curve, ``q.witness_note`` says whether a witness was found.
+
+    Raises
+    ------
+    SmoothingError
+        ``exc`` itself without a curvature bound (no rescue); else, when no try gives a
+        curve, ``exc`` with what the rescue found appended to its message and under
+        ``stats["witness"]``: whether the witness search found a curvature-bounded path.
     """
     sm = planner.smoother
     if sm.kappa_max is None:
-        return None
+        raise exc
     radius = planner.robot.radius
     grid = planner.grid
-    q.witness_note = "no curvature-bounded path found by the witness search"
+    note = "no time left for the witness search"
     for margin, cap_s in ((grid.resolution, 1.0), (0.0, math.inf)):
         left = sm.time_budget_s - (time.perf_counter() - t_start)
         if left <= 0:
-            return None
+            break
         with q.timer.stage("smooth"):
             witness = curvature_witness(
                 grid, radius + margin, q.start, q.goal, sm.kappa_max,
@@ -125,14 +132,16 @@ def witness_rescue(
             )  # fmt: skip
             cells = None if witness is None else witness_grid_path(witness, q.inflated)
         if cells is None or len(cells) < 2:
+            if not note.startswith("a curvature-bounded path exists"):
+                note = "no curvature-bounded path found by the witness search"
             continue
-        q.witness_note = "a curvature-bounded path exists, but no certified curve was fitted along it"
+        note = "a curvature-bounded path exists, but no certified curve was fitted along it"
         steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
         length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
         path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
         left = sm.time_budget_s - (time.perf_counter() - t_start)
         if left <= 0:
-            return None
+            break
         try:
             corridor, smooth = fit_in_corridor(
                 planner, q, path, dataclasses.replace(sm, time_budget_s=left), witness
@@ -141,7 +150,7 @@ def witness_rescue(
             logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
             continue
         return path, corridor, smooth
-    return None
+    raise SmoothingError(f"{exc}; witness rescue: {note}", dict(exc.stats, witness=note)) from exc
 
 
 #: the polygons of a witness rescue are grown around every this-many-th witness point (the
@@ -149,7 +158,9 @@ def witness_rescue(
 WITNESS_STRIDE = 4
 
 
-def witness_corridor(planner: Any, witness: np.ndarray) -> PolygonCorridor:
+def witness_corridor(
+    raw_grid: OccupancyGrid, radius: float, witness: np.ndarray
+) -> PolygonCorridor:
     """Polygons around a curvature witness's own points (m), not centred.
 
     A witness keeps the exact radius and bends at the curvature bound, often along a wall;
@@ -159,7 +170,7 @@ def witness_corridor(planner: Any, witness: np.ndarray) -> PolygonCorridor:
     without centring (``centre_cells=0``), the regions follow its arcs.
     """
     pts = np.vstack([witness[::WITNESS_STRIDE][:-1], witness[-1:]])
-    return build_polygon_corridor(planner.grid, pts, planner.robot.radius, centre_cells=0.0)
+    return build_polygon_corridor(raw_grid, pts, radius, centre_cells=0.0)
 
 
 def polygon_corridor(

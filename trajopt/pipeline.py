@@ -541,13 +541,7 @@ class Planner:
         try:
             q.corridor, smooth = fit_in_corridor(self, q, q.path, self.smoother)
         except SmoothingError as exc:
-            found = witness_rescue(self, q, exc, t_start)
-            if found is None:
-                if q.witness_note is None:
-                    raise
-                stats = dict(exc.stats, witness=q.witness_note)
-                raise SmoothingError(f"{exc}; witness rescue: {q.witness_note}", stats) from exc
-            q.path, q.corridor, smooth = found
+            q.path, q.corridor, smooth = witness_rescue(self, q, exc, t_start)
             q.rescue = "witness"
         return smooth
 

@@ -74,9 +74,6 @@ class PlanQuery:
         The corridor of the smooth path (or of the fallback's polyline).
     rescue : str or None
         ``"witness"`` when the curve came from the witness rescue.
-    witness_note : str or None
-        After a witness rescue that gave no curve: whether the witness search found a
-        curvature-bounded path (the failure's message and ``stats["witness"]`` say it).
     previous : PlanSteps or None
         A re-plan's old steps: the polygon corridor may keep their regions along the rest
         of the path it shares with them (:mod:`trajopt.polygon_corridor.reuse`).
@@ -99,7 +96,6 @@ class PlanQuery:
     path: Any = None
     corridor: PolygonCorridor | Corridor | None = None
     rescue: str | None = None
-    witness_note: str | None = None
     previous: PlanSteps | None = None
     regions_kept: int = 0
     timer: StageTimer = field(default_factory=StageTimer)
