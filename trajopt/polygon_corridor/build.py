@@ -230,9 +230,6 @@ def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> G
     regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
     path_m = np.array([ox, oy]) + res * seed
     path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
-    regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
-    path_m = np.array([ox, oy]) + res * seed
-    path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
     return GrownRegions(regions, hm, vm, nrow, nvs, degen, path_m, seed_src, pts_m,
                         clear_c * res, r, res, (ox, oy))  # fmt: skip
 

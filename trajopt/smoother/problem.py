@@ -95,8 +95,8 @@ class QPData:
     nb: int
     lbx: np.ndarray
     ubx: np.ndarray
-    heading: np.ndarray  # heading rows, shape (4, 2 nb)
-    lba: np.ndarray  # bounds of the heading and region rows, shape (4 + k nb,)
+    heading: np.ndarray  # heading rows, shape (N_HEADING_ROWS = 5, 2 nb)
+    lba: np.ndarray  # bounds of the heading and region rows, shape (5 + k nb,)
     uba: np.ndarray
     k: int = 2  # region rows per control point
     region_coef: np.ndarray | None = None  # their (a_x, a_y), shape (nb, k, 2); None: x +- y
@@ -362,7 +362,6 @@ def objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
     if length > 0:
         band += 2.0 * length * smoothness_band(t, p, n, 1)
     rhs = fidelity * band_rhs(span, vals, pts, n)
-    g = np.zeros(2 * n)
     nb = bucket_size(n)
     g = np.zeros(2 * nb)
     g[:n] = -2.0 * rhs[:, 0]
