@@ -2,8 +2,8 @@
 
 In one run:
 
-1. **Throughput, 1 vs 2 workers** on the same queries: a ``LocalCluster`` of 1 worker
-   process, then one of 2 (one thread each); every worker first plans one warm-up query
+1. **Throughput, 1 vs 2 workers** on the same queries: a local cluster of 1 worker
+   process, then one of 2 (``bench.connect``, one thread each); every worker first plans one warm-up query
    per map (map load and inflation, numba cache load, first CasADi solver builds), then :func:`trajopt.bench.run` is timed from
    the first submission to the last Parquet file. Rows per second and the ratio.
 2. **Kill and resume**: ``trajopt bench run`` (local cluster) in a subprocess, SIGKILL once
@@ -55,13 +55,8 @@ def sources(data: Path, limit: int) -> list[bench.MapQueries]:
 
 
 def timed_run(srcs, methods, workers: int, out: Path, chunk_size: int) -> tuple[float, int]:
-    from distributed import Client, LocalCluster
-
-    from trajopt.bench.runner import worker_env
-
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None, env=worker_env())
-    client = Client(cluster)
+    client = bench.connect("local", workers=workers)  # the command line's local cluster
+    cluster = client.cluster
     try:
         for src in srcs:  # every worker loads every map and plans one query of it, once
             warm = bench.make_chunks([src], methods, set(), 1)[0]

@@ -138,6 +138,15 @@ BENCHES: tuple[Bench, ...] = (
           "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
           "and the report on 10^5 rows.",
           ("--limit", "6")),
+    Bench("harness_scaling", "Benchmark harness: 1 vs 2 workers on shared-small, and why",
+          "bench_harness_scaling.py",
+          "`trajopt bench`'s throughput on `shared-small` with 1 and 2 local Dask workers in "
+          "the same run (3 rounds; measured after the workers' warm-up, and end to end), "
+          "where the workers' time goes (planning, scoring, the rest of the tasks, idle), a "
+          "cProfile of a serial pass, and the machine's own 1-vs-2-process ceiling for the "
+          "same work without Dask. Each measurement waits for other processes to go quiet "
+          "and reports the cores they used meanwhile.",
+          ("--rounds", "3")),
 )
 
 

@@ -260,7 +260,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--scheduler", default="local",
                    help="'local' (LocalCluster, default), 'serial', or tcp://host:8786")
     r.add_argument("--workers", type=int, help="local worker processes (default: cores)")
-    r.add_argument("--chunk-size", type=int, default=4, help="queries per task (default 4)")
+    r.add_argument("--chunk-size", type=int,
+                   help="queries per task (default: at least 8 tasks per worker, at most 4 "
+                   "queries each)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=_cmd_bench_run)
     r = bsub.add_parser(

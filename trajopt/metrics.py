@@ -50,6 +50,7 @@ __all__ = [
     "path_metrics",
     "trajectory_metrics",
     "point_clearance",
+    "min_clearance",
     "distance_to_polyline",
     "hausdorff_distance",
     "polyline_hausdorff",
@@ -273,6 +274,92 @@ def _directed_polyline(a: np.ndarray, b: np.ndarray, spacing: float) -> float:
     return float(distance_to_polyline(pa[keep], b).max())
 
 
+@dataclass(frozen=True, slots=True)
+class _Obstacles:
+    """The occupied squares of a grid that can be nearest to a point, and a KD-tree of them.
+
+    Only occupied cells with a free 8-neighbour or on the map edge can be nearest.
+    ``tree`` is ``None`` when nothing is occupied.
+    """
+
+    centres: np.ndarray
+    tree: Any
+    res: float
+    ox: float
+    oy: float
+    nx: int
+    ny: int
+
+
+#: The last few grids' obstacle trees, each with the grid it was built from (compared with
+#: ``is``, so a cached entry can never belong to another grid).
+_OBSTACLES: list[tuple[Any, _Obstacles]] = []
+_OBSTACLES_KEPT = 4
+
+
+def _obstacles(grid: Any) -> _Obstacles:
+    """Build (or fetch) the :class:`_Obstacles` of a grid.
+
+    An :class:`astar.OccupancyGrid` is immutable (its ``occupied`` is a read-only copy), so
+    its tree is kept for the next call: a benchmark scores every method's path of every
+    query against the same map. Other grid-like objects are rebuilt on every call.
+    """
+    from astar.grid import OccupancyGrid
+
+    cacheable = type(grid) is OccupancyGrid
+    if cacheable:
+        for g, obs in _OBSTACLES:
+            if g is grid:
+                return obs
+    from scipy.ndimage import binary_erosion
+    from scipy.spatial import cKDTree
+
+    occ = np.asarray(grid.occupied, dtype=bool)
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = occ.shape
+    if occ.any():
+        interior = binary_erosion(occ, structure=np.ones((3, 3), bool), border_value=0)
+        iy, ix = np.nonzero(occ & ~interior)
+        centres = np.column_stack([ox + (ix + 0.5) * res, oy + (iy + 0.5) * res])
+        tree = cKDTree(centres)
+    else:
+        centres, tree = np.empty((0, 2)), None
+    obs = _Obstacles(centres, tree, res, ox, oy, nx, ny)
+    if cacheable:
+        _OBSTACLES.insert(0, (grid, obs))
+        del _OBSTACLES[_OBSTACLES_KEPT:]
+    return obs
+
+
+def _square_distance(p: np.ndarray, obs: _Obstacles, d0: np.ndarray) -> np.ndarray:
+    """Exact distance from each point to the nearest obstacle square.
+
+    ``d0`` is each point's distance to the nearest obstacle centre: the nearest square
+    has its centre within ``d0 + res / sqrt(2)``, so the exact point-to-square distance
+    ``hypot(max(0, |dx| - res/2), max(0, |dy| - res/2))`` is evaluated for those only. A
+    point's value depends on that point alone (not on the others passed with it).
+    """
+    out = np.full(len(p), np.inf)
+    if obs.tree is None or not len(p):
+        return out
+    res, centres = obs.res, obs.centres
+    pid, cid = _neighbours_within(obs.tree, p, d0 + res * math.sqrt(0.5) + 1e-12)
+    dx = np.maximum(0.0, np.abs(p[pid, 0] - centres[cid, 0]) - 0.5 * res)
+    dy = np.maximum(0.0, np.abs(p[pid, 1] - centres[cid, 1]) - 0.5 * res)
+    np.minimum.at(out, pid, np.hypot(dx, dy))
+    return out
+
+
+def _border_distance(p: np.ndarray, obs: _Obstacles) -> np.ndarray:
+    """Distance from each point to the outside of the map (0 outside it)."""
+    edge = np.minimum.reduce([
+        p[:, 0] - obs.ox, obs.ox + obs.nx * obs.res - p[:, 0],
+        p[:, 1] - obs.oy, obs.oy + obs.ny * obs.res - p[:, 1],
+    ])
+    return np.maximum(edge, 0.0)
+
+
 def point_clearance(points: np.ndarray, grid: Any, *, border_occupied: bool = False) -> np.ndarray:
     """Exact distance (m) from each point to the nearest occupied cell, cells as squares.
 
@@ -297,32 +384,53 @@ def point_clearance(points: np.ndarray, grid: Any, *, border_occupied: bool = Fa
     KD-tree over their centres gives the nearest centre distance ``d0``; the nearest square
     has its centre within ``d0 + res / sqrt(2)``, so the exact point-to-square distance
     ``hypot(max(0, |dx| - res/2), max(0, |dy| - res/2))`` is evaluated for those only.
+    The tree of an :class:`astar.OccupancyGrid` is kept for the next calls (the last few
+    grids).
     """
-    from scipy.ndimage import binary_erosion
-    from scipy.spatial import cKDTree
-
     p = np.asarray(points, dtype=float).reshape(-1, 2)
-    occ = np.asarray(grid.occupied, dtype=bool)
-    res = float(grid.resolution)
-    ox, oy = (float(v) for v in grid.origin)
-    ny, nx = occ.shape
-    out = np.full(len(p), np.inf)
-    if occ.any() and len(p):
-        interior = binary_erosion(occ, structure=np.ones((3, 3), bool), border_value=0)
-        iy, ix = np.nonzero(occ & ~interior)
-        centres = np.column_stack([ox + (ix + 0.5) * res, oy + (iy + 0.5) * res])
-        tree = cKDTree(centres)
-        d0, _ = tree.query(p)
-        pid, cid = _neighbours_within(tree, p, d0 + res * math.sqrt(0.5) + 1e-12)
-        dx = np.maximum(0.0, np.abs(p[pid, 0] - centres[cid, 0]) - 0.5 * res)
-        dy = np.maximum(0.0, np.abs(p[pid, 1] - centres[cid, 1]) - 0.5 * res)
-        np.minimum.at(out, pid, np.hypot(dx, dy))
+    obs = _obstacles(grid)
+    if obs.tree is not None and len(p):
+        out = _square_distance(p, obs, obs.tree.query(p)[0])
+    else:
+        out = np.full(len(p), np.inf)
     if border_occupied:
-        edge = np.minimum.reduce(
-            [p[:, 0] - ox, ox + nx * res - p[:, 0], p[:, 1] - oy, oy + ny * res - p[:, 1]]
-        )
-        out = np.minimum(out, np.maximum(edge, 0.0))
+        out = np.minimum(out, _border_distance(p, obs))
     return out
+
+
+def min_clearance(points: np.ndarray, grid: Any, *, border_occupied: bool = False) -> float:
+    """``point_clearance(points, grid, border_occupied=...).min()``, bit for bit, faster.
+
+    The distance to a square is at most the distance ``d0`` to its centre and at least
+    ``d0 - res / sqrt(2)``. So the minimum is at most ``m = min(d0)`` (with the border
+    distance), and only the points whose lower bound is within ``m`` (plus a rounding
+    slack) can hold it: the exact distances are evaluated for those points only, exactly
+    as :func:`point_clearance` evaluates them.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2), n >= 1
+    grid : astar.OccupancyGrid
+    border_occupied : bool
+
+    Returns
+    -------
+    float
+        ``inf`` when nothing is occupied (and the border is not).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if not len(p):
+        raise InvalidInputError("min_clearance needs at least one point")
+    obs = _obstacles(grid)
+    edge = _border_distance(p, obs) if border_occupied else np.full(len(p), np.inf)
+    if obs.tree is None:
+        return float(edge.min())
+    d0 = obs.tree.query(p)[0]
+    upper = float(np.minimum(d0, edge).min())  # the answer is at most this
+    lower = np.minimum(d0 - obs.res * math.sqrt(0.5), edge)  # each point's is at least this
+    keep = np.nonzero(lower <= upper + 1e-9 * (1.0 + abs(upper)))[0]
+    exact = _square_distance(p[keep], obs, d0[keep])
+    return float(np.minimum(exact, edge[keep]).min())
 
 
 def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
@@ -434,7 +542,7 @@ def path_metrics(
     curve_line = curve.points if is_poly else xy
     haus = polyline_hausdorff(curve_line, ref, spacing=ds)
 
-    clear = float(point_clearance(geom, grid, border_occupied=border_occupied).min())
+    clear = min_clearance(geom, grid, border_occupied=border_occupied)
     ref_len = float(np.sum(np.hypot(*np.diff(ref, axis=0).T))) if len(ref) > 1 else 0.0
 
     if is_poly:

@@ -83,6 +83,8 @@ def test_serial_rows_are_queries_times_methods(serial, sources):
     assert serial[serial["method"] == "astar"]["ok"].all()
     ok = serial[serial["ok"]]
     assert (ok["n_samples"] > 0).all() and np.isfinite(ok["min_clearance_m"]).all()
+    # every scored row says how long its scoring took (apart from runtime_s)
+    assert (ok["score_s"] > 0).all() and np.isfinite(ok["score_s"]).all()
     traj = serial[serial["method"].str.startswith("trajopt") & serial["ok"]]
     assert len(traj) > 0
     # trajopt's certificate, measured by the independent metric; the stage timings add up
@@ -156,6 +158,86 @@ def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources,
     again = bench.run(src, out, methods=METHODS, scheduler="serial", resume=True,
                       progress=False)
     assert again.rows_written == 0 and again.chunks == 0
+
+
+def _mq(name: str, lengths, resolution: float = 1.0, cells=None) -> bench.MapQueries:
+    """Synthetic map queries (never loaded): optimal lengths, or NaN with end cells."""
+    qs = []
+    for i, length in enumerate(lengths):
+        goal = (1, 0) if cells is None else cells[i]
+        qs.append(bench.Query(f"{name}/scen/{i}", i, 0, (0, 0), goal, length))
+    return bench.MapQueries(f"/nowhere/{name}", name, "scen", 1.0, resolution, tuple(qs))
+
+
+def test_auto_chunk_size_rule():
+    from trajopt.bench.runner import MAX_AUTO_CHUNK, TASKS_PER_WORKER, auto_chunk_size
+
+    assert auto_chunk_size(20, 2) == 1  # shared-small on 2 workers: one query per task
+    assert auto_chunk_size(20, 1) == 2
+    assert auto_chunk_size(10_000, 2) == MAX_AUTO_CHUNK  # large suites: chunks of 4
+    assert auto_chunk_size(3, 16) == 1
+    for n in range(1, 300):
+        for w in (1, 2, 3, 8):
+            k = auto_chunk_size(n, w)
+            assert 1 <= k <= MAX_AUTO_CHUNK
+            if k > 1:  # chunks of several queries only while every worker gets 8 tasks
+                assert math.ceil(n / k) >= TASKS_PER_WORKER * w
+
+
+def test_make_chunks_runs_the_longest_first():
+    nan = math.nan
+    a = _mq("a.map", [5.0, 300.0, 40.0, 300.0, 1.0])
+    b = _mq("b.yaml", [nan] * 4, resolution=0.05,
+            cells=[(10, 0), (400, 300), (0, 2000), (3, 4)])  # octile lengths, 0.05 m cells
+    c = _mq("c.map", [2.0, 3.0])
+    methods = ("astar", "trajopt")
+    done = {("a.map/scen/1", "trajopt"), ("c.map/scen/0", "astar"), ("c.map/scen/0", "trajopt")}
+    chunks = bench.make_chunks([c, b, a], methods, done, 2)
+    # every pair not done, exactly once; chunks of <= 2 queries of one map
+    pairs = [(q.query_id, m) for ch in chunks for q, ms in ch.work for m in ms]
+    want = {(q.query_id, m) for mq in (a, b, c) for q in mq.queries for m in methods} - done
+    assert len(pairs) == len(set(pairs)) and set(pairs) == want
+    assert all(1 <= len(ch.work) <= 2 for ch in chunks)
+    assert all(ch.maps.map_name == ch.work[0][0].query_id.split("/")[0] for ch in chunks)
+    # maps one after the other, the costliest first
+    names = [ch.maps.map_name for ch in chunks]
+    order = list(dict.fromkeys(names))
+    assert order == ["a.map", "b.yaml", "c.map"]
+    assert names == sorted(names, key=order.index)
+    totals = [sum(ch.cost for ch in chunks if ch.maps.map_name == m) for m in order]
+    assert totals == sorted(totals, reverse=True)
+    # within a map, the longest query first (pairs already done count less); ties in order
+    flat_a = [q.query_id for ch in chunks if ch.maps is a for q, _ in ch.work]
+    assert flat_a == ["a.map/scen/3", "a.map/scen/1", "a.map/scen/2", "a.map/scen/0",
+                      "a.map/scen/4"]
+    flat_b = [q.index for ch in chunks if ch.maps is b for q, _ in ch.work]
+    assert flat_b == [2, 1, 0, 3]  # 2000 cells, then 400 x 300 (octile 524), 10, 5
+    assert bench.runner.query_cost(b.queries[1], 0.05) == pytest.approx(
+        25 + 0.05 * (400 + (math.sqrt(2) - 1) * 300))
+    assert chunks[0].cost == pytest.approx(2 * (25 + 300) + 1 * (25 + 300))
+
+
+def test_run_reports_warm_up_wall_time_and_chunk_size(sources, tmp_path):
+    from trajopt.bench.runner import auto_chunk_size
+
+    res = bench.run([sources[0]], tmp_path / "a", methods=["astar", "bspline-fit"],
+                    scheduler="serial", progress=False)
+    assert res.chunk_size == auto_chunk_size(3, 1) and res.chunks == 3
+    assert res.warm_up_s > 0 and res.wall_s >= res.elapsed_s + res.warm_up_s
+    res = bench.run([sources[0]], tmp_path / "b", methods=["astar"], scheduler="serial",
+                    progress=False, warm_up=False, chunk_size=2)
+    assert res.warm_up_s == 0 and res.chunk_size == 2 and res.chunks == 2
+    with pytest.raises(BenchmarkError, match="chunk_size must be an integer >= 1"):
+        bench.run([sources[0]], tmp_path / "c", methods=["astar"], scheduler="serial",
+                  chunk_size=0, progress=False)
+
+
+def test_warm_up_plans_and_scores_every_method_once():
+    from trajopt.bench.methods import warm_up
+
+    assert warm_up(["astar", "bspline-fit", "trajopt"]) > 0
+    with pytest.raises(BenchmarkError, match="method 'rrt' is unknown"):
+        warm_up("astar,rrt")
 
 
 def test_half_written_chunk_is_never_read(sources, tmp_path):

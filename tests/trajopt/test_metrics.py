@@ -141,6 +141,67 @@ def test_clearance_border_occupied() -> None:
     )
 
 
+def _brute_clearance(pts, occ, res, origin):
+    iy, ix = np.nonzero(occ)
+    cx = origin[0] + (ix + 0.5) * res
+    cy = origin[1] + (iy + 0.5) * res
+    dx = np.maximum(0, np.abs(pts[:, None, 0] - cx[None]) - 0.5 * res)
+    dy = np.maximum(0, np.abs(pts[:, None, 1] - cy[None]) - 0.5 * res)
+    return np.hypot(dx, dy).min(axis=1) if len(cx) else np.full(len(pts), np.inf)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("border", [False, True])
+def test_min_clearance_is_the_minimum_of_point_clearance_exactly(seed, border) -> None:
+    # min_clearance evaluates the exact distance for a few points only: its value must be
+    # point_clearance(...).min() bit for bit, and match brute force; paths along walls,
+    # across cells and outside the map, on sparse, dense and empty grids
+    rng = np.random.default_rng(seed)
+    density = [0.0, 0.02, 0.15, 0.5, 0.9, 0.15][seed]
+    occ = rng.random((30, 25)) < density
+    g = OccupancyGrid(occ, 0.05, (-0.3, 0.2))
+    walk = np.cumsum(rng.normal(scale=0.02, size=(400, 2)), axis=0) + [0.3, 1.0]
+    pts = np.vstack([walk, rng.uniform([-0.5, 0.0], [1.2, 1.9], (50, 2))])
+    pc = metrics.point_clearance(pts, g, border_occupied=border)
+    mc = metrics.min_clearance(pts, g, border_occupied=border)
+    assert mc == pc.min()
+    brute = _brute_clearance(pts, occ, 0.05, (-0.3, 0.2))
+    if border:
+        edge = np.minimum.reduce([pts[:, 0] + 0.3, 0.95 - pts[:, 0], pts[:, 1] - 0.2,
+                                  1.7 - pts[:, 1]])
+        brute = np.minimum(brute, np.maximum(edge, 0.0))
+    assert mc == pytest.approx(brute.min(), abs=1e-12) or (math.isinf(mc) and
+                                                          math.isinf(brute.min()))
+    for i in range(0, len(pts), 37):  # one point alone: the same value
+        assert metrics.min_clearance(pts[i:i + 1], g, border_occupied=border) == pc[i]
+
+
+def test_clearance_tree_is_kept_per_grid_object_only() -> None:
+    # the obstacle tree of an OccupancyGrid is reused; another grid (even with an equal
+    # shape) never gets it, and a grid-like object that is not an OccupancyGrid is never
+    # cached (its array could change)
+    pts = np.array([[0.55, 0.8]])
+    a = _one_cell_grid(5, 5)
+    b = _one_cell_grid(5, 2)
+    assert metrics.min_clearance(pts, a) == pytest.approx(0.2)
+    assert metrics.min_clearance(pts, b) == pytest.approx(0.5)
+    assert metrics.min_clearance(pts, a) == pytest.approx(0.2)
+
+    class Loose:
+        resolution, origin = 0.1, (0.0, 0.0)
+
+        def __init__(self):
+            self.occupied = np.zeros((20, 20), bool)
+
+    g = Loose()
+    g.occupied[5, 5] = True
+    assert metrics.point_clearance(pts, g)[0] == pytest.approx(0.2)
+    g.occupied[5, 5], g.occupied[7, 5] = False, True  # square [0.5, 0.6] x [0.7, 0.8]
+    assert metrics.point_clearance(pts, g)[0] == pytest.approx(0.0)
+    with pytest.raises(InvalidInputError, match="at least one point"):
+        metrics.min_clearance(np.empty((0, 2)), a)
+
+
 def test_collision_flag_uses_the_radius() -> None:
     g = _one_cell_grid(10, 10)  # square [1.0, 1.1] x [1.0, 1.1]
     line = Line([0.0, 1.3], [2.0, 1.3])  # 0.2 m above the square

@@ -55,7 +55,7 @@ COLUMNS: dict[str, str] = {
     "ratio_jerk": _FLT, "ratio_omega": _FLT, "ratio_a_lat": _FLT,
     "fallback_used": _BOOL, "corridor": _STR,
     # compute times (s) and where the row was computed
-    "runtime_s": _FLT, "reference_search_s": _FLT, "stage_inflate_s": _FLT,
+    "runtime_s": _FLT, "reference_search_s": _FLT, "score_s": _FLT, "stage_inflate_s": _FLT,
     "stage_search_s": _FLT, "stage_corridor_s": _FLT, "stage_smooth_s": _FLT,
     "stage_timing_s": _FLT, "stage_fallback_s": _FLT, "stage_total_s": _FLT,
     "worker": _STR,

@@ -24,7 +24,9 @@ Methods (:data:`METHODS`):
   ``pmp-bspline``, ``pmp-cubic``.
 
 A worker process keeps the context of the last maps it saw (:func:`map_context`), so a
-chunk of queries on one map loads and inflates the map once.
+chunk of queries on one map loads and inflates the map once; :func:`warm_up` pays a
+process's one-time costs (imports, numba kernel loads, solver plugins) before a run's clock
+starts.
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ __all__ = [
     "map_context",
     "check_methods",
     "evaluate_query",
+    "warm_up",
 ]
 
 #: Stage names of :class:`trajopt.Planner` copied into ``stage_<name>_s`` columns.
@@ -74,6 +77,9 @@ class MethodOutput:
         Columns of the row this method fills (``duration_s``, ``stage_smooth_s``, ...).
     runtime_s : float or None
         Compute time (s); default the wall time of the call.
+    score_s : float
+        Time the method spent scoring its own output (s): the trajopt variants'
+        :func:`~trajopt.metrics.trajectory_metrics`; not part of ``runtime_s``.
     """
 
     path: Any
@@ -81,6 +87,7 @@ class MethodOutput:
     note: str = ""
     extras: Mapping[str, Any] = field(default_factory=dict)
     runtime_s: float | None = None
+    score_s: float = 0.0
 
 
 @dataclass
@@ -222,7 +229,9 @@ def _trajopt(variant: str) -> MethodFn:
         runtime = time.perf_counter() - t0
         stats = traj.stats
         stages = stats.get("stages_s", {})
+        t1 = time.perf_counter()
         timed = trajectory_metrics(traj, planner.robot)
+        score = time.perf_counter() - t1
         extras: dict[str, Any] = {k: float(timed[k]) for k in TIMED if k in timed}
         extras.update({f"stage_{k}_s": float(stages[k]) for k in STAGES if k in stages})
         extras["fallback_used"] = bool(stats.get("fallback"))
@@ -230,7 +239,7 @@ def _trajopt(variant: str) -> MethodFn:
         note = ""
         if stats.get("fallback"):
             note = f"fallback after {stats.get('fallback_error')}: {stats.get('fallback_reason')}"
-        return MethodOutput(traj.path, True, note, extras, runtime)
+        return MethodOutput(traj.path, True, note, extras, runtime, score)
 
     return run
 
@@ -341,7 +350,10 @@ def evaluate_query(mctx: MapContext, start: tuple[int, int], goal: tuple[int, in
 
     Each dict holds ``method``, ``ok``, ``valid``, ``failure`` (the error type, ``""``
     when ok), ``note``, every :class:`trajopt.metrics.PathMetrics` field, ``runtime_s``,
-    ``reference_search_s`` and what the method adds (``duration_s``, ``stage_*_s``, ...).
+    ``reference_search_s``, ``score_s`` (the time spent scoring this method's output:
+    :func:`~trajopt.metrics.path_metrics` and, for the trajopt variants,
+    :func:`~trajopt.metrics.trajectory_metrics`) and what the method adds
+    (``duration_s``, ``stage_*_s``, ...).
     When the reference search fails (an end point blocked for the radius, or no path),
     every method gets that failure: the query is infeasible for the robot.
     """
@@ -391,14 +403,66 @@ def evaluate_query(mctx: MapContext, start: tuple[int, int], goal: tuple[int, in
             rows.append(row)
             continue
         runtime = out.runtime_s if out.runtime_s is not None else time.perf_counter() - t1
+        t2 = time.perf_counter()
         if out.path is None:
             metrics = _nan_metrics(spacing)
         else:
             metrics = path_metrics(out.path, grid=mctx.grid, reference=qctx.reference,
                                    radius=mctx.radius, sample_spacing=spacing,
                                    border_occupied=True).as_dict()
+        score = float(out.score_s) + (time.perf_counter() - t2)
         ok = bool(out.valid and out.path is not None)
         row.update(ok=ok, valid=bool(out.valid), failure="" if ok else "InvalidResult",
-                   note=out.note, runtime_s=float(runtime), **metrics, **dict(out.extras))
+                   note=out.note, runtime_s=float(runtime), score_s=score, **metrics,
+                   **dict(out.extras))
         rows.append(row)
     return rows
+
+
+def warm_up(methods: object = None) -> float:
+    """Pay a process's one-time costs: plan and score one small query with every method.
+
+    The first query of a fresh process spends most of its time on costs no later query
+    pays (imports of numba, SciPy and CasADi, numba kernels loaded from the disk cache,
+    CasADi's solver plugins, the metrics' SciPy modules:
+    ``python benchmarks/bench_first_call.py``). This runs :func:`evaluate_query` with every
+    method but the peers on the small built-in map of :func:`trajopt.warm_up.warm_up_map`
+    (a wall with a gap), so those costs are paid here; the peers' modules are imported
+    only (a peer run takes its whole time budget). :func:`trajopt.bench.run` calls it on
+    every worker before its clock starts.
+
+    What it cannot pay ahead: loading and inflating the benchmark's own maps, and the
+    solver builds of problem sizes first met on them (the curvature-bounded smoother
+    builds an IPOPT problem per new size).
+
+    Parameters
+    ----------
+    methods : sequence of str or comma-separated str, optional
+        Default :data:`DEFAULT_METHODS`.
+
+    Returns
+    -------
+    float
+        Wall time (s).
+    """
+    t0 = time.perf_counter()
+    import importlib
+
+    import astar
+    from trajopt.pipeline import Planner
+    from trajopt.warm_up import warm_up_map
+
+    names = check_methods(DEFAULT_METHODS if methods is None else methods)
+    planner = Planner(astar.OccupancyGrid(np.zeros((2, 2), dtype=bool), 1.0))
+    grid, start, goal = warm_up_map(planner)
+    radius = float(planner.robot.radius)
+    inflated = astar.inflate(grid, radius, metric="square", outside_occupied=True)
+    mctx = MapContext(grid, radius, inflated)
+    cells = [tuple(int(v) for v in grid.world_to_cell(p)) for p in (start, goal)]
+    local = tuple(m for m in names if METHODS[m].family != "peer")
+    if local:
+        evaluate_query(mctx, cells[0], cells[1], local)  # type: ignore[arg-type]
+    for m in names:
+        for mod in METHODS[m].requires:
+            importlib.import_module(mod)
+    return time.perf_counter() - t0

@@ -3,7 +3,10 @@
 :func:`run` checks everything first (maps and scenario files were checked when the
 :class:`~trajopt.bench.suites.MapQueries` were made; here the methods, the scheduler
 address and the dataset folder), then cuts the (query, method) pairs the dataset does not
-hold yet into :class:`Chunk` tasks of ``chunk_size`` queries of one map, and submits them:
+hold yet into :class:`Chunk` tasks of ``chunk_size`` queries of one map
+(:func:`make_chunks`; by default :func:`auto_chunk_size`: at least
+:data:`TASKS_PER_WORKER` tasks per worker, at most :data:`MAX_AUTO_CHUNK` queries each),
+longest first, and submits them:
 
 * ``scheduler="local"`` (default): a :class:`distributed.LocalCluster` of ``workers``
   processes (default one per core, one thread each) started for the run and closed after;
@@ -12,6 +15,12 @@ hold yet into :class:`Chunk` tasks of ``chunk_size`` queries of one map, and sub
 * ``scheduler="tcp://host:8786"`` (any Dask address): an existing scheduler (its workers
   need ``trajopt`` installed and the map files at the same paths);
 * ``scheduler="serial"``: in this process, no Dask (the reference for the tests).
+
+Before the clock starts, every worker (or this process, for ``"serial"``) runs
+:func:`~trajopt.bench.methods.warm_up`: one small query with every method, which pays
+the process's imports, numba kernel loads and solver plugin loads (about 1-3 s in a fresh
+process; ``warm_up=False`` leaves them in the measured time). :class:`RunSummary` reports
+the measured time (``elapsed_s``), the warm-up and the end-to-end wall time apart.
 
 A worker runs a chunk with :func:`run_chunk` (the map is loaded and inflated once per
 worker, :func:`~trajopt.bench.methods.map_context`); the client writes each finished
@@ -39,9 +48,42 @@ from trajopt.bench.methods import check_methods, evaluate_query, map_context
 from trajopt.bench.suites import MapQueries, Query
 from trajopt.errors import BenchmarkError
 
-__all__ = ["Chunk", "RunSummary", "run", "run_chunk", "make_chunks", "connect"]
+__all__ = [
+    "Chunk",
+    "RunSummary",
+    "run",
+    "run_chunk",
+    "make_chunks",
+    "auto_chunk_size",
+    "query_cost",
+    "connect",
+    "TASKS_PER_WORKER",
+    "MAX_AUTO_CHUNK",
+    "LOCAL_DASK_CONFIG",
+]
 
 logger = logging.getLogger(__name__)
+
+#: :func:`auto_chunk_size` makes at least this many tasks per worker (when there are
+#: enough queries), so that the last tasks to finish are short and no worker idles long.
+TASKS_PER_WORKER = 8
+#: ... and at most this many queries per task (fewer tasks and files on large suites).
+MAX_AUTO_CHUNK = 4
+#: Dask settings of the local cluster (:func:`connect`). Its periodic monitors (each
+#: worker's statistical profiler every 10 ms, the memory monitor every 100 ms, the event-loop
+#: tick every 20 ms, the system monitor every 500 ms) feed a dashboard the local cluster
+#: does not start, and took 0.14 of a core with 2 idle workers on the 2-core machine (0.016
+#: with these settings): time taken from the workers when every core runs one.
+LOCAL_DASK_CONFIG: dict[str, Any] = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+}
+#: Fixed part of :func:`query_cost`, in metres of path: a short query still costs the
+#: reference search, the corridor, the fits and the scoring of every method (about as
+#: much as 25 m of trajectory, measured on ``shared-small``).
+_COST_FIXED_M = 25.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,6 +109,11 @@ class Chunk:
         """Rows this chunk writes."""
         return sum(len(m) for _, m in self.work)
 
+    @property
+    def cost(self) -> float:
+        """Estimated compute cost (:func:`query_cost` x methods, summed; no unit)."""
+        return sum(query_cost(q, self.maps.resolution_m) * len(m) for q, m in self.work)
+
 
 @dataclass(frozen=True, slots=True)
 class RunSummary:
@@ -85,9 +132,17 @@ class RunSummary:
     chunks : int
         Chunks run by this call.
     elapsed_s : float
-        Wall time of the computation (s), from the first submission to the last file.
+        Wall time of the computation (s), from the first submission to the last file:
+        the workers' warm-up is not in it (``warm_up_s``).
     workers : int
         Worker processes (1 for ``"serial"``).
+    warm_up_s : float
+        Wall time of the warm-up of every worker before the clock (s; 0 without it).
+    wall_s : float
+        End-to-end wall time of the call (s): checks, starting and closing a local
+        cluster, the warm-up and the computation.
+    chunk_size : int
+        Queries per chunk used.
     """
 
     out: Path
@@ -97,28 +152,65 @@ class RunSummary:
     chunks: int
     elapsed_s: float
     workers: int
+    warm_up_s: float = 0.0
+    wall_s: float = 0.0
+    chunk_size: int = 0
+
+
+def query_cost(q: Query, resolution_m: float) -> float:
+    """Estimate the compute cost of one (query, method) pair roughly, to run long ones first.
+
+    ``25 + L``, with ``L`` the path length in metres: the scenario's optimal length
+    when known, else the octile distance between the end cells. The timing and the
+    trajectory metrics, which dominate long queries, grow with the trajectory's duration,
+    i.e. with its length in metres; the constant stands for the per-query costs.
+    """
+    length = q.optimal_length_cells
+    if not math.isfinite(length):
+        dx, dy = abs(q.goal[0] - q.start[0]), abs(q.goal[1] - q.start[1])
+        length = max(dx, dy) + (math.sqrt(2.0) - 1.0) * min(dx, dy)
+    return _COST_FIXED_M + float(length) * float(resolution_m)
+
+
+def auto_chunk_size(n_queries: int, n_workers: int) -> int:
+    """Return the queries per chunk when none is given.
+
+    ``n_queries // (TASKS_PER_WORKER * n_workers)`` clipped to ``[1, MAX_AUTO_CHUNK]``:
+    many small tasks balance the workers (``shared-small``, 20 queries, on 2 workers: one
+    query per task); large suites keep chunks of 4 queries.
+    """
+    return max(1, min(MAX_AUTO_CHUNK, n_queries // (TASKS_PER_WORKER * max(1, n_workers))))
 
 
 def make_chunks(sources: Sequence[MapQueries], methods: Sequence[str],
                 done: set[tuple[str, str]], chunk_size: int) -> list[Chunk]:
-    """Cut the (query, method) pairs not in ``done`` into chunks.
+    """Cut the (query, method) pairs not in ``done`` into chunks, in the order to run them.
 
-    Cut the (query, method) pairs not in ``done`` into chunks of ``chunk_size`` queries of one
-    map (in map order, then query order).
+    Chunks hold ``chunk_size`` queries of one map. The order is longest first at two
+    levels (by :func:`query_cost`), so the last tasks to finish are short: the maps by
+    their total cost, and within a map the queries (ties in query order), cut into chunks
+    in that order. A worker thus moves from map to map and loads each at most once
+    while the maps' chunks last, and the last chunks are the cheapest map's shortest
+    queries. Chunk ids hash the work, so a chunk's file is the same in every run that
+    cuts it the same way.
     """
-    chunks: list[Chunk] = []
-    for mq in sources:
+    per_map: list[tuple[float, int, list[Chunk]]] = []
+    for k, mq in enumerate(sources):
         todo = []
         for q in mq.queries:
             ms = tuple(m for m in methods if (q.query_id, m) not in done)
             if ms:
                 todo.append((q, ms))
+        todo.sort(key=lambda w: -query_cost(w[0], mq.resolution_m) * len(w[1]))  # stable
+        chunks: list[Chunk] = []
         for i in range(0, len(todo), chunk_size):
             work = tuple(todo[i:i + chunk_size])
             h = hashlib.sha1(repr([(q.query_id, ms) for q, ms in work]).encode()).hexdigest()
             stem = Path(mq.map_name).stem.replace(" ", "_")
             chunks.append(Chunk(f"{stem}-{h[:12]}", mq, work))
-    return chunks
+        per_map.append((sum(c.cost for c in chunks), k, chunks))
+    per_map.sort(key=lambda t: (-t[0], t[1]))
+    return [c for _, _, chunks in per_map for c in chunks]
 
 
 def run_chunk(chunk: Chunk) -> list[dict[str, Any]]:
@@ -173,7 +265,8 @@ def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10
     """Return a :class:`distributed.Client` for ``scheduler`` (``"local"`` or an address).
 
     With ``"local"`` the client owns a new :class:`distributed.LocalCluster` of
-    ``workers`` processes (default ``os.cpu_count()``), closed with the client
+    ``workers`` processes (default ``os.cpu_count()``, one thread each, no dashboard, the
+    quiet monitors of :data:`LOCAL_DASK_CONFIG`), closed with the client
     (``client.close(); client.cluster.close()``).
 
     Raises
@@ -181,16 +274,18 @@ def connect(scheduler: str, *, workers: int | None = None, timeout_s: float = 10
     BenchmarkError
         Malformed address, or no scheduler answering at it within ``timeout_s``.
     """
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler == "local":
         _quiet_dask()
         n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-            silence_logs=logging.ERROR, env=worker_env(),
-        )
-        return Client(cluster)
+        with dask.config.set(LOCAL_DASK_CONFIG):  # the workers get it when they start
+            cluster = LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=logging.ERROR, env=worker_env(),
+            )
+            return Client(cluster)
     if "://" not in scheduler or not scheduler.split("://", 1)[1]:
         raise BenchmarkError(
             f"scheduler must be 'local', 'serial' or a Dask address like "
@@ -211,12 +306,13 @@ def run(
     methods: Sequence[str] | str | None = None,
     scheduler: str = "local",
     workers: int | None = None,
-    chunk_size: int = 4,
+    chunk_size: int | None = None,
     resume: bool = False,
     retries: int = 2,
     progress: bool = True,
     client: Any = None,
     connect_timeout_s: float = 10.0,
+    warm_up: bool = True,
 ) -> RunSummary:
     """Run ``methods`` on every query of ``sources`` and write the rows to ``out``.
 
@@ -234,8 +330,9 @@ def run(
         ``"local"``, ``"serial"`` or a Dask scheduler address (module docstring).
     workers : int, optional
         Worker processes of the local cluster (default one per core).
-    chunk_size : int
-        Queries per task (>= 1).
+    chunk_size : int, optional
+        Queries per task (>= 1); default :func:`auto_chunk_size` of the queries to run
+        and the workers.
     resume : bool
         Skip the (query, method) pairs ``out`` already holds.
     retries : int
@@ -246,6 +343,9 @@ def run(
         Use this client instead of ``scheduler`` (not closed).
     connect_timeout_s : float
         How long to wait for a remote scheduler (s).
+    warm_up : bool
+        Run :func:`~trajopt.bench.methods.warm_up` on every worker before the clock
+        starts (``RunSummary.warm_up_s``).
 
     Returns
     -------
@@ -260,7 +360,9 @@ def run(
         A peer method whose package is missing.
     """
     from trajopt.bench.methods import DEFAULT_METHODS
+    from trajopt.bench.methods import warm_up as warm_up_worker
 
+    t_call = time.perf_counter()
     names = check_methods(DEFAULT_METHODS if methods is None else methods)
     srcs = list(sources)
     if not srcs or not any(mq.queries for mq in srcs):
@@ -268,7 +370,8 @@ def run(
     ids = [q.query_id for mq in srcs for q in mq.queries]
     if len(set(ids)) != len(ids):
         raise BenchmarkError("query ids must be unique: a map and source appear twice")
-    for nm, v, lo in (("chunk_size", chunk_size, 1), ("retries", retries, 0),
+    for nm, v, lo in (("chunk_size", 1 if chunk_size is None else chunk_size, 1),
+                      ("retries", retries, 0),
                       ("workers", 1 if workers is None else workers, 1)):
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise BenchmarkError(f"{nm} must be an integer >= {lo}, got {v!r}")
@@ -277,41 +380,55 @@ def run(
             f"scheduler must be 'local', 'serial' or a Dask address like 'tcp://host:8786', "
             f"got {scheduler!r}"
         )
+    serial = client is None and scheduler == "serial"
     own_client = None
     if client is None and scheduler not in ("serial", "local"):
         own_client = connect(scheduler, timeout_s=connect_timeout_s)  # fail before writing
+    warm_s = 0.0
     try:
         d = prepare(out, {"radius_m": {mq.map_name: mq.radius_m for mq in srcs}}, resume=resume)
         done = existing_keys(d) if resume else set()
         expected = len(ids) * len(names)
         skipped = sum(1 for i in ids for m in names if (i, m) in done)
-        chunks = make_chunks(srcs, names, done, chunk_size)
+        n_todo = sum(1 for i in ids if any((i, m) not in done for m in names))
+        n_workers = 1
+        cl = None
+        if not serial and n_todo:
+            if client is None and own_client is None:
+                own_client = connect("local", workers=workers)
+            cl = client if client is not None else own_client
+            n_workers = max(1, len(cl.scheduler_info()["workers"]))
+        size = chunk_size if chunk_size is not None else auto_chunk_size(n_todo, n_workers)
+        chunks = make_chunks(srcs, names, done, size)
+        if warm_up and chunks:
+            t_warm = time.perf_counter()
+            if cl is None:
+                warm_up_worker(names)
+            else:
+                cl.run(warm_up_worker, names)  # every worker, in parallel; waits for all
+            warm_s = time.perf_counter() - t_warm
         from tqdm.auto import tqdm
 
         bar = tqdm(total=expected, initial=skipped, unit="row", desc="bench",
                    disable=not progress, file=sys.stderr, dynamic_ncols=True)
         written = 0
-        n_workers = 1
         t0 = time.perf_counter()
         try:
-            if client is None and scheduler == "serial":
+            if cl is None:
                 for ch in chunks:
                     rows = run_chunk(ch)
                     write_chunk(d, ch.chunk_id, rows)
                     written += len(rows)
                     bar.update(len(rows))
             elif chunks:
-                if client is None and own_client is None:
-                    own_client = connect("local", workers=workers)
-                cl = client if client is not None else own_client
                 from distributed import as_completed
 
-                n_workers = max(1, len(cl.scheduler_info()["workers"]))
-                t0 = time.perf_counter()
+                # make_chunks' order (longest first) as Dask priorities: a queued task
+                # with a higher priority is handed to the next free worker first
                 futures = {
                     cl.submit(run_chunk, ch, key=f"trajopt-bench-{ch.chunk_id}",
-                              retries=retries, pure=False): ch
-                    for ch in chunks
+                              retries=retries, pure=False, priority=len(chunks) - k): ch
+                    for k, ch in enumerate(chunks)
                 }
                 for fut in as_completed(futures):
                     ch = futures[fut]
@@ -335,4 +452,5 @@ def run(
             f"(queries x methods)"
         )
     return RunSummary(Path(d), expected, skipped, written, len(chunks),
-                      elapsed if math.isfinite(elapsed) else 0.0, n_workers)
+                      elapsed if math.isfinite(elapsed) else 0.0, n_workers, warm_s,
+                      time.perf_counter() - t_call, size)
