@@ -230,6 +230,32 @@ def test_distance_to_polyline_matches_brute_force() -> None:
     np.testing.assert_allclose(metrics.distance_to_polyline(p, v), brute, atol=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_polyline_hausdorff_is_the_maximum_over_every_densified_point(seed) -> None:
+    # the coarse-then-fine filter may skip points, but never one that holds the maximum:
+    # the result equals the exact distance of every densified point, maximised, bit for bit
+    # (and brute force); a curve near the reference, one far off, and the reference itself
+    rng = np.random.default_rng(seed)
+    ref = np.cumsum(rng.choice([-1.0, 0.0, 1.0], size=(60, 2)), axis=0) * 0.1
+    curve = [ref + rng.normal(scale=0.03, size=ref.shape), ref + [0.0, 0.5], ref.copy(),
+             np.c_[np.linspace(-1, 1, 300), np.sin(np.linspace(0, 9, 300))],
+             ref[::-1] + rng.normal(scale=0.2, size=ref.shape)][seed]
+    spacing = 0.005
+    got = metrics.polyline_hausdorff(curve, ref, spacing=spacing)
+    want = 0.0
+    for a, b in ((curve, ref), (ref, curve)):
+        pa = metrics._densify(a, spacing)
+        exact = metrics.distance_to_polyline(pa, b)
+        want = max(want, float(exact.max()))
+        seg0, seg = b[:-1], np.diff(b, axis=0)
+        dd = np.sum(seg * seg, -1)  # 0 for a repeated vertex
+        w = np.sum((pa[:, None] - seg0) * seg, -1)
+        t = np.clip(np.divide(w, dd, out=np.zeros_like(w), where=dd > 0), 0, 1)
+        brute = np.linalg.norm(pa[:, None] - (seg0 + t[..., None] * seg), axis=-1).min(axis=1)
+        np.testing.assert_allclose(exact, brute, atol=1e-12)
+    assert got == want
+
+
 def test_offset_line_mse_hausdorff_and_end_errors() -> None:
     ref = np.c_[np.linspace(0, 1, 11), np.zeros(11)]
     line = Line([0.0, 0.04], [1.0, 0.04])
