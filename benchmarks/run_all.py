@@ -145,7 +145,11 @@ BENCHES: tuple[Bench, ...] = (
           "where the workers' time goes (planning, scoring, the rest of the tasks, idle), a "
           "cProfile of a serial pass, and the machine's own 1-vs-2-process ceiling for the "
           "same work without Dask. Each measurement waits for other processes to go quiet "
-          "and reports the cores they used meanwhile.",
+          "and reports the cores they used meanwhile (a round where they used more than "
+          "0.15 cores is not counted and is repeated). On this 2-vCPU VM the host's speed "
+          "drifts by tens of per cent from minute to minute (the fixed loop's time), so a "
+          "single round's ratio moves by about as much: read the quiet rounds' median and "
+          "the per-run split.",
           ("--rounds", "3")),
 )
 
