@@ -155,4 +155,7 @@ def squared_distances(occupied: np.ndarray, metric: Literal["centre", "square"])
         raise ValueError(f"occupied must be 2-D, got shape {occ.shape}")
     if metric not in ("centre", "square"):
         raise ValueError(f"metric must be 'centre' or 'square', got {metric!r}")
+    if occ.flags.writeable:  # read-only either way: one compiled signature (no copy)
+        occ = occ.view()
+        occ.flags.writeable = False
     return _transform(occ, metric == "square")

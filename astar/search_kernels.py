@@ -53,7 +53,8 @@ def stack_push(stk, ssize, scap, v):  # pragma: no cover - compiled
     if ssize == scap:
         scap *= 2
         ns = np.empty(scap, dtype=np.int32)
-        ns[:ssize] = stk[:ssize]
+        for i in range(ssize):  # a loop, not a slice copy: no shape-mismatch error code
+            ns[i] = stk[i]
         stk = ns
     stk[ssize] = v
     return stk, ssize + 1, scap
@@ -67,9 +68,10 @@ def heap_push(hf, hg, hn, size, cap, fnew, gnew, v):  # pragma: no cover - compi
         nf = np.empty(cap, dtype=np.float64)
         ng = np.empty(cap, dtype=np.float64)
         nn = np.empty(cap, dtype=np.int32)
-        nf[:size] = hf[:size]
-        ng[:size] = hg[:size]
-        nn[:size] = hn[:size]
+        for i in range(size):  # a loop, not slice copies: no shape-mismatch error code
+            nf[i] = hf[i]
+            ng[i] = hg[i]
+            nn[i] = hn[i]
         hf = nf
         hg = ng
         hn = nn
@@ -265,7 +267,10 @@ def _jump_diag(free, n, dh, dv, w, goal):  # pragma: no cover - numba
             return -1
         if n == goal:
             return n
-        if _jump_straight(free, n, dh, w, goal) >= 0 or _jump_straight(free, n, dv, 1, goal) >= 0:
+        if (
+            _jump_straight(free, n, dh, w, goal) >= 0
+            or _jump_straight(free, n, dv, np.int64(1), goal) >= 0  # not a literal 1
+        ):
             return n
 
 
@@ -312,11 +317,14 @@ def jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
     expanded = 0
     found = False
     while size > 0 or ssize > 0:
+        # u as int64 (the open lists hold int32): _jump_straight and _jump_diag then have
+        # one compiled signature each
         if ssize > 0:
             ssize -= 1
-            u = stk[ssize]
+            u = np.int64(stk[ssize])
         else:
-            u, fcur, size = heap_pop(hf, hg, hn, size)
+            u32, fcur, size = heap_pop(hf, hg, hn, size)
+            u = np.int64(u32)
         if rec[4 * u] == closed:
             continue
         rec[4 * u] = closed
@@ -338,7 +346,7 @@ def jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
                 dv = sdv[k]
                 if k < 4:
                     if free[u + dh + dv] != 0:
-                        v = _jump_straight(free, u, dh + dv, 1 if dh == 0 else w, goal)
+                        v = _jump_straight(free, u, dh + dv, np.int64(1) if dh == 0 else w, goal)
                         if v >= 0:
                             succ[ns] = v
                             ns += 1
@@ -361,7 +369,7 @@ def jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
                         succ[ns] = v
                         ns += 1
                 if free[u + dv] != 0:
-                    v = _jump_straight(free, u, dv, 1, goal)
+                    v = _jump_straight(free, u, dv, np.int64(1), goal)
                     if v >= 0:
                         succ[ns] = v
                         ns += 1
@@ -371,7 +379,7 @@ def jps_kernel(free, width, start, goal, rec, gen):  # pragma: no cover - numba
                     ns += 1
             else:
                 d = dh + dv  # the direction of travel
-                p = w if sy == 0 else 1  # perpendicular offset
+                p = w if sy == 0 else np.int64(1)  # perpendicular offset
                 if free[u + d] != 0:
                     v = _jump_straight(free, u, d, p, goal)
                     if v >= 0:

@@ -37,8 +37,31 @@ def bit_length(x):  # pragma: no cover - compiled
     return n
 
 
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """Return ``a`` read-only (a read-only view when ``a`` is writable; no copy)."""
+    if not a.flags.writeable:
+        return a
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
+def weighted_kernel(free, width, start, goal, conn8, cut, cost, rec, recf, gen, lm, lg):
+    """Run :func:`_weighted_search` with its inputs ``free``, ``cost``, ``lm``, ``lg`` read-only.
+
+    The compiled search takes read-only and writable arrays alike, but numba compiles it
+    once for each combination of flags it meets; handing it read-only views (no copies)
+    keeps one compiled signature for every caller (the searches, the landmark trees). The
+    arguments and the result are :func:`_weighted_search`'s.
+    """
+    return _weighted_search(
+        _read_only(free), width, start, goal, conn8, cut, _read_only(cost), rec, recf, gen,
+        _read_only(lm), _read_only(lg),
+    )  # fmt: skip
+
+
 @njit(cache=True)
-def weighted_kernel(
+def _weighted_search(
     free,  # uint8 [H*W], padded with a blocked ring
     width,  # W = nx + 2
     start,  # padded flat index
@@ -183,13 +206,14 @@ def weighted_kernel(
                 if used == cap:
                     cap *= 2
                     nk = np.empty(cap, dtype=np.uint64)
-                    nk[:used] = pkey[:used]
-                    pkey = nk
                     nn = np.empty(cap, dtype=np.int32)
-                    nn[:used] = pnode[:used]
-                    pnode = nn
                     nt = np.empty(cap, dtype=np.int32)
-                    nt[:used] = pnext[:used]
+                    for q in range(used):  # loops, not slice copies: no shape-error code
+                        nk[q] = pkey[q]
+                        nn[q] = pnode[q]
+                        nt[q] = pnext[q]
+                    pkey = nk
+                    pnode = nn
                     pnext = nt
                 e = used
                 used += 1

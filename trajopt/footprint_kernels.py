@@ -82,7 +82,7 @@ def swept_hull(rho, phi, lo, hi, max_arc):  # pragma: no cover - compiled
     nv = rho.shape[0]
     per = 2 * n + 1 if step > 0 else n + 1
     pts = np.empty((nv * per, 2))
-    m = 0
+    m = np.int64(0)  # not a literal 0: one compiled signature of hull_of
     for i in range(nv):
         for a in range(n + 1):
             ang = phi[i] + lo + step * a
@@ -150,7 +150,9 @@ def span_margins(bez, rho, phi, max_arc, cap, tol, max_depth,
     for s in range(m):
         lo, hi = cone(bez[s, 1:] - bez[s, :-1])
         heads[s, 0], heads[s, 1] = lo, hi
-        stack[0] = bez[s]
+        for r in range(p1):  # element copies here and below: no shape-mismatch error code
+            stack[0, r, 0] = bez[s, r, 0]
+            stack[0, r, 1] = bez[s, r, 1]
         depth[0] = 0
         top = 1
         worst = np.inf
@@ -163,12 +165,16 @@ def span_margins(bez, rho, phi, max_arc, cap, tol, max_depth,
                 worst = min(worst, g)
                 continue
             # de Casteljau at 1/2: left half to stack[top], right half to stack[top + 1]
-            work[:] = cur
             for r in range(p1):
-                stack[top, r] = work[0]
-                stack[top + 1, p1 - 1 - r] = work[p1 - 1 - r]
+                work[r, 0] = cur[r, 0]
+                work[r, 1] = cur[r, 1]
+            for r in range(p1):
+                for c in range(2):
+                    stack[top, r, c] = work[0, c]
+                    stack[top + 1, p1 - 1 - r, c] = work[p1 - 1 - r, c]
                 for i in range(p1 - 1 - r):
-                    work[i] = 0.5 * (work[i] + work[i + 1])
+                    for c in range(2):
+                        work[i, c] = 0.5 * (work[i, c] + work[i + 1, c])
             depth[top] = depth[top + 1] = d + 1
             top += 2
         margins[s] = worst

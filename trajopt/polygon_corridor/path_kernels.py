@@ -41,10 +41,12 @@ def hull4(pts, n, out):  # pragma: no cover - compiled
     # drop duplicates (a point or a segment)
     m = 0
     for i in range(max(k, 1)):
-        q = p[idx[i]]
-        if m > 0 and abs(q[0] - out[m - 1, 0]) <= 1e-12 and abs(q[1] - out[m - 1, 1]) <= 1e-12:
+        qx = p[idx[i], 0]
+        qy = p[idx[i], 1]
+        if m > 0 and abs(qx - out[m - 1, 0]) <= 1e-12 and abs(qy - out[m - 1, 1]) <= 1e-12:
             continue
-        out[m] = q
+        out[m, 0] = qx  # element copies: no shape-mismatch error code to compile
+        out[m, 1] = qy
         m += 1
     if m > 1 and abs(out[m - 1, 0] - out[0, 0]) <= 1e-12 and abs(out[m - 1, 1] - out[0, 1]) <= 1e-12:
         m -= 1

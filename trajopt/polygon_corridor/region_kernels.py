@@ -69,7 +69,8 @@ def _tidy(v, lab, nv):  # pragma: no cover - compiled
             if abs(v[i, 0] - v[j, 0]) <= 1e-12 and abs(v[i, 1] - v[j, 1]) <= 1e-12:
                 # zero-length edge i: remove vertex i (vertex j keeps its own edge)
                 for k in range(i, nv - 1):
-                    v[k] = v[k + 1]
+                    v[k, 0] = v[k + 1, 0]
+                    v[k, 1] = v[k + 1, 1]
                     lab[k] = lab[k + 1]
                 nv -= 1
                 changed = True
@@ -83,7 +84,8 @@ def _tidy(v, lab, nv):  # pragma: no cover - compiled
             if abs(cr) <= 1e-14:
                 # straight angle at i: the merged edge h -> j keeps edge h's row
                 for k in range(i, nv - 1):
-                    v[k] = v[k + 1]
+                    v[k, 0] = v[k + 1, 0]
+                    v[k, 1] = v[k + 1, 1]
                     lab[k] = lab[k + 1]
                 nv -= 1
                 changed = True
@@ -253,7 +255,7 @@ def grow_region(seed, ns, p0x, p0y, p1x, p1y, ext, r, margin,
     va[2, 0], va[2, 1] = wx1, wy1
     va[3, 0], va[3, 1] = wx0, wy1
     la[0], la[1], la[2], la[3] = 0, 1, 2, 3
-    nv = 4
+    nv = np.int64(4)  # not a literal 4: one compiled signature of _clip
     for row in range(4, nh):
         nv = _clip(va, la, nv, h[row, 0], h[row, 1], h[row, 2], row, vb, lb)
         va, vb = vb, va
@@ -302,8 +304,11 @@ def grow_all(p, e, r, margin, kmax, rects, meta, bstart, bids, stamp, buf):  # p
         status[k] = st
         if st == 0:
             nvs[k] = nv
-            hh[k, :nv] = oh[:nv]
-            vv[k, :nv] = ov[:nv]
+            for i in range(nv):  # element copies: no shape-mismatch error code to compile
+                for c in range(3):
+                    hh[k, i, c] = oh[i, c]
+                vv[k, i, 0] = ov[i, 0]
+                vv[k, i, 1] = ov[i, 1]
     return hh, vv, nvs, status
 
 
@@ -320,7 +325,9 @@ def clip_convex(v, nv, rows, nrows, tol):  # pragma: no cover - compiled
     la = np.full(cap, -1, np.int64)
     vb = np.empty((cap, 2))
     lb = np.empty(cap, np.int64)
-    va[:nv] = v[:nv]
+    for i in range(nv):  # element copies: no shape-mismatch error code to compile
+        va[i, 0] = v[i, 0]
+        va[i, 1] = v[i, 1]
     n = nv
     for i in range(nrows):
         n = _clip(va, la, n, rows[i, 0], rows[i, 1], rows[i, 2] + tol, i, vb, lb)
@@ -435,16 +442,19 @@ def chain_geometry(hm, vm, nrow, nvert, degen, p, s, tol):  # pragma: no cover -
     for k in range(m - 1):
         n1 = nrow[k]
         n2 = nrow[k + 1]
-        for i in range(n1):
-            both[i] = hm[k, i]
+        for i in range(n1):  # element copies: no shape-mismatch error code to compile
+            for c in range(3):
+                both[i, c] = hm[k, i, c]
         for i in range(n2):
-            both[n1 + i] = hm[k + 1, i]
+            for c in range(3):
+                both[n1 + i, c] = hm[k + 1, i, c]
         lo, hi = polyline_interval(both, n1 + n2, p, s, s[k + 1], s[k + 1], tol)
         overlap_s[k, 0] = lo
         overlap_s[k, 1] = hi
         nv = nvert[k]
         for i in range(nv):
-            va[i] = vm[k, i]
+            va[i, 0] = vm[k, i, 0]
+            va[i, 1] = vm[k, i, 1]
             la[i] = -(i + 1)
         for j in range(n2):
             nv = _clip(va, la, nv, hm[k + 1, j, 0], hm[k + 1, j, 1], hm[k + 1, j, 2], j, vb, lb)
@@ -455,13 +465,16 @@ def chain_geometry(hm, vm, nrow, nvert, degen, p, s, tol):  # pragma: no cover -
         nv = _tidy(va, la, nv)
         ov_n[k] = nv
         for i in range(nv):
-            ov_v[k, i] = va[i]
+            ov_v[k, i, 0] = va[i, 0]
+            ov_v[k, i, 1] = va[i, 1]
             if degen[k] or degen[k + 1]:
                 continue
             if la[i] >= 0:
-                ov_h[k, i] = hm[k + 1, la[i]]
+                for c in range(3):
+                    ov_h[k, i, c] = hm[k + 1, la[i], c]
             else:
-                ov_h[k, i] = hm[k, -la[i] - 1]
+                for c in range(3):
+                    ov_h[k, i, c] = hm[k, -la[i] - 1, c]
     return region_s, overlap_s, ov_v, ov_h, ov_n
 
 

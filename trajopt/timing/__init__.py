@@ -21,7 +21,7 @@ Method
    polynomial pieces by Bernstein coefficients, bisects them until the bound is tight
    (0.1 % of the cap) or harmless, and maps each piece to the intervals its exact arc-length
    range touches. For the library's curves (the base class's arc length and geometry, a
-   ``Robot``'s own ``speed_cap``) one compiled call does this together with the grid's
+   ``Robot``'s own ``speed_cap``) compiled code does this together with the grid's
    ``u(s)``, heading and curvature (:func:`trajopt.timing.cap_kernel.polynomial_tables`,
    from the Taylor coefficients of each piece's velocity; ``interval_kappa_max`` is the NumPy
    form of the same method and the path for other curves). Any other curve is sampled: an

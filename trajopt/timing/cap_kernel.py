@@ -1,6 +1,6 @@
 """The cap table's compiled path for piecewise-polynomial curves (numba).
 
-:func:`polynomial_tables` does in one compiled call what :func:`trajopt.timing.build_cap_table`
+:func:`polynomial_tables` does in two compiled calls what :func:`trajopt.timing.build_cap_table`
 needs from a curve with a ``polynomial_degree`` whose arc length is the base class's
 (:class:`~trajopt.curve.ParametricCurve`, e.g. every B-spline of the library):
 
@@ -22,6 +22,7 @@ compares the two) and the path for other curves and speed caps.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -111,7 +112,11 @@ def polynomial_tables(
         return None
     lo, hi = (float(x) for x in curve.domain)
     bp = np.asarray(curve.breakpoints(), dtype=float)
-    w = _piece_ends(bp, lo, hi)  # np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
+    inner = bp[(bp > lo) & (bp < hi)]
+    if inner.size > 1 and not np.all(inner[1:] > inner[:-1]):
+        w = np.union1d([lo, hi], inner)  # sorted, without repeats
+    else:  # the usual case, already so: the same array, without union1d's sort
+        w = np.concatenate(([lo], inner, [hi]))
     mid = 0.5 * (w[:-1] + w[1:])
     half = 0.5 * (w[1:] - w[:-1])
     coef = np.empty((mid.size, degree, 2))
@@ -123,11 +128,17 @@ def polynomial_tables(
     tw = 0.0 if robot.track_width is None else float(robot.track_width)
     wv = math.inf if robot.wheel_v_max is None else float(robot.wheel_v_max)
     limits = np.array([robot.v_max, robot.a_lat_max, robot.omega_max, tw, wv], dtype=float)
+    s_grid = np.ascontiguousarray(s_grid, dtype=float)
     h = float(s_grid[-1]) / (s_grid.size - 1)
-    u, kappa, theta, still, kmax, cap, end_caps = _tables(
-        w, coef, nodes, s_nodes, v_nodes, np.ascontiguousarray(s_grid, dtype=float), h,
-        STILL_SPEED_RATIO * curve.mean_speed(), _ZERO * curve.length / (hi - lo), limits,
-        _K_GRID, _GL_X, _GL_W, float(rtol), bool(node_kappa),
+    u, kappa, theta, still, end_caps = _node_tables(
+        w, coef, nodes, s_nodes, v_nodes, s_grid, STILL_SPEED_RATIO * curve.mean_speed(), limits,
+        bool(node_kappa),
+    )  # fmt: skip
+    p2b, shift = matrices(degree)
+    X, S, V = workspace(degree)
+    kmax, cap = _interval_bounds(
+        w, coef, nodes, s_nodes, h, s_grid.size - 1, _ZERO * curve.length / (hi - lo), limits,
+        _K_GRID, _GL_X, _GL_W, float(rtol), p2b, shift, X, S, V, True,
     )  # fmt: skip
     if still:  # zero parametric speed at a node: the limit of the tangent direction
         raw = np.asarray(curve(u, 1), dtype=float)
@@ -136,28 +147,6 @@ def polynomial_tables(
         th[mask] = curve.heading(u[mask])
         theta = np.unwrap(th)
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
-
-
-@njit(cache=True)
-def _piece_ends(bp, lo, hi):  # pragma: no cover - compiled
-    """``np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])``: sorted, without repeats."""
-    buf = np.empty(bp.shape[0] + 2)
-    buf[0] = lo
-    buf[1] = hi
-    k = 2
-    for x in bp:
-        if lo < x < hi:
-            buf[k] = x
-            k += 1
-    buf = np.sort(buf[:k])
-    out = np.empty(k)
-    out[0] = buf[0]
-    m = 1
-    for i in range(1, k):
-        if buf[i] != buf[i - 1]:
-            out[m] = buf[i]
-            m += 1
-    return out[:m]
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -221,39 +210,40 @@ def _s_at_u(u, piece, w, coef, nodes, s_nodes, gl_x, gl_w):  # pragma: no cover 
     return s_nodes[i] + half * acc
 
 
-@njit(cache=True)
-def _binomials(n):  # pragma: no cover - compiled
-    out = np.zeros((n + 1, n + 1))
-    for i in range(n + 1):
-        out[i, 0] = 1.0
-        for k in range(1, i + 1):
-            out[i, k] = out[i - 1, k - 1] + (out[i - 1, k] if k <= i - 1 else 0.0)
-    return out
-
-
-@njit(cache=True, inline="always", **NO_REFCOUNT)
-def _bernstein_range(P, off, n_coef, p2b, want_max_abs):  # pragma: no cover - compiled
-    """Largest ``|b_i|`` (or smallest ``b_i``) of the Bernstein coefficients of ``P[off:off + n_coef]``.
+@njit(cache=True, **NO_REFCOUNT)
+def _bernstein_max_abs(P, off, n_coef, p2b):  # pragma: no cover - compiled
+    """Largest ``|b_i|`` of the Bernstein coefficients of ``P[off:off + n_coef]``.
 
     ``b_i = sum_{k <= i} C(i, k) / C(n, k) P_k`` on ``[0, 1]``, ``n = n_coef - 1``
     (``p2b[n, i, k]`` holds the factors).
     """
     n = n_coef - 1
-    best = 0.0 if want_max_abs else np.inf
+    best = 0.0
     for i in range(n + 1):
         b = 0.0
         for k in range(i + 1):
             b += p2b[n, i, k] * P[off + k]
-        if want_max_abs:
-            b = abs(b)
-            if b > best:
-                best = b
-        elif b < best:
+        b = abs(b)
+        if b > best:
             best = b
     return best
 
 
-@njit(cache=True, inline="always", **NO_REFCOUNT)
+@njit(cache=True, **NO_REFCOUNT)
+def _bernstein_min(P, off, n_coef, p2b):  # pragma: no cover - compiled
+    """Smallest ``b_i`` of the Bernstein coefficients of ``P[off:off + n_coef]`` (as above)."""
+    n = n_coef - 1
+    best = np.inf
+    for i in range(n + 1):
+        b = 0.0
+        for k in range(i + 1):
+            b += p2b[n, i, k] * P[off + k]
+        if b < best:
+            best = b
+    return best
+
+
+@njit(cache=True, **NO_REFCOUNT)
 def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     """``X = V x V'`` and ``S = |V|^2`` (power basis) of the ``m`` coefficients ``V[:m]``.
 
@@ -282,13 +272,25 @@ def _cross_and_norm(V, m, X, S):  # pragma: no cover - compiled
     return max(2 * m - 2, 1), 2 * m - 1
 
 
-@njit(cache=True)
-def matrices(p):  # pragma: no cover - compiled
-    """Constant matrices of :func:`bound_from_taylor` for degree ``p``.
+def _binomials(n: int) -> np.ndarray:
+    """Pascal's triangle ``C(i, k)`` for ``i, k <= n`` (float, exact), by its additions."""
+    out = np.zeros((n + 1, n + 1))
+    for i in range(n + 1):
+        out[i, 0] = 1.0
+        for k in range(1, i + 1):
+            out[i, k] = out[i - 1, k - 1] + (out[i - 1, k] if k <= i - 1 else 0.0)
+    return out
+
+
+@lru_cache(maxsize=8)
+def matrices(p: int) -> tuple[np.ndarray, np.ndarray]:
+    """Constant matrices of :func:`bound_from_taylor` for degree ``p`` (read-only, cached).
 
     Bernstein factors ``p2b[n, i, k] = C(i, k) / C(n, k)`` (``n <= 2 p``) and the maps
     ``shift[0, i, k]``, ``shift[1, i, k]`` of coefficients in ``tau = t - 1/2`` to powers of
-    ``t`` and of ``1 - t`` (``curvature_bound._shift_matrices``).
+    ``t`` and of ``1 - t`` (``curvature_bound._shift_matrices``). Every entry is a ratio of
+    exact integers or an integer times a power of two, so these NumPy loops give the values
+    the compiled ones gave, bit for bit.
     """
     comb = _binomials(2 * p + 2)
     nm = 2 * p + 1
@@ -302,33 +304,38 @@ def matrices(p):  # pragma: no cover - compiled
         for i in range(k + 1):
             shift[0, i, k] = comb[k, i] * (-0.5) ** (k - i)
             shift[1, i, k] = comb[k, i] * 0.5 ** (k - i) * (-1.0) ** i
+    p2b.flags.writeable = False
+    shift.flags.writeable = False
     return p2b, shift
 
 
-@njit(cache=True)
-def workspace(p):  # pragma: no cover - compiled
+def workspace(p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Work arrays ``X``, ``S``, ``V`` of :func:`bound_from_taylor` for degree ``p``."""
     return np.empty(2 * p + 2), np.empty(2 * p + 2), np.empty((p, 2))
 
 
-@njit(cache=True)
-def bound_from_taylor(gam, flip, k_free, p2b, shift, X, S, V):  # pragma: no cover - compiled
+def bound_from_taylor(
+    gam: np.ndarray, flip: int, k_free: float, p2b: np.ndarray, shift: np.ndarray,
+    X: np.ndarray, S: np.ndarray, V: np.ndarray,
+) -> float:  # fmt: skip
     """Bernstein bound on ``|kappa|`` from the Taylor coefficients ``gam`` (p, 2) of ``c_t``.
 
     ``gam[k]`` multiplies ``(t - 1/2)^k`` on the local ``t`` in ``[0, 1]``; ``flip`` is 1
     (zero speed at ``t = 0``), -1 (at ``t = 1``) or 0. ``p2b``, ``shift`` come from
     :func:`matrices`; ``X``, ``S``, ``V`` are work arrays (:func:`workspace`).
-    The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`.
+    The arithmetic of :func:`trajopt.curvature_bound.kappa_bound`, by the compiled
+    :func:`_evaluate` on one piece.
     """
     p = gam.shape[0]
     coef = np.empty((1, p, 2))  # one piece on [-1, 1]: the interval [-1/2, 1/2] keeps gam as is
     coef[0] = gam
     work = np.empty((p, 2))
     w = np.array([-1.0, 1.0])
-    return _evaluate(coef, p, 0, w, -0.5, 0.5, flip, k_free, p2b, shift, X, S, V, work)
+    return float(_evaluate(coef, p, 0, w, -0.5, 0.5, int(flip), float(k_free), p2b, shift,
+                           X, S, V, work, True, True))  # fmt: skip
 
 
-@njit(cache=True, inline="always", **NO_REFCOUNT)
+@njit(cache=True, **NO_REFCOUNT)
 def _zero_start(V, p):  # pragma: no cover - compiled
     """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
     scale = 0.0
@@ -338,7 +345,7 @@ def _zero_start(V, p):  # pragma: no cover - compiled
     return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
 
 
-@njit(cache=True, inline="always", **NO_REFCOUNT)
+@njit(cache=True, **NO_REFCOUNT)
 def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
     """Taylor coefficients ``gam`` (p, 2) of ``c_t`` about the middle of ``[a, b]``."""
     pm = 0.5 * (w[piece] + w[piece + 1])
@@ -356,12 +363,6 @@ def _taylor(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
         for k in range(p):
             gam[k, d] *= f
             f *= r
-
-
-@njit(cache=True, **NO_REFCOUNT)
-def _taylor_at(coef, p, piece, w, a, b, gam):  # pragma: no cover - compiled
-    """:func:`_taylor` as a call of its own (for callers with reference counting)."""
-    _taylor(coef, p, piece, w, a, b, gam)
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -388,24 +389,10 @@ def _sampled(gam, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _tables(
-    w,
-    coef,
-    nodes,
-    s_nodes,
-    v_nodes,
-    s_grid,
-    h,
-    still_speed,
-    zero_speed,
-    limits,
-    k_grid,
-    gl_x,
-    gl_w,
-    rtol,
-    node_kappa,
+def _node_tables(
+    w, coef, nodes, s_nodes, v_nodes, s_grid, still_speed, limits, node_kappa
 ):  # pragma: no cover - compiled
-    """Node tables and interval bounds (see :func:`polynomial_tables`)."""
+    """Node tables of :func:`polynomial_tables`: ``u``, ``kappa``, ``theta``, ``still``, ``end_caps``."""
     n = s_grid.shape[0] - 1
     m = w.shape[0] - 1
     nn = nodes.shape[0]
@@ -477,29 +464,26 @@ def _tables(
             corr += dm - dd
         theta[q] = raw + corr
         prev = raw
-    kmax = _interval_bounds(w, coef, nodes, s_nodes, h, n, zero_speed, limits, k_grid,
-                            gl_x, gl_w, rtol)  # fmt: skip
-    cap = np.empty(n)
-    for q in range(n):
-        cap[q] = speed_cap(kmax[q], limits)
     end_caps = np.empty(4)  # the cap at the nodes 0, 1, n - 1 and n
     for q, node in enumerate((0, 1, n - 1, n)):
         end_caps[q] = speed_cap(kappa[node], limits)
-    return u, kappa, theta, still, kmax, cap, end_caps
+    return u, kappa, theta, still, end_caps
 
 
 @njit(cache=True, **NO_REFCOUNT)
 def _evaluate(
-    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor=True, unrolled=True
+    coef, p, piece, w, a, b, flip, k_free, p2b, shift, X, S, V, gam, taylor, unrolled
 ):  # pragma: no cover - compiled
     """Bound on ``|kappa|`` (1/m) on ``[a, b]`` inside polynomial piece ``piece``.
 
     ``gam`` receives the Taylor coefficients of ``c_t`` (:func:`_taylor`; the caller samples
     ``|kappa|`` from them with :func:`_sampled` where it needs that; ``taylor=False``: the
     caller filled ``gam`` for this interval already); the bound is that of
-    :func:`bound_from_taylor` (one compiled function per interval: no inner calls). A cubic
-    piece without a zero-speed end goes to :func:`trajopt.timing.cap_cubic.bound_cubic`
-    (the same operations unrolled) unless ``unrolled`` is False.
+    :func:`bound_from_taylor`. A cubic piece without a zero-speed end goes to
+    :func:`trajopt.timing.cap_cubic.bound_cubic` (the same operations unrolled) unless
+    ``unrolled`` is False. The helpers are compiled functions of their own, called with one
+    signature each (LLVM inlines them into this one); numba's own inlining of them took
+    longer to compile than all of them together.
     """
     if p == 3 and flip == 0 and unrolled:  # the common case, unrolled (same operations)
         return bound_cubic(coef, piece, w, a, b, gam)
@@ -508,6 +492,7 @@ def _evaluate(
     if p < 2:
         return 0.0
     sh = 1 if flip == -1 else 0  # powers of t, or of 1 - t (zero speed at t = 1)
+    zero = np.int64(0)  # a run-time 0, not a literal: one compiled signature of each callee
     for i in range(p):
         for d in range(2):
             acc = 0.0
@@ -516,8 +501,8 @@ def _evaluate(
             V[i, d] = acc
     if flip == 0 or not _zero_start(V, p):
         nx, ns = _cross_and_norm(V, p, X, S)
-        bx = _bernstein_range(X, 0, nx, p2b, True)
-        bs = _bernstein_range(S, 0, ns, p2b, False)
+        bx = _bernstein_max_abs(X, zero, nx, p2b)
+        bs = _bernstein_min(S, zero, ns, p2b)
         if bx == 0.0:
             return 0.0
         if not bs > 0.0:
@@ -534,9 +519,9 @@ def _evaluate(
     for i in range(m):
         gsum += abs(V[i, 0]) + abs(V[i, 1])
     nx, ns = _cross_and_norm(V, m, X, S)
-    s_min = _bernstein_range(S, 0, ns, p2b, False)
+    s_min = _bernstein_min(S, zero, ns, p2b)
     y0 = X[0]
-    base = _bernstein_range(X, 1, nx - 1, p2b, True)
+    base = _bernstein_max_abs(X, zero + 1, nx - 1, p2b)
     if s_min > 0.0:
         base = base / (s_min * math.sqrt(s_min))
     else:
@@ -554,13 +539,17 @@ def _evaluate(
 
 @njit(cache=True)
 def _interval_bounds(
-    w, coef, nodes, s_nodes, h, n, zero_speed, limits, k_grid, gl_x, gl_w, rtol
+    w, coef, nodes, s_nodes, h, n, zero_speed, limits, k_grid, gl_x, gl_w, rtol, p2b, shift,
+    X, S, V, unrolled,
 ):  # pragma: no cover - compiled
-    """``interval_kappa_max`` on the pieces' polynomials: bound per grid interval (1/m)."""
+    """``interval_kappa_max`` on the pieces' polynomials: ``(kmax, cap)`` per grid interval.
+
+    ``kmax`` (1/m) bounds ``|kappa|`` over each interval and ``cap`` is its
+    :func:`speed_cap`; ``p2b``, ``shift`` from :func:`matrices`, ``X``, ``S``, ``V`` from
+    :func:`workspace`, ``unrolled`` as :func:`_evaluate`'s.
+    """
     m = w.shape[0] - 1
     p = coef.shape[1]
-    p2b, shift = matrices(p)
-    X, S, V = workspace(p)
     gam = np.empty((p, 2))
     cap0 = speed_cap(0.0, limits)
     k_free = 0.0
@@ -569,7 +558,7 @@ def _interval_bounds(
             k_free = k
     # zero parametric speed at an end of the domain
     flip = np.zeros(m, np.int64)
-    vx, vy = _poly_d1(coef, 0, -1.0)
+    vx, vy = _poly_d1(coef, np.int64(0), -1.0)  # np.int64: no literal-0 signature
     if math.hypot(vx, vy) <= zero_speed:
         flip[0] = 1
     vx, vy = _poly_d1(coef, m - 1, 1.0)
@@ -593,19 +582,18 @@ def _interval_bounds(
         final = work >= _MAX_WORK or depth == _MAX_DEPTH  # every bound is kept as it is
         for i in range(cnt):
             wide = lsb[i] - lsa[i] > h and not final
+            taylor = True  # whether _evaluate computes gam (False: it holds this interval's)
             if wide and flip[i] == 0:
                 # a sampled curvature above k_free: the bound (>= every value) binds as
                 # well, and a wide piece binding is split whatever its bound
-                _taylor_at(coef, p, lpc[i], w, la[i], lb[i], gam)
+                _taylor(coef, p, lpc[i], w, la[i], lb[i], gam)
                 if _sampled(gam, p) > k_free * (1.0 + 1e-9):
                     split[i] = True
                     n_split += 1
                     continue
-                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                                X, S, V, gam, False)  # fmt: skip
-            else:
-                k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                                X, S, V, gam)  # fmt: skip
+                taylor = False
+            k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
+                            X, S, V, gam, taylor, unrolled)  # fmt: skip
             if k_b > k_free and wide:  # split: no sample needed
                 split[i] = True
                 n_split += 1
@@ -652,4 +640,7 @@ def _interval_bounds(
             r += 1
         la, lb, lsa, lsb, lpc, flip = na, nb, nsa, nsb, npc, nfl
         work += la.shape[0]
-    return kmax
+    cap = np.empty(n)
+    for q in range(n):
+        cap[q] = speed_cap(kmax[q], limits)
+    return kmax, cap

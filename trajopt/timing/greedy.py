@@ -31,7 +31,7 @@ STACK = 96  # rows of piece_ok's bisection stack
 # greedy's time. Their callers allocate (the bisection stack ``stk`` included).
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def advance(s, v, a, j, t):
     """State after ``t`` seconds of constant jerk ``j`` from ``(s, v, a)``."""
     return (
@@ -49,7 +49,8 @@ def build_table(ci):
     while (1 << levels) <= n:
         levels += 1
     st = np.empty((levels, n))
-    st[0, :] = ci
+    for i in range(n):  # a loop, not st[0, :] = ci: no shape-mismatch error code to compile
+        st[0, i] = ci[i]
     for k in range(1, levels):
         w = 1 << (k - 1)
         for i in range(n - (1 << k) + 1):
@@ -214,7 +215,7 @@ def piece_ok(st, lg, h, length, s, v, a, j, T, tmin, stk):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def brake_times(v, a, vt, j, amax):
     """Time-optimal jerk-limited change from ``(v, a)`` down to ``(vt, 0)``.
 
@@ -242,7 +243,7 @@ def brake_times(v, a, vt, j, amax):
     return t1, t2, amax / j, 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def brake_end(s, v, a, t1, t2, t3, j):
     """Arc length at the end of the ``brake_times`` phases."""
     s, v, a = advance(s, v, a, -j, t1)
@@ -271,7 +272,7 @@ def stop_ok(st, lg, h, length, s, v, a, j, amax, tmin, stk):
     return True, s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _end_test(s1, v1, a1, v_end, length, j, amax):
     """Return whether ``(s1, v1, a1)`` can still end at ``length`` with ``v_end``, and ``s_stop``.
 
@@ -380,8 +381,9 @@ def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmi
     ``counts`` receives the numbers of phase and bound rows written; the status
     ``_NEED_ROOM`` means the buffers filled up (nothing is kept).
     """
-    n_ph = 0
-    n_b = 0
+    # row counters typed int64 from the start: a literal 0 would compile _put once more
+    n_ph = np.int64(0)
+    n_b = np.int64(0)
     s = 0.0
     v = v0
     a = a0
@@ -571,20 +573,6 @@ def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmi
     counts[0] = n_ph
     counts[1] = n_b
     return status
-
-
-@njit(cache=True)
-def phases_ok(st, lg, h, length, ph_t, ph_s, ph_v, ph_a, ph_j, t_end, tmin):
-    """Every phase (rows of start states and jerks, ending at ``t_end``) under the cap."""
-    n = ph_t.shape[0]
-    stk = np.empty((STACK, 4))
-    for i in range(n):
-        te = ph_t[i + 1] if i + 1 < n else t_end
-        if not piece_ok(
-            st, lg, h, length, ph_s[i], ph_v[i], ph_a[i], ph_j[i], te - ph_t[i], tmin, stk
-        ):
-            return False
-    return True
 
 
 @njit(cache=True)
