@@ -6,6 +6,10 @@
   ``explore`` (fresh random examples each run, for looking for new failures:
   ``HYPOTHESIS_PROFILE=explore python -m pytest``). Cases an exploration finds are pinned
   in their test with ``@example``.
+* A fresh clone (or venv, or CI runner) has no compiled numba kernels yet: the session
+  first compiles every kernel numba's cache lacks, in two worker processes
+  (:func:`trajopt.kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
+  one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
 """
 
 from __future__ import annotations
@@ -21,6 +25,25 @@ settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 _REPO = Path(__file__).resolve().parents[1]
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Compile the kernels numba's disk cache lacks before the first test (module docstring)."""
+    if os.environ.get("TRAJOPT_PRECOMPILE", "1") == "0":
+        return
+    from trajopt import kernel_cache
+
+    cold = kernel_cache.cold_kernels()
+    if not cold:
+        return
+    tr = session.config.pluginmanager.get_plugin("terminalreporter")
+    say = tr.write_line if tr is not None else print
+    say(f"trajopt: compiling {len(cold)} numba kernels first (once per environment; "
+        "TRAJOPT_PRECOMPILE=0 skips)...")  # fmt: skip
+    report = kernel_cache.compile_kernels()
+    say(f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s")
+    for name, error in report.failed.items():
+        say(f"trajopt: warm-up exercise {name!r} failed: {error}")
 
 
 def data_dir() -> Path:

@@ -7,6 +7,7 @@ from numba import njit
 
 from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError
+from trajopt.kernel_cache import watch_compiles
 
 __all__ = ["BSplineCurve", "clamped_uniform_knots"]
 
@@ -205,6 +206,9 @@ def derivative_control_points(t: np.ndarray, c: np.ndarray, k: int) -> tuple[np.
     ok = den > 0
     q[ok] = k * np.diff(c, axis=0)[ok] / den[ok, None]
     return t[1:-1], q
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 
 from trajopt.errors import InvalidInputError
+from trajopt.kernel_cache import watch_compiles
 
 __all__ = [
     "border_distance",
@@ -54,6 +55,9 @@ __all__ = [
     "segment_squares_distance",
     "window_rects",
 ]
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 # ================================================================= kernels (cell units)

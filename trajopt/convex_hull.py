@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from trajopt.kernel_cache import watch_compiles
+
 __all__ = ["convex_hull", "monotone_chain", "sort_xy"]
 
 
@@ -15,6 +17,9 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
         return p
     h, k = monotone_chain(np.ascontiguousarray(p), len(p), 0.0)
     return p[h[: k - 1]]
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

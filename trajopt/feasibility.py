@@ -35,6 +35,7 @@ from numba import njit
 import astar
 from trajopt.clearance import point_square_dist2
 from trajopt.errors import InvalidInputError
+from trajopt.kernel_cache import watch_compiles
 
 __all__ = ["curvature_witness", "witness_grid_path"]
 
@@ -176,6 +177,9 @@ def _sample_finish(x, y, th, goal, turn_r, psi, side) -> np.ndarray:
     f = np.linspace(0.0, 1.0, n)[1:, None]
     line = arc[-1] + f * (np.asarray(goal) - arc[-1])
     return np.vstack([arc, line])
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

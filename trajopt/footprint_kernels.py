@@ -15,11 +15,15 @@ import numpy as np
 from numba import njit
 
 from trajopt.convex_hull import monotone_chain, sort_xy
+from trajopt.kernel_cache import watch_compiles
 from trajopt.polygon_corridor.obstacle_index import poly_clearance
 
 __all__ = ["cone", "hull_of", "span_margins", "swept_hull"]
 
 TWO_PI = 2.0 * math.pi
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -1,4 +1,8 @@
-"""trajopt.warm_up: the first plan after it loads no compiled kernel, for every planner kind."""
+"""trajopt.warm_up: the first plan after it loads no compiled kernel, for every planner kind.
+
+``warm_up()`` without a planner loads every kernel: then no planner kind loads one.
+(``tests/trajopt/test_kernel_cache.py`` checks that it compiles and reaches every kernel.)
+"""
 
 from __future__ import annotations
 
@@ -65,10 +69,11 @@ def test_warm_up_map_leaves_room_for_the_robot(kind):
     assert grid.occupied[:, grid.occupied.shape[1] // 2].any()  # a wall between them
 
 
-@pytest.mark.parametrize("kind", ["disc", "costmap", "rectangle"])
+@pytest.mark.parametrize("kind", ["disc", "costmap", "rectangle", "all"])
 def test_first_plans_after_warm_up_load_no_kernel(kind):
     # a fresh process: after warm_up(planner), the paper scene's four queries load or compile
-    # no numba kernel (counted at numba's own cache and dispatcher entry points)
+    # no numba kernel (counted at numba's own cache and dispatcher entry points); after
+    # warm_up() with no planner, neither do those of every planner kind nor a comparison
     script = textwrap.dedent(
         """
         import sys
@@ -85,8 +90,24 @@ def test_first_plans_after_warm_up_load_no_kernel(kind):
                                       convention="costmap_2d")
         elif kind == "rectangle":
             robot = trajopt.Robot.rectangle(2.2 * scene.robot_radius, 1.4 * scene.robot_radius)
-        planner = trajopt.Planner(grid, robot)
-        trajopt.warm_up(planner)
+        planners = [trajopt.Planner(grid, robot)]
+        if kind == "all":
+            values = np.where(grid.occupied, 254, 0).astype(np.uint8)
+            r = scene.robot_radius
+            costmap = astar.from_costmap(values, grid.resolution, grid.origin,
+                                         convention="costmap_2d")
+            planners += [
+                trajopt.Planner(grid, trajopt.Robot.rectangle(2.2 * r, 1.4 * r)),
+                trajopt.Planner(costmap, robot),
+                trajopt.Planner(costmap, robot, landmarks=4),
+                trajopt.Planner(grid, robot, corridor="boxes"),
+                trajopt.Planner(grid, robot, smoother=trajopt.Smoother(kappa_max=1 / (2 * r))),
+                trajopt.Planner(grid, robot, inflation="paper"),
+                trajopt.Planner(grid, robot, search="shortest"),
+            ]
+            trajopt.warm_up()
+        else:
+            trajopt.warm_up(planners[0])
         events = []
         load, compile_ = caching.Cache.load_overload, Dispatcher.compile
         def counting_load(self, *a, **k):
@@ -100,8 +121,12 @@ def test_first_plans_after_warm_up_load_no_kernel(kind):
             return out
         caching.Cache.load_overload = counting_load
         Dispatcher.compile = counting_compile
-        for name in scene.target_names:
-            planner.plan(scene.start, scene.goal(name))
+        for planner in planners:
+            for name in scene.target_names:
+                planner.plan(scene.start, scene.goal(name))
+        if kind == "all":
+            trajopt.compare(grid, scene.start, scene.goal("A"), robot_radius=scene.robot_radius,
+                            w_cells=scene.w_cells)
         print("EVENTS", events)
         """
     )

@@ -23,11 +23,15 @@ from trajopt.clearance import (
     segment_rect_distance,
     window_rects,
 )
+from trajopt.kernel_cache import watch_compiles
 
 __all__ = ["BUCKET_CELLS", "ObstacleIndex", "gather", "point_nearest", "poly_clearance",
            "seg_clearance"]  # fmt: skip
 
 BUCKET_CELLS = 8
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -12,6 +12,7 @@ import numpy as np
 from numba import njit
 
 from trajopt.convex_hull import monotone_chain, sort_xy
+from trajopt.kernel_cache import watch_compiles
 from trajopt.polygon_corridor.obstacle_index import point_nearest, poly_clearance, seg_clearance
 
 __all__ = [
@@ -22,6 +23,9 @@ __all__ = [
     "seed_points",
     "simplify_path",
 ]
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

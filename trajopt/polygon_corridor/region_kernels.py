@@ -17,6 +17,7 @@ from trajopt.clearance import (
     polygon_rect_closest,
     segment_rect_distance,
 )
+from trajopt.kernel_cache import watch_compiles
 from trajopt.polygon_corridor.obstacle_index import gather, poly_clearance
 from trajopt.polygon_corridor.path_kernels import seed_points
 
@@ -24,6 +25,9 @@ __all__ = ["certify_all", "chain_geometry", "clip_convex", "grow_all", "grow_reg
            "polyline_interval"]  # fmt: skip
 
 
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

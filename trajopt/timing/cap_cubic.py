@@ -12,9 +12,13 @@ import math
 import numpy as np
 from numba import njit
 
+from trajopt.kernel_cache import watch_compiles
 from trajopt.timing.kernel_options import NO_REFCOUNT
 
 __all__ = ["bound_cubic"]
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True, **NO_REFCOUNT)

@@ -30,6 +30,7 @@ from numba import njit
 
 from trajopt.curvature_bound import _MAX_DEPTH, _MAX_WORK, _RTOL_TIP, _TIP, _ZERO
 from trajopt.curve import STILL_SPEED_RATIO, ParametricCurve
+from trajopt.kernel_cache import watch_compiles
 from trajopt.robot import Robot
 from trajopt.timing.cap_cubic import bound_cubic
 from trajopt.timing.kernel_options import NO_REFCOUNT
@@ -147,6 +148,9 @@ def polynomial_tables(
         th[mask] = curve.heading(u[mask])
         theta = np.unwrap(th)
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True, **NO_REFCOUNT)

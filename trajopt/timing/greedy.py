@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from trajopt.kernel_cache import watch_compiles
 from trajopt.timing.kernel_options import NO_REFCOUNT
 
 #: greedy exit codes
@@ -29,6 +30,9 @@ STACK = 96  # rows of piece_ok's bisection stack
 # (``NO_REFCOUNT``, :mod:`trajopt.timing.kernel_options`): they allocate nothing, and the
 # atomic increments and decrements of the arrays passed to them otherwise take most of the
 # greedy's time. Their callers allocate (the bisection stack ``stk`` included).
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

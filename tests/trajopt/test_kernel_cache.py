@@ -1,0 +1,167 @@
+"""trajopt.kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
+
+* Every numba dispatcher of astar and trajopt lives in a module of ``KERNEL_MODULES``.
+* ``trajopt.warm_up()`` leaves every kernel compiled and loaded (a signature each), and
+  its exercises reach every kernel, directly or through the kernels that call it (so a new
+  kernel the exercises leave out fails here, whatever numba's cache holds).
+* In a fresh numba cache: the kernels are cold, worker processes compile them into the
+  cache, and a first compilation logs one notice per process (none when loading).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from trajopt import kernel_cache
+
+
+def _run(script: str, *args: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    out = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(script), *args],
+        capture_output=True, text=True, check=False, env=env,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr[-3000:]
+    return out
+
+
+def _fresh_cache(tmp_path) -> dict:
+    """The environment of a process with an empty numba cache (a fresh clone's)."""
+    return dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+
+
+def test_every_dispatcher_is_in_a_kernel_module():
+    script = """
+        import importlib, json, pkgutil
+        from numba.core.dispatcher import Dispatcher
+        import astar, trajopt
+        found = {}
+        for pkg in (astar, trajopt):
+            for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
+                mod = importlib.import_module(m.name)
+                for k, v in vars(mod).items():
+                    if isinstance(v, Dispatcher) and v.py_func.__module__ == m.name:
+                        found.setdefault(m.name, []).append(k)
+        print(json.dumps(found))
+    """
+    found = json.loads(_run(script).stdout)
+    assert set(found) == set(kernel_cache.KERNEL_MODULES)
+    listed = kernel_cache.dispatchers()
+    assert sorted(listed) == sorted(f"{m}.{k}" for m, ks in found.items() for k in ks)
+
+
+WARM_UP_REACHES_EVERYTHING = """
+    import json, types
+    from numba.core.dispatcher import Dispatcher
+    reached = set()
+    enter = Dispatcher._compile_for_args  # a kernel's first call from Python
+    def record(self, *args, **kws):
+        reached.add(self)
+        return enter(self, *args, **kws)
+    Dispatcher._compile_for_args = record
+    import trajopt
+    from trajopt import kernel_cache
+    trajopt.warm_up()
+    every = kernel_cache.dispatchers()
+    def names(code):
+        out = set(code.co_names)
+        for c in code.co_consts:
+            if isinstance(c, types.CodeType):
+                out |= names(c)
+        return out
+    def callees(d):
+        g, used = d.py_func.__globals__, names(d.py_func.__code__)
+        out = []
+        for n in used:
+            v = g.get(n)
+            if isinstance(v, types.ModuleType):  # module.kernel inside a kernel
+                out += [getattr(v, a) for a in used if isinstance(getattr(v, a, None), Dispatcher)]
+            elif isinstance(v, Dispatcher):
+                out.append(v)
+        return out
+    closure, todo = set(), list(reached)
+    while todo:
+        d = todo.pop()
+        if d not in closure:
+            closure.add(d)
+            todo += callees(d)
+    inline = {k for k, d in every.items() if d.targetoptions.get("inline") == "always"}
+    print(json.dumps({
+        "unreached": sorted(k for k, d in every.items() if d not in closure),
+        "unloaded": sorted(k for k, d in every.items() if k not in inline and not d.signatures),
+        "inline_called_alone": sorted(k for k in inline if every[k].signatures),
+    }))
+"""
+
+
+def test_warm_up_compiles_loads_and_reaches_every_kernel():
+    # A fresh process: after trajopt.warm_up() every kernel has a compiled signature (the
+    # inline="always" ones excepted: numba inlines them into their callers, so they have none
+    # of their own), and the exercises reach every dispatcher, by a call from Python or as a
+    # callee of one they call (read from the kernels' code): a new kernel left out of the
+    # exercises fails here even when numba's cache already holds it from another run.
+    out = json.loads(_run(WARM_UP_REACHES_EVERYTHING).stdout.splitlines()[-1])
+    assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt.warm_up.EXERCISES)"
+    assert out["unloaded"] == [], "kernels without a compiled signature after warm_up()"
+    assert out["inline_called_alone"] == []
+
+
+def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
+    env = _fresh_cache(tmp_path)
+    script = """
+        import json
+        from trajopt import kernel_cache
+        cold = kernel_cache.cold_kernels()
+        report = kernel_cache.compile_kernels(["grid", "astar"], workers=2)
+        print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
+                          "failed": report.failed, "left": kernel_cache.cold_kernels()}))
+    """
+    out = json.loads(_run(script, env=env).stdout)
+    grid = {"astar.distance_transform._transform", "astar.distance_transform._column_pass",
+            "astar.distance_transform._row_pass", "astar.inflation._dilate_rows",
+            "astar.search_kernels.astar_kernel", "astar.search_kernels.unroll_path"}  # fmt: skip
+    assert set(out["cold"]) == set(kernel_cache.kernels())  # nothing cached yet
+    assert out["workers"] == 2 and out["failed"] == {}
+    assert grid <= set(out["compiled"])
+    assert not grid & set(out["left"])
+    assert set(out["left"]) == set(out["cold"]) - set(out["compiled"])
+    # the cache the workers filled serves a new process: it loads, nothing compiles
+    script = """
+        import numba.core.event as ev
+        from numba.core.dispatcher import Dispatcher
+        from trajopt import kernel_cache
+        rec = ev.install_recorder("numba:compile").__enter__()
+        n = kernel_cache.load_kernels(["astar.distance_transform", "astar.inflation",
+                                       "astar.search_kernels"])
+        print(n, sum(1 for e in rec.buffer if e[1].is_start))
+    """
+    loaded, compiled = map(int, _run(script, env=env).stdout.split())
+    assert loaded >= len(grid) and compiled == 0
+    # a first compilation in a process logs one line; loading logs nothing
+    script = """
+        import logging
+        logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
+        import numpy as np
+        from trajopt.convex_hull import convex_hull
+        convex_hull(np.random.default_rng(0).normal(size=(20, 2)))
+        convex_hull(np.random.default_rng(1).normal(size=(20, 2)))
+    """
+    for expect in (1, 0):
+        err = _run(script, env=env).stderr
+        lines = [s for s in err.splitlines() if "compiling numerical kernels once" in s]
+        assert len(lines) == expect, err
+        if expect:
+            assert lines[0].startswith("WARNING trajopt.kernel_cache: trajopt: compiling")
+            assert "trajopt warm-up" in lines[0]
+
+
+def test_unknown_exercise_is_an_error():
+    from trajopt.errors import InvalidInputError
+
+    with pytest.raises(InvalidInputError, match="unknown warm-up exercise 'nope'"):
+        kernel_cache.compile_kernels(["nope"], force=True)

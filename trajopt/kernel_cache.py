@@ -1,0 +1,530 @@
+"""The compiled kernels of astar and trajopt: their one-time compilation, shown and done ahead.
+
+Every compiled kernel of the two packages is a numba ``@njit(cache=True)`` function in one of
+:data:`KERNEL_MODULES`. numba compiles a kernel the first time it is called with a new
+signature and keeps the machine code in its disk cache (``__pycache__`` beside the source,
+or ``$NUMBA_CACHE_DIR``); later processes load it in milliseconds. A new environment (a
+fresh clone, venv, container or CI runner) starts with an empty cache and pays the
+compilation once: about half a minute of CPU for all kernels.
+
+This module makes that visible and lets it be paid ahead of time:
+
+* :func:`watch_compiles` (installed by the trajopt kernel modules when they are imported)
+  logs one WARNING on the logger ``trajopt.kernel_cache`` the first time a kernel of the
+  two packages compiles in a process. WARNING, not INFO, because it explains a one-time
+  latency of tens of seconds in a call that otherwise takes milliseconds, which a robot
+  program should hear about and can act on (``trajopt warm-up`` in its image build); it is
+  the level Matplotlib uses for "building the font cache". Loading from the cache logs
+  nothing. The library prints nothing; the ``trajopt`` command line shows the notice.
+* :func:`cold_kernels` lists the kernels with nothing valid in the disk cache, without
+  compiling anything (it reads numba's cache index files).
+* :func:`compile_kernels` compiles them by running the warm-up exercises
+  (:data:`trajopt.warm_up.EXERCISES`: small searches, plans and timings that between them
+  call every kernel with the argument types the library uses) in worker processes, two at
+  a time on two cores; numba's cache holds one file per kernel and signature and writes
+  them atomically, so the workers fill one cache for every later process.
+* :func:`load_kernels` loads every kernel's cached signatures into this process (also the
+  kernels that only other kernels call, whose code is otherwise only loaded inside their
+  callers).
+
+:func:`trajopt.warm_up` and ``trajopt warm-up`` combine the last two.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import os
+import selectors
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = [
+    "KERNEL_MODULES",
+    "CompileReport",
+    "cold_kernels",
+    "compile_kernels",
+    "dispatchers",
+    "kernels",
+    "load_kernels",
+    "watch_compiles",
+]
+
+_log = logging.getLogger(__name__)
+
+#: Modules that define the compiled (numba) kernels of astar and trajopt.
+KERNEL_MODULES: tuple[str, ...] = (
+    "astar.distance_transform",
+    "astar.inflation",
+    "astar.search_kernels",
+    "astar.weighted_kernel",
+    "trajopt.bspline",
+    "trajopt.clearance",
+    "trajopt.convex_hull",
+    "trajopt.feasibility",
+    "trajopt.footprint_kernels",
+    "trajopt.polygon_corridor.obstacle_index",
+    "trajopt.polygon_corridor.path_kernels",
+    "trajopt.polygon_corridor.region_kernels",
+    "trajopt.timing.cap_cubic",
+    "trajopt.timing.cap_kernel",
+    "trajopt.timing.greedy",
+)
+
+#: CPU seconds one kernel takes to compile, on average (2-core machine, numba 0.68); the
+#: notice's estimate.
+SECONDS_PER_KERNEL = 0.5
+
+#: Environment variable set in the worker processes of :func:`compile_kernels`.
+WORKER_ENV = "TRAJOPT_KERNEL_WORKER"
+
+_PACKAGES = ("astar.", "trajopt.")
+
+
+# ----------------------------------------------------------------------------- inventory
+def dispatchers(modules: Iterable[str] = KERNEL_MODULES) -> dict[str, Any]:
+    """Return every numba dispatcher defined in ``modules``, by ``"module.name"``.
+
+    The modules are imported (which compiles nothing). Kernels with ``inline="always"``
+    are included: numba inlines them into their callers and never compiles them alone.
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    out: dict[str, Any] = {}
+    for name in modules:
+        module = importlib.import_module(name)
+        for attr, value in vars(module).items():
+            if isinstance(value, Dispatcher) and value.py_func.__module__ == name:
+                out[f"{name}.{attr}"] = value
+    return out
+
+
+def kernels(modules: Iterable[str] = KERNEL_MODULES) -> dict[str, Any]:
+    """:func:`dispatchers` without the ``inline="always"`` ones: the kernels numba compiles."""
+    return {k: d for k, d in dispatchers(modules).items() if not _inlined(d)}
+
+
+def _inlined(d: Any) -> bool:
+    return d.targetoptions.get("inline", "never") == "always"
+
+
+def _cached_signatures(d: Any) -> list[Any] | None:
+    """Signatures of ``d`` with a valid entry in numba's disk cache (``None``: cannot tell).
+
+    Valid means what numba itself checks before loading one: the index file matches the
+    source file's stamp and this numba version, and the entry's key (signature, target
+    machine, bytecode hash) is the one numba would look up now. Reads numba's private
+    cache objects: any failure there answers ``None``.
+    """
+    try:
+        cache = d._cache
+        if not hasattr(cache, "_cache_file"):
+            return None  # caching disabled (a NullCache)
+        index = cache._cache_file._load_index()
+        codegen = d.targetctx.codegen()
+        return [key[0] for key in index if key == cache._index_key(key[0], codegen)]
+    except Exception:  # noqa: BLE001 - a numba without these internals: unknown
+        return None
+
+
+def cold_kernels(modules: Iterable[str] = KERNEL_MODULES) -> list[str]:
+    """Return the kernels with no valid entry in numba's disk cache (they would compile).
+
+    Nothing is compiled or loaded: numba's index files are read. A kernel whose cache
+    cannot be inspected counts as compiled.
+    """
+    cold = []
+    for name, d in kernels(modules).items():
+        sigs = _cached_signatures(d)
+        if sigs is not None and not sigs:
+            cold.append(name)
+    return cold
+
+
+def load_kernels(modules: Iterable[str] = KERNEL_MODULES) -> int:
+    """Load every cached signature of every kernel into this process; return how many.
+
+    Signatures already loaded are skipped. Only cached ones are loaded: nothing compiles.
+    """
+    n = 0
+    for d in kernels(modules).values():
+        for sig in _cached_signatures(d) or ():
+            if tuple(sig) not in d.overloads:
+                d.compile(sig)
+                n += 1
+    return n
+
+
+def estimate_seconds(n_kernels: int, workers: int = 1) -> float:
+    """Rough wall time (s) to compile ``n_kernels`` kernels with ``workers`` processes."""
+    return SECONDS_PER_KERNEL * n_kernels / max(1, workers)
+
+
+# ----------------------------------------------------------------------------- the notice
+_watch: dict[str, Any] = {"installed": False, "noticed": False, "hooks": []}
+
+
+def watch_compiles() -> None:
+    """Install, once per process, the listener that announces kernel compilation.
+
+    On the first compilation of an astar or trajopt kernel in the process it logs one
+    WARNING (module docstring) and calls every hook of :func:`add_compile_hook`. A
+    kernel loaded from numba's cache triggers nothing: numba only signals a compilation.
+    """
+    if _watch["installed"]:
+        return
+    from numba.core import event
+
+    class _Listener(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            d = ev.data["dispatcher"]
+            if not getattr(d.py_func, "__module__", "").startswith(_PACKAGES):
+                return
+            if not _watch["noticed"]:
+                _watch["noticed"] = True
+                _notice(d)
+
+        def on_end(self, ev: Any) -> None:
+            d = ev.data["dispatcher"]
+            name = f"{d.py_func.__module__}.{d.py_func.__name__}"
+            if name.startswith(_PACKAGES):
+                for hook in list(_watch["hooks"]):
+                    hook(name)
+
+    event.register("numba:compile", _Listener())
+    _watch["installed"] = True
+
+
+def add_compile_hook(hook: Callable[[str], None]) -> None:
+    """Call ``hook("module.kernel")`` each time a kernel of the packages finishes compiling."""
+    watch_compiles()
+    _watch["hooks"].append(hook)
+
+
+def _notice(d: Any) -> None:
+    if os.environ.get(WORKER_ENV):
+        return  # a worker of compile_kernels: its parent reports
+    try:
+        n = len(cold_kernels())
+    except Exception:  # noqa: BLE001 - the notice must never break a compile
+        n = 0
+    about = f", up to about {estimate_seconds(n):.0f} s" if n else ""
+    _log.warning(
+        "trajopt: compiling numerical kernels once for this environment (numba, starting "
+        "with %s%s); later processes load them from the cache. `trajopt warm-up` or "
+        "trajopt.warm_up() compiles all of them ahead of time, in parallel.",
+        d.py_func.__name__, about,
+    )  # fmt: skip
+
+
+# ----------------------------------------------------------------------------- compilation
+@dataclass
+class CompileReport:
+    """What :func:`compile_kernels` did.
+
+    Attributes
+    ----------
+    cold : list of str
+        Kernels with nothing cached before (``"module.kernel"``).
+    compiled : list of str
+        Kernels compiled by the workers (a kernel compiled for two signatures counts once).
+    exercises : list of str
+        Warm-up exercises run.
+    timeline : list of tuple
+        ``(exercise, worker, start, end)`` (s since the call; worker 0: this process).
+    failed : dict of str to str
+        Exercises that raised, with the error (their kernels compile when first used).
+    workers : int
+        Worker processes (0: ran in this process).
+    seconds : float
+        Wall time until every exercise was done (so far, while :meth:`wait` would wait).
+    """
+
+    cold: list[str] = field(default_factory=list)
+    compiled: list[str] = field(default_factory=list)
+    exercises: list[str] = field(default_factory=list)
+    timeline: list[tuple[str, int, float, float]] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    workers: int = 0
+    seconds: float = 0.0
+    _thread: Any = field(default=None, repr=False)
+
+    def wait(self) -> CompileReport:
+        """Wait for the exercises still running in the background (``first``); return self."""
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        return self
+
+
+def compile_kernels(
+    exercises: Sequence[str] | None = None,
+    *,
+    workers: int | None = None,
+    progress: Callable[[int, int, str], None] | None = None,
+    first: Sequence[str] | None = None,
+    force: bool = False,
+) -> CompileReport:
+    """Compile the cold kernels into numba's disk cache by running the warm-up exercises.
+
+    Parameters
+    ----------
+    exercises : sequence of str, optional
+        Names in :data:`trajopt.warm_up.EXERCISES` (with the ones they depend on); default
+        all, which call every kernel of the packages.
+    workers : int, optional
+        Worker processes; default ``min(2, CPUs)``. ``0`` or ``1`` runs the exercises in this
+        process, one after the other (the kernels are then also loaded here).
+    progress : callable, optional
+        ``progress(done, total, kernel)`` after each cold kernel compiles (``total`` is the
+        number of cold kernels), and once at the end with ``done == total``.
+    first : sequence of str, optional
+        Exercises to run before the others; the call returns as soon as they (and those
+        they depend on) are done, while the workers go on with the rest in the background
+        (:meth:`CompileReport.wait` waits for them). Default: return when all are done.
+    force : bool
+        Run the exercises even when no kernel is cold.
+
+    Returns
+    -------
+    CompileReport
+        Nothing runs (and ``seconds`` is ~0) when every kernel is already cached. An
+        exercise that fails is reported, not raised: its kernels then compile on first use.
+    """
+    import threading
+
+    from trajopt.warm_up import EXERCISES
+
+    t0 = time.perf_counter()
+    cold = cold_kernels()
+    report = CompileReport(cold=list(cold))
+    if not cold and not force:
+        return report
+    names = _with_dependencies(EXERCISES, list(EXERCISES) if exercises is None else exercises)
+    early = set(_with_dependencies(EXERCISES, first)) if first is not None else set(names)
+    names.sort(key=lambda n: (n not in early, -EXERCISES[n].seconds))  # early, longest first
+    if workers is None:
+        workers = min(2, os.cpu_count() or 1)
+    if os.environ.get(WORKER_ENV):
+        workers = 0  # never nest workers
+    done: set[str] = set()
+
+    def seen(kernel: str) -> None:
+        if kernel in report.cold and kernel not in done:
+            done.add(kernel)
+            report.compiled.append(kernel)
+            if progress is not None:
+                progress(len(done), len(cold), kernel)
+
+    def finish() -> None:
+        if progress is not None:
+            progress(len(cold), len(cold), "")
+        report.seconds = time.perf_counter() - t0
+
+    if workers >= 2:
+        try:
+            pool = _Workers(min(workers, len(names)), EXERCISES, report, seen, t0)
+        except OSError as exc:  # no subprocess here: run them in this process
+            _log.info("compile_kernels: no worker processes (%s); compiling here", exc)
+        else:
+            report.workers = pool.n
+            early_done = threading.Event()
+
+            def run() -> None:
+                try:
+                    pool.run(names, early, early_done)
+                finally:
+                    early_done.set()
+                    finish()
+
+            thread = threading.Thread(target=run, name="trajopt-compile", daemon=True)
+            thread.start()
+            report._thread = thread
+            early_done.wait()
+            if first is None:
+                report.wait()
+            return report
+    add_compile_hook(seen)
+    try:
+        for name in names:
+            t1 = time.perf_counter() - t0
+            try:
+                EXERCISES[name].run()
+                report.exercises.append(name)
+                report.timeline.append((name, 0, t1, time.perf_counter() - t0))
+            except Exception as exc:  # noqa: BLE001 - reported, the kernels compile later
+                report.failed[name] = f"{type(exc).__name__}: {exc}"
+    finally:
+        _watch["hooks"].remove(seen)
+    finish()
+    return report
+
+
+def _with_dependencies(table: dict[str, Any], names: Iterable[str]) -> list[str]:
+    """``names`` and what they depend on, dependencies first, unknown names rejected."""
+    from trajopt.errors import InvalidInputError
+
+    out: list[str] = []
+
+    def add(name: str) -> None:
+        if name not in table:
+            raise InvalidInputError(
+                f"unknown warm-up exercise {name!r}; known: {', '.join(sorted(table))}"
+            )
+        if name in out:
+            return
+        for dep in table[name].after:
+            add(dep)
+        out.append(name)
+
+    for name in names:
+        add(name)
+    return out
+
+
+class _Workers:
+    """Worker processes that run warm-up exercises named on their stdin (:func:`_worker`)."""
+
+    def __init__(self, n: int, table: dict[str, Any], report: CompileReport,
+                 seen: Callable[[str], None], t0: float) -> None:  # fmt: skip
+        self.table, self.report, self.seen, self.t0 = table, report, seen, t0
+        env = dict(os.environ, **{WORKER_ENV: "1"})
+        self.procs: list[subprocess.Popen] = []
+        self.logs = []
+        try:
+            for _ in range(n):
+                log = tempfile.TemporaryFile(mode="w+")
+                self.logs.append(log)
+                self.procs.append(subprocess.Popen(
+                    [sys.executable, "-m", "trajopt.kernel_cache", "--worker"],
+                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True,
+                    bufsize=1, env=env,
+                ))  # fmt: skip
+        except OSError:
+            self.close()
+            raise
+        self.n = n
+
+    def run(self, names: list[str], early: set[str], early_done: Any) -> None:
+        """Run ``names`` in this order as their dependencies allow.
+
+        ``early_done`` is set once every exercise in ``early`` is over.
+        """
+        table, report = self.table, self.report
+        pending = list(names)
+        finished: set[str] = set()
+        busy: dict[int, str | None] = {p.pid: None for p in self.procs}
+        started: dict[int, float] = {}
+        sel = selectors.DefaultSelector()
+        for proc in self.procs:
+            sel.register(proc.stdout, selectors.EVENT_READ, proc)
+
+        def assign() -> None:
+            for proc in self.procs:
+                if busy[proc.pid] is not None or proc.poll() is not None:
+                    continue
+                ready = [n for n in pending if all(d in finished for d in table[n].after)]
+                if not ready:
+                    return
+                name = ready[0]
+                pending.remove(name)
+                busy[proc.pid] = name
+                started[proc.pid] = time.perf_counter() - self.t0
+                proc.stdin.write(name + "\n")
+                proc.stdin.flush()
+
+        def over(proc: subprocess.Popen, error: str | None) -> None:
+            name = busy[proc.pid]
+            busy[proc.pid] = None
+            finished.add(name)
+            if error is None:
+                report.exercises.append(name)
+                report.timeline.append((name, self.procs.index(proc) + 1, started[proc.pid],
+                                        time.perf_counter() - self.t0))  # fmt: skip
+            else:
+                report.failed[name] = error
+            if early <= finished:
+                early_done.set()
+
+        try:
+            assign()
+            while any(v is not None for v in busy.values()):
+                for key, _ in sel.select(timeout=1.0):
+                    proc = key.data
+                    line = proc.stdout.readline()
+                    if not line:  # the worker died
+                        sel.unregister(proc.stdout)
+                        if busy[proc.pid] is not None:
+                            over(proc, f"worker exited with {proc.wait()}: {self._tail(proc)}")
+                        continue
+                    kind, _, rest = line.rstrip("\n").partition(" ")
+                    if kind == "compiled":
+                        self.seen(rest)
+                    elif kind == "done":
+                        over(proc, None)
+                    elif kind == "failed":
+                        over(proc, rest.replace("\\n", "\n"))
+                assign()
+                if pending and all(v is None for v in busy.values()):
+                    if all(p.poll() is not None for p in self.procs):
+                        for name in pending:
+                            report.failed[name] = "no worker left"
+                        break
+                    finished.update(n for n in names if n not in pending)  # failed deps
+                    assign()
+        finally:
+            sel.close()
+            self.close()
+
+    def _tail(self, proc: subprocess.Popen) -> str:
+        log = self.logs[self.procs.index(proc)]
+        log.seek(0)
+        return log.read()[-500:].strip()
+
+    def close(self) -> None:
+        for proc in self.procs:
+            try:
+                proc.stdin.close()
+            except OSError:
+                pass
+        for proc in self.procs:
+            try:
+                proc.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        for log in self.logs:
+            log.close()
+
+
+def _worker() -> int:
+    """Serve :func:`compile_kernels`: run the exercises named on stdin, one a line."""
+    from trajopt.warm_up import EXERCISES
+
+    add_compile_hook(lambda name: print("compiled", name, flush=True))
+    for line in sys.stdin:
+        name = line.strip()
+        if not name:
+            continue
+        try:
+            EXERCISES[name].run()
+        except Exception as exc:  # noqa: BLE001 - reported to the parent
+            detail = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+            print("failed", detail.replace("\n", "\\n"), flush=True)
+        else:
+            print("done", name, flush=True)
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover - run by compile_kernels
+    if sys.argv[1:] == ["--worker"]:
+        from trajopt.kernel_cache import _worker as _serve  # the module, not __main__
+
+        sys.exit(_serve())
+    sys.exit(f"usage: {sys.executable} -m trajopt.kernel_cache --worker (used by compile_kernels)")
