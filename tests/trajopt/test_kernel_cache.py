@@ -6,6 +6,7 @@
   kernel the exercises leave out fails here, whatever numba's cache holds).
 * In a fresh numba cache: the kernels are cold, worker processes compile them into the
   cache, and a first compilation logs one notice per process (none when loading).
+* ``trajopt warm-up`` on the command line.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import textwrap
 import pytest
 
 from trajopt import kernel_cache
+from trajopt.cli import main
 
 
 def _run(script: str, *args: str, env: dict | None = None) -> subprocess.CompletedProcess:
@@ -158,6 +160,21 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
         if expect:
             assert lines[0].startswith("WARNING trajopt.kernel_cache: trajopt: compiling")
             assert "trajopt warm-up" in lines[0]
+
+
+def test_cli_warm_up(capsys):
+    assert main(["warm-up", "--workers", "1"]) == 0
+    out = capsys.readouterr().out
+    n = len(kernel_cache.kernels())
+    assert f"{n} of {n} kernels compiled and loaded" in out
+    assert kernel_cache.cold_kernels() == []
+
+
+@pytest.mark.parametrize("workers", ["0", "-1"])
+def test_cli_warm_up_rejects_bad_workers(workers, capsys):
+    assert main(["warm-up", "--workers", workers]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--workers must be >= 1" in err
 
 
 def test_unknown_exercise_is_an_error():
