@@ -690,8 +690,8 @@ def _cmd_bench_report(args: argparse.Namespace) -> int:
 
 def _cmd_warm_up(args: argparse.Namespace) -> int:
     from trajopt import kernel_cache
-    from trajopt.warm_up import warm_up
 
+    warm_up = kernel_cache.warm_up_module().warm_up
     if args.workers is not None and args.workers < 1:
         raise CliError(f"--workers must be >= 1, got {args.workers}")
     t0 = time.perf_counter()
@@ -771,13 +771,13 @@ def _compile_notice(args: argparse.Namespace) -> Any:
     """
     if args.command not in _PLANNING or getattr(args, "bench_command", "run") != "run":
         return None
-    from trajopt.warm_up import CORE_EXERCISES
+    from trajopt import kernel_cache
 
     notice = logging.getLogger("trajopt.kernel_cache")
     if not any(isinstance(h, _StderrLines) for h in notice.handlers):
         notice.addHandler(_StderrLines())
         notice.propagate = False
-    return _compile_kernels(CORE_EXERCISES, None)
+    return _compile_kernels(kernel_cache.warm_up_module().CORE_EXERCISES, None)
 
 
 class _StderrLines(logging.StreamHandler):

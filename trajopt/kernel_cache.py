@@ -224,6 +224,22 @@ def _notice(d: Any) -> None:
 
 
 # ----------------------------------------------------------------------------- compilation
+def warm_up_module() -> Any:
+    """Return the module :mod:`trajopt.warm_up`, leaving ``trajopt.warm_up`` the function.
+
+    The package exports the function :func:`trajopt.warm_up` lazily under the name of the
+    module that defines it. The first ``import trajopt.warm_up`` makes the import system
+    set the package attribute ``warm_up`` to the module, after which ``from trajopt import
+    warm_up`` would give the module; this puts the function back.
+    """
+    import trajopt
+
+    module = importlib.import_module("trajopt.warm_up")
+    if vars(trajopt).get("warm_up") is not module.warm_up:
+        trajopt.warm_up = module.warm_up
+    return module
+
+
 @dataclass
 class CompileReport:
     """What :func:`compile_kernels` did.
@@ -299,7 +315,7 @@ def compile_kernels(
     """
     import threading
 
-    from trajopt.warm_up import EXERCISES
+    EXERCISES = warm_up_module().EXERCISES  # noqa: N806 - the module's constant
 
     t0 = time.perf_counter()
     cold = cold_kernels()
@@ -505,7 +521,7 @@ class _Workers:
 
 def _worker() -> int:
     """Serve :func:`compile_kernels`: run the exercises named on stdin, one a line."""
-    from trajopt.warm_up import EXERCISES
+    EXERCISES = warm_up_module().EXERCISES  # noqa: N806 - the module's constant
 
     add_compile_hook(lambda name: print("compiled", name, flush=True))
     for line in sys.stdin:

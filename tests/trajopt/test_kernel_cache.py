@@ -182,3 +182,19 @@ def test_unknown_exercise_is_an_error():
 
     with pytest.raises(InvalidInputError, match="unknown warm-up exercise 'nope'"):
         kernel_cache.compile_kernels(["nope"], force=True)
+
+
+def test_the_exercises_leave_trajopt_warm_up_the_function():
+    # the module trajopt.warm_up holds the exercises; importing it must not leave the package
+    # attribute trajopt.warm_up the module (it shadowed the function in a fresh clone's suite)
+    script = """
+        import types
+        import trajopt.warm_up  # the import system sets trajopt.warm_up to the module
+        from trajopt import kernel_cache
+        assert isinstance(vars(trajopt)["warm_up"], types.ModuleType)
+        kernel_cache.warm_up_module()
+        from trajopt import warm_up
+        assert callable(warm_up) and not isinstance(warm_up, types.ModuleType), warm_up
+        print("ok")
+    """
+    assert _run(script).stdout.strip() == "ok"
