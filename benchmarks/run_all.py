@@ -146,7 +146,8 @@ BENCHES: tuple[Bench, ...] = (
           "cProfile of a serial pass, and the machine's own 1-vs-2-process ceiling for the "
           "same work without Dask. Each measurement waits for other processes to go quiet "
           "and reports the cores they used meanwhile (a round where they used more than "
-          "0.15 cores is not counted and is repeated). On this 2-vCPU VM the host's speed "
+          "0.15 cores, or where the workers got under 85 % of their wall time as CPU, is "
+          "not counted and is repeated). On this 2-vCPU VM the host's speed "
           "drifts by tens of per cent from minute to minute (the fixed loop's time), so a "
           "single round's ratio moves by about as much: read the quiet rounds' median and "
           "the per-run split.",
