@@ -35,7 +35,6 @@ from __future__ import annotations
 import importlib
 import logging
 import os
-import selectors
 import subprocess
 import sys
 import tempfile
@@ -83,6 +82,10 @@ SECONDS_PER_KERNEL = 0.5
 
 #: Environment variable set in the worker processes of :func:`compile_kernels`.
 WORKER_ENV = "TRAJOPT_KERNEL_WORKER"
+
+#: Seconds without a line from any worker after which :func:`compile_kernels` stops them
+#: (a kernel compiles in seconds; the exercises' kernels then compile on first use).
+IDLE_LIMIT_S = 300.0
 
 _PACKAGES = ("astar.", "trajopt.")
 
@@ -430,16 +433,27 @@ class _Workers:
     def run(self, names: list[str], early: set[str], early_done: Any) -> None:
         """Run ``names`` in this order as their dependencies allow.
 
-        ``early_done`` is set once every exercise in ``early`` is over.
+        ``early_done`` is set once every exercise in ``early`` is over. One thread per
+        worker reads its lines (a blocking read each: no line can wait unseen in a buffer);
+        a worker silent for :data:`IDLE_LIMIT_S` is stopped and its exercise reported.
         """
+        import queue
+        import threading
+
         table, report = self.table, self.report
         pending = list(names)
         finished: set[str] = set()
         busy: dict[int, str | None] = {p.pid: None for p in self.procs}
         started: dict[int, float] = {}
-        sel = selectors.DefaultSelector()
+        lines: queue.Queue = queue.Queue()
+
+        def read(proc: subprocess.Popen) -> None:
+            for line in proc.stdout:
+                lines.put((proc, line))
+            lines.put((proc, None))
+
         for proc in self.procs:
-            sel.register(proc.stdout, selectors.EVENT_READ, proc)
+            threading.Thread(target=read, args=(proc,), daemon=True).start()
 
         def assign() -> None:
             for proc in self.procs:
@@ -452,8 +466,11 @@ class _Workers:
                 pending.remove(name)
                 busy[proc.pid] = name
                 started[proc.pid] = time.perf_counter() - self.t0
-                proc.stdin.write(name + "\n")
-                proc.stdin.flush()
+                try:
+                    proc.stdin.write(name + "\n")
+                    proc.stdin.flush()
+                except OSError:  # it died: its reader reports the end
+                    pass
 
         def over(proc: subprocess.Popen, error: str | None) -> None:
             name = busy[proc.pid]
@@ -471,37 +488,40 @@ class _Workers:
         try:
             assign()
             while any(v is not None for v in busy.values()):
-                for key, _ in sel.select(timeout=1.0):
-                    proc = key.data
-                    line = proc.stdout.readline()
-                    if not line:  # the worker died
-                        sel.unregister(proc.stdout)
+                try:
+                    proc, line = lines.get(timeout=IDLE_LIMIT_S)
+                except queue.Empty:
+                    for proc in self.procs:
                         if busy[proc.pid] is not None:
-                            over(proc, f"worker exited with {proc.wait()}: {self._tail(proc)}")
-                        continue
-                    kind, _, rest = line.rstrip("\n").partition(" ")
-                    if kind == "compiled":
-                        self.seen(rest)
-                    elif kind == "done":
-                        over(proc, None)
-                    elif kind == "failed":
-                        over(proc, rest.replace("\\n", "\n"))
+                            over(proc, f"no word from its worker for {IDLE_LIMIT_S:.0f} s")
+                    self.kill()
+                    break
+                if line is None:  # the worker ended
+                    if busy[proc.pid] is not None:
+                        over(proc, f"worker exited with {proc.wait()}: {self._tail(proc)}")
+                    continue
+                kind, _, rest = line.rstrip("\n").partition(" ")
+                if kind == "compiled":
+                    self.seen(rest)
+                elif kind == "done" and busy[proc.pid] is not None:
+                    over(proc, None)
+                elif kind == "failed" and busy[proc.pid] is not None:
+                    over(proc, rest.replace("\\n", "\n"))
                 assign()
-                if pending and all(v is None for v in busy.values()):
-                    if all(p.poll() is not None for p in self.procs):
-                        for name in pending:
-                            report.failed[name] = "no worker left"
-                        break
-                    finished.update(n for n in names if n not in pending)  # failed deps
-                    assign()
+            for name in pending:  # workers gone before these could run
+                report.failed[name] = "not run: no worker left"
         finally:
-            sel.close()
             self.close()
 
     def _tail(self, proc: subprocess.Popen) -> str:
         log = self.logs[self.procs.index(proc)]
         log.seek(0)
         return log.read()[-500:].strip()
+
+    def kill(self) -> None:
+        for proc in self.procs:
+            if proc.poll() is None:
+                proc.kill()
 
     def close(self) -> None:
         for proc in self.procs:
@@ -520,10 +540,20 @@ class _Workers:
 
 
 def _worker() -> int:
-    """Serve :func:`compile_kernels`: run the exercises named on stdin, one a line."""
+    """Serve :func:`compile_kernels`: run the exercises named on stdin, one a line.
+
+    Lines to the parent go to the original stdout; anything else written to file
+    descriptor 1 (by Python or by a solver's C code) goes to stderr, the parent's log.
+    """
+    protocol = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(2, 1)
     EXERCISES = warm_up_module().EXERCISES  # noqa: N806 - the module's constant
 
-    add_compile_hook(lambda name: print("compiled", name, flush=True))
+    def say(*words: str) -> None:
+        protocol.write(" ".join(words) + "\n")
+        protocol.flush()
+
+    add_compile_hook(lambda name: say("compiled", name))
     for line in sys.stdin:
         name = line.strip()
         if not name:
@@ -532,9 +562,9 @@ def _worker() -> int:
             EXERCISES[name].run()
         except Exception as exc:  # noqa: BLE001 - reported to the parent
             detail = "".join(traceback.format_exception_only(type(exc), exc)).strip()
-            print("failed", detail.replace("\n", "\\n"), flush=True)
+            say("failed", detail.replace("\n", "\\n"))
         else:
-            print("done", name, flush=True)
+            say("done", name)
     return 0
 
 
