@@ -5,7 +5,7 @@ Every compiled kernel of the two packages is a numba ``@njit(cache=True)`` funct
 signature and keeps the machine code in its disk cache (``__pycache__`` beside the source,
 or ``$NUMBA_CACHE_DIR``); later processes load it in milliseconds. A new environment (a
 fresh clone, venv, container or CI runner) starts with an empty cache and pays the
-compilation once: about half a minute of CPU for all kernels.
+compilation once: about 50 s of CPU for all kernels on a 2-core machine (numba 0.68).
 
 This module makes that visible and lets it be paid ahead of time:
 

@@ -3,7 +3,7 @@
 Two one-time costs stand before a fast plan:
 
 * **Once per environment** (fresh clone, venv, container, CI runner): numba compiles the
-  compiled kernels of astar and trajopt into its disk cache, about half a minute of CPU.
+  compiled kernels of astar and trajopt into its disk cache, about 50 s of CPU.
   :func:`warm_up` first compiles every kernel that is not cached yet, by running the
   :data:`EXERCISES` (small searches, plans, timings, a fallback and a comparison that between
   them call every kernel with the argument types the library uses) in two worker processes
