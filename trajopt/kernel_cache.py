@@ -9,8 +9,8 @@ compilation once: about 50 s of CPU for all kernels on a 2-core machine (numba 0
 
 This module makes that visible and lets it be paid ahead of time:
 
-* :func:`watch_compiles` (installed by the trajopt kernel modules when they are imported)
-  logs one WARNING on the logger ``trajopt.kernel_cache`` the first time a kernel of the
+* :func:`watch_compiles` (installed by the trajopt kernel modules when they are imported,
+  so a program that imports only ``astar`` is not told) logs one WARNING on the logger ``trajopt.kernel_cache`` the first time a kernel of the
   two packages compiles in a process. WARNING, not INFO, because it explains a one-time
   latency of tens of seconds in a call that otherwise takes milliseconds, which a robot
   program should hear about and can act on (``trajopt warm-up`` in its image build); it is
@@ -47,11 +47,14 @@ from typing import Any
 __all__ = [
     "KERNEL_MODULES",
     "CompileReport",
+    "add_compile_hook",
     "cold_kernels",
     "compile_kernels",
     "dispatchers",
+    "estimate_seconds",
     "kernels",
     "load_kernels",
+    "warm_up_module",
     "watch_compiles",
 ]
 
