@@ -18,7 +18,7 @@ import numpy as np
 from astar import validation
 from astar.errors import InvalidInputError
 
-__all__ = ["OccupancyGrid"]
+__all__ = ["OccupancyGrid", "check_grid"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,3 +182,26 @@ class OccupancyGrid:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def check_grid(value: object) -> OccupancyGrid:
+    """Return ``value`` if it is an :class:`OccupancyGrid` (the check of a ``grid`` argument).
+
+    Parameters
+    ----------
+    value : object
+        The ``grid`` argument of a public function of :mod:`astar`.
+
+    Returns
+    -------
+    OccupancyGrid
+        ``value`` itself.
+
+    Raises
+    ------
+    InvalidInputError
+        ``value`` is not an :class:`OccupancyGrid` (the message names its type).
+    """
+    if not isinstance(value, OccupancyGrid):
+        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(value).__name__}")
+    return value

@@ -48,7 +48,7 @@ from numba import njit
 from astar import validation
 from astar.distance_transform import squared_distances
 from astar.errors import InvalidInputError
-from astar.grid import OccupancyGrid
+from astar.grid import OccupancyGrid, check_grid
 
 __all__ = ["Metric", "avoidance_area", "clearance", "clearance_cost", "inflate"]
 
@@ -230,7 +230,7 @@ def inflate(
     >>> inflate(g, 0.1).occupied.sum()  # the cell and its 4 edge neighbours
     5
     """
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     r = validation.nonnegative_float("radius", radius, "metres")
     metric = validation.choice("metric", metric, _METRICS)  # type: ignore[assignment]
     occ, pad = _padded(grid.occupied, bool(outside_occupied))
@@ -289,7 +289,7 @@ def clearance(
     as an integer (cells squared, or quarter cells squared for ``"square"``); only the final
     square root rounds.
     """
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     metric = validation.choice("metric", metric, _METRICS)  # type: ignore[assignment]
     occ, pad = _padded(grid.occupied, bool(outside_occupied))
     if not occ.any():
@@ -330,7 +330,7 @@ def avoidance_area(grid: OccupancyGrid, w_cells: int, *, border: bool = True) ->
     InvalidInputError
         ``grid`` is not an :class:`OccupancyGrid` or ``w_cells`` is not an integer ``>= 0``.
     """
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)):
         raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
     w = int(w_cells)
@@ -394,7 +394,7 @@ def clearance_cost(
     InvalidInputError
         A parameter breaks the rules above.
     """
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     r = validation.nonnegative_float("radius", radius, "metres")
     falloff = validation.nonnegative_float("falloff_cells", falloff_cells, "cells")
     if falloff == 0.0:

@@ -24,7 +24,8 @@ import numpy as np
 
 from astar import validation
 from astar.errors import InvalidInputError
-from astar.grid import OccupancyGrid
+from astar.grid import OccupancyGrid, check_grid
+from astar.search_workspace import LOCK, padded_free, workspace
 
 __all__ = ["Landmarks", "build_landmarks"]
 
@@ -90,7 +91,7 @@ class Landmarks:
             (the message counts them): the bounds may then overestimate, so build new
             landmarks.
         """
-        grid = validation.grid(grid)
+        grid = check_grid(grid)
         if grid.shape != self.grid.shape:
             raise InvalidInputError(
                 f"grid has shape {grid.shape}, the landmarks' grid {self.grid.shape}"
@@ -143,10 +144,9 @@ def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivi
     """
     from scipy import ndimage
 
-    from astar.search import _LOCK, _padded_free, _workspace
     from astar.weighted_kernel import weighted_kernel
 
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= int(k) <= 64:
         raise InvalidInputError(f"k must be an integer in [1, 64] (landmarks), got {k!r}")
     if isinstance(connectivity, bool) or connectivity not in (4, 8):
@@ -162,9 +162,9 @@ def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivi
     largest = int(np.argmax(np.bincount(labels.ravel())[1:])) + 1
     iy0, ix0 = np.argwhere(labels == largest)[0]
     width = grid.nx + 2
-    with _LOCK:
-        free = _padded_free(grid.occupied)
-        ws = _workspace(free.shape[0])
+    with LOCK:
+        free = padded_free(grid.occupied)
+        ws = workspace(free.shape[0])
 
         def tree(source: int) -> np.ndarray:
             gen = ws.next_gen()

@@ -25,7 +25,8 @@ cost-so-far of a cell is kept as two integers -- its numbers of straight and dia
 so equal costs compare exactly equal and ties are broken exactly: among equal ``f = g + h`` the
 deeper node (larger ``g``) is expanded first, then the earlier pushed one. The search is
 therefore deterministic. The padded grid of the last few grids searched is cached (grids are
-immutable).
+immutable); the caches, the buffers and the lock that serialises the searches live in
+:mod:`astar.search_workspace`, shared with :func:`astar.build_landmarks`.
 
 With a ``cost`` the keys are floats that rarely tie and the open list is a radix heap on their
 bit patterns (:mod:`astar.weighted_kernel`): exact, monotone, several times faster than the
@@ -43,8 +44,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Literal
 
@@ -52,9 +51,10 @@ import numpy as np
 
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
-from astar.grid import OccupancyGrid
+from astar.grid import OccupancyGrid, check_grid
 from astar.landmarks import Landmarks
 from astar.search_kernels import astar_kernel, jps_kernel
+from astar.search_workspace import LOCK, padded_free, workspace
 from astar.weighted_kernel import weighted_kernel
 
 __all__ = ["GridPath", "find_path"]
@@ -137,31 +137,7 @@ class GridPath:
         )
 
 
-# --------------------------------------------------------------------------- caches
-class _Workspace:
-    """Work buffers of one padded size, reused between searches (guarded by a lock)."""
-
-    __slots__ = ("gen", "rec", "recf")
-
-    def __init__(self, n: int) -> None:
-        # one cache line touch per cell: [stamp, parent, straight steps, diagonal steps]; the
-        # two step counts double as the float64 cost so far of the weighted search (recf)
-        self.rec = np.zeros(4 * n, dtype=np.int32)
-        self.recf = self.rec.view(np.float64)
-        self.gen = 1
-
-    def next_gen(self) -> int:
-        self.gen += 2
-        if self.gen >= 2**31 - 4:
-            self.rec[0::4] = 0
-            self.gen = 1
-        return self.gen
-
-
-_LOCK = threading.Lock()
-_WORKSPACES: OrderedDict[int, _Workspace] = OrderedDict()
-_PADDED: OrderedDict[int, tuple[np.ndarray, np.ndarray]] = OrderedDict()
-_CACHE_SIZE = 4
+# --------------------------------------------------------------------------- constants
 _EMPTY_COST = np.zeros(1, dtype=np.float64)
 _NO_LANDMARKS = (np.zeros((0, 1)), np.zeros(0))
 
@@ -189,37 +165,6 @@ def _check_landmarks(landmarks: object, grid: OccupancyGrid, cost: object, conne
             f"corner_cutting={landmarks.corner_cutting}; got {connectivity}, {bool(corner_cutting)}"
         )
     return landmarks.cost
-
-
-def _workspace(n: int) -> _Workspace:
-    ws = _WORKSPACES.get(n)
-    if ws is None:
-        ws = _Workspace(n)
-        _WORKSPACES[n] = ws
-        while len(_WORKSPACES) > _CACHE_SIZE:
-            _WORKSPACES.popitem(last=False)
-    else:
-        _WORKSPACES.move_to_end(n)
-    return ws
-
-
-def _padded_free(occupied: np.ndarray) -> np.ndarray:
-    """Flat uint8 free mask of ``occupied`` with a blocked one-cell ring (cached by identity)."""
-    key = id(occupied)
-    hit = _PADDED.get(key)
-    if hit is not None and hit[0] is occupied:
-        _PADDED.move_to_end(key)
-        return hit[1]
-    ny, nx = occupied.shape
-    free = np.zeros((ny + 2, nx + 2), dtype=np.uint8)
-    free[1:-1, 1:-1] = ~occupied
-    flat = free.ravel()
-    flat.flags.writeable = False
-    # keep a reference to `occupied` so its id cannot be reused while cached
-    _PADDED[key] = (occupied, flat)
-    while len(_PADDED) > _CACHE_SIZE:
-        _PADDED.popitem(last=False)
-    return flat
 
 
 # --------------------------------------------------------------------------- public API
@@ -291,7 +236,7 @@ def find_path(
     >>> p.cells.tolist(), round(p.length, 6)
     ([[0, 0], [1, 1], [2, 2], [3, 2]], 3.828427)
     """
-    grid = validation.grid(grid)
+    grid = check_grid(grid)
     if isinstance(connectivity, bool) or connectivity not in (4, 8):
         raise InvalidInputError(f"connectivity must be 4 or 8, got {connectivity!r}")
     sx, sy = validation.cell("start", start, grid)
@@ -313,9 +258,9 @@ def find_path(
         lg = np.ascontiguousarray(lm[:, t])
     # jump point search for the plain shortest path under the Moving AI rules
     jps = connectivity == 8 and not corner_cutting and not weighted
-    with _LOCK:
-        free = _padded_free(grid.occupied)
-        ws = _workspace(free.shape[0])
+    with LOCK:
+        free = padded_free(grid.occupied)
+        ws = workspace(free.shape[0])
         gen = ws.next_gen()
         if weighted:
             found, path, expanded, gcost, na, nb = weighted_kernel(

@@ -4,6 +4,9 @@ Every checker takes the field's ``name`` first and the ``value`` second (as
 :mod:`trajopt.validation`), returns the cleaned value, or raises
 :class:`~astar.errors.InvalidInputError` whose message names the field, the value and the
 rule, so that every public function of :mod:`astar` reports bad input the same way.
+
+This module does not import :mod:`astar.grid` (which builds on it): the check of a ``grid``
+argument is :func:`astar.grid.check_grid`.
 """
 
 from __future__ import annotations
@@ -18,14 +21,13 @@ import numpy as np
 from astar.errors import InvalidInputError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from astar.grid import OccupancyGrid  # astar.grid imports this module
+    from astar.grid import OccupancyGrid  # annotations only: astar.grid imports this module
 
 __all__ = [
     "bool_grid",
     "cell",
     "cell_costs",
     "choice",
-    "grid",
     "integer_values",
     "nonnegative_float",
     "nonnegative_int",
@@ -108,15 +110,6 @@ def choice(name: str, value: object, choices: Sequence[str]) -> str:
     """One of the strings ``choices``."""
     if not isinstance(value, str) or value not in choices:
         raise InvalidInputError(f"{name} must be one of {tuple(choices)}, got {value!r}")
-    return value
-
-
-def grid(value: object) -> OccupancyGrid:
-    """Return an :class:`~astar.grid.OccupancyGrid` (the ``grid`` argument)."""
-    from astar.grid import OccupancyGrid
-
-    if not isinstance(value, OccupancyGrid):
-        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(value).__name__}")
     return value
 
 
