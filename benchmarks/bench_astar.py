@@ -119,8 +119,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--maps", nargs="+", default=list(DEFAULT_MAPS))
     ap.add_argument("--n", type=int, default=20, help="queries per map (whole longest buckets)")
     ap.add_argument("--repeat", type=int, default=3, help="timings per query (best kept)")
-    ap.add_argument("--long", type=int, default=20,
-                    help="clearance-cost queries timed on the warehouse-size map (0: none)")
+    ap.add_argument(
+        "--long",
+        type=int,
+        default=20,
+        help="clearance-cost queries timed on the warehouse-size map (0: none)",
+    )
     args = ap.parse_args(argv)
     print(
         f"{'map':<16}{'queries':>8}{'buckets':>10}{'ours ms':>10}{'pyastar2d ms':>14}"

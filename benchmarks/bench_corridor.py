@@ -23,7 +23,7 @@ code; the narrow ones that leave no grid path after inflation are skipped and na
   a warehouse-size map).
 
 With a curvature bound a failure is a failure on a *feasible* query only when
-:func:`trajopt.feasibility.curvature_witness` finds a witness (``--witness``).
+:func:`trajopt.planning._feasibility.curvature_witness` finds a witness (``--witness``).
 
 Run: ``python benchmarks/bench_corridor.py [--per-map 12] [--seed 0] [--repeats 3]``.
 """
@@ -46,10 +46,10 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from bench_curvature import data_dir, draw_pairs  # noqa: E402
 
 import astar  # noqa: E402
+from trajopt._planner import Planner  # noqa: E402
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError  # noqa: E402
-from trajopt.feasibility import curvature_witness  # noqa: E402
-from trajopt.pipeline import Planner  # noqa: E402
-from trajopt.robot import Robot  # noqa: E402
+from trajopt.planning._feasibility import curvature_witness  # noqa: E402
+from trajopt.robot._robot import Robot  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
 
 MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5", "AR0046SR"]
@@ -168,8 +168,11 @@ def queries(per_map: int, seed: int):
     d = data_dir()
     for name in MOVINGAI + ROS:
         kind = "movingai" if name in MOVINGAI else "ros"
-        f = d / kind / ("maps" if kind == "movingai" else "") / (
-            f"{name}.map" if kind == "movingai" else f"{name}.yaml"
+        f = (
+            d
+            / kind
+            / ("maps" if kind == "movingai" else "")
+            / (f"{name}.map" if kind == "movingai" else f"{name}.yaml")
         )
         if not f.exists():
             print(f"skipped {name}: {f} not found (set TRAJOPT_DATA)")
@@ -239,9 +242,11 @@ def main(argv: list[str] | None = None) -> int:
                 rec["feasible"] = w is not None
             rows[cfg].append(rec)
     print(f"{n_q} queries, {time.perf_counter() - t_all:.0f} s")
-    print("| bound | search | corridor | solved | in polygons | dense violations | "
-          "median min-clearance/r | median int k^2 ds | corridor ms med/p95 | "
-          "smooth ms med/p95 | plan ms med |")
+    print(
+        "| bound | search | corridor | solved | in polygons | dense violations | "
+        "median min-clearance/r | median int k^2 ds | corridor ms med/p95 | "
+        "smooth ms med/p95 | plan ms med |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for cfg in configs:
         corr, search, kap = cfg
@@ -269,9 +274,11 @@ def main(argv: list[str] | None = None) -> int:
             f"{pct('smooth', 50):.2f} / {pct('smooth', 95):.2f} | {pct('plan', 50):.1f} |"
         )
         for r in fails:
-            print(f"    failed: {r['map']} {r['query']} {r['error']}"
-                  + (f" feasible={r.get('feasible')}" if 'feasible' in r else "")
-                  + (" touching" if r["touching"] else ""))
+            print(
+                f"    failed: {r['map']} {r['query']} {r['error']}"
+                + (f" feasible={r.get('feasible')}" if "feasible" in r else "")
+                + (" touching" if r["touching"] else "")
+            )
         if corr == "polygons":
             for r in ok:
                 if not r["in_polygons"]:
@@ -290,8 +297,10 @@ def main(argv: list[str] | None = None) -> int:
         tp = np.median([y["times"]["plan"] for _, y in pairs_]) * 1e3
         print(f"| {name} | {len(pairs_)} | {tb:.1f} | {tp:.1f} | {tp / tb:.2f} |")
     print()
-    print("| bound | search | queries both solved | median duration polygons / boxes | "
-          "p10 / p90 | median int k^2 polygons / boxes |")
+    print(
+        "| bound | search | queries both solved | median duration polygons / boxes | "
+        "p10 / p90 | median int k^2 polygons / boxes |"
+    )
     print("|---|---|---|---|---|---|")
     for kap in (False, True):
         for search in ("clearance", "shortest"):
@@ -302,9 +311,11 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             ratio = np.array([y["duration"] / x["duration"] for x, y in both])
             k2 = np.array([(y["int_k2"] + 1e-12) / (x["int_k2"] + 1e-12) for x, y in both])
-            print(f"| {'1/(2r)' if kap else 'none'} | {search} | {len(both)} | "
-                  f"{np.median(ratio):.3f} | {np.percentile(ratio, 10):.3f} / "
-                  f"{np.percentile(ratio, 90):.3f} | {np.median(k2):.3f} |")
+            print(
+                f"| {'1/(2r)' if kap else 'none'} | {search} | {len(both)} | "
+                f"{np.median(ratio):.3f} | {np.percentile(ratio, 10):.3f} / "
+                f"{np.percentile(ratio, 90):.3f} | {np.median(k2):.3f} |"
+            )
     return 0
 
 

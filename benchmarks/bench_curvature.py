@@ -23,7 +23,7 @@ by side:
 Targets (issue 8): success >= 98 % of *feasible* scenarios, median <= 10 ms, p95 <= 50 ms.
 A random query may admit no curve of bounded curvature at all (a pocket reached through a
 passage narrower than the turning radius). Every failure is therefore handed to
-:func:`trajopt.feasibility.curvature_witness` (a hybrid A* over arcs of radius
+:func:`trajopt.planning._feasibility.curvature_witness` (a hybrid A* over arcs of radius
 ``1 / kappa_max`` with exact clearance checks): a failure with a witness is a failure on a
 feasible query; one without is counted apart (probably infeasible, not proven). A success is
 its own witness, so the success rate over feasible queries is
@@ -49,10 +49,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
+from trajopt._planner import Planner  # noqa: E402
 from trajopt.errors import SmoothingError, TimingError  # noqa: E402
-from trajopt.feasibility import curvature_witness  # noqa: E402
-from trajopt.pipeline import Planner  # noqa: E402
-from trajopt.robot import Robot  # noqa: E402
+from trajopt.planning._feasibility import curvature_witness  # noqa: E402
+from trajopt.robot._robot import Robot  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
 
 MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5"]
@@ -173,8 +173,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--per-map", type=int, default=25, help="scenarios per map")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--repeats", type=int, default=5,
-                    help="timed calls per query; the best is reported (default 5)")
+    ap.add_argument(
+        "--repeats",
+        type=int,
+        default=5,
+        help="timed calls per query; the best is reported (default 5)",
+    )
     args = ap.parse_args()
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")

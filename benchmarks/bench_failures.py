@@ -3,15 +3,15 @@
 Plans every query of two sets with ``Planner(grid, Robot(radius=r))`` (``default``) and with
 ``Smoother(kappa_max=1 / (2 r))`` (``kappa``), and counts the failures by type and message:
 
-* ``shared-full``: the named benchmark suite (:func:`trajopt.bench.suites.suite`): the
+* ``shared-full``: the named benchmark suite (:func:`trajopt.analysis.bench._suites.suite`): the
   feasible scenarios of the shared Moving AI maps (radius 2.5 cells) and seeded random
   queries on the shared ROS maps (radius 0.165 m), at most ``--limit`` per map;
 * ``random``: seeded random start/goal pairs (both ends free for the robot and connected,
-  :func:`trajopt.bench.suites.random_queries`) on the shared Moving AI maps at several radii
+  :func:`trajopt.analysis.bench._suites.random_queries`) on the shared Moving AI maps at several radii
   (``--radii``, in cells): small rooms, one-robot-wide passages and diagonal streets, where
   the rare failures live.
 
-Every failure of ``kappa`` is handed to :func:`trajopt.feasibility.curvature_witness` (20 s,
+Every failure of ``kappa`` is handed to :func:`trajopt.planning._feasibility.curvature_witness` (20 s,
 2 M expansions): with a witness the query is feasible for the bound and the failure counts
 against the planner; without one it is counted apart (probably infeasible: a pocket behind a
 passage narrower than the turning radius). Reported per set and variant: queries, failures,
@@ -33,11 +33,11 @@ import time
 import numpy as np
 
 import astar
-from trajopt.bench.suites import data_dir, random_queries, suite
+from trajopt._planner import Planner
+from trajopt.analysis.bench._suites import data_dir, random_queries, suite
 from trajopt.errors import TrajoptError
-from trajopt.feasibility import curvature_witness
-from trajopt.pipeline import Planner
-from trajopt.robot import Robot
+from trajopt.planning._feasibility import curvature_witness
+from trajopt.robot._robot import Robot
 from trajopt.smoother import Smoother
 
 MAPS = ("den312d", "rmtst01", "AR0046SR", "Berlin_0_256", "arena")
@@ -61,8 +61,18 @@ def run_queries(grid, radius: float, pairs, rows: list, label: str) -> None:
                 p.plan(s, g)
             except TrajoptError as exc:
                 err = f"{type(exc).__name__}: {exc}"
-            rows.append(dict(set=label, variant=name, grid=grid, radius=radius, start=s,
-                             goal=g, err=err, t=time.perf_counter() - t0))
+            rows.append(
+                dict(
+                    set=label,
+                    variant=name,
+                    grid=grid,
+                    radius=radius,
+                    start=s,
+                    goal=g,
+                    err=err,
+                    t=time.perf_counter() - t0,
+                )
+            )
 
 
 def main() -> None:
@@ -77,8 +87,10 @@ def main() -> None:
     t_all = time.perf_counter()
     for mq in suite("shared-full", limit=args.limit):
         grid = astar.load_map(mq.map_path)
-        cells = [(grid.cell_to_world(np.array(q.start)), grid.cell_to_world(np.array(q.goal)))
-                 for q in mq.queries]
+        cells = [
+            (grid.cell_to_world(np.array(q.start)), grid.cell_to_world(np.array(q.goal)))
+            for q in mq.queries
+        ]
         run_queries(grid, mq.radius_m, cells, rows, "shared-full")
     for r_cells in (float(v) for v in args.radii.split(",")):
         for name in MAPS:
@@ -89,8 +101,10 @@ def main() -> None:
                 mq = random_queries(path, args.random, seed=args.seed, radius_m=r)
             except TrajoptError:  # no room for this radius on this map
                 continue
-            cells = [(grid.cell_to_world(np.array(q.start)),
-                      grid.cell_to_world(np.array(q.goal))) for q in mq.queries]
+            cells = [
+                (grid.cell_to_world(np.array(q.start)), grid.cell_to_world(np.array(q.goal)))
+                for q in mq.queries
+            ]
             run_queries(grid, r, cells, rows, f"random r={r_cells:g} cells")
     # witness every curvature-bounded failure
     for row in rows:
@@ -103,26 +117,32 @@ def main() -> None:
     groups: dict[tuple[str, str], list[dict]] = collections.defaultdict(list)
     for row in rows:
         groups[(row["set"], row["variant"])].append(row)
-    print(f"{'set':<24}{'variant':<9}{'queries':>8}{'failed':>8}{'success':>9}"
-          f"{'feasible*':>10}{'fail median s':>14}{'fail max s':>11}")
+    print(
+        f"{'set':<24}{'variant':<9}{'queries':>8}{'failed':>8}{'success':>9}"
+        f"{'feasible*':>10}{'fail median s':>14}{'fail max s':>11}"
+    )
     for (label, variant), rs in groups.items():
         fails = [r for r in rs if r["err"]]
         witnessed = [r for r in fails if r["witness"]]
         ok = len(rs) - len(fails)
         feas = ok / (ok + len(witnessed)) if variant == "kappa" and ok + len(witnessed) else None
         ts = [r["t"] for r in fails]
-        print(f"{label:<24}{variant:<9}{len(rs):>8}{len(fails):>8}{ok / len(rs):>9.2%}"
-              f"{'' if feas is None else f'{feas:.2%}':>10}"
-              f"{statistics.median(ts) if ts else float('nan'):>14.2f}"
-              f"{max(ts) if ts else float('nan'):>11.2f}")
+        print(
+            f"{label:<24}{variant:<9}{len(rs):>8}{len(fails):>8}{ok / len(rs):>9.2%}"
+            f"{'' if feas is None else f'{feas:.2%}':>10}"
+            f"{statistics.median(ts) if ts else float('nan'):>14.2f}"
+            f"{max(ts) if ts else float('nan'):>11.2f}"
+        )
     print("* kappa: successes / (successes + failures on queries with a curvature witness)")
     print()
     for row in rows:
         if row["err"]:
             tag = {None: "", True: " [witness found]", False: " [no witness]"}[row["witness"]]
-            print(f"{row['set']} {row['variant']} r={row['radius']:g} "
-                  f"{np.round(row['start'], 2).tolist()} -> {np.round(row['goal'], 2).tolist()}"
-                  f" ({row['t']:.2f} s){tag}: {row['err'][:220]}")
+            print(
+                f"{row['set']} {row['variant']} r={row['radius']:g} "
+                f"{np.round(row['start'], 2).tolist()} -> {np.round(row['goal'], 2).tolist()}"
+                f" ({row['t']:.2f} s){tag}: {row['err'][:220]}"
+            )
     print(f"\nwall time {time.perf_counter() - t_all:.0f} s")
 
 

@@ -52,12 +52,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
-from trajopt.bench.suites import select_evenly as select_scenarios  # noqa: E402
+from trajopt._planner import Planner  # noqa: E402
+from trajopt.analysis.bench._suites import select_evenly as select_scenarios  # noqa: E402
+from trajopt.analysis.metrics import path_metrics  # noqa: E402
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError  # noqa: E402
-from trajopt.fallback import StopAndTurnTrajectory  # noqa: E402
-from trajopt.metrics import path_metrics  # noqa: E402
-from trajopt.pipeline import Planner  # noqa: E402
-from trajopt.robot import Robot  # noqa: E402
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory  # noqa: E402
+from trajopt.robot._robot import Robot  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
 
 MAPS = [

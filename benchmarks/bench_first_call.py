@@ -108,9 +108,12 @@ def main() -> None:
     """Print the median first-call breakdown over fresh processes."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5, help="fresh processes (default 5)")
-    ap.add_argument("--python", default=None,
-                    help="interpreter of another environment with trajopt installed, e.g. a "
-                         "clean virtual environment's (default: this one, on this checkout)")
+    ap.add_argument(
+        "--python",
+        default=None,
+        help="interpreter of another environment with trajopt installed, e.g. a "
+        "clean virtual environment's (default: this one, on this checkout)",
+    )
     args = ap.parse_args()
     if args.python is None:  # this checkout, from its root
         python, cwd = sys.executable, Path(__file__).resolve().parents[1]
@@ -136,8 +139,12 @@ def main() -> None:
     total = 1e3 * statistics.median(r["import_trajopt"] + r["first"] for r in runs)
     print(f"  import trajopt + first plan {total:7.1f} ms")
     print(f"after trajopt.warm_up() at start-up, median of {args.runs} processes")
-    print(f"  warm_up()                 {1e3 * statistics.median(r['warm_up'] for r in warm):7.1f} ms")
-    print(f"  first plan (wall)         {1e3 * statistics.median(r['first'] for r in warm):7.1f} ms")
+    print(
+        f"  warm_up()                 {1e3 * statistics.median(r['warm_up'] for r in warm):7.1f} ms"
+    )
+    print(
+        f"  first plan (wall)         {1e3 * statistics.median(r['first'] for r in warm):7.1f} ms"
+    )
 
 
 if __name__ == "__main__":

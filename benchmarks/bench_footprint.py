@@ -44,7 +44,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from trajopt.errors import TrajoptError  # noqa: E402
+from trajopt.errors import TrajoptError
 
 ROS = ("turtlebot3_world", "smoothers_world", "depot")
 MOVINGAI = ("den312d", "Berlin_0_256", "arena")
@@ -92,8 +92,8 @@ def queries(grid, r_free, n, rng):
 @contextlib.contextmanager
 def without_footprint_rounds():
     """The previous design, for comparison in the same run: the fit only certifies."""
-    import trajopt.smoother.attempts as attempts
-    from trajopt.smoother.footprint_rounds import FootprintRounds
+    import trajopt.smoother._attempts as attempts
+    from trajopt.smoother._footprint_rounds import FootprintRounds
 
     saved = attempts.footprint_scp, FootprintRounds.pin
     attempts.footprint_scp = lambda *a, **k: None
@@ -115,7 +115,9 @@ def run_maps(args, rng, quiet: bool = False) -> tuple[int, int, list[float]]:
     maps += [(n, d / "movingai" / "maps" / f"{n}.map", 2.5) for n in MOVINGAI]
     all_smooth: list[float] = []
     total_solved = total_queries = 0
-    trajopt.warm_up(trajopt.Planner(astar.load_map(maps[0][1]), trajopt.Robot.rectangle(0.64, 0.4)))
+    trajopt.warm_up(
+        trajopt.Planner(astar.load_map(maps[0][1]), trajopt.Robot.rectangle(0.64, 0.4))
+    )
     for name, path, r_cells in maps:
         grid = astar.load_map(path)
         diam = 2 * (0.2 if r_cells is None else r_cells * grid.resolution)
@@ -151,7 +153,7 @@ def run_maps(args, rng, quiet: bool = False) -> tuple[int, int, list[float]]:
                 cert.append(1e3 * fst["certificate_s"])
 
             def mp(v):
-                return (f"{statistics.median(v):.1f}/{np.percentile(v, 95):.1f}" if v else "-")
+                return f"{statistics.median(v):.1f}/{np.percentile(v, 95):.1f}" if v else "-"
 
             rung_s = ",".join(f"{rungs.get(i, 0)}" for i in range(3))
             total_solved += solved
@@ -198,10 +200,14 @@ def run_doors(args) -> None:
             ok_disc += 1
         except TrajoptError:
             pass
-    print(f"doors ({len(cases)}: widths {lo:.2f}-{hi:.2f} m, walls 2-8 cells, 3 offsets; "
-          f"footprint 0.7 x 0.4 m, circumscribed diameter {2 * robot.circumscribed_radius:.3f} m)")
-    print(f"  solved with the footprint {ok}/{len(cases)} ({100 * ok / len(cases):.0f} %), "
-          f"collisions {collided}; with the circumscribed disc {ok_disc}/{len(cases)}")
+    print(
+        f"doors ({len(cases)}: widths {lo:.2f}-{hi:.2f} m, walls 2-8 cells, 3 offsets; "
+        f"footprint 0.7 x 0.4 m, circumscribed diameter {2 * robot.circumscribed_radius:.3f} m)"
+    )
+    print(
+        f"  solved with the footprint {ok}/{len(cases)} ({100 * ok / len(cases):.0f} %), "
+        f"collisions {collided}; with the circumscribed disc {ok_disc}/{len(cases)}"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -11,7 +11,7 @@ In one run:
    (query, method) exactly once, the finished files untouched, and equal the complete run
    (every column but wall times).
 3. **Report speed**: the rows of step 1 copied to ``--report-rows`` rows (new query ids, 20
-   files), then ``trajopt.bench.report`` (read + summary table) and the figures, timed.
+   files), then ``trajopt.analysis.bench._report`` (read + summary table) and the figures, timed.
 
 Run::
 
@@ -39,17 +39,20 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from trajopt import bench  # noqa: E402
-from trajopt.bench.dataset import TIMING_COLUMNS, part_files  # noqa: E402
+from trajopt.analysis import bench  # noqa: E402
+from trajopt.analysis.bench._dataset import TIMING_COLUMNS, part_files  # noqa: E402
 
 MAPS = ("den312d", "rmtst01", "Berlin_0_256")
 
 
 def sources(data: Path, limit: int) -> list[bench.MapQueries]:
     return [
-        bench.movingai_queries(data / "movingai" / "scen" / f"{m}.map.scen",
-                               data / "movingai" / "maps" / f"{m}.map", limit=limit,
-                               feasible_only=True)
+        bench.movingai_queries(
+            data / "movingai" / "scen" / f"{m}.map.scen",
+            data / "movingai" / "maps" / f"{m}.map",
+            limit=limit,
+            feasible_only=True,
+        )
         for m in MAPS
     ]
 
@@ -61,8 +64,9 @@ def timed_run(srcs, methods, workers: int, out: Path, chunk_size: int) -> tuple[
         for src in srcs:  # every worker loads every map and plans one query of it, once
             warm = bench.make_chunks([src], methods, set(), 1)[0]
             client.run(functools.partial(bench.run_chunk, warm))
-        res = bench.run(srcs, out, methods=methods, client=client, chunk_size=chunk_size,
-                        progress=False)
+        res = bench.run(
+            srcs, out, methods=methods, client=client, chunk_size=chunk_size, progress=False
+        )
     finally:
         client.close()
         cluster.close()
@@ -89,28 +93,48 @@ def kill_and_resume(data: Path, limit: int, methods, tmp: Path, reference) -> No
     out = tmp / "killed"
     cmd = [sys.executable, "-m", "trajopt.cli", "bench", "run"]
     cmd += [str(data / "movingai" / "scen" / f"{m}.map.scen") for m in MAPS[:1]]
-    cmd += ["--limit", str(limit), "--feasible-only", "--methods", ",".join(methods),
-            "--out", str(out), "--workers", "2", "--chunk-size", "1", "--no-progress"]
+    cmd += [
+        "--limit",
+        str(limit),
+        "--feasible-only",
+        "--methods",
+        ",".join(methods),
+        "--out",
+        str(out),
+        "--workers",
+        "2",
+        "--chunk-size",
+        "1",
+        "--no-progress",
+    ]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     n_chunks = len(bench.make_chunks(sources(data, limit)[:1], methods, set(), 1))
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            start_new_session=True)
+    proc = subprocess.Popen(
+        cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
     while len(part_files(out)) < n_chunks // 2 and proc.poll() is None:
         time.sleep(0.01)
     os.killpg(proc.pid, signal.SIGKILL)  # the CLI and its cluster's processes
     proc.wait()
     before = {p.name: p.read_bytes() for p in part_files(out)}
     t0 = time.perf_counter()
-    subprocess.run(cmd + ["--resume"], env=env, check=True, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL)
+    subprocess.run(
+        cmd + ["--resume"],
+        env=env,
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     dt = time.perf_counter() - t0
     df = bench.read_dataset(out)
     untouched = all((out / n).read_bytes() == b for n, b in before.items())
     dup = int(df.duplicated(["query_id", "method"]).sum())
     ref = reference[reference["map"] == f"{MAPS[0]}.map"]
-    print(f"kill + resume: killed with {len(before)} of {n_chunks} chunk files; resume "
-          f"{dt:.1f} s; rows {len(df)} (expected {len(ref)}), duplicates {dup}, finished "
-          f"files untouched {untouched}, equal to the complete run {same_rows(df, ref)}")
+    print(
+        f"kill + resume: killed with {len(before)} of {n_chunks} chunk files; resume "
+        f"{dt:.1f} s; rows {len(df)} (expected {len(ref)}), duplicates {dup}, finished "
+        f"files untouched {untouched}, equal to the complete run {same_rows(df, ref)}"
+    )
 
 
 def report_speed(df, n_rows: int, tmp: Path) -> None:
@@ -124,8 +148,12 @@ def report_speed(df, n_rows: int, tmp: Path) -> None:
     big = pd.concat([df.assign(query_id=df["query_id"] + f"#{i}") for i in range(reps)])
     big = big.iloc[:n_rows]
     for i, part in enumerate(np.array_split(np.arange(len(big)), 20)):
-        pq.write_table(pa.Table.from_pandas(big.iloc[part], schema=bench.dataset.schema(),
-                                            preserve_index=False), out / f"part-{i:02d}.parquet")
+        pq.write_table(
+            pa.Table.from_pandas(
+                big.iloc[part], schema=bench.dataset.schema(), preserve_index=False
+            ),
+            out / f"part-{i:02d}.parquet",
+        )
     t0 = time.perf_counter()
     text = bench.report(out)
     t_table = time.perf_counter() - t0
@@ -147,8 +175,7 @@ def main() -> None:
     methods = bench.check_methods(args.methods)
     srcs = sources(data, args.limit)
     n_q = sum(len(s.queries) for s in srcs)
-    print(f"{n_q} queries on {', '.join(MAPS)} x {len(methods)} methods, "
-          f"{os.cpu_count()} cores")
+    print(f"{n_q} queries on {', '.join(MAPS)} x {len(methods)} methods, {os.cpu_count()} cores")
     tmp = Path(tempfile.mkdtemp(prefix="bench_harness_"))
     try:
         res = {}
@@ -157,9 +184,11 @@ def main() -> None:
             res[w] = rows / elapsed
             df = bench.read_dataset(tmp / f"w{w}")
             busy = float(np.nansum(df["runtime_s"]) + np.nansum(df["reference_search_s"]))
-            print(f"{w} worker(s): {rows} rows in {elapsed:.2f} s = {res[w]:.2f} rows/s; "
-                  f"methods' compute {busy:.2f} s = {busy / (elapsed * w):.0%} of "
-                  f"{w} x wall (load average before: {os.getloadavg()[0]:.2f})")
+            print(
+                f"{w} worker(s): {rows} rows in {elapsed:.2f} s = {res[w]:.2f} rows/s; "
+                f"methods' compute {busy:.2f} s = {busy / (elapsed * w):.0%} of "
+                f"{w} x wall (load average before: {os.getloadavg()[0]:.2f})"
+            )
         print(f"throughput 2 workers / 1 worker: {res[2] / res[1]:.2f}x")
         d1, d2 = bench.read_dataset(tmp / "w1"), bench.read_dataset(tmp / "w2")
         print(f"1-worker and 2-worker rows equal (all but wall times): {same_rows(d1, d2)}")

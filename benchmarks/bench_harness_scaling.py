@@ -13,7 +13,7 @@ in-task wall time with nothing else running (the VM's host took the cores). For 
 
 * **measured**: :func:`trajopt.bench.run`'s ``elapsed_s``, from the first submission to the
   last Parquet file, and the throughput in queries/s. The workers are warmed before it
-  (:func:`trajopt.bench.methods.warm_up`, one small query with every method: imports,
+  (:func:`trajopt.analysis.bench._methods.warm_up`, one small query with every method: imports,
   numba kernel loads, solver plugins), as ``bench.run`` does by default; this script calls
   that warm-up itself, then ``bench.run(..., warm_up=False)``, so that it can read the
   processes' CPU times between the two;
@@ -72,7 +72,7 @@ if str(ROOT) not in sys.path and "PYTHONPATH" not in os.environ:
 
 import numpy as np  # noqa: E402
 
-from trajopt import bench  # noqa: E402
+from trajopt.analysis import bench  # noqa: E402
 
 
 class Others:
@@ -148,8 +148,10 @@ def wait_quiet(max_wait_s: float, limit: float = BUSY_CORES) -> str:
             waited = time.perf_counter() - t0
             return f"waited {waited:.0f} s for a quiet machine" if waited > 3 else ""
         if time.perf_counter() - t0 > max_wait_s:
-            return (f"the machine stayed busy ({others.mean_cores:.2f} cores used by other "
-                    f"processes) for {max_wait_s:.0f} s: measuring anyway")
+            return (
+                f"the machine stayed busy ({others.mean_cores:.2f} cores used by other "
+                f"processes) for {max_wait_s:.0f} s: measuring anyway"
+            )
 
 
 def loop_time(n: int = 2_000_000) -> float:
@@ -173,8 +175,9 @@ def _cpu(pid: int) -> float:
     return float(t.user + t.system)
 
 
-def one_run(srcs, methods, workers: int, out: Path, chunk_size: int | None,
-            max_wait_s: float) -> dict:
+def one_run(
+    srcs, methods, workers: int, out: Path, chunk_size: int | None, max_wait_s: float
+) -> dict:
     """One measured run on a fresh local cluster; returns its figures."""
     from distributed import get_task_stream
 
@@ -200,8 +203,7 @@ def one_run(srcs, methods, workers: int, out: Path, chunk_size: int | None,
         if chunk_size is not None:
             kwargs["chunk_size"] = chunk_size
         with get_task_stream(client=client) as ts:
-            res = bench.run(srcs, out, methods=methods, client=client, progress=False,
-                            **kwargs)
+            res = bench.run(srcs, out, methods=methods, client=client, progress=False, **kwargs)
         cpu1 = {p: _cpu(p) for p in cpu0}
         stream = list(ts.data)
     finally:
@@ -230,21 +232,38 @@ def one_run(srcs, methods, workers: int, out: Path, chunk_size: int | None,
     window = res.elapsed_s * res.workers
     worker_cpu = sum(cpu1[p] - cpu0[p] for p in pids.values())
     return {
-        "workers": res.workers, "load": load, "cluster": t_cluster, "warm": t_warm,
-        "elapsed": res.elapsed_s, "close": t_close, "wall": wall, "queries": n_q,
-        "rows": res.rows_written, "chunks": res.chunks,
-        "chunk_size": getattr(res, "chunk_size", chunk_size), "planning": planning,
-        "scoring": scoring, "busy": busy, "window": window, "idle": window - busy,
-        "tail": tail, "worker_cpu": worker_cpu, "client_cpu": cpu1[me] - cpu0[me],
-        "others": others.mean_cores, "speed": speed,
+        "workers": res.workers,
+        "load": load,
+        "cluster": t_cluster,
+        "warm": t_warm,
+        "elapsed": res.elapsed_s,
+        "close": t_close,
+        "wall": wall,
+        "queries": n_q,
+        "rows": res.rows_written,
+        "chunks": res.chunks,
+        "chunk_size": getattr(res, "chunk_size", chunk_size),
+        "planning": planning,
+        "scoring": scoring,
+        "busy": busy,
+        "window": window,
+        "idle": window - busy,
+        "tail": tail,
+        "worker_cpu": worker_cpu,
+        "client_cpu": cpu1[me] - cpu0[me],
+        "others": others.mean_cores,
+        "speed": speed,
     }
 
 
 def describe(r: dict) -> str:
     pct = (lambda x: f"{100 * x / r['window']:.0f}%") if r["window"] > 0 else (lambda x: "-")
     other = r["busy"] - r["planning"] - (0.0 if math.isnan(r["scoring"]) else r["scoring"])
-    scoring = "not split out" if math.isnan(r["scoring"]) else \
-        f"{r['scoring']:.2f} s ({pct(r['scoring'])})"
+    scoring = (
+        "not split out"
+        if math.isnan(r["scoring"])
+        else f"{r['scoring']:.2f} s ({pct(r['scoring'])})"
+    )
     return (
         f"{r['workers']} worker(s): measured {r['elapsed']:.2f} s = "
         f"{r['queries'] / r['elapsed']:.2f} queries/s ({r['rows']} rows, {r['chunks']} chunks "
@@ -268,15 +287,15 @@ def profile_split(srcs, methods, tmp: Path) -> None:
         warm(list(methods))
     kw = {"warm_up": False} if warm is not None else {}
     t = time.perf_counter()
-    res = bench.run(srcs, tmp / "serial", methods=methods, scheduler="serial",
-                    progress=False, **kw)
+    res = bench.run(srcs, tmp / "serial", methods=methods, scheduler="serial", progress=False, **kw)
     n_q = sum(len(s.queries) for s in srcs)
-    print(f"serial in this process (no Dask, warm): {res.elapsed_s:.2f} s = "
-          f"{n_q / res.elapsed_s:.2f} queries/s (call {time.perf_counter() - t:.2f} s)")
+    print(
+        f"serial in this process (no Dask, warm): {res.elapsed_s:.2f} s = "
+        f"{n_q / res.elapsed_s:.2f} queries/s (call {time.perf_counter() - t:.2f} s)"
+    )
     prof = cProfile.Profile()
     prof.enable()
-    bench.run(srcs, tmp / "profiled", methods=methods, scheduler="serial", progress=False,
-              **kw)
+    bench.run(srcs, tmp / "profiled", methods=methods, scheduler="serial", progress=False, **kw)
     prof.disable()
     st = pstats.Stats(prof).stats  # (file, line, name) -> (cc, nc, tt, ct, callers)
 
@@ -288,25 +307,37 @@ def profile_split(srcs, methods, tmp: Path) -> None:
             if caller is None:
                 total += ct
             else:
-                total += sum(v[3] for (cf, _, cn), v in callers.items()
-                             if cf.replace(os.sep, "/").endswith(caller[0]) and cn == caller[1])
+                total += sum(
+                    v[3]
+                    for (cf, _, cn), v in callers.items()
+                    if cf.replace(os.sep, "/").endswith(caller[0]) and cn == caller[1]
+                )
         return total
 
-    whole = cum("trajopt/bench/runner.py", "run")
-    methods_s = cum("trajopt/bench/methods.py", "run")  # the methods' closures
-    traj_m = cum("trajopt/metrics.py", "trajectory_metrics")
-    path_m = cum("trajopt/metrics.py", "path_metrics")
-    ref = cum("astar/search.py", "find_path", ("trajopt/bench/methods.py", "evaluate_query"))
-    maps = cum("trajopt/bench/methods.py", "map_context")
-    write = cum("trajopt/bench/dataset.py", "write_chunk")
+    whole = cum("trajopt/analysis/bench/_runner.py", "run")
+    methods_s = cum("trajopt/analysis/bench/_methods.py", "run")  # the methods' closures
+    traj_m = cum("trajopt/analysis/metrics.py", "trajectory_metrics")
+    path_m = cum("trajopt/analysis/metrics.py", "path_metrics")
+    ref = cum(
+        "astar/search.py", "find_path", ("trajopt/analysis/bench/_methods.py", "evaluate_query")
+    )
+    maps = cum("trajopt/analysis/bench/_methods.py", "map_context")
+    write = cum("trajopt/analysis/bench/_dataset.py", "write_chunk")
     plan = methods_s - traj_m
-    parts = [("planning (the methods)", plan), ("reference A*", ref),
-             ("scoring: path_metrics", path_m), ("scoring: trajectory_metrics", traj_m),
-             ("map load + inflation", maps), ("Parquet writes", write)]
+    parts = [
+        ("planning (the methods)", plan),
+        ("reference A*", ref),
+        ("scoring: path_metrics", path_m),
+        ("scoring: trajectory_metrics", traj_m),
+        ("map load + inflation", maps),
+        ("Parquet writes", write),
+    ]
     rest = whole - sum(v for _, v in parts)
     text = ", ".join(f"{k} {v:.2f} s ({100 * v / whole:.0f}%)" for k, v in parts)
-    print(f"cProfile of a serial pass ({whole:.2f} s with the profiler's overhead): {text}, "
-          f"rest {rest:.2f} s ({100 * rest / whole:.0f}%)")
+    print(
+        f"cProfile of a serial pass ({whole:.2f} s with the profiler's overhead): {text}, "
+        f"rest {rest:.2f} s ({100 * rest / whole:.0f}%)"
+    )
 
 
 def _ceiling_child(job: tuple) -> float:
@@ -337,8 +368,9 @@ def ceiling(srcs, methods, max_wait_s: float) -> None:
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    env = {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
-                                          "MKL_NUM_THREADS")}
+    env = {
+        k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+    }
     os.environ.update({k: "1" for k in env})  # as the Dask workers (runner.worker_env)
     try:
         ctx = mp.get_context("spawn")
@@ -347,21 +379,29 @@ def ceiling(srcs, methods, max_wait_s: float) -> None:
                 wait_quiet(max_wait_s)
                 times, busy = {}, {}
                 for n in (1, 2):
-                    with ctx.Manager() as manager, \
-                            ProcessPoolExecutor(n, mp_context=ctx) as pool, Others() as others:
+                    with (
+                        ctx.Manager() as manager,
+                        ProcessPoolExecutor(n, mp_context=ctx) as pool,
+                        Others() as others,
+                    ):
                         barrier = manager.Barrier(n)
-                        futs = [pool.submit(_ceiling_child, (kind, srcs, methods, barrier))
-                                for _ in range(n)]
+                        futs = [
+                            pool.submit(_ceiling_child, (kind, srcs, methods, barrier))
+                            for _ in range(n)
+                        ]
                         times[n] = [f.result() for f in futs]
                     busy[n] = others.mean_cores
                 one, two = times[1][0], max(times[2])
                 what = "pure-Python loop" if kind == "loop" else "the suite (run_chunk, warm)"
                 clean = max(busy.values()) < BUSY_CORES
-                print(f"ceiling, {what}: 1 process alone {one:.2f} s; 2 at once "
-                      f"{', '.join(f'{t:.2f}' for t in times[2])} s; throughput ratio "
-                      f"{2 * one / two:.2f}x (other processes used {busy[1]:.2f} and "
-                      f"{busy[2]:.2f} cores meanwhile"
-                      f"{'' if clean else ': busy, repeated'})", flush=True)
+                print(
+                    f"ceiling, {what}: 1 process alone {one:.2f} s; 2 at once "
+                    f"{', '.join(f'{t:.2f}' for t in times[2])} s; throughput ratio "
+                    f"{2 * one / two:.2f}x (other processes used {busy[1]:.2f} and "
+                    f"{busy[2]:.2f} cores meanwhile"
+                    f"{'' if clean else ': busy, repeated'})",
+                    flush=True,
+                )
                 if clean:
                     break
     finally:
@@ -377,20 +417,31 @@ def main() -> None:
     ap.add_argument("--suite", default="shared-small")
     ap.add_argument("--methods", default=",".join(bench.DEFAULT_METHODS))
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--chunk-size", type=int, default=None,
-                    help="queries per task (default: bench.run's own choice)")
+    ap.add_argument(
+        "--chunk-size",
+        type=int,
+        default=None,
+        help="queries per task (default: bench.run's own choice)",
+    )
     ap.add_argument("--no-profile", action="store_true", help="skip the serial profile")
-    ap.add_argument("--no-ceiling", action="store_true",
-                    help="skip the 1-vs-2-process ceiling without Dask")
-    ap.add_argument("--max-wait", type=float, default=300.0,
-                    help="before each measurement, wait up to this long (s) for other "
-                    "processes to use under 0.15 cores")
+    ap.add_argument(
+        "--no-ceiling", action="store_true", help="skip the 1-vs-2-process ceiling without Dask"
+    )
+    ap.add_argument(
+        "--max-wait",
+        type=float,
+        default=300.0,
+        help="before each measurement, wait up to this long (s) for other "
+        "processes to use under 0.15 cores",
+    )
     args = ap.parse_args()
     methods = bench.check_methods(args.methods)
     srcs = bench.suite(args.suite)
     n_q = sum(len(s.queries) for s in srcs)
-    print(f"{args.suite}: {n_q} queries on {len(srcs)} maps x {len(methods)} methods, "
-          f"{os.cpu_count()} cores; {args.rounds} round(s) of 1 and 2 workers")
+    print(
+        f"{args.suite}: {n_q} queries on {len(srcs)} maps x {len(methods)} methods, "
+        f"{os.cpu_count()} cores; {args.rounds} round(s) of 1 and 2 workers"
+    )
     tmp = Path(tempfile.mkdtemp(prefix="bench_scaling_"))
     ratios, ratios_e2e, busy_rounds = [], [], []
     try:
@@ -399,38 +450,49 @@ def main() -> None:
             order = (1, 2) if k % 2 == 0 else (2, 1)
             got = {}
             for w in order:
-                got[w] = one_run(srcs, methods, w, tmp / f"r{k}-w{w}", args.chunk_size,
-                                 args.max_wait)
+                got[w] = one_run(
+                    srcs, methods, w, tmp / f"r{k}-w{w}", args.chunk_size, args.max_wait
+                )
                 print(f"round {k + 1}, {describe(got[w])}", flush=True)
             r = got[1]["elapsed"] / got[2]["elapsed"]
             r2 = got[1]["wall"] / got[2]["wall"]
             busy = max(got[1]["others"], got[2]["others"]) >= BUSY_CORES
-            starved = min(got[w]["worker_cpu"] / max(got[w]["busy"], 1e-9) for w in got) \
-                < MIN_CPU_SHARE
+            starved = (
+                min(got[w]["worker_cpu"] / max(got[w]["busy"], 1e-9) for w in got) < MIN_CPU_SHARE
+            )
             clean = not busy and not starved
-            why = (f"other processes above {BUSY_CORES} cores" if busy else
-                   f"workers' CPU below {MIN_CPU_SHARE:.0%} of their in-task wall time")
+            why = (
+                f"other processes above {BUSY_CORES} cores"
+                if busy
+                else f"workers' CPU below {MIN_CPU_SHARE:.0%} of their in-task wall time"
+            )
             if clean:
                 ratios.append(r)
                 ratios_e2e.append(r2)
             else:
                 busy_rounds.append(r)
-            print(f"round {k + 1}: throughput 2 workers / 1 worker: measured {r:.2f}x, "
-                  f"end-to-end {r2:.2f}x"
-                  f"{'' if clean else f' ({why}: not counted)'}",
-                  flush=True)
+            print(
+                f"round {k + 1}: throughput 2 workers / 1 worker: measured {r:.2f}x, "
+                f"end-to-end {r2:.2f}x"
+                f"{'' if clean else f' ({why}: not counted)'}",
+                flush=True,
+            )
             k += 1
         if ratios:
-            print(f"ratio 2/1 workers over {len(ratios)} quiet round(s): measured "
-                  f"{', '.join(f'{x:.2f}' for x in ratios)} (median "
-                  f"{statistics.median(ratios):.2f}x); end-to-end "
-                  f"{', '.join(f'{x:.2f}' for x in ratios_e2e)} (median "
-                  f"{statistics.median(ratios_e2e):.2f}x); busy rounds not counted: "
-                  f"{', '.join(f'{x:.2f}' for x in busy_rounds) or 'none'}")
+            print(
+                f"ratio 2/1 workers over {len(ratios)} quiet round(s): measured "
+                f"{', '.join(f'{x:.2f}' for x in ratios)} (median "
+                f"{statistics.median(ratios):.2f}x); end-to-end "
+                f"{', '.join(f'{x:.2f}' for x in ratios_e2e)} (median "
+                f"{statistics.median(ratios_e2e):.2f}x); busy rounds not counted: "
+                f"{', '.join(f'{x:.2f}' for x in busy_rounds) or 'none'}"
+            )
         else:
-            print(f"no quiet round in {k}: measured ratios "
-                  f"{', '.join(f'{x:.2f}' for x in busy_rounds)} (all with other processes "
-                  f"running)")
+            print(
+                f"no quiet round in {k}: measured ratios "
+                f"{', '.join(f'{x:.2f}' for x in busy_rounds)} (all with other processes "
+                f"running)"
+            )
         if not args.no_profile:
             profile_split(srcs, methods, tmp)
         if not args.no_ceiling:

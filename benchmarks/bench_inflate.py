@@ -77,8 +77,10 @@ def main(argv: list[str] | None = None) -> int:
                                  args.repeat)  # fmt: skip
         equal = bool(np.array_equal(field, ref_field))
         same &= equal
-        print(f"  astar.clearance ({metric}) {1e3 * t_ours:9.1f} ms   scipy {1e3 * t_ref:9.1f} ms"
-              f"   ratio scipy / ours {t_ref / t_ours:6.2f}x   identical: {equal}")
+        print(
+            f"  astar.clearance ({metric}) {1e3 * t_ours:9.1f} ms   scipy {1e3 * t_ref:9.1f} ms"
+            f"   ratio scipy / ours {t_ref / t_ours:6.2f}x   identical: {equal}"
+        )
     return 0 if same else 1
 
 

@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from trajopt.ros_mcap import message_definition  # noqa: E402
+from trajopt.motion._mcap import message_definition
 
 
 def data_dir() -> Path:
@@ -49,8 +49,9 @@ def sixty_second_trajectory():
         if 60.0 <= traj.duration <= 63.0:
             break
         v *= traj.duration / 61.5
-        timed = trajopt.time_parameterize(traj.path, trajopt.Robot(radius=0.25, v_max=v,
-                                                                   wheel_v_max=2 * v))
+        timed = trajopt.time_parameterize(
+            traj.path, trajopt.Robot(radius=0.25, v_max=v, wheel_v_max=2 * v)
+        )
         traj = dataclasses.replace(timed, steps=traj.steps)
     return traj
 

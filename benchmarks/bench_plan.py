@@ -98,8 +98,10 @@ def report(name: str, best: list[dict], peer: list[float], failures: int) -> Non
         v = np.array([b.get(s, np.nan) for b in best]) * 1e3
         print(f"  {s:<10}{np.nanmedian(v):>12.2f}{np.nanpercentile(v, 95):>10.2f}")
     if peer:
-        print(f"  peer: plain make_lsq_spline fit of the same A* path, median "
-              f"{1e3 * np.median(peer):.2f} ms")
+        print(
+            f"  peer: plain make_lsq_spline fit of the same A* path, median "
+            f"{1e3 * np.median(peer):.2f} ms"
+        )
         total = np.median([b["total"] for b in best])
         print(f"  ratio total/plain-fit (median) {total / np.median(peer):.1f}x")
 
@@ -122,8 +124,10 @@ def main() -> None:
     report("paper scene (SP -> A-D), warm", best, peer, failures)
     if best:
         med = 1e3 * np.median([b["total"] for b in best])
-        print(f"  target: median <= 20 ms per warm query -> {med:.1f} ms "
-              f"({'met' if med <= 20 else 'NOT met'})")
+        print(
+            f"  target: median <= 20 ms per warm query -> {med:.1f} ms "
+            f"({'met' if med <= 20 else 'NOT met'})"
+        )
 
     ros = data_dir() / "ros"
     if not ros.is_dir():
@@ -140,8 +144,9 @@ def main() -> None:
             except trajopt.TrajoptError:
                 pass
         best, peer, failures = run(planner, qs, args.repeat)
-        report(f"{yaml.stem} ({grid.nx}x{grid.ny}, {grid.resolution} m), warm", best, peer,
-               failures)
+        report(
+            f"{yaml.stem} ({grid.nx}x{grid.ny}, {grid.resolution} m), warm", best, peer, failures
+        )
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Benchmark: polygon corridors (:mod:`trajopt.polygon_corridor`) vs box corridors.
+"""Benchmark: polygon corridors (:mod:`trajopt.corridor`) vs box corridors.
 
 On start/goal pairs drawn from the shared Moving AI maps (robot radius 2.5 cells) and ROS
 maps (radius 0.2 m), the A* path (clearance-aware search, as ``Planner`` does by default,
@@ -41,12 +41,18 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from bench_curvature import data_dir  # noqa: E402
 
 import astar  # noqa: E402
-from trajopt.corridor import build_corridor  # noqa: E402
+from trajopt.corridor import build_corridor, build_polygon_corridor  # noqa: E402
 from trajopt.errors import TrajoptError  # noqa: E402
-from trajopt.polygon_corridor import build_polygon_corridor  # noqa: E402
 
-MOVINGAI = ["arena", "den312d", "Berlin_0_256", "rmtst01", "random512-40-5", "AR0046SR",
-            "Boston_0_1024"]
+MOVINGAI = [
+    "arena",
+    "den312d",
+    "Berlin_0_256",
+    "rmtst01",
+    "random512-40-5",
+    "AR0046SR",
+    "Boston_0_1024",
+]
 ROS = ["turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10"]
 
 
@@ -130,30 +136,40 @@ def main() -> None:
     failures = []
     for name, raw, r in maps:
         infl = astar.inflate(raw, r, metric="square", outside_occupied=True)
-        cost = astar.clearance_cost(raw, r, outside_occupied=True) if args.search == "clearance" else None
+        cost = (
+            astar.clearance_cost(raw, r, outside_occupied=True)
+            if args.search == "clearance"
+            else None
+        )
         for path in draw_paths(raw, infl, cost, args.per_map, rng):
-            tb, boxes = best_time(lambda: build_corridor(infl, path, radius=r, raw_grid=raw),  # noqa: B023
-                                  args.repeats)
+            tb, boxes = best_time(
+                lambda: build_corridor(infl, path, radius=r, raw_grid=raw),  # noqa: B023
+                args.repeats,
+            )
             try:
-                tp, poly = best_time(lambda: build_polygon_corridor(raw, path, r),  # noqa: B023
-                                     args.repeats)
+                tp, poly = best_time(
+                    lambda: build_polygon_corridor(raw, path, r),  # noqa: B023
+                    args.repeats,
+                )
             except TrajoptError as exc:
                 failures.append(f"{name} {path!r}: {exc}")
                 continue
             ov = poly.overlap_lengths_m / raw.resolution
-            rows.append({
-                "map": name,
-                "cells": len(path),
-                "boxes_s": tb,
-                "poly_s": tp,
-                "n_boxes": len(boxes),
-                "n_poly": len(poly),
-                "ov_min": float(ov.min()) if len(ov) else math.inf,
-                "ov_med": float(np.median(ov)) if len(ov) else math.inf,
-                "degenerate": sum(g.degenerate for g in poly.regions),
-                "area_ratio": area_ratio(poly, boxes, path.cells),
-                "sides_max": max(g.n_sides for g in poly.regions),
-            })
+            rows.append(
+                {
+                    "map": name,
+                    "cells": len(path),
+                    "boxes_s": tb,
+                    "poly_s": tp,
+                    "n_boxes": len(boxes),
+                    "n_poly": len(poly),
+                    "ov_min": float(ov.min()) if len(ov) else math.inf,
+                    "ov_med": float(np.median(ov)) if len(ov) else math.inf,
+                    "degenerate": sum(g.degenerate for g in poly.regions),
+                    "area_ratio": area_ratio(poly, boxes, path.cells),
+                    "sides_max": max(g.n_sides for g in poly.regions),
+                }
+            )
     if not rows:
         print("no paths of 100-300 cells drawn")
         return
@@ -161,9 +177,11 @@ def main() -> None:
     tp = np.array([x["poly_s"] for x in rows]) * 1e3
     used = list(dict.fromkeys(x["map"] for x in rows))
     unused = [name for name, _, _ in maps if name not in used]
-    print(f"{len(rows)} paths of 100-300 cells on {len(used)} maps (search={args.search}, "
-          f"best of {args.repeats}); {len(failures)} polygon failures"
-          + (f"; no such path drawn on {', '.join(unused)}" if unused else ""))
+    print(
+        f"{len(rows)} paths of 100-300 cells on {len(used)} maps (search={args.search}, "
+        f"best of {args.repeats}); {len(failures)} polygon failures"
+        + (f"; no such path drawn on {', '.join(unused)}" if unused else "")
+    )
     print(f"{'':28}{'boxes':>10}{'polygons':>10}{'ratio':>8}")
     for q, label in ((50, "build median (ms)"), (95, "build p95 (ms)"), (100, "build max (ms)")):
         a, b = np.percentile(tb, q), np.percentile(tp, q)
@@ -173,17 +191,25 @@ def main() -> None:
     print(f"{'regions per path (median)':28}{np.median(nb):10.0f}{np.median(npg):10.0f}")
     ovmin = np.array([x["ov_min"] for x in rows])
     ovmed = np.array([x["ov_med"] for x in rows])
-    print(f"polygon overlap along the path (cells): smallest {ovmin.min():.2f}, "
-          f"p5 of per-path smallest {np.percentile(ovmin, 5):.2f}, median {np.median(ovmed):.2f}")
-    print(f"degenerate regions: {sum(x['degenerate'] for x in rows)}; most sides: "
-          f"{max(x['sides_max'] for x in rows)}")
-    print(f"region area per path cell, polygon / box (median over paths): "
-          f"{np.median([x['area_ratio'] for x in rows]):.2f}")
+    print(
+        f"polygon overlap along the path (cells): smallest {ovmin.min():.2f}, "
+        f"p5 of per-path smallest {np.percentile(ovmin, 5):.2f}, median {np.median(ovmed):.2f}"
+    )
+    print(
+        f"degenerate regions: {sum(x['degenerate'] for x in rows)}; most sides: "
+        f"{max(x['sides_max'] for x in rows)}"
+    )
+    print(
+        f"region area per path cell, polygon / box (median over paths): "
+        f"{np.median([x['area_ratio'] for x in rows]):.2f}"
+    )
     print("\nper map (median ms, boxes / polygons):")
     for name in dict.fromkeys(x["map"] for x in rows):
         sub = [x for x in rows if x["map"] == name]
-        print(f"  {name:26} n={len(sub):3d}  {1e3 * np.median([x['boxes_s'] for x in sub]):6.2f}"
-              f"  {1e3 * np.median([x['poly_s'] for x in sub]):6.2f}")
+        print(
+            f"  {name:26} n={len(sub):3d}  {1e3 * np.median([x['boxes_s'] for x in sub]):6.2f}"
+            f"  {1e3 * np.median([x['poly_s'] for x in sub]):6.2f}"
+        )
     for f in failures:
         print("failed:", f[:200])
 

@@ -25,7 +25,7 @@ map is measured independently of its certificate (``trajopt.metrics.point_cleara
 ``build_polygon_corridor`` on the same path, timed right after it.
 
 A second part runs on a warehouse-size map, willow at 5 cm cells (each 10 cm cell split in
-four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt.warm_up``, one
+four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt._warm_up``, one
 untimed plan), one with 6 search landmarks (``Planner(landmarks=6)``) and one without, in
 the same run: the whole ``plan`` of each query (start and goal at least 5 m apart: a new
 goal for the planner), and, with the landmarks, a re-plan to a new goal (the next query's)
@@ -57,9 +57,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from trajopt.errors import TrajoptError  # noqa: E402
-from trajopt.metrics import point_clearance, trajectory_metrics  # noqa: E402
-from trajopt.polygon_corridor import build_polygon_corridor  # noqa: E402
+from trajopt.analysis.metrics import point_clearance, trajectory_metrics
+from trajopt.corridor import build_polygon_corridor
+from trajopt.errors import TrajoptError
 
 MAPS = ("turtlebot3_world", "smoothers_world", "depot", "willow-2010-02-18-0.10")
 
@@ -109,8 +109,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--queries", type=int, default=6, help="queries per map")
     ap.add_argument("--every", type=float, default=0.5, help="re-plan period (s)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--warehouse", type=int, default=12,
-                    help="queries on the warehouse-size map (0: skip that part)")
+    ap.add_argument(
+        "--warehouse",
+        type=int,
+        default=12,
+        help="queries on the warehouse-size map (0: skip that part)",
+    )
     args = ap.parse_args(argv)
     d = ros_dir()
     if d is None:
@@ -249,9 +253,14 @@ def appearing(d: Path, robot, args, rng) -> None:
                     cor = new.steps.corridor
                     t1 = time.perf_counter()
                     build_polygon_corridor(planner.grid, cor.input_path, robot.radius)
-                    kept_regions.append((new.stats["stages_s"]["corridor"],
-                                         time.perf_counter() - t1,
-                                         new.stats["corridor_regions_kept"], len(cor.regions)))
+                    kept_regions.append(
+                        (
+                            new.stats["stages_s"]["corridor"],
+                            time.perf_counter() - t1,
+                            new.stats["corridor_regions_kept"],
+                            len(cor.regions),
+                        )
+                    )
                 worst = max(worst, jump(traj.state_at(args.every), new.state_at(0.0)))
                 ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
                 smp = new.sample_uniform(0.01)

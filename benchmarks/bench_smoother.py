@@ -28,13 +28,13 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
-from trajopt.bspline import clamped_uniform_knots  # noqa: E402
-from trajopt.clearance import points_clearance  # noqa: E402
+import trajopt.smoother._qp as smoother_qp  # noqa: E402
 from trajopt.corridor import build_corridor  # noqa: E402
 from trajopt.errors import SmoothingError  # noqa: E402
+from trajopt.geometry._bspline import clamped_uniform_knots  # noqa: E402
+from trajopt.geometry._clearance import points_clearance  # noqa: E402
 from trajopt.smoother import Smoother  # noqa: E402
-from trajopt.smoother import qp as smoother_qp  # noqa: E402
-from trajopt.smoother.basis import CURV_SAMPLES  # noqa: E402
+from trajopt.smoother._basis import CURV_SAMPLES  # noqa: E402
 
 
 def data_dir() -> Path:
@@ -82,7 +82,7 @@ def scenarios(n_total: int, seed: int = 0):
 
 def paper_cases():
     try:
-        from trajopt import scenes
+        from trajopt.analysis import scenes
     except ImportError:
         return []
     sc = scenes.paper()

@@ -79,8 +79,8 @@ def forward_backward_duration(curve, robot, ds: float = 0.001) -> float:
 
 
 def paper_curves(robot):
-    from trajopt import scenes
-    from trajopt.pipeline import Planner
+    from trajopt._planner import Planner
+    from trajopt.analysis import scenes
 
     scene = scenes.paper()
     planner = Planner(scene.grid, robot)
@@ -95,7 +95,7 @@ def paper_curves(robot):
 
 def movingai_curves(robot, limit: int, data: Path):
     import astar
-    from trajopt.pipeline import Planner
+    from trajopt._planner import Planner
 
     per_map = max(1, math.ceil(limit / len(MAPS)) + 4)
     out, fails = [], 0
@@ -135,7 +135,7 @@ def main() -> None:
 
     logging.getLogger("toppra").setLevel(logging.ERROR)
     from tests.conftest import data_dir
-    from trajopt.robot import Robot
+    from trajopt.robot._robot import Robot
     from trajopt.timing import time_parameterize
 
     robot = Robot()

@@ -34,8 +34,8 @@ BASE = "1510844"  # the timing before the speed-up of issue #19 (part 4)
 def _worker(curves_file: str, repeat: int) -> None:
     """Time every saved curve with the ``trajopt`` on ``sys.path``; print JSON."""
     import trajopt
-    from trajopt.bspline import BSplineCurve
-    from trajopt.robot import Robot
+    from trajopt.geometry._bspline import BSplineCurve
+    from trajopt.robot._robot import Robot
     from trajopt.timing import time_parameterize
 
     data = np.load(curves_file)
@@ -62,7 +62,7 @@ def _save_curves(limit: int, path: Path) -> list[str]:
     import bench_timing
 
     from tests.conftest import data_dir
-    from trajopt.robot import Robot
+    from trajopt.robot._robot import Robot
 
     robot = Robot()
     curves = bench_timing.paper_curves(robot)

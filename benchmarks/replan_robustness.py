@@ -42,8 +42,8 @@ from bench_replan import MAPS, jump, queries, ros_dir  # noqa: E402
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from trajopt.errors import TrajoptError  # noqa: E402
-from trajopt.metrics import point_clearance, trajectory_metrics  # noqa: E402
+from trajopt.analysis.metrics import point_clearance, trajectory_metrics
+from trajopt.errors import TrajoptError
 
 JUMP_TOL = 1e-6
 

@@ -32,8 +32,12 @@ from tests.trajopt.test_plan_properties import (  # noqa: E402
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--examples", type=int, default=N_EXAMPLES_SLOW,
-                        help=f"number of examples (default {N_EXAMPLES_SLOW})")
+    parser.add_argument(
+        "--examples",
+        type=int,
+        default=N_EXAMPLES_SLOW,
+        help=f"number of examples (default {N_EXAMPLES_SLOW})",
+    )
     args = parser.parse_args(argv)
     if args.examples < 1:
         parser.error(f"--examples must be >= 1, got {args.examples}")

@@ -43,115 +43,185 @@ class Bench:
 
 
 BENCHES: tuple[Bench, ...] = (
-    Bench("inflate", "Inflation and clearance: `astar` vs SciPy's distance transform",
-          "bench_inflate.py",
-          "Median time to inflate a random grid by 10 cells with both metrics, against "
-          "thresholding `scipy.ndimage.distance_transform_edt`, and to compute the clearance "
-          "field with both metrics, against scipy's transform; the results must agree.",
-          ("--size", "2000", "--repeat", "3")),
-    Bench("astar", "A*: `astar.find_path` vs `pyastar2d`", "bench_astar.py",
-          "Median search time on Moving AI scenarios of the shared maps, against pyastar2d "
-          "on the same queries (path costs must agree); then the clearance-cost search on a "
-          "warehouse-size map (willow at 5 cm), checked against scipy's Dijkstra.",
-          ("--n", "10", "--repeat", "3")),
-    Bench("timing", "Timing: jerk-limited timing vs TOPP-RA", "bench_timing.py",
-          "Compute time and duration of `time_parameterize` against TOPP-RA's jerk-free "
-          "time-optimal profile on the same paths.",
-          ("--limit", "20", "--repeat", "3")),
-    Bench("timing_compare", "Timing: compute time against the timing before its speed-up",
-          "compare_timing.py",
-          "`time_parameterize` of this tree against commit 1510844 (before issue #19's faster "
-          "timing) on the same saved curves, alternating fresh processes: compute time per "
-          "second of trajectory and the relative difference of the durations.",
-          ("--limit", "20", "--repeat", "3", "--rounds", "2")),
-    Bench("smoother", "Smoother: corridor-constrained B-spline", "bench_smoother.py",
-          "Warm solve and first-build times, success and clearance of the smoother, "
-          "against a plain least-squares B-spline on the same paths.",
-          ("--n", "15", "--kappa-n", "6", "--reps", "2")),
-    Bench("plan", "Whole pipeline: warm per-query latency", "bench_plan.py",
-          "Per-stage wall time of `Planner.plan` on the paper scene and the shared ROS "
-          "maps.",
-          ("--repeat", "3", "--ros-queries", "5")),
-    Bench("polygon_corridor", "Corridors: convex polygons vs boxes",
-          "bench_polygon_corridor.py",
-          "Build time, area and overlap of the polygon corridor against the box corridor "
-          "on the same A* paths.",
-          ("--per-map", "8", "--repeats", "2")),
-    Bench("corridor", "Planner: polygon corridors vs box corridors", "bench_corridor.py",
-          "Success, smoothing time and path quality of `plan` with polygons against boxes "
-          "on held-out queries.",
-          ("--per-map", "6", "--repeats", "1")),
-    Bench("curvature", "Curvature-bounded smoothing", "bench_curvature.py",
-          "The SCP curvature bound against IPOPT on the same problems.",
-          ("--per-map", "8", "--repeats", "2")),
-    Bench("budget", "Smoother time budget", "bench_budget.py",
-          "Success rate of curvature-bounded plans for several time budgets.",
-          ("--per-map", "4", "--repeats", "1")),
-    Bench("fallback", "Robustness: smoother, stop-and-turn fallback, failures",
-          "bench_fallback.py",
-          "Outcome of every query on the shared maps with and without the fallback.",
-          ("--limit-per-map", "10")),
-    Bench("failures", "Failures at scale: default and curvature-bounded planner",
-          "bench_failures.py",
-          "Failures of the default and the curvature-bounded (1/(2r)) planner on the "
-          "shared-full suite and on random queries at several radii; curvature-bounded "
-          "failures classified by a curvature witness; median time of a failing query.",
-          ("--limit", "40", "--random", "40", "--radii", "1.5,2.5"),
-          ("--limit", "400", "--random", "250", "--radii", "1.5,2.5,3.5")),
-    Bench("timing_property", "Timing: the speed cap on sharp curvature peaks",
-          "timing_property_run.py",
-          "Random curves with sharp curvature peaks: worst ratio of the sampled speed to "
-          "its cap.",
-          ("--examples", "100")),
-    Bench("mcap", "ROS 2 export: MCAP writing speed", "bench_mcap.py",
-          "Writing a 60 s trajectory at 100 Hz to MCAP, against mcap_ros2's generic "
-          "writer in the same run.",
-          ("--repeat", "3")),
-    Bench("replan", "Re-planning from a moving robot", "bench_replan.py",
-          "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal: "
-          "the rest kept, and with `reuse=False` a full plan; then one new goal), the jump "
-          "at the splice and the limits of the new trajectory, against a fresh plan from "
-          "rest at the same point; a drive with obstacles appearing before every re-plan; "
-          "then whole plans and re-plans to a new goal on a warehouse-size map (willow at "
-          "5 cm).",
-          ("--queries", "4")),
-    Bench("replan_robustness", "Re-planning: every guarantee on many re-plans",
-          "replan_robustness.py",
-          "Re-plans with `reuse=False` from moving robots on the shared ROS maps to the same "
-          "goal and to two other goals, and braked results re-planned again mid-brake: "
-          "outcomes (planned, braked, refused by type), latency, and every violation of the "
-          "splice continuity, the limits, the clearance, or an untyped error.",
-          ("--queries", "3")),
-    Bench("first_call", "First plan in a fresh process", "bench_first_call.py",
-          "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
-          "warm on disk), split into imports, numba cache loads, solver build and the "
-          "rest, and of the first plan after `trajopt.warm_up()` at start-up.",
-          ("--runs", "5")),
-    Bench("footprint", "Rectangular robots: collisions and doors", "bench_footprint.py",
-          "Rectangles (1.6 x 1.0 and 2:1 of the disc's diameter) on the shared maps, checked "
-          "by an independent collision test, why refused queries were refused, the "
-          "smoothing stage with the footprint certificate and rounds, the same queries "
-          "without the footprint rounds (the previous design), and door passages narrower "
-          "than the circumscribed disc, against that disc in the same run.",
-          ("--per-map", "15")),
-    Bench("harness", "Benchmark harness: Dask scaling", "bench_harness.py",
-          "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
-          "and the report on 10^5 rows.",
-          ("--limit", "6")),
-    Bench("harness_scaling", "Benchmark harness: 1 vs 2 workers on shared-small, and why",
-          "bench_harness_scaling.py",
-          "`trajopt bench`'s throughput on `shared-small` with 1 and 2 local Dask workers in "
-          "the same run (3 rounds; measured after the workers' warm-up, and end to end), "
-          "where the workers' time goes (planning, scoring, the rest of the tasks, idle), a "
-          "cProfile of a serial pass, and the machine's own 1-vs-2-process ceiling for the "
-          "same work without Dask. Each measurement waits for other processes to go quiet "
-          "and reports the cores they used meanwhile (a round where they used more than "
-          "0.15 cores, or where the workers got under 85 % of their wall time as CPU, is "
-          "not counted and is repeated). On this 2-vCPU VM the host's speed "
-          "drifts by tens of per cent from minute to minute (the fixed loop's time), so a "
-          "single round's ratio moves by about as much: read the quiet rounds' median and "
-          "the per-run split.",
-          ("--rounds", "3")),
+    Bench(
+        "inflate",
+        "Inflation and clearance: `astar` vs SciPy's distance transform",
+        "bench_inflate.py",
+        "Median time to inflate a random grid by 10 cells with both metrics, against "
+        "thresholding `scipy.ndimage.distance_transform_edt`, and to compute the clearance "
+        "field with both metrics, against scipy's transform; the results must agree.",
+        ("--size", "2000", "--repeat", "3"),
+    ),
+    Bench(
+        "astar",
+        "A*: `astar.find_path` vs `pyastar2d`",
+        "bench_astar.py",
+        "Median search time on Moving AI scenarios of the shared maps, against pyastar2d "
+        "on the same queries (path costs must agree); then the clearance-cost search on a "
+        "warehouse-size map (willow at 5 cm), checked against scipy's Dijkstra.",
+        ("--n", "10", "--repeat", "3"),
+    ),
+    Bench(
+        "timing",
+        "Timing: jerk-limited timing vs TOPP-RA",
+        "bench_timing.py",
+        "Compute time and duration of `time_parameterize` against TOPP-RA's jerk-free "
+        "time-optimal profile on the same paths.",
+        ("--limit", "20", "--repeat", "3"),
+    ),
+    Bench(
+        "timing_compare",
+        "Timing: compute time against the timing before its speed-up",
+        "compare_timing.py",
+        "`time_parameterize` of this tree against commit 1510844 (before issue #19's faster "
+        "timing) on the same saved curves, alternating fresh processes: compute time per "
+        "second of trajectory and the relative difference of the durations.",
+        ("--limit", "20", "--repeat", "3", "--rounds", "2"),
+    ),
+    Bench(
+        "smoother",
+        "Smoother: corridor-constrained B-spline",
+        "bench_smoother.py",
+        "Warm solve and first-build times, success and clearance of the smoother, "
+        "against a plain least-squares B-spline on the same paths.",
+        ("--n", "15", "--kappa-n", "6", "--reps", "2"),
+    ),
+    Bench(
+        "plan",
+        "Whole pipeline: warm per-query latency",
+        "bench_plan.py",
+        "Per-stage wall time of `Planner.plan` on the paper scene and the shared ROS maps.",
+        ("--repeat", "3", "--ros-queries", "5"),
+    ),
+    Bench(
+        "polygon_corridor",
+        "Corridors: convex polygons vs boxes",
+        "bench_polygon_corridor.py",
+        "Build time, area and overlap of the polygon corridor against the box corridor "
+        "on the same A* paths.",
+        ("--per-map", "8", "--repeats", "2"),
+    ),
+    Bench(
+        "corridor",
+        "Planner: polygon corridors vs box corridors",
+        "bench_corridor.py",
+        "Success, smoothing time and path quality of `plan` with polygons against boxes "
+        "on held-out queries.",
+        ("--per-map", "6", "--repeats", "1"),
+    ),
+    Bench(
+        "curvature",
+        "Curvature-bounded smoothing",
+        "bench_curvature.py",
+        "The SCP curvature bound against IPOPT on the same problems.",
+        ("--per-map", "8", "--repeats", "2"),
+    ),
+    Bench(
+        "budget",
+        "Smoother time budget",
+        "bench_budget.py",
+        "Success rate of curvature-bounded plans for several time budgets.",
+        ("--per-map", "4", "--repeats", "1"),
+    ),
+    Bench(
+        "fallback",
+        "Robustness: smoother, stop-and-turn fallback, failures",
+        "bench_fallback.py",
+        "Outcome of every query on the shared maps with and without the fallback.",
+        ("--limit-per-map", "10"),
+    ),
+    Bench(
+        "failures",
+        "Failures at scale: default and curvature-bounded planner",
+        "bench_failures.py",
+        "Failures of the default and the curvature-bounded (1/(2r)) planner on the "
+        "shared-full suite and on random queries at several radii; curvature-bounded "
+        "failures classified by a curvature witness; median time of a failing query.",
+        ("--limit", "40", "--random", "40", "--radii", "1.5,2.5"),
+        ("--limit", "400", "--random", "250", "--radii", "1.5,2.5,3.5"),
+    ),
+    Bench(
+        "timing_property",
+        "Timing: the speed cap on sharp curvature peaks",
+        "timing_property_run.py",
+        "Random curves with sharp curvature peaks: worst ratio of the sampled speed to its cap.",
+        ("--examples", "100"),
+    ),
+    Bench(
+        "mcap",
+        "ROS 2 export: MCAP writing speed",
+        "bench_mcap.py",
+        "Writing a 60 s trajectory at 100 Hz to MCAP, against mcap_ros2's generic "
+        "writer in the same run.",
+        ("--repeat", "3"),
+    ),
+    Bench(
+        "replan",
+        "Re-planning from a moving robot",
+        "bench_replan.py",
+        "Re-plan latency every 0.5 s of trajectory time on the shared ROS maps (same goal: "
+        "the rest kept, and with `reuse=False` a full plan; then one new goal), the jump "
+        "at the splice and the limits of the new trajectory, against a fresh plan from "
+        "rest at the same point; a drive with obstacles appearing before every re-plan; "
+        "then whole plans and re-plans to a new goal on a warehouse-size map (willow at "
+        "5 cm).",
+        ("--queries", "4"),
+    ),
+    Bench(
+        "replan_robustness",
+        "Re-planning: every guarantee on many re-plans",
+        "replan_robustness.py",
+        "Re-plans with `reuse=False` from moving robots on the shared ROS maps to the same "
+        "goal and to two other goals, and braked results re-planned again mid-brake: "
+        "outcomes (planned, braked, refused by type), latency, and every violation of the "
+        "splice continuity, the limits, the clearance, or an untyped error.",
+        ("--queries", "3"),
+    ),
+    Bench(
+        "first_call",
+        "First plan in a fresh process",
+        "bench_first_call.py",
+        "Wall time of the first `plan` after `import trajopt` (paper scene, numba cache "
+        "warm on disk), split into imports, numba cache loads, solver build and the "
+        "rest, and of the first plan after `trajopt.warm_up()` at start-up.",
+        ("--runs", "5"),
+    ),
+    Bench(
+        "footprint",
+        "Rectangular robots: collisions and doors",
+        "bench_footprint.py",
+        "Rectangles (1.6 x 1.0 and 2:1 of the disc's diameter) on the shared maps, checked "
+        "by an independent collision test, why refused queries were refused, the "
+        "smoothing stage with the footprint certificate and rounds, the same queries "
+        "without the footprint rounds (the previous design), and door passages narrower "
+        "than the circumscribed disc, against that disc in the same run.",
+        ("--per-map", "15"),
+    ),
+    Bench(
+        "harness",
+        "Benchmark harness: Dask scaling",
+        "bench_harness.py",
+        "Throughput of `trajopt bench` with 1 and 2 Dask workers on the same queries, "
+        "and the report on 10^5 rows.",
+        ("--limit", "6"),
+    ),
+    Bench(
+        "harness_scaling",
+        "Benchmark harness: 1 vs 2 workers on shared-small, and why",
+        "bench_harness_scaling.py",
+        "`trajopt bench`'s throughput on `shared-small` with 1 and 2 local Dask workers in "
+        "the same run (3 rounds; measured after the workers' warm-up, and end to end), "
+        "where the workers' time goes (planning, scoring, the rest of the tasks, idle), a "
+        "cProfile of a serial pass, and the machine's own 1-vs-2-process ceiling for the "
+        "same work without Dask. Each measurement waits for other processes to go quiet "
+        "and reports the cores they used meanwhile (a round where they used more than "
+        "0.15 cores, or where the workers got under 85 % of their wall time as CPU, is "
+        "not counted and is repeated). On this 2-vCPU VM the host's speed "
+        "drifts by tens of per cent from minute to minute (the fixed loop's time), so a "
+        "single round's ratio moves by about as much: read the quiet rounds' median and "
+        "the per-run split.",
+        ("--rounds", "3"),
+    ),
 )
 
 

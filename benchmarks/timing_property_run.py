@@ -25,10 +25,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from tests.trajopt.test_timing import check_limits  # noqa: E402
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots  # noqa: E402
-from trajopt.errors import TimingError  # noqa: E402
-from trajopt.robot import Robot  # noqa: E402
-from trajopt.timing import time_parameterize  # noqa: E402
+from trajopt.errors import TimingError
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.robot._robot import Robot
+from trajopt.timing import time_parameterize
 
 ROBOT = Robot(
     v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
@@ -78,8 +78,10 @@ def main(argv: list[str] | None = None) -> int:
             check_limits(traj, ROBOT)
         except AssertionError as exc:
             bad.append((ratio, str(exc)[:200], np.asarray(c.c)))
-    print(f"curves: {done}, TimingError: {errors}, violations: {len(bad)}, "
-          f"max v/cap on 1 ms samples: {worst:.6f} ({time.perf_counter() - t0:.0f} s)")
+    print(
+        f"curves: {done}, TimingError: {errors}, violations: {len(bad)}, "
+        f"max v/cap on 1 ms samples: {worst:.6f} ({time.perf_counter() - t0:.0f} s)"
+    )
     for ratio, msg, ctrl in sorted(bad, key=lambda b: -b[0]):
         print(f"- v/cap {ratio:.4f}: {msg!r}\n  control points: {np.round(ctrl, 12).tolist()}")
     return 1 if bad else 0

@@ -8,8 +8,8 @@ import math
 import numpy as np
 
 import astar
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
-from trajopt.curve import ParametricCurve
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._curve import ParametricCurve
 
 __all__ = ["Arc", "door_grid", "l_shaped_grid", "line", "square_inflated", "staircase_passage"]
 

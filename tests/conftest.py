@@ -8,7 +8,7 @@
   in their test with ``@example``.
 * A fresh clone (or venv, or CI runner) has no compiled numba kernels yet: the session
   first compiles every kernel numba's cache lacks, in two worker processes
-  (:func:`trajopt.kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
+  (:func:`trajopt._kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
 """
 
@@ -31,7 +31,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile the kernels numba's disk cache lacks before the first test (module docstring)."""
     if os.environ.get("TRAJOPT_PRECOMPILE", "1") == "0":
         return
-    from trajopt import kernel_cache
+    import trajopt._kernel_cache as kernel_cache
 
     cold = kernel_cache.cold_kernels()
     if not cold:

@@ -50,7 +50,9 @@ def test_type_checking_block_imports_every_lazy_export(package):
     seen = _type_checking_imports(mod)
     want = dict(mod._EXPORTS)
     want.update({name: package for name in getattr(mod, "_SUBMODULES", ())})
-    wrong = {name: (where, seen.get(name)) for name, where in want.items() if seen.get(name) != where}
+    wrong = {
+        name: (where, seen.get(name)) for name, where in want.items() if seen.get(name) != where
+    }
     assert not wrong, f"{package}: TYPE_CHECKING imports missing or from another module: {wrong}"
     assert set(seen) == set(mod.__all__) == set(want)
     for name, where in seen.items():  # and each names the very object __getattr__ returns

@@ -1,9 +1,27 @@
 """trajopt: occupancy grid + start + goal -> timed, collision-free, smooth trajectory.
 
-Pipeline: :func:`astar.inflate` -> :func:`astar.find_path` -> :func:`build_corridor`
--> :class:`Smoother` -> :func:`time_parameterize`, or all at once with :func:`plan`.
+Pipeline: :func:`astar.inflate` -> :func:`astar.find_path` -> :func:`build_polygon_corridor`
+(or :func:`build_corridor`) -> :class:`Smoother` -> :func:`time_parameterize`, or all at once
+with :func:`plan` (one query) and :class:`Planner` (many queries and re-plans on one map).
 
-Public names are imported lazily (PEP 562) so that ``import trajopt`` stays fast;
+**Core**: :func:`plan`, :class:`Planner`, :class:`Robot`, :class:`Trajectory`,
+:class:`State`, :class:`Smoother`, the errors (:class:`TrajoptError` and its subclasses)
+and :func:`warm_up` (compile the numerical kernels ahead of time).
+
+**Stages**, for users who compose them: the corridors (:class:`PolygonCorridor` of
+:class:`ConvexPolygon`, :class:`Corridor` of :class:`Box`), :class:`SmoothPath`, the curves
+(:class:`ParametricCurve`, :class:`BSplineCurve`), :func:`time_parameterize` with
+:class:`SpeedLimits` (:func:`load_speed_mask`), the stop-and-turn motion
+(:func:`stop_and_turn`, :class:`StopAndTurnTrajectory`), :class:`TurnInPlace` and
+:class:`TrajectoryChain`, and the ROS 2 MCAP files (:func:`write_mcap`, :func:`read_mcap`).
+
+**Analysis**: :func:`compare` and :class:`ComparisonTable` (the chapter's table), and the
+modules ``trajopt.metrics``, ``trajopt.fits``, ``trajopt.scenes``, ``trajopt.plotting``,
+``trajopt.comparison`` and ``trajopt.bench`` (all in :mod:`trajopt.analysis`).
+
+The packages below hold the stages (``geometry``, ``robot``, ``motion``, ``corridor``,
+``smoother``, ``timing``, ``planning``, ``replan``, ``analysis``); ``docs/architecture.md``
+draws the flow. Names are imported lazily (PEP 562) so that ``import trajopt`` stays fast;
 heavy dependencies (CasADi, ruckig, matplotlib) load when first used.
 """
 
@@ -18,56 +36,62 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 __version__ = "0.1.0"
 
 _EXPORTS: dict[str, str] = {
-    # errors
+    # core
+    "plan": "trajopt._planner",
+    "Planner": "trajopt._planner",
+    "Robot": "trajopt.robot",
+    "State": "trajopt.robot",
+    "Trajectory": "trajopt.motion",
+    "Smoother": "trajopt.smoother",
+    "warm_up": "trajopt._warm_up",
     "TrajoptError": "trajopt.errors",
     "InvalidInputError": "trajopt.errors",
     "NoPathError": "trajopt.errors",
     "SmoothingError": "trajopt.errors",
     "TimingError": "trajopt.errors",
     "IllPosedFitError": "trajopt.errors",
-    # curves
-    "ParametricCurve": "trajopt.curve",
-    "BSplineCurve": "trajopt.bspline",
-    # corridor and smoother
+    # stages
+    "ParametricCurve": "trajopt.geometry",
+    "BSplineCurve": "trajopt.geometry",
     "Box": "trajopt.corridor",
     "Corridor": "trajopt.corridor",
     "build_corridor": "trajopt.corridor",
-    "ConvexPolygon": "trajopt.polygon_corridor",
-    "PolygonCorridor": "trajopt.polygon_corridor",
-    "build_polygon_corridor": "trajopt.polygon_corridor",
-    "Smoother": "trajopt.smoother",
+    "ConvexPolygon": "trajopt.corridor",
+    "PolygonCorridor": "trajopt.corridor",
+    "build_polygon_corridor": "trajopt.corridor",
     "SmoothPath": "trajopt.smoother",
-    # timing
-    "Robot": "trajopt.robot",
     "time_parameterize": "trajopt.timing",
-    "Trajectory": "trajopt.trajectory",
-    "TrajectoryChain": "trajopt.trajectory_chain",
-    "TurnInPlace": "trajopt.trajectory_chain",
-    "State": "trajopt.state",
-    "SpeedLimits": "trajopt.speed_limits",
-    "load_speed_mask": "trajopt.speed_limits",
-    # ROS 2 files
-    "read_mcap": "trajopt.ros_mcap",
-    "write_mcap": "trajopt.ros_mcap",
-    # the opt-in stop-and-turn fallback
-    "StopAndTurnTrajectory": "trajopt.fallback",
-    "stop_and_turn": "trajopt.fallback",
-    # pipeline and analysis
-    "plan": "trajopt.pipeline",
-    "Planner": "trajopt.pipeline",
-    "warm_up": "trajopt.warm_up",
-    "compare": "trajopt.comparison",
-    "ComparisonTable": "trajopt.comparison",
+    "SpeedLimits": "trajopt.timing",
+    "load_speed_mask": "trajopt.timing",
+    "stop_and_turn": "trajopt.timing",
+    "StopAndTurnTrajectory": "trajopt.motion",
+    "TrajectoryChain": "trajopt.motion",
+    "TurnInPlace": "trajopt.motion",
+    "read_mcap": "trajopt.motion",
+    "write_mcap": "trajopt.motion",
+    # analysis
+    "compare": "trajopt.analysis.comparison",
+    "ComparisonTable": "trajopt.analysis.comparison",
 }
 
-_SUBMODULES = {"scenes", "fits", "metrics", "plotting", "cli", "fallback"}
+#: Public modules reachable as ``trajopt.<name>`` (loaded on first use).
+_SUBMODULES: dict[str, str] = {
+    "scenes": "trajopt.analysis.scenes",
+    "fits": "trajopt.analysis.fits",
+    "metrics": "trajopt.analysis.metrics",
+    "plotting": "trajopt.analysis.plotting",
+    "comparison": "trajopt.analysis.comparison",
+    "bench": "trajopt.analysis.bench",
+    "cli": "trajopt.cli",
+}
 
 __all__ = sorted(_EXPORTS) + sorted(_SUBMODULES)
 
 
 def __getattr__(name: str) -> Any:
-    if name in _SUBMODULES:
-        module = importlib.import_module(f"trajopt.{name}")
+    module_name = _SUBMODULES.get(name)
+    if module_name is not None:
+        module = importlib.import_module(module_name)
         globals()[name] = module
         return module
     module_name = _EXPORTS.get(name)
@@ -83,11 +107,19 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
-    from trajopt import cli, fallback, fits, metrics, plotting, scenes
-    from trajopt.bspline import BSplineCurve
-    from trajopt.comparison import ComparisonTable, compare
-    from trajopt.corridor import Box, Corridor, build_corridor
-    from trajopt.curve import ParametricCurve
+    from trajopt import cli
+    from trajopt._planner import Planner, plan
+    from trajopt._warm_up import warm_up
+    from trajopt.analysis import bench, comparison, fits, metrics, plotting, scenes
+    from trajopt.analysis.comparison import ComparisonTable, compare
+    from trajopt.corridor import (
+        Box,
+        ConvexPolygon,
+        Corridor,
+        PolygonCorridor,
+        build_corridor,
+        build_polygon_corridor,
+    )
     from trajopt.errors import (
         IllPosedFitError,
         InvalidInputError,
@@ -96,15 +128,15 @@ if TYPE_CHECKING:  # pragma: no cover
         TimingError,
         TrajoptError,
     )
-    from trajopt.fallback import StopAndTurnTrajectory, stop_and_turn
-    from trajopt.pipeline import Planner, plan
-    from trajopt.polygon_corridor import ConvexPolygon, PolygonCorridor, build_polygon_corridor
-    from trajopt.robot import Robot
-    from trajopt.ros_mcap import read_mcap, write_mcap
+    from trajopt.geometry import BSplineCurve, ParametricCurve
+    from trajopt.motion import (
+        StopAndTurnTrajectory,
+        Trajectory,
+        TrajectoryChain,
+        TurnInPlace,
+        read_mcap,
+        write_mcap,
+    )
+    from trajopt.robot import Robot, State
     from trajopt.smoother import Smoother, SmoothPath
-    from trajopt.speed_limits import SpeedLimits, load_speed_mask
-    from trajopt.state import State
-    from trajopt.timing import time_parameterize
-    from trajopt.trajectory import Trajectory
-    from trajopt.trajectory_chain import TrajectoryChain, TurnInPlace
-    from trajopt.warm_up import warm_up
+    from trajopt.timing import SpeedLimits, load_speed_mask, stop_and_turn, time_parameterize

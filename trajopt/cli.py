@@ -252,21 +252,35 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--resume", action="store_true", help="skip rows the dataset already holds")
     r.add_argument("--methods", help="comma-separated methods (default: all but the peers)")
     r.add_argument("--limit", type=int, help="scenarios (or random queries) per map")
-    r.add_argument("--queries", type=int, default=20,
-                   help="random queries per map INPUT (default 20)")
+    r.add_argument(
+        "--queries", type=int, default=20, help="random queries per map INPUT (default 20)"
+    )
     r.add_argument("--seed", type=int, default=0, help="seed of the random queries (default 0)")
-    r.add_argument("--radius-cells", type=float, default=2.5,
-                   help="robot radius on Moving AI maps, in cells (default 2.5)")
-    r.add_argument("--radius", type=float, default=0.165,
-                   help="robot radius on other maps [m] (default 0.165)")
-    r.add_argument("--feasible-only", action="store_true",
-                   help="keep only scenarios whose end cells are free for the radius")
-    r.add_argument("--scheduler", default="local",
-                   help="'local' (LocalCluster, default), 'serial', or tcp://host:8786")
+    r.add_argument(
+        "--radius-cells",
+        type=float,
+        default=2.5,
+        help="robot radius on Moving AI maps, in cells (default 2.5)",
+    )
+    r.add_argument(
+        "--radius", type=float, default=0.165, help="robot radius on other maps [m] (default 0.165)"
+    )
+    r.add_argument(
+        "--feasible-only",
+        action="store_true",
+        help="keep only scenarios whose end cells are free for the radius",
+    )
+    r.add_argument(
+        "--scheduler",
+        default="local",
+        help="'local' (LocalCluster, default), 'serial', or tcp://host:8786",
+    )
     r.add_argument("--workers", type=int, help="local worker processes (default: cores)")
-    r.add_argument("--chunk-size", type=int,
-                   help="queries per task (default: at least 8 tasks per worker, at most 4 "
-                   "queries each)")
+    r.add_argument(
+        "--chunk-size",
+        type=int,
+        help="queries per task (default: at least 8 tasks per worker, at most 4 queries each)",
+    )
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=_cmd_bench_run)
     r = bsub.add_parser(
@@ -347,7 +361,7 @@ def _read_footprint_file(path: str) -> Any:
     import math
 
     from trajopt.errors import InvalidInputError
-    from trajopt.footprint import Footprint
+    from trajopt.robot._footprint import Footprint
 
     where = f"--footprint-file {path!r}"
     file = Path(path)
@@ -408,8 +422,8 @@ def _numbers(values: Sequence[float]) -> str:
 
 def _robot(args: argparse.Namespace):
     from trajopt.errors import InvalidInputError
-    from trajopt.footprint import Footprint
-    from trajopt.robot import Robot
+    from trajopt.robot._footprint import Footprint
+    from trajopt.robot._robot import Robot
 
     names = ("radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max", "track_width",
              "wheel_v_max")  # fmt: skip
@@ -443,7 +457,7 @@ _PLOT_POSES = (5, 40)  # least and most footprints drawn along the trajectory by
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
-    from trajopt.pipeline import Planner
+    from trajopt._planner import Planner
     from trajopt.smoother import Smoother
 
     if args.out and Path(args.out).suffix.lower() not in _OUT_SUFFIXES:
@@ -457,7 +471,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     robot = _robot(args)
     speed_limits = None
     if args.speed_mask:
-        from trajopt.speed_limits import load_speed_mask
+        from trajopt.timing._speed_limits import load_speed_mask
 
         speed_limits = load_speed_mask(
             args.speed_mask,
@@ -508,7 +522,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         import matplotlib.pyplot as plt
         import numpy as np
 
-        from trajopt.plotting import plot_footprints, plot_paths
+        from trajopt.analysis.plotting import plot_footprints, plot_paths
 
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
@@ -558,7 +572,7 @@ def _avoidance(grid: Any, table: Any) -> Any:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from trajopt.comparison import compare
+    from trajopt.analysis.comparison import compare
 
     grid = _load(args)
     # the comparison's methods are disc models: a footprint enters by its circumscribed radius
@@ -572,7 +586,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         _atomic_write(args.out, lambda tmp: tmp.write_text(text + "\n"))
     if args.plot:
         _require_matplotlib()
-        from trajopt.plotting import plot_paths
+        from trajopt.analysis.plotting import plot_paths
 
         paths = {k: v for k, v in table.paths.items() if v is not None}
         fig, _ = plot_paths(
@@ -587,10 +601,10 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from trajopt.comparison import compare
-    from trajopt.pipeline import Planner
-    from trajopt.robot import Robot
-    from trajopt.scenes import paper
+    from trajopt._planner import Planner
+    from trajopt.analysis.comparison import compare
+    from trajopt.analysis.scenes import paper
+    from trajopt.robot._robot import Robot
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -620,7 +634,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         csv_text = _table_text(table, "csv")
         _atomic_write(out / f"compare_{name}.csv", lambda tmp, s=csv_text: tmp.write_text(s))
         if plots:
-            from trajopt.plotting import plot_paths, plot_profiles
+            from trajopt.analysis.plotting import plot_paths, plot_profiles
 
             paths = {k: v for k, v in table.paths.items() if v is not None}
             fig, _ = plot_paths(
@@ -641,7 +655,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _bench_sources(args: argparse.Namespace) -> list[Any]:
-    from trajopt import bench
+    from trajopt.analysis import bench
 
     if args.limit is not None and args.limit < 1:
         raise CliError(f"--limit must be >= 1, got {args.limit}")
@@ -651,14 +665,25 @@ def _bench_sources(args: argparse.Namespace) -> list[Any]:
         raise CliError(f"--map needs exactly one .scen INPUT, got {len(args.inputs)}")
     sources = []
     if args.suite:
-        sources += bench.suite(args.suite, args.data, limit=args.limit,
-                               radius_cells=args.radius_cells, radius_m=args.radius,
-                               seed=args.seed)
+        sources += bench.suite(
+            args.suite,
+            args.data,
+            limit=args.limit,
+            radius_cells=args.radius_cells,
+            radius_m=args.radius,
+            seed=args.seed,
+        )
     for item in args.inputs:
         if item.endswith(".scen"):
-            sources.append(bench.movingai_queries(
-                item, args.map, limit=args.limit, radius_cells=args.radius_cells,
-                feasible_only=args.feasible_only))
+            sources.append(
+                bench.movingai_queries(
+                    item,
+                    args.map,
+                    limit=args.limit,
+                    radius_cells=args.radius_cells,
+                    feasible_only=args.feasible_only,
+                )
+            )
         else:
             n = args.queries if args.limit is None else min(args.queries, args.limit)
             sources.append(bench.random_queries(item, n, seed=args.seed, radius_m=args.radius))
@@ -666,21 +691,30 @@ def _bench_sources(args: argparse.Namespace) -> list[Any]:
 
 
 def _cmd_bench_run(args: argparse.Namespace) -> int:
-    from trajopt import bench
+    from trajopt.analysis import bench
 
     sources = _bench_sources(args)
-    res = bench.run(sources, args.out, methods=args.methods, scheduler=args.scheduler,
-                    workers=args.workers, chunk_size=args.chunk_size, resume=args.resume,
-                    progress=not args.no_progress)
-    print(f"{res.rows_written} rows written, {res.rows_skipped} already held, "
-          f"{res.rows_expected} in all ({res.chunks} chunks, {res.workers} workers, "
-          f"{res.elapsed_s:.1f} s) -> {res.out}")
+    res = bench.run(
+        sources,
+        args.out,
+        methods=args.methods,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        chunk_size=args.chunk_size,
+        resume=args.resume,
+        progress=not args.no_progress,
+    )
+    print(
+        f"{res.rows_written} rows written, {res.rows_skipped} already held, "
+        f"{res.rows_expected} in all ({res.chunks} chunks, {res.workers} workers, "
+        f"{res.elapsed_s:.1f} s) -> {res.out}"
+    )
     print(bench.report(res.out))
     return 0
 
 
 def _cmd_bench_report(args: argparse.Namespace) -> int:
-    from trajopt import bench
+    from trajopt.analysis import bench
 
     print(bench.report(args.dataset, figures_dir=args.figures))
     if args.figures:
@@ -689,7 +723,7 @@ def _cmd_bench_report(args: argparse.Namespace) -> int:
 
 
 def _cmd_warm_up(args: argparse.Namespace) -> int:
-    from trajopt import kernel_cache
+    import trajopt._kernel_cache as kernel_cache
 
     warm_up = kernel_cache.warm_up_module().warm_up
     if args.workers is not None and args.workers < 1:
@@ -723,7 +757,7 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
     With ``first`` (warm-up exercises) it returns when those are compiled, the rest going on
     in the background (the report's ``wait()``).
     """
-    from trajopt import kernel_cache
+    import trajopt._kernel_cache as kernel_cache
 
     cold = kernel_cache.cold_kernels()
     if not cold:
@@ -748,9 +782,7 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
             bar.set_postfix_str(kernel.rsplit(".", 1)[-1], refresh=True)
 
     try:
-        report = kernel_cache.compile_kernels(
-            workers=n_workers, progress=progress, first=first
-        )
+        report = kernel_cache.compile_kernels(workers=n_workers, progress=progress, first=first)
     finally:
         if bar is not None:
             bar.close()
@@ -767,13 +799,13 @@ def _compile_notice(args: argparse.Namespace) -> Any:
     they are compiled while the worker processes go on with the others (the returned
     report's ``wait()``, called when the command is done). A kernel the command needs that
     is not compiled yet compiles when first used, with the library's one-line notice (logger
-    ``trajopt.kernel_cache``) on stderr.
+    ``trajopt._kernel_cache``) on stderr.
     """
     if args.command not in _PLANNING or getattr(args, "bench_command", "run") != "run":
         return None
-    from trajopt import kernel_cache
+    import trajopt._kernel_cache as kernel_cache
 
-    notice = logging.getLogger("trajopt.kernel_cache")
+    notice = logging.getLogger("trajopt._kernel_cache")
     if not any(isinstance(h, _StderrLines) for h in notice.handlers):
         notice.addHandler(_StderrLines())
         notice.propagate = False

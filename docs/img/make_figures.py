@@ -25,7 +25,7 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from trajopt.plotting import plot_map, plot_paths  # noqa: E402
+from trajopt.analysis.plotting import plot_map, plot_paths  # noqa: E402
 
 
 def paper_scene() -> None:

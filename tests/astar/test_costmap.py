@@ -141,7 +141,7 @@ def _grid_path_cost(path, cost: np.ndarray) -> float:
 
 def test_plans_on_a_nav2_costmap_avoid_cost_and_keep_the_certificate(shared_data):
     import trajopt
-    from trajopt.metrics import point_clearance
+    from trajopt.analysis.metrics import point_clearance
 
     g = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     c = nav2_inflation(g.occupied, g.resolution, r_ins=0.15, r_inf=0.6, k=3.0)

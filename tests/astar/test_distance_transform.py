@@ -94,9 +94,7 @@ def test_accepts_other_dtypes_and_layouts():
     ref = brute_squared(occ.astype(bool), "centre")
     np.testing.assert_array_equal(squared_distances(occ, "centre"), ref)
     np.testing.assert_array_equal(squared_distances(occ.T.copy().T, "centre"), ref)
-    np.testing.assert_array_equal(
-        squared_distances(np.asfortranarray(occ.T), "centre"), ref.T
-    )
+    np.testing.assert_array_equal(squared_distances(np.asfortranarray(occ.T), "centre"), ref.T)
 
 
 def test_rejects_bad_input():

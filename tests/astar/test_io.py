@@ -788,8 +788,14 @@ def test_yaml_alias_bomb_fails_fast(tmp_path: Path) -> None:
     (tmp_path / "a.pgm").write_bytes(b"P5\n2 2\n255\n" + bytes(4))
     lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
     lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]" for i in range(1, 9)]
-    base = ["image: a.pgm", "origin: [0, 0, 0]", "negate: 0", "occupied_thresh: 0.65",
-            "free_thresh: 0.196", "resolution: 0.1"]
+    base = [
+        "image: a.pgm",
+        "origin: [0, 0, 0]",
+        "negate: 0",
+        "occupied_thresh: 0.65",
+        "free_thresh: 0.196",
+        "resolution: 0.1",
+    ]
     for key in ("resolution", "origin", "negate", "image", "mode", "free_thresh"):
         body = [ln for ln in base if not ln.startswith(key + ":")] + [f"{key}: *a8"]
         path = tmp_path / f"bomb_{key}.yaml"
@@ -806,13 +812,21 @@ def test_png_declaring_huge_size_is_refused_before_decoding(tmp_path: Path) -> N
     import zlib
 
     def chunk(kind: bytes, data: bytes) -> bytes:
-        return (struct.pack(">I", len(data)) + kind + data
-                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+        return (
+            struct.pack(">I", len(data))
+            + kind
+            + data
+            + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+        )
 
     for w, h in ((10_000, 10_000), (100_000, 100_000), (2**31 - 1, 2**31 - 1)):
         ihdr = struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)  # 8-bit grey
-        data = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr)
-                + chunk(b"IDAT", zlib.compress(b"\x00" * 1000)) + chunk(b"IEND", b""))
+        data = (
+            b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", ihdr)
+            + chunk(b"IDAT", zlib.compress(b"\x00" * 1000))
+            + chunk(b"IEND", b"")
+        )
         (tmp_path / "big.png").write_bytes(data)
         tracemalloc.start()
         try:
@@ -830,8 +844,11 @@ def test_png_declaring_huge_size_is_refused_before_decoding(tmp_path: Path) -> N
         ("h.map", b"type octile\nheight 99999999\nwidth 99999999\nmap\n" + b"." * 100),
         ("h.pgm", b"P5\n60000 60000\n255\n" + bytes(100)),
         ("h.pbm", b"P4\n2000000000 2000000000\n" + bytes(100)),
-        ("h.npy", b"\x93NUMPY\x01\x00\x46\x00{'descr': '|b1', 'fortran_order': False, "
-                  b"'shape': (999999, 999999), }   \n" + bytes(8)),
+        (
+            "h.npy",
+            b"\x93NUMPY\x01\x00\x46\x00{'descr': '|b1', 'fortran_order': False, "
+            b"'shape': (999999, 999999), }   \n" + bytes(8),
+        ),
     ],
 )
 def test_huge_declared_sizes_allocate_nothing(tmp_path: Path, name: str, data: bytes) -> None:
@@ -860,8 +877,9 @@ _NUMBER = st.one_of(
     c=_NUMBER,
     tail=st.binary(max_size=64),
 )
-def test_fuzz_hostile_headers(fuzz_dir: Path, kind: str, a: str, b: str, c: str,
-                              tail: bytes) -> None:
+def test_fuzz_hostile_headers(
+    fuzz_dir: Path, kind: str, a: str, b: str, c: str, tail: bytes
+) -> None:
     # well-formed looking headers with hostile numbers: negative, huge, NaN, empty
     if kind == "map":
         data = f"type octile\nheight {a}\nwidth {b}\nmap\n".encode() + tail
@@ -871,9 +889,10 @@ def test_fuzz_hostile_headers(fuzz_dir: Path, kind: str, a: str, b: str, c: str,
         magic = "P5" if kind == "pgm" else "P3"
         data = f"{magic}\n{a} {b}\n{c}\n".encode() + tail
     else:
-        data = (f"image: valid.pgm\nresolution: {a}\norigin: [{b}, {c}, 0]\nnegate: {c}\n"
-                f"occupied_thresh: {b}\nfree_thresh: {a}\nmode: !!python/name:os.system\n"
-                ).encode() + tail
+        data = (
+            f"image: valid.pgm\nresolution: {a}\norigin: [{b}, {c}, 0]\nnegate: {c}\n"
+            f"occupied_thresh: {b}\nfree_thresh: {a}\nmode: !!python/name:os.system\n"
+        ).encode() + tail
     path = fuzz_dir / f"hostile.{kind}"
     path.write_bytes(data)
     t0 = time.perf_counter()

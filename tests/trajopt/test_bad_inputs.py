@@ -48,15 +48,22 @@ def test_start_equals_goal_and_same_cell() -> None:
 
 
 def test_goal_blocked_by_paper_inflation_names_cell_and_clearance() -> None:
-    with pytest.raises(InvalidInputError, match=r"goal .* cell \(\d+, \d+\), which is blocked.*"
-                       r"radius 0.12 m.*clearance of the cell centre"):
+    with pytest.raises(
+        InvalidInputError,
+        match=r"goal .* cell \(\d+, \d+\), which is blocked.*"
+        r"radius 0.12 m.*clearance of the cell centre",
+    ):
         trajopt.plan(door_grid(), (0.4, 0.3), (1.32, 0.3), ROBOT, inflation="paper")
 
 
 @pytest.mark.parametrize(
     ("shape", "match"),
-    [((0, 5), "must not be empty"), ((5, 0), "must not be empty"), ((3,), "2-D"),
-     ((2, 2, 2), "2-D")],
+    [
+        ((0, 5), "must not be empty"),
+        ((5, 0), "must not be empty"),
+        ((3,), "2-D"),
+        ((2, 2, 2), "2-D"),
+    ],
 )
 def test_zero_size_and_wrong_shape_maps(shape, match) -> None:
     with pytest.raises(astar.InvalidInputError, match=match):
@@ -65,8 +72,12 @@ def test_zero_size_and_wrong_shape_maps(shape, match) -> None:
 
 @pytest.mark.parametrize(
     ("occ", "match"),
-    [(np.array([["a", "b"]]), "dtype"), (np.array([[0.5, 1.0]]), "0/1"),
-     (np.array([[np.nan, 0.0]]), "NaN"), (np.array([[2, 0]]), "found 2")],
+    [
+        (np.array([["a", "b"]]), "dtype"),
+        (np.array([[0.5, 1.0]]), "0/1"),
+        (np.array([[np.nan, 0.0]]), "NaN"),
+        (np.array([[2, 0]]), "found 2"),
+    ],
 )
 def test_wrong_dtype_maps(occ, match) -> None:
     with pytest.raises(astar.InvalidInputError, match=match):
@@ -76,7 +87,12 @@ def test_wrong_dtype_maps(occ, match) -> None:
 @pytest.mark.parametrize(
     ("grid", "robot", "kwargs", "match"),
     [
-        (np.zeros((4, 4), bool), None, {}, "grid must be an astar.OccupancyGrid or astar.Costmap, got ndarray"),
+        (
+            np.zeros((4, 4), bool),
+            None,
+            {},
+            "grid must be an astar.OccupancyGrid or astar.Costmap, got ndarray",
+        ),
         ("door", {"radius": 0.1}, {}, "robot must be a trajopt.Robot, got dict"),
         ("door", None, {"timing_dt": 0.0}, r"timing_dt must be a number in \(0, 0.5\]"),
         ("door", None, {"timing_dt": math.nan}, "timing_dt"),
@@ -144,8 +160,12 @@ def test_bad_time_parameterize_arguments() -> None:
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
-    [({"start_heading": math.nan}, "start_heading"), ({"goal_heading": "north"}, "goal_heading"),
-     ({"v_start": -0.1}, "v_start"), ({"v_end": math.inf}, "v_end")],
+    [
+        ({"start_heading": math.nan}, "start_heading"),
+        ({"goal_heading": "north"}, "goal_heading"),
+        ({"v_start": -0.1}, "v_start"),
+        ({"v_end": math.inf}, "v_end"),
+    ],
 )
 def test_bad_query_options(kwargs, match) -> None:
     with pytest.raises(InvalidInputError, match=match):

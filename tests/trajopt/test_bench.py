@@ -18,8 +18,8 @@ import pytest
 pytest.importorskip("distributed", reason="the bench extra (dask[distributed]) is missing")
 pytest.importorskip("pyarrow", reason="the bench extra (pyarrow) is missing")
 
-from trajopt import bench  # noqa: E402
-from trajopt.errors import BenchmarkError, PeerUnavailableError  # noqa: E402
+from trajopt.analysis import bench  # noqa: E402
+from trajopt.errors import BenchmarkError, PeerUnavailableError
 
 REPO = Path(__file__).resolve().parents[2]
 METHODS = ("trajopt", "astar", "bspline-fit")
@@ -29,8 +29,9 @@ METHODS = ("trajopt", "astar", "bspline-fit")
 def sources(shared_data):
     """3 feasible den312d scenarios and 2 random turtlebot3 queries."""
     return [
-        bench.movingai_queries(shared_data / "movingai" / "scen" / "den312d.map.scen",
-                               limit=3, feasible_only=True),
+        bench.movingai_queries(
+            shared_data / "movingai" / "scen" / "den312d.map.scen", limit=3, feasible_only=True
+        ),
         bench.random_queries(shared_data / "ros" / "turtlebot3_world.yaml", 2, seed=3),
     ]
 
@@ -47,8 +48,9 @@ def client():
     from distributed import Client, LocalCluster
 
     env = {"PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                           dashboard_address=None, env=env)
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, env=env
+    )
     cl = Client(cluster)
     yield cl
     cl.close()
@@ -109,14 +111,22 @@ def test_dask_two_workers_equal_serial(client, sources, serial, tmp_path):
 def test_a_worker_killed_mid_task_has_its_chunk_retried(client, sources, serial, tmp_path):
     out = tmp_path / "killed"
     result: dict = {}
-    run = threading.Thread(target=lambda: result.update(res=bench.run(
-        sources[:1], out, methods=METHODS, client=client, chunk_size=1, progress=False)))
+    run = threading.Thread(
+        target=lambda: result.update(
+            res=bench.run(
+                sources[:1], out, methods=METHODS, client=client, chunk_size=1, progress=False
+            )
+        )
+    )
     run.start()
     killed = None
     deadline = time.monotonic() + 30
     while killed is None and time.monotonic() < deadline:
-        busy = [w for w, tasks in client.processing().items()
-                if any("trajopt-bench" in str(t) for t in tasks)]
+        busy = [
+            w
+            for w, tasks in client.processing().items()
+            if any("trajopt-bench" in str(t) for t in tasks)
+        ]
         if busy:
             pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
             os.kill(pid, signal.SIGKILL)
@@ -132,9 +142,26 @@ def test_a_worker_killed_mid_task_has_its_chunk_retried(client, sources, serial,
 def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources, tmp_path):
     out = tmp_path / "resumed"
     scen = shared_data / "movingai" / "scen" / "den312d.map.scen"
-    cmd = [sys.executable, "-m", "trajopt.cli", "bench", "run", str(scen), "--limit", "3",
-           "--feasible-only", "--methods", ",".join(METHODS), "--out", str(out),
-           "--scheduler", "serial", "--chunk-size", "1", "--no-progress"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "trajopt.cli",
+        "bench",
+        "run",
+        str(scen),
+        "--limit",
+        "3",
+        "--feasible-only",
+        "--methods",
+        ",".join(METHODS),
+        "--out",
+        str(out),
+        "--scheduler",
+        "serial",
+        "--chunk-size",
+        "1",
+        "--no-progress",
+    ]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
@@ -145,8 +172,9 @@ def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources,
     first = {p.name: p.read_bytes() for p in bench.dataset.part_files(out)}
     assert 1 <= len(first) < 3, "the run should have been killed between chunks 1 and 3"
     src = [sources[0]]
-    res = bench.run(src, out, methods=METHODS, scheduler="serial", chunk_size=1,
-                    resume=True, progress=False)
+    res = bench.run(
+        src, out, methods=METHODS, scheduler="serial", chunk_size=1, resume=True, progress=False
+    )
     assert res.rows_skipped == len(first) * len(METHODS)
     assert res.rows_skipped + res.rows_written == res.rows_expected == 3 * len(METHODS)
     for name, data in first.items():  # finished files untouched
@@ -155,8 +183,7 @@ def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources,
     assert not df.duplicated(["query_id", "method"]).any()
     assert_same_rows(df, serial[serial["map"] == "den312d.map"])
     # a second resume has nothing to do
-    again = bench.run(src, out, methods=METHODS, scheduler="serial", resume=True,
-                      progress=False)
+    again = bench.run(src, out, methods=METHODS, scheduler="serial", resume=True, progress=False)
     assert again.rows_written == 0 and again.chunks == 0
 
 
@@ -170,7 +197,7 @@ def _mq(name: str, lengths, resolution: float = 1.0, cells=None) -> bench.MapQue
 
 
 def test_auto_chunk_size_rule():
-    from trajopt.bench.runner import MAX_AUTO_CHUNK, TASKS_PER_WORKER, auto_chunk_size
+    from trajopt.analysis.bench._runner import MAX_AUTO_CHUNK, TASKS_PER_WORKER, auto_chunk_size
 
     assert auto_chunk_size(20, 2) == 1  # shared-small on 2 workers: one query per task
     assert auto_chunk_size(20, 1) == 2
@@ -187,8 +214,9 @@ def test_auto_chunk_size_rule():
 def test_make_chunks_runs_the_longest_first():
     nan = math.nan
     a = _mq("a.map", [5.0, 300.0, 40.0, 300.0, 1.0])
-    b = _mq("b.yaml", [nan] * 4, resolution=0.05,
-            cells=[(10, 0), (400, 300), (0, 2000), (3, 4)])  # octile lengths, 0.05 m cells
+    b = _mq(
+        "b.yaml", [nan] * 4, resolution=0.05, cells=[(10, 0), (400, 300), (0, 2000), (3, 4)]
+    )  # octile lengths, 0.05 m cells
     c = _mq("c.map", [2.0, 3.0])
     methods = ("astar", "trajopt")
     done = {("a.map/scen/1", "trajopt"), ("c.map/scen/0", "astar"), ("c.map/scen/0", "trajopt")}
@@ -208,32 +236,56 @@ def test_make_chunks_runs_the_longest_first():
     assert totals == sorted(totals, reverse=True)
     # within a map, the longest query first (pairs already done count less); ties in order
     flat_a = [q.query_id for ch in chunks if ch.maps is a for q, _ in ch.work]
-    assert flat_a == ["a.map/scen/3", "a.map/scen/1", "a.map/scen/2", "a.map/scen/0",
-                      "a.map/scen/4"]
+    assert flat_a == [
+        "a.map/scen/3",
+        "a.map/scen/1",
+        "a.map/scen/2",
+        "a.map/scen/0",
+        "a.map/scen/4",
+    ]
     flat_b = [q.index for ch in chunks if ch.maps is b for q, _ in ch.work]
     assert flat_b == [2, 1, 0, 3]  # 2000 cells, then 400 x 300 (octile 524), 10, 5
     assert bench.runner.query_cost(b.queries[1], 0.05) == pytest.approx(
-        25 + 0.05 * (400 + (math.sqrt(2) - 1) * 300))
+        25 + 0.05 * (400 + (math.sqrt(2) - 1) * 300)
+    )
     assert chunks[0].cost == pytest.approx(2 * (25 + 300) + 1 * (25 + 300))
 
 
 def test_run_reports_warm_up_wall_time_and_chunk_size(sources, tmp_path):
-    from trajopt.bench.runner import auto_chunk_size
+    from trajopt.analysis.bench._runner import auto_chunk_size
 
-    res = bench.run([sources[0]], tmp_path / "a", methods=["astar", "bspline-fit"],
-                    scheduler="serial", progress=False)
+    res = bench.run(
+        [sources[0]],
+        tmp_path / "a",
+        methods=["astar", "bspline-fit"],
+        scheduler="serial",
+        progress=False,
+    )
     assert res.chunk_size == auto_chunk_size(3, 1) and res.chunks == 3
     assert res.warm_up_s > 0 and res.wall_s >= res.elapsed_s + res.warm_up_s
-    res = bench.run([sources[0]], tmp_path / "b", methods=["astar"], scheduler="serial",
-                    progress=False, warm_up=False, chunk_size=2)
+    res = bench.run(
+        [sources[0]],
+        tmp_path / "b",
+        methods=["astar"],
+        scheduler="serial",
+        progress=False,
+        warm_up=False,
+        chunk_size=2,
+    )
     assert res.warm_up_s == 0 and res.chunk_size == 2 and res.chunks == 2
     with pytest.raises(BenchmarkError, match="chunk_size must be an integer >= 1"):
-        bench.run([sources[0]], tmp_path / "c", methods=["astar"], scheduler="serial",
-                  chunk_size=0, progress=False)
+        bench.run(
+            [sources[0]],
+            tmp_path / "c",
+            methods=["astar"],
+            scheduler="serial",
+            chunk_size=0,
+            progress=False,
+        )
 
 
 def test_warm_up_plans_and_scores_every_method_once():
-    from trajopt.bench.methods import warm_up
+    from trajopt.analysis.bench._methods import warm_up
 
     assert warm_up(["astar", "bspline-fit", "trajopt"]) > 0
     with pytest.raises(BenchmarkError, match="method 'rrt' is unknown"):
@@ -260,8 +312,9 @@ def test_bad_input_is_a_typed_error_before_any_work(shared_data, sources, tmp_pa
     with pytest.raises(BenchmarkError, match="method 'rrt' is unknown"):
         bench.run(sources, out, methods=["trajopt", "rrt"], progress=False)
     with pytest.raises(BenchmarkError, match="'tcp://127.0.0.1:9' is unreachable"):
-        bench.run(sources, out, scheduler="tcp://127.0.0.1:9", connect_timeout_s=0.5,
-                  progress=False)
+        bench.run(
+            sources, out, scheduler="tcp://127.0.0.1:9", connect_timeout_s=0.5, progress=False
+        )
     with pytest.raises(BenchmarkError, match="scheduler must be"):
         bench.run(sources, out, scheduler="localhost:8786", progress=False)
     with pytest.raises(BenchmarkError, match="suite must be one of"):
@@ -273,8 +326,9 @@ def test_missing_peer_names_the_extra(monkeypatch):
     import importlib.util
 
     real = importlib.util.find_spec
-    monkeypatch.setattr(importlib.util, "find_spec",
-                        lambda name, *a: None if name == "ompl" else real(name, *a))
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "ompl" else real(name, *a)
+    )
     with pytest.raises(PeerUnavailableError, match="install the `peers` extra"):
         bench.check_methods(["trajopt", "ompl-rrtstar"])
 
@@ -310,9 +364,26 @@ def test_cli_run_and_report(shared_data, tmp_path, capsys):
 
     out = tmp_path / "cli"
     scen = shared_data / "movingai" / "scen" / "rmtst01.map.scen"
-    assert main(["bench", "run", str(scen), "--limit", "2", "--feasible-only", "--methods",
-                 "astar,bspline-fit", "--out", str(out), "--scheduler", "serial",
-                 "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "bench",
+                "run",
+                str(scen),
+                "--limit",
+                "2",
+                "--feasible-only",
+                "--methods",
+                "astar,bspline-fit",
+                "--out",
+                str(out),
+                "--scheduler",
+                "serial",
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
     assert "4 rows written" in text and "bspline-fit" in text
     assert main(["bench", "report", str(out), "--figures", str(tmp_path / "f")]) == 0
@@ -322,7 +393,7 @@ def test_cli_run_and_report(shared_data, tmp_path, capsys):
 
 @pytest.mark.parametrize("method", ["ompl-rrtstar", "ompl-bitstar", "pmp-bspline", "pmp-cubic"])
 def test_peer_rows_are_scored(method, sources, monkeypatch):
-    from trajopt.bench import peers
+    import trajopt.analysis.bench._peers as peers
 
     for mod in bench.METHODS[method].requires:
         pytest.importorskip(mod, reason=f"{method} needs the peers extra")

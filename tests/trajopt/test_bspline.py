@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.interpolate import BSpline, make_lsq_spline
 
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.errors import InvalidInputError
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 
 
 def _curve(n=8, k=3, seed=0):
@@ -35,8 +35,14 @@ def test_de_boor_matches_scipy_with_repeated_knots(k):
     c = BSplineCurve(t, rng.normal(size=(n, 2)), k)
     u = np.concatenate([rng.uniform(0.3, 2.0, 200), t[k : n + 1]])
     for nu in range(k + 2):
-        ref = np.stack([BSpline(t, c.c[:, a], k)(u, nu) for a in range(2)], axis=1) if nu <= k else 0.0
-        np.testing.assert_allclose(c(u, nu), np.broadcast_to(ref, (u.size, 2)), rtol=1e-12, atol=1e-10)
+        ref = (
+            np.stack([BSpline(t, c.c[:, a], k)(u, nu) for a in range(2)], axis=1)
+            if nu <= k
+            else 0.0
+        )
+        np.testing.assert_allclose(
+            c(u, nu), np.broadcast_to(ref, (u.size, 2)), rtol=1e-12, atol=1e-10
+        )
     for nu in range(1, k):
         ref = BSpline(t, c.c, k).derivative(nu)
         np.testing.assert_allclose(c.derivative(nu)(u), ref(u), rtol=1e-12, atol=1e-10)

@@ -1,12 +1,12 @@
 """The timing's compiled paths against their NumPy references and independent samples.
 
-* ``trajopt.timing.cap_kernel``: the per-interval Bernstein bound equals
+* ``trajopt.timing._cap_kernel``: the per-interval Bernstein bound equals
   ``curvature_bound.kappa_bound`` (the NumPy reference) within 1e-12, the grid bounds equal
   ``interval_kappa_max`` and cover densely sampled ``|kappa|``, and the node tables equal the
   curve's own ``u_at_s``, curvature and heading.
   The unrolled bound of a cubic piece (``cap_cubic.bound_cubic``) equals the general loops
   bit for bit.
-* ``trajopt.timing.greedy``: repeating cruise steps gives the same phases as testing every
+* ``trajopt.timing._greedy``: repeating cruise steps gives the same phases as testing every
   step, also when its buffers fill up.
 """
 
@@ -18,12 +18,13 @@ import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
+import trajopt.timing._cap_kernel as cap_kernel
+import trajopt.timing._greedy as greedy
 from tests.trajopt.test_curvature_bound import _dense_max_per_interval
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
-from trajopt.curvature_bound import interval_kappa_max, kappa_bound
-from trajopt.robot import Robot
-from trajopt.timing import cap_kernel, greedy
-from trajopt.timing.cap_table import T_MIN
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
+from trajopt.robot._robot import Robot
+from trajopt.timing._cap_table import T_MIN
 
 ROBOT = Robot()
 SETTINGS = settings(max_examples=15, deadline=None,
@@ -182,7 +183,7 @@ def test_cruise_steps_give_the_same_phases(levels, widths, v_end):
 def test_kernel_options_follow_what_numba_knows(monkeypatch):
     from numba.core import cpu
 
-    from trajopt.timing import kernel_options
+    import trajopt.timing._kernel_options as kernel_options
 
     assert kernel_options._no_refcount() == {"_nrt": False}  # this numba knows the option
     monkeypatch.setattr(cpu, "CPUTargetOptions", type("Bare", (), {}))

@@ -23,8 +23,24 @@ def door_map(tmp_path):
 
 def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     out = tmp_path / "traj.csv"
-    rc = main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-               "--radius", "0.12", "--out", str(out), "--dt", "0.05"])
+    rc = main(
+        [
+            "plan",
+            str(door_map),
+            "--start",
+            "0.4",
+            "0.3",
+            "--goal",
+            "2.6",
+            "1.6",
+            "--radius",
+            "0.12",
+            "--out",
+            str(out),
+            "--dt",
+            "0.05",
+        ]
+    )
     assert rc == 0
     # read as a user would, with no options: the first line is the header
     with open(out, newline="") as fh:
@@ -39,8 +55,25 @@ def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     assert "duration" in capsys.readouterr().out
     js = tmp_path / "traj.json"
-    assert main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-                 "--radius", "0.12", "--out", str(js)]) == 0
+    assert (
+        main(
+            [
+                "plan",
+                str(door_map),
+                "--start",
+                "0.4",
+                "0.3",
+                "--goal",
+                "2.6",
+                "1.6",
+                "--radius",
+                "0.12",
+                "--out",
+                str(js),
+            ]
+        )
+        == 0
+    )
     assert "duration" in json.loads(js.read_text())
 
 
@@ -58,41 +91,77 @@ def run(argv) -> int:
         (["plan", "MISSING.yaml", "--start", "0", "0", "--goal", "1", "1"], "does not exist"),
         (["plan", "{map}", "--start", "1.52", "0.3", "--goal", "2.6", "1.6"], "occupied cell"),
         (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "9", "9"], "outside the map"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "-1"],
-         "v_max"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--out", "x.txt"],
-         "--out must end in .csv, .json or .mcap"),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "-1"],
+            "v_max",
+        ),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--out", "x.txt"],
+            "--out must end in .csv, .json or .mcap",
+        ),
         (["plan", "{map}", "--start", "0.4"], "expected 2 arguments"),
         (["bench", "run", "{map}", "--limit", "0", "--out", "o"], "--limit must be >= 1"),
         (["nonsense"], "invalid choice"),
         # issue 7: bad values reach the library's typed errors, still one line and exit 2
-        (["plan", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
-         "start must be finite"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "inf", "1.6"],
-         "goal must be finite"),
-        (["plan", "{map}", "--start", "1.40", "0.3", "--goal", "2.6", "1.6"],
-         "0.1 m from the nearest obstacle (or the map edge); the robot needs at least its "
-         "radius 0.165 m"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--radius", "0"],
-         "Robot.radius must be finite and > 0"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "inf"],
-         "Robot.v_max must be finite"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-          "--resolution", "-1"], "resolution must be finite and > 0"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-          "--kappa-max", "-2"], "kappa_max"),
-        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-          "--radius", "abc"], "invalid float value"),
+        (
+            ["plan", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
+            "start must be finite",
+        ),
+        (["plan", "{map}", "--start", "0.4", "0.3", "--goal", "inf", "1.6"], "goal must be finite"),
+        (
+            ["plan", "{map}", "--start", "1.40", "0.3", "--goal", "2.6", "1.6"],
+            "0.1 m from the nearest obstacle (or the map edge); the robot needs at least its "
+            "radius 0.165 m",
+        ),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--radius", "0"],
+            "Robot.radius must be finite and > 0",
+        ),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--v-max", "inf"],
+            "Robot.v_max must be finite",
+        ),
+        (
+            [
+                "plan",
+                "{map}",
+                "--start",
+                "0.4",
+                "0.3",
+                "--goal",
+                "2.6",
+                "1.6",
+                "--resolution",
+                "-1",
+            ],
+            "resolution must be finite and > 0",
+        ),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--kappa-max", "-2"],
+            "kappa_max",
+        ),
+        (
+            ["plan", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--radius", "abc"],
+            "invalid float value",
+        ),
         (["plan", "{garbage}", "--start", "0", "0", "--goal", "1", "1"], "MapFormatError"),
-        (["compare", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-          "--radius", "-1"], "robot_radius must be finite and > 0"),
-        (["compare", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
-         "start must be finite"),
+        (
+            ["compare", "{map}", "--start", "0.4", "0.3", "--goal", "2.6", "1.6", "--radius", "-1"],
+            "robot_radius must be finite and > 0",
+        ),
+        (
+            ["compare", "{map}", "--start", "nan", "0.3", "--goal", "2.6", "1.6"],
+            "start must be finite",
+        ),
         (["bench", "run", "{badscen}", "--out", "o"], "field start_y must be an integer >= 0"),
-        (["bench", "run", "{map}", "--chunk-size", "0", "--out", "o"],
-         "chunk_size must be an integer >= 1"),
-        (["bench", "run", "{map}", "--radius", "nan", "--out", "o"],
-         "radius_m must be a finite number > 0"),
+        (
+            ["bench", "run", "{map}", "--chunk-size", "0", "--out", "o"],
+            "chunk_size must be an integer >= 1",
+        ),
+        (
+            ["bench", "run", "{map}", "--radius", "nan", "--out", "o"],
+            "radius_m must be a finite number > 0",
+        ),
         (["bench", "run", "{map}", "--methods", "rrt", "--out", "o"], "method 'rrt' is unknown"),
         (["bench", "run", "--out", "o"], "give INPUT files or --suite"),
         (["bench", "report", "missing"], "dataset 'missing' does not exist"),
@@ -121,16 +190,31 @@ def test_help_for_every_command(capsys):
 def test_failed_write_keeps_the_old_file(door_map, tmp_path):
     out = tmp_path / "traj.csv"
     out.write_text("good\n")
-    rc = main(["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "9", "9",
-               "--out", str(out)])
+    rc = main(
+        ["plan", str(door_map), "--start", "0.4", "0.3", "--goal", "9", "9", "--out", str(out)]
+    )
     assert rc == 2
     assert out.read_text() == "good\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["door.pgm", "door.yaml", "traj.csv"]
 
 
 def test_compare_markdown(door_map, capsys):
-    rc = main(["compare", str(door_map), "--start", "0.4", "0.3", "--goal", "2.6", "1.6",
-               "--radius", "0.12", "--format", "markdown"])
+    rc = main(
+        [
+            "compare",
+            str(door_map),
+            "--start",
+            "0.4",
+            "0.3",
+            "--goal",
+            "2.6",
+            "1.6",
+            "--radius",
+            "0.12",
+            "--format",
+            "markdown",
+        ]
+    )
     assert rc == 0
     out = capsys.readouterr().out
     assert out.count("|") > 20 and "proposed" in out
@@ -139,7 +223,7 @@ def test_compare_markdown(door_map, capsys):
 def test_plan_on_a_costmap_with_a_speed_mask_to_mcap(tmp_path, capsys):
     from PIL import Image
 
-    from trajopt.ros_mcap import read_mcap
+    from trajopt.motion._mcap import read_mcap
 
     # a 3 x 2 m room at 5 cm with a wall stub; costmap in raw mode (OccupancyGrid values)
     og = np.zeros((40, 60), np.int64)
@@ -234,7 +318,7 @@ def test_plan_footprint_files(door_map, tmp_path, capsys):
 
 
 def test_compare_takes_the_footprint_circumscribed_radius(door_map, capsys, monkeypatch):
-    import trajopt.comparison
+    import trajopt.analysis.comparison
 
     seen = {}
     real = trajopt.comparison.compare
@@ -256,27 +340,56 @@ def test_compare_takes_the_footprint_circumscribed_radius(door_map, capsys, monk
         (["--footprint", "0.2", "0.1", "0.05", "0.3"], {}, "expected 2 or 3 numbers"),
         (["--footprint", "0.2", "0.1", "0.3"], {}, "--footprint 0.2 0.1 0.3: rear_offset"),
         (["--footprint", "0.2", "-0.1"], {}, "--footprint 0.2 -0.1: width must be finite"),
-        (["--radius", "0.1", "--footprint", "0.2", "0.1"], {},
-         "argument --footprint: not allowed with argument --radius"),
-        (["--footprint", "0.2", "0.1", "--footprint-file", "fp.json"], {},
-         "not allowed with argument --footprint"),
-        (["--footprint-file", "missing.json"], {},
-         "--footprint-file 'missing.json' does not exist"),
-        (["--footprint-file", "star.json"],
-         {"star.json": "[[0.2, 0], [0.02, 0.02], [0, 0.2], [-0.2, 0], [0, -0.2]]"},
-         "--footprint-file 'star.json': footprint must be a convex polygon"),
-        (["--footprint-file", "out.csv"], {"out.csv": "0.1,0.1\n0.2,0.1\n0.2,0.2\n"},
-         "must contain the rotation centre (0, 0) strictly inside"),
-        (["--footprint-file", "bad.json"], {"bad.json": '{"corners": [[0, 1]]}'},
-         "--footprint-file 'bad.json' has no key 'vertices'"),
-        (["--footprint-file", "bad.json"], {"bad.json": "[[0.1, 0.1, 0], [1, 2]]"},
-         "--footprint-file 'bad.json' must hold a JSON list of [x, y] vertices"),
-        (["--footprint-file", "bad.json"], {"bad.json": "[[0.1, 0.1],"},
-         "--footprint-file 'bad.json' is not valid JSON"),
-        (["--footprint-file", "bad.csv"], {"bad.csv": "x,y\n0.1,0.1\n0.1;oops\n"},
-         "--footprint-file 'bad.csv' line 3: '0.1;oops' is not rows of two numbers"),
-        (["--footprint-file", "bad.csv"], {"bad.csv": "-0.1 -0.1 0\n0.1 -0.1\n0 0.1\n"},
-         "line 1: '-0.1 -0.1 0' is not rows of two numbers 'x, y' (m)"),
+        (
+            ["--radius", "0.1", "--footprint", "0.2", "0.1"],
+            {},
+            "argument --footprint: not allowed with argument --radius",
+        ),
+        (
+            ["--footprint", "0.2", "0.1", "--footprint-file", "fp.json"],
+            {},
+            "not allowed with argument --footprint",
+        ),
+        (
+            ["--footprint-file", "missing.json"],
+            {},
+            "--footprint-file 'missing.json' does not exist",
+        ),
+        (
+            ["--footprint-file", "star.json"],
+            {"star.json": "[[0.2, 0], [0.02, 0.02], [0, 0.2], [-0.2, 0], [0, -0.2]]"},
+            "--footprint-file 'star.json': footprint must be a convex polygon",
+        ),
+        (
+            ["--footprint-file", "out.csv"],
+            {"out.csv": "0.1,0.1\n0.2,0.1\n0.2,0.2\n"},
+            "must contain the rotation centre (0, 0) strictly inside",
+        ),
+        (
+            ["--footprint-file", "bad.json"],
+            {"bad.json": '{"corners": [[0, 1]]}'},
+            "--footprint-file 'bad.json' has no key 'vertices'",
+        ),
+        (
+            ["--footprint-file", "bad.json"],
+            {"bad.json": "[[0.1, 0.1, 0], [1, 2]]"},
+            "--footprint-file 'bad.json' must hold a JSON list of [x, y] vertices",
+        ),
+        (
+            ["--footprint-file", "bad.json"],
+            {"bad.json": "[[0.1, 0.1],"},
+            "--footprint-file 'bad.json' is not valid JSON",
+        ),
+        (
+            ["--footprint-file", "bad.csv"],
+            {"bad.csv": "x,y\n0.1,0.1\n0.1;oops\n"},
+            "--footprint-file 'bad.csv' line 3: '0.1;oops' is not rows of two numbers",
+        ),
+        (
+            ["--footprint-file", "bad.csv"],
+            {"bad.csv": "-0.1 -0.1 0\n0.1 -0.1\n0 0.1\n"},
+            "line 1: '-0.1 -0.1 0' is not rows of two numbers 'x, y' (m)",
+        ),
     ],
 )
 def test_bad_footprints_are_one_line_exit_2(

@@ -15,10 +15,10 @@ import pytest
 from astar.grid import OccupancyGrid
 from astar.inflation import avoidance_area
 from astar.search import find_path
-from trajopt import fits, scenes
+from trajopt.analysis import fits, scenes
 from trajopt.errors import InvalidInputError, NoPathError
 
-cmp = importlib.import_module("trajopt.comparison")
+cmp = importlib.import_module("trajopt.analysis.comparison")
 
 CHAPTER_METHODS = ("A*", "A* + avoidance area", "polynomial fit", "B-spline fit")
 #: What compare runs by default: the chapter's four and the proposed method.

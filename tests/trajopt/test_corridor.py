@@ -184,8 +184,10 @@ def test_bridge_across_a_diagonal_gap_is_certified_and_lets_the_curve_flow():
     dg = bridges[0].diagonal
     ox0, oy0 = raw.origin
     sd_cells = (
-        (dg[0] - ox0 - oy0) / 0.1, (dg[1] - ox0 - oy0) / 0.1,
-        (dg[2] - ox0 + oy0) / 0.1, (dg[3] - ox0 + oy0) / 0.1,
+        (dg[0] - ox0 - oy0) / 0.1,
+        (dg[1] - ox0 - oy0) / 0.1,
+        (dg[2] - ox0 + oy0) / 0.1,
+        (dg[3] - ox0 + oy0) / 0.1,
     )
     sampled, _ = _sampled_rect_clearance(sd_cells, squares)
     assert sampled >= r / 0.1 - 1e-9
@@ -225,4 +227,6 @@ def test_diagonal_box_containment():
     assert b.is_diagonal and not Box(0.0, 1.0, 0.0, 1.0, 0, 1, 0, 1).is_diagonal
     v = b.vertices()
     assert v.shape == (4, 2)
-    np.testing.assert_allclose(sorted(map(tuple, v)), [(0.0, 1.0), (1.0, 0.0), (1.0, 2.0), (2.0, 1.0)])
+    np.testing.assert_allclose(
+        sorted(map(tuple, v)), [(0.0, 1.0), (1.0, 0.0), (1.0, 2.0), (2.0, 1.0)]
+    )

@@ -1,6 +1,6 @@
 """A re-plan's polygon corridor keeps the old regions along the path the two share.
 
-References: the exact polygon-to-map distance of :func:`trajopt.clearance.polygon_clearance`
+References: the exact polygon-to-map distance of :func:`trajopt.geometry._clearance.polygon_clearance`
 (separating axes and vertex-edge distances, not the corridor's own certificate kernels) for
 every region on the *current* map, point-in-region tests for the chain, the old corridor's
 own regions for the kept ones, and the independent KD-tree clearance of
@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 import trajopt
-from trajopt.clearance import polygon_clearance
-from trajopt.metrics import point_clearance
-from trajopt.polygon_corridor import CLEARANCE_TOL_M, build_polygon_corridor
-from trajopt.polygon_corridor.reuse import corridor_with_rest, shared_suffix
-from trajopt.replan_keep import remaining_grid_path
+from trajopt.analysis.metrics import point_clearance
+from trajopt.corridor import CLEARANCE_TOL_M, build_polygon_corridor
+from trajopt.corridor._polygons.reuse import corridor_with_rest, shared_suffix
+from trajopt.geometry._clearance import polygon_clearance
+from trajopt.replan._keep import remaining_grid_path
 
 ROBOT = trajopt.Robot()
 

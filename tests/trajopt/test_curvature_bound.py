@@ -1,4 +1,4 @@
-"""Tests of trajopt.curvature_bound against hand derivations and dense sampling."""
+"""Tests of trajopt.geometry._curvature_bound against hand derivations and dense sampling."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import cumulative_trapezoid
 
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
-from trajopt.curvature_bound import interval_kappa_max, kappa_bound
-from trajopt.robot import Robot
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
+from trajopt.robot._robot import Robot
 
 ROBOT = Robot(v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
               wheel_v_max=None)  # fmt: skip

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trajopt.curve import ParametricCurve, PolylineCurve
+from trajopt.geometry._curve import ParametricCurve, PolylineCurve
 
 
 class Arc(ParametricCurve):

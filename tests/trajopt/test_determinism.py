@@ -22,8 +22,10 @@ OTHER_QUERIES = [((0.4, 0.3), (2.8, 0.3)), ((0.4, 1.6), (2.0, 1.8)), ((2.6, 1.6)
 
 def fingerprint(traj: trajopt.Trajectory) -> dict[str, np.ndarray]:
     """Everything a user can read from a trajectory, as arrays to compare exactly."""
-    out = {f"sample_{k}": np.asarray(v) for k, v in
-           traj.sample(np.linspace(0.0, traj.duration, 1000)).as_dict().items()}
+    out = {
+        f"sample_{k}": np.asarray(v)
+        for k, v in traj.sample(np.linspace(0.0, traj.duration, 1000)).as_dict().items()
+    }
     out["control_points"] = np.asarray(traj.path.control_points)
     out["knots"] = np.asarray(traj.path.knots)
     for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
@@ -83,7 +85,7 @@ def test_fresh_process_gives_the_same_answer() -> None:
 
 def _records_equal(a: dict, b: dict) -> bool:
     """Exact equality of two benchmark rows, wall times and the worker left out."""
-    from trajopt.bench import TIMING_COLUMNS
+    from trajopt.analysis.bench import TIMING_COLUMNS
 
     ka = {k for k in a if k not in TIMING_COLUMNS}
     kb = {k for k in b if k not in TIMING_COLUMNS}
@@ -101,10 +103,11 @@ def _records_equal(a: dict, b: dict) -> bool:
 def test_bench_records_serial_equal_parallel_exactly(shared_data) -> None:
     # the benchmark's rows (every metric of every scenario) of a serial run and of a
     # 2-process run are equal exactly (tests/trajopt/test_bench.py does the same on Dask)
-    from trajopt import bench
+    from trajopt.analysis import bench
 
-    src = bench.movingai_queries(shared_data / "movingai" / "scen" / "den312d.map.scen",
-                                 limit=4, feasible_only=True)
+    src = bench.movingai_queries(
+        shared_data / "movingai" / "scen" / "den312d.map.scen", limit=4, feasible_only=True
+    )
     chunks = bench.make_chunks([src], ["trajopt", "bspline-fit"], set(), 1)
     serial = [r for ch in chunks for r in bench.run_chunk(ch)]
     with ProcessPoolExecutor(max_workers=2) as pool:

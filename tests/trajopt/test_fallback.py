@@ -16,10 +16,12 @@ import pytest
 import astar
 import trajopt
 from tests.reference import polyline_samples, square_clearance
+from trajopt.analysis.metrics import trajectory_metrics
 from trajopt.cli import main
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.fallback import StopAndTurnTrajectory, polyline_clearance, stop_and_turn
-from trajopt.metrics import trajectory_metrics
+from trajopt.geometry._clearance import polyline_clearance
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.timing._stop_and_turn import stop_and_turn
 
 REL = 1e-9
 DEFAULT = trajopt.Robot()
@@ -360,7 +362,7 @@ def test_fallback_needs_rest_at_both_ends(zigzag):
 
 
 def test_failed_clearance_check_reraises_the_original_error(zigzag, monkeypatch):
-    import trajopt.fallback as fallback
+    import trajopt.timing._stop_and_turn as fallback
 
     monkeypatch.setattr(fallback, "polyline_clearance", lambda *a, **k: 0.0)
     grid, start, goal = zigzag

@@ -10,7 +10,7 @@ import astar
 from tests.reference import square_clearance
 from trajopt import Planner, Robot, Smoother, build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.feasibility import curvature_witness, witness_grid_path
+from trajopt.planning._feasibility import curvature_witness, witness_grid_path
 
 
 def _three_point_curvature(p: np.ndarray) -> np.ndarray:
@@ -148,7 +148,10 @@ def test_witness_grid_path_none_and_errors():
     assert witness_grid_path(np.array([[-0.5, 0.5], [1.5, 0.5]]), grid) is None  # outside
     split = np.zeros((5, 5), dtype=bool)
     split[:, 2] = True
-    assert witness_grid_path(np.array([[0.5, 0.5], [4.5, 0.5]]), astar.OccupancyGrid(split, 1.0)) is None
+    assert (
+        witness_grid_path(np.array([[0.5, 0.5], [4.5, 0.5]]), astar.OccupancyGrid(split, 1.0))
+        is None
+    )
     with pytest.raises(InvalidInputError, match="witness"):
         witness_grid_path(np.zeros((3, 3)), grid)
     with pytest.raises(InvalidInputError, match="witness"):
@@ -188,7 +191,9 @@ def test_polygon_corridor_plans_the_curvature_bounded_pillar_query(shared_data):
     # bound, found along the A* path or through the rescue
     raw = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     radius, kmax = 0.2, 1.0 / 0.4
-    planner = Planner(raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10))
+    planner = Planner(
+        raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10)
+    )
     p0, p1 = raw.cell_to_world(np.array([169, 205])), raw.cell_to_world(np.array([197, 230]))
     traj = planner.plan(p0, p1)
     sp = traj.steps.smooth_path
@@ -216,12 +221,14 @@ def test_planner_failure_says_whether_a_witness_exists():
     assert ei.value.stats["witness"].startswith("no curvature-bounded path")
 
 
-@pytest.mark.parametrize(("radius", "start", "goal"), [
-    (2.5, (32.5, 41.5), (27.5, 68.5)),
-    (1.5, (6.5, 58.5), (8.5, 70.5)),
-])
-def test_witness_rescue_grows_its_polygons_around_the_witness(shared_data, radius, start,
-                                                                goal):
+@pytest.mark.parametrize(
+    ("radius", "start", "goal"),
+    [
+        (2.5, (32.5, 41.5), (27.5, 68.5)),
+        (1.5, (6.5, 58.5), (8.5, 70.5)),
+    ],
+)
+def test_witness_rescue_grows_its_polygons_around_the_witness(shared_data, radius, start, goal):
     # den312d, kappa_max = 1 / (2 r): the fit along the A* path fails; the witness hugs the
     # walls at the exact radius and the corridor of its (centred, simplified) grid path left
     # its arcs outside every region; polygons grown around the witness itself hold a curve

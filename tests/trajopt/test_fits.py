@@ -12,12 +12,12 @@ from hypothesis import assume, event, example, given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
-from trajopt import fits
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
-from trajopt.curve import ParametricCurve
+from trajopt.analysis import fits
+from trajopt.analysis.fits._bspline_fit import BSPLINE_SWING_MAX, schoenberg_whitney_matches
+from trajopt.analysis.fits._robust import bisquare
 from trajopt.errors import IllPosedFitError, InvalidInputError
-from trajopt.fits.bspline_fit import BSPLINE_SWING_MAX, schoenberg_whitney_matches
-from trajopt.fits.robust import bisquare
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._curve import ParametricCurve
 
 
 def _staircase(n: int = 60) -> np.ndarray:
@@ -111,9 +111,7 @@ def test_bisquare_without_leverage_is_statsmodels_rlm(seed: int, share: float) -
     rlm, tukey = _rlm_tukey()
     x, y, _, _ = _noisy_quadratic(seed, share)
     v = _chebyshev_design(x, 2)
-    coef, robust, _, conv = bisquare(
-        v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
-    )
+    coef, robust, _, conv = bisquare(v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False)
     ref = rlm(y, v, M=tukey).fit(scale_est=_our_scale_rule(3), conv="coefs", tol=1e-13, maxiter=500)
     assert conv
     # the same estimator: equal up to the two iterations' stopping tolerances (sigma = 0.01)
@@ -162,7 +160,7 @@ def paper_paths() -> dict[str, np.ndarray]:
     """Cell centres (m) of the A* paths from SP to A-D on the paper scene's avoidance area."""
     from astar.inflation import avoidance_area
     from astar.search import find_path
-    from trajopt import scenes
+    from trajopt.analysis import scenes
 
     sc = scenes.paper()
     avoid = avoidance_area(sc.grid, sc.w_cells, border=True)
@@ -180,9 +178,7 @@ def test_bisquare_on_paper_paths_without_leverage_is_statsmodels_rlm(paper_paths
         x, y = pts[:, 0], pts[:, 1]
         for order in range(1, 11):
             v = _chebyshev_design(x, order)
-            coef, _, _, conv = bisquare(
-                v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False
-            )
+            coef, _, _, conv = bisquare(v, y[:, None], np.ones(len(y)), 1e-12, 500, leverage=False)
             if not conv:  # a redescending M-estimate may cycle; RLM is then no reference
                 continue
             ref = rlm(y, v, M=tukey).fit(
@@ -552,7 +548,7 @@ def test_a_fit_that_swings_raises_naming_the_fit_the_value_and_the_rule() -> Non
     ok = fits.fit_bspline(p, degree=k, n_ctrl=allowed, parameterization="chord")
     assert _reference_swing(p, ok.c) <= BSPLINE_SWING_MAX
     # the comparison records the refused fit as invalid, with the reason
-    from trajopt.comparison.builtin_methods import _method_bspline
+    from trajopt.analysis.comparison._builtin_methods import _method_bspline
 
     class Ctx:
         reference = p

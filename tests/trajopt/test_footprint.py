@@ -1,6 +1,6 @@
 """Oriented footprints: the polygon, its swept bound, the certificate, and whole plans.
 
-References are brute force and independent of :mod:`trajopt.footprint`: dense rotations
+References are brute force and independent of :mod:`trajopt.robot._footprint`: dense rotations
 of the footprint for the swept bound, dense tangent samples for the heading intervals,
 and a point-sampling collision check (points inside the posed footprint against the
 occupied squares) for the certificate and the plans.
@@ -17,9 +17,14 @@ from hypothesis import strategies as st
 
 import astar
 import trajopt
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.errors import InvalidInputError
-from trajopt.footprint import Footprint, certify_footprint, convex_hull, span_heading_intervals
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.robot._footprint import (
+    Footprint,
+    certify_footprint,
+    convex_hull,
+    span_heading_intervals,
+)
 
 
 def inside_convex(poly: np.ndarray, pts: np.ndarray, tol: float = 1e-12) -> np.ndarray:
@@ -48,7 +53,9 @@ def collides(grid: astar.OccupancyGrid, fp: Footprint, x, y, theta) -> bool:
     out = []
     for xi, yi, ti in zip(np.atleast_1d(x), np.atleast_1d(y), np.atleast_1d(theta), strict=True):
         c, s = math.cos(ti), math.sin(ti)
-        w = np.column_stack([xi + c * pts[:, 0] - s * pts[:, 1], yi + s * pts[:, 0] + c * pts[:, 1]])
+        w = np.column_stack(
+            [xi + c * pts[:, 0] - s * pts[:, 1], yi + s * pts[:, 0] + c * pts[:, 1]]
+        )
         out.append(w)
     w = np.vstack(out)
     q = (w - np.asarray(grid.origin)) / grid.resolution
@@ -63,7 +70,9 @@ def collides(grid: astar.OccupancyGrid, fp: Footprint, x, y, theta) -> bool:
 # ------------------------------------------------------------------ the polygon
 def test_rectangle_by_hand():
     fp = Footprint.rectangle(0.6, 0.4, rear_offset=0.15)
-    np.testing.assert_allclose(fp.vertices, [[-0.15, -0.2], [0.45, -0.2], [0.45, 0.2], [-0.15, 0.2]])
+    np.testing.assert_allclose(
+        fp.vertices, [[-0.15, -0.2], [0.45, -0.2], [0.45, 0.2], [-0.15, 0.2]]
+    )
     assert fp.inscribed_radius == pytest.approx(0.15)  # the rear edge
     assert fp.circumscribed_radius == pytest.approx(math.hypot(0.45, 0.2))
     np.testing.assert_allclose(fp.at(1.0, 2.0, math.pi / 2)[1], [1.2, 2.45])
@@ -110,8 +119,12 @@ def test_swept_hull_contains_every_rotation(lo, span, which):
     assert inside_convex(hull, pts, tol=1e-12).all()
     # and not loose: within 10 % of the brute-force hull's area for spans up to 45 degrees
     if span <= math.pi / 4:
+
         def area(p):
-            return 0.5 * abs(np.dot(p[:, 0], np.roll(p[:, 1], -1)) - np.dot(np.roll(p[:, 0], -1), p[:, 1]))
+            return 0.5 * abs(
+                np.dot(p[:, 0], np.roll(p[:, 1], -1)) - np.dot(np.roll(p[:, 0], -1), p[:, 1])
+            )
+
         assert area(hull) <= 1.1 * area(convex_hull(pts)) + 1e-12
 
 
@@ -173,7 +186,7 @@ def test_rectangle_through_a_door_its_circumscribed_disc_cannot_pass(door):
     assert fpst["min_margin_m"] > 0.0
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
     assert not collides(door, robot.footprint, smp.x, smp.y, smp.theta)
-    from trajopt.metrics import trajectory_metrics
+    from trajopt.analysis.metrics import trajectory_metrics
 
     assert trajectory_metrics(traj, robot)["within_limits"]
 

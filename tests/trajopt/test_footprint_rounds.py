@@ -17,15 +17,15 @@ from scipy.spatial import ConvexHull
 
 import astar
 import trajopt
+import trajopt.robot._footprint_kernels as footprint_kernels
 from tests.trajopt.test_footprint import collides
-from trajopt import footprint_kernels
-from trajopt.footprint import MAX_ARC_RAD, Footprint, polygons_clearance
-from trajopt.footprint_planning import disc_planner
-from trajopt.polygon_corridor import build_polygon_corridor
+from trajopt.corridor import build_polygon_corridor
+from trajopt.planning._footprint_ladder import disc_planner
+from trajopt.robot._footprint import MAX_ARC_RAD, Footprint, polygons_clearance
 from trajopt.smoother import Smoother
-from trajopt.smoother.footprint_scp import FootprintSCP, corners_cells
-from trajopt.smoother.problem import assemble, build_problem
-from trajopt.smoother.qp import solve_qp
+from trajopt.smoother._footprint_scp import FootprintSCP, corners_cells
+from trajopt.smoother._problem import assemble, build_problem
+from trajopt.smoother._qp import solve_qp
 
 
 # ------------------------------------------------------------------ kernels
@@ -70,8 +70,8 @@ def test_span_margins_bound_dense_poses(seed):
     grid = astar.OccupancyGrid(occ, res)
     fp = Footprint.rectangle(0.5, 0.3)
     bez = rng.uniform(0.8, 2.2, size=(1, 4, 2))
-    from trajopt.clearance import grid_cells
-    from trajopt.polygon_corridor.obstacle_index import ObstacleIndex
+    from trajopt.geometry._clearance import grid_cells
+    from trajopt.geometry._obstacle_index import ObstacleIndex
 
     occ_c, r, ox, oy = grid_cells(grid)
     idx = ObstacleIndex(occ_c, 0, 60, 0, 60)
@@ -83,7 +83,9 @@ def test_span_margins_bound_dense_poses(seed):
     t = np.linspace(0.0, 1.0, 400)[:, None]
     b = bez[0]
     xy = (1 - t) ** 3 * b[0] + 3 * (1 - t) ** 2 * t * b[1] + 3 * (1 - t) * t**2 * b[2] + t**3 * b[3]
-    dxy = 3 * ((1 - t) ** 2 * (b[1] - b[0]) + 2 * (1 - t) * t * (b[2] - b[1]) + t**2 * (b[3] - b[2]))
+    dxy = 3 * (
+        (1 - t) ** 2 * (b[1] - b[0]) + 2 * (1 - t) * t * (b[2] - b[1]) + t**2 * (b[3] - b[2])
+    )
     theta = np.arctan2(dxy[:, 1], dxy[:, 0])
     dense = polygons_clearance([fp.at(x, y, th) for (x, y), th in zip(xy, theta, strict=True)],
                                grid, cap * r)  # fmt: skip
@@ -125,8 +127,10 @@ def test_corner_rows_are_first_order_in_the_control_points():
     def posed(zz):
         """Corners posed on the curve of ``zz`` at the samples, from the curve itself."""
         c = np.column_stack([zz[:n], zz[nb : nb + n]])
-        curve = trajopt.bspline.BSplineCurve(knots, c, p)
-        u = np.concatenate([np.linspace(knots[p + j], knots[p + j + 1], 5)[:4] for j in range(n - p)])
+        curve = trajopt.geometry._bspline.BSplineCurve(knots, c, p)
+        u = np.concatenate(
+            [np.linspace(knots[p + j], knots[p + j + 1], 5)[:4] for j in range(n - p)]
+        )
         u[-4:] = np.linspace(knots[n - 1], knots[n], 4)  # the last span reaches its end
         xy, d = curve(u), curve(u, 1)
         th = np.arctan2(d[:, 1], d[:, 0])
@@ -171,7 +175,7 @@ def test_scp_turns_a_rectangle_between_two_halls():
     plain = disc_planner(trajopt.Planner(grid, robot), robot.inscribed_radius)
     plain.smoothing_footprint = None
     curve = plain.plan(s, g).path
-    assert not trajopt.footprint.certify_footprint(curve, robot.footprint, grid).ok
+    assert not trajopt.robot._footprint.certify_footprint(curve, robot.footprint, grid).ok
     traj = planner.plan(s, g)
     fst = traj.stats["footprint"]
     assert fst["rounds"] >= 1 and fst["rejected"] == [] and fst["min_margin_m"] > 0
@@ -200,7 +204,9 @@ def test_a_start_along_a_wall_pins_its_heading():
     traj = trajopt.Planner(grid, robot).plan(start, goal)
     assert traj.stats["footprint"]["rounds"] >= 1
     theta0 = float(traj.sample(np.array([0.0])).theta[0])
-    assert math.isclose(theta0 / (2 * math.pi / 72), round(theta0 / (2 * math.pi / 72)), abs_tol=1e-6)
+    assert math.isclose(
+        theta0 / (2 * math.pi / 72), round(theta0 / (2 * math.pi / 72)), abs_tol=1e-6
+    )
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
     assert not collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
 

@@ -1,4 +1,4 @@
-"""trajopt.kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
+"""trajopt._kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
 
 * Every numba dispatcher of astar and trajopt lives in a module of ``KERNEL_MODULES``.
 * ``trajopt.warm_up()`` leaves every kernel compiled and loaded (a signature each), and
@@ -19,7 +19,7 @@ import textwrap
 
 import pytest
 
-from trajopt import kernel_cache
+import trajopt._kernel_cache as kernel_cache
 from trajopt.cli import main
 
 
@@ -67,7 +67,7 @@ WARM_UP_REACHES_EVERYTHING = """
         return enter(self, *args, **kws)
     Dispatcher._compile_for_args = record
     import trajopt
-    from trajopt import kernel_cache
+    import trajopt._kernel_cache as kernel_cache
     trajopt.warm_up()
     every = kernel_cache.dispatchers()
     def names(code):
@@ -108,7 +108,7 @@ def test_warm_up_compiles_loads_and_reaches_every_kernel():
     # callee of one they call (read from the kernels' code): a new kernel left out of the
     # exercises fails here even when numba's cache already holds it from another run.
     out = json.loads(_run(WARM_UP_REACHES_EVERYTHING).stdout.splitlines()[-1])
-    assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt.warm_up.EXERCISES)"
+    assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt._warm_up.EXERCISES)"
     assert out["unloaded"] == [], "kernels without a compiled signature after warm_up()"
     assert out["inline_called_alone"] == []
 
@@ -117,7 +117,7 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
     env = _fresh_cache(tmp_path)
     script = """
         import json
-        from trajopt import kernel_cache
+        import trajopt._kernel_cache as kernel_cache
         cold = kernel_cache.cold_kernels()
         report = kernel_cache.compile_kernels(["grid", "astar"], workers=2)
         print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
@@ -139,8 +139,8 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
         logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
         import numba.core.event as ev
         import numpy as np
-        from trajopt import kernel_cache
-        from trajopt.convex_hull import convex_hull
+        import trajopt._kernel_cache as kernel_cache
+        from trajopt.geometry._convex_hull import convex_hull
         rec = ev.install_recorder("numba:compile").__enter__()
         n = kernel_cache.load_kernels(["astar.distance_transform", "astar.inflation",
                                        "astar.search_kernels"])
@@ -156,7 +156,7 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
     assert "compiling numerical kernels" not in before, before
     lines = [s for s in after.splitlines() if "compiling numerical kernels once" in s]
     assert len(lines) == 1, after
-    assert lines[0].startswith("WARNING trajopt.kernel_cache: trajopt: compiling")
+    assert lines[0].startswith("WARNING trajopt._kernel_cache: trajopt: compiling")
     assert "trajopt warm-up" in lines[0]
 
 
@@ -183,12 +183,12 @@ def test_unknown_exercise_is_an_error():
 
 
 def test_the_exercises_leave_trajopt_warm_up_the_function():
-    # the module trajopt.warm_up holds the exercises; importing it must not leave the package
-    # attribute trajopt.warm_up the module (it shadowed the function in a fresh clone's suite)
+    # the module trajopt._warm_up holds the exercises; importing it must not leave the package
+    # attribute trajopt._warm_up the module (it shadowed the function in a fresh clone's suite)
     script = """
         import types
-        import trajopt.warm_up  # the import system sets trajopt.warm_up to the module
-        from trajopt import kernel_cache
+        import trajopt._warm_up  # the import system sets trajopt._warm_up to the module
+        import trajopt._kernel_cache as kernel_cache
         assert isinstance(vars(trajopt)["warm_up"], types.ModuleType)
         kernel_cache.warm_up_module()
         from trajopt import warm_up

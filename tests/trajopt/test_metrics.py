@@ -9,9 +9,9 @@ import pytest
 from scipy.spatial.distance import directed_hausdorff
 
 from astar.grid import OccupancyGrid
-from trajopt import metrics
-from trajopt.curve import ParametricCurve, PolylineCurve
+from trajopt.analysis import metrics
 from trajopt.errors import InvalidInputError
+from trajopt.geometry._curve import ParametricCurve, PolylineCurve
 
 
 class Circle(ParametricCurve):
@@ -167,13 +167,15 @@ def test_min_clearance_is_the_minimum_of_point_clearance_exactly(seed, border) -
     assert mc == pc.min()
     brute = _brute_clearance(pts, occ, 0.05, (-0.3, 0.2))
     if border:
-        edge = np.minimum.reduce([pts[:, 0] + 0.3, 0.95 - pts[:, 0], pts[:, 1] - 0.2,
-                                  1.7 - pts[:, 1]])
+        edge = np.minimum.reduce(
+            [pts[:, 0] + 0.3, 0.95 - pts[:, 0], pts[:, 1] - 0.2, 1.7 - pts[:, 1]]
+        )
         brute = np.minimum(brute, np.maximum(edge, 0.0))
-    assert mc == pytest.approx(brute.min(), abs=1e-12) or (math.isinf(mc) and
-                                                          math.isinf(brute.min()))
+    assert mc == pytest.approx(brute.min(), abs=1e-12) or (
+        math.isinf(mc) and math.isinf(brute.min())
+    )
     for i in range(0, len(pts), 37):  # one point alone: the same value
-        assert metrics.min_clearance(pts[i:i + 1], g, border_occupied=border) == pc[i]
+        assert metrics.min_clearance(pts[i : i + 1], g, border_occupied=border) == pc[i]
 
 
 def test_clearance_tree_is_kept_per_grid_object_only() -> None:
@@ -237,9 +239,13 @@ def test_polyline_hausdorff_is_the_maximum_over_every_densified_point(seed) -> N
     # (and brute force); a curve near the reference, one far off, and the reference itself
     rng = np.random.default_rng(seed)
     ref = np.cumsum(rng.choice([-1.0, 0.0, 1.0], size=(60, 2)), axis=0) * 0.1
-    curve = [ref + rng.normal(scale=0.03, size=ref.shape), ref + [0.0, 0.5], ref.copy(),
-             np.c_[np.linspace(-1, 1, 300), np.sin(np.linspace(0, 9, 300))],
-             ref[::-1] + rng.normal(scale=0.2, size=ref.shape)][seed]
+    curve = [
+        ref + rng.normal(scale=0.03, size=ref.shape),
+        ref + [0.0, 0.5],
+        ref.copy(),
+        np.c_[np.linspace(-1, 1, 300), np.sin(np.linspace(0, 9, 300))],
+        ref[::-1] + rng.normal(scale=0.2, size=ref.shape),
+    ][seed]
     spacing = 0.005
     got = metrics.polyline_hausdorff(curve, ref, spacing=spacing)
     want = 0.0

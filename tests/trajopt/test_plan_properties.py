@@ -111,8 +111,10 @@ def case_params(draw: Any) -> CaseParams:
     density = 0.0 if kind == "open" else draw(st.floats(0.0, 0.4))
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)
-    limits = tuple(_log_uniform(rng, lo, hi) for lo, hi in
-                   ((0.05, 3.0), (0.05, 5.0), (0.1, 20.0), (0.05, 5.0), (0.1, 6.0)))
+    limits = tuple(
+        _log_uniform(rng, lo, hi)
+        for lo, hi in ((0.05, 3.0), (0.05, 5.0), (0.1, 20.0), (0.05, 5.0), (0.1, 6.0))
+    )
     wheels = None
     if rng.random() < 0.6:
         wheels = (_log_uniform(rng, 0.05, 1.0), _log_uniform(rng, 0.05, 4.0))
@@ -176,8 +178,16 @@ def build_case(p: CaseParams) -> Case:
     radius = p.radius_cells * p.resolution
     v, a, j, alat, om = p.limits
     tw, wv = (None, None) if p.wheels is None else p.wheels
-    robot = trajopt.Robot(radius=radius, v_max=v, a_max=a, j_max=j, a_lat_max=alat,
-                          omega_max=om, track_width=tw, wheel_v_max=wv)
+    robot = trajopt.Robot(
+        radius=radius,
+        v_max=v,
+        a_max=a,
+        j_max=j,
+        a_lat_max=alat,
+        omega_max=om,
+        track_width=tw,
+        wheel_v_max=wv,
+    )
     # cells whose centre is at least radius + 1.2 cells from every occupied cell centre
     # and the outside (so a point within 0.3 cells of the centre clears the squares by
     # more than the radius)
@@ -257,8 +267,7 @@ def check_trajectory(case: Case, traj: trajopt.Trajectory) -> None:
 def run_case(case: Case) -> str:
     """Plan one case and check it: ``"ok"`` or the name of the documented error raised."""
     try:
-        traj = trajopt.plan(case.grid, case.start, case.goal, case.robot,
-                            search=case.params.search)
+        traj = trajopt.plan(case.grid, case.start, case.goal, case.robot, search=case.params.search)
     except DOCUMENTED_ERRORS as exc:
         assert str(exc).strip(), f"{type(exc).__name__} with an empty message"
         return type(exc).__name__
@@ -317,7 +326,9 @@ def summary(counts: Counter) -> str:
     lines = [f"examples {counts['examples']} in {counts['seconds']:.1f} s"]
     for group in ("easy", "other"):
         n = sum(v for k, v in counts.items() if isinstance(k, tuple) and k[0] == group)
-        outs = sorted((k[1], v) for k, v in counts.items() if isinstance(k, tuple) and k[0] == group)
+        outs = sorted(
+            (k[1], v) for k, v in counts.items() if isinstance(k, tuple) and k[0] == group
+        )
         text = ", ".join(f"{o} {v} ({100 * v / max(n, 1):.1f}%)" for o, v in outs)
         lines.append(f"{group:5s} {n:6d}: {text}")
     return "\n".join(lines)
@@ -354,13 +365,15 @@ def test_brute_clearance_reference() -> None:
     occ = np.zeros((4, 5), bool)
     occ[1, 2] = True
     grid = astar.OccupancyGrid(occ, 0.5, (1.0, -1.0))
-    pts = np.array([
-        [2.25, -0.25],  # inside the occupied cell (2, 1)
-        [2.25, 0.5],  # 0.5 m above the cell's top edge, 1.0 m from the top of the map
-        [3.0, 0.25],  # 0.5 m from the right edge of the map, 0.56 m from the cell
-        [1.1, -0.9],  # 0.1 m from the left and the bottom edge
-        [0.0, 0.0],  # outside the map
-    ])
+    pts = np.array(
+        [
+            [2.25, -0.25],  # inside the occupied cell (2, 1)
+            [2.25, 0.5],  # 0.5 m above the cell's top edge, 1.0 m from the top of the map
+            [3.0, 0.25],  # 0.5 m from the right edge of the map, 0.56 m from the cell
+            [1.1, -0.9],  # 0.1 m from the left and the bottom edge
+            [0.0, 0.0],  # outside the map
+        ]
+    )
     expected = [0.0, 0.5, 0.5, 0.1, 0.0]
     np.testing.assert_allclose(square_clearance(grid, pts), expected)
     # a finite reach changes nothing below it
@@ -370,10 +383,22 @@ def test_brute_clearance_reference() -> None:
 
 
 def test_easy_case_is_solved_and_checked() -> None:
-    p = CaseParams(nx=30, ny=24, resolution=0.1, origin=(-3.0, 7.0), kind="open", density=0.0,
-                   seed=1, radius_cells=2.0, limits=(0.5, 0.5, 2.0, 0.5, 1.5),
-                   wheels=(0.28, 0.6), placement="free", start_u=(0.05, 0.5),
-                   goal_u=(0.9, 0.2), search="clearance")
+    p = CaseParams(
+        nx=30,
+        ny=24,
+        resolution=0.1,
+        origin=(-3.0, 7.0),
+        kind="open",
+        density=0.0,
+        seed=1,
+        radius_cells=2.0,
+        limits=(0.5, 0.5, 2.0, 0.5, 1.5),
+        wheels=(0.28, 0.6),
+        placement="free",
+        start_u=(0.05, 0.5),
+        goal_u=(0.9, 0.2),
+        search="clearance",
+    )
     case = build_case(p)
     assert case.easy
     assert run_case(case) == "ok"
@@ -386,34 +411,94 @@ def test_easy_case_is_solved_and_checked() -> None:
 #: ``v_max`` alone, so the cap's second differences saw nothing (fix: the refinement is also
 #: triggered by the curvature and the heading turned across the interval).
 LONG_RUN_REGRESSIONS = [
-    CaseParams(nx=37, ny=35, resolution=0.02, origin=(-42.03455006990392, 1.0610332041184023),
-               kind="noise", density=0.04461853399020709, seed=271, radius_cells=0.3,
-               limits=(1.2287056093495625, 2.4631022051498985, 2.436874143589767,
-                       0.15759917419355918, 0.2200679889025887),
-               wheels=(0.1273194557145569, 0.16939038094315778), placement="free",
-               start_u=(0.6707056139143968, 0.48952608447613766),
-               goal_u=(0.22077411087396948, 0.1794140376661879), search="shortest"),
-    CaseParams(nx=185, ny=185, resolution=0.02, origin=(-22.715220426935844, 14.809789894512278),
-               kind="rects", density=0.3228308498960803, seed=404449, radius_cells=1.0,
-               limits=(1.8397166384476524, 1.2758191036121025, 0.13863895925020747,
-                       0.051971840274298554, 0.2134671579100811),
-               wheels=None, placement="free",
-               start_u=(0.44158910125218054, 0.45388536497759757),
-               goal_u=(0.6248740044942592, 0.39199239484726056), search="shortest"),
-    CaseParams(nx=263, ny=53, resolution=0.02, origin=(-32.635599283490635, 8.560444051930936),
-               kind="open", density=0.0, seed=88951, radius_cells=3.7341887608176094,
-               limits=(0.19640807923914286, 0.6048735300260856, 2.9379557705089585,
-                       0.477313259224586, 1.1985725787341952),
-               wheels=(0.1350596797315405, 0.7925183391904915), placement="free",
-               start_u=(0.9039971539893077, 0.552487378838519),
-               goal_u=(0.10263176663338891, 0.5327734746412508), search="shortest"),
-    CaseParams(nx=241, ny=241, resolution=0.02, origin=(-7.063890756780431, -37.04815565142743),
-               kind="open", density=0.0, seed=241, radius_cells=1.793505217775715,
-               limits=(0.12334911502200994, 0.256570939580716, 4.997715717676668,
-                       0.3549876964665092, 0.24937269029064907),
-               wheels=(0.06206227062020115, 0.398343455474496), placement="free",
-               start_u=(0.25276862474180684, 0.614340341618957),
-               goal_u=(0.6050592382758567, 0.7928488771994384), search="clearance"),
+    CaseParams(
+        nx=37,
+        ny=35,
+        resolution=0.02,
+        origin=(-42.03455006990392, 1.0610332041184023),
+        kind="noise",
+        density=0.04461853399020709,
+        seed=271,
+        radius_cells=0.3,
+        limits=(
+            1.2287056093495625,
+            2.4631022051498985,
+            2.436874143589767,
+            0.15759917419355918,
+            0.2200679889025887,
+        ),
+        wheels=(0.1273194557145569, 0.16939038094315778),
+        placement="free",
+        start_u=(0.6707056139143968, 0.48952608447613766),
+        goal_u=(0.22077411087396948, 0.1794140376661879),
+        search="shortest",
+    ),
+    CaseParams(
+        nx=185,
+        ny=185,
+        resolution=0.02,
+        origin=(-22.715220426935844, 14.809789894512278),
+        kind="rects",
+        density=0.3228308498960803,
+        seed=404449,
+        radius_cells=1.0,
+        limits=(
+            1.8397166384476524,
+            1.2758191036121025,
+            0.13863895925020747,
+            0.051971840274298554,
+            0.2134671579100811,
+        ),
+        wheels=None,
+        placement="free",
+        start_u=(0.44158910125218054, 0.45388536497759757),
+        goal_u=(0.6248740044942592, 0.39199239484726056),
+        search="shortest",
+    ),
+    CaseParams(
+        nx=263,
+        ny=53,
+        resolution=0.02,
+        origin=(-32.635599283490635, 8.560444051930936),
+        kind="open",
+        density=0.0,
+        seed=88951,
+        radius_cells=3.7341887608176094,
+        limits=(
+            0.19640807923914286,
+            0.6048735300260856,
+            2.9379557705089585,
+            0.477313259224586,
+            1.1985725787341952,
+        ),
+        wheels=(0.1350596797315405, 0.7925183391904915),
+        placement="free",
+        start_u=(0.9039971539893077, 0.552487378838519),
+        goal_u=(0.10263176663338891, 0.5327734746412508),
+        search="shortest",
+    ),
+    CaseParams(
+        nx=241,
+        ny=241,
+        resolution=0.02,
+        origin=(-7.063890756780431, -37.04815565142743),
+        kind="open",
+        density=0.0,
+        seed=241,
+        radius_cells=1.793505217775715,
+        limits=(
+            0.12334911502200994,
+            0.256570939580716,
+            4.997715717676668,
+            0.3549876964665092,
+            0.24937269029064907,
+        ),
+        wheels=(0.06206227062020115, 0.398343455474496),
+        placement="free",
+        start_u=(0.25276862474180684, 0.614340341618957),
+        goal_u=(0.6050592382758567, 0.7928488771994384),
+        search="clearance",
+    ),
 ]
 
 

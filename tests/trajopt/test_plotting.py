@@ -8,9 +8,9 @@ import matplotlib
 import numpy as np
 import pytest
 
-from trajopt.footprint import Footprint
-from trajopt.plotting import plot_footprints
-from trajopt.robot import Robot
+from trajopt.analysis.plotting import plot_footprints
+from trajopt.robot._footprint import Footprint
+from trajopt.robot._robot import Robot
 
 matplotlib.use("Agg")
 
@@ -77,8 +77,8 @@ def test_array_footprint_and_bad_arguments(ax):
 
 
 def test_path_points_of_a_timed_trajectory():
-    from trajopt.plotting import path_points
-    from trajopt.trajectory import SampledExport
+    from trajopt.analysis.plotting import path_points
+    from trajopt.motion._trajectory import SampledExport
 
     class Timed(SampledExport, _Line):  # sample_uniform from SampledExport, motion from _Line
         pass

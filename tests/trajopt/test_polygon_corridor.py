@@ -1,4 +1,4 @@
-"""Tests of :mod:`trajopt.polygon_corridor` against brute force.
+"""Tests of :mod:`trajopt.corridor` against brute force.
 
 The references here are independent of the module: exact point-to-square distances to
 every occupied cell of the raw map (and to the outside of the map) computed naively with
@@ -18,16 +18,16 @@ import astar
 from astar.grid import OccupancyGrid
 from tests.cases import square_inflated, staircase_passage
 from tests.reference import square_clearance
-from trajopt import scenes
-from trajopt.corridor import build_corridor
-from trajopt.errors import InvalidInputError
-from trajopt.polygon_corridor import (
+from trajopt.analysis import scenes
+from trajopt.corridor import (
     CLEARANCE_TOL_M,
     ConvexPolygon,
     PolygonCorridor,
+    build_corridor,
     build_polygon_corridor,
-    polygon_clearance,
 )
+from trajopt.errors import InvalidInputError
+from trajopt.geometry._clearance import polygon_clearance
 
 
 # ---------------------------------------------------------------- references
@@ -96,8 +96,9 @@ def assert_corridor_certified(corr: PolygonCorridor, grid: OccupancyGrid, radius
         lo, hi = corr.region_s[k]
         assert lo <= corr.path_s[k] + 1e-12 and hi >= corr.path_s[k + 1] - 1e-12
         s = np.linspace(lo, hi, 25)
-        pts = np.column_stack([np.interp(s, corr.path_s, corr.path[:, 0]),
-                               np.interp(s, corr.path_s, corr.path[:, 1])])
+        pts = np.column_stack(
+            [np.interp(s, corr.path_s, corr.path[:, 0]), np.interp(s, corr.path_s, corr.path[:, 1])]
+        )
         assert reg.contains(pts, tol=1e-9).all()
         a, b = corr.region_index[k]
         assert a <= k and b >= k + 1
@@ -112,8 +113,9 @@ def assert_corridor_certified(corr: PolygonCorridor, grid: OccupancyGrid, radius
         assert lo <= t[k] <= hi
         assert lo <= corr.path_s[k + 1] <= hi
         s = np.linspace(lo, hi, 15)
-        pts = np.column_stack([np.interp(s, corr.path_s, corr.path[:, 0]),
-                               np.interp(s, corr.path_s, corr.path[:, 1])])
+        pts = np.column_stack(
+            [np.interp(s, corr.path_s, corr.path[:, 0]), np.interp(s, corr.path_s, corr.path[:, 1])]
+        )
         assert corr.regions[k].contains(pts, tol=1e-9).all()
         assert corr.regions[k + 1].contains(pts, tol=1e-9).all()
         ov = corr.overlaps[k]
@@ -279,7 +281,9 @@ def test_paper_scene_certified(target, search) -> None:
     scene = scenes.paper()
     grid, radius = scene.grid, scene.robot_radius
     infl = square_inflated(grid, radius)
-    cost = astar.clearance_cost(grid, radius, outside_occupied=True) if search == "clearance" else None
+    cost = (
+        astar.clearance_cost(grid, radius, outside_occupied=True) if search == "clearance" else None
+    )
     path = astar.find_path(infl, scene.start_cell, scene.goal_cell(target), cost=cost)
     corr = build_polygon_corridor(grid, path, radius)
     assert_corridor_certified(corr, grid, radius)
@@ -332,9 +336,13 @@ def _room(n: int = 20, res: float = 0.1) -> OccupancyGrid:
 
 def test_radius_larger_than_free_space_at_start_and_goal() -> None:
     grid = _room()
-    with pytest.raises(InvalidInputError, match=r"start \[0\.15, 0\.15\] m has clearance 0\.15 m.*radius 0\.25"):
+    with pytest.raises(
+        InvalidInputError, match=r"start \[0\.15, 0\.15\] m has clearance 0\.15 m.*radius 0\.25"
+    ):
         build_polygon_corridor(grid, np.array([[0.15, 0.15], [1.0, 0.4]]), 0.25)
-    with pytest.raises(InvalidInputError, match=r"goal \[0\.75, 0\.75\] m has clearance 0\.0707107 m"):
+    with pytest.raises(
+        InvalidInputError, match=r"goal \[0\.75, 0\.75\] m has clearance 0\.0707107 m"
+    ):
         build_polygon_corridor(grid, np.array([[0.5, 0.5], [0.75, 0.75]]), 0.3)
 
 
@@ -355,10 +363,15 @@ def test_path_through_a_gap_narrower_than_2r() -> None:
     occ[9:12, 14:16] = False  # a 3-cell gap: 0.3 m < 2 r = 0.5 m
     grid = OccupancyGrid(occ, res)
     path = astar.find_path(astar.inflate(grid, 0.1, metric="square"), (5, 10), (25, 10))
-    with pytest.raises(InvalidInputError, match=r"path point \d+ .* m has clearance 0\.\d+ m, less than the radius 0\.25 m"):
+    with pytest.raises(
+        InvalidInputError,
+        match=r"path point \d+ .* m has clearance 0\.\d+ m, less than the radius 0\.25 m",
+    ):
         build_polygon_corridor(grid, path, 0.25)
     # a straight segment across the wall with free end points: the segment rule
-    with pytest.raises(InvalidInputError, match=r"path segment .* narrower than 2 \* radius = 0\.2 m"):
+    with pytest.raises(
+        InvalidInputError, match=r"path segment .* narrower than 2 \* radius = 0\.2 m"
+    ):
         build_polygon_corridor(grid, np.array([[0.5, 0.5], [2.5, 0.5]]), 0.1)
 
 
@@ -394,7 +407,9 @@ def test_convex_polygon_value() -> None:
     ov = sq.intersection(shifted)
     assert ov.area == pytest.approx(0.25)
     assert ov.contains(ov.vertices, tol=1e-12).all()
-    touching = ConvexPolygon(A=sq.A, b=sq.b + np.array([0.0, 1.0, 0.0, -1.0]), vertices=v + [1.0, 0.0])
+    touching = ConvexPolygon(
+        A=sq.A, b=sq.b + np.array([0.0, 1.0, 0.0, -1.0]), vertices=v + [1.0, 0.0]
+    )
     edge = sq.intersection(touching)
     assert edge.degenerate and edge.area == 0.0 and len(edge.vertices) == 2
     far = ConvexPolygon(A=sq.A, b=sq.b + np.array([0.0, 5.0, 0.0, -5.0]), vertices=v + [5.0, 0.0])

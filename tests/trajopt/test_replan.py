@@ -17,9 +17,9 @@ from hypothesis import strategies as st
 
 import astar
 import trajopt
+from trajopt.analysis.metrics import point_clearance, trajectory_metrics
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
-from trajopt.metrics import point_clearance, trajectory_metrics
-from trajopt.state import State
+from trajopt.robot._state import State
 
 ROBOT = trajopt.Robot()
 
@@ -139,7 +139,7 @@ def test_state_above_its_cap_is_refused(scene):
 
 
 def test_braking_first_when_the_cap_requires_it():
-    from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+    from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 
     # a 90-degree bend 0.5 m ahead, entered from 0.45 m/s: its cap is far lower
     c = np.array([(0, 0), (0.3, 0), (0.5, 0), (0.6, 0.1), (0.6, 0.3), (0.6, 0.6)], float)

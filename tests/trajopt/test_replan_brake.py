@@ -16,13 +16,13 @@ import pytest
 from scipy.integrate import trapezoid
 
 import trajopt
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.analysis.metrics import point_clearance, trajectory_metrics
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
-from trajopt.fallback import turn_limits
-from trajopt.metrics import point_clearance, trajectory_metrics
-from trajopt.replan_brake import brake_on_path
-from trajopt.trajectory import Trajectory
-from trajopt.trajectory_chain import TrajectoryChain, TurnInPlace, turn_in_place
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._trajectory import Trajectory
+from trajopt.replan._brake import brake_on_path
+from trajopt.timing._stop_and_turn import turn_in_place, turn_limits
 
 ROBOT = trajopt.Robot()
 
@@ -193,7 +193,7 @@ def test_a_box_qp_out_of_reach_is_a_typed_failure(shared_data):
     # a moving start whose heading row the boxes' variable bounds cannot reach: piqp through
     # casadi.conic rejected the clipped rows (lower above upper) with a RuntimeError
     import astar
-    from trajopt.state import State
+    from trajopt.robot._state import State
 
     grid = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     planner = trajopt.Planner(grid, trajopt.Robot(radius=0.2),

@@ -17,9 +17,9 @@ from scipy.interpolate import BSpline
 from scipy.spatial import Delaunay
 
 import trajopt
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.analysis.metrics import point_clearance, trajectory_metrics
 from trajopt.errors import InvalidInputError
-from trajopt.metrics import point_clearance, trajectory_metrics
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 
 ROBOT = trajopt.Robot()
 
@@ -184,7 +184,7 @@ def _step_costs(cells: np.ndarray, cost: np.ndarray) -> float:
 
 def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
     from tests.astar.test_search import dijkstra_costs
-    from trajopt.map_update import change_reach
+    from trajopt.planning._caches import change_reach
 
     grid = scene.grid
     planner = trajopt.Planner(grid, ROBOT)
@@ -209,7 +209,7 @@ def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
     # first cell on the updated map (scipy's Dijkstra on the inflated grid)
     k = next(j for j in range(len(cells)) if tuple(cells[j]) in {tuple(c) for c in old_cells})
     rest = cells[k:]
-    assert np.array_equal(rest, old_cells[-len(rest):])
+    assert np.array_equal(rest, old_cells[-len(rest) :])
     planner.update_map(updated)
     occ = np.asarray(planner.inflated_grid.occupied)
     ref = dijkstra_costs(occ, tuple(rest[0]), 8, False, planner.search_cost)

@@ -1,4 +1,4 @@
-"""Tests of trajopt.robot: validation and the curvature-dependent speed cap (by hand)."""
+"""Tests of trajopt.robot._robot: validation and the curvature-dependent speed cap (by hand)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from trajopt.errors import InvalidInputError
-from trajopt.robot import Robot
+from trajopt.robot._robot import Robot
 
 
 def test_default_is_the_chapter_robot():

@@ -1,7 +1,7 @@
 """ROS 2 MCAP export, checked with two independent readers.
 
 ``mcap-ros2-support``'s decoder and ``rosbags``' deserialiser both decode the file from the
-message definitions stored in it; neither shares code with :mod:`trajopt.ros_mcap`.
+message definitions stored in it; neither shares code with :mod:`trajopt.motion._mcap`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import pytest
 
 import trajopt
 from trajopt.errors import InvalidInputError
-from trajopt.fallback import stop_and_turn
-from trajopt.ros_mcap import TOPICS, McapExportError, read_mcap, write_mcap
+from trajopt.motion._mcap import TOPICS, McapExportError, read_mcap, write_mcap
+from trajopt.timing._stop_and_turn import stop_and_turn
 
 mcap_reader = pytest.importorskip("mcap.reader", reason="needs the 'ros' extra (mcap)")
 mcap_ros2_decoder = pytest.importorskip("mcap_ros2.decoder", reason="needs mcap-ros2-support")
@@ -30,9 +30,7 @@ def planned():
 def _decode_with_mcap_ros2(path: Path) -> dict[str, list]:
     out: dict[str, list] = {}
     with open(path, "rb") as f:
-        reader = mcap_reader.make_reader(
-            f, decoder_factories=[mcap_ros2_decoder.DecoderFactory()]
-        )
+        reader = mcap_reader.make_reader(f, decoder_factories=[mcap_ros2_decoder.DecoderFactory()])
         for schema, channel, message, ros in reader.iter_decoded_messages():
             assert schema.encoding == "ros2msg" and channel.message_encoding == "cdr"
             assert schema.name == TOPICS[channel.topic]
@@ -61,15 +59,15 @@ def test_round_trip_with_mcap_ros2_decoder(planned, tmp_path):
     np.testing.assert_allclose(tw[:, 1], smp.omega, atol=1e-12)
     assert {r.header.frame_id for _, r in msgs["/twist"]} == {"base_link"}
     # the raw map, cell for cell, in nav_msgs/OccupancyGrid order (row 0 at the origin)
-    (_, grid_msg), = msgs["/map"]
+    ((_, grid_msg),) = msgs["/map"]
     g = planned.steps.raw_grid
     assert (grid_msg.info.width, grid_msg.info.height) == (g.nx, g.ny)
     assert math.isclose(grid_msg.info.resolution, g.resolution, rel_tol=1e-7)
     data = np.frombuffer(bytes(grid_msg.data), np.int8).reshape(g.ny, g.nx)
     np.testing.assert_array_equal(data == 100, g.occupied)
-    (_, path_msg), = msgs["/plan"]
+    ((_, path_msg),) = msgs["/plan"]
     assert len(path_msg.poses) == len(ref)
-    (_, markers), = msgs["/corridor"]
+    ((_, markers),) = msgs["/corridor"]
     regions = planned.steps.corridor.regions
     assert len(markers.markers) == len(regions)
     for m, region in zip(markers.markers, regions, strict=True):
@@ -141,7 +139,7 @@ def test_atomic_and_typed_failures(planned, tmp_path, monkeypatch):
         planned.to_mcap(blocker / "t.mcap")
     good = planned.to_mcap(tmp_path / "t.mcap", dt=0.1)
     before = good.read_bytes()
-    import trajopt.ros_mcap as rm
+    import trajopt.motion._mcap as rm
 
     def boom(*args, **kwargs):
         raise OSError("disk full")

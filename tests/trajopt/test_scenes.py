@@ -9,7 +9,7 @@ import pytest
 
 from astar.inflation import avoidance_area, inflate
 from astar.search import find_path
-from trajopt import scenes
+from trajopt.analysis import scenes
 from trajopt.errors import InvalidInputError
 
 

@@ -17,15 +17,15 @@ import numpy as np
 import pytest
 from scipy.interpolate import BSpline, make_lsq_spline
 
+import trajopt.smoother._basis as smoother_basis
+import trajopt.smoother._qp as smoother_qp
 from astar.grid import OccupancyGrid
 from tests.cases import l_shaped_grid
 from tests.reference import brute_inflate_square, dijkstra_path, square_clearance
-from trajopt.bspline import clamped_uniform_knots
 from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.geometry._bspline import clamped_uniform_knots
 from trajopt.smoother import Smoother, SmoothPath
-from trajopt.smoother import basis as smoother_basis
-from trajopt.smoother import qp as smoother_qp
 
 
 # ----------------------------------------------------------------- references
@@ -175,16 +175,34 @@ def test_working_set_qp_matches_a_reference_solver(fraction):
     uba_r[layout.sample_row0 :][off] = np.inf
     ubx_r[2 * nb :][~active] = 0.0
     ref = ca.conic(
-        "ref", "osqp",
-        {"h": smoother_qp.qp_solver(nb, p, "osqp", layout.m, False).sparsity_in("h"),
-         "a": layout.sparsity},
-        {"osqp": {"verbose": False, "eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 200000,
-                  "polish": True}, "print_time": False, "error_on_fail": True},
+        "ref",
+        "osqp",
+        {
+            "h": smoother_qp.qp_solver(nb, p, "osqp", layout.m, False).sparsity_in("h"),
+            "a": layout.sparsity,
+        },
+        {
+            "osqp": {
+                "verbose": False,
+                "eps_abs": 1e-9,
+                "eps_rel": 1e-9,
+                "max_iter": 200000,
+                "polish": True,
+            },
+            "print_time": False,
+            "error_on_fail": True,
+        },
     )
     gg = np.concatenate([g, np.full(S, penalty)])
-    out = ref(h=ca.DM(ref.sparsity_in("h"), smoother_qp.h_nonzeros(full, nb, p)), g=gg,
-              a=ca.DM(layout.sparsity, layout.nonzeros(trip)),
-              lbx=lbx, ubx=ubx_r, lba=lba_r, uba=uba_r)
+    out = ref(
+        h=ca.DM(ref.sparsity_in("h"), smoother_qp.h_nonzeros(full, nb, p)),
+        g=gg,
+        a=ca.DM(layout.sparsity, layout.nonzeros(trip)),
+        lbx=lbx,
+        ubx=ubx_r,
+        lba=lba_r,
+        uba=uba_r,
+    )
     x_ref = np.asarray(out["x"]).ravel()
     np.testing.assert_allclose(cost, float(out["cost"]), rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(z, x_ref[: 2 * nb], atol=1e-4)
@@ -399,7 +417,7 @@ def test_curvature_excess_between_samples_is_retried_on_the_same_knots(shared_da
 
 def test_paper_scene_targets_certified():
     import astar
-    from trajopt import scenes
+    from trajopt.analysis import scenes
 
     sc = scenes.paper()
     r = sc.robot_width / 2

@@ -13,10 +13,10 @@ import trajopt
 from astar import OccupancyGrid
 from tests.cases import square_inflated, staircase_passage
 from tests.reference import square_clearance
-from trajopt import scenes
+from trajopt.analysis import scenes
+from trajopt.analysis.metrics import trajectory_metrics
+from trajopt.corridor import build_polygon_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.metrics import trajectory_metrics
-from trajopt.polygon_corridor import build_polygon_corridor
 from trajopt.smoother import Smoother
 
 
@@ -204,8 +204,9 @@ def test_polygon_corridor_bad_input():
         Smoother().fit(None, object())
 
 
-@pytest.mark.parametrize(("start", "goal"), [((49.5, 39.5), (30.5, 42.5)),
-                                             ((21.5, 43.5), (49.5, 37.5))])
+@pytest.mark.parametrize(
+    ("start", "goal"), [((49.5, 39.5), (30.5, 42.5)), ((21.5, 43.5), (49.5, 37.5))]
+)
 def test_den312d_passage_mouth_queries(shared_data, start, goal):
     # random queries on den312d (radius 2.5 cells) that failed with heading_continuity:
     # a passage exactly 2 r wide entered from the corner of a room
@@ -221,15 +222,18 @@ def test_polygon_box_a_rounding_error_short_of_a_degenerate_line():
     # rounding error short of the region's line, its bounding box must still meet the line
     import dataclasses
 
-    from trajopt.polygon_corridor import ConvexPolygon
+    from trajopt.corridor import ConvexPolygon
 
     grid = passage_into_room(4)
     start, goal = np.array([45.5, 9.5]), np.array([8.5, 10.5])
     traj = trajopt.plan(grid, start, goal, trajopt.Robot(radius=2.5))
     corr = traj.steps.corridor
     regions = list(corr.regions)
-    k = next(i for i in range(len(regions) - 1)
-             if regions[i + 1].degenerate and not regions[i].degenerate)
+    k = next(
+        i
+        for i in range(len(regions) - 1)
+        if regions[i + 1].degenerate and not regions[i].degenerate
+    )
     reg = regions[k]
     v = reg.vertices.copy()
     top = v[:, 1] >= 10.5 - 1e-12

@@ -16,8 +16,8 @@ from PIL import Image
 import astar
 import trajopt
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.fallback import stop_and_turn
-from trajopt.speed_limits import SpeedLimits, load_speed_mask
+from trajopt.timing._speed_limits import SpeedLimits, load_speed_mask
+from trajopt.timing._stop_and_turn import stop_and_turn
 
 
 def test_nav2_decoding_rule_by_hand():
@@ -26,10 +26,14 @@ def test_nav2_decoding_rule_by_hand():
     # 0 and -1: no limit; 70 -> 30 %; 100 -> 0 %, which nav2_msgs/SpeedLimit reads as "none"
     expect = [math.inf, math.inf, 30.0, math.inf, 70.0, 99.0]
     np.testing.assert_array_equal(pct.limit[0], expect)
-    np.testing.assert_allclose(pct.speed_caps(2.0)[0], [math.inf, math.inf, 0.6, math.inf, 1.4, 1.98])
+    np.testing.assert_allclose(
+        pct.speed_caps(2.0)[0], [math.inf, math.inf, 0.6, math.inf, 1.4, 1.98]
+    )
     over = SpeedLimits.from_mask(v, 0.1, type=1, base=50.0, multiplier=1.0)
     # 50 + 70 = 120 % and 150 % are out of [0, 100]: ignored as Nav2 does
-    np.testing.assert_array_equal(over.limit[0], [math.inf, math.inf, math.inf, math.inf, 80.0, 51.0])
+    np.testing.assert_array_equal(
+        over.limit[0], [math.inf, math.inf, math.inf, math.inf, 80.0, 51.0]
+    )
     ab = SpeedLimits.from_mask(v, 0.1, type="absolute", base=-0.2, multiplier=0.01)
     np.testing.assert_allclose(ab.limit[0], [math.inf, math.inf, 0.5, 0.8, 0.1, math.inf])
     assert ab.type == "absolute" and SpeedLimits.from_mask(v, 0.1, type=2).type == "absolute"
@@ -88,7 +92,12 @@ def test_box_caps_against_brute_force():
         for iy in range(7):
             for ix in range(9):
                 x0, y0 = 0.3 + ix * 0.25, -0.4 + iy * 0.25
-                if x0 <= hi[k, 0] and x0 + 0.25 > lo[k, 0] and y0 <= hi[k, 1] and y0 + 0.25 > lo[k, 1]:
+                if (
+                    x0 <= hi[k, 0]
+                    and x0 + 0.25 > lo[k, 0]
+                    and y0 <= hi[k, 1]
+                    and y0 + 0.25 > lo[k, 1]
+                ):
                     best = min(best, caps[iy, ix])
         assert got[k] == best
 

@@ -10,12 +10,12 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 from tests.cases import Arc, line
-from trajopt.bspline import BSplineCurve, clamped_uniform_knots
-from trajopt.curve import ParametricCurve
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.robot import Robot
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._curve import ParametricCurve
+from trajopt.motion._trajectory import Trajectory
+from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
-from trajopt.trajectory import Trajectory
 
 TOL = 1e-3  # relative tolerance of the curvature-dependent limits on dense samples
 

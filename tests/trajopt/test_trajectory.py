@@ -1,4 +1,4 @@
-"""Tests of trajopt.trajectory: vectorised evaluation against independent references."""
+"""Tests of trajopt.motion._trajectory: vectorised evaluation against independent references."""
 
 from __future__ import annotations
 
@@ -13,9 +13,9 @@ import pytest
 
 from tests.cases import Arc, line
 from trajopt.errors import InvalidInputError
-from trajopt.robot import Robot
+from trajopt.motion._trajectory import SAMPLE_UNITS, Trajectory
+from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
-from trajopt.trajectory import SAMPLE_UNITS, Trajectory
 
 J = 2.0
 PLAIN = Robot(track_width=None, wheel_v_max=None)
@@ -187,8 +187,8 @@ def _csv_references(traj, dt, frame):
 @pytest.fixture(scope="module")
 def exported(driven):
     """A planned trajectory (SP -> A), a chain (a turn in place, then it) and a stop-and-turn."""
-    from trajopt.fallback import stop_and_turn
-    from trajopt.trajectory_chain import TrajectoryChain, turn_in_place
+    from trajopt.motion._chain import TrajectoryChain
+    from trajopt.timing._stop_and_turn import stop_and_turn, turn_in_place
 
     planner, traj = driven
     x0, y0, th0 = (float(v) for v in traj.sample(0.0)[1:4])
@@ -219,7 +219,12 @@ def test_csv_reads_with_pandas_and_numpy_without_options(exported, kind, frame, 
     for field_name, want in zip(arr.dtype.names, ref.values(), strict=True):
         np.testing.assert_array_equal(arr[field_name], want, err_msg=field_name)
     mangled = "".join(c for c in frame if c.isalnum() or c == "_")
-    assert arr.dtype.names[:4] == ("t_s", f"x_m_{mangled}", f"y_m_{mangled}", f"theta_rad_{mangled}")
+    assert arr.dtype.names[:4] == (
+        "t_s",
+        f"x_m_{mangled}",
+        f"y_m_{mangled}",
+        f"theta_rad_{mangled}",
+    )
     assert "v_ms" in arr.dtype.names and "a_ms2" in arr.dtype.names
 
     # the frame is recoverable from the header alone

@@ -1,4 +1,4 @@
-"""trajopt.warm_up: the first plan after it loads no compiled kernel, for every planner kind.
+"""trajopt._warm_up: the first plan after it loads no compiled kernel, for every planner kind.
 
 ``warm_up()`` without a planner loads every kernel: then no planner kind loads one.
 (``tests/trajopt/test_kernel_cache.py`` checks that it compiles and reaches every kernel.)
@@ -15,8 +15,8 @@ import pytest
 
 import astar
 from trajopt import Planner, Robot, Smoother, warm_up
+from trajopt._warm_up import warm_up_map
 from trajopt.errors import InvalidInputError
-from trajopt.warm_up import warm_up_map
 
 
 def _square_distance(p: np.ndarray, grid: astar.OccupancyGrid) -> float:

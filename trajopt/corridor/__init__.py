@@ -1,33 +1,28 @@
-"""Safe corridors: overlapping axis-aligned boxes of free cells grown around a grid path.
+"""Corridors: chains of convex regions around a path that certify a clearance from the raw map.
 
-A :class:`Corridor` is the convex decomposition of free space that the smoother uses to
-certify clearance: every span of the B-spline keeps its control points inside one box, so
-(by the convex-hull property) the whole continuous curve lies inside the union of boxes.
+Two kinds, with the same role for the smoother (every span of the curve keeps its control
+points in one region, so by the convex-hull property the whole curve stays in the union):
 
-Contract for certified clearance
---------------------------------
-To certify a clearance ``r`` (metres) from the *raw* map, two things are needed together:
-
-1. the grid given to :func:`build_corridor` must be
-   ``astar.inflate(raw, r, metric="square", outside_occupied=True)``: a cell is blocked
-   when its centre is closer than ``r`` to an occupied cell taken as a *square* (and the
-   outside of the map counts as occupied);
-2. every box of free cells is shrunk to the rectangle spanned by its cell *centres*
-   (half a cell per side), which :func:`build_corridor` always does.
-
-Then any point of a shrunk box is at least ``r`` from every occupied square: for an
-occupied square ``Q`` outside the box, the box's cell centre nearest to ``Q`` along each
-axis is no farther from ``Q`` on either axis than the point, and that centre is free, so
-its distance to ``Q`` is ``>= r``. With centre-to-centre inflation, or without the
-shrink, the curve can cut obstacle corners (see ``docs/concepts.md``).
-
-Modules: :mod:`~trajopt.corridor.regions` (the values), :mod:`~trajopt.corridor.build`
-(:func:`build_corridor`), :mod:`~trajopt.corridor.growth` (growing the boxes) and
-:mod:`~trajopt.corridor.bridges` (45-degree bridges).
+* :class:`PolygonCorridor` of :class:`ConvexPolygon` (:func:`build_polygon_corridor`, the
+  default): regions grown in continuous space around the path, certified by the exact
+  distance to every occupied square (contract in :mod:`trajopt.corridor._polygons`);
+* :class:`Corridor` of :class:`Box` (:func:`build_corridor`): axis-aligned boxes of free
+  cells of the inflated grid (contract in :mod:`trajopt.corridor._boxes`).
 """
 
-from trajopt.corridor.bridges import rotated_rect_clearance
-from trajopt.corridor.build import build_corridor
-from trajopt.corridor.regions import Box, Corridor
+from trajopt.corridor._boxes.bridges import rotated_rect_clearance
+from trajopt.corridor._boxes.build import build_corridor
+from trajopt.corridor._boxes.regions import Box, Corridor
+from trajopt.corridor._polygons.build import build_polygon_corridor
+from trajopt.corridor._polygons.regions import CLEARANCE_TOL_M, ConvexPolygon, PolygonCorridor
 
-__all__ = ["Box", "Corridor", "build_corridor", "rotated_rect_clearance"]
+__all__ = [
+    "Box",
+    "CLEARANCE_TOL_M",
+    "ConvexPolygon",
+    "Corridor",
+    "PolygonCorridor",
+    "build_corridor",
+    "build_polygon_corridor",
+    "rotated_rect_clearance",
+]

@@ -13,7 +13,7 @@ arc length along the path) to path points ``p_r`` at their arc lengths ``u_r``:
 With the *fidelity* objective (default in a box corridor) ``p_r`` are the A* cell centres,
 ``lam = 1`` and ``ell = 0``: the chapter's least-squares fidelity (equation (3)) plus the
 knot-aware integrated squared ``m``-th derivative (exact Gram matrix of the derivative
-basis). With the *taut* objective (default in a :class:`~trajopt.polygon_corridor.
+basis). With the *taut* objective (default in a :class:`~trajopt.corridor.
 PolygonCorridor`) ``p_r`` are the corridor's path sampled once per cell, ``lam`` is small
 and the length term pulls the curve taut. Positions and parameters are divided by the grid
 resolution first, so the default weights work on every map.
@@ -37,20 +37,20 @@ their regions, exact endpoints, dense-sample clearance against the raw map, no c
 curvature bound. On failure the knots are refined; when that is exhausted
 :class:`~trajopt.errors.SmoothingError` is raised with the solver statistics.
 
-Modules: :mod:`~trajopt.smoother.options` (the :class:`Smoother` options),
-:mod:`~trajopt.smoother.attempts` (the attempt loop), :mod:`~trajopt.smoother.problem`
-(problem assembly in cell units), :mod:`~trajopt.smoother.basis` (B-spline basis maths),
-:mod:`~trajopt.smoother.qp` (the convex QP and its solver cache),
-:mod:`~trajopt.smoother.scp` (the curvature bound by SCP), :mod:`~trajopt.smoother.nlp`
-(IPOPT), :mod:`~trajopt.smoother.certificate` and :mod:`~trajopt.smoother.status` (solve
+Modules: :mod:`~trajopt.smoother._options` (the :class:`Smoother` options),
+:mod:`~trajopt.smoother._attempts` (the attempt loop), :mod:`~trajopt.smoother._problem`
+(problem assembly in cell units), :mod:`~trajopt.smoother._basis` (B-spline basis maths),
+:mod:`~trajopt.smoother._qp` (the convex QP and its solver cache),
+:mod:`~trajopt.smoother._scp` (the curvature bound by SCP), :mod:`~trajopt.smoother._nlp`
+(IPOPT), :mod:`~trajopt.smoother._certificate` and :mod:`~trajopt.smoother._status` (solve
 statuses and the statistics).
 """
 
-from trajopt.smoother.certificate import Certificate, certify
-from trajopt.smoother.options import CurvatureSolver, Objective, QPSolver, Smoother
-from trajopt.smoother.path import SmoothPath
-from trajopt.smoother.problem import graded_knots
-from trajopt.smoother.status import SolveInfo, SolveStatus
+from trajopt.smoother._certificate import Certificate, certify
+from trajopt.smoother._options import CurvatureSolver, Objective, QPSolver, Smoother
+from trajopt.smoother._path import SmoothPath
+from trajopt.smoother._problem import graded_knots
+from trajopt.smoother._status import SolveInfo, SolveStatus
 
 __all__ = [
     "Certificate",

@@ -17,12 +17,12 @@ Method
    ``max(v_start, v_end)`` may use the cap without that factor so that boundary speeds
    equal to the cap are allowed. For a curve with a ``polynomial_degree`` (every curve of
    the library) the bound is rigorous whatever the width of a curvature peak:
-   :func:`trajopt.curvature_bound.interval_kappa_max` bounds ``|kappa|`` on the curve's
+   :func:`trajopt.geometry._curvature_bound.interval_kappa_max` bounds ``|kappa|`` on the curve's
    polynomial pieces by Bernstein coefficients, bisects them until the bound is tight
    (0.1 % of the cap) or harmless, and maps each piece to the intervals its exact arc-length
    range touches. For the library's curves (the base class's arc length and geometry, a
    ``Robot``'s own ``speed_cap``) compiled code does this together with the grid's
-   ``u(s)``, heading and curvature (:func:`trajopt.timing.cap_kernel.polynomial_tables`,
+   ``u(s)``, heading and curvature (:func:`trajopt.timing._cap_kernel.polynomial_tables`,
    from the Taylor coefficients of each piece's velocity; ``interval_kappa_max`` is the NumPy
    form of the same method and the path for other curves). Any other curve is sampled: an
    interval gets the smaller cap at its ends minus a second-difference bound on a convex
@@ -61,17 +61,29 @@ by construction of the table for polynomial curves (relative 1e-4 margin), and u
 sampling's resolution for other curves. On the benchmark paths the durations are within a few percent of TOPP-RA's
 jerk-free time-optimal answer (``benchmarks/bench_timing.py``).
 
-Modules: :mod:`~trajopt.timing.parameterize` (the entry point),
-:mod:`~trajopt.timing.cap_table` (stage 1) with :mod:`~trajopt.timing.cap_kernel` (its
-compiled path; :mod:`~trajopt.timing.cap_cubic` its bound on cubic pieces, unrolled),
-:mod:`~trajopt.timing.greedy` (the compiled
-kernels of stage 2), :mod:`~trajopt.timing.compress` (stages 3 and 4) and
-:mod:`~trajopt.timing.ruckig_profile` (the ruckig wrapper, also used by the stop-and-turn
+Modules: :mod:`~trajopt.timing._parameterize` (the entry point),
+:mod:`~trajopt.timing._cap_table` (stage 1) with :mod:`~trajopt.timing._cap_kernel` (its
+compiled path; :mod:`~trajopt.timing._cap_cubic` its bound on cubic pieces, unrolled),
+:mod:`~trajopt.timing._greedy` (the compiled
+kernels of stage 2), :mod:`~trajopt.timing._compress` (stages 3 and 4) and
+:mod:`~trajopt.timing._ruckig_profile` (the ruckig wrapper, also used by the stop-and-turn
 fallback).
 """
 
-from trajopt.timing.cap_table import CapTable, build_cap_table
-from trajopt.timing.parameterize import time_parameterize
-from trajopt.timing.ruckig_profile import RuckigProfile
+from trajopt.timing._cap_table import CapTable, build_cap_table
+from trajopt.timing._parameterize import time_parameterize
+from trajopt.timing._ruckig_profile import RuckigProfile
+from trajopt.timing._speed_limits import SpeedLimits, load_speed_mask
+from trajopt.timing._stop_and_turn import stop_and_turn, turn_in_place, turn_limits
 
-__all__ = ["CapTable", "RuckigProfile", "build_cap_table", "time_parameterize"]
+__all__ = [
+    "CapTable",
+    "RuckigProfile",
+    "SpeedLimits",
+    "build_cap_table",
+    "load_speed_mask",
+    "stop_and_turn",
+    "time_parameterize",
+    "turn_in_place",
+    "turn_limits",
+]

@@ -1,0 +1,344 @@
+"""Warm-up: compile the kernels once per environment, pay a process's start costs once.
+
+Two one-time costs stand before a fast plan:
+
+* **Once per environment** (fresh clone, venv, container, CI runner): numba compiles the
+  compiled kernels of astar and trajopt into its disk cache, about 50 s of CPU.
+  :func:`warm_up` first compiles every kernel that is not cached yet, by running the
+  :data:`EXERCISES` (small searches, plans, timings, a fallback and a comparison that between
+  them call every kernel with the argument types the library uses) in two worker processes
+  (:func:`trajopt._kernel_cache.compile_kernels`). ``trajopt warm-up`` does the same from a
+  shell, e.g. in a container build or a CI cache step.
+* **Once per process**: importing numba, SciPy and CasADi, initialising numba's compiler
+  context, loading each compiled kernel from numba's disk cache and loading the CasADi
+  solver plugins (``python benchmarks/bench_first_call.py`` prints the split). A robot
+  program that calls :func:`warm_up` at start-up, before its first goal arrives, pays them
+  there; the first real plan then costs about what a warm one does.
+
+With a planner, the warm-up then plans one query on a small built-in map (a wall with a
+gap, so the search, the corridor, the smoother and the timing all run) with the planner's
+own settings: its robot (or footprint), search mode, corridor kind, smoother options, timing
+step and fallback, so the kernels loaded are the ones its queries use. The map and its
+resolution are scaled to the robot, so the warm-up takes the same short time for any
+robot size. Two paths stay unloaded: the stop-and-turn fallback, which only a failed
+smoother or timing runs, may load kernels of its own the first time it is used; and
+speed-limit zones are not copied (their lookup is plain NumPy). Without a planner, every
+kernel of the library is loaded (:func:`trajopt._kernel_cache.load_kernels`) and the
+default planner plans the query.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from astar.costmap import from_costmap
+from astar.grid import OccupancyGrid
+from trajopt._planner import Planner
+from trajopt.errors import InvalidInputError
+
+_log = logging.getLogger(__name__)
+
+#: side of the warm-up map in cells
+WARM_UP_CELLS = 60
+
+
+def warm_up_map(planner: Planner) -> tuple[OccupancyGrid, tuple[float, float], tuple[float, float]]:
+    """Return the warm-up map for ``planner`` and its query.
+
+    Parameters
+    ----------
+    planner : Planner
+        Its robot's (circumscribed) radius and its smoother's curvature bound set the
+        map's scale.
+
+    Returns
+    -------
+    grid : astar.OccupancyGrid
+        ``WARM_UP_CELLS`` square cells, side ``12 * max(radius, 1 / kappa_max)`` metres
+        (three radii with ``inflation="paper"``),
+        with a wall up from the bottom edge over 60 % of the height in the middle and a
+        block 1.6 radii left of the start (so the clearance checks meet an obstacle).
+    start, goal : tuple of float
+        World points (m) on either side of the wall, ``0.2`` of the side from the
+        bottom and from the left and right edges.
+    """
+    scale = planner.robot.radius
+    if planner.inflation == "paper":  # the avoidance area adds about 2 radii
+        scale *= 3.0
+    if planner.smoother.kappa_max is not None:
+        scale = max(scale, 1.0 / planner.smoother.kappa_max)
+    n = WARM_UP_CELLS
+    resolution = 12.0 * scale / n
+    occupied = np.zeros((n, n), dtype=bool)
+    half = max(1, math.ceil(0.05 * n))
+    occupied[: int(0.6 * n), n // 2 - half : n // 2 + half] = True
+    occupied[int(0.17 * n) : int(0.23 * n), int(0.03 * n) : int(0.07 * n)] = True  # near the start
+    side = n * resolution
+    return OccupancyGrid(occupied, resolution), (0.2 * side, 0.2 * side), (0.8 * side, 0.2 * side)
+
+
+def warm_up(planner: Planner | None = None) -> float:
+    """Compile what is not compiled yet, then load what a plan needs, before the first query.
+
+    Parameters
+    ----------
+    planner : Planner, optional
+        The planner whose settings the warm-up copies (robot, search mode, corridor,
+        smoother, timing step, fallback); its map and caches are not touched. Default: every
+        kernel of the library is loaded and a planner with :func:`~trajopt.plan`'s defaults
+        plans the warm-up query.
+
+    Returns
+    -------
+    float
+        Wall time the warm-up took (s).
+
+    Raises
+    ------
+    InvalidInputError
+        ``planner`` is not a :class:`Planner`.
+    TrajoptError
+        The warm-up query failed (it should not: the map is built for the robot; the
+        error says which stage).
+
+    Notes
+    -----
+    The compilation runs only when some kernel has nothing in numba's disk cache
+    (:func:`trajopt._kernel_cache.cold_kernels`), in two worker processes; an exercise that
+    fails there is logged and its kernels compile on first use instead.
+    """
+    import trajopt._kernel_cache as kernel_cache
+
+    t0 = time.perf_counter()
+    if planner is not None and not isinstance(planner, Planner):
+        raise InvalidInputError(f"planner must be a trajopt.Planner, got {type(planner).__name__}")
+    report = kernel_cache.compile_kernels()
+    for name, error in report.failed.items():
+        _log.warning("warm_up: exercise %r failed (its kernels compile on first use): %s",
+                     name, error)  # fmt: skip
+    if planner is None:
+        for name, exercise in EXERCISES.items():
+            if name not in report.failed:
+                exercise.run()  # loads the kernels with the library's own calls
+        kernel_cache.load_kernels()  # and the ones only other kernels call
+        planner = _default_planner()
+    _plan_like(planner)
+    return time.perf_counter() - t0
+
+
+def _default_planner() -> Planner:
+    return Planner(OccupancyGrid(np.zeros((2, 2), dtype=bool), 1.0))
+
+
+def _plan_like(planner: Planner) -> None:
+    """Plan the warm-up query of ``planner`` with a copy of it (its caches stay as they are)."""
+    grid, start, goal = warm_up_map(planner)
+    search_map: OccupancyGrid | object = grid
+    if planner.costmap is not None:
+        values = np.zeros(grid.occupied.shape, dtype=np.uint8)
+        values[:, : WARM_UP_CELLS // 4] = 100  # a graded band for the costmap's cost term
+        values[grid.occupied] = 254  # lethal
+        search_map = from_costmap(values, grid.resolution, grid.origin, convention="costmap_2d")
+    copy = Planner(
+        search_map,
+        planner.robot,
+        inflation=planner.inflation,
+        search=planner.search,
+        smoother=planner.smoother,
+        timing_dt=planner.timing_dt,
+        fallback=planner.fallback,
+        corridor=planner.corridor,
+        costmap_weight=planner.costmap_weight,
+        landmarks=planner.landmarks,
+    )
+    copy.plan(start, goal)
+
+
+# ------------------------------------------------------------------------------ exercises
+@dataclass(frozen=True)
+class Exercise:
+    """A warm-up exercise: library calls on small inputs that compile a set of kernels.
+
+    Attributes
+    ----------
+    run : callable
+        Runs the calls (no arguments, no result).
+    after : tuple of str
+        Exercises to run first: their kernels are then loaded, not compiled again, when
+        this one runs in another worker process.
+    seconds : float
+        Rough compile time (s) when every kernel is cold: longest first.
+    """
+
+    run: Callable[[], None]
+    after: tuple[str, ...] = ()
+    seconds: float = 1.0
+
+
+def _default_query() -> tuple[Planner, tuple[float, float], tuple[float, float]]:
+    grid, start, goal = warm_up_map(_default_planner())
+    return Planner(grid), start, goal
+
+
+def _around_the_wall(planner: Planner, start, goal) -> np.ndarray:
+    """Return a polyline (m) from ``start`` over the warm-up map's wall to ``goal``."""
+    side = planner.grid.occupied.shape[1] * planner.grid.resolution
+    return np.array([start, [start[0], 0.85 * side], [goal[0], 0.85 * side], goal])
+
+
+def _exercise_timing() -> None:
+    """Time a cubic B-spline (an S-bend) from rest and between moving states."""
+    from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+    from trajopt.robot._robot import Robot
+    from trajopt.timing import time_parameterize
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1.0], [3.0, 1.0], [4.0, 0.0], [5.0, 0.0]])
+    curve = BSplineCurve(clamped_uniform_knots(len(pts), 3, (0.0, 6.0)), pts, 3)
+    robot = Robot()
+    time_parameterize(curve, robot)
+    time_parameterize(curve, robot, v_start=0.05, v_end=0.05)
+
+
+def _exercise_polygons() -> None:
+    """Grow a polygon corridor along a polyline; intersect two of its polygons."""
+    from trajopt.corridor import build_polygon_corridor
+
+    planner, start, goal = _default_query()
+    corridor = build_polygon_corridor(planner.grid, _around_the_wall(planner, start, goal),
+                                      planner.robot.radius)  # fmt: skip
+    if len(corridor.regions) > 1:
+        corridor.regions[0].intersection(corridor.regions[1], tol=1e-9)
+
+
+def _search_query() -> tuple[OccupancyGrid, tuple[int, int], tuple[int, int]]:
+    grid, start, goal = warm_up_map(_default_planner())
+    a, b = grid.world_to_cell(start), grid.world_to_cell(goal)
+    return grid, (int(a[0]), int(a[1])), (int(b[0]), int(b[1]))
+
+
+def _exercise_search() -> None:
+    """Search without a cost (jump points), with a cost and with ALT landmarks."""
+    import astar
+
+    grid, a, b = _search_query()
+    astar.find_path(grid, a, b)
+    cost = np.ones(grid.shape)
+    astar.find_path(grid, a, b, cost=cost)
+    astar.find_path(grid, a, b, landmarks=astar.build_landmarks(grid, cost, 2))
+
+
+def _exercise_astar() -> None:
+    """Search 4-connected and cutting corners (plain A*, not jump points)."""
+    import astar
+
+    grid, a, b = _search_query()
+    astar.find_path(grid, a, b, connectivity=4)
+    astar.find_path(grid, a, b, corner_cutting=True)
+
+
+def _exercise_grid() -> None:
+    """Inflate (both metrics), the avoidance area, clearance fields and the clearance cost."""
+    import astar
+
+    grid, _, _ = warm_up_map(_default_planner())
+    r = 2.0 * grid.resolution
+    astar.inflate(grid, r)
+    astar.inflate(grid, r, metric="square", outside_occupied=True)
+    astar.avoidance_area(grid, 2, border=True)
+    astar.clearance(grid)
+    astar.clearance(grid, metric="square", outside_occupied=True)
+    astar.clearance_cost(grid, r, outside_occupied=True)
+
+
+def _exercise_fallback() -> None:
+    """Run the stop-and-turn fallback's checks and the curvature witness (their own kernels)."""
+    from trajopt.geometry._clearance import polyline_clearance
+    from trajopt.planning._feasibility import curvature_witness
+    from trajopt.timing._stop_and_turn import stop_and_turn
+
+    planner, start, goal = _default_query()
+    points = _around_the_wall(planner, start, goal)
+    r = planner.robot.radius
+    polyline_clearance(points, planner.grid, window_m=2.0 * r, outside_occupied=True)
+    stop_and_turn(points, planner.robot)
+    curvature_witness(planner.grid, r, np.asarray(start), np.asarray(goal), 1.0 / (2.0 * r),
+                      time_limit_s=5.0)  # fmt: skip
+
+
+def _exercise_plan() -> None:
+    """Plan with the defaults: clearance cost, search, polygon corridor, smoother, timing."""
+    planner, start, goal = _default_query()
+    planner.plan(start, goal)
+
+
+def _exercise_footprint() -> None:
+    """Plan for a rectangular robot (the footprint certificate and its rounds)."""
+    from trajopt.robot._robot import Robot
+
+    r = _default_planner().robot.radius
+    _plan_like(Planner(_default_planner().grid, Robot.rectangle(2.2 * r, 1.4 * r)))
+
+
+def _exercise_planners() -> None:
+    """Plan with the other planner kinds, on a costmap too, and re-plan.
+
+    Boxes, the chapter's inflation, shortest paths, a curvature bound, ALT landmarks; a
+    re-plan that keeps the corridor and one that does not.
+    """
+    from trajopt.robot._robot import Robot
+    from trajopt.smoother import Smoother
+
+    base = _default_planner()
+    r = base.robot.radius
+    costmap = from_costmap(np.zeros((4, 4), dtype=np.uint8), 1.0, convention="costmap_2d")
+    for p in (
+        Planner(base.grid, corridor="boxes"),
+        Planner(base.grid, inflation="paper"),
+        Planner(base.grid, search="shortest"),
+        Planner(base.grid, smoother=Smoother(kappa_max=1.0 / (2.0 * r))),
+        Planner(base.grid, landmarks=2),
+        Planner(costmap, Robot(radius=r)),
+    ):
+        _plan_like(p)
+    planner, start, goal = _default_query()
+    traj = planner.plan(start, goal)
+    planner.replan(traj, 0.3 * traj.duration, latency=0.0)
+    planner.replan(traj, 0.3 * traj.duration, latency=0.0, reuse=False)
+
+
+def _exercise_compare() -> None:
+    """Compare the chapter's methods (:func:`trajopt.compare`)."""
+    from trajopt.analysis.comparison import compare
+
+    planner, start, goal = _default_query()
+    compare(planner.grid, start, goal, robot_radius=planner.robot.radius, w_cells=2)
+
+
+#: The warm-up exercises by name; between them they call every compiled kernel of astar and
+#: trajopt (``tests/trajopt/test_warm_up.py`` checks it) with the library's argument types.
+#: ``timing``, ``polygons``, ``search``, ``grid``, ``astar`` and ``fallback`` share few kernels
+#: and run side by side; the others mostly load theirs.
+EXERCISES: dict[str, Exercise] = {
+    "timing": Exercise(_exercise_timing, seconds=13.5),
+    "polygons": Exercise(_exercise_polygons, seconds=15.0),
+    "search": Exercise(_exercise_search, seconds=4.0),
+    "grid": Exercise(_exercise_grid, seconds=2.5),
+    "astar": Exercise(_exercise_astar, seconds=2.0),
+    "fallback": Exercise(_exercise_fallback, seconds=3.5),
+    "plan": Exercise(_exercise_plan, after=("timing", "polygons", "search", "grid"), seconds=1.0),
+    "footprint": Exercise(
+        _exercise_footprint, after=("timing", "polygons", "search", "grid"), seconds=3.5
+    ),  # fmt: skip
+    "planners": Exercise(_exercise_planners, after=("plan", "astar", "fallback"), seconds=1.0),
+    "compare": Exercise(_exercise_compare, after=("plan",), seconds=0.5),
+}
+
+#: What a default plan and :func:`trajopt.compare` need (with what they depend on): the
+#: command line compiles these first and starts its command when they are done.
+CORE_EXERCISES: tuple[str, ...] = ("plan", "compare")

@@ -1,0 +1,173 @@
+"""Peer planners as benchmark methods (optional: the ``peers`` extra).
+
+* ``ompl-rrtstar``, ``ompl-bitstar``: OMPL (the ``ompl`` wheel) in an R2 state space over
+  the map's extent; a state is valid when its cell is free on the inflated grid (the same
+  grid the reference A* searches); RRT* or BIT* minimising path length for
+  :data:`OMPL_TIME_LIMIT_S` seconds (seeded with :data:`OMPL_SEED`), then
+  ``PathSimplifier.simplifyMax`` and ``smoothBSpline``. OMPL checks motions at discrete
+  states (its default resolution), as its users do.
+* ``pmp-bspline``, ``pmp-cubic``: python-motion-planning's point-based curve generators
+  (``BSpline`` interpolation, degree 3, and ``CubicSpline``) through the corner points of
+  the reference A* path.
+
+The outputs are sampled polylines (metres) that :func:`trajopt.analysis.bench._methods.evaluate_query`
+scores like every other method. A peer that finds no solution, or raises any exception of its own
+(e.g. python-motion-planning's interpolation on a singular system), raises
+:class:`PeerFailure` (a row with ``failure = "PeerFailure"``, the reason in ``note``). A peer whose package is missing raises
+:class:`~trajopt.errors.PeerUnavailableError` when the run is checked, before any work.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import PeerUnavailableError
+
+#: Planning time of the OMPL planners per query (s).
+OMPL_TIME_LIMIT_S = 1.0
+#: Seed of OMPL's random number generator (set before every query).
+OMPL_SEED = 1
+_PACKAGES = {"ompl": "ompl", "python_motion_planning": "python-motion-planning"}
+
+
+class PeerFailure(RuntimeError):
+    """A peer planner returned no solution for a query (a row value, not a crash)."""
+
+
+def require(module: str, method: str) -> None:
+    """Raise :class:`PeerUnavailableError` unless ``module`` can be imported."""
+    if importlib.util.find_spec(module) is None:
+        raise PeerUnavailableError(
+            f"method {method!r} needs the package {_PACKAGES.get(module, module)!r}, which is "
+            "not installed: install the `peers` extra (pip install 'trajopt[peers]')"
+        )
+
+
+def corner_points(points: np.ndarray) -> np.ndarray:
+    """Return the vertices of a polyline where its direction changes, ends included.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 2)
+
+    Returns
+    -------
+    ndarray, shape (m, 2), m <= n
+    """
+    p = np.asarray(points, dtype=float)
+    if len(p) <= 2:
+        return p.copy()
+    d = np.diff(p, axis=0)
+    cross = d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]
+    dot = np.sum(d[:-1] * d[1:], axis=1)
+    turn = (np.abs(cross) > 1e-12) | (dot < 0)
+    keep = np.concatenate([[True], turn, [True]])
+    return p[keep]
+
+
+def _ompl(planner: str, q: Any) -> np.ndarray:
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(OMPL_SEED)
+    grid = q.map.grid
+    occ = np.asarray(q.map.inflated.occupied)
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = occ.shape
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, ox)
+    bounds.setHigh(0, ox + nx * res)
+    bounds.setLow(1, oy)
+    bounds.setHigh(1, oy + ny * res)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+
+    def valid(state: Any) -> bool:
+        ix = math.floor((state[0] - ox) / res)
+        iy = math.floor((state[1] - oy) / res)
+        return 0 <= ix < nx and 0 <= iy < ny and not occ[iy, ix]
+
+    ss.setStateValidityChecker(valid)
+    s = space.allocState()
+    g = space.allocState()
+    s[0], s[1] = (float(v) for v in q.start)
+    g[0], g[1] = (float(v) for v in q.goal)
+    ss.setStartAndGoalStates(s, g)
+    si = ss.getSpaceInformation()
+    ss.setPlanner(og.RRTstar(si) if planner == "rrtstar" else og.BITstar(si))
+    ss.solve(OMPL_TIME_LIMIT_S)
+    if not ss.haveExactSolutionPath():
+        raise PeerFailure(f"OMPL {planner}: no exact solution in {OMPL_TIME_LIMIT_S} s")
+    path = ss.getSolutionPath()
+    simplifier = og.PathSimplifier(si)
+    simplifier.simplifyMax(path)
+    simplifier.smoothBSpline(path)
+    return np.array([(st[0], st[1]) for st in path.getStates()], dtype=float)
+
+
+def _pmp(kind: str, q: Any) -> np.ndarray:
+    import python_motion_planning as pmp
+
+    pts = corner_points(q.reference)
+    if len(pts) < 2:
+        raise PeerFailure("python-motion-planning: the reference has fewer than 2 points")
+    length_cells = float(np.sum(np.hypot(*np.diff(q.reference, axis=0).T))) / float(
+        q.map.grid.resolution
+    )
+    step = 1.0 / min(2000.0, max(200.0, 2.0 * length_cells))
+    gen = pmp.BSpline(step=step, k=3) if kind == "bspline" else pmp.CubicSpline(step=step)
+    path, info = gen.generate([tuple(p) for p in pts])
+    if not info.get("success") or len(path) < 2:
+        raise PeerFailure(f"python-motion-planning {kind}: generation failed ({info})")
+    return np.asarray(path, dtype=float)[:, :2]
+
+
+def run(name: str, q: Any) -> Any:
+    """Run the peer ``name`` on a :class:`~trajopt.analysis.bench._methods.QueryContext`.
+
+    Returns
+    -------
+    MethodOutput
+        The peer's polyline (metres) and its compute time.
+
+    Raises
+    ------
+    PeerUnavailableError
+        Its package is missing.
+    PeerFailure
+        It found no solution.
+    """
+    from trajopt.analysis.bench._methods import METHODS, MethodOutput
+
+    for mod in METHODS[name].requires:
+        require(mod, name)
+    t0 = time.perf_counter()
+    try:
+        if name.startswith("ompl-"):
+            pts = _ompl(name.removeprefix("ompl-"), q)
+            note = (
+                f"{name.removeprefix('ompl-')}, {OMPL_TIME_LIMIT_S} s, simplifyMax + smoothBSpline"
+            )
+        else:
+            pts = _pmp(name.removeprefix("pmp-"), q)
+            note = f"{name.removeprefix('pmp-')} through the reference's corner points"
+    except PeerFailure:
+        raise
+    except Exception as exc:  # the peer's own crash is its row's failure, not the run's
+        raise PeerFailure(f"{name} raised {type(exc).__name__}: {exc}") from exc
+    runtime = time.perf_counter() - t0
+    # drop repeated vertices (a polyline needs distinct consecutive points)
+    keep = np.concatenate([[True], np.any(np.diff(pts, axis=0) != 0.0, axis=1)])
+    pts = pts[keep]
+    if len(pts) < 2:
+        raise PeerFailure(f"{name}: the path has fewer than 2 distinct points")
+    return MethodOutput(pts, True, note, runtime_s=runtime)

@@ -1,0 +1,683 @@
+"""Path and trajectory metrics: one set for every method in the comparison.
+
+:func:`path_metrics` scores any :class:`~trajopt.geometry._curve.ParametricCurve` (B-spline,
+polynomial, smoother output) or a polyline (an ``(n, 2)`` array in metres, a
+:class:`~trajopt.geometry._curve.PolylineCurve`, or an :class:`astar.GridPath` converted with the
+grid) against the raw map and the A* reference path. :func:`trajectory_metrics` adds the
+peaks of a timed trajectory against the robot's limits.
+
+Definitions (``Q_i``, ``i = 1..N``: reference A* points in metres; ``C``: the curve,
+sampled every ``sample_spacing`` metres of arc length, polyline vertices always included):
+
+* ``mse_m2``: the chapter's equation (3) divided by ``N``, ``mean_i |C(u_i) - Q_i|^2``. The
+  correspondence ``u_i`` is, by default, the **nearest point** of the curve to ``Q_i``
+  (exact distance to the sampled polyline of the curve; the chord error of a smooth
+  curve is ``~ kappa ds^2 / 8``). This is the same rule for every method, including
+  polylines and curves that were not fitted to ``Q``; it is never larger than the value
+  at the parameters a fit used. Pass ``params`` to evaluate at given parameters instead.
+* ``start_error_x_m`` ... ``end_error_y_m``: ``|C(u_0) - Q_1|`` and ``|C(u_1) - Q_N|`` per axis.
+* ``hausdorff_m``: symmetric Hausdorff distance between the sampled curve and the
+  reference polyline (each side: exact distance from samples to the other polyline;
+  exact up to ``sample_spacing / 2``).
+* ``min_clearance_m``: minimum over the samples of the exact Euclidean distance to the
+  nearest occupied cell of the **raw** grid, cells taken as closed squares (0 inside one).
+  Cells outside the map are free unless ``border_occupied``.
+* ``collision``: ``min_clearance_m < radius`` (with a 1e-9 m tolerance).
+* ``length_m``, ``length_ratio`` (to the reference polyline's length).
+* ``max_curvature_1pm``, ``rms_curvature_1pm = sqrt(int kappa^2 ds / L)``,
+  ``int_sq_curvature_1pm = int kappa^2 ds`` (trapezoid over the samples). A polyline has its
+  curvature concentrated at the vertices; it is scored with the discrete curvature
+  ``theta_j / l_j`` (turn angle over half the sum of the adjacent segment lengths) and
+  ``int kappa^2 ds = sum_j theta_j^2 / l_j``.
+* ``max_heading_jump_rad``: the largest change of heading between consecutive samples
+  ``sample_spacing`` apart (a 45-degree A* corner scores 0.785 rad; a C2 curve scores about
+  ``max |kappa| * sample_spacing``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import InvalidInputError
+from trajopt.geometry._curve import ParametricCurve, PolylineCurve
+
+__all__ = [
+    "PathMetrics",
+    "path_metrics",
+    "trajectory_metrics",
+    "point_clearance",
+    "min_clearance",
+    "distance_to_polyline",
+    "hausdorff_distance",
+    "polyline_hausdorff",
+    "heading_jumps",
+]
+
+#: Default arc-length spacing of the samples (m).
+DEFAULT_SAMPLE_SPACING = 0.005
+_COLLISION_TOL = 1e-9
+#: Most samples taken along one path; beyond it the spacing grows (and is reported).
+_MAX_SAMPLES = 20_000
+
+
+@dataclass(frozen=True, slots=True)
+class PathMetrics:
+    """Geometric scores of one path (see the module docstring for the definitions).
+
+    Attributes
+    ----------
+    mse_m2 : float
+        Mean squared deviation from the reference points (m^2).
+    start_error_x_m, start_error_y_m, end_error_x_m, end_error_y_m : float
+        Absolute end-point errors per axis (m).
+    hausdorff_m : float
+        Symmetric Hausdorff distance to the reference polyline (m).
+    min_clearance_m : float
+        Smallest distance from the path to an occupied square of the raw grid (m).
+    collision : bool
+        ``min_clearance_m < radius``.
+    length_m : float
+        Arc length (m).
+    length_ratio : float
+        ``length_m`` over the reference polyline's length.
+    max_curvature_1pm, rms_curvature_1pm : float
+        Largest and root-mean-square curvature (1/m).
+    int_sq_curvature_1pm : float
+        ``int kappa^2 ds`` (1/m).
+    max_heading_jump_rad : float
+        Largest heading change between consecutive samples (rad).
+    sample_spacing_m : float
+        Arc-length spacing of the samples (m).
+    n_samples : int
+        Number of samples used.
+    """
+
+    mse_m2: float
+    start_error_x_m: float
+    start_error_y_m: float
+    end_error_x_m: float
+    end_error_y_m: float
+    hausdorff_m: float
+    min_clearance_m: float
+    collision: bool
+    length_m: float
+    length_ratio: float
+    max_curvature_1pm: float
+    rms_curvature_1pm: float
+    int_sq_curvature_1pm: float
+    max_heading_jump_rad: float
+    sample_spacing_m: float
+    n_samples: int
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the metrics as a plain ``dict`` (field order)."""
+        return asdict(self)
+
+    @classmethod
+    def nan(cls, sample_spacing: float = math.nan) -> PathMetrics:
+        """Return a record of NaNs (``collision=False``): for a method that produced no path."""
+        vals: dict[str, Any] = {f: math.nan for f in cls.__dataclass_fields__}
+        vals.update(collision=False, sample_spacing_m=sample_spacing, n_samples=0)
+        return cls(**vals)
+
+
+# ============================================================================ inputs
+def _points_of(obj: object, grid: Any, name: str) -> np.ndarray:
+    """World points (m) of an (n, 2) array, a PolylineCurve or a GridPath (needs grid)."""
+    if isinstance(obj, PolylineCurve):
+        return np.asarray(obj.points, dtype=float)
+    if hasattr(obj, "cells"):
+        if grid is None:
+            raise InvalidInputError(f"{name}: converting a GridPath to metres needs the grid")
+        return np.asarray(grid.cell_to_world(np.asarray(obj.cells)), dtype=float)
+    p = np.asarray(obj, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < 1:
+        raise InvalidInputError(f"{name} must be points of shape (n, 2) in metres, got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise InvalidInputError(f"{name} must be finite")
+    return p
+
+
+def _as_curve(path: object, grid: Any) -> ParametricCurve:
+    if isinstance(path, ParametricCurve):
+        return path
+    if all(hasattr(path, a) for a in ("domain", "sample", "heading", "curvature", "length")):
+        return path  # type: ignore[return-value]  # duck-typed ParametricCurve
+    return PolylineCurve(_points_of(path, grid, "path"))
+
+
+# ============================================================================ geometry
+def distance_to_polyline(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """Exact Euclidean distance from each point to a polyline.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+    vertices : array_like, shape (m, 2)
+        Polyline vertices (m >= 1), in order.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+
+    Notes
+    -----
+    A KD-tree gives the nearest vertex distance ``d0``; the nearest point of the polyline
+    lies on a segment with an end vertex within ``d0 + max segment length``, so only the
+    segments around those vertices are measured.
+    """
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+    tree = cKDTree(v)
+    d0, _ = tree.query(p)
+    if len(v) < 2 or len(p) == 0:
+        return d0
+    seg = np.diff(v, axis=0)
+    lmax = float(np.max(np.hypot(seg[:, 0], seg[:, 1])))
+    pid, vid = _neighbours_within(tree, p, d0 + lmax + 1e-12)
+    # segments on both sides of every candidate vertex
+    sid = np.concatenate([vid - 1, vid])
+    pid = np.concatenate([pid, pid])
+    ok = (sid >= 0) & (sid < len(v) - 1)
+    sid, pid = sid[ok], pid[ok]
+    a = v[sid]
+    d = seg[sid]
+    w = p[pid] - a
+    dd = np.sum(d * d, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(dd > 0, np.sum(w * d, axis=1) / dd, 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    dist = np.hypot(*(w - t[:, None] * d).T)
+    out = d0.copy()
+    np.minimum.at(out, pid, dist)
+    return out
+
+
+def _neighbours_within(tree: Any, p: np.ndarray, radius: np.ndarray, k: int = 32):
+    """All (point index, tree index) pairs with distance <= radius[i], vectorised.
+
+    Queries the ``k`` nearest first (one array call); points whose ``k``-th neighbour is
+    still inside their radius are completed with a ball query.
+    """
+    k = min(k, tree.n)
+    radius = np.asarray(radius, dtype=float)
+    dist, idx = tree.query(p, k=k, distance_upper_bound=float(radius.max()))
+    dist, idx = dist.reshape(len(p), k), idx.reshape(len(p), k)
+    inside = dist <= radius[:, None]
+    full = np.nonzero(inside[:, -1])[0] if k < tree.n else np.empty(0, np.int64)
+    inside[full] = False
+    pid = [np.nonzero(inside)[0]]
+    vid = [idx[inside]]
+    if len(full):
+        lists = tree.query_ball_point(p[full], radius[full])
+        counts = np.fromiter((len(x) for x in lists), dtype=np.int64, count=len(lists))
+        pid.append(np.repeat(full, counts))
+        vid.append(np.concatenate([np.asarray(x, dtype=np.int64) for x in lists]))
+    return np.concatenate(pid), np.concatenate(vid)
+
+
+def hausdorff_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Symmetric Hausdorff distance between two finite point sets (m), by KD-trees.
+
+    Parameters
+    ----------
+    a : array_like, shape (n, 2)
+    b : array_like, shape (m, 2)
+    """
+    from scipy.spatial import cKDTree
+
+    pa = np.asarray(a, dtype=float).reshape(-1, 2)
+    pb = np.asarray(b, dtype=float).reshape(-1, 2)
+    if len(pa) == 0 or len(pb) == 0:
+        raise InvalidInputError("hausdorff_distance needs two non-empty point sets")
+    dab = cKDTree(pb).query(pa)[0].max()
+    dba = cKDTree(pa).query(pb)[0].max()
+    return float(max(dab, dba))
+
+
+def _densify(vertices: np.ndarray, spacing: float) -> np.ndarray:
+    """Polyline vertices plus points every ``<= spacing`` along each segment."""
+    v = np.asarray(vertices, dtype=float)
+    if len(v) < 2:
+        return v
+    seg = np.diff(v, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / spacing).astype(int))
+    idx = np.repeat(np.arange(len(seg)), n)
+    first = np.concatenate([[0], np.cumsum(n)[:-1]])
+    t = (np.arange(int(n.sum())) - first[idx]) / n[idx]
+    return np.vstack([v[idx] + t[:, None] * seg[idx], v[-1:]])
+
+
+def polyline_hausdorff(a: np.ndarray, b: np.ndarray, *, spacing: float) -> float:
+    """Symmetric Hausdorff distance between two polylines (m).
+
+    Each polyline is densified every ``spacing`` metres and the exact distance from those
+    points to the other polyline is taken, so the result is exact up to ``spacing / 2``
+    (and exact when the extreme deviation is at a vertex).
+    """
+    return float(max(_directed_polyline(a, b, spacing), _directed_polyline(b, a, spacing)))
+
+
+#: :func:`_directed_polyline` first measures every this-many-th point of the densified path.
+_COARSE_STEP = 8
+
+
+def _directed_polyline(a: np.ndarray, b: np.ndarray, spacing: float) -> float:
+    """``max_{p in densified a} dist(p, polyline b)``; exact distances only where needed.
+
+    ``d0``, the distance to the nearest point of ``b`` densified every ``spacing``, is at
+    least the exact distance and at most it plus ``spacing / 2``; so only the points with
+    ``d0`` within ``spacing / 2`` of a point's lower bound can hold the maximum, and the
+    exact distance (:func:`distance_to_polyline`, whose value at a point does not depend
+    on the other points) is taken for those only. ``d0`` is measured first at every
+    ``_COARSE_STEP``-th point: it is 1-Lipschitz, so ``d0`` at a neighbour plus the
+    distance to it bounds the points in between, and only those whose bound reaches the
+    coarse lower bound are measured. Every point that can hold the maximum is measured
+    exactly, so the result is the maximum over all the densified points, bit for bit.
+    """
+    from scipy.spatial import cKDTree
+
+    pa, pb = _densify(a, spacing), _densify(b, spacing)
+    tree = cKDTree(pb)
+    slack = 1e-9  # m; far above the rounding of the bounds (~1e-15 m)
+    n = len(pa)
+    cand = np.arange(n)
+    if n > 4 * _COARSE_STEP:
+        ci = np.unique(np.append(np.arange(0, n, _COARSE_STEP), n - 1))
+        dc = tree.query(pa[ci])[0]
+        low = float(np.max(dc)) - 0.5 * spacing  # the maximum is at least this
+        k = np.clip(np.searchsorted(ci, cand, side="right") - 1, 0, len(ci) - 2)
+        lo, hi = ci[k], ci[k + 1]
+        bound = np.minimum(
+            dc[k] + np.hypot(*(pa - pa[lo]).T), dc[k + 1] + np.hypot(*(pa - pa[hi]).T)
+        )  # >= d0 at every point
+        cand = cand[bound >= low - slack]
+    d0 = tree.query(pa[cand])[0]  # >= the exact distance, and <= it + spacing / 2
+    keep = cand[d0 >= d0.max() - 0.5 * spacing - slack]  # only these can hold the maximum
+    return float(distance_to_polyline(pa[keep], b).max())
+
+
+@dataclass(frozen=True, slots=True)
+class _Obstacles:
+    """The occupied squares of a grid that can be nearest to a point, and a KD-tree of them.
+
+    Only occupied cells with a free 8-neighbour or on the map edge can be nearest.
+    ``tree`` is ``None`` when nothing is occupied.
+    """
+
+    centres: np.ndarray
+    tree: Any
+    res: float
+    ox: float
+    oy: float
+    nx: int
+    ny: int
+
+
+#: The last few grids' obstacle trees, each with the grid it was built from (compared with
+#: ``is``, so a cached entry can never belong to another grid).
+_OBSTACLES: list[tuple[Any, _Obstacles]] = []
+_OBSTACLES_KEPT = 4
+
+
+def _obstacles(grid: Any) -> _Obstacles:
+    """Build (or fetch) the :class:`_Obstacles` of a grid.
+
+    An :class:`astar.OccupancyGrid` is immutable (its ``occupied`` is a read-only copy), so
+    its tree is kept for the next call: a benchmark scores every method's path of every
+    query against the same map. Other grid-like objects are rebuilt on every call.
+    """
+    from astar.grid import OccupancyGrid
+
+    cacheable = type(grid) is OccupancyGrid
+    if cacheable:
+        for g, obs in _OBSTACLES:
+            if g is grid:
+                return obs
+    from scipy.ndimage import binary_erosion
+    from scipy.spatial import cKDTree
+
+    occ = np.asarray(grid.occupied, dtype=bool)
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = occ.shape
+    if occ.any():
+        interior = binary_erosion(occ, structure=np.ones((3, 3), bool), border_value=0)
+        iy, ix = np.nonzero(occ & ~interior)
+        centres = np.column_stack([ox + (ix + 0.5) * res, oy + (iy + 0.5) * res])
+        tree = cKDTree(centres)
+    else:
+        centres, tree = np.empty((0, 2)), None
+    obs = _Obstacles(centres, tree, res, ox, oy, nx, ny)
+    if cacheable:
+        _OBSTACLES.insert(0, (grid, obs))
+        del _OBSTACLES[_OBSTACLES_KEPT:]
+    return obs
+
+
+def _square_distance(p: np.ndarray, obs: _Obstacles, d0: np.ndarray) -> np.ndarray:
+    """Exact distance from each point to the nearest obstacle square.
+
+    ``d0`` is each point's distance to the nearest obstacle centre: the nearest square
+    has its centre within ``d0 + res / sqrt(2)``, so the exact point-to-square distance
+    ``hypot(max(0, |dx| - res/2), max(0, |dy| - res/2))`` is evaluated for those only. A
+    point's value depends on that point alone (not on the others passed with it).
+    """
+    out = np.full(len(p), np.inf)
+    if obs.tree is None or not len(p):
+        return out
+    res, centres = obs.res, obs.centres
+    pid, cid = _neighbours_within(obs.tree, p, d0 + res * math.sqrt(0.5) + 1e-12)
+    dx = np.maximum(0.0, np.abs(p[pid, 0] - centres[cid, 0]) - 0.5 * res)
+    dy = np.maximum(0.0, np.abs(p[pid, 1] - centres[cid, 1]) - 0.5 * res)
+    np.minimum.at(out, pid, np.hypot(dx, dy))
+    return out
+
+
+def _border_distance(p: np.ndarray, obs: _Obstacles) -> np.ndarray:
+    """Distance from each point to the outside of the map (0 outside it)."""
+    edge = np.minimum.reduce(
+        [
+            p[:, 0] - obs.ox,
+            obs.ox + obs.nx * obs.res - p[:, 0],
+            p[:, 1] - obs.oy,
+            obs.oy + obs.ny * obs.res - p[:, 1],
+        ]
+    )
+    return np.maximum(edge, 0.0)
+
+
+def point_clearance(points: np.ndarray, grid: Any, *, border_occupied: bool = False) -> np.ndarray:
+    """Exact distance (m) from each point to the nearest occupied cell, cells as squares.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        World points in metres.
+    grid : astar.OccupancyGrid
+        The raw map.
+    border_occupied : bool
+        Treat everything outside the map as occupied (distance to the map edge counts).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        0 for points inside an occupied cell (or outside the map when
+        ``border_occupied``); ``inf`` when nothing is occupied.
+
+    Notes
+    -----
+    Only occupied cells with a free 8-neighbour or on the map edge can be nearest. A
+    KD-tree over their centres gives the nearest centre distance ``d0``; the nearest square
+    has its centre within ``d0 + res / sqrt(2)``, so the exact point-to-square distance
+    ``hypot(max(0, |dx| - res/2), max(0, |dy| - res/2))`` is evaluated for those only.
+    The tree of an :class:`astar.OccupancyGrid` is kept for the next calls (the last few
+    grids).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    obs = _obstacles(grid)
+    if obs.tree is not None and len(p):
+        out = _square_distance(p, obs, obs.tree.query(p)[0])
+    else:
+        out = np.full(len(p), np.inf)
+    if border_occupied:
+        out = np.minimum(out, _border_distance(p, obs))
+    return out
+
+
+def min_clearance(points: np.ndarray, grid: Any, *, border_occupied: bool = False) -> float:
+    """``point_clearance(points, grid, border_occupied=...).min()``, bit for bit, faster.
+
+    The distance to a square is at most the distance ``d0`` to its centre and at least
+    ``d0 - res / sqrt(2)``. So the minimum is at most ``m = min(d0)`` (with the border
+    distance), and only the points whose lower bound is within ``m`` (plus a rounding
+    slack) can hold it: the exact distances are evaluated for those points only, exactly
+    as :func:`point_clearance` evaluates them.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2), n >= 1
+    grid : astar.OccupancyGrid
+    border_occupied : bool
+
+    Returns
+    -------
+    float
+        ``inf`` when nothing is occupied (and the border is not).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if not len(p):
+        raise InvalidInputError("min_clearance needs at least one point")
+    obs = _obstacles(grid)
+    edge = _border_distance(p, obs) if border_occupied else np.full(len(p), np.inf)
+    if obs.tree is None:
+        return float(edge.min())
+    d0 = obs.tree.query(p)[0]
+    upper = float(np.minimum(d0, edge).min())  # the answer is at most this
+    lower = np.minimum(d0 - obs.res * math.sqrt(0.5), edge)  # each point's is at least this
+    keep = np.nonzero(lower <= upper + 1e-9 * (1.0 + abs(upper)))[0]
+    exact = _square_distance(p[keep], obs, d0[keep])
+    return float(np.minimum(exact, edge[keep]).min())
+
+
+def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
+
+
+def heading_jumps(headings: np.ndarray) -> np.ndarray:
+    """Absolute heading change between consecutive samples, wrapped to [0, pi] (rad)."""
+    h = np.asarray(headings, dtype=float)
+    d = np.diff(h)
+    return np.abs((d + np.pi) % (2.0 * np.pi) - np.pi)
+
+
+def _polyline_curvature(v: np.ndarray) -> tuple[float, float]:
+    """Discrete ``(max kappa, int kappa^2 ds)`` of a polyline (turn angle / local length)."""
+    if len(v) < 3:
+        return 0.0, 0.0
+    seg = np.diff(v, axis=0)
+    lens = np.hypot(seg[:, 0], seg[:, 1])
+    turn = heading_jumps(np.arctan2(seg[:, 1], seg[:, 0]))
+    local = 0.5 * (lens[:-1] + lens[1:])
+    kappa = turn / local
+    return float(kappa.max()), float(np.sum(turn * turn / local))
+
+
+# ============================================================================ path metrics
+def path_metrics(
+    path: object,
+    *,
+    grid: Any,
+    reference: object,
+    radius: float,
+    sample_spacing: float = DEFAULT_SAMPLE_SPACING,
+    params: np.ndarray | None = None,
+    border_occupied: bool = False,
+) -> PathMetrics:
+    """Score a curve or polyline against the raw map and the A* reference.
+
+    Parameters
+    ----------
+    path : ParametricCurve or array_like (n, 2) or PolylineCurve or astar.GridPath
+        The path to score (metres; a GridPath is converted with ``grid``).
+    grid : astar.OccupancyGrid
+        The raw map (clearance is measured to its occupied squares).
+    reference : array_like (N, 2) or PolylineCurve or astar.GridPath
+        The A* reference points ``Q_i`` (metres), in path order.
+    radius : float
+        Robot radius (m, >= 0): the collision threshold on the clearance.
+    sample_spacing : float
+        Arc-length spacing of the samples (m, > 0), also the spacing of the heading jumps.
+    params : array_like, shape (N,), optional
+        Curve parameters ``u_i`` matching the reference points: the MSE is then equation
+        (3) at these parameters instead of at the nearest points.
+    border_occupied : bool
+        Count the outside of the map as occupied for the clearance.
+
+    Returns
+    -------
+    PathMetrics
+    """
+    try:
+        ds = float(sample_spacing)
+        r = float(radius)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"sample_spacing and radius must be numbers, got {sample_spacing!r}, {radius!r}"
+        ) from exc
+    if not (math.isfinite(ds) and ds > 0):
+        raise InvalidInputError(f"sample_spacing must be finite and > 0 m, got {ds!r}")
+    if not (math.isfinite(r) and r >= 0):
+        raise InvalidInputError(f"radius must be finite and >= 0 m, got {r!r}")
+    if grid is None or not hasattr(grid, "occupied"):
+        raise InvalidInputError(f"grid must be an astar.OccupancyGrid, got {type(grid).__name__}")
+    ref = _points_of(reference, grid, "reference")
+    curve = _as_curve(path, grid)
+    is_poly = isinstance(curve, PolylineCurve)
+
+    length = float(curve.length)
+    if not math.isfinite(length):
+        raise InvalidInputError(f"path length must be finite, got {length!r} m")
+    if length / ds > _MAX_SAMPLES:
+        # a wildly oscillating fit (e.g. y = f(x) across a vertical stretch) would need
+        # billions of samples; coarsen the spacing (reported in sample_spacing_m)
+        ds = length / _MAX_SAMPLES
+    smp = curve.sample(ds=ds)
+    xy = np.asarray(smp.xy, dtype=float)
+    geom = np.vstack([xy, curve.points]) if is_poly else xy
+    length = float(curve.length)
+
+    # MSE (equation (3) / N)
+    if params is not None:
+        u = np.asarray(params, dtype=float)
+        if u.shape != (len(ref),):
+            raise InvalidInputError(
+                f"params must have shape ({len(ref)},) (one per reference point), got {u.shape}"
+            )
+        dev = np.asarray(curve(u), dtype=float) - ref
+        mse = float(np.mean(np.sum(dev * dev, axis=1)))
+    else:
+        line = curve.points if is_poly else xy
+        mse = float(np.mean(distance_to_polyline(ref, line) ** 2))
+
+    lo, hi = curve.domain
+    p0 = np.asarray(curve(lo), dtype=float).reshape(2)
+    p1 = np.asarray(curve(hi), dtype=float).reshape(2)
+    e0 = np.abs(p0 - ref[0])
+    e1 = np.abs(p1 - ref[-1])
+
+    curve_line = curve.points if is_poly else xy
+    haus = polyline_hausdorff(curve_line, ref, spacing=ds)
+
+    clear = min_clearance(geom, grid, border_occupied=border_occupied)
+    ref_len = float(np.sum(np.hypot(*np.diff(ref, axis=0).T))) if len(ref) > 1 else 0.0
+
+    if is_poly:
+        kmax, k2 = _polyline_curvature(np.asarray(curve.points))
+    else:
+        k = np.abs(np.asarray(smp.curvature, dtype=float))
+        kmax = float(np.max(k)) if len(k) else 0.0
+        k2 = float(_trapezoid(k * k, smp.s)) if len(k) > 1 else 0.0
+    rms = math.sqrt(k2 / length) if length > 0 and math.isfinite(k2) else math.nan
+    jumps = heading_jumps(np.asarray(curve.heading(smp.u), dtype=float))
+    return PathMetrics(
+        mse_m2=mse,
+        start_error_x_m=float(e0[0]),
+        start_error_y_m=float(e0[1]),
+        end_error_x_m=float(e1[0]),
+        end_error_y_m=float(e1[1]),
+        hausdorff_m=haus,
+        min_clearance_m=clear,
+        collision=bool(clear < r - _COLLISION_TOL),
+        length_m=length,
+        length_ratio=length / ref_len if ref_len > 0 else math.nan,
+        max_curvature_1pm=kmax,
+        rms_curvature_1pm=rms,
+        int_sq_curvature_1pm=k2,
+        max_heading_jump_rad=float(jumps.max()) if len(jumps) else 0.0,
+        sample_spacing_m=ds,
+        n_samples=int(len(xy)),
+    )
+
+
+# ============================================================================ trajectories
+_TRAJ_QUANTITIES = (
+    # (sample field, robot limit attribute, key stem, unit suffix)
+    ("v", "v_max", "v", "mps"),
+    ("a", "a_max", "a", "mps2"),
+    ("jerk", "j_max", "jerk", "mps3"),
+    ("omega", "omega_max", "omega", "radps"),
+    ("a_lat", "a_lat_max", "a_lat", "mps2"),
+)
+
+
+def _field(rec: Any, name: str) -> np.ndarray | None:
+    try:
+        val = rec[name]
+    except (KeyError, IndexError, TypeError):
+        val = getattr(rec, name, None)
+    return None if val is None else np.asarray(val, dtype=float)
+
+
+def trajectory_metrics(
+    traj: Any, robot: Any, *, dt: float = 0.005, tol: float = 1e-6
+) -> dict[str, Any]:
+    """Duration and peak |v|, |a|, |jerk|, |omega|, |a_lat| of a timed trajectory.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        Anything with ``duration`` (s) and ``sample(t)`` returning a mapping or record of
+        named arrays (``t, x, y, theta, v, omega, a, jerk, a_lat, kappa, s``).
+    robot : Robot
+        Anything with ``v_max, a_max, j_max, omega_max, a_lat_max`` (a missing or ``None``
+        limit gives a NaN ratio and is not checked).
+    dt : float
+        Sampling step (s, > 0); the end time is always sampled.
+    tol : float
+        Relative tolerance of ``within_limits``.
+
+    Returns
+    -------
+    dict
+        ``duration_s``, ``sample_dt_s``, and for each quantity ``q`` in ``v, a, jerk,
+        omega, a_lat``: ``peak_q_<unit>``, ``limit_q_<unit>`` and ``ratio_q`` (peak over
+        limit), plus ``within_limits`` (every ratio <= 1 + tol). ``a_lat`` falls back to
+        ``v^2 kappa`` when the samples lack it.
+    """
+    try:
+        step = float(dt)
+        duration = float(traj.duration)
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise InvalidInputError(f"traj needs a numeric duration and dt a number: {exc}") from exc
+    if not (math.isfinite(step) and step > 0):
+        raise InvalidInputError(f"dt must be finite and > 0 s, got {step!r}")
+    if not (math.isfinite(duration) and duration >= 0):
+        raise InvalidInputError(f"traj.duration must be finite and >= 0 s, got {duration!r}")
+    n = max(2, int(math.ceil(duration / step)) + 1)
+    t = np.linspace(0.0, duration, n)
+    rec = traj.sample(t)
+    out: dict[str, Any] = {"duration_s": duration, "sample_dt_s": duration / (n - 1)}
+    ok = True
+    for fld, lim_name, stem, unit in _TRAJ_QUANTITIES:
+        vals = _field(rec, fld)
+        if vals is None and fld == "a_lat":
+            v, kap = _field(rec, "v"), _field(rec, "kappa")
+            vals = None if v is None or kap is None else v * v * kap
+        peak = float(np.max(np.abs(vals))) if vals is not None and vals.size else math.nan
+        lim = getattr(robot, lim_name, None)
+        lim = math.nan if lim is None else float(lim)
+        ratio = peak / lim if lim > 0 else math.nan
+        out[f"peak_{stem}_{unit}"] = peak
+        out[f"limit_{stem}_{unit}"] = lim
+        out[f"ratio_{stem}"] = ratio
+        if math.isfinite(ratio) and ratio > 1.0 + tol:
+            ok = False
+    out["within_limits"] = ok
+    return out

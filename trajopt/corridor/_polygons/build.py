@@ -1,0 +1,478 @@
+"""Building the polygon corridor around a path (:func:`build_polygon_corridor`)."""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from trajopt._validation import nonnegative, positive
+from trajopt.corridor._polygons.path_kernels import (
+    centre_path,
+    junction_extensions,
+    path_clearances,
+    simplify_path,
+)
+from trajopt.corridor._polygons.region_kernels import certify_all, chain_geometry, grow_all
+from trajopt.corridor._polygons.regions import (
+    CLEARANCE_TOL_M,
+    ROUND_M,
+    ConvexPolygon,
+    PolygonCorridor,
+    degenerate_from,
+    point_region,
+    segment_region,
+    shoelace,
+)
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.geometry._clearance import grid_cells
+from trajopt.geometry._obstacle_index import ObstacleIndex
+
+logger = logging.getLogger("trajopt.corridor")
+
+MAX_SIDES = 256
+
+
+def _path_points(path: Any, res: float, ox: float, oy: float) -> np.ndarray:
+    """World points (m) of a GridPath / integer cells (cell centres) or float points."""
+    cells = getattr(path, "cells", None)
+    arr = np.asarray(path if cells is None else cells)
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
+        raise InvalidInputError(f"path must have shape (n, 2) with n >= 1, got {arr.shape}")
+    if np.issubdtype(arr.dtype, np.integer):
+        c = arr.astype(float)
+        return np.column_stack([ox + (c[:, 0] + 0.5) * res, oy + (c[:, 1] + 0.5) * res])
+    if not np.issubdtype(arr.dtype, np.floating):
+        raise InvalidInputError(
+            f"path must hold integer cells (ix, iy) or float world points (m), got {arr.dtype}"
+        )
+    p = arr.astype(float)
+    if not np.all(np.isfinite(p)):
+        raise InvalidInputError("path points must be finite")
+    return p
+
+
+def _point_name(i: int, n: int) -> str:
+    if i == 0:
+        return "start"
+    if i == n - 1:
+        return "goal"
+    return f"path point {i}"
+
+
+def build_polygon_corridor(
+    raw_grid: Any,
+    path: Any,
+    radius: float,
+    *,
+    margin_cells: float = 16.0,
+    max_segment_cells: float = 20.0,
+    overlap_cells: float = 4.0,
+    centre_cells: float = 1.0,
+    centre_trigger_cells: float = 2.0,
+    simplify_slack_cells: float = 0.3,
+    open_cells: float = 2.0,
+) -> PolygonCorridor:
+    """Grow a chain of certified convex polygons around a path (module docstring).
+
+    Parameters
+    ----------
+    raw_grid : astar.OccupancyGrid
+        The *raw* map (obstacles not inflated); the outside of the map counts as occupied.
+    path : astar.GridPath or array_like, shape (n, 2)
+        Integer cells ``(ix, iy)`` (a ``GridPath`` or an integer array; their cell centres
+        are used), or float world points (m), from start to goal. Every point and every
+        segment between consecutive points must keep ``radius`` from the raw map: an A*
+        path on ``astar.inflate(raw_grid, radius, metric="square", outside_occupied=True)``
+        does.
+    radius : float
+        Clearance (m) every region keeps from the raw map (finite, ``> 0``: at 0 the
+        certificate could not tell touching an obstacle from overlapping it).
+    margin_cells : float, optional
+        How far (cells) a region may reach beyond its seed's bounding box (> 0). Default 16.
+    max_segment_cells : float, optional
+        Longest segment (cells) of the simplified path, hence of a region's seed (> 0).
+        Default 20.
+    overlap_cells : float, optional
+        How far (cells) each seed reaches into the neighbouring segments, so that
+        consecutive regions share at least twice this much path where obstacles allow
+        (>= 0). Default 4.
+    centre_cells : float, optional
+        Largest push (cells) of an interior path point away from its nearest obstacle
+        (>= 0; 0 disables centring). Default 1.
+    centre_trigger_cells : float, optional
+        Only points closer than ``radius`` plus this (cells) to an obstacle are pushed
+        (>= 0). Default 2.
+    simplify_slack_cells : float, optional
+        Clearance (cells) a simplified segment may lose against the points it replaces,
+        never going below ``radius`` (>= 0). Default 0.3.
+    open_cells : float, optional
+        Clearance beyond ``radius`` plus this (cells) counts as open space when simplifying
+        (>= 0). Default 2.
+
+    Returns
+    -------
+    PolygonCorridor
+        Every region certified: exact clearance ``>= radius - CLEARANCE_TOL_M``.
+
+    Raises
+    ------
+    InvalidInputError
+        A path point outside the map; a start, goal or path point, or a path segment,
+        closer than ``radius`` to an occupied square or the outside of the map (a radius
+        larger than the free space there, or a gap narrower than ``2 radius``); fewer
+        than two distinct path points; an option out of range. The message names the
+        point, its clearance and the rule.
+    SmoothingError
+        A region failed its certificate or lost its seed (a bug: the construction
+        prevents both; the corridor is never returned then).
+
+    Notes
+    -----
+    Deterministic. Costs grow with the path length and the number of obstacle
+    rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
+    """
+    g = grow_regions(raw_grid, path, radius, margin_cells=margin_cells,
+                     max_segment_cells=max_segment_cells, overlap_cells=overlap_cells,
+                     centre_cells=centre_cells, centre_trigger_cells=centre_trigger_cells,
+                     simplify_slack_cells=simplify_slack_cells, open_cells=open_cells)  # fmt: skip
+    return assemble_corridor(*g)
+
+
+class GrownRegions(NamedTuple):
+    """Certified regions around a path, before the chain geometry (:func:`grow_regions`).
+
+    The first arguments of :func:`assemble_corridor`, in its order.
+    """
+
+    regions: list[ConvexPolygon]
+    hm: np.ndarray
+    vm: np.ndarray
+    nrow: np.ndarray
+    nvs: np.ndarray
+    degen: np.ndarray
+    path_m: np.ndarray
+    seed_src: np.ndarray
+    pts_m: np.ndarray
+    clear_m: np.ndarray
+    radius: float
+    resolution: float
+    origin: tuple[float, float]
+
+
+def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> GrownRegions:
+    """Grow and certify the regions of :func:`build_polygon_corridor` (same parameters).
+
+    ``options`` are its keyword options, with its defaults. Raises what it raises, but does
+    not compute the chain's intervals and overlaps (:func:`assemble_corridor` does).
+    """
+    unknown = sorted(set(options) - set(build_polygon_corridor.__kwdefaults__))
+    if unknown:
+        raise InvalidInputError(f"unknown corridor options {unknown}")
+    opt = {**build_polygon_corridor.__kwdefaults__, **options}
+    occ, res, ox, oy = grid_cells(raw_grid)
+    r = positive("radius", radius)
+    margin = positive("margin_cells", opt["margin_cells"])
+    max_len = positive("max_segment_cells", opt["max_segment_cells"])
+    ext = nonnegative("overlap_cells", opt["overlap_cells"])
+    push = nonnegative("centre_cells", opt["centre_cells"])
+    trigger = nonnegative("centre_trigger_cells", opt["centre_trigger_cells"])
+    slack = nonnegative("simplify_slack_cells", opt["simplify_slack_cells"])
+    open_c = nonnegative("open_cells", opt["open_cells"])
+    ny, nx = occ.shape
+    pts_m = _path_points(path, res, ox, oy)
+    n_in = len(pts_m)
+    r_c = r / res
+    tol_c = CLEARANCE_TOL_M / res
+    pc_ = (pts_m - np.array([ox, oy])) / res  # cell units
+    outside = (pc_[:, 0] < 0) | (pc_[:, 0] > nx) | (pc_[:, 1] < 0) | (pc_[:, 1] > ny)
+    if outside.any():
+        i = int(np.nonzero(outside)[0][0])
+        raise InvalidInputError(
+            f"{_point_name(i, n_in)} {pts_m[i].tolist()} m lies outside the map "
+            f"[{ox}, {ox + nx * res}] x [{oy}, {oy + ny * res}] m"
+        )
+    src, p = _distinct_points(pc_, n_in)
+    reach = margin + r_c + push + ext + 3.0
+    idx = ObstacleIndex(
+        occ,
+        int(math.floor(p[:, 0].min() - reach)),
+        int(math.ceil(p[:, 0].max() + reach)) + 1,
+        int(math.floor(p[:, 1].min() - reach)),
+        int(math.ceil(p[:, 1].max() + reach)) + 1,
+    )
+    opts = (margin, max_len, ext, push, trigger, slack, open_c)
+    seed, seed_src, hh, vv, nvs, degen = _grow_regions(idx, p, src, pts_m, r_c, tol_c, res, opts)
+    # the certificate: exact clearance of every region (cell units)
+    clear_c = certify_all(vv, nvs, r_c + 1.0, *idx.args)
+    bad = np.nonzero(clear_c < r_c - tol_c)[0]
+    if len(bad):
+        k = int(bad[0])
+        raise SmoothingError(
+            f"region {k} failed its certificate: clearance {clear_c[k] * res:.9g} m < radius "
+            f"{r} m - {CLEARANCE_TOL_M:g} m",
+            {"region": k, "clearance_m": float(clear_c[k] * res)},
+        )
+    logger.debug(
+        "polygon corridor: %d regions for %d path points (%d obstacle rectangles)",
+        len(seed) - 1,
+        n_in,
+        len(idx.rects),
+    )
+    regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
+    path_m = np.array([ox, oy]) + res * seed
+    path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
+    return GrownRegions(regions, hm, vm, nrow, nvs, degen, path_m, seed_src, pts_m,
+                        clear_c * res, r, res, (ox, oy))  # fmt: skip
+
+
+def _distinct_points(pc_: np.ndarray, n_in: int) -> tuple[np.ndarray, np.ndarray]:
+    """Return the path without repeated points (cell units) and where each kept one came from."""
+    keep_in = np.concatenate([[True], np.any(np.diff(pc_, axis=0) != 0.0, axis=1)])
+    src = np.nonzero(keep_in)[0]
+    p = np.ascontiguousarray(pc_[src])
+    if len(p) < 2:
+        raise InvalidInputError(
+            f"path needs at least two distinct points, got {len(p)} ({n_in} given)"
+        )
+    return src, p
+
+
+def _grow_regions(
+    idx: ObstacleIndex,
+    p: np.ndarray,
+    src: np.ndarray,
+    pts_m: np.ndarray,
+    r_c: float,
+    tol_c: float,
+    res: float,
+    opts: tuple,
+) -> tuple:
+    """Check, centre and simplify the path, then grow one region per simplified segment.
+
+    Check, centre and simplify the path, then grow one region per simplified segment (cell
+    units). Returns ``(seed, seed_src, hh, vv, nvs, degen)``.
+    """
+    margin, max_len, ext, push, trigger, slack, open_c = opts
+    args = idx.args
+    cap = r_c + open_c + 2.0
+    pcl, scl = path_clearances(p, cap, *args)
+    _check_path_clearance(pts_m, src, pcl, scl, r_c, tol_c, res)
+    # centre, then simplify
+    if push > 0.0 and len(p) > 2:
+        p = centre_path(p, r_c, push, trigger, 2, *args)
+        pcl, scl = path_clearances(p, cap, *args)
+    keep = simplify_path(p, pcl, scl, r_c, slack, open_c, max_len, *args)
+    seed = np.ascontiguousarray(p[keep])
+    seed_src = src[keep]
+    e = junction_extensions(seed, ext, r_c, tol_c, *args)
+    kmax = int(min(4 + len(idx.rects), MAX_SIDES))
+    hh, vv, nvs, status = grow_all(seed, e, r_c, margin, kmax, *args)
+    bad = np.nonzero(status >= 2)[0]
+    if len(bad):
+        k, st = int(bad[0]), int(status[bad[0]])
+        why = {
+            2: "its seed meets an obstacle's dilation",
+            3: "it lost a seed point",
+            4: f"it needs more than {kmax} sides",
+        }[st]
+        raise SmoothingError(
+            f"region {k} around path segment {seed_src[k]}..{seed_src[k + 1]} could not be "
+            f"grown: {why}",
+            {"region": k, "status": st},
+        )
+    degen = status == 1
+    for k in np.nonzero(degen)[0]:  # no interior: the seed segment, extended along its line
+        vv[k, :2] = _line_extension(seed[k], seed[k + 1], ext, r_c, tol_c, args)
+        nvs[k] = 2
+    return seed, seed_src, hh, vv, nvs, degen
+
+
+def _line_extension(
+    a: np.ndarray, b: np.ndarray, ext: float, r_c: float, tol_c: float, args: tuple
+) -> np.ndarray:
+    """Return the ends of segment ``a -> b`` extended along its line (cell units).
+
+    A degenerate region (a passage exactly ``2 r`` wide) is a segment of the line its
+    free space lies on. Its neighbours meet it where the path enters that line, often at
+    the tip of a wedge (the path reaches the line at an angle); a region holding only its
+    seed segment then overlaps the wedge in a sliver, and the control points shared by the
+    two regions are squeezed into it (the QP stalls or the curve nearly stops there).
+    Each end is therefore extended along the line by the largest of ``ext``, ``ext / 2``,
+    ``ext / 4`` (cells) whose added piece keeps ``r_c - tol_c`` from every obstacle, as
+    the seed extensions of the other regions are (the region is certified afterwards
+    like every other).
+    """
+    d = b - a
+    u = d / math.hypot(d[0], d[1])
+    cap = r_c + 1.0
+    out = np.array([a, b], dtype=float)
+    for end, sign in ((0, -1.0), (1, 1.0)):
+        p = out[end]
+        for e in (ext, 0.5 * ext, 0.25 * ext):
+            if e <= 0.0:
+                break
+            q = p + sign * e * u
+            _, sc = path_clearances(np.ascontiguousarray(np.array([p, q])), cap, *args)
+            if sc[0] >= r_c - tol_c:
+                out[end] = q
+                break
+    return out
+
+
+def metric_regions(
+    seed: np.ndarray,
+    hh: np.ndarray,
+    vv: np.ndarray,
+    nvs: np.ndarray,
+    degen: np.ndarray,
+    res: float,
+    origin: tuple[float, float],
+) -> tuple[list[ConvexPolygon], np.ndarray, np.ndarray, np.ndarray]:
+    """Return grown regions (cell units) in world metres: ``(regions, hm, vm, nrow)``.
+
+    ``hm[k, :nrow[k]]`` are region ``k``'s rows ``(a_x, a_y, b)`` (m), ``vm[k, :nvs[k]]``
+    its vertices (m); a degenerate region becomes its seed segment's region.
+    """
+    o = np.array(origin, dtype=float)
+    vm = o + res * vv
+    hm = hh.copy()
+    hm[:, :, 2] = res * hh[:, :, 2] + hh[:, :, :2] @ o
+    nrow = nvs.copy()
+    regions: list[ConvexPolygon] = []
+    for k in range(len(seed) - 1):
+        if degen[k]:
+            reg = segment_region(vm[k, 0], vm[k, 1])
+            nrow[k] = reg.n_sides
+            hm[k, : nrow[k], :2] = reg.A
+            hm[k, : nrow[k], 2] = reg.b
+        else:
+            n = nvs[k]
+            reg = ConvexPolygon._construct_fast(hm[k, :n, :2], hm[k, :n, 2], vm[k, :n], False)
+        regions.append(reg)
+    return regions, hm, vm, nrow
+
+
+def assemble_corridor(
+    regions: list[ConvexPolygon],
+    hm: np.ndarray,
+    vm: np.ndarray,
+    nrow: np.ndarray,
+    nvs: np.ndarray,
+    degen: np.ndarray,
+    path_m: np.ndarray,
+    seed_src: np.ndarray,
+    pts_m: np.ndarray,
+    clear: np.ndarray,
+    r: float,
+    res: float,
+    origin: tuple[float, float],
+) -> PolygonCorridor:
+    """Return the :class:`PolygonCorridor` of certified regions around the polyline ``path_m``.
+
+    Region ``k`` (world metres: ``regions[k]``, rows ``hm[k, :nrow[k]]``, vertices
+    ``vm[k, :nvs[k]]``) contains segment ``k`` of ``path_m`` (shape (m + 1, 2)); ``seed_src``
+    maps each vertex to the input path ``pts_m``; ``clear`` (m) is each region's certified
+    clearance. Computes the chain's path intervals, overlaps and transitions.
+    """
+    ox, oy = origin
+    m = len(path_m) - 1
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path_m, axis=0).T))])
+    region_s, overlap_s, ov_v, ov_h, ov_n = chain_geometry(
+        hm, vm, nrow, nvs, degen, path_m, s, ROUND_M
+    )
+    bad = np.nonzero(~np.isfinite(region_s[:, 0]))[0]
+    if len(bad):
+        raise SmoothingError(
+            f"region {int(bad[0])} does not contain its path segment", {"region": int(bad[0])}
+        )
+    bad = np.nonzero(~np.isfinite(overlap_s[:, 0]))[0]
+    if len(bad):
+        k = int(bad[0])
+        raise SmoothingError(
+            f"regions {k} and {k + 1} do not both contain their shared path vertex",
+            {"region": k},
+        )
+    region_index = np.column_stack(
+        [
+            np.searchsorted(s, region_s[:, 0] - 1e-12, side="left"),
+            np.searchsorted(s, region_s[:, 1] + 1e-12, side="right") - 1,
+        ]
+    )
+    overlaps: list[ConvexPolygon] = []
+    for k in range(m - 1):
+        n = int(ov_n[k])
+        v = ov_v[k, :n]
+        if n >= 3 and not (degen[k] or degen[k + 1]) and shoelace(v) > 0.0:
+            ov = ConvexPolygon._construct_fast(ov_h[k, :n, :2], ov_h[k, :n, 2], v, False)
+        elif n == 0:  # only touching at their shared path vertex (within rounding)
+            ov = point_region(path_m[k + 1])
+        else:
+            ov = degenerate_from(v)
+        overlaps.append(ov)
+    lo, hi = overlap_s[:, 0], overlap_s[:, 1]
+    trans = 0.5 * (
+        np.maximum(lo, 0.5 * (s[:-2] + s[1:-1])) + np.minimum(hi, 0.5 * (s[1:-1] + s[2:]))
+    )
+    trans_pts = np.column_stack(
+        [np.interp(trans, s, path_m[:, 0]), np.interp(trans, s, path_m[:, 1])]
+    ).reshape(-1, 2)
+    return PolygonCorridor(
+        regions=tuple(regions),
+        path=path_m,
+        path_s=s,
+        source_index=seed_src,
+        input_path=pts_m,
+        region_s=region_s,
+        region_index=region_index,
+        transitions_m=trans,
+        transition_points=trans_pts,
+        overlap_s=overlap_s,
+        overlaps=tuple(overlaps),
+        clearance_m=clear,
+        radius=r,
+        resolution=res,
+        origin=(ox, oy),
+    )
+
+
+def _check_path_clearance(
+    pts_m: np.ndarray,
+    src: np.ndarray,
+    pcl: np.ndarray,
+    scl: np.ndarray,
+    r_c: float,
+    tol_c: float,
+    res: float,
+) -> None:
+    """Raise for the first point, then segment, closer than ``r`` to the raw map.
+
+    Raise for the first point, then segment, closer than ``r`` to the raw map (``src`` maps the
+    de-duplicated points, whose clearances ``pcl``/``scl`` are in cells, to the input points
+    ``pts_m``).
+    """
+    n_in = len(pts_m)
+    bad = np.nonzero(pcl < r_c - tol_c)[0]
+    if len(bad):
+        # the end points first: a radius larger than the free space there
+        last = len(pcl) - 1
+        i = sorted(bad.tolist(), key=lambda j: (j not in (0, last), j))[0]
+        j = int(src[i])
+        raise InvalidInputError(
+            f"{_point_name(j, n_in)} {pts_m[j].tolist()} m has clearance {pcl[i] * res:.6g} m, "
+            f"less than the radius {r_c * res:.6g} m: every path point must keep the radius "
+            "from every occupied cell (a square) and from the outside of the map"
+        )
+    bad = np.nonzero(scl < r_c - tol_c)[0]
+    if len(bad):
+        i = int(bad[0])
+        a, b = int(src[i]), int(src[i + 1])
+        raise InvalidInputError(
+            f"path segment from point {a} {pts_m[a].tolist()} m to point {b} "
+            f"{pts_m[b].tolist()} m has clearance {scl[i] * res:.6g} m, less than the radius "
+            f"{r_c * res:.6g} m: it passes a gap narrower than 2 * radius = "
+            f"{2 * r_c * res:.6g} m; search the path on "
+            "astar.inflate(raw_grid, radius, metric='square', outside_occupied=True)"
+        )

@@ -1,0 +1,282 @@
+"""Planar B-spline curves ``(t, c, k)`` evaluated with de Boor's algorithm."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from trajopt._kernel_cache import watch_compiles
+from trajopt.errors import InvalidInputError
+from trajopt.geometry._curve import ParametricCurve
+
+
+class BSplineCurve(ParametricCurve):
+    """A planar B-spline ``C(u) = sum_i c_i B_{i,k}(u)``.
+
+    Parameters
+    ----------
+    t : array_like, shape (n + k + 1,)
+        Non-decreasing knots.
+    c : array_like, shape (n, 2)
+        Control points in metres.
+    k : int
+        Degree (>= 1).
+
+    Notes
+    -----
+    The curve is defined on ``[t[k], t[n]]``; parameters outside are clipped. For a
+    clamped knot vector (first and last knot repeated ``k + 1`` times) the curve starts at
+    ``c[0]`` and ends at ``c[-1]``, and span ``j`` (``t[k+j] <= u < t[k+j+1]``) lies in the
+    convex hull of ``c[j:j+k+1]``.
+    """
+
+    __slots__ = ("t", "c", "k", "_derivatives", "_arc_cache")
+
+    def __init__(self, t: np.ndarray, c: np.ndarray, k: int) -> None:
+        t = np.array(t, dtype=float)
+        c = np.array(c, dtype=float)
+        k = int(k)
+        if k < 1:
+            raise InvalidInputError(f"degree k must be >= 1, got {k}")
+        if c.ndim != 2 or c.shape[1] != 2:
+            raise InvalidInputError(f"control points c must have shape (n, 2), got {c.shape}")
+        n = c.shape[0]
+        if n < k + 1:
+            raise InvalidInputError(f"need at least k + 1 = {k + 1} control points, got {n}")
+        if t.shape != (n + k + 1,):
+            raise InvalidInputError(
+                f"need n + k + 1 = {n + k + 1} knots for {n} control points of degree {k}, "
+                f"got {t.shape[0] if t.ndim == 1 else t.shape}"
+            )
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(c))):
+            raise InvalidInputError("knots and control points must be finite")
+        if np.any(np.diff(t) < 0):
+            raise InvalidInputError("knots t must be non-decreasing")
+        if not t[n] > t[k]:
+            raise InvalidInputError(f"empty domain: t[k]={t[k]} must be < t[n]={t[n]}")
+        t.flags.writeable = False
+        c.flags.writeable = False
+        self.t, self.c, self.k = t, c, k
+        self._derivatives: dict[int, tuple[np.ndarray, np.ndarray]] = {0: (t, c)}
+
+    @classmethod
+    def from_scipy(cls, spline) -> BSplineCurve:
+        """Wrap a :class:`scipy.interpolate.BSpline` whose coefficients have shape (n, 2)."""
+        n = len(spline.t) - spline.k - 1
+        return cls(spline.t, np.asarray(spline.c)[:n], spline.k)
+
+    @property
+    def control_points(self) -> np.ndarray:
+        """Control points, shape (n, 2) (read-only view)."""
+        return self.c
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """Parameter interval ``(u0, u1)`` of the curve."""
+        n = self.c.shape[0]
+        return (float(self.t[self.k]), float(self.t[n]))
+
+    def breakpoints(self) -> np.ndarray:
+        """Return the parameters where the polynomial pieces meet (with the ends)."""
+        n = self.c.shape[0]
+        return np.unique(self.t[self.k : n + 1])
+
+    @property
+    def polynomial_degree(self) -> int:
+        """Degree of the polynomial pieces (the curvature bound uses it)."""
+        return self.k
+
+    def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        """Position or ``nu``-th derivative at ``u``; shape ``u.shape + (2,)``."""
+        uu = np.asarray(u, dtype=np.float64)
+        if nu > self.k:
+            return np.zeros(uu.shape + (2,))
+        t, c = self._derivative_coefficients(nu)  # float64, contiguous
+        flat = np.ascontiguousarray(uu.reshape(-1))
+        return de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
+
+    def derivative(self, nu: int = 1) -> BSplineCurve:
+        """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
+        if not 1 <= nu < self.k:
+            raise InvalidInputError(f"nu must be in [1, k-1] = [1, {self.k - 1}], got {nu}")
+        t, c = self._derivative_coefficients(nu)
+        return BSplineCurve(t, c, self.k - nu)
+
+    def _derivative_coefficients(self, nu: int) -> tuple[np.ndarray, np.ndarray]:
+        """Knots and control points of the ``nu``-th derivative (cached)."""
+        if nu not in self._derivatives:
+            t, c = self._derivative_coefficients(nu - 1)
+            td, cd = derivative_control_points(t, c, self.k - nu + 1)
+            # read-only like the curve's own: one compiled signature of the evaluator for all
+            td.flags.writeable = False
+            cd.flags.writeable = False
+            self._derivatives[nu] = td, cd
+        return self._derivatives[nu]
+
+    def tail(self, u0: float) -> BSplineCurve:
+        """Return the curve on ``[u0, t[n]]`` as a clamped B-spline of its own (exact).
+
+        ``u0`` is inserted as a knot until it has multiplicity ``k`` (Boehm's insertion,
+        which leaves the curve unchanged); the control points from the one at ``C(u0)`` on
+        are the tail's. Each new control point is a convex combination of the control
+        points of the span holding ``u0``, so it lies in every convex set holding them. The
+        derivatives' coefficients are cut the same way from this curve's own, so they stay
+        accurate when ``u0`` lies a hair before a knot (differences of the tail's control
+        points over so short a first span would not).
+
+        Parameters
+        ----------
+        u0 : float
+            Start of the tail, in ``[t[k], t[n])`` (the curve's parameter, unchanged).
+
+        Raises
+        ------
+        InvalidInputError
+            ``u0`` outside ``[t[k], t[n])``.
+        """
+        lo, hi = self.domain
+        u0 = float(u0)
+        if not lo <= u0 < hi:
+            raise InvalidInputError(f"u0 must lie in the domain [{lo}, {hi}), got {u0!r}")
+        if u0 == lo:
+            return self
+        out = BSplineCurve(*_tail_coefficients(self.t, self.c, self.k, u0), self.k)
+        for nu in range(1, self.k + 1):
+            out._derivatives[nu] = _tail_coefficients(
+                *self._derivative_coefficients(nu), self.k - nu, u0
+            )
+        return out
+
+    def span_of(self, u: np.ndarray | float) -> np.ndarray:
+        """Index ``j`` of the non-empty span holding ``u`` (control points ``c[j:j+k+1]``)."""
+        n = self.c.shape[0]
+        uu = np.clip(np.asarray(u, dtype=float), *self.domain)
+        j = np.searchsorted(self.t, uu, side="right") - 1
+        return np.clip(j, self.k, n - 1) - self.k
+
+    def __repr__(self) -> str:
+        return f"BSplineCurve(k={self.k}, n={self.c.shape[0]}, domain={self.domain})"
+
+
+def _tail_coefficients(t: np.ndarray, c: np.ndarray, k: int, u0: float):
+    """Knots and control points of the spline ``(t, c, k)`` (``k >= 0``) cut to ``[u0, ...]``.
+
+    Boehm's insertion of ``u0`` up to multiplicity ``k``; the tail starts with ``u0``
+    repeated ``k + 1`` times.
+    """
+    t, c = np.array(t, dtype=float), np.array(c, dtype=float)
+    for _ in range(max(0, k - int(np.count_nonzero(t == u0)))):
+        m = int(np.searchsorted(t, u0, side="right")) - 1  # t[m] <= u0 < t[m + 1]
+        i = np.arange(m - k + 1, m + 1)
+        alpha = ((u0 - t[i]) / (t[i + k] - t[i]))[:, None]
+        mixed = (1.0 - alpha) * c[i - 1] + alpha * c[i]
+        c = np.concatenate([c[: m - k + 1], mixed, c[m:]])
+        t = np.insert(t, m + 1, u0)
+    m = int(np.searchsorted(t, u0, side="right")) - 1  # the span [u0, next knot)
+    tt, cc = np.concatenate([[u0], t[m - k + 1 :]]), np.ascontiguousarray(c[m - k :])
+    tt.flags.writeable = False
+    cc.flags.writeable = False
+    return tt, cc
+
+
+def derivative_control_points(
+    t: np.ndarray, c: np.ndarray, k: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return the knots and control points of the derivative of the spline ``(t, c, k)``.
+
+    The derivative is a B-spline of degree ``k - 1`` on the knots ``t[1:-1]`` with control
+    points ``Q_i = k (c_{i+1} - c_i) / (t_{i+k+1} - t_{i+1})`` (``0`` where that knot
+    interval is empty).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n + k + 1,)
+    c : ndarray, shape (n, d)
+    k : int
+        Degree (>= 1).
+
+    Returns
+    -------
+    knots : ndarray, shape (n + k - 1,)
+    control_points : ndarray, shape (n - 1, d)
+    """
+    n = len(c)
+    den = t[k + 1 : n + k] - t[1:n]
+    q = np.zeros((n - 1, c.shape[1]))
+    ok = den > 0
+    q[ok] = k * np.diff(c, axis=0)[ok] / den[ok, None]
+    return t[1:-1], q
+
+
+watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+
+
+@njit(cache=True)
+def de_boor(t, c, k, u):  # pragma: no cover - compiled
+    """Evaluate the spline ``(t, c, k)`` with de Boor's algorithm.
+
+    Parameters
+    ----------
+    t : ndarray of float64, shape (n + k + 1,)
+        Non-decreasing knots (contiguous, as every array here: the function is compiled).
+    c : ndarray, shape (n, d)
+        Control points.
+    k : int
+        Degree (>= 0).
+    u : ndarray, shape (m,)
+        Parameters; those outside the domain ``[t[k], t[n]]`` are clamped to it (the last
+        span is closed on the right).
+
+    Returns
+    -------
+    ndarray, shape (m, d)
+        NaN rows where ``u`` is NaN.
+    """
+    n, dim = c.shape
+    out = np.empty((u.shape[0], dim))
+    d = np.empty((k + 1, dim))
+    lo = t[k]
+    hi = t[n]
+    for q in range(u.shape[0]):
+        x = u[q]
+        if not x == x:
+            out[q, :] = np.nan
+            continue
+        x = min(max(x, lo), hi)
+        j = np.searchsorted(t, x, side="right") - 1
+        j = min(max(j, k), n - 1)
+        for i in range(k + 1):
+            for a in range(dim):
+                d[i, a] = c[j - k + i, a]
+        for r in range(1, k + 1):
+            for i in range(k, r - 1, -1):
+                left = t[j - k + i]
+                alpha = (x - left) / (t[j + 1 + i - r] - left)
+                for a in range(dim):
+                    d[i, a] = (1.0 - alpha) * d[i - 1, a] + alpha * d[i, a]
+        for a in range(dim):
+            out[q, a] = d[k, a]
+    return out
+
+
+def clamped_uniform_knots(n: int, k: int, domain: tuple[float, float] = (0.0, 1.0)) -> np.ndarray:
+    """Clamped knot vector with uniform interior knots.
+
+    Parameters
+    ----------
+    n : int
+        Number of control points (>= k + 1).
+    k : int
+        Degree.
+    domain : tuple of float
+        ``(u0, u1)``.
+
+    Returns
+    -------
+    ndarray, shape (n + k + 1,)
+    """
+    if n < k + 1:
+        raise InvalidInputError(f"need n >= k + 1 = {k + 1} control points, got {n}")
+    a, b = domain
+    interior = np.linspace(a, b, n - k + 1)
+    return np.concatenate([np.full(k, a), interior, np.full(k, b)])

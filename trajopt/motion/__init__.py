@@ -1,0 +1,26 @@
+"""Timed motions as values: what the planner returns and what a robot drives.
+
+* :class:`Trajectory`: a timed smooth curve (built by :func:`trajopt.time_parameterize`);
+* :class:`StopAndTurnTrajectory`: a polyline driven straight with turns in place at rest
+  (built by :func:`trajopt.stop_and_turn`);
+* :class:`TurnInPlace` and :class:`TrajectoryChain`: a rotation at rest, and motions played
+  one after another (a braking re-plan);
+* :class:`TrajectorySample`, and the ROS 2 MCAP writer and reader.
+"""
+
+from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.motion._trajectory import Trajectory, TrajectorySample
+
+__all__ = [
+    "McapContents",
+    "McapExportError",
+    "StopAndTurnTrajectory",
+    "Trajectory",
+    "TrajectoryChain",
+    "TrajectorySample",
+    "TurnInPlace",
+    "read_mcap",
+    "write_mcap",
+]

@@ -1,0 +1,493 @@
+"""ROS 2 MCAP files of a planned trajectory: what RViz and Foxglove open.
+
+:func:`write_mcap` (and :meth:`Trajectory.to_mcap`) writes an MCAP file with the ``ros2``
+profile: each topic carries a standard ROS 2 message type whose definition is stored in the
+file (``ros2msg`` schema encoding), and each message is serialised in CDR (the ROS 2 wire
+format, little-endian), so any ROS 2 MCAP reader decodes it without this library:
+
+==================  ================================  =============================================
+topic               type                              content
+==================  ================================  =============================================
+``/map``            ``nav_msgs/msg/OccupancyGrid``    the raw map (100 occupied, 0 free)
+``/map_inflated``   ``nav_msgs/msg/OccupancyGrid``    the grid the robot centre moved in
+``/plan``           ``nav_msgs/msg/Path``             the samples' poses (heading quaternions)
+``/corridor``       ``visualization_msgs/msg/MarkerArray``  one closed ``LINE_STRIP`` per region
+``/pose``           ``geometry_msgs/msg/PoseStamped`` one per sample, stamped at its time
+``/twist``          ``geometry_msgs/msg/TwistStamped`` ``linear.x = v``, ``angular.z = omega``
+==================  ================================  =============================================
+
+The maps and the corridor come from ``trajectory.steps`` (a trajectory returned by
+:func:`trajopt.plan`); a trajectory timed by hand has only ``/plan``, ``/pose`` and
+``/twist``. Poses are in ``frame_id`` (default ``"map"``), twists in ``child_frame_id``
+(default ``"base_link"``, the robot frame: ``v`` forward, ``omega`` counter-clockwise).
+Every message is logged at its header stamp: ``start_time`` (s since the Unix epoch,
+default 0) plus the sample time; the map, path and corridor at ``start_time``.
+
+The file is written atomically (a temporary file beside it, then a rename): a failure
+leaves no partial file. :func:`read_mcap` reads such a file back.
+
+Needs the ``mcap`` and ``mcap-ros2-support`` packages (``pip install trajopt[ros]``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from astar.files import atomic_write
+from astar.grid import OccupancyGrid
+from trajopt.errors import InvalidInputError, TrajoptError
+
+#: Topic -> ROS 2 message type written by :func:`write_mcap`.
+TOPICS: dict[str, str] = {
+    "/map": "nav_msgs/msg/OccupancyGrid",
+    "/map_inflated": "nav_msgs/msg/OccupancyGrid",
+    "/plan": "nav_msgs/msg/Path",
+    "/corridor": "visualization_msgs/msg/MarkerArray",
+    "/pose": "geometry_msgs/msg/PoseStamped",
+    "/twist": "geometry_msgs/msg/TwistStamped",
+}
+
+
+class McapExportError(TrajoptError, OSError):
+    """The MCAP file cannot be written or read (the message names the file and the cause)."""
+
+
+# ============================================================== message definitions
+# The standard ROS 2 interface definitions (fields only), one block per type; a schema is
+# its type's block followed by the blocks of every type it uses.
+_DEFS: dict[str, str] = {
+    "builtin_interfaces/Time": "int32 sec\nuint32 nanosec",
+    "builtin_interfaces/Duration": "int32 sec\nuint32 nanosec",
+    "std_msgs/Header": "builtin_interfaces/Time stamp\nstring frame_id",
+    "std_msgs/ColorRGBA": "float32 r\nfloat32 g\nfloat32 b\nfloat32 a",
+    "geometry_msgs/Point": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Vector3": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Quaternion": "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1",
+    "geometry_msgs/Pose": "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation",
+    "geometry_msgs/PoseStamped": "std_msgs/Header header\ngeometry_msgs/Pose pose",
+    "geometry_msgs/Twist": "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular",
+    "geometry_msgs/TwistStamped": "std_msgs/Header header\ngeometry_msgs/Twist twist",
+    "nav_msgs/MapMetaData": (
+        "builtin_interfaces/Time map_load_time\nfloat32 resolution\nuint32 width\n"
+        "uint32 height\ngeometry_msgs/Pose origin"
+    ),
+    "nav_msgs/OccupancyGrid": "std_msgs/Header header\nnav_msgs/MapMetaData info\nint8[] data",
+    "nav_msgs/Path": "std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses",
+    "sensor_msgs/CompressedImage": "std_msgs/Header header\nstring format\nuint8[] data",
+    "visualization_msgs/UVCoordinate": "float32 u\nfloat32 v",
+    "visualization_msgs/MeshFile": "string filename\nuint8[] data",
+    "visualization_msgs/Marker": (
+        "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\n"
+        "int32 LINE_LIST=5\nint32 CUBE_LIST=6\nint32 SPHERE_LIST=7\nint32 POINTS=8\n"
+        "int32 TEXT_VIEW_FACING=9\nint32 MESH_RESOURCE=10\nint32 TRIANGLE_LIST=11\n"
+        "int32 ARROW_STRIP=12\nint32 ADD=0\nint32 MODIFY=0\nint32 DELETE=2\nint32 DELETEALL=3\n"
+        "std_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\n"
+        "geometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n"
+        "builtin_interfaces/Duration lifetime\nbool frame_locked\n"
+        "geometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\nstring texture_resource\n"
+        "sensor_msgs/CompressedImage texture\n"
+        "visualization_msgs/UVCoordinate[] uv_coordinates\nstring text\nstring mesh_resource\n"
+        "visualization_msgs/MeshFile mesh_file\nbool mesh_use_embedded_materials"
+    ),
+    "visualization_msgs/MarkerArray": "visualization_msgs/Marker[] markers",
+}
+_SEP = "=" * 80
+
+
+def _uses(name: str) -> list[str]:
+    """Types used by ``name``, depth first, each once."""
+    out: list[str] = []
+
+    def visit(t: str) -> None:
+        for line in _DEFS[t].splitlines():
+            ftype = line.split()[0].removesuffix("[]")
+            if "/" in ftype and ftype not in out:
+                visit(ftype)
+                out.append(ftype)
+
+    visit(name)
+    return out
+
+
+def message_definition(datatype: str) -> str:
+    """Return the ``ros2msg`` schema text of ``datatype`` (e.g. ``"nav_msgs/msg/Path"``)."""
+    short = datatype.replace("/msg/", "/")
+    parts = [_DEFS[short]]
+    for dep in _uses(short):
+        parts.append(f"{_SEP}\nMSG: {dep}\n{_DEFS[dep]}")
+    return "\n".join(parts) + "\n"
+
+
+# ============================================================== CDR encoding
+class _Cdr:
+    """Little-endian CDR (XCDR1) writer.
+
+    Primitives aligned to their size from the start of the payload (after the 4-byte
+    encapsulation header).
+    """
+
+    __slots__ = ("buf",)
+
+    def __init__(self) -> None:
+        self.buf = bytearray(b"\x00\x01\x00\x00")
+
+    def _align(self, n: int) -> None:
+        pad = (-(len(self.buf) - 4)) % n
+        if pad:
+            self.buf += b"\x00" * pad
+
+    def pack(self, fmt: str, size: int, *values: Any) -> None:
+        self._align(size)
+        self.buf += struct.pack("<" + fmt, *values)
+
+    def string(self, s: str) -> None:
+        data = s.encode("utf-8") + b"\x00"
+        self.pack("I", 4, len(data))
+        self.buf += data
+
+    def byte_seq(self, data: bytes) -> None:
+        self.pack("I", 4, len(data))
+        self.buf += data
+
+    def time(self, ns: int) -> None:
+        self.pack("iI", 4, ns // 1_000_000_000, ns % 1_000_000_000)
+
+    def header(self, ns: int, frame_id: str) -> None:
+        self.time(ns)
+        self.string(frame_id)
+
+    def pose(self, x: float, y: float, qz: float, qw: float) -> None:
+        self.pack("7d", 8, x, y, 0.0, 0.0, 0.0, qz, qw)
+
+    def data(self) -> bytes:
+        return bytes(self.buf)
+
+
+def _encode_grid(grid: OccupancyGrid, ns: int, frame_id: str) -> bytes:
+    w = _Cdr()
+    w.header(ns, frame_id)
+    w.time(ns)
+    ny, nx = grid.shape
+    w.pack("fII", 4, float(grid.resolution), nx, ny)
+    w.pose(float(grid.origin[0]), float(grid.origin[1]), 0.0, 1.0)
+    w.byte_seq(np.where(grid.occupied, 100, 0).astype(np.int8).tobytes())
+    return w.data()
+
+
+def _encode_pose_stamped(w: _Cdr, ns: int, frame_id: str, x, y, qz, qw) -> None:
+    w.header(ns, frame_id)
+    w.pose(x, y, qz, qw)
+
+
+def _encode_path(ns0: int, stamps, frame_id: str, x, y, qz, qw) -> bytes:
+    w = _Cdr()
+    w.header(ns0, frame_id)
+    w.pack("I", 4, len(stamps))
+    for k in range(len(stamps)):
+        _encode_pose_stamped(w, int(stamps[k]), frame_id, x[k], y[k], qz[k], qw[k])
+    return w.data()
+
+
+def _encode_markers(polygons: list[np.ndarray], ns: int, frame_id: str) -> bytes:
+    w = _Cdr()
+    w.pack("I", 4, len(polygons))
+    for k, poly in enumerate(polygons):
+        w.header(ns, frame_id)
+        w.string("corridor")
+        w.pack("iii", 4, k, 4, 0)  # id, LINE_STRIP, ADD
+        w.pose(0.0, 0.0, 0.0, 1.0)
+        w.pack("3d", 8, 0.01, 0.0, 0.0)  # scale.x: line width (m)
+        w.pack("4f", 4, 0.1, 0.45, 0.85, 1.0)
+        w.pack("iI", 4, 0, 0)  # lifetime 0: forever
+        w.pack("?", 1, False)
+        closed = np.vstack([poly, poly[:1]]) if len(poly) > 1 else poly
+        w.pack("I", 4, len(closed))
+        for px, py in closed:
+            w.pack("3d", 8, float(px), float(py), 0.0)
+        w.pack("I", 4, 0)  # colors
+        w.string("")  # texture_resource
+        w.header(0, "")  # texture.header
+        w.string("")  # texture.format
+        w.byte_seq(b"")  # texture.data
+        w.pack("I", 4, 0)  # uv_coordinates
+        w.string("")  # text
+        w.string("")  # mesh_resource
+        w.string("")  # mesh_file.filename
+        w.byte_seq(b"")  # mesh_file.data
+        w.pack("?", 1, False)
+    return w.data()
+
+
+# ============================================================== write
+def write_mcap(
+    trajectory: Any,
+    path: str | os.PathLike[str],
+    *,
+    dt: float = 0.01,
+    frame_id: str = "map",
+    child_frame_id: str = "base_link",
+    start_time: float = 0.0,
+) -> Path:
+    """Write a timed trajectory (and its map and corridor) as a ROS 2 MCAP file.
+
+    Parameters
+    ----------
+    trajectory : Trajectory or StopAndTurnTrajectory
+        The motion; its ``steps`` (when present) give the maps and the corridor.
+    path : str or os.PathLike
+        Output file (``.mcap``); its folder is created if needed.
+    dt : float, optional
+        Sample spacing (s) of ``/pose``, ``/twist`` and ``/plan`` (the end time is always
+        included).
+    frame_id, child_frame_id : str, optional
+        The fixed frame of poses, maps and markers, and the robot frame of the twists.
+    start_time : float, optional
+        Stamp of ``t = 0`` in seconds since the Unix epoch (finite, ``>= 0``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    InvalidInputError
+        A bad ``dt``, ``start_time`` or frame name.
+    McapExportError
+        The file cannot be written (the message names it and the cause), or the ``mcap``
+        package is missing.
+    """
+    for name, value in (("frame_id", frame_id), ("child_frame_id", child_frame_id)):
+        if not isinstance(value, str) or not value:
+            raise InvalidInputError(f"{name} must be a non-empty string, got {value!r}")
+    if isinstance(start_time, bool) or not isinstance(start_time, int | float):
+        raise InvalidInputError(f"start_time must be a number of seconds, got {start_time!r}")
+    if not (math.isfinite(start_time) and 0.0 <= start_time < 2.0**31):
+        raise InvalidInputError(
+            f"start_time must be finite and in [0, 2^31) s since the epoch, got {start_time!r}"
+        )
+    try:
+        from mcap.writer import CompressionType, Writer
+    except ImportError:  # pragma: no cover - the ros extra is part of dev
+        raise McapExportError(
+            "writing MCAP needs the 'mcap' package: pip install 'trajopt[ros]'"
+        ) from None
+    smp = trajectory.sample_uniform(dt)
+    whole = math.floor(start_time)
+    ns0 = int(whole) * 1_000_000_000 + int(round((start_time - whole) * 1e9))
+    stamps = ns0 + np.rint(np.asarray(smp.t) * 1e9).astype(np.int64)
+    x = np.asarray(smp.x, dtype=float)
+    y = np.asarray(smp.y, dtype=float)
+    half = 0.5 * np.asarray(smp.theta, dtype=float)
+    qz, qw = np.sin(half), np.cos(half)
+    v = np.asarray(smp.v, dtype=float)
+    om = np.asarray(smp.omega, dtype=float)
+    steps = getattr(trajectory, "steps", None)
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as f:
+            mw = Writer(f, compression=CompressionType.ZSTD)
+            mw.start(profile="ros2", library="trajopt")
+            schema_ids: dict[str, int] = {}
+            channels: dict[str, int] = {}
+
+            def channel(topic: str) -> int:
+                dtype = TOPICS[topic]
+                if dtype not in schema_ids:
+                    schema_ids[dtype] = mw.register_schema(
+                        name=dtype, encoding="ros2msg",
+                        data=message_definition(dtype).encode("utf-8"),
+                    )  # fmt: skip
+                channels[topic] = mw.register_channel(
+                    topic=topic, message_encoding="cdr", schema_id=schema_ids[dtype]
+                )
+                return channels[topic]
+
+            if steps is not None:
+                for topic, grid in (
+                    ("/map", steps.raw_grid),
+                    ("/map_inflated", steps.inflated_grid),
+                ):
+                    mw.add_message(channel(topic), log_time=ns0, publish_time=ns0,
+                                   data=_encode_grid(grid, ns0, frame_id))  # fmt: skip
+            mw.add_message(channel("/plan"), log_time=ns0, publish_time=ns0,
+                           data=_encode_path(ns0, stamps, frame_id, x, y, qz, qw))  # fmt: skip
+            if steps is not None and steps.corridor is not None:
+                polys = _corridor_polygons(steps.corridor)
+                mw.add_message(channel("/corridor"), log_time=ns0, publish_time=ns0,
+                               data=_encode_markers(polys, ns0, frame_id))  # fmt: skip
+            c_pose, c_twist = channel("/pose"), channel("/twist")
+            for k in range(len(stamps)):
+                ns = int(stamps[k])
+                w = _Cdr()
+                _encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
+                mw.add_message(c_pose, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
+                w = _Cdr()
+                w.header(ns, child_frame_id)
+                w.pack("6d", 8, v[k], 0.0, 0.0, 0.0, 0.0, om[k])
+                mw.add_message(c_twist, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
+            mw.finish()
+
+    target = Path(path)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        return atomic_write(target, write)
+    except OSError as exc:
+        raise McapExportError(f"{target}: cannot write the MCAP file: {exc}") from exc
+
+
+def _corridor_polygons(corridor: Any) -> list[np.ndarray]:
+    regions = getattr(corridor, "regions", None)
+    if regions is None:
+        regions = getattr(corridor, "boxes", ())
+    out = []
+    for r in regions:
+        verts = r.vertices() if callable(r.vertices) else r.vertices
+        out.append(np.asarray(verts, dtype=float).reshape(-1, 2))
+    return out
+
+
+# ============================================================== read
+@dataclass(frozen=True)
+class McapContents:
+    """What :func:`read_mcap` found in a file written by :func:`write_mcap`.
+
+    Attributes
+    ----------
+    stamps_ns : ndarray of int64, shape (n,)
+        Header stamps of the ``/pose`` messages (ns since the epoch).
+    t : ndarray, shape (n,)
+        Time since the first pose (s).
+    x, y, theta : ndarray, shape (n,)
+        Poses (m, m, rad; ``theta`` from the quaternion, unwrapped).
+    v, omega : ndarray, shape (n,)
+        ``/twist`` ``linear.x`` (m/s) and ``angular.z`` (rad/s).
+    path : ndarray, shape (m, 3)
+        ``/plan`` poses ``(x, y, theta)``.
+    maps : dict of str to OccupancyGrid
+        ``/map`` and ``/map_inflated`` when present (occupied = value 100). The message
+        stores the resolution as float32; it is read back as the shortest decimal that
+        rounds to that float32 (so 0.05 stays 0.05).
+    corridor : list of ndarray, shape (k, 2) each
+        The corridor regions' closed outlines from ``/corridor``.
+    frame_id, child_frame_id : str
+        Frames of the poses and of the twists.
+    """
+
+    stamps_ns: np.ndarray
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    path: np.ndarray
+    maps: dict[str, OccupancyGrid] = field(default_factory=dict)
+    corridor: list[np.ndarray] = field(default_factory=list)
+    frame_id: str = ""
+    child_frame_id: str = ""
+
+
+def read_mcap(path: str | os.PathLike[str]) -> McapContents:
+    """Read back a file written by :func:`write_mcap` (decoded by ``mcap-ros2-support``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The MCAP file.
+
+    Returns
+    -------
+    McapContents
+
+    Raises
+    ------
+    McapExportError
+        The file is missing, not MCAP, or lacks the ``/pose`` and ``/twist`` topics.
+    """
+    p = Path(path)
+    try:
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
+    except ImportError:  # pragma: no cover
+        raise McapExportError(
+            "reading MCAP needs 'mcap' and 'mcap-ros2-support': pip install 'trajopt[ros]'"
+        ) from None
+    poses: list[tuple[int, float, float, float, float]] = []
+    twists: list[tuple[float, float]] = []
+    path_rows: list[tuple[float, float, float]] = []
+    maps: dict[str, OccupancyGrid] = {}
+    corridor: list[np.ndarray] = []
+    frames = {"frame_id": "", "child_frame_id": ""}
+    try:
+        with open(p, "rb") as f:
+            reader = make_reader(f, decoder_factories=[DecoderFactory()])
+            for _schema, channel, _msg, ros in reader.iter_decoded_messages():
+                topic = channel.topic
+                if topic == "/pose":
+                    st = ros.header.stamp
+                    o = ros.pose.orientation
+                    poses.append((st.sec * 1_000_000_000 + st.nanosec, ros.pose.position.x,
+                                  ros.pose.position.y, o.z, o.w))  # fmt: skip
+                    frames["frame_id"] = ros.header.frame_id
+                elif topic == "/twist":
+                    twists.append((ros.twist.linear.x, ros.twist.angular.z))
+                    frames["child_frame_id"] = ros.header.frame_id
+                elif topic == "/plan":
+                    for ps in ros.poses:
+                        o = ps.pose.orientation
+                        path_rows.append((ps.pose.position.x, ps.pose.position.y,
+                                          2.0 * math.atan2(o.z, o.w)))  # fmt: skip
+                elif topic in ("/map", "/map_inflated"):
+                    info = ros.info
+                    data = np.frombuffer(bytes(ros.data), dtype=np.int8) if isinstance(
+                        ros.data, bytes | bytearray) else np.asarray(ros.data, dtype=np.int8)  # fmt: skip
+                    occ = data.reshape(info.height, info.width) == 100
+                    # MapMetaData.resolution is float32: take the shortest decimal that
+                    # rounds to it (0.03 for float32(0.03)), the value a map YAML gave
+                    res = float(np.format_float_positional(np.float32(info.resolution)))
+                    maps[topic] = OccupancyGrid(
+                        occ, res,
+                        (info.origin.position.x, info.origin.position.y),
+                    )  # fmt: skip
+                elif topic == "/corridor":
+                    for m in ros.markers:
+                        corridor.append(np.array([[q.x, q.y] for q in m.points], dtype=float))
+    except OSError as exc:
+        raise McapExportError(f"{p}: cannot read the MCAP file: {exc}") from exc
+    except Exception as exc:  # the mcap reader raises its own types on malformed files
+        raise McapExportError(
+            f"{p}: not a readable MCAP file ({type(exc).__name__}: {exc})"
+        ) from exc
+    if not poses or len(twists) != len(poses):
+        raise McapExportError(
+            f"{p}: expected /pose and /twist messages of equal count (a file written by "
+            f"trajopt.write_mcap), found {len(poses)} and {len(twists)}"
+        )
+    arr = np.array(poses, dtype=object)
+    stamps = np.array([r[0] for r in poses], dtype=np.int64)
+    xyq = np.array([r[1:] for r in poses], dtype=float)
+    del arr
+    theta = np.unwrap(2.0 * np.arctan2(xyq[:, 2], xyq[:, 3]))
+    tw = np.array(twists, dtype=float)
+    return McapContents(
+        stamps_ns=stamps,
+        t=(stamps - stamps[0]) / 1e9,
+        x=xyq[:, 0],
+        y=xyq[:, 1],
+        theta=theta,
+        v=tw[:, 0],
+        omega=tw[:, 1],
+        path=np.array(path_rows, dtype=float).reshape(-1, 3),
+        maps=maps,
+        corridor=corridor,
+        frame_id=frames["frame_id"],
+        child_frame_id=frames["child_frame_id"],
+    )

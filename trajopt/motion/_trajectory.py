@@ -1,0 +1,551 @@
+"""A timed trajectory along a planar curve: ``t -> (x, y, theta, v, omega, a, jerk, ...)``.
+
+The motion along arc length ``s(t)`` is a chain of constant-jerk phases (the pieces of the
+ruckig profiles and greedy steps made by :func:`trajopt.time_parameterize`). Each phase is
+stored as its start time and start state ``(s, v, a)`` plus its jerk, so sampling any
+number of times is a vectorised ``searchsorted`` and a cubic polynomial: no per-sample call
+into ruckig. Pose, heading and curvature then come from the curve at ``u = u_at_s(s)``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from astar.files import atomic_write
+from trajopt._validation import number, readonly
+from trajopt.errors import InvalidInputError
+from trajopt.geometry._curve import ParametricCurve
+from trajopt.robot._robot import Robot
+from trajopt.robot._state import State
+
+#: Unit of every sampled quantity.
+SAMPLE_UNITS: dict[str, str] = {
+    "t": "s",
+    "x": "m",
+    "y": "m",
+    "theta": "rad",
+    "v": "m/s",
+    "omega": "rad/s",
+    "a": "m/s^2",
+    "jerk": "m/s^3",
+    "a_lat": "m/s^2",
+    "kappa": "1/m",
+    "s": "m",
+    "v_left": "m/s",
+    "v_right": "m/s",
+}
+
+
+class TrajectorySample(NamedTuple):
+    """Samples of a :class:`Trajectory`; every array has the shape of the query times.
+
+    Attributes
+    ----------
+    t : time (s), clipped to ``[0, duration]``
+    x, y : position (m)
+    theta : heading from the curve's tangent, continuous and unwrapped (rad)
+    v : speed along the path ``ds/dt`` (m/s)
+    omega : yaw rate ``kappa * v`` (rad/s)
+    a : tangential acceleration (m/s^2)
+    jerk : tangential jerk (m/s^3)
+    a_lat : signed lateral acceleration ``kappa * v^2`` (m/s^2)
+    kappa : signed curvature (1/m)
+    s : arc length travelled (m)
+    v_left, v_right : wheel speeds ``v * (1 -+ kappa * track_width / 2)`` (m/s), or ``None``
+        when the robot has no ``track_width``
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    a: np.ndarray
+    jerk: np.ndarray
+    a_lat: np.ndarray
+    kappa: np.ndarray
+    s: np.ndarray
+    v_left: np.ndarray | None = None
+    v_right: np.ndarray | None = None
+
+    def as_dict(self) -> dict[str, np.ndarray]:
+        """Return the arrays by name (``v_left``/``v_right`` only when present)."""
+        return {k: v for k, v in self._asdict().items() if v is not None}
+
+
+def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample:
+    """Return a :class:`TrajectorySample` of read-only copies of ``arrays``.
+
+    ``arrays`` holds ``t``, ``x``, ``y``, ``theta``, ``v``, ``omega``, ``a``, ``jerk``,
+    ``a_lat``, ``kappa`` and ``s``; the wheel speeds ``v -+ omega * track_width / 2`` are
+    added when the robot has a track width.
+    """
+    if robot.track_width is not None:
+        half = 0.5 * robot.track_width
+        arrays["v_left"] = arrays["v"] - arrays["omega"] * half
+        arrays["v_right"] = arrays["v"] + arrays["omega"] * half
+    return TrajectorySample(**{k: readonly(x) for k, x in arrays.items()})
+
+
+class SampledExport:
+    """The sampling and file export shared by every timed trajectory of :mod:`trajopt`.
+
+    A subclass provides ``duration`` (s), ``sample(t)`` returning a
+    :class:`TrajectorySample` and ``to_dict(dt)``; the helpers below give it
+    ``sample_uniform``, ``to_poses`` and the writers ``to_json``, ``to_csv`` and
+    ``to_mcap`` (atomic writes, each naming the frame of its poses).
+    """
+
+    __slots__ = ()
+
+    def sample_uniform(self, dt: float) -> TrajectorySample:
+        """Sample every ``dt`` seconds from 0, plus the end time ``duration``.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), > 0.
+        """
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise InvalidInputError(f"dt must be a finite number > 0 s, got {dt!r}")
+        duration = self.duration  # type: ignore[attr-defined]
+        n = int(math.floor(duration / dt + 1e-9))
+        t = np.arange(n + 1) * dt
+        if t[-1] < duration - 1e-12:
+            t = np.append(t, duration)
+        else:
+            t[-1] = min(t[-1], duration)
+        return self.sample(t)  # type: ignore[attr-defined]
+
+    def to_json(self, path: str | os.PathLike, dt: float = 0.01, *, frame_id: str = "map") -> Path:
+        """Write :meth:`to_dict` as JSON (atomically: temp file + rename); returns the path.
+
+        The top-level ``frame_id`` names the frame of ``x``, ``y`` and ``theta``.
+        """
+        frame = _frame_id(frame_id)
+        out = {"frame_id": frame, **self.to_dict(dt)}  # type: ignore[attr-defined]
+        return _atomic_write(Path(path), json.dumps(out, indent=1))
+
+    def to_csv(self, path: str | os.PathLike, dt: float = 0.01, *, frame_id: str = "map") -> Path:
+        """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
+
+        The first line is the header: one column per sampled quantity (``t``, ``x``, ``y``,
+        ``theta``, ``v``, ``omega``, ``a``, ``jerk``, ``a_lat``, ``kappa``, ``s``, and
+        ``v_left``, ``v_right`` when the robot has a track width), each named with its unit
+        in brackets, e.g. ``t [s]``, ``v [m/s]``. The pose columns also name their frame in
+        parentheses: ``x [m] (map)``, ``y [m] (map)``, ``theta [rad] (map)``. Every other
+        line is one sample, all numbers, so the file reads with no options:
+        ``pandas.read_csv(path)`` keeps these column names, and
+        ``numpy.genfromtxt(path, delimiter=",", names=True)`` gives a structured array whose
+        field names drop the brackets and other punctuation and put ``_`` for spaces
+        (``t_s``, ``x_m_map``, ``theta_rad_map``, ``v_ms``, ``a_ms2``).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file; missing parent folders are created.
+        dt : float
+            Time step (s), > 0; the end time ``duration`` is always the last row.
+        frame_id : str
+            Frame of ``x``, ``y`` and ``theta`` (default ``"map"``). It goes into the header,
+            so it may not contain ``,``, ``"``, ``#``, ``(``, ``)`` or control characters.
+
+        Raises
+        ------
+        InvalidInputError
+            ``dt`` is not a finite number > 0, or ``frame_id`` is not a non-empty one-line
+            string that a CSV header can carry.
+        """
+        frame = _csv_frame_id(frame_id)
+        smp = self.sample_uniform(dt).as_dict()
+        names = list(smp)
+        import io
+
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow([_csv_column(n, frame) for n in names])
+        cols = np.column_stack([np.asarray(smp[n]) for n in names])
+        for row in cols:
+            w.writerow([repr(float(x)) for x in row])
+        return _atomic_write(Path(path), buf.getvalue())
+
+    def state_at(self, t: float) -> State:
+        """Return the robot's :class:`~trajopt.robot._state.State` at time ``t`` (s).
+
+        Position, heading, signed curvature, speed and tangential acceleration of the
+        trajectory at ``t``, which must lie in ``[0, duration]``: the start of a re-plan
+        (:meth:`trajopt.Planner.replan`).
+
+        Raises
+        ------
+        InvalidInputError
+            ``t`` is not a number in ``[0, duration]``.
+        """
+        duration = float(self.duration)  # type: ignore[attr-defined]
+        tt = number("t", t, unit="s", lo=0.0, hi=duration)
+        smp = self.sample(np.array([tt]))  # type: ignore[attr-defined]
+        return State(
+            x=float(smp.x[0]),
+            y=float(smp.y[0]),
+            theta=float(smp.theta[0]),
+            kappa=float(smp.kappa[0]),
+            v=max(0.0, float(smp.v[0])),
+            a=float(smp.a[0]),
+        )
+
+    def to_poses(self, dt: float = 0.01) -> np.ndarray:
+        """Poses every ``dt`` seconds in the shape of ``nav_msgs/Path``, without ROS.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), > 0; the end time is always included.
+
+        Returns
+        -------
+        ndarray, structured, shape (n,)
+            Records ``(t, x, y, qz, qw)`` of float64: time (s), position (m) and the
+            heading as a unit quaternion about z (``qz = sin(theta/2)``,
+            ``qw = cos(theta/2)``).
+        """
+        smp = self.sample_uniform(dt)
+        out = np.empty(len(smp.t), dtype=POSE_DTYPE)
+        half = 0.5 * np.asarray(smp.theta)
+        out["t"], out["x"], out["y"] = smp.t, smp.x, smp.y
+        out["qz"], out["qw"] = np.sin(half), np.cos(half)
+        return out
+
+    def to_mcap(
+        self,
+        path: str | os.PathLike,
+        dt: float = 0.01,
+        *,
+        frame_id: str = "map",
+        child_frame_id: str = "base_link",
+        start_time: float = 0.0,
+    ) -> Path:
+        """Write a ROS 2 MCAP file: maps, path, corridor, stamped poses and twists.
+
+        See :func:`trajopt.motion._mcap.write_mcap` (topics, types, frames and stamps).
+        """
+        from trajopt.motion._mcap import write_mcap
+
+        return write_mcap(
+            self, path, dt=dt, frame_id=frame_id, child_frame_id=child_frame_id,
+            start_time=start_time,
+        )  # fmt: skip
+
+
+class AtRestEnds(SampledExport):
+    """A :class:`SampledExport` that starts and ends at rest (stop-and-turn moves, turns)."""
+
+    __slots__ = ()
+
+    @property
+    def v_start(self) -> float:
+        """Speed at the start: always 0 (m/s)."""
+        return 0.0
+
+    @property
+    def v_end(self) -> float:
+        """Speed at the end: always 0 (m/s)."""
+        return 0.0
+
+
+#: The record of :meth:`Trajectory.to_poses`.
+POSE_DTYPE = np.dtype([("t", "f8"), ("x", "f8"), ("y", "f8"), ("qz", "f8"), ("qw", "f8")])
+
+
+def _frame_id(value: object) -> str:
+    if not isinstance(value, str) or not value or "\n" in value:
+        raise InvalidInputError(f"frame_id must be a non-empty one-line string, got {value!r}")
+    return value
+
+
+# Sampled quantities whose CSV column names the frame (the pose in that frame).
+_CSV_POSE_COLUMNS: tuple[str, ...] = ("x", "y", "theta")
+
+# Characters a ``frame_id`` may not contain in a CSV header: the delimiter, the quote,
+# numpy's comment mark, the parentheses around the frame.
+_CSV_FRAME_FORBIDDEN = frozenset(',"#()')
+
+
+def _csv_column(name: str, frame_id: str) -> str:
+    """Return the CSV header of the sampled quantity ``name``.
+
+    ``"<name> [<unit>]"`` with the unit from :data:`SAMPLE_UNITS`, followed by
+    ``" (<frame_id>)"`` for the pose columns ``x``, ``y`` and ``theta``.
+    """
+    head = f"{name} [{SAMPLE_UNITS[name]}]"
+    return f"{head} ({frame_id})" if name in _CSV_POSE_COLUMNS else head
+
+
+def _csv_frame_id(value: object) -> str:
+    frame = _frame_id(value)
+    bad = sorted({c for c in frame if c in _CSV_FRAME_FORBIDDEN or not c.isprintable()})
+    if bad:
+        raise InvalidInputError(
+            f"frame_id {frame!r} contains {''.join(bad)!r}: a CSV header's frame may not "
+            "contain ',', '\"', '#', '(', ')' or control characters"
+        )
+    return frame
+
+
+def export_dict(traj: Any, fmt: str, dt: float, extra: dict[str, Any]) -> dict[str, Any]:
+    """Return the ``to_dict`` layout shared by the trajectory classes.
+
+    A header (format, units, duration, length, end speeds, robot, stats), then ``extra``, then
+    the ``samples``.
+    """
+    smp = traj.sample_uniform(dt).as_dict()
+    units = {k: u for k, u in SAMPLE_UNITS.items() if k in smp}
+    out: dict[str, Any] = {
+        "format": fmt,
+        "units": units,
+        "duration": traj.duration,
+        "duration_unit": "s",
+        "length": traj.length,
+        "length_unit": "m",
+        "v_start": traj.v_start,
+        "v_end": traj.v_end,
+        "robot": traj.robot.to_dict(),
+        "stats": _jsonable(traj.stats),
+    }
+    out.update(extra)
+    out["samples"] = {k: np.asarray(x).tolist() for k, x in smp.items()}
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class Trajectory(SampledExport):
+    """A jerk-limited timed motion along a curve.
+
+    Built by :func:`trajopt.time_parameterize`; the constructor checks shapes only.
+
+    Parameters
+    ----------
+    path : ParametricCurve
+        The curve followed (e.g. the smoother's ``SmoothPath``).
+    robot : Robot
+        The limits the timing holds.
+    phase_t : array_like, shape (p,)
+        Start time of each constant-jerk phase (s); ``phase_t[0] == 0``, non-decreasing.
+    phase_s, phase_v, phase_a : array_like, shape (p,)
+        Arc length (m), speed (m/s) and acceleration (m/s^2) at the start of each phase.
+    phase_j : array_like, shape (p,)
+        Jerk during each phase (m/s^3).
+    duration : float
+        End time (s); the motion ends at ``s = path.length`` with speed ``v_end``.
+    v_start, v_end : float
+        Speeds at the start and at the end (m/s).
+    stats : dict
+        Per-stage wall times (s) and counts; the pipeline may add its own entries.
+    theta_grid_s, theta_grid : array_like, shape (g,)
+        A dense table of the unwrapped heading (rad) against arc length (m), the reference
+        that makes sampled headings continuous.
+    u_grid : array_like, shape (g,) or (0,)
+        Curve parameter at ``theta_grid_s``: a table that speeds up the arc-length lookup.
+    steps : object, optional
+        The pipeline's intermediate results (``trajopt._planner.PlanSteps``) when planned by
+        :func:`trajopt.plan`, else ``None``.
+    """
+
+    path: ParametricCurve
+    robot: Robot
+    phase_t: np.ndarray
+    phase_s: np.ndarray
+    phase_v: np.ndarray
+    phase_a: np.ndarray
+    phase_j: np.ndarray
+    duration: float
+    v_start: float
+    v_end: float
+    stats: dict[str, Any] = field(default_factory=dict)
+    theta_grid_s: np.ndarray = field(default_factory=lambda: readonly([]))
+    theta_grid: np.ndarray = field(default_factory=lambda: readonly([]))
+    u_grid: np.ndarray = field(default_factory=lambda: readonly([]))
+    steps: Any = None
+
+    def __post_init__(self) -> None:
+        names = ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j")
+        arrays = [readonly(getattr(self, n)) for n in names]
+        p = arrays[0].shape
+        for n, arr in zip(names, arrays, strict=True):
+            if arr.ndim != 1 or arr.shape != p or p[0] < 1:
+                raise InvalidInputError(
+                    f"{n} must have shape (p,) with p >= 1 like phase_t {p}, got {arr.shape}"
+                )
+            object.__setattr__(self, n, arr)
+        if not math.isfinite(self.duration) or self.duration < arrays[0][-1]:
+            raise InvalidInputError(
+                f"duration must be finite and >= the last phase start {arrays[0][-1]}, "
+                f"got {self.duration!r}"
+            )
+        object.__setattr__(self, "duration", float(self.duration))
+        gs, gt = readonly(self.theta_grid_s), readonly(self.theta_grid)
+        if gs.shape != gt.shape or gs.ndim != 1:
+            raise InvalidInputError(
+                f"theta_grid_s and theta_grid must have equal shapes (g,), got {gs.shape}, "
+                f"{gt.shape}"
+            )
+        object.__setattr__(self, "theta_grid_s", gs)
+        object.__setattr__(self, "theta_grid", gt)
+        ug = readonly(self.u_grid)
+        if ug.shape[0] and ug.shape != gs.shape:
+            raise InvalidInputError(
+                f"u_grid must be empty or have the shape of theta_grid_s {gs.shape}, got {ug.shape}"
+            )
+        object.__setattr__(self, "u_grid", ug)
+
+    # ------------------------------------------------------------------ basic
+    @property
+    def length(self) -> float:
+        """Arc length of the path (m)."""
+        return float(self.path.length)
+
+    @property
+    def n_phases(self) -> int:
+        """Number of constant-jerk phases."""
+        return int(self.phase_t.shape[0])
+
+    def motion(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
+        """Return the motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
+
+        Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
+        ``(length, v_end, 0, 0)``.
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        k = np.searchsorted(self.phase_t, tt, side="right") - 1
+        k = np.clip(k, 0, self.phase_t.shape[0] - 1)
+        tau = tt - self.phase_t[k]
+        j = self.phase_j[k]
+        a0 = self.phase_a[k]
+        v0 = self.phase_v[k]
+        s = self.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
+        v = v0 + tau * (a0 + 0.5 * j * tau)
+        a = a0 + j * tau
+        end = tt >= self.duration
+        length = self.length
+        s = np.where(end, length, np.clip(s, 0.0, length))
+        v = np.where(end, self.v_end, np.where((v < 0.0) & (v > -1e-9), 0.0, v))
+        a = np.where(end, 0.0, a)
+        j = np.where(end, 0.0, j)
+        return s, v, a, j
+
+    def _u_at_s(self, s: np.ndarray) -> np.ndarray:
+        """Curve parameter at arc length ``s``.
+
+        The dense ``u_grid`` table, then Newton steps on ``path.s_at_u``, repeated (at most 6)
+        where a step moved ``u`` by more than 1e-9 of the domain (near a sharp curvature peak
+        the table's first guess can be 1e-5 of the domain off). Falls back to ``path.u_at_s``
+        without a table.
+        """
+        path = self.path
+        if self.u_grid.shape[0] < 2:
+            return np.asarray(path.u_at_s(s))
+        u = np.array(np.interp(s, self.theta_grid_s, self.u_grid), dtype=float)
+        ss = np.broadcast_to(np.asarray(s, dtype=float), u.shape)
+        lo, hi = path.domain
+        todo = np.ones(u.shape, dtype=bool)  # only points whose last step moved go on
+        for _ in range(6):
+            uu = u[todo]
+            sp = np.asarray(path.speed(uu))
+            err = np.asarray(path.s_at_u(uu)) - ss[todo]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = np.where(sp > 0, err / sp, 0.0)
+            u[todo] = np.clip(uu - step, lo, hi)
+            # Newton converges quadratically: after a step below 1e-9 of the domain the
+            # next would be ~1e-16 of it, so only larger steps are followed up
+            moving = np.abs(step) > 1e-9 * (hi - lo)
+            if not np.any(moving):
+                break
+            todo[todo] = moving
+        return u
+
+    def sample(self, t: np.ndarray | float) -> TrajectorySample:
+        """Evaluate the trajectory at times ``t`` (vectorised).
+
+        Parameters
+        ----------
+        t : float or array_like, any shape
+            Times (s); clipped to ``[0, duration]``.
+
+        Returns
+        -------
+        TrajectorySample
+            Read-only arrays of the shape of ``t`` (see :class:`TrajectorySample`).
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        s, v, a, j = self.motion(tt)
+        path = self.path
+        u = self._u_at_s(s)
+        xy = np.asarray(path(u))
+        raw = np.asarray(path.heading(u))
+        kappa = np.asarray(path.curvature(u))
+        if self.theta_grid_s.shape[0] >= 2:
+            ref = np.interp(s, self.theta_grid_s, self.theta_grid)
+            theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
+        else:
+            theta = raw
+        omega = kappa * v
+        return make_sample(self.robot, t=tt, x=xy[..., 0], y=xy[..., 1], theta=theta, v=v,
+                           omega=omega, a=a, jerk=j, a_lat=omega * v, kappa=kappa, s=s)  # fmt: skip
+
+    # ------------------------------------------------------------------ export
+    def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
+        """Return a JSON-ready description: units, robot, stats, the exact phases and samples.
+
+        Parameters
+        ----------
+        dt : float
+            Sample spacing (s) of the ``samples`` table.
+        """
+        phases = {
+            "units": {"t": "s", "s": "m", "v": "m/s", "a": "m/s^2", "jerk": "m/s^3"},
+            "t": self.phase_t.tolist(),
+            "s": self.phase_s.tolist(),
+            "v": self.phase_v.tolist(),
+            "a": self.phase_a.tolist(),
+            "jerk": self.phase_j.tolist(),
+        }
+        return export_dict(self, "trajopt.Trajectory", dt, {"phases": phases})
+
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory(duration={self.duration:.4g} s, length={self.length:.4g} m, "
+            f"phases={self.n_phases})"
+        )
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, (str, int, float, bool)) or x is None:
+        return x
+    return repr(x)
+
+
+def _atomic_write(path: Path, text: str) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+
+    return atomic_write(path, write)

@@ -1,0 +1,237 @@
+"""The planner's corridor-and-fit stage.
+
+Polygons first, boxes where they fail, and the witness rescue of a curvature-bounded fit.
+
+Functions take the :class:`~trajopt._planner.Planner` (its raw map, robot, inflation,
+corridor kind and smoother) and the query record (:class:`~trajopt.planning._query.PlanQuery`),
+whose timer gets the corridor builds under ``corridor`` and the fits (and the witness
+search) under ``smooth``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt.corridor import Box, Corridor, PolygonCorridor, build_corridor, build_polygon_corridor
+from trajopt.corridor._polygons.reuse import corridor_with_rest
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.geometry._clearance import box_clearance
+from trajopt.planning._feasibility import curvature_witness, witness_grid_path
+from trajopt.planning._query import PlanQuery, PlanSteps
+from trajopt.smoother import Smoother, SmoothPath
+
+logger = logging.getLogger("trajopt._planner")
+
+
+def fit_in_corridor(
+    planner: Any, q: PlanQuery, path: Any, smoother: Smoother, witness: np.ndarray | None = None
+) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
+    """Build the corridor around ``path`` and fit in it.
+
+    Polygons first (when chosen), then boxes; the fits share ``smoother.time_budget_s``
+    (the corridor builds do not count against it). With a curvature ``witness`` (points, m,
+    from :func:`~trajopt.planning._feasibility.curvature_witness`), the polygons are grown around the
+    witness itself (:func:`witness_corridor`), the boxes around ``path``.
+
+    Returns ``(corridor, smooth_path)``; raises the box fit's ``SmoothingError`` (or
+    ``InvalidInputError``) when every corridor failed.
+    """
+    spent = 0.0  # seconds spent fitting: the corridor builds (and numba's first
+    # compilation of their kernels) do not count against the smoother's budget
+    kinds = ["boxes"]
+    if planner.corridor == "polygons" and planner.inflation == "exact":
+        kinds.insert(0, "polygons")
+    first_failure: SmoothingError | None = None
+    for i, kind in enumerate(kinds):
+        last = i == len(kinds) - 1
+        try:
+            with q.timer.stage("corridor"):
+                if kind == "polygons" and witness is not None:
+                    corridor = witness_corridor(planner.grid, planner.robot.radius, witness)
+                    q.regions_kept = 0
+                elif kind == "polygons":
+                    corridor, q.regions_kept = polygon_corridor(planner, path, q.start, q.goal,
+                                                                q.previous)  # fmt: skip
+                else:
+                    corridor = box_corridor(planner, q.inflated, path, q.start, q.goal)
+        except InvalidInputError as exc:
+            if last and first_failure is not None:
+                # the polygons were built but the fit in them failed: that is the failure
+                raise first_failure from exc
+            if last:
+                raise
+            logger.debug("%s corridor not built (%s); trying the next kind", kind, exc)
+            continue
+        left = smoother.time_budget_s - spent
+        t_fit = time.perf_counter()
+        try:
+            if left <= 0:
+                raise SmoothingError("time budget exhausted before the box corridor", {})
+            sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
+            with q.timer.stage("smooth"):
+                smooth = sm.fit(path, corridor, raw_grid=planner.grid,
+                                radius=planner.robot.radius, start=q.start, goal=q.goal,
+                                start_heading=q.start_heading, goal_heading=q.goal_heading,
+                                start_curvature=q.start_curvature,
+                                footprint=planner.smoothing_footprint)  # fmt: skip
+            return corridor, smooth
+        except SmoothingError as exc:
+            spent += time.perf_counter() - t_fit
+            if last:
+                raise
+            first_failure = first_failure or exc
+            logger.debug("fit in the %s corridor failed (%s); trying the next kind", kind, exc)
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def witness_rescue(
+    planner: Any, q: PlanQuery, exc: SmoothingError, t_start: float
+) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath]:
+    """Return the second try of a curvature-bounded fit, along a witness.
+
+    A witness that keeps one cell more than the radius is tried first (its grid path
+    stays off the inflated grid's edges, so the corridor has room to turn; its search
+    is capped at 1 s), then one with the exact radius. The polygons of each try are grown
+    around the witness (:func:`witness_corridor`), the boxes around the grid path that
+    follows it. Both tries share the smoother's time budget, counted from ``t_start``.
+
+    Raises
+    ------
+    SmoothingError
+        ``exc`` itself without a curvature bound (no rescue); else, when no try gives a
+        curve, ``exc`` with what the rescue found appended to its message and under
+        ``stats["witness"]``: whether the witness search found a curvature-bounded path.
+    """
+    sm = planner.smoother
+    if sm.kappa_max is None:
+        raise exc
+    radius = planner.robot.radius
+    grid = planner.grid
+    note = "no time left for the witness search"
+    for margin, cap_s in ((grid.resolution, 1.0), (0.0, math.inf)):
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            break
+        with q.timer.stage("smooth"):
+            witness = curvature_witness(
+                grid, radius + margin, q.start, q.goal, sm.kappa_max,
+                time_limit_s=min(left, cap_s),
+            )  # fmt: skip
+            cells = None if witness is None else witness_grid_path(witness, q.inflated)
+        if cells is None or len(cells) < 2:
+            if not note.startswith("a curvature-bounded path exists"):
+                note = "no curvature-bounded path found by the witness search"
+            continue
+        note = "a curvature-bounded path exists, but no certified curve was fitted along it"
+        steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+        length = float(np.sum(np.where(steps == 2, np.sqrt(2.0), 1.0)))
+        path = astar.GridPath(cells=cells, length=length, cost=length, expanded=0)
+        left = sm.time_budget_s - (time.perf_counter() - t_start)
+        if left <= 0:
+            break
+        try:
+            corridor, smooth = fit_in_corridor(
+                planner, q, path, dataclasses.replace(sm, time_budget_s=left), witness
+            )
+        except (SmoothingError, InvalidInputError) as exc2:
+            logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
+            continue
+        return path, corridor, smooth
+    raise SmoothingError(f"{exc}; witness rescue: {note}", dict(exc.stats, witness=note)) from exc
+
+
+#: the polygons of a witness rescue are grown around every this-many-th witness point (the
+#: witness is sampled at most an eighth of a cell apart: about every half cell)
+WITNESS_STRIDE = 4
+
+
+def witness_corridor(
+    raw_grid: OccupancyGrid, radius: float, witness: np.ndarray
+) -> PolygonCorridor:
+    """Polygons around a curvature witness's own points (m), not centred.
+
+    A witness keeps the exact radius and bends at the curvature bound, often along a wall;
+    the corridor of the grid path that follows it is centred away from the walls and
+    simplified into long segments, and can leave the witness's arcs outside every region
+    (no curvature-bounded curve in it). Grown around about every half cell of the witness,
+    without centring (``centre_cells=0``), the regions follow its arcs.
+    """
+    pts = np.vstack([witness[::WITNESS_STRIDE][:-1], witness[-1:]])
+    return build_polygon_corridor(raw_grid, pts, radius, centre_cells=0.0)
+
+
+def polygon_corridor(
+    planner: Any, path: Any, p0: np.ndarray, p1: np.ndarray, previous: PlanSteps | None = None
+) -> tuple[PolygonCorridor, int]:
+    """Polygons around the A* path, from the exact start to the exact goal.
+
+    With a re-plan's ``previous`` steps, their polygon corridor's regions along the rest
+    of the path the two share are kept when still certified
+    (:func:`~trajopt.corridor._polygons.reuse.corridor_with_rest`). Returns the corridor and
+    the number of regions kept.
+    """
+    centres = np.asarray(planner.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
+    points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
+    radius = planner.robot.radius
+    if previous is not None and isinstance(previous.corridor, PolygonCorridor):
+        out = corridor_with_rest(planner.grid, points, radius, previous.corridor,
+                                 previous.raw_grid)  # fmt: skip
+        if out is not None:
+            return out
+    return build_polygon_corridor(planner.grid, points, radius), 0
+
+
+def box_corridor(
+    planner: Any, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray
+) -> Corridor:
+    """Boxes of free cells around the A* path, the end boxes widened to the exact ends.
+
+    Bridges (45-degree regions certified against the raw map) cross diagonal gaps; not
+    with the chapter's avoidance area, which the curve must not enter either.
+    """
+    bridge_map = planner.grid if planner.inflation == "exact" else None
+    corridor = build_corridor(inflated, path, radius=planner.robot.radius, raw_grid=bridge_map)
+    return widen_end_boxes(corridor, planner.grid, p0, p1, planner.robot.radius)
+
+
+def widen_end_boxes(
+    corridor: Corridor, raw: OccupancyGrid, p0: np.ndarray, p1: np.ndarray, radius: float
+) -> Corridor:
+    """Widen the first/last box to hold the exact start/goal, after an exact clearance check."""
+    boxes = list(corridor.boxes)
+    changed = False
+    for name, idx, p in (("start", 0, p0), ("goal", len(boxes) - 1, p1)):
+        b = boxes[idx]
+        if b.contains(p):
+            continue
+        lo = np.minimum([b.xmin, b.ymin], p)
+        hi = np.maximum([b.xmax, b.ymax], p)
+        clr = box_clearance(raw, lo, hi)
+        if clr < radius:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m cannot join the corridor with clearance {radius} m: "
+                f"the box joining it to the path comes {clr:.4g} m from an obstacle; move it "
+                "towards free space or onto the centre of its cell"
+            )
+        boxes[idx] = Box(
+            xmin=float(lo[0]),
+            xmax=float(hi[0]),
+            ymin=float(lo[1]),
+            ymax=float(hi[1]),
+            ix0=b.ix0,
+            ix1=b.ix1,
+            iy0=b.iy0,
+            iy1=b.iy1,
+        )
+        changed = True
+    if not changed:
+        return corridor
+    return dataclasses.replace(corridor, boxes=tuple(boxes))

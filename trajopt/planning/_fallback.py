@@ -1,0 +1,55 @@
+"""The planner's opt-in stop-and-turn fallback along the A* polyline."""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import SmoothingError
+from trajopt.geometry._clearance import polyline_clearance
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.planning._corridor_fit import box_corridor
+from trajopt.timing._stop_and_turn import stop_and_turn
+
+logger = logging.getLogger(__name__)
+
+
+def polyline_fallback(planner: Any, q: Any, exc: Exception) -> tuple[StopAndTurnTrajectory, dict]:
+    """Return a planner's stop-and-turn trajectory along the A* polyline, or re-raise ``exc``.
+
+    The polyline *exact start -> A* path cell centres -> exact goal* of the query ``q``
+    (:class:`~trajopt.planning._query.PlanQuery`) must keep ``planner.robot.radius`` from the raw
+    map (exact distance to the obstacle squares); otherwise ``exc``, the smoother's or the
+    timing's error, is raised again. Also returns the statistics the trajectory gets
+    (``fallback_error``, ``fallback_reason``, ``fallback_min_clearance_m``, ``smoother``).
+    """
+    grid = planner.grid
+    if q.corridor is None:
+        with q.timer.stage("corridor"):
+            q.corridor = box_corridor(planner, q.inflated, q.path, q.start, q.goal)
+    centres = np.asarray(grid.cell_to_world(np.asarray(q.path.cells)), dtype=float)
+    points = np.vstack([q.start, centres.reshape(-1, 2), q.goal])
+    radius = planner.robot.radius
+    window = radius + 2.0 * float(grid.resolution)
+    clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
+    if clearance < radius - 1e-9:
+        logger.warning(
+            "stop_and_turn fallback rejected: the A* polyline comes %.6g m from an obstacle "
+            "(radius %.6g m)",
+            clearance,
+            radius,
+        )
+        raise exc
+    traj = stop_and_turn(points, planner.robot, start_heading=q.start_heading,
+                         goal_heading=q.goal_heading, speed_limits=planner.speed_limits)  # fmt: skip
+    logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
+    extra: dict[str, Any] = {
+        "fallback_error": type(exc).__name__,
+        "fallback_reason": str(exc),
+        "fallback_min_clearance_m": float(clearance),
+    }
+    if isinstance(exc, SmoothingError):
+        extra["smoother"] = dict(exc.stats)
+    return traj, extra
