@@ -34,6 +34,12 @@ Stages (each timed in ``Trajectory.stats["stages_s"]``):
 
 The :class:`~trajopt.motion._trajectory.Trajectory` carries every stage's result in ``.steps``.
 
+**Structure.** :class:`Planner` and :func:`plan` hold no planning logic: they validate
+their settings into one :class:`~trajopt.planning._options.PlannerOptions`, keep the map's
+:class:`~trajopt.planning._caches.PlannerCaches`, and hand both, with the request, to
+:func:`~trajopt.planning._runner.run_query` (which runs the stages above, or a footprint
+robot's disc ladder) or to :func:`~trajopt.replan.replan_from`.
+
 **Fallback** (opt-in, ``fallback="stop_and_turn"``). When the smoother raises
 :class:`~trajopt.errors.SmoothingError` (after its own refinements), or the timing raises
 :class:`~trajopt.errors.TimingError` on the smooth curve, and both end speeds are 0, the
@@ -51,46 +57,38 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
-import dataclasses
 import threading
 import time
 from collections.abc import Sequence
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt._validation import integer, point
-from trajopt.corridor import PolygonCorridor
-from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.geometry._clearance import polygon_clearance
+from trajopt.errors import InvalidInputError
 from trajopt.motion._chain import TrajectoryChain
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import Trajectory
-from trajopt.planning._caches import update_caches
-from trajopt.planning._corridor_fit import fit_in_corridor, witness_rescue
-from trajopt.planning._fallback import polyline_fallback
-from trajopt.planning._footprint_ladder import plan_with_footprint
-from trajopt.planning._query import PlanQuery, PlanSteps
-from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, smooth_for_speed
-from trajopt.robot._robot import Robot, avoidance_width
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._disc import PlanResult
+from trajopt.planning._options import (
+    CorridorKind,
+    Fallback,
+    Inflation,
+    PlannerOptions,
+    PlanRequest,
+    Search,
+)
+from trajopt.planning._query import PlanSteps
+from trajopt.planning._runner import run_query
+from trajopt.replan._replan import BRAKE_AFTER_S, replan_from
+from trajopt.robot._robot import Robot
 from trajopt.robot._state import State
-from trajopt.smoother import Smoother, SmoothPath
-from trajopt.timing import time_parameterize
-from trajopt.timing._speed_limits import SpeedLimits, check_overlap
+from trajopt.smoother import Smoother
+from trajopt.timing._speed_limits import SpeedLimits
 
-Inflation = Literal["exact", "paper"]
-Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]
-Fallback = Literal["stop_and_turn"]
-CorridorKind = Literal["polygons", "boxes"]
-#: What :meth:`Planner.plan` returns: a smooth trajectory, or the stop-and-turn fallback.
-PlanResult = Trajectory | StopAndTurnTrajectory
-_INFLATIONS = ("exact", "paper")
-_SEARCHES = ("clearance", "shortest", "costmap", "costmap+clearance")
-_FALLBACKS = (None, "stop_and_turn")
-_CORRIDORS = ("polygons", "boxes")
+__all__ = ["plan", "Planner", "PlannerOptions", "PlanSteps", "Inflation", "Search", "Fallback",
+           "PlanResult"]  # fmt: skip
 
 
 class Planner:
@@ -172,121 +170,128 @@ class Planner:
         speed_limits: SpeedLimits | None = None,
         landmarks: int = 0,
     ) -> None:
-        costmap: Costmap | None = None
-        if isinstance(grid, Costmap):
-            costmap, grid = grid, grid.grid
-        if not isinstance(grid, OccupancyGrid):
+        settings = PlannerOptions(
+            robot=robot,
+            inflation=inflation,
+            w_cells=w_cells,
+            search=search,
+            smoother=smoother,
+            timing_dt=timing_dt,
+            fallback=fallback,
+            corridor=corridor,
+            costmap_weight=costmap_weight,
+            speed_limits=speed_limits,
+            landmarks=landmarks,
+        )
+        self._init(grid, settings)
+
+    @classmethod
+    def from_options(cls, grid: OccupancyGrid | Costmap, options: PlannerOptions) -> Planner:
+        """Return a planner on ``grid`` with ``options`` (as :func:`plan` builds its own).
+
+        Parameters
+        ----------
+        grid : astar.OccupancyGrid or astar.Costmap
+            The raw map, or a costmap.
+        options : PlannerOptions
+            The settings (each one documented in :class:`Planner`).
+        """
+        if not isinstance(options, PlannerOptions):
             raise InvalidInputError(
-                f"grid must be an astar.OccupancyGrid or astar.Costmap, got {type(grid).__name__}"
+                f"options must be a trajopt.planning PlannerOptions, got {type(options).__name__}"
             )
-        if search is None:
-            search = "clearance" if costmap is None else "costmap"
-        robot = Robot() if robot is None else robot
-        if not isinstance(robot, Robot):
-            raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
-        if inflation not in _INFLATIONS:
-            raise InvalidInputError(f"inflation must be one of {_INFLATIONS}, got {inflation!r}")
-        if search not in _SEARCHES:
-            raise InvalidInputError(f"search must be one of {_SEARCHES}, got {search!r}")
-        if search.startswith("costmap") and costmap is None:
-            raise InvalidInputError(
-                f"search={search!r} needs the grid to be an astar.Costmap "
-                "(astar.load_costmap / astar.from_costmap), got an OccupancyGrid"
-            )
-        if costmap is not None:
-            costmap.search_cost(costmap_weight)  # validates the weight
-        if speed_limits is not None:
-            check_overlap(speed_limits, grid)
-        if not (fallback is None or (isinstance(fallback, str) and fallback in _FALLBACKS)):
-            raise InvalidInputError(f"fallback must be one of {_FALLBACKS}, got {fallback!r}")
-        if not (isinstance(corridor, str) and corridor in _CORRIDORS):
-            raise InvalidInputError(f"corridor must be one of {_CORRIDORS}, got {corridor!r}")
-        landmarks = integer("landmarks", landmarks, 0, 64)
-        if w_cells is None:
-            w_cells = avoidance_width(robot.width, grid.resolution)
-        if isinstance(w_cells, bool) or not isinstance(w_cells, (int, np.integer)) or w_cells < 0:
-            raise InvalidInputError(f"w_cells must be an integer >= 0, got {w_cells!r}")
-        if (
-            isinstance(timing_dt, bool)
-            or not isinstance(timing_dt, (int, float, np.integer, np.floating))
-            or not 0.0 < float(timing_dt) <= 0.5
-        ):
-            raise InvalidInputError(f"timing_dt must be a number in (0, 0.5] s, got {timing_dt!r}")
-        smoother = Smoother() if smoother is None else smoother
-        if not isinstance(smoother, Smoother):
-            raise InvalidInputError(
-                f"smoother must be a trajopt.Smoother, got {type(smoother).__name__}"
-            )
-        self.grid = grid
-        self.robot = robot
-        self.inflation: Inflation = inflation
-        self.w_cells = int(w_cells)
-        self.search: Search = search
-        self.smoother = smoother
-        self.timing_dt = float(timing_dt)
-        self.fallback: Fallback | None = fallback
-        self.corridor: CorridorKind = corridor
-        self.costmap = costmap
-        self.costmap_weight = float(costmap_weight)
-        self.speed_limits = speed_limits
-        self.landmarks = int(landmarks)
-        self._landmarks: astar.Landmarks | None = None  # built on the first search that uses them
+        planner = cls.__new__(cls)
+        planner._init(grid, options)
+        return planner
+
+    def _init(self, grid: OccupancyGrid | Costmap, settings: PlannerOptions) -> None:
+        options, raw, costmap = settings.for_map(grid)
+        self.options = options
+        self.caches = PlannerCaches(raw, costmap, options)
         self._lock = threading.RLock()
         self._latencies: collections.deque[float] = collections.deque(maxlen=32)
-        self._inflated: OccupancyGrid | None = None
-        self._cost: np.ndarray | None = None
-        self._disc_planners: dict[float, Planner] = {}  # footprint robots: the disc models
-        #: optional ``(planner, query) -> (grid path, inflated grid)`` run after the search
-        #: (a footprint robot's oriented check of the grid path)
-        self.path_check: Any = None
-        #: a footprint robot's disc model: the footprint its smoother must also certify
-        self.smoothing_footprint: Any = None
+
+    # ------------------------------------------------------------- settings
+    @property
+    def grid(self) -> OccupancyGrid:
+        """The raw map (the latest one given to :meth:`update_map` or :meth:`replan`)."""
+        return self.caches.grid
+
+    @property
+    def costmap(self) -> Costmap | None:
+        """The costmap the planner was built from (``None`` for an occupancy grid)."""
+        return self.caches.costmap
+
+    @property
+    def robot(self) -> Robot:
+        """The robot planned for."""
+        return self.options.robot
+
+    @property
+    def smoother(self) -> Smoother:
+        """The smoother's options."""
+        return self.options.smoother
+
+    @property
+    def inflation(self) -> Inflation:
+        """``"exact"`` or ``"paper"``."""
+        return self.options.inflation
+
+    @property
+    def w_cells(self) -> int:
+        """``W`` of ``inflation="paper"`` (cells)."""
+        return self.options.w_cells
+
+    @property
+    def search(self) -> Search:
+        """The A* cost in use."""
+        return self.options.search
+
+    @property
+    def corridor(self) -> CorridorKind:
+        """The corridor kind tried first."""
+        return self.options.corridor
+
+    @property
+    def fallback(self) -> Fallback | None:
+        """The opt-in fallback (``None`` or ``"stop_and_turn"``)."""
+        return self.options.fallback
+
+    @property
+    def timing_dt(self) -> float:
+        """Step of the timing's forward greedy (s)."""
+        return self.options.timing_dt
+
+    @property
+    def costmap_weight(self) -> float:
+        """Weight of a costmap's graded cost in the search."""
+        return self.options.costmap_weight
+
+    @property
+    def speed_limits(self) -> SpeedLimits | None:
+        """The speed-limit zones, if any."""
+        return self.options.speed_limits
+
+    @property
+    def landmarks(self) -> int:
+        """Number of ALT landmarks of the searches with a cost (0: none)."""
+        return self.options.landmarks
 
     # -------------------------------------------------------------- caches
     @property
     def inflated_grid(self) -> OccupancyGrid:
         """The grid the robot centre moves in (computed once per map)."""
-        with self._lock:
-            if self._inflated is None:
-                self._inflated = self.grid.with_occupied(self._inflate(self.grid))
-            return self._inflated
+        return self.caches.inflated
 
     @property
     def search_cost(self) -> np.ndarray | None:
         """Per-cell A* cost (``None`` for ``search="shortest"``), computed once per map."""
-        if self.search == "shortest":
-            return None
-        with self._lock:
-            if self._cost is None:
-                cost = self._clearance_cost(self.grid)
-                if self.costmap is not None and self.search.startswith("costmap"):
-                    cost += self.costmap.search_cost(self.costmap_weight)
-                self._cost = cost
-            return self._cost
+        return self.caches.search_cost
 
     @property
     def search_landmarks(self) -> astar.Landmarks | None:
         """ALT landmarks of the inflated grid and search cost (``None`` without), built once."""
-        if self.landmarks == 0 or self.search == "shortest":
-            return None
-        with self._lock:
-            if self._landmarks is None:
-                self._landmarks = astar.build_landmarks(self.inflated_grid, self.search_cost,
-                                                        self.landmarks)  # fmt: skip
-            return self._landmarks
-
-    def _inflate(self, grid: OccupancyGrid) -> np.ndarray:
-        occ = astar.inflate(grid, self.robot.radius, metric="square", outside_occupied=True)
-        out = occ.occupied
-        if self.inflation == "paper":
-            out = out | astar.avoidance_area(grid, self.w_cells, border=True).occupied
-        return out
-
-    def _clearance_cost(self, grid: OccupancyGrid) -> np.ndarray:
-        cost = np.zeros(grid.shape)
-        if self.search in ("clearance", "costmap+clearance"):
-            cost += astar.clearance_cost(grid, self.robot.radius, outside_occupied=True)
-        return cost
+        return self.caches.landmarks
 
     def update_map(self, grid: OccupancyGrid) -> dict[str, Any]:
         """Replace the raw map, recomputing the caches only where the change reaches.
@@ -318,7 +323,8 @@ class Planner:
             ``grid`` is not an OccupancyGrid, or the planner plans on a costmap (make a new
             :class:`Planner` from the new costmap).
         """
-        return update_caches(self, grid)
+        with self._lock:
+            return self.caches.update(grid)
 
     # ---------------------------------------------------------------- query
     def plan(
@@ -368,19 +374,10 @@ class Planner:
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
         """
-        return self._query(start, goal, start_heading, goal_heading, v_start, v_end, None)
-
-    def _query(self, start, goal, start_heading, goal_heading, v_start, v_end, warm):
-        """:meth:`plan`, with a re-plan's :class:`~trajopt.planning._query.WarmStart` (or ``None``)."""
+        request = PlanRequest(start, goal, start_heading, goal_heading, v_start, v_end)
         with self._lock:
             t0 = time.perf_counter()
-            if self.robot.footprint is not None:
-                out = plan_with_footprint(self, start, goal, start_heading=start_heading,
-                                          goal_heading=goal_heading, v_start=v_start,
-                                          v_end=v_end)  # fmt: skip
-            else:
-                out = self._plan(start, goal, start_heading, goal_heading, v_start, v_end,
-                                 warm)  # fmt: skip
+            out = run_query(self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -447,164 +444,13 @@ class Planner:
             As :meth:`plan`; ``TimingError``: it must brake and cannot stop in time.
         """
         with self._lock:
-            return replan_from(self, trajectory, t, goal, grid, latency=latency,
-                               goal_heading=goal_heading, v_end=v_end, reuse=reuse,
-                               brake_after_s=brake_after_s)  # fmt: skip
-
-    def _plan(self, start, goal, start_heading, goal_heading, v_start, v_end,
-              warm=None) -> PlanResult:  # fmt: skip
-        kappa0 = None
-        a0 = 0.0
-        if isinstance(start, State):
-            if start_heading is not None or v_start != 0.0:
-                raise InvalidInputError(
-                    "start is a State: its theta and v are the start heading and speed; "
-                    f"leave start_heading (got {start_heading!r}) and v_start (got "
-                    f"{v_start!r}) at their defaults"
-                )
-            start_heading, kappa0, v_start, a0 = start.theta, start.kappa, start.v, start.a
-            start = start.position
-        p0 = point("start", start)
-        p1 = point("goal", goal)
-        q = PlanQuery(
-            start=p0,
-            goal=p1,
-            start_cell=self._check_endpoint("start", p0),
-            goal_cell=self._check_endpoint("goal", p1),
-            start_heading=start_heading,
-            goal_heading=goal_heading,
-            start_curvature=kappa0,
-            v_start=v_start,
-            v_end=v_end,
-            a_start=a0,
-            previous=None if warm is None else warm.previous,
-        )
-        with q.timer.stage("inflate"):
-            q.inflated = self.inflated_grid
-        self._check_reachable_ends(q)
-        ends = [q.start_cell, q.goal_cell]
-        grid_path = None if warm is None else warm.grid_path
-        reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
-        with q.timer.stage("search"):
-            q.path = grid_path if reused else self._search(q)
-            if self.path_check is not None:
-                q.path, q.inflated = self.path_check(self, q)
-        smooth = None
-        try:
-            smooth = self._smooth(q)
-            try:
-                traj = self._time(q, smooth)
-            except TimingError:
-                if v_start <= 0.0:
-                    raise
-                smooth = smooth_for_speed(self, q)
-                traj = self._time(q, smooth)
-        except (SmoothingError, TimingError) as exc:
-            if self.fallback is None or v_start != 0.0 or v_end != 0.0 or q.a_start != 0.0:
-                raise
-            return self._fallback(q, exc)
-        smoother_stats = dict(smooth.stats)
-        smoother_stats["rescue"] = q.rescue
-        kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
-        return self._result(q, traj, smooth, smoother=smoother_stats, corridor=kind,
-                            grid_path="reused" if reused else "searched",
-                            corridor_regions_kept=q.regions_kept)  # fmt: skip
-
-    def _search(self, q: PlanQuery) -> astar.GridPath:
-        """Return the A* path of the query on the inflated grid (typed error without one)."""
-        try:
-            lms = self.search_landmarks
-            return astar.find_path(
-                q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
-                cost=self.search_cost if lms is None else None, landmarks=lms,
-            )  # fmt: skip
-        except astar.NoPathError as exc:
-            raise NoPathError(
-                f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
-                f"robot of radius {self.robot.radius} m (inflation={self.inflation!r}): {exc}"
-            ) from exc
-
-    def _time(self, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
-        with q.timer.stage("timing"):
-            return time_parameterize(smooth, self.robot, v_start=q.v_start, v_end=q.v_end,
-                                     dt=self.timing_dt, speed_limits=self.speed_limits,
-                                     a_start=q.a_start)  # fmt: skip
-
-    def _smooth(self, q: PlanQuery) -> SmoothPath:
-        """Return the corridor and the certified curve.
-
-        The corridor and the certified curve (``q.path``, ``q.corridor``), with the witness
-        rescue of a curvature-bounded fit.
-        """
-        t_start = time.perf_counter()
-        try:
-            q.corridor, smooth = fit_in_corridor(self, q, q.path, self.smoother)
-        except SmoothingError as exc:
-            q.path, q.corridor, smooth = witness_rescue(self, q, exc, t_start)
-            q.rescue = "witness"
-        return smooth
-
-    def _check_reachable_ends(self, q: PlanQuery) -> None:
-        for name, p, c in (("start", q.start, q.start_cell), ("goal", q.goal, q.goal_cell)):
-            if q.inflated.occupied[c[1], c[0]]:
-                raise InvalidInputError(
-                    f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
-                    f"inflation={self.inflation!r} avoidance area (robot radius "
-                    f"{self.robot.radius} m); clearance of the cell centre "
-                    f"{_point_clearance(self.grid, self.grid.cell_to_world(c)):.4g} m"
-                )
-        if tuple(q.start_cell) == tuple(q.goal_cell):
-            raise InvalidInputError(
-                f"start {q.start.tolist()} m and goal {q.goal.tolist()} m lie in the same cell "
-                f"{_cell(q.start_cell)}; the planner needs them at least one cell apart"
-            )
-
-    def _result(self, q: PlanQuery, traj: Any, smooth: SmoothPath | None, **extra: Any) -> Any:
-        """Return the one place that attaches :class:`PlanSteps` and the planner's statistics."""
-        stages = q.timer.finish()
-        steps = PlanSteps(
-            raw_grid=self.grid,
-            inflated_grid=q.inflated,
-            grid_path=q.path,
-            corridor=q.corridor,
-            smooth_path=smooth,
-            start=(float(q.start[0]), float(q.start[1])),
-            goal=(float(q.goal[0]), float(q.goal[1])),
-            stages_s=stages,
-        )
-        stats = dict(traj.stats)
-        stats.update(extra)
-        stats["stages_s"] = dict(stages)
-        stats["inflation"] = self.inflation
-        stats["search"] = self.search
-        return dataclasses.replace(traj, stats=stats, steps=steps)
-
-    def _fallback(self, q: PlanQuery, exc: Exception) -> StopAndTurnTrajectory:
-        """Return the stop-and-turn trajectory along the A* polyline, or ``exc`` re-raised."""
-        with q.timer.stage("fallback"):
-            traj, extra = polyline_fallback(self, q, exc)
-        return self._result(q, traj, None, **extra)
-
-    def _check_endpoint(self, name: str, p: np.ndarray) -> np.ndarray:
-        grid = self.grid
-        c = grid.world_to_cell(p)
-        if not grid.in_bounds(c):
-            ox, oy = grid.origin
-            raise InvalidInputError(
-                f"{name} {p.tolist()} m is outside the map "
-                f"[{ox}, {ox + grid.width}] x [{oy}, {oy + grid.height}] m"
-            )
-        if grid.occupied[c[1], c[0]]:
-            raise InvalidInputError(
-                f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
-            )
-        clr = _point_clearance(grid, p)
-        if clr < self.robot.radius:
-            raise InvalidInputError(
-                f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
-                f"edge); the robot needs at least its radius {self.robot.radius} m"
-            )
-        return c
+            t0 = time.perf_counter()
+            lat = self.latency_s if latency is None else latency
+            out = replan_from(self.options, self.caches, trajectory, t, goal, grid, latency=lat,
+                              goal_heading=goal_heading, v_end=v_end, reuse=reuse,
+                              brake_after_s=brake_after_s)  # fmt: skip
+            self._latencies.append(time.perf_counter() - t0)
+            return out
 
 
 def plan(
@@ -673,20 +519,20 @@ def plan(
     >>> traj = trajopt.plan(scene.grid, scene.start, scene.goal("A"))  # doctest: +SKIP
     >>> traj.duration  # doctest: +SKIP
     """
-    planner = Planner(
-        grid,
-        robot,
+    options = PlannerOptions(
+        robot=robot,
         inflation=inflation,
+        w_cells=w_cells,
         search=search,
         smoother=smoother,
-        w_cells=w_cells,
+        timing_dt=timing_dt,
         fallback=fallback,
         corridor=corridor,
         costmap_weight=costmap_weight,
         speed_limits=speed_limits,
-        timing_dt=timing_dt,
         landmarks=landmarks,
     )
+    planner = Planner.from_options(grid, options)
     return planner.plan(
         start,
         goal,
@@ -695,14 +541,3 @@ def plan(
         v_start=v_start,
         v_end=v_end,
     )
-
-
-# ------------------------------------------------------------------ helpers
-def _cell(c: np.ndarray) -> tuple[int, int]:
-    """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
-    return (int(c[0]), int(c[1]))
-
-
-def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
-    """Exact clearance (m) of a world point from the raw map (outside occupied)."""
-    return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)

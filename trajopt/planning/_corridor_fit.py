@@ -2,10 +2,11 @@
 
 Polygons first, boxes where they fail, and the witness rescue of a curvature-bounded fit.
 
-Functions take the :class:`~trajopt._planner.Planner` (its raw map, robot, inflation,
-corridor kind and smoother) and the query record (:class:`~trajopt.planning._query.PlanQuery`),
-whose timer gets the corridor builds under ``corridor`` and the fits (and the witness
-search) under ``smooth``.
+Functions take the planner's options (:class:`~trajopt.planning._options.PlannerOptions`:
+robot, inflation, corridor kind, smoother), the raw map and the query record
+(:class:`~trajopt.planning._query.PlanQuery`: the ends, the footprint the smoother must also
+certify), whose timer gets the corridor builds under ``corridor`` and the fits (and the
+witness search) under ``smooth``.
 """
 
 from __future__ import annotations
@@ -22,9 +23,10 @@ import astar
 from astar.grid import OccupancyGrid
 from trajopt.corridor import Box, Corridor, PolygonCorridor, build_corridor, build_polygon_corridor
 from trajopt.corridor._polygons.reuse import corridor_with_rest
-from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.geometry._clearance import box_clearance
 from trajopt.planning._feasibility import curvature_witness, witness_grid_path
+from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import PlanQuery, PlanSteps
 from trajopt.smoother import Smoother, SmoothPath
 
@@ -32,7 +34,12 @@ logger = logging.getLogger("trajopt._planner")
 
 
 def fit_in_corridor(
-    planner: Any, q: PlanQuery, path: Any, smoother: Smoother, witness: np.ndarray | None = None
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    q: PlanQuery,
+    path: Any,
+    smoother: Smoother,
+    witness: np.ndarray | None = None,
 ) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
     """Build the corridor around ``path`` and fit in it.
 
@@ -47,7 +54,7 @@ def fit_in_corridor(
     spent = 0.0  # seconds spent fitting: the corridor builds (and numba's first
     # compilation of their kernels) do not count against the smoother's budget
     kinds = ["boxes"]
-    if planner.corridor == "polygons" and planner.inflation == "exact":
+    if options.corridor == "polygons" and options.inflation == "exact":
         kinds.insert(0, "polygons")
     first_failure: SmoothingError | None = None
     for i, kind in enumerate(kinds):
@@ -55,13 +62,14 @@ def fit_in_corridor(
         try:
             with q.timer.stage("corridor"):
                 if kind == "polygons" and witness is not None:
-                    corridor = witness_corridor(planner.grid, planner.robot.radius, witness)
+                    corridor = witness_corridor(grid, options.robot.radius, witness)
                     q.regions_kept = 0
                 elif kind == "polygons":
-                    corridor, q.regions_kept = polygon_corridor(planner, path, q.start, q.goal,
-                                                                q.previous)  # fmt: skip
+                    corridor, q.regions_kept = polygon_corridor(
+                        grid, options.robot.radius, path, q.start, q.goal, q.previous
+                    )
                 else:
-                    corridor = box_corridor(planner, q.inflated, path, q.start, q.goal)
+                    corridor = box_corridor(options, grid, q.inflated, path, q.start, q.goal)
         except InvalidInputError as exc:
             if last and first_failure is not None:
                 # the polygons were built but the fit in them failed: that is the failure
@@ -77,11 +85,10 @@ def fit_in_corridor(
                 raise SmoothingError("time budget exhausted before the box corridor", {})
             sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
             with q.timer.stage("smooth"):
-                smooth = sm.fit(path, corridor, raw_grid=planner.grid,
-                                radius=planner.robot.radius, start=q.start, goal=q.goal,
-                                start_heading=q.start_heading, goal_heading=q.goal_heading,
-                                start_curvature=q.start_curvature,
-                                footprint=planner.smoothing_footprint)  # fmt: skip
+                smooth = sm.fit(path, corridor, raw_grid=grid, radius=options.robot.radius,
+                                start=q.start, goal=q.goal, start_heading=q.start_heading,
+                                goal_heading=q.goal_heading, start_curvature=q.start_curvature,
+                                footprint=q.footprint)  # fmt: skip
             return corridor, smooth
         except SmoothingError as exc:
             spent += time.perf_counter() - t_fit
@@ -93,7 +100,11 @@ def fit_in_corridor(
 
 
 def witness_rescue(
-    planner: Any, q: PlanQuery, exc: SmoothingError, t_start: float
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    q: PlanQuery,
+    exc: SmoothingError,
+    t_start: float,
 ) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath]:
     """Return the second try of a curvature-bounded fit, along a witness.
 
@@ -110,11 +121,10 @@ def witness_rescue(
         curve, ``exc`` with what the rescue found appended to its message and under
         ``stats["witness"]``: whether the witness search found a curvature-bounded path.
     """
-    sm = planner.smoother
+    sm = options.smoother
     if sm.kappa_max is None:
         raise exc
-    radius = planner.robot.radius
-    grid = planner.grid
+    radius = options.robot.radius
     note = "no time left for the witness search"
     for margin, cap_s in ((grid.resolution, 1.0), (0.0, math.inf)):
         left = sm.time_budget_s - (time.perf_counter() - t_start)
@@ -139,7 +149,7 @@ def witness_rescue(
             break
         try:
             corridor, smooth = fit_in_corridor(
-                planner, q, path, dataclasses.replace(sm, time_budget_s=left), witness
+                options, grid, q, path, dataclasses.replace(sm, time_budget_s=left), witness
             )
         except (SmoothingError, InvalidInputError) as exc2:
             logger.debug("witness rescue (margin %g m) failed after %s: %s", margin, exc, exc2)
@@ -169,7 +179,12 @@ def witness_corridor(
 
 
 def polygon_corridor(
-    planner: Any, path: Any, p0: np.ndarray, p1: np.ndarray, previous: PlanSteps | None = None
+    grid: OccupancyGrid,
+    radius: float,
+    path: Any,
+    p0: np.ndarray,
+    p1: np.ndarray,
+    previous: PlanSteps | None = None,
 ) -> tuple[PolygonCorridor, int]:
     """Polygons around the A* path, from the exact start to the exact goal.
 
@@ -178,28 +193,32 @@ def polygon_corridor(
     (:func:`~trajopt.corridor._polygons.reuse.corridor_with_rest`). Returns the corridor and
     the number of regions kept.
     """
-    centres = np.asarray(planner.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
+    centres = np.asarray(grid.cell_to_world(np.asarray(path.cells)), dtype=float)
     points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
-    radius = planner.robot.radius
     if previous is not None and isinstance(previous.corridor, PolygonCorridor):
-        out = corridor_with_rest(planner.grid, points, radius, previous.corridor,
-                                 previous.raw_grid)  # fmt: skip
+        out = corridor_with_rest(grid, points, radius, previous.corridor, previous.raw_grid)
         if out is not None:
             return out
-    return build_polygon_corridor(planner.grid, points, radius), 0
+    return build_polygon_corridor(grid, points, radius), 0
 
 
 def box_corridor(
-    planner: Any, inflated: OccupancyGrid, path: Any, p0: np.ndarray, p1: np.ndarray
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    inflated: OccupancyGrid,
+    path: Any,
+    p0: np.ndarray,
+    p1: np.ndarray,
 ) -> Corridor:
     """Boxes of free cells around the A* path, the end boxes widened to the exact ends.
 
     Bridges (45-degree regions certified against the raw map) cross diagonal gaps; not
     with the chapter's avoidance area, which the curve must not enter either.
     """
-    bridge_map = planner.grid if planner.inflation == "exact" else None
-    corridor = build_corridor(inflated, path, radius=planner.robot.radius, raw_grid=bridge_map)
-    return widen_end_boxes(corridor, planner.grid, p0, p1, planner.robot.radius)
+    radius = options.robot.radius
+    bridge_map = grid if options.inflation == "exact" else None
+    corridor = build_corridor(inflated, path, radius=radius, raw_grid=bridge_map)
+    return widen_end_boxes(corridor, grid, p0, p1, radius)
 
 
 def widen_end_boxes(
@@ -235,3 +254,49 @@ def widen_end_boxes(
     if not changed:
         return corridor
     return dataclasses.replace(corridor, boxes=tuple(boxes))
+
+
+def smooth_for_speed(options: PlannerOptions, grid: OccupancyGrid, q: PlanQuery) -> SmoothPath:
+    """Fit again with a curvature bound the start speed can follow.
+
+    A moving start whose speed cannot be brought under the cap of the first curve
+    (too sharp a turn too soon) gets a second fit bounded by the curvature whose cap
+    is that speed (``Robot.speed_cap``), 5 % tighter but never below the state's own
+    curvature, which must already be within it.
+
+    Raises
+    ------
+    TimingError
+        The state's speed plus ``a^2 / (2 j)`` (its peak before a positive acceleration
+        can be undone) is above the cap at its own curvature.
+    SmoothingError
+        No curve within that bound (the message says why the bound was imposed).
+    """
+    r = options.robot
+    # the speed rises by a^2 / (2 j) before a positive acceleration can be undone
+    v = q.v_start + max(q.a_start, 0.0) ** 2 / (2.0 * r.j_max)
+    bounds = [r.a_lat_max / (v * v), r.omega_max / v]
+    if r.track_width is not None and r.wheel_v_max is not None and v < r.wheel_v_max:
+        bounds.append((r.wheel_v_max / v - 1.0) * 2.0 / r.track_width)
+    k0 = abs(q.start_curvature or 0.0)
+    if k0 > min(bounds):
+        raise TimingError(
+            f"the start state reaches {v:.6g} m/s on curvature {k0:.6g} 1/m (its speed "
+            f"{q.v_start:.6g} m/s plus a^2 / (2 j)): above the speed cap there "
+            f"({float(r.speed_cap(k0)):.6g} m/s)"
+        )
+    # a little below the cap, but never below the state's own curvature
+    k_speed = max(0.95 * min(bounds), k0)
+    sm = options.smoother
+    kmax = k_speed if sm.kappa_max is None else min(k_speed, sm.kappa_max)
+    sm = dataclasses.replace(sm, kappa_max=kmax)
+    try:
+        q.corridor, smooth = fit_in_corridor(options, grid, q, q.path, sm)
+    except SmoothingError as exc:
+        raise SmoothingError(
+            f"the start state moves at {v:.6g} m/s: no curve from it turns gently enough "
+            f"(curvature <= {kmax:.6g} 1/m) to slow down under the speed cap in time: {exc}",
+            exc.stats,
+        ) from exc
+    q.rescue = "speed"
+    return smooth

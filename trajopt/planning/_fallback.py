@@ -1,4 +1,8 @@
-"""The planner's opt-in stop-and-turn fallback along the A* polyline."""
+"""The planner's opt-in fallback: the A* polyline driven with stops and turns in place.
+
+Used by :func:`~trajopt.planning._disc.plan_disc` when the smoother or the timing fails
+(``fallback="stop_and_turn"``); the motion itself is :func:`trajopt.stop_and_turn`'s.
+"""
 
 from __future__ import annotations
 
@@ -7,31 +11,35 @@ from typing import Any
 
 import numpy as np
 
+from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError
 from trajopt.geometry._clearance import polyline_clearance
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.planning._corridor_fit import box_corridor
+from trajopt.planning._options import PlannerOptions
+from trajopt.planning._query import PlanQuery
 from trajopt.timing._stop_and_turn import stop_and_turn
 
 logger = logging.getLogger(__name__)
 
 
-def polyline_fallback(planner: Any, q: Any, exc: Exception) -> tuple[StopAndTurnTrajectory, dict]:
-    """Return a planner's stop-and-turn trajectory along the A* polyline, or re-raise ``exc``.
+def polyline_fallback(
+    options: PlannerOptions, grid: OccupancyGrid, q: PlanQuery, exc: Exception
+) -> tuple[StopAndTurnTrajectory, dict[str, Any]]:
+    """Return the stop-and-turn trajectory along the A* polyline, or re-raise ``exc``.
 
     The polyline *exact start -> A* path cell centres -> exact goal* of the query ``q``
-    (:class:`~trajopt.planning._query.PlanQuery`) must keep ``planner.robot.radius`` from the raw
-    map (exact distance to the obstacle squares); otherwise ``exc``, the smoother's or the
+    must keep the robot radius from the raw map ``grid`` (exact distance to the obstacle squares); otherwise ``exc``, the smoother's or the
     timing's error, is raised again. Also returns the statistics the trajectory gets
     (``fallback_error``, ``fallback_reason``, ``fallback_min_clearance_m``, ``smoother``).
     """
-    grid = planner.grid
+    robot = options.robot
     if q.corridor is None:
         with q.timer.stage("corridor"):
-            q.corridor = box_corridor(planner, q.inflated, q.path, q.start, q.goal)
+            q.corridor = box_corridor(options, grid, q.inflated, q.path, q.start, q.goal)
     centres = np.asarray(grid.cell_to_world(np.asarray(q.path.cells)), dtype=float)
     points = np.vstack([q.start, centres.reshape(-1, 2), q.goal])
-    radius = planner.robot.radius
+    radius = robot.radius
     window = radius + 2.0 * float(grid.resolution)
     clearance = polyline_clearance(points, grid, window_m=window, outside_occupied=True)
     if clearance < radius - 1e-9:
@@ -42,8 +50,8 @@ def polyline_fallback(planner: Any, q: Any, exc: Exception) -> tuple[StopAndTurn
             radius,
         )
         raise exc
-    traj = stop_and_turn(points, planner.robot, start_heading=q.start_heading,
-                         goal_heading=q.goal_heading, speed_limits=planner.speed_limits)  # fmt: skip
+    traj = stop_and_turn(points, robot, start_heading=q.start_heading,
+                         goal_heading=q.goal_heading, speed_limits=options.speed_limits)  # fmt: skip
     logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
     extra: dict[str, Any] = {
         "fallback_error": type(exc).__name__,

@@ -9,8 +9,8 @@ the first result whose footprint certificate passes:
    the search accepts every passage at least as wide as the footprint's narrowest
    extent through the rotation centre, and the corridor and the smoother certify that
    disc clearance (no path for it: :class:`~trajopt.errors.NoPathError` at once);
-2. the disc model's smoother is given the footprint
-   (:attr:`~trajopt._planner.Planner.smoothing_footprint`): it accepts a curve only when
+2. the disc model's smoother is given the footprint (the ``footprint`` of
+   :func:`~trajopt.planning._disc.plan_disc`): it accepts a curve only when
    :func:`~trajopt.robot._footprint.certify_footprint` passes too (per span, the Minkowski sum of
    the control-point hull and the footprint swept over the span's heading interval,
    exactly clear of the raw map), and runs its footprint rounds (pinned end headings, the
@@ -41,10 +41,14 @@ from typing import Any
 import numpy as np
 
 import astar
+from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.robot._footprint import certify_footprint
-from trajopt.robot._robot import Robot
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import PlanQuery
+from trajopt.robot._footprint import Footprint, certify_footprint
 
 
 def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:
@@ -53,61 +57,13 @@ def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:
     return [r for i, r in enumerate(out) if i == 0 or r > out[i - 1] * (1 + 1e-9)]
 
 
-def _new_disc(planner: Any, radius: float) -> Any:
-    """Return a new disc model of ``radius`` (m) with the planner's options."""
-    from trajopt._planner import Planner
-
-    r = planner.robot
-    disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
-                 a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
-                 wheel_v_max=r.wheel_v_max)  # fmt: skip
-    last = radius >= r.circumscribed_radius * (1 - 1e-9)
-    disc_model = Planner(
-        planner.costmap if planner.costmap is not None else planner.grid,
-        disc,
-        inflation=planner.inflation,
-        w_cells=planner.w_cells,
-        search=planner.search,
-        smoother=planner.smoother,
-        timing_dt=planner.timing_dt,
-        fallback=planner.fallback if last else None,
-        corridor=planner.corridor,
-        costmap_weight=planner.costmap_weight,
-        speed_limits=planner.speed_limits,
-        landmarks=planner.landmarks,
-    )
-    disc_model.smoothing_footprint = r.footprint
-    return disc_model
-
-
-def disc_planner(planner: Any, radius: float) -> Any:
-    """Return (and cache) the planner's disc model of ``radius`` (m), same options."""
-    cache = planner._disc_planners
-    if radius not in cache:
-        cache[radius] = _new_disc(planner, radius)
-    return cache[radius]
-
-
-def checked_planner(planner: Any, radius: float) -> Any:
-    """Return (and cache) the disc model of ``radius`` with an oriented path check.
-
-    Its grid path gets the footprint's oriented check (:func:`oriented_path_check`).
-    """
-    key = ("checked", radius)
-    cache = planner._disc_planners
-    if key not in cache:
-        checked = _new_disc(planner, radius)
-        footprint, raw = planner.robot.footprint, planner.grid
-        checked.path_check = lambda p, q: oriented_path_check(p, q, footprint, raw)
-        cache[key] = checked
-    return cache[key]
-
-
 #: most re-searches of the oriented grid-path check
 MAX_RESEARCHES = 4
 
 
-def oriented_path_check(disc: Any, q: Any, footprint: Any, raw: Any) -> tuple[Any, Any]:
+def oriented_path_check(
+    caches: PlannerCaches, q: PlanQuery, footprint: Footprint
+) -> tuple[astar.GridPath, OccupancyGrid]:
     """Check the footprint along a disc model's grid path; re-search around collisions.
 
     At every interior path cell the footprint is placed at the heading of the path there
@@ -120,6 +76,7 @@ def oriented_path_check(disc: Any, q: Any, footprint: Any, raw: Any) -> tuple[An
     """
     from trajopt.robot._footprint import polygons_clearance
 
+    raw = caches.grid
     path, grid = q.path, q.inflated
     for _ in range(MAX_RESEARCHES):
         cells = np.asarray(path.cells)
@@ -142,15 +99,23 @@ def oriented_path_check(disc: Any, q: Any, footprint: Any, raw: Any) -> tuple[An
         trial = grid.with_occupied(occ)
         try:
             path = astar.find_path(trial, tuple(cells[0]), tuple(cells[-1]),
-                                   cost=disc.search_cost)  # fmt: skip
+                                   cost=caches.search_cost)  # fmt: skip
         except astar.NoPathError:
             return path, grid
         grid = trial
     return path, grid
 
 
-def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> Any:
-    """Return :meth:`~trajopt._planner.Planner.plan`'s result for a footprint robot.
+def plan_with_footprint(
+    options: PlannerOptions, caches: PlannerCaches, request: PlanRequest
+) -> PlanResult:
+    """Plan one query for a footprint robot (module docstring): the disc ladder.
+
+    Each rung is a disc model (:meth:`PlannerOptions.disc`, with caches of its own on the
+    map: :meth:`PlannerCaches.disc`) planned by :func:`~trajopt.planning._disc.plan_disc`
+    with the footprint its smoother must also certify; below the circumscribed radius each
+    rung is tried again with :func:`oriented_path_check`. A re-plan's warm start is not
+    used: its grid path and corridor were made for one rung's radius.
 
     Raises
     ------
@@ -162,35 +127,41 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
         No rung gives a curve whose footprint certificate passes (the message lists why
         each radius failed).
     """
-    robot = planner.robot
+    robot = options.robot
     fp = robot.footprint
-    check_end_poses(planner, start, goal, kwargs.get("start_heading"), kwargs.get("goal_heading"))
+    check_end_poses(fp, caches.grid, request)
     ladder = radius_ladder(fp.inscribed_radius, fp.circumscribed_radius)
     failures: list[str] = []
     errors: list[Exception] = []
-    attempts = []
+    attempts: list[tuple[float, bool]] = []
     for r in ladder:
-        attempts.append((r, disc_planner))
+        attempts.append((r, False))
         if r < ladder[-1]:  # a second try with the oriented check of the grid path
-            attempts.append((r, checked_planner))
-    for i, (r, make) in enumerate(attempts):
-        disc = make(planner, r)
+            attempts.append((r, True))
+    for i, (r, checked) in enumerate(attempts):
+        disc = options.disc(r, last=r >= robot.circumscribed_radius * (1 - 1e-9))
+        check = None
+        if checked:
+
+            def check(c: PlannerCaches, q: PlanQuery) -> tuple[astar.GridPath, OccupancyGrid]:
+                return oriented_path_check(c, q, fp)
+
         try:
-            traj = disc.plan(start, goal, **kwargs)
+            traj = plan_disc(disc, caches.disc(disc), request, footprint=fp, path_check=check)
         except InvalidInputError as exc:
             if i == 0:
                 raise
-            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
+            failures.append(f"{_label(r, checked)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
         except NoPathError as exc:
             if i == 0:  # no path for the inscribed disc: none for any footprint pose either
                 raise NoPathError(f"no path for the footprint's inscribed disc: {exc}") from None
-            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
+            failures.append(f"{_label(r, checked)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
         except (SmoothingError, TimingError) as exc:
-            failures.append(f"{_label(r, make)}: {type(exc).__name__}: {exc}")
+            failures.append(f"{_label(r, checked)}: {type(exc).__name__}: {exc}")
             errors.append(exc)
             continue
         cert_s = 0.0
@@ -202,11 +173,11 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
             cert_s = smoother_stats.get("footprint_certificate_s", 0.0)
             if cert is None:  # a box corridor's fit, or a curve from elsewhere
                 t_cert = time.perf_counter()
-                cert = certify_footprint(traj.path, fp, planner.grid)
+                cert = certify_footprint(traj.path, fp, caches.grid)
                 cert_s = time.perf_counter() - t_cert
             if not cert.ok:
                 failures.append(
-                    f"{_label(r, make)}: footprint certificate failed at span "
+                    f"{_label(r, checked)}: footprint certificate failed at span "
                     f"{cert.worst_span} (margin {cert.min_margin_m:.4g} m)"
                 )
                 errors.append(SmoothingError(failures[-1], {}))
@@ -232,8 +203,7 @@ def plan_with_footprint(planner: Any, start: Any, goal: Any, **kwargs: Any) -> A
     raise SmoothingError("no footprint-certified trajectory: " + "; ".join(failures), stats)
 
 
-def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | None,
-                    goal_heading: float | None) -> None:  # fmt: skip
+def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanRequest) -> None:
     """Raise when the footprint cannot stand at the start or the goal.
 
     With a heading (given, or a :class:`~trajopt.robot._state.State`'s ``theta``) the footprint at
@@ -249,8 +219,10 @@ def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | 
     from trajopt.robot._footprint import polygons_clearance
     from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
 
-    fp, raw = planner.robot.footprint, planner.grid
-    for name, end, heading in (("start", start, start_heading), ("goal", goal, goal_heading)):
+    fp = footprint
+    ends = (("start", request.start, request.start_heading),
+            ("goal", request.goal, request.goal_heading))  # fmt: skip
+    for name, end, heading in ends:
         theta = getattr(end, "theta", None) if heading is None else heading
         xy = np.array([getattr(end, "x", None), getattr(end, "y", None)], dtype=float)
         if not np.all(np.isfinite(xy)):
@@ -274,5 +246,5 @@ def check_end_poses(planner: Any, start: Any, goal: Any, start_heading: float | 
             )
 
 
-def _label(radius: float, make: Any) -> str:
-    return f"radius {radius:.4g} m" + (", oriented check" if make is checked_planner else "")
+def _label(radius: float, checked: bool) -> str:
+    return f"radius {radius:.4g} m" + (", oriented check" if checked else "")

@@ -76,6 +76,8 @@ class PlanQuery:
         of the path it shares with them (:mod:`trajopt.corridor._polygons.reuse`).
     regions_kept : int
         How many regions of the result's polygon corridor are ``previous``'s.
+    footprint : Footprint or None
+        The footprint the smoother must also certify (a footprint robot's disc model).
     timer : StageTimer
     """
 
@@ -95,6 +97,7 @@ class PlanQuery:
     rescue: str | None = None
     previous: PlanSteps | None = None
     regions_kept: int = 0
+    footprint: Any = None
     timer: StageTimer = field(default_factory=StageTimer)
 
 

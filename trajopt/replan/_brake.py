@@ -42,8 +42,12 @@ from trajopt.geometry._clearance import points_clearance
 from trajopt.geometry._curve import CurveSegment
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._trajectory import Trajectory
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
+from trajopt.planning._runner import run_query
 from trajopt.replan._keep import target_change
+from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
 from trajopt.timing._greedy import advance, brake_times
 from trajopt.timing._stop_and_turn import turn_in_place
@@ -124,7 +128,8 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
 
 
 def brake_turn_go(
-    planner: Any,
+    options: PlannerOptions,
+    caches: PlannerCaches,
     trajectory: Any,
     ts: float,
     goal: Sequence[float],
@@ -138,8 +143,10 @@ def brake_turn_go(
 
     Parameters
     ----------
-    planner : Planner
-        The planner re-planning, with its current map.
+    options : PlannerOptions
+        The re-planning planner's options.
+    caches : PlannerCaches
+        Its caches, with the current map.
     trajectory : Trajectory or TrajectoryChain
         The trajectory driven; a chain is braked on the piece playing at ``ts`` (a turn in
         place playing then is finished first).
@@ -169,7 +176,8 @@ def brake_turn_go(
     if isinstance(trajectory, TrajectoryChain):  # what plays at ts; earlier pieces are past
         i, t_in = trajectory.piece_at(ts)
         traj = trajectory.pieces[i]
-    if planner.robot.footprint is not None or not isinstance(traj, (Trajectory, TurnInPlace)):
+    robot = options.robot
+    if robot.footprint is not None or not isinstance(traj, (Trajectory, TurnInPlace)):
         raise error
     pieces: list[Any] = []
     starts: list[float] = []
@@ -183,7 +191,7 @@ def brake_turn_go(
         brake = brake_on_path(traj, t_in)
         if brake is not None:
             steps = getattr(traj, "steps", None) or getattr(trajectory, "steps", None)
-            _check_new_obstacles(planner, steps, brake)
+            _check_new_obstacles(robot, caches.grid, steps, brake)
             pieces.append(brake)
             starts.append(0.0)
             stop = brake.sample(np.array([brake.duration]))
@@ -191,10 +199,12 @@ def brake_turn_go(
             stop = traj.sample(np.array([t_in]))
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     try:
-        out = planner._query(p_stop, goal, None, goal_heading, 0.0, v_end,
-                             WarmStart(None, previous))  # fmt: skip
+        request = PlanRequest(p_stop, goal, goal_heading=goal_heading, v_end=v_end)
+        out = run_query(options, caches, request, WarmStart(None, previous))
     except TrajoptError as exc:
-        rest = None if brake is None else _resume(planner, traj, brake, goal, goal_heading, v_end)
+        rest = None
+        if brake is not None:
+            rest = _resume(options, caches.grid, traj, brake, goal, goal_heading, v_end)
         if rest is None:
             exc.args = (f"{exc.args[0]} (planned from rest after braking to a stop at "
                         f"{p_stop} m, since {error})",) + exc.args[1:]  # fmt: skip
@@ -203,9 +213,9 @@ def brake_turn_go(
                      f"path resumed from rest ({type(exc).__name__} from the stop)",
                      brake_m=float(brake.length), brake_s=brake.duration, turn_rad=0.0,
                      turn_s=0.0)  # fmt: skip
-        return TrajectoryChain(tuple(pieces + rest), planner.robot, stats, traj.steps)
+        return TrajectoryChain(tuple(pieces + rest), robot, stats, traj.steps)
     first = out.sample(np.array([0.0]))
-    turn = turn_in_place(p_stop, float(stop.theta[0]), float(first.theta[0]), planner.robot)
+    turn = turn_in_place(p_stop, float(stop.theta[0]), float(first.theta[0]), robot)
     if turn.duration > 0.0:
         pieces.append(turn)
         starts.append(0.0)
@@ -219,10 +229,18 @@ def brake_turn_go(
         turn_rad=float(turn.stats["turn_rad"]),
         turn_s=turn.duration,
     )
-    return TrajectoryChain(tuple(pieces), planner.robot, stats, out.steps, tuple(starts))
+    return TrajectoryChain(tuple(pieces), robot, stats, out.steps, tuple(starts))
 
 
-def _resume(planner, traj, brake, goal, goal_heading, v_end) -> list[Trajectory] | None:
+def _resume(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    traj: Trajectory,
+    brake: Trajectory,
+    goal: Sequence[float],
+    goal_heading: float | None,
+    v_end: float,
+) -> list[Trajectory] | None:
     """Return the old path's rest from the stop, timed from rest, if the goal is the old one.
 
     ``[]`` when the stop is the old path's end; ``None`` when the goal, goal heading or end
@@ -234,20 +252,19 @@ def _resume(planner, traj, brake, goal, goal_heading, v_end) -> list[Trajectory]
     u_stop, u_end = brake.path.domain[1], traj.path.domain[1]
     if not u_stop < u_end:
         return []
-    rest = time_parameterize(CurveSegment(traj.path, u_stop, u_end), planner.robot,
-                             v_end=v_end, dt=planner.timing_dt,
-                             speed_limits=planner.speed_limits)  # fmt: skip
-    _check_new_obstacles(planner, steps, rest)
+    rest = time_parameterize(CurveSegment(traj.path, u_stop, u_end), options.robot,
+                             v_end=v_end, dt=options.timing_dt,
+                             speed_limits=options.speed_limits)  # fmt: skip
+    _check_new_obstacles(options.robot, grid, steps, rest)
     return [rest]
 
 
-def _check_new_obstacles(planner: Any, steps: Any, brake: Trajectory) -> None:
+def _check_new_obstacles(robot: Robot, grid: OccupancyGrid, steps: Any, brake: Trajectory) -> None:
     """Raise :class:`TimingError` if a cell occupied since ``steps`` was planned is in reach.
 
     ``brake``: a piece driven on the old path (the stop, or the old path's resumed rest).
     """
     old = getattr(steps, "raw_grid", None)
-    grid = planner.grid
     if old is grid:
         return
     fresh = np.asarray(grid.occupied)
@@ -259,12 +276,12 @@ def _check_new_obstacles(planner: Any, steps: Any, brake: Trajectory) -> None:
     n = max(2, int(math.ceil(brake.length / ds)) + 1)
     s = np.linspace(0.0, brake.length, n)
     xy = np.asarray(brake.path(brake._u_at_s(s)))
-    need = planner.robot.radius + 0.5 * (s[1] - s[0])
+    need = robot.radius + 0.5 * (s[1] - s[0])
     clear = points_clearance(xy, OccupancyGrid(fresh, grid.resolution, grid.origin), 2.0 * need)
     k = int(np.argmin(clear))
     if clear[k] < need:
         raise TimingError(
             f"the robot cannot stop before an obstacle: braking on its path it comes "
             f"{clear[k]:.4g} m from a newly occupied cell at {xy[k].round(4).tolist()} m "
-            f"(needs {planner.robot.radius} m)"
+            f"(needs {robot.radius} m)"
         )

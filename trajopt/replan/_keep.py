@@ -30,7 +30,9 @@ from astar.search import GridPath
 from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
 from trajopt.motion._trajectory import Trajectory
-from trajopt.planning._caches import change_reach
+from trajopt.planning._caches import PlannerCaches, change_reach
+from trajopt.planning._options import PlannerOptions
+from trajopt.planning._query import PlanSteps
 from trajopt.smoother import SmoothPath
 from trajopt.smoother._certificate import certify
 
@@ -41,7 +43,8 @@ _MAX_NEAR_CHANGES = 20_000
 
 
 def keep_rest(
-    planner: Any,
+    options: PlannerOptions,
+    caches: PlannerCaches,
     trajectory: Any,
     ts: float,
     goal: Sequence[float] | None,
@@ -53,8 +56,10 @@ def keep_rest(
 
     Parameters
     ----------
-    planner : Planner
-        The planner re-planning, with its current map.
+    options : PlannerOptions
+        The re-planning planner's options.
+    caches : PlannerCaches
+        Its caches, with the current map.
     trajectory : Trajectory or StopAndTurnTrajectory
         The trajectory being driven.
     ts : float
@@ -77,9 +82,9 @@ def keep_rest(
     smooth = getattr(steps, "smooth_path", None)
     if not isinstance(trajectory, Trajectory) or not isinstance(smooth, SmoothPath):
         return None, "not a smoothed trajectory of a Planner"
-    if planner.robot.footprint is not None:
+    if options.robot.footprint is not None:
         return None, "footprint robot"
-    if trajectory.robot != planner.robot:
+    if trajectory.robot != options.robot:
         return None, "planned for another robot"
     why = target_change(trajectory, goal, goal_heading, v_end)
     if why:
@@ -94,13 +99,13 @@ def keep_rest(
     span_box = smooth.certificate.span_box[int(smooth.curve.span_of(u0)) :]
     corridor = steps.corridor
     regions = corridor.regions if isinstance(corridor, PolygonCorridor) else corridor.boxes
-    why = _map_change(planner, steps, [regions[i] for i in np.unique(span_box)])
+    why = _map_change(options, caches, steps, [regions[i] for i in np.unique(span_box)])
     if why:
         return None, why
     tail = smooth.curve.tail(u0)
     start = tail.c[0]
     cert = certify(tail, corridor, span_box, start=start, goal=np.asarray(steps.goal),
-                   raw_grid=planner.grid, radius=smooth.certificate.radius_m,
+                   raw_grid=caches.grid, radius=smooth.certificate.radius_m,
                    kappa_bound=smooth.certificate.kappa_bound)  # fmt: skip
     if not cert.ok:
         return None, f"the rest fails its certificate ({', '.join(cert.failures)})"
@@ -108,8 +113,8 @@ def keep_rest(
     out = trajectory_after(trajectory, ts, path, u0)
     elapsed = time.perf_counter() - t0
     stages = {"keep": elapsed, "total": elapsed}
-    new_steps = dataclasses.replace(steps, raw_grid=planner.grid,
-                                    inflated_grid=planner.inflated_grid, smooth_path=path,
+    new_steps = dataclasses.replace(steps, raw_grid=caches.grid,
+                                    inflated_grid=caches.inflated, smooth_path=path,
                                     start=(float(start[0]), float(start[1])), stages_s=stages)  # fmt: skip
     stats = dict(out.stats)
     stats["stages_s"] = stages
@@ -141,16 +146,18 @@ def target_change(
     return ""
 
 
-def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
+def _map_change(
+    options: PlannerOptions, caches: PlannerCaches, steps: PlanSteps, regions: list[Any]
+) -> str:
     """Return why the map change breaks the rest of the old curve ('' when it does not)."""
-    old, new = steps.raw_grid, planner.grid
+    old, new = steps.raw_grid, caches.grid
     if old is new:
         return ""
     if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
         return "map of another shape"
     # a cell the search could not enter before and can now may open a better route; a raw
     # cell freed inside what stays inflated adds nothing to the search's graph
-    if np.any(steps.inflated_grid.occupied & ~planner.inflated_grid.occupied):
+    if np.any(steps.inflated_grid.occupied & ~caches.inflated.occupied):
         return "cells freed"
     iy, ix = np.divmod(np.flatnonzero(new.occupied & ~old.occupied), new.nx)
     if ix.size == 0:
@@ -160,9 +167,9 @@ def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
     # a region keeps the radius (plus the avoidance area with inflation="paper") from every
     # occupied square; a new square whose centre is farther than that plus its half-diagonal
     # from the region's bounding box cannot come closer
-    reach = planner.robot.radius + res * (math.sqrt(0.5) + 1e-9)
-    if planner.inflation == "paper":
-        reach += planner.w_cells * res
+    reach = options.robot.radius + res * (math.sqrt(0.5) + 1e-9)
+    if options.inflation == "paper":
+        reach += options.w_cells * res
     for reg in regions:
         v = np.asarray(reg.vertices if isinstance(reg.vertices, np.ndarray) else reg.vertices())
         lo, hi = v.min(axis=0) - reach, v.max(axis=0) + reach
@@ -171,7 +178,9 @@ def _map_change(planner: Any, steps: Any, regions: list[Any]) -> str:
     return ""
 
 
-def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> GridPath | None:
+def remaining_grid_path(
+    options: PlannerOptions, caches: PlannerCaches, steps: PlanSteps, start_cell: np.ndarray
+) -> GridPath | None:
     """Return the rest of the old grid path joined from ``start_cell``, if the map allows.
 
     The join is the straight line of king moves from ``start_cell`` to the nearest cell of
@@ -185,8 +194,10 @@ def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> Gri
 
     Parameters
     ----------
-    planner : Planner
-        The re-planning planner, with its current map.
+    options : PlannerOptions
+        The re-planning planner's options.
+    caches : PlannerCaches
+        Its caches, with the current map.
     steps : PlanSteps
         The old trajectory's steps (its grid path, raw and inflated grids).
     start_cell : ndarray of int, shape (2,)
@@ -197,13 +208,13 @@ def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> Gri
     astar.GridPath or None
         ``expanded`` 0, ``length`` and ``cost`` recomputed on the current search cost.
     """
-    old, new = steps.raw_grid, planner.grid
+    old, new = steps.raw_grid, caches.grid
     if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
         return None
     start = np.asarray(start_cell, dtype=np.int64)
     if not new.in_bounds(start):
         return None
-    free = ~np.asarray(planner.inflated_grid.occupied)
+    free = ~np.asarray(caches.inflated.occupied)
     if np.any(np.asarray(steps.inflated_grid.occupied) & free):
         return None  # cells freed: another route may be cheaper now
     cells = np.asarray(steps.grid_path.cells)
@@ -221,7 +232,7 @@ def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> Gri
     if not (np.all(free[a[:, 1], a[:, 0] + step[diag, 0]])
             and np.all(free[a[:, 1] + step[diag, 1], a[:, 0]])):  # fmt: skip
         return None
-    _, reach = change_reach(planner, new.resolution)
+    _, reach = change_reach(options, new.resolution)
     iy, ix = np.divmod(np.flatnonzero(new.occupied != old.occupied), new.nx)
     lo, hi = path.min(axis=0) - reach, path.max(axis=0) + reach
     near = (ix >= lo[0]) & (ix <= hi[0]) & (iy >= lo[1]) & (iy <= hi[1])
@@ -232,7 +243,7 @@ def remaining_grid_path(planner: Any, steps: Any, start_cell: np.ndarray) -> Gri
         if len(chunk) and np.min(np.max(np.abs(chunk[:, None, :] - path[None]), axis=2)) <= reach:
             return None
     length_steps = np.where(diag, math.sqrt(2.0), 1.0)
-    cost = planner.search_cost
+    cost = caches.search_cost
     if cost is None:
         step_costs = length_steps
     else:

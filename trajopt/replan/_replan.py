@@ -20,24 +20,25 @@ curvature, speed and acceleration: a C2 splice) and takes the first of these tha
 A chain is re-planned like any trajectory: while its last piece (the plan from rest) plays,
 that piece is; before, the chain's rest is kept when the map, goal, goal heading and end
 speed are unchanged, and a turn in place playing at the splice is finished first.
-:func:`smooth_for_speed` is the second fit a fast start needs.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 from astar.grid import OccupancyGrid
 from trajopt._validation import nonnegative, number, point
-from trajopt.errors import InvalidInputError, SmoothingError, TimingError
+from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
-from trajopt.planning._corridor_fit import fit_in_corridor
-from trajopt.planning._query import PlanQuery, WarmStart
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._disc import check_endpoint
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import WarmStart
+from trajopt.planning._runner import run_query
 from trajopt.replan._brake import brake_turn_go
 from trajopt.replan._keep import BLOCKED_NEAR, keep_rest, remaining_grid_path, target_change
-from trajopt.smoother import SmoothPath
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
 BRAKE_AFTER_S = 0.1
@@ -46,20 +47,26 @@ NO_REUSE = "reuse=False"
 
 
 def replan_from(
-    planner: Any,
+    options: PlannerOptions,
+    caches: PlannerCaches,
     trajectory: Any,
     t: float,
     goal: Sequence[float] | None,
     grid: OccupancyGrid | None,
     *,
-    latency: float | None,
+    latency: float,
     goal_heading: float | None,
     v_end: float,
     reuse: bool = True,
     brake_after_s: float | None = BRAKE_AFTER_S,
 ) -> Any:
-    """Return :meth:`~trajopt._planner.Planner.replan`'s trajectory (see there)."""
-    lat = planner.latency_s if latency is None else nonnegative("latency", latency, "s")
+    """Return :meth:`~trajopt._planner.Planner.replan`'s trajectory (see there).
+
+    ``options`` and ``caches`` are the planner's; ``latency`` (s) is the splice's lead
+    (the planner passes its recent median when the caller gives none); ``grid``, an
+    updated map, is applied to ``caches`` first (:meth:`PlannerCaches.update`).
+    """
+    lat = nonnegative("latency", latency, "s")
     t_now = number("t", t, unit="s", lo=0.0, hi=float(trajectory.duration))
     ts = t_now + lat
     if ts > trajectory.duration:
@@ -77,7 +84,7 @@ def replan_from(
     if brake_after_s is not None:
         brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
-        planner.update_map(grid)
+        caches.update(grid)
     out, why = None, NO_REUSE
     piece, t_piece = trajectory, ts
     if isinstance(trajectory, TrajectoryChain):
@@ -85,13 +92,13 @@ def replan_from(
         if i == len(trajectory.pieces) - 1:  # driving the chain's last plan: re-plan that
             piece = trajectory.pieces[i]
     if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
-        out, why = _keep_chain(planner, trajectory, ts, goal, goal_heading, v_end)
+        out, why = _keep_chain(caches.grid, trajectory, ts, goal, goal_heading, v_end)
     elif reuse:
-        out, why = keep_rest(planner, piece, t_piece, goal, goal_heading=goal_heading,
+        out, why = keep_rest(options, caches, piece, t_piece, goal, goal_heading=goal_heading,
                              v_end=v_end)  # fmt: skip
     if out is None:
-        out = _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, why,
-                             brake_after_s)  # fmt: skip
+        target = _Target(goal, goal_heading, v_end)
+        out = _plan_or_brake(options, caches, trajectory, ts, piece, target, why, brake_after_s)
     stats = dict(out.stats)
     if why == "kept":
         stats["replan"] = "kept"
@@ -102,17 +109,40 @@ def replan_from(
     return dataclasses.replace(out, stats=stats)
 
 
-def _keep_chain(planner, chain, ts, goal, goal_heading, v_end) -> tuple[Any, str]:
+class _Target(NamedTuple):
+    """Where a re-plan goes: the goal (m), its heading (rad) and the end speed (m/s)."""
+
+    goal: Sequence[float]
+    goal_heading: float | None
+    v_end: float
+
+
+def _keep_chain(
+    grid: OccupancyGrid,
+    chain: TrajectoryChain,
+    ts: float,
+    goal: Sequence[float],
+    goal_heading: float | None,
+    v_end: float,
+) -> tuple[TrajectoryChain | None, str]:
     """Return the rest of a brake-turn-go chain from ``ts`` if nothing it relies on changed."""
     steps = chain.steps
-    if steps is None or planner.grid is not steps.raw_grid:
+    if steps is None or grid is not steps.raw_grid:
         return None, "the map changed"
     why = target_change(chain, goal, goal_heading, v_end)  # a chain has no path: no heading
     return (None, why) if why else (chain.after(ts), "kept")
 
 
-def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, why,
-                   brake_after_s):  # fmt: skip
+def _plan_or_brake(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    trajectory: Any,
+    ts: float,
+    piece: Any,
+    target: _Target,
+    why: str,
+    brake_after_s: float | None,
+) -> Any:
     """Plan from the state at ``ts``; brake, turn and go when that fails (:func:`replan_from`).
 
     The plan from the moving state gets the smoother's time budget capped at
@@ -122,80 +152,31 @@ def _plan_or_brake(planner, trajectory, ts, piece, goal, goal_heading, v_end, wh
     an invalid goal is raised as such. A footprint robot, which does not brake this way,
     keeps the whole budget.
     """
+    goal, goal_heading, v_end = target
     previous = None if why == NO_REUSE else getattr(piece, "steps", None)
+
+    def brake(error: TrajoptError) -> TrajectoryChain:
+        return brake_turn_go(options, caches, trajectory, ts, goal, goal_heading=goal_heading,
+                             v_end=v_end, error=error, previous=previous)  # fmt: skip
+
     if isinstance(piece, TrajectoryChain):
         i, tau = piece.piece_at(ts)
         if isinstance(piece.pieces[i], TurnInPlace) and tau < piece.pieces[i].duration:
-            error = TimingError("the robot is turning in place at the splice")
-            return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
-                                 v_end=v_end, error=error, previous=previous)  # fmt: skip
+            return brake(TimingError("the robot is turning in place at the splice"))
     state = trajectory.state_at(ts)
     path = None
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
-        path = remaining_grid_path(planner, piece.steps,
-                                   planner.grid.world_to_cell(state.position))  # fmt: skip
+        path = remaining_grid_path(options, caches, piece.steps,
+                                   caches.grid.world_to_cell(state.position))  # fmt: skip
     warm = WarmStart(path, previous)
-    if brake_after_s is None or planner.robot.footprint is not None:  # no brake to fall on
-        return planner._query(state, goal, None, goal_heading, 0.0, v_end, warm)
-    smoother = planner.smoother
-    planner.smoother = dataclasses.replace(
-        smoother, time_budget_s=min(smoother.time_budget_s, brake_after_s)
-    )
+    request = PlanRequest(state, goal, goal_heading=goal_heading, v_end=v_end)
+    if brake_after_s is None or options.robot.footprint is not None:  # no brake to fall on
+        return run_query(options, caches, request, warm)
     try:
-        return planner._query(state, goal, None, goal_heading, 0.0, v_end, warm)
+        return run_query(options, caches, request, warm, budget_s=brake_after_s)
     except (SmoothingError, TimingError) as exc:
-        error = exc
+        error: TrajoptError = exc
     except InvalidInputError as exc:  # the goal's own error, else the moving start's
-        planner._check_endpoint("goal", point("goal", goal))
+        check_endpoint(options, caches.grid, "goal", point("goal", goal))
         error = exc
-    finally:
-        planner.smoother = smoother
-    return brake_turn_go(planner, trajectory, ts, goal, goal_heading=goal_heading,
-                         v_end=v_end, error=error, previous=previous)  # fmt: skip
-
-
-def smooth_for_speed(planner: Any, q: PlanQuery) -> SmoothPath:
-    """Fit again with a curvature bound the start speed can follow.
-
-    A moving start whose speed cannot be brought under the cap of the first curve
-    (too sharp a turn too soon) gets a second fit bounded by the curvature whose cap
-    is that speed (``Robot.speed_cap``), 5 % tighter but never below the state's own
-    curvature, which must already be within it.
-
-    Raises
-    ------
-    TimingError
-        The state's speed plus ``a^2 / (2 j)`` (its peak before a positive acceleration
-        can be undone) is above the cap at its own curvature.
-    SmoothingError
-        No curve within that bound (the message says why the bound was imposed).
-    """
-    r = planner.robot
-    # the speed rises by a^2 / (2 j) before a positive acceleration can be undone
-    v = q.v_start + max(q.a_start, 0.0) ** 2 / (2.0 * r.j_max)
-    bounds = [r.a_lat_max / (v * v), r.omega_max / v]
-    if r.track_width is not None and r.wheel_v_max is not None and v < r.wheel_v_max:
-        bounds.append((r.wheel_v_max / v - 1.0) * 2.0 / r.track_width)
-    k0 = abs(q.start_curvature or 0.0)
-    if k0 > min(bounds):
-        raise TimingError(
-            f"the start state reaches {v:.6g} m/s on curvature {k0:.6g} 1/m (its speed "
-            f"{q.v_start:.6g} m/s plus a^2 / (2 j)): above the speed cap there "
-            f"({float(r.speed_cap(k0)):.6g} m/s)"
-        )
-    # a little below the cap, but never below the state's own curvature
-    k_speed = max(0.95 * min(bounds), k0)
-    kmax = (
-        k_speed if planner.smoother.kappa_max is None else min(k_speed, planner.smoother.kappa_max)
-    )
-    sm = dataclasses.replace(planner.smoother, kappa_max=kmax)
-    try:
-        q.corridor, smooth = fit_in_corridor(planner, q, q.path, sm)
-    except SmoothingError as exc:
-        raise SmoothingError(
-            f"the start state moves at {v:.6g} m/s: no curve from it turns gently enough "
-            f"(curvature <= {kmax:.6g} 1/m) to slow down under the speed cap in time: {exc}",
-            exc.stats,
-        ) from exc
-    q.rescue = "speed"
-    return smooth
+    return brake(error)

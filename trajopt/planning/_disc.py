@@ -1,0 +1,257 @@
+"""One query for a disc robot: validate the ends, search, fit in a corridor, time.
+
+:func:`plan_disc` runs the stages of :mod:`trajopt._planner` (module docstring there) for a
+robot whose shape is its disc (a footprint robot's disc models run here too, with the
+footprint the smoother must also certify and an optional check of the grid path). Every
+input is explicit: the options, the map's caches, the request and a re-plan's warm start.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt._validation import point
+from trajopt.corridor import PolygonCorridor
+from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
+from trajopt.geometry._clearance import polygon_clearance
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.motion._trajectory import Trajectory
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
+from trajopt.planning._fallback import polyline_fallback
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import PlanQuery, PlanSteps, WarmStart
+from trajopt.robot._footprint import Footprint
+from trajopt.robot._state import State
+from trajopt.smoother import SmoothPath
+from trajopt.timing import time_parameterize
+
+#: What a query returns: a smooth trajectory, or the stop-and-turn fallback.
+PlanResult = Trajectory | StopAndTurnTrajectory
+#: A check of the grid path after the search: ``(caches, query) -> (grid path, inflated
+#: grid it was found on)`` (a footprint robot's oriented check).
+PathCheck = Callable[[PlannerCaches, PlanQuery], tuple[astar.GridPath, OccupancyGrid]]
+
+
+def plan_disc(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    warm: WarmStart | None = None,
+    *,
+    footprint: Footprint | None = None,
+    path_check: PathCheck | None = None,
+) -> PlanResult:
+    """Plan one query for the disc of ``options.robot`` (see :meth:`trajopt.Planner.plan`).
+
+    Parameters
+    ----------
+    options : PlannerOptions
+        Resolved for the map of ``caches``.
+    caches : PlannerCaches
+        The map and its inflated grid, search cost and landmarks for ``options``.
+    request : PlanRequest
+        The ends, headings and speeds.
+    warm : WarmStart, optional
+        A re-plan's grid path (used instead of a search when its end cells are the
+        query's) and old steps (whose polygon regions the corridor may keep).
+    footprint : Footprint, optional
+        The footprint the smoother must also certify (a footprint robot's disc model).
+    path_check : callable, optional
+        Run on the grid path after the search (:data:`PathCheck`).
+
+    Returns
+    -------
+    Trajectory or StopAndTurnTrajectory
+
+    Raises
+    ------
+    InvalidInputError, NoPathError, SmoothingError, TimingError
+        As :meth:`trajopt.Planner.plan`.
+    """
+    start, goal = request.start, request.goal
+    start_heading, v_start = request.start_heading, request.v_start
+    kappa0 = None
+    a0 = 0.0
+    if isinstance(start, State):
+        if start_heading is not None or v_start != 0.0:
+            raise InvalidInputError(
+                "start is a State: its theta and v are the start heading and speed; "
+                f"leave start_heading (got {start_heading!r}) and v_start (got "
+                f"{v_start!r}) at their defaults"
+            )
+        start_heading, kappa0, v_start, a0 = start.theta, start.kappa, start.v, start.a
+        start = start.position
+    p0 = point("start", start)
+    p1 = point("goal", goal)
+    q = PlanQuery(
+        start=p0,
+        goal=p1,
+        start_cell=check_endpoint(options, caches.grid, "start", p0),
+        goal_cell=check_endpoint(options, caches.grid, "goal", p1),
+        start_heading=start_heading,
+        goal_heading=request.goal_heading,
+        start_curvature=kappa0,
+        v_start=v_start,
+        v_end=request.v_end,
+        a_start=a0,
+        previous=None if warm is None else warm.previous,
+        footprint=footprint,
+    )
+    with q.timer.stage("inflate"):
+        q.inflated = caches.inflated
+    _check_reachable_ends(options, caches.grid, q)
+    ends = [q.start_cell, q.goal_cell]
+    grid_path = None if warm is None else warm.grid_path
+    reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
+    with q.timer.stage("search"):
+        q.path = grid_path if reused else _search(options, caches, q)
+        if path_check is not None:
+            q.path, q.inflated = path_check(caches, q)
+    smooth = None
+    try:
+        smooth = _smooth(options, caches.grid, q)
+        try:
+            traj = _time(options, q, smooth)
+        except TimingError:
+            if q.v_start <= 0.0:
+                raise
+            smooth = smooth_for_speed(options, caches.grid, q)
+            traj = _time(options, q, smooth)
+    except (SmoothingError, TimingError) as exc:
+        if options.fallback is None or q.v_start != 0.0 or q.v_end != 0.0 or q.a_start != 0.0:
+            raise
+        with q.timer.stage("fallback"):
+            fallback, extra = polyline_fallback(options, caches.grid, q, exc)
+        return _result(options, caches.grid, q, fallback, None, **extra)
+    smoother_stats = dict(smooth.stats)
+    smoother_stats["rescue"] = q.rescue
+    kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
+    return _result(options, caches.grid, q, traj, smooth, smoother=smoother_stats,
+                   corridor=kind, grid_path="reused" if reused else "searched",
+                   corridor_regions_kept=q.regions_kept)  # fmt: skip
+
+
+def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> astar.GridPath:
+    """Return the A* path of the query on the inflated grid (typed error without one)."""
+    try:
+        lms = caches.landmarks
+        return astar.find_path(
+            q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
+            cost=caches.search_cost if lms is None else None, landmarks=lms,
+        )  # fmt: skip
+    except astar.NoPathError as exc:
+        raise NoPathError(
+            f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
+            f"robot of radius {options.robot.radius} m (inflation={options.inflation!r}): {exc}"
+        ) from exc
+
+
+def _time(options: PlannerOptions, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
+    with q.timer.stage("timing"):
+        return time_parameterize(smooth, options.robot, v_start=q.v_start, v_end=q.v_end,
+                                 dt=options.timing_dt, speed_limits=options.speed_limits,
+                                 a_start=q.a_start)  # fmt: skip
+
+
+def _smooth(options: PlannerOptions, grid: OccupancyGrid, q: PlanQuery) -> SmoothPath:
+    """Return the certified curve, setting ``q.corridor`` (and ``q.path`` after a rescue)."""
+    t_start = time.perf_counter()
+    try:
+        q.corridor, smooth = fit_in_corridor(options, grid, q, q.path, options.smoother)
+    except SmoothingError as exc:
+        q.path, q.corridor, smooth = witness_rescue(options, grid, q, exc, t_start)
+        q.rescue = "witness"
+    return smooth
+
+
+def _check_reachable_ends(options: PlannerOptions, grid: OccupancyGrid, q: PlanQuery) -> None:
+    for name, p, c in (("start", q.start, q.start_cell), ("goal", q.goal, q.goal_cell)):
+        if q.inflated.occupied[c[1], c[0]]:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
+                f"inflation={options.inflation!r} avoidance area (robot radius "
+                f"{options.robot.radius} m); clearance of the cell centre "
+                f"{_point_clearance(grid, grid.cell_to_world(c)):.4g} m"
+            )
+    if tuple(q.start_cell) == tuple(q.goal_cell):
+        raise InvalidInputError(
+            f"start {q.start.tolist()} m and goal {q.goal.tolist()} m lie in the same cell "
+            f"{_cell(q.start_cell)}; the planner needs them at least one cell apart"
+        )
+
+
+def _result(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    q: PlanQuery,
+    traj: Any,
+    smooth: SmoothPath | None,
+    **extra: Any,
+) -> Any:
+    """Attach :class:`PlanSteps` and the planner's statistics (the one place that does)."""
+    stages = q.timer.finish()
+    steps = PlanSteps(
+        raw_grid=grid,
+        inflated_grid=q.inflated,
+        grid_path=q.path,
+        corridor=q.corridor,
+        smooth_path=smooth,
+        start=(float(q.start[0]), float(q.start[1])),
+        goal=(float(q.goal[0]), float(q.goal[1])),
+        stages_s=stages,
+    )
+    stats = dict(traj.stats)
+    stats.update(extra)
+    stats["stages_s"] = dict(stages)
+    stats["inflation"] = options.inflation
+    stats["search"] = options.search
+    return dataclasses.replace(traj, stats=stats, steps=steps)
+
+
+def check_endpoint(
+    options: PlannerOptions, grid: OccupancyGrid, name: str, p: np.ndarray
+) -> np.ndarray:
+    """Return the cell of an end point ``p`` (m), or raise naming why it is not valid.
+
+    Raises
+    ------
+    InvalidInputError
+        ``p`` outside the map, on an occupied cell, or closer to an obstacle (or the map
+        edge) than the robot radius (the message gives the clearance found).
+    """
+    c = grid.world_to_cell(p)
+    if not grid.in_bounds(c):
+        ox, oy = grid.origin
+        raise InvalidInputError(
+            f"{name} {p.tolist()} m is outside the map "
+            f"[{ox}, {ox + grid.width}] x [{oy}, {oy + grid.height}] m"
+        )
+    if grid.occupied[c[1], c[0]]:
+        raise InvalidInputError(
+            f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
+        )
+    clr = _point_clearance(grid, p)
+    if clr < options.robot.radius:
+        raise InvalidInputError(
+            f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
+            f"edge); the robot needs at least its radius {options.robot.radius} m"
+        )
+    return c
+
+
+def _cell(c: np.ndarray) -> tuple[int, int]:
+    """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
+    return (int(c[0]), int(c[1]))
+
+
+def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
+    """Exact clearance (m) of a world point from the raw map (outside occupied)."""
+    return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)

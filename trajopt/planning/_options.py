@@ -1,0 +1,212 @@
+"""What a planner is set up with (:class:`PlannerOptions`) and what one query asks (:class:`PlanRequest`).
+
+Both :func:`trajopt.plan` and :class:`trajopt.Planner` build their options here, so the two
+cannot disagree on a setting, its default or its validation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from astar.costmap import Costmap
+from astar.grid import OccupancyGrid
+from trajopt._validation import integer
+from trajopt.errors import InvalidInputError
+from trajopt.robot._robot import Robot, avoidance_width
+from trajopt.robot._state import State
+from trajopt.smoother import Smoother
+from trajopt.timing._speed_limits import SpeedLimits, check_overlap
+
+Inflation = Literal["exact", "paper"]
+Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]
+Fallback = Literal["stop_and_turn"]
+CorridorKind = Literal["polygons", "boxes"]
+INFLATIONS = ("exact", "paper")
+SEARCHES = ("clearance", "shortest", "costmap", "costmap+clearance")
+FALLBACKS = (None, "stop_and_turn")
+CORRIDORS = ("polygons", "boxes")
+
+
+@dataclass(frozen=True, slots=True)
+class PlannerOptions:
+    """A planner's settings, validated (see :class:`trajopt.Planner` for each one's meaning).
+
+    Attributes
+    ----------
+    robot : Robot
+        Size and limits; ``None`` is ``Robot()``.
+    inflation : {"exact", "paper"}
+        Obstacles grown by the radius (certified), or with the chapter's avoidance area on top.
+    w_cells : int or None
+        ``W`` of ``inflation="paper"`` (cells); ``None`` until :meth:`for_map` sets the
+        default :func:`~trajopt.robot.avoidance_width`.
+    search : {"clearance", "shortest", "costmap", "costmap+clearance"} or None
+        A* cost; ``None`` until :meth:`for_map` picks ``"clearance"`` (occupancy grid) or
+        ``"costmap"`` (costmap).
+    smoother : Smoother
+        Smoother options; ``None`` is ``Smoother()``.
+    timing_dt : float
+        Step of the timing's forward greedy (s), in (0, 0.5].
+    fallback : {None, "stop_and_turn"}
+        The opt-in fallback when the smoother or the timing fails.
+    corridor : {"polygons", "boxes"}
+        Corridor kind tried first.
+    costmap_weight : float
+        Weight of a costmap's graded cost in the search (:meth:`astar.Costmap.search_cost`).
+    speed_limits : SpeedLimits or None
+        Speed-limit zones of the timing.
+    landmarks : int
+        ALT landmarks of the searches with a cost, 0-64.
+
+    Raises
+    ------
+    InvalidInputError
+        A setting of the wrong type or outside its range, naming it and its rule.
+    """
+
+    robot: Robot = field(default_factory=Robot)
+    inflation: Inflation = "exact"
+    w_cells: int | None = None
+    search: Search | None = None
+    smoother: Smoother = field(default_factory=Smoother)
+    timing_dt: float = 0.02
+    fallback: Fallback | None = None
+    corridor: CorridorKind = "polygons"
+    costmap_weight: float = 2.0
+    speed_limits: SpeedLimits | None = None
+    landmarks: int = 0
+
+    def __post_init__(self) -> None:
+        robot = Robot() if self.robot is None else self.robot
+        if not isinstance(robot, Robot):
+            raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
+        if self.inflation not in INFLATIONS:
+            raise InvalidInputError(
+                f"inflation must be one of {INFLATIONS}, got {self.inflation!r}"
+            )
+        if self.search is not None and self.search not in SEARCHES:
+            raise InvalidInputError(f"search must be one of {SEARCHES}, got {self.search!r}")
+        fallback = self.fallback
+        if not (fallback is None or (isinstance(fallback, str) and fallback in FALLBACKS)):
+            raise InvalidInputError(f"fallback must be one of {FALLBACKS}, got {fallback!r}")
+        corridor = self.corridor
+        if not (isinstance(corridor, str) and corridor in CORRIDORS):
+            raise InvalidInputError(f"corridor must be one of {CORRIDORS}, got {corridor!r}")
+        landmarks = integer("landmarks", self.landmarks, 0, 64)
+        w = self.w_cells
+        if w is not None and (isinstance(w, bool) or not isinstance(w, (int, np.integer)) or w < 0):
+            raise InvalidInputError(f"w_cells must be an integer >= 0, got {w!r}")
+        dt = self.timing_dt
+        if (
+            isinstance(dt, bool)
+            or not isinstance(dt, (int, float, np.integer, np.floating))
+            or not 0.0 < float(dt) <= 0.5
+        ):
+            raise InvalidInputError(f"timing_dt must be a number in (0, 0.5] s, got {dt!r}")
+        smoother = Smoother() if self.smoother is None else self.smoother
+        if not isinstance(smoother, Smoother):
+            raise InvalidInputError(
+                f"smoother must be a trajopt.Smoother, got {type(smoother).__name__}"
+            )
+        object.__setattr__(self, "robot", robot)
+        object.__setattr__(self, "smoother", smoother)
+        object.__setattr__(self, "landmarks", int(landmarks))
+        object.__setattr__(self, "timing_dt", float(dt))
+        object.__setattr__(self, "costmap_weight", float(self.costmap_weight))
+        if w is not None:
+            object.__setattr__(self, "w_cells", int(w))
+
+    def for_map(
+        self, grid: OccupancyGrid | Costmap
+    ) -> tuple[PlannerOptions, OccupancyGrid, Costmap | None]:
+        """Return the options resolved for a map, the raw grid and the costmap (or ``None``).
+
+        Picks the default search (``"costmap"`` for a costmap, else ``"clearance"``) and the
+        default ``w_cells`` (:func:`~trajopt.robot.avoidance_width` at the map's resolution),
+        and checks what depends on the map: a costmap search needs a costmap, the costmap
+        weight, and speed-limit zones that overlap the map.
+
+        Parameters
+        ----------
+        grid : astar.OccupancyGrid or astar.Costmap
+            The raw map, or a costmap (its obstacle cells are the map).
+
+        Raises
+        ------
+        InvalidInputError
+            Naming the setting and the rule.
+        """
+        costmap: Costmap | None = None
+        if isinstance(grid, Costmap):
+            costmap, grid = grid, grid.grid
+        if not isinstance(grid, OccupancyGrid):
+            raise InvalidInputError(
+                f"grid must be an astar.OccupancyGrid or astar.Costmap, got {type(grid).__name__}"
+            )
+        search = self.search
+        if search is None:
+            search = "clearance" if costmap is None else "costmap"
+        if search.startswith("costmap") and costmap is None:
+            raise InvalidInputError(
+                f"search={search!r} needs the grid to be an astar.Costmap "
+                "(astar.load_costmap / astar.from_costmap), got an OccupancyGrid"
+            )
+        if costmap is not None:
+            costmap.search_cost(self.costmap_weight)  # validates the weight
+        if self.speed_limits is not None:
+            check_overlap(self.speed_limits, grid)
+        w_cells = self.w_cells
+        if w_cells is None:
+            w_cells = avoidance_width(self.robot.width, grid.resolution)
+        resolved = dataclasses.replace(self, search=search, w_cells=w_cells)
+        return resolved, grid, costmap
+
+    def disc(self, radius: float, *, last: bool) -> PlannerOptions:
+        """Return the options of a footprint robot's disc model of ``radius`` (m).
+
+        The disc has the robot's limits and no footprint; it keeps the fallback only when
+        ``last`` (the circumscribed disc, which holds the footprint in every heading).
+        """
+        r = self.robot
+        disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
+                     a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
+                     wheel_v_max=r.wheel_v_max)  # fmt: skip
+        return dataclasses.replace(self, robot=disc, fallback=self.fallback if last else None)
+
+    def with_budget(self, budget_s: float | None) -> PlannerOptions:
+        """Return the options with the smoother's time budget capped at ``budget_s`` (s)."""
+        if budget_s is None:
+            return self
+        sm = self.smoother
+        capped = dataclasses.replace(sm, time_budget_s=min(sm.time_budget_s, budget_s))
+        return dataclasses.replace(self, smoother=capped)
+
+
+@dataclass(frozen=True, slots=True)
+class PlanRequest:
+    """What one query asks: the ends, their headings and speeds (validated by the runner).
+
+    Attributes
+    ----------
+    start : sequence of float, shape (2,), or State
+        Start point ``(x, y)`` (m), or a moving robot's state (then ``start_heading`` and
+        ``v_start`` stay at their defaults: the state's ``theta`` and ``v`` are used).
+    goal : sequence of float, shape (2,)
+        End point (m).
+    start_heading, goal_heading : float or None
+        Exact headings at the ends (rad).
+    v_start, v_end : float
+        Speeds at the ends (m/s).
+    """
+
+    start: Sequence[float] | State
+    goal: Sequence[float]
+    start_heading: float | None = None
+    goal_heading: float | None = None
+    v_start: float = 0.0
+    v_end: float = 0.0

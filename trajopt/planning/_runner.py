@@ -1,0 +1,50 @@
+"""The one query runner every entry point calls: :func:`run_query`.
+
+:func:`trajopt.plan`, :meth:`trajopt.Planner.plan`, a re-plan from a moving state, the plan
+from rest after braking, and the benchmark's planner methods all plan through it, with
+their options, the map's caches, the request, a re-plan's warm start and a time budget as
+explicit inputs.
+"""
+
+from __future__ import annotations
+
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._footprint_ladder import plan_with_footprint
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import WarmStart
+
+
+def run_query(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    warm: WarmStart | None = None,
+    budget_s: float | None = None,
+) -> PlanResult:
+    """Plan one query: a disc robot's stages, or a footprint robot's disc ladder.
+
+    Parameters
+    ----------
+    options : PlannerOptions
+        Resolved for the map of ``caches`` (:meth:`PlannerOptions.for_map`).
+    caches : PlannerCaches
+        The map and what queries on it share.
+    request : PlanRequest
+        The ends, headings and speeds.
+    warm : WarmStart, optional
+        A re-plan's grid path and old steps (a disc robot's; a footprint robot's ladder
+        plans each rung afresh).
+    budget_s : float, optional
+        Cap on the smoother's time budget (s) for this query (a re-plan's, which brakes
+        rather than wait).
+
+    Returns
+    -------
+    Trajectory or StopAndTurnTrajectory
+        See :meth:`trajopt.Planner.plan`.
+    """
+    options = options.with_budget(budget_s)
+    if options.robot.footprint is not None:
+        return plan_with_footprint(options, caches, request)
+    return plan_disc(options, caches, request, warm)
