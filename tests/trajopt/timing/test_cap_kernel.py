@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import trajopt.timing._cap_kernel as cap_kernel
 import trajopt.timing._greedy as greedy
-from tests.trajopt.test_curvature_bound import _dense_max_per_interval
+from tests.trajopt.geometry.test_curvature_bound import _dense_max_per_interval
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
 from trajopt.robot._robot import Robot

@@ -21,7 +21,7 @@ pytest.importorskip("pyarrow", reason="the bench extra (pyarrow) is missing")
 from trajopt.analysis import bench  # noqa: E402
 from trajopt.errors import BenchmarkError, PeerUnavailableError
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 METHODS = ("trajopt", "astar", "bspline-fit")
 
 

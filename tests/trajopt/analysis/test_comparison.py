@@ -168,7 +168,7 @@ def test_one_off_methods_by_mapping() -> None:
 
 def test_register_method_adds_a_row_without_touching_others() -> None:
     name = "straight line (test)"
-    cmp.register_method(name, "tests.trajopt.test_comparison:_line_method")
+    cmp.register_method(name, "tests.trajopt.analysis.test_comparison:_line_method")
     try:
         assert name in cmp.registered_methods()
         with pytest.raises(InvalidInputError, match="already registered"):

@@ -102,7 +102,7 @@ def _records_equal(a: dict, b: dict) -> bool:
 
 def test_bench_records_serial_equal_parallel_exactly(shared_data) -> None:
     # the benchmark's rows (every metric of every scenario) of a serial run and of a
-    # 2-process run are equal exactly (tests/trajopt/test_bench.py does the same on Dask)
+    # 2-process run are equal exactly (tests/trajopt/analysis/test_bench.py does the same on Dask)
     from trajopt.analysis import bench
 
     src = bench.movingai_queries(

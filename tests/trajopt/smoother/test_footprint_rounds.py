@@ -18,7 +18,7 @@ from scipy.spatial import ConvexHull
 import astar
 import trajopt
 import trajopt.robot._footprint_kernels as footprint_kernels
-from tests.trajopt.test_footprint import collides
+from tests.trajopt.robot.test_footprint import collides
 from trajopt.corridor import build_polygon_corridor
 from trajopt.planning._footprint_ladder import disc_planner
 from trajopt.robot._footprint import MAX_ARC_RAD, Footprint, polygons_clearance
