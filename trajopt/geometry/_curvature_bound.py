@@ -39,11 +39,18 @@ from math import comb
 
 import numpy as np
 
-_ZERO = 1e-9  # a leading coefficient below this fraction of the largest counts as zero
-_MAX_DEPTH = 30  # bisections of one interval at most
-_MAX_WORK = 400_000  # intervals evaluated by the refinement at most (per call)
-_TIP = 1e-6  # m: arc length next to a zero-speed end left out of the bound at most
-_RTOL_TIP = 1e-3  # relative share of the bound spent on the tip term
+#: A parametric speed (or a velocity polynomial's value at ``t = 0``) below this fraction of
+#: the mean parametric speed (of the polynomial's largest coefficient) counts as zero.
+ZERO_SPEED_RATIO = 1e-9
+#: Bisections of one interval at most.
+MAX_DEPTH = 30
+#: Intervals evaluated by the refinement at most (per call).
+MAX_WORK = 400_000
+#: Arc length (m) next to a zero-speed end that the bound may leave out, at most.
+TIP_M = 1e-6
+#: Share of ``max(bound, k_free)`` (relative) the tip term may reach where the bound holds;
+#: the bound is raised by this share.
+TIP_RTOL = 1e-3
 
 
 def interval_kappa_max(
@@ -97,9 +104,9 @@ def interval_kappa_max(
     sp_scale = curve.length / (hi - lo)
     v_ends = np.hypot(*np.asarray(curve(np.array([lo, hi]), 1), dtype=float).T)
     flip = np.zeros(a.shape, dtype=np.int8)  # +1: zero speed at a, -1: at b
-    if v_ends[0] <= _ZERO * sp_scale:
+    if v_ends[0] <= ZERO_SPEED_RATIO * sp_scale:
         flip[0] = 1
-    if v_ends[1] <= _ZERO * sp_scale and flip[-1] == 0:
+    if v_ends[1] <= ZERO_SPEED_RATIO * sp_scale and flip[-1] == 0:
         flip[-1] = -1
 
     k_free = _free_curvature(speed_cap)
@@ -108,8 +115,8 @@ def interval_kappa_max(
     split = _to_split(k_b, k_s, sb - sa, h, k_free, speed_cap, rtol)
     work = a.size
     done = [(a[~split], b[~split], sa[~split], sb[~split], np.maximum(k_b, k_s)[~split])]
-    for _ in range(_MAX_DEPTH):
-        if not np.any(split) or work >= _MAX_WORK:
+    for _ in range(MAX_DEPTH):
+        if not np.any(split) or work >= MAX_WORK:
             break
         la, lb, lf, lsa, lsb = a[split], b[split], flip[split], sa[split], sb[split]
         mid = 0.5 * (la + lb)
@@ -255,14 +262,14 @@ def _zero_speed_bound(V: np.ndarray, k_free: float) -> np.ndarray:
 
     ``V = t g`` gives ``kappa = Y0 / (t |g|^3) + q / |g|^3`` with ``Y = g x g'``,
     ``Y0 = Y(0)`` and ``q = (Y - Y0) / t``. The bound ``B = max |q| / min |g|^3`` holds where
-    the first term is below ``_RTOL_TIP * max(B, k_free)``, i.e. for ``t >= t0``; the tip ``[0, t0]`` is
-    left out when its arc length (at most ``t0^2 sum |g_i|``) is below ``_TIP`` metres,
-    otherwise the curvature counts as unbounded (``inf``).
+    the first term is below ``TIP_RTOL * max(B, k_free)``, i.e. for ``t >= t0``; the tip
+    ``[0, t0]`` is left out when its arc length (at most ``t0^2 sum |g_i|``) is below ``TIP_M``
+    metres, otherwise the curvature counts as unbounded (``inf``).
     """
     out = np.full(V.shape[0], np.inf)
     scale = np.abs(V).max(axis=(1, 2))
     v0 = np.hypot(V[:, 0, 0], V[:, 0, 1])
-    ok = (v0 <= _ZERO * scale) & (V.shape[1] >= 2)
+    ok = (v0 <= ZERO_SPEED_RATIO * scale) & (V.shape[1] >= 2)
     if np.any(~ok):
         out[~ok] = _plain_bound(V[~ok])
     if not np.any(ok):
@@ -280,9 +287,9 @@ def _zero_speed_bound(V: np.ndarray, k_free: float) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         base = np.where(s_min > 0.0, base / np.maximum(s_min, 0.0) ** 1.5, np.inf)
         k_ref = np.maximum(base, k_free)
-        t0 = np.abs(Y[:, 0]) / (_RTOL_TIP * k_ref * np.maximum(s_min, 0.0) ** 1.5)
+        t0 = np.abs(Y[:, 0]) / (TIP_RTOL * k_ref * np.maximum(s_min, 0.0) ** 1.5)
     tip = t0 * t0 * np.abs(g).sum(axis=(1, 2))
-    res = np.where((s_min > 0.0) & (tip <= _TIP), np.maximum(base, 0.0) * (1.0 + _RTOL_TIP), np.inf)
+    res = np.where((s_min > 0.0) & (tip <= TIP_M), np.maximum(base, 0.0) * (1.0 + TIP_RTOL), np.inf)
     res = np.where(Y[:, 0] == 0.0, base, res)
     out[ok] = res
     return out

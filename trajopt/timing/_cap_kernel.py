@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit
 
 from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry._curvature_bound import _MAX_DEPTH, _MAX_WORK, _RTOL_TIP, _TIP, _ZERO
+from trajopt.geometry._curvature_bound import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO
 from trajopt.geometry._curve import STILL_SPEED_RATIO, ParametricCurve
 from trajopt.robot._robot import Robot
 from trajopt.timing._cap_cubic import bound_cubic
@@ -141,8 +141,8 @@ def polynomial_tables(
     p2b, shift = matrices(degree)
     X, S, V = workspace(degree)
     kmax, cap = _interval_bounds(
-        w, coef, nodes, s_nodes, h, s_grid.size - 1, _ZERO * curve.length / (hi - lo), limits,
-        _K_GRID, _GL_X, _GL_W, float(rtol), p2b, shift, X, S, V, True,
+        w, coef, nodes, s_nodes, h, s_grid.size - 1, ZERO_SPEED_RATIO * curve.length / (hi - lo),
+        limits, _K_GRID, _GL_X, _GL_W, float(rtol), p2b, shift, X, S, V, True,
     )  # fmt: skip
     if still:  # zero parametric speed at a node: the limit of the tangent direction
         raw = np.asarray(curve(u, 1), dtype=float)
@@ -344,12 +344,12 @@ def bound_from_taylor(
 
 @njit(cache=True, **NO_REFCOUNT)
 def _zero_start(V, p):  # pragma: no cover - compiled
-    """Whether the velocity at ``t = 0`` is zero (below ``_ZERO`` of the largest coefficient)."""
+    """Whether the velocity at ``t = 0`` is zero (below ``ZERO_SPEED_RATIO`` of its largest)."""
     scale = 0.0
     for i in range(p):
         for d in range(2):
             scale = max(scale, abs(V[i, d]))
-    return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= _ZERO * scale
+    return p >= 2 and math.hypot(V[0, 0], V[0, 1]) <= ZERO_SPEED_RATIO * scale
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -538,9 +538,9 @@ def _evaluate(
     if not s_min > 0.0:
         return np.inf
     k_ref = max(base, k_free)
-    t0 = abs(y0) / (_RTOL_TIP * k_ref * (s_min * math.sqrt(s_min)))
-    if t0 * t0 * gsum <= _TIP:
-        return max(base, 0.0) * (1.0 + _RTOL_TIP)
+    t0 = abs(y0) / (TIP_RTOL * k_ref * (s_min * math.sqrt(s_min)))
+    if t0 * t0 * gsum <= TIP_M:
+        return max(base, 0.0) * (1.0 + TIP_RTOL)
     return np.inf
 
 
@@ -597,12 +597,12 @@ def _interval_bounds(
         lsb[i] = _s_at_u(lb[i], i, w, coef, nodes, s_nodes, gl_x, gl_w)
     kmax = np.zeros(n)
     work = m
-    for depth in range(_MAX_DEPTH + 1):
+    for depth in range(MAX_DEPTH + 1):
         cnt = la.shape[0]
         split = np.zeros(cnt, np.bool_)
         kb = np.empty(cnt)
         n_split = 0
-        final = work >= _MAX_WORK or depth == _MAX_DEPTH  # every bound is kept as it is
+        final = work >= MAX_WORK or depth == MAX_DEPTH  # every bound is kept as it is
         for i in range(cnt):
             wide = lsb[i] - lsa[i] > h and not final
             taylor = True  # whether _evaluate computes gam (False: it holds this interval's)
