@@ -4,7 +4,8 @@ Pipeline: :func:`astar.inflate` -> :func:`astar.find_path` -> :func:`build_polyg
 (or :func:`build_corridor`) -> :class:`Smoother` -> :func:`time_parameterize`, or all at once
 with :func:`plan` (one query) and :class:`Planner` (many queries and re-plans on one map).
 
-**Core**: :func:`plan`, :class:`Planner`, :class:`Robot`, :class:`Trajectory`,
+**Core**: :func:`plan`, :class:`Planner` (settings as one value: :class:`PlannerOptions`),
+:class:`Robot`, :class:`Trajectory`,
 :class:`State`, :class:`Smoother`, the errors (:class:`TrajoptError` and its subclasses)
 and :func:`warm_up` (compile the numerical kernels ahead of time).
 
@@ -39,6 +40,7 @@ _EXPORTS: dict[str, str] = {
     # core
     "plan": "trajopt._planner",
     "Planner": "trajopt._planner",
+    "PlannerOptions": "trajopt._planner",
     "Robot": "trajopt.robot",
     "State": "trajopt.robot",
     "Trajectory": "trajopt.motion",
@@ -108,7 +110,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # pragma: no cover
     from trajopt import cli
-    from trajopt._planner import Planner, plan
+    from trajopt._planner import Planner, PlannerOptions, plan
     from trajopt._warm_up import warm_up
     from trajopt.analysis import bench, comparison, fits, metrics, plotting, scenes
     from trajopt.analysis.comparison import ComparisonTable, compare

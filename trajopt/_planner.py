@@ -57,6 +57,7 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
+import inspect
 import threading
 import time
 from collections.abc import Sequence
@@ -147,6 +148,10 @@ class Planner:
         ``"boxes"``: axis-aligned boxes of free cells only (:func:`build_corridor`). With
         ``inflation="paper"`` the corridor is always boxes (the polygons keep the radius
         from the raw map, not from the chapter's avoidance area).
+    options : PlannerOptions, optional
+        All of the settings above (``robot`` included) as one value, e.g. to build several
+        planners, or :func:`plan` calls, alike; the keywords must then stay at their
+        defaults.
 
     Notes
     -----
@@ -169,9 +174,11 @@ class Planner:
         costmap_weight: float = 2.0,
         speed_limits: SpeedLimits | None = None,
         landmarks: int = 0,
+        options: PlannerOptions | None = None,
     ) -> None:
-        settings = PlannerOptions(
-            robot=robot,
+        settings = _settings(
+            options,
+            robot,
             inflation=inflation,
             w_cells=w_cells,
             search=search,
@@ -184,25 +191,6 @@ class Planner:
             landmarks=landmarks,
         )
         self._init(grid, settings)
-
-    @classmethod
-    def from_options(cls, grid: OccupancyGrid | Costmap, options: PlannerOptions) -> Planner:
-        """Return a planner on ``grid`` with ``options`` (as :func:`plan` builds its own).
-
-        Parameters
-        ----------
-        grid : astar.OccupancyGrid or astar.Costmap
-            The raw map, or a costmap.
-        options : PlannerOptions
-            The settings (each one documented in :class:`Planner`).
-        """
-        if not isinstance(options, PlannerOptions):
-            raise InvalidInputError(
-                f"options must be a trajopt.planning PlannerOptions, got {type(options).__name__}"
-            )
-        planner = cls.__new__(cls)
-        planner._init(grid, options)
-        return planner
 
     def _init(self, grid: OccupancyGrid | Costmap, settings: PlannerOptions) -> None:
         options, raw, costmap = settings.for_map(grid)
@@ -473,6 +461,7 @@ def plan(
     speed_limits: SpeedLimits | None = None,
     timing_dt: float = 0.02,
     landmarks: int = 0,
+    options: PlannerOptions | None = None,
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
@@ -505,6 +494,8 @@ def plan(
     fallback : {None, "stop_and_turn"}
         Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
         module docstring); default ``None``: the failure raises.
+    options : PlannerOptions, optional
+        Every setting (``robot`` included) as one value (see :class:`Planner`).
 
     Returns
     -------
@@ -519,20 +510,21 @@ def plan(
     >>> traj = trajopt.plan(scene.grid, scene.start, scene.goal("A"))  # doctest: +SKIP
     >>> traj.duration  # doctest: +SKIP
     """
-    options = PlannerOptions(
-        robot=robot,
+    planner = Planner(
+        grid,
+        robot,
         inflation=inflation,
-        w_cells=w_cells,
         search=search,
         smoother=smoother,
-        timing_dt=timing_dt,
+        w_cells=w_cells,
         fallback=fallback,
         corridor=corridor,
         costmap_weight=costmap_weight,
         speed_limits=speed_limits,
+        timing_dt=timing_dt,
         landmarks=landmarks,
+        options=options,
     )
-    planner = Planner.from_options(grid, options)
     return planner.plan(
         start,
         goal,
@@ -541,3 +533,33 @@ def plan(
         v_start=v_start,
         v_end=v_end,
     )
+
+
+def _settings(
+    options: PlannerOptions | None, robot: Robot | None, **keywords: Any
+) -> PlannerOptions:
+    """Return the settings given as ``options``, or built from the keywords.
+
+    Raises
+    ------
+    InvalidInputError
+        ``options`` is not a :class:`PlannerOptions`, or it comes with a keyword (or the
+        robot) set as well.
+    """
+    if options is None:
+        return PlannerOptions(robot=robot, **keywords)
+    if not isinstance(options, PlannerOptions):
+        raise InvalidInputError(
+            f"options must be a trajopt.PlannerOptions, got {type(options).__name__}"
+        )
+    defaults = inspect.signature(Planner.__init__).parameters
+    given = [k for k, v in keywords.items() if v is not defaults[k].default
+             and v != defaults[k].default]  # fmt: skip
+    if robot is not None:
+        given.insert(0, "robot")
+    if given:
+        raise InvalidInputError(
+            f"give the planner's settings either as options or as keywords, not both: got "
+            f"options and {', '.join(given)}"
+        )
+    return options

@@ -166,21 +166,21 @@ def test_planner_with_landmarks_plans_the_same_through_map_updates():
     plain = trajopt.Planner(grid, robot).plan(a, b)
     planner = trajopt.Planner(grid, robot, landmarks=4)
     with_lm = planner.plan(a, b)
-    assert planner._landmarks is not None and planner._landmarks.k == 4
+    assert planner.caches.built_landmarks is not None and planner.caches.built_landmarks.k == 4
     assert with_lm.steps.grid_path.cost == pytest.approx(plain.steps.grid_path.cost, rel=1e-12)
-    built = planner._landmarks.distances
+    built = planner.caches.built_landmarks.distances
     # obstacles added: the landmarks are carried over, the search stays exact
     occ2 = occ.copy()
     occ2[40:50, 10:20] = True
     occ2[18:22, 30:34] = True  # near the door: the path's clearance cost rises
     assert planner.update_map(OccupancyGrid(occ2, 0.05))["landmarks"] == "rebased"
-    assert planner._landmarks.distances is built
+    assert planner.caches.built_landmarks.distances is built
     again = planner.plan(a, b)
     fresh = trajopt.Planner(OccupancyGrid(occ2, 0.05), robot).plan(a, b)
     assert again.steps.grid_path.cost == pytest.approx(fresh.steps.grid_path.cost, rel=1e-12)
     # a cell freed: dropped, and built again by the next search
     assert planner.update_map(OccupancyGrid(occ, 0.05))["landmarks"] == "dropped"
-    assert planner._landmarks is None
+    assert planner.caches.built_landmarks is None
     back = planner.plan(a, b)
     assert back.steps.grid_path.cost == pytest.approx(plain.steps.grid_path.cost, rel=1e-12)
-    assert planner._landmarks is not None and planner._landmarks.distances is not built
+    assert planner.caches.built_landmarks is not None and planner.caches.built_landmarks.distances is not built

@@ -88,6 +88,11 @@ class PlannerCaches:
                                                         o.landmarks)  # fmt: skip
             return self._landmarks
 
+    @property
+    def built_landmarks(self) -> astar.Landmarks | None:
+        """The landmarks if a search has built them (``None`` otherwise; builds nothing)."""
+        return self._landmarks
+
     def disc(self, options: PlannerOptions) -> PlannerCaches:
         """Return (and keep) the caches of a disc model with ``options`` on this map."""
         radius = options.robot.radius

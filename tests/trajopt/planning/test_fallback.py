@@ -362,7 +362,7 @@ def test_fallback_needs_rest_at_both_ends(zigzag):
 
 
 def test_failed_clearance_check_reraises_the_original_error(zigzag, monkeypatch):
-    import trajopt.timing._stop_and_turn as fallback
+    import trajopt.planning._fallback as fallback
 
     monkeypatch.setattr(fallback, "polyline_clearance", lambda *a, **k: 0.0)
     grid, start, goal = zigzag

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 
@@ -95,3 +96,39 @@ def test_plan_refuses_what_the_planner_refuses(grid, kwargs):
     assert type(ours.value) is type(theirs.value)
     assert str(ours.value) == str(theirs.value)
     assert next(iter(kwargs)) in str(ours.value)
+
+
+def test_planner_keywords_are_the_options_fields():
+    """``Planner`` and ``plan`` take each setting of ``PlannerOptions`` by the same name, with
+    the field's own default (a factory default shows as ``None``), and ``options`` itself."""
+    fields = {f.name: f for f in dataclasses.fields(trajopt.PlannerOptions)}
+    params = inspect.signature(trajopt.Planner.__init__).parameters
+    keywords = [n for n in params if n not in {"self", "grid", "options"}]
+    assert sorted(keywords) == sorted(fields)
+    for name in keywords:
+        f = fields[name]
+        default = None if f.default is dataclasses.MISSING else f.default
+        assert params[name].default == default, name
+    assert "options" in inspect.signature(trajopt.plan).parameters
+
+
+def test_options_give_the_keywords_plan(grid):
+    opts = trajopt.PlannerOptions(robot=ROBOT, timing_dt=0.05, corridor="boxes")
+    a = trajopt.plan(grid, START, GOAL, options=opts)
+    b = trajopt.plan(grid, START, GOAL, ROBOT, timing_dt=0.05, corridor="boxes")
+    c = trajopt.Planner(grid, options=opts).plan(START, GOAL)
+    t = np.linspace(0.0, a.duration, 200)
+    for other in (b, c):
+        assert other.duration == a.duration
+        np.testing.assert_array_equal(np.asarray(a.sample(t)), np.asarray(other.sample(t)))
+
+
+@pytest.mark.parametrize("extra", [{"corridor": "boxes"}, {"timing_dt": 0.05}])
+def test_options_and_keywords_together_are_refused(grid, extra):
+    opts = trajopt.PlannerOptions(robot=ROBOT)
+    with pytest.raises(InvalidInputError, match="either as options or as keywords"):
+        trajopt.plan(grid, START, GOAL, options=opts, **extra)
+    with pytest.raises(InvalidInputError, match="not both: got options and robot"):
+        trajopt.Planner(grid, ROBOT, options=opts)
+    with pytest.raises(InvalidInputError, match="options must be a trajopt.PlannerOptions"):
+        trajopt.Planner(grid, options={"corridor": "boxes"})
