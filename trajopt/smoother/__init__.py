@@ -42,8 +42,9 @@ Modules: :mod:`~trajopt.smoother._options` (the :class:`Smoother` options),
 (problem assembly in cell units), :mod:`~trajopt.smoother._basis` (B-spline basis maths),
 :mod:`~trajopt.smoother._qp` (the convex QP and its solver cache),
 :mod:`~trajopt.smoother._scp` (the curvature bound by SCP), :mod:`~trajopt.smoother._nlp`
-(IPOPT), :mod:`~trajopt.smoother._certificate` and :mod:`~trajopt.smoother._status` (solve
-statuses and the statistics).
+(IPOPT), :mod:`~trajopt.smoother._solver_builds` (the lock and the record of the solver
+builds both share), :mod:`~trajopt.smoother._certificate` and
+:mod:`~trajopt.smoother._status` (solve statuses and the statistics).
 """
 
 from trajopt.smoother._certificate import Certificate, certify

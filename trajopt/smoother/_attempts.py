@@ -17,7 +17,7 @@ import functools
 import logging
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,6 +32,7 @@ from trajopt.smoother._footprint_rounds import FootprintRounds, footprint_scp
 from trajopt.smoother._nlp import solve_curvature_ipopt
 from trajopt.smoother._path import SmoothPath
 from trajopt.smoother._problem import (
+    N_HEADING_ROWS,
     EmptyBoundsError,
     Problem,
     QPData,
@@ -40,9 +41,12 @@ from trajopt.smoother._problem import (
     objective,
     project_heading,
 )
-from trajopt.smoother._qp import N_HEADING_ROWS, solve_qp, warm_imports
+from trajopt.smoother._qp import solve_qp, warm_imports
 from trajopt.smoother._scp import CurvatureSCP
 from trajopt.smoother._status import AttemptRecord, SolveInfo, SolveStatus, summarize
+
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
 
 logger = logging.getLogger(__name__)
 
@@ -62,7 +66,7 @@ class AttemptFailed(Exception):
 
 
 def fit(
-    options: Any,
+    options: Smoother,
     grid_path_or_points: Any,
     corridor: Corridor | PolygonCorridor,
     *,
@@ -204,8 +208,17 @@ def fit(
     )
 
 
-def _check(options: Any, corridor: Any, raw_grid: Any, radius: float, fp: Any, ends: tuple,
-           c_cells: np.ndarray, t_cells: np.ndarray, span_box: np.ndarray) -> tuple:  # fmt: skip
+def _check(
+    options: Smoother,
+    corridor: Corridor | PolygonCorridor,
+    raw_grid: Any,
+    radius: float,
+    fp: FootprintRounds | None,
+    ends: tuple,
+    c_cells: np.ndarray,
+    t_cells: np.ndarray,
+    span_box: np.ndarray,
+) -> tuple:
     """Return the curve of ``c_cells`` (cells) and its certificates.
 
     ``(curve, certificate, footprint certificate)``: the last only with a footprint
@@ -223,7 +236,7 @@ def _check(options: Any, corridor: Any, raw_grid: Any, radius: float, fp: Any, e
 
 
 def solve_attempt(
-    options: Any,
+    options: Smoother,
     prob: Problem,
     h: float,
     remaining: float,
@@ -281,7 +294,7 @@ def solve_attempt(
     return c, t, asm.span_box
 
 
-def fit_free(options: Any, points: Any, u: Any, knots: Any) -> BSplineCurve:
+def fit_free(options: Smoother, points: Any, u: Any, knots: Any) -> BSplineCurve:
     """:meth:`Smoother.fit_free` (see there)."""
     pts = np.asarray(points, dtype=float)
     uu = np.asarray(u, dtype=float)

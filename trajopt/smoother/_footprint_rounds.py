@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,6 +32,9 @@ from trajopt.robot._footprint import (
 )
 from trajopt.smoother._footprint_scp import FootprintSCP, corners_cells
 from trajopt.smoother._problem import Problem, assemble, project_heading
+
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
 
 #: most SCP rounds on one knot vector (then the knots are refined)
 FOOTPRINT_ROUNDS = 4
@@ -109,7 +112,7 @@ class FootprintRounds:
         self.start_heading, self.goal_heading = self._before
 
 
-def footprint_scp(options: Any, prob: Problem, h: float, c_cells: np.ndarray,
+def footprint_scp(options: Smoother, prob: Problem, h: float, c_cells: np.ndarray,
                   cert: FootprintCertificate, fp: FootprintRounds, r_cells: float,
                   check: Callable[..., tuple]) -> tuple | None:  # fmt: skip
     """Run the SCP rounds on the knots of span ``h`` from the failed curve ``c_cells``.

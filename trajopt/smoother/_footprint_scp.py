@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, sample_bases
-from trajopt.smoother._problem import Assembly, Problem
-from trajopt.smoother._qp import N_HEADING_ROWS, constraint_layout, solve_working_set
+from trajopt.smoother._problem import N_HEADING_ROWS, Assembly, Problem
+from trajopt.smoother._qp import constraint_layout, solve_working_set
 
 #: (corner, half-plane) rows per sample
 ROWS_PER_SAMPLE = 2

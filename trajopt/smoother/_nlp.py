@@ -7,14 +7,17 @@ from __future__ import annotations
 
 import functools
 import time
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, curvature_samples
-from trajopt.smoother._problem import QPData
-from trajopt.smoother._qp import LOCK, N_HEADING_ROWS, is_built
+from trajopt.smoother._problem import N_HEADING_ROWS, QPData
+from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
+
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
 
 
 @functools.lru_cache(maxsize=32)
@@ -133,7 +136,7 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
 
 
 def solve_curvature_ipopt(
-    options: Any,
+    options: Smoother,
     qp: QPData,
     t: np.ndarray,
     z0: np.ndarray,

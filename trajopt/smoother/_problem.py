@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,14 @@ from trajopt.smoother._basis import (
     find_spans,
     smoothness_band,
 )
+
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
+
+
+#: Heading rows at the top of every constraint matrix (:func:`heading_rows`: the start and goal
+#: tangents, two rows each, and the start curvature).
+N_HEADING_ROWS = 5
 
 
 class EmptyBoundsError(Exception):
@@ -351,16 +359,16 @@ def objective(pts, u, t, p, n, weight, order, *, fidelity=1.0, length=0.0):
 
 
 def heading_rows(prob: Problem, n: int, nb: int, alpha: float | None = None):
-    """Return the end-condition rows ``(A (5, 2 nb), lba, uba)``.
+    """Return the end-condition rows ``(A (N_HEADING_ROWS, 2 nb), lba, uba)``.
 
     Rows 0-1: ``c_1`` on the start-heading ray (``cross(d, c_1 - c_0) = 0``,
     ``dot(d, c_1 - c_0) >= 1e-3``, or ``= alpha`` with a start curvature); rows 2-3: the
     same for ``c_{n-2}`` and the goal heading; row 4: the start curvature
     (:func:`start_curvature_row`), unused rows with infinite bounds.
     """
-    amat = np.zeros((5, 2 * nb))
-    lba = np.full(5, -np.inf)
-    uba = np.full(5, np.inf)
+    amat = np.zeros((N_HEADING_ROWS, 2 * nb))
+    lba = np.full(N_HEADING_ROWS, -np.inf)
+    uba = np.full(N_HEADING_ROWS, np.inf)
     eps = 1e-3  # cells: keeps c_1 != c_0 so the end heading is defined
     if prob.start_dir is not None:
         dx, dy = prob.start_dir
@@ -486,7 +494,7 @@ def project_heading(
 
 
 def build_problem(
-    options: Any,
+    options: Smoother,
     grid_path_or_points: Any,
     corridor: Corridor | PolygonCorridor,
     *,
@@ -577,7 +585,7 @@ def build_problem(
     return prob, p0, p1
 
 
-def assemble(options: Any, prob: Problem, h: float) -> Assembly:
+def assemble(options: Smoother, prob: Problem, h: float) -> Assembly:
     """Return the QP of one attempt on the knots of longest span ``h`` (cells).
 
     Control-point bounds are the intersection of the regions of the spans each point

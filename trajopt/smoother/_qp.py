@@ -11,19 +11,21 @@ from __future__ import annotations
 
 import functools
 import logging
-import threading
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from trajopt.smoother._problem import QPData
+from trajopt.smoother._nlp import qp_ipopt
+from trajopt.smoother._problem import N_HEADING_ROWS, QPData
+from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
 
-logger = logging.getLogger(__name__)
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
 
-LOCK = threading.Lock()
+logger = logging.getLogger(__name__)
 
 
 def _band_pattern(nb: int, p: int):
@@ -34,10 +36,6 @@ def _band_pattern(nb: int, p: int):
         rows.append(r)
         cols.append(np.full(len(r), c))
     return np.concatenate(rows), np.concatenate(cols)
-
-
-#: heading rows at the top of every constraint matrix (start/goal tangent; see smoother)
-N_HEADING_ROWS = 5
 
 
 @functools.lru_cache(maxsize=64)
@@ -397,9 +395,6 @@ def piqp_info(z: np.ndarray, result: tuple, t_wall: float, t_cpu: float) -> Solv
     )
 
 
-_BUILT: set[tuple] = set()
-
-
 _WARM: list[str] = []  # what warm_imports has loaded: "casadi", "piqp"
 
 
@@ -426,20 +421,7 @@ def warm_imports(casadi: bool = True) -> None:
     _WARM.append("piqp")
 
 
-def is_built(kind: str, nb: int, p: int, verbose: bool) -> bool:
-    """Whether the solver ``(kind, nb, p, verbose)`` was built before in this process.
-
-    Whether the solver ``(kind, nb, p, verbose)`` was built before in this process (and mark it
-    built): its build time is then not counted again.
-    """
-    key = (kind, nb, p, verbose)
-    if key in _BUILT:
-        return True
-    _BUILT.add(key)
-    return False
-
-
-def solve_qp(options: Any, qp: QPData, x0: np.ndarray | None = None) -> SolveInfo:
+def solve_qp(options: Smoother, qp: QPData, x0: np.ndarray | None = None) -> SolveInfo:
     """One solve of the corridor QP (no curvature rows) by ``options.qp_solver``.
 
     Parameters
@@ -476,8 +458,6 @@ def solve_qp(options: Any, qp: QPData, x0: np.ndarray | None = None) -> SolveInf
     tb = time.perf_counter()
     built = is_built(f"{solver_name}-0-{qp.k}", nb, p, options.verbose)
     if solver_name == "ipopt":
-        from trajopt.smoother._nlp import qp_ipopt
-
         solver = qp_ipopt(nb, p, options.verbose)
     else:
         solver = qp_solver(nb, p, solver_name, 0, options.verbose, qp.k)

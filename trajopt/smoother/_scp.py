@@ -30,7 +30,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,6 +38,9 @@ from trajopt.smoother._basis import CURV_SAMPLES, band_quadratic, curvature_samp
 from trajopt.smoother._problem import QPData
 from trajopt.smoother._qp import constraint_layout, piqp_info, solve_working_set
 from trajopt.smoother._status import SolveInfo, SolveStatus
+
+if TYPE_CHECKING:
+    from trajopt.smoother._options import Smoother
 
 logger = logging.getLogger(__name__)
 
@@ -112,7 +115,7 @@ class CurvatureSCP:
 
     def __init__(
         self,
-        options: Any,
+        options: Smoother,
         qp: QPData,
         knots: np.ndarray,
         kmax: float,
