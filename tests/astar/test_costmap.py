@@ -1,8 +1,9 @@
 """Costmaps: conventions, Nav2's translation table, files, and planning on a costmap.
 
-The references are independent of :mod:`astar.costmap`: Nav2's published translation
-(``1 + floor(97 (c - 1) / 251)``) and inflation-layer formula are re-written here from
-their definitions, and distances come from :func:`scipy.ndimage.distance_transform_edt`.
+The references (``tests/reference.py``) are independent of :mod:`astar.costmap`: Nav2's
+published translation (``1 + floor(97 (c - 1) / 251)``) and inflation-layer formula are
+re-written from their definitions, and distances come from
+:func:`scipy.ndimage.distance_transform_edt`.
 """
 
 from __future__ import annotations
@@ -12,32 +13,11 @@ import math
 import numpy as np
 import pytest
 from PIL import Image
-from scipy import ndimage
 
 import astar
 from astar.costmap import Costmap, from_costmap, load_costmap
 from astar.errors import InvalidInputError, MapFormatError
-
-
-def nav2_translate(c: np.ndarray) -> np.ndarray:
-    """costmap_2d uint8 -> nav_msgs/OccupancyGrid int8, as Nav2's publisher does."""
-    c = np.asarray(c, dtype=np.int64)
-    out = 1 + (97 * (c - 1)) // 251
-    out = np.where(c == 0, 0, out)
-    out = np.where(c == 253, 99, out)
-    out = np.where(c == 254, 100, out)
-    return np.where(c == 255, -1, out)
-
-
-def nav2_inflation(occupied: np.ndarray, res: float, r_ins: float, r_inf: float, k: float):
-    """costmap_2d values of a static + inflation layer (Nav2's formulas)."""
-    d = ndimage.distance_transform_edt(~occupied) * res
-    c = np.zeros(occupied.shape, np.int64)
-    band = (d > r_ins) & (d <= r_inf)
-    c[band] = np.floor(252.0 * np.exp(-k * (d[band] - r_ins))).astype(np.int64)
-    c[d <= r_ins] = 253
-    c[occupied] = 254
-    return c
+from tests.reference import grid_path_cost, nav2_inflation, nav2_translate
 
 
 def test_costmap_2d_classes_and_cost():
@@ -131,14 +111,6 @@ def test_load_costmap_errors(tmp_path):
         load_costmap(tmp_path / "c.png")
 
 
-def _grid_path_cost(path, cost: np.ndarray) -> float:
-    """The search's objective, recomputed: sum of step length x (1 + mean cell cost)."""
-    cells = np.asarray(path.cells)
-    c = cost[cells[:, 1], cells[:, 0]]
-    steps = np.hypot(*np.diff(cells, axis=0).T)
-    return float(np.sum(steps * (1.0 + 0.5 * (c[:-1] + c[1:]))))
-
-
 def test_plans_on_a_nav2_costmap_avoid_cost_and_keep_the_certificate(shared_data):
     import trajopt
     from trajopt.analysis.metrics import point_clearance
@@ -158,8 +130,8 @@ def test_plans_on_a_nav2_costmap_avoid_cost_and_keep_the_certificate(shared_data
         ta = p_cost.plan(start, goal)
         tb = p_short.plan(start, goal)
         # the costmap search is optimal for its own objective
-        obj_a = _grid_path_cost(ta.steps.grid_path, weighted)
-        obj_b = _grid_path_cost(tb.steps.grid_path, weighted)
+        obj_a = grid_path_cost(ta.steps.grid_path.cells, weighted)
+        obj_b = grid_path_cost(tb.steps.grid_path.cells, weighted)
         assert obj_a <= obj_b + 1e-9
         for t, out in ((ta, means_cost), (tb, means_short)):
             smp = t.sample_uniform(0.01)

@@ -12,25 +12,7 @@ import numpy as np
 import pytest
 
 from astar.distance_transform import UNREACHED, squared_distances
-from tests.reference import scipy_distance_cells
-
-
-def brute_squared(occ: np.ndarray, metric: str) -> np.ndarray:
-    """All-pairs minimum, in cells^2 (centre) or quarter cells^2 (square), as int64."""
-    ny, nx = occ.shape
-    iy, ix = np.mgrid[0:ny, 0:nx]
-    oy, ox = np.nonzero(occ)
-    if ox.size == 0:
-        return np.full(occ.shape, UNREACHED, dtype=np.int64)
-    dx = np.abs(ix.ravel()[:, None] - ox[None, :]).astype(np.int64)
-    dy = np.abs(iy.ravel()[:, None] - oy[None, :]).astype(np.int64)
-    if metric == "centre":
-        d2 = dx * dx + dy * dy
-    else:  # nearest point of the square [c - 1/2, c + 1/2]: offset max(|k| - 1/2, 0), doubled
-        ax = np.maximum(2 * dx - 1, 0)
-        ay = np.maximum(2 * dy - 1, 0)
-        d2 = ax * ax + ay * ay
-    return d2.min(axis=1).reshape(occ.shape)
+from tests.reference import brute_squared, scipy_distance_cells
 
 
 def _random_grids(seed: int, count: int, max_side: int):

@@ -17,66 +17,9 @@ from scipy import ndimage
 
 from astar import InvalidInputError, OccupancyGrid
 from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
+from tests.reference import INFLATION_TOL, brute_distance, brute_inflate, chapter_avoidance
 
-TOL = 1e-9  # documented: distances within this relative tolerance of the radius equal it
-
-
-# ----------------------------------------------------------------------------- references
-def _centres(shape):
-    ny, nx = shape
-    iy, ix = np.mgrid[0:ny, 0:nx]
-    return ix.ravel().astype(float), iy.ravel().astype(float)
-
-
-def brute_distance(occ, metric, outside):
-    """Distance in cells from every cell centre to the nearest obstacle (all pairs)."""
-    ny, nx = occ.shape
-    x, y = _centres(occ.shape)
-    oy, ox = np.nonzero(occ)
-    d = np.full(x.shape, np.inf)
-    if ox.size:
-        dx = np.abs(x[:, None] - ox[None, :])
-        dy = np.abs(y[:, None] - oy[None, :])
-        if metric == "square":
-            dx = np.maximum(0.0, dx - 0.5)
-            dy = np.maximum(0.0, dy - 0.5)
-        d = np.sqrt(dx**2 + dy**2).min(axis=1)
-    if outside:
-        if metric == "centre":  # nearest centre of a cell outside the map
-            b = np.minimum.reduce([x + 1, nx - x, y + 1, ny - y])
-        else:  # nearest point of the region outside the map rectangle
-            b = np.minimum.reduce([x + 0.5, nx - x - 0.5, y + 0.5, ny - y - 0.5])
-        d = np.minimum(d, b)
-    return d.reshape(occ.shape)
-
-
-def brute_inflate(occ, r_cells, metric, outside):
-    d = brute_distance(occ, metric, outside)
-    # compare squared distances (integers, or quarter-integers for squares) with r^2
-    if metric == "centre":
-        out = d**2 <= r_cells**2 * (1 + TOL)
-    else:
-        out = d**2 < r_cells**2 * (1 - TOL)
-    return out | occ
-
-
-def chapter_avoidance(occ, w, border):
-    """The chapter's loop, literally: W rounds of 'mark cells next to a full cell as full'."""
-    ny, nx = occ.shape
-    full = occ.copy()
-    for _ in range(w):
-        new = full.copy()
-        for iy in range(ny):
-            for ix in range(nx):
-                for dy in (-1, 0, 1):
-                    for dx in (-1, 0, 1):
-                        jy, jx = iy + dy, ix + dx
-                        inside = 0 <= jy < ny and 0 <= jx < nx
-                        if (inside and full[jy, jx]) or (not inside and border):
-                            new[iy, ix] = True
-        full = new
-    return full
-
+TOL = INFLATION_TOL  # documented: distances within this relative tolerance of the radius equal it
 
 grids = st.tuples(
     st.integers(1, 12), st.integers(1, 12), st.floats(0.0, 0.4), st.integers(0, 2**31)

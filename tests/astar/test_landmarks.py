@@ -1,6 +1,6 @@
 """ALT landmarks: their distances, exact searches with them, and the refusals.
 
-References: scipy's Dijkstra on the explicit step graph (``tests.astar.test_search``).
+References: scipy's Dijkstra on the explicit step graph (``tests/reference.py``).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pytest
 import astar
 import trajopt
 from astar import InvalidInputError, OccupancyGrid, build_landmarks, clearance_cost, find_path
-from tests.astar.test_search import check_path, dijkstra_costs
+from tests.reference import check_path, dijkstra_costs
 
 
 def rooms(seed: int, ny: int = 48, nx: int = 64) -> np.ndarray:
@@ -183,4 +183,7 @@ def test_planner_with_landmarks_plans_the_same_through_map_updates():
     assert planner.caches.built_landmarks is None
     back = planner.plan(a, b)
     assert back.steps.grid_path.cost == pytest.approx(plain.steps.grid_path.cost, rel=1e-12)
-    assert planner.caches.built_landmarks is not None and planner.caches.built_landmarks.distances is not built
+    assert (
+        planner.caches.built_landmarks is not None
+        and planner.caches.built_landmarks.distances is not built
+    )

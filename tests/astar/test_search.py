@@ -10,67 +10,12 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 import astar
 from astar import GridPath, InvalidInputError, NoPathError, OccupancyGrid, find_path
+from tests.reference import check_path, dijkstra_costs
 
 SQRT2 = math.sqrt(2.0)
-
-
-# ----------------------------------------------------------------------------- references
-def legal_step(occ, a, b, connectivity, corner_cutting):
-    """Whether the move a -> b (cells (ix, iy)) is legal under the documented rules."""
-    ny, nx = occ.shape
-    (ax, ay), (bx, by) = a, b
-    dx, dy = bx - ax, by - ay
-    if not (0 <= bx < nx and 0 <= by < ny) or occ[by, bx] or occ[ay, ax]:
-        return False
-    if (abs(dx), abs(dy)) in ((1, 0), (0, 1)):
-        return True
-    if connectivity == 4 or (abs(dx), abs(dy)) != (1, 1):
-        return False
-    return corner_cutting or (not occ[ay, ax + dx] and not occ[ay + dy, ax])
-
-
-def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):
-    """Cheapest cost from ``start`` to every cell by scipy's Dijkstra on an explicit graph."""
-    ny, nx = occ.shape
-    rows, cols, w = [], [], []
-    moves = [(1, 0), (-1, 0), (0, 1), (0, -1)]
-    if connectivity == 8:
-        moves += [(1, 1), (1, -1), (-1, 1), (-1, -1)]
-    for iy in range(ny):
-        for ix in range(nx):
-            for dx, dy in moves:
-                if legal_step(occ, (ix, iy), (ix + dx, iy + dy), connectivity, corner_cutting):
-                    step = SQRT2 if dx and dy else 1.0
-                    if cost is not None:
-                        step *= 1.0 + 0.5 * (cost[iy, ix] + cost[iy + dy, ix + dx])
-                    rows.append(iy * nx + ix)
-                    cols.append((iy + dy) * nx + ix + dx)
-                    w.append(step)
-    graph = csr_matrix((w, (rows, cols)), shape=(nx * ny, nx * ny))
-    d = dijkstra(graph, indices=start[1] * nx + start[0])
-    return d.reshape(ny, nx)
-
-
-def check_path(path, occ, start, goal, connectivity, corner_cutting, cost=None):
-    """Every step legal, ends right, reported length and cost equal the recomputed ones."""
-    cells = path.cells
-    assert cells.dtype == np.int64 and cells.ndim == 2 and cells.shape[1] == 2
-    assert tuple(cells[0]) == tuple(start) and tuple(cells[-1]) == tuple(goal)
-    length = total = 0.0
-    for a, b in zip(cells[:-1], cells[1:], strict=True):
-        assert legal_step(occ, tuple(a), tuple(b), connectivity, corner_cutting), (a, b)
-        step = SQRT2 if abs(a - b).sum() == 2 else 1.0
-        length += step
-        if cost is not None:
-            step *= 1.0 + 0.5 * (cost[a[1], a[0]] + cost[b[1], b[0]])
-        total += step
-    assert path.length == pytest.approx(length, rel=1e-12, abs=1e-12)
-    assert path.cost == pytest.approx(total if cost is not None else length, rel=1e-12, abs=1e-12)
 
 
 # ----------------------------------------------------------------------------- property tests

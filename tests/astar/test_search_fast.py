@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from astar import InvalidInputError, NoPathError, OccupancyGrid, clearance_cost, find_path
-from tests.astar.test_search import check_path, dijkstra_costs
+from tests.reference import check_path, dijkstra_costs
 
 
 @st.composite

@@ -14,19 +14,10 @@ import numpy as np
 import pytest
 
 import astar
+from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
 from trajopt._warm_up import warm_up_map
 from trajopt.errors import InvalidInputError
-
-
-def _square_distance(p: np.ndarray, grid: astar.OccupancyGrid) -> float:
-    """Brute force: distance (m) from a point to every occupied square and to the map edge."""
-    res = grid.resolution
-    iy, ix = np.nonzero(grid.occupied)
-    lo = np.stack([ix, iy], axis=1) * res
-    d = np.maximum(np.maximum(lo - p, p - (lo + res)), 0.0)
-    edge = min(p[0], p[1], grid.occupied.shape[1] * res - p[0], grid.occupied.shape[0] * res - p[1])
-    return float(min(np.sqrt((d**2).sum(axis=1)).min(), edge))
 
 
 def _free_grid() -> astar.OccupancyGrid:
@@ -65,7 +56,7 @@ def test_warm_up_map_leaves_room_for_the_robot(kind):
     grid, start, goal = warm_up_map(planner)
     need = planner.robot.radius * (3.0 if planner.inflation == "paper" else 1.0)
     for p in (start, goal):
-        assert _square_distance(np.asarray(p), grid) >= need
+        assert point_square_distance(np.asarray(p), grid) >= need
     assert grid.occupied[:, grid.occupied.shape[1] // 2].any()  # a wall between them
 
 

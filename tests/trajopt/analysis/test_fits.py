@@ -12,6 +12,7 @@ from hypothesis import assume, event, example, given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
+from tests.reference import brute_force_schoenberg_whitney, control_point_swing
 from trajopt.analysis import fits
 from trajopt.analysis.fits._bspline_fit import BSPLINE_SWING_MAX, schoenberg_whitney_matches
 from trajopt.analysis.fits._robust import bisquare
@@ -394,15 +395,6 @@ def test_schoenberg_whitney_failure_is_exact_rank_deficiency() -> None:
     assert np.linalg.matrix_rank(a) < len(p)  # numpy's default tolerance: singular
 
 
-def _brute_force_schoenberg_whitney(a: np.ndarray, u: np.ndarray) -> bool:
-    """Some strictly increasing sites u_(j_0) < ... with B_i(u_(j_i)) != 0 (by enumeration)."""
-    m, n = a.shape
-    for rows in itertools.combinations(range(m), n):
-        if np.all(np.diff(u[list(rows)]) > 0) and all(a[j, i] != 0 for i, j in enumerate(rows)):
-            return True
-    return False
-
-
 @given(
     k=st.integers(1, 4),
     extra=st.integers(0, 3),
@@ -424,7 +416,7 @@ def test_schoenberg_whitney_greedy_equals_enumeration(k: int, extra: int, sites)
     a = BSpline.design_matrix(u, t, k).toarray() if n <= len(u) else None
     ours = schoenberg_whitney_matches(u, t, k) == n
     event(f"schoenberg-whitney holds: {ours}")
-    assert ours == (a is not None and _brute_force_schoenberg_whitney(a, u))
+    assert ours == (a is not None and brute_force_schoenberg_whitney(a, u))
 
 
 @given(
@@ -458,7 +450,7 @@ def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
         with pytest.raises(IllPosedFitError, match="Schoenberg-Whitney|numerically singular"):
             fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
         return
-    swing = _reference_swing(p, c_ref)
+    swing = control_point_swing(p, c_ref)
     assume(abs(swing - BSPLINE_SWING_MAX) > 1e-6)  # not at the threshold
     if swing > BSPLINE_SWING_MAX:
         event("swings")
@@ -468,13 +460,6 @@ def test_bspline_fit_raises_exactly_when_lstsq_rank_is_deficient(
         event("fitted")
         curve = fits.fit_bspline(p, degree=k, n_ctrl=n, parameterization=kind)
         np.testing.assert_allclose(curve.c, c_ref, atol=1e-9)
-
-
-def _reference_swing(p: np.ndarray, c: np.ndarray) -> float:
-    """Largest distance of a control point from the data's bounding box over its longer side
-    (the nearest point of the box by clipping)."""
-    lo, hi = p.min(axis=0), p.max(axis=0)
-    return float(np.linalg.norm(c - np.clip(c, lo, hi), axis=1).max() / np.max(hi - lo))
 
 
 _DIRS8 = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)]
@@ -510,14 +495,14 @@ def test_square_fits_of_random_staircases_never_swing() -> None:
                 if "swings away" in msg:
                     refused_swing += 1
                     c_ref = np.linalg.lstsq(a, p, rcond=None)[0]
-                    assert _reference_swing(p, c_ref) > BSPLINE_SWING_MAX
+                    assert control_point_swing(p, c_ref) > BSPLINE_SWING_MAX
                     ratio = float(msg.split(" times the data's extent")[0].rsplit(", ", 1)[1])
-                    assert ratio == pytest.approx(_reference_swing(p, c_ref), rel=1e-2)
+                    assert ratio == pytest.approx(control_point_swing(p, c_ref), rel=1e-2)
                 else:
                     assert "Schoenberg-Whitney" in msg or "numerically singular" in msg
                 continue
             returned += 1
-            assert _reference_swing(p, curve.c) <= BSPLINE_SWING_MAX
+            assert control_point_swing(p, curve.c) <= BSPLINE_SWING_MAX
             np.testing.assert_allclose(a @ curve.c, curve(u), atol=1e-9)
     assert returned > 50 and refused_swing > 50  # both branches are exercised
 
@@ -532,7 +517,7 @@ def test_a_fit_that_swings_raises_naming_the_fit_the_value_and_the_rule() -> Non
     a, _, _ = _reference_design(p, k, n, "chord")
     c_ref, _, rank, _ = np.linalg.lstsq(a, p, rcond=1.0 / fits.BSPLINE_COND_MAX)
     assert rank == n  # well conditioned enough for the design checks
-    swing = _reference_swing(p, c_ref)
+    swing = control_point_swing(p, c_ref)
     assert swing > BSPLINE_SWING_MAX
     # the package face re-exports the check and its bound
     assert fits.BSPLINE_SWING_MAX == BSPLINE_SWING_MAX
@@ -546,7 +531,7 @@ def test_a_fit_that_swings_raises_naming_the_fit_the_value_and_the_rule() -> Non
     allowed = int(msg.rsplit("allow at most ", 1)[1].split()[0])
     assert k + 1 <= allowed < n  # and that count does fit, inside the bound
     ok = fits.fit_bspline(p, degree=k, n_ctrl=allowed, parameterization="chord")
-    assert _reference_swing(p, ok.c) <= BSPLINE_SWING_MAX
+    assert control_point_swing(p, ok.c) <= BSPLINE_SWING_MAX
     # the comparison records the refused fit as invalid, with the reason
     from trajopt.analysis.comparison._builtin_methods import _method_bspline
 
@@ -593,7 +578,7 @@ def test_sweep_of_random_staircases_ranks_no_swinging_fit_valid() -> None:
             if r.valid:
                 a, _, _ = _reference_design(p, r.params["degree"], r.params["n_ctrl"], "chord")
                 c_ref = np.linalg.lstsq(a, p, rcond=None)[0]
-                assert _reference_swing(p, c_ref) <= BSPLINE_SWING_MAX, r
+                assert control_point_swing(p, c_ref) <= BSPLINE_SWING_MAX, r
             elif "swings away from the data" in r.reason:
                 refused_swing += 1
                 assert math.isinf(r.mse)

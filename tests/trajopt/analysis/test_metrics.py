@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial.distance import directed_hausdorff
 
 from astar.grid import OccupancyGrid
+from tests.reference import cell_square_clearance
 from trajopt.analysis import metrics
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._curve import ParametricCurve, PolylineCurve
@@ -141,15 +142,6 @@ def test_clearance_border_occupied() -> None:
     )
 
 
-def _brute_clearance(pts, occ, res, origin):
-    iy, ix = np.nonzero(occ)
-    cx = origin[0] + (ix + 0.5) * res
-    cy = origin[1] + (iy + 0.5) * res
-    dx = np.maximum(0, np.abs(pts[:, None, 0] - cx[None]) - 0.5 * res)
-    dy = np.maximum(0, np.abs(pts[:, None, 1] - cy[None]) - 0.5 * res)
-    return np.hypot(dx, dy).min(axis=1) if len(cx) else np.full(len(pts), np.inf)
-
-
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("border", [False, True])
 def test_min_clearance_is_the_minimum_of_point_clearance_exactly(seed, border) -> None:
@@ -165,7 +157,7 @@ def test_min_clearance_is_the_minimum_of_point_clearance_exactly(seed, border) -
     pc = metrics.point_clearance(pts, g, border_occupied=border)
     mc = metrics.min_clearance(pts, g, border_occupied=border)
     assert mc == pc.min()
-    brute = _brute_clearance(pts, occ, 0.05, (-0.3, 0.2))
+    brute = cell_square_clearance(pts, occ, 0.05, (-0.3, 0.2))
     if border:
         edge = np.minimum.reduce(
             [pts[:, 0] + 0.3, 0.95 - pts[:, 0], pts[:, 1] - 0.2, 1.7 - pts[:, 1]]

@@ -1,7 +1,7 @@
 """Tests of :mod:`trajopt.corridor` against brute force on hand-built and random grids.
 
-The helpers here (brute-force square inflation and an octile Dijkstra) are independent of
-:mod:`astar` and are reused by ``test_smoother.py``.
+The references (brute-force square inflation, an octile Dijkstra, a sampled rectangle
+clearance) are independent of :mod:`astar` and live in ``tests/reference.py``.
 """
 
 from __future__ import annotations
@@ -15,12 +15,12 @@ from hypothesis import strategies as st
 
 from astar.grid import OccupancyGrid
 from tests.cases import l_shaped_grid
-from tests.reference import brute_inflate_square, dijkstra_path
+from tests.reference import brute_inflate_square, dijkstra_path, sampled_rect_clearance
 from trajopt.corridor import Box, Corridor, build_corridor
 from trajopt.errors import InvalidInputError
 
 
-# ---------------------------------------------------------------- references
+# ---------------------------------------------------------------- checks
 def assert_corridor_valid(corr: Corridor, free: np.ndarray, cells: np.ndarray, res: float, origin):
     """Every box free (brute force), consecutive boxes overlap, the path is covered."""
     ox, oy = origin
@@ -123,20 +123,6 @@ def test_random_grids_brute_force(seed, density):
 
 
 # ------------------------------------------------------------------- bridges
-def _sampled_rect_clearance(sd, squares, m=81):
-    """Min distance from points sampled on a 45-degree rectangle (interior and boundary)
-    to axis-aligned unit squares: an upper bound on the exact distance, within the
-    sampling spacing."""
-    smin, smax, dmin, dmax = sd
-    s, d = np.meshgrid(np.linspace(smin, smax, m), np.linspace(dmin, dmax, m))
-    px, py = ((s + d) / 2).ravel(), ((s - d) / 2).ravel()
-    qx, qy = squares[:, 0], squares[:, 1]
-    gx = np.maximum(0, np.maximum(qx[None] - px[:, None], px[:, None] - (qx[None] + 1)))
-    gy = np.maximum(0, np.maximum(qy[None] - py[:, None], py[:, None] - (qy[None] + 1)))
-    spacing = max(smax - smin, dmax - dmin) / (m - 1) / math.sqrt(2)
-    return float(np.hypot(gx, gy).min()), spacing
-
-
 def test_rotated_rect_clearance_matches_sampling():
     from trajopt.corridor import rotated_rect_clearance
 
@@ -147,7 +133,7 @@ def test_rotated_rect_clearance_matches_sampling():
         sd = (s0, s0 + rng.uniform(0, 4), d0, d0 + rng.uniform(0, 4))
         squares = rng.integers(-6, 6, size=(int(rng.integers(1, 6)), 2)).astype(float)
         exact = rotated_rect_clearance(sd, squares)
-        sampled, spacing = _sampled_rect_clearance(sd, squares)
+        sampled, spacing = sampled_rect_clearance(sd, squares)
         assert exact <= sampled + 1e-12
         assert sampled <= exact + spacing + 1e-12
         hits += exact == 0.0
@@ -189,7 +175,7 @@ def test_bridge_across_a_diagonal_gap_is_certified_and_lets_the_curve_flow():
         (dg[2] - ox0 + oy0) / 0.1,
         (dg[3] - ox0 + oy0) / 0.1,
     )
-    sampled, _ = _sampled_rect_clearance(sd_cells, squares)
+    sampled, _ = sampled_rect_clearance(sd_cells, squares)
     assert sampled >= r / 0.1 - 1e-9
     # its vertices satisfy its own containment test, and the chain still covers the path
     assert np.all(bridges[0].contains(bridges[0].vertices(), tol=1e-12))

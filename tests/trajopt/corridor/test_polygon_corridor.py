@@ -1,8 +1,9 @@
 """Tests of :mod:`trajopt.corridor` against brute force.
 
-The references here are independent of the module: exact point-to-square distances to
-every occupied cell of the raw map (and to the outside of the map) computed naively with
-numpy over all cells, evaluated on dense samples of each polygon's boundary and interior.
+The references (``tests/reference.py``) are independent of the module: exact
+point-to-square distances to every occupied cell of the raw map (and to the outside of the
+map) computed naively with numpy over all cells, evaluated on dense samples of each
+polygon's boundary and interior.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from hypothesis import strategies as st
 import astar
 from astar.grid import OccupancyGrid
 from tests.cases import square_inflated, staircase_passage
-from tests.reference import square_clearance
+from tests.reference import boundary_samples, brute_polygon_clearance, square_clearance
 from trajopt.analysis import scenes
 from trajopt.corridor import (
     CLEARANCE_TOL_M,
@@ -30,50 +31,7 @@ from trajopt.errors import InvalidInputError
 from trajopt.geometry._clearance import polygon_clearance
 
 
-# ---------------------------------------------------------------- references
-def boundary_samples(v: np.ndarray, spacing: float) -> np.ndarray:
-    """Vertices and points every ``spacing`` (at most) along the closed boundary."""
-    out = [v]
-    k = len(v)
-    for i in range(k if k > 2 else k - 1):
-        a, b = v[i], v[(i + 1) % k]
-        n = max(2, int(math.ceil(np.hypot(*(b - a)) / spacing)) + 1)
-        t = np.linspace(0.0, 1.0, n)[:, None]
-        out.append(a + t * (b - a))
-    return np.vstack(out)
-
-
-def interior_samples(poly: ConvexPolygon, spacing: float) -> np.ndarray:
-    """Grid points at ``spacing`` inside the polygon (plus its vertices)."""
-    v = poly.vertices
-    lo, hi = v.min(axis=0), v.max(axis=0)
-    xs = np.arange(lo[0], hi[0] + spacing, spacing)
-    ys = np.arange(lo[1], hi[1] + spacing, spacing)
-    g = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-    return np.vstack([v, g[poly.contains(g)]])
-
-
-def brute_polygon_clearance(v: np.ndarray, grid: OccupancyGrid, spacing: float) -> float:
-    """Dense-sampling estimate of a convex polygon's clearance: the boundary sampled every
-    ``spacing`` (the nearest point of a disjoint square lies on the boundary), 0 when an
-    interior sample falls in an occupied square or outside the map."""
-    d = float(square_clearance(grid, boundary_samples(v, spacing)).min())
-    if len(v) >= 3:
-        poly = ConvexPolygon(
-            A=_edge_normals(v), b=np.einsum("ij,ij->i", _edge_normals(v), v), vertices=v
-        )
-        inner = interior_samples(poly, spacing)
-        if np.any(square_clearance(grid, inner) == 0.0):
-            return 0.0
-    return d
-
-
-def _edge_normals(v: np.ndarray) -> np.ndarray:
-    e = np.roll(v, -1, axis=0) - v
-    n = np.column_stack([e[:, 1], -e[:, 0]])
-    return n / np.hypot(n[:, 0], n[:, 1])[:, None]
-
-
+# ---------------------------------------------------------------- checks
 def assert_corridor_certified(corr: PolygonCorridor, grid: OccupancyGrid, radius: float) -> None:
     """Every region keeps ``radius`` on dense samples (brute force), covers its own path
     segment, and consecutive regions share the transition point and their overlap."""

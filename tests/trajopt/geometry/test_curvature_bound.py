@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-from scipy.integrate import cumulative_trapezoid
 
+from tests.reference import dense_kappa_max_per_interval
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
 from trajopt.robot._robot import Robot
@@ -41,18 +41,6 @@ def test_parabola_bound_holds_and_tightens(a, b):
     assert kk.max() == pytest.approx(exact, rel=1e-4)
 
 
-def _dense_max_per_interval(c: BSplineCurve, h: float, n: int) -> np.ndarray:
-    """Largest |kappa| per arc-length interval from 100 001 samples, arc length by the
-    trapezoid rule on the same samples (independent of the library's quadrature)."""
-    u = np.linspace(*c.domain, 100_001)
-    s = cumulative_trapezoid(c.speed(u), u, initial=0.0)
-    k = np.abs(c.curvature(u))
-    i = np.clip((s / h).astype(int), 0, n - 1)
-    out = np.zeros(n)
-    np.maximum.at(out, i, k)
-    return out
-
-
 @settings(max_examples=12, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])  # fmt: skip
 @given(
@@ -69,7 +57,7 @@ def test_grid_bounds_cover_dense_samples(pts, degree):
     n = 400
     h = c.length / n
     kmax = interval_kappa_max(c, h, n, degree, ROBOT.speed_cap)
-    dense = _dense_max_per_interval(c, h, n)
+    dense = dense_kappa_max_per_interval(c, h, n)
     # a rigorous bound: never below a sample (up to the trapezoid rule's arc-length error,
     # which can move a sample into the neighbouring interval)
     nb = np.maximum(kmax, np.maximum(np.r_[kmax[1:], 0.0], np.r_[0.0, kmax[:-1]]))

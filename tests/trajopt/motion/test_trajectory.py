@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from tests.cases import Arc, line
+from tests.reference import integrate_jerk
 from trajopt.errors import InvalidInputError
 from trajopt.motion._trajectory import SAMPLE_UNITS, Trajectory
 from trajopt.robot._robot import Robot
@@ -28,24 +29,9 @@ def _rest_to_rest():
     return d, j
 
 
-def _integrate(d, j, dt=2.0**-13):
-    """Reference: integrate the jerk signal numerically (no polynomial formulas). ``dt``
-    divides every phase duration, so the jerk is constant on each step: ``a`` and ``v`` are
-    exact (trapezoid on linear ``a``), ``s`` is within ~1e-9 m (trapezoid on quadratic ``v``)."""
-    n = int(round(d.sum() / dt))
-    t = np.arange(n + 1) * dt
-    edges = np.concatenate([[0.0], np.cumsum(d)])
-    mid = t[:-1] + dt / 2
-    jerk = j[np.clip(np.searchsorted(edges, mid, side="right") - 1, 0, len(d) - 1)]
-    a = np.concatenate([[0.0], np.cumsum(jerk * dt)])
-    v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * dt)])
-    s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * dt)])
-    return t, s, v, a
-
-
 def _hand_trajectory(robot=PLAIN):
     d, j = _rest_to_rest()
-    t_ref, s_ref, v_ref, a_ref = _integrate(d, j)
+    t_ref, s_ref, v_ref, a_ref = integrate_jerk(d, j)
     edges = np.concatenate([[0.0], np.cumsum(d)])
     idx = np.round(edges[:-1] / (t_ref[1] - t_ref[0])).astype(int)
     length = float(s_ref[-1])

@@ -15,7 +15,14 @@ import pytest
 
 import astar
 import trajopt
-from tests.reference import polyline_samples, square_clearance
+from tests.reference import (
+    closed_form_duration,
+    polyline_samples,
+    ruckig_rest_to_rest_duration,
+    square_clearance,
+    turn_limits_by_hand,
+    v_limit_by_hand,
+)
 from trajopt.analysis.metrics import trajectory_metrics
 from trajopt.cli import main
 from trajopt.errors import InvalidInputError, SmoothingError
@@ -29,66 +36,18 @@ WHEELS = trajopt.Robot(v_max=0.8, omega_max=5.0, track_width=0.5, wheel_v_max=0.
 PLAIN = trajopt.Robot(track_width=None, wheel_v_max=None, radius=0.2)
 
 
-# ------------------------------------------------------------------ references
-def ruckig_duration(d: float, vmax: float, amax: float, jmax: float) -> float:
-    """ruckig's rest-to-rest duration for a 1-DoF move of length ``d`` (direct call)."""
-    from ruckig import InputParameter, Ruckig, Trajectory
-
-    inp = InputParameter(1)
-    inp.current_position = [0.0]
-    inp.target_position = [d]
-    inp.max_velocity = [vmax]
-    inp.max_acceleration = [amax]
-    inp.max_jerk = [jmax]
-    traj = Trajectory(1)
-    Ruckig(1).calculate(inp, traj)
-    return float(traj.duration)
-
-
-def closed_form_duration(d: float, v: float, a: float, j: float) -> float:
-    """Time-optimal rest-to-rest time under |v|, |a|, |jerk| limits (textbook cases).
-
-    The ramp from rest to speed ``w`` takes ``w/a + a/j`` if ``a`` is reached, else
-    ``2 sqrt(w/j)``, and covers ``w * T/2`` (the ramp is point-symmetric); two ramps and a
-    cruise at ``v`` if there is room, else two ramps to the peak speed found by bisection.
-    """
-
-    def ramp(w: float) -> float:
-        return w / a + a / j if w >= a * a / j else 2.0 * math.sqrt(w / j)
-
-    if v * ramp(v) <= d:
-        return 2.0 * ramp(v) + (d - v * ramp(v)) / v
-    lo, hi = 0.0, v
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if mid * ramp(mid) < d else (lo, mid)
-    return 2.0 * ramp(0.5 * (lo + hi))
-
-
-def turn_limits_by_hand(robot: trajopt.Robot) -> tuple[float, float, float]:
-    half = robot.track_width / 2 if robot.track_width is not None else robot.radius
-    w = robot.omega_max
-    if robot.track_width is not None:
-        w = min(w, robot.wheel_v_max / half)
-    return w, robot.a_max / half, robot.j_max / half
-
-
-def v_limit(robot: trajopt.Robot) -> float:
-    return min(robot.v_max, robot.wheel_v_max or math.inf)
-
-
 # ------------------------------------------------------------------ geometry
 SQUARE = np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)])
 
 
 def test_square_path_matches_hand_computed_turns_and_ruckig_legs():
     traj = stop_and_turn(SQUARE, DEFAULT)
-    leg = ruckig_duration(1.0, 0.5, 0.5, 2.0)
+    leg = ruckig_rest_to_rest_duration(1.0, 0.5, 0.5, 2.0)
     assert leg == pytest.approx(3.25, rel=1e-12)  # by hand: ramps of 1.25 s + cruise 0.75 s
     w, al, z = 1.5, 0.5 / 0.14, 2.0 / 0.14  # omega_max binds: wheels allow 0.6/0.14 rad/s
     assert turn_limits_by_hand(DEFAULT) == pytest.approx((w, al, z), rel=1e-15)
     turn = closed_form_duration(math.pi / 2, w, al, z)
-    assert turn == pytest.approx(ruckig_duration(math.pi / 2, w, al, z), rel=1e-9)
+    assert turn == pytest.approx(ruckig_rest_to_rest_duration(math.pi / 2, w, al, z), rel=1e-9)
     assert traj.stats["n_turns"] == 3 and traj.stats["n_segments"] == 4
     assert traj.stats["turn_total_rad"] == pytest.approx(3 * math.pi / 2, rel=1e-15)
     assert traj.duration == pytest.approx(4 * leg + 3 * turn, rel=1e-12)
@@ -116,7 +75,7 @@ def test_end_headings_use_the_shortest_signed_angle(robot):
     # start: 3.0 -> 0 by -3.0 rad; end: 0 -> -0.5 rad
     expect = (
         closed_form_duration(3.0, w, al, z)
-        + closed_form_duration(2.0, v_limit(robot), robot.a_max, robot.j_max)
+        + closed_form_duration(2.0, v_limit_by_hand(robot), robot.a_max, robot.j_max)
         + closed_form_duration(0.5, w, al, z)
     )
     assert traj.duration == pytest.approx(expect, rel=1e-9)
@@ -142,7 +101,7 @@ def test_limits_continuity_and_turning_only_at_rest(robot):
     t = np.linspace(0.0, traj.duration, 200_001)
     smp = traj.sample(t)
     th, w, al, z = traj.heading_motion(t)
-    vl = v_limit(robot)
+    vl = v_limit_by_hand(robot)
     w_lim, al_lim, z_lim = turn_limits_by_hand(robot)
     assert smp.v.max() <= vl * (1 + REL) and smp.v.min() >= 0.0
     assert smp.v.max() >= vl * (1 - 1e-9)  # the long legs do reach it
@@ -194,14 +153,17 @@ def test_duration_is_the_sum_of_ruckig_legs_and_turns():
     pts = random_polyline(np.random.default_rng(11))
     traj = stop_and_turn(pts, WHEELS)
     d = np.diff(traj.vertices, axis=0)
-    legs = sum(ruckig_duration(float(np.hypot(*x)), 0.3, WHEELS.a_max, WHEELS.j_max) for x in d)
+    legs = sum(
+        ruckig_rest_to_rest_duration(float(np.hypot(*x)), 0.3, WHEELS.a_max, WHEELS.j_max)
+        for x in d
+    )
     heads = np.arctan2(d[:, 1], d[:, 0])
     turns = [
         abs(math.remainder(b - a, 2 * math.pi)) for a, b in zip(heads[:-1], heads[1:], strict=True)
     ]
     w, al, z = turn_limits_by_hand(WHEELS)
     assert w == pytest.approx(0.3 / 0.25)  # the wheels bind, not omega_max
-    total = legs + sum(ruckig_duration(x, w, al, z) for x in turns)
+    total = legs + sum(ruckig_rest_to_rest_duration(x, w, al, z) for x in turns)
     assert traj.duration == pytest.approx(total, rel=1e-12)
     assert traj.stats["drive_time_s"] == pytest.approx(legs, rel=1e-12)
 

@@ -7,20 +7,10 @@ import numpy as np
 import pytest
 
 import astar
-from tests.reference import square_clearance
+from tests.reference import square_clearance, three_point_curvature
 from trajopt import Planner, Robot, Smoother, build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.planning._feasibility import curvature_witness, witness_grid_path
-
-
-def _three_point_curvature(p: np.ndarray) -> np.ndarray:
-    """Curvature of the circle through consecutive point triples (hand formula)."""
-    a, b, c = p[:-2], p[1:-1], p[2:]
-    ab = np.hypot(*(b - a).T)
-    bc = np.hypot(*(c - b).T)
-    ca = np.hypot(*(a - c).T)
-    cross = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
-    return 2.0 * np.abs(cross) / (ab * bc * ca)
 
 
 def test_open_room_witness_holds_every_promise():
@@ -37,7 +27,7 @@ def test_open_room_witness_holds_every_promise():
     assert step.max() <= 0.1 / 8 + 1e-12
     assert square_clearance(grid, w).min() >= radius - 1e-9
     keep = np.concatenate([[True], step > 1e-12])  # drop the repeated junction points
-    kappa = _three_point_curvature(w[keep])
+    kappa = three_point_curvature(w[keep])
     assert np.nanmax(kappa) <= kmax * (1 + 1e-6)
 
 
@@ -242,5 +232,5 @@ def test_witness_rescue_grows_its_polygons_around_the_witness(shared_data, radiu
     u = np.linspace(*sp.domain, 8000)
     assert square_clearance(grid, sp(u)).min() >= radius - 1e-9
     p = sp(u)
-    assert _three_point_curvature(p[::4]).max() <= kmax * 1.01
+    assert three_point_curvature(p[::4]).max() <= kmax * 1.01
     np.testing.assert_allclose(p[[0, -1]], [start, goal], atol=1e-9)

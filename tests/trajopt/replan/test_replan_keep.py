@@ -17,6 +17,7 @@ from scipy.interpolate import BSpline
 from scipy.spatial import Delaunay
 
 import trajopt
+from tests.reference import dijkstra_costs, grid_path_cost
 from trajopt.analysis.metrics import point_clearance, trajectory_metrics
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
@@ -174,16 +175,7 @@ def test_footprint_robots_and_fallbacks_are_planned_anew(scene):
     assert new.stats["replan"] == "planned: footprint robot"
 
 
-def _step_costs(cells: np.ndarray, cost: np.ndarray) -> float:
-    """The search's cost of a path of cells: step length times one plus the mean cell cost."""
-    d = np.diff(cells, axis=0)
-    length = np.where(np.all(d != 0, axis=1), math.sqrt(2.0), 1.0)
-    c = cost[cells[:, 1], cells[:, 0]]
-    return float(np.sum(length * (1.0 + 0.5 * (c[:-1] + c[1:]))))
-
-
 def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
-    from tests.astar.test_search import dijkstra_costs
     from trajopt.planning._caches import change_reach
 
     grid = scene.grid
@@ -214,8 +206,10 @@ def test_a_block_near_the_rest_but_off_its_grid_path_reuses_the_path(scene):
     occ = np.asarray(planner.inflated_grid.occupied)
     ref = dijkstra_costs(occ, tuple(rest[0]), 8, False, planner.search_cost)
     goal = tuple(rest[-1])
-    assert _step_costs(rest, planner.search_cost) == pytest.approx(ref[goal[1], goal[0]], rel=1e-9)
-    assert new.steps.grid_path.cost == pytest.approx(_step_costs(cells, planner.search_cost))
+    assert grid_path_cost(rest, planner.search_cost) == pytest.approx(
+        ref[goal[1], goal[0]], rel=1e-9
+    )
+    assert new.steps.grid_path.cost == pytest.approx(grid_path_cost(cells, planner.search_cost))
     smp = new.sample_uniform(0.005)
     clr = point_clearance(np.column_stack([smp.x, smp.y]), updated, border_occupied=True)
     assert clr.min() >= ROBOT.radius - 1e-6

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 import astar
 import trajopt
+from tests.reference import footprint_collides, inside_convex
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.robot._footprint import (
@@ -25,46 +26,6 @@ from trajopt.robot._footprint import (
     convex_hull,
     span_heading_intervals,
 )
-
-
-def inside_convex(poly: np.ndarray, pts: np.ndarray, tol: float = 1e-12) -> np.ndarray:
-    e = np.roll(poly, -1, axis=0) - poly
-    c = e[None, :, 0] * (pts[:, None, 1] - poly[None, :, 1]) - e[None, :, 1] * (
-        pts[:, None, 0] - poly[None, :, 0]
-    )
-    return np.all(c >= -tol, axis=1)
-
-
-def footprint_points(fp: Footprint, n: int = 12) -> np.ndarray:
-    """Points filling the footprint (robot frame): its boundary and a grid inside."""
-    v = fp.vertices
-    edges = [v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i])
-             for i in range(len(v))]  # fmt: skip
-    lo, hi = v.min(axis=0), v.max(axis=0)
-    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n))
-    grid = np.column_stack([gx.ravel(), gy.ravel()])
-    return np.vstack(edges + [grid[inside_convex(v, grid)]])
-
-
-def collides(grid: astar.OccupancyGrid, fp: Footprint, x, y, theta) -> bool:
-    """Brute force: does any sampled point of the posed footprint lie in an occupied square
-    or outside the map?"""
-    pts = footprint_points(fp)
-    out = []
-    for xi, yi, ti in zip(np.atleast_1d(x), np.atleast_1d(y), np.atleast_1d(theta), strict=True):
-        c, s = math.cos(ti), math.sin(ti)
-        w = np.column_stack(
-            [xi + c * pts[:, 0] - s * pts[:, 1], yi + s * pts[:, 0] + c * pts[:, 1]]
-        )
-        out.append(w)
-    w = np.vstack(out)
-    q = (w - np.asarray(grid.origin)) / grid.resolution
-    ix, iy = np.floor(q[:, 0]).astype(int), np.floor(q[:, 1]).astype(int)
-    ny, nx = grid.shape
-    outside = (ix < 0) | (iy < 0) | (ix >= nx) | (iy >= ny)
-    if outside.any():
-        return True
-    return bool(grid.occupied[iy, ix].any())
 
 
 # ------------------------------------------------------------------ the polygon
@@ -164,13 +125,13 @@ def test_certificate_is_sound_and_catches_a_collision(door):
     assert cert.ok and cert.min_margin_m == pytest.approx(0.05, abs=1e-6)
     u = np.linspace(0.0, 2.4, 500)
     xy = good(u)
-    assert not collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
+    assert not footprint_collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
     low = straight + [0.0, -0.12]  # 12 cm off the door's axis: the body hits the jamb
     bad = BSplineCurve(clamped_uniform_knots(8, 3, (0.0, 2.4)), low, 3)
     cert = certify_footprint(bad, fp, door)
     assert not cert.ok and cert.min_margin_m == 0.0
     xy = bad(u)
-    assert collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
+    assert footprint_collides(door, fp, xy[:, 0], xy[:, 1], np.zeros(len(u)))
 
 
 # ------------------------------------------------------------------ plans
@@ -185,7 +146,7 @@ def test_rectangle_through_a_door_its_circumscribed_disc_cannot_pass(door):
     assert fpst["disc_radius_m"] == pytest.approx(robot.inscribed_radius)
     assert fpst["min_margin_m"] > 0.0
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
-    assert not collides(door, robot.footprint, smp.x, smp.y, smp.theta)
+    assert not footprint_collides(door, robot.footprint, smp.x, smp.y, smp.theta)
     from trajopt.analysis.metrics import trajectory_metrics
 
     assert trajectory_metrics(traj, robot)["within_limits"]
@@ -199,7 +160,7 @@ def test_footprint_replan_splices(door):
     a, b = traj.state_at(1.0), new.state_at(0.0)
     assert max(abs(a.x - b.x), abs(a.y - b.y), abs(a.theta - b.theta), abs(a.v - b.v)) < 1e-6
     smp = new.sample(np.linspace(0.0, new.duration, 2000))
-    assert not collides(door, robot.footprint, smp.x, smp.y, smp.theta)
+    assert not footprint_collides(door, robot.footprint, smp.x, smp.y, smp.theta)
 
 
 @settings(max_examples=6, deadline=None)
@@ -222,4 +183,4 @@ def test_random_scenes_never_collide(seed):
     if traj.stats.get("fallback"):
         return
     smp = traj.sample(np.linspace(0.0, traj.duration, 1500))
-    assert not collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
+    assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)

@@ -18,7 +18,7 @@ from scipy.spatial import ConvexHull
 import astar
 import trajopt
 import trajopt.robot._footprint_kernels as footprint_kernels
-from tests.trajopt.robot.test_footprint import collides
+from tests.reference import footprint_collides
 from trajopt.corridor import build_polygon_corridor
 from trajopt.planning._footprint_ladder import disc_planner
 from trajopt.robot._footprint import MAX_ARC_RAD, Footprint, polygons_clearance
@@ -180,7 +180,7 @@ def test_scp_turns_a_rectangle_between_two_halls():
     fst = traj.stats["footprint"]
     assert fst["rounds"] >= 1 and fst["rejected"] == [] and fst["min_margin_m"] > 0
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
-    assert not collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
+    assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
 
 
 def test_a_turn_the_rectangle_cannot_make_is_refused():
@@ -208,7 +208,7 @@ def test_a_start_along_a_wall_pins_its_heading():
         theta0 / (2 * math.pi / 72), round(theta0 / (2 * math.pi / 72)), abs_tol=1e-6
     )
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
-    assert not collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
+    assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
 
 
 def test_end_poses_and_paths_refused_with_their_reason():

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import trajopt.timing._cap_kernel as cap_kernel
 import trajopt.timing._greedy as greedy
-from tests.trajopt.geometry.test_curvature_bound import _dense_max_per_interval
+from tests.reference import dense_kappa_max_per_interval
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
 from trajopt.robot._robot import Robot
@@ -92,7 +92,7 @@ def test_compiled_tables_equal_the_reference_and_cover_samples(pts, degree):
     np.testing.assert_allclose(tab.theta, np.unwrap(c.heading(u)), rtol=0.0, atol=1e-9)
     # rigorous: never below a dense sample (up to the trapezoid rule's arc-length error,
     # which can move a sample into the neighbouring interval)
-    dense = _dense_max_per_interval(c, h, n)
+    dense = dense_kappa_max_per_interval(c, h, n)
     k = tab.kmax
     nb = np.maximum(k, np.maximum(np.r_[k[1:], 0.0], np.r_[0.0, k[:-1]]))
     assert np.all(dense <= nb * (1 + 1e-9) + 1e-12)

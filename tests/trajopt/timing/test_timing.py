@@ -10,6 +10,7 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 from tests.cases import Arc, line
+from tests.reference import ruckig_profile
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curve import ParametricCurve
@@ -88,19 +89,6 @@ def check_limits(traj: Trajectory, robot: Robot, v_start=0.0, v_end=0.0, n=20001
     return smp
 
 
-def ruckig_duration(length, v0, v1, robot, v_max):
-    from ruckig import InputParameter, Result, Ruckig
-    from ruckig import Trajectory as RT
-
-    inp = InputParameter(1)
-    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [v0], [0.0]
-    inp.target_position, inp.target_velocity, inp.target_acceleration = [length], [v1], [0.0]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v_max], [robot.a_max], [robot.j_max]
-    tr = RT(1)
-    assert Ruckig(1).calculate(inp, tr) == Result.Working
-    return tr.duration, tr
-
-
 # ------------------------------------------------------------------ hand cases
 ROBOT = Robot()
 
@@ -109,7 +97,7 @@ ROBOT = Robot()
 def test_straight_line_is_ruckigs_1dof_answer(length):
     traj = time_parameterize(line(length), ROBOT)
     smp = check_limits(traj, ROBOT)
-    ref, _ = ruckig_duration(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
+    ref, _ = ruckig_profile(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
     # the cap carries a 1e-4 relative margin: never faster than ruckig, at most that slower
     assert ref - 1e-9 <= traj.duration <= ref * (1 + 2e-4) + 1e-9
     assert np.allclose(smp.theta, 0.3)
@@ -121,7 +109,7 @@ def test_short_line_does_not_reach_v_max():
     traj = time_parameterize(line(length), ROBOT)
     smp = check_limits(traj, ROBOT)
     assert smp.v.max() < 0.9 * ROBOT.v_max
-    ref, _ = ruckig_duration(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
+    ref, _ = ruckig_profile(length, 0.0, 0.0, ROBOT, ROBOT.v_max)
     assert traj.duration == pytest.approx(ref, rel=1e-9)
 
 
@@ -168,7 +156,7 @@ def test_boundary_speeds():
     c = line(3.0)
     traj = time_parameterize(c, ROBOT, v_start=0.3, v_end=0.2)
     check_limits(traj, ROBOT, v_start=0.3, v_end=0.2)
-    ref, _ = ruckig_duration(3.0, 0.3, 0.2, ROBOT, ROBOT.v_max)
+    ref, _ = ruckig_profile(3.0, 0.3, 0.2, ROBOT, ROBOT.v_max)
     assert ref - 1e-9 <= traj.duration <= ref * (1 + 2e-4)
     # at the cap exactly is allowed
     traj = time_parameterize(c, ROBOT, v_start=ROBOT.v_max, v_end=ROBOT.v_max)
@@ -457,8 +445,8 @@ def test_zero_speed_ends_are_timed_and_headed(form, dt):
     u = np.linspace(*c.domain, 200001)[200:-200]
     k_max = float(np.abs(c.curvature(u)).max())
     assert k_max < 0.7
-    fast, _ = ruckig_duration(c.length, 0.0, 0.0, STUCK_ROBOT, STUCK_ROBOT.v_max)
-    slow, _ = ruckig_duration(c.length, 0.0, 0.0, STUCK_ROBOT, STUCK_ROBOT.speed_cap(k_max))
+    fast, _ = ruckig_profile(c.length, 0.0, 0.0, STUCK_ROBOT, STUCK_ROBOT.v_max)
+    slow, _ = ruckig_profile(c.length, 0.0, 0.0, STUCK_ROBOT, STUCK_ROBOT.speed_cap(k_max))
     assert fast - 1e-9 <= traj.duration <= 1.01 * slow + 1.0
     check_limits(traj, STUCK_ROBOT, n=int(traj.duration / 1e-3) + 1)  # every 1 ms
     # the heading at the ends is the limit of the direction of motion: along P2 - P0 at the
