@@ -262,15 +262,15 @@ PLAN = ["--start", "0.4", "0.3", "--goal", "2.6", "1.6"]
 
 def _figures(monkeypatch) -> list:
     """Record the figures the CLI saves (then save them as usual)."""
-    import trajopt.cli as cli
+    import trajopt.cli._plan as plan_commands
 
-    saved, original = [], cli._save_figure
+    saved, original = [], plan_commands.save_figure
 
     def record(fig, path):
         saved.append(fig)
         return original(fig, path)
 
-    monkeypatch.setattr(cli, "_save_figure", record)
+    monkeypatch.setattr(plan_commands, "save_figure", record)
     return saved
 
 
