@@ -170,7 +170,7 @@ def paper() -> Scene:
     for ix0, iy0, side in PAPER_OBSTACLES_CELLS:
         occ[iy0 : iy0 + side, ix0 : ix0 + side] = True
         obstacles.append((round(ix0 * res, 10), round(iy0 * res, 10), round(side * res, 10)))
-    grid = OccupancyGrid._construct_fast(occ, res, (0.0, 0.0))
+    grid = OccupancyGrid(occ, res, (0.0, 0.0))
     return Scene(
         name="paper",
         grid=grid,

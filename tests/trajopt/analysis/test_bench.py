@@ -19,6 +19,8 @@ pytest.importorskip("distributed", reason="the bench extra (dask[distributed]) i
 pytest.importorskip("pyarrow", reason="the bench extra (pyarrow) is missing")
 
 from trajopt.analysis import bench  # noqa: E402
+from trajopt.analysis.bench._dataset import part_files  # noqa: E402
+from trajopt.analysis.bench._runner import query_cost  # noqa: E402
 from trajopt.errors import BenchmarkError, PeerUnavailableError
 
 REPO = Path(__file__).resolve().parents[3]
@@ -165,11 +167,11 @@ def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources,
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
-    while not bench.dataset.part_files(out) and time.monotonic() < deadline:
+    while not part_files(out) and time.monotonic() < deadline:
         time.sleep(0.02)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    first = {p.name: p.read_bytes() for p in bench.dataset.part_files(out)}
+    first = {p.name: p.read_bytes() for p in part_files(out)}
     assert 1 <= len(first) < 3, "the run should have been killed between chunks 1 and 3"
     src = [sources[0]]
     res = bench.run(
@@ -245,7 +247,7 @@ def test_make_chunks_runs_the_longest_first():
     ]
     flat_b = [q.index for ch in chunks if ch.maps is b for q, _ in ch.work]
     assert flat_b == [2, 1, 0, 3]  # 2000 cells, then 400 x 300 (octile 524), 10, 5
-    assert bench.runner.query_cost(b.queries[1], 0.05) == pytest.approx(
+    assert query_cost(b.queries[1], 0.05) == pytest.approx(
         25 + 0.05 * (400 + (math.sqrt(2) - 1) * 300)
     )
     assert chunks[0].cost == pytest.approx(2 * (25 + 300) + 1 * (25 + 300))

@@ -12,6 +12,7 @@
 Modules, one thing each: :mod:`~trajopt.analysis.bench._suites` (maps, queries, named suites),
 :mod:`~trajopt.analysis.bench._methods` (the methods and the shared scoring),
 :mod:`~trajopt.analysis.bench._peers` (OMPL and python-motion-planning, optional),
+:mod:`~trajopt.analysis.bench._records` (a method's output and a peer's failure, shared by both),
 :mod:`~trajopt.analysis.bench._runner` (chunks on Dask distributed),
 :mod:`~trajopt.analysis.bench._dataset` (the Parquet files), :mod:`~trajopt.analysis.bench._report`
 (summary table and figures). Needs the ``bench`` extra (dask[distributed], pyarrow, tqdm,

@@ -34,47 +34,19 @@ from __future__ import annotations
 import functools
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from trajopt.analysis.bench._records import MethodOutput, PeerFailure
 from trajopt.errors import BenchmarkError
 
 #: Stage names of :class:`trajopt.Planner` copied into ``stage_<name>_s`` columns.
 STAGES = ("inflate", "search", "corridor", "smooth", "timing", "fallback", "total")
 #: Timed-trajectory columns (from :func:`trajopt.metrics.trajectory_metrics`).
 TIMED = ("duration_s", "ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat")
-
-
-@dataclass(frozen=True, slots=True)
-class MethodOutput:
-    """What a method returns for one query.
-
-    Attributes
-    ----------
-    path : ParametricCurve or ndarray (n, 2) or None
-        The path in metres (``None``: no path, metrics are NaN).
-    valid : bool
-        The method's own validity verdict (e.g. a fit the data cannot determine).
-    note : str
-        Free text.
-    extras : Mapping[str, Any]
-        Columns of the row this method fills (``duration_s``, ``stage_smooth_s``, ...).
-    runtime_s : float or None
-        Compute time (s); default the wall time of the call.
-    score_s : float
-        Time the method spent scoring its own output (s): the trajopt variants'
-        :func:`~trajopt.metrics.trajectory_metrics`; not part of ``runtime_s``.
-    """
-
-    path: Any
-    valid: bool = True
-    note: str = ""
-    extras: Mapping[str, Any] = field(default_factory=dict)
-    runtime_s: float | None = None
-    score_s: float = 0.0
 
 
 @dataclass
@@ -255,9 +227,9 @@ def _compare_method(name: str) -> MethodFn:
 
 def _peer(name: str) -> MethodFn:
     def run(q: QueryContext) -> MethodOutput:
-        import trajopt.analysis.bench._peers as peers
+        from trajopt.analysis.bench._peers import run as run_peer
 
-        return peers.run(name, q)
+        return run_peer(name, q, METHODS[name].requires)
 
     return run
 
@@ -302,11 +274,11 @@ def check_methods(methods: object) -> tuple[str, ...]:
             raise BenchmarkError(f"method {m!r} is unknown; known methods: {list(METHODS)}")
     if len(set(names)) != len(names):
         raise BenchmarkError(f"methods must not repeat a name, got {list(names)}")
-    import trajopt.analysis.bench._peers as peers
+    from trajopt.analysis.bench._peers import require
 
     for m in names:
         for mod in METHODS[m].requires:
-            peers.require(mod, m)
+            require(mod, m)
     return names
 
 
@@ -318,7 +290,6 @@ def _soft_errors() -> tuple[type[BaseException], ...]:
     global _SOFT
     if _SOFT is None:
         import astar
-        from trajopt.analysis.bench._peers import PeerFailure
         from trajopt.errors import TrajoptError
 
         _SOFT = (TrajoptError, astar.AstarError, PeerFailure)

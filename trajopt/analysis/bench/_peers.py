@@ -22,10 +22,12 @@ from __future__ import annotations
 import importlib.util
 import math
 import time
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from trajopt.analysis.bench._records import MethodOutput, PeerFailure
 from trajopt.errors import PeerUnavailableError
 
 #: Planning time of the OMPL planners per query (s).
@@ -33,10 +35,6 @@ OMPL_TIME_LIMIT_S = 1.0
 #: Seed of OMPL's random number generator (set before every query).
 OMPL_SEED = 1
 _PACKAGES = {"ompl": "ompl", "python_motion_planning": "python-motion-planning"}
-
-
-class PeerFailure(RuntimeError):
-    """A peer planner returned no solution for a query (a row value, not a crash)."""
 
 
 def require(module: str, method: str) -> None:
@@ -131,8 +129,10 @@ def _pmp(kind: str, q: Any) -> np.ndarray:
     return np.asarray(path, dtype=float)[:, :2]
 
 
-def run(name: str, q: Any) -> Any:
+def run(name: str, q: Any, requires: Sequence[str]) -> MethodOutput:
     """Run the peer ``name`` on a :class:`~trajopt.analysis.bench._methods.QueryContext`.
+
+    ``requires`` are the modules the peer needs (its method's ``requires``), checked first.
 
     Returns
     -------
@@ -146,9 +146,7 @@ def run(name: str, q: Any) -> Any:
     PeerFailure
         It found no solution.
     """
-    from trajopt.analysis.bench._methods import METHODS, MethodOutput
-
-    for mod in METHODS[name].requires:
+    for mod in requires:
         require(mod, name)
     t0 = time.perf_counter()
     try:
