@@ -5,8 +5,9 @@ zones as one more cap) on a uniform arc-length grid of spacing at most 2.5 mm, e
 lower bound of the cap over its whole interval (rigorous for curves with a
 ``polynomial_degree``: the method of :func:`trajopt.geometry._curvature_bound.interval_kappa_max`,
 compiled with the grid's ``u(s)`` and heading in :mod:`trajopt.timing._cap_kernel` for the
-library's curves; sampled with refinement otherwise). The :class:`CapTable` record carries the values, their sparse table
-for O(1) range minima, and the cap's local minima that the greedy slows down for.
+library's curves; sampled with refinement otherwise). The :class:`CapTable` record carries
+the values, their sparse table for O(1) range minima, and the cap's local minima that the
+greedy slows down for; :attr:`CapTable.arrays` is the part the compiled greedy reads.
 """
 
 from __future__ import annotations
@@ -71,6 +72,13 @@ class CapTable:
     def n(self) -> int:
         """Number of intervals."""
         return int(self.ci.shape[0])
+
+    @property
+    def arrays(self) -> greedy.CapArrays:
+        """The kernels' view of the table (:class:`~trajopt.timing._greedy.CapArrays`)."""
+        return greedy.CapArrays(
+            self.st, self.lg, float(self.h), float(self.length), self.min_s, self.min_v
+        )
 
     @property
     def vtop(self) -> float:

@@ -7,6 +7,8 @@ sparse table for O(1) range minima. See :mod:`trajopt.timing` for the method.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -33,6 +35,107 @@ STACK = 96  # rows of piece_ok's bisection stack
 
 
 watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+
+
+class CapArrays(NamedTuple):
+    """The speed cap as the greedy kernels read it.
+
+    A numba kernel takes arrays and numbers, not a :class:`~trajopt.timing._cap_table.CapTable`:
+    this record (:attr:`CapTable.arrays <trajopt.timing._cap_table.CapTable.arrays>`) carries
+    the part of it the kernels query, with fixed types (one compiled signature).
+
+    Attributes
+    ----------
+    st : ndarray of float64, shape (levels, n)
+        Sparse table of the interval caps (m/s) for O(1) range minima (:func:`build_table`);
+        row 0 holds the caps of the ``n`` grid intervals.
+    lg : ndarray of int64, shape (n + 2,)
+        ``floor(log2(k))`` for range lengths ``k`` (:func:`build_table`).
+    h : float
+        Grid spacing (m).
+    length : float
+        Arc length of the curve (m), ``n h``.
+    min_s : ndarray of float64, shape (k,)
+        Arc lengths (m) of the cap's local minima, ascending.
+    min_v : ndarray of float64, shape (k,)
+        The caps there (m/s).
+    """
+
+    st: np.ndarray
+    lg: np.ndarray
+    h: float
+    length: float
+    min_s: np.ndarray
+    min_v: np.ndarray
+
+
+class GreedyLimits(NamedTuple):
+    """The start state, the end speed, the limits and the settings of one :func:`greedy` run.
+
+    Build it with the field types given (Python ``float``, ``int``, ``bool``): numba compiles
+    :func:`greedy` once per type signature.
+
+    Attributes
+    ----------
+    v0 : float
+        Speed at ``s = 0`` (m/s).
+    a0 : float
+        Acceleration at ``s = 0`` (m/s^2).
+    v_end : float
+        Speed to end with at ``s = length`` (m/s).
+    amax : float
+        Largest ``|a|`` (m/s^2).
+    j : float
+        Largest ``|jerk|`` (m/s^3).
+    dt : float
+        Step of the greedy (s).
+    ncand : int
+        Jerk candidates per step, ``j`` down to ``-j`` evenly (>= 2).
+    tmin : float
+        Finest bisection of a piece in the cap test (s).
+    max_steps : int
+        Steps at most.
+    cruise : bool
+        Repeat a speed-holding step without re-testing while the caps ahead allow it.
+    """
+
+    v0: float
+    a0: float
+    v_end: float
+    amax: float
+    j: float
+    dt: float
+    ncand: int
+    tmin: float
+    max_steps: int
+    cruise: bool
+
+
+class _Buffers(NamedTuple):
+    """Work arrays of :func:`_run`, allocated by :func:`greedy`.
+
+    Attributes
+    ----------
+    run_end : ndarray of int64, shape (n,)
+        Last interval of the run of equal caps holding each interval.
+    phases : ndarray, shape (rows, 5)
+        Receives the phase rows ``(t0, s0, v0, a0, jerk)``.
+    bounds : ndarray, shape (rows, 5)
+        Receives the bound rows ``(t, s, v, a, phase_index)``.
+    stk : ndarray, shape (STACK, 4)
+        :func:`piece_ok`'s bisection stack.
+    cands : ndarray, shape (ncand + 1,)
+        The step's candidate jerks (m/s^3).
+    counts : ndarray of int64, shape (2,)
+        Receives the numbers of phase and bound rows written.
+    """
+
+    run_end: np.ndarray
+    phases: np.ndarray
+    bounds: np.ndarray
+    stk: np.ndarray
+    cands: np.ndarray
+    counts: np.ndarray
 
 
 @njit(cache=True)
@@ -331,18 +434,26 @@ def _put(buf, n, t, s, v, a, j):
 
 
 @njit(cache=True)
-def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
-           cruise=True, rows=0):  # fmt: skip
+def greedy(cap, lim, rows):
     """Run the forward greedy over piecewise-constant jerk with an exact stop-profile test.
 
-    It starts at ``s = 0`` with speed ``v0`` and acceleration ``a0``. With ``cruise``, a
-    step that holds the speed (``a = 0`` before and after, jerk 0) is repeated without
-    re-testing while every query of the step (its pieces, its stop profile and the end test,
-    within :func:`cruise_reach` of the state) lies on one run of equal caps ahead: each
-    repeat would see the same caps and make the same choice, so the phases are the same as
-    with ``cruise=False``. The phase and bound buffers start with ``rows`` rows (0: twice
+    It starts at ``s = 0`` with speed ``lim.v0`` and acceleration ``lim.a0``. With
+    ``lim.cruise``, a step that holds the speed (``a = 0`` before and after, jerk 0) is
+    repeated without re-testing while every query of the step (its pieces, its stop profile
+    and the end test, within :func:`cruise_reach` of the state) lies on one run of equal caps
+    ahead: each repeat would see the same caps and make the same choice, so the phases are the
+    same as without ``cruise``. The phase and bound buffers start with ``rows`` rows (0: twice
     the time at the cap everywhere, in steps, plus 1024); a run that fills them runs again
     with twice the room.
+
+    Parameters
+    ----------
+    cap : CapArrays
+        The speed cap.
+    lim : GreedyLimits
+        Start state, end speed, limits and settings.
+    rows : int
+        Initial rows of the phase and bound buffers (0: sized from the cap).
 
     Returns
     -------
@@ -353,6 +464,7 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
     status : int
         One of the exit codes of this module.
     """
+    st, h = cap.st, cap.h
     n_int = st.shape[1]
     # last interval of the run of equal caps holding each interval (for cruise steps)
     run_end = np.empty(n_int, np.int64)
@@ -363,28 +475,32 @@ def greedy(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, t
         t_cap = 0.0
         for i in range(n_int):
             t_cap += h / st[0, i]
-        rows = int(min(2.0 * t_cap / dt, 4.0 * max_steps)) + 1024
+        rows = int(min(2.0 * t_cap / lim.dt, 4.0 * lim.max_steps)) + 1024
     stk = np.empty((STACK, 4))  # piece_ok's bisection stack
-    cands = np.empty(ncand + 1)
+    cands = np.empty(lim.ncand + 1)
     counts = np.zeros(2, np.int64)
     while True:
         phases = np.empty((rows, 5))
         bounds = np.empty((rows, 5))
-        status = _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin,
-                      max_steps, cruise, run_end, phases, bounds, stk, cands, counts)  # fmt: skip
+        status = _run(cap, lim, _Buffers(run_end, phases, bounds, stk, cands, counts))
         if status != _NEED_ROOM:
             return phases[: counts[0]], bounds[: counts[1]], status
         rows *= 2
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def _run(st, lg, h, length, min_s, min_v, v0, a0, v_end, amax, j, dt, ncand, tmin, max_steps,
-         cruise, run_end, phases, bounds, stk, cands, counts):  # fmt: skip
+def _run(cap, lim, buf):
     """Run the loop of :func:`greedy` on buffers it does not grow; return the status.
 
-    ``counts`` receives the numbers of phase and bound rows written; the status
-    ``_NEED_ROOM`` means the buffers filled up (nothing is kept).
+    ``cap`` (:class:`CapArrays`) and ``lim`` (:class:`GreedyLimits`) as for :func:`greedy`;
+    ``buf`` (:class:`_Buffers`) receives the rows and, in ``buf.counts``, their numbers; the
+    status ``_NEED_ROOM`` means the buffers filled up (nothing is kept).
     """
+    st, lg, h, length, min_s, min_v = cap.st, cap.lg, cap.h, cap.length, cap.min_s, cap.min_v
+    v0, a0, v_end, amax, j, dt = lim.v0, lim.a0, lim.v_end, lim.amax, lim.j, lim.dt
+    ncand, tmin, max_steps, cruise = lim.ncand, lim.tmin, lim.max_steps, lim.cruise
+    run_end, phases, bounds = buf.run_end, buf.phases, buf.bounds
+    stk, cands, counts = buf.stk, buf.cands, buf.counts
     # row counters typed int64 from the start: a literal 0 would compile _put once more
     n_ph = np.int64(0)
     n_b = np.int64(0)

@@ -200,10 +200,19 @@ def _run_greedy(
     vtop = table.vtop
     t_lower = length / vtop
     max_steps = int(min(5e6, 100.0 * (t_lower + 10.0 * (vtop / amax + amax / jmax)) / dt + 1000))
-    phases, bounds, status = greedy.greedy(
-        table.st, table.lg, h, length, table.min_s, table.min_v, v_start, a_start, v_end, amax,
-        jmax, dt, N_CAND, T_MIN, max_steps, True,
-    )  # fmt: skip
+    limits = greedy.GreedyLimits(
+        v0=float(v_start),
+        a0=float(a_start),
+        v_end=float(v_end),
+        amax=float(amax),
+        j=float(jmax),
+        dt=float(dt),
+        ncand=N_CAND,
+        tmin=T_MIN,
+        max_steps=max_steps,
+        cruise=True,
+    )
+    phases, bounds, status = greedy.greedy(table.arrays, limits, 0)
     if status == greedy.START_INFEASIBLE:
         raise TimingError(
             f"v_start={v_start:.6g} m/s, a_start={a_start:.6g} m/s^2 cannot be brought under "

@@ -166,15 +166,16 @@ def test_cruise_steps_give_the_same_phases(levels, widths, v_end):
     is_min[1:-1] = (ci[1:-1] < ci[:-2]) & (ci[1:-1] <= ci[2:])
     min_s = np.flatnonzero(is_min) * h
     min_v = ci[is_min]
-    args = (stt, lg, h, length, min_s, min_v, 0.0, 0.0, v_end, 0.5, 2.0, 0.02, 9, T_MIN, 10**6)
-    fast = greedy.greedy(*args, True)
-    slow = greedy.greedy(*args, False)
+    cap = greedy.CapArrays(stt, lg, h, length, min_s, min_v)
+    lim = greedy.GreedyLimits(0.0, 0.0, v_end, 0.5, 2.0, 0.02, 9, T_MIN, 10**6, True)
+    fast = greedy.greedy(cap, lim, 0)
+    slow = greedy.greedy(cap, lim._replace(cruise=False), 0)
     assert fast[2] == slow[2]
     np.testing.assert_array_equal(fast[0], slow[0])
     np.testing.assert_array_equal(fast[1], slow[1])
     # buffers too small at first: the greedy runs again with more room, same phases
     for cruise, ref in ((True, fast), (False, slow)):
-        small = greedy.greedy(*args, cruise, 8)
+        small = greedy.greedy(cap, lim._replace(cruise=cruise), 8)
         assert small[2] == ref[2]
         np.testing.assert_array_equal(small[0], ref[0])
         np.testing.assert_array_equal(small[1], ref[1])
