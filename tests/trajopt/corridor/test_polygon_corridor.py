@@ -8,6 +8,7 @@ polygon's boundary and interior.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -26,6 +27,12 @@ from trajopt.corridor import (
     PolygonCorridor,
     build_corridor,
     build_polygon_corridor,
+)
+from trajopt.corridor._polygons.build import (
+    GrownRegions,
+    PolygonOptions,
+    assemble_corridor,
+    grow_regions,
 )
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._clearance import polygon_clearance
@@ -346,6 +353,45 @@ def test_bad_arguments() -> None:
         build_polygon_corridor(grid, np.zeros((3, 3)), 0.1)
     with pytest.raises(InvalidInputError, match="OccupancyGrid"):
         build_polygon_corridor(np.zeros((4, 4)), pts, 0.1)
+
+
+def test_polygon_options_are_checked_on_construction() -> None:
+    opts = PolygonOptions(margin_cells=3, open_cells=np.float32(1.5))
+    assert opts == PolygonOptions(margin_cells=3.0, open_cells=1.5)
+    assert all(type(v) is float for v in dataclasses.astuple(opts))
+    assert dataclasses.astuple(PolygonOptions()) == (16.0, 20.0, 4.0, 1.0, 2.0, 0.3, 2.0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        opts.margin_cells = 1.0  # type: ignore[misc]
+    for bad in (
+        {"margin_cells": 0.0},
+        {"max_segment_cells": -1.0},
+        {"overlap_cells": -0.5},
+        {"centre_cells": math.nan},
+        {"centre_trigger_cells": math.inf},
+        {"simplify_slack_cells": "0.3"},
+        {"open_cells": True},
+    ):
+        (name,) = bad
+        with pytest.raises(InvalidInputError, match=name):
+            PolygonOptions(**bad)
+    with pytest.raises(InvalidInputError, match="PolygonOptions"):
+        grow_regions(_room(), np.array([[0.5, 0.5], [1.5, 0.5]]), 0.1, {"margin_cells": 3.0})
+
+
+def test_grown_regions_assemble_into_the_built_corridor() -> None:
+    grid = _room()
+    pts = np.array([[0.25, 0.25], [1.65, 0.35], [1.75, 1.75]])
+    grown = grow_regions(grid, pts, 0.1, PolygonOptions(centre_cells=0.0))
+    assert isinstance(grown, GrownRegions)
+    m = len(grown.regions)
+    assert grown.hm.shape[0] == grown.vm.shape[0] == m
+    assert grown.path_m.shape == (m + 1, 2) and grown.clear_m.shape == (m,)
+    built = build_polygon_corridor(grid, pts, 0.1, centre_cells=0.0)
+    assembled = assemble_corridor(grown)
+    np.testing.assert_array_equal(assembled.path, built.path)
+    np.testing.assert_array_equal(assembled.transitions_m, built.transitions_m)
+    for a, b in zip(assembled.regions, built.regions, strict=True):
+        np.testing.assert_array_equal(a.vertices, b.vertices)
 
 
 # ---------------------------------------------------------------- the value

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any, NamedTuple
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -33,6 +34,112 @@ from trajopt.geometry._obstacle_index import ObstacleIndex
 logger = logging.getLogger("trajopt.corridor")
 
 MAX_SIDES = 256
+
+
+@dataclass(frozen=True)
+class PolygonOptions:
+    """How :func:`build_polygon_corridor` prepares the path and grows the regions (cells).
+
+    Validated on construction; every value is kept as a float.
+
+    Attributes
+    ----------
+    margin_cells : float
+        How far (cells) a region may reach beyond its seed's bounding box (> 0).
+    max_segment_cells : float
+        Longest segment (cells) of the simplified path, hence of a region's seed (> 0).
+    overlap_cells : float
+        How far (cells) each seed reaches into the neighbouring segments (>= 0).
+    centre_cells : float
+        Largest push (cells) of an interior path point away from its nearest obstacle
+        (>= 0; 0 disables centring).
+    centre_trigger_cells : float
+        Only points closer than ``radius`` plus this (cells) to an obstacle are pushed (>= 0).
+    simplify_slack_cells : float
+        Clearance (cells) a simplified segment may lose against the points it replaces (>= 0).
+    open_cells : float
+        Clearance beyond ``radius`` plus this (cells) counts as open space when simplifying
+        (>= 0).
+
+    Raises
+    ------
+    InvalidInputError
+        A value that is not a finite number, or out of its range.
+    """
+
+    margin_cells: float = 16.0
+    max_segment_cells: float = 20.0
+    overlap_cells: float = 4.0
+    centre_cells: float = 1.0
+    centre_trigger_cells: float = 2.0
+    simplify_slack_cells: float = 0.3
+    open_cells: float = 2.0
+
+    def __post_init__(self) -> None:
+        checked = {
+            "margin_cells": positive("margin_cells", self.margin_cells),
+            "max_segment_cells": positive("max_segment_cells", self.max_segment_cells),
+            "overlap_cells": nonnegative("overlap_cells", self.overlap_cells),
+            "centre_cells": nonnegative("centre_cells", self.centre_cells),
+            "centre_trigger_cells": nonnegative("centre_trigger_cells", self.centre_trigger_cells),
+            "simplify_slack_cells": nonnegative("simplify_slack_cells", self.simplify_slack_cells),
+            "open_cells": nonnegative("open_cells", self.open_cells),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+
+@dataclass(frozen=True)
+class GrownRegions:
+    """Certified regions around a path, before the chain geometry.
+
+    What :func:`grow_regions` returns and :func:`assemble_corridor` takes (``m`` regions, world
+    metres). The arrays are padded: region ``k`` uses the first ``nrow[k]`` rows of ``hm[k]``
+    and the first ``nvs[k]`` rows of ``vm[k]``.
+
+    Attributes
+    ----------
+    regions : list of ConvexPolygon, length m
+        The regions; region ``k`` contains segment ``k`` of ``path_m``.
+    hm : ndarray, shape (m, q, 3)
+        Half-plane rows ``(a_x, a_y, b)`` of every region (``a . p <= b``, m).
+    vm : ndarray, shape (m, v, 2)
+        Vertices of every region (m); a degenerate region's two are its segment's ends.
+    nrow : ndarray of int64, shape (m,)
+        Rows used per region.
+    nvs : ndarray of int64, shape (m,)
+        Vertices used per region.
+    degen : ndarray of bool, shape (m,)
+        Degenerate regions (no interior: a segment).
+    path_m : ndarray, shape (m + 1, 2)
+        The corridor's path (m): the simplified path, its ends the input path's.
+    seed_src : ndarray of int, shape (m + 1,)
+        Index in ``pts_m`` of each vertex of ``path_m``.
+    pts_m : ndarray, shape (N, 2)
+        The input path (m).
+    clear_m : ndarray, shape (m,)
+        Certified clearance of each region from the raw map (m).
+    radius : float
+        Clearance every region keeps (m).
+    resolution : float
+        Cell size of the map (m).
+    origin : tuple of float
+        World position of the map's corner ``(x, y)`` (m).
+    """
+
+    regions: list[ConvexPolygon]
+    hm: np.ndarray
+    vm: np.ndarray
+    nrow: np.ndarray
+    nvs: np.ndarray
+    degen: np.ndarray
+    path_m: np.ndarray
+    seed_src: np.ndarray
+    pts_m: np.ndarray
+    clear_m: np.ndarray
+    radius: float
+    resolution: float
+    origin: tuple[float, float]
 
 
 def _path_points(path: Any, res: float, ox: float, oy: float) -> np.ndarray:
@@ -134,53 +241,33 @@ def build_polygon_corridor(
     Deterministic. Costs grow with the path length and the number of obstacle
     rectangles within ``margin_cells`` of it; see ``benchmarks/bench_polygon_corridor.py``.
     """
-    g = grow_regions(raw_grid, path, radius, margin_cells=margin_cells,
-                     max_segment_cells=max_segment_cells, overlap_cells=overlap_cells,
-                     centre_cells=centre_cells, centre_trigger_cells=centre_trigger_cells,
-                     simplify_slack_cells=simplify_slack_cells, open_cells=open_cells)  # fmt: skip
-    return assemble_corridor(*g)
+    options = PolygonOptions(
+        margin_cells=margin_cells,
+        max_segment_cells=max_segment_cells,
+        overlap_cells=overlap_cells,
+        centre_cells=centre_cells,
+        centre_trigger_cells=centre_trigger_cells,
+        simplify_slack_cells=simplify_slack_cells,
+        open_cells=open_cells,
+    )
+    return assemble_corridor(grow_regions(raw_grid, path, radius, options))
 
 
-class GrownRegions(NamedTuple):
-    """Certified regions around a path, before the chain geometry (:func:`grow_regions`).
+def grow_regions(
+    raw_grid: Any, path: Any, radius: float, options: PolygonOptions | None = None
+) -> GrownRegions:
+    """Grow and certify the regions of :func:`build_polygon_corridor`.
 
-    The first arguments of :func:`assemble_corridor`, in its order.
+    ``raw_grid``, ``path`` and ``radius`` as there; ``options`` its keyword options (default
+    ``PolygonOptions()``, its defaults). Raises what it raises, but does not compute the
+    chain's intervals and overlaps (:func:`assemble_corridor` does).
     """
-
-    regions: list[ConvexPolygon]
-    hm: np.ndarray
-    vm: np.ndarray
-    nrow: np.ndarray
-    nvs: np.ndarray
-    degen: np.ndarray
-    path_m: np.ndarray
-    seed_src: np.ndarray
-    pts_m: np.ndarray
-    clear_m: np.ndarray
-    radius: float
-    resolution: float
-    origin: tuple[float, float]
-
-
-def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> GrownRegions:
-    """Grow and certify the regions of :func:`build_polygon_corridor` (same parameters).
-
-    ``options`` are its keyword options, with its defaults. Raises what it raises, but does
-    not compute the chain's intervals and overlaps (:func:`assemble_corridor` does).
-    """
-    unknown = sorted(set(options) - set(build_polygon_corridor.__kwdefaults__))
-    if unknown:
-        raise InvalidInputError(f"unknown corridor options {unknown}")
-    opt = {**build_polygon_corridor.__kwdefaults__, **options}
+    if options is None:
+        options = PolygonOptions()
+    elif not isinstance(options, PolygonOptions):
+        raise InvalidInputError(f"options must be a PolygonOptions, got {type(options).__name__}")
     occ, res, ox, oy = grid_cells(raw_grid)
     r = positive("radius", radius)
-    margin = positive("margin_cells", opt["margin_cells"])
-    max_len = positive("max_segment_cells", opt["max_segment_cells"])
-    ext = nonnegative("overlap_cells", opt["overlap_cells"])
-    push = nonnegative("centre_cells", opt["centre_cells"])
-    trigger = nonnegative("centre_trigger_cells", opt["centre_trigger_cells"])
-    slack = nonnegative("simplify_slack_cells", opt["simplify_slack_cells"])
-    open_c = nonnegative("open_cells", opt["open_cells"])
     ny, nx = occ.shape
     pts_m = _path_points(path, res, ox, oy)
     n_in = len(pts_m)
@@ -195,7 +282,7 @@ def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> G
             f"[{ox}, {ox + nx * res}] x [{oy}, {oy + ny * res}] m"
         )
     src, p = _distinct_points(pc_, n_in)
-    reach = margin + r_c + push + ext + 3.0
+    reach = options.margin_cells + r_c + options.centre_cells + options.overlap_cells + 3.0
     idx = ObstacleIndex(
         occ,
         int(math.floor(p[:, 0].min() - reach)),
@@ -203,8 +290,7 @@ def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> G
         int(math.floor(p[:, 1].min() - reach)),
         int(math.ceil(p[:, 1].max() + reach)) + 1,
     )
-    opts = (margin, max_len, ext, push, trigger, slack, open_c)
-    seed, seed_src, hh, vv, nvs, degen = _grow_regions(idx, p, src, pts_m, r_c, tol_c, res, opts)
+    seed, seed_src, hh, vv, nvs, degen = _grow_regions(idx, p, src, pts_m, r_c, tol_c, res, options)
     # the certificate: exact clearance of every region (cell units)
     clear_c = certify_all(vv, nvs, r_c + 1.0, *idx.args)
     bad = np.nonzero(clear_c < r_c - tol_c)[0]
@@ -224,8 +310,21 @@ def grow_regions(raw_grid: Any, path: Any, radius: float, **options: float) -> G
     regions, hm, vm, nrow = metric_regions(seed, hh, vv, nvs, degen, res, (ox, oy))
     path_m = np.array([ox, oy]) + res * seed
     path_m[0], path_m[-1] = pts_m[src[0]], pts_m[src[-1]]
-    return GrownRegions(regions, hm, vm, nrow, nvs, degen, path_m, seed_src, pts_m,
-                        clear_c * res, r, res, (ox, oy))  # fmt: skip
+    return GrownRegions(
+        regions=regions,
+        hm=hm,
+        vm=vm,
+        nrow=nrow,
+        nvs=nvs,
+        degen=degen,
+        path_m=path_m,
+        seed_src=seed_src,
+        pts_m=pts_m,
+        clear_m=clear_c * res,
+        radius=r,
+        resolution=res,
+        origin=(ox, oy),
+    )
 
 
 def _distinct_points(pc_: np.ndarray, n_in: int) -> tuple[np.ndarray, np.ndarray]:
@@ -248,14 +347,15 @@ def _grow_regions(
     r_c: float,
     tol_c: float,
     res: float,
-    opts: tuple,
+    opts: PolygonOptions,
 ) -> tuple:
     """Check, centre and simplify the path, then grow one region per simplified segment.
 
-    Check, centre and simplify the path, then grow one region per simplified segment (cell
-    units). Returns ``(seed, seed_src, hh, vv, nvs, degen)``.
+    Cell units. Returns ``(seed, seed_src, hh, vv, nvs, degen)``.
     """
-    margin, max_len, ext, push, trigger, slack, open_c = opts
+    margin, max_len, ext = opts.margin_cells, opts.max_segment_cells, opts.overlap_cells
+    push, trigger = opts.centre_cells, opts.centre_trigger_cells
+    slack, open_c = opts.simplify_slack_cells, opts.open_cells
     args = idx.args
     cap = r_c + open_c + 2.0
     pcl, scl = path_clearances(p, cap, *args)
@@ -355,29 +455,29 @@ def metric_regions(
     return regions, hm, vm, nrow
 
 
-def assemble_corridor(
-    regions: list[ConvexPolygon],
-    hm: np.ndarray,
-    vm: np.ndarray,
-    nrow: np.ndarray,
-    nvs: np.ndarray,
-    degen: np.ndarray,
-    path_m: np.ndarray,
-    seed_src: np.ndarray,
-    pts_m: np.ndarray,
-    clear: np.ndarray,
-    r: float,
-    res: float,
-    origin: tuple[float, float],
-) -> PolygonCorridor:
-    """Return the :class:`PolygonCorridor` of certified regions around the polyline ``path_m``.
+def assemble_corridor(grown: GrownRegions) -> PolygonCorridor:
+    """Return the :class:`PolygonCorridor` of certified regions around the path ``grown.path_m``.
 
-    Region ``k`` (world metres: ``regions[k]``, rows ``hm[k, :nrow[k]]``, vertices
-    ``vm[k, :nvs[k]]``) contains segment ``k`` of ``path_m`` (shape (m + 1, 2)); ``seed_src``
-    maps each vertex to the input path ``pts_m``; ``clear`` (m) is each region's certified
-    clearance. Computes the chain's path intervals, overlaps and transitions.
+    Computes the chain's path intervals, overlaps and transitions.
+
+    Parameters
+    ----------
+    grown : GrownRegions
+        The regions (region ``k`` contains segment ``k`` of ``grown.path_m``).
+
+    Returns
+    -------
+    PolygonCorridor
+
+    Raises
+    ------
+    SmoothingError
+        A region does not contain its path segment, or two consecutive regions do not both
+        contain their shared path vertex (not expected of :func:`grow_regions`' regions).
     """
-    ox, oy = origin
+    hm, vm, nrow, nvs, degen = grown.hm, grown.vm, grown.nrow, grown.nvs, grown.degen
+    path_m = grown.path_m
+    ox, oy = grown.origin
     m = len(path_m) - 1
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path_m, axis=0).T))])
     region_s, overlap_s, ov_v, ov_h, ov_n = chain_geometry(
@@ -420,20 +520,20 @@ def assemble_corridor(
         [np.interp(trans, s, path_m[:, 0]), np.interp(trans, s, path_m[:, 1])]
     ).reshape(-1, 2)
     return PolygonCorridor(
-        regions=tuple(regions),
+        regions=tuple(grown.regions),
         path=path_m,
         path_s=s,
-        source_index=seed_src,
-        input_path=pts_m,
+        source_index=grown.seed_src,
+        input_path=grown.pts_m,
         region_s=region_s,
         region_index=region_index,
         transitions_m=trans,
         transition_points=trans_pts,
         overlap_s=overlap_s,
         overlaps=tuple(overlaps),
-        clearance_m=clear,
-        radius=r,
-        resolution=res,
+        clearance_m=grown.clear_m,
+        radius=grown.radius,
+        resolution=grown.resolution,
         origin=(ox, oy),
     )
 

@@ -110,7 +110,7 @@ def corridor_with_rest(
     except (InvalidInputError, SmoothingError):
         return None
     try:
-        corridor = assemble_corridor(*_joined(head, previous, k0, offset, pts, clear_kept))
+        corridor = assemble_corridor(_joined(head, previous, k0, offset, pts, clear_kept))
     except SmoothingError:  # the chain does not close at the join (not expected)
         return None
     return corridor, m - k0
@@ -167,8 +167,12 @@ def _joined(
     offset: int,
     pts: np.ndarray,
     clear_kept: np.ndarray,
-) -> tuple:
-    """:func:`assemble_corridor`'s arguments for the head's regions then ``previous``'s from ``k0``."""
+) -> GrownRegions:
+    """Return the head's regions then ``previous``'s from ``k0``, as one :class:`GrownRegions`.
+
+    ``offset`` maps ``previous``'s input indices to those of ``pts`` (the new input path, m);
+    ``clear_kept`` (m) are the kept regions' clearances on the current map.
+    """
     kept = previous.regions[k0:]
     n_head = len(head.regions)
     n = n_head + len(kept)
@@ -190,5 +194,18 @@ def _joined(
     path_m = np.vstack([head.path_m[:-1], previous.path[k0:]])
     seed_src = np.concatenate([head.seed_src[:-1], src[k0:] + offset])
     clear = np.concatenate([head.clear_m, clear_kept])
-    return (list(head.regions) + list(kept), hm, vm, nrow, nvs, degen, path_m, seed_src, pts,
-            clear, head.radius, head.resolution, head.origin)  # fmt: skip
+    return GrownRegions(
+        regions=list(head.regions) + list(kept),
+        hm=hm,
+        vm=vm,
+        nrow=nrow,
+        nvs=nvs,
+        degen=degen,
+        path_m=path_m,
+        seed_src=seed_src,
+        pts_m=pts,
+        clear_m=clear,
+        radius=head.radius,
+        resolution=head.resolution,
+        origin=head.origin,
+    )
