@@ -1,6 +1,6 @@
 """Long robustness run (issue 7, section 1): the whole-pipeline property on many examples.
 
-Runs the property of ``tests/trajopt/test_plan_properties.py`` (random grids, robots and
+Runs the property of ``tests/trajopt/planning/test_plan_properties.py`` (random grids, robots and
 queries; ``trajopt.plan`` must return a trajectory that holds every guarantee or raise a
 documented error) without stopping at the first broken guarantee, then prints the outcome
 counts per group (``easy``: open grids with well-placed end points) and every violation
@@ -9,7 +9,7 @@ with the parameters that reproduce it::
     python benchmarks/robustness_long_run.py              # 10 000 examples (~1 h on 2 cores)
     python benchmarks/robustness_long_run.py --examples 500
 
-``pytest -m slow tests/trajopt/test_plan_properties.py`` runs the same 10 000 examples as
+``pytest -m slow tests/trajopt/planning/test_plan_properties.py`` runs the same 10 000 examples as
 a test (stopping and shrinking at the first failure). Exit code 1 when a guarantee broke.
 """
 
@@ -22,7 +22,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.trajopt.test_plan_properties import (  # noqa: E402
+from tests.trajopt.planning.test_plan_properties import (  # noqa: E402
     EASY_FAILURE_LIMIT,
     N_EXAMPLES_SLOW,
     run_property,

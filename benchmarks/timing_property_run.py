@@ -4,7 +4,7 @@ Draws curves as in issue 17 (4-9 control points in [-2, 2]^2, consecutive points
 apart, parametric speed never below 5 % of its maximum, length > 0.5 m) from a seeded
 generator, times each with ``time_parameterize`` for a slow, tight-turning robot and checks
 the trajectory on samples 1 ms apart against the speed cap computed from the trajectory's
-own curvature and from the curve's curvature at ``u_at_s(s)``, and every other limit with ``tests/trajopt/test_timing.check_limits``::
+own curvature and from the curve's curvature at ``u_at_s(s)``, and every other limit with ``tests/trajopt/timing/test_timing.check_limits``::
 
     python benchmarks/timing_property_run.py                   # 1000 curves, seed 0
     python benchmarks/timing_property_run.py --examples 200 --seed 3
@@ -24,7 +24,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.trajopt.test_timing import check_limits  # noqa: E402
+from tests.trajopt.timing.test_timing import check_limits  # noqa: E402
 from trajopt.errors import TimingError
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.robot._robot import Robot

@@ -27,7 +27,7 @@ def bound_cubic(coef, piece, w, a, b, gam):  # pragma: no cover - compiled
     ``g`` of ``c_t`` about the interval's middle, also written to ``gam``; the shift to
     powers of ``t``, ``v``; ``_cross_and_norm``: ``X = v x v'`` and ``S = |v|^2``;
     ``_bernstein_range`` with the factors of ``matrices`` as literals), unrolled, so the
-    bounds are bit-identical (``tests/trajopt/test_cap_kernel.py`` compares the two).
+    bounds are bit-identical (``tests/trajopt/timing/test_cap_kernel.py`` compares the two).
     """
     pm = 0.5 * (w[piece] + w[piece + 1])
     ph = 0.5 * (w[piece + 1] - w[piece])

@@ -15,7 +15,7 @@ The curve enters through the Taylor coefficients of its velocity at the middle o
 polynomial piece (``degree`` calls ``curve(mid, k)``); every later value, at a node, at a
 Gauss-Legendre point or on a bisected interval, is that piece's polynomial (exact up to
 round-off, as the curve's own evaluation is). The NumPy functions of
-:mod:`trajopt.geometry._curvature_bound` stay the reference (``tests/trajopt/test_curvature_bound.py``
+:mod:`trajopt.geometry._curvature_bound` stay the reference (``tests/trajopt/geometry/test_curvature_bound.py``
 compares the two) and the path for other curves and speed caps.
 """
 

@@ -28,7 +28,8 @@ def old(scene):
     planner = trajopt.Planner(scene.grid, ROBOT)
     traj = planner.plan(scene.start, scene.goal("B"))
     state = traj.state_at(1.0)
-    path = remaining_grid_path(planner, traj.steps, scene.grid.world_to_cell(state.position))
+    cell = scene.grid.world_to_cell(state.position)
+    path = remaining_grid_path(planner.options, planner.caches, traj.steps, cell)
     centres = np.asarray(scene.grid.cell_to_world(np.asarray(path.cells)), dtype=float)
     points = np.vstack([state.position, centres[1:-1], traj.steps.corridor.input_path[-1]])
     return planner, traj, points

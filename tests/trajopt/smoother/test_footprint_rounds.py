@@ -20,7 +20,8 @@ import trajopt
 import trajopt.robot._footprint_kernels as footprint_kernels
 from tests.reference import footprint_collides
 from trajopt.corridor import build_polygon_corridor
-from trajopt.planning._footprint_ladder import disc_planner
+from trajopt.planning._disc import plan_disc
+from trajopt.planning._options import PlanRequest
 from trajopt.robot._footprint import MAX_ARC_RAD, Footprint, polygons_clearance
 from trajopt.smoother import Smoother
 from trajopt.smoother._footprint_scp import FootprintSCP, corners_cells
@@ -172,9 +173,8 @@ def test_scp_turns_a_rectangle_between_two_halls():
     grid, s, g = l_halls(0.56)
     planner = trajopt.Planner(grid, robot)
     # the disc model alone: its curve is not clear for the footprint
-    plain = disc_planner(trajopt.Planner(grid, robot), robot.inscribed_radius)
-    plain.smoothing_footprint = None
-    curve = plain.plan(s, g).path
+    disc = planner.options.disc(robot.inscribed_radius, last=False)
+    curve = plan_disc(disc, planner.caches.disc(disc), PlanRequest(s, g)).path
     assert not trajopt.robot._footprint.certify_footprint(curve, robot.footprint, grid).ok
     traj = planner.plan(s, g)
     fst = traj.stats["footprint"]
