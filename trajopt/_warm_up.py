@@ -30,7 +30,6 @@ default planner plans the query.
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -40,48 +39,10 @@ import numpy as np
 from astar.costmap import from_costmap
 from astar.grid import OccupancyGrid
 from trajopt._planner import Planner
+from trajopt.analysis.scenes import WARM_UP_CELLS, warm_up_map
 from trajopt.errors import InvalidInputError
 
 _log = logging.getLogger(__name__)
-
-#: side of the warm-up map in cells
-WARM_UP_CELLS = 60
-
-
-def warm_up_map(planner: Planner) -> tuple[OccupancyGrid, tuple[float, float], tuple[float, float]]:
-    """Return the warm-up map for ``planner`` and its query.
-
-    Parameters
-    ----------
-    planner : Planner
-        Its robot's (circumscribed) radius and its smoother's curvature bound set the
-        map's scale.
-
-    Returns
-    -------
-    grid : astar.OccupancyGrid
-        ``WARM_UP_CELLS`` square cells, side ``12 * max(radius, 1 / kappa_max)`` metres
-        (three radii with ``inflation="paper"``),
-        with a wall up from the bottom edge over 60 % of the height in the middle and a
-        block 1.6 radii left of the start (so the clearance checks meet an obstacle).
-    start, goal : tuple of float
-        World points (m) on either side of the wall, ``0.2`` of the side from the
-        bottom and from the left and right edges.
-    """
-    scale = planner.robot.radius
-    if planner.inflation == "paper":  # the avoidance area adds about 2 radii
-        scale *= 3.0
-    if planner.smoother.kappa_max is not None:
-        scale = max(scale, 1.0 / planner.smoother.kappa_max)
-    n = WARM_UP_CELLS
-    resolution = 12.0 * scale / n
-    occupied = np.zeros((n, n), dtype=bool)
-    half = max(1, math.ceil(0.05 * n))
-    occupied[: int(0.6 * n), n // 2 - half : n // 2 + half] = True
-    occupied[int(0.17 * n) : int(0.23 * n), int(0.03 * n) : int(0.07 * n)] = True  # near the start
-    side = n * resolution
-    return OccupancyGrid(occupied, resolution), (0.2 * side, 0.2 * side), (0.8 * side, 0.2 * side)
-
 
 def warm_up(planner: Planner | None = None) -> float:
     """Compile what is not compiled yet, then load what a plan needs, before the first query.

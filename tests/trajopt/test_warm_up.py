@@ -16,7 +16,7 @@ import pytest
 import astar
 from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
-from trajopt._warm_up import warm_up_map
+from trajopt.analysis.scenes import warm_up_map
 from trajopt.errors import InvalidInputError
 
 

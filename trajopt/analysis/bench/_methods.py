@@ -414,7 +414,7 @@ def warm_up(methods: object = None) -> float:
     pays (imports of numba, SciPy and CasADi, numba kernels loaded from the disk cache,
     CasADi's solver plugins, the metrics' SciPy modules:
     ``python benchmarks/bench_first_call.py``). This runs :func:`evaluate_query` with every
-    method but the peers on the small built-in map of :func:`trajopt._warm_up.warm_up_map`
+    method but the peers on the small built-in map of :func:`trajopt.analysis.scenes.warm_up_map`
     (a wall with a gap), so those costs are paid here; the peers' modules are imported
     only (a peer run takes its whole time budget). :func:`trajopt.bench.run` calls it on
     every worker before its clock starts.
@@ -438,7 +438,7 @@ def warm_up(methods: object = None) -> float:
 
     import astar
     from trajopt._planner import Planner
-    from trajopt._warm_up import warm_up_map
+    from trajopt.analysis.scenes import warm_up_map
 
     names = check_methods(DEFAULT_METHODS if methods is None else methods)
     planner = Planner(astar.OccupancyGrid(np.zeros((2, 2), dtype=bool), 1.0))
