@@ -164,15 +164,25 @@ def from_costmap(
             f"convention must be one of {_CONVENTIONS} (the value encoding of the costmap; "
             f"it is never guessed), got {convention!r}"
         )
-    for name, flag in (("inscribed_occupied", inscribed_occupied),
-                       ("unknown_occupied", unknown_occupied)):  # fmt: skip
+    for name, flag in (
+        ("inscribed_occupied", inscribed_occupied),
+        ("unknown_occupied", unknown_occupied),
+    ):
         if not isinstance(flag, bool | np.bool_):
             raise InvalidInputError(f"{name} must be a bool, got {flag!r}")
     v = validation.integer_values(values)
     if convention == "costmap_2d":
-        lo, hi, rule = 0, 255, "0..255 (0 free, 1..252 graded, 253 inscribed, 254 lethal, 255 unknown)"
+        lo, hi, rule = (
+            0,
+            255,
+            "0..255 (0 free, 1..252 graded, 253 inscribed, 254 lethal, 255 unknown)",
+        )
     else:
-        lo, hi, rule = -1, 100, "-1..100 (-1 unknown, 0 free, 1..98 graded, 99 inscribed, 100 lethal)"
+        lo, hi, rule = (
+            -1,
+            100,
+            "-1..100 (-1 unknown, 0 free, 1..98 graded, 99 inscribed, 100 lethal)",
+        )
     bad = (v < lo) | (v > hi)
     if np.any(bad):
         iy, ix = (int(i) for i in np.argwhere(bad)[0])

@@ -61,8 +61,9 @@ class Landmarks:
         """Number of landmarks."""
         return int(self.cells.shape[0])
 
-    def rebase(self, grid: OccupancyGrid, cost: object,
-               window: tuple[int, int, int, int] | None = None) -> Landmarks:  # fmt: skip
+    def rebase(
+        self, grid: OccupancyGrid, cost: object, window: tuple[int, int, int, int] | None = None
+    ) -> Landmarks:
         """Return these landmarks for a grid and cost that only got harder to cross.
 
         When every cell occupied in :attr:`grid` is still occupied in ``grid`` and no cell's
@@ -117,12 +118,24 @@ class Landmarks:
         if c.flags.writeable or not c.flags.c_contiguous:
             c = np.array(c, order="C")
             c.flags.writeable = False
-        return Landmarks(grid=grid, cost=c, cells=self.cells, distances=self.distances,
-                         connectivity=self.connectivity, corner_cutting=self.corner_cutting)  # fmt: skip
+        return Landmarks(
+            grid=grid,
+            cost=c,
+            cells=self.cells,
+            distances=self.distances,
+            connectivity=self.connectivity,
+            corner_cutting=self.corner_cutting,
+        )
 
 
-def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivity: int = 8,
-                    corner_cutting: bool = False) -> Landmarks:  # fmt: skip
+def build_landmarks(
+    grid: OccupancyGrid,
+    cost: object,
+    k: int = 6,
+    *,
+    connectivity: int = 8,
+    corner_cutting: bool = False,
+) -> Landmarks:
     """Return ``k`` landmarks for searches on ``grid`` with ``cost`` (module docstring).
 
     Parameters
@@ -168,8 +181,20 @@ def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivi
 
         def tree(source: int) -> np.ndarray:
             gen = ws.next_gen()
-            weighted_kernel(free, width, source, -1, connectivity == 8, bool(corner_cutting),
-                            c.ravel(), ws.rec, ws.recf, gen, np.zeros((0, 1)), np.zeros(0))  # fmt: skip
+            weighted_kernel(
+                free,
+                width,
+                source,
+                -1,
+                connectivity == 8,
+                bool(corner_cutting),
+                c.ravel(),
+                ws.rec,
+                ws.recf,
+                gen,
+                np.zeros((0, 1)),
+                np.zeros(0),
+            )
             return np.where(ws.rec[0::4] == gen + 1, ws.recf[1::2], np.inf)
 
         nearest = tree(int((iy0 + 1) * width + ix0 + 1))  # cost to the nearest chosen cell
@@ -187,5 +212,11 @@ def build_landmarks(grid: OccupancyGrid, cost: object, k: int = 6, *, connectivi
     dist.flags.writeable = False
     cells_a = np.array(cells, dtype=np.int64)
     cells_a.flags.writeable = False
-    return Landmarks(grid=grid, cost=c, cells=cells_a, distances=dist,
-                     connectivity=int(connectivity), corner_cutting=bool(corner_cutting))  # fmt: skip
+    return Landmarks(
+        grid=grid,
+        cost=c,
+        cells=cells_a,
+        distances=dist,
+        connectivity=int(connectivity),
+        corner_cutting=bool(corner_cutting),
+    )

@@ -142,8 +142,9 @@ _EMPTY_COST = np.zeros(1, dtype=np.float64)
 _NO_LANDMARKS = (np.zeros((0, 1)), np.zeros(0))
 
 
-def _check_landmarks(landmarks: object, grid: OccupancyGrid, cost: object, connectivity: int,
-                     corner_cutting: bool) -> np.ndarray:  # fmt: skip
+def _check_landmarks(
+    landmarks: object, grid: OccupancyGrid, cost: object, connectivity: int, corner_cutting: bool
+) -> np.ndarray:
     """Return the landmarks' cost after checking that they serve this search."""
     if not isinstance(landmarks, Landmarks):
         raise InvalidInputError(
@@ -154,7 +155,9 @@ def _check_landmarks(landmarks: object, grid: OccupancyGrid, cost: object, conne
         landmarks.grid.shape == grid.shape
         and np.array_equal(landmarks.grid.occupied, grid.occupied)
     ):
-        raise InvalidInputError("landmarks were built for another grid (their bounds hold there only)")
+        raise InvalidInputError(
+            "landmarks were built for another grid (their bounds hold there only)"
+        )
     if cost is not None and cost is not landmarks.cost:
         raise InvalidInputError(
             "with landmarks, pass no cost (or landmarks.cost): their bounds hold for that cost only"
@@ -264,9 +267,19 @@ def find_path(
         gen = ws.next_gen()
         if weighted:
             found, path, expanded, gcost, na, nb = weighted_kernel(
-                free, width, s, t, connectivity == 8, bool(corner_cutting), cflat, ws.rec,
-                ws.recf, gen, lm, lg,
-            )  # fmt: skip
+                free,
+                width,
+                s,
+                t,
+                connectivity == 8,
+                bool(corner_cutting),
+                cflat,
+                ws.rec,
+                ws.recf,
+                gen,
+                lm,
+                lg,
+            )
         elif jps:
             found, path, expanded, gcost, na, nb = jps_kernel(free, width, s, t, ws.rec, gen)
         else:

@@ -55,9 +55,19 @@ def weighted_kernel(free, width, start, goal, conn8, cut, cost, rec, recf, gen, 
     arguments and the result are :func:`_weighted_search`'s.
     """
     return _weighted_search(
-        _read_only(free), width, start, goal, conn8, cut, _read_only(cost), rec, recf, gen,
-        _read_only(lm), _read_only(lg),
-    )  # fmt: skip
+        _read_only(free),
+        width,
+        start,
+        goal,
+        conn8,
+        cut,
+        _read_only(cost),
+        rec,
+        recf,
+        gen,
+        _read_only(lm),
+        _read_only(lg),
+    )
 
 
 @njit(cache=True)

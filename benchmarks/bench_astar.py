@@ -179,8 +179,9 @@ def bench_clearance_search(n_long: int, repeat: int) -> None:
         print(f"clearance-cost search: skipped ({f} not found)")
         return
     w = astar.load_map(f)
-    big = astar.OccupancyGrid(np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1),
-                              w.resolution / 2, w.origin)  # fmt: skip
+    big = astar.OccupancyGrid(
+        np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1), w.resolution / 2, w.origin
+    )
     inflated = astar.inflate(big, 0.25)
     cost = astar.clearance_cost(big, 0.25)
     free = np.argwhere(~inflated.occupied)
@@ -218,18 +219,24 @@ def bench_clearance_search(n_long: int, repeat: int) -> None:
         d = dijkstra(graph, indices=s[1] * big.nx + s[0])[g[1] * big.nx + g[0]]
         worst = max(worst, abs(d - c) / d)
     t = np.array(times)
-    print(f"\nclearance-cost search, willow at 5 cm ({big.nx} x {big.ny}), radius 0.25 m, the "
-          f"{n_long} longest of {3 * n_long} queries (path cost {found[n_long - 1][0]:.0f}-"
-          f"{found[0][0]:.0f} cells)")  # fmt: skip
-    print(f"  time median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, max "
-          f"{t.max():.1f} ms (target <= 30 ms); expansions median {np.median(expanded):.0f}; "
-          f"{np.median(t * 1e6 / np.array(expanded)):.0f} ns per expansion")  # fmt: skip
+    print(
+        f"\nclearance-cost search, willow at 5 cm ({big.nx} x {big.ny}), radius 0.25 m, the "
+        f"{n_long} longest of {3 * n_long} queries (path cost {found[n_long - 1][0]:.0f}-"
+        f"{found[0][0]:.0f} cells)"
+    )
+    print(
+        f"  time median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, max "
+        f"{t.max():.1f} ms (target <= 30 ms); expansions median {np.median(expanded):.0f}; "
+        f"{np.median(t * 1e6 / np.array(expanded)):.0f} ns per expansion"
+    )
     ta = np.array(times_alt)
-    print(f"  with 6 landmarks (built once in {build_s:.2f} s): median {np.median(ta):.1f} ms, p95 "
-          f"{np.percentile(ta, 95):.1f} ms, max {ta.max():.1f} ms; expansions median "
-          f"{np.median(expanded_alt):.0f}; median time ratio landmarks / none "
-          f"{np.median(ta / t):.2f}; cost vs the plain search max relative error "
-          f"{alt_err:.1e}")  # fmt: skip
+    print(
+        f"  with 6 landmarks (built once in {build_s:.2f} s): median {np.median(ta):.1f} ms, p95 "
+        f"{np.percentile(ta, 95):.1f} ms, max {ta.max():.1f} ms; expansions median "
+        f"{np.median(expanded_alt):.0f}; median time ratio landmarks / none "
+        f"{np.median(ta / t):.2f}; cost vs the plain search max relative error "
+        f"{alt_err:.1e}"
+    )
     print(f"  cost vs scipy's Dijkstra on the 3 longest: max relative error {worst:.1e}")
 
 

@@ -121,8 +121,9 @@ def touching(raw, radius: float, a, b) -> bool:
     radius from the walls)."""
     key = (id(raw), radius, a, b)
     if key not in _TOUCH:
-        g = astar.inflate(raw, radius + 1e-6 * raw.resolution, metric="square",
-                          outside_occupied=True)  # fmt: skip
+        g = astar.inflate(
+            raw, radius + 1e-6 * raw.resolution, metric="square", outside_occupied=True
+        )
         try:
             astar.find_path(g, a, b)
             _TOUCH[key] = False
@@ -230,11 +231,17 @@ def main(argv: list[str] | None = None) -> int:
             key = (name, radius, cfg)
             if key not in planners:
                 sm = Smoother(kappa_max=1.0 / (2 * radius), time_budget_s=5) if kap else None
-                planners[key] = Planner(raw, Robot(radius=radius), search=search, smoother=sm,
-                                        corridor=corr)  # fmt: skip
+                planners[key] = Planner(
+                    raw, Robot(radius=radius), search=search, smoother=sm, corridor=corr
+                )
             traj, err, times = run(planners[key], p0, p1, args.repeats)
-            rec = {"map": name, "query": (a, b), "error": err, "times": times,
-                   "touching": touching(raw, radius, a, b)}  # fmt: skip
+            rec = {
+                "map": name,
+                "query": (a, b),
+                "error": err,
+                "times": times,
+                "touching": touching(raw, radius, a, b),
+            }
             if traj is not None:
                 rec.update(measure(traj, raw, radius))
             elif kap and args.witness:
@@ -289,8 +296,11 @@ def main(argv: list[str] | None = None) -> int:
     print("|---|---|---|---|---|")
     b_rows, p_rows = rows[("boxes", "clearance", False)], rows[("polygons", "clearance", False)]
     for name in dict.fromkeys(r["map"] for r in b_rows):
-        pairs_ = [(x, y) for x, y in zip(b_rows, p_rows, strict=True)
-                  if x["map"] == name and not x["error"] and not y["error"]]  # fmt: skip
+        pairs_ = [
+            (x, y)
+            for x, y in zip(b_rows, p_rows, strict=True)
+            if x["map"] == name and not x["error"] and not y["error"]
+        ]
         if not pairs_:
             continue
         tb = np.median([x["times"]["plan"] for x, _ in pairs_]) * 1e3

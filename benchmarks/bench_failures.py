@@ -110,9 +110,15 @@ def main() -> None:
     for row in rows:
         row["witness"] = None
         if row["err"] and row["variant"] == "kappa":
-            w = curvature_witness(row["grid"], row["radius"], row["start"], row["goal"],
-                                  1.0 / (2.0 * row["radius"]), time_limit_s=20.0,
-                                  max_expansions=2_000_000)  # fmt: skip
+            w = curvature_witness(
+                row["grid"],
+                row["radius"],
+                row["start"],
+                row["goal"],
+                1.0 / (2.0 * row["radius"]),
+                time_limit_s=20.0,
+                max_expansions=2_000_000,
+            )
             row["witness"] = w is not None
     groups: dict[tuple[str, str], list[dict]] = collections.defaultdict(list)
     for row in rows:

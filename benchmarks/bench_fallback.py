@@ -229,15 +229,33 @@ def print_table(rows: list[dict], kappa: bool, snap: float) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--maps", nargs="+", default=MAPS, choices=MAPS, metavar="MAP",
-                    help=f"Moving AI maps (default all: {' '.join(MAPS)})")  # fmt: skip
-    ap.add_argument("--limit-per-map", type=int, default=None,
-                    help="scenarios per map, evenly spread over the buckets (default all)")  # fmt: skip
-    ap.add_argument("--kappa", choices=("off", "on", "both"), default="off",
-                    help="curvature bound 1/(2r) in the smoother (default off)")  # fmt: skip
-    ap.add_argument("--snap", type=float, default=0.0, metavar="K",
-                    help="move infeasible end points to the nearest free cell within K cells "
-                    "(default 0: off)")  # fmt: skip
+    ap.add_argument(
+        "--maps",
+        nargs="+",
+        default=MAPS,
+        choices=MAPS,
+        metavar="MAP",
+        help=f"Moving AI maps (default all: {' '.join(MAPS)})",
+    )
+    ap.add_argument(
+        "--limit-per-map",
+        type=int,
+        default=None,
+        help="scenarios per map, evenly spread over the buckets (default all)",
+    )
+    ap.add_argument(
+        "--kappa",
+        choices=("off", "on", "both"),
+        default="off",
+        help="curvature bound 1/(2r) in the smoother (default off)",
+    )
+    ap.add_argument(
+        "--snap",
+        type=float,
+        default=0.0,
+        metavar="K",
+        help="move infeasible end points to the nearest free cell within K cells (default 0: off)",
+    )
     args = ap.parse_args()
     if args.limit_per_map is not None and args.limit_per_map < 1:
         ap.error(f"--limit-per-map must be >= 1, got {args.limit_per_map}")

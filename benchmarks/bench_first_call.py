@@ -99,8 +99,9 @@ def run_child(cwd: Path, python: str, warm: bool = False) -> dict:
     """Run one fresh process (after ``trajopt.warm_up()`` if ``warm``); timings in seconds."""
     code = f"WARM = {warm}\n" + CHILD
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    out = subprocess.run([python, "-c", code], cwd=cwd, check=True,
-                         capture_output=True, text=True, env=env)  # fmt: skip
+    out = subprocess.run(
+        [python, "-c", code], cwd=cwd, check=True, capture_output=True, text=True, env=env
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

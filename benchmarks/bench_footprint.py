@@ -59,8 +59,9 @@ def collides(grid, fp, x, y, theta) -> bool:
     """Independent check: points filling the posed footprint vs occupied squares."""
     v = fp.vertices
     n = 10
-    edges = [v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i])
-             for i in range(len(v))]  # fmt: skip
+    edges = [
+        v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i]) for i in range(len(v))
+    ]
     lo, hi = v.min(axis=0), v.max(axis=0)
     gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n))
     pts = np.vstack(edges + [np.column_stack([gx.ravel(), gy.ravel()])])
@@ -76,8 +77,9 @@ def collides(grid, fp, x, y, theta) -> bool:
 
 
 def queries(grid, r_free, n, rng):
-    free = np.argwhere(~astar.inflate(grid, r_free, metric="square",
-                                      outside_occupied=True).occupied)  # fmt: skip
+    free = np.argwhere(
+        ~astar.inflate(grid, r_free, metric="square", outside_occupied=True).occupied
+    )
     out = []
     for _ in range(40 * n):
         if len(out) == n or len(free) < 2:
@@ -107,22 +109,24 @@ def without_footprint_rounds():
 def run_maps(args, rng, quiet: bool = False) -> tuple[int, int, list[float]]:
     """Plan the map queries; return (solved, queries, smoothing times in ms)."""
     say = (lambda *a, **k: None) if quiet else print
-    say(f"{'map':18s} {'shape':>9s} {'solved':>7s} {'no path':>7s} {'no pose':>7s} "
-          f"{'no curve':>8s} {'collide':>7s} {'rungs':>9s} {'rounds':>6s} "
-          f"{'smooth med/p95 ms':>18s} {'cert med/p95 ms':>16s}")  # fmt: skip
+    say(
+        f"{'map':18s} {'shape':>9s} {'solved':>7s} {'no path':>7s} {'no pose':>7s} "
+        f"{'no curve':>8s} {'collide':>7s} {'rungs':>9s} {'rounds':>6s} "
+        f"{'smooth med/p95 ms':>18s} {'cert med/p95 ms':>16s}"
+    )
     d = data_dir()
     maps = [(n, d / "ros" / f"{n}.yaml", None) for n in ROS]
     maps += [(n, d / "movingai" / "maps" / f"{n}.map", 2.5) for n in MOVINGAI]
     all_smooth: list[float] = []
     total_solved = total_queries = 0
-    trajopt.warm_up(
-        trajopt.Planner(astar.load_map(maps[0][1]), trajopt.Robot.rectangle(0.64, 0.4))
-    )
+    trajopt.warm_up(trajopt.Planner(astar.load_map(maps[0][1]), trajopt.Robot.rectangle(0.64, 0.4)))
     for name, path, r_cells in maps:
         grid = astar.load_map(path)
         diam = 2 * (0.2 if r_cells is None else r_cells * grid.resolution)
-        for shape, (ln, wd) in (("1.6x1.0", (1.6 * diam, 1.0 * diam)),
-                                ("2:1", (1.6 * diam, 0.8 * diam))):  # fmt: skip
+        for shape, (ln, wd) in (
+            ("1.6x1.0", (1.6 * diam, 1.0 * diam)),
+            ("2:1", (1.6 * diam, 0.8 * diam)),
+        ):
             robot = trajopt.Robot.rectangle(ln, wd)
             planner = trajopt.Planner(grid, robot)
             qs = queries(grid, robot.inscribed_radius + grid.resolution, args.per_map, rng)
@@ -158,14 +162,18 @@ def run_maps(args, rng, quiet: bool = False) -> tuple[int, int, list[float]]:
             rung_s = ",".join(f"{rungs.get(i, 0)}" for i in range(3))
             total_solved += solved
             total_queries += len(qs)
-            say(f"{name:18s} {shape:>9s} {solved:3d}/{len(qs):<3d} {refused['no path']:7d} "
-                  f"{refused['no pose']:7d} {refused['no curve']:8d} {collided:7d} {rung_s:>9s} "
-                  f"{with_rounds:6d} {mp(smooth):>18s} {mp(cert):>16s}")  # fmt: skip
+            say(
+                f"{name:18s} {shape:>9s} {solved:3d}/{len(qs):<3d} {refused['no path']:7d} "
+                f"{refused['no pose']:7d} {refused['no curve']:8d} {collided:7d} {rung_s:>9s} "
+                f"{with_rounds:6d} {mp(smooth):>18s} {mp(cert):>16s}"
+            )
             all_smooth.extend(smooth)
     if all_smooth:
-        say(f"smoothing stage over all solved queries: median {statistics.median(all_smooth):.1f} "
-              f"ms, p95 {np.percentile(all_smooth, 95):.1f} ms, max {max(all_smooth):.1f} ms "
-              f"({len(all_smooth)} plans)")  # fmt: skip
+        say(
+            f"smoothing stage over all solved queries: median {statistics.median(all_smooth):.1f} "
+            f"ms, p95 {np.percentile(all_smooth, 95):.1f} ms, max {max(all_smooth):.1f} ms "
+            f"({len(all_smooth)} plans)"
+        )
     return total_solved, total_queries, all_smooth
 
 
@@ -221,10 +229,12 @@ def main(argv: list[str] | None = None) -> int:
     ok, n, smooth = run_maps(args, np.random.default_rng(args.seed))
     with without_footprint_rounds():
         ok0, n0, smooth0 = run_maps(args, np.random.default_rng(args.seed), quiet=True)
-    print(f"the same queries without the footprint rounds (no pinned end heading, no footprint "
-          f"SCP; the ladder only): solved {ok0}/{n0}, smoothing p95 "
-          f"{np.percentile(smooth0, 95):.1f} ms; with them: {ok}/{n}, "
-          f"{np.percentile(smooth, 95):.1f} ms")  # fmt: skip
+    print(
+        f"the same queries without the footprint rounds (no pinned end heading, no footprint "
+        f"SCP; the ladder only): solved {ok0}/{n0}, smoothing p95 "
+        f"{np.percentile(smooth0, 95):.1f} ms; with them: {ok}/{n}, "
+        f"{np.percentile(smooth, 95):.1f} ms"
+    )
     run_doors(args)
     return 0
 

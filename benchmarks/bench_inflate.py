@@ -73,8 +73,9 @@ def main(argv: list[str] | None = None) -> int:
     print("clearance field (metres, every cell)")
     for metric in ("centre", "square"):
         t_ours, field = timed(lambda m=metric: astar.clearance(grid, metric=m), args.repeat)
-        t_ref, ref_field = timed(lambda m=metric: scipy_distance_cells(occ, m) * args.resolution,
-                                 args.repeat)  # fmt: skip
+        t_ref, ref_field = timed(
+            lambda m=metric: scipy_distance_cells(occ, m) * args.resolution, args.repeat
+        )
         equal = bool(np.array_equal(field, ref_field))
         same &= equal
         print(

@@ -72,17 +72,37 @@ def write_reference(traj, path: Path, dt: float) -> None:
         for k in range(len(smp.t)):
             ns = int(round(smp.t[k] * 1e9))
             stamp = {"sec": ns // 10**9, "nanosec": ns % 10**9}
-            w.write_message("/pose", s_pose, {
-                "header": {"stamp": stamp, "frame_id": "map"},
-                "pose": {"position": {"x": smp.x[k], "y": smp.y[k], "z": 0.0},
-                         "orientation": {"x": 0.0, "y": 0.0, "z": np.sin(half[k]),
-                                         "w": np.cos(half[k])}},
-            }, log_time=ns, publish_time=ns)  # fmt: skip
-            w.write_message("/twist", s_tw, {
-                "header": {"stamp": stamp, "frame_id": "base_link"},
-                "twist": {"linear": {"x": smp.v[k], "y": 0.0, "z": 0.0},
-                          "angular": {"x": 0.0, "y": 0.0, "z": smp.omega[k]}},
-            }, log_time=ns, publish_time=ns)  # fmt: skip
+            w.write_message(
+                "/pose",
+                s_pose,
+                {
+                    "header": {"stamp": stamp, "frame_id": "map"},
+                    "pose": {
+                        "position": {"x": smp.x[k], "y": smp.y[k], "z": 0.0},
+                        "orientation": {
+                            "x": 0.0,
+                            "y": 0.0,
+                            "z": np.sin(half[k]),
+                            "w": np.cos(half[k]),
+                        },
+                    },
+                },
+                log_time=ns,
+                publish_time=ns,
+            )
+            w.write_message(
+                "/twist",
+                s_tw,
+                {
+                    "header": {"stamp": stamp, "frame_id": "base_link"},
+                    "twist": {
+                        "linear": {"x": smp.v[k], "y": 0.0, "z": 0.0},
+                        "angular": {"x": 0.0, "y": 0.0, "z": smp.omega[k]},
+                    },
+                },
+                log_time=ns,
+                publish_time=ns,
+            )
         w.finish()
 
 
@@ -95,8 +115,10 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     traj = sixty_second_trajectory()
     n = len(traj.sample_uniform(0.01).t)
-    print(f"trajectory: {traj.duration:.2f} s, {traj.length:.2f} m, {n} samples at 100 Hz, "
-          f"corridor of {len(traj.steps.corridor.regions)} regions")  # fmt: skip
+    print(
+        f"trajectory: {traj.duration:.2f} s, {traj.length:.2f} m, {n} samples at 100 Hz, "
+        f"corridor of {len(traj.steps.corridor.regions)} regions"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "traj.mcap"
         ours, ref = [], []
@@ -109,11 +131,15 @@ def main(argv: list[str] | None = None) -> int:
             ref.append(time.perf_counter() - t0)
         size = out.stat().st_size
     m_ours, m_ref = statistics.median(ours), statistics.median(ref)
-    print(f"to_mcap (all topics):                 median {1e3 * m_ours:7.1f} ms "
-          f"(best {1e3 * min(ours):.1f}), {size / 1e6:.2f} MB")  # fmt: skip
+    print(
+        f"to_mcap (all topics):                 median {1e3 * m_ours:7.1f} ms "
+        f"(best {1e3 * min(ours):.1f}), {size / 1e6:.2f} MB"
+    )
     print(f"mcap_ros2 Writer (/pose, /twist only): median {1e3 * m_ref:7.1f} ms")
-    print(f"ratio to_mcap / mcap_ros2 writer: {m_ours / m_ref:.2f}; target < 500 ms: "
-          f"{'met' if m_ours < 0.5 else 'NOT met'}")  # fmt: skip
+    print(
+        f"ratio to_mcap / mcap_ros2 writer: {m_ours / m_ref:.2f}; target < 500 ms: "
+        f"{'met' if m_ours < 0.5 else 'NOT met'}"
+    )
     return 0
 
 

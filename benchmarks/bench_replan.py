@@ -80,8 +80,9 @@ def ros_dir() -> Path | None:
 
 def queries(grid, robot, n, rng):
     """``n`` random (start, goal) pairs at least 2 m apart in free space."""
-    free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
-                                      outside_occupied=True).occupied)  # fmt: skip
+    free = np.argwhere(
+        ~astar.inflate(grid, robot.radius + 0.1, metric="square", outside_occupied=True).occupied
+    )
     out = []
     for _ in range(50 * n):
         if len(out) == n or len(free) == 0:
@@ -121,11 +122,15 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     rng = np.random.default_rng(args.seed)
     robot = trajopt.Robot(radius=0.2)
-    print(f"robot radius {robot.radius} m, v_max {robot.v_max} m/s; re-plan every "
-          f"{args.every} s of trajectory time, latency 0")  # fmt: skip
-    print(f"{'map':26s} {'replans':>7s} {'ok':>4s} {'refused':>7s} {'kept':>4s} {'braked':>6s} "
-          f"{'kept ms':>7s} {'full ms':>7s} {'full p95':>8s} {'fresh ms':>8s} {'max jump':>9s} "
-          f"{'limits':>6s} {'new goal ok (braked)':>20s}")  # fmt: skip
+    print(
+        f"robot radius {robot.radius} m, v_max {robot.v_max} m/s; re-plan every "
+        f"{args.every} s of trajectory time, latency 0"
+    )
+    print(
+        f"{'map':26s} {'replans':>7s} {'ok':>4s} {'refused':>7s} {'kept':>4s} {'braked':>6s} "
+        f"{'kept ms':>7s} {'full ms':>7s} {'full p95':>8s} {'fresh ms':>8s} {'max jump':>9s} "
+        f"{'limits':>6s} {'new goal ok (braked)':>20s}"
+    )
     all_kept: list[float] = []
     all_full: list[float] = []
     goal_ms: dict[str, list[float]] = {"smooth": [], "braked": []}
@@ -169,8 +174,9 @@ def main(argv: list[str] | None = None) -> int:
                 new = planner.replan(traj, min(1.0, traj.duration / 2), goal=other, latency=0.0)
                 braked = new.stats["replan"].startswith("braked")
                 goal_ms["braked" if braked else "smooth"].append(1e3 * (time.perf_counter() - t0))
-                worst = max(worst, jump(traj.state_at(min(1.0, traj.duration / 2)),
-                                        new.state_at(0.0)))  # fmt: skip
+                worst = max(
+                    worst, jump(traj.state_at(min(1.0, traj.duration / 2)), new.state_at(0.0))
+                )
                 ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
                 new_goal["ok"] += 1
                 new_goal["braked"] += braked
@@ -180,17 +186,23 @@ def main(argv: list[str] | None = None) -> int:
         all_full += full
         ref = ", ".join(f"{v} {k}" for k, v in refused.items()) or "0"
         goals = f"{new_goal['ok']}/{new_goal['ok'] + new_goal['refused']} ({new_goal['braked']})"
-        print(f"{name:26s} {n_ok + sum(refused.values()):7d} {n_ok:4d} {ref:>7s} {n_kept:4d} "
-              f"{n_braked:6d} {_med(kept):7.1f} {_med(full):7.1f} {_p95(full):8.1f} "
-              f"{_med(fresh):8.1f} {worst:9.1e} {str(ok_limits):>6s} {goals:>20s}")  # fmt: skip
+        print(
+            f"{name:26s} {n_ok + sum(refused.values()):7d} {n_ok:4d} {ref:>7s} {n_kept:4d} "
+            f"{n_braked:6d} {_med(kept):7.1f} {_med(full):7.1f} {_p95(full):8.1f} "
+            f"{_med(fresh):8.1f} {worst:9.1e} {str(ok_limits):>6s} {goals:>20s}"
+        )
     if all_full:
-        print(f"all maps, same goal and map: kept re-plans median {_med(all_kept):.2f} ms, p95 "
-              f"{_p95(all_kept):.2f} ms ({len(all_kept)}); full re-plans (reuse=False) median "
-              f"{_med(all_full):.1f} ms, p95 {_p95(all_full):.1f} ms ({len(all_full)})")  # fmt: skip
-        print(f"new goal: smooth re-plans median {_med(goal_ms['smooth']):.1f} ms, p95 "
-              f"{_p95(goal_ms['smooth']):.1f} ms ({len(goal_ms['smooth'])}); braked re-plans "
-              f"median {_med(goal_ms['braked']):.1f} ms, p95 {_p95(goal_ms['braked']):.1f} ms "
-              f"({len(goal_ms['braked'])})")  # fmt: skip
+        print(
+            f"all maps, same goal and map: kept re-plans median {_med(all_kept):.2f} ms, p95 "
+            f"{_p95(all_kept):.2f} ms ({len(all_kept)}); full re-plans (reuse=False) median "
+            f"{_med(all_full):.1f} ms, p95 {_p95(all_full):.1f} ms ({len(all_full)})"
+        )
+        print(
+            f"new goal: smooth re-plans median {_med(goal_ms['smooth']):.1f} ms, p95 "
+            f"{_p95(goal_ms['smooth']):.1f} ms ({len(goal_ms['smooth'])}); braked re-plans "
+            f"median {_med(goal_ms['braked']):.1f} ms, p95 {_p95(goal_ms['braked']):.1f} ms "
+            f"({len(goal_ms['braked'])})"
+        )
     appearing(d, robot, args, np.random.default_rng(args.seed))
     if args.warehouse:
         warehouse(d, args.warehouse, np.random.default_rng(args.seed))
@@ -207,12 +219,16 @@ def _p95(x) -> float:
 
 def appearing(d: Path, robot, args, rng) -> None:
     """Drive each query re-planning every ``args.every`` s while obstacles appear."""
-    print(f"\nobstacles appearing: before every re-plan a 2 x 2 cell block turns occupied at "
-          f"a random free place at least {robot.radius + 0.3:.2f} m from the robot; the robot "
-          f"drives each new trajectory")  # fmt: skip
-    print(f"{'map':26s} {'replans':>7s} {'kept':>5s} {'planned':>7s} {'path kept':>9s} "
-          f"{'braked':>6s} {'refused':>7s} {'median ms':>9s} {'p95 ms':>7s} {'max jump':>9s} "
-          f"{'limits':>6s} {'min clear m':>11s}")  # fmt: skip
+    print(
+        f"\nobstacles appearing: before every re-plan a 2 x 2 cell block turns occupied at "
+        f"a random free place at least {robot.radius + 0.3:.2f} m from the robot; the robot "
+        f"drives each new trajectory"
+    )
+    print(
+        f"{'map':26s} {'replans':>7s} {'kept':>5s} {'planned':>7s} {'path kept':>9s} "
+        f"{'braked':>6s} {'refused':>7s} {'median ms':>9s} {'p95 ms':>7s} {'max jump':>9s} "
+        f"{'limits':>6s} {'min clear m':>11s}"
+    )
     kept_regions: list[tuple[float, float, int, int]] = []  # corridor s, fresh s, kept, all
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
@@ -238,8 +254,9 @@ def appearing(d: Path, robot, args, rng) -> None:
                         break
                 t0 = time.perf_counter()
                 try:
-                    new = planner.replan(traj, args.every, grid=grid.with_occupied(occ.copy()),
-                                         latency=0.0)  # fmt: skip
+                    new = planner.replan(
+                        traj, args.every, grid=grid.with_occupied(occ.copy()), latency=0.0
+                    )
                 except TrajoptError:
                     refused += 1
                     break
@@ -264,36 +281,50 @@ def appearing(d: Path, robot, args, rng) -> None:
                 worst = max(worst, jump(traj.state_at(args.every), new.state_at(0.0)))
                 ok_limits &= bool(trajectory_metrics(new, robot)["within_limits"])
                 smp = new.sample_uniform(0.01)
-                clear = min(clear, float(point_clearance(np.column_stack([smp.x, smp.y]),
-                                                         planner.grid, border_occupied=True).min()))  # fmt: skip
+                clear = min(
+                    clear,
+                    float(
+                        point_clearance(
+                            np.column_stack([smp.x, smp.y]), planner.grid, border_occupied=True
+                        ).min()
+                    ),
+                )
                 traj = new
-        print(f"{name:26s} {kept + planned + braked + refused:7d} {kept:5d} {planned:7d} "
-              f"{reused:9d} {braked:6d} {refused:7d} {_med(times):9.1f} {_p95(times):7.1f} {worst:9.1e} "
-              f"{str(ok_limits):>6s} {clear:11.4f}")  # fmt: skip
-    print(f"(min clear: the smallest distance from a 10 ms sample of any new trajectory to an "
-          f"occupied cell of its updated map, by trajopt.metrics.point_clearance; the robot "
-          f"radius is {robot.radius} m)")  # fmt: skip
+        print(
+            f"{name:26s} {kept + planned + braked + refused:7d} {kept:5d} {planned:7d} "
+            f"{reused:9d} {braked:6d} {refused:7d} {_med(times):9.1f} {_p95(times):7.1f} {worst:9.1e} "
+            f"{str(ok_limits):>6s} {clear:11.4f}"
+        )
+    print(
+        f"(min clear: the smallest distance from a 10 ms sample of any new trajectory to an "
+        f"occupied cell of its updated map, by trajopt.metrics.point_clearance; the robot "
+        f"radius is {robot.radius} m)"
+    )
     if kept_regions:
         cor = [1e3 * c for c, _, _, _ in kept_regions]
         fresh = [1e3 * f for _, f, _, _ in kept_regions]
         share = [k / n for _, _, k, n in kept_regions]
-        print(f"planned re-plans that kept corridor regions: {len(cor)}, median share kept "
-              f"{100 * _med(share):.0f} %; corridor stage median {_med(cor):.2f} ms against "
-              f"{_med(fresh):.2f} ms for a fresh corridor on the same path (ratio "
-              f"{_med(fresh) / _med(cor):.2f})")  # fmt: skip
+        print(
+            f"planned re-plans that kept corridor regions: {len(cor)}, median share kept "
+            f"{100 * _med(share):.0f} %; corridor stage median {_med(cor):.2f} ms against "
+            f"{_med(fresh):.2f} ms for a fresh corridor on the same path (ratio "
+            f"{_med(fresh) / _med(cor):.2f})"
+        )
 
 
 def warehouse(d: Path, n: int, rng) -> None:
     """Whole plans and re-plans to a new goal on willow at 5 cm (module docstring)."""
     w = astar.load_map(d / "willow-2010-02-18-0.10.yaml")
-    grid = astar.OccupancyGrid(np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1),
-                               w.resolution / 2, w.origin)  # fmt: skip
+    grid = astar.OccupancyGrid(
+        np.repeat(np.repeat(w.occupied, 2, axis=0), 2, axis=1), w.resolution / 2, w.origin
+    )
     robot = trajopt.Robot(radius=0.25)
     planner = trajopt.Planner(grid, robot, landmarks=6)
     plain = trajopt.Planner(grid, robot)
     trajopt.warm_up(planner)
-    free = np.argwhere(~astar.inflate(grid, robot.radius + 0.1, metric="square",
-                                      outside_occupied=True).occupied)  # fmt: skip
+    free = np.argwhere(
+        ~astar.inflate(grid, robot.radius + 0.1, metric="square", outside_occupied=True).occupied
+    )
     qs = []
     while len(qs) < n + 1:
         a, b = free[rng.integers(len(free), size=2)]
@@ -333,32 +364,41 @@ def warehouse(d: Path, n: int, rng) -> None:
         occ[iy - 4 : iy + 4, ix - 4 : ix + 4] = True
         t0 = time.perf_counter()
         try:
-            new = upd.replan(traj, min(2.0, traj.duration / 3),
-                             grid=grid.with_occupied(occ.copy()), latency=0.0)  # fmt: skip
+            new = upd.replan(
+                traj, min(2.0, traj.duration / 3), grid=grid.with_occupied(occ.copy()), latency=0.0
+            )
             blocked.append(1e3 * (time.perf_counter() - t0))
             braked["block"] += new.stats["replan"].startswith("braked")
         except TrajoptError:
             blocked_refused += 1
         lm_kept += upd._landmarks is not None
-    print(f"\nwarehouse-size map: willow at 5 cm ({grid.nx} x {grid.ny} cells), radius 0.25 m, "
-          f"{len(plans)} queries 5 m or more apart, warm planner")  # fmt: skip
-    print(f"  whole plan (new goal), landmarks=6: median {statistics.median(plans):.1f} ms, p95 "
-          f"{np.percentile(plans, 95):.1f} ms (target median <= 40 ms); without landmarks: "
-          f"median {statistics.median(plain_ms):.1f} ms, p95 {np.percentile(plain_ms, 95):.1f} "
-          f"ms")  # fmt: skip
+    print(
+        f"\nwarehouse-size map: willow at 5 cm ({grid.nx} x {grid.ny} cells), radius 0.25 m, "
+        f"{len(plans)} queries 5 m or more apart, warm planner"
+    )
+    print(
+        f"  whole plan (new goal), landmarks=6: median {statistics.median(plans):.1f} ms, p95 "
+        f"{np.percentile(plans, 95):.1f} ms (target median <= 40 ms); without landmarks: "
+        f"median {statistics.median(plain_ms):.1f} ms, p95 {np.percentile(plain_ms, 95):.1f} "
+        f"ms"
+    )
     split = ", ".join(f"{k} {statistics.median(v):.1f}" for k, v in stages.items() if k != "total")
     print(f"  stage medians (ms): {split}")
     if replans:
-        print(f"  re-plan to a new goal from the moving robot: median "
-              f"{statistics.median(replans):.1f} ms, p95 {np.percentile(replans, 95):.1f} ms "
-              f"({len(replans)} re-plans, {braked['new goal']} braked, {refused} refused; target "
-              f"median <= 40 ms)")  # fmt: skip
+        print(
+            f"  re-plan to a new goal from the moving robot: median "
+            f"{statistics.median(replans):.1f} ms, p95 {np.percentile(replans, 95):.1f} ms "
+            f"({len(replans)} re-plans, {braked['new goal']} braked, {refused} refused; target "
+            f"median <= 40 ms)"
+        )
     if blocked:
-        print(f"  re-plan after a 0.4 m block appears on the path ahead (landmarks=6, the "
-              f"blocks accumulating): median {statistics.median(blocked):.1f} ms, p95 "
-              f"{np.percentile(blocked, 95):.1f} ms ({len(blocked)} re-plans, {braked['block']} "
-              f"braked, {blocked_refused} refused); landmarks carried over {lm_kept} of "
-              f"{len(qs) - 1} updates")  # fmt: skip
+        print(
+            f"  re-plan after a 0.4 m block appears on the path ahead (landmarks=6, the "
+            f"blocks accumulating): median {statistics.median(blocked):.1f} ms, p95 "
+            f"{np.percentile(blocked, 95):.1f} ms ({len(blocked)} re-plans, {braked['block']} "
+            f"braked, {blocked_refused} refused); landmarks carried over {lm_kept} of "
+            f"{len(qs) - 1} updates"
+        )
 
 
 if __name__ == "__main__":

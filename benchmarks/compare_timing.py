@@ -40,8 +40,10 @@ def _worker(curves_file: str, repeat: int) -> None:
 
     data = np.load(curves_file)
     robot = Robot()
-    curves = [BSplineCurve(data[f"t{i}"], data[f"c{i}"], int(data[f"k{i}"]))
-              for i in range(int(data["n"]))]  # fmt: skip
+    curves = [
+        BSplineCurve(data[f"t{i}"], data[f"c{i}"], int(data[f"k{i}"]))
+        for i in range(int(data["n"]))
+    ]
     for c in curves:
         time_parameterize(c, robot)  # numba cache, arc-length tables
     out = []
@@ -77,8 +79,14 @@ def _save_curves(limit: int, path: Path) -> list[str]:
 
 def _run(tree: Path, curves_file: Path, repeat: int) -> dict:
     env = dict(os.environ, PYTHONPATH=str(tree))
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", str(curves_file),
-           "--repeat", str(repeat)]  # fmt: skip
+    cmd = [
+        sys.executable,
+        str(Path(__file__).resolve()),
+        "--worker",
+        str(curves_file),
+        "--repeat",
+        str(repeat),
+    ]
     res = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True, check=True)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -98,15 +106,26 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         base_tree = Path(tmp) / "base"
         base_tree.mkdir()
-        archive = subprocess.run(["git", "archive", args.base, "trajopt", "astar"], cwd=ROOT,
-                                 capture_output=True, check=True).stdout  # fmt: skip
+        archive = subprocess.run(
+            ["git", "archive", args.base, "trajopt", "astar"],
+            cwd=ROOT,
+            capture_output=True,
+            check=True,
+        ).stdout
         subprocess.run(["tar", "-x", "-C", str(base_tree)], input=archive, check=True)
         curves_file = Path(tmp) / "curves.npz"
         names = _save_curves(args.limit, curves_file)
-        rev = subprocess.run(["git", "rev-parse", "--short", args.base], cwd=ROOT,
-                             capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
-        print(f"{len(names)} curves; base {args.base} ({rev}) vs this tree; best of "
-              f"{args.repeat} x {args.rounds} rounds")  # fmt: skip
+        rev = subprocess.run(
+            ["git", "rev-parse", "--short", args.base],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+        print(
+            f"{len(names)} curves; base {args.base} ({rev}) vs this tree; best of "
+            f"{args.repeat} x {args.rounds} rounds"
+        )
         best = {"base": np.full(len(names), np.inf), "head": np.full(len(names), np.inf)}
         dur: dict[str, np.ndarray] = {}
         for _ in range(args.rounds):
@@ -116,16 +135,22 @@ def main() -> None:
                 dur[key] = np.array([r["duration"] for r in out["rows"]])
     rel = (dur["head"] - dur["base"]) / dur["base"]
     per = {k: 1e3 * best[k] / dur[k] for k in best}  # ms of compute per s of trajectory
-    print(f"\n  {'path':42s} {'duration s':>10s} {'rel. diff':>10s} {'ms/s base':>10s} "
-          f"{'ms/s new':>9s} {'speed-up':>8s}")  # fmt: skip
+    print(
+        f"\n  {'path':42s} {'duration s':>10s} {'rel. diff':>10s} {'ms/s base':>10s} "
+        f"{'ms/s new':>9s} {'speed-up':>8s}"
+    )
     for i, name in enumerate(names):
-        print(f"  {name[:42]:42s} {dur['head'][i]:10.3f} {rel[i]:10.2e} {per['base'][i]:10.4f} "
-              f"{per['head'][i]:9.4f} {per['base'][i] / per['head'][i]:8.2f}")  # fmt: skip
+        print(
+            f"  {name[:42]:42s} {dur['head'][i]:10.3f} {rel[i]:10.2e} {per['base'][i]:10.4f} "
+            f"{per['head'][i]:9.4f} {per['base'][i] / per['head'][i]:8.2f}"
+        )
     paper = np.array([n.startswith("paper:") for n in names])
     for label, sel in (("paper scene", paper), ("all paths", np.ones_like(paper))):
-        print(f"\n{label}: compute per second of trajectory (best of runs), median "
-              f"{np.median(per['base'][sel]):.4f} ms -> {np.median(per['head'][sel]):.4f} ms, "
-              f"max {per['base'][sel].max():.4f} ms -> {per['head'][sel].max():.4f} ms")  # fmt: skip
+        print(
+            f"\n{label}: compute per second of trajectory (best of runs), median "
+            f"{np.median(per['base'][sel]):.4f} ms -> {np.median(per['head'][sel]):.4f} ms, "
+            f"max {per['base'][sel].max():.4f} ms -> {per['head'][sel].max():.4f} ms"
+        )
     print(
         f"max |relative duration difference| {np.abs(rel).max():.2e} "
         f"(median {np.median(np.abs(rel)):.2e})"

@@ -98,9 +98,11 @@ def main(argv: list[str] | None = None) -> int:
     total: Counter = Counter()
     times: dict[str, list[float]] = {}
     bad: list[str] = []
-    print(f"robot radius {robot.radius} m; re-plans every {args.every} s with reuse=False to "
-          f"the same goal, the next query's goal and another query's start; braked results "
-          f"re-planned again halfway through their brake and turn")  # fmt: skip
+    print(
+        f"robot radius {robot.radius} m; re-plans every {args.every} s with reuse=False to "
+        f"the same goal, the next query's goal and another query's start; braked results "
+        f"re-planned again halfway through their brake and turn"
+    )
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
         planner = trajopt.Planner(grid, robot)
@@ -115,18 +117,29 @@ def main(argv: list[str] | None = None) -> int:
             for t in np.arange(0.5, traj.duration - 0.3, args.every):
                 for goal in goals:
                     where = f"{name} query {k} {p0} -> {p1}, t {t:.2f} s, goal {goal}"
-                    new = replan(planner, traj, float(t), goal, grid, robot, out, times, bad,
-                                 where)  # fmt: skip
+                    new = replan(planner, traj, float(t), goal, grid, robot, out, times, bad, where)
                     if isinstance(new, trajopt.TrajectoryChain) and len(new.pieces) > 1:
                         tq = float(0.5 * new.piece_times[-2])
-                        replan(planner, new, tq, p0, grid, robot, out, times, bad,
-                               f"{where}, then the chain at {tq:.2f} s to {p0}")  # fmt: skip
+                        replan(
+                            planner,
+                            new,
+                            tq,
+                            p0,
+                            grid,
+                            robot,
+                            out,
+                            times,
+                            bad,
+                            f"{where}, then the chain at {tq:.2f} s to {p0}",
+                        )
         total.update(out)
         print(f"  {name:26s} " + ", ".join(f"{k} {v}" for k, v in sorted(out.items())))
     print("all maps: " + ", ".join(f"{k} {v}" for k, v in sorted(total.items())))
     for how, v in sorted(times.items()):
-        print(f"  {how:8s} re-plans: median {statistics.median(v):.1f} ms, p95 "
-              f"{np.percentile(v, 95):.1f} ms, max {max(v):.0f} ms ({len(v)})")  # fmt: skip
+        print(
+            f"  {how:8s} re-plans: median {statistics.median(v):.1f} ms, p95 "
+            f"{np.percentile(v, 95):.1f} ms, max {max(v):.0f} ms ({len(v)})"
+        )
     print(f"violations: {len(bad)}")
     for b in bad:
         print("  " + b)

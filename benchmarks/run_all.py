@@ -307,8 +307,9 @@ def main(argv: list[str] | None = None) -> int:
     mode = ap.add_mutually_exclusive_group()
     mode.add_argument("--quick", action="store_true", help="small settings (default)")
     mode.add_argument("--full", action="store_true", help="the scripts' own defaults")
-    ap.add_argument("--only", nargs="+", choices=[b.name for b in BENCHES],
-                    help="run these benchmarks only")  # fmt: skip
+    ap.add_argument(
+        "--only", nargs="+", choices=[b.name for b in BENCHES], help="run these benchmarks only"
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
     args = ap.parse_args(argv)
     chosen = [b for b in BENCHES if args.only is None or b.name in args.only]

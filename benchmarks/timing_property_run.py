@@ -31,9 +31,14 @@ from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
 
 ROBOT = Robot(
-    v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
+    v_max=0.5,
+    a_max=0.5,
+    j_max=2.0,
+    a_lat_max=0.5,
+    omega_max=1.5,
+    track_width=None,
     wheel_v_max=None,
-)  # fmt: skip
+)
 
 
 def draw_curve(rng: np.random.Generator) -> BSplineCurve | None:

@@ -38,8 +38,10 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         return
     tr = session.config.pluginmanager.get_plugin("terminalreporter")
     say = tr.write_line if tr is not None else print
-    say(f"trajopt: compiling {len(cold)} numba kernels first (once per environment; "
-        "TRAJOPT_PRECOMPILE=0 skips)...")  # fmt: skip
+    say(
+        f"trajopt: compiling {len(cold)} numba kernels first (once per environment; "
+        "TRAJOPT_PRECOMPILE=0 skips)..."
+    )
     report = kernel_cache.compile_kernels()
     say(f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s")
     for name, error in report.failed.items():

@@ -113,9 +113,11 @@ def square_clearance(
     for k in range(0, len(pts), chunk):
         qx, qy = px[k : k + chunk], py[k : k + chunk]
         near = (
-            (x0 + res >= qx.min() - reach) & (x0 <= qx.max() + reach)
-            & (y0 + res >= qy.min() - reach) & (y0 <= qy.max() + reach)
-        )  # fmt: skip
+            (x0 + res >= qx.min() - reach)
+            & (x0 <= qx.max() + reach)
+            & (y0 + res >= qy.min() - reach)
+            & (y0 <= qy.max() + reach)
+        )
         if not near.any():
             continue
         cx, cy = x0[near], y0[near]
@@ -557,8 +559,9 @@ def footprint_points(fp: Footprint, n: int = 12) -> np.ndarray:
     grid over the bounding box, kept where :func:`inside_convex`.
     """
     v = fp.vertices
-    edges = [v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i])
-             for i in range(len(v))]  # fmt: skip
+    edges = [
+        v[i] + np.linspace(0, 1, n)[:, None] * (v[(i + 1) % len(v)] - v[i]) for i in range(len(v))
+    ]
     lo, hi = v.min(axis=0), v.max(axis=0)
     gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n))
     grid = np.column_stack([gx.ravel(), gy.ravel()])

@@ -52,8 +52,12 @@ def test_type_checking_block_imports_every_lazy_export(package):
     subs = getattr(mod, "_SUBMODULES", ())
     # a public module is imported from the package that holds it (trajopt.analysis for
     # trajopt.scenes) when the lazy map names where it lives, else from the package itself
-    want.update({name: subs[name].rpartition(".")[0] if isinstance(subs, dict) else package
-                 for name in subs})  # fmt: skip
+    want.update(
+        {
+            name: subs[name].rpartition(".")[0] if isinstance(subs, dict) else package
+            for name in subs
+        }
+    )
     wrong = {
         name: (where, seen.get(name)) for name, where in want.items() if seen.get(name) != where
     }

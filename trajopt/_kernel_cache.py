@@ -211,8 +211,9 @@ def _notice(d: Any) -> None:
         "trajopt: compiling numerical kernels once for this environment (numba, starting "
         "with %s%s); later processes load them from the cache. `trajopt warm-up` or "
         "trajopt.warm_up() compiles all of them ahead of time, in parallel.",
-        d.py_func.__name__, about,
-    )  # fmt: skip
+        d.py_func.__name__,
+        about,
+    )
 
 
 # ----------------------------------------------------------------------------- compilation
@@ -388,8 +389,14 @@ def _with_dependencies(table: dict[str, Any], names: Iterable[str]) -> list[str]
 class _Workers:
     """Worker processes that run warm-up exercises named on their stdin (:func:`_worker`)."""
 
-    def __init__(self, n: int, table: dict[str, Any], report: CompileReport,
-                 seen: Callable[[str], None], t0: float) -> None:  # fmt: skip
+    def __init__(
+        self,
+        n: int,
+        table: dict[str, Any],
+        report: CompileReport,
+        seen: Callable[[str], None],
+        t0: float,
+    ) -> None:
         self.table, self.report, self.seen, self.t0 = table, report, seen, t0
         env = dict(os.environ, **{WORKER_ENV: "1"})
         self.procs: list[subprocess.Popen] = []
@@ -398,11 +405,17 @@ class _Workers:
             for _ in range(n):
                 log = tempfile.TemporaryFile(mode="w+")
                 self.logs.append(log)
-                self.procs.append(subprocess.Popen(
-                    [sys.executable, "-m", "trajopt._kernel_cache", "--worker"],
-                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True,
-                    bufsize=1, env=env,
-                ))  # fmt: skip
+                self.procs.append(
+                    subprocess.Popen(
+                        [sys.executable, "-m", "trajopt._kernel_cache", "--worker"],
+                        stdin=subprocess.PIPE,
+                        stdout=subprocess.PIPE,
+                        stderr=log,
+                        text=True,
+                        bufsize=1,
+                        env=env,
+                    )
+                )
         except OSError:
             self.close()
             raise
@@ -456,8 +469,14 @@ class _Workers:
             finished.add(name)
             if error is None:
                 report.exercises.append(name)
-                report.timeline.append((name, self.procs.index(proc) + 1, started[proc.pid],
-                                        time.perf_counter() - self.t0))  # fmt: skip
+                report.timeline.append(
+                    (
+                        name,
+                        self.procs.index(proc) + 1,
+                        started[proc.pid],
+                        time.perf_counter() - self.t0,
+                    )
+                )
             else:
                 report.failed[name] = error
             if early <= finished:

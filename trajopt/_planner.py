@@ -88,8 +88,16 @@ from trajopt.robot._state import State
 from trajopt.smoother import Smoother
 from trajopt.timing._speed_limits import SpeedLimits
 
-__all__ = ["plan", "Planner", "PlannerOptions", "PlanSteps", "Inflation", "Search", "Fallback",
-           "PlanResult"]  # fmt: skip
+__all__ = [
+    "plan",
+    "Planner",
+    "PlannerOptions",
+    "PlanSteps",
+    "Inflation",
+    "Search",
+    "Fallback",
+    "PlanResult",
+]
 
 
 class Planner:
@@ -434,9 +442,19 @@ class Planner:
         with self._lock:
             t0 = time.perf_counter()
             lat = self.latency_s if latency is None else latency
-            out = replan_from(self.options, self.caches, trajectory, t, goal, grid, latency=lat,
-                              goal_heading=goal_heading, v_end=v_end, reuse=reuse,
-                              brake_after_s=brake_after_s)  # fmt: skip
+            out = replan_from(
+                self.options,
+                self.caches,
+                trajectory,
+                t,
+                goal,
+                grid,
+                latency=lat,
+                goal_heading=goal_heading,
+                v_end=v_end,
+                reuse=reuse,
+                brake_after_s=brake_after_s,
+            )
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -553,8 +571,9 @@ def _settings(
             f"options must be a trajopt.PlannerOptions, got {type(options).__name__}"
         )
     defaults = inspect.signature(Planner.__init__).parameters
-    given = [k for k, v in keywords.items() if v is not defaults[k].default
-             and v != defaults[k].default]  # fmt: skip
+    given = [
+        k for k, v in keywords.items() if v is not defaults[k].default and v != defaults[k].default
+    ]
     if robot is not None:
         given.insert(0, "robot")
     if given:

@@ -44,6 +44,7 @@ from trajopt.errors import InvalidInputError
 
 _log = logging.getLogger(__name__)
 
+
 def warm_up(planner: Planner | None = None) -> float:
     """Compile what is not compiled yet, then load what a plan needs, before the first query.
 
@@ -81,8 +82,9 @@ def warm_up(planner: Planner | None = None) -> float:
         raise InvalidInputError(f"planner must be a trajopt.Planner, got {type(planner).__name__}")
     report = kernel_cache.compile_kernels()
     for name, error in report.failed.items():
-        _log.warning("warm_up: exercise %r failed (its kernels compile on first use): %s",
-                     name, error)  # fmt: skip
+        _log.warning(
+            "warm_up: exercise %r failed (its kernels compile on first use): %s", name, error
+        )
     if planner is None:
         for name, exercise in EXERCISES.items():
             if name not in report.failed:
@@ -171,8 +173,9 @@ def _exercise_polygons() -> None:
     from trajopt.corridor import build_polygon_corridor
 
     planner, start, goal = _default_query()
-    corridor = build_polygon_corridor(planner.grid, _around_the_wall(planner, start, goal),
-                                      planner.robot.radius)  # fmt: skip
+    corridor = build_polygon_corridor(
+        planner.grid, _around_the_wall(planner, start, goal), planner.robot.radius
+    )
     if len(corridor.regions) > 1:
         corridor.regions[0].intersection(corridor.regions[1], tol=1e-9)
 
@@ -228,8 +231,9 @@ def _exercise_fallback() -> None:
     r = planner.robot.radius
     polyline_clearance(points, planner.grid, window_m=2.0 * r, outside_occupied=True)
     stop_and_turn(points, planner.robot)
-    curvature_witness(planner.grid, r, np.asarray(start), np.asarray(goal), 1.0 / (2.0 * r),
-                      time_limit_s=5.0)  # fmt: skip
+    curvature_witness(
+        planner.grid, r, np.asarray(start), np.asarray(goal), 1.0 / (2.0 * r), time_limit_s=5.0
+    )
 
 
 def _exercise_plan() -> None:
@@ -295,7 +299,7 @@ EXERCISES: dict[str, Exercise] = {
     "plan": Exercise(_exercise_plan, after=("timing", "polygons", "search", "grid"), seconds=1.0),
     "footprint": Exercise(
         _exercise_footprint, after=("timing", "polygons", "search", "grid"), seconds=3.5
-    ),  # fmt: skip
+    ),
     "planners": Exercise(_exercise_planners, after=("plan", "astar", "fallback"), seconds=1.0),
     "compare": Exercise(_exercise_compare, after=("plan",), seconds=0.5),
 }

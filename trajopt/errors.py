@@ -79,6 +79,6 @@ class BenchmarkError(InvalidInputError):
 class PeerUnavailableError(BenchmarkError):
     """A peer method was requested but its package is not installed.
 
-    A peer method (OMPL, python-motion-planning) was requested but its package is not installed;
-    the message says to install the ``peers`` extra (``pip install 'trajopt[peers]'``).
+    The peers are OMPL and python-motion-planning; the message says to install the ``peers``
+    extra (``pip install 'trajopt[peers]'``).
     """

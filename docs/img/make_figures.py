@@ -43,8 +43,13 @@ def paper_scene() -> None:
         ax=ax0,
     )
     ax0.set_title("proposed: SP to A-D (travel times)")
-    table = trajopt.compare(scene.grid, scene.start, scene.goal("D"),
-                            robot_radius=scene.robot_radius, w_cells=scene.w_cells)  # fmt: skip
+    table = trajopt.compare(
+        scene.grid,
+        scene.start,
+        scene.goal("D"),
+        robot_radius=scene.robot_radius,
+        w_cells=scene.w_cells,
+    )
     paths = {k: v for k, v in table.paths.items() if v is not None}
     plot_paths(
         scene.grid,
@@ -66,8 +71,12 @@ def diagonal_passage() -> None:
     radius = r_cells * res
     th = math.radians(angle)
     iy, ix = np.mgrid[0:n, 0:n]
-    ds = np.array([-math.sin(th) * (ix + cx - n / 2) + math.cos(th) * (iy + cy - n / 2)
-                   for cx, cy in ((0, 0), (1, 0), (0, 1), (1, 1))])  # fmt: skip
+    ds = np.array(
+        [
+            -math.sin(th) * (ix + cx - n / 2) + math.cos(th) * (iy + cy - n / 2)
+            for cx, cy in ((0, 0), (1, 0), (0, 1), (1, 1))
+        ]
+    )
     h = (2 * r_cells + 1) / 2
     occ = np.all(ds >= h, axis=0) | np.all(ds <= -h, axis=0)
     grid = astar.OccupancyGrid(occ, res)
@@ -79,8 +88,12 @@ def diagonal_passage() -> None:
     p0 = grid.cell_to_world(np.array([xs[ia], ys[ia]]))
     p1 = grid.cell_to_world(np.array([xs[ib], ys[ib]]))
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 6))
-    path = astar.find_path(infl, (int(xs[ia]), int(ys[ia])), (int(xs[ib]), int(ys[ib])),
-                           cost=astar.clearance_cost(grid, radius, outside_occupied=True))  # fmt: skip
+    path = astar.find_path(
+        infl,
+        (int(xs[ia]), int(ys[ia])),
+        (int(xs[ib]), int(ys[ib])),
+        cost=astar.clearance_cost(grid, radius, outside_occupied=True),
+    )
     boxes = trajopt.build_corridor(infl, path, radius=radius, raw_grid=grid)
     plot_map(grid, inflated=infl, corridor=boxes, ax=ax0)
     cells = grid.cell_to_world(np.asarray(path.cells))
@@ -95,8 +108,9 @@ def diagonal_passage() -> None:
     corr = traj.steps.corridor
     plot_map(grid, inflated=infl, corridor=corr, ax=ax1)
     xy = traj.path(np.linspace(*traj.path.domain, 400))
-    ax1.plot(xy[:, 0], xy[:, 1], color="tab:blue", lw=2,
-             label=f"certified curve, {traj.duration:.2f} s")  # fmt: skip
+    ax1.plot(
+        xy[:, 0], xy[:, 1], color="tab:blue", lw=2, label=f"certified curve, {traj.duration:.2f} s"
+    )
     ax1.set_title(f"polygons ({len(corr.regions)})")
     ax1.legend(loc="upper left")
     for ax in (ax0, ax1):

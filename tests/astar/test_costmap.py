@@ -122,8 +122,12 @@ def test_plans_on_a_nav2_costmap_avoid_cost_and_keep_the_certificate(shared_data
     p_cost = trajopt.Planner(cm, robot)
     p_short = trajopt.Planner(cm, robot, search="shortest")
     assert p_cost.search == "costmap"
-    queries = [((-1.55, -0.55), (1.6, 0.5)), ((-0.5, -1.9), (0.55, 1.85)),
-               ((-2.0, 0.4), (1.9, -0.6)), ((-1.1, 1.6), (1.05, -1.65))]  # fmt: skip
+    queries = [
+        ((-1.55, -0.55), (1.6, 0.5)),
+        ((-0.5, -1.9), (0.55, 1.85)),
+        ((-2.0, 0.4), (1.9, -0.6)),
+        ((-1.1, 1.6), (1.05, -1.65)),
+    ]
     means_cost, means_short = [], []
     weighted = cm.search_cost(2.0)
     for start, goal in queries:
@@ -152,8 +156,7 @@ def test_costmap_search_modes_need_a_costmap(shared_data):
     g = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     with pytest.raises(trajopt.InvalidInputError, match="needs the grid to be an astar.Costmap"):
         trajopt.Planner(g, search="costmap")
-    cm = from_costmap(np.where(g.occupied, 254, 0), g.resolution, g.origin,
-                      convention="costmap_2d")  # fmt: skip
+    cm = from_costmap(np.where(g.occupied, 254, 0), g.resolution, g.origin, convention="costmap_2d")
     both = trajopt.Planner(cm, trajopt.Robot(radius=0.15), search="costmap+clearance")
     ref = astar.clearance_cost(g, 0.15, outside_occupied=True) + cm.search_cost(2.0)
     np.testing.assert_allclose(both.search_cost, ref)

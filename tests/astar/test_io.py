@@ -510,9 +510,14 @@ def test_scenario_record_is_frozen_and_validated() -> None:
         ({"bucket": 1.5}, "int"),
     ]:
         args = dict(
-            bucket=0, map_name="a.map", width=4, height=3, start=(0, 0), goal=(3, 2),
+            bucket=0,
+            map_name="a.map",
+            width=4,
+            height=3,
+            start=(0, 0),
+            goal=(3, 2),
             optimal_length=2.5,
-        )  # fmt: skip
+        )
         args.update(kwargs)
         with pytest.raises(InvalidInputError, match=rule):
             Scenario(**args)

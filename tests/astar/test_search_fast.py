@@ -120,7 +120,8 @@ def test_radix_heap_search_on_a_large_clearance_cost(connectivity, corner_cuttin
     reach = np.argwhere(np.isfinite(ref))
     goals = [tuple(c[::-1]) for c in reach[np.argsort(-ref[np.isfinite(ref)])[:3]]]
     for goal in goals:
-        p = find_path(grid, (0, 0), goal, cost=cost, connectivity=connectivity,
-                      corner_cutting=corner_cutting)  # fmt: skip
+        p = find_path(
+            grid, (0, 0), goal, cost=cost, connectivity=connectivity, corner_cutting=corner_cutting
+        )
         assert p.cost == pytest.approx(ref[goal[1], goal[0]], rel=1e-12)
         check_path(p, occ, (0, 0), goal, connectivity, corner_cutting, cost)

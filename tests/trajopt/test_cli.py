@@ -245,9 +245,27 @@ def test_plan_on_a_costmap_with_a_speed_mask_to_mcap(tmp_path, capsys):
         "negate: 0\noccupied_thresh: 1.0\nfree_thresh: 0.0\n"
     )
     out = tmp_path / "traj.mcap"
-    rc = main(["plan", str(tmp_path / "cm.yaml"), "--costmap", "--start", "0.5", "0.5",
-               "--goal", "2.6", "0.5", "--radius", "0.12", "--speed-mask",
-               str(tmp_path / "mask.yaml"), "--out", str(out), "--dt", "0.01"])  # fmt: skip
+    rc = main(
+        [
+            "plan",
+            str(tmp_path / "cm.yaml"),
+            "--costmap",
+            "--start",
+            "0.5",
+            "0.5",
+            "--goal",
+            "2.6",
+            "0.5",
+            "--radius",
+            "0.12",
+            "--speed-mask",
+            str(tmp_path / "mask.yaml"),
+            "--out",
+            str(out),
+            "--dt",
+            "0.01",
+        ]
+    )
     assert rc == 0, capsys.readouterr().err
     back = read_mcap(out)
     zone = back.x >= 2.0 + 1e-9
@@ -283,8 +301,21 @@ def test_plan_with_a_rectangle_footprint_writes_it_and_plots_it(
     out, fig = tmp_path / "traj.json", tmp_path / "fig.png"
     # 0.2 x 0.12 m, rotation centre 0.05 m ahead of the rear edge: circumscribed radius
     # hypot(0.15, 0.06) = 0.1616 m, below the 0.3 m clearance of start and goal
-    rc = main(["plan", str(door_map), *PLAN, "--footprint", "0.2", "0.12", "0.05",
-               "--out", str(out), "--plot", str(fig)])  # fmt: skip
+    rc = main(
+        [
+            "plan",
+            str(door_map),
+            *PLAN,
+            "--footprint",
+            "0.2",
+            "0.12",
+            "0.05",
+            "--out",
+            str(out),
+            "--plot",
+            str(fig),
+        ]
+    )
     assert rc == 0, capsys.readouterr().err
     robot = json.loads(out.read_text())["robot"]
     np.testing.assert_allclose(
@@ -309,8 +340,17 @@ def test_plan_footprint_files(door_map, tmp_path, capsys):
     for name, text in files.items():
         (tmp_path / name).write_text(text)
         out = tmp_path / f"{name}.json"
-        rc = main(["plan", str(door_map), *PLAN, "--footprint-file", str(tmp_path / name),
-                   "--out", str(out)])  # fmt: skip
+        rc = main(
+            [
+                "plan",
+                str(door_map),
+                *PLAN,
+                "--footprint-file",
+                str(tmp_path / name),
+                "--out",
+                str(out),
+            ]
+        )
         assert rc == 0, (name, capsys.readouterr().err)
         robot = json.loads(out.read_text())["robot"]
         assert len(robot["footprint"]) == 4

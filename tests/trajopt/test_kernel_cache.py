@@ -26,8 +26,11 @@ from trajopt.cli import main
 def _run(script: str, *args: str, env: dict | None = None) -> subprocess.CompletedProcess:
     out = subprocess.run(
         [sys.executable, "-c", textwrap.dedent(script), *args],
-        capture_output=True, text=True, check=False, env=env,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        check=False,
+        env=env,
+    )
     assert out.returncode == 0, out.stderr[-3000:]
     return out
 
@@ -124,9 +127,14 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
                           "failed": report.failed, "left": kernel_cache.cold_kernels()}))
     """
     out = json.loads(_run(script, env=env).stdout)
-    grid = {"astar.distance_transform._transform", "astar.distance_transform._column_pass",
-            "astar.distance_transform._row_pass", "astar.inflation._dilate_rows",
-            "astar.search_kernels.astar_kernel", "astar.search_kernels.unroll_path"}  # fmt: skip
+    grid = {
+        "astar.distance_transform._transform",
+        "astar.distance_transform._column_pass",
+        "astar.distance_transform._row_pass",
+        "astar.inflation._dilate_rows",
+        "astar.search_kernels.astar_kernel",
+        "astar.search_kernels.unroll_path",
+    }
     assert set(out["cold"]) == set(kernel_cache.kernels())  # nothing cached yet
     assert out["workers"] == 2 and out["failed"] == {}
     assert grid <= set(out["compiled"])

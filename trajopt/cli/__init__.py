@@ -67,5 +67,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USAGE
     finally:
         if compiling is not None and compiling.wait().cold:
-            print(f"trajopt: compiled {len(compiling.compiled)} kernels in "
-                  f"{compiling.seconds:.1f} s", file=sys.stderr)  # fmt: skip
+            print(
+                f"trajopt: compiled {len(compiling.compiled)} kernels in {compiling.seconds:.1f} s",
+                file=sys.stderr,
+            )

@@ -69,16 +69,20 @@ def shape_args(g: Any, radius_help: str) -> None:
     shape = g.add_mutually_exclusive_group()
     shape.add_argument("--radius", type=float, help=radius_help)
     shape.add_argument(
-        "--footprint", nargs="+", type=float, action=FootprintAction,
+        "--footprint",
+        nargs="+",
+        type=float,
+        action=FootprintAction,
         help="rectangular footprint [m]: length L (x forward), width W and the rear offset "
         "REAR from the rotation centre back to the rear edge (default L/2); the disc-model "
         "stages keep its circumscribed radius clear",
-    )  # fmt: skip
+    )
     shape.add_argument(
-        "--footprint-file", metavar="PATH",
+        "--footprint-file",
+        metavar="PATH",
         help="convex footprint polygon [m, robot frame, x forward]: JSON (a list of [x, y] "
         "or {\"vertices\": [[x, y], ...]}) or CSV/text rows 'x, y'",
-    )  # fmt: skip
+    )
 
 
 def robot_args(p: argparse.ArgumentParser) -> None:
@@ -214,8 +218,16 @@ def robot_from_args(args: argparse.Namespace):
     from trajopt.robot._footprint import Footprint
     from trajopt.robot._robot import Robot
 
-    names = ("radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max", "track_width",
-             "wheel_v_max")  # fmt: skip
+    names = (
+        "radius",
+        "v_max",
+        "a_max",
+        "j_max",
+        "a_lat_max",
+        "omega_max",
+        "track_width",
+        "wheel_v_max",
+    )
     kwargs = {k: getattr(args, k, None) for k in names}
     kwargs = {k: v for k, v in kwargs.items() if v is not None}
     if getattr(args, "no_wheels", False):

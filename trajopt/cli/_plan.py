@@ -39,18 +39,27 @@ def _ros_args(p: argparse.ArgumentParser) -> None:
         "mode raw): lethal cells are obstacles, the graded cost steers the search",
     )
     g.add_argument(
-        "--costmap-weight", type=float, default=2.0,
+        "--costmap-weight",
+        type=float,
+        default=2.0,
         help="weight of the costmap's normalised cost in the search (default 2)",
-    )  # fmt: skip
+    )
     g.add_argument("--speed-mask", metavar="YAML", help="Nav2 speed filter mask (map_server YAML)")
     g.add_argument(
-        "--speed-mask-type", choices=("percentage", "absolute"), default="percentage",
+        "--speed-mask-type",
+        choices=("percentage", "absolute"),
+        default="percentage",
         help="limit in percent of --v-max or in m/s (Nav2 filter type 1 or 2; default percentage)",
-    )  # fmt: skip
-    g.add_argument("--speed-mask-base", type=float, default=0.0,
-                   help="Nav2 'base': limit = value * multiplier + base (default 0)")  # fmt: skip
-    g.add_argument("--speed-mask-multiplier", type=float, default=1.0,
-                   help="Nav2 'multiplier' (default 1)")  # fmt: skip
+    )
+    g.add_argument(
+        "--speed-mask-base",
+        type=float,
+        default=0.0,
+        help="Nav2 'base': limit = value * multiplier + base (default 0)",
+    )
+    g.add_argument(
+        "--speed-mask-multiplier", type=float, default=1.0, help="Nav2 'multiplier' (default 1)"
+    )
     g.add_argument("--frame-id", default="map", help="frame of the written poses (default map)")
 
 

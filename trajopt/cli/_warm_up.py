@@ -30,8 +30,12 @@ def add_parser(sub: Any) -> None:
         "query. Run it once after installing (a container build, a CI cache step) so that "
         "no later command compiles.",
     )
-    p.add_argument("--workers", type=int, default=None,
-                   help="worker processes that compile (default: min(2, CPUs); 1: this one)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes that compile (default: min(2, CPUs); 1: this one)",
+    )
     p.set_defaults(func=_cmd_warm_up)
 
 
@@ -44,15 +48,19 @@ def _cmd_warm_up(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     report = _compile_kernels(None, args.workers)
     if report.cold and not report.failed:
-        print(f"compiled {len(report.compiled)} of {len(report.cold)} uncached kernels in "
-              f"{report.seconds:.1f} s ({report.workers or 1} process(es))")  # fmt: skip
+        print(
+            f"compiled {len(report.compiled)} of {len(report.cold)} uncached kernels in "
+            f"{report.seconds:.1f} s ({report.workers or 1} process(es))"
+        )
     for name, error in report.failed.items():
         print(f"trajopt warm-up: exercise {name!r} failed: {error}", file=sys.stderr)
     warm_up()
     n = len(kernel_cache.kernels())
     left = kernel_cache.cold_kernels()
-    print(f"{n - len(left)} of {n} kernels compiled and loaded; warm-up took "
-          f"{time.perf_counter() - t0:.1f} s")  # fmt: skip
+    print(
+        f"{n - len(left)} of {n} kernels compiled and loaded; warm-up took "
+        f"{time.perf_counter() - t0:.1f} s"
+    )
     if left:
         print(f"trajopt warm-up: not compiled: {', '.join(left)}", file=sys.stderr)
         return 1
@@ -72,9 +80,12 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
         return kernel_cache.CompileReport()
     n_workers = workers if workers is not None else min(2, os.cpu_count() or 1)
     about = kernel_cache.estimate_seconds(len(cold), n_workers)
-    print(f"trajopt: compiling numerical kernels once for this environment (about "
-          f"{about:.0f} s; later runs load them from numba's cache)...", file=sys.stderr,
-          flush=True)  # fmt: skip
+    print(
+        f"trajopt: compiling numerical kernels once for this environment (about "
+        f"{about:.0f} s; later runs load them from numba's cache)...",
+        file=sys.stderr,
+        flush=True,
+    )
     bar = None
     if sys.stderr.isatty():
         try:
@@ -95,8 +106,11 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
         if bar is not None:
             bar.close()
     if first is None:
-        print(f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s",
-              file=sys.stderr, flush=True)  # fmt: skip
+        print(
+            f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s",
+            file=sys.stderr,
+            flush=True,
+        )
     return report
 
 

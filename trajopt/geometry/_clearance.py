@@ -264,8 +264,7 @@ def window_rects(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndar
 def polygon_rects_distance(v, nv, rects):  # pragma: no cover - compiled
     """Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects``.
 
-    Exact distance from a convex polygon ``v[:nv]`` to the nearest of ``rects`` (``inf`` for
-    none).
+    ``inf`` when ``rects`` is empty.
     """
     best = np.inf
     for i in range(rects.shape[0]):

@@ -101,15 +101,29 @@ class TurnInPlace(AtRestEnds):
             q = np.where(end, abs(self.turn_rad), q)
             dq = np.where(end, 0.0, dq)
         zero = np.zeros_like(tt)
-        return make_sample(self.robot, t=tt, x=zero + self.position[0],
-                           y=zero + self.position[1], theta=self.theta0 + self.sign * q,
-                           v=zero, omega=self.sign * dq, a=zero, jerk=zero, a_lat=zero,
-                           kappa=zero, s=zero)  # fmt: skip
+        return make_sample(
+            self.robot,
+            t=tt,
+            x=zero + self.position[0],
+            y=zero + self.position[1],
+            theta=self.theta0 + self.sign * q,
+            v=zero,
+            omega=self.sign * dq,
+            a=zero,
+            jerk=zero,
+            a_lat=zero,
+            kappa=zero,
+            s=zero,
+        )
 
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
         """Return a JSON-ready description (the layout of :meth:`Trajectory.to_dict`)."""
-        turn = {"x": float(self.position[0]), "y": float(self.position[1]),
-                "theta0": self.theta0, "turn_rad": self.turn_rad}  # fmt: skip
+        turn = {
+            "x": float(self.position[0]),
+            "y": float(self.position[1]),
+            "theta0": self.theta0,
+            "turn_rad": self.turn_rad,
+        }
         return export_dict(self, "trajopt.TurnInPlace", dt, {"turn": turn})
 
     def __repr__(self) -> str:
@@ -220,8 +234,9 @@ class TrajectoryChain(SampledExport):
     def after(self, t: float) -> TrajectoryChain:
         """Return the chain from time ``t`` (s) on, with its clock starting at 0 there."""
         i, tau = self.piece_at(t)
-        return TrajectoryChain(self.pieces[i:], self.robot, dict(self.stats), self.steps,
-                               (tau,) + self.starts[i + 1 :])  # fmt: skip
+        return TrajectoryChain(
+            self.pieces[i:], self.robot, dict(self.stats), self.steps, (tau,) + self.starts[i + 1 :]
+        )
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample:
         """Evaluate the chain at times ``t`` (s, clipped to ``[0, duration]``; vectorised)."""
@@ -246,15 +261,22 @@ class TrajectoryChain(SampledExport):
         ``pieces`` lists each piece's type, its start time on the chain's clock (s) and its
         played duration (s).
         """
-        pieces = [{"type": type(p).__name__, "t0": float(self._t[i]),
-                   "duration": float(self._t[i + 1] - self._t[i])}
-                  for i, p in enumerate(self.pieces)]  # fmt: skip
+        pieces = [
+            {
+                "type": type(p).__name__,
+                "t0": float(self._t[i]),
+                "duration": float(self._t[i + 1] - self._t[i]),
+            }
+            for i, p in enumerate(self.pieces)
+        ]
         return export_dict(self, "trajopt.TrajectoryChain", dt, {"pieces": pieces})
 
     def __repr__(self) -> str:
         kinds = ", ".join(type(p).__name__ for p in self.pieces)
-        return (f"TrajectoryChain(duration={self.duration:.4g} s, length={self.length:.4g} m, "
-                f"pieces=[{kinds}])")  # fmt: skip
+        return (
+            f"TrajectoryChain(duration={self.duration:.4g} s, length={self.length:.4g} m, "
+            f"pieces=[{kinds}])"
+        )
 
 
 def _at(smp: TrajectorySample, i: int) -> dict[str, float]:

@@ -302,9 +302,10 @@ def write_mcap(
                 dtype = TOPICS[topic]
                 if dtype not in schema_ids:
                     schema_ids[dtype] = mw.register_schema(
-                        name=dtype, encoding="ros2msg",
+                        name=dtype,
+                        encoding="ros2msg",
                         data=message_definition(dtype).encode("utf-8"),
-                    )  # fmt: skip
+                    )
                 channels[topic] = mw.register_channel(
                     topic=topic, message_encoding="cdr", schema_id=schema_ids[dtype]
                 )
@@ -315,14 +316,26 @@ def write_mcap(
                     ("/map", steps.raw_grid),
                     ("/map_inflated", steps.inflated_grid),
                 ):
-                    mw.add_message(channel(topic), log_time=ns0, publish_time=ns0,
-                                   data=_encode_grid(grid, ns0, frame_id))  # fmt: skip
-            mw.add_message(channel("/plan"), log_time=ns0, publish_time=ns0,
-                           data=_encode_path(ns0, stamps, frame_id, x, y, qz, qw))  # fmt: skip
+                    mw.add_message(
+                        channel(topic),
+                        log_time=ns0,
+                        publish_time=ns0,
+                        data=_encode_grid(grid, ns0, frame_id),
+                    )
+            mw.add_message(
+                channel("/plan"),
+                log_time=ns0,
+                publish_time=ns0,
+                data=_encode_path(ns0, stamps, frame_id, x, y, qz, qw),
+            )
             if steps is not None and steps.corridor is not None:
                 polys = _corridor_polygons(steps.corridor)
-                mw.add_message(channel("/corridor"), log_time=ns0, publish_time=ns0,
-                               data=_encode_markers(polys, ns0, frame_id))  # fmt: skip
+                mw.add_message(
+                    channel("/corridor"),
+                    log_time=ns0,
+                    publish_time=ns0,
+                    data=_encode_markers(polys, ns0, frame_id),
+                )
             c_pose, c_twist = channel("/pose"), channel("/twist")
             for k in range(len(stamps)):
                 ns = int(stamps[k])
@@ -434,8 +447,15 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
                 if topic == "/pose":
                     st = ros.header.stamp
                     o = ros.pose.orientation
-                    poses.append((st.sec * 1_000_000_000 + st.nanosec, ros.pose.position.x,
-                                  ros.pose.position.y, o.z, o.w))  # fmt: skip
+                    poses.append(
+                        (
+                            st.sec * 1_000_000_000 + st.nanosec,
+                            ros.pose.position.x,
+                            ros.pose.position.y,
+                            o.z,
+                            o.w,
+                        )
+                    )
                     frames["frame_id"] = ros.header.frame_id
                 elif topic == "/twist":
                     twists.append((ros.twist.linear.x, ros.twist.angular.z))
@@ -443,20 +463,25 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
                 elif topic == "/plan":
                     for ps in ros.poses:
                         o = ps.pose.orientation
-                        path_rows.append((ps.pose.position.x, ps.pose.position.y,
-                                          2.0 * math.atan2(o.z, o.w)))  # fmt: skip
+                        path_rows.append(
+                            (ps.pose.position.x, ps.pose.position.y, 2.0 * math.atan2(o.z, o.w))
+                        )
                 elif topic in ("/map", "/map_inflated"):
                     info = ros.info
-                    data = np.frombuffer(bytes(ros.data), dtype=np.int8) if isinstance(
-                        ros.data, bytes | bytearray) else np.asarray(ros.data, dtype=np.int8)  # fmt: skip
+                    data = (
+                        np.frombuffer(bytes(ros.data), dtype=np.int8)
+                        if isinstance(ros.data, bytes | bytearray)
+                        else np.asarray(ros.data, dtype=np.int8)
+                    )
                     occ = data.reshape(info.height, info.width) == 100
                     # MapMetaData.resolution is float32: take the shortest decimal that
                     # rounds to it (0.03 for float32(0.03)), the value a map YAML gave
                     res = float(np.format_float_positional(np.float32(info.resolution)))
                     maps[topic] = OccupancyGrid(
-                        occ, res,
+                        occ,
+                        res,
                         (info.origin.position.x, info.origin.position.y),
-                    )  # fmt: skip
+                    )
                 elif topic == "/corridor":
                     for m in ros.markers:
                         corridor.append(np.array([[q.x, q.y] for q in m.points], dtype=float))

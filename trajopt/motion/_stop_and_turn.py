@@ -86,9 +86,16 @@ class StopAndTurnTrajectory(AtRestEnds):
 
     def __post_init__(self) -> None:
         names = (
-            "phase_t", "phase_sigma", "phase_v", "phase_a", "phase_j", "phase_theta",
-            "phase_omega", "phase_alpha", "phase_zeta",
-        )  # fmt: skip
+            "phase_t",
+            "phase_sigma",
+            "phase_v",
+            "phase_a",
+            "phase_j",
+            "phase_theta",
+            "phase_omega",
+            "phase_alpha",
+            "phase_zeta",
+        )
         shape = np.shape(self.phase_t)
         for n in names:
             arr = readonly(getattr(self, n))
@@ -205,9 +212,20 @@ class StopAndTurnTrajectory(AtRestEnds):
         f = (sig / self._seg_len[seg])[..., None]
         xy = (1.0 - f) * pts[seg] + f * pts[seg + 1]
         zero = np.zeros_like(tt)
-        return make_sample(self.robot, t=tt, x=xy[..., 0], y=xy[..., 1], theta=theta, v=v,
-                           omega=omega, a=a, jerk=j, a_lat=zero, kappa=zero,
-                           s=self._seg_s[seg] + sig)  # fmt: skip
+        return make_sample(
+            self.robot,
+            t=tt,
+            x=xy[..., 0],
+            y=xy[..., 1],
+            theta=theta,
+            v=v,
+            omega=omega,
+            a=a,
+            jerk=j,
+            a_lat=zero,
+            kappa=zero,
+            s=self._seg_s[seg] + sig,
+        )
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
@@ -220,8 +238,15 @@ class StopAndTurnTrajectory(AtRestEnds):
         """
         phases = {
             "units": {
-                "t": "s", "segment": "index", "sigma": "m", "v": "m/s", "a": "m/s^2",
-                "jerk": "m/s^3", "theta": "rad", "omega": "rad/s", "alpha": "rad/s^2",
+                "t": "s",
+                "segment": "index",
+                "sigma": "m",
+                "v": "m/s",
+                "a": "m/s^2",
+                "jerk": "m/s^3",
+                "theta": "rad",
+                "omega": "rad/s",
+                "alpha": "rad/s^2",
                 "zeta": "rad/s^3",
             },
             "t": self.phase_t.tolist(),
@@ -234,7 +259,7 @@ class StopAndTurnTrajectory(AtRestEnds):
             "omega": self.phase_omega.tolist(),
             "alpha": self.phase_alpha.tolist(),
             "zeta": self.phase_zeta.tolist(),
-        }  # fmt: skip
+        }
         extra = {
             "vertices": {"unit": "m", "xy": self.vertices.tolist()},
             "theta_end": self.theta_end,

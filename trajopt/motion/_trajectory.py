@@ -240,9 +240,13 @@ class SampledExport:
         from trajopt.motion._mcap import write_mcap
 
         return write_mcap(
-            self, path, dt=dt, frame_id=frame_id, child_frame_id=child_frame_id,
+            self,
+            path,
+            dt=dt,
+            frame_id=frame_id,
+            child_frame_id=child_frame_id,
             start_time=start_time,
-        )  # fmt: skip
+        )
 
 
 class AtRestEnds(SampledExport):
@@ -497,8 +501,20 @@ class Trajectory(SampledExport):
         else:
             theta = raw
         omega = kappa * v
-        return make_sample(self.robot, t=tt, x=xy[..., 0], y=xy[..., 1], theta=theta, v=v,
-                           omega=omega, a=a, jerk=j, a_lat=omega * v, kappa=kappa, s=s)  # fmt: skip
+        return make_sample(
+            self.robot,
+            t=tt,
+            x=xy[..., 0],
+            y=xy[..., 1],
+            theta=theta,
+            v=v,
+            omega=omega,
+            a=a,
+            jerk=j,
+            a_lat=omega * v,
+            kappa=kappa,
+            s=s,
+        )
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:

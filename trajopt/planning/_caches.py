@@ -84,8 +84,9 @@ class PlannerCaches:
             return None
         with self._lock:
             if self._landmarks is None:
-                self._landmarks = astar.build_landmarks(self.inflated, self.search_cost,
-                                                        o.landmarks)  # fmt: skip
+                self._landmarks = astar.build_landmarks(
+                    self.inflated, self.search_cost, o.landmarks
+                )
             return self._landmarks
 
     @property
@@ -141,15 +142,23 @@ class PlannerCaches:
                 self.grid, self._inflated, self._cost = grid, None, None
                 had = self._landmarks is not None
                 self._landmarks = None
-                return {"changed_cells": None, "window": None, "reset": True,
-                        "landmarks": "dropped" if had else None}  # fmt: skip
+                return {
+                    "changed_cells": None,
+                    "window": None,
+                    "reset": True,
+                    "landmarks": "dropped" if had else None,
+                }
             changed = np.flatnonzero(np.asarray(grid.occupied) != np.asarray(old.occupied))
             n_changed = int(changed.size)
             self.grid = grid
             lms = self._landmarks
             if n_changed == 0:
-                return {"changed_cells": 0, "window": None, "reset": False,
-                        "landmarks": None if lms is None else "kept"}  # fmt: skip
+                return {
+                    "changed_cells": 0,
+                    "window": None,
+                    "reset": False,
+                    "landmarks": None if lms is None else "kept",
+                }
             self._landmarks = None
             iy, ix = np.divmod(changed, grid.nx)  # flatnonzero: far faster than a 2-D nonzero
             box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
@@ -171,8 +180,12 @@ class PlannerCaches:
                     state = "rebased"
                 except AstarInputError:  # a cell freed or a cost lowered
                     state = "dropped"
-            return {"changed_cells": n_changed, "window": window, "reset": False,
-                    "landmarks": state}  # fmt: skip
+            return {
+                "changed_cells": n_changed,
+                "window": window,
+                "reset": False,
+                "landmarks": state,
+            }
 
 
 def change_reach(options: PlannerOptions, resolution: float) -> tuple[int, int]:

@@ -85,10 +85,18 @@ def fit_in_corridor(
                 raise SmoothingError("time budget exhausted before the box corridor", {})
             sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
             with q.timer.stage("smooth"):
-                smooth = sm.fit(path, corridor, raw_grid=grid, radius=options.robot.radius,
-                                start=q.start, goal=q.goal, start_heading=q.start_heading,
-                                goal_heading=q.goal_heading, start_curvature=q.start_curvature,
-                                footprint=q.footprint)  # fmt: skip
+                smooth = sm.fit(
+                    path,
+                    corridor,
+                    raw_grid=grid,
+                    radius=options.robot.radius,
+                    start=q.start,
+                    goal=q.goal,
+                    start_heading=q.start_heading,
+                    goal_heading=q.goal_heading,
+                    start_curvature=q.start_curvature,
+                    footprint=q.footprint,
+                )
             return corridor, smooth
         except SmoothingError as exc:
             spent += time.perf_counter() - t_fit
@@ -132,9 +140,13 @@ def witness_rescue(
             break
         with q.timer.stage("smooth"):
             witness = curvature_witness(
-                grid, radius + margin, q.start, q.goal, sm.kappa_max,
+                grid,
+                radius + margin,
+                q.start,
+                q.goal,
+                sm.kappa_max,
                 time_limit_s=min(left, cap_s),
-            )  # fmt: skip
+            )
             cells = None if witness is None else witness_grid_path(witness, q.inflated)
         if cells is None or len(cells) < 2:
             if not note.startswith("a curvature-bounded path exists"):

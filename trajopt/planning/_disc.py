@@ -134,9 +134,17 @@ def plan_disc(
     smoother_stats = dict(smooth.stats)
     smoother_stats["rescue"] = q.rescue
     kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
-    return _result(options, caches.grid, q, traj, smooth, smoother=smoother_stats,
-                   corridor=kind, grid_path="reused" if reused else "searched",
-                   corridor_regions_kept=q.regions_kept)  # fmt: skip
+    return _result(
+        options,
+        caches.grid,
+        q,
+        traj,
+        smooth,
+        smoother=smoother_stats,
+        corridor=kind,
+        grid_path="reused" if reused else "searched",
+        corridor_regions_kept=q.regions_kept,
+    )
 
 
 def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> astar.GridPath:
@@ -144,9 +152,12 @@ def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> ast
     try:
         lms = caches.landmarks
         return astar.find_path(
-            q.inflated, _cell(q.start_cell), _cell(q.goal_cell),
-            cost=caches.search_cost if lms is None else None, landmarks=lms,
-        )  # fmt: skip
+            q.inflated,
+            _cell(q.start_cell),
+            _cell(q.goal_cell),
+            cost=caches.search_cost if lms is None else None,
+            landmarks=lms,
+        )
     except astar.NoPathError as exc:
         raise NoPathError(
             f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
@@ -156,9 +167,15 @@ def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> ast
 
 def _time(options: PlannerOptions, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
     with q.timer.stage("timing"):
-        return time_parameterize(smooth, options.robot, v_start=q.v_start, v_end=q.v_end,
-                                 dt=options.timing_dt, speed_limits=options.speed_limits,
-                                 a_start=q.a_start)  # fmt: skip
+        return time_parameterize(
+            smooth,
+            options.robot,
+            v_start=q.v_start,
+            v_end=q.v_end,
+            dt=options.timing_dt,
+            speed_limits=options.speed_limits,
+            a_start=q.a_start,
+        )
 
 
 def _smooth(options: PlannerOptions, grid: OccupancyGrid, q: PlanQuery) -> SmoothPath:

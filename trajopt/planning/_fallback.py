@@ -50,8 +50,13 @@ def polyline_fallback(
             radius,
         )
         raise exc
-    traj = stop_and_turn(points, robot, start_heading=q.start_heading,
-                         goal_heading=q.goal_heading, speed_limits=options.speed_limits)  # fmt: skip
+    traj = stop_and_turn(
+        points,
+        robot,
+        start_heading=q.start_heading,
+        goal_heading=q.goal_heading,
+        speed_limits=options.speed_limits,
+    )
     logger.info("smoother/timing failed (%s); returned the stop_and_turn fallback", exc)
     extra: dict[str, Any] = {
         "fallback_error": type(exc).__name__,

@@ -262,8 +262,8 @@ def _finish(x, y, th, gx, gy, turn_r, occ, w, r):
 def _distance_field(occ, w, r, gx, gy):
     """8-connected step counts from the goal cell over cells that may hold a free point.
 
-    8-connected step counts from the goal cell over cells that may hold a free point (centre
-    clearance >= ``r - sqrt(2)/2``); a heuristic in cells (inf elsewhere).
+    Such a cell's centre keeps at least ``r - sqrt(2)/2``; the counts are a heuristic in
+    cells (inf elsewhere).
     """
     ny, nx = occ.shape
     relax = max(0.0, r - 0.7072)

@@ -89,8 +89,9 @@ def oriented_path_check(
         d = ahead - back
         theta = np.arctan2(d[:, 1], d[:, 0])
         inner = np.arange(2, n - 2)
-        clr = polygons_clearance([footprint.at(*centres[i], theta[i]) for i in inner], raw,
-                                 raw.resolution)  # fmt: skip
+        clr = polygons_clearance(
+            [footprint.at(*centres[i], theta[i]) for i in inner], raw, raw.resolution
+        )
         bad = inner[clr <= 0.0]
         if bad.size == 0:
             return path, grid
@@ -98,8 +99,9 @@ def oriented_path_check(
         occ[cells[bad, 1], cells[bad, 0]] = True
         trial = grid.with_occupied(occ)
         try:
-            path = astar.find_path(trial, tuple(cells[0]), tuple(cells[-1]),
-                                   cost=caches.search_cost)  # fmt: skip
+            path = astar.find_path(
+                trial, tuple(cells[0]), tuple(cells[-1]), cost=caches.search_cost
+            )
         except astar.NoPathError:
             return path, grid
         grid = trial
@@ -220,8 +222,10 @@ def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanReque
     from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
 
     fp = footprint
-    ends = (("start", request.start, request.start_heading),
-            ("goal", request.goal, request.goal_heading))  # fmt: skip
+    ends = (
+        ("start", request.start, request.start_heading),
+        ("goal", request.goal, request.goal_heading),
+    )
     for name, end, heading in ends:
         theta = getattr(end, "theta", None) if heading is None else heading
         xy = np.array([getattr(end, "x", None), getattr(end, "y", None)], dtype=float)

@@ -173,9 +173,16 @@ class PlannerOptions:
         ``last`` (the circumscribed disc, which holds the footprint in every heading).
         """
         r = self.robot
-        disc = Robot(radius=radius, v_max=r.v_max, a_max=r.a_max, j_max=r.j_max,
-                     a_lat_max=r.a_lat_max, omega_max=r.omega_max, track_width=r.track_width,
-                     wheel_v_max=r.wheel_v_max)  # fmt: skip
+        disc = Robot(
+            radius=radius,
+            v_max=r.v_max,
+            a_max=r.a_max,
+            j_max=r.j_max,
+            a_lat_max=r.a_lat_max,
+            omega_max=r.omega_max,
+            track_width=r.track_width,
+            wheel_v_max=r.wheel_v_max,
+        )
         return dataclasses.replace(self, robot=disc, fallback=self.fallback if last else None)
 
     def with_budget(self, budget_s: float | None) -> PlannerOptions:

@@ -115,7 +115,10 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
     return Trajectory(
         path=CurveSegment(traj.path, u0, u1),
         robot=robot,
-        phase_t=ph[:, 0], phase_s=ph[:, 1], phase_v=ph[:, 2], phase_a=ph[:, 3],
+        phase_t=ph[:, 0],
+        phase_s=ph[:, 1],
+        phase_v=ph[:, 2],
+        phase_a=ph[:, 3],
         phase_j=ph[:, 4],
         duration=t,
         v_start=v0,
@@ -124,7 +127,7 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
         theta_grid_s=np.concatenate([[0.0], gs[inside] - s0, [s_end - s0]]),
         theta_grid=np.concatenate([[theta0], traj.theta_grid[inside], [theta1]]),
         u_grid=u_grid,
-    )  # fmt: skip
+    )
 
 
 def brake_turn_go(
@@ -206,13 +209,20 @@ def brake_turn_go(
         if brake is not None:
             rest = _resume(options, caches.grid, traj, brake, goal, goal_heading, v_end)
         if rest is None:
-            exc.args = (f"{exc.args[0]} (planned from rest after braking to a stop at "
-                        f"{p_stop} m, since {error})",) + exc.args[1:]  # fmt: skip
+            exc.args = (
+                f"{exc.args[0]} (planned from rest after braking to a stop at "
+                f"{p_stop} m, since {error})",
+            ) + exc.args[1:]
             raise
-        stats = dict(traj.stats, replan=f"braked: {type(error).__name__}: {error}; the old "
-                     f"path resumed from rest ({type(exc).__name__} from the stop)",
-                     brake_m=float(brake.length), brake_s=brake.duration, turn_rad=0.0,
-                     turn_s=0.0)  # fmt: skip
+        stats = dict(
+            traj.stats,
+            replan=f"braked: {type(error).__name__}: {error}; the old "
+            f"path resumed from rest ({type(exc).__name__} from the stop)",
+            brake_m=float(brake.length),
+            brake_s=brake.duration,
+            turn_rad=0.0,
+            turn_s=0.0,
+        )
         return TrajectoryChain(tuple(pieces + rest), robot, stats, traj.steps)
     first = out.sample(np.array([0.0]))
     turn = turn_in_place(p_stop, float(stop.theta[0]), float(first.theta[0]), robot)
@@ -252,9 +262,13 @@ def _resume(
     u_stop, u_end = brake.path.domain[1], traj.path.domain[1]
     if not u_stop < u_end:
         return []
-    rest = time_parameterize(CurveSegment(traj.path, u_stop, u_end), options.robot,
-                             v_end=v_end, dt=options.timing_dt,
-                             speed_limits=options.speed_limits)  # fmt: skip
+    rest = time_parameterize(
+        CurveSegment(traj.path, u_stop, u_end),
+        options.robot,
+        v_end=v_end,
+        dt=options.timing_dt,
+        speed_limits=options.speed_limits,
+    )
     _check_new_obstacles(options.robot, grid, steps, rest)
     return [rest]
 

@@ -104,18 +104,30 @@ def keep_rest(
         return None, why
     tail = smooth.curve.tail(u0)
     start = tail.c[0]
-    cert = certify(tail, corridor, span_box, start=start, goal=np.asarray(steps.goal),
-                   raw_grid=caches.grid, radius=smooth.certificate.radius_m,
-                   kappa_bound=smooth.certificate.kappa_bound)  # fmt: skip
+    cert = certify(
+        tail,
+        corridor,
+        span_box,
+        start=start,
+        goal=np.asarray(steps.goal),
+        raw_grid=caches.grid,
+        radius=smooth.certificate.radius_m,
+        kappa_bound=smooth.certificate.kappa_bound,
+    )
     if not cert.ok:
         return None, f"the rest fails its certificate ({', '.join(cert.failures)})"
     path = dataclasses.replace(smooth, curve=tail, certificate=cert, footprint_certificate=None)
     out = trajectory_after(trajectory, ts, path, u0)
     elapsed = time.perf_counter() - t0
     stages = {"keep": elapsed, "total": elapsed}
-    new_steps = dataclasses.replace(steps, raw_grid=caches.grid,
-                                    inflated_grid=caches.inflated, smooth_path=path,
-                                    start=(float(start[0]), float(start[1])), stages_s=stages)  # fmt: skip
+    new_steps = dataclasses.replace(
+        steps,
+        raw_grid=caches.grid,
+        inflated_grid=caches.inflated,
+        smooth_path=path,
+        start=(float(start[0]), float(start[1])),
+        stages_s=stages,
+    )
     stats = dict(out.stats)
     stats["stages_s"] = stages
     stats["replan"] = "kept"
@@ -229,8 +241,10 @@ def remaining_grid_path(
     step = np.diff(path, axis=0)
     diag = np.all(step != 0, axis=1)
     a = path[:-1][diag]
-    if not (np.all(free[a[:, 1], a[:, 0] + step[diag, 0]])
-            and np.all(free[a[:, 1] + step[diag, 1], a[:, 0]])):  # fmt: skip
+    if not (
+        np.all(free[a[:, 1], a[:, 0] + step[diag, 0]])
+        and np.all(free[a[:, 1] + step[diag, 1], a[:, 0]])
+    ):
         return None
     _, reach = change_reach(options, new.resolution)
     iy, ix = np.divmod(np.flatnonzero(new.occupied != old.occupied), new.nx)
@@ -249,8 +263,9 @@ def remaining_grid_path(
     else:
         c = cost[path[:, 1], path[:, 0]]
         step_costs = length_steps * (1.0 + 0.5 * (c[:-1] + c[1:]))
-    return GridPath(cells=path, length=float(length_steps.sum()), cost=float(step_costs.sum()),
-                    expanded=0)  # fmt: skip
+    return GridPath(
+        cells=path, length=float(length_steps.sum()), cost=float(step_costs.sum()), expanded=0
+    )
 
 
 def trajectory_after(traj: Trajectory, ts: float, path: Any, u0: float) -> Trajectory:

@@ -94,8 +94,9 @@ def replan_from(
     if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
         out, why = _keep_chain(caches.grid, trajectory, ts, goal, goal_heading, v_end)
     elif reuse:
-        out, why = keep_rest(options, caches, piece, t_piece, goal, goal_heading=goal_heading,
-                             v_end=v_end)  # fmt: skip
+        out, why = keep_rest(
+            options, caches, piece, t_piece, goal, goal_heading=goal_heading, v_end=v_end
+        )
     if out is None:
         target = _Target(goal, goal_heading, v_end)
         out = _plan_or_brake(options, caches, trajectory, ts, piece, target, why, brake_after_s)
@@ -156,8 +157,17 @@ def _plan_or_brake(
     previous = None if why == NO_REUSE else getattr(piece, "steps", None)
 
     def brake(error: TrajoptError) -> TrajectoryChain:
-        return brake_turn_go(options, caches, trajectory, ts, goal, goal_heading=goal_heading,
-                             v_end=v_end, error=error, previous=previous)  # fmt: skip
+        return brake_turn_go(
+            options,
+            caches,
+            trajectory,
+            ts,
+            goal,
+            goal_heading=goal_heading,
+            v_end=v_end,
+            error=error,
+            previous=previous,
+        )
 
     if isinstance(piece, TrajectoryChain):
         i, tau = piece.piece_at(ts)
@@ -166,8 +176,9 @@ def _plan_or_brake(
     state = trajectory.state_at(ts)
     path = None
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
-        path = remaining_grid_path(options, caches, piece.steps,
-                                   caches.grid.world_to_cell(state.position))  # fmt: skip
+        path = remaining_grid_path(
+            options, caches, piece.steps, caches.grid.world_to_cell(state.position)
+        )
     warm = WarmStart(path, previous)
     request = PlanRequest(state, goal, goal_heading=goal_heading, v_end=v_end)
     if brake_after_s is None or options.robot.footprint is not None:  # no brake to fall on

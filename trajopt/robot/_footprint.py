@@ -366,9 +366,18 @@ def _bezier_spans(spline: Any) -> np.ndarray:
     w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
     a, h = w[:-1], np.diff(w)
     a, h = a[h > 0], h[h > 0]
-    coef = np.stack([np.asarray(spline(a, j), dtype=float).reshape(len(a), 2)
-                     * (h ** j / math.factorial(j))[:, None] for j in range(p + 1)],
-                    axis=1)  # fmt: skip
-    mix = np.array([[math.comb(i, j) / math.comb(p, j) if j <= i else 0.0
-                     for j in range(p + 1)] for i in range(p + 1)])  # fmt: skip
+    coef = np.stack(
+        [
+            np.asarray(spline(a, j), dtype=float).reshape(len(a), 2)
+            * (h**j / math.factorial(j))[:, None]
+            for j in range(p + 1)
+        ],
+        axis=1,
+    )
+    mix = np.array(
+        [
+            [math.comb(i, j) / math.comb(p, j) if j <= i else 0.0 for j in range(p + 1)]
+            for i in range(p + 1)
+        ]
+    )
     return np.einsum("ij,mjd->mid", mix, coef)

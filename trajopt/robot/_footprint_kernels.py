@@ -117,8 +117,9 @@ def _piece_margin(bez, rho, phi, max_arc, cap, rects, meta, bstart, bids, stamp,
 
 
 @njit(cache=True)
-def span_margins(bez, rho, phi, max_arc, cap, tol, max_depth,
-                 rects, meta, bstart, bids, stamp, buf):  # pragma: no cover - compiled  # fmt: skip
+def span_margins(
+    bez, rho, phi, max_arc, cap, tol, max_depth, rects, meta, bstart, bids, stamp, buf
+):  # pragma: no cover - compiled
     """Return every piece's margin and heading interval.
 
     Parameters

@@ -133,12 +133,14 @@ def fit(
         remaining = options.time_budget_s - (time.perf_counter() - t_call)
         if remaining <= 0:
             break
-        rec = AttemptRecord(attempt=len(attempts) + 1, span_cells=h,
-                            kappa_margin=None if warm is None else margin)  # fmt: skip
+        rec = AttemptRecord(
+            attempt=len(attempts) + 1, span_cells=h, kappa_margin=None if warm is None else margin
+        )
         attempts.append(rec)
         try:
-            c_cells, t_cells, span_box = solve_attempt(options, prob, h, remaining, margin,
-                                                       warm, rec)  # fmt: skip
+            c_cells, t_cells, span_box = solve_attempt(
+                options, prob, h, remaining, margin, warm, rec
+            )
         except AttemptFailed as exc:
             rec.failure = str(exc)
             h, margin, warm = max(0.5, h / 2), options.kappa_margin, None
@@ -148,14 +150,21 @@ def fit(
         curve, cert, fcert = check(c_cells, t_cells, span_box)
         rec.certificate_ok = cert.ok
         if fcert is not None and not fcert.ok:  # the disc is clear, the footprint is not
-            rec.failure = (f"footprint certificate: span {fcert.worst_span}, margin "
-                           f"{fcert.min_margin_m:.3g} m")  # fmt: skip
+            rec.failure = (
+                f"footprint certificate: span {fcert.worst_span}, margin {fcert.min_margin_m:.3g} m"
+            )
             if fp.pin(fcert, c_cells, (p0, p1)):
                 try:
                     prob, p0, p1 = build_problem(
-                        options, grid_path_or_points, corridor, start=start, goal=goal,
-                        hs=fp.start_heading, hg=fp.goal_heading, start_kappa=ks,
-                    )  # fmt: skip
+                        options,
+                        grid_path_or_points,
+                        corridor,
+                        start=start,
+                        goal=goal,
+                        hs=fp.start_heading,
+                        hg=fp.goal_heading,
+                        start_kappa=ks,
+                    )
                     margin, warm = options.kappa_margin, None
                     continue
                 except InvalidInputError as exc:  # the pinned heading leaves its region
@@ -172,8 +181,9 @@ def fit(
             stats = summarize(attempts, time.perf_counter() - t_call, success=True)
             if fp is not None:
                 stats.update(footprint_certificate_s=fp.time_s, footprint_rounds=fp.rounds)
-            return SmoothPath(curve=curve, stats=stats, certificate=cert,
-                              footprint_certificate=fcert)  # fmt: skip
+            return SmoothPath(
+                curve=curve, stats=stats, certificate=cert, footprint_certificate=fcert
+            )
         if cert.ok:  # the footprint still fails: refine the knots
             h, margin, warm = max(0.5, h / 2), options.kappa_margin, None
             spans_tried += 1
@@ -192,8 +202,9 @@ def fit(
             # (cheaper than a refinement, which doubles the problem; a larger excess
             # tightens the bound at many samples at once, and the warm start is then no
             # better than a cold one)
-            logger.debug("dense max kappa %.4g x the bound: same knots again",
-                         cert.kappa_max_sampled / kmax)  # fmt: skip
+            logger.debug(
+                "dense max kappa %.4g x the bound: same knots again", cert.kappa_max_sampled / kmax
+            )
             margin *= MARGIN_RETRY * kmax / cert.kappa_max_sampled
             warm = c_cells
             continue
@@ -229,9 +240,17 @@ def _check(
     c = np.asarray(corridor.origin, dtype=float) + res * c_cells
     c[0], c[-1] = ends
     curve = BSplineCurve(t_cells * res, c, options.degree)
-    cert = certify(curve, corridor, span_box, start=ends[0], goal=ends[1], raw_grid=raw_grid,
-                   radius=radius, kappa_bound=options.kappa_max,
-                   samples_per_cell=options.samples_per_cell)  # fmt: skip
+    cert = certify(
+        curve,
+        corridor,
+        span_box,
+        start=ends[0],
+        goal=ends[1],
+        raw_grid=raw_grid,
+        radius=radius,
+        kappa_bound=options.kappa_max,
+        samples_per_cell=options.samples_per_cell,
+    )
     return curve, cert, (fp.certify(curve) if (cert.ok and fp is not None) else None)
 
 
@@ -316,9 +335,17 @@ def fit_free(options: Smoother, points: Any, u: Any, knots: Any) -> BSplineCurve
     ubx = np.full(2 * nb, np.inf)
     lbx[n:nb] = ubx[n:nb] = lbx[nb + n :] = ubx[nb + n :] = 0.0
     n_rows = N_HEADING_ROWS + 2 * nb
-    qp = QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx,
-                heading=np.zeros((N_HEADING_ROWS, 2 * nb)),
-                lba=np.full(n_rows, -np.inf), uba=np.full(n_rows, np.inf))  # fmt: skip
+    qp = QPData(
+        full=full,
+        g=g,
+        n=n,
+        nb=nb,
+        lbx=lbx,
+        ubx=ubx,
+        heading=np.zeros((N_HEADING_ROWS, 2 * nb)),
+        lba=np.full(n_rows, -np.inf),
+        uba=np.full(n_rows, np.inf),
+    )
     info = solve_qp(options, qp)
     if not info.success:
         raise SmoothingError(f"unconstrained fit failed: {info.detail}", info.to_stats())

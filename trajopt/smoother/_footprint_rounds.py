@@ -64,8 +64,14 @@ class FootprintRounds:
         Pins and SCP rounds run, and the footprint certificates' time (s), over the fit.
     """
 
-    def __init__(self, footprint: Footprint, raw_grid: Any, res: float,
-                 start_heading: float | None, goal_heading: float | None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        footprint: Footprint,
+        raw_grid: Any,
+        res: float,
+        start_heading: float | None,
+        goal_heading: float | None,
+    ) -> None:
         self.footprint, self.raw_grid, self.res = footprint, raw_grid, float(res)
         self.start_heading, self.goal_heading = start_heading, goal_heading
         self._free = [start_heading is None, goal_heading is None]
@@ -79,8 +85,9 @@ class FootprintRounds:
         self.time_s += time.perf_counter() - t0
         return out
 
-    def pin(self, cert: FootprintCertificate, c_cells: np.ndarray,
-            ends_m: tuple[np.ndarray, np.ndarray]) -> bool:  # fmt: skip
+    def pin(
+        self, cert: FootprintCertificate, c_cells: np.ndarray, ends_m: tuple[np.ndarray, np.ndarray]
+    ) -> bool:
         """Pin a free end heading whose end span failed ``cert``; ``True`` if one was pinned.
 
         ``c_cells``: the failed curve's control points (their end directions are its end
@@ -94,8 +101,9 @@ class FootprintRounds:
                 continue
             self._free[end] = False  # one try per end
             d = c_cells[b] - c_cells[a]
-            theta = _nearest(*end_headings(self.footprint, self.raw_grid, ends_m[end]),
-                             math.atan2(d[1], d[0]))  # fmt: skip
+            theta = _nearest(
+                *end_headings(self.footprint, self.raw_grid, ends_m[end]), math.atan2(d[1], d[0])
+            )
             if theta is None:
                 continue
             self._before = (self.start_heading, self.goal_heading)
@@ -112,9 +120,16 @@ class FootprintRounds:
         self.start_heading, self.goal_heading = self._before
 
 
-def footprint_scp(options: Smoother, prob: Problem, h: float, c_cells: np.ndarray,
-                  cert: FootprintCertificate, fp: FootprintRounds, r_cells: float,
-                  check: Callable[..., tuple]) -> tuple | None:  # fmt: skip
+def footprint_scp(
+    options: Smoother,
+    prob: Problem,
+    h: float,
+    c_cells: np.ndarray,
+    cert: FootprintCertificate,
+    fp: FootprintRounds,
+    r_cells: float,
+    check: Callable[..., tuple],
+) -> tuple | None:
     """Run the SCP rounds on the knots of span ``h`` from the failed curve ``c_cells``.
 
     ``check(c_cells, knots, span_box)`` returns ``(curve, certificate, footprint
@@ -148,8 +163,9 @@ def footprint_scp(options: Smoother, prob: Problem, h: float, c_cells: np.ndarra
     return None
 
 
-def spans_to_tighten(margins_m: np.ndarray, n_spans: int, degree: int,
-                     previous: np.ndarray | None) -> np.ndarray:  # fmt: skip
+def spans_to_tighten(
+    margins_m: np.ndarray, n_spans: int, degree: int, previous: np.ndarray | None
+) -> np.ndarray:
     """Return the spans that get footprint rows: the failing ones, ``p`` spans around each.
 
     ``margins_m``: the footprint certificate's margin per span (a length other than
@@ -165,8 +181,9 @@ def spans_to_tighten(margins_m: np.ndarray, n_spans: int, degree: int,
     return out
 
 
-def end_headings(footprint: Footprint, raw_grid: Any, point: np.ndarray,
-                 cap_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def end_headings(
+    footprint: Footprint, raw_grid: Any, point: np.ndarray, cap_m: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Return :data:`END_HEADINGS` sampled headings (rad) and the footprint's clearance there (m).
 
     The exact clearance of the footprint placed on ``point`` (m) at each heading in

@@ -66,8 +66,15 @@ class FootprintSCP:
         heading's linearisation fails.
     """
 
-    def __init__(self, asm: Assembly, prob: Problem, corners: np.ndarray, r_cells: float,
-                 degree: int, speed_floor: float) -> None:  # fmt: skip
+    def __init__(
+        self,
+        asm: Assembly,
+        prob: Problem,
+        corners: np.ndarray,
+        r_cells: float,
+        degree: int,
+        speed_floor: float,
+    ) -> None:
         qp = asm.qp
         n, nb, p = qp.n, qp.nb, int(degree)
         self.asm, self.p, self.F = asm, p, np.asarray(corners, dtype=float)
@@ -113,8 +120,10 @@ class FootprintSCP:
         v = np.maximum(np.hypot(D[:, 0], D[:, 1]), 1e-9)
         T = D / v[:, None]
         N = np.column_stack([-T[:, 1], T[:, 0]])
-        RF = np.stack([T[:, :1] * F[:, 0] - T[:, 1:] * F[:, 1],
-                       T[:, 1:] * F[:, 0] + T[:, :1] * F[:, 1]], axis=2)  # fmt: skip
+        RF = np.stack(
+            [T[:, :1] * F[:, 0] - T[:, 1:] * F[:, 1], T[:, 1:] * F[:, 0] + T[:, :1] * F[:, 1]],
+            axis=2,
+        )
         RpF = np.stack([-RF[..., 1], RF[..., 0]], axis=2)  # R(theta + pi/2) f
         W = C[:, None, :] + RF  # posed corners (ns, K, 2)
         with np.errstate(invalid="ignore"):
@@ -151,9 +160,17 @@ class FootprintSCP:
         lbx = np.concatenate([lo, np.zeros(S)])
         ubx = np.concatenate([hi, np.full(S, SLACK_MAX)])
         znew, _, ok, status, _ = solve_working_set(
-            qp.full, qp.g, self.layout, trip, lbx, ubx, self.lba, self.uba, self.work,
+            qp.full,
+            qp.g,
+            self.layout,
+            trip,
+            lbx,
+            ubx,
+            self.lba,
+            self.uba,
+            self.work,
             SLACK_PENALTY,
-        )  # fmt: skip
+        )
         return (np.clip(znew, qp.lbx, qp.ubx) if ok else None), status
 
 

@@ -619,9 +619,16 @@ def assemble(options: Smoother, prob: Problem, h: float) -> Assembly:
     dhi[[0, -1]] = np.inf
     if prob.taut:
         band, g, const = objective(
-            prob.targets, prob.u, t, p, n, options.smoothness_weight, options.smoothness_order,
-            fidelity=options.taut_fidelity_weight, length=options.taut_length_weight,
-        )  # fmt: skip
+            prob.targets,
+            prob.u,
+            t,
+            p,
+            n,
+            options.smoothness_weight,
+            options.smoothness_order,
+            fidelity=options.taut_fidelity_weight,
+            length=options.taut_length_weight,
+        )
     else:
         band, g, const = objective(
             prob.targets, prob.u, t, p, n, options.smoothness_weight, options.smoothness_order
@@ -654,7 +661,27 @@ def assemble(options: Smoother, prob: Problem, h: float) -> Assembly:
     for d in range(2):
         guess = np.interp(greville, prob.u, prob.targets[:, d])
         x0[d * nb : d * nb + n] = np.clip(guess, lbx[d * nb : d * nb + n], ubx[d * nb : d * nb + n])
-    qp = QPData(full=full, g=g, n=n, nb=nb, lbx=lbx, ubx=ubx, heading=heading,
-                lba=lba, uba=uba, k=k_rows, region_coef=coef)  # fmt: skip
-    return Assembly(qp=qp, knots=t, span_box=span_box, lo=lo, hi=hi, point_rows=rows_of_points,
-                    x0=x0, const=const, start_alpha=alpha)  # fmt: skip
+    qp = QPData(
+        full=full,
+        g=g,
+        n=n,
+        nb=nb,
+        lbx=lbx,
+        ubx=ubx,
+        heading=heading,
+        lba=lba,
+        uba=uba,
+        k=k_rows,
+        region_coef=coef,
+    )
+    return Assembly(
+        qp=qp,
+        knots=t,
+        span_box=span_box,
+        lo=lo,
+        hi=hi,
+        point_rows=rows_of_points,
+        x0=x0,
+        const=const,
+        start_alpha=alpha,
+    )

@@ -229,8 +229,9 @@ def _casadi_sparsity(nb: int, p: int, m: int, k: int) -> Any:
     import casadi as ca
 
     layout = constraint_layout(nb, p, m, k)
-    sp, mapping = ca.Sparsity.triplet(layout.n_rows, layout.n_cols, layout.trip_rows.tolist(),
-                                      layout.trip_cols.tolist(), False)  # fmt: skip
+    sp, mapping = ca.Sparsity.triplet(
+        layout.n_rows, layout.n_cols, layout.trip_rows.tolist(), layout.trip_cols.tolist(), False
+    )
     if not np.array_equal(np.asarray(mapping), layout.nz_from_triplet):  # pragma: no cover
         raise AssertionError("casadi's CCS order differs from the layout's")
     return sp
@@ -483,10 +484,12 @@ def solve_qp(options: Smoother, qp: QPData, x0: np.ndarray | None = None) -> Sol
             if np.any(gap > 0.0):  # a row out of reach of the variable bounds
                 i = int(np.argmax(gap))
                 return SolveInfo(
-                    solver=solver_name, status=SolveStatus.SOLVER_FAILED,
+                    solver=solver_name,
+                    status=SolveStatus.SOLVER_FAILED,
                     detail=f"primal infeasible: row {i} is out of reach of the variable bounds",
-                    build_time_s=build, z=np.full(2 * nb, np.nan),
-                )  # fmt: skip
+                    build_time_s=build,
+                    z=np.full(2 * nb, np.nan),
+                )
         hval = ca.DM(solver.sparsity_in("h"), hnz)
         aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
         out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)

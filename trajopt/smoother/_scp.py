@@ -220,9 +220,17 @@ class CurvatureSCP:
         ts = time.perf_counter()
         tc = time.process_time()
         z, *result = solve_working_set(
-            qp.full, qp.g, self.layout, trip, lbx_s, ubx_s, self.lba, self.uba, self.work,
+            qp.full,
+            qp.g,
+            self.layout,
+            trip,
+            lbx_s,
+            ubx_s,
+            self.lba,
+            self.uba,
+            self.work,
             self.set.slack_penalty,
-        )  # fmt: skip
+        )
         info = piqp_info(z, result, ts, tc)
         info.extra["n_samples"] = int(self.work.sum())
         return info
@@ -269,10 +277,19 @@ class CurvatureSCP:
             logger.debug(
                 "SCP %d: %.1f ms (cpu %.1f ms, %d it, %d samples), step %.3g (trust %.3g), "
                 "max kappa/bound %.4g, min speed %.3g, merit %.6g -> %.6g (predicted %.6g)",
-                it + 1, 1e3 * info.solve_time_s, 1e3 * info.solve_cpu_s, info.iterations,
-                info.extra["n_samples"], step, delta, new.kap.max() / self.kb, new.sp.min(),
-                cur.merit, new.merit, cur.merit - predicted,
-            )  # fmt: skip
+                it + 1,
+                1e3 * info.solve_time_s,
+                1e3 * info.solve_cpu_s,
+                info.iterations,
+                info.extra["n_samples"],
+                step,
+                delta,
+                new.kap.max() / self.kb,
+                new.sp.min(),
+                cur.merit,
+                new.merit,
+                cur.merit - predicted,
+            )
             if predicted <= tol:  # no decrease predicted: a stationary point of the model
                 status = "converged" if cur.ok else "stalled"
                 break

@@ -135,15 +135,38 @@ def polynomial_tables(
     s_grid = np.ascontiguousarray(s_grid, dtype=float)
     h = float(s_grid[-1]) / (s_grid.size - 1)
     u, kappa, theta, still, end_caps = _node_tables(
-        w, coef, nodes, s_nodes, v_nodes, s_grid, STILL_SPEED_RATIO * curve.mean_speed(), limits,
+        w,
+        coef,
+        nodes,
+        s_nodes,
+        v_nodes,
+        s_grid,
+        STILL_SPEED_RATIO * curve.mean_speed(),
+        limits,
         bool(node_kappa),
-    )  # fmt: skip
+    )
     p2b, shift = matrices(degree)
     X, S, V = workspace(degree)
     kmax, cap = _interval_bounds(
-        w, coef, nodes, s_nodes, h, s_grid.size - 1, ZERO_SPEED_RATIO * curve.length / (hi - lo),
-        limits, _K_GRID, _GL_X, _GL_W, float(rtol), p2b, shift, X, S, V, True,
-    )  # fmt: skip
+        w,
+        coef,
+        nodes,
+        s_nodes,
+        h,
+        s_grid.size - 1,
+        ZERO_SPEED_RATIO * curve.length / (hi - lo),
+        limits,
+        _K_GRID,
+        _GL_X,
+        _GL_W,
+        float(rtol),
+        p2b,
+        shift,
+        X,
+        S,
+        V,
+        True,
+    )
     if still:  # zero parametric speed at a node: the limit of the tangent direction
         raw = np.asarray(curve(u, 1), dtype=float)
         th = np.arctan2(raw[:, 1], raw[:, 0])
@@ -322,9 +345,15 @@ def workspace(p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def bound_from_taylor(
-    gam: np.ndarray, flip: int, k_free: float, p2b: np.ndarray, shift: np.ndarray,
-    X: np.ndarray, S: np.ndarray, V: np.ndarray,
-) -> float:  # fmt: skip
+    gam: np.ndarray,
+    flip: int,
+    k_free: float,
+    p2b: np.ndarray,
+    shift: np.ndarray,
+    X: np.ndarray,
+    S: np.ndarray,
+    V: np.ndarray,
+) -> float:
     """Bernstein bound on ``|kappa|`` from the Taylor coefficients ``gam`` (p, 2) of ``c_t``.
 
     ``gam[k]`` multiplies ``(t - 1/2)^k`` on the local ``t`` in ``[0, 1]``; ``flip`` is 1
@@ -338,8 +367,26 @@ def bound_from_taylor(
     coef[0] = gam
     work = np.empty((p, 2))
     w = np.array([-1.0, 1.0])
-    return float(_evaluate(coef, p, 0, w, -0.5, 0.5, int(flip), float(k_free), p2b, shift,
-                           X, S, V, work, True, True))  # fmt: skip
+    return float(
+        _evaluate(
+            coef,
+            p,
+            0,
+            w,
+            -0.5,
+            0.5,
+            int(flip),
+            float(k_free),
+            p2b,
+            shift,
+            X,
+            S,
+            V,
+            work,
+            True,
+            True,
+        )
+    )
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -615,8 +662,24 @@ def _interval_bounds(
                     n_split += 1
                     continue
                 taylor = False
-            k_b = _evaluate(coef, p, lpc[i], w, la[i], lb[i], flip[i], k_free, p2b, shift,
-                            X, S, V, gam, taylor, unrolled)  # fmt: skip
+            k_b = _evaluate(
+                coef,
+                p,
+                lpc[i],
+                w,
+                la[i],
+                lb[i],
+                flip[i],
+                k_free,
+                p2b,
+                shift,
+                X,
+                S,
+                V,
+                gam,
+                taylor,
+                unrolled,
+            )
             if k_b > k_free and wide:  # split: no sample needed
                 split[i] = True
                 n_split += 1

@@ -92,11 +92,11 @@ class CapTable:
     def rows_ok(self, rows: np.ndarray) -> bool:
         """Whether constant-jerk rows ``(t0, s0, v0, a0, jerk, duration)`` stay under the cap.
 
-        Whether constant-jerk rows ``(t0, s0, v0, a0, jerk, duration)`` stay under the cap
-        (exact on the grid).
+        Exact on the table's grid.
         """
-        return bool(greedy.rows_ok(self.st, self.lg, self.h, self.length,
-                                   np.ascontiguousarray(rows), T_MIN))  # fmt: skip
+        return bool(
+            greedy.rows_ok(self.st, self.lg, self.h, self.length, np.ascontiguousarray(rows), T_MIN)
+        )
 
 
 def build_cap_table(
@@ -121,9 +121,10 @@ def build_cap_table(
     s_nodes[-1] = length
     degree = getattr(curve, "polynomial_degree", None)
     fast = (
-        None if degree is None
+        None
+        if degree is None
         else polynomial_tables(curve, robot, s_nodes, int(degree), node_kappa=False)
-    )  # fmt: skip
+    )
     if fast is not None:  # the compiled path: node tables and bounds in one call
         u_nodes, kappa, theta, kmax, ci, raw_kappa = fast
         ends = np.array([0, 1, n_int - 1, n_int])
@@ -169,9 +170,12 @@ def build_cap_table(
     # boundary speeds (up to the cap at the end nodes), its sparse table and local minima
     ci = np.array(ci, dtype=float)  # a fresh array: changed in place
     i_low, _, st, lg, idx = greedy.finish_caps(
-        ci, 1.0 - CAP_MARGIN, max(v_start, v_end), min(v_start, raw[0], raw[1]),
+        ci,
+        1.0 - CAP_MARGIN,
+        max(v_start, v_end),
+        min(v_start, raw[0], raw[1]),
         min(v_end, raw[-1], raw[-2]),
-    )  # fmt: skip
+    )
     if not ci[i_low] > 1e-6:
         if np.isnan(kappa[i_low]):  # the compiled path keeps the end nodes only
             kappa = np.asarray(curve.curvature(u_nodes), dtype=float)
@@ -181,8 +185,18 @@ def build_cap_table(
         )
     min_s = idx * h
     min_v = ci[idx]
-    return CapTable(ci=ci, h=h, length=length, st=st, lg=lg, min_s=min_s, min_v=min_v,
-                    s_nodes=s_nodes, u_nodes=u_nodes, theta=theta)  # fmt: skip
+    return CapTable(
+        ci=ci,
+        h=h,
+        length=length,
+        st=st,
+        lg=lg,
+        min_s=min_s,
+        min_v=min_v,
+        s_nodes=s_nodes,
+        u_nodes=u_nodes,
+        theta=theta,
+    )
 
 
 def _zone_caps(
@@ -305,8 +319,8 @@ def _interval_caps(
 def _golden_min_cap(curve, robot: Robot, s_sub: np.ndarray, cap_sub: np.ndarray) -> np.ndarray:
     """Lowest cap found by golden-section search next to each row's lowest sample.
 
-    Lowest cap found by golden-section search in the two fine steps around each row's lowest
-    sample (shape (k,)); all rows are searched at once.
+    The search covers the two fine steps around that sample; all rows are searched at once.
+    Returns shape (k,).
     """
     k = np.argmin(cap_sub, axis=1)
     rows = np.arange(len(k))

@@ -71,6 +71,5 @@ class RuckigProfile:
             return None
         b = prof.brake
         brake = (tuple(b.t), tuple(b.j)) if b.duration > 0.0 else (_NO_BRAKE, _NO_BRAKE)
-        rows = profile_rows(float(s0), float(v0), float(a0), *brake, tuple(prof.t),
-                            tuple(prof.j))  # fmt: skip
+        rows = profile_rows(float(s0), float(v0), float(a0), *brake, tuple(prof.t), tuple(prof.j))
         return rows if rows.shape[0] else None

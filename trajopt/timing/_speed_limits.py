@@ -210,8 +210,12 @@ class SpeedLimits:
         span_x = int((ix1 - ix0).max()) + 1
         span_y = int((iy1 - iy0).max()) + 1
         if span_x * span_y > 64:  # boxes much larger than a cell: a 2-D running minimum
-            return np.array([self._box_min(caps, a, b, c, d) for a, b, c, d in
-                             zip(ix0, ix1, iy0, iy1, strict=True)])  # fmt: skip
+            return np.array(
+                [
+                    self._box_min(caps, a, b, c, d)
+                    for a, b, c, d in zip(ix0, ix1, iy0, iy1, strict=True)
+                ]
+            )
         for dx in range(span_x):
             ix = ix0 + dx
             for dy in range(span_y):

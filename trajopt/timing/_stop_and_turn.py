@@ -336,6 +336,11 @@ def turn_in_place(position: Any, theta_from: float, theta_to: float, robot: Robo
     rows = np.zeros((0, 5))
     if abs(d) > 1e-12:
         rows = RestToRest(*turn_limits(robot)).solve(abs(d))
-    return TurnInPlace(position=np.asarray(position, dtype=float), theta0=float(theta_from),
-                       sign=1.0 if d >= 0 else -1.0, rows=rows, robot=robot,
-                       stats={"turn_rad": d})  # fmt: skip
+    return TurnInPlace(
+        position=np.asarray(position, dtype=float),
+        theta0=float(theta_from),
+        sign=1.0 if d >= 0 else -1.0,
+        rows=rows,
+        robot=robot,
+        stats={"turn_rad": d},
+    )

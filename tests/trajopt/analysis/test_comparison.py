@@ -52,8 +52,17 @@ def room_table() -> cmp.ComparisonTable:
 # ---------------------------------------------------------------------------- table
 def test_default_rows_and_columns(room_table: cmp.ComparisonTable) -> None:
     assert room_table.methods == DEFAULT_METHODS
-    for col in ("mse_m2", "hausdorff_m", "min_clearance_m", "collision", "length_ratio",
-                "max_curvature_1pm", "max_heading_jump_rad", "runtime_s", "note"):  # fmt: skip
+    for col in (
+        "mse_m2",
+        "hausdorff_m",
+        "min_clearance_m",
+        "collision",
+        "length_ratio",
+        "max_curvature_1pm",
+        "max_heading_jump_rad",
+        "runtime_s",
+        "note",
+    ):
         assert col in room_table.columns
     assert room_table.meta["w_cells"] == math.ceil(2 * 0.15 / 0.05)
     proposed = room_table.row("proposed")
@@ -153,9 +162,12 @@ def test_one_off_methods_by_mapping() -> None:
         raise NoPathError("nothing here")
 
     t = cmp.compare(
-        _room(), (0.5, 0.5), (2.5, 2.3), robot_radius=0.15,
+        _room(),
+        (0.5, 0.5),
+        (2.5, 2.3),
+        robot_radius=0.15,
         methods={"line": _line_method, "broken": failing},
-    )  # fmt: skip
+    )
     assert t.methods == ("line", "broken")
     line = t.row("line")
     assert line["length_m"] == pytest.approx(math.hypot(2.0, 1.8))
@@ -240,7 +252,7 @@ def paper_results() -> dict:
             w_cells=sc.w_cells,
             poly=poly,
             bspline=bspline,
-        )  # fmt: skip
+        )
         for name in sc.target_names
     }
     return {"scene": sc, "poly": poly_sweep, "bspline": bs_sweep, "tables": tables}

@@ -287,8 +287,9 @@ def test_as_dict_and_bad_inputs() -> None:
     with pytest.raises(InvalidInputError, match="radius"):
         metrics.path_metrics(ref, grid=_empty_grid(), reference=ref, radius=-1)
     with pytest.raises(InvalidInputError, match="params"):
-        metrics.path_metrics(Line([0, 0], [1, 0]), grid=_empty_grid(), reference=ref, radius=0.1,
-                             params=np.zeros(3))  # fmt: skip
+        metrics.path_metrics(
+            Line([0, 0], [1, 0]), grid=_empty_grid(), reference=ref, radius=0.1, params=np.zeros(3)
+        )
     with pytest.raises(InvalidInputError, match="reference"):
         metrics.path_metrics(ref, grid=_empty_grid(), reference=np.ones(3), radius=0.1)
     with pytest.raises(InvalidInputError, match="grid"):

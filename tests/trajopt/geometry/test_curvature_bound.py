@@ -12,8 +12,15 @@ from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curvature_bound import interval_kappa_max, kappa_bound
 from trajopt.robot._robot import Robot
 
-ROBOT = Robot(v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
-              wheel_v_max=None)  # fmt: skip
+ROBOT = Robot(
+    v_max=0.5,
+    a_max=0.5,
+    j_max=2.0,
+    a_lat_max=0.5,
+    omega_max=1.5,
+    track_width=None,
+    wheel_v_max=None,
+)
 
 
 def parabola() -> BSplineCurve:
@@ -36,18 +43,25 @@ def test_parabola_bound_holds_and_tightens(a, b):
     # on 2^10 pieces the largest bound is within 1e-4 of the exact maximum
     e = np.linspace(a, b, 1025)
     kk = kappa_bound(c, e[:-1], e[1:], 2)
-    assert np.all(kk >= parabola_kappa(np.where(e[:-1] * e[1:] <= 0, 0.0,
-                                                 np.minimum(abs(e[:-1]), abs(e[1:])))) * (1 - 1e-12))  # fmt: skip
+    assert np.all(
+        kk
+        >= parabola_kappa(np.where(e[:-1] * e[1:] <= 0, 0.0, np.minimum(abs(e[:-1]), abs(e[1:]))))
+        * (1 - 1e-12)
+    )
     assert kk.max() == pytest.approx(exact, rel=1e-4)
 
 
-@settings(max_examples=12, deadline=None,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])  # fmt: skip
+@settings(
+    max_examples=12,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
 @given(
-    pts=st.lists(st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=9,
-                 unique=True),
+    pts=st.lists(
+        st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=9, unique=True
+    ),
     degree=st.sampled_from([2, 3, 5]),
-)  # fmt: skip
+)
 def test_grid_bounds_cover_dense_samples(pts, degree):
     p = np.asarray(pts, dtype=float)
     assume(len(p) > degree and np.min(np.hypot(*np.diff(p, axis=0).T)) > 0.2)

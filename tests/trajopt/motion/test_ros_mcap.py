@@ -48,8 +48,12 @@ def test_round_trip_with_mcap_ros2_decoder(planned, tmp_path):
     ns = np.array([r.header.stamp.sec * 10**9 + r.header.stamp.nanosec for _, r in poses])
     np.testing.assert_allclose((ns - 1700000000_250000000) / 1e9, ref["t"], atol=1e-9, rtol=0)
     assert all(log == r.header.stamp.sec * 10**9 + r.header.stamp.nanosec for log, r in poses)
-    got = np.array([[r.pose.position.x, r.pose.position.y, r.pose.orientation.z,
-                     r.pose.orientation.w] for _, r in poses])  # fmt: skip
+    got = np.array(
+        [
+            [r.pose.position.x, r.pose.position.y, r.pose.orientation.z, r.pose.orientation.w]
+            for _, r in poses
+        ]
+    )
     for k, name in enumerate(("x", "y", "qz", "qw")):
         np.testing.assert_allclose(got[:, k], ref[name], atol=1e-9, rtol=0)
     assert {r.header.frame_id for _, r in poses} == {"map"}
@@ -98,8 +102,9 @@ def test_rosbags_reads_the_file(planned, tmp_path):
 
 
 def test_read_mcap_reads_back(planned, tmp_path):
-    path = write_mcap(planned, tmp_path / "t.mcap", dt=0.02, frame_id="world",
-                      child_frame_id="base_footprint")  # fmt: skip
+    path = write_mcap(
+        planned, tmp_path / "t.mcap", dt=0.02, frame_id="world", child_frame_id="base_footprint"
+    )
     back = read_mcap(path)
     smp = planned.sample_uniform(0.02)
     np.testing.assert_allclose(back.t, smp.t, atol=1e-9)
@@ -118,8 +123,9 @@ def test_to_poses_is_a_unit_quaternion_of_the_heading(planned):
     np.testing.assert_allclose(rec["qz"] ** 2 + rec["qw"] ** 2, 1.0)
     smp = planned.sample_uniform(0.1)
     yaw = 2.0 * np.arctan2(rec["qz"], rec["qw"])
-    np.testing.assert_allclose(np.remainder(yaw - smp.theta + np.pi, 2 * np.pi) - np.pi, 0.0,
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        np.remainder(yaw - smp.theta + np.pi, 2 * np.pi) - np.pi, 0.0, atol=1e-12
+    )
     assert rec["t"][-1] == planned.duration
 
 

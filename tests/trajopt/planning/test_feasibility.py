@@ -154,8 +154,12 @@ def test_planner_rescues_a_curvature_bounded_query_along_the_witness(shared_data
     # space between them, and the fit along it is certified
     raw = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
     radius, kmax = 0.2, 1.0 / 0.4
-    planner = Planner(raw, Robot(radius=radius), smoother=Smoother(kappa_max=kmax, time_budget_s=10),
-                      corridor="boxes")  # fmt: skip
+    planner = Planner(
+        raw,
+        Robot(radius=radius),
+        smoother=Smoother(kappa_max=kmax, time_budget_s=10),
+        corridor="boxes",
+    )
     p0, p1 = raw.cell_to_world(np.array([169, 205])), raw.cell_to_world(np.array([197, 230]))
     path = astar.find_path(planner.inflated_grid, (169, 205), (197, 230), cost=planner.search_cost)
     corr = build_corridor(planner.inflated_grid, path, radius=radius, raw_grid=raw)

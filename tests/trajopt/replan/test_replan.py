@@ -67,9 +67,16 @@ def test_start_curvature_is_exact(scene, kappa):
     path = astar.find_path(inflated, tuple(c0), tuple(c1))
     pts = np.vstack([scene.start, g.cell_to_world(np.asarray(path.cells))[1:-1], scene.goal("A")])
     corridor = trajopt.build_polygon_corridor(g, pts, ROBOT.radius)
-    sp = trajopt.Smoother().fit(path, corridor, raw_grid=g, radius=ROBOT.radius,
-                                start=scene.start, goal=scene.goal("A"), start_heading=0.3,
-                                start_curvature=kappa)  # fmt: skip
+    sp = trajopt.Smoother().fit(
+        path,
+        corridor,
+        raw_grid=g,
+        radius=ROBOT.radius,
+        start=scene.start,
+        goal=scene.goal("A"),
+        start_heading=0.3,
+        start_curvature=kappa,
+    )
     assert sp.certificate.ok
     # the curvature from the spline's own derivatives (BSplineCurve), not from the rows
     d1 = sp.curve(np.array([0.0]), 1)[0]

@@ -29,8 +29,13 @@ ROBOT = trajopt.Robot()
 
 
 def _jump(a, b) -> float:
-    return max(math.hypot(a.x - b.x, a.y - b.y), abs(math.remainder(a.theta - b.theta, math.tau)),
-               abs(a.kappa - b.kappa), abs(a.v - b.v), abs(a.a - b.a))  # fmt: skip
+    return max(
+        math.hypot(a.x - b.x, a.y - b.y),
+        abs(math.remainder(a.theta - b.theta, math.tau)),
+        abs(a.kappa - b.kappa),
+        abs(a.v - b.v),
+        abs(a.a - b.a),
+    )
 
 
 def _check_motion(traj, robot=ROBOT, dt=1e-3):
@@ -48,8 +53,9 @@ def _check_motion(traj, robot=ROBOT, dt=1e-3):
 
 
 def test_stop_from_cruise_matches_the_hand_formula():
-    line = BSplineCurve(clamped_uniform_knots(6, 3), np.column_stack([np.linspace(0, 3, 6),
-                                                                      np.zeros(6)]), 3)  # fmt: skip
+    line = BSplineCurve(
+        clamped_uniform_knots(6, 3), np.column_stack([np.linspace(0, 3, 6), np.zeros(6)]), 3
+    )
     traj = trajopt.time_parameterize(line, ROBOT)
     ts = 0.5 * traj.duration
     s0, v0, a0, _ = (float(x) for x in traj.motion(ts))
@@ -197,8 +203,9 @@ def test_a_box_qp_out_of_reach_is_a_typed_failure(shared_data):
     from trajopt.robot._state import State
 
     grid = astar.load_map(shared_data / "ros" / "turtlebot3_world.yaml")
-    planner = trajopt.Planner(grid, trajopt.Robot(radius=0.2),
-                              smoother=trajopt.Smoother(time_budget_s=0.5))  # fmt: skip
+    planner = trajopt.Planner(
+        grid, trajopt.Robot(radius=0.2), smoother=trajopt.Smoother(time_budget_s=0.5)
+    )
     s = State(x=0.527907, y=-0.326162, theta=-1.62805, kappa=-0.112344, v=0.218226, a=-0.5)
     with pytest.raises(SmoothingError, match="primal infeasible"):
         planner.plan(s, (0.675, 1.525))
@@ -207,10 +214,21 @@ def test_a_box_qp_out_of_reach_is_a_typed_failure(shared_data):
 def test_a_state_that_would_reverse_to_stop_is_refused():
     # v = 0.01 m/s at a = -0.5 m/s^2: ramping a back to 0 at j = 2 m/s^3 takes 0.25 s, in
     # which the speed falls by 0.5 * 0.25 - 0.5 * 2 * 0.25^2 = 0.0625 m/s > 0.01 m/s
-    line = BSplineCurve(clamped_uniform_knots(4, 3), np.column_stack([np.linspace(0, 1, 4),
-                                                                      np.zeros(4)]), 3)  # fmt: skip
-    traj = Trajectory(path=line, robot=ROBOT, phase_t=[0.0], phase_s=[0.0], phase_v=[0.01],
-                      phase_a=[-0.5], phase_j=[0.0], duration=0.01, v_start=0.01, v_end=0.0)  # fmt: skip
+    line = BSplineCurve(
+        clamped_uniform_knots(4, 3), np.column_stack([np.linspace(0, 1, 4), np.zeros(4)]), 3
+    )
+    traj = Trajectory(
+        path=line,
+        robot=ROBOT,
+        phase_t=[0.0],
+        phase_s=[0.0],
+        phase_v=[0.01],
+        phase_a=[-0.5],
+        phase_j=[0.0],
+        duration=0.01,
+        v_start=0.01,
+        v_end=0.0,
+    )
     with pytest.raises(TimingError, match="without reversing"):
         brake_on_path(traj, 0.0)
 

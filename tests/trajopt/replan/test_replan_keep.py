@@ -37,8 +37,12 @@ def _random_curve(k: int, seed: int) -> BSplineCurve:
 def test_tail_is_the_same_curve(k, where):
     curve = _random_curve(k, seed=k)
     knot = float(curve.t[k + 5])
-    u0 = {"interior": 1.234567, "on a knot": knot, "a hair before a knot": knot - 1e-10,
-          "start": 0.0}[where]  # fmt: skip
+    u0 = {
+        "interior": 1.234567,
+        "on a knot": knot,
+        "a hair before a knot": knot - 1e-10,
+        "start": 0.0,
+    }[where]
     tail = curve.tail(u0)
     assert tail.domain == (u0, 2.6)
     u = np.linspace(u0, 2.6, 301)
@@ -116,8 +120,9 @@ def test_what_is_not_kept(driven, scene):
             continue  # a typed refusal of the new query is fine; being kept is not
         assert new.stats["replan"] == f"planned: {why}"
     # the goal heading it already has is no change
-    same = planner.replan(traj, 1.0, latency=0.0,
-                          goal_heading=float(traj.state_at(traj.duration).theta))  # fmt: skip
+    same = planner.replan(
+        traj, 1.0, latency=0.0, goal_heading=float(traj.state_at(traj.duration).theta)
+    )
     assert same.stats["replan"] == "kept"
 
 
@@ -147,8 +152,11 @@ def test_map_updates_far_from_the_rest_keep_it_near_ones_do_not(scene):
 
     # a free cell blocked 7-9 cells beside the path ahead (not on it): re-planned
     ahead = np.asarray(grid.world_to_cell(kept.state_at(0.7 * kept.duration).position))
-    near_cell = next(tuple(ahead + (0, d)) for d in (7, 8, 9, -7, -8, -9)
-                     if not far.occupied[ahead[1] + d, ahead[0]])  # fmt: skip
+    near_cell = next(
+        tuple(ahead + (0, d))
+        for d in (7, 8, 9, -7, -8, -9)
+        if not far.occupied[ahead[1] + d, ahead[0]]
+    )
     near = _edit(far, [near_cell], True)
     new = planner.replan(kept, 0.5, grid=near, latency=0.0)
     assert new.stats["replan"] == "planned: cells blocked near the rest of the path"

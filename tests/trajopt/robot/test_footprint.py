@@ -73,8 +73,11 @@ def test_robot_footprint_rules():
 @settings(max_examples=40, deadline=None)
 @given(st.floats(-4.0, 4.0), st.floats(0.0, 7.0), st.integers(0, 2))
 def test_swept_hull_contains_every_rotation(lo, span, which):
-    fp = [Footprint.rectangle(0.6, 0.4, 0.15), Footprint.rectangle(0.3, 0.3),
-          Footprint(np.array([[0.4, 0.0], [-0.1, 0.25], [-0.2, -0.2]]))][which]  # fmt: skip
+    fp = [
+        Footprint.rectangle(0.6, 0.4, 0.15),
+        Footprint.rectangle(0.3, 0.3),
+        Footprint(np.array([[0.4, 0.0], [-0.1, 0.25], [-0.2, -0.2]])),
+    ][which]
     hull = fp.swept_hull(lo, lo + span)
     pts = np.vstack([fp.at(0.0, 0.0, t) for t in np.linspace(lo, lo + span, 721)])
     assert inside_convex(hull, pts, tol=1e-12).all()
@@ -171,8 +174,11 @@ def test_random_scenes_never_collide(seed):
     occ = np.asarray(astar.inflate(astar.OccupancyGrid(occ, 0.05), 0.05).occupied)
     grid = astar.OccupancyGrid(occ, 0.05)
     robot = trajopt.Robot.rectangle(float(rng.uniform(0.3, 0.5)), 0.24)
-    free = np.argwhere(~astar.inflate(grid, robot.circumscribed_radius + 0.05,
-                                      metric="square", outside_occupied=True).occupied)  # fmt: skip
+    free = np.argwhere(
+        ~astar.inflate(
+            grid, robot.circumscribed_radius + 0.05, metric="square", outside_occupied=True
+        ).occupied
+    )
     if len(free) < 2:
         return
     a, b = free[0], free[-1]

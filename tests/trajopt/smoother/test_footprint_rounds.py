@@ -88,8 +88,9 @@ def test_span_margins_bound_dense_poses(seed):
         (1 - t) ** 2 * (b[1] - b[0]) + 2 * (1 - t) * t * (b[2] - b[1]) + t**2 * (b[3] - b[2])
     )
     theta = np.arctan2(dxy[:, 1], dxy[:, 0])
-    dense = polygons_clearance([fp.at(x, y, th) for (x, y), th in zip(xy, theta, strict=True)],
-                               grid, cap * r)  # fmt: skip
+    dense = polygons_clearance(
+        [fp.at(x, y, th) for (x, y), th in zip(xy, theta, strict=True)], grid, cap * r
+    )
     assert margins[0] * r <= dense.min() + 1e-9
     rel = np.remainder(theta - heads[0, 0], 2 * math.pi)
     assert np.all((rel <= heads[0, 1] - heads[0, 0] + 1e-9) | (rel >= 2 * math.pi - 1e-9))
@@ -136,9 +137,13 @@ def test_corner_rows_are_first_order_in_the_control_points():
         xy, d = curve(u), curve(u, 1)
         th = np.arctan2(d[:, 1], d[:, 0])
         F = fp.vertices / res
-        return xy[:, None, :] + np.stack([np.cos(th)[:, None] * F[:, 0] - np.sin(th)[:, None] * F[:, 1],
-                                          np.sin(th)[:, None] * F[:, 0] + np.cos(th)[:, None] * F[:, 1]],
-                                         axis=2)  # fmt: skip
+        return xy[:, None, :] + np.stack(
+            [
+                np.cos(th)[:, None] * F[:, 0] - np.sin(th)[:, None] * F[:, 1],
+                np.sin(th)[:, None] * F[:, 0] + np.cos(th)[:, None] * F[:, 1],
+            ],
+            axis=2,
+        )
 
     W0 = posed(z)
     errors = []

@@ -112,8 +112,9 @@ def test_constraint_layout_ccs_order_matches_casadi_and_scipy(nb, p, m, k):
 
     layout = smoother_qp.constraint_layout(nb, p, m, k)
     rows, cols = layout.trip_rows, layout.trip_cols
-    _, mapping = ca.Sparsity.triplet(layout.n_rows, layout.n_cols, rows.tolist(), cols.tolist(),
-                                     False)  # fmt: skip
+    _, mapping = ca.Sparsity.triplet(
+        layout.n_rows, layout.n_cols, rows.tolist(), cols.tolist(), False
+    )
     np.testing.assert_array_equal(layout.nz_from_triplet, np.asarray(mapping))
     vals = np.random.default_rng(nb).normal(size=layout.n_triplets)
     ref = sps.coo_array((vals, (rows, cols)), shape=(layout.n_rows, layout.n_cols)).tocsc()

@@ -174,8 +174,9 @@ def test_taut_objective_is_shorter_than_fidelity_in_the_same_corridor():
 def test_end_headings_in_polygons():
     scene = scenes.paper()
     robot = trajopt.Robot(radius=scene.robot_radius)
-    traj = trajopt.plan(scene.grid, scene.start, scene.goal("B"), robot, start_heading=1.2,
-                        goal_heading=0.5)  # fmt: skip
+    traj = trajopt.plan(
+        scene.grid, scene.start, scene.goal("B"), robot, start_heading=1.2, goal_heading=0.5
+    )
     assert traj.stats["corridor"] == "polygons"
     sp = traj.steps.smooth_path
     h = sp.heading(np.array(sp.domain))

@@ -27,10 +27,14 @@ from trajopt.robot._robot import Robot
 from trajopt.timing._cap_table import T_MIN
 
 ROBOT = Robot()
-SETTINGS = settings(max_examples=15, deadline=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])  # fmt: skip
-POINTS = st.lists(st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=10,
-                  unique=True)  # fmt: skip
+SETTINGS = settings(
+    max_examples=15,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+POINTS = st.lists(
+    st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=4, max_size=10, unique=True
+)
 
 
 def _curve(pts, degree: int) -> BSplineCurve:
@@ -63,8 +67,9 @@ def test_compiled_bound_equals_the_numpy_reference(pts, degree, seed):
     X, S, V = cap_kernel.workspace(degree)
     for i in range(a.size):
         h, mid = b[i] - a[i], 0.5 * (a[i] + b[i])
-        gam = np.stack([c(np.array([mid]), k + 1)[0] * h ** (k + 1) / _fact(k)
-                        for k in range(degree)])  # fmt: skip
+        gam = np.stack(
+            [c(np.array([mid]), k + 1)[0] * h ** (k + 1) / _fact(k) for k in range(degree)]
+        )
         got = cap_kernel.bound_from_taylor(gam, 0, 0.0, p2b, shift, X, S, V)
         assert got == ref[i] or abs(got - ref[i]) <= 1e-12 * ref[i]
         # and it bounds |kappa| sampled densely on the interval
@@ -112,8 +117,9 @@ def test_compiled_tables_at_zero_speed_ends():
         fin = np.isfinite(ref)
         np.testing.assert_allclose(tab.kmax[fin], ref[fin], rtol=1e-12)
         # the heading at the zero-speed start is the tangent's limit (the curve's own rule)
-        assert math.isclose(tab.theta[0], float(c.heading(np.array([c.domain[0]]))[0]),
-                            abs_tol=1e-12)  # fmt: skip
+        assert math.isclose(
+            tab.theta[0], float(c.heading(np.array([c.domain[0]]))[0]), abs_tol=1e-12
+        )
 
 
 @settings(max_examples=30, deadline=None)

@@ -73,8 +73,9 @@ def test_load_speed_mask_scale_mode_like_nav2_tutorial(tmp_path):
     sl = load_speed_mask(tmp_path / "mask.yaml", type="percentage", base=100.0, multiplier=-1.0)
     np.testing.assert_array_equal(sl.limit, [[math.inf, 60.0], [30.0, math.inf]])
     assert sl.origin == (-1.0, -1.0) and sl.resolution == 0.5
-    np.testing.assert_allclose(sl.cap_at([[-0.75, -0.25], [0.1, -0.9], [5.0, 5.0]], 1.0),
-                               [0.3, math.inf, math.inf])  # fmt: skip
+    np.testing.assert_allclose(
+        sl.cap_at([[-0.75, -0.25], [0.1, -0.9], [5.0, 5.0]], 1.0), [0.3, math.inf, math.inf]
+    )
     with pytest.raises(astar.MapFormatError, match="does not exist"):
         load_speed_mask(tmp_path / "nope.yaml", type="percentage")
 
@@ -135,8 +136,9 @@ def test_mask_with_its_own_resolution_and_origin():
     sc = trajopt.scenes.paper()
     robot = trajopt.Robot()
     vals = np.full((5, 10), 80)  # a 1 x 0.5 m mask at 0.1 m cells, offset from the map
-    sl = SpeedLimits.from_mask(vals, 0.1, (1.55, 0.22), type="percentage", base=100.0,
-                               multiplier=-1.0)  # fmt: skip
+    sl = SpeedLimits.from_mask(
+        vals, 0.1, (1.55, 0.22), type="percentage", base=100.0, multiplier=-1.0
+    )
     traj = trajopt.plan(sc.grid, sc.start, sc.goal("A"), robot, speed_limits=sl)
     n_in, _ = _check_held(traj, sl, robot.v_max)
     assert n_in > 0

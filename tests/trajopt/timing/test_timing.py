@@ -25,9 +25,18 @@ TOL = 1e-3  # relative tolerance of the curvature-dependent limits on dense samp
 def hairpin() -> BSplineCurve:
     """Up 2 m, a tight U-turn of about 0.3 m radius, back down."""
     p = np.array(
-        [[0, 0], [0, 1.0], [0, 2.0], [0.05, 2.35], [0.3, 2.5], [0.55, 2.35], [0.6, 2.0],
-         [0.6, 1.0], [0.6, 0.0]]
-    )  # fmt: skip
+        [
+            [0, 0],
+            [0, 1.0],
+            [0, 2.0],
+            [0.05, 2.35],
+            [0.3, 2.5],
+            [0.55, 2.35],
+            [0.6, 2.0],
+            [0.6, 1.0],
+            [0.6, 0.0],
+        ]
+    )
     return BSplineCurve(clamped_uniform_knots(len(p), 3), p, 3)
 
 
@@ -263,9 +272,14 @@ def test_random_bsplines_hold_every_limit(pts, v_start):
 
 # ------------------------------------------------------------------ sharp curvature peaks
 TIGHT = Robot(
-    v_max=0.5, a_max=0.5, j_max=2.0, a_lat_max=0.5, omega_max=1.5, track_width=None,
+    v_max=0.5,
+    a_max=0.5,
+    j_max=2.0,
+    a_lat_max=0.5,
+    omega_max=1.5,
+    track_width=None,
     wheel_v_max=None,
-)  # fmt: skip
+)
 
 
 def check_cap_every_ms(traj: Trajectory, robot: Robot) -> float:
@@ -306,16 +320,32 @@ def random_bspline(pts) -> BSplineCurve | None:
 #: near-cusps found by benchmarks/timing_property_run.py: curvature peaks of 40-550 1/m
 #: (the first broke the cap by 3.7 % before the curvature bound, the others the heading)
 NEAR_CUSPS = [
-    [[0.608257072678, -0.793493179105], [0.988374419489, -0.277047245437],
-     [-1.307359075047, -1.239708986695], [-1.207738551184, 1.761347093472],
-     [-1.140176274906, 1.118656538961]],
-    [[0.617470520978, 1.461962157232], [1.226367443287, -1.755230953997],
-     [-1.350916088042, 0.751389883279], [0.060034133237, -0.071852490007]],
-    [[-0.252063884981, 0.727865287151], [1.926441102402, 0.174457280839],
-     [-1.976548725328, -0.796009686561], [-1.505021737051, -0.924810666734]],
-    [[0.070799125241, -0.400370352421], [-1.419073426495, 0.446698278894],
-     [1.698675162278, -1.033854906609], [1.788695725153, 0.092766534842]],
-]  # fmt: skip
+    [
+        [0.608257072678, -0.793493179105],
+        [0.988374419489, -0.277047245437],
+        [-1.307359075047, -1.239708986695],
+        [-1.207738551184, 1.761347093472],
+        [-1.140176274906, 1.118656538961],
+    ],
+    [
+        [0.617470520978, 1.461962157232],
+        [1.226367443287, -1.755230953997],
+        [-1.350916088042, 0.751389883279],
+        [0.060034133237, -0.071852490007],
+    ],
+    [
+        [-0.252063884981, 0.727865287151],
+        [1.926441102402, 0.174457280839],
+        [-1.976548725328, -0.796009686561],
+        [-1.505021737051, -0.924810666734],
+    ],
+    [
+        [0.070799125241, -0.400370352421],
+        [-1.419073426495, 0.446698278894],
+        [1.698675162278, -1.033854906609],
+        [1.788695725153, 0.092766534842],
+    ],
+]
 
 
 @pytest.mark.parametrize("pts", NEAR_CUSPS)
@@ -418,22 +448,32 @@ def chain_as_bspline(ctrl: np.ndarray) -> BSplineCurve:
     n, m, _ = ctrl.shape
     p = m - 1
     c = np.vstack([ctrl[0, :1]] + [ctrl[i, 1:] for i in range(n)])
-    t = np.concatenate([np.zeros(p + 1)] + [np.full(p, float(i)) for i in range(1, n)]
-                       + [np.full(p + 1, float(n))])  # fmt: skip
+    t = np.concatenate(
+        [np.zeros(p + 1)] + [np.full(p, float(i)) for i in range(1, n)] + [np.full(p + 1, float(n))]
+    )
     return BSplineCurve(t, c, p)
 
 
 STUCK_ROBOT = Robot(
-    radius=2.5, v_max=2.0, a_max=1.0, j_max=2.0, a_lat_max=2.0, omega_max=2.0,
-    track_width=None, wheel_v_max=None,
-)  # fmt: skip
+    radius=2.5,
+    v_max=2.0,
+    a_max=1.0,
+    j_max=2.0,
+    a_lat_max=2.0,
+    omega_max=2.0,
+    track_width=None,
+    wheel_v_max=None,
+)
 
 
 @pytest.mark.parametrize(
     "form,dt",
-    [("chain, kappa at 2 cm from the ends", 0.02), ("chain, kappa at 2 cm from the ends", 0.05),
-     ("bspline", 0.02)],
-)  # fmt: skip
+    [
+        ("chain, kappa at 2 cm from the ends", 0.02),
+        ("chain, kappa at 2 cm from the ends", 0.05),
+        ("bspline", 0.02),
+    ],
+)
 def test_zero_speed_ends_are_timed_and_headed(form, dt):
     ctrl = stuck_case()
     c = BezierChain(ctrl, 0.02) if form.startswith("chain") else chain_as_bspline(ctrl)

@@ -22,8 +22,8 @@ watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
 def hull4(pts, n, out):  # pragma: no cover - compiled
     """Convex hull (counter-clockwise, no collinear points) of ``pts[:n]``.
 
-    Convex hull (counter-clockwise, no collinear points) of ``pts[:n]`` (n <= 8) into ``out``;
-    returns its vertex count (1 for a point, 2 for a segment).
+    For ``n <= 8`` points, written into ``out``; returns its vertex count (1 for a point, 2
+    for a segment).
     """
     p = np.empty((n, 2))
     for i in range(n):

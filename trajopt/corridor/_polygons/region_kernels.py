@@ -1,8 +1,8 @@
 """Compiled kernels that grow the polygon corridor's regions.
 
-Compiled kernels that grow the polygon corridor's regions (cell units) and compute the chain's
-geometry: clipping, region growth around each path segment, the path interval inside each
-region, the overlaps, and the regions' exact clearance.
+They work in cell units and compute the chain's geometry: clipping, region growth around
+each path segment, the path interval inside each region, the overlaps, and the regions'
+exact clearance.
 """
 
 from __future__ import annotations
@@ -386,8 +386,7 @@ def clip_convex(v, nv, rows, nrows, tol):  # pragma: no cover - compiled
 def _seg_inside(rows, nrows, p, i, tol):  # pragma: no cover - compiled
     """Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows.
 
-    Parameter interval ``(t0, t1)`` of segment ``p[i] -> p[i + 1]`` inside the rows (``t0 > t1``
-    when empty).
+    ``t0 > t1`` when the segment misses them.
     """
     ax, ay = p[i, 0], p[i, 1]
     dx = p[i + 1, 0] - ax
