@@ -7,6 +7,7 @@ import importlib
 import inspect
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -72,3 +73,67 @@ def test_import_is_light():
     code = "import sys, trajopt, astar; print(' '.join(sorted(m for m in ('casadi', 'piqp', 'ruckig', 'numba', 'matplotlib', 'scipy') if m in sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+#: trajopt's layers from the bottom (docs/architecture.md): a module may import its own
+#: layer's and lower layers' modules, never a higher layer's (TYPE_CHECKING imports aside)
+LAYERS = [
+    {"errors", "_validation", "_kernel_cache"},
+    {"geometry"},
+    {"robot"},
+    {"motion"},
+    {"corridor"},
+    {"smoother"},
+    {"timing"},
+    {"planning"},
+    {"replan"},
+    {"_planner"},
+    {"analysis"},
+    {"_warm_up"},
+    {"cli"},
+]
+
+
+def _layer(module: str) -> int:
+    top = module.split(".")[1] if module.count(".") else "__init__"
+    for i, names in enumerate(LAYERS):
+        if top in names:
+            return i
+    return len(LAYERS)  # the package face, which loads lazily
+
+
+def _imports(path: Path) -> list[tuple[str, int]]:
+    """``(imported trajopt module, line)`` of every import outside ``if TYPE_CHECKING:``."""
+    tree = ast.parse(path.read_text())
+    guarded = {
+        id(sub)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+        for sub in ast.walk(node)
+    }
+    out = []
+    for node in ast.walk(tree):
+        if id(node) in guarded:
+            continue
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names = [node.module]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            continue
+        out += [(n, node.lineno) for n in names if n.startswith("trajopt.")]
+    return out
+
+
+def test_no_import_runs_up_a_layer():
+    root = Path(trajopt.__file__).parent
+    upward = []
+    for path in root.rglob("*.py"):
+        rel = path.relative_to(root.parent).with_suffix("")
+        here = ".".join(rel.parts).removesuffix(".__init__")
+        if here == "trajopt":
+            continue
+        for target, line in _imports(path):
+            if _layer(target) > _layer(here):
+                upward.append(f"{rel}.py:{line} imports {target}")
+    assert not upward, upward
