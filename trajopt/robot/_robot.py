@@ -17,14 +17,29 @@ field                     default    meaning
 ``omega_max``             1.5 rad/s  yaw rate ``kappa * v``
 ``track_width``           0.28 m     distance between the two drive wheels
 ``wheel_v_max``           0.6 m/s    speed of either wheel ``v * (1 +- kappa * track_width/2)``
+``drive``                 differential  how the base moves (below)
 ========================  =========  =========================================================
+
+Drive types (``drive``):
+
+* ``"differential"`` (the default): the robot faces its direction of travel; it can turn in
+  place at rest, so a required start or goal heading is met by turning there when no curve
+  can leave (arrive) along it.
+* ``"omni"`` (mecanum or omni-wheel bases): the orientation is independent of the direction
+  of travel. The path is planned as for a disc (with a footprint: its circumscribed disc,
+  which holds it in every orientation) and the orientation is its own jerk-limited profile,
+  turned while driving. ``omega_max`` bounds the yaw rate of that profile and not the
+  speed along a curve, and the wheel terms (``track_width``, ``wheel_v_max``) of a
+  differential drive do not apply to its speed cap.
+* ``"ackermann"`` (car-like: a turning radius, reversing) is not supported yet; it is
+  refused with a clear error.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -34,6 +49,9 @@ from trajopt.robot._footprint import Footprint
 
 #: The chapter robot's footprint radius (m): half of its 0.33 m width.
 DEFAULT_RADIUS = 0.165
+#: How a robot's base moves (:class:`Robot`'s ``drive``).
+Drive = Literal["differential", "omni"]
+DRIVES = ("differential", "omni")
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,13 +83,18 @@ class Robot:
     footprint : Footprint or array_like, shape (k, 2), optional
         A convex footprint in the robot frame (x forward, metres, the rotation centre at
         the origin, strictly inside); see :meth:`rectangle`.
+    drive : {"differential", "omni"}
+        How the base moves (module docstring): a differential drive faces its direction of
+        travel and turns in place at rest; an omnidirectional base turns independently of
+        it. Default ``"differential"``.
 
     Raises
     ------
     InvalidInputError
         A limit is not a finite number > 0, only one of ``track_width`` and
         ``wheel_v_max`` is given, a bad footprint (non-convex, self-intersecting, fewer than
-        3 vertices, the origin not inside, NaN), or a radius contradicting it.
+        3 vertices, the origin not inside, NaN), a radius contradicting it, or an unknown
+        ``drive`` (``"ackermann"`` included: not supported yet).
     """
 
     radius: float = 0.165
@@ -83,8 +106,16 @@ class Robot:
     track_width: float | None = 0.28
     wheel_v_max: float | None = 0.6
     footprint: Footprint | None = None
+    drive: Drive = "differential"
 
     def __post_init__(self) -> None:
+        if self.drive == "ackermann":
+            raise InvalidInputError(
+                "Robot.drive='ackermann' (a car-like robot: turning radius, reversing) is not "
+                f"supported yet; use one of {DRIVES}"
+            )
+        if not (isinstance(self.drive, str) and self.drive in DRIVES):
+            raise InvalidInputError(f"Robot.drive must be one of {DRIVES}, got {self.drive!r}")
         fp = self.footprint
         if fp is not None and not isinstance(fp, Footprint):
             try:
@@ -142,7 +173,9 @@ class Robot:
         """Curvature-dependent speed limit (m/s).
 
         ``min(v_max, sqrt(a_lat_max/|k|), omega_max/|k|, wheel_v_max/(1 + |k| track_width/2))``
-        (the wheel term only when ``track_width`` is set). ``k = 0`` gives ``v_max``; an
+        (the wheel term only when ``track_width`` is set). An omnidirectional base
+        (``drive="omni"``) turns its body independently of the path, so only
+        ``min(v_max, sqrt(a_lat_max/|k|))`` applies to it. ``k = 0`` gives ``v_max``; an
         infinite or NaN curvature gives 0.
 
         Parameters
@@ -158,6 +191,9 @@ class Robot:
         k = np.where(np.isnan(k), np.inf, k)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             cap = np.minimum(self.v_max, np.sqrt(self.a_lat_max / k))
+            if self.drive == "omni":
+                cap = np.where(np.isinf(k), 0.0, cap)
+                return float(cap) if cap.ndim == 0 else cap
             cap = np.minimum(cap, self.omega_max / k)
             if self.track_width is not None:
                 cap = np.minimum(cap, self.wheel_v_max / (1.0 + 0.5 * self.track_width * k))
