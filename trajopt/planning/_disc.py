@@ -224,6 +224,8 @@ def _result(
         start=(float(q.start[0]), float(q.start[1])),
         goal=(float(q.goal[0]), float(q.goal[1])),
         stages_s=stages,
+        start_heading=q.start_heading,
+        goal_heading=q.goal_heading,
     )
     stats = dict(traj.stats)
     stats.update(extra)

@@ -15,7 +15,7 @@ import numpy as np
 
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt._validation import integer
+from trajopt._validation import heading, integer
 from trajopt.errors import InvalidInputError
 from trajopt.robot._robot import Robot, avoidance_width
 from trajopt.robot._state import State
@@ -196,7 +196,10 @@ class PlannerOptions:
 
 @dataclass(frozen=True, slots=True)
 class PlanRequest:
-    """What one query asks: the ends, their headings and speeds (validated by the runner).
+    """What one query asks: the ends, their headings and speeds.
+
+    The headings are checked here (finite, in radians); the points and speeds by the stages
+    that use them.
 
     Attributes
     ----------
@@ -217,3 +220,7 @@ class PlanRequest:
     goal_heading: float | None = None
     v_start: float = 0.0
     v_end: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "start_heading", heading("start_heading", self.start_heading))
+        object.__setattr__(self, "goal_heading", heading("goal_heading", self.goal_heading))

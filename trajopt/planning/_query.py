@@ -144,6 +144,9 @@ class PlanSteps:
         ``timing``, ``total``. ``inflate`` is ~0 when the planner's cache served it. With
         the fallback: ``fallback`` (checking and timing the polyline) and no ``timing``
         unless the timing was the stage that failed.
+    start_heading, goal_heading : float or None
+        The headings the query asked for at its ends (rad; ``None``: free). A re-plan to
+        the same goal keeps ``goal_heading``.
     """
 
     raw_grid: OccupancyGrid
@@ -154,3 +157,5 @@ class PlanSteps:
     start: tuple[float, float]
     goal: tuple[float, float]
     stages_s: dict[str, float]
+    start_heading: float | None = None
+    goal_heading: float | None = None

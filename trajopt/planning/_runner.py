@@ -12,6 +12,7 @@ from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._footprint_ladder import plan_with_footprint
 from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._pose import needs_pose_plan, plan_pose
 from trajopt.planning._query import WarmStart
 
 
@@ -23,6 +24,10 @@ def run_query(
     budget_s: float | None = None,
 ) -> PlanResult:
     """Plan one query: a disc robot's stages, or a footprint robot's disc ladder.
+
+    A differential drive given an end heading where it stands still plans pose to pose
+    (:func:`~trajopt.planning._pose.plan_pose`: turns in place where they are faster or
+    where no curve leaves along the heading).
 
     Parameters
     ----------
@@ -41,10 +46,23 @@ def run_query(
 
     Returns
     -------
-    Trajectory or StopAndTurnTrajectory
+    Trajectory, StopAndTurnTrajectory or TrajectoryChain
         See :meth:`trajopt.Planner.plan`.
     """
     options = options.with_budget(budget_s)
+    if needs_pose_plan(options.robot, request):
+
+        def plan(req: PlanRequest, w: WarmStart | None, b: float | None) -> PlanResult:
+            return _plan(options.with_budget(b), caches, req, w)
+
+        return plan_pose(options, caches.grid, request, plan, warm)
+    return _plan(options, caches, request, warm)
+
+
+def _plan(
+    options: PlannerOptions, caches: PlannerCaches, request: PlanRequest, warm: WarmStart | None
+) -> PlanResult:
+    """Run a disc robot's stages, or a footprint robot's disc ladder (which starts afresh)."""
     if options.robot.footprint is not None:
         return plan_with_footprint(options, caches, request)
     return plan_disc(options, caches, request, warm)

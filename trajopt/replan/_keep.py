@@ -141,7 +141,8 @@ def target_change(
     """Why a re-plan's goal, goal heading or end speed differ from ``trajectory``'s.
 
     ``""`` when they do not. ``goal`` ``None`` is the old goal; a goal heading counts as
-    new unless ``trajectory`` has a ``path`` that ends with it (within 1e-9 rad).
+    new unless the old plan asked for it (its steps' ``goal_heading``) or ``trajectory``
+    has a ``path`` that ends with it (within 1e-9 rad).
     """
     steps = trajectory.steps
     if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
@@ -149,6 +150,12 @@ def target_change(
     if v_end != trajectory.v_end:
         return "new end speed"
     if goal_heading is not None:
+        asked = getattr(steps, "goal_heading", None)
+        if (
+            asked is not None
+            and abs(math.remainder(float(goal_heading) - asked, 2 * math.pi)) <= 1e-9
+        ):
+            return ""
         path = getattr(trajectory, "path", None)
         if path is None:
             return "new goal heading"

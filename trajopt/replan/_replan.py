@@ -81,6 +81,8 @@ def replan_from(
                 "goal is required: the trajectory has no steps (it was not planned by a Planner)"
             )
         goal = steps.goal
+        if goal_heading is None:  # the same goal: the same heading there
+            goal_heading = getattr(steps, "goal_heading", None)
     if brake_after_s is not None:
         brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
@@ -89,7 +91,9 @@ def replan_from(
     piece, t_piece = trajectory, ts
     if isinstance(trajectory, TrajectoryChain):
         i, t_piece = trajectory.piece_at(ts)
-        if i == len(trajectory.pieces) - 1:  # driving the chain's last plan: re-plan that
+        last = trajectory.pieces[i]
+        if i == len(trajectory.pieces) - 1 and not isinstance(last, TurnInPlace):
+            # driving the chain's last plan: re-plan that
             piece = trajectory.pieces[i]
     if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
         out, why = _keep_chain(caches.grid, trajectory, ts, goal, goal_heading, v_end)

@@ -283,8 +283,10 @@ def test_polygon_corridor_smooths_the_zigzag(zigzag):
 
 
 def test_planner_fallback_is_safe_exact_and_deterministic(zigzag):
+    # the box corridor cannot smooth the zigzag (above): the fallback drives the polyline
+    # and turns in place onto the goal heading at its end
     grid, start, goal = zigzag
-    planner = trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn")
+    planner = trajopt.Planner(grid, ZZ_ROBOT, fallback="stop_and_turn", corridor="boxes")
     traj = planner.plan(start, goal, goal_heading=0.0)
     assert isinstance(traj, StopAndTurnTrajectory)
     st = traj.stats
@@ -309,7 +311,9 @@ def test_planner_fallback_is_safe_exact_and_deterministic(zigzag):
     assert math.remainder(float(smp.theta[-1]), 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
     assert trajectory_metrics(traj, ZZ_ROBOT)["within_limits"]
     # determinism: a fresh planner and trajopt.plan give the same answer bit for bit
-    again = trajopt.plan(grid, start, goal, ZZ_ROBOT, goal_heading=0.0, fallback="stop_and_turn")
+    again = trajopt.plan(
+        grid, start, goal, ZZ_ROBOT, goal_heading=0.0, fallback="stop_and_turn", corridor="boxes"
+    )
     t = np.linspace(0.0, traj.duration, 500)
     for a, b in zip(traj.sample(t), again.sample(t), strict=True):
         np.testing.assert_array_equal(a, b)
