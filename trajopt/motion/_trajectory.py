@@ -41,26 +41,44 @@ SAMPLE_UNITS: dict[str, str] = {
     "s": "m",
     "v_left": "m/s",
     "v_right": "m/s",
+    "course": "rad",
+    "vx": "m/s",
+    "vy": "m/s",
+    "v_body_x": "m/s",
+    "v_body_y": "m/s",
 }
 
 
 class TrajectorySample(NamedTuple):
     """Samples of a :class:`Trajectory`; every array has the shape of the query times.
 
+    The fields after ``s`` are optional (``None`` when absent; :meth:`as_dict` and the
+    exports leave them out): the wheel speeds of a differential drive, and the direction of
+    travel and velocities of an omnidirectional motion
+    (:class:`~trajopt.motion._omni.OmniTrajectory`), whose ``theta`` is the body's
+    orientation and ``omega`` its rate.
+
     Attributes
     ----------
     t : time (s), clipped to ``[0, duration]``
     x, y : position (m)
-    theta : heading from the curve's tangent, continuous and unwrapped (rad)
+    theta : heading from the curve's tangent, continuous and unwrapped (rad); for an
+        omnidirectional motion the orientation of the body, independent of the path
     v : speed along the path ``ds/dt`` (m/s)
-    omega : yaw rate ``kappa * v`` (rad/s)
+    omega : yaw rate ``kappa * v`` (rad/s); ``d theta / dt`` in turns and for an
+        omnidirectional motion
     a : tangential acceleration (m/s^2)
     jerk : tangential jerk (m/s^3)
     a_lat : signed lateral acceleration ``kappa * v^2`` (m/s^2)
     kappa : signed curvature (1/m)
     s : arc length travelled (m)
     v_left, v_right : wheel speeds ``v * (1 -+ kappa * track_width / 2)`` (m/s), or ``None``
-        when the robot has no ``track_width``
+        when the robot has no ``track_width`` or is omnidirectional
+    course : direction of travel, the path's tangent, continuous and unwrapped (rad), or
+        ``None`` (only an omnidirectional motion has it apart from ``theta``)
+    vx, vy : world-frame velocity ``v * (cos, sin)(course)`` (m/s), or ``None``
+    v_body_x, v_body_y : body-frame velocity, ``(vx, vy)`` rotated by ``-theta`` (m/s): what
+        an omnidirectional base is commanded with; or ``None``
     """
 
     t: np.ndarray
@@ -76,9 +94,14 @@ class TrajectorySample(NamedTuple):
     s: np.ndarray
     v_left: np.ndarray | None = None
     v_right: np.ndarray | None = None
+    course: np.ndarray | None = None
+    vx: np.ndarray | None = None
+    vy: np.ndarray | None = None
+    v_body_x: np.ndarray | None = None
+    v_body_y: np.ndarray | None = None
 
     def as_dict(self) -> dict[str, np.ndarray]:
-        """Return the arrays by name (``v_left``/``v_right`` only when present)."""
+        """Return the arrays by name (the optional fields only when present)."""
         return {k: v for k, v in self._asdict().items() if v is not None}
 
 
@@ -86,10 +109,11 @@ def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample:
     """Return a :class:`TrajectorySample` of read-only copies of ``arrays``.
 
     ``arrays`` holds ``t``, ``x``, ``y``, ``theta``, ``v``, ``omega``, ``a``, ``jerk``,
-    ``a_lat``, ``kappa`` and ``s``; the wheel speeds ``v -+ omega * track_width / 2`` are
-    added when the robot has a track width.
+    ``a_lat``, ``kappa`` and ``s`` (and may hold the other optional fields of
+    :class:`TrajectorySample`); the wheel speeds ``v -+ omega * track_width / 2`` are added
+    when the robot is a differential drive with a track width.
     """
-    if robot.track_width is not None:
+    if robot.track_width is not None and robot.drive != "omni":
         half = 0.5 * robot.track_width
         arrays["v_left"] = arrays["v"] - arrays["omega"] * half
         arrays["v_right"] = arrays["v"] + arrays["omega"] * half
@@ -139,10 +163,12 @@ class SampledExport:
         """Write samples every ``dt`` seconds as CSV (atomically); returns the path.
 
         The first line is the header: one column per sampled quantity (``t``, ``x``, ``y``,
-        ``theta``, ``v``, ``omega``, ``a``, ``jerk``, ``a_lat``, ``kappa``, ``s``, and
-        ``v_left``, ``v_right`` when the robot has a track width), each named with its unit
-        in brackets, e.g. ``t [s]``, ``v [m/s]``. The pose columns also name their frame in
-        parentheses: ``x [m] (map)``, ``y [m] (map)``, ``theta [rad] (map)``. Every other
+        ``theta``, ``v``, ``omega``, ``a``, ``jerk``, ``a_lat``, ``kappa``, ``s``, then
+        ``v_left``, ``v_right`` for a differential drive with a track width, or ``course``,
+        ``vx``, ``vy``, ``v_body_x``, ``v_body_y`` for an omnidirectional motion), each named
+        with its unit in brackets, e.g. ``t [s]``, ``v [m/s]``. The pose columns (and the
+        world-frame ``course``, ``vx``, ``vy``) also name their frame in parentheses:
+        ``x [m] (map)``, ``y [m] (map)``, ``theta [rad] (map)``. Every other
         line is one sample, all numbers, so the file reads with no options:
         ``pandas.read_csv(path)`` keeps these column names, and
         ``numpy.genfromtxt(path, delimiter=",", names=True)`` gives a structured array whose
@@ -275,8 +301,9 @@ def _frame_id(value: object) -> str:
     return value
 
 
-# Sampled quantities whose CSV column names the frame (the pose in that frame).
-_CSV_POSE_COLUMNS: tuple[str, ...] = ("x", "y", "theta")
+# Sampled quantities whose CSV column names the frame (the pose, and the direction of
+# travel and velocity of an omnidirectional motion, in that frame).
+_CSV_POSE_COLUMNS: tuple[str, ...] = ("x", "y", "theta", "course", "vx", "vy")
 
 # Characters a ``frame_id`` may not contain in a CSV header: the delimiter, the quote,
 # numpy's comment mark, the parentheses around the frame.
@@ -287,7 +314,8 @@ def _csv_column(name: str, frame_id: str) -> str:
     """Return the CSV header of the sampled quantity ``name``.
 
     ``"<name> [<unit>]"`` with the unit from :data:`SAMPLE_UNITS`, followed by
-    ``" (<frame_id>)"`` for the pose columns ``x``, ``y`` and ``theta``.
+    ``" (<frame_id>)"`` for the pose columns ``x``, ``y`` and ``theta`` (and the world-frame
+    ``course``, ``vx`` and ``vy`` of an omnidirectional motion).
     """
     head = f"{name} [{SAMPLE_UNITS[name]}]"
     return f"{head} ({frame_id})" if name in _CSV_POSE_COLUMNS else head

@@ -5,7 +5,9 @@
 * ``|a| <= a_max``, ``|jerk| <= j_max``, ``v >= 0`` (``s`` never decreases), and
 * the curvature-dependent speed cap ``v <= cap(s) = Robot.speed_cap(kappa(s))``, i.e.
   ``v <= v_max``, lateral acceleration ``|kappa| v^2 <= a_lat_max``, yaw rate
-  ``|kappa| v <= omega_max`` and wheel speeds ``v (1 + |kappa| w/2) <= wheel_v_max``.
+  ``|kappa| v <= omega_max`` and wheel speeds ``v (1 + |kappa| w/2) <= wheel_v_max`` (an
+  omnidirectional robot, ``drive="omni"``, has only the first two: its body turns
+  independently of the path, see :func:`orient`).
 
 ruckig (community edition, 1-DoF, no ``intermediate_positions``: that option sends the
 problem to a cloud service) holds the first group; the cap is held by the design below.
@@ -67,10 +69,12 @@ compiled path; :mod:`~trajopt.timing._cap_cubic` its bound on cubic pieces, unro
 :mod:`~trajopt.timing._greedy` (the compiled
 kernels of stage 2), :mod:`~trajopt.timing._compress` (stages 3 and 4) and
 :mod:`~trajopt.timing._ruckig_profile` (the ruckig wrapper, also used by the stop-and-turn
-fallback).
+fallback). :mod:`~trajopt.timing._orientation` (:func:`orient`) gives an omnidirectional
+robot's translation its own orientation profile, turned while it drives.
 """
 
 from trajopt.timing._cap_table import CapTable, build_cap_table
+from trajopt.timing._orientation import orient
 from trajopt.timing._parameterize import time_parameterize
 from trajopt.timing._ruckig_profile import RuckigProfile
 from trajopt.timing._speed_limits import SpeedLimits, load_speed_mask
@@ -82,6 +86,7 @@ __all__ = [
     "SpeedLimits",
     "build_cap_table",
     "load_speed_mask",
+    "orient",
     "stop_and_turn",
     "time_parameterize",
     "turn_in_place",

@@ -141,7 +141,9 @@ def test_exports(tmp_path):
     d = traj.to_dict(dt=0.05)
     assert d["units"]["v"] == "m/s" and d["units"]["theta"] == "rad"
     assert d["duration"] == traj.duration and d["duration_unit"] == "s"
-    assert set(d["samples"]) == set(SAMPLE_UNITS)  # v_left/v_right present with track_width
+    # v_left/v_right present with track_width; an omni motion's course, vx, ... absent
+    omni_only = {"course", "vx", "vy", "v_body_x", "v_body_y"}
+    assert set(d["samples"]) == set(SAMPLE_UNITS) - omni_only
     smp = traj.sample_uniform(0.05)
     assert np.allclose(d["samples"]["x"], smp.x)
     p = traj.to_json(tmp_path / "sub" / "traj.json", dt=0.05)

@@ -517,3 +517,31 @@ def test_a_zero_speed_end_that_turns_is_a_timing_error():
     assert k[1] > 5 * k[0] > 5.0  # unbounded towards the end
     with pytest.raises(TimingError, match="unbounded"):
         time_parameterize(c, ROBOT)
+
+
+# ------------------------------------------------------------------ omnidirectional drive
+@pytest.mark.parametrize("form", ["bspline", "arc"])  # the compiled cap path, the NumPy one
+def test_omni_speed_cap_has_no_yaw_rate_or_wheel_term(form):
+    """An omni base on a circle: steady at ``min(v_max, sqrt(a_lat_max r))`` by hand.
+
+    Its yaw-rate (``omega_max r = 0.12 m/s``) and wheel terms (``0.6 / (1 + 0.14 / r)``)
+    would bind for a differential drive of the same limits; on 1 ms samples the speed stays
+    under the hand cap of the curve's own curvature.
+    """
+    r = 0.4
+    robot = Robot(omega_max=0.3, drive="omni")  # default track_width and wheel_v_max
+    curve = lsq_circle(r, 1.0) if form == "bspline" else Arc(r, 2 * np.pi)
+    traj = time_parameterize(curve, robot)
+    smp = traj.sample(np.append(np.arange(0.0, traj.duration, 1e-3), traj.duration))
+    kappa = np.abs(np.asarray(curve.curvature(curve.u_at_s(smp.s))))
+    with np.errstate(divide="ignore"):
+        cap = np.minimum(robot.v_max, np.sqrt(robot.a_lat_max / kappa))
+    assert np.all(smp.v <= cap * (1 + TOL) + 1e-9), float(np.max(smp.v / cap))
+    assert np.all(np.abs(smp.a) <= robot.a_max * (1 + 1e-9) + 1e-9)
+    assert np.all(np.abs(smp.jerk) <= robot.j_max * (1 + 1e-9) + 1e-9)
+    expect = min(robot.v_max, math.sqrt(robot.a_lat_max * r))  # 0.447 m/s
+    mid = (smp.s > 0.4 * curve.length) & (smp.s < 0.6 * curve.length)
+    assert np.all(np.abs(smp.v[mid] - expect) <= 2e-3 * expect)
+    assert smp.v_left is None  # no wheel speeds for an omni base
+    differential = time_parameterize(curve, Robot(omega_max=0.3))
+    assert traj.duration < 0.5 * differential.duration
