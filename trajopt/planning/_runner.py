@@ -11,6 +11,7 @@ from __future__ import annotations
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._footprint_ladder import plan_with_footprint
+from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._pose import needs_pose_plan, plan_pose
 from trajopt.planning._query import WarmStart
@@ -27,7 +28,9 @@ def run_query(
 
     A differential drive given an end heading where it stands still plans pose to pose
     (:func:`~trajopt.planning._pose.plan_pose`: turns in place where they are faster or
-    where no curve leaves along the heading).
+    where no curve leaves along the heading); an omnidirectional base plans the path of its
+    (circumscribed) disc and turns its orientation while it drives
+    (:func:`~trajopt.planning._omni.plan_omni`).
 
     Parameters
     ----------
@@ -46,10 +49,12 @@ def run_query(
 
     Returns
     -------
-    Trajectory, StopAndTurnTrajectory or TrajectoryChain
+    Trajectory, StopAndTurnTrajectory, TrajectoryChain or OmniTrajectory
         See :meth:`trajopt.Planner.plan`.
     """
     options = options.with_budget(budget_s)
+    if options.robot.drive == "omni":
+        return plan_omni(options, caches, request, warm)
     if needs_pose_plan(options.robot, request):
 
         def plan(req: PlanRequest, w: WarmStart | None, b: float | None) -> PlanResult:

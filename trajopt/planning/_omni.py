@@ -1,0 +1,80 @@
+"""Plans of an omnidirectional base: the path of a disc, the orientation turned while driving.
+
+An omni base (``Robot(drive="omni")``) moves in any direction whatever its orientation. The
+path is planned as for a disc of the robot's radius (with a footprint: its circumscribed
+disc, which holds the footprint in every orientation, so the path is clear whatever the
+orientation does), with free headings; the orientation is then its own jerk-limited profile
+from the start heading to the goal heading (:func:`trajopt.timing.orient`), synchronised
+with the translation, so the total duration grows only when the turn cannot fit in the
+travel time. With no heading given the plan is the translation alone (its orientation is
+its direction of travel, as a differential drive's).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.motion._trajectory import Trajectory
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import PlanSteps, WarmStart
+from trajopt.timing._orientation import orient
+from trajopt.timing._stop_and_turn import stop_and_turn
+
+
+def plan_omni(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    warm: WarmStart | None = None,
+) -> PlanResult:
+    """Plan one query for an omnidirectional base (module docstring).
+
+    Parameters
+    ----------
+    options : PlannerOptions
+        The planner's options (``options.robot.drive == "omni"``).
+    caches : PlannerCaches
+        The map's caches.
+    request : PlanRequest
+        The query; a :class:`~trajopt.robot.State` start continues its direction of travel
+        (its ``theta``), and its orientation profile starts at ``start_heading`` (default: that
+        direction).
+    warm : WarmStart, optional
+        A re-plan's warm start.
+
+    Returns
+    -------
+    Trajectory, OmniTrajectory or StopAndTurnTrajectory
+        An :class:`~trajopt.motion.OmniTrajectory` when a heading is given.
+    """
+    h0, h1 = request.start_heading, request.goal_heading
+    # the path leaves and arrives along its own directions (a moving State's included)
+    free = dataclasses.replace(request, start_heading=None, goal_heading=None)
+    translation = plan_disc(options, caches, free, warm)
+    if h0 is None and h1 is None:
+        return translation
+    if isinstance(translation, StopAndTurnTrajectory):  # the fallback turns at its ends
+        out = stop_and_turn(translation.vertices, options.robot, start_heading=h0,
+                            goal_heading=h1, speed_limits=options.speed_limits)  # fmt: skip
+        return dataclasses.replace(out, stats=dict(translation.stats),
+                                   steps=_asked(translation.steps, request))  # fmt: skip
+    assert isinstance(translation, Trajectory)
+    ends = translation.sample(np.array([0.0, translation.duration]))
+    theta0 = float(ends.theta[0]) if h0 is None else h0
+    theta1 = float(ends.theta[1]) if h1 is None else h1
+    out = orient(translation, options.robot, theta0, theta1)
+    return dataclasses.replace(out, steps=_asked(translation.steps, request))
+
+
+def _asked(steps: PlanSteps | None, request: PlanRequest) -> PlanSteps | None:
+    """Return ``steps`` recording the headings the request asked for."""
+    if steps is None:
+        return None
+    return dataclasses.replace(
+        steps, start_heading=request.start_heading, goal_heading=request.goal_heading
+    )
