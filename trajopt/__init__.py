@@ -14,7 +14,8 @@ and :func:`warm_up` (compile the numerical kernels ahead of time).
 (:class:`ParametricCurve`, :class:`BSplineCurve`), :func:`time_parameterize` with
 :class:`SpeedLimits` (:func:`load_speed_mask`), the stop-and-turn motion
 (:func:`stop_and_turn`, :class:`StopAndTurnTrajectory`), :class:`TurnInPlace` and
-:class:`TrajectoryChain`, and the ROS 2 MCAP files (:func:`write_mcap`, :func:`read_mcap`).
+:class:`TrajectoryChain` (a differential drive's pose-to-pose plans), :class:`OmniTrajectory`
+(an omnidirectional base's), and the ROS 2 MCAP files (:func:`write_mcap`, :func:`read_mcap`).
 
 **Analysis**: :func:`compare` and :class:`ComparisonTable` (the chapter's table), and the
 modules ``trajopt.metrics``, ``trajopt.fits``, ``trajopt.scenes``, ``trajopt.plotting``,
@@ -69,6 +70,7 @@ _EXPORTS: dict[str, str] = {
     "StopAndTurnTrajectory": "trajopt.motion",
     "TrajectoryChain": "trajopt.motion",
     "TurnInPlace": "trajopt.motion",
+    "OmniTrajectory": "trajopt.motion",
     "read_mcap": "trajopt.motion",
     "write_mcap": "trajopt.motion",
     # analysis
@@ -132,6 +134,7 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from trajopt.geometry import BSplineCurve, ParametricCurve
     from trajopt.motion import (
+        OmniTrajectory,
         StopAndTurnTrajectory,
         Trajectory,
         TrajectoryChain,

@@ -7,18 +7,19 @@
   one after another (a braking re-plan);
 * :class:`OmniTrajectory`: an omnidirectional base's translation with an orientation of its
   own (built by :func:`trajopt.timing.orient`);
-* :class:`TrajectorySample`, and the ROS 2 MCAP writer and reader.
+* :class:`TrajectorySample` and :class:`OmniSample`, and the ROS 2 MCAP writer and reader.
 """
 
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import Trajectory, TrajectorySample
+from trajopt.motion._trajectory import OmniSample, Trajectory, TrajectorySample
 
 __all__ = [
     "McapContents",
     "McapExportError",
+    "OmniSample",
     "OmniTrajectory",
     "StopAndTurnTrajectory",
     "Trajectory",

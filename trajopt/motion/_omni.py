@@ -12,7 +12,7 @@ built by :func:`trajopt.timing.orient`. The motion lasts ``max(T, T_rot)``: when
 takes longer than the drive, the robot stands at the path's end (``v = 0``) while it
 finishes turning.
 
-Sampling conventions (:class:`~trajopt.motion._trajectory.TrajectorySample`):
+Sampling conventions (:class:`~trajopt.motion._trajectory.OmniSample`):
 
 * ``theta`` is the **orientation** of the body (rad, continuous and unwrapped) and ``omega``
   its rate ``d theta / dt`` (rad/s): what the base turns by. The pose of :meth:`to_poses`
@@ -42,12 +42,7 @@ import numpy as np
 
 from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
-from trajopt.motion._trajectory import (
-    SampledExport,
-    Trajectory,
-    TrajectorySample,
-    export_dict,
-)
+from trajopt.motion._trajectory import OmniSample, SampledExport, Trajectory, export_dict
 from trajopt.robot._robot import Robot
 from trajopt.robot._state import State
 
@@ -231,7 +226,7 @@ class OmniTrajectory(SampledExport):
             np.where(end, 0.0, z),
         )
 
-    def sample(self, t: np.ndarray | float) -> TrajectorySample:
+    def sample(self, t: np.ndarray | float) -> OmniSample:
         """Evaluate the motion at times ``t`` (vectorised).
 
         Parameters
@@ -241,7 +236,7 @@ class OmniTrajectory(SampledExport):
 
         Returns
         -------
-        TrajectorySample
+        OmniSample
             Read-only arrays of the shape of ``t``: ``theta``/``omega`` the orientation and
             its rate, ``course``, ``vx``, ``vy``, ``v_body_x``, ``v_body_y`` set, no wheel
             speeds (module docstring).
@@ -271,7 +266,7 @@ class OmniTrajectory(SampledExport):
             "v_body_x": c * vx + s * vy,
             "v_body_y": c * vy - s * vx,
         }
-        return TrajectorySample(**{k: readonly(x) for k, x in arrays.items()})
+        return OmniSample(**{k: readonly(x) for k, x in arrays.items()})
 
     def state_at(self, t: float) -> State:
         """Return the translation's :class:`~trajopt.robot._state.State` at time ``t`` (s).

@@ -52,11 +52,9 @@ SAMPLE_UNITS: dict[str, str] = {
 class TrajectorySample(NamedTuple):
     """Samples of a :class:`Trajectory`; every array has the shape of the query times.
 
-    The fields after ``s`` are optional (``None`` when absent; :meth:`as_dict` and the
-    exports leave them out): the wheel speeds of a differential drive, and the direction of
-    travel and velocities of an omnidirectional motion
-    (:class:`~trajopt.motion._omni.OmniTrajectory`), whose ``theta`` is the body's
-    orientation and ``omega`` its rate.
+    The wheel speeds are optional (``None`` without a differential drive's track width;
+    :meth:`as_dict` and the exports leave them out). An omnidirectional motion's samples are
+    an :class:`OmniSample`.
 
     Attributes
     ----------
@@ -74,11 +72,6 @@ class TrajectorySample(NamedTuple):
     s : arc length travelled (m)
     v_left, v_right : wheel speeds ``v * (1 -+ kappa * track_width / 2)`` (m/s), or ``None``
         when the robot has no ``track_width`` or is omnidirectional
-    course : direction of travel, the path's tangent, continuous and unwrapped (rad), or
-        ``None`` (only an omnidirectional motion has it apart from ``theta``)
-    vx, vy : world-frame velocity ``v * (cos, sin)(course)`` (m/s), or ``None``
-    v_body_x, v_body_y : body-frame velocity, ``(vx, vy)`` rotated by ``-theta`` (m/s): what
-        an omnidirectional base is commanded with; or ``None``
     """
 
     t: np.ndarray
@@ -94,15 +87,48 @@ class TrajectorySample(NamedTuple):
     s: np.ndarray
     v_left: np.ndarray | None = None
     v_right: np.ndarray | None = None
-    course: np.ndarray | None = None
-    vx: np.ndarray | None = None
-    vy: np.ndarray | None = None
-    v_body_x: np.ndarray | None = None
-    v_body_y: np.ndarray | None = None
 
     def as_dict(self) -> dict[str, np.ndarray]:
         """Return the arrays by name (the optional fields only when present)."""
         return {k: v for k, v in self._asdict().items() if v is not None}
+
+
+class OmniSample(NamedTuple):
+    """Samples of an :class:`~trajopt.motion.OmniTrajectory` (omnidirectional base).
+
+    The fields of :class:`TrajectorySample` (``theta`` is the body's orientation and
+    ``omega`` its rate; no wheel speeds), then the direction of travel and the velocities.
+
+    Attributes
+    ----------
+    t, x, y, theta, v, omega, a, jerk, a_lat, kappa, s
+        As :class:`TrajectorySample`.
+    course : direction of travel, the path's tangent, continuous and unwrapped (rad)
+    vx, vy : world-frame velocity ``v * (cos, sin)(course)`` (m/s)
+    v_body_x, v_body_y : body-frame velocity, ``(vx, vy)`` rotated by ``-theta`` (m/s): what
+        an omnidirectional base is commanded with
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    a: np.ndarray
+    jerk: np.ndarray
+    a_lat: np.ndarray
+    kappa: np.ndarray
+    s: np.ndarray
+    course: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    v_body_x: np.ndarray
+    v_body_y: np.ndarray
+
+    def as_dict(self) -> dict[str, np.ndarray]:
+        """Return the arrays by name."""
+        return dict(self._asdict())
 
 
 def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample:
