@@ -443,3 +443,164 @@ def test_bad_footprints_are_one_line_exit_2(
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1, err
         assert match in err, err
+
+
+# ------------------------------------------------- drives and end headings (issue 33, part 5)
+def _wrapped(a):
+    return np.remainder(np.asarray(a, dtype=float) + np.pi, 2.0 * np.pi) - np.pi
+
+
+def test_plan_honours_the_headings_in_every_written_file(door_map, tmp_path, capsys, monkeypatch):
+    """Start facing away from the goal: the plan turns in place, every file ends exactly."""
+    import pandas as pd
+    from matplotlib.quiver import Quiver
+
+    from trajopt.motion._mcap import read_mcap
+
+    saved = _figures(monkeypatch)
+    h0, h1 = 3.0, -1.5
+    head = ["--radius", "0.12", "--start-heading", str(h0), "--goal-heading", str(h1)]
+    csv_out, fig = tmp_path / "traj.csv", tmp_path / "fig.png"
+    rc = main(["plan", str(door_map), *PLAN, *head, "--out", str(csv_out), "--plot", str(fig)])
+    assert rc == 0, capsys.readouterr().err
+    line = capsys.readouterr().out.splitlines()[0]
+    assert "turned in place at the start" in line and "goal" in line, line
+    df = pd.read_csv(csv_out)
+    theta = df["theta [rad] (map)"].to_numpy()
+    assert abs(_wrapped(theta[0] - h0)) <= 1e-9 and abs(_wrapped(theta[-1] - h1)) <= 1e-9
+    still = df["v [m/s]"].to_numpy() == 0.0
+    assert still[:3].all() and still[-3:].all()  # the turns: standing while the heading moves
+    assert np.abs(df["omega [rad/s]"].to_numpy()[still]).max() > 0.1
+    assert df["x [m] (map)"].iloc[0] == pytest.approx(0.4) and df["y [m] (map)"].iloc[-1] == (
+        pytest.approx(1.6)
+    )
+    # JSON and MCAP of the same chain
+    js, mc = tmp_path / "traj.json", tmp_path / "traj.mcap"
+    for out in (js, mc):
+        assert main(["plan", str(door_map), *PLAN, *head, "--out", str(out)]) == 0
+    data = json.loads(js.read_text())
+    assert data["format"] == "trajopt.TrajectoryChain"
+    th = data["samples"]["theta"]
+    assert abs(_wrapped(th[0] - h0)) <= 1e-9 and abs(_wrapped(th[-1] - h1)) <= 1e-9
+    assert [p["type"] for p in data["pieces"]] == ["TurnInPlace", "Trajectory", "TurnInPlace"]
+    back = read_mcap(mc)
+    assert abs(_wrapped(back.theta[0] - h0)) <= 1e-6 and abs(_wrapped(back.theta[-1] - h1)) <= 1e-6
+    # the figure: heading arrows along the trajectory and the two turns marked
+    (ax,) = saved[0].axes
+    assert any(isinstance(c, Quiver) for c in ax.collections)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "turn in place" in labels
+
+
+def test_plan_heading_without_a_turn_says_so(door_map, capsys):
+    # the free curve leaves and arrives close to these: the curve takes them, no turn
+    rc = main(
+        [
+            "plan",
+            str(door_map),
+            *PLAN,
+            "--radius",
+            "0.12",
+            "--start-heading",
+            "0.5",
+            "--goal-heading",
+            "0.9",
+        ]
+    )
+    assert rc == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert "turned in place" in out or "end headings met by the curve, no turn in place" in out
+    from trajopt.cli._plan import _turn_note
+
+    assert _turn_note({}) == ""  # no heading asked: nothing said
+    assert _turn_note({"pose": {"turn_start_rad": 0.0, "turn_goal_rad": 0.0}}) == (
+        "; end headings met by the curve, no turn in place"
+    )
+    assert _turn_note({"pose": {"turn_start_rad": 0.0, "turn_goal_rad": -1.25}}) == (
+        "; turned in place at the goal -1.250 rad"
+    )
+    # an omni base turns its body while it drives (trajopt.timing.orient's statistics)
+    assert _turn_note({"orientation": {"turn_rad": 1.5, "hold_s": 0.0}}) == (
+        "; orientation turned +1.500 rad while driving"
+    )
+    assert _turn_note({"orientation": {"turn_rad": -3.0, "hold_s": 0.25}}) == (
+        "; orientation turned -3.000 rad while driving and 0.250 s standing at the goal"
+    )
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--start-heading", "nan"], "argument --start-heading: the angle must be finite (rad)"),
+        (["--goal-heading", "inf"], "argument --goal-heading: the angle must be finite (rad)"),
+        (["--goal-heading=-inf"], "the angle must be finite (rad), got '-inf'"),
+        (["--start-heading", "north"], "expected an angle in radians, got 'north'"),
+        (
+            ["--drive", "ackermann"],
+            "InvalidInputError: Robot.drive='ackermann' (a car-like robot: turning radius, "
+            "reversing) is not supported yet",
+        ),
+        (["--drive", "tank"], "Robot.drive must be one of ('differential', 'omni'), got 'tank'"),
+    ],
+)
+def test_bad_heading_or_drive_is_one_line_exit_2(extra, match, door_map, capsys):
+    assert run(["plan", str(door_map), *PLAN, *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert match in err, err
+
+
+def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
+    import trajopt._planner
+
+    seen = []
+    real = trajopt._planner.Planner
+
+    class Spy(real):
+        def __init__(self, grid, robot=None, **kwargs):
+            seen.append(robot)
+            super().__init__(grid, robot, **kwargs)
+
+    monkeypatch.setattr(trajopt._planner, "Planner", Spy)
+    out = tmp_path / "omni.json"
+    rc = main(
+        ["plan", str(door_map), *PLAN, "--radius", "0.12", "--drive", "omni", "--out", str(out)]
+    )
+    assert rc == 0, capsys.readouterr().err
+    assert seen[-1].drive == "omni" and seen[-1].radius == 0.12
+    assert json.loads(out.read_text())["robot"]["drive"] == "omni"
+    assert "omni drive" in capsys.readouterr().out
+    # with headings: the orientation turns while driving and ends exactly at the goal's
+    import pandas as pd
+
+    csv_out = tmp_path / "omni.csv"
+    rc = main(
+        [
+            "plan",
+            str(door_map),
+            *PLAN,
+            "--radius",
+            "0.12",
+            "--drive",
+            "omni",
+            "--start-heading",
+            "3",
+            "--goal-heading",
+            "-1.5",
+            "--out",
+            str(csv_out),
+        ]
+    )
+    assert rc == 0, capsys.readouterr().err
+    assert "omni drive" in (line := capsys.readouterr().out) and "orientation turned" in line
+    df = pd.read_csv(csv_out)
+    theta = df["theta [rad] (map)"].to_numpy()
+    assert abs(_wrapped(theta[0] - 3.0)) <= 1e-9 and abs(_wrapped(theta[-1] + 1.5)) <= 1e-9
+    assert "course [rad] (map)" in df.columns and "v_body_y [m/s]" in df.columns
+    assert main(["plan", str(door_map), *PLAN, "--radius", "0.12"]) == 0
+    assert seen[-1].drive == "differential"  # the default
+    with pytest.raises(SystemExit):
+        main(["plan", "--help"])
+    help_text = capsys.readouterr().out
+    for opt in ("--drive {differential,omni}", "--start-heading RAD", "--goal-heading RAD"):
+        assert opt in help_text

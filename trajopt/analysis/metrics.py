@@ -32,6 +32,24 @@ sampled every ``sample_spacing`` metres of arc length, polyline vertices always 
 * ``max_heading_jump_rad``: the largest change of heading between consecutive samples
   ``sample_spacing`` apart (a 45-degree A* corner scores 0.785 rad; a C2 curve scores about
   ``max |kappa| * sample_spacing``).
+
+A timed trajectory given as the path (a :class:`~trajopt.Trajectory`, a
+:class:`~trajopt.motion.TrajectoryChain` with turns in place, a stop-and-turn trajectory) is
+scored along the path it drives (:func:`trajectory_path`).
+
+Turns in place
+--------------
+A differential drive meets a required end heading by turning where it stands: the pieces
+of a :class:`~trajopt.motion.TrajectoryChain` (and the corners of the stop-and-turn
+fallback) where ``v = 0`` while ``omega != 0`` (``kappa = a_lat = 0`` there). Such a turn
+is held to the turn limits of :func:`trajopt.timing.turn_limits` (yaw rate, yaw
+acceleration and yaw jerk of the wheels turning on the spot), not to the driving rule
+``omega = kappa v``: :func:`trajectory_metrics` checks the samples standing still
+(``|v| <=`` :data:`STANDING_V`) against them, the yaw acceleration and jerk from the
+finite differences of the sampled ``omega``. An omnidirectional motion (samples with a
+``course``, the direction of travel, beside ``theta``, the orientation) turns its body by a
+profile under the same limits while it drives: all its samples are checked against them.
+:func:`turns_in_place` lists the turns in place.
 """
 
 from __future__ import annotations
@@ -55,6 +73,10 @@ __all__ = [
     "hausdorff_distance",
     "polyline_hausdorff",
     "heading_jumps",
+    "trajectory_path",
+    "TurnSpan",
+    "turns_in_place",
+    "STANDING_V",
 ]
 
 #: Default arc-length spacing of the samples (m).
@@ -62,6 +84,10 @@ DEFAULT_SAMPLE_SPACING = 0.005
 _COLLISION_TOL = 1e-9
 #: Most samples taken along one path; beyond it the spacing grows (and is reported).
 _MAX_SAMPLES = 20_000
+#: A sample whose speed is at most this (m/s) stands still: a turn in place when it yaws.
+STANDING_V = 1e-9
+#: Yaw rate (rad/s) above which a standing sample turns.
+_TURNING_OMEGA = 1e-9
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,7 +173,48 @@ def _as_curve(path: object, grid: Any) -> ParametricCurve:
         return path
     if all(hasattr(path, a) for a in ("domain", "sample", "heading", "curvature", "length")):
         return path  # type: ignore[return-value]  # duck-typed ParametricCurve
+    if hasattr(path, "duration") and hasattr(path, "sample"):  # a timed trajectory
+        return _as_curve(trajectory_path(path), grid)
     return PolylineCurve(_points_of(path, grid, "path"))
+
+
+#: Time step (s) of the polyline :func:`trajectory_path` samples when no piece's path serves.
+_PATH_DT = 0.002
+
+
+def trajectory_path(traj: Any) -> Any:
+    """Return the path a timed trajectory drives along (metres).
+
+    Parameters
+    ----------
+    traj : Trajectory, TrajectoryChain or StopAndTurnTrajectory
+        Anything with ``duration`` (s) and ``sample(t)`` returning ``x, y`` (m); its
+        ``path`` is used when it has one.
+
+    Returns
+    -------
+    ParametricCurve or PolylineCurve
+        ``traj.path`` when set (a :class:`~trajopt.Trajectory`'s curve, the stop-and-turn
+        polyline); for a chain whose only moving piece is played whole (a pose-to-pose plan:
+        turns in place and one curve), that piece's path. Otherwise the polyline of the
+        positions sampled every 2 ms (points that do not move dropped; a trajectory that
+        never moves gives a polyline of length 0 at its point).
+    """
+    path = getattr(traj, "path", None)
+    if path is not None:
+        return path
+    pieces = getattr(traj, "pieces", None)
+    if pieces:
+        starts = tuple(getattr(traj, "starts", ())) or (0.0,) * len(pieces)
+        moving = [(p, t0) for p, t0 in zip(pieces, starts, strict=True) if float(p.length) > 0.0]
+        if len(moving) == 1 and moving[0][1] == 0.0:
+            return trajectory_path(moving[0][0])
+    duration = float(traj.duration)
+    n = max(2, min(int(math.ceil(duration / _PATH_DT)) + 1, 50 * _MAX_SAMPLES))
+    smp = traj.sample(np.linspace(0.0, duration, n))
+    xy = np.column_stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)])
+    keep = np.concatenate([[True], np.hypot(*np.diff(xy, axis=0).T) > 1e-9])
+    return PolylineCurve(xy[keep])
 
 
 # ============================================================================ geometry
@@ -615,6 +682,8 @@ _TRAJ_QUANTITIES = (
     ("omega", "omega_max", "omega", "radps"),
     ("a_lat", "a_lat_max", "a_lat", "mps2"),
 )
+#: The turn-in-place quantities: (key stem, unit suffix), in the order of ``turn_limits``.
+_TURN_QUANTITIES = (("turn_omega", "radps"), ("turn_alpha", "radps2"), ("turn_zeta", "radps3"))
 
 
 def _field(rec: Any, name: str) -> np.ndarray | None:
@@ -625,19 +694,71 @@ def _field(rec: Any, name: str) -> np.ndarray | None:
     return None if val is None else np.asarray(val, dtype=float)
 
 
+def _needed(rec: Any, name: str) -> np.ndarray:
+    vals = _field(rec, name)
+    if vals is None:
+        raise InvalidInputError(f"the trajectory's samples have no {name!r}")
+    return vals
+
+
+def _turn_limits(robot: Any) -> tuple[float, float, float]:
+    """``trajopt.timing.turn_limits(robot)``; NaNs for a robot without the fields they need."""
+    from trajopt.timing._stop_and_turn import turn_limits
+
+    try:
+        return tuple(float(x) for x in turn_limits(robot))  # type: ignore[return-value]
+    except (AttributeError, TypeError, ValueError, ZeroDivisionError):
+        return (math.nan,) * 3
+
+
+def _turn_peaks(t: np.ndarray, rec: Any) -> list[float]:
+    """Peak |yaw rate|, |yaw acceleration| and |yaw jerk| of the turning samples.
+
+    The turning samples are those standing still, or every sample when the samples carry a
+    ``course`` (an omnidirectional motion, whose ``omega`` is its orientation's rate). The
+    yaw acceleration is the difference quotient of ``omega`` over each step whose two
+    samples turn, the yaw jerk the second difference over three (the grid is uniform). On a
+    jerk-limited turn (``omega`` continuously differentiable) these are averages of the true
+    values over the step, so they never exceed the true peaks.
+    """
+    v, omega = _field(rec, "v"), _field(rec, "omega")
+    if v is None or omega is None or not v.size:
+        return [0.0, 0.0, 0.0]
+    v = np.broadcast_to(v, t.shape)
+    omega = np.broadcast_to(omega, t.shape)
+    if _field(rec, "course") is not None:
+        turning = np.ones(t.shape, bool)
+    else:
+        turning = np.abs(v) <= STANDING_V
+    peaks = [float(np.max(np.abs(omega[turning]), initial=0.0))]
+    h = float(t[1] - t[0]) if len(t) > 1 else 0.0
+    if h <= 0.0:
+        return peaks + [0.0, 0.0]
+    both = turning[1:] & turning[:-1]
+    alpha = np.diff(omega) / h
+    peaks.append(float(np.max(np.abs(alpha[both]), initial=0.0)))
+    three = both[1:] & both[:-1]
+    zeta = np.diff(alpha) / h
+    peaks.append(float(np.max(np.abs(zeta[three]), initial=0.0)))
+    return peaks
+
+
 def trajectory_metrics(
     traj: Any, robot: Any, *, dt: float = 0.005, tol: float = 1e-6
 ) -> dict[str, Any]:
-    """Duration and peak |v|, |a|, |jerk|, |omega|, |a_lat| of a timed trajectory.
+    """Duration and peak |v|, |a|, |jerk|, |omega|, |a_lat| of a timed trajectory, and its turns.
 
     Parameters
     ----------
-    traj : Trajectory
+    traj : Trajectory or TrajectoryChain
         Anything with ``duration`` (s) and ``sample(t)`` returning a mapping or record of
-        named arrays (``t, x, y, theta, v, omega, a, jerk, a_lat, kappa, s``).
+        named arrays (``t, x, y, theta, v, omega, a, jerk, a_lat, kappa, s``): a
+        :class:`~trajopt.Trajectory`, a :class:`~trajopt.motion.TrajectoryChain` with turns
+        in place, a stop-and-turn trajectory.
     robot : Robot
         Anything with ``v_max, a_max, j_max, omega_max, a_lat_max`` (a missing or ``None``
-        limit gives a NaN ratio and is not checked).
+        limit gives a NaN ratio and is not checked); the turns are checked against
+        :func:`trajopt.timing.turn_limits` of it.
     dt : float
         Sampling step (s, > 0); the end time is always sampled.
     tol : float
@@ -648,8 +769,13 @@ def trajectory_metrics(
     dict
         ``duration_s``, ``sample_dt_s``, and for each quantity ``q`` in ``v, a, jerk,
         omega, a_lat``: ``peak_q_<unit>``, ``limit_q_<unit>`` and ``ratio_q`` (peak over
-        limit), plus ``within_limits`` (every ratio <= 1 + tol). ``a_lat`` falls back to
-        ``v^2 kappa`` when the samples lack it.
+        limit; ``a_lat`` falls back to ``v^2 kappa`` when the samples lack it). The turns
+        (module docstring: the samples standing still, or all of an omnidirectional motion's)
+        add ``turn_omega`` (yaw rate, rad/s), ``turn_alpha`` (yaw acceleration, rad/s^2)
+        and ``turn_zeta`` (yaw jerk, rad/s^3), each with ``peak_``, ``limit_`` (from
+        :func:`trajopt.timing.turn_limits`; NaN, not checked, for a robot without the
+        fields it needs) and ``ratio_`` keys; the peaks are 0 when the trajectory never
+        turns on the spot. ``within_limits``: every ratio <= 1 + tol.
     """
     try:
         step = float(dt)
@@ -665,6 +791,16 @@ def trajectory_metrics(
     rec = traj.sample(t)
     out: dict[str, Any] = {"duration_s": duration, "sample_dt_s": duration / (n - 1)}
     ok = True
+
+    def record(stem: str, unit: str, peak: float, lim: float) -> None:
+        nonlocal ok
+        ratio = peak / lim if lim > 0 else math.nan
+        out[f"peak_{stem}_{unit}"] = peak
+        out[f"limit_{stem}_{unit}"] = lim
+        out[f"ratio_{stem}"] = ratio
+        if math.isfinite(ratio) and ratio > 1.0 + tol:
+            ok = False
+
     for fld, lim_name, stem, unit in _TRAJ_QUANTITIES:
         vals = _field(rec, fld)
         if vals is None and fld == "a_lat":
@@ -672,12 +808,95 @@ def trajectory_metrics(
             vals = None if v is None or kap is None else v * v * kap
         peak = float(np.max(np.abs(vals))) if vals is not None and vals.size else math.nan
         lim = getattr(robot, lim_name, None)
-        lim = math.nan if lim is None else float(lim)
-        ratio = peak / lim if lim > 0 else math.nan
-        out[f"peak_{stem}_{unit}"] = peak
-        out[f"limit_{stem}_{unit}"] = lim
-        out[f"ratio_{stem}"] = ratio
-        if math.isfinite(ratio) and ratio > 1.0 + tol:
-            ok = False
+        record(stem, unit, peak, math.nan if lim is None else float(lim))
+    peaks = _turn_peaks(t, rec)
+    for (stem, unit), peak, lim in zip(_TURN_QUANTITIES, peaks, _turn_limits(robot), strict=True):
+        record(stem, unit, peak, lim)
     out["within_limits"] = ok
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class TurnSpan:
+    """One turn in place found by :func:`turns_in_place` (times to the sampling step).
+
+    Attributes
+    ----------
+    t0, t1 : float
+        First and last sample of the turn (s): the robot stands still from ``t0`` to ``t1``
+        and yaws in between.
+    x, y : float
+        Where it turns (m).
+    theta0, theta1 : float
+        Heading at ``t0`` and ``t1`` (rad, as sampled: continuous, not wrapped).
+    """
+
+    t0: float
+    t1: float
+    x: float
+    y: float
+    theta0: float
+    theta1: float
+
+    @property
+    def turn_rad(self) -> float:
+        """The signed angle turned, ``theta1 - theta0`` (rad)."""
+        return self.theta1 - self.theta0
+
+
+def turns_in_place(traj: Any, *, dt: float = 0.01) -> list[TurnSpan]:
+    """Return the turns in place of a timed trajectory, in time order.
+
+    A turn is a run of consecutive samples standing still (``|v| <=`` :data:`STANDING_V`)
+    in which the robot yaws (``|omega| > 1e-9`` rad/s at one of them): the turns in place of
+    a :class:`~trajopt.motion.TrajectoryChain` and the corners of the stop-and-turn
+    fallback. Turns one after another at the same spot are one span.
+
+    Parameters
+    ----------
+    traj : Trajectory or TrajectoryChain
+        Anything with ``duration`` (s) and ``sample(t)`` returning ``t``-aligned arrays
+        ``x, y, theta, v, omega``.
+    dt : float
+        Sampling step (s, finite, > 0; at most 1e6 samples); a turn shorter than it may be
+        missed, and the span's ends are within it of the turn's.
+
+    Returns
+    -------
+    list of TurnSpan
+    """
+    try:
+        step = float(dt)
+        duration = float(traj.duration)
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise InvalidInputError(f"traj needs a numeric duration and dt a number: {exc}") from exc
+    if not (math.isfinite(step) and step > 0):
+        raise InvalidInputError(f"dt must be finite and > 0 s, got {step!r}")
+    if not (math.isfinite(duration) and duration >= 0):
+        raise InvalidInputError(f"traj.duration must be finite and >= 0 s, got {duration!r}")
+    if duration / step > 1e6:
+        raise InvalidInputError(
+            f"dt={step!r} s gives more than 1e6 samples over {duration:.6g} s; use a larger dt"
+        )
+    n = max(2, int(math.ceil(duration / step)) + 1)
+    t = np.linspace(0.0, duration, n)
+    smp = traj.sample(t)
+    x, y, theta, v, omega = (
+        np.broadcast_to(_needed(smp, k), t.shape) for k in ("x", "y", "theta", "v", "omega")
+    )
+    still = np.abs(v) <= STANDING_V
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
+    spans = []
+    for i0, i1 in zip(edges[::2], edges[1::2] - 1, strict=True):
+        if np.any(np.abs(omega[i0 : i1 + 1]) > _TURNING_OMEGA):
+            spans.append(
+                TurnSpan(
+                    float(t[i0]),
+                    float(t[i1]),
+                    float(x[i0]),
+                    float(y[i0]),
+                    float(theta[i0]),
+                    float(theta[i1]),
+                )
+            )
+    return spans

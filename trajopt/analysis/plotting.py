@@ -1,8 +1,8 @@
 """Figures: the map with avoidance area, corridor and paths.
 
 Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11), the
-robot's footprint (or disc) at regular times along a timed trajectory, and time plots of a
-trajectory with its limits.
+robot's footprint (or disc) at regular times along a timed trajectory, its heading as
+arrows with the turns in place marked, and time plots of a trajectory with its limits.
 
 matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
 Every function returns the matplotlib objects it drew on, for further styling.
@@ -18,10 +18,19 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.geometry._curve import ParametricCurve
 
-__all__ = ["plot_map", "plot_paths", "plot_footprints", "plot_profiles", "path_points"]
+__all__ = [
+    "plot_map",
+    "plot_paths",
+    "plot_footprints",
+    "plot_headings",
+    "plot_profiles",
+    "path_points",
+]
 
 #: Most poses :func:`plot_footprints` draws; a smaller ``every_s`` is refused.
 MAX_FOOTPRINTS = 10_000
+#: Most heading arrows :func:`plot_headings` draws.
+MAX_ARROWS = 10_000
 
 _COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
 
@@ -33,7 +42,8 @@ def path_points(path: Any, spacing: float | None = None) -> np.ndarray:
     ----------
     path : ParametricCurve, timed trajectory or array_like, shape (m, 2)
         Curves are sampled every ``spacing`` metres (default: 400 samples); timed
-        trajectories (``Trajectory``, ``TrajectoryChain``, ...) every 10 ms.
+        trajectories (``Trajectory``, ``TrajectoryChain``, anything with ``duration`` and
+        ``sample``) every 10 ms.
     spacing : float, optional
         Sample spacing in metres for curves.
     """
@@ -42,6 +52,11 @@ def path_points(path: Any, spacing: float | None = None) -> np.ndarray:
     if hasattr(path, "sample_uniform"):
         smp = path.sample_uniform(0.01)
         return np.column_stack([smp.x, smp.y])
+    if _is_timed(path):
+        duration = float(path.duration)
+        n = int(np.clip(np.ceil(duration / 0.01), 1, 1_000_000)) + 1
+        smp = path.sample(np.linspace(0.0, duration, n))
+        return np.column_stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)])
     pts = np.asarray(path, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"path must be a curve or an (m, 2) array, got shape {pts.shape}")
@@ -121,6 +136,7 @@ def plot_paths(
     start: Sequence[float] | None = None,
     goals: Mapping[str, Sequence[float]] | None = None,
     zoom: tuple[float, float, float, float] | None = None,
+    arrows: int = 0,
     ax: Any = None,
 ) -> tuple[Any, Any]:
     """Return the map with every method's path (the chapter's Figures 7-10; with ``zoom``, 11).
@@ -129,8 +145,10 @@ def plot_paths(
     ----------
     grid : OccupancyGrid
         Raw map.
-    paths : mapping of str to curve or array_like (m, 2)
-        Method name -> path in metres.
+    paths : mapping of str to curve, timed trajectory or array_like (m, 2)
+        Method name -> path in metres. A timed trajectory (``Trajectory``,
+        ``TrajectoryChain``, ...) is drawn along the positions it passes (solid, as curves;
+        polylines dashed).
     inflated, corridor : optional
         See :func:`plot_map`.
     start : (x, y), optional
@@ -139,17 +157,37 @@ def plot_paths(
         Named targets (m).
     zoom : (xmin, xmax, ymin, ymax), optional
         Axis limits in metres for a zoomed view.
+    arrows : int
+        Heading arrows per timed trajectory (:func:`plot_headings`: ``theta`` at ``arrows``
+        evenly timed samples, both ends included, and its turns in place marked), in the
+        trajectory's colour; 0 (default) draws none. Curves and polylines get none.
     ax : matplotlib Axes, optional
 
     Returns
     -------
     (Figure, Axes)
+
+    Raises
+    ------
+    ValueError
+        ``arrows`` not an integer in ``[0, MAX_ARROWS]``, or a path that is neither a curve,
+        a timed trajectory nor an (m, 2) array.
     """
+    n_arrows = _arrow_count(arrows)
     fig, ax = plot_map(grid, inflated=inflated, corridor=corridor, ax=ax)
+    marked = False  # one legend entry for the turns in place of every trajectory
     for i, (name, path) in enumerate(paths.items()):
         pts = path_points(path)
-        style = "-" if isinstance(path, ParametricCurve) else "--"
-        ax.plot(pts[:, 0], pts[:, 1], style, color=_COLORS[i % len(_COLORS)], lw=1.4, label=name)
+        timed = _is_timed(path)
+        color = _COLORS[i % len(_COLORS)]
+        style = "-" if isinstance(path, ParametricCurve) or timed else "--"
+        ax.plot(pts[:, 0], pts[:, 1], style, color=color, lw=1.4, label=name)
+        if timed and n_arrows:
+            _, marks = plot_headings(ax, path, n_arrows, color=color)
+            if marks is not None:
+                if marked:
+                    marks.set_label("_nolegend_")
+                marked = True
     if start is not None:
         ax.plot(*start, "ks", ms=7, label="start")
     for name, g in (goals or {}).items():
@@ -160,6 +198,135 @@ def plot_paths(
         ax.set_ylim(zoom[2], zoom[3])
     ax.legend(loc="best", fontsize="small")
     return fig, ax
+
+
+def _is_timed(path: Any) -> bool:
+    """Whether ``path`` is a timed trajectory (not a curve, not points)."""
+    return (
+        not isinstance(path, ParametricCurve)
+        and hasattr(path, "duration")
+        and callable(getattr(path, "sample", None))
+    )
+
+
+def _arrow_count(arrows: Any) -> int:
+    if isinstance(arrows, bool) or not isinstance(arrows, (int, np.integer)):
+        raise ValueError(f"arrows must be an integer >= 0, got {arrows!r}")
+    if not 0 <= arrows <= MAX_ARROWS:
+        raise ValueError(f"arrows must lie in [0, {MAX_ARROWS}], got {arrows!r}")
+    return int(arrows)
+
+
+def plot_headings(
+    ax: Any,
+    trajectory: Any,
+    n: int = 20,
+    *,
+    length: float | None = None,
+    color: str = "tab:blue",
+    turns: bool = True,
+    label: str | None = None,
+) -> tuple[Any, Any]:
+    """Draw the heading ``theta`` as arrows at evenly timed samples, and mark the turns in place.
+
+    The arrows point along ``theta`` (for a differential drive the direction of travel, for
+    an omnidirectional base its orientation, which may differ from the path's direction).
+    A turn in place (the robot stands and yaws: :func:`trajopt.metrics.turns_in_place`) is
+    marked by a ring at its spot, annotated with the angle turned.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        Axes in metres (e.g. from :func:`plot_paths`).
+    trajectory : Trajectory or TrajectoryChain
+        Anything with ``duration`` (s) and ``sample(t)`` returning named arrays ``x, y``
+        (m) and ``theta`` (rad); the turns are found from ``v`` (m/s) and ``omega``
+        (rad/s), and not marked when the samples lack them.
+    n : int
+        Number of arrows (>= 1, at most :data:`MAX_ARROWS`), at ``t = k duration / (n - 1)``
+        (one arrow at ``t = 0`` when ``n = 1``).
+    length : float, optional
+        Arrow length (m, finite, > 0); default 6 % of the larger side of the trajectory's
+        bounding box (0.1 m for a trajectory that does not move).
+    color : str
+        Colour of the arrows and the turn marks.
+    turns : bool
+        Mark the turns in place (default ``True``).
+    label : str, optional
+        Legend label of the arrows (default none); the turn marks are labelled
+        ``"turn in place"``.
+
+    Returns
+    -------
+    (Quiver, Line2D or None)
+        The arrows and the turn marks (``None`` when there is no turn or ``turns`` is off).
+
+    Raises
+    ------
+    ValueError
+        ``n`` not an integer in ``[1, MAX_ARROWS]``, a bad ``length`` or a non-finite
+        duration.
+    """
+    count = _arrow_count(n)
+    if count < 1:
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    duration = float(trajectory.duration)
+    if not (np.isfinite(duration) and duration >= 0.0):
+        raise ValueError(f"trajectory duration must be finite and >= 0 (s), got {duration!r}")
+    t = np.linspace(0.0, duration, count)
+    smp = trajectory.sample(t)
+    x, y, theta = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (smp.x, smp.y, smp.theta))
+    if length is None:
+        pts = path_points(trajectory)
+        extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        arrow = 0.06 * extent if extent > 0.0 else 0.1
+    else:
+        try:
+            arrow = float(length)
+        except (TypeError, ValueError):
+            raise ValueError(f"length must be a number of metres > 0, got {length!r}") from None
+        if not (np.isfinite(arrow) and arrow > 0.0):
+            raise ValueError(f"length must be finite and > 0 (m), got {length!r}")
+    quiver = ax.quiver(
+        x,
+        y,
+        arrow * np.cos(theta),
+        arrow * np.sin(theta),
+        angles="xy",
+        scale_units="xy",
+        scale=1.0,
+        width=0.004,
+        color=color,
+        zorder=4,
+        label=label,
+    )
+    marks = None
+    if turns and all(hasattr(smp, k) for k in ("v", "omega")):
+        from trajopt.analysis.metrics import turns_in_place
+
+        spans = turns_in_place(trajectory, dt=max(duration / 20_000, 0.01))
+        if spans:
+            (marks,) = ax.plot(
+                [sp.x for sp in spans],
+                [sp.y for sp in spans],
+                "o",
+                ms=11,
+                mfc="none",
+                mec=color,
+                mew=1.4,
+                zorder=5,
+                label="turn in place",
+            )
+            for sp in spans:
+                ax.annotate(
+                    f"{sp.turn_rad:+.2f} rad",
+                    (sp.x, sp.y),
+                    textcoords="offset points",
+                    xytext=(6, -12),
+                    fontsize="small",
+                    color=color,
+                )
+    return quiver, marks
 
 
 def plot_footprints(

@@ -10,6 +10,7 @@ output helpers (:func:`atomic_output`, :func:`save_figure`) write files atomical
 from __future__ import annotations
 
 import argparse
+import math
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -63,6 +64,17 @@ class CliError(Exception):
     """A user-facing failure: printed as one line, exit code 2."""
 
 
+def finite_angle(text: str) -> float:
+    """Return an angle (rad) given on the command line: a finite number, else a usage error."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an angle in radians, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"the angle must be finite (rad), got {text!r}")
+    return value
+
+
 # ----------------------------------------------------------------- arguments
 def shape_args(g: Any, radius_help: str) -> None:
     """Add ``--radius``, ``--footprint`` and ``--footprint-file``, mutually exclusive."""
@@ -98,6 +110,14 @@ def robot_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--wheel-v-max", type=float, help="max wheel speed [m/s]")
     g.add_argument(
         "--no-wheels", action="store_true", help="no differential-drive wheel-speed limit"
+    )
+    g.add_argument(
+        "--drive",
+        default="differential",
+        metavar="{differential,omni}",
+        help="how the base moves: 'differential' (default; faces its direction of travel, "
+        "turns in place at rest) or 'omni' (mecanum/omni wheels: the orientation is "
+        "independent of the direction of travel)",
     )
 
 
@@ -230,6 +250,8 @@ def robot_from_args(args: argparse.Namespace):
     )
     kwargs = {k: getattr(args, k, None) for k in names}
     kwargs = {k: v for k, v in kwargs.items() if v is not None}
+    if getattr(args, "drive", None) is not None:
+        kwargs["drive"] = args.drive  # validated by Robot ('ackermann' refused with its reason)
     if getattr(args, "no_wheels", False):
         kwargs["track_width"] = None
         kwargs["wheel_v_max"] = None

@@ -15,6 +15,7 @@ from typing import Any
 from trajopt.cli._common import (
     CliError,
     atomic_output,
+    finite_angle,
     load_map,
     map_args,
     require_matplotlib,
@@ -26,6 +27,7 @@ from trajopt.cli._common import (
 
 _OUT_SUFFIXES = (".csv", ".json", ".mcap")
 _PLOT_POSES = (5, 40)  # least and most footprints drawn along the trajectory by plan --plot
+_PLOT_ARROWS = 16  # heading arrows drawn by plan --plot when a heading is asked or the base is omni
 
 
 # ----------------------------------------------------------------- arguments
@@ -94,8 +96,20 @@ def add_parsers(sub: Any) -> None:
         "axis-aligned boxes of free cells only",
     )
     p.add_argument("--kappa-max", type=float, help="curvature bound [1/m] for the smoother")
-    p.add_argument("--start-heading", type=float, help="exact start heading [rad]")
-    p.add_argument("--goal-heading", type=float, help="exact goal heading [rad]")
+    p.add_argument(
+        "--start-heading",
+        type=finite_angle,
+        metavar="RAD",
+        help="heading the robot starts with [rad, map frame, finite]; a differential drive "
+        "turns in place first when that is needed or faster",
+    )
+    p.add_argument(
+        "--goal-heading",
+        type=finite_angle,
+        metavar="RAD",
+        help="heading required at the goal [rad, map frame, finite]; a differential drive "
+        "turns in place at the goal when that is needed or faster",
+    )
     p.add_argument(
         "--fallback",
         action="store_true",
@@ -177,16 +191,22 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         costmap_weight=args.costmap_weight,
         speed_limits=speed_limits,
     )
+    t0 = time.perf_counter()
     traj = planner.plan(
         args.start, args.goal, start_heading=args.start_heading, goal_heading=args.goal_heading
     )
-    stages = traj.stats.get("stages_s", {})
+    wall = time.perf_counter() - t0
+    # a pose plan's stage times are its chosen candidate's: the query took the wall time
+    total = wall if traj.stats.get("pose") else traj.stats.get("stages_s", {}).get("total")
     line = (
-        f"duration {traj.duration:.3f} s, length {traj.path.length:.3f} m, "
-        f"planned in {1e3 * stages.get('total', float('nan')):.1f} ms"
+        f"duration {traj.duration:.3f} s, length {traj.length:.3f} m, "
+        f"planned in {1e3 * (float('nan') if total is None else total):.1f} ms"
     )
+    if robot.drive != "differential":
+        line += f", {robot.drive} drive"
     if traj.stats.get("corridor"):
         line += f", corridor {traj.stats['corridor']}"
+    line += _turn_note(traj.stats)
     if traj.stats.get("fallback"):
         reason = str(traj.stats.get("fallback_reason", "")).splitlines()[0][:120]
         line += (
@@ -213,13 +233,17 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
         name = "stop and turn" if traj.stats.get("fallback") else "proposed"
+        posed = robot.drive != "differential" or (
+            args.start_heading is not None or args.goal_heading is not None
+        )
         plot_paths(
             grid,
-            {"A*": steps.grid_path.to_world(grid), name: traj.path},
+            {"A*": steps.grid_path.to_world(grid), name: traj},
             inflated=steps.inflated_grid,
             corridor=steps.corridor,
             start=steps.start,
             goals={"goal": steps.goal},
+            arrows=_PLOT_ARROWS if posed else 0,
             ax=ax,
         )
         if robot.footprint is not None:
@@ -230,6 +254,29 @@ def _cmd_plan(args: argparse.Namespace) -> int:
             ax.legend(loc="best", fontsize="small")
         print(f"wrote {save_figure(fig, args.plot)}")
     return 0
+
+
+def _turn_note(stats: Any) -> str:
+    """Return the summary line's note on how the plan met the end headings.
+
+    A differential drive's pose plan (``stats["pose"]``) says which ends it turned in place
+    at; an omnidirectional one (``stats["orientation"]``) how far its body turned while it
+    drove, and how long it stood at the goal to finish the turn.
+    """
+    pose, orientation = stats.get("pose"), stats.get("orientation")
+    if pose:
+        turns = {e: float(pose.get(f"turn_{e}_rad", 0.0)) for e in ("start", "goal")}
+        done = [f"{e} {a:+.3f} rad" for e, a in turns.items() if a != 0.0]
+        if not done:
+            return "; end headings met by the curve, no turn in place"
+        return f"; turned in place at the {', '.join(done)}"
+    if orientation:
+        note = f"; orientation turned {float(orientation.get('turn_rad', 0.0)):+.3f} rad"
+        hold = float(orientation.get("hold_s", 0.0))
+        if hold > 0.0:
+            return note + f" while driving and {hold:.3f} s standing at the goal"
+        return note + " while driving"
+    return ""
 
 
 def _table_text(table: Any, fmt: str) -> str:

@@ -310,3 +310,49 @@ def test_polynomial_tuned_on_a_does_worse_elsewhere_especially_vertical(paper_re
     for name in rows:
         assert bs[name]["fit_mse_m2"] < rows[name]["fit_mse_m2"], name
         assert bs[name]["hausdorff_m"] < rows[name]["hausdorff_m"], name
+
+
+# ------------------------------------------------------ pose to pose (issue 33, part 5)
+def test_proposed_with_headings_turns_in_place_and_holds_the_turn_limits() -> None:
+    """The paper scene SP -> A facing away from A: the plan is a chain with turns in place."""
+    from trajopt.analysis.metrics import trajectory_metrics, trajectory_path
+
+    scene = scenes.paper()
+    headings = {"start_heading": math.pi, "goal_heading": -math.pi / 2}
+    table = cmp.compare(
+        scene.grid,
+        scene.start,
+        scene.goal("A"),
+        robot_radius=scene.robot_radius,
+        w_cells=scene.w_cells,
+        methods=["A*", "proposed"],
+        options={"proposed": headings},
+    )
+    row = table.row("proposed")
+    assert row["valid"] and not row["collision"], row["note"]
+    assert "turns in place start +3.13 rad" in row["note"]
+    for key in ("ratio_v", "ratio_a", "ratio_omega", "ratio_turn_omega", "ratio_turn_alpha"):
+        assert row[key] <= 1 + 1e-6, key
+    assert row["ratio_turn_omega"] > 0.9  # a half turn reaches the turn's yaw-rate limit
+    # the row scores the curve the chain drives; the turn columns are the proposed row's
+    import trajopt
+
+    chain = trajopt.Planner(scene.grid).plan(scene.start, scene.goal("A"), **headings)
+    assert isinstance(chain, trajopt.TrajectoryChain)
+    assert row["length_m"] == pytest.approx(trajectory_path(chain).length, rel=1e-9)
+    assert row["duration_s"] == pytest.approx(trajectory_metrics(chain, chain.robot)["duration_s"])
+    assert math.isnan(table.row("A*").get("ratio_turn_omega", math.nan))
+    # an omni base turns its body while it drives: same columns, the turn in the note
+    omni = trajopt.Robot(radius=scene.robot_radius, drive="omni")
+    table = cmp.compare(
+        scene.grid,
+        scene.start,
+        scene.goal("A"),
+        robot_radius=scene.robot_radius,
+        w_cells=scene.w_cells,
+        methods=["proposed"],
+        options={"proposed": {"robot": omni, **headings}},
+    )
+    row = table.row("proposed")
+    assert row["valid"] and "orientation turned" in row["note"], row["note"]
+    assert 0 < row["ratio_turn_omega"] <= 1 + 1e-6 and row["ratio_turn_alpha"] <= 1 + 1e-6

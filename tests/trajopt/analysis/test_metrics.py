@@ -353,3 +353,184 @@ def test_trajectory_metrics_record_without_a_lat_and_missing_limit() -> None:
     assert math.isnan(out["ratio_a_lat"]) and out["within_limits"] is True
     with pytest.raises(InvalidInputError, match="dt"):
         metrics.trajectory_metrics(Traj(), Robot(), dt=0.0)
+
+
+# ------------------------------------------------------ turns in place (issue 33, part 5)
+#: The paper scene's query SP -> A with the robot facing away from the goal at the start and
+#: a goal heading the curve does not arrive along: turns in place at both ends.
+HEADINGS = (math.pi, -math.pi / 2)
+
+
+@pytest.fixture(scope="module")
+def posed(scene):
+    """``(robot, chain)``: a default robot's pose-to-pose plan SP -> A."""
+    import trajopt
+
+    planner = trajopt.Planner(scene.grid)
+    chain = planner.plan(
+        scene.start, scene.goal("A"), start_heading=HEADINGS[0], goal_heading=HEADINGS[1]
+    )
+    return planner.robot, chain
+
+
+def _standing_fd(traj, dt: float = 1e-3):
+    """Peak |d theta/dt| and |d^2 theta/dt^2| of the standing samples, from theta alone.
+
+    Independent of the samples' ``omega``: first and second differences of the heading
+    sampled every ``dt`` over runs where the robot stands (``v == 0``). Both are averages
+    of the true rate and acceleration over the stencil, so never above the true peaks.
+    """
+    t = np.linspace(0.0, traj.duration, int(round(traj.duration / dt)) + 1)
+    smp = traj.sample(t)
+    h = t[1] - t[0]
+    still = np.asarray(smp.v) == 0.0
+    theta = np.asarray(smp.theta)
+    rate = np.diff(theta) / h
+    both = still[1:] & still[:-1]
+    acc = np.diff(theta, 2) / h**2
+    three = both[1:] & both[:-1]
+    return float(np.abs(rate[both]).max()), float(np.abs(acc[three]).max())
+
+
+def test_chain_turns_are_held_to_the_turn_limits(posed) -> None:
+    from tests.reference import turn_limits_by_hand
+    from trajopt.motion import TrajectoryChain, TurnInPlace
+
+    robot, chain = posed
+    assert isinstance(chain, TrajectoryChain)
+    assert [type(p) for p in chain.pieces][0] is TurnInPlace
+    assert type(chain.pieces[-1]) is TurnInPlace
+    out = metrics.trajectory_metrics(chain, robot)
+    assert out["within_limits"] is True, out
+    w_lim, alpha_lim, zeta_lim = turn_limits_by_hand(robot)
+    assert out["limit_turn_omega_radps"] == pytest.approx(w_lim, rel=1e-12)
+    assert out["limit_turn_alpha_radps2"] == pytest.approx(alpha_lim, rel=1e-12)
+    assert out["limit_turn_zeta_radps3"] == pytest.approx(zeta_lim, rel=1e-12)
+    # the turns of pi and ~2 rad reach the yaw-rate and yaw-acceleration limits: the peaks
+    # of the metrics agree with the finite differences of the sampled heading
+    rate_fd, acc_fd = _standing_fd(chain)
+    assert rate_fd <= w_lim * (1 + 1e-9) and acc_fd <= alpha_lim * (1 + 1e-6)
+    assert out["peak_turn_omega_radps"] == pytest.approx(rate_fd, rel=1e-3)
+    assert out["peak_turn_alpha_radps2"] == pytest.approx(acc_fd, rel=1e-2)
+    assert out["ratio_turn_omega"] == pytest.approx(1.0, rel=1e-3)
+    assert out["ratio_turn_alpha"] == pytest.approx(1.0, rel=1e-2)
+    # a turn in place has v = 0 and kappa = 0: nothing of the driving rule trips on it
+    turn = chain.pieces[0].sample(np.linspace(0.0, chain.pieces[0].duration, 50))
+    assert np.all(turn.v == 0) and np.all(turn.kappa == 0) and np.abs(turn.omega).max() > 1
+    for key in ("ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat"):
+        assert out[key] <= 1 + 1e-6, key
+
+
+def test_a_turn_beyond_the_turn_limits_is_caught() -> None:
+    import trajopt
+    from trajopt.motion import TrajectoryChain
+    from trajopt.timing import turn_in_place
+
+    fast = trajopt.Robot()  # turns at min(1.5, 0.6 / 0.14) rad/s, 0.5 / 0.14 rad/s^2
+    chain = TrajectoryChain((turn_in_place((1.0, 1.0), 0.0, 2.5, fast),), fast)
+    assert metrics.trajectory_metrics(chain, fast)["within_limits"] is True
+    # the same turn for slower wheels (1 rad/s): within omega_max, beyond the turn's rate
+    slow_wheels = trajopt.Robot(wheel_v_max=0.14)
+    out = metrics.trajectory_metrics(chain, slow_wheels)
+    assert out["ratio_omega"] <= 1.0 and out["ratio_turn_omega"] == pytest.approx(1.5, rel=1e-6)
+    assert out["within_limits"] is False
+    # a wider track (h = 0.28 m): half the yaw acceleration allowed
+    wide = trajopt.Robot(track_width=0.56, wheel_v_max=1.2)
+    out = metrics.trajectory_metrics(chain, wide)
+    assert out["ratio_turn_omega"] <= 1.0 and out["ratio_turn_alpha"] > 1.9
+    assert out["within_limits"] is False
+
+    # a robot without the fields of the turn limits: not checked
+    class Bare:
+        v_max, a_max, j_max, omega_max, a_lat_max = 1.0, 1.0, 1.0, 1.0, 1.0
+
+    out = metrics.trajectory_metrics(chain, Bare())
+    assert math.isnan(out["limit_turn_omega_radps"]) and out["peak_turn_omega_radps"] > 1
+    assert out["within_limits"] is False  # omega_max = 1 still holds the turn's 1.5 rad/s
+
+
+def test_plain_trajectory_and_stop_and_turn(driven) -> None:
+    import trajopt
+    from tests.reference import turn_limits_by_hand
+
+    planner, traj = driven
+    out = metrics.trajectory_metrics(traj, planner.robot)
+    assert out["within_limits"] is True
+    assert out["peak_turn_omega_radps"] == out["peak_turn_alpha_radps2"] == 0.0
+    assert metrics.turns_in_place(traj) == []
+    # the stop-and-turn fallback: a turn in place at each of its two corners
+    robot = trajopt.Robot()
+    sat = trajopt.stop_and_turn([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)], robot)
+    out = metrics.trajectory_metrics(sat, robot)
+    assert out["within_limits"] is True
+    w_lim, alpha_lim, _ = turn_limits_by_hand(robot)
+    rate_fd, acc_fd = _standing_fd(sat)
+    assert out["peak_turn_omega_radps"] == pytest.approx(rate_fd, rel=1e-3)
+    assert rate_fd <= w_lim * (1 + 1e-9)
+    assert acc_fd <= alpha_lim * (1 + 1e-6)
+    spans = metrics.turns_in_place(sat)
+    assert [(round(s.x, 9), round(s.y, 9)) for s in spans] == [(1.0, 0.0), (1.0, 1.0)]
+    assert [s.turn_rad for s in spans] == pytest.approx([math.pi / 2] * 2, abs=1e-5)
+
+
+def test_turns_in_place_of_a_chain(posed, scene) -> None:
+    robot, chain = posed
+    spans = metrics.turns_in_place(chain)
+    assert len(spans) == 2
+    first, last = spans
+    assert first.t0 == 0.0 and (first.x, first.y) == pytest.approx(scene.start, abs=1e-12)
+    assert (last.x, last.y) == pytest.approx(scene.goal("A"), abs=1e-9)
+    assert first.theta0 == pytest.approx(HEADINGS[0], abs=1e-12)
+    assert first.turn_rad == pytest.approx(chain.pieces[0].turn_rad, abs=1e-4)
+    assert last.t1 == pytest.approx(chain.duration)
+    assert math.remainder(last.theta1 - HEADINGS[1], 2 * math.pi) == pytest.approx(0, abs=1e-9)
+    assert last.turn_rad == pytest.approx(chain.pieces[-1].turn_rad, abs=1e-4)
+    with pytest.raises(InvalidInputError, match="dt"):
+        metrics.turns_in_place(chain, dt=0.0)
+
+
+def test_path_metrics_of_a_chain_score_the_curve_it_drives(posed, scene) -> None:
+    robot, chain = posed
+    curve = chain.pieces[1].path
+    assert metrics.trajectory_path(chain) is curve
+    ref = chain.steps.grid_path.to_world(scene.grid)
+    kw = dict(grid=scene.grid, reference=ref, radius=robot.radius)
+    a = metrics.path_metrics(chain, **kw)
+    b = metrics.path_metrics(curve, **kw)
+    assert a == b and not a.collision
+    assert a.length_m == pytest.approx(chain.length, rel=1e-6)
+    # a chain played from the middle of its curve: the polyline of its sampled positions
+    rest = chain.after(0.5 * chain.duration)
+    line = metrics.trajectory_path(rest)
+    assert isinstance(line, PolylineCurve)
+    assert line.length == pytest.approx(rest.length, rel=1e-3)
+    np.testing.assert_allclose(line.points[-1], np.asarray(scene.goal("A")), atol=1e-9)
+
+
+def test_omni_orientation_is_held_to_the_turn_limits_everywhere() -> None:
+    """An omni base turns while it drives: every sample's yaw is a turn (skip until wired)."""
+    import trajopt
+    import trajopt.timing
+    from tests.reference import turn_limits_by_hand
+    from trajopt.geometry._curve import PolylineCurve
+
+    orient = getattr(trajopt.timing, "orient", None)
+    if orient is None:
+        pytest.skip("trajopt.timing.orient (the omni orientation profile) is not in yet")
+    robot = trajopt.Robot(drive="omni")
+    line = trajopt.time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [0.6, 0.0]])), robot)
+    traj = orient(line, robot, 0.0, 3.0)  # the half turn outlasts the 0.6 m drive
+    assert traj.duration > line.duration
+    out = metrics.trajectory_metrics(traj, robot)
+    assert out["within_limits"] is True, out
+    w_lim, alpha_lim, _ = turn_limits_by_hand(robot)
+    t = np.linspace(0.0, traj.duration, int(round(traj.duration / 1e-3)) + 1)
+    theta = np.asarray(traj.sample(t).theta)
+    rate = np.abs(np.diff(theta) / (t[1] - t[0])).max()
+    acc = np.abs(np.diff(theta, 2) / (t[1] - t[0]) ** 2).max()
+    assert rate <= w_lim * (1 + 1e-9) and acc <= alpha_lim * (1 + 1e-6)
+    assert out["peak_turn_omega_radps"] == pytest.approx(rate, rel=1e-3)
+    assert out["peak_turn_alpha_radps2"] == pytest.approx(acc, rel=1e-2)
+    # while driving too: the same profile against slower wheels is caught
+    out = metrics.trajectory_metrics(traj, trajopt.Robot(drive="omni", wheel_v_max=0.07))
+    assert out["ratio_turn_omega"] > 1 and out["within_limits"] is False

@@ -86,3 +86,79 @@ def test_path_points_of_a_timed_trajectory():
     pts = path_points(Timed())
     assert pts.shape == (401, 2)  # every 10 ms of 4 s, both ends
     assert np.allclose(pts[:, 0], pts[:, 1]) and pts[-1, 0] == pytest.approx(2.0 / np.sqrt(2.0))
+
+
+# ------------------------------------------------------ heading arrows (issue 33, part 5)
+def _turn_drive_turn():
+    """A chain: turn in place at (0, 0) from pi to 0, drive 1 m along x, turn to pi / 2."""
+    import trajopt
+    from trajopt.geometry._curve import PolylineCurve
+    from trajopt.motion import TrajectoryChain
+    from trajopt.timing import time_parameterize, turn_in_place
+
+    robot = trajopt.Robot()
+    drive = time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [1.0, 0.0]])), robot)
+    return TrajectoryChain(
+        (
+            turn_in_place((0.0, 0.0), np.pi, 0.0, robot),
+            drive,
+            turn_in_place((1.0, 0.0), 0.0, np.pi / 2, robot),
+        ),
+        robot,
+    )
+
+
+def test_heading_arrows_and_turns_in_place(ax):
+    from matplotlib.quiver import Quiver
+
+    from trajopt.analysis.plotting import plot_headings
+
+    chain = _turn_drive_turn()
+    quiver, marks = plot_headings(ax, chain, 9, length=0.2, color="tab:red")
+    assert isinstance(quiver, Quiver) and quiver in ax.collections
+    t = np.linspace(0.0, chain.duration, 9)
+    smp = chain.sample(t)
+    np.testing.assert_allclose(quiver.X, smp.x)
+    np.testing.assert_allclose(quiver.Y, smp.y)
+    np.testing.assert_allclose(quiver.U, 0.2 * np.cos(smp.theta), atol=1e-12)
+    np.testing.assert_allclose(quiver.V, 0.2 * np.sin(smp.theta), atol=1e-12)
+    assert abs(quiver.U[0] + 0.2) < 1e-9  # the first arrow faces the start heading, pi
+    # both turns marked where they happen, with the angle turned
+    np.testing.assert_allclose(marks.get_xdata(), [0.0, 1.0], atol=1e-9)
+    np.testing.assert_allclose(marks.get_ydata(), [0.0, 0.0], atol=1e-9)
+    assert marks.get_label() == "turn in place"
+    assert sorted(a.get_text() for a in ax.texts) == ["+1.57 rad", "-3.14 rad"]
+    # a trajectory that only drives: arrows, no marks; bad arguments refused
+    assert plot_headings(ax, _Line(), 3, turns=True)[1] is None
+    for bad in (0, -1, 2.5, True):
+        with pytest.raises(ValueError, match="n must|arrows must"):
+            plot_headings(ax, chain, bad)
+    with pytest.raises(ValueError, match="length must be finite"):
+        plot_headings(ax, chain, 3, length=float("nan"))
+
+
+def test_plot_paths_arrows_option(ax):
+    from matplotlib.quiver import Quiver
+
+    import astar
+    from trajopt.analysis.plotting import plot_paths
+
+    grid = astar.OccupancyGrid(np.zeros((30, 40), bool), 0.05)
+    chain = _turn_drive_turn()
+    curve = chain.pieces[1].path
+    plot_paths(grid, {"curve": curve, "chain": chain}, arrows=12, ax=ax)
+    (quiver,) = [c for c in ax.collections if isinstance(c, Quiver)]  # the timed entry only
+    assert len(quiver.X) == 12
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    assert lines["chain"].get_linestyle() == "-" and lines["turn in place"].get_marker() == "o"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "curve",
+        "chain",
+        "turn in place",
+    ]
+    # default: no arrows
+    ax.clear()
+    plot_paths(grid, {"chain": chain}, ax=ax)
+    assert not [c for c in ax.collections if isinstance(c, Quiver)]
+    with pytest.raises(ValueError, match="arrows must"):
+        plot_paths(grid, {"chain": chain}, arrows=-2, ax=ax)

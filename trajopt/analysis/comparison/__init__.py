@@ -21,7 +21,11 @@ Built-in methods (the chapter's four, in this order):
 
 and the proposed method, ``'proposed'``: :func:`trajopt.plan` (certified corridor smoother
 and ruckig timing; its own clearance-aware A* path), with the timed metrics as extra
-columns (``duration_s``, ``ratio_v``, ...).
+columns (``duration_s``, ``ratio_v``, ...). ``options={"proposed": {"start_heading": h0,
+"goal_heading": h1}}`` plans it pose to pose: a differential drive may then turn in place
+at an end (a :class:`~trajopt.motion.TrajectoryChain`), the row scores the curve it drives,
+and its turns are checked against the turn limits (``ratio_turn_omega``,
+``ratio_turn_alpha``).
 
 ``'polynomial fit (parametric)'`` is registered too but is not run by default.
 
