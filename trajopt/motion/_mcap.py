@@ -19,7 +19,9 @@ topic               type                              content
 The maps and the corridor come from ``trajectory.steps`` (a trajectory returned by
 :func:`trajopt.plan`); a trajectory timed by hand has only ``/plan``, ``/pose`` and
 ``/twist``. Poses are in ``frame_id`` (default ``"map"``), twists in ``child_frame_id``
-(default ``"base_link"``, the robot frame: ``v`` forward, ``omega`` counter-clockwise).
+(default ``"base_link"``, the robot frame: ``v`` forward, ``omega`` counter-clockwise; an
+omnidirectional base's twist is its body-frame velocity ``linear.x = v_body_x``,
+``linear.y = v_body_y`` and its orientation rate).
 Every message is logged at its header stamp: ``start_time`` (s since the Unix epoch,
 default 0) plus the sample time; the map, path and corridor at ``start_time``.
 
@@ -288,6 +290,10 @@ def write_mcap(
     half = 0.5 * np.asarray(smp.theta, dtype=float)
     qz, qw = np.sin(half), np.cos(half)
     v = np.asarray(smp.v, dtype=float)
+    vy = np.zeros_like(v)  # a differential drive moves along its heading
+    if hasattr(smp, "v_body_x"):  # an omnidirectional base: its body-frame velocity
+        v = np.asarray(smp.v_body_x, dtype=float)
+        vy = np.asarray(smp.v_body_y, dtype=float)
     om = np.asarray(smp.omega, dtype=float)
     steps = getattr(trajectory, "steps", None)
 
@@ -344,7 +350,7 @@ def write_mcap(
                 mw.add_message(c_pose, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
                 w = _Cdr()
                 w.header(ns, child_frame_id)
-                w.pack("6d", 8, v[k], 0.0, 0.0, 0.0, 0.0, om[k])
+                w.pack("6d", 8, v[k], vy[k], 0.0, 0.0, 0.0, om[k])
                 mw.add_message(c_twist, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
             mw.finish()
 

@@ -302,3 +302,14 @@ def test_invalid_construction():
     moving = time_parameterize(line(1.0), OMNI, v_end=0.2)
     with pytest.raises(InvalidInputError, match="v_end"):
         dataclasses.replace(traj, translation=moving, turn_duration=moving.duration + 1.0)
+
+
+def test_the_mcap_twist_of_an_omni_base_is_its_body_velocity(tmp_path):
+    read_ros2_messages = pytest.importorskip("mcap_ros2.reader").read_ros2_messages
+    traj, _ = _omni(0.5)
+    path = traj.to_mcap(tmp_path / "omni.mcap", dt=0.05)
+    twists = [m.ros_msg.twist for m in read_ros2_messages(str(path), topics=["/twist"])]
+    smp = traj.sample(np.arange(len(twists)) * 0.05)
+    np.testing.assert_allclose([t.linear.x for t in twists], smp.v_body_x, atol=1e-12)
+    np.testing.assert_allclose([t.linear.y for t in twists], smp.v_body_y, atol=1e-12)
+    np.testing.assert_allclose([t.angular.z for t in twists], smp.omega, atol=1e-12)
