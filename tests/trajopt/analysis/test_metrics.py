@@ -11,6 +11,7 @@ from scipy.spatial.distance import directed_hausdorff
 from astar.grid import OccupancyGrid
 from tests.reference import cell_square_clearance
 from trajopt.analysis import metrics
+from trajopt.analysis._distances import densify
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._curve import ParametricCurve, PolylineCurve
 
@@ -242,7 +243,7 @@ def test_polyline_hausdorff_is_the_maximum_over_every_densified_point(seed) -> N
     got = metrics.polyline_hausdorff(curve, ref, spacing=spacing)
     want = 0.0
     for a, b in ((curve, ref), (ref, curve)):
-        pa = metrics._densify(a, spacing)
+        pa = densify(a, spacing)
         exact = metrics.distance_to_polyline(pa, b)
         want = max(want, float(exact.max()))
         seg0, seg = b[:-1], np.diff(b, axis=0)
