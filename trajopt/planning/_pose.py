@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from typing import Any
 
 import numpy as np
@@ -127,6 +128,7 @@ def plan_pose(
         The free candidate's errors; ``SmoothingError`` when a footprint cannot turn at an
         end and no curve leaves (arrives) along the given heading.
     """
+    t_start = time.perf_counter()
     robot = options.robot
     request = at_rest(request)
     turn_ends = _turn_ends(request)
@@ -194,6 +196,8 @@ def plan_pose(
             steps, start_heading=request.start_heading, goal_heading=request.goal_heading
         )
     stats = dict(out.stats)
+    # the stages are the chosen candidate's; the total is the whole query's
+    stats["stages_s"] = dict(stats.get("stages_s", {}), total=time.perf_counter() - t_start)
     stats["pose"] = {
         "chosen": chosen,
         "durations_s": {k: float(v.duration) for k, v in candidates.items()},
