@@ -141,6 +141,18 @@ BENCHES: tuple[Bench, ...] = (
         ("--limit", "400", "--random", "250", "--radii", "1.5,2.5,3.5"),
     ),
     Bench(
+        "refusals",
+        "Fast refusals: unconnected queries",
+        "bench_refusals.py",
+        "Refusal time of queries whose ends lie in different components of the inflated "
+        "grid (an island of the map, or a goal walled into a closed room), start in the "
+        "largest component, on the larger shared Moving AI maps, the shared ROS maps and a "
+        "warehouse-size map (willow at 5 cm): `Planner.plan` until its `NoPathError` (from "
+        "the component labels) against the A* the planner ran before on the same queries "
+        "(until it had exhausted the start's component), with the labelling time.",
+        ("--queries", "10", "--repeat", "2"),
+    ),
+    Bench(
         "timing_property",
         "Timing: the speed cap on sharp curvature peaks",
         "timing_property_run.py",

@@ -58,6 +58,7 @@ __all__ = [
     "nav2_translate",
     "point_square_distance",
     "polyline_samples",
+    "reachable_cells",
     "ruckig_profile",
     "ruckig_rest_to_rest_duration",
     "sampled_rect_clearance",
@@ -234,6 +235,33 @@ def legal_step(occ, a, b, connectivity, corner_cutting):
     if connectivity == 4 or (abs(dx), abs(dy)) != (1, 1):
         return False
     return corner_cutting or (not occ[ay, ax + dx] and not occ[ay + dy, ax])
+
+
+def reachable_cells(occ, start, connectivity=8, corner_cutting=False) -> set[tuple[int, int]]:
+    """Every cell a search can reach from ``start``, by breadth-first search.
+
+    Moves are :func:`legal_step` (the documented rules of :func:`astar.find_path`: with the
+    defaults, 8-connected without corner cutting); ``occ`` is a boolean array
+    ``occ[iy, ix]``, cells are ``(ix, iy)`` and ``start`` must be free. Returns the set of
+    cells reached, ``start`` included.
+    """
+    moves = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+    if connectivity == 8:
+        moves += [(1, 1), (1, -1), (-1, 1), (-1, -1)]
+    start = (int(start[0]), int(start[1]))
+    assert not occ[start[1], start[0]], "start must be free"
+    seen = {start}
+    frontier = [start]
+    while frontier:
+        nxt = []
+        for ax, ay in frontier:
+            for dx, dy in moves:
+                b = (ax + dx, ay + dy)
+                if b not in seen and legal_step(occ, (ax, ay), b, connectivity, corner_cutting):
+                    seen.add(b)
+                    nxt.append(b)
+        frontier = nxt
+    return seen
 
 
 def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):

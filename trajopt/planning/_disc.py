@@ -112,6 +112,8 @@ def plan_disc(
     grid_path = None if warm is None else warm.grid_path
     reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
     with q.timer.stage("search"):
+        if not reused:
+            _check_connected(options, caches, q)
         q.path = grid_path if reused else _search(options, caches, q)
         if path_check is not None:
             q.path, q.inflated = path_check(caches, q)
@@ -163,6 +165,26 @@ def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> ast
             f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
             f"robot of radius {options.robot.radius} m (inflation={options.inflation!r}): {exc}"
         ) from exc
+
+
+def _check_connected(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> None:
+    """Refuse at once when the end cells lie in different components of the inflated grid.
+
+    The search reaches exactly the cells of the start's component
+    (:func:`~trajopt.planning._caches.component_labels`), so this raises the
+    :class:`NoPathError` it would raise after exhausting that component.
+    """
+    labels = caches.components
+    (sx, sy), (gx, gy) = _cell(q.start_cell), _cell(q.goal_cell)
+    a, b = int(labels[sy, sx]), int(labels[gy, gx])
+    if a != b:
+        raise NoPathError(
+            f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "
+            f"robot of radius {options.robot.radius} m (inflation={options.inflation!r}): "
+            f"they are not connected for this robot radius (start cell ({sx}, {sy}) lies "
+            f"in component {a} of the inflated grid, goal cell ({gx}, {gy}) in component "
+            f"{b})"
+        )
 
 
 def _time(options: PlannerOptions, q: PlanQuery, smooth: SmoothPath) -> Trajectory:
