@@ -45,6 +45,7 @@ from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError, TimingError
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import WarmStart
 from trajopt.robot._footprint import Footprint, polygons_clearance
@@ -131,6 +132,8 @@ def plan_pose(
     t_start = time.perf_counter()
     robot = options.robot
     request = at_rest(request)
+    if robot.footprint is not None:  # a pose the footprint cannot take is refused first
+        check_end_poses(robot.footprint, grid, request)
     turn_ends = _turn_ends(request)
     free_request = dataclasses.replace(
         request,
