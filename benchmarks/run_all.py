@@ -210,6 +210,21 @@ BENCHES: tuple[Bench, ...] = (
         ("--per-map", "15"),
     ),
     Bench(
+        "pose",
+        "Pose to pose: random end headings, differential and omni drives",
+        "bench_pose.py",
+        "The shared suite's queries (Moving AI scenarios at 2.5 cells, seeded random pairs "
+        "on the ROS maps) with seeded random start and goal headings, for a disc robot with "
+        "`drive=\"differential\"` and `drive=\"omni\"`: success, collisions under an "
+        "independent exact check on 1 ms samples (distance to the raw map's occupied "
+        "squares), both headings to 1e-6 rad, every limit on 1 ms samples (turns in place "
+        "against `turn_limits`); the duration against the same query with free headings "
+        "(differential: overhead, turns in place, never slower than turn-drive-turn; omni: "
+        "ratio), and the warm plan time with headings over the free plan's, same run.",
+        ("--quick",),
+        ("--limit", "30"),
+    ),
+    Bench(
         "harness",
         "Benchmark harness: Dask scaling",
         "bench_harness.py",
