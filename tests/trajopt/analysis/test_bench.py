@@ -21,6 +21,7 @@ pytest.importorskip("pyarrow", reason="the bench extra (pyarrow) is missing")
 from trajopt.analysis import bench  # noqa: E402
 from trajopt.analysis.bench._dataset import part_files  # noqa: E402
 from trajopt.analysis.bench._runner import query_cost  # noqa: E402
+from trajopt.analysis.bench._suites import data_dir  # noqa: E402
 from trajopt.errors import BenchmarkError, PeerUnavailableError
 
 REPO = Path(__file__).resolve().parents[3]
@@ -408,3 +409,12 @@ def test_peer_rows_are_scored(method, sources, monkeypatch):
         assert math.isfinite(row["min_clearance_m"]) and math.isfinite(row["runtime_s"])
     else:
         assert row["failure"] == "PeerFailure"
+
+
+def test_the_default_data_folder_is_beside_the_checkout(monkeypatch):
+    # shared/data next to the checkout that holds the package (no $TRAJOPT_DATA)
+    monkeypatch.delenv("TRAJOPT_DATA", raising=False)
+    expected = REPO.parent / "shared" / "data"
+    if not (expected / "movingai").is_dir():
+        pytest.skip(f"no shared data at {expected}")
+    assert data_dir() == expected

@@ -110,7 +110,8 @@ def data_dir(path: str | os.PathLike[str] | None = None) -> Path:
     elif os.environ.get("TRAJOPT_DATA"):
         d = Path(os.environ["TRAJOPT_DATA"])
     else:
-        d = Path(__file__).resolve().parents[3] / "shared" / "data"
+        checkout = Path(__file__).resolve().parents[3]  # trajopt/analysis/bench/ -> the checkout
+        d = checkout.parent / "shared" / "data"
     if not ((d / "movingai").is_dir() and (d / "ros").is_dir()):
         raise BenchmarkError(
             f"data folder {str(d)!r} must hold the shared 'movingai' and 'ros' folders; "
