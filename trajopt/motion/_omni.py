@@ -5,8 +5,9 @@ path whatever way its body faces. :class:`OmniTrajectory` pairs
 
 * the **translation**: a :class:`~trajopt.motion._trajectory.Trajectory` along the path
   (duration ``T``), timed under the omni speed cap (:meth:`Robot.speed_cap`), and
-* the **orientation**: a jerk-limited 1-DoF profile of the body's yaw, rest to rest, stored
-  as constant-jerk rows (duration ``T_rot``),
+* the **orientation**: a jerk-limited 1-DoF profile of the body's yaw, ending at rest (and
+  starting at rest, or, in a re-plan, with the yaw rate and acceleration the body had),
+  stored as constant-jerk rows (duration ``T_rot``),
 
 built by :func:`trajopt.timing.orient`. The motion lasts ``max(T, T_rot)``: when the turn
 takes longer than the drive, the robot stands at the path's end (``v = 0``) while it
@@ -26,6 +27,9 @@ Sampling conventions (:class:`~trajopt.motion._trajectory.OmniSample`):
 * No wheel speeds (``v_left``, ``v_right`` are those of a differential drive).
 
 For times ``t > T`` the translation holds its end: ``s = length``, ``v = a = jerk = 0``.
+
+A re-plan that keeps the rest of the motion cuts it with :meth:`OmniTrajectory.after`: the
+orientation's phases from the cut on, shifted in time, beside the translation's rest.
 
 MCAP (:meth:`~trajopt.motion._trajectory.SampledExport.to_mcap`): ``/plan`` and ``/pose``
 carry the orientation; ``/twist`` is written by :func:`trajopt.motion._mcap.write_mcap` as
@@ -267,6 +271,97 @@ class OmniTrajectory(SampledExport):
             "v_body_y": c * vy - s * vx,
         }
         return OmniSample(**{k: readonly(x) for k, x in arrays.items()})
+
+    def after(self, t: float, translation: Trajectory) -> OmniTrajectory:
+        """Return the motion from time ``t`` (s) on, its clock starting at 0 there.
+
+        The orientation's constant-jerk phases after ``t`` are kept as they are, shifted by
+        ``t``; the phase holding ``t`` starts at ``t`` with the orientation's state there
+        (angle, rate, acceleration), so the samples are this trajectory's, shifted in time
+        (to rounding). The translation's rest is the caller's (a re-plan cuts and certifies
+        it again: :func:`trajopt.replan._keep.keep_rest`).
+
+        Parameters
+        ----------
+        t : float
+            The cut (s), in ``[0, T)``: the translation is still driving.
+        translation : Trajectory
+            ``self.translation`` from ``t`` on (duration ``T - t`` to 1e-9 s).
+
+        Returns
+        -------
+        OmniTrajectory
+            Of duration ``max(T, T_rot) - t``, with this trajectory's ``stats`` and
+            ``steps``; ``theta_start`` is the orientation at ``t``, ``theta_end`` this one's.
+
+        Raises
+        ------
+        InvalidInputError
+            ``t`` not in ``[0, T)``, or ``translation`` not a :class:`Trajectory` of that
+            duration.
+        """
+        t_drive = self.translation.duration
+        tt = number("t", t, unit="s", lo=0.0)
+        if not tt < t_drive:
+            raise InvalidInputError(
+                f"t must lie before the translation's end ({t_drive:.6g} s) to cut it, got {tt!r}"
+            )
+        if (
+            not isinstance(translation, Trajectory)
+            or abs(translation.duration - (t_drive - tt)) > 1e-9
+        ):
+            what = (
+                f"duration {translation.duration!r} s"
+                if isinstance(translation, Trajectory)
+                else type(translation).__name__
+            )
+            raise InvalidInputError(
+                f"translation must be this translation from t = {tt!r} s on (a Trajectory of "
+                f"duration {t_drive - tt!r} s), got {what}"
+            )
+        rows, t_rot = self.orientation_after(tt)
+        theta = float(rows[0, 1]) if rows.shape[0] else self.theta_end
+        return OmniTrajectory(
+            translation=translation,
+            robot=self.robot,
+            rows=rows,
+            turn_duration=t_rot,
+            theta_start=theta,
+            theta_end=self.theta_end,
+            stats=dict(self.stats),
+            steps=self.steps,
+        )
+
+    def orientation_after(self, t: float) -> tuple[np.ndarray, float]:
+        """Return the orientation's profile from time ``t`` (s) on, its clock starting there.
+
+        Parameters
+        ----------
+        t : float
+            The cut (s), in ``[0, duration]``.
+
+        Returns
+        -------
+        (ndarray, float)
+            The rows ``(t0, theta, omega, alpha, zeta)`` after ``t`` (the first one starts
+            at 0 with the orientation's state at ``t``, the others are this profile's,
+            shifted by ``t``; shape ``(0, 5)`` once the turn is over) and the time left to
+            turn (s, ``max(0, turn_duration - t)``).
+
+        Raises
+        ------
+        InvalidInputError
+            ``t`` is not a number in ``[0, duration]``.
+        """
+        tt = number("t", t, unit="s", lo=0.0, hi=self.duration)
+        rows, t_rot = self.rows, self.turn_duration - tt
+        if rows.shape[0] == 0 or t_rot <= 0.0:
+            return np.zeros((0, 5)), 0.0
+        theta, omega, alpha, _ = (float(x) for x in self.orientation(tt))
+        k = int(np.searchsorted(rows[:, 0], tt, side="right")) - 1
+        later = rows[k + 1 :].copy()
+        later[:, 0] -= tt
+        return np.vstack([[0.0, theta, omega, alpha, rows[k, 4]], later]), float(t_rot)
 
     def state_at(self, t: float) -> State:
         """Return the translation's :class:`~trajopt.robot._state.State` at time ``t`` (s).

@@ -15,7 +15,7 @@ import numpy as np
 
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt._validation import heading, integer
+from trajopt._validation import heading, integer, number
 from trajopt.errors import InvalidInputError
 from trajopt.robot._robot import Robot, avoidance_width
 from trajopt.robot._state import State
@@ -209,9 +209,15 @@ class PlanRequest:
     goal : sequence of float, shape (2,)
         End point (m).
     start_heading, goal_heading : float or None
-        Exact headings at the ends (rad).
+        Exact headings at the ends (rad). For an omnidirectional base, the orientation of
+        the body (also with a :class:`State` start, whose ``theta`` is the direction of
+        travel).
     v_start, v_end : float
         Speeds at the ends (m/s).
+    start_omega, start_alpha : float
+        An omnidirectional base's yaw rate (rad/s) and yaw acceleration (rad/s^2) at the
+        start: a re-plan continues the orientation of a body that is turning (default 0;
+        finite here, within the yaw limits where the orientation is planned).
     """
 
     start: Sequence[float] | State
@@ -220,7 +226,15 @@ class PlanRequest:
     goal_heading: float | None = None
     v_start: float = 0.0
     v_end: float = 0.0
+    start_omega: float = 0.0
+    start_alpha: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "start_heading", heading("start_heading", self.start_heading))
         object.__setattr__(self, "goal_heading", heading("goal_heading", self.goal_heading))
+        object.__setattr__(
+            self, "start_omega", number("start_omega", self.start_omega, unit="rad/s")
+        )
+        object.__setattr__(
+            self, "start_alpha", number("start_alpha", self.start_alpha, unit="rad/s^2")
+        )

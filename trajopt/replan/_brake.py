@@ -16,7 +16,8 @@ robot, or the way ahead is blocked, no such curve may fit in the free space. The
    least ``radius + ds / 2`` from them: the distance to the cells is 1-Lipschitz along the
    path), and a robot that cannot stop before one is a :class:`~trajopt.errors.TimingError`.
 2. **Turn in place** (:func:`trajopt.timing._stop_and_turn.turn_in_place`) to the heading the
-   new plan starts with: a disc turns within its own footprint.
+   new plan starts with: a disc turns within its own footprint. (An omnidirectional base
+   needs no turn: its plan from rest starts with the heading it stopped with.)
 3. **Go**: a plan from rest at the stop point with a free start heading
    (:meth:`~trajopt._planner.Planner.plan`; the planner's fallback applies). If that plan
    fails (e.g. the stop lies in the goal's cell) and the goal, goal heading and end speed
@@ -26,6 +27,17 @@ robot, or the way ahead is blocked, no such curve may fit in the free space. The
 The result is a :class:`~trajopt.motion._chain.TrajectoryChain`; ``stats["replan"]``
 says ``"braked: <why the smooth re-plan failed>"``, ``stats["brake_m"]``,
 ``stats["brake_s"]``, ``stats["turn_rad"]`` and ``stats["turn_s"]`` describe the stop.
+
+An omnidirectional base driving an :class:`~trajopt.motion.OmniTrajectory` (its body's
+orientation apart from its direction of travel) brakes and goes without a turn in place
+(:func:`_brake_go_omni`): while the translation brakes on the old path, the body's yaw rate
+is brought to rest as fast as the yaw limits allow
+(:func:`trajopt.timing._orientation.stop_orientation`; the stop piece is an
+``OmniTrajectory``, or a :class:`~trajopt.motion._chain.TurnInPlace` when the translation
+is at rest already), and the plan from rest starts its orientation where that left it
+(``start_heading``), turning to the goal heading while it drives. Position, orientation,
+speed, acceleration and yaw rate are continuous at every join; ``stats["turn_rad"]`` and
+``stats["turn_s"]`` are then the angle and time of the yaw stop.
 """
 
 from __future__ import annotations
@@ -41,16 +53,19 @@ from trajopt.errors import TimingError, TrajoptError
 from trajopt.geometry._clearance import points_clearance
 from trajopt.geometry._curve import CurveSegment
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
 from trajopt.planning._runner import run_query
 from trajopt.replan._keep import target_change
+from trajopt.replan._omni import orientation_at, turn_piece
 from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
 from trajopt.timing._greedy import advance, brake_times
-from trajopt.timing._stop_and_turn import turn_in_place
+from trajopt.timing._orientation import orient, stop_orientation, yaw_stop
+from trajopt.timing._stop_and_turn import turn_in_place, turn_limits
 
 
 def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
@@ -150,9 +165,11 @@ def brake_turn_go(
         The re-planning planner's options.
     caches : PlannerCaches
         Its caches, with the current map.
-    trajectory : Trajectory or TrajectoryChain
+    trajectory : Trajectory, OmniTrajectory or TrajectoryChain
         The trajectory driven; a chain is braked on the piece playing at ``ts`` (a turn in
-        place playing then is finished first).
+        place playing then is finished first). An omnidirectional base's
+        :class:`~trajopt.motion.OmniTrajectory` stops its yaw rate while it brakes and
+        goes without a turn in place (module docstring).
     ts : float
         The splice time on its clock (s).
     goal : sequence of float, shape (2,)
@@ -180,6 +197,9 @@ def brake_turn_go(
         i, t_in = trajectory.piece_at(ts)
         traj = trajectory.pieces[i]
     robot = options.robot
+    if robot.footprint is None and isinstance(traj, OmniTrajectory):
+        target = (goal, goal_heading, v_end)
+        return _brake_go_omni(options, caches, trajectory, ts, target, error, previous)
     if robot.footprint is not None or not isinstance(traj, (Trajectory, TurnInPlace)):
         raise error
     pieces: list[Any] = []
@@ -202,7 +222,11 @@ def brake_turn_go(
             stop = traj.sample(np.array([t_in]))
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     try:
-        request = PlanRequest(p_stop, goal, goal_heading=goal_heading, v_end=v_end)
+        # an omni base turns while it drives: its plan starts at the heading it stops with
+        h0 = float(stop.theta[0]) if robot.drive == "omni" else None
+        request = PlanRequest(
+            p_stop, goal, start_heading=h0, goal_heading=goal_heading, v_end=v_end
+        )
         out = run_query(options, caches, request, WarmStart(None, previous))
     except TrajoptError as exc:
         rest = None
@@ -240,6 +264,124 @@ def brake_turn_go(
         turn_s=turn.duration,
     )
     return TrajectoryChain(tuple(pieces), robot, stats, out.steps, tuple(starts))
+
+
+def _brake_go_omni(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    trajectory: Any,
+    ts: float,
+    target: tuple[Sequence[float], float | None, float],
+    error: TrajoptError,
+    previous: PlanSteps | None,
+) -> TrajectoryChain:
+    """Brake an omnidirectional base, stop its yaw rate, and go (module docstring).
+
+    ``trajectory`` plays an :class:`OmniTrajectory` at ``ts`` (itself, or a chain's piece);
+    ``target`` is ``(goal, goal_heading, v_end)``. When the plan from rest fails and the
+    target is the old one, the old path's rest is driven from the stop (timed from rest) with
+    the orientation turned to the old end orientation, as :func:`brake_turn_go` does.
+    """
+    goal, goal_heading, v_end = target
+    robot = options.robot
+    traj, t_in = trajectory, ts
+    if isinstance(trajectory, TrajectoryChain):
+        i, t_in = trajectory.piece_at(ts)
+        traj = trajectory.pieces[i]
+    start = orientation_at(trajectory, ts)
+    assert isinstance(traj, OmniTrajectory) and start is not None
+    translation = traj.translation
+    brake = None
+    if t_in < translation.duration:
+        brake = brake_on_path(translation, t_in)
+    pieces: list[Any] = []
+    if brake is not None:  # the translation brakes; the yaw rate stops beside it
+        steps = translation.steps or traj.steps or getattr(trajectory, "steps", None)
+        _check_new_obstacles(robot, caches.grid, steps, brake)
+        stop = stop_orientation(
+            brake, robot, start.theta, omega_start=start.omega, alpha_start=start.alpha
+        )
+        end = brake.sample(np.array([brake.duration]))
+        theta_stop, t_stop = stop.theta_end, stop.turn_duration
+        pieces.append(stop)
+    else:  # standing: only the yaw rate stops
+        end = translation.sample(np.array([min(t_in, translation.duration)]))
+        rows, t_stop = yaw_stop(start.omega, start.alpha, turn_limits(robot))
+        theta_stop = start.theta
+        if rows.shape[0]:
+            turn = turn_piece((end.x[0], end.y[0]), start.theta, rows, t_stop, robot)
+            theta_stop = start.theta + turn.turn_rad
+            pieces.append(turn)
+    p_stop = (float(end.x[0]), float(end.y[0]))
+    braked = f"braked: {type(error).__name__}: {error}"
+    stop_stats = {
+        "brake_m": 0.0 if brake is None else float(brake.length),
+        "brake_s": 0.0 if brake is None else brake.duration,
+        "turn_rad": float(theta_stop - start.theta),
+        "turn_s": float(t_stop),
+    }
+    try:
+        request = PlanRequest(
+            p_stop, goal, start_heading=theta_stop, goal_heading=goal_heading, v_end=v_end
+        )
+        out = run_query(options, caches, request, WarmStart(None, previous))
+    except TrajoptError as exc:
+        rest = _resume_omni(options, caches.grid, traj, brake, theta_stop, p_stop, target)
+        if rest is None or not pieces + rest:  # nothing to drive: the stop is the goal
+            exc.args = (
+                f"{exc.args[0]} (planned from rest after braking to a stop at "
+                f"{p_stop} m, since {error})",
+            ) + exc.args[1:]
+            raise
+        stats = dict(
+            traj.stats,
+            replan=f"{braked}; the old path resumed from rest ({type(exc).__name__} from the stop)",
+            **stop_stats,
+        )
+        return TrajectoryChain(tuple(pieces + rest), robot, stats, traj.steps)
+    pieces.append(out)
+    stats = dict(out.stats, replan=braked, **stop_stats)
+    return TrajectoryChain(tuple(pieces), robot, stats, out.steps)
+
+
+def _resume_omni(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    traj: OmniTrajectory,
+    brake: Trajectory | None,
+    theta_stop: float,
+    p_stop: tuple[float, float],
+    target: tuple[Sequence[float], float | None, float],
+) -> list[Any] | None:
+    """Return the old motion's rest from the stop, from rest, if the target is the old one.
+
+    The translation's rest is :func:`_resume`'s; the orientation turns from ``theta_stop``
+    (rad) to the old end orientation beside it (:func:`~trajopt.timing.orient`), or in
+    place when the stop is the path's end. ``None`` when the goal, goal heading or end speed
+    differ, or when the robot stood still mid-path (nothing to resume from).
+    """
+    goal, goal_heading, v_end = target
+    if traj.steps is None or target_change(traj, goal, None, v_end):
+        return None
+    if goal_heading is not None and (
+        abs(math.remainder(float(goal_heading) - traj.theta_end, 2.0 * math.pi)) > 1e-9
+    ):
+        return None
+    robot = options.robot
+    if brake is None:
+        tr = traj.translation
+        stop = tr.sample(np.array([tr.duration]))
+        if math.hypot(float(stop.x[0]) - p_stop[0], float(stop.y[0]) - p_stop[1]) > 1e-9:
+            return None
+        rest: list[Trajectory] | None = []
+    else:
+        rest = _resume(options, grid, traj.translation, brake, goal, None, v_end)
+    if rest is None:
+        return None
+    if rest:
+        return [orient(rest[0], robot, theta_stop, traj.theta_end)]
+    turn = turn_in_place(p_stop, theta_stop, traj.theta_end, robot)
+    return [turn] if turn.duration > 0.0 else []
 
 
 def _resume(

@@ -12,6 +12,11 @@ searched, fitted or timed again: the curve is cut at the splice
 the splice on are kept as they are, shifted in time and arc length, and the cut curve is
 certified again against the corridor and the current map.
 
+An omnidirectional base's :class:`~trajopt.motion.OmniTrajectory` is kept the same way
+(:func:`keep_omni`): its translation's rest by :func:`keep_rest`, and beside it the rest of
+its orientation profile, cut at the splice (:meth:`~trajopt.motion.OmniTrajectory.after`),
+when the goal heading is the orientation it ends at.
+
 When the rest cannot be kept because new obstacles came near it, :func:`remaining_grid_path`
 may still hand the re-plan the rest of the old grid path, so that it skips the search.
 """
@@ -29,10 +34,13 @@ import numpy as np
 from astar.search import GridPath
 from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
+from trajopt.motion._chain import TrajectoryChain
+from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches, change_reach
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import PlanSteps
+from trajopt.replan._omni import turn_piece
 from trajopt.smoother import SmoothPath
 from trajopt.smoother._certificate import certify
 
@@ -133,6 +141,78 @@ def keep_rest(
     stats["replan"] = "kept"
     stats["corridor_regions_kept"] = len(regions) if isinstance(corridor, PolygonCorridor) else 0
     return dataclasses.replace(out, steps=new_steps, stats=stats), "kept"
+
+
+def keep_omni(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    trajectory: OmniTrajectory,
+    ts: float,
+    goal: Sequence[float] | None,
+    *,
+    goal_heading: float | None,
+    v_end: float,
+) -> tuple[OmniTrajectory | TrajectoryChain | None, str]:
+    """Return the rest of an omnidirectional base's motion from ``ts`` if a re-plan may keep it.
+
+    The translation's rest is :func:`keep_rest`'s (the same rules: goal, end speed and map);
+    the goal heading must be the orientation the motion ends at (``theta_end``, modulo
+    ``2 pi`` within 1e-9 rad), or ``None``. The orientation's phases from ``ts`` on are kept
+    as they are, shifted in time (:meth:`OmniTrajectory.after`). At a ``ts`` where the
+    translation is over and the body stands finishing its turn, the rest is that turn (a
+    :class:`~trajopt.motion._chain.TurnInPlace` in a
+    :class:`~trajopt.motion._chain.TrajectoryChain`) when the map is the one planned on.
+
+    Parameters
+    ----------
+    options, caches, ts, goal, goal_heading, v_end
+        As :func:`keep_rest`; ``goal_heading`` the orientation asked at the goal (rad).
+    trajectory : OmniTrajectory
+        The trajectory being driven.
+
+    Returns
+    -------
+    (OmniTrajectory or TrajectoryChain or None, str)
+        The kept trajectory (time 0 at the splice; its ``steps`` record the headings the
+        old plan asked for) and ``"kept"``, or ``None`` and why the rest cannot be kept.
+    """
+    steps = trajectory.steps
+    if steps is None:
+        return None, "not a smoothed trajectory of a Planner"
+    if options.robot.footprint is not None:
+        return None, "footprint robot"
+    if goal is not None and tuple(point("goal", goal).tolist()) != tuple(steps.goal):
+        return None, "new goal"
+    if v_end != trajectory.v_end:
+        return None, "new end speed"
+    if goal_heading is not None and (
+        abs(math.remainder(float(goal_heading) - trajectory.theta_end, 2.0 * math.pi)) > 1e-9
+    ):
+        return None, "new goal heading"
+    translation = trajectory.translation
+    if ts >= translation.duration:  # standing at the path's end: the turn goes on
+        if caches.grid is not steps.raw_grid:
+            return None, "the map changed"
+        rows, t_rot = trajectory.orientation_after(ts)
+        if t_rot <= 0.0:
+            return None, "at the end"
+        end = translation.sample(np.array([translation.duration]))
+        turn = turn_piece(
+            (float(end.x[0]), float(end.y[0])), rows[0, 1], rows, t_rot, options.robot
+        )
+        stats = dict(trajectory.stats, stages_s={"keep": 0.0, "total": 0.0}, replan="kept")
+        return TrajectoryChain((turn,), options.robot, stats, steps), "kept"
+    rest, why = keep_rest(options, caches, translation, ts, goal, goal_heading=None, v_end=v_end)
+    if rest is None:
+        return None, why
+    out = trajectory.after(ts, rest)
+    new_steps = rest.steps
+    if new_steps is not None:
+        new_steps = dataclasses.replace(
+            new_steps, start_heading=steps.start_heading, goal_heading=steps.goal_heading
+        )
+    stats = {**trajectory.stats, **rest.stats}  # the orientation's, and the keep's
+    return dataclasses.replace(out, stats=stats, steps=new_steps), "kept"
 
 
 def target_change(

@@ -20,6 +20,15 @@ curvature, speed and acceleration: a C2 splice) and takes the first of these tha
 A chain is re-planned like any trajectory: while its last piece (the plan from rest) plays,
 that piece is; before, the chain's rest is kept when the map, goal, goal heading and end
 speed are unchanged, and a turn in place playing at the splice is finished first.
+
+An omnidirectional base's :class:`~trajopt.motion.OmniTrajectory` is re-planned with its
+orientation continued (:mod:`trajopt.replan._omni`): the plan from the moving state starts
+its orientation at the body's angle, yaw rate and yaw acceleration at the splice
+(``start_heading``, ``start_omega``, ``start_alpha``), the kept rest keeps the rest of the
+orientation profile (:func:`~trajopt.replan._keep.keep_omni`), and a braking re-plan stops
+the yaw rate while it brakes. A plain :class:`~trajopt.Trajectory` of an omni base faces its
+direction of travel; re-planned to a goal heading, its orientation starts with the
+direction of travel's rate and acceleration when they are within the yaw limits.
 """
 
 from __future__ import annotations
@@ -32,13 +41,21 @@ from astar.grid import OccupancyGrid
 from trajopt._validation import nonnegative, number, point
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._omni import OmniTrajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import check_endpoint
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import WarmStart
 from trajopt.planning._runner import run_query
 from trajopt.replan._brake import brake_turn_go
-from trajopt.replan._keep import BLOCKED_NEAR, keep_rest, remaining_grid_path, target_change
+from trajopt.replan._keep import (
+    BLOCKED_NEAR,
+    keep_omni,
+    keep_rest,
+    remaining_grid_path,
+    target_change,
+)
+from trajopt.replan._omni import course_orientation, orientation_at, translation_state
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
 BRAKE_AFTER_S = 0.1
@@ -98,7 +115,8 @@ def replan_from(
     if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
         out, why = _keep_chain(caches.grid, trajectory, ts, goal, goal_heading, v_end)
     elif reuse:
-        out, why = keep_rest(
+        keep = keep_omni if isinstance(piece, OmniTrajectory) else keep_rest
+        out, why = keep(
             options, caches, piece, t_piece, goal, goal_heading=goal_heading, v_end=v_end
         )
     if out is None:
@@ -177,14 +195,21 @@ def _plan_or_brake(
         i, tau = piece.piece_at(ts)
         if isinstance(piece.pieces[i], TurnInPlace) and tau < piece.pieces[i].duration:
             return brake(TimingError("the robot is turning in place at the splice"))
-    state = trajectory.state_at(ts)
+    state = translation_state(trajectory, ts)
     path = None
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
         path = remaining_grid_path(
             options, caches, piece.steps, caches.grid.world_to_cell(state.position)
         )
     warm = WarmStart(path, previous)
+    body = orientation_at(trajectory, ts)  # an omni base's orientation goes on
+    if body is None and goal_heading is not None:
+        body = course_orientation(trajectory, ts, options.robot)
     request = PlanRequest(state, goal, goal_heading=goal_heading, v_end=v_end)
+    if body is not None:
+        request = dataclasses.replace(
+            request, start_heading=body.theta, start_omega=body.omega, start_alpha=body.alpha
+        )
     if brake_after_s is None or options.robot.footprint is not None:  # no brake to fall on
         return run_query(options, caches, request, warm)
     try:

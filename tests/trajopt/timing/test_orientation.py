@@ -3,7 +3,10 @@
 References: the yaw limits by hand (``tests.reference.turn_limits_by_hand``), ruckig called
 directly for the time-optimal turn (``ruckig_rest_to_rest_duration``), the independent
 producer ``turn_in_place`` for the same turn at rest, finite differences of the sampled
-orientation on 1 ms samples for the limits, and the shortest signed angle by hand.
+orientation on 1 ms samples for the limits, and the shortest signed angle by hand. A
+turning start (``omega_start``, ``alpha_start``): ruckig called directly and unscaled for
+the time-optimal duration, forward differences at the start, and the hand formula of a yaw
+stop from a constant rate.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from trajopt.errors import InvalidInputError, TimingError
 from trajopt.motion import OmniTrajectory
 from trajopt.robot._robot import Robot
 from trajopt.timing import orient, time_parameterize, turn_in_place
+from trajopt.timing._orientation import stop_orientation
 
 OMNI = Robot(drive="omni")
 PLAIN_OMNI = Robot(drive="omni", track_width=None, wheel_v_max=None, radius=0.3)
@@ -209,3 +213,138 @@ def test_a_turn_that_outlasts_a_moving_end_is_a_timing_error():
     with pytest.raises(TimingError, match="v_end"):
         orient(moving, OMNI, 0.0, 3.0)
     assert orient(moving, OMNI, 0.0, 0.05).duration == moving.duration  # a turn that fits
+
+
+# ------------------------------------------------------------------ a turning start
+def _ruckig_from(d: float, w0: float, a0: float, limits) -> float:
+    """Reference: ruckig called directly, unscaled, for the turn 0 -> d from (w0, a0)."""
+    from ruckig import InputParameter, Result, Ruckig
+    from ruckig import Trajectory as RuckigTrajectory
+
+    w, al, z = limits
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [w0], [a0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [d], [0.0], [0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [w], [al], [z]
+    traj = RuckigTrajectory(1)
+    assert Ruckig(1).calculate(inp, traj) == Result.Working
+    return float(traj.duration)
+
+
+def _feasible(w0: float, a0: float, limits) -> bool:
+    w, al, z = limits
+    return abs(w0) <= w and abs(a0) <= al and abs(w0 + a0 * abs(a0) / (2 * z)) <= w
+
+
+def check_turning_start(traj: OmniTrajectory, robot: Robot, start, goal, w0, a0):
+    """A profile from (start, w0, a0): its start by finite differences, its end, its limits."""
+    w_lim, al_lim, z_lim = turn_limits_by_hand(robot)
+    th0, om0, al0, _ = traj.orientation(0.0)
+    assert (float(th0), float(om0), float(al0)) == (start, w0, a0)
+    # the start's rate and acceleration by forward differences of the sampled angle:
+    # theta(h) = start + w0 h + a0 h^2 / 2 + zeta h^3 / 6 with |zeta| <= zeta_lim
+    h = 1e-4
+    th = np.asarray(traj.orientation(np.array([0.0, h, 2 * h]))[0])
+    assert abs((th[1] - th[0]) / h - w0) <= abs(a0) * h / 2 + z_lim * h**2 / 6 + 1e-9
+    assert abs((th[2] - 2 * th[1] + th[0]) / h**2 - a0) <= z_lim * h + 1e-6
+    # the end: the goal (modulo 2 pi), at rest, reached without a jump at turn_duration
+    t_end = traj.turn_duration
+    assert abs(_wrap(traj.theta_end - goal)) <= 1e-9
+    assert abs(traj.theta_end - start) <= math.pi + 1e-12
+    before = np.asarray(traj.orientation(np.array([max(0.0, t_end - 1e-7)]))[0])[0]
+    assert abs(before - traj.theta_end) <= w_lim * 1e-7 + 1e-12
+    _, w_end, al_end, _ = traj.orientation(traj.duration)
+    assert w_end == 0.0 and al_end == 0.0
+    # the limits on 1 ms samples (finite differences)
+    t = np.arange(0.0, traj.duration, MS)
+    th = np.asarray(traj.sample(t).theta)
+    assert np.abs(np.diff(th) / MS).max() <= w_lim * (1 + 1e-6) + 1e-9
+    if th.size > 2:
+        assert np.abs(np.diff(th, 2) / MS**2).max() <= al_lim * (1 + 1e-6) + 1e-6
+    if th.size > 3:
+        assert np.abs(np.diff(th, 3) / MS**3).max() <= z_lim * (1 + 1e-6) + 1e-3
+
+
+@pytest.mark.parametrize(
+    "start,goal,w0,a0",
+    [
+        (0.0, 1.5, 0.8, 0.0),  # turning towards the goal
+        (0.0, 1.5, -0.8, 0.0),  # turning away from it: it stops and comes back
+        (1.0, 1.0, 1.2, -1.0),  # turning at its goal: overshoots and returns
+        (2.0, -2.5, 1.4, 0.2),  # across +-pi, near the rate limit
+        (-1.0, 2.0, 0.0, 3.0),  # accelerating from a standstill
+        (0.3, 0.3 + 1e-10, 1e-6, 0.0),  # a tiny turn, a tiny rate
+    ],
+)
+def test_a_turning_start_continues_its_rate(start, goal, w0, a0):
+    limits = turn_limits_by_hand(OMNI)
+    assert _feasible(w0, a0, limits)
+    for length in (0.05, 1.5):  # a turn that outlasts the drive, one that fits in it
+        translation = _translation(length)
+        traj = orient(translation, OMNI, start, goal, omega_start=w0, alpha_start=a0)
+        check_turning_start(traj, OMNI, start, goal, w0, a0)
+        turn = math.remainder(goal - start, 2 * math.pi)
+        t_opt = _ruckig_from(turn, w0, a0, limits)
+        st_ = traj.stats["orientation"]
+        assert st_["turn_min_s"] == pytest.approx(t_opt, rel=1e-9, abs=1e-12)
+        assert traj.duration == pytest.approx(max(translation.duration, t_opt), rel=1e-9)
+        assert (st_["omega_start"], st_["alpha_start"]) == (w0, a0)
+        # the translation is untouched
+        t = np.linspace(0.0, translation.duration, 97)
+        np.testing.assert_array_equal(traj.sample(t).x, translation.sample(t).x)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    start=ANGLE,
+    goal=ANGLE,
+    w_frac=st.floats(-1.0, 1.0),
+    a_frac=st.floats(-1.0, 1.0),
+    length=st.sampled_from([0.05, 0.4, 1.5]),
+)
+def test_random_turning_starts_hold_every_limit(start, goal, w_frac, a_frac, length):
+    limits = turn_limits_by_hand(OMNI)
+    w0, a0 = w_frac * limits[0], a_frac * limits[1]
+    if not _feasible(w0, a0, limits):
+        a0 = 0.0
+    traj = orient(_translation(length), OMNI, start, goal, omega_start=w0, alpha_start=a0)
+    check_turning_start(traj, OMNI, start, goal, w0, a0)
+
+
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        ({"omega_start": math.nan}, r"omega_start must be finite.*nan"),
+        ({"omega_start": "1"}, r"omega_start must be a number.*'1'"),
+        ({"alpha_start": math.inf}, r"alpha_start must be finite.*inf"),
+        ({"omega_start": 1.6}, r"omega_start.*\|omega_start\| <= 1\.5 rad/s, got 1\.6"),
+        ({"omega_start": -1.6}, r"omega_start.*<= 1\.5.*got -1\.6"),
+        ({"alpha_start": 3.6}, r"alpha_start.*\|alpha_start\| <= 3\.57143 rad/s\^2, got 3\.6"),
+        # within each limit, but the acceleration carries the rate past its limit
+        ({"omega_start": 1.4, "alpha_start": 2.0}, r"omega_start \+ alpha_start.*1\.54.*1\.4"),
+    ],
+)
+def test_bad_turning_starts_are_refused(kwargs, match):
+    assert turn_limits_by_hand(OMNI)[:2] == pytest.approx((1.5, 3.571428571428571))
+    with pytest.raises(InvalidInputError, match=match):
+        orient(_translation(1.0), OMNI, 0.0, 1.0, **kwargs)
+    with pytest.raises(InvalidInputError, match=match):
+        stop_orientation(_translation(1.0), OMNI, 0.0, **{"omega_start": 0.5, **kwargs})
+
+
+@pytest.mark.parametrize("w0", [0.1, 0.9, -1.5])
+def test_the_yaw_stop_matches_the_hand_formula(w0):
+    w_lim, al_lim, z_lim = turn_limits_by_hand(OMNI)
+    translation = _translation(0.4)
+    traj = stop_orientation(translation, OMNI, 0.5, omega_start=w0)
+    # hand: from (w0, 0) to rest, jerk -z then (if needed) -alpha_lim then +z; the rate is
+    # point-symmetric about the middle, so the angle is w0 t / 2
+    w = abs(w0)
+    t = w / al_lim + al_lim / z_lim if w >= al_lim**2 / z_lim else 2 * math.sqrt(w / z_lim)
+    assert traj.turn_duration == pytest.approx(t, rel=1e-12)
+    assert traj.theta_end == pytest.approx(0.5 + w0 * t / 2, abs=1e-12)
+    check_turning_start(traj, OMNI, 0.5, traj.theta_end, w0, 0.0)
+    assert traj.duration == max(translation.duration, traj.turn_duration)
+    assert traj.stats["orientation"]["stop"]
+    at_rest = stop_orientation(translation, OMNI, 0.5, omega_start=0.0)
+    assert at_rest.n_phases == 0 and at_rest.theta_end == 0.5
