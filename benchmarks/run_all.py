@@ -141,6 +141,17 @@ BENCHES: tuple[Bench, ...] = (
         ("--limit", "400", "--random", "250", "--radii", "1.5,2.5,3.5"),
     ),
     Bench(
+        "ipopt",
+        "IPOPT vs piqp and the SCP in polygon corridors",
+        "bench_ipopt.py",
+        "On the shared-small suite, the same queries planned with piqp and with "
+        '`qp_solver="ipopt"`, and with a bound 1/(2r) by the SCP and by '
+        '`curvature_solver="ipopt"`: success rates, duration ratios, median smoothing and '
+        "solver times and their ratios (with and without the one-off IPOPT builds).",
+        ("--limit", "5"),
+        (),
+    ),
+    Bench(
         "refusals",
         "Fast refusals: unconnected queries",
         "bench_refusals.py",

@@ -82,17 +82,13 @@ def fit(
     """:meth:`Smoother.fit` (see there)."""
     polygons = isinstance(corridor, PolygonCorridor)
     # one-off module imports do not count against the time budget; polygon QPs go to piqp
-    # directly, the others through casadi
-    warm_imports(casadi=not polygons or options.qp_solver != "piqp")
+    # directly, the others (and every IPOPT problem) through casadi
+    ipopt = "ipopt" in (options.qp_solver, options.curvature_solver)
+    warm_imports(casadi=not polygons or options.qp_solver != "piqp" or ipopt)
     t_call = time.perf_counter()
     if not (polygons or isinstance(corridor, Corridor)):
         raise InvalidInputError(
             f"corridor must be a Corridor or a PolygonCorridor, got {type(corridor).__name__}"
-        )
-    if polygons and "ipopt" in (options.qp_solver, options.curvature_solver):
-        raise InvalidInputError(
-            "qp_solver='ipopt' and curvature_solver='ipopt' take box corridors only; a "
-            "PolygonCorridor is solved by piqp or osqp (and the SCP)"
         )
     res = corridor.resolution
     rad = corridor.radius if radius is None else float(radius)
@@ -290,7 +286,7 @@ def solve_attempt(
         info = SolveInfo(solver="warm", status=SolveStatus.WARM_START, detail="warm start", z=z)
     rec.n_control_points, rec.padded_size, rec.qp = n, nb, info
     if not info.success:
-        raise AttemptFailed(f"QP solver {info.solver}: {info.detail}")
+        raise AttemptFailed(f"QP solver {info.solver}: {_failure(info)}")
     z = np.clip(info.z, qp.lbx, qp.ubx)
     const = asm.const
     if options.kappa_max is not None:
@@ -303,7 +299,7 @@ def solve_attempt(
             cinfo = solve_curvature_ipopt(options, qp, t, z, kmax_cells, remaining, margin)
         rec.nlp = cinfo
         if not cinfo.success:
-            raise AttemptFailed(f"curvature bound ({cinfo.solver}): {cinfo.detail}")
+            raise AttemptFailed(f"curvature bound ({cinfo.solver}): {_failure(cinfo)}")
         z = np.clip(cinfo.z, qp.lbx, qp.ubx)
     c = np.column_stack([z[:n], z[nb : nb + n]])
     project_heading(c, prob, asm.lo, asm.hi, asm.point_rows, asm.start_alpha)
@@ -311,6 +307,13 @@ def solve_attempt(
     zc[:n], zc[nb : nb + n] = c[:, 0], c[:, 1]
     rec.cost = band_quadratic(qp.full, qp.g, zc, const)
     return c, t, asm.span_box
+
+
+def _failure(info: SolveInfo) -> str:
+    """Return what a failed solver call reports: its status (and IPOPT's iteration count)."""
+    if info.solver == "ipopt":
+        return f"IPOPT status {info.detail!r} after {info.iterations} iteration(s)"
+    return info.detail
 
 
 def fit_free(options: Smoother, points: Any, u: Any, knots: Any) -> BSplineCurve:

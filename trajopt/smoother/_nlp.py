@@ -1,6 +1,10 @@
 """IPOPT problems of the smoother (``qp_solver="ipopt"``, ``curvature_solver="ipopt"``).
 
-The convex QP and the exact curvature-bounded NLP, built with CasADi once per padded size.
+The convex QP and the exact curvature-bounded NLP, built with CasADi once per problem shape
+(padded control points ``nb``, degree ``p``, region rows per point ``k``) and re-solved with
+parameters: the objective's band and linear term, and the non-zeros of the constraint rows of
+:func:`~trajopt.smoother._qp.constraint_layout` (heading rows and the region rows of a box or a
+polygon corridor).
 """
 
 from __future__ import annotations
@@ -12,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, curvature_samples
-from trajopt.smoother._problem import N_HEADING_ROWS, QPData
+from trajopt.smoother._problem import QPData
 from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
 
@@ -21,35 +25,95 @@ if TYPE_CHECKING:
 
 
 @functools.lru_cache(maxsize=32)
-def qp_ipopt(nb: int, p: int, verbose: bool):
-    """Return the same convex problem (no sample rows) solved by IPOPT (fallback / reference).
+def qp_ipopt(nb: int, p: int, k: int, verbose: bool):
+    """Return the corridor QP (no sample rows) as an IPOPT problem, built once per shape.
 
-    Parameters ``[h band (p+1)*nb, g (2nb), heading rows (4*2nb)]``.
+    The rows are those of :func:`~trajopt.smoother._qp.constraint_layout` ``(nb, p, 0, k)``
+    (heading rows, then ``k`` region rows per control point: the diagonal rows of a box
+    corridor, the half-planes of a polygon corridor), ``lba <= A z <= uba``, with ``A``'s
+    sparsity fixed and its non-zeros a parameter.
+
+    Parameters
+    ----------
+    nb, p, k : int
+        Padded control points, degree and region rows per control point.
+    verbose : bool
+        IPOPT's output.
+
+    Returns
+    -------
+    casadi.Function
+        An ``nlpsol`` with parameters ``[h band ((p+1) nb), g (2 nb), A non-zeros (CCS)]``
+        (:func:`qp_parameters`).
     """
     import casadi as ca
 
     z = ca.SX.sym("z", 2 * nb)
     hb = ca.SX.sym("hb", (p + 1) * nb)
     g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
-    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
+    amat, anz = _rows_matrix(nb, p, k)
     nlp = {
         "x": z,
-        "p": ca.vertcat(hb, g, a),
-        "f": f,
-        "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb)),
+        "p": ca.vertcat(hb, g, anz),
+        "f": _band_quadratic(z, hb, nb, p) + ca.dot(g, z),
+        "g": ca.mtimes(amat, z),
     }
     with LOCK:
-        return ca.nlpsol("smoother_qp_ipopt", "ipopt", nlp, _ipopt_opts(verbose))
+        return ca.nlpsol(f"smoother_qp_ipopt_{k}", "ipopt", nlp, _ipopt_opts(verbose))
 
 
-def _diag_rows(z, nb: int):
-    """``[x_0 + y_0, x_0 - y_0, x_1 + y_1, ...]`` (the layout's diagonal rows)."""
+def _rows_matrix(nb: int, p: int, k: int):
+    """Symbolic ``A`` of :func:`constraint_layout` ``(nb, p, 0, k)`` and its non-zeros."""
     import casadi as ca
 
-    x, y = z[:nb], z[nb:]
-    return ca.reshape(ca.horzcat(x + y, x - y).T, 2 * nb, 1)
+    from trajopt.smoother._qp import constraint_layout
+
+    sp = constraint_layout(nb, p, 0, k).sparsity
+    anz = ca.SX.sym("a", sp.nnz())
+    return ca.SX(sp, anz), anz
+
+
+def row_values(qp: QPData, p: int) -> np.ndarray:
+    """CCS non-zeros of the rows ``A`` of ``qp`` (:func:`_rows_matrix`'s parameter)."""
+    from trajopt.smoother._qp import constraint_layout
+
+    layout = constraint_layout(qp.nb, p, 0, qp.k)
+    return layout.nonzeros(layout.values(qp.heading, None, qp.region_coef))
+
+
+def qp_parameters(qp: QPData, p: int) -> np.ndarray:
+    """Parameter vector of :func:`qp_ipopt` for ``qp``."""
+    return np.concatenate([qp.full.ravel(), qp.g, row_values(qp, p)])
+
+
+def ipopt_info(solver, out: dict, solve: float, cpu: float, build: float, left: float):
+    """Return the :class:`SolveInfo` of an IPOPT solve (its status and iteration count).
+
+    A solve that IPOPT does not report as successful (``Solve_Succeeded`` or
+    ``Solved_To_Acceptable_Level``), a non-finite solution or one longer than ``left``
+    seconds is a failure; ``detail`` is IPOPT's return status.
+    """
+    st = solver.stats()
+    z = np.asarray(out["x"], dtype=float).ravel()
+    finite = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
+    iters = int(st.get("iter_count", 0) or 0)
+    detail = str(st.get("return_status", ""))
+    if solve > left:
+        status = SolveStatus.OVER_BUDGET
+        detail += " (over budget)"
+    else:
+        status = SolveStatus.SOLVED if finite else SolveStatus.SOLVER_FAILED
+    return SolveInfo(
+        solver="ipopt",
+        status=status,
+        detail=detail,
+        iterations=iters,
+        solve_time_s=solve,
+        solve_cpu_s=cpu,
+        build_time_s=build,
+        cost=float(out["f"]) if "f" in out else float("nan"),
+        z=z,
+    )
 
 
 def _band_quadratic(z, hb, nb: int, p: int):
@@ -75,6 +139,10 @@ def _ipopt_opts(verbose: bool) -> dict:
             "mu_strategy": "adaptive",
             "bound_relax_factor": 0.0,
             "honor_original_bounds": "yes",
+            # the rows are imposed 1e-6 cells inside the regions: a solution IPOPT accepts
+            # must not leave them by more (its defaults allow 1e-4 and 1e-2 cells)
+            "constr_viol_tol": 1e-7,
+            "acceptable_constr_viol_tol": 1e-7,
         },
         "print_time": verbose,
         "error_on_fail": False,
@@ -82,18 +150,29 @@ def _ipopt_opts(verbose: bool) -> dict:
 
 
 @functools.lru_cache(maxsize=16)
-def curvature_nlp(nb: int, p: int, verbose: bool):
-    """IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``.
+def curvature_nlp(nb: int, p: int, k: int, verbose: bool):
+    """Return the exact curvature-bounded problem as an IPOPT problem, built once per shape.
 
-    IPOPT problem: the QP objective, the heading and diagonal rows, and per sample ``r``
-    (``CURV_SAMPLES`` per span, span ``j`` touching control points ``j .. j + p``)
-
+    The QP objective, the rows of :func:`qp_ipopt` (``lba <= A z <= uba``, ``A``'s non-zeros a
+    parameter: box or polygon corridors alike) and per sample ``r`` (``CURV_SAMPLES`` per
+    span, span ``j`` touching control points ``j .. j + p``)
     ``cross_r^2 - kmax^2 * speed2_r^3 <= 0`` and ``speed2_r >= floor_r^2`` (via ``lbg``),
-
     with ``cross = x'y'' - y'x''`` and ``speed2 = x'^2 + y'^2`` from basis-derivative values
-    passed as parameters. Parameters: ``[hb, g, a, b1 (S*(p+1)), b2 (S*(p+1)), kmax^2]``.
-    Constraint order: 4 heading rows, ``2 nb`` diagonal rows, then ``S`` curvature rows,
-    then ``S`` speed rows.
+    passed as parameters.
+
+    Parameters
+    ----------
+    nb, p, k : int
+        Padded control points, degree and region rows per control point.
+    verbose : bool
+        IPOPT's output.
+
+    Returns
+    -------
+    casadi.Function
+        An ``nlpsol`` with parameters ``[hb, g, A non-zeros, b1 (S (p+1)), b2 (S (p+1)),
+        kmax^2]``; constraints: the ``5 + k nb`` rows, then ``S`` curvature rows, then ``S``
+        speed rows.
     """
     import casadi as ca
 
@@ -102,13 +181,12 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
     z = ca.SX.sym("z", 2 * nb)
     hb = ca.SX.sym("hb", (p + 1) * nb)
     g = ca.SX.sym("g", 2 * nb)
-    a = ca.SX.sym("a", N_HEADING_ROWS * 2 * nb)
+    amat, anz = _rows_matrix(nb, p, k)
     b1 = ca.SX.sym("b1", S * (p + 1))
     b2 = ca.SX.sym("b2", S * (p + 1))
     k2 = ca.SX.sym("k2")
     x, y = z[:nb], z[nb:]
     f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    amat = ca.reshape(a, N_HEADING_ROWS, 2 * nb)
     span = np.repeat(np.arange(ns), CURV_SAMPLES)
     B1 = ca.reshape(b1, S, p + 1)
     B2 = ca.reshape(b2, S, p + 1)
@@ -127,12 +205,12 @@ def curvature_nlp(nb: int, p: int, verbose: bool):
     gcurv = cross * cross - k2 * sp2 * sp2 * sp2
     nlp = {
         "x": z,
-        "p": ca.vertcat(hb, g, a, b1, b2, k2),
+        "p": ca.vertcat(hb, g, anz, b1, b2, k2),
         "f": f,
-        "g": ca.vertcat(ca.mtimes(amat, z), _diag_rows(z, nb), gcurv, sp2),
+        "g": ca.vertcat(ca.mtimes(amat, z), gcurv, sp2),
     }
     with LOCK:
-        return ca.nlpsol("smoother_curv", "ipopt", nlp, _ipopt_opts(verbose))
+        return ca.nlpsol(f"smoother_curv_{k}", "ipopt", nlp, _ipopt_opts(verbose))
 
 
 def solve_curvature_ipopt(
@@ -144,11 +222,33 @@ def solve_curvature_ipopt(
     remaining: float,
     margin: float,
 ) -> SolveInfo:
-    """Return the curvature-bounded problem by IPOPT, warm started at ``z0`` (cells).
+    """Return the curvature-bounded problem solved by IPOPT, warm started at ``z0`` (cells).
 
     ``|kappa| <= margin * kmax`` (1/cell) and ``|C'| >= options.speed_floor`` at
-    :data:`~trajopt.smoother._basis.CURV_SAMPLES` samples per span; a solve longer than the
-    ``remaining`` budget (s) is a failure.
+    :data:`~trajopt.smoother._basis.CURV_SAMPLES` samples per span, within the rows of ``qp``
+    (box or polygon corridor); a solve longer than the ``remaining`` budget (s) is a failure.
+
+    Parameters
+    ----------
+    options : Smoother
+        ``degree``, ``speed_floor`` and ``verbose`` are used.
+    qp : QPData
+        The attempt's convex problem (cell units, padded).
+    t : ndarray
+        Knots (cells).
+    z0 : ndarray, shape (2 nb,)
+        Starting point (the QP's or an earlier attempt's solution).
+    kmax : float
+        Curvature bound (1/cell).
+    remaining : float
+        Time left (s).
+    margin : float
+        Factor on ``kmax`` at the samples.
+
+    Returns
+    -------
+    SolveInfo
+        ``detail`` is IPOPT's return status, ``iterations`` its iteration count.
     """
     p = options.degree
     n, nb = qp.n, qp.nb
@@ -158,7 +258,7 @@ def solve_curvature_ipopt(
         [
             qp.full.ravel(),
             qp.g,
-            qp.heading.ravel(order="F"),
+            row_values(qp, p),
             B1.ravel(order="F"),
             B2.ravel(order="F"),
             [(margin * kmax) ** 2],
@@ -170,26 +270,12 @@ def solve_curvature_ipopt(
     off = len(qp.lba) + S
     lbg[off : off + (n - p) * ms] = options.speed_floor**2
     tb = time.perf_counter()
-    built = is_built("curv", nb, p, options.verbose)
-    solver = curvature_nlp(nb, p, options.verbose)
+    built = is_built(f"curv-{qp.k}", nb, p, options.verbose)
+    solver = curvature_nlp(nb, p, qp.k, options.verbose)
     build = 0.0 if built else time.perf_counter() - tb
     left = max(0.05, remaining - build - 0.02)
     ts = time.perf_counter()
+    tc = time.process_time()
     out = solver(x0=z0, p=par, lbx=qp.lbx, ubx=qp.ubx, lbg=lbg, ubg=ubg)
     solve = time.perf_counter() - ts
-    st = solver.stats()
-    z = np.asarray(out["x"], dtype=float).ravel()
-    finite = bool(st.get("success", False)) and bool(np.all(np.isfinite(z)))
-    if solve > left:
-        status = SolveStatus.OVER_BUDGET
-    else:
-        status = SolveStatus.SOLVED if finite else SolveStatus.SOLVER_FAILED
-    return SolveInfo(
-        solver="ipopt",
-        status=status,
-        detail=str(st.get("return_status", "")) + ("" if solve <= left else " (over budget)"),
-        iterations=int(st.get("iter_count", 0) or 0),
-        solve_time_s=solve,
-        build_time_s=build,
-        z=z,
-    )
+    return ipopt_info(solver, out, solve, time.process_time() - tc, build, left)

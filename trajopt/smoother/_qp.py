@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from trajopt.smoother._nlp import qp_ipopt
+from trajopt.smoother._nlp import ipopt_info, qp_ipopt, qp_parameters
 from trajopt.smoother._problem import N_HEADING_ROWS, QPData
 from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
@@ -459,40 +459,45 @@ def solve_qp(options: Smoother, qp: QPData, x0: np.ndarray | None = None) -> Sol
     tb = time.perf_counter()
     built = is_built(f"{solver_name}-0-{qp.k}", nb, p, options.verbose)
     if solver_name == "ipopt":
-        solver = qp_ipopt(nb, p, options.verbose)
-    else:
-        solver = qp_solver(nb, p, solver_name, 0, options.verbose, qp.k)
+        # the layout's rows (box or polygon corridor) with their non-zeros as parameters
+        solver = qp_ipopt(nb, p, qp.k, options.verbose)
+        build = 0.0 if built else time.perf_counter() - tb
+        ts = time.perf_counter()
+        tc = time.process_time()
+        out = solver(x0=x0, p=qp_parameters(qp, p), lbx=lbx, ubx=ubx, lbg=lba, ubg=uba)
+        info = ipopt_info(
+            solver, out, time.perf_counter() - ts, time.process_time() - tc, build, np.inf
+        )
+        info.z = info.z[: 2 * nb]
+        return info
+    solver = qp_solver(nb, p, solver_name, 0, options.verbose, qp.k)
     build = 0.0 if built else time.perf_counter() - tb
     ts = time.perf_counter()
     tc = time.process_time()
-    if solver_name == "ipopt":
-        par = np.concatenate([qp.full.ravel(), qp.g, qp.heading.ravel(order="F")])
-        out = solver(x0=x0, p=par, lbx=lbx, ubx=ubx, lbg=lba, ubg=uba)
-    else:
-        import casadi as ca
+    import casadi as ca
 
-        layout = constraint_layout(nb, p, 0, qp.k)
-        hnz = h_nonzeros(qp.full, nb, p)
-        trip = layout.values(qp.heading, None, qp.region_coef)
-        if solver_name == "piqp":
-            # piqp warns about (and drops) infinite rows, and large finite ones hurt
-            # its conditioning: bound every row by its range over the variable bounds
-            lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
-            lba = np.maximum(lba, lo_r - 1.0)
-            uba = np.minimum(uba, hi_r + 1.0)
-            gap = lba - uba
-            if np.any(gap > 0.0):  # a row out of reach of the variable bounds
-                i = int(np.argmax(gap))
-                return SolveInfo(
-                    solver=solver_name,
-                    status=SolveStatus.SOLVER_FAILED,
-                    detail=f"primal infeasible: row {i} is out of reach of the variable bounds",
-                    build_time_s=build,
-                    z=np.full(2 * nb, np.nan),
-                )
-        hval = ca.DM(solver.sparsity_in("h"), hnz)
-        aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
-        out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+    layout = constraint_layout(nb, p, 0, qp.k)
+    hnz = h_nonzeros(qp.full, nb, p)
+    trip = layout.values(qp.heading, None, qp.region_coef)
+    if solver_name == "piqp":
+        # piqp warns about (and drops) infinite rows, and large finite ones hurt
+        # its conditioning: bound every row by its range over the variable bounds
+        lo_r, hi_r = layout.implied_range(trip, lbx, ubx)
+        lba = np.maximum(lba, lo_r - 1.0)
+        uba = np.minimum(uba, hi_r + 1.0)
+        gap = lba - uba
+        if np.any(gap > 0.0):  # a row out of reach of the variable bounds
+            i = int(np.argmax(gap))
+            return SolveInfo(
+                solver=solver_name,
+                status=SolveStatus.SOLVER_FAILED,
+                detail=f"primal infeasible: row {i} is out of reach of the variable bounds",
+                build_time_s=build,
+                z=np.full(2 * nb, np.nan),
+            )
+    hval = ca.DM(solver.sparsity_in("h"), hnz)
+    aval = ca.DM(layout.sparsity, layout.nonzeros(trip))
+    out = solver(h=hval, g=qp.g, a=aval, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
     solve = time.perf_counter() - ts
     cpu = time.process_time() - tc
     st = solver.stats()

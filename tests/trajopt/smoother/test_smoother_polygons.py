@@ -200,10 +200,6 @@ def test_polygon_corridor_bad_input():
     infl = square_inflated(grid, r)
     path = astar.find_path(infl, scene.start_cell, scene.goal_cell("A"))
     corr = build_polygon_corridor(grid, path, r)
-    with pytest.raises(InvalidInputError, match="ipopt"):
-        Smoother(qp_solver="ipopt").fit(None, corr)
-    with pytest.raises(InvalidInputError, match="ipopt"):
-        Smoother(kappa_max=1.0, curvature_solver="ipopt").fit(None, corr)
     with pytest.raises(InvalidInputError, match="start .* must lie in the corridor's region 0"):
         Smoother().fit(None, corr, start=(0.0, 0.0))
     with pytest.raises(InvalidInputError, match="objective must be one of"):
