@@ -29,8 +29,8 @@ The convex problem is a sparse banded QP solved by piqp (by default): through
 ``casadi.conic`` in a box corridor, directly in a polygon corridor (its rows per point
 vary). The curvature-bounded problem is solved by sequential convex programming
 (``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex problem,
-warm-started from the QP (``curvature_solver="ipopt"``). Solvers are built once per padded
-size and cached.
+warm-started from the QP (``curvature_solver="ipopt"``), in box and polygon corridors alike.
+Solvers are built once per problem shape (padded size, degree, rows per point) and cached.
 
 Every result is verified (:class:`Certificate`) before it is returned: control points in
 their regions, exact endpoints, dense-sample clearance against the raw map, no cusp, and the

@@ -51,15 +51,18 @@ class Smoother:
     qp_solver : {"piqp", "osqp", "ipopt"}, optional
         Solver of the convex problem. Default "piqp" (an interior-point method: steady
         iteration counts, and no state kept between calls, so results are reproducible
-        bit for bit; osqp warm-starts its duals from the previous call).
+        bit for bit; osqp warm-starts its duals from the previous call). ``"ipopt"``
+        solves the same problem with IPOPT (CasADi ``nlpsol``, built once per problem
+        shape), in box and polygon corridors.
     curvature_solver : {"scp", "ipopt"}, optional
         How the curvature-bounded problem is solved. ``"scp"`` (default): sequential
         convex programming, a few piqp QPs in which the bound is linearised
         conservatively around the previous iterate's tangents, inside a trust region
         (from 64 control points up, only the samples near the bound, and their
         neighbours, enter the QPs; the step's acceptance still checks every sample).
-        ``"ipopt"``: the exact non-convex problem by IPOPT, warm started from the QP
-        (slower by one to two orders of magnitude; see ``docs/benchmarks.md``).
+        ``"ipopt"``: the exact non-convex problem by IPOPT, warm started from the QP, in
+        box and polygon corridors (about 3x the SCP's smoothing time on the shared
+        queries, with durations within 0.1 %; see ``docs/benchmarks.md``).
     scp_iterations : int, optional
         Most SCP iterations. Default 25.
     time_budget_s : float, optional
