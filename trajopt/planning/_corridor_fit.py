@@ -84,6 +84,11 @@ def fit_in_corridor(
             if left <= 0:
                 raise SmoothingError("time budget exhausted before the box corridor", {})
             sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
+            # a costmap's graded cost (search "costmap" or "costmap+clearance") enters the
+            # smoother's objective with costmap_weight; the IPOPT problems do not hold it yet
+            cost = q.cost
+            if "ipopt" in (sm.qp_solver, sm.curvature_solver if sm.kappa_max else ""):
+                cost = None
             with q.timer.stage("smooth"):
                 smooth = sm.fit(
                     path,
@@ -96,6 +101,8 @@ def fit_in_corridor(
                     goal_heading=q.goal_heading,
                     start_curvature=q.start_curvature,
                     footprint=q.footprint,
+                    cost=cost,
+                    cost_weight=options.costmap_weight,
                 )
             return corridor, smooth
         except SmoothingError as exc:

@@ -105,6 +105,8 @@ def plan_disc(
         previous=None if warm is None else warm.previous,
         footprint=footprint,
     )
+    if caches.costmap is not None and options.search.startswith("costmap"):
+        q.cost = caches.costmap  # the smoother minimises its graded cost too
     with q.timer.stage("inflate"):
         q.inflated = caches.inflated
     _check_reachable_ends(options, caches.grid, q)

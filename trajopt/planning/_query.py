@@ -78,6 +78,9 @@ class PlanQuery:
         How many regions of the result's polygon corridor are ``previous``'s.
     footprint : Footprint or None
         The footprint the smoother must also certify (a footprint robot's disc model).
+    cost : astar.Costmap or None
+        On a costmap searched by its cost: the costmap, whose normalised cost the smoother
+        minimises with ``costmap_weight``.
     timer : StageTimer
     """
 
@@ -98,6 +101,7 @@ class PlanQuery:
     previous: PlanSteps | None = None
     regions_kept: int = 0
     footprint: Any = None
+    cost: Any = None  # the costmap whose graded cost the smoother minimises (or None)
     timer: StageTimer = field(default_factory=StageTimer)
 
 

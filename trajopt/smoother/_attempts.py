@@ -13,6 +13,7 @@ end heading may be pinned or the same knots solved again by the footprint SCP
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 import math
@@ -28,6 +29,7 @@ from trajopt.geometry._bspline import BSplineCurve
 from trajopt.robot._footprint import Footprint
 from trajopt.smoother._basis import band_quadratic, bucket_size
 from trajopt.smoother._certificate import certify
+from trajopt.smoother._cost import CostField, CostTerm, cost_field, cost_rounds
 from trajopt.smoother._footprint_rounds import FootprintRounds, footprint_scp
 from trajopt.smoother._nlp import solve_curvature_ipopt
 from trajopt.smoother._path import SmoothPath
@@ -78,6 +80,8 @@ def fit(
     goal_heading: float | None = None,
     start_curvature: float | None = None,
     footprint: Footprint | None = None,
+    cost: Any = None,
+    cost_weight: float = 2.0,
 ) -> SmoothPath:
     """:meth:`Smoother.fit` (see there)."""
     polygons = isinstance(corridor, PolygonCorridor)
@@ -107,6 +111,18 @@ def fit(
         ks = number("start_curvature", start_curvature, unit="1/m")
         if hs is None:
             raise InvalidInputError("start_curvature needs start_heading (the tangent it bends)")
+    field = cost_field(cost, cost_weight, raw_grid)
+    if field is not None and options.qp_solver == "ipopt":
+        raise InvalidInputError(
+            "cost: the cost term is minimised by sequential QP rounds (qp_solver 'piqp' or "
+            "'osqp'), not yet in the IPOPT problem; got qp_solver='ipopt'"
+        )
+    if field is not None and options.kappa_max is not None and options.curvature_solver == "ipopt":
+        raise InvalidInputError(
+            "cost: the cost term is minimised by sequential QP rounds before the SCP, not yet "
+            "in the IPOPT problem; got curvature_solver='ipopt'"
+        )
+    cost_at = None if field is None else (field, np.asarray(corridor.origin, dtype=float))
     if corridor.length_m <= 0:
         raise InvalidInputError("the corridor's path has zero length (start == goal)")
     prob, p0, p1 = build_problem(
@@ -135,7 +151,7 @@ def fit(
         attempts.append(rec)
         try:
             c_cells, t_cells, span_box = solve_attempt(
-                options, prob, h, remaining, margin, warm, rec
+                options, prob, h, remaining, margin, warm, rec, cost_at
             )
         except AttemptFailed as exc:
             rec.failure = str(exc)
@@ -175,6 +191,8 @@ def fit(
             rec.footprint_margin_m = fcert.min_margin_m
         if cert.ok and (fcert is None or fcert.ok):
             stats = summarize(attempts, time.perf_counter() - t_call, success=True)
+            if rec.cost_rounds is not None:
+                stats["cost_rounds"] = dict(rec.cost_rounds)
             if fp is not None:
                 stats.update(footprint_certificate_s=fp.time_s, footprint_rounds=fp.rounds)
             return SmoothPath(
@@ -258,10 +276,15 @@ def solve_attempt(
     margin: float,
     warm: np.ndarray | None,
     rec: AttemptRecord,
+    cost_at: tuple[CostField, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One attempt on the knots of span ``h`` (cells).
 
-    The QP, then with a curvature bound the SCP or IPOPT (sampled bound ``margin * kappa_max``).
+    The QP, then with a cost field (``cost_at``: the field and the corridor's origin, m) the
+    damped QP rounds of the linearised cost term (:func:`~trajopt.smoother._cost.cost_rounds`;
+    on a warm retry from the warm control points), then with a
+    curvature bound the SCP or IPOPT (sampled bound ``margin * kappa_max``; the SCP's linear
+    term then holds the cost gradient at the rounds' result).
     ``warm``: control points (cells) of an earlier attempt on the same knots; the curvature
     solver then starts from them instead of the QP solution. Fills ``rec``; returns the control
     points (cells, shape (n, 2)), the knots (cells) and every span's region.
@@ -289,11 +312,17 @@ def solve_attempt(
         raise AttemptFailed(f"QP solver {info.solver}: {_failure(info)}")
     z = np.clip(info.z, qp.lbx, qp.ubx)
     const = asm.const
+    qp_curv = qp
+    if cost_at is not None:
+        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, t, options.degree, nb)
+        deadline = t_enter + remaining
+        z, g_lin, rec.cost_rounds = cost_rounds(options, qp, term, z, const, deadline, solve_qp)
+        qp_curv = dataclasses.replace(qp, g=g_lin)
     if options.kappa_max is not None:
         kmax_cells = options.kappa_max * prob.res
         remaining -= time.perf_counter() - t_enter  # what the QP stage left
         if options.curvature_solver == "scp":
-            scp = CurvatureSCP(options, qp, t, kmax_cells, margin, const)
+            scp = CurvatureSCP(options, qp_curv, t, kmax_cells, margin, const)
             cinfo = scp.run(z, remaining, trust=TRUST_WARM if warm is not None else TRUST_COLD)
         else:
             cinfo = solve_curvature_ipopt(options, qp, t, z, kmax_cells, remaining, margin)

@@ -141,6 +141,8 @@ class Smoother:
         goal_heading: float | None = None,
         start_curvature: float | None = None,
         footprint: Footprint | None = None,
+        cost: Any = None,
+        cost_weight: float = 2.0,
     ) -> SmoothPath:
         """Fit a certified smooth path inside ``corridor``.
 
@@ -176,6 +178,20 @@ class Smoother:
             :mod:`~trajopt.smoother._footprint_rounds` (a pinned end heading; in a polygon
             corridor without a curvature bound, the footprint SCP); then the knots are
             refined.
+        cost : astar.Costmap or array_like, shape (ny, nx), optional
+            A cost field over the raw grid's cells (needs ``raw_grid``): a costmap (its
+            normalised :attr:`~astar.Costmap.cost`; its grid must have the raw grid's shape,
+            resolution and origin) or per-cell costs in ``[0, 1]``, row 0 at the bottom. The
+            objective then gains ``cost_weight * integral cost(C(u)) |C'(u)| du`` (cost per
+            unit length, cell units; the cells' values interpolated bilinearly between
+            their centres), minimised by damped sequential QP rounds that linearise it
+            around the current iterate (module :mod:`trajopt.smoother._cost`); the corridor
+            rows stay hard constraints and the certificate is unchanged. Not with
+            ``qp_solver="ipopt"`` or ``curvature_solver="ipopt"`` (not yet in the IPOPT
+            problem). ``stats["cost_rounds"]`` reports the rounds and the curve's mean cost.
+        cost_weight : float, optional
+            ``w`` of the cost term (dimensionless, finite, >= 0; 0 drops the term). Default
+            2 (the planner's ``costmap_weight``).
 
         Returns
         -------
@@ -203,6 +219,8 @@ class Smoother:
             goal_heading=goal_heading,
             start_curvature=start_curvature,
             footprint=footprint,
+            cost=cost,
+            cost_weight=cost_weight,
         )
 
     def fit_free(self, points: np.ndarray, u: np.ndarray, knots: np.ndarray) -> BSplineCurve:

@@ -122,6 +122,7 @@ class AttemptRecord:
     failure: str | None = None
     certificate_ok: bool | None = None
     footprint_margin_m: float | None = None
+    cost_rounds: dict[str, Any] | None = None  # the cost field's QP rounds (_cost.cost_rounds)
 
     @property
     def last(self) -> SolveInfo | None:
@@ -149,6 +150,8 @@ class AttemptRecord:
             )
             if self.nlp is not None:
                 out["nlp"] = self.nlp.to_stats()
+            if self.cost_rounds is not None:
+                out["cost_rounds"] = dict(self.cost_rounds)
         if self.cost is not None:
             out["cost"] = self.cost
         if self.failure is not None:

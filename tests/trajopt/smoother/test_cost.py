@@ -1,0 +1,159 @@
+"""The cost field in the smoother's objective (issue 34, part 2).
+
+References are independent of the code under test: central finite differences of the
+objective, the mean cost measured on dense samples of the returned curve, and the
+certificate recomputed by ``certify``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import astar
+from trajopt.corridor import build_polygon_corridor
+from trajopt.errors import InvalidInputError
+from trajopt.smoother import Smoother
+from trajopt.smoother._cost import CostTerm, cost_field
+from trajopt.smoother._problem import assemble, build_problem
+from trajopt.smoother._qp import solve_qp
+
+RES = 0.05
+START, GOAL = (0.8, 1.1), (2.9, 3.2)
+
+
+def l_hall():
+    """An L of two 1.2 m halls; the inner corner's walls lined with a 0.35 m band of cost 1."""
+    occ = np.ones((80, 80), bool)
+    occ[10:34, 10:70] = False  # y 0.5 .. 1.7 m
+    occ[10:70, 46:70] = False  # x 2.3 .. 3.5 m
+    grid = astar.OccupancyGrid(occ, RES)
+    yy, xx = np.mgrid[0:80, 0:80]
+    x, y = (xx + 0.5) * RES, (yy + 0.5) * RES
+    band = ((y > 1.35) & (y < 1.7) & (x < 2.65)) | ((x > 2.3) & (x < 2.65) & (y > 1.35))
+    cost = np.where(band & ~occ, 1.0, 0.0)
+    pts = np.vstack([np.linspace(START, (2.9, 1.1), 40), np.linspace((2.9, 1.1), GOAL, 40)[1:]])
+    return grid, cost, build_polygon_corridor(grid, pts, 0.2)
+
+
+def dense_mean_cost(curve, cost, grid) -> float:
+    """Mean cell cost per metre on 20000 samples (nearest cell: no interpolation)."""
+    a, b = curve.domain
+    pts = curve(np.linspace(a, b, 20001))
+    mid = 0.5 * (pts[1:] + pts[:-1])
+    d = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    ix = np.floor(mid / grid.resolution).astype(int)
+    return float(np.sum(cost[ix[:, 1], ix[:, 0]] * d) / np.sum(d))
+
+
+def test_gradient_matches_central_differences():
+    """The cost term's gradient against central finite differences of its value."""
+    grid, cost, corridor = l_hall()
+    smooth_cost = cost_field(
+        np.clip(cost + 0.3 * np.sin(np.arange(cost.size).reshape(cost.shape)), 0, 1), 2.0, grid
+    )
+    options = Smoother()
+    prob, _, _ = build_problem(options, None, corridor, start=START, goal=GOAL, hs=None, hg=None)
+    asm = assemble(options, prob, 4.0)
+    z = solve_qp(options, asm.qp, x0=asm.x0).z
+    qp = asm.qp
+    term = CostTerm.on_knots(
+        smooth_cost, np.asarray(corridor.origin), RES, asm.knots, options.degree, qp.nb
+    )
+    _, grad = term.value_grad(z)
+    rng = np.random.default_rng(3)
+    z = z + rng.uniform(-0.3, 0.3, z.shape) * (np.arange(len(z)) % qp.nb < qp.n)
+    _, grad = term.value_grad(z)
+    eps = 1e-6
+    idx = [i for i in range(2 * qp.nb) if i % qp.nb < qp.n]
+    fd = np.empty(len(idx))
+    for k, i in enumerate(idx):
+        e = np.zeros_like(z)
+        e[i] = eps
+        fd[k] = (term.value_grad(z + e)[0] - term.value_grad(z - e)[0]) / (2 * eps)
+    assert np.max(np.abs(fd - grad[idx])) <= 1e-5 * (1 + np.max(np.abs(fd)))
+    assert np.all(grad[[i for i in range(2 * qp.nb) if i % qp.nb >= qp.n]] == 0.0)
+
+
+def test_bilinear_field_interpolates_cell_centres():
+    """At the cell centres the field is the cell's value."""
+    grid, cost, _ = l_hall()
+    f = cost_field(cost, 1.0, grid)
+    iy, ix = np.nonzero(np.ones_like(cost, bool))
+    v, _ = f.at(np.column_stack([(ix + 0.5) * RES, (iy + 0.5) * RES]))
+    np.testing.assert_allclose(v, cost[iy, ix], atol=1e-12)
+
+
+@pytest.mark.parametrize("kappa_max", [None, 2.0])
+def test_cost_aware_curve_leaves_the_band(kappa_max):
+    """Cost-blind, the taut curve cuts the band at the inner corner; cost-aware it does not."""
+    grid, cost, corridor = l_hall()
+    sm = Smoother(kappa_max=kappa_max)
+    kw = dict(raw_grid=grid, radius=0.2, start=START, goal=GOAL)
+    blind = sm.fit(None, corridor, **kw)
+    aware = sm.fit(None, corridor, cost=cost, cost_weight=2.0, **kw)
+    m_blind = dense_mean_cost(blind.curve, cost, grid)
+    m_aware = dense_mean_cost(aware.curve, cost, grid)
+    assert m_blind > 0.04
+    assert m_aware < 0.25 * m_blind
+    assert aware.certificate.ok and aware.certificate.min_clearance_m >= 0.2 - 1e-9
+    assert aware.stats["cost_rounds"]["accepted"] >= 1
+    if kappa_max is not None:
+        assert aware.certificate.kappa_max_sampled <= kappa_max * (1 + 1e-9)
+
+
+def test_mean_cost_non_increasing_in_the_weight():
+    """Heavier weights never raise the curve's mean cost (beyond the rounds' tolerance)."""
+    grid, cost, corridor = l_hall()
+    kw = dict(raw_grid=grid, radius=0.2, start=START, goal=GOAL, cost=cost)
+    means = [
+        dense_mean_cost(Smoother().fit(None, corridor, cost_weight=w, **kw).curve, cost, grid)
+        for w in (0.0, 0.5, 2.0, 10.0)
+    ]
+    assert all(b <= a + 2e-3 for a, b in zip(means, means[1:], strict=False)), means
+
+
+def test_no_cost_and_zero_weight_are_the_cost_blind_fit():
+    """cost=None and cost_weight=0 give the cost-blind curve bit for bit."""
+    grid, cost, corridor = l_hall()
+    kw = dict(raw_grid=grid, radius=0.2, start=START, goal=GOAL)
+    a = Smoother().fit(None, corridor, **kw)
+    b = Smoother().fit(None, corridor, cost=cost, cost_weight=0.0, **kw)
+    assert np.array_equal(a.curve.c, b.curve.c)
+    assert "cost_rounds" not in a.stats
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(cost_weight=-1.0), "cost_weight must be finite and >= 0"),
+        (dict(cost_weight=math.inf), "cost_weight must be finite and >= 0"),
+        (dict(cost_weight=math.nan), "cost_weight must be finite and >= 0"),
+        (dict(cost_weight="2"), "cost_weight must be a number"),
+        (dict(cost=np.zeros((79, 80))), r"raw grid's shape \(80, 80\)"),
+        (dict(cost=np.full((80, 80), np.nan)), "cost must be finite"),
+        (dict(cost=np.full((80, 80), 2.0)), r"normalised to \[0, 1\]"),
+        (dict(cost=np.full((80, 80), -0.1)), r"normalised to \[0, 1\]"),
+    ],
+)
+def test_bad_cost_input_is_refused(kwargs, match):
+    grid, cost, corridor = l_hall()
+    kw = dict(raw_grid=grid, radius=0.2, start=START, goal=GOAL, cost=cost)
+    kw.update(kwargs)
+    with pytest.raises(InvalidInputError, match=match):
+        Smoother().fit(None, corridor, **kw)
+
+
+def test_costmap_of_another_resolution_is_refused():
+    grid, cost, corridor = l_hall()
+    values = np.zeros((80, 80), np.int16)
+    other = astar.from_costmap(values, resolution=0.1, convention="costmap_2d")
+    kw = dict(raw_grid=grid, radius=0.2, start=START, goal=GOAL)
+    with pytest.raises(InvalidInputError, match="resolution 0.1 m must equal"):
+        Smoother().fit(None, corridor, cost=other, **kw)
+    with pytest.raises(InvalidInputError, match="cost needs raw_grid"):
+        Smoother().fit(None, corridor, cost=cost, start=START, goal=GOAL, radius=0.2)
+    with pytest.raises(InvalidInputError, match="not yet in the IPOPT problem"):
+        Smoother(qp_solver="ipopt").fit(None, corridor, cost=cost, **kw)
