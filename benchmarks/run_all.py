@@ -152,6 +152,17 @@ BENCHES: tuple[Bench, ...] = (
         (),
     ),
     Bench(
+        "costmap-smoother",
+        "The costmap's cost in the smoother",
+        "bench_costmap_smoother.py",
+        "On Nav2-style inflation costmaps of the shared ROS maps, seeded random queries at "
+        "costmap_weight 1, 2, 5, 10 with the smoother's cost term and at 2 without it: the "
+        "trajectory's mean normalised cost per metre against its A* path's, the duration "
+        "and the smoothing time against the cost-blind smoother's.",
+        ("--queries", "4"),
+        ("--queries", "20"),
+    ),
+    Bench(
         "refusals",
         "Fast refusals: unconnected queries",
         "bench_refusals.py",
@@ -226,7 +237,7 @@ BENCHES: tuple[Bench, ...] = (
         "bench_pose.py",
         "The shared suite's queries (Moving AI scenarios at 2.5 cells, seeded random pairs "
         "on the ROS maps) with seeded random start and goal headings, for a disc robot with "
-        "`drive=\"differential\"` and `drive=\"omni\"`: success, collisions under an "
+        '`drive="differential"` and `drive="omni"`: success, collisions under an '
         "independent exact check on 1 ms samples (distance to the raw map's occupied "
         "squares), both headings to 1e-6 rad, every limit on 1 ms samples (turns in place "
         "against `turn_limits`); the duration against the same query with free headings "
