@@ -28,6 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import astar  # noqa: E402
+import trajopt.smoother._layout as smoother_layout  # noqa: E402
 import trajopt.smoother._qp as smoother_qp  # noqa: E402
 from trajopt.corridor import build_corridor  # noqa: E402
 from trajopt.errors import SmoothingError  # noqa: E402
@@ -228,14 +229,14 @@ def main() -> None:
     # cold build of fresh sizes (cache cleared): the QP's conic and the layout of the SCP's
     # sample rows (the SCP's QPs go to piqp directly: nothing else to build)
     smoother_qp.qp_solver.cache_clear()
-    smoother_qp.constraint_layout.cache_clear()
+    smoother_layout.constraint_layout.cache_clear()
     tb = []
     for nb in (64, 128):
         t0 = time.perf_counter()
         smoother_qp.qp_solver(nb, 3, "piqp", 0, False)
         tq = time.perf_counter() - t0
         t0 = time.perf_counter()
-        smoother_qp.constraint_layout(nb, 3, CURV_SAMPLES)
+        smoother_layout.constraint_layout(nb, 3, CURV_SAMPLES)
         tb.append((nb, tq, time.perf_counter() - t0))
         print(
             f"cold build nb={nb}: piqp conic {tq * 1e3:.1f} ms, SCP row layout "

@@ -30,8 +30,9 @@ from typing import Any
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, sample_bases
+from trajopt.smoother._layout import constraint_layout
 from trajopt.smoother._problem import N_HEADING_ROWS, Assembly, Problem
-from trajopt.smoother._qp import constraint_layout, solve_working_set
+from trajopt.smoother._qp import solve_working_set
 
 #: (corner, half-plane) rows per sample
 ROWS_PER_SAMPLE = 2

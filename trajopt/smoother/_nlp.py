@@ -3,7 +3,7 @@
 The convex QP and the exact curvature-bounded NLP, built with CasADi once per problem shape
 (padded control points ``nb``, degree ``p``, region rows per point ``k``) and re-solved with
 parameters: the objective's band and linear term, and the non-zeros of the constraint rows of
-:func:`~trajopt.smoother._qp.constraint_layout` (heading rows and the region rows of a box or a
+:func:`~trajopt.smoother._layout.constraint_layout` (heading rows and the region rows of a box or a
 polygon corridor).
 """
 
@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, curvature_samples
+from trajopt.smoother._layout import constraint_layout
 from trajopt.smoother._problem import QPData
 from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
 def qp_ipopt(nb: int, p: int, k: int, verbose: bool):
     """Return the corridor QP (no sample rows) as an IPOPT problem, built once per shape.
 
-    The rows are those of :func:`~trajopt.smoother._qp.constraint_layout` ``(nb, p, 0, k)``
+    The rows are those of :func:`~trajopt.smoother._layout.constraint_layout` ``(nb, p, 0, k)``
     (heading rows, then ``k`` region rows per control point: the diagonal rows of a box
     corridor, the half-planes of a polygon corridor), ``lba <= A z <= uba``, with ``A``'s
     sparsity fixed and its non-zeros a parameter.
@@ -66,8 +67,6 @@ def _rows_matrix(nb: int, p: int, k: int):
     """Symbolic ``A`` of :func:`constraint_layout` ``(nb, p, 0, k)`` and its non-zeros."""
     import casadi as ca
 
-    from trajopt.smoother._qp import constraint_layout
-
     sp = constraint_layout(nb, p, 0, k).sparsity
     anz = ca.SX.sym("a", sp.nnz())
     return ca.SX(sp, anz), anz
@@ -75,8 +74,6 @@ def _rows_matrix(nb: int, p: int, k: int):
 
 def row_values(qp: QPData, p: int) -> np.ndarray:
     """CCS non-zeros of the rows ``A`` of ``qp`` (:func:`_rows_matrix`'s parameter)."""
-    from trajopt.smoother._qp import constraint_layout
-
     layout = constraint_layout(qp.nb, p, 0, qp.k)
     return layout.nonzeros(layout.values(qp.heading, None, qp.region_coef))
 

@@ -35,8 +35,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, band_quadratic, curvature_samples
+from trajopt.smoother._layout import constraint_layout
 from trajopt.smoother._problem import QPData
-from trajopt.smoother._qp import constraint_layout, piqp_info, solve_working_set
+from trajopt.smoother._qp import piqp_info, solve_working_set
 from trajopt.smoother._status import SolveInfo, SolveStatus
 
 if TYPE_CHECKING:

@@ -21,7 +21,7 @@ from trajopt.analysis import scenes
 from trajopt.analysis.bench._suites import random_queries
 from trajopt.corridor import build_polygon_corridor
 from trajopt.errors import SmoothingError
-from trajopt.smoother import Smoother, _nlp, _qp
+from trajopt.smoother import Smoother, _layout, _nlp, _qp
 from trajopt.smoother._attempts import solve_attempt
 from trajopt.smoother._problem import assemble, build_problem
 from trajopt.smoother._status import AttemptRecord
@@ -56,7 +56,7 @@ def test_ipopt_qp_reaches_piqps_optimum_on_polygons(target):
     assert got.cost == pytest.approx(ref.cost, rel=1e-7, abs=1e-7)
     np.testing.assert_allclose(got.z, ref.z, atol=1e-4)  # cells
     # IPOPT's point is feasible for every region row (to its tolerance)
-    layout = _qp.constraint_layout(qp.nb, 3, 0, qp.k)
+    layout = _layout.constraint_layout(qp.nb, 3, 0, qp.k)
     trip = layout.values(qp.heading, None, qp.region_coef)
     az = np.bincount(
         layout.trip_rows, weights=trip * got.z[layout.trip_cols], minlength=layout.n_rows

@@ -18,6 +18,7 @@ import pytest
 from scipy.interpolate import BSpline, make_lsq_spline
 
 import trajopt.smoother._basis as smoother_basis
+import trajopt.smoother._layout as smoother_layout
 import trajopt.smoother._qp as smoother_qp
 from astar.grid import OccupancyGrid
 from tests.cases import l_shaped_grid
@@ -26,6 +27,7 @@ from trajopt.corridor import build_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.geometry._bspline import clamped_uniform_knots
 from trajopt.smoother import Smoother, SmoothPath
+from trajopt.smoother._problem import N_HEADING_ROWS
 
 
 # ----------------------------------------------------------------- references
@@ -110,7 +112,7 @@ def test_constraint_layout_ccs_order_matches_casadi_and_scipy(nb, p, m, k):
     import casadi as ca
     import scipy.sparse as sps
 
-    layout = smoother_qp.constraint_layout(nb, p, m, k)
+    layout = smoother_layout.constraint_layout(nb, p, m, k)
     rows, cols = layout.trip_rows, layout.trip_cols
     _, mapping = ca.Sparsity.triplet(
         layout.n_rows, layout.n_cols, rows.tolist(), cols.tolist(), False
@@ -132,17 +134,17 @@ def _random_scp_qp(rng, nb=20, p=3, m=4):
     full[0] = 4.0 + rng.uniform(0, 1, nb)
     full[1:] = rng.uniform(-0.5, 0.5, (p, nb))  # diagonally dominant: positive definite
     g = rng.normal(0, 3, 2 * nb)
-    layout = smoother_qp.constraint_layout(nb, p, m)
+    layout = smoother_layout.constraint_layout(nb, p, m)
     S = layout.n_samples
-    heading = np.zeros((smoother_qp.N_HEADING_ROWS, 2 * nb))
+    heading = np.zeros((N_HEADING_ROWS, 2 * nb))
     heading[0, :4] = rng.normal(0, 1, 4)
     vals = rng.normal(0, 1, (S, 3, 2 * (p + 1)))
     lba = np.full(layout.n_rows, -np.inf)
     uba = np.full(layout.n_rows, np.inf)
     lba[0], uba[0] = -1.0, 1.0
     r0 = layout.sample_row0
-    lba[smoother_qp.N_HEADING_ROWS : r0] = -3.0
-    uba[smoother_qp.N_HEADING_ROWS : r0] = 3.0
+    lba[N_HEADING_ROWS:r0] = -3.0
+    uba[N_HEADING_ROWS:r0] = 3.0
     rows = r0 + 3 * np.arange(S)
     uba[rows] = rng.uniform(-1, 1, S)
     uba[rows + 1] = rng.uniform(-1, 1, S)
