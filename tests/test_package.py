@@ -102,8 +102,8 @@ def _layer(module: str) -> int:
     return len(LAYERS)  # the package face, which loads lazily
 
 
-def _imports(path: Path) -> list[tuple[str, int]]:
-    """``(imported trajopt module, line)`` of every import outside ``if TYPE_CHECKING:``."""
+def _imports(path: Path, prefixes: tuple[str, ...] = ("trajopt.",)) -> list[tuple[str, int]]:
+    """``(imported module, line)`` of every import of ``prefixes`` outside TYPE_CHECKING."""
     tree = ast.parse(path.read_text())
     guarded = {
         id(sub)
@@ -121,7 +121,9 @@ def _imports(path: Path) -> list[tuple[str, int]]:
             names = [a.name for a in node.names]
         else:
             continue
-        out += [(n, node.lineno) for n in names if n.startswith("trajopt.")]
+        if isinstance(node, ast.ImportFrom):  # "from pkg import module" imports pkg.module
+            names += [f"{node.module}.{a.name}" for a in node.names]
+        out += [(n, node.lineno) for n in names if n.startswith(prefixes)]
     return out
 
 
@@ -137,3 +139,48 @@ def test_no_import_runs_up_a_layer():
             if _layer(target) > _layer(here):
                 upward.append(f"{rel}.py:{line} imports {target}")
     assert not upward, upward
+
+
+def test_no_import_circle_between_files():
+    """No cycle in the graph of imports between trajopt's and astar's files (function-level
+    imports included, TYPE_CHECKING ones aside): a depth-first search for a back edge."""
+    root = Path(trajopt.__file__).parent.parent
+    files = {
+        ".".join(p.relative_to(root).with_suffix("").parts).removesuffix(".__init__"): p
+        for pkg in ("trajopt", "astar")
+        for p in (root / pkg).rglob("*.py")
+    }
+
+    def resolve(name: str) -> str | None:
+        while name and name not in files:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    edges = {}
+    for mod, path in files.items():
+        targets = set()
+        for target, _ in _imports(path, prefixes=("trajopt.", "astar.")):
+            t = resolve(target)
+            # a package face loads its own modules: not an edge back from them
+            if t and t != mod and not (path.name == "__init__.py" and t.startswith(mod + ".")):
+                targets.add(t)
+        edges[mod] = targets
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(m: str) -> list[str] | None:
+        state[m] = 1
+        stack.append(m)
+        for n in sorted(edges[m]):
+            if state.get(n) == 1:
+                return stack[stack.index(n) :] + [n]
+            if n not in state and (cycle := visit(n)):
+                return cycle
+        state[m] = 2
+        stack.pop()
+        return None
+
+    for m in sorted(files):
+        if m not in state:
+            cycle = visit(m)
+            assert cycle is None, " -> ".join(cycle)
