@@ -314,7 +314,10 @@ def solve_attempt(
     const = asm.const
     qp_curv = qp
     if cost_at is not None:
-        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, t, options.degree, nb)
+        # taut: the term in units of the length term's marginal (2 * taut_length_weight per
+        # cell at unit speed), so that w trades length for cost as the A* search does
+        scale = 2.0 * options.taut_length_weight if prob.taut else 1.0
+        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, t, options.degree, nb, scale)
         deadline = t_enter + remaining
         z, g_lin, rec.cost_rounds = cost_rounds(options, qp, term, z, const, deadline, solve_qp)
         qp_curv = dataclasses.replace(qp, g=g_lin)

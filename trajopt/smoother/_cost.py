@@ -1,10 +1,13 @@
 """A cost field in the smoother's objective (a costmap's graded cost, a preference layer).
 
-The objective gains ``w * integral cost(C(u)) |C'(u)| du``: the cost per unit of length
-travelled, in cell units (``C`` in cells, ``u`` the arc-length-like parameter in cells), so
-that ``w = 1`` weighs a path through cost 1 as much as a unit of ``taut_length_weight``'s
-length term per unit ``|C'|^2``. The cell values are made smooth by bilinear interpolation
-between cell centres; the integral is a Gauss-Legendre quadrature (:data:`N_GAUSS` points per
+The objective gains ``s * w * integral cost(C(u)) |C'(u)| du``: the cost per unit of length
+travelled, in cell units (``C`` in cells, ``u`` the arc-length-like parameter in cells). In
+the taut objective ``s = 2 * taut_length_weight``, the marginal of its length term
+``taut_length_weight * integral |C'|^2`` per cell of length at unit speed, so that the
+objective trades length for cost as the A* search does (``length * (1 + w * cost)``); in
+the fidelity objective ``s = 1``. The cell values are smoothed by a Gaussian of
+:data:`SIGMA` cells (the inflation band's edges become slopes that the linearised rounds
+see) and interpolated bilinearly between cell centres; the integral is a Gauss-Legendre quadrature (:data:`N_GAUSS` points per
 knot span). The QP and SCP paths minimise it by sequential QP rounds that linearise it
 around the current iterate (:func:`cost_rounds`); the corridor rows stay hard constraints in
 every round, so the clearance certificate is the one of the QP without the term.
@@ -32,9 +35,15 @@ N_GAUSS = 4
 #: most sequential QP rounds of the linearised cost term
 MAX_ROUNDS = 8
 #: the rounds stop when a round lowers the objective by less than this fraction
-ROUND_TOL = 1e-3
+ROUND_TOL = 1e-2
 #: first proximal weight (per control point coordinate, cell units) of the damped rounds
 RHO0 = 1.0
+#: standard deviation (cells) of the Gaussian smoothing of the cell costs before the
+#: interpolation: the inflation band's edges become slopes the linearised rounds can follow
+SIGMA = 1.0
+
+# the last read-only cost array seen and its validated, smoothed copy
+_CACHE: dict[str, Any] = {}
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,6 +149,30 @@ def cost_field(cost: Any, weight: Any, raw_grid: Any) -> CostField | None:
                 f"grid's {tuple(raw_grid.origin)} m"
             )
         cost = cost.cost
+    src = cost
+    if (
+        _CACHE.get("src") is src
+        and _CACHE.get("sigma") == SIGMA
+        and src.shape == tuple(raw_grid.shape)
+        and not src.flags.writeable
+    ):
+        arr = _CACHE["arr"]  # the same read-only array (a Costmap's cost): validated, smoothed
+    else:
+        arr = _validated(cost, raw_grid)
+        if isinstance(src, np.ndarray) and not src.flags.writeable and src.base is None:
+            _CACHE.update(src=src, sigma=SIGMA, arr=arr)
+    if w == 0.0:
+        return None
+    return CostField(
+        cost=arr,
+        weight=w,
+        resolution=float(raw_grid.resolution),
+        origin=np.asarray(raw_grid.origin, dtype=float),
+    )
+
+
+def _validated(cost: Any, raw_grid: Any) -> np.ndarray:
+    """Return the per-cell costs checked (shape, finite, in [0, 1]), smoothed, read-only."""
     try:
         arr = np.asarray(cost, dtype=float)
     except (TypeError, ValueError):
@@ -159,16 +192,13 @@ def cost_field(cost: Any, weight: Any, raw_grid: Any) -> CostField | None:
     if arr.size and (arr.min() < 0.0 or arr.max() > 1.0):
         v = arr.min() if arr.min() < 0.0 else arr.max()
         raise InvalidInputError(f"cost must be normalised to [0, 1], got {float(v)!r}")
-    if w == 0.0:
-        return None
     arr = np.array(arr, dtype=float)
+    if SIGMA > 0:
+        from scipy import ndimage
+
+        arr = ndimage.gaussian_filter(arr, SIGMA, mode="nearest")
     arr.setflags(write=False)
-    return CostField(
-        cost=arr,
-        weight=w,
-        resolution=float(raw_grid.resolution),
-        origin=np.asarray(raw_grid.origin, dtype=float),
-    )
+    return arr
 
 
 @dataclass(slots=True)
@@ -190,6 +220,8 @@ class CostTerm:
         Basis values and first derivatives there.
     wq : ndarray, shape (Q,)
         Quadrature weights (cells).
+    scale : float
+        ``s``, the factor of ``w`` (see the module docstring).
     """
 
     field: CostField
@@ -202,12 +234,20 @@ class CostTerm:
     b0: np.ndarray
     b1: np.ndarray
     wq: np.ndarray
+    scale: float = 1.0
 
     @classmethod
     def on_knots(
-        cls, field: CostField, origin: np.ndarray, res: float, t: np.ndarray, p: int, nb: int
+        cls,
+        field: CostField,
+        origin: np.ndarray,
+        res: float,
+        t: np.ndarray,
+        p: int,
+        nb: int,
+        scale: float = 1.0,
     ) -> CostTerm:
-        """Quadrature of the knots ``t`` (cells, clamped, degree ``p``)."""
+        """Quadrature of the knots ``t`` (cells, clamped, degree ``p``); ``scale`` multiplies w."""
         n = len(t) - p - 1
         brk = np.unique(t)
         a, b = brk[:-1], brk[1:]
@@ -226,6 +266,7 @@ class CostTerm:
             b0=basis_derivs(t, p, span, u, 0),
             b1=basis_derivs(t, p, span, u, 1),
             wq=wq,
+            scale=float(scale),
         )
 
     def value_grad(self, z: np.ndarray) -> tuple[float, np.ndarray]:
@@ -252,7 +293,7 @@ class CostTerm:
         val, grad_m = self.field.at(self.origin + self.res * pos)
         grad_c = grad_m * self.res  # per cell
         speed = np.hypot(der[:, 0], der[:, 1])
-        w = self.field.weight * self.wq
+        w = self.scale * self.field.weight * self.wq
         value = float(np.sum(w * val * speed))
         unit = der / np.maximum(speed, 1e-12)[:, None]
         # d/dc_k: w (grad cost . B_k) |C'| + w cost (C'/|C'|) B'_k

@@ -78,12 +78,30 @@ def test_gradient_matches_central_differences():
 
 
 def test_bilinear_field_interpolates_cell_centres():
-    """At the cell centres the field is the cell's value."""
+    """At the cell centres the field is the Gaussian-smoothed cell's value."""
+    from scipy import ndimage
+
+    from trajopt.smoother._cost import SIGMA
+
     grid, cost, _ = l_hall()
     f = cost_field(cost, 1.0, grid)
     iy, ix = np.nonzero(np.ones_like(cost, bool))
     v, _ = f.at(np.column_stack([(ix + 0.5) * RES, (iy + 0.5) * RES]))
-    np.testing.assert_allclose(v, cost[iy, ix], atol=1e-12)
+    smooth = ndimage.gaussian_filter(np.asarray(cost, float), SIGMA, mode="nearest")
+    np.testing.assert_allclose(v, smooth[iy, ix], atol=1e-12)
+    assert f.cost.min() >= 0.0 and f.cost.max() <= 1.0
+
+
+def test_read_only_cost_is_validated_once_and_reused():
+    """A read-only cost array (a Costmap's) is smoothed once; a writeable one every call."""
+    grid, cost, _ = l_hall()
+    ro = np.array(cost, dtype=float)
+    ro.flags.writeable = False
+    assert cost_field(ro, 1.0, grid).cost is cost_field(ro, 2.0, grid).cost
+    rw = np.array(cost, dtype=float)
+    a = cost_field(rw, 1.0, grid).cost
+    rw[:] = 0.0
+    assert np.all(cost_field(rw, 1.0, grid).cost == 0.0) and np.any(a > 0.0)
 
 
 @pytest.mark.parametrize("kappa_max", [None, 2.0])
