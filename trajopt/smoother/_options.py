@@ -182,9 +182,13 @@ class Smoother:
             A cost field over the raw grid's cells (needs ``raw_grid``): a costmap (its
             normalised :attr:`~astar.Costmap.cost`; its grid must have the raw grid's shape,
             resolution and origin) or per-cell costs in ``[0, 1]``, row 0 at the bottom. The
-            objective then gains ``cost_weight * integral cost(C(u)) |C'(u)| du`` (cost per
-            unit length, cell units; the cells' values interpolated bilinearly between
-            their centres), minimised by damped sequential QP rounds that linearise it
+            objective then gains ``s * cost_weight * integral cost(C(u)) |C'(u)| du`` (cost
+            per unit length, cell units; the cells' values blurred by a Gaussian of one cell
+            and interpolated bilinearly between their centres; ``s = 2 *
+            taut_length_weight`` with the taut objective, the price of one more cell of
+            length, so that the weight trades cost against length as the costmap search
+            does, and 1 with the fidelity objective), minimised by damped sequential QP
+            rounds that linearise it
             around the current iterate (module :mod:`trajopt.smoother._cost`); the corridor
             rows stay hard constraints and the certificate is unchanged. Not with
             ``qp_solver="ipopt"`` or ``curvature_solver="ipopt"`` (not yet in the IPOPT
