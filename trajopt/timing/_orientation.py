@@ -149,28 +149,15 @@ def orient(
             f"than the translation ({t_drive:.6g} s), which ends moving at v_end = "
             f"{translation.v_end!r} m/s: the robot cannot stand at the end to finish it"
         )
-    stats: dict[str, Any] = dict(translation.stats)
-    stats["orientation"] = {
-        "turn_rad": float(h_end - h0),
-        "turn_s": float(t_rot),
-        "turn_min_s": float(t_min),
-        "translation_s": float(t_drive),
-        "hold_s": float(max(0.0, t_rot - t_drive)),
-        "synchronized": bool(t_rot <= t_drive),
-        "omega_start": w0,
-        "alpha_start": a0,
-        "limits": {"omega": w_lim, "alpha": al_lim, "zeta": z_lim},
-        "compute_s": time.perf_counter() - t_start,
-    }
-    return OmniTrajectory(
-        translation=translation,
-        robot=robot,
-        rows=rows,
-        turn_duration=t_rot,
-        theta_start=h0,
-        theta_end=h_end,
-        stats=stats,
-        steps=translation.steps,
+    return _omni(
+        translation,
+        robot,
+        rows,
+        (h0, h_end),
+        (t_rot, t_min),
+        (w0, a0),
+        (w_lim, al_lim, z_lim),
+        t_start,
     )
 
 
@@ -278,30 +265,8 @@ def stop_orientation(
             f"the yaw stop takes {t_rot:.6g} s, longer than the translation "
             f"({t_drive:.6g} s), which ends moving at v_end = {translation.v_end!r} m/s"
         )
-    w_lim, al_lim, z_lim = limits
-    stats: dict[str, Any] = dict(translation.stats)
-    stats["orientation"] = {
-        "turn_rad": float(h_end - h0),
-        "turn_s": float(t_rot),
-        "turn_min_s": float(t_rot),
-        "translation_s": float(t_drive),
-        "hold_s": float(max(0.0, t_rot - t_drive)),
-        "synchronized": bool(t_rot <= t_drive),
-        "omega_start": w0,
-        "alpha_start": a0,
-        "stop": True,
-        "limits": {"omega": w_lim, "alpha": al_lim, "zeta": z_lim},
-        "compute_s": time.perf_counter() - t_start,
-    }
-    return OmniTrajectory(
-        translation=translation,
-        robot=robot,
-        rows=rows,
-        turn_duration=t_rot,
-        theta_start=h0,
-        theta_end=h_end,
-        stats=stats,
-        steps=translation.steps,
+    return _omni(
+        translation, robot, rows, (h0, h_end), (t_rot, t_rot), (w0, a0), limits, t_start, stop=True
     )
 
 
@@ -502,3 +467,54 @@ def _land(rows: np.ndarray, duration: float, target: float) -> np.ndarray:
         return rows
     fix = np.linalg.lstsq(m, err, rcond=None)[0]
     return _integrate(dur, jerks + fix, w0, a0)
+
+
+def _omni(
+    translation: Trajectory,
+    robot: Robot,
+    rows: np.ndarray,
+    headings: tuple[float, float],
+    times: tuple[float, float],
+    start: tuple[float, float],
+    limits: tuple[float, float, float],
+    t_start: float,
+    *,
+    stop: bool = False,
+) -> OmniTrajectory:
+    """Return the :class:`OmniTrajectory` of an orientation profile, with its statistics.
+
+    ``headings`` are the orientation at the start and the end (rad), ``times`` the profile's
+    duration and its time-optimal duration (s), ``start`` the starting yaw rate and
+    acceleration (rad/s, rad/s^2), ``limits`` the yaw limits, ``t_start`` when the
+    computation began (``time.perf_counter``), ``stop`` whether the profile is a yaw stop.
+    """
+    h0, h_end = headings
+    t_rot, t_min = times
+    t_drive = translation.duration
+    w_lim, al_lim, z_lim = limits
+    orientation: dict[str, Any] = {
+        "turn_rad": float(h_end - h0),
+        "turn_s": float(t_rot),
+        "turn_min_s": float(t_min),
+        "translation_s": float(t_drive),
+        "hold_s": float(max(0.0, t_rot - t_drive)),
+        "synchronized": bool(t_rot <= t_drive),
+        "omega_start": start[0],
+        "alpha_start": start[1],
+    }
+    if stop:
+        orientation["stop"] = True
+    orientation["limits"] = {"omega": w_lim, "alpha": al_lim, "zeta": z_lim}
+    orientation["compute_s"] = time.perf_counter() - t_start
+    stats: dict[str, Any] = dict(translation.stats)
+    stats["orientation"] = orientation
+    return OmniTrajectory(
+        translation=translation,
+        robot=robot,
+        rows=rows,
+        turn_duration=t_rot,
+        theta_start=h0,
+        theta_end=h_end,
+        stats=stats,
+        steps=translation.steps,
+    )
