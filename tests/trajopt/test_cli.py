@@ -21,26 +21,26 @@ def door_map(tmp_path):
     return astar.save_map(grid, tmp_path / "door.yaml")
 
 
+def door_plan(door_map, *extra: str) -> list[str]:
+    """The argv of ``trajopt plan`` on the door map, start to goal, radius 0.12 m, then ``extra``."""
+    return [
+        "plan",
+        str(door_map),
+        "--start",
+        "0.4",
+        "0.3",
+        "--goal",
+        "2.6",
+        "1.6",
+        "--radius",
+        "0.12",
+        *extra,
+    ]
+
+
 def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     out = tmp_path / "traj.csv"
-    rc = main(
-        [
-            "plan",
-            str(door_map),
-            "--start",
-            "0.4",
-            "0.3",
-            "--goal",
-            "2.6",
-            "1.6",
-            "--radius",
-            "0.12",
-            "--out",
-            str(out),
-            "--dt",
-            "0.05",
-        ]
-    )
+    rc = main(door_plan(door_map, "--out", str(out), "--dt", "0.05"))
     assert rc == 0
     # read as a user would, with no options: the first line is the header
     with open(out, newline="") as fh:
@@ -55,25 +55,7 @@ def test_plan_writes_csv_and_json(door_map, tmp_path, capsys):
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     assert "duration" in capsys.readouterr().out
     js = tmp_path / "traj.json"
-    assert (
-        main(
-            [
-                "plan",
-                str(door_map),
-                "--start",
-                "0.4",
-                "0.3",
-                "--goal",
-                "2.6",
-                "1.6",
-                "--radius",
-                "0.12",
-                "--out",
-                str(js),
-            ]
-        )
-        == 0
-    )
+    assert main(door_plan(door_map, "--out", str(js))) == 0
     assert "duration" in json.loads(js.read_text())
 
 
