@@ -22,6 +22,7 @@ from trajopt.smoother._solver_builds import LOCK, is_built
 from trajopt.smoother._status import SolveInfo, SolveStatus
 
 if TYPE_CHECKING:
+    from trajopt.smoother._nlp_cost import CostWindow, WindowedCost
     from trajopt.smoother._options import Smoother
 
 
@@ -125,6 +126,38 @@ def _band_quadratic(z, hb, nb: int, p: int):
     return f
 
 
+def _curvature_rows(z, nb: int, p: int):
+    """Symbolic curvature and speed rows of :func:`curvature_nlp` and their parameters.
+
+    Returns ``(b1, b2, k2), (cross^2 - k2 speed2^3, speed2)`` at ``CURV_SAMPLES`` samples
+    per span of the ``nb`` padded control points ``z``.
+    """
+    import casadi as ca
+
+    ns = nb - p
+    S = ns * CURV_SAMPLES
+    b1 = ca.SX.sym("b1", S * (p + 1))
+    b2 = ca.SX.sym("b2", S * (p + 1))
+    k2 = ca.SX.sym("k2")
+    x, y = z[:nb], z[nb:]
+    span = np.repeat(np.arange(ns), CURV_SAMPLES)
+    B1 = ca.reshape(b1, S, p + 1)
+    B2 = ca.reshape(b2, S, p + 1)
+    dx = 0
+    dy = 0
+    ddx = 0
+    ddy = 0
+    for c in range(p + 1):
+        idx = (span + c).tolist()
+        dx = dx + B1[:, c] * x[idx]
+        dy = dy + B1[:, c] * y[idx]
+        ddx = ddx + B2[:, c] * x[idx]
+        ddy = ddy + B2[:, c] * y[idx]
+    cross = dx * ddy - dy * ddx
+    sp2 = dx * dx + dy * dy
+    return (b1, b2, k2), (cross * cross - k2 * sp2 * sp2 * sp2, sp2)
+
+
 def _ipopt_opts(verbose: bool) -> dict:
     return {
         "ipopt": {
@@ -173,33 +206,12 @@ def curvature_nlp(nb: int, p: int, k: int, verbose: bool):
     """
     import casadi as ca
 
-    ns = nb - p
-    S = ns * CURV_SAMPLES
     z = ca.SX.sym("z", 2 * nb)
     hb = ca.SX.sym("hb", (p + 1) * nb)
     g = ca.SX.sym("g", 2 * nb)
     amat, anz = _rows_matrix(nb, p, k)
-    b1 = ca.SX.sym("b1", S * (p + 1))
-    b2 = ca.SX.sym("b2", S * (p + 1))
-    k2 = ca.SX.sym("k2")
-    x, y = z[:nb], z[nb:]
     f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
-    span = np.repeat(np.arange(ns), CURV_SAMPLES)
-    B1 = ca.reshape(b1, S, p + 1)
-    B2 = ca.reshape(b2, S, p + 1)
-    dx = 0
-    dy = 0
-    ddx = 0
-    ddy = 0
-    for c in range(p + 1):
-        idx = (span + c).tolist()
-        dx = dx + B1[:, c] * x[idx]
-        dy = dy + B1[:, c] * y[idx]
-        ddx = ddx + B2[:, c] * x[idx]
-        ddy = ddy + B2[:, c] * y[idx]
-    cross = dx * ddy - dy * ddx
-    sp2 = dx * dx + dy * dy
-    gcurv = cross * cross - k2 * sp2 * sp2 * sp2
+    (b1, b2, k2), (gcurv, sp2) = _curvature_rows(z, nb, p)
     nlp = {
         "x": z,
         "p": ca.vertcat(hb, g, anz, b1, b2, k2),
@@ -276,3 +288,162 @@ def solve_curvature_ipopt(
     out = solver(x0=z0, p=par, lbx=qp.lbx, ubx=qp.ubx, lbg=lbg, ubg=ubg)
     solve = time.perf_counter() - ts
     return ipopt_info(solver, out, solve, time.process_time() - tc, build, left)
+
+
+@functools.lru_cache(maxsize=16)
+def smoother_nlp(
+    nb: int, p: int, k: int, curvature: bool, window: CostWindow | None, verbose: bool
+):
+    """Return the smoother's whole problem as an IPOPT problem, built once per shape.
+
+    The QP objective and rows of :func:`qp_ipopt`; with ``curvature`` the curvature and
+    speed rows of :func:`curvature_nlp`; with a cost ``window``
+    (:mod:`~trajopt.smoother._nlp_cost`) the cost term
+    ``sum_q wq_q cost(P_q) sqrt(x'_q^2 + y'_q^2 + EPS)`` at ``Q = N_GAUSS (nb - p)``
+    quadrature points (point ``q`` on span ``q // N_GAUSS``), ``P_q`` the curve point in the
+    window's local coordinates and ``cost`` the window's cubic B-spline (its coefficients
+    constants of the problem: one build per window).
+
+    Parameters
+    ----------
+    nb, p, k : int
+        Padded control points, degree and region rows per control point.
+    curvature : bool
+        Add the curvature-bound rows.
+    window : CostWindow or None
+        The cost window, or ``None`` without a cost term.
+    verbose : bool
+        IPOPT's output.
+
+    Returns
+    -------
+    casadi.Function
+        An ``nlpsol`` with parameters (in this order) ``[hb, g, A non-zeros]``, with
+        ``curvature`` ``[b1, b2, kmax^2]`` (as :func:`curvature_nlp`), with a window
+        ``[qb0 (Q (p+1)), qb1 (Q (p+1)), s w wq (Q), offset (2)]``; constraints: the
+        ``5 + k nb`` rows, then with ``curvature`` ``S`` curvature rows and ``S`` speed rows.
+    """
+    import casadi as ca
+
+    from trajopt.smoother._nlp_cost import EPS, N_GAUSS, spline_function
+
+    z = ca.SX.sym("z", 2 * nb)
+    hb = ca.SX.sym("hb", (p + 1) * nb)
+    g = ca.SX.sym("g", 2 * nb)
+    amat, anz = _rows_matrix(nb, p, k)
+    f = _band_quadratic(z, hb, nb, p) + ca.dot(g, z)
+    par = [hb, g, anz]
+    rows = [ca.mtimes(amat, z)]
+    if curvature:
+        cpar, crows = _curvature_rows(z, nb, p)
+        par += list(cpar)
+        rows += list(crows)
+    name = f"smoother_nlp_{k}_{int(curvature)}"
+    if window is not None:
+        Q = N_GAUSS * (nb - p)
+        qb0 = ca.SX.sym("qb0", Q * (p + 1))
+        qb1 = ca.SX.sym("qb1", Q * (p + 1))
+        wq = ca.SX.sym("wq", Q)
+        off = ca.SX.sym("off", 2)
+        B0 = ca.reshape(qb0, Q, p + 1)
+        B1 = ca.reshape(qb1, Q, p + 1)
+        span = np.repeat(np.arange(nb - p), N_GAUSS)
+        x, y = z[:nb], z[nb:]
+        px, py, dx, dy = off[0], off[1], 0, 0
+        for c in range(p + 1):
+            idx = (span + c).tolist()
+            px = px + B0[:, c] * x[idx]
+            py = py + B0[:, c] * y[idx]
+            dx = dx + B1[:, c] * x[idx]
+            dy = dy + B1[:, c] * y[idx]
+        spline = spline_function(window)
+        # call nodes (never inlined): the spline is an MX function of constant coefficients
+        vals = ca.vertcat(
+            *[spline.call([ca.vertcat(px[q], py[q])], False, True)[0] for q in range(Q)]
+        )
+        f = f + ca.dot(wq * vals, ca.sqrt(dx * dx + dy * dy + EPS))
+        par += [qb0, qb1, wq, off]
+        name += f"_{window.shape[0]}x{window.shape[1]}"
+    nlp = {"x": z, "p": ca.vertcat(*par), "f": f, "g": ca.vertcat(*rows)}
+    with LOCK:
+        return ca.nlpsol(name, "ipopt", nlp, _ipopt_opts(verbose))
+
+
+def solve_nlp(
+    options: Smoother,
+    qp: QPData,
+    t: np.ndarray,
+    z0: np.ndarray,
+    remaining: float,
+    *,
+    kmax: float | None = None,
+    margin: float = 1.0,
+    cost: WindowedCost | None = None,
+) -> tuple[SolveInfo, float]:
+    """Return the whole problem (:func:`smoother_nlp`) solved by IPOPT from ``z0`` (cells).
+
+    Parameters
+    ----------
+    options : Smoother
+        ``degree``, ``speed_floor`` and ``verbose`` are used.
+    qp : QPData
+        The attempt's convex problem (cell units, padded): objective and rows.
+    t : ndarray
+        Knots (cells).
+    z0 : ndarray, shape (2 nb,)
+        Starting point (cells).
+    remaining : float
+        Time left (s); a longer solve is a failure.
+    kmax : float or None
+        Curvature bound (1/cell), imposed as ``margin * kmax`` at the samples; ``None``: no
+        curvature rows.
+    margin : float
+        Factor on ``kmax``.
+    cost : WindowedCost or None
+        The cost term on its window (:func:`~trajopt.smoother._nlp_cost.windowed`).
+
+    Returns
+    -------
+    info : SolveInfo
+        ``cost`` is the objective at IPOPT's point (without ``qp``'s constant), ``detail``
+        IPOPT's return status, ``iterations`` its iteration count.
+    start_objective : float
+        The same objective at ``z0``.
+    """
+    p = options.degree
+    n, nb = qp.n, qp.nb
+    par = [qp.full.ravel(), qp.g, row_values(qp, p)]
+    lbg, ubg = [qp.lba], [qp.uba]
+    if kmax is not None:
+        ms = CURV_SAMPLES
+        _, B1, B2 = curvature_samples(t, p, n, nb)
+        par += [B1.ravel(order="F"), B2.ravel(order="F"), [(margin * kmax) ** 2]]
+        S = (nb - p) * ms
+        low = np.full(S, -np.inf)
+        low[: (n - p) * ms] = options.speed_floor**2
+        lbg += [np.full(S, -np.inf), low]
+        ubg += [np.zeros(S), np.full(S, np.inf)]
+    win = None
+    if cost is not None:
+        par += cost.parameters()
+        win = cost.window
+    par_v = np.concatenate([np.ravel(a) for a in par])
+    tb = time.perf_counter()
+    key = f"nlp-{qp.k}-{kmax is not None}-{None if win is None else hash(win)}"
+    built = is_built(key, nb, p, options.verbose)
+    solver = smoother_nlp(nb, p, qp.k, kmax is not None, win, options.verbose)
+    build = 0.0 if built else time.perf_counter() - tb
+    f0 = float(solver.get_function("nlp_f")(z0, par_v))
+    left = max(0.05, remaining - build - 0.02)
+    ts = time.perf_counter()
+    tc = time.process_time()
+    out = solver(
+        x0=z0,
+        p=par_v,
+        lbx=qp.lbx,
+        ubx=qp.ubx,
+        lbg=np.concatenate(lbg),
+        ubg=np.concatenate(ubg),
+    )
+    solve = time.perf_counter() - ts
+    return ipopt_info(solver, out, solve, time.process_time() - tc, build, left), f0

@@ -22,6 +22,8 @@ _QP_SOLVERS = ("osqp", "piqp", "ipopt")
 CurvatureSolver = Literal["scp", "ipopt"]
 _CURVATURE_SOLVERS = ("scp", "ipopt")
 _OBJECTIVES = ("auto", "fidelity", "taut")
+Refine = Literal["ipopt"]
+_REFINES = (None, "ipopt")
 Objective = Literal["auto", "fidelity", "taut"]
 
 
@@ -87,6 +89,17 @@ class Smoother:
         Weight of each path point in the taut objective (>= 0). Default 0.02.
     taut_length_weight : float, optional
         Weight of the length term in the taut objective (>= 0), in cell units. Default 2.
+    refine : {None, "ipopt"}, optional
+        ``"ipopt"``: after the fast path (the QP, the cost rounds, the SCP), each attempt's
+        result is polished by IPOPT on the same problem (the objective with the exact cost
+        term when a cost is given, the exact curvature bound when ``kappa_max`` is set, the
+        same corridor rows and end conditions; module :mod:`trajopt.smoother._nlp_solve`),
+        warm started from it. The polished curve is kept only when IPOPT succeeds, its
+        objective is not higher and it passes the certificates; otherwise the fast result
+        is kept. ``stats["refine"]`` says which and why (IPOPT's status and iteration
+        count, the objective before and after, the time). Nothing to polish when IPOPT
+        already solved the whole problem (``qp_solver="ipopt"`` without a bound,
+        ``curvature_solver="ipopt"`` with one). Default ``None``.
     verbose : bool, optional
         Let the solvers print. Default False.
     """
@@ -107,6 +120,7 @@ class Smoother:
     objective: Objective = "auto"
     taut_fidelity_weight: float = 0.02
     taut_length_weight: float = 2.0
+    refine: Refine | None = None
     verbose: bool = False
 
     def __post_init__(self) -> None:
@@ -127,6 +141,7 @@ class Smoother:
         choice("objective", self.objective, _OBJECTIVES)
         number("taut_fidelity_weight", self.taut_fidelity_weight, lo=0.0)
         number("taut_length_weight", self.taut_length_weight, lo=0.0)
+        choice("refine", self.refine, _REFINES)
 
     def fit(
         self,
@@ -190,9 +205,11 @@ class Smoother:
             does, and 1 with the fidelity objective), minimised by damped sequential QP
             rounds that linearise it
             around the current iterate (module :mod:`trajopt.smoother._cost`); the corridor
-            rows stay hard constraints and the certificate is unchanged. Not with
-            ``qp_solver="ipopt"`` or ``curvature_solver="ipopt"`` (not yet in the IPOPT
-            problem). ``stats["cost_rounds"]`` reports the rounds and the curve's mean cost.
+            rows stay hard constraints and the certificate is unchanged. With
+            ``qp_solver="ipopt"`` (or ``curvature_solver="ipopt"`` and ``kappa_max``) IPOPT
+            minimises the term exactly instead, the cell values' cubic B-spline in place of
+            the bilinear interpolation (module :mod:`trajopt.smoother._nlp_cost`).
+            ``stats["cost_rounds"]`` reports the rounds and the curve's mean cost.
         cost_weight : float, optional
             ``w`` of the cost term (dimensionless, finite, >= 0; 0 drops the term). Default
             2 (the planner's ``costmap_weight``).
