@@ -42,6 +42,13 @@ _EXPORTS: dict[str, str] = {
     "GridPath": "astar.search",
     "Landmarks": "astar.landmarks",
     "build_landmarks": "astar.landmarks",
+    # car-like robots: Hybrid-A* over (x, y, heading), Reeds-Shepp and Dubins paths
+    "find_pose_path": "astar.hybrid",
+    "PosePath": "astar.hybrid",
+    "NoPosePathError": "astar.hybrid",
+    "CarPath": "astar.reeds_shepp",
+    "reeds_shepp_path": "astar.reeds_shepp",
+    "dubins_path": "astar.reeds_shepp",
 }
 
 __all__ = sorted(_EXPORTS)
@@ -64,9 +71,11 @@ if TYPE_CHECKING:  # pragma: no cover
     from astar.costmap import Costmap, from_costmap, load_costmap
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid
+    from astar.hybrid import NoPosePathError, PosePath, find_pose_path
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
     from astar.io import from_intensity, load_map, save_map
     from astar.landmarks import Landmarks, build_landmarks
     from astar.movingai import Scenario, read_scenarios
+    from astar.reeds_shepp import CarPath, dubins_path, reeds_shepp_path
     from astar.ros_map import read_map_values
     from astar.search import GridPath, find_path

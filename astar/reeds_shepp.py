@@ -251,8 +251,12 @@ _BASE_BACKWARDS = np.array([False, False, True, False, False, True, True, False]
 
 
 @njit(cache=True)
-def rs_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
-    """Shortest Reeds-Shepp word to ``(x, y, phi)`` from the origin, ``R = 1``.
+def rs_word(x, y, phi, kinds, lens, buf, rev_w, cusp_w, arc_w):  # pragma: no cover - compiled
+    """Shortest (or cheapest) Reeds-Shepp word to ``(x, y, phi)`` from the origin, ``R = 1``.
+
+    A word costs ``sum(|s_i| w_i) + cusp_w * cusps`` with ``w_i = rev_w`` (times ``arc_w`` on
+    an arc) for a backwards segment and ``1`` (times ``arc_w`` on an arc) forwards; with
+    ``rev_w = arc_w = 1`` and ``cusp_w = 0`` that is the length (the shortest word).
 
     Parameters
     ----------
@@ -265,10 +269,14 @@ def rs_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
     buf : ndarray of float64, shape (5,)
         Scratch.
 
+    rev_w, cusp_w, arc_w : float
+        Weights of the cost (``cusp_w`` in units of ``R``); ``1, 0, 1`` for the length.
+
     Returns
     -------
-    length : float
-        Total length in units of ``R`` (``inf`` only on non-finite input).
+    cost : float
+        The word's cost (its length with unit weights), units of ``R`` (``inf`` only on
+        non-finite input).
     n : int
         Number of segments written.
     """
@@ -300,8 +308,17 @@ def rs_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
             if not _base_word(k, px, py, pphi, psin, cphi, buf):
                 continue
             total = 0.0
+            last = 0.0
             for i in range(nseg):
-                total += abs(buf[i])
+                si = buf[i]
+                if si != 0.0:
+                    w = rev_w if (si < 0.0) != flip else 1.0
+                    if _BASE_KINDS[k, i] != 0:
+                        w *= arc_w
+                    total += abs(si) * w
+                    if last != 0.0 and (last < 0.0) != (si < 0.0):
+                        total += cusp_w
+                    last = si
             if total < best:
                 best = total
                 nbest = nseg
@@ -350,10 +367,11 @@ def _dubins_ccc(x, y, phi, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def dubins_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
-    """Shortest Dubins word (forwards only) to ``(x, y, phi)`` from the origin, ``R = 1``.
+def dubins_word(x, y, phi, kinds, lens, buf, arc_w):  # pragma: no cover - compiled
+    """Shortest (or cheapest) Dubins word (forwards only) to ``(x, y, phi)``, ``R = 1``.
 
-    Same arguments and returns as :func:`rs_word`; every length is ``>= 0`` and ``n = 3``.
+    Same arguments and returns as :func:`rs_word` (arcs weigh ``arc_w``, 1 for the length);
+    every length is ``>= 0`` and ``n = 3``.
     """
     best = np.inf
     for fam in range(3):  # 0: C S C same side, 1: C S C opposite sides, 2: C C C
@@ -384,7 +402,7 @@ def dubins_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
                 ok = _dubins_ccc(x, py, pphi, buf)
             if not ok:
                 continue
-            total = buf[0] + buf[1] + buf[2]
+            total = (buf[0] + buf[2]) * arc_w + buf[1] * (arc_w if fam == 2 else 1.0)
             if total < best:
                 best = total
                 s = -1 if refl else 1
@@ -398,8 +416,10 @@ def dubins_word(x, y, phi, kinds, lens, buf):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pragma: no cover
-    """Shortest car path between two poses: Reeds-Shepp (``reverse``) or Dubins.
+def car_word(
+    x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf, rev_w, cusp_w, arc_w
+):  # pragma: no cover - compiled
+    """Shortest (or cheapest) car path between two poses: Reeds-Shepp (``reverse``) or Dubins.
 
     Parameters
     ----------
@@ -411,11 +431,14 @@ def car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pr
         True: Reeds-Shepp (backwards allowed); False: Dubins.
     kinds, lens, buf : ndarray, shape (5,)
         Out: kinds (int8) and signed lengths (float64, unit of ``R``); scratch (float64).
+    rev_w, cusp_w, arc_w : float
+        Cost weights (:func:`rs_word`; ``cusp_w`` in the unit of ``R``); ``1, 0, 1``: the
+        shortest path.
 
     Returns
     -------
-    length : float
-        Length (unit of ``R``).
+    cost : float
+        Its cost (the length with unit weights), unit of ``R``.
     n : int
         Number of segments.
     """
@@ -427,9 +450,9 @@ def car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pr
     y = (-s * dx + c * dy) / radius
     phi = _mod_pi(th1 - th0)
     if reverse:
-        total, n = rs_word(x, y, phi, kinds, lens, buf)
+        total, n = rs_word(x, y, phi, kinds, lens, buf, rev_w, cusp_w / radius, arc_w)
     else:
-        total, n = dubins_word(x, y, phi, kinds, lens, buf)
+        total, n = dubins_word(x, y, phi, kinds, lens, buf, arc_w)
     for i in range(n):
         lens[i] *= radius
     return total * radius, n
@@ -438,7 +461,7 @@ def car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pr
 @njit(cache=True)
 def car_length(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pragma: no cover
     """Length of :func:`car_word` (same arguments; the buffers are overwritten)."""
-    total, _ = car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf)
+    total, _ = car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
     return total
 
 
@@ -616,7 +639,7 @@ def _car_path(start: object, goal: object, turning_radius: object, reverse: bool
     kinds = np.zeros(5, np.int8)
     lens = np.zeros(5)
     buf = np.zeros(5)
-    _, n = car_word(*s, *g, r, reverse, kinds, lens, buf)
+    _, n = car_word(*s, *g, r, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
     letters = "".join(_LETTERS[int(k)] for k in kinds[:n])
     return CarPath(s, g, r, letters, lens[:n])
 

@@ -1,0 +1,520 @@
+"""Compiled kernels of :func:`astar.find_pose_path`: Hybrid-A* over (x, y, heading bin).
+
+The search (Dolgov, Thrun, Montemerlo and Diebel, "Practical search techniques in path
+planning for autonomous driving", 2008; "Path planning for autonomous vehicles in unknown
+semi-structured environments", IJRR 2010) keeps continuous poses ``(x, y, heading)`` in
+*cell units* (cell ``(ix, iy)`` covers ``[ix - 0.5, ix + 0.5) x [iy - 0.5, iy + 0.5)``, its
+centre at ``(ix, iy)``) and merges them in discrete states ``(ix, iy, heading bin)``: a state
+keeps the cheapest pose that reached it, and a closed state is never reopened.
+
+* **Motion primitives**: an arc of signed curvature ``kappa`` (``curvatures``, e.g.
+  ``{+1/R, 0, -1/R}``) and arc length ``prim_len``, forwards and (with ``reverse``) backwards.
+* **Costs** (cells): the primitive's length, times ``reverse_penalty`` backwards, times
+  ``1 + turn_penalty`` on an arc, times ``1 + steer_penalty`` when its curvature differs from
+  the previous primitive's; plus ``cusp_penalty`` when the direction of travel flips.
+* **Collision check**: each primitive (and each analytic shot) is sampled at arc-length spacing
+  ``<= step`` (sub-cell) and every cell that the chords between consecutive samples cross is
+  tested (a supercover traversal: a chord through a cell corner tests both side cells).
+* **Analytic expansion**: every few expansions (every ``max(1, floor(h / analytic_ratio))``,
+  so every expansion near the goal) the Reeds-Shepp (Dubins without ``reverse``) word from the
+  expanded pose to the goal pose that is cheapest *under the search's costs* (backwards
+  lengths weighted, cusps charged; not merely the shortest, which is how Smac's shots end up
+  driving long distances backwards) is collision-checked; a clear one gives a path that ends
+  exactly at the goal pose. The search then goes on, for at most as many expansions again
+  (plus ``polish``), while an open node could still lead to a cheaper path (its ``f``, a lower
+  bound of the cost, is below the best path's cost), and returns the cheapest path found.
+* **Heuristic**: ``max(h2d, euclid, car)``: ``h2d`` is the 8-connected shortest distance on the
+  free grid from the goal's cell (:func:`distance_field`, no corner cutting, as Smac's 2-D
+  heuristic), ``car`` the obstacle-free Reeds-Shepp/Dubins length, evaluated within
+  ``car_window`` cells of the goal (farther, it exceeds the Euclidean distance by a bounded
+  amount that ``h2d`` already dominates, and costs microseconds per node).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numba
+import numpy as np
+from numba import njit
+
+from astar.reeds_shepp import advance, car_word
+from astar.search_kernels import heap_pop, heap_push
+
+__all__ = ["distance_field", "hybrid_kernel", "word_clear"]
+
+FOUND = 1
+EXHAUSTED = 0
+MAX_EXPANSIONS = 2
+TIME_BUDGET = 3
+
+
+@njit(cache=True)
+def distance_field(free, gx, gy):  # pragma: no cover - compiled
+    """8-connected shortest distance (cells) from cell ``(gx, gy)`` over the free cells.
+
+    A diagonal step (length ``sqrt(2)``) needs both orthogonal cells it passes between free.
+
+    Parameters
+    ----------
+    free : ndarray of uint8, shape (ny, nx)
+        1 on free cells.
+    gx, gy : int
+        The source cell (free).
+
+    Returns
+    -------
+    ndarray of float64, shape (ny, nx)
+        Distance in cells; ``inf`` where unreachable or blocked.
+    """
+    ny, nx = free.shape
+    sqrt2 = 1.4142135623730951
+    dist = np.full((ny, nx), np.inf)
+    ddx = np.array([1, -1, 0, 0, 1, -1, 1, -1])
+    ddy = np.array([0, 0, 1, -1, 1, 1, -1, -1])
+    cap = 1024
+    hf = np.empty(cap)
+    hg = np.empty(cap)
+    hn = np.empty(cap, dtype=np.int32)
+    size = 0
+    dist[gy, gx] = 0.0
+    hf, hg, hn, size, cap = heap_push(hf, hg, hn, size, cap, 0.0, 0.0, gy * nx + gx)
+    while size > 0:
+        u, d, size = heap_pop(hf, hg, hn, size)
+        uy = u // nx
+        ux = u - uy * nx
+        if d > dist[uy, ux]:
+            continue
+        for k in range(8):
+            vx = ux + ddx[k]
+            vy = uy + ddy[k]
+            if vx < 0 or vy < 0 or vx >= nx or vy >= ny or free[vy, vx] == 0:
+                continue
+            w = 1.0
+            if k >= 4:
+                if free[uy, vx] == 0 or free[vy, ux] == 0:
+                    continue
+                w = sqrt2
+            nd = d + w
+            if nd < dist[vy, vx]:
+                dist[vy, vx] = nd
+                hf, hg, hn, size, cap = heap_push(hf, hg, hn, size, cap, nd, nd, vy * nx + vx)
+    return dist
+
+
+@njit(cache=True, inline="always")
+def _cell_free(free, ix, iy):  # pragma: no cover - compiled
+    ny, nx = free.shape
+    return 0 <= ix < nx and 0 <= iy < ny and free[iy, ix] != 0
+
+
+@njit(cache=True)
+def segment_clear(free, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Whether every cell the segment ``(x0, y0) -> (x1, y1)`` (cell units) crosses is free."""
+    u0 = x0 + 0.5
+    v0 = y0 + 0.5
+    u1 = x1 + 0.5
+    v1 = y1 + 0.5
+    ix = int(math.floor(u0))
+    iy = int(math.floor(v0))
+    ex = int(math.floor(u1))
+    ey = int(math.floor(v1))
+    if not _cell_free(free, ix, iy):
+        return False
+    if ix == ex and iy == ey:
+        return True
+    if not _cell_free(free, ex, ey):
+        return False
+    du = u1 - u0
+    dv = v1 - v0
+    sx = 1 if du > 0.0 else -1
+    sy = 1 if dv > 0.0 else -1
+    inf = np.inf
+    tdx = abs(1.0 / du) if du != 0.0 else inf
+    tdy = abs(1.0 / dv) if dv != 0.0 else inf
+    if du > 0.0:
+        tmx = (ix + 1.0 - u0) * tdx
+    elif du < 0.0:
+        tmx = (u0 - ix) * tdx
+    else:
+        tmx = inf
+    if dv > 0.0:
+        tmy = (iy + 1.0 - v0) * tdy
+    elif dv < 0.0:
+        tmy = (v0 - iy) * tdy
+    else:
+        tmy = inf
+    left = abs(ex - ix) + abs(ey - iy)
+    while left > 0:
+        if tmx < tmy:
+            ix += sx
+            tmx += tdx
+            left -= 1
+        elif tmy < tmx:
+            iy += sy
+            tmy += tdy
+            left -= 1
+        else:  # through a cell corner: both side cells count as touched
+            if not _cell_free(free, ix + sx, iy) or not _cell_free(free, ix, iy + sy):
+                return False
+            ix += sx
+            iy += sy
+            tmx += tdx
+            tmy += tdy
+            left -= 2
+        if not _cell_free(free, ix, iy):
+            return False
+    return True
+
+
+@njit(cache=True)
+def arc_clear(free, x, y, th, kappa, s, step):  # pragma: no cover - compiled
+    """Whether the arc from pose ``(x, y, th)``, curvature ``kappa``, signed length ``s`` is free.
+
+    Sampled at arc-length spacing ``<= step``; the chords between samples are traversed.
+    """
+    m = max(1, int(math.ceil(abs(s) / step)))
+    px = x
+    py = y
+    for q in range(1, m + 1):
+        qx, qy, _ = advance(x, y, th, kappa, s * q / m)
+        if not segment_clear(free, px, py, qx, qy):
+            return False
+        px = qx
+        py = qy
+    return True
+
+
+@njit(cache=True)
+def word_clear(free, x, y, th, radius, kinds, lens, n, step):  # pragma: no cover - compiled
+    """Whether a Reeds-Shepp/Dubins word from pose ``(x, y, th)`` stays on free cells."""
+    for i in range(n):
+        if lens[i] == 0.0:
+            continue
+        kappa = kinds[i] / radius
+        if not arc_clear(free, x, y, th, kappa, lens[i], step):
+            return False
+        x, y, th = advance(x, y, th, kappa, lens[i])
+    return True
+
+
+@njit(cache=True, inline="always")
+def _hash(key, mask):  # pragma: no cover - compiled
+    h = (key * 0x9E3779B97F4A7C15) & 0x7FFFFFFFFFFFFFFF
+    return (h >> 17) & mask
+
+
+@njit(cache=True)
+def _slot(keys, key):  # pragma: no cover - compiled
+    """Slot of ``key`` in the open-addressing table ``keys`` (or the empty slot it would take)."""
+    mask = keys.shape[0] - 1
+    i = _hash(key, mask)
+    while keys[i] != key and keys[i] != -1:
+        i = (i + 1) & mask
+    return i
+
+
+@njit(cache=True)
+def _rehash(keys, vals):  # pragma: no cover - compiled
+    nk = np.full(2 * keys.shape[0], -1, dtype=np.int64)
+    nv = np.empty(2 * keys.shape[0], dtype=np.int32)
+    for i in range(keys.shape[0]):
+        if keys[i] != -1:
+            j = _slot(nk, keys[i])
+            nk[j] = keys[i]
+            nv[j] = vals[i]
+    return nk, nv
+
+
+@njit(cache=True)
+def _grow_f(a):  # pragma: no cover - compiled
+    b = np.empty(2 * a.shape[0], dtype=a.dtype)
+    for i in range(a.shape[0]):
+        b[i] = a[i]
+    return b
+
+
+@njit(cache=True)
+def _grow_i(a):  # pragma: no cover - compiled
+    b = np.empty(2 * a.shape[0], dtype=a.dtype)
+    for i in range(a.shape[0]):
+        b[i] = a[i]
+    return b
+
+
+@njit(cache=True)
+def _grow_b(a):  # pragma: no cover - compiled
+    b = np.zeros(2 * a.shape[0], dtype=a.dtype)
+    for i in range(a.shape[0]):
+        b[i] = a[i]
+    return b
+
+
+@njit(cache=True)
+def _now():  # pragma: no cover - compiled
+    with numba.objmode(t="float64"):
+        t = time.perf_counter()
+    return t
+
+
+@njit(cache=True)
+def _heuristic(
+    x, y, th, gx, gy, gth, h2d, radius, reverse, window, kinds, lens, buf
+):  # pragma: no cover
+    ny, nx = h2d.shape
+    ix = min(max(int(math.floor(x + 0.5)), 0), nx - 1)
+    iy = min(max(int(math.floor(y + 0.5)), 0), ny - 1)
+    e = math.hypot(gx - x, gy - y)
+    h = max(h2d[iy, ix], e)
+    if e < window:
+        c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
+        h = max(h, c)
+    return h
+
+
+@njit(cache=True)
+def hybrid_kernel(
+    free,  # uint8 (ny, nx): 1 on free cells
+    h2d,  # float64 (ny, nx): distance_field from the goal's cell
+    sx,  # start pose (cells, rad)
+    sy,
+    sth,
+    gx,  # goal pose
+    gy,
+    gth,
+    radius,  # turning radius R (cells)
+    curvatures,  # float64 (nc,): signed curvatures of the primitives (1/cells)
+    prim_len,  # arc length of every primitive (cells)
+    nbins,  # heading bins
+    reverse,  # backwards primitives and Reeds-Shepp (else Dubins)
+    reverse_penalty,  # >= 1, multiplies a backwards primitive's length
+    cusp_penalty,  # >= 0, cells added per change of direction
+    turn_penalty,  # >= 0, an arc costs its length times 1 + turn_penalty
+    steer_penalty,  # >= 0, a change of curvature costs the length times 1 + steer_penalty more
+    analytic_ratio,  # > 0: shot every max(1, h / analytic_ratio) expansions
+    car_window,  # cells: the car-length heuristic is evaluated closer than this to the goal
+    step,  # collision sampling spacing (cells)
+    max_expansions,
+    deadline,  # time.perf_counter() value at which the search gives up
+    polish,  # after the first path: search on for at most expansions + polish more
+):  # pragma: no cover - numba
+    """Run Hybrid-A* from the start pose to the goal pose (the comments give each argument).
+
+    Returns
+    -------
+    status : int
+        ``FOUND`` (1), ``EXHAUSTED`` (0), ``MAX_EXPANSIONS`` (2) or ``TIME_BUDGET`` (3).
+    chain : ndarray of int32, shape (k,)
+        Node indices from the start node (0) to the node the shot leaves from (found only).
+    nodes : ndarray of float64, shape (n, 3)
+        Poses of the nodes created (x, y, heading unwrapped).
+    prims : ndarray of int32, shape (n,)
+        Primitive reaching each node: ``2 * curvature index + (1 if backwards)``; -1 at start.
+    shot_kinds, shot_lens : ndarray, shape (5,)
+        The analytic shot's word; ``shot_n`` segments of it.
+    shot_n, expansions, shots : int
+        Segments of the shot, nodes expanded, analytic shots tried.
+    """
+    two_pi = 2.0 * math.pi
+    bin_w = two_pi / nbins
+    ny, nx = free.shape
+    nc = curvatures.shape[0]
+    ndirs = 2 if reverse else 1
+    kinds = np.zeros(5, dtype=np.int8)
+    lens = np.zeros(5)
+    buf = np.zeros(5)
+    shot_kinds = np.zeros(5, dtype=np.int8)
+    shot_lens = np.zeros(5)
+
+    ncap = 4096
+    px = np.empty(ncap)
+    py = np.empty(ncap)
+    pth = np.empty(ncap)
+    pg = np.empty(ncap)
+    par = np.empty(ncap, dtype=np.int32)
+    prim = np.empty(ncap, dtype=np.int32)
+    closed = np.zeros(ncap, dtype=np.uint8)
+    keyof = np.empty(ncap, dtype=np.int64)
+    keys = np.full(1 << 14, -1, dtype=np.int64)
+    vals = np.empty(1 << 14, dtype=np.int32)
+    used = 0
+
+    hcap = 4096
+    hf = np.empty(hcap)
+    hg = np.empty(hcap)
+    hn = np.empty(hcap, dtype=np.int32)
+    size = 0
+
+    # start node
+    b0 = int(math.floor(sth / bin_w + 0.5)) % nbins
+    k0 = (int(math.floor(sy + 0.5)) * nx + int(math.floor(sx + 0.5))) * nbins + b0
+    px[0] = sx
+    py[0] = sy
+    pth[0] = sth
+    pg[0] = 0.0
+    par[0] = -1
+    prim[0] = -1
+    keyof[0] = k0
+    nn = 1
+    s0 = _slot(keys, k0)
+    keys[s0] = k0
+    vals[s0] = 0
+    used = 1
+    h0 = _heuristic(sx, sy, sth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf)
+    hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, h0, 0.0, 0)
+
+    expansions = 0
+    shots = 0
+    countdown = 0
+    status = EXHAUSTED
+    last = -1
+    shot_n = 0
+    best = np.inf  # cost of the best path found so far (search path + shot)
+    stop_at = max_expansions
+    while size > 0:
+        u, fu, size = heap_pop(hf, hg, hn, size)
+        if closed[u] != 0:
+            continue
+        su = _slot(keys, keyof[u])
+        if vals[su] != u:
+            continue  # superseded by a cheaper pose in the same state
+        if fu >= best:
+            break  # no open node can lead to a cheaper path (f is a lower bound of the cost)
+        closed[u] = 1
+        expansions += 1
+        if expansions > stop_at:
+            if status != FOUND:
+                status = MAX_EXPANSIONS
+            break
+        if (expansions & 127) == 0 and _now() > deadline:
+            if status != FOUND:
+                status = TIME_BUDGET
+            break
+        ux = px[u]
+        uy = py[u]
+        uth = pth[u]
+        ug = pg[u]
+        pu = prim[u]
+        # analytic expansion to the goal pose: the cheapest word under the search's costs
+        countdown -= 1
+        if countdown <= 0:
+            shots += 1
+            c, n = car_word(
+                ux,
+                uy,
+                uth,
+                gx,
+                gy,
+                gth,
+                radius,
+                reverse,
+                kinds,
+                lens,
+                buf,
+                reverse_penalty,
+                cusp_penalty,
+                1.0 + turn_penalty,
+            )
+            if pu >= 0:
+                for i in range(n):
+                    if lens[i] != 0.0:
+                        if (lens[i] < 0.0) != ((pu & 1) == 1):
+                            c += cusp_penalty
+                        break
+            if ug + c < best and word_clear(free, ux, uy, uth, radius, kinds, lens, n, step):
+                if status != FOUND:
+                    # keep searching for a cheaper path, at most as long again
+                    stop_at = min(max_expansions, 2 * expansions + polish)
+                status = FOUND
+                best = ug + c
+                last = u
+                shot_n = n
+                for i in range(n):
+                    shot_kinds[i] = kinds[i]
+                    shot_lens[i] = lens[i]
+            countdown = max(1, int((fu - ug) / analytic_ratio))
+        for ci in range(nc):
+            kappa = curvatures[ci]
+            for di in range(ndirs):
+                d = 1.0 if di == 0 else -1.0
+                s = d * prim_len
+                if not arc_clear(free, ux, uy, uth, kappa, s, step):
+                    continue
+                cx, cy, cth = advance(ux, uy, uth, kappa, s)
+                cost = prim_len
+                if di == 1:
+                    cost *= reverse_penalty
+                if kappa != 0.0:
+                    cost *= 1.0 + turn_penalty
+                if pu >= 0:
+                    if curvatures[pu >> 1] != kappa:
+                        cost *= 1.0 + steer_penalty
+                    if (pu & 1) != di:
+                        cost += cusp_penalty
+                cg = ug + cost
+                b = int(math.floor(cth / bin_w + 0.5)) % nbins
+                ck = (int(math.floor(cy + 0.5)) * nx + int(math.floor(cx + 0.5))) * nbins + b
+                sl = _slot(keys, ck)
+                if keys[sl] == ck:
+                    v = vals[sl]
+                    if closed[v] != 0 or cg >= pg[v]:
+                        continue
+                if nn == px.shape[0]:
+                    px = _grow_f(px)
+                    py = _grow_f(py)
+                    pth = _grow_f(pth)
+                    pg = _grow_f(pg)
+                    par = _grow_i(par)
+                    prim = _grow_i(prim)
+                    keyof = _grow_i(keyof)
+                    closed = _grow_b(closed)
+                w = nn
+                nn += 1
+                px[w] = cx
+                py[w] = cy
+                pth[w] = cth
+                pg[w] = cg
+                par[w] = u
+                prim[w] = 2 * ci + di
+                keyof[w] = ck
+                if keys[sl] != ck:
+                    keys[sl] = ck
+                    used += 1
+                vals[sl] = w
+                if 2 * used > keys.shape[0]:
+                    keys, vals = _rehash(keys, vals)
+                hw = _heuristic(
+                    cx, cy, cth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf
+                )
+                hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, cg + hw, cg, w)
+
+    nodes = np.empty((nn, 3))
+    for i in range(nn):
+        nodes[i, 0] = px[i]
+        nodes[i, 1] = py[i]
+        nodes[i, 2] = pth[i]
+    if status == FOUND:
+        k = 0
+        v = last
+        while v >= 0:
+            k += 1
+            v = par[v]
+        chain = np.empty(k, dtype=np.int32)
+        v = last
+        for i in range(k - 1, -1, -1):
+            chain[i] = v
+            v = par[v]
+    else:
+        chain = np.empty(0, dtype=np.int32)
+    return (
+        status,
+        chain,
+        nodes,
+        prim[:nn].copy(),
+        shot_kinds,
+        shot_lens,
+        shot_n,
+        expansions,
+        shots,
+    )

@@ -1,0 +1,245 @@
+"""Hybrid-A* pose paths: hand-made manoeuvres, independent dense checks, bad input."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+from astar import InvalidInputError, NoPathError, OccupancyGrid
+from astar.hybrid import NoPosePathError, PosePath, find_pose_path
+
+
+def _wrap(a):
+    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+
+
+def check_path(p: PosePath, free: np.ndarray, start, goal, radius: float) -> None:
+    """Independent checks of a returned path against the grid and the car's rules."""
+    free = np.asarray(free, bool)
+    ny, nx = free.shape
+    pc = p.pieces
+    assert pc.shape[1] == 5 and pc.shape[0] >= 1
+    # curvature of every piece within 1/R; no empty pieces
+    assert np.all(np.abs(pc[:, 3]) <= 1.0 / radius * (1 + 1e-12))
+    assert np.all(pc[:, 4] != 0.0)
+    # dense resampling of the pieces (0.01 cells), by a midpoint integration of our own
+    pts = []
+    x, y, th = pc[0, :3]
+    assert np.allclose([x, y], start[:2], atol=1e-12) and abs(_wrap(th - start[2])) < 1e-12
+    for px, py, pth, k, s in pc:
+        # each piece starts where the previous one ended
+        assert math.hypot(px - x, py - y) < 1e-9 and abs(_wrap(pth - th)) < 1e-9
+        m = max(1, int(abs(s) / 0.01))
+        ds = s / m
+        # the chord of each step: length 2 sin(k ds / 2) / k along the mid-step heading
+        chord = ds if k == 0 else 2.0 * math.sin(0.5 * k * ds) / k
+        x, y, th = px, py, pth
+        for _ in range(m):
+            thm = th + 0.5 * k * ds
+            x += chord * math.cos(thm)
+            y += chord * math.sin(thm)
+            th += k * ds
+            pts.append((x, y))
+    pts = np.array(pts)
+    ix = np.floor(pts[:, 0] + 0.5).astype(int)
+    iy = np.floor(pts[:, 1] + 0.5).astype(int)
+    inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+    assert inside.all(), "the path leaves the grid"
+    assert free[iy, ix].all(), f"collision at {pts[~free[iy, ix]][:3].tolist()}"
+    # the integration lands on the goal; the returned end pose is the goal exactly
+    assert math.hypot(x - goal[0], y - goal[1]) < 1e-9 and abs(_wrap(th - goal[2])) < 1e-9
+    assert p.poses[-1, 0] == goal[0] and p.poses[-1, 1] == goal[1]
+    assert abs(_wrap(p.poses[-1, 2] - goal[2])) < 1e-12
+    assert np.all(p.poses[0] == np.asarray(start, float))
+    # poses: motion along the heading (forwards or backwards as `directions` says)
+    d = np.diff(p.poses[:, :2], axis=0)
+    step = np.hypot(d[:, 0], d[:, 1])
+    mid = p.poses[:-1, 2] + 0.5 * np.diff(p.poses[:, 2])
+    along = d[:, 0] * np.cos(mid) + d[:, 1] * np.sin(mid)
+    assert np.all(np.sign(along[step > 1e-9]) == p.directions[1:][step > 1e-9])
+    assert np.allclose(np.abs(along), step, rtol=1e-6, atol=1e-9)
+    # curvature from the poses: a chord c of an arc of radius >= R turns by <= 2 asin(c / 2R)
+    turn = np.abs(np.diff(p.poses[:, 2]))
+    assert np.all(turn <= 2 * np.arcsin(np.minimum(1.0, step / (2 * radius))) * (1 + 1e-9) + 1e-12)
+    # segments: contiguous, shared cusp poses, one direction each, flips between them
+    seg = p.segments
+    assert seg[0, 0] == 0 and seg[-1, 1] == len(p) - 1
+    assert np.all(seg[1:, 0] == seg[:-1, 1])
+    for a, b in seg:
+        assert len(set(p.directions[a + 1 : b + 1].tolist())) == 1
+    dirs = [p.directions[b] for _, b in seg]
+    assert all(u != v for u, v in zip(dirs[:-1], dirs[1:], strict=True))
+    assert p.cusps == len(seg) - 1 == int(np.count_nonzero(np.diff(np.sign(pc[:, 4]))))
+    assert p.length == pytest.approx(np.abs(pc[:, 4]).sum())
+    assert p.reverse_length == pytest.approx(-pc[pc[:, 4] < 0, 4].sum())
+
+
+def _closed(ny, nx):
+    free = np.zeros((ny, nx), bool)
+    free[1:-1, 1:-1] = True
+    return free
+
+
+def test_goal_straight_behind():
+    free = _closed(9, 30)
+    start, goal = (20.0, 4.0, 0.0), (12.0, 4.0, 0.0)
+    p = find_pose_path(free, start, goal, turning_radius=4.0)
+    check_path(p, free, start, goal, 4.0)
+    assert p.length == pytest.approx(8.0) and p.reverse_length == pytest.approx(8.0)
+    assert p.cusps == 0 and np.all(p.directions == -1)
+    # forwards only: a loop, which this corridor (7 cells < 2R + ...) cannot hold
+    with pytest.raises(NoPosePathError, match="forwards only") as e:
+        find_pose_path(free, start, goal, turning_radius=4.0, reverse=False)
+    assert e.value.reason == "exhausted" and isinstance(e.value, NoPathError)
+    # in the open, forwards only goes round: longer than a full circle of radius R... at least
+    # pi R (turn back) and no backwards motion
+    free = _closed(40, 40)
+    p = find_pose_path(free, (24, 20, 0), (16, 20, 0), turning_radius=4.0, reverse=False)
+    check_path(p, free, (24, 20, 0), (16, 20, 0), 4.0)
+    assert p.reverse_length == 0 and p.cusps == 0 and p.length > 2 * math.pi * 4.0
+
+
+def test_u_turn_round_a_block():
+    """Lanes 5 cells wide (< 2R = 6): forwards only, the car must drive round the block."""
+    free = _closed(22, 50)
+    free[6:16, 6:44] = False
+    start, goal = (20.0, 3.0, 0.0), (20.0, 18.0, math.pi)
+    p = find_pose_path(free, start, goal, turning_radius=3.0, reverse=False)
+    check_path(p, free, start, goal, 3.0)
+    assert p.cusps == 0 and p.reverse_length == 0
+    assert p.poses[:, 0].max() > 44  # round the east end of the block
+    q = find_pose_path(free, start, goal, turning_radius=3.0)
+    check_path(q, free, start, goal, 3.0)
+
+
+def test_three_point_turn_in_a_dead_end():
+    """A corridor 7 cells wide, closed at its east end, R = 5 (2R = 10 > 7): turn round."""
+    free = _closed(9, 40)
+    start, goal = (30.0, 4.0, 0.0), (30.0, 4.0, math.pi)
+    p = find_pose_path(free, start, goal, turning_radius=5.0)
+    check_path(p, free, start, goal, 5.0)
+    assert p.cusps >= 2 and p.reverse_length > 0
+    t = time.perf_counter()
+    with pytest.raises(NoPosePathError, match="no forwards-only path") as e:
+        find_pose_path(free, start, goal, turning_radius=5.0, reverse=False)
+    assert e.value.reason == "exhausted" and time.perf_counter() - t < 1.0
+
+
+def test_parallel_parking():
+    """A slot 1.3 car lengths long beside a street (car length = R = 6 cells, as a car of
+    length 4.5 m with a 5 m turning radius), the free space of the car's reference point."""
+    radius = 6.0
+    free = np.zeros((16, 50), bool)
+    free[6:15, 1:49] = True  # the street
+    free[2:6, 20:28] = True  # the slot: 8 cells = 1.33 car lengths, 4 deep
+    goal = (24.0, 3.0, 0.0)
+    for start in [(32.0, 9.0, 0.0), (8.0, 10.0, 0.0), (40.0, 10.0, math.pi)]:
+        p = find_pose_path(free, start, goal, turning_radius=radius)
+        check_path(p, free, start, goal, radius)
+    # backing in from beside the slot, the classic manoeuvre: it reverses
+    p = find_pose_path(free, (32.0, 9.0, 0.0), goal, turning_radius=radius)
+    assert p.reverse_length > 0
+
+
+def test_random_grids_are_checked():
+    rng = np.random.default_rng(1)
+    found = 0
+    for _ in range(12):
+        free = _closed(30, 30) & (rng.random((30, 30)) > 0.12)
+        cells = np.argwhere(free)
+        a, b = cells[rng.choice(len(cells), 2, replace=False)]
+        start = (float(a[1]), float(a[0]), float(rng.uniform(-np.pi, np.pi)))
+        goal = (float(b[1]), float(b[0]), float(rng.uniform(-np.pi, np.pi)))
+        for rev in (True, False):
+            try:
+                p = find_pose_path(
+                    free, start, goal, turning_radius=2.0, reverse=rev, time_budget=0.5
+                )
+            except NoPosePathError as e:
+                assert e.reason in ("disconnected", "exhausted", "time_budget")
+                continue
+            found += 1
+            check_path(p, free, start, goal, 2.0)
+            if not rev:
+                assert p.cusps == 0 and p.reverse_length == 0
+    assert found >= 6
+
+
+def test_occupancy_grid_input_and_world():
+    occ = ~_closed(12, 20)
+    g = OccupancyGrid(occ, resolution=0.05, origin=(1.0, 2.0))
+    p = find_pose_path(g, (5, 5, 0), (14, 6, 0.3), turning_radius=3.0)
+    check_path(p, ~occ, (5, 5, 0), (14, 6, 0.3), 3.0)
+    w = p.to_world(g)
+    assert w[0].tolist() == pytest.approx([1.0 + 5.5 * 0.05, 2.0 + 5.5 * 0.05, 0.0])
+    assert not p.poses.flags.writeable and p.stats["expanded"] >= 1
+
+
+def test_same_pose():
+    free = _closed(10, 10)
+    p = find_pose_path(free, (4, 4, 1.0), (4, 4, 1.0), turning_radius=2.0)
+    assert len(p) == 1 and p.length == 0 and p.cusps == 0 and p.pieces.shape == (0, 5)
+    assert p.poses.tolist() == [[4.0, 4.0, 1.0]] and p.segments.tolist() == [[0, 0]]
+
+
+def test_refusals_say_why():
+    free = _closed(10, 21)
+    free[:, 10] = False
+    t = time.perf_counter()
+    with pytest.raises(NoPosePathError, match="different free regions") as e:
+        find_pose_path(free, (3, 5, 0), (15, 5, 0), turning_radius=2.0)
+    assert e.value.reason == "disconnected" and time.perf_counter() - t < 0.5
+    free = _closed(40, 40)
+    free[10:30, 20] = False
+    with pytest.raises(NoPosePathError, match="max_expansions=3") as e:
+        find_pose_path(free, (5, 20, 0), (35, 20, math.pi), turning_radius=3.0, max_expansions=3)
+    assert e.value.reason == "max_expansions" and e.value.stats["expanded"] >= 3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"turning_radius": 0.0}, "turning_radius"),
+        ({"turning_radius": -2.0}, "turning_radius"),
+        ({"turning_radius": math.nan}, "turning_radius"),
+        ({"turning_radius": math.inf}, "turning_radius"),
+        ({"turning_radius": 2.0, "reverse": "yes"}, "reverse must be a bool"),
+        ({"turning_radius": 2.0, "heading_bins": 4}, "heading_bins must be >= 8"),
+        ({"turning_radius": 2.0, "curvatures": 4}, "curvatures must be odd"),
+        (
+            {"turning_radius": 2.0, "reverse_penalty": 0.5},
+            "reverse_penalty must be finite and >= 1",
+        ),
+        ({"turning_radius": 2.0, "cusp_penalty": -1}, "cusp_penalty"),
+        ({"turning_radius": 2.0, "time_budget": 0}, "time_budget"),
+        ({"turning_radius": 2.0, "max_expansions": 0}, "max_expansions must be >= 1"),
+        ({"turning_radius": 2.0, "primitive_length": -1.0}, "primitive_length"),
+    ],
+)
+def test_bad_parameters(kwargs, match):
+    with pytest.raises(InvalidInputError, match=match):
+        find_pose_path(_closed(10, 10), (3, 3, 0), (6, 6, 0), **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("start", "match"),
+    [
+        ((3, 3), "start must be a pose"),
+        ((3, 3, math.nan), "start must be finite"),
+        ((30, 3, 0), "outside the grid"),
+        ((0, 0, 0), "blocked cell"),
+        ("abc", "start must be a pose"),
+    ],
+)
+def test_bad_poses(start, match):
+    with pytest.raises(InvalidInputError, match=match):
+        find_pose_path(_closed(10, 10), start, (6, 6, 0), turning_radius=2.0)
+
+
+def test_bad_grid():
+    for g in (np.ones((5, 5), int), np.ones((2, 5, 5), bool), [[True]], np.ones((0, 3), bool)):
+        with pytest.raises(InvalidInputError, match="grid must be"):
+            find_pose_path(g, (1, 1, 0), (2, 2, 0), turning_radius=1.0)
