@@ -60,6 +60,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.geometry._obstacle_index",
     "trajopt.corridor._polygons.path_kernels",
     "trajopt.corridor._polygons.region_kernels",
+    "trajopt.smoother._cost_kernels",
     "trajopt.timing._cap_cubic",
     "trajopt.timing._cap_kernel",
     "trajopt.timing._greedy",

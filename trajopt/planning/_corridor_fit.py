@@ -85,10 +85,8 @@ def fit_in_corridor(
                 raise SmoothingError("time budget exhausted before the box corridor", {})
             sm = smoother if i == 0 else dataclasses.replace(smoother, time_budget_s=left)
             # a costmap's graded cost (search "costmap" or "costmap+clearance") enters the
-            # smoother's objective with costmap_weight; the IPOPT problems do not hold it yet
+            # smoother's objective with costmap_weight
             cost = q.cost
-            if "ipopt" in (sm.qp_solver, sm.curvature_solver if sm.kappa_max else ""):
-                cost = None
             with q.timer.stage("smooth"):
                 smooth = sm.fit(
                     path,

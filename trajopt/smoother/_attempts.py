@@ -29,9 +29,17 @@ from trajopt.geometry._bspline import BSplineCurve
 from trajopt.robot._footprint import Footprint
 from trajopt.smoother._basis import band_quadratic, bucket_size
 from trajopt.smoother._certificate import certify
-from trajopt.smoother._cost import CostField, CostTerm, cost_field, cost_rounds
+from trajopt.smoother._cost import (
+    CostField,
+    CostTerm,
+    cost_field,
+    cost_rounds,
+    cost_scale,
+    linearised,
+)
 from trajopt.smoother._footprint_rounds import FootprintRounds, footprint_scp
 from trajopt.smoother._nlp import solve_curvature_ipopt
+from trajopt.smoother._nlp_solve import cost_ipopt, ipopt_cost, refine_ipopt
 from trajopt.smoother._path import SmoothPath
 from trajopt.smoother._problem import (
     N_HEADING_ROWS,
@@ -43,7 +51,7 @@ from trajopt.smoother._problem import (
     objective,
     project_heading,
 )
-from trajopt.smoother._qp import solve_qp, warm_imports
+from trajopt.smoother._qp import RoundSolver, solve_qp, warm_imports
 from trajopt.smoother._scp import CurvatureSCP
 from trajopt.smoother._status import AttemptRecord, SolveInfo, SolveStatus, summarize
 
@@ -112,16 +120,6 @@ def fit(
         if hs is None:
             raise InvalidInputError("start_curvature needs start_heading (the tangent it bends)")
     field = cost_field(cost, cost_weight, raw_grid)
-    if field is not None and options.qp_solver == "ipopt":
-        raise InvalidInputError(
-            "cost: the cost term is minimised by sequential QP rounds (qp_solver 'piqp' or "
-            "'osqp'), not yet in the IPOPT problem; got qp_solver='ipopt'"
-        )
-    if field is not None and options.kappa_max is not None and options.curvature_solver == "ipopt":
-        raise InvalidInputError(
-            "cost: the cost term is minimised by sequential QP rounds before the SCP, not yet "
-            "in the IPOPT problem; got curvature_solver='ipopt'"
-        )
     cost_at = None if field is None else (field, np.asarray(corridor.origin, dtype=float))
     if corridor.length_m <= 0:
         raise InvalidInputError("the corridor's path has zero length (start == goal)")
@@ -149,9 +147,10 @@ def fit(
             attempt=len(attempts) + 1, span_cells=h, kappa_margin=None if warm is None else margin
         )
         attempts.append(rec)
+        refined = None if options.refine is None else {}
         try:
             c_cells, t_cells, span_box = solve_attempt(
-                options, prob, h, remaining, margin, warm, rec, cost_at
+                options, prob, h, remaining, margin, warm, rec, cost_at, refined
             )
         except AttemptFailed as exc:
             rec.failure = str(exc)
@@ -190,7 +189,21 @@ def fit(
         if fcert is not None:
             rec.footprint_margin_m = fcert.min_margin_m
         if cert.ok and (fcert is None or fcert.ok):
+            if refined is not None:
+                curve, cert, fcert = _polished(
+                    refined, check, (curve, cert, fcert), t_cells, span_box
+                )
+                if refined["stats"].get("kept"):
+                    rec.cost = refined["cost"]
+                    if rec.cost_rounds is not None:  # the term at the polished curve
+                        rec.cost_rounds = dict(
+                            rec.cost_rounds,
+                            cost_term=refined["cost_term"],
+                            mean_cost=refined["mean_cost"],
+                        )
             stats = summarize(attempts, time.perf_counter() - t_call, success=True)
+            if refined is not None:
+                stats["refine"] = refined["stats"]
             if rec.cost_rounds is not None:
                 stats["cost_rounds"] = dict(rec.cost_rounds)
             if fp is not None:
@@ -231,6 +244,29 @@ def fit(
         f"(time_budget_s={options.time_budget_s}): {last}",
         stats,
     )
+
+
+def _polished(
+    refined: dict, check: Any, fast: tuple, t_cells: np.ndarray, span_box: np.ndarray
+) -> tuple:
+    """Return the IPOPT polish's curve and certificates when it passes them, else ``fast``.
+
+    ``refined``: :func:`solve_attempt`'s polish (its ``"stats"`` get the outcome);
+    ``check``: :func:`_check` of the fit; ``fast``: the fast result's ``(curve, certificate,
+    footprint certificate)``, both certified.
+    """
+    st = refined["stats"]
+    if "c" not in refined:
+        st["kept"] = False
+        return fast
+    t0 = time.perf_counter()
+    got = check(refined["c"], t_cells, span_box)
+    st["certificate_s"] = time.perf_counter() - t0
+    st["kept"] = bool(got[1].ok and (got[2] is None or got[2].ok))
+    if not st["kept"]:
+        st["status"] = "not certified"
+        return fast
+    return got
 
 
 def _check(
@@ -277,6 +313,7 @@ def solve_attempt(
     warm: np.ndarray | None,
     rec: AttemptRecord,
     cost_at: tuple[CostField, np.ndarray] | None = None,
+    refined: dict | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One attempt on the knots of span ``h`` (cells).
 
@@ -286,8 +323,13 @@ def solve_attempt(
     curvature bound the SCP or IPOPT (sampled bound ``margin * kappa_max``; the SCP's linear
     term then holds the cost gradient at the rounds' result).
     ``warm``: control points (cells) of an earlier attempt on the same knots; the curvature
-    solver then starts from them instead of the QP solution. Fills ``rec``; returns the control
-    points (cells, shape (n, 2)), the knots (cells) and every span's region.
+    solver then starts from them instead of the QP solution. With IPOPT as the QP solver (or
+    the curvature solver, with a bound) the cost term is IPOPT's exact one instead of the
+    rounds' (:func:`~trajopt.smoother._nlp_solve.cost_ipopt`). ``refined``: a dict that
+    receives the IPOPT polish of the result (:func:`~trajopt.smoother._nlp_solve.refine_ipopt`;
+    ``"stats"``, and ``"c"``, its control points in cells, when it is offered). Fills ``rec``;
+    returns the control points (cells, shape (n, 2)), the knots (cells) and every span's
+    region.
 
     Raises
     ------
@@ -301,7 +343,16 @@ def solve_attempt(
         raise AttemptFailed(str(exc)) from None
     qp, t = asm.qp, asm.knots
     n, nb = qp.n, qp.nb
-    if warm is None:
+    term = None
+    if cost_at is not None:
+        scale = cost_scale(options, prob.taut)
+        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, t, options.degree, nb, scale)
+    rounds = RoundSolver(qp)
+    if warm is None and term is not None and not ipopt_cost(options):
+        # the first QP holds the cost term linearised around the path's targets (the rounds'
+        # model there), so that the rounds start from a cost-aware curve
+        info = rounds(options, linearised(qp, term, asm.x0), asm.x0)
+    elif warm is None:
         info = solve_qp(options, qp, x0=asm.x0)
     else:
         z = asm.x0.copy()
@@ -312,16 +363,21 @@ def solve_attempt(
         raise AttemptFailed(f"QP solver {info.solver}: {_failure(info)}")
     z = np.clip(info.z, qp.lbx, qp.ubx)
     const = asm.const
-    qp_curv = qp
-    if cost_at is not None:
-        # taut: the term in units of the length term's marginal (2 * taut_length_weight per
-        # cell at unit speed), so that w trades length for cost as the A* search does
-        scale = 2.0 * options.taut_length_weight if prob.taut else 1.0
-        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, t, options.degree, nb, scale)
-        deadline = t_enter + remaining
-        z, g_lin, rec.cost_rounds = cost_rounds(options, qp, term, z, const, deadline, solve_qp)
+    qp_curv, nlp_done = qp, False
+    if term is not None:
+        if ipopt_cost(options):  # IPOPT minimises the exact term (with its curvature rows)
+            left = remaining - (time.perf_counter() - t_enter)
+            z, g_lin, rec.cost_rounds, rec.nlp = cost_ipopt(
+                options, qp, t, z, term, prob, margin, left
+            )
+            if not rec.nlp.success:
+                raise AttemptFailed(f"cost term (ipopt): {_failure(rec.nlp)}")
+            nlp_done = options.kappa_max is not None
+        else:
+            deadline = t_enter + remaining
+            z, g_lin, rec.cost_rounds = cost_rounds(options, qp, term, z, const, deadline, rounds)
         qp_curv = dataclasses.replace(qp, g=g_lin)
-    if options.kappa_max is not None:
+    if options.kappa_max is not None and not nlp_done:
         kmax_cells = options.kappa_max * prob.res
         remaining -= time.perf_counter() - t_enter  # what the QP stage left
         if options.curvature_solver == "scp":
@@ -333,6 +389,18 @@ def solve_attempt(
         if not cinfo.success:
             raise AttemptFailed(f"curvature bound ({cinfo.solver}): {_failure(cinfo)}")
         z = np.clip(cinfo.z, qp.lbx, qp.ubx)
+    if refined is not None:  # Smoother(refine="ipopt"): the polish, offered to the caller
+        left = remaining - (time.perf_counter() - t_enter)
+        zr, refined["stats"] = refine_ipopt(options, qp, t, z, term, prob, margin, left, const)
+        if zr is not None:
+            cr = refined["c"] = np.column_stack([zr[:n], zr[nb : nb + n]])
+            project_heading(cr, prob, asm.lo, asm.hi, asm.point_rows, asm.start_alpha)
+            zr = np.zeros(2 * nb)
+            zr[:n], zr[nb : nb + n] = cr[:, 0], cr[:, 1]
+            refined["cost"] = band_quadratic(qp.full, qp.g, zr, const)
+            if term is not None:
+                refined["cost_term"] = term.value_grad(zr)[0]
+                refined["mean_cost"] = term.mean_cost(zr)
     c = np.column_stack([z[:n], z[nb : nb + n]])
     project_heading(c, prob, asm.lo, asm.hi, asm.point_rows, asm.start_alpha)
     zc = np.zeros(2 * nb)

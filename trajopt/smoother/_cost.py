@@ -1,16 +1,18 @@
 """A cost field in the smoother's objective (a costmap's graded cost, a preference layer).
 
 The objective gains ``s * w * integral cost(C(u)) |C'(u)| du``: the cost per unit of length
-travelled, in cell units (``C`` in cells, ``u`` the arc-length-like parameter in cells). In
-the taut objective ``s = 2 * taut_length_weight``, the marginal of its length term
-``taut_length_weight * integral |C'|^2`` per cell of length at unit speed, so that the
-objective trades length for cost as the A* search does (``length * (1 + w * cost)``); in
-the fidelity objective ``s = 1``. The cell values are smoothed by a Gaussian of
-:data:`SIGMA` cells (the inflation band's edges become slopes that the linearised rounds
-see) and interpolated bilinearly between cell centres; the integral is a Gauss-Legendre quadrature (:data:`N_GAUSS` points per
-knot span). The QP and SCP paths minimise it by sequential QP rounds that linearise it
-around the current iterate (:func:`cost_rounds`); the corridor rows stay hard constraints in
-every round, so the clearance certificate is the one of the QP without the term.
+travelled, in cell units (``C`` in cells, ``u`` the arc-length-like parameter in cells), with
+``s`` from :func:`cost_scale` (in the taut objective a multiple of the price of one more cell
+of length, so that ``w`` trades cost against length as the A* search's ``length * (1 + w
+cost)`` does; 1 in the fidelity objective). The cell values are smoothed by a Gaussian of
+:data:`SIGMA` cells (the inflation band's edges become slopes that the rounds see) and
+interpolated bilinearly between cell centres; the integral is a Gauss-Legendre quadrature
+(:data:`N_GAUSS` points per knot span), evaluated with its gradient and a convex model of its
+Hessian by the compiled :func:`~trajopt.smoother._cost_kernels.cost_term_kernel`. The QP and
+SCP paths minimise it by sequential QP rounds on that model with a line search
+(:func:`cost_rounds`; the attempt's first QP already holds the model around the path); the
+corridor rows stay hard constraints in every round, so the clearance certificate is the one
+of the QP without the term.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.smoother._basis import band_quadratic, basis_derivs, find_spans
+from trajopt.smoother._cost_kernels import cost_term
 
 if TYPE_CHECKING:
     from trajopt.smoother._options import Smoother
@@ -34,13 +37,24 @@ if TYPE_CHECKING:
 N_GAUSS = 4
 #: most sequential QP rounds of the linearised cost term
 MAX_ROUNDS = 8
-#: the rounds stop when a round lowers the objective by less than this fraction
-ROUND_TOL = 1e-2
-#: first proximal weight (per control point coordinate, cell units) of the damped rounds
-RHO0 = 1.0
+#: the rounds stop when a round's decrease of the objective is less than this fraction of
+#: the decrease of all rounds so far
+ROUND_TOL = 0.1
+#: first proximal weight (per control point coordinate, cell units) of the rounds' model
+RHO0 = 1e-1
+#: the proximal weight is never halved below this
+RHO_MIN = 1e-3
+#: halvings of the step the line search tries before a round is retried with more damping
+LINE_SEARCH_STEPS = 4
+#: fraction of the model's predicted decrease a step must achieve
+ARMIJO = 1e-4
 #: standard deviation (cells) of the Gaussian smoothing of the cell costs before the
 #: interpolation: the inflation band's edges become slopes the linearised rounds can follow
 SIGMA = 1.0
+
+#: the smoother's price of cost relative to the search's: a cell of cost weighs this many
+#: cells of taut length (see :func:`cost_scale`)
+BEND_FACTOR = 4.0
 
 # the last read-only cost array seen and its validated, smoothed copy
 _CACHE: dict[str, Any] = {}
@@ -101,6 +115,32 @@ class CostField:
         gx = ((1 - ty) * (c10 - c00) + ty * (c11 - c01)) * inx
         gy = ((1 - tx) * (c01 - c00) + tx * (c11 - c10)) * iny
         return v, np.column_stack([gx, gy]) / self.resolution
+
+
+def cost_scale(options: Smoother, taut: bool) -> float:
+    """``s``, the factor of the weight in the cost term (see the module docstring).
+
+    With the taut objective, ``s = BEND_FACTOR * 2 * taut_length_weight``: ``2 *
+    taut_length_weight`` is the price of one more cell of length at unit speed, so that
+    with :data:`BEND_FACTOR` 1 the weight would trade cost against length exactly as the
+    costmap search does (``length * (1 + w cost)``). The smoother's curve also pays for
+    bending, which a grid path does not: at equal prices it cuts back through the band the
+    search went round. :data:`BEND_FACTOR` = 4 is the factor at which, on Nav2-style
+    inflation costmaps of the shared ROS maps at the default weight 2, the trajectory's mean
+    cost stays within 5 % of its A* path's (``benchmarks/bench_costmap_smoother.py``). With
+    the fidelity objective (no length term), ``s = 1``.
+
+    Parameters
+    ----------
+    options : Smoother
+    taut : bool
+        Whether the attempt uses the taut objective.
+
+    Returns
+    -------
+    float
+    """
+    return BEND_FACTOR * 2.0 * options.taut_length_weight if taut else 1.0
 
 
 def cost_field(cost: Any, weight: Any, raw_grid: Any) -> CostField | None:
@@ -222,6 +262,8 @@ class CostTerm:
         Quadrature weights (cells).
     scale : float
         ``s``, the factor of ``w`` (see the module docstring).
+    last_mean : float
+        The mean cost per unit length of the curve :meth:`evaluate` saw last.
     """
 
     field: CostField
@@ -235,6 +277,7 @@ class CostTerm:
     b1: np.ndarray
     wq: np.ndarray
     scale: float = 1.0
+    last_mean: float = 0.0
 
     @classmethod
     def on_knots(
@@ -280,41 +323,116 @@ class CostTerm:
         Returns
         -------
         value : float
-            ``w * sum_q wq cost(C(u_q)) |C'(u_q)|`` (cells of length times cost).
+            ``s * w * sum_q wq cost(C(u_q)) |C'(u_q)|`` (cells of length times cost).
         grad : ndarray, shape (2 nb,)
             Its gradient (zero on the padded variables).
         """
-        nb, n, p = self.nb, self.n, self.p
+        value, grad, _ = self.evaluate(z, with_model=False)
+        return value, grad
+
+    def model_band(self, z: np.ndarray) -> np.ndarray:
+        """Upper band of a convex, isotropic model of the term's Hessian at ``z``.
+
+        ``s * w * sum_q wq |C'_q| kappa_q B_q B_q^T`` per coordinate, with ``kappa_q`` the
+        non-negative part of the largest eigenvalue of the cost's Hessian at the quadrature
+        point. The bilinear interpolant is linear along each axis inside a cell, so its own
+        second derivatives vanish; the Hessian is the central difference of its gradient
+        over one cell either side (the field's curvature at the scale of a cell). This is
+        the second-order part of the term along the direction the cost curves most,
+        without the (small, indefinite) terms of ``|C'|``; the rounds add it to the QP's
+        Hessian so that a step follows the cost's curvature instead of a fixed damping.
+
+        Parameters
+        ----------
+        z : ndarray, shape (2 nb,)
+            Control points (cells).
+
+        Returns
+        -------
+        ndarray, shape (p + 1, nb)
+            ``band[d, j] = H[j, j + d]`` of the per-coordinate block (cell units).
+        """
+        return self.evaluate(z, with_model=True)[2]
+
+    def evaluate(
+        self, z: np.ndarray, with_model: bool = True
+    ) -> tuple[float, np.ndarray, np.ndarray | None]:
+        """Return the value, gradient and (``with_model``) model band in one pass.
+
+        See :meth:`value_grad` and :meth:`model_band`; the compiled
+        :func:`~trajopt.smoother._cost_kernels.cost_term_kernel` does the work.
+        """
+        nb, n = self.nb, self.n
+        f = self.field
         c = np.column_stack([z[:n], z[nb : nb + n]])
-        idx = self.span[:, None] + np.arange(p + 1)[None, :]  # (Q, p + 1)
-        cq = c[idx]  # (Q, p + 1, 2)
-        pos = np.einsum("qk,qkd->qd", self.b0, cq)
-        der = np.einsum("qk,qkd->qd", self.b1, cq)
-        val, grad_m = self.field.at(self.origin + self.res * pos)
-        grad_c = grad_m * self.res  # per cell
-        speed = np.hypot(der[:, 0], der[:, 1])
-        w = self.scale * self.field.weight * self.wq
-        value = float(np.sum(w * val * speed))
-        unit = der / np.maximum(speed, 1e-12)[:, None]
-        # d/dc_k: w (grad cost . B_k) |C'| + w cost (C'/|C'|) B'_k
-        gq = (w * speed)[:, None, None] * self.b0[:, :, None] * grad_c[:, None, :]
-        gq += (w * val)[:, None, None] * self.b1[:, :, None] * unit[:, None, :]
-        g = np.zeros((n, 2))
-        np.add.at(g, idx.ravel(), gq.reshape(-1, 2))
-        out = np.zeros(2 * nb)
-        out[:n], out[nb : nb + n] = g[:, 0], g[:, 1]
-        return value, out
+        a = (self.origin - f.origin) / f.resolution - 0.5
+        value, length, g, band = cost_term(
+            f.cost, a, f.resolution / self.res, c, self.span, self.b0, self.b1, self.wq, with_model
+        )
+        self.last_mean = value / max(length, 1e-12)
+        factor = self.scale * f.weight
+        grad = np.zeros(2 * nb)
+        grad[:n], grad[nb : nb + n] = factor * g[:, 0], factor * g[:, 1]
+        if band is not None:
+            band = factor * np.pad(band, ((0, 0), (0, nb - n)))
+        return factor * value, grad, band
 
     def mean_cost(self, z: np.ndarray) -> float:
         """Return the curve's mean cost per unit length (without the weight)."""
-        nb, n, p = self.nb, self.n, self.p
-        c = np.column_stack([z[:n], z[nb : nb + n]])
-        idx = self.span[:, None] + np.arange(p + 1)[None, :]
-        pos = np.einsum("qk,qkd->qd", self.b0, c[idx])
-        der = np.einsum("qk,qkd->qd", self.b1, c[idx])
-        val, _ = self.field.at(self.origin + self.res * pos)
-        speed = np.hypot(der[:, 0], der[:, 1]) * self.wq
-        return float(np.sum(val * speed) / max(np.sum(speed), 1e-12))
+        self.evaluate(z, with_model=False)
+        return self.last_mean
+
+
+def _band_matvec(band: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``blockdiag(Hb, Hb) @ z`` for the symmetric upper band ``band`` of ``Hb``."""
+    nb = band.shape[1]
+    out = np.zeros_like(z)
+    for blk in (slice(0, nb), slice(nb, 2 * nb)):
+        v = z[blk]
+        o = band[0] * v
+        for d in range(1, band.shape[0]):
+            o[: nb - d] += band[d, : nb - d] * v[d:]
+            o[d:] += band[d, : nb - d] * v[: nb - d]
+        out[blk] = o
+    return out
+
+
+def linearised(
+    qp: QPData,
+    term: CostTerm,
+    z: np.ndarray,
+    rho: float = RHO0,
+    grad: np.ndarray | None = None,
+    model: np.ndarray | None = None,
+) -> QPData:
+    """Return the QP plus the rounds' convex model of the cost term around ``z``.
+
+    The model: the term's gradient at ``z``, the curvature :meth:`CostTerm.model_band` and
+    a proximal ``rho/2 |. - z|^2`` (its constant dropped); the rows and bounds are ``qp``'s.
+
+    Parameters
+    ----------
+    qp : QPData
+    term : CostTerm
+    z : ndarray, shape (2 nb,)
+        Linearisation point (cells); need not be feasible.
+    rho : float
+        Proximal weight (cell units).
+    grad : ndarray, shape (2 nb,), optional
+        The term's gradient at ``z`` when the caller has it.
+    model : ndarray, shape (p + 1, nb), optional
+        Its :meth:`CostTerm.model_band` at ``z`` when the caller has it (not modified).
+
+    Returns
+    -------
+    QPData
+        ``qp`` with the model's Hessian band added to ``full`` and its linear part to ``g``.
+    """
+    if grad is None or model is None:
+        _, grad, model = term.evaluate(z)
+    model = model.copy()
+    model[0, : qp.n] += rho
+    return replace(qp, full=qp.full + model, g=qp.g + grad - _band_matvec(model, z))
 
 
 def cost_rounds(
@@ -326,12 +444,19 @@ def cost_rounds(
     deadline: float,
     solve: Any,
 ) -> tuple[np.ndarray, np.ndarray, dict]:
-    """Damped sequential QP rounds on ``1/2 z'Hz + g'z + const + cost(z)``.
+    """Sequential QP rounds on ``1/2 z'Hz + g'z + const + cost(z)``.
 
-    Each round adds the cost term's gradient at the current iterate ``z_k`` to ``g`` and a
-    proximal term ``rho/2 |z - z_k|^2`` (a damped Gauss-Newton step inside the same
-    corridor rows and bounds); a round is accepted only when it lowers the true objective
-    (else ``rho`` is quadrupled and the round retried; after an accepted round it is halved).
+    Each round minimises, inside the same corridor rows and bounds, the QP plus a convex
+    quadratic model of the cost term around the current iterate ``z_k``: its value and
+    gradient there, and the curvature of :meth:`CostTerm.model_band` plus a proximal
+    ``rho/2 |z - z_k|^2``. The feasible set is convex, so every point between ``z_k`` and
+    the round's solution is feasible: a backtracking line search along that step accepts
+    the first point that lowers the true objective by a fraction of the model's predicted
+    decrease; when none does, ``rho`` is quadrupled and the round retried (after an
+    accepted full step it is halved). The rounds stop when one lowers the objective by
+    less than :data:`ROUND_TOL` of what all rounds so far lowered it, at
+    :data:`MAX_ROUNDS` or at ``deadline``;
+    a curve on which the cost is flat (zero gradient) takes no round.
 
     Parameters
     ----------
@@ -356,37 +481,50 @@ def cost_rounds(
         ``g`` plus the cost gradient at ``z`` (the linear term a later curvature stage
         minimises).
     stats : dict
-        ``rounds``, ``accepted``, ``cost_term`` (at ``z``), ``mean_cost`` before and after.
+        ``rounds`` (QP solves), ``accepted``, ``cost_term`` (at ``z``), ``mean_cost`` before
+        and after.
     """
-    nb, n = qp.nb, qp.n
-    val, grad = term.value_grad(z)
-    f = band_quadratic(qp.full, qp.g, z, const) + val
-    stats = {"rounds": 0, "accepted": 0, "mean_cost_qp": term.mean_cost(z)}
+    val, grad, model = term.evaluate(z)
+    f = f0 = band_quadratic(qp.full, qp.g, z, const) + val
+    mean = term.last_mean
+    stats = {"rounds": 0, "accepted": 0, "mean_cost_qp": mean}
     rho = RHO0
+    if not np.any(grad):
+        stats.update(cost_term=val, mean_cost=stats["mean_cost_qp"])
+        return z, qp.g + grad, stats
     for _ in range(MAX_ROUNDS):
         if time.perf_counter() > deadline:
             break
         stats["rounds"] += 1
-        full = qp.full.copy()
-        full[0, :n] += rho
-        g = qp.g + grad
-        g[:n] -= rho * z[:n]
-        g[nb : nb + n] -= rho * z[nb : nb + n]
-        info: SolveInfo = solve(options, replace(qp, full=full, g=g), z)
+        lin_qp = linearised(qp, term, z, rho, grad, model)
+        info: SolveInfo = solve(options, lin_qp, z)
         if not info.success:
             rho *= 4.0
             continue
-        zn = np.clip(info.z, qp.lbx, qp.ubx)
-        vn, gn = term.value_grad(zn)
-        fn = band_quadratic(qp.full, qp.g, zn, const) + vn
-        if fn >= f:
+        step = np.clip(info.z, qp.lbx, qp.ubx) - z
+        # the model's decrease: -(grad + H z_k + g)'d - 1/2 d'(H + M)d >= 0 at its minimum
+        lin = float((qp.g + grad + _band_matvec(qp.full, z)) @ step)
+        quad = band_quadratic(lin_qp.full, np.zeros_like(step), step)
+        pred = -(lin + quad)
+        accepted = False
+        t = 1.0
+        for _ls in range(LINE_SEARCH_STEPS):
+            zn = z + t * step
+            vn, gn, mn = term.evaluate(zn)
+            fn = band_quadratic(qp.full, qp.g, zn, const) + vn
+            if fn < f - ARMIJO * t * max(pred, 0.0):
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
             rho *= 4.0
             continue
         stats["accepted"] += 1
-        done = f - fn <= ROUND_TOL * max(abs(f), 1e-9)
-        z, val, grad, f = zn, vn, gn, fn
-        rho = max(0.5 * rho, 1e-3)
+        done = f - fn <= ROUND_TOL * (f0 - fn)
+        z, val, grad, model, f, mean = zn, vn, gn, mn, fn, term.last_mean
+        if t == 1.0:
+            rho = max(0.5 * rho, RHO_MIN)
         if done:
             break
-    stats.update(cost_term=val, mean_cost=term.mean_cost(z))
+    stats.update(cost_term=val, mean_cost=mean)
     return z, qp.g + grad, stats

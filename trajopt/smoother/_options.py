@@ -199,13 +199,13 @@ class Smoother:
             resolution and origin) or per-cell costs in ``[0, 1]``, row 0 at the bottom. The
             objective then gains ``s * cost_weight * integral cost(C(u)) |C'(u)| du`` (cost
             per unit length, cell units; the cells' values blurred by a Gaussian of one cell
-            and interpolated bilinearly between their centres; ``s = 2 *
-            taut_length_weight`` with the taut objective, the price of one more cell of
-            length, so that the weight trades cost against length as the costmap search
-            does, and 1 with the fidelity objective), minimised by damped sequential QP
-            rounds that linearise it
-            around the current iterate (module :mod:`trajopt.smoother._cost`); the corridor
-            rows stay hard constraints and the certificate is unchanged. With
+            and interpolated bilinearly between their centres; ``s = 4 * 2 *
+            taut_length_weight`` with the taut objective, four times the price of one more
+            cell of length, since the curve also pays for bending where the costmap search
+            pays only for length; 1 with the fidelity objective), minimised by sequential QP
+            rounds on a convex model of the term around the current iterate, with a line
+            search (module :mod:`trajopt.smoother._cost`); the corridor rows stay hard
+            constraints and the certificate is unchanged. With
             ``qp_solver="ipopt"`` (or ``curvature_solver="ipopt"`` and ``kappa_max``) IPOPT
             minimises the term exactly instead, the cell values' cubic B-spline in place of
             the bilinear interpolation (module :mod:`trajopt.smoother._nlp_cost`).

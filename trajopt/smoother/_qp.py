@@ -171,9 +171,37 @@ def solve_working_set(
     iterations : int
     """
     import piqp
+
+    solver = piqp.SparseSolver()
+    solver.settings.verbose = False
+    solver.setup(
+        *working_set_matrices(full, g, layout, trip, lbx, ubx, lba, uba, active, slack_penalty)
+    )
+    return piqp_result(solver, 2 * layout.nb)
+
+
+def working_set_matrices(
+    full: np.ndarray,
+    g: np.ndarray,
+    layout: ConstraintLayout,
+    trip: np.ndarray,
+    lbx: np.ndarray,
+    ubx: np.ndarray,
+    lba: np.ndarray,
+    uba: np.ndarray,
+    active: np.ndarray,
+    slack_penalty: float,
+) -> tuple:
+    """Return piqp's ``setup`` arguments for :func:`solve_working_set`'s problem.
+
+    ``(P, c, A, b, G, h_l, h_u, x_l, x_u)``.
+
+    The arguments are :func:`solve_working_set`'s; no equality block (``A``, ``b`` are
+    ``None``): the fixed rows enter ``G`` with equal bounds.
+    """
     import scipy.sparse as sps
 
-    nb, p = layout.nb, layout.p
+    nb = layout.nb
     n_fixed = layout.sample_row0
     keep_row = np.ones(layout.n_rows, dtype=bool)
     keep_row[n_fixed:] = np.repeat(active, 3)
@@ -187,23 +215,95 @@ def solve_working_set(
         (trip[sel], (new_row[layout.trip_rows[sel]], new_col[layout.trip_cols[sel]])),
         shape=(int(keep_row.sum()), n_cols),
     )
-    hr, hc, hd, hcol = upper_band_triplets(nb, p)
-    P = sps.csc_matrix((full[hd, hcol], (hr, hc)), shape=(n_cols, n_cols))
+    P = band_hessian(full, n_cols)
     c = np.concatenate([g, np.full(int(active.sum()), slack_penalty)])
     # large finite row bounds hurt piqp's conditioning: bound each row by its range
     # (every triplet of a kept row is selected: its columns are kept, zeros add nothing)
     lo_r, hi_r = layout.implied_range(trip, lbx, ubx, select=sel)
     h_l = np.maximum(lba, lo_r - 1.0)[keep_row]
     h_u = np.minimum(uba, hi_r + 1.0)[keep_row]
-    solver = piqp.SparseSolver()
-    solver.settings.verbose = False
-    solver.setup(P, c, None, None, A, h_l, h_u, lbx[keep_col], ubx[keep_col])
+    return P, c, None, None, A, h_l, h_u, lbx[keep_col], ubx[keep_col]
+
+
+def band_hessian(full: np.ndarray, n_cols: int):
+    """Upper triangle of ``blockdiag(Hb, Hb)`` (CSC, ``n_cols`` square) from the band ``full``.
+
+    Every band entry is stored (zeros included), so the pattern depends only on the shape:
+    piqp's ``update`` needs the pattern of its ``setup``.
+    """
+    import scipy.sparse as sps
+
+    p1, nb = full.shape
+    indptr, indices, d, col = _band_csc(nb, p1 - 1, n_cols)
+    return sps.csc_matrix((full[d, col], indices, indptr), shape=(n_cols, n_cols))
+
+
+@functools.lru_cache(maxsize=64)
+def _band_csc(nb: int, p: int, n_cols: int) -> tuple[np.ndarray, ...]:
+    """CSC ``indptr``, ``indices`` of :func:`band_hessian` and each entry's band position."""
+    import scipy.sparse as sps
+
+    hr, hc, hd, hcol = upper_band_triplets(nb, p)
+    m = sps.csc_matrix((np.arange(1, len(hr) + 1, dtype=float), (hr, hc)), shape=(n_cols, n_cols))
+    order = m.data.astype(np.int64) - 1
+    return m.indptr.copy(), m.indices.copy(), hd[order], hcol[order]
+
+
+def piqp_result(solver, n_z: int) -> tuple[np.ndarray, float, bool, str, int]:
+    """``(z, cost, success, status, iterations)`` of a piqp ``solve`` (``z`` its first ``n_z``)."""
+    import piqp
+
     status = solver.solve()
     x = np.asarray(solver.result.x, dtype=float)
     success = status == piqp.PIQP_SOLVED and bool(np.all(np.isfinite(x)))
-    z = x[: 2 * nb] if success else np.zeros(2 * nb)
+    z = x[:n_z] if success else np.zeros(n_z)
     cost = float(solver.result.info.primal_obj) if success else float("nan")
     return z, cost, success, str(status), int(solver.result.info.iter)
+
+
+class RoundSolver:
+    """:func:`solve_qp` for a sequence of QPs that differ only in Hessian and linear term.
+
+    The sequential rounds of the cost term (:func:`~trajopt.smoother._cost.cost_rounds`)
+    solve the attempt's QP again and again with a new Hessian band and linear term and the
+    same rows and bounds. On a polygon corridor with piqp, the first call sets piqp up and
+    later calls only ``update`` ``P`` and ``c`` (piqp keeps its symbolic factorisation and
+    the constraint matrix); otherwise every call is :func:`solve_qp`.
+
+    Parameters
+    ----------
+    base : QPData
+        The attempt's QP: the rows and bounds every call shares.
+    """
+
+    def __init__(self, base: QPData) -> None:
+        self.base = base
+        self.solver = None
+        self.n_cols = 0
+
+    def __call__(self, options: Smoother, qp: QPData, x0: np.ndarray | None = None) -> SolveInfo:
+        """Solve ``qp`` (``base`` with another ``full`` and ``g``); see :func:`solve_qp`."""
+        if options.qp_solver != "piqp" or qp.region_coef is None:
+            return solve_qp(options, qp, x0)
+        ts = time.perf_counter()
+        tc = time.process_time()
+        if self.solver is None:
+            import piqp
+
+            b = self.base
+            layout = constraint_layout(b.nb, options.degree, 0, b.k)
+            trip = layout.values(b.heading, None, b.region_coef)
+            args = working_set_matrices(
+                qp.full, qp.g, layout, trip, b.lbx, b.ubx, b.lba, b.uba, np.zeros(0, bool), 0.0
+            )
+            self.n_cols = args[0].shape[0]
+            self.solver = piqp.SparseSolver()
+            self.solver.settings.verbose = False
+            self.solver.setup(*args)
+        else:
+            self.solver.update(P=band_hessian(qp.full, self.n_cols), c=qp.g)
+        z, *result = piqp_result(self.solver, 2 * qp.nb)
+        return piqp_info(z, result, ts, tc)
 
 
 def piqp_info(z: np.ndarray, result: tuple, t_wall: float, t_cpu: float) -> SolveInfo:

@@ -77,6 +77,112 @@ def test_gradient_matches_central_differences():
     assert np.all(grad[[i for i in range(2 * qp.nb) if i % qp.nb >= qp.n]] == 0.0)
 
 
+def _term_and_qp(weight: float = 2.0):
+    """The L hall's cost term on one attempt's knots, its QP and the QP's solution."""
+    grid, cost, corridor = l_hall()
+    field = cost_field(
+        np.clip(cost + 0.3 * np.sin(np.arange(cost.size).reshape(cost.shape)), 0, 1), weight, grid
+    )
+    options = Smoother()
+    prob, _, _ = build_problem(options, None, corridor, start=START, goal=GOAL, hs=None, hg=None)
+    asm = assemble(options, prob, 4.0)
+    term = CostTerm.on_knots(
+        field, np.asarray(corridor.origin), RES, asm.knots, options.degree, asm.qp.nb, 3.0
+    )
+    return options, term, asm, solve_qp(options, asm.qp, x0=asm.x0).z
+
+
+def _reference_term(term, z):
+    """Value, gradient and model band of the term in NumPy from ``CostField.at`` (dense)."""
+    nb, n, p = term.nb, term.n, term.p
+    c = np.column_stack([z[:n], z[nb : nb + n]])
+    w = term.scale * term.field.weight * term.wq
+    value, grad, hess = 0.0, np.zeros((n, 2)), np.zeros((n, n))
+    h = term.field.resolution
+    for q in range(len(term.wq)):
+        ids = term.span[q] + np.arange(p + 1)
+        pos = term.b0[q] @ c[ids]
+        der = term.b1[q] @ c[ids]
+        xy = term.origin + term.res * pos
+        v, g = term.field.at(xy[None, :])
+        speed = np.hypot(*der)
+        value += w[q] * v[0] * speed
+        grad[ids] += w[q] * (speed * np.outer(term.b0[q], g[0] * term.res))
+        grad[ids] += w[q] * v[0] * np.outer(term.b1[q], der / speed)
+        # the Hessian of the field: central differences of its gradient, one cell each side
+        hxx_row = term.field.at((xy + [h, 0])[None])[1] - term.field.at((xy - [h, 0])[None])[1]
+        hyy_row = term.field.at((xy + [0, h])[None])[1] - term.field.at((xy - [0, h])[None])[1]
+        H = np.array([hxx_row[0], hyy_row[0]]) / (2 * h)
+        lam = max(np.linalg.eigvalsh(0.5 * (H + H.T)).max(), 0.0) * term.res**2
+        hess[np.ix_(ids, ids)] += w[q] * speed * lam * np.outer(term.b0[q], term.b0[q])
+    out = np.zeros(2 * nb)
+    out[:n], out[nb : nb + n] = grad[:, 0], grad[:, 1]
+    band = np.zeros((p + 1, nb))
+    for d in range(p + 1):
+        band[d, : n - d] = np.diagonal(hess, d)
+    return value, out, band
+
+
+def test_compiled_term_matches_a_numpy_reference():
+    """Value, gradient and model band of the kernel against a dense NumPy evaluation."""
+    _, term, asm, z = _term_and_qp()
+    rng = np.random.default_rng(5)
+    z = z + rng.uniform(-0.4, 0.4, z.shape) * (np.arange(len(z)) % asm.qp.nb < asm.qp.n)
+    value, grad, band = term.evaluate(z)
+    ref_value, ref_grad, ref_band = _reference_term(term, z)
+    assert value == pytest.approx(ref_value, rel=1e-12)
+    np.testing.assert_allclose(grad, ref_grad, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(band, ref_band, rtol=1e-10, atol=1e-12)
+    assert np.any(band > 0.0)
+    assert term.mean_cost(z) == pytest.approx(
+        value / (term.scale * term.field.weight * np.sum(term.wq * np.hypot(*_derivs(term, z)))),
+        rel=1e-12,
+    )
+
+
+def _derivs(term, z):
+    nb, n, p = term.nb, term.n, term.p
+    c = np.column_stack([z[:n], z[nb : nb + n]])
+    der = np.array([term.b1[q] @ c[term.span[q] + np.arange(p + 1)] for q in range(len(term.wq))])
+    return der.T
+
+
+def test_round_solver_updates_match_fresh_solves():
+    """piqp set up once and updated with new Hessians and linear terms: fresh solves' answers."""
+    from trajopt.smoother._cost import linearised
+    from trajopt.smoother._qp import RoundSolver
+
+    options, term, asm, z = _term_and_qp()
+    rounds = RoundSolver(asm.qp)
+    for k, rho in enumerate((1.0, 0.1, 0.01)):
+        qp = linearised(asm.qp, term, z + 0.1 * k, rho)
+        a, b = rounds(options, qp, z), solve_qp(options, qp, x0=z)
+        assert a.success and b.success
+        np.testing.assert_allclose(a.z, b.z, atol=1e-7)
+    assert rounds.solver is not None
+
+
+def test_rounds_descend_and_stay_feasible():
+    """Every round lowers the true objective; the result satisfies the QP's rows and bounds."""
+    from trajopt.smoother._basis import band_quadratic
+    from trajopt.smoother._cost import cost_rounds
+    from trajopt.smoother._qp import RoundSolver
+
+    options, term, asm, z0 = _term_and_qp()
+    qp = asm.qp
+    f0 = band_quadratic(qp.full, qp.g, z0, asm.const) + term.value_grad(z0)[0]
+    z, g_lin, stats = cost_rounds(options, qp, term, z0, asm.const, math.inf, RoundSolver(qp))
+    f = band_quadratic(qp.full, qp.g, z, asm.const) + term.value_grad(z)[0]
+    assert stats["accepted"] >= 1 and f < f0
+    assert stats["cost_term"] == pytest.approx(term.value_grad(z)[0], rel=1e-12)
+    np.testing.assert_allclose(g_lin, qp.g + term.value_grad(z)[1], rtol=1e-12)
+    assert np.all(z >= qp.lbx - 1e-9) and np.all(z <= qp.ubx + 1e-9)
+    coef, lb, ub = asm.point_rows
+    c = np.column_stack([z[: qp.nb], z[qp.nb :]])
+    rows = np.einsum("ikd,id->ik", coef, c)
+    assert np.all(rows >= lb - 1e-7) and np.all(rows <= ub + 1e-7)
+
+
 def test_bilinear_field_interpolates_cell_centres():
     """At the cell centres the field is the Gaussian-smoothed cell's value."""
     from scipy import ndimage
@@ -173,5 +279,3 @@ def test_costmap_of_another_resolution_is_refused():
         Smoother().fit(None, corridor, cost=other, **kw)
     with pytest.raises(InvalidInputError, match="cost needs raw_grid"):
         Smoother().fit(None, corridor, cost=cost, start=START, goal=GOAL, radius=0.2)
-    with pytest.raises(InvalidInputError, match="not yet in the IPOPT problem"):
-        Smoother(qp_solver="ipopt").fit(None, corridor, cost=cost, **kw)
