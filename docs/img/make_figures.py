@@ -6,6 +6,8 @@
 * ``diagonal_passage.png``: a 30-degree staircase passage of free width ``2 r + 1`` cells:
   the box corridor (left; its fit fails) and the polygon corridor with the certified curve
   (right).
+* ``costmap_weights.png``: one query on a Nav2-style inflation costmap at ``costmap_weight``
+  0, 1, 3 and 10: the A* path and the smoothed trajectory over the graded cost.
 """
 
 from __future__ import annotations
@@ -121,6 +123,65 @@ def diagonal_passage() -> None:
     plt.close(fig)
 
 
+def costmap_weights() -> None:
+    from scipy import ndimage
+
+    res = 0.05
+    occ = np.zeros((80, 140), dtype=bool)  # 7 m x 4 m
+    occ[[0, -1], :] = True
+    occ[:, [0, -1]] = True
+    occ[0:34, 46:50] = True  # a wall from the bottom with a gap above it
+    occ[46:80, 92:96] = True  # and one from the top
+    occ[20:30, 110:125] = True  # a table
+    d = ndimage.distance_transform_edt(~occ) * res
+    r_ins, r_inf, k = 0.15, 0.6, 3.0
+    values = np.zeros(occ.shape, np.uint8)
+    band = (d > r_ins) & (d <= r_inf)
+    values[band] = np.floor(252.0 * np.exp(-k * (d[band] - r_ins))).astype(np.uint8)
+    values[d <= r_ins] = 253
+    values[occ] = 254
+    cm = astar.from_costmap(values, res, convention="costmap_2d")
+    robot = trajopt.Robot(radius=r_ins)
+    start, goal = (0.6, 0.6), (6.4, 3.4)
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7.4))
+    for ax, w in zip(axes.ravel(), (0.0, 1.0, 3.0, 10.0), strict=True):
+        traj = trajopt.Planner(cm, robot, search="costmap", costmap_weight=w).plan(start, goal)
+        ax.imshow(
+            np.where(occ, np.nan, cm.cost),
+            origin="lower",
+            extent=(0, occ.shape[1] * res, 0, occ.shape[0] * res),
+            cmap="Oranges",
+            vmin=0,
+            vmax=1,
+        )
+        ax.imshow(
+            np.where(occ, 1.0, np.nan),
+            origin="lower",
+            extent=(0, occ.shape[1] * res, 0, occ.shape[0] * res),
+            cmap="Greys",
+            vmin=0,
+            vmax=1,
+        )
+        cells = np.asarray(traj.steps.grid_path.cells, dtype=float)
+        ax.plot(*((cells + 0.5) * res).T, "--", color="tab:blue", lw=1, label="A* path")
+        sp = traj.steps.smooth_path
+        a, b = sp.curve.domain
+        xy = sp.curve(np.linspace(a, b, 2000))
+        ax.plot(*xy.T, color="tab:green", lw=2, label="trajectory")
+        seg = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+        mid = np.floor(0.5 * (xy[1:] + xy[:-1]) / res).astype(int)
+        mean = float(np.sum(cm.cost[mid[:, 1], mid[:, 0]] * seg) / np.sum(seg))
+        ax.set_title(f"costmap_weight {w:g}: mean cost {mean:.3f}, {traj.duration:.2f} s")
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+    axes[0, 0].legend(loc="upper left")
+    fig.tight_layout()
+    fig.savefig(HERE / "costmap_weights.png", dpi=90)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
     paper_scene()
     diagonal_passage()
+    costmap_weights()
