@@ -23,11 +23,13 @@ keeps the cheapest pose that reached it, and a closed state is never reopened.
   exactly at the goal pose. The search then goes on, for at most as many expansions again
   (plus ``polish``), while an open node could still lead to a cheaper path (its ``f``, a lower
   bound of the cost, is below the best path's cost), and returns the cheapest path found.
-* **Heuristic**: ``max(h2d, euclid, car)``: ``h2d`` is the 8-connected shortest distance on the
-  free grid from the goal's cell (:func:`distance_field`, no corner cutting, as Smac's 2-D
-  heuristic), ``car`` the obstacle-free Reeds-Shepp/Dubins length, evaluated within
-  ``car_window`` cells of the goal (farther, it exceeds the Euclidean distance by a bounded
-  amount that ``h2d`` already dominates, and costs microseconds per node).
+* **Heuristic**: ``max(h2d, euclid, car)``: ``h2d`` a lower bound of the 8-connected shortest
+  distance on the free grid from the goal's cell (:func:`distance_field`, no corner cutting,
+  as Smac's 2-D heuristic), ``car`` the obstacle-free Reeds-Shepp/Dubins length, evaluated
+  within ``car_window`` cells of the goal (farther, it exceeds the Euclidean distance by a
+  bounded amount that ``h2d`` already dominates) and lazily: a node enters the open list with
+  ``max(h2d, euclid)``, and when popped the first time it gets ``car`` too and goes back if its
+  ``f`` grew (a Reeds-Shepp length costs a few microseconds; most nodes are never popped).
 """
 
 from __future__ import annotations
@@ -51,10 +53,15 @@ TIME_BUDGET = 3
 
 
 @njit(cache=True)
-def distance_field(free, gx, gy):  # pragma: no cover - compiled
-    """8-connected shortest distance (cells) from cell ``(gx, gy)`` over the free cells.
+def distance_field(free, gx, gy, sx, sy, slack):  # pragma: no cover - compiled
+    """Lower bound of the 8-connected grid distance (cells) to cell ``(gx, gy)``.
 
-    A diagonal step (length ``sqrt(2)``) needs both orthogonal cells it passes between free.
+    Dial's bucket queue with integer step costs 5 (straight) and 7 (diagonal, which needs both
+    orthogonal cells it passes between free): distances ``d / 5`` are exact for straight
+    moves and under-estimate a diagonal (1.4 for ``sqrt(2)``), so they bound the octile
+    distance from below. The search stops once cell ``(sx, sy)`` is settled and the frontier
+    is ``slack`` cells beyond it; every cell not settled by then gets the frontier distance,
+    which is below its true distance (a lower bound still).
 
     Parameters
     ----------
@@ -62,45 +69,89 @@ def distance_field(free, gx, gy):  # pragma: no cover - compiled
         1 on free cells.
     gx, gy : int
         The source cell (free).
+    sx, sy : int
+        The cell whose distance the caller needs first (the start).
+    slack : float
+        Cells to go on past ``(sx, sy)``'s distance (``inf``: the whole free region).
 
     Returns
     -------
-    ndarray of float64, shape (ny, nx)
-        Distance in cells; ``inf`` where unreachable or blocked.
+    dist : ndarray of float64, shape (ny, nx)
+        Distance in cells (a lower bound); ``inf`` on blocked cells and, when the search
+        exhausted its region, on cells it could not reach.
+    reached : bool
+        Whether ``(sx, sy)`` was reached.
     """
     ny, nx = free.shape
-    sqrt2 = 1.4142135623730951
-    dist = np.full((ny, nx), np.inf)
+    big = np.int64(1) << 60
+    d = np.full(ny * nx, big, dtype=np.int64)
     ddx = np.array([1, -1, 0, 0, 1, -1, 1, -1])
     ddy = np.array([0, 0, 1, -1, 1, 1, -1, -1])
     cap = 1024
-    hf = np.empty(cap)
-    hg = np.empty(cap)
-    hn = np.empty(cap, dtype=np.int32)
-    size = 0
-    dist[gy, gx] = 0.0
-    hf, hg, hn, size, cap = heap_push(hf, hg, hn, size, cap, 0.0, 0.0, gy * nx + gx)
-    while size > 0:
-        u, d, size = heap_pop(hf, hg, hn, size)
-        uy = u // nx
-        ux = u - uy * nx
-        if d > dist[uy, ux]:
-            continue
-        for k in range(8):
-            vx = ux + ddx[k]
-            vy = uy + ddy[k]
-            if vx < 0 or vy < 0 or vx >= nx or vy >= ny or free[vy, vx] == 0:
-                continue
-            w = 1.0
-            if k >= 4:
-                if free[uy, vx] == 0 or free[vy, ux] == 0:
+    buckets = np.empty((8, cap), dtype=np.int32)
+    counts = np.zeros(8, dtype=np.int64)
+    src = gy * nx + gx
+    d[src] = 0
+    buckets[0, 0] = src
+    counts[0] = 1
+    pending = 1
+    cur = np.int64(0)
+    s = sy * nx + sx
+    stop = big
+    while pending > 0:
+        b = cur & 7
+        while counts[b] > 0:
+            counts[b] -= 1
+            pending -= 1
+            u = buckets[b, counts[b]]
+            if d[u] != cur:
+                continue  # stale entry
+            uy = u // nx
+            ux = u - uy * nx
+            for k in range(8):
+                vx = ux + ddx[k]
+                vy = uy + ddy[k]
+                if vx < 0 or vy < 0 or vx >= nx or vy >= ny or free[vy, vx] == 0:
                     continue
-                w = sqrt2
-            nd = d + w
-            if nd < dist[vy, vx]:
-                dist[vy, vx] = nd
-                hf, hg, hn, size, cap = heap_push(hf, hg, hn, size, cap, nd, nd, vy * nx + vx)
-    return dist
+                w = 5
+                if k >= 4:
+                    if free[uy, vx] == 0 or free[vy, ux] == 0:
+                        continue
+                    w = 7
+                v = vy * nx + vx
+                nd = cur + w
+                if nd < d[v]:
+                    d[v] = nd
+                    bb = nd & 7
+                    if counts[bb] == cap:
+                        nb = np.empty((8, 2 * cap), dtype=np.int32)
+                        for i in range(8):
+                            for j in range(counts[i]):
+                                nb[i, j] = buckets[i, j]
+                        buckets = nb
+                        cap *= 2
+                    buckets[bb, counts[bb]] = v
+                    counts[bb] += 1
+                    pending += 1
+        if stop == big and d[s] <= cur:
+            stop = cur + np.int64(min(slack * 5.0, 1e15))
+        if cur >= stop:
+            break
+        cur += 1
+    out = np.empty((ny, nx))
+    frontier = (cur + 1) / 5.0
+    for i in range(ny * nx):
+        iy = i // nx
+        ix = i - iy * nx
+        if free[iy, ix] == 0:
+            out[iy, ix] = np.inf
+        elif d[i] <= cur:
+            out[iy, ix] = d[i] / 5.0
+        elif pending > 0:
+            out[iy, ix] = frontier  # not settled: at least the frontier's distance
+        else:
+            out[iy, ix] = np.inf  # unreachable
+    return out, d[s] < big
 
 
 @njit(cache=True, inline="always")
@@ -258,16 +309,22 @@ def _now():  # pragma: no cover - compiled
     return t
 
 
+@njit(cache=True, inline="always")
+def _cheap_h(x, y, gx, gy, h2d):  # pragma: no cover - compiled
+    """Return ``max(h2d of the pose's cell, Euclidean distance to the goal)`` (cells)."""
+    ny, nx = h2d.shape
+    ix = min(max(int(math.floor(x + 0.5)), 0), nx - 1)
+    iy = min(max(int(math.floor(y + 0.5)), 0), ny - 1)
+    return max(h2d[iy, ix], math.hypot(gx - x, gy - y))
+
+
 @njit(cache=True)
 def _heuristic(
     x, y, th, gx, gy, gth, h2d, radius, reverse, window, kinds, lens, buf
 ):  # pragma: no cover
-    ny, nx = h2d.shape
-    ix = min(max(int(math.floor(x + 0.5)), 0), nx - 1)
-    iy = min(max(int(math.floor(y + 0.5)), 0), ny - 1)
-    e = math.hypot(gx - x, gy - y)
-    h = max(h2d[iy, ix], e)
-    if e < window:
+    """Return the full heuristic: :func:`_cheap_h` and, near the goal, the car length."""
+    h = _cheap_h(x, y, gx, gy, h2d)
+    if math.hypot(gx - x, gy - y) < window:
         c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
         h = max(h, c)
     return h
@@ -298,6 +355,7 @@ def hybrid_kernel(
     max_expansions,
     deadline,  # time.perf_counter() value at which the search gives up
     polish,  # after the first path: search on for at most expansions + polish more
+    hweight,  # >= 1: f = g + hweight * h (1: A*; more: weighted A*, faster, cost <= hweight x)
 ):  # pragma: no cover - numba
     """Run Hybrid-A* from the start pose to the goal pose (the comments give each argument).
 
@@ -335,6 +393,7 @@ def hybrid_kernel(
     par = np.empty(ncap, dtype=np.int32)
     prim = np.empty(ncap, dtype=np.int32)
     closed = np.zeros(ncap, dtype=np.uint8)
+    lazy = np.zeros(ncap, dtype=np.uint8)  # 1: the car-length heuristic is still to add
     keyof = np.empty(ncap, dtype=np.int64)
     keys = np.full(1 << 14, -1, dtype=np.int64)
     vals = np.empty(1 << 14, dtype=np.int32)
@@ -362,7 +421,7 @@ def hybrid_kernel(
     vals[s0] = 0
     used = 1
     h0 = _heuristic(sx, sy, sth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf)
-    hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, h0, 0.0, 0)
+    hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, hweight * h0, 0.0, 0)
 
     expansions = 0
     shots = 0
@@ -381,6 +440,27 @@ def hybrid_kernel(
             continue  # superseded by a cheaper pose in the same state
         if fu >= best:
             break  # no open node can lead to a cheaper path (f is a lower bound of the cost)
+        if lazy[u] != 0:
+            # the car-length part of the heuristic, evaluated when popped (lazy A*)
+            lazy[u] = 0
+            fl = pg[u] + hweight * _heuristic(
+                px[u],
+                py[u],
+                pth[u],
+                gx,
+                gy,
+                gth,
+                h2d,
+                radius,
+                reverse,
+                car_window,
+                kinds,
+                lens,
+                buf,
+            )
+            if fl > fu:
+                hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, fl, pg[u], u)
+                continue
         closed[u] = 1
         expansions += 1
         if expansions > stop_at:
@@ -433,7 +513,7 @@ def hybrid_kernel(
                 for i in range(n):
                     shot_kinds[i] = kinds[i]
                     shot_lens[i] = lens[i]
-            countdown = max(1, int((fu - ug) / analytic_ratio))
+            countdown = max(1, int((fu - ug) / hweight / analytic_ratio))
         for ci in range(nc):
             kappa = curvatures[ci]
             for di in range(ndirs):
@@ -469,6 +549,7 @@ def hybrid_kernel(
                     prim = _grow_i(prim)
                     keyof = _grow_i(keyof)
                     closed = _grow_b(closed)
+                    lazy = _grow_b(lazy)
                 w = nn
                 nn += 1
                 px[w] = cx
@@ -484,10 +565,10 @@ def hybrid_kernel(
                 vals[sl] = w
                 if 2 * used > keys.shape[0]:
                     keys, vals = _rehash(keys, vals)
-                hw = _heuristic(
-                    cx, cy, cth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf
+                lazy[w] = 1
+                hf, hg, hn, size, hcap = heap_push(
+                    hf, hg, hn, size, hcap, cg + hweight * _cheap_h(cx, cy, gx, gy, h2d), cg, w
                 )
-                hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, cg + hw, cg, w)
 
     nodes = np.empty((nn, 3))
     for i in range(nn):

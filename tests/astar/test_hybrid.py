@@ -113,6 +113,10 @@ def test_u_turn_round_a_block():
     assert p.poses[:, 0].max() > 44  # round the east end of the block
     q = find_pose_path(free, start, goal, turning_radius=3.0)
     check_path(q, free, start, goal, 3.0)
+    # plain A* ordering (heuristic_weight=1): a path no costlier than the weighted search's
+    r = find_pose_path(free, start, goal, turning_radius=3.0, reverse=False, heuristic_weight=1.0)
+    check_path(r, free, start, goal, 3.0)
+    assert r.length <= p.length * 1.5
 
 
 def test_three_point_turn_in_a_dead_end():
@@ -217,6 +221,10 @@ def test_refusals_say_why():
         ({"turning_radius": 2.0, "time_budget": 0}, "time_budget"),
         ({"turning_radius": 2.0, "max_expansions": 0}, "max_expansions must be >= 1"),
         ({"turning_radius": 2.0, "primitive_length": -1.0}, "primitive_length"),
+        (
+            {"turning_radius": 2.0, "heuristic_weight": 0.9},
+            "heuristic_weight must be finite and >= 1",
+        ),
     ],
 )
 def test_bad_parameters(kwargs, match):
