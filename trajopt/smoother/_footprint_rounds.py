@@ -30,6 +30,7 @@ from trajopt.robot._footprint import (
     certify_footprint,
     polygons_clearance,
 )
+from trajopt.smoother._cost import CostField, CostTerm, cost_scale, linearised
 from trajopt.smoother._footprint_scp import FootprintSCP, corners_cells
 from trajopt.smoother._problem import Problem, assemble, project_heading
 
@@ -129,15 +130,23 @@ def footprint_scp(
     fp: FootprintRounds,
     r_cells: float,
     check: Callable[..., tuple],
+    cost_at: tuple[CostField, np.ndarray] | None = None,
 ) -> tuple | None:
     """Run the SCP rounds on the knots of span ``h`` from the failed curve ``c_cells``.
 
     ``check(c_cells, knots, span_box)`` returns ``(curve, certificate, footprint
     certificate)``. Returns that triple for the first round whose certificates both pass,
-    or ``None`` (a QP failed, the disc certificate failed, or the rounds ran out).
+    or ``None`` (a QP failed, the disc certificate failed, or the rounds ran out). With a
+    cost field (``cost_at``: the field and the corridor's origin, m) each round minimises
+    the objective with the cost term's convex model around the round's start
+    (:func:`~trajopt.smoother._cost.linearised`), as the cost rounds do.
     """
     asm = assemble(options, prob, h)
     p, n, nb = options.degree, asm.qp.n, asm.qp.nb
+    term = None
+    if cost_at is not None:
+        scale = cost_scale(options, prob.taut)
+        term = CostTerm.on_knots(cost_at[0], cost_at[1], prob.res, asm.knots, p, nb, scale)
     scp = FootprintSCP(
         asm, prob, corners_cells(fp.footprint, fp.res), r_cells, p, options.speed_floor
     )
@@ -150,7 +159,8 @@ def footprint_scp(
         z = np.zeros(2 * nb)
         z[:n], z[nb : nb + n] = c[:, 0], c[:, 1]
         scp.linearise(z)
-        znew, _ = scp.solve(z, TRUST_CELLS)
+        objective = None if term is None else linearised(asm.qp, term, z)
+        znew, _ = scp.solve(z, TRUST_CELLS, objective)
         if znew is None:
             return None
         c = np.column_stack([znew[:n], znew[nb : nb + n]])

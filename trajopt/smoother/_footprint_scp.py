@@ -31,7 +31,7 @@ import numpy as np
 
 from trajopt.smoother._basis import CURV_SAMPLES, sample_bases
 from trajopt.smoother._layout import constraint_layout
-from trajopt.smoother._problem import N_HEADING_ROWS, Assembly, Problem
+from trajopt.smoother._problem import N_HEADING_ROWS, Assembly, Problem, QPData
 from trajopt.smoother._qp import solve_working_set
 
 #: (corner, half-plane) rows per sample
@@ -146,12 +146,18 @@ class FootprintSCP:
         self.vals[:ns, 2, p + 1 :] = self.B1 * T[:, 1:]
         self.lba[self.rows + 2] = np.maximum(self.floor, SPEED_KEEP * v)
 
-    def solve(self, z: np.ndarray, trust: float = np.inf) -> tuple[np.ndarray | None, str]:
+    def solve(
+        self, z: np.ndarray, trust: float = np.inf, objective: QPData | None = None
+    ) -> tuple[np.ndarray | None, str]:
         """One QP from ``z``, each coordinate within ``trust`` cells of it.
 
-        Returns the new control points (``None`` on failure) and the solver's status.
+        ``objective``: the QP whose ``full`` and ``g`` are minimised (default the attempt's;
+        with a cost field, :func:`~trajopt.smoother._cost.linearised` of it at ``z``); the
+        rows and bounds are always the attempt's. Returns the new control points (``None``
+        on failure) and the solver's status.
         """
         qp, S = self.asm.qp, self.layout.n_samples
+        obj = qp if objective is None else objective
         trip = self.layout.values(qp.heading, self.vals, qp.region_coef)
         n_fixed = self.layout.sample_row0 - N_HEADING_ROWS  # triplets of the fixed rows / 2
         rows = trip[2 * (N_HEADING_ROWS * qp.nb + n_fixed) :].reshape(S, 3, -1)
@@ -161,8 +167,8 @@ class FootprintSCP:
         lbx = np.concatenate([lo, np.zeros(S)])
         ubx = np.concatenate([hi, np.full(S, SLACK_MAX)])
         znew, _, ok, status, _ = solve_working_set(
-            qp.full,
-            qp.g,
+            obj.full,
+            obj.g,
             self.layout,
             trip,
             lbx,

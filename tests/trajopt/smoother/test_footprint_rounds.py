@@ -232,3 +232,33 @@ def test_end_poses_and_paths_refused_with_their_reason():
         planner.plan((0.73, 0.25), (1.5, 1.0))
     with pytest.raises(trajopt.InvalidInputError, match="goal pose .* heading"):
         planner.plan((1.0, 1.0), (1.5, 0.25), goal_heading=math.pi / 2)
+
+
+def test_scp_round_with_a_cost_field_trades_towards_lower_cost():
+    """A round that minimises the cost term's model ends lower on a cost ramp than a blind one."""
+    from trajopt.smoother._cost import CostTerm, cost_field, linearised
+
+    grid, s, g = l_halls(0.7)
+    fp = Footprint.rectangle(0.7, 0.4)
+    r = fp.inscribed_radius
+    pts = np.vstack([np.linspace(s, (g[0], s[1]), 40), np.linspace((g[0], s[1]), g, 30)[1:]])
+    corridor = build_polygon_corridor(grid, pts, r)
+    options = Smoother()
+    prob, _, _ = build_problem(options, None, corridor, start=s, goal=g, hs=None, hg=None)
+    asm = assemble(options, prob, 4.0)
+    z = solve_qp(options, asm.qp, x0=asm.x0).z
+    res, p, n = grid.resolution, options.degree, asm.qp.n
+    yy, xx = np.mgrid[0:200, 0:200]
+    ramp = np.clip(1.0 - (xx - yy + 200) / 400.0, 0.0, 1.0)  # cheaper towards the outer walls
+    term = CostTerm.on_knots(
+        cost_field(ramp, 5.0, grid), np.asarray(corridor.origin), res, asm.knots, p, asm.qp.nb, 8
+    )
+    scp = FootprintSCP(asm, prob, corners_cells(fp, res), r / res, p, 0.2)
+    scp.activate(np.ones(n - p, dtype=bool))
+    scp.linearise(z)
+    blind, _ = scp.solve(z, 2.0)
+    aware, _ = scp.solve(z, 2.0, linearised(asm.qp, term, z))
+    assert blind is not None and aware is not None
+    assert term.value_grad(aware)[0] < term.value_grad(blind)[0] - 1e-3 * abs(
+        term.value_grad(blind)[0]
+    )
