@@ -519,10 +519,12 @@ def test_plan_heading_without_a_turn_says_so(door_map, capsys):
         (["--start-heading", "north"], "expected an angle in radians, got 'north'"),
         (
             ["--drive", "ackermann"],
-            "InvalidInputError: Robot.drive='ackermann' (a car-like robot: turning radius, "
-            "reversing) is not supported yet",
+            "InvalidInputError: Robot.min_turning_radius is required with drive='ackermann'",
         ),
-        (["--drive", "tank"], "Robot.drive must be one of ('differential', 'omni'), got 'tank'"),
+        (
+            ["--drive", "tank"],
+            "Robot.drive must be one of ('differential', 'omni', 'ackermann'), got 'tank'",
+        ),
     ],
 )
 def test_bad_heading_or_drive_is_one_line_exit_2(extra, match, door_map, capsys):
@@ -584,5 +586,9 @@ def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
     with pytest.raises(SystemExit):
         main(["plan", "--help"])
     help_text = capsys.readouterr().out
-    for opt in ("--drive {differential,omni}", "--start-heading RAD", "--goal-heading RAD"):
+    for opt in (
+        "--drive {differential,omni,ackermann}",
+        "--start-heading RAD",
+        "--goal-heading RAD",
+    ):
         assert opt in help_text

@@ -114,10 +114,22 @@ def robot_args(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--drive",
         default="differential",
-        metavar="{differential,omni}",
+        metavar="{differential,omni,ackermann}",
         help="how the base moves: 'differential' (default; faces its direction of travel, "
-        "turns in place at rest) or 'omni' (mecanum/omni wheels: the orientation is "
-        "independent of the direction of travel)",
+        "turns in place at rest), 'omni' (mecanum/omni wheels: the orientation is "
+        "independent of the direction of travel) or 'ackermann' (car-like: needs "
+        "--min-turning-radius and both --start-heading and --goal-heading; may reverse)",
+    )
+    g.add_argument(
+        "--min-turning-radius", type=float, help="car-like robot's minimum turning radius [m]"
+    )
+    g.add_argument("--wheelbase", type=float, help="car-like robot's wheelbase [m]")
+    g.add_argument("--v-max-reverse", type=float, help="car-like robot's max speed backwards [m/s]")
+    g.add_argument(
+        "--steer-rate-max", type=float, help="car-like robot's max steering rate [rad/s]"
+    )
+    g.add_argument(
+        "--forward-only", action="store_true", help="car-like robot never reverses (Dubins)"
     )
 
 
@@ -247,11 +259,17 @@ def robot_from_args(args: argparse.Namespace):
         "omega_max",
         "track_width",
         "wheel_v_max",
+        "min_turning_radius",
+        "wheelbase",
+        "v_max_reverse",
+        "steer_rate_max",
     )
     kwargs = {k: getattr(args, k, None) for k in names}
     kwargs = {k: v for k, v in kwargs.items() if v is not None}
     if getattr(args, "drive", None) is not None:
-        kwargs["drive"] = args.drive  # validated by Robot ('ackermann' refused with its reason)
+        kwargs["drive"] = args.drive  # validated by Robot
+    if getattr(args, "forward_only", False):
+        kwargs["reverse"] = False  # refused by Robot unless drive='ackermann'
     if getattr(args, "no_wheels", False):
         kwargs["track_width"] = None
         kwargs["wheel_v_max"] = None

@@ -31,8 +31,27 @@ Drive types (``drive``):
   turned while driving. ``omega_max`` bounds the yaw rate of that profile and not the
   speed along a curve, and the wheel terms (``track_width``, ``wheel_v_max``) of a
   differential drive do not apply to its speed cap.
-* ``"ackermann"`` (car-like: a turning radius, reversing) is not supported yet; it is
-  refused with a clear error.
+* ``"ackermann"`` (car-like: forklifts, tuggers, carts): it faces its direction of travel
+  (forwards, or backwards when ``reverse``), cannot turn in place and turns no tighter than
+  ``min_turning_radius`` (required). Plans are Hybrid-A* paths (:func:`astar.find_pose_path`)
+  split at their cusps, each segment a certified curve with ``|kappa| <= 1 / R``, timed from
+  rest to rest (:mod:`trajopt.planning._car`). Its own fields:
+
+  =======================  =========  ======================================================
+  field                    default    meaning
+  =======================  =========  ======================================================
+  ``min_turning_radius``   (required) ``R`` (m): the path's curvature is at most ``1/R``
+  ``reverse``              True       may drive backwards (Reeds-Shepp); False: forwards
+                                      only (Dubins)
+  ``wheelbase``            None       ``L`` (m): samples then carry the steering angle
+                                      ``atan(L kappa)``
+  ``v_max_reverse``        None       backwards speed limit (m/s); ``None`` is ``v_max``
+  ``steer_rate_max``       None       steering-angle rate limit (rad/s), needs ``wheelbase``;
+                                      held by the timing (:meth:`Robot.steer_speed_cap`)
+  =======================  =========  ======================================================
+
+  These fields are refused with the other drives. The yaw-rate, lateral-acceleration and
+  (rear) wheel-speed caps of a differential drive apply as they are.
 """
 
 from __future__ import annotations
@@ -50,8 +69,16 @@ from trajopt.robot._footprint import Footprint
 #: The chapter robot's footprint radius (m): half of its 0.33 m width.
 DEFAULT_RADIUS = 0.165
 #: How a robot's base moves (:class:`Robot`'s ``drive``).
-Drive = Literal["differential", "omni"]
-DRIVES = ("differential", "omni")
+Drive = Literal["differential", "omni", "ackermann"]
+DRIVES = ("differential", "omni", "ackermann")
+#: The fields only a car-like robot (``drive="ackermann"``) takes, and their "unset" values.
+CAR_FIELDS = {
+    "min_turning_radius": None,
+    "reverse": True,
+    "wheelbase": None,
+    "v_max_reverse": None,
+    "steer_rate_max": None,
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,10 +110,25 @@ class Robot:
     footprint : Footprint or array_like, shape (k, 2), optional
         A convex footprint in the robot frame (x forward, metres, the rotation centre at
         the origin, strictly inside); see :meth:`rectangle`.
-    drive : {"differential", "omni"}
+    drive : {"differential", "omni", "ackermann"}
         How the base moves (module docstring): a differential drive faces its direction of
         travel and turns in place at rest; an omnidirectional base turns independently of
-        it. Default ``"differential"``.
+        it; a car-like robot (``"ackermann"``) faces its direction of travel (or its reverse)
+        and turns no tighter than ``min_turning_radius``. Default ``"differential"``.
+    min_turning_radius : float or None
+        A car-like robot's minimum turning radius ``R`` (m), finite and > 0; required with
+        ``drive="ackermann"``, refused with the other drives.
+    reverse : bool
+        Whether a car-like robot may drive backwards (default True); ``False`` gives
+        forward-only (Dubins) plans.
+    wheelbase : float or None
+        A car-like robot's wheelbase ``L`` (m, > 0): samples then carry the steering angle
+        ``atan(L kappa)`` (rad) and its rate.
+    v_max_reverse : float or None
+        A car-like robot's speed limit backwards (m/s, > 0); ``None`` is ``v_max``.
+    steer_rate_max : float or None
+        A car-like robot's steering-angle rate limit (rad/s, > 0), held by the timing as a
+        speed cap (:meth:`steer_speed_cap`); needs ``wheelbase``.
 
     Raises
     ------
@@ -94,7 +136,10 @@ class Robot:
         A limit is not a finite number > 0, only one of ``track_width`` and
         ``wheel_v_max`` is given, a bad footprint (non-convex, self-intersecting, fewer than
         3 vertices, the origin not inside, NaN), a radius contradicting it, or an unknown
-        ``drive`` (``"ackermann"`` included: not supported yet).
+        ``drive``; with ``drive="ackermann"``: ``min_turning_radius`` missing, not finite
+        or <= 0, ``wheelbase``, ``v_max_reverse`` or ``steer_rate_max`` not finite or <= 0,
+        ``reverse`` not a bool, ``steer_rate_max`` without ``wheelbase``; any of those
+        fields given with another drive.
     """
 
     radius: float = 0.165
@@ -107,15 +152,16 @@ class Robot:
     wheel_v_max: float | None = 0.6
     footprint: Footprint | None = None
     drive: Drive = "differential"
+    min_turning_radius: float | None = None
+    reverse: bool = True
+    wheelbase: float | None = None
+    v_max_reverse: float | None = None
+    steer_rate_max: float | None = None
 
     def __post_init__(self) -> None:
-        if self.drive == "ackermann":
-            raise InvalidInputError(
-                "Robot.drive='ackermann' (a car-like robot: turning radius, reversing) is not "
-                f"supported yet; use one of {DRIVES}"
-            )
         if not (isinstance(self.drive, str) and self.drive in DRIVES):
             raise InvalidInputError(f"Robot.drive must be one of {DRIVES}, got {self.drive!r}")
+        self._check_car_fields()
         fp = self.footprint
         if fp is not None and not isinstance(fp, Footprint):
             try:
@@ -142,6 +188,85 @@ class Robot:
         if self.track_width is not None:
             object.__setattr__(self, "track_width", _positive("track_width", self.track_width))
             object.__setattr__(self, "wheel_v_max", _positive("wheel_v_max", self.wheel_v_max))
+
+    def _check_car_fields(self) -> None:
+        """Validate the fields of a car-like robot (and refuse them with another drive)."""
+        if self.drive != "ackermann":
+            given = {
+                k: getattr(self, k)
+                for k, unset in CAR_FIELDS.items()
+                if getattr(self, k) is not unset and getattr(self, k) != unset
+            }
+            if given:
+                what = ", ".join(f"{k}={v!r}" for k, v in given.items())
+                raise InvalidInputError(
+                    f"Robot: {what} apply only to a car-like robot (drive='ackermann'), "
+                    f"got drive={self.drive!r}"
+                )
+            return
+        if self.min_turning_radius is None:
+            raise InvalidInputError(
+                "Robot.min_turning_radius is required with drive='ackermann' (a car-like "
+                "robot's minimum turning radius, finite and > 0 m), got None"
+                + ("" if self.wheelbase is None else f" (with wheelbase={self.wheelbase!r} m)")
+            )
+        if not isinstance(self.reverse, bool | np.bool_):
+            raise InvalidInputError(f"Robot.reverse must be True or False, got {self.reverse!r}")
+        object.__setattr__(self, "reverse", bool(self.reverse))
+        object.__setattr__(
+            self,
+            "min_turning_radius",
+            positive("Robot.min_turning_radius", self.min_turning_radius, "m"),
+        )
+        for name, unit in (
+            ("wheelbase", "m"),
+            ("v_max_reverse", "m/s"),
+            ("steer_rate_max", "rad/s"),
+        ):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, positive(f"Robot.{name}", value, unit))
+        if self.steer_rate_max is not None and self.wheelbase is None:
+            raise InvalidInputError(
+                f"Robot.steer_rate_max={self.steer_rate_max!r} rad/s needs a wheelbase (the "
+                "steering angle is atan(wheelbase * kappa)), got wheelbase=None"
+            )
+
+    @property
+    def v_max_backwards(self) -> float:
+        """Speed limit backwards (m/s): ``v_max_reverse``, or ``v_max`` when it is unset."""
+        return self.v_max if self.v_max_reverse is None else float(self.v_max_reverse)
+
+    def steer_speed_cap(
+        self, kappa: np.ndarray | float, dkappa_ds: np.ndarray | float
+    ) -> np.ndarray | float:
+        """Speed limit (m/s) that holds the steering-angle rate of a car-like robot.
+
+        The steering angle is ``delta = atan(L kappa)`` (``L`` the wheelbase), so its rate
+        along a path is ``d delta / dt = L (d kappa / ds) v / (1 + (L kappa)^2)``, and
+        ``|d delta / dt| <= steer_rate_max`` holds exactly when
+        ``v <= steer_rate_max (1 + (L kappa)^2) / (L |d kappa / ds|)``. Infinite where
+        ``d kappa / ds = 0`` or without a steering-rate limit.
+
+        Parameters
+        ----------
+        kappa, dkappa_ds : float or array_like, broadcastable
+            Curvature (1/m) and its derivative along the arc length (1/m^2).
+
+        Returns
+        -------
+        float or ndarray, the broadcast shape
+        """
+        k = np.asarray(kappa, dtype=float)
+        dk = np.abs(np.asarray(dkappa_ds, dtype=float))
+        if self.steer_rate_max is None or self.wheelbase is None:
+            cap = np.full(np.broadcast(k, dk).shape, np.inf)
+        else:
+            wb = self.wheelbase
+            with np.errstate(divide="ignore", invalid="ignore"):
+                cap = self.steer_rate_max * (1.0 + (wb * k) ** 2) / (wb * dk)
+            cap = np.where(np.isnan(cap), 0.0, cap)
+        return float(cap) if cap.ndim == 0 else cap
 
     @classmethod
     def rectangle(
@@ -205,6 +330,9 @@ class Robot:
     def to_dict(self) -> dict[str, Any]:
         """Return the fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
         out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        if self.drive != "ackermann":  # the car's fields only for a car (older files unchanged)
+            for k in CAR_FIELDS:
+                del out[k]
         out["footprint"] = None if self.footprint is None else self.footprint.to_list()
         return out
 
