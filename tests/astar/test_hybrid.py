@@ -251,3 +251,24 @@ def test_bad_grid():
     for g in (np.ones((5, 5), int), np.ones((2, 5, 5), bool), [[True]], np.ones((0, 3), bool)):
         with pytest.raises(InvalidInputError, match="grid must be"):
             find_pose_path(g, (1, 1, 0), (2, 2, 0), turning_radius=1.0)
+
+
+def test_arc_bulge_between_samples_is_caught():
+    """An arc (R = 6.6) whose samples and chords stay right of x = 4.5 but which bulges
+    0.0002 cells into the blocked column ix = 4 between two samples (seen on smoothers_world)."""
+    from astar.hybrid_kernel import arc_clear, segment_clear
+    from astar.reeds_shepp import advance
+
+    free = np.ones((10, 10), np.uint8)
+    free[:, 4] = 0
+    x, y, th, k, s = (
+        4.50037729000536,
+        5.11793064003186,
+        4.699224192658562,
+        1 / 6.6,
+        1.727875959474386,
+    )
+    m = math.ceil(abs(s) / 0.2)
+    pts = [advance(x, y, th, k, s * q / m)[:2] for q in range(m + 1)]
+    assert all(segment_clear(free, *a, *b) for a, b in zip(pts[:-1], pts[1:], strict=True))
+    assert not arc_clear(free, x, y, th, k, s, 0.2)
