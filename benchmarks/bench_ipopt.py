@@ -1,23 +1,39 @@
 """IPOPT against piqp (and the SCP) in the default polygon corridor, on the same queries.
 
-Plans every query of a named suite of the shared maps (``trajopt.bench.suite``) four ways,
+Plans every query of a named suite of the shared maps (``trajopt.bench.suite``) six ways,
 in the same run and the same process:
 
 * ``piqp``: the default planner (the corridor QP by piqp);
 * ``ipopt``: ``Smoother(qp_solver="ipopt")`` (the same convex QP by IPOPT);
+* ``polish``: ``Smoother(refine="ipopt")`` (piqp, then IPOPT on the same problem, warm
+  started; kept when not worse and certified);
 * ``scp``: ``Smoother(kappa_max=1 / (2 r))`` (the QP, then the sequential convex programme);
 * ``kappa-ipopt``: ``Smoother(kappa_max=1 / (2 r), curvature_solver="ipopt")`` (the QP, then
-  the exact non-convex curvature-bounded NLP by IPOPT, warm started from the QP).
+  the exact non-convex curvature-bounded NLP by IPOPT, warm started from the QP);
+* ``scp-polish``: ``Smoother(kappa_max=1 / (2 r), refine="ipopt")`` (the SCP, then IPOPT on
+  the exact problem).
 
-Reported per variant: success rate and corridor kind; per pair (``ipopt`` against ``piqp``,
-``kappa-ipopt`` against ``scp``), over the queries both planned: the trajectory duration ratio
-(median, smallest, largest, and the share within 3 %), the median smoothing-stage time of
-each and their ratio, the same without the one-off IPOPT builds (a solver is built once per
-problem shape, then re-solved with parameters), and the median solver time of each. Each
-query is planned once per variant after one warm-up plan per map and variant.
+Reported per variant: success rate and corridor kind, and over the queries every variant of
+its group (no bound, bound) planned: the median smoothing-stage time, objective value
+(``stats["cost"]``, cell units) and trajectory duration; per pair (``ipopt`` and ``polish``
+against ``piqp``, ``kappa-ipopt`` and ``scp-polish`` against ``scp``), over the queries both
+planned: the trajectory duration ratio (median, smallest, largest, and the share within 3 %),
+the median smoothing-stage time of each and their ratio, the same without the one-off IPOPT
+builds (a solver is built once per problem shape, then re-solved with parameters), and the
+median solver time of each; the polish outcomes (kept, not better, failed).
 
-Run: ``python benchmarks/bench_ipopt.py [--suite shared-small] [--limit N]`` (the shared
-data: ``$TRAJOPT_DATA`` or ``../shared/data``; skipped with a message when absent).
+With ``--costmap-queries N`` (> 0), also N seeded random queries per shared ROS map on its
+Nav2-style inflation costmap (``bench_costmap_smoother.nav2_values``, a disc of 0.15 m,
+``costmap_weight`` 2), smoothed three ways: ``rounds`` (the default: the QP rounds of the
+linearised cost term), ``ipopt-cost`` (``qp_solver="ipopt"``: IPOPT on the exact cost term)
+and ``polish`` (the rounds, then ``refine="ipopt"``): success, median smoothing time,
+objective (``stats["cost"]`` plus the cost term at the curve, bilinear, as the rounds
+measure it), the trajectory's mean cost per metre against its A* path's, and duration.
+Each query is planned once per variant after one warm-up plan per map and variant.
+
+Run: ``python benchmarks/bench_ipopt.py [--suite shared-small] [--limit N] [--costmap-queries
+N]`` (the shared data: ``$TRAJOPT_DATA`` or ``../shared/data``; skipped with a message when
+absent).
 """
 
 from __future__ import annotations
@@ -37,18 +53,23 @@ from trajopt.errors import TrajoptError
 from trajopt.robot._robot import Robot
 from trajopt.smoother import Smoother
 
-VARIANTS = ("piqp", "ipopt", "scp", "kappa-ipopt")
-PAIRS = (("ipopt", "piqp"), ("kappa-ipopt", "scp"))
+VARIANTS = ("piqp", "ipopt", "polish", "scp", "kappa-ipopt", "scp-polish")
+GROUPS = (("piqp", "ipopt", "polish"), ("scp", "kappa-ipopt", "scp-polish"))
+PAIRS = (("ipopt", "piqp"), ("polish", "piqp"), ("kappa-ipopt", "scp"), ("scp-polish", "scp"))
+COST_VARIANTS = ("rounds", "ipopt-cost", "polish")
+COST_WEIGHT = 2.0
 
 
 def smoothers(radius: float) -> dict[str, Smoother]:
-    """The four smoothers of one robot radius (m)."""
+    """The six smoothers of one robot radius (m)."""
     k = 1.0 / (2.0 * radius)
     return {
         "piqp": Smoother(),
         "ipopt": Smoother(qp_solver="ipopt"),
+        "polish": Smoother(refine="ipopt"),
         "scp": Smoother(kappa_max=k),
         "kappa-ipopt": Smoother(kappa_max=k, curvature_solver="ipopt"),
+        "scp-polish": Smoother(kappa_max=k, refine="ipopt"),
     }
 
 
@@ -70,7 +91,13 @@ def plan_one(planner: Planner, p0, p1) -> dict:
         "build_s": float(st.get("build_time_s", 0.0)),
         "solve_s": float(st.get("solve_time_s", float("nan"))),
         "wall_s": wall,
+        "objective": float(st.get("cost", float("nan"))),
+        "refine": st.get("refine", {}).get("status", "") + ("+" if _kept(st) else ""),
     }
+
+
+def _kept(st: dict) -> bool:
+    return bool(st.get("refine", {}).get("kept", False))
 
 
 def _median(xs) -> float:
@@ -83,6 +110,9 @@ def main(argv=None) -> int:
     ap.add_argument("--suite", choices=("shared-small", "shared-full"), default="shared-small")
     ap.add_argument("--limit", type=int, default=None, help="at most this many queries per map")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--costmap-queries", type=int, default=0, help="random queries per ROS costmap (0: none)"
+    )
     args = ap.parse_args(argv)
     root = data_dir(None)
     if not (root / "movingai").is_dir() or not (root / "ros").is_dir():
@@ -115,13 +145,29 @@ def main(argv=None) -> int:
             rows.append(row)
     n = len(rows)
     print(f"suite {args.suite}, limit {args.limit}: {n} queries on {len(mqs)} maps")
-    print(f"{'variant':<13}{'success':>9}{'polygons':>10}{'median smooth ms':>18}")
-    for v in VARIANTS:
-        ok = [r[v] for r in rows if r[v]["ok"]]
-        poly = sum(1 for o in ok if o["corridor"] == "polygons")
-        print(
-            f"{v:<13}{len(ok) / n:>9.1%}{poly:>10}{1e3 * _median(o['smooth_s'] for o in ok):>18.2f}"
-        )
+    print(
+        f"{'variant':<13}{'success':>9}{'polygons':>10}{'common':>8}{'smooth ms':>11}"
+        f"{'objective':>12}{'duration s':>12}"
+    )
+    for group in GROUPS:
+        common = [r for r in rows if all(r[v]["ok"] for v in group)]
+        for v in group:
+            ok = [r[v] for r in rows if r[v]["ok"]]
+            poly = sum(1 for o in ok if o["corridor"] == "polygons")
+            print(
+                f"{v:<13}{len(ok) / n:>9.1%}{poly:>10}{len(common):>8}"
+                f"{1e3 * _median(r[v]['smooth_s'] for r in common):>11.2f}"
+                f"{_median(r[v]['objective'] for r in common):>12.3f}"
+                f"{_median(r[v]['duration'] for r in common):>12.3f}"
+            )
+    print("smooth ms, objective (stats['cost'], cell units), duration: medians over `common`")
+    print("outcomes: status of the polish, + when kept")
+    for v in ("polish", "scp-polish"):
+        counts = {}
+        for r in rows:
+            if r[v]["ok"]:
+                counts[r[v]["refine"]] = counts.get(r[v]["refine"], 0) + 1
+        print(f"{v} outcomes: " + ", ".join(f"{k} {c}" for k, c in sorted(counts.items())))
     print()
     print(
         f"{'pair':<20}{'both':>6}{'dur med':>9}{'dur min':>9}{'dur max':>9}{'<=3%':>7}"
@@ -154,8 +200,109 @@ def main(argv=None) -> int:
         print()
         for r, v in fails:
             print(f"{v} {r['map']} #{r['i']}: {r[v]['err']}")
+    if args.costmap_queries > 0:
+        print()
+        costmap_section(root, args.costmap_queries, args.seed)
     print(f"\nwall time {time.perf_counter() - t_all:.0f} s")
     return 0
+
+
+def costmap_section(root, queries: int, seed: int) -> None:
+    """The cost term by the QP rounds, by IPOPT, and the rounds polished by IPOPT."""
+    from bench_costmap_smoother import R_INS, densify, mean_cost, nav2_values
+
+    rng = np.random.default_rng(seed)
+    robot = Robot(radius=R_INS)
+    smo = {
+        "rounds": Smoother(),
+        "ipopt-cost": Smoother(qp_solver="ipopt"),
+        "polish": Smoother(refine="ipopt"),
+    }
+    rows = []
+    maps = sorted((root / "ros").glob("*.yaml"))
+    for path in maps:
+        grid = astar.load_map(path)
+        values = nav2_values(~grid.free, grid.resolution)
+        cm = astar.from_costmap(values, grid.resolution, grid.origin, convention="costmap_2d")
+        planners = {
+            v: Planner(cm, robot, costmap_weight=COST_WEIGHT, smoother=s) for v, s in smo.items()
+        }
+        free = np.argwhere(cm.cost < 0.5)
+        pairs = []
+        while len(pairs) < queries:
+            i, j = rng.integers(len(free), size=2)
+            p0 = grid.cell_to_world(free[i][::-1].copy())
+            p1 = grid.cell_to_world(free[j][::-1].copy())
+            if np.linalg.norm(p1 - p0) >= 2.0:
+                pairs.append((p0, p1))
+        for p in planners.values():  # warm-up
+            _cost_plan(p, cm, *pairs[0], densify, mean_cost)
+        for p0, p1 in pairs:
+            rows.append(
+                {v: _cost_plan(p, cm, p0, p1, densify, mean_cost) for v, p in planners.items()}
+            )
+    n = len(rows)
+    common = [r for r in rows if all(r[v]["ok"] for v in COST_VARIANTS)]
+    print(
+        f"costmaps: {len(maps)} ROS maps, {queries} queries each (seed {seed}), weight "
+        f"{COST_WEIGHT:g}; {len(common)} of {n} planned by every variant"
+    )
+    print(
+        f"{'variant':<12}{'success':>9}{'smooth ms':>11}{'objective':>12}{'obj/rounds':>12}"
+        f"{'cost/A*':>9}{'duration s':>12}{'dur/rounds':>12}"
+    )
+    for v in COST_VARIANTS:
+        ok = sum(1 for r in rows if r[v]["ok"])
+        rel = _median(r[v]["objective"] / r["rounds"]["objective"] for r in common)
+        dur = _median(r[v]["duration"] / r["rounds"]["duration"] for r in common)
+        print(
+            f"{v:<12}{ok / max(n, 1):>9.1%}"
+            f"{1e3 * _median(r[v]['smooth_s'] for r in common):>11.2f}"
+            f"{_median(r[v]['objective'] for r in common):>12.3f}{rel:>12.5f}"
+            f"{_median(r[v]['traj'] / max(r[v]['astar'], 1e-9) for r in common):>9.3f}"
+            f"{_median(r[v]['duration'] for r in common):>12.3f}{dur:>12.5f}"
+        )
+    counts = {}
+    for r in rows:
+        if r["polish"]["ok"]:
+            counts[r["polish"]["refine"]] = counts.get(r["polish"]["refine"], 0) + 1
+    print("polish outcomes: " + ", ".join(f"{k} {c}" for k, c in sorted(counts.items())))
+    print(
+        "medians over the common queries; objective: stats['cost'] + the cost term "
+        "(bilinear) at the curve, cell units; cost/A*: mean cost per metre, trajectory / A* path"
+    )
+    for r in rows:
+        for v in COST_VARIANTS:
+            if not r[v]["ok"]:
+                print(f"{v}: {r[v]['err']}")
+
+
+def _cost_plan(planner: Planner, cm, p0, p1, densify, mean_cost) -> dict:
+    """One costmap query: objective, mean costs of trajectory and A* path, duration, time."""
+    try:
+        traj = planner.plan(p0, p1)
+    except TrajoptError as exc:
+        return {"ok": False, "err": f"{type(exc).__name__}: {exc}"[:200]}
+    sp = getattr(traj.steps, "smooth_path", None)
+    gp = getattr(traj.steps, "grid_path", None)
+    if sp is None or gp is None:
+        return {"ok": False, "err": "no smooth path (fallback)"}
+    res = cm.grid.resolution
+    a, b = sp.curve.domain
+    curve = sp.curve(np.linspace(a, b, max(200, int(40 * (b - a) / res))))
+    cells = np.asarray(gp.cells, dtype=float)
+    poly = densify(np.asarray(cm.grid.origin) + (cells + 0.5) * res, 0.1 * res)
+    st = sp.stats
+    term = st.get("cost_rounds", {}).get("cost_term", 0.0)
+    return {
+        "ok": True,
+        "objective": float(st["cost"]) + float(term),
+        "traj": mean_cost(curve, cm),
+        "astar": mean_cost(poly, cm),
+        "duration": float(traj.duration),
+        "smooth_s": float(traj.stats["stages_s"]["smooth"]),
+        "refine": st.get("refine", {}).get("status", "") + ("+" if _kept(st) else ""),
+    }
 
 
 if __name__ == "__main__":

@@ -39,7 +39,6 @@ from trajopt.smoother._cost import (
 )
 from trajopt.smoother._footprint_rounds import FootprintRounds, footprint_scp
 from trajopt.smoother._nlp import solve_curvature_ipopt
-from trajopt.smoother._nlp_footprint import footprint_by_ipopt, footprint_ipopt
 from trajopt.smoother._nlp_solve import cost_ipopt, ipopt_cost, refine_ipopt
 from trajopt.smoother._path import SmoothPath
 from trajopt.smoother._problem import (
@@ -182,15 +181,7 @@ def fit(
                 except InvalidInputError as exc:  # the pinned heading leaves its region
                     logger.debug("footprint: end heading not pinned (%s)", exc)
                     fp.unpin()
-            if polygons and footprint_by_ipopt(options):  # the exact rows, by IPOPT
-                left = options.time_budget_s - (time.perf_counter() - t_call)
-                found = footprint_ipopt(
-                    options, prob, h, c_cells, fcert, fp, rad / res, check, left
-                )
-                if found is not None:
-                    curve, cert, fcert = found
-                    rec.failure = None
-            elif polygons and options.kappa_max is None:
+            if polygons and options.kappa_max is None:
                 found = footprint_scp(
                     options, prob, h, c_cells, fcert, fp, rad / res, check, cost_at
                 )

@@ -292,7 +292,12 @@ def solve_curvature_ipopt(
 
 @functools.lru_cache(maxsize=16)
 def smoother_nlp(
-    nb: int, p: int, k: int, curvature: bool, window: CostWindow | None, verbose: bool
+    nb: int,
+    p: int,
+    k: int,
+    curvature: bool,
+    window: CostWindow | None,
+    verbose: bool,
 ):
     """Return the smoother's whole problem as an IPOPT problem, built once per shape.
 

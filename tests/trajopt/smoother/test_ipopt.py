@@ -3,7 +3,12 @@
 The convex corridor QP solved by IPOPT must reach piqp's optimum (the same objective value
 and control points within solver tolerance); the exact curvature-bounded NLP must hold its
 bound on dense samples (three-point curvature, no curve evaluation of its own); end
-headings hold; an IPOPT failure is a typed error carrying IPOPT's status.
+headings hold; an IPOPT failure is a typed error carrying IPOPT's status. With a cost field,
+IPOPT's exact cost term reaches an objective no higher than the QP rounds' (piqp, an
+independent solver) and keeps the curve out of a high-cost band (dense nearest-cell costs);
+its cost spline matches the field at the cell centres, CasADi's own bspline interpolant
+between them, and central differences; the IPOPT polish (``refine="ipopt"``) never raises
+the objective and keeps the certificate and the end headings.
 """
 
 from __future__ import annotations
@@ -17,12 +22,17 @@ import astar
 import trajopt
 from tests.cases import square_inflated
 from tests.reference import square_clearance, three_point_curvature
+from tests.trajopt.smoother.test_cost import GOAL as HALL_GOAL
+from tests.trajopt.smoother.test_cost import RES, dense_mean_cost, l_hall
+from tests.trajopt.smoother.test_cost import START as HALL_START
 from trajopt.analysis import scenes
 from trajopt.analysis.bench._suites import random_queries
 from trajopt.corridor import build_polygon_corridor
-from trajopt.errors import SmoothingError
-from trajopt.smoother import Smoother, _layout, _nlp, _qp
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.smoother import Smoother, _layout, _nlp, _nlp_cost, _qp
 from trajopt.smoother._attempts import solve_attempt
+from trajopt.smoother._cost import CostTerm, cost_field
+from trajopt.smoother._nlp_solve import on_window
 from trajopt.smoother._problem import assemble, build_problem
 from trajopt.smoother._status import AttemptRecord
 
@@ -184,3 +194,178 @@ def test_ipopt_curvature_failure_is_not_a_qp_result(monkeypatch):
     assert type(ei.value).__name__ == "AttemptFailed"
     assert rec.nlp is not None and rec.nlp.solver == "ipopt" and not rec.nlp.success
     assert math.isfinite(rec.nlp.solve_time_s)
+
+
+# --- the cost term in the IPOPT problem, and the IPOPT polish (refine="ipopt") ---------------
+
+
+def _hall_attempt(options: Smoother, cost_at, h: float = 4.0):
+    """One attempt of ``options`` in the L hall of test_cost: (control points, record, prob)."""
+    _, _, corridor = l_hall()
+    prob, _, _ = build_problem(
+        options, None, corridor, start=HALL_START, goal=HALL_GOAL, hs=None, hg=None
+    )
+    rec = AttemptRecord(attempt=1, span_cells=h)
+    c, t, _ = solve_attempt(options, prob, h, 60.0, options.kappa_margin, None, rec, cost_at)
+    return c, t, rec, prob
+
+
+@pytest.mark.parametrize("kappa_max", [None, 2.0])
+def test_cost_ipopt_no_worse_than_the_rounds_and_out_of_the_band(kappa_max):
+    """IPOPT on the exact cost term: an objective no higher than the QP rounds' (its own
+    objective, at both points), and, like them, a curve out of the high-cost band."""
+    grid, cost, corridor = l_hall()
+    field = cost_field(cost, 2.0, grid)
+    cost_at = (field, np.asarray(corridor.origin, dtype=float))
+    rounds = Smoother(kappa_max=kappa_max)
+    fast = {"qp_solver": "ipopt"} if kappa_max is None else {"curvature_solver": "ipopt"}
+    exact = Smoother(kappa_max=kappa_max, **fast)
+    c_r, t, rec_r, prob = _hall_attempt(rounds, cost_at)
+    c_i, t_i, rec_i, _ = _hall_attempt(exact, cost_at)
+    np.testing.assert_array_equal(t, t_i)
+    assert rec_i.nlp is not None and rec_i.nlp.solver == "ipopt" and rec_i.nlp.success
+    assert rec_i.cost_rounds["rounds"] == 0  # no QP rounds: IPOPT minimised the term
+    # the objective IPOPT minimised, at the rounds' result (same knots, same problem)
+    asm = assemble(exact, prob, 4.0)
+    qp = asm.qp
+    z = np.zeros(2 * qp.nb)
+    z[: qp.n], z[qp.nb : qp.nb + qp.n] = c_r[:, 0], c_r[:, 1]
+    term = CostTerm.on_knots(field, cost_at[1], RES, t, 3, qp.nb, rec_scale(rounds, prob))
+    kw = {} if kappa_max is None else {"kmax": kappa_max * RES, "margin": exact.kappa_margin}
+    _, f_rounds = _nlp.solve_nlp(exact, qp, t, z, 60.0, cost=on_window(term, prob), **kw)
+    assert rec_i.nlp.cost <= f_rounds + 1e-6 * abs(f_rounds)
+    # both fits: certified and out of the band (dense nearest-cell cost, no interpolation)
+    kw = dict(raw_grid=grid, radius=0.2, start=HALL_START, goal=HALL_GOAL)
+    blind = rounds.fit(None, corridor, **kw)
+    sp = exact.fit(None, corridor, cost=cost, cost_weight=2.0, **kw)
+    assert sp.certificate.ok and "ipopt" in sp.stats["solver"]
+    assert dense_mean_cost(sp.curve, cost, grid) < 0.25 * dense_mean_cost(blind.curve, cost, grid)
+    if kappa_max is not None:
+        assert _dense_kappa(sp.curve) <= kappa_max * (1 + 1e-3)
+
+
+def rec_scale(options: Smoother, prob) -> float:
+    """``s`` of the cost term as the attempt built it (CostTerm.on_knots's ``scale``)."""
+    from trajopt.smoother import _cost
+
+    if hasattr(_cost, "cost_scale"):
+        return _cost.cost_scale(options, prob.taut)
+    return 2.0 * options.taut_length_weight if prob.taut else 1.0
+
+
+def test_cost_spline_interpolates_the_field_and_its_gradient():
+    """The problem's cost spline: the field's values at cell centres (CostField.at), CasADi's
+    own bspline interpolant between them, and its gradient against central differences."""
+    import casadi as ca
+
+    grid, cost, corridor = l_hall()
+    rough = np.clip(cost + 0.3 * np.sin(np.arange(cost.size).reshape(cost.shape)), 0, 1)
+    field = cost_field(rough, 1.0, grid)
+    win = _nlp_cost.window(field, np.array([10.0, 10.0]), np.array([60.0, 60.0]))
+    f = _nlp_cost.spline_function(win)
+    wx, wy = win.shape
+    # cell centres: the (smoothed) cell values, as CostField.at gives them there
+    rng = np.random.default_rng(5)
+    ij = np.column_stack([rng.integers(2, wx - 2, 40), rng.integers(2, wy - 2, 40)])
+    cells = ij + np.asarray(win.cell0)
+    ok = (cells[:, 0] < field.cost.shape[1]) & (cells[:, 1] < field.cost.shape[0])
+    world = field.origin + field.resolution * (cells[ok] + 0.5)
+    at, _ = field.at(world)
+    got = np.array([float(f(p)) for p in ij[ok].astype(float)])
+    np.testing.assert_allclose(got, at, atol=1e-12)
+    # between the centres: CasADi's interpolant of the same values (its own coefficients)
+    vals = _nlp_cost.window_values(field.cost, win.shape, win.cell0)
+    ref = ca.interpolant(
+        "ref",
+        "bspline",
+        [np.arange(wx, dtype=float), np.arange(wy, dtype=float)],
+        vals.ravel(order="F"),
+    )
+    pts = rng.uniform(2.0, min(wx, wy) - 3.0, (40, 2)) + rng.uniform(0.2, 0.8, (40, 2))
+    pts = np.floor(pts) + rng.uniform(0.2, 0.8, (40, 2))  # away from the cell boundaries
+    np.testing.assert_allclose([float(f(p)) for p in pts], [float(ref(p)) for p in pts], atol=1e-9)
+    # its gradient (CasADi AD, what IPOPT uses) against central differences
+    xy = ca.MX.sym("xy", 2)
+    grad = ca.Function("g", [xy], [ca.gradient(f(xy), xy)])
+    eps = 1e-6
+    for p in pts[:10]:
+        fd = [
+            (float(f(p + e)) - float(f(p - e))) / (2 * eps)
+            for e in (np.array([eps, 0]), np.array([0, eps]))
+        ]
+        np.testing.assert_allclose(np.asarray(grad(p)).ravel(), fd, atol=1e-6)
+
+
+def test_cost_window_of_a_large_field_covers_the_corridor_and_clamps():
+    """A field above WHOLE_FIELD_CELLS: a window around the box, edge cells repeated."""
+    big = np.zeros((8, 2 * _nlp_cost.WHOLE_FIELD_CELLS // 8 + 8))
+    big[:, -1] = 1.0
+    grid = astar.OccupancyGrid(np.zeros(big.shape, bool), 0.05)
+    field = cost_field(big, 1.0, grid)
+    nx = big.shape[1]
+    win = _nlp_cost.window(field, np.array([nx - 20.0, 2.0]), np.array([nx - 3.0, 5.0]))
+    assert win.shape[0] % _nlp_cost.WINDOW_BUCKET == 0 and win.shape[0] < nx
+    lo = np.asarray(win.cell0)
+    assert lo[0] <= nx - 20 - _nlp_cost.WINDOW_MARGIN
+    assert lo[0] + win.shape[0] - 1 >= nx - 3 + _nlp_cost.WINDOW_MARGIN
+    vals = _nlp_cost.window_values(field.cost, win.shape, win.cell0)
+    np.testing.assert_array_equal(vals[:, 0], vals[:, 1])  # rows below the map: row 0
+    assert _nlp_cost.window(field, np.array([nx - 20.0, 2.0]), np.array([nx - 3.0, 5.0])) is win
+
+
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"kappa_max": 2.0}],
+    ids=["qp-rounds", "scp-rounds"],
+)
+def test_refine_never_raises_the_objective_and_keeps_the_certificate(options):
+    grid, cost, corridor = l_hall()
+    kw = dict(raw_grid=grid, radius=0.2, start=HALL_START, goal=HALL_GOAL)
+    for extra in ({}, {"cost": cost, "cost_weight": 2.0}):
+        fast = Smoother(**options).fit(None, corridor, **kw, **extra)
+        sp = Smoother(refine="ipopt", **options).fit(None, corridor, **kw, **extra)
+        st = sp.stats["refine"]
+        assert st["status"] in ("improved", "not better", "failed", "not certified")
+        assert sp.certificate.ok
+        # the same knots: the polish starts from the fast result, whose objective it reports
+        assert sp.stats["n_control_points"] == fast.stats["n_control_points"]
+        if st["kept"]:
+            assert st["status"] == "improved"
+            assert st["objective_after"] <= st["objective_before"]
+            if not extra:  # no cost term: stats["cost"] is the whole objective
+                assert sp.stats["cost"] <= fast.stats["cost"] + 1e-9 * abs(fast.stats["cost"])
+        else:
+            np.testing.assert_array_equal(sp.curve.control_points, fast.curve.control_points)
+        if "kappa_max" in options:
+            assert _dense_kappa(sp.curve) <= options["kappa_max"] * (1 + 1e-3)
+
+
+def test_refine_is_skipped_when_ipopt_solved_the_whole_problem():
+    _, grid, r, corr = _paper_corridor("B")
+    sp = Smoother(qp_solver="ipopt", refine="ipopt").fit(None, corr, raw_grid=grid, radius=r)
+    assert sp.stats["refine"]["status"] == "skipped" and not sp.stats["refine"]["kept"]
+
+
+def test_end_headings_hold_with_refine():
+    scene, grid, r, corr = _paper_corridor("B")
+    start, goal = np.array(scene.start), np.array(scene.goal("B"))
+    sp = Smoother(kappa_max=1.0 / (2.0 * r), refine="ipopt").fit(
+        None,
+        corr,
+        raw_grid=grid,
+        radius=r,
+        start=start,
+        goal=goal,
+        start_heading=1.2,
+        goal_heading=0.5,
+    )
+    assert sp.certificate.ok and sp.stats["refine"]["status"] != "skipped"
+    h = sp.heading(np.array(sp.domain))
+    np.testing.assert_allclose(np.angle(np.exp(1j * (h - [1.2, 0.5]))), 0.0, atol=1e-9)
+    np.testing.assert_allclose(sp.curve(np.array(sp.domain)), [start, goal], atol=1e-12)
+
+
+@pytest.mark.parametrize("value", ["IPOPT", "scp", "piqp", True, 1, ""])
+def test_bad_refine_values_are_typed_errors(value):
+    with pytest.raises(InvalidInputError, match=r"refine must be one of \(None, 'ipopt'\)"):
+        Smoother(refine=value)
