@@ -144,12 +144,16 @@ BENCHES: tuple[Bench, ...] = (
         "ipopt",
         "IPOPT vs piqp and the SCP in polygon corridors",
         "bench_ipopt.py",
-        "On the shared-small suite, the same queries planned with piqp and with "
-        '`qp_solver="ipopt"`, and with a bound 1/(2r) by the SCP and by '
-        '`curvature_solver="ipopt"`: success rates, duration ratios, median smoothing and '
-        "solver times and their ratios (with and without the one-off IPOPT builds).",
-        ("--limit", "5"),
-        (),
+        "On the shared-small suite, the same queries planned with piqp, with "
+        '`qp_solver="ipopt"` and with `refine="ipopt"` (the IPOPT polish), and with a bound '
+        '1/(2r) by the SCP, by `curvature_solver="ipopt"` and by the SCP polished: success '
+        "rates, median smoothing time, objective and duration, duration ratios, smoothing and "
+        "solver time ratios (with and without the one-off IPOPT builds), the polish's "
+        "outcomes; then on Nav2-style inflation costmaps of the shared ROS maps at weight 2, "
+        'the cost term by the QP rounds, by IPOPT (`qp_solver="ipopt"`) and the rounds '
+        "polished: success, smoothing time, objective, cost against the A* path, duration.",
+        ("--limit", "5", "--costmap-queries", "3"),
+        ("--costmap-queries", "10"),
     ),
     Bench(
         "costmap-smoother",

@@ -339,6 +339,7 @@ def solve_attempt(
         Empty bounds, or a solver failure (``rec`` holds the solver records).
     """
     t_enter = time.perf_counter()
+    t_budget = t_enter + remaining  # the attempt's deadline
     try:
         asm = assemble(options, prob, h)
     except EmptyBoundsError as exc:
@@ -392,7 +393,7 @@ def solve_attempt(
             raise AttemptFailed(f"curvature bound ({cinfo.solver}): {_failure(cinfo)}")
         z = np.clip(cinfo.z, qp.lbx, qp.ubx)
     if refined is not None:  # Smoother(refine="ipopt"): the polish, offered to the caller
-        left = remaining - (time.perf_counter() - t_enter)
+        left = t_budget - time.perf_counter()
         zr, refined["stats"] = refine_ipopt(options, qp, t, z, term, prob, margin, left, const)
         if zr is not None:
             cr = refined["c"] = np.column_stack([zr[:n], zr[nb : nb + n]])
