@@ -35,6 +35,7 @@ logger = logging.getLogger(__name__)
 
 _COLLISION_STEP = 0.2  # cells: arc-length spacing of the collision samples
 _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyond the start
+_RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
 _REASONS = ("disconnected", "exhausted", "max_expansions", "time_budget")
 
@@ -90,7 +91,8 @@ class PosePath:
     stats : dict
         ``expanded`` (nodes expanded), ``nodes`` (created), ``shots`` (analytic expansions
         tried), ``heuristic_s``, ``search_s``, ``total_s`` (seconds), ``primitive_length``
-        (cells), ``heading_bins``.
+        (cells) and ``heading_bins`` of the search that found the path, ``retried`` (whether
+        the finer second search ran).
 
     Attributes
     ----------
@@ -324,7 +326,10 @@ def find_pose_path(
     only: a path that needs finer headings or shorter primitives than the search uses may be
     missed, and the path found is cheap, not cheapest: after the first collision-free analytic
     shot the search goes on for at most as many expansions again (plus 100) and keeps the
-    cheapest path (costs: length, backwards and arc weights, cusps). The heuristic is
+    cheapest path (costs: length, backwards and arc weights, cusps). When the search exhausts
+    a small region (at most 20 000 expansions: a pocket where no primitive fits, a dead end),
+    it runs once more with primitives a third as long and three times as many heading bins,
+    within the remaining budgets. The heuristic is
     ``max(h2d, Euclidean distance, Reeds-Shepp/Dubins length)``, all lower bounds of the
     length: ``h2d`` is a Dijkstra distance from the goal's cell on the free grid (steps 1 and
     1.4, below the octile ``sqrt(2)``; computed up to ``20 R + 50`` cells beyond the start,
@@ -370,7 +375,7 @@ def find_pose_path(
     budget = validation.positive_float("time_budget", time_budget)
     hw = _number("heuristic_weight", heuristic_weight, 1.0, ">= 1")
 
-    from astar.hybrid_kernel import FOUND, TIME_BUDGET, distance_field, hybrid_kernel
+    from astar.hybrid_kernel import EXHAUSTED, FOUND, TIME_BUDGET, distance_field, hybrid_kernel
 
     gix, giy = int(math.floor(gx + 0.5)), int(math.floor(gy + 0.5))
     six, siy = int(math.floor(sx + 0.5)), int(math.floor(sy + 0.5))
@@ -398,48 +403,71 @@ def find_pose_path(
     kappas = np.linspace(-1.0 / radius, 1.0 / radius, nc)
     kappas[nc // 2] = 0.0
     kappas = np.ascontiguousarray(kappas[np.argsort(np.abs(kappas), kind="stable")])
-    status, chain, nodes, prims, skinds, slens, sn, expanded, shots = hybrid_kernel(
-        free,
-        h2d,
-        sx,
-        sy,
-        sth,
-        gx,
-        gy,
-        gth,
-        radius,
-        kappas,
-        prim_len,
-        nbins,
-        reverse,
-        rp,
-        cp,
-        tp,
-        sp,
-        ratio,
-        max(30.0, 12.0 * radius),
-        _COLLISION_STEP,
-        max_exp,
-        t1 + budget,
-        _POLISH,
-        hw,
-    )
+
+    def search(plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
+        return hybrid_kernel(
+            free,
+            h2d,
+            sx,
+            sy,
+            sth,
+            gx,
+            gy,
+            gth,
+            radius,
+            kappas,
+            plen,
+            bins,
+            reverse,
+            rp,
+            cp,
+            tp,
+            sp,
+            ratio,
+            max(30.0, 12.0 * radius),
+            _COLLISION_STEP,
+            exp_left,
+            deadline,
+            _POLISH,
+            hw,
+        )
+
+    out = search(prim_len, nbins, max_exp, t1 + budget)
+    status, expanded, shots, retried = out[0], int(out[7]), int(out[8]), False
+    if status == EXHAUSTED and expanded <= _RETRY_BELOW and max_exp > expanded:
+        # a small region was exhausted (a pocket where no primitive fits?): once more with
+        # primitives a third as long and three times as many heading bins
+        out = search(prim_len / 3.0, 3 * nbins, max_exp - expanded, t1 + budget)
+        status, retried = out[0], True
+        expanded += int(out[7])
+        shots += int(out[8])
+        if status == FOUND:
+            prim_len, nbins = prim_len / 3.0, 3 * nbins
+    _, chain, nodes, prims, skinds, slens, sn = out[:7]
     t2 = time.perf_counter()
     stats.update(
-        expanded=int(expanded),
+        expanded=expanded,
         nodes=int(nodes.shape[0]),
-        shots=int(shots),
+        shots=shots,
         search_s=t2 - t1,
+        retried=retried,
+        primitive_length=prim_len,
+        heading_bins=nbins,
     )
     if status != FOUND:
         stats["total_s"] = time.perf_counter() - t0
         mode = "forwards and backwards" if reverse else "forwards only (reverse=False)"
-        if status == 0:
+        if status == EXHAUSTED:
             reason = "exhausted"
             why = (
                 f"every reachable (x, y, heading) state was expanded ({expanded}) driving {mode} "
                 f"with turning radius {radius:g} cells"
             )
+            if retried:
+                why += (
+                    f", and again with primitives of {prim_len / 3.0:.3g} cells and {3 * nbins} "
+                    "heading bins"
+                )
             if not reverse:
                 why += (
                     "; no forwards-only path exists at this resolution (reverse=True may find one)"

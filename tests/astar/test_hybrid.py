@@ -272,3 +272,34 @@ def test_arc_bulge_between_samples_is_caught():
     pts = [advance(x, y, th, k, s * q / m)[:2] for q in range(m + 1)]
     assert all(segment_clear(free, *a, *b) for a, b in zip(pts[:-1], pts[1:], strict=True))
     assert not arc_clear(free, x, y, th, k, s, 0.2)
+
+
+POCKET = """
+##############################
+####################...#######
+#.......................######
+#.......................######
+#.......................######
+#........................S####
+###.......................####
+###.......................####
+###.......................####
+#########################.####
+#########################.####
+##############################
+"""
+
+
+def test_pocket_where_no_primitive_fits_is_retried_finer():
+    """A start at the end of a pocket, heading into the wall (den312d inflated by 2.5 cells,
+    held-out query 21): no primitive of 1.75 cells fits; the finer second search gets out."""
+    rows = [r for r in POCKET.strip().splitlines()][::-1]  # row 0 at the bottom
+    free = np.array([[c != "#" for c in r] for r in rows])
+    sy = next(i for i, r in enumerate(rows) if "S" in r)
+    start, goal = (
+        (float(rows[sy].index("S")), float(sy), 2.1211601392508337),
+        (14.0, float(sy), 2.356),
+    )
+    p = find_pose_path(free, start, goal, turning_radius=5.0)
+    check_path(p, free, start, goal, 5.0)
+    assert p.stats["retried"] and p.cusps >= 1
