@@ -7,6 +7,8 @@ import time
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from astar import InvalidInputError, NoPathError, OccupancyGrid
 from astar.hybrid import NoPosePathError, PosePath, find_pose_path
@@ -303,3 +305,37 @@ def test_pocket_where_no_primitive_fits_is_retried_finer():
     p = find_pose_path(free, start, goal, turning_radius=5.0)
     check_path(p, free, start, goal, 5.0)
     assert p.stats["retried"] and p.cusps >= 1
+
+
+@st.composite
+def _queries(draw):
+    ny = draw(st.integers(8, 18))
+    nx = draw(st.integers(8, 18))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    free = _closed(ny, nx) & (rng.random((ny, nx)) > draw(st.floats(0.0, 0.25)))
+    cells = np.argwhere(free)
+    assume(len(cells) >= 2)
+    i, j = rng.choice(len(cells), 2, replace=False)
+    heads = draw(st.tuples(st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi)))
+    start = (float(cells[i][1]), float(cells[i][0]), heads[0])
+    goal = (float(cells[j][1]), float(cells[j][0]), heads[1])
+    return free, start, goal, draw(st.floats(0.8, 4.0)), draw(st.booleans())
+
+
+@settings(max_examples=30, deadline=None)
+@given(_queries())
+def test_random_grids_hypothesis(q):
+    """Every path found is collision-free (dense), within the curvature bound, exact at both
+    ends, its segments consistent; every refusal a typed NoPathError with a reason."""
+    free, start, goal, radius, reverse = q
+    try:
+        p = find_pose_path(
+            free, start, goal, turning_radius=radius, reverse=reverse, time_budget=0.3
+        )
+    except NoPosePathError as e:
+        assert e.reason in ("disconnected", "exhausted", "time_budget", "max_expansions")
+        return
+    check_path(p, free, start, goal, radius)
+    if not reverse:
+        assert p.cusps == 0 and p.reverse_length == 0
