@@ -30,6 +30,8 @@ The convex problem is a sparse banded QP solved by piqp (by default): through
 vary). The curvature-bounded problem is solved by sequential convex programming
 (``curvature_solver="scp"``, the default) or by IPOPT on the exact non-convex problem,
 warm-started from the QP (``curvature_solver="ipopt"``), in box and polygon corridors alike.
+A cost field's term is minimised by QP rounds on its convex models, or exactly by IPOPT with
+an IPOPT solver; ``refine="ipopt"`` polishes the fast result by IPOPT on the whole problem.
 Solvers are built once per problem shape (padded size, degree, rows per point) and cached.
 
 Every result is verified (:class:`Certificate`) before it is returned: control points in

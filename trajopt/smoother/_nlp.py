@@ -1,10 +1,13 @@
-"""IPOPT problems of the smoother (``qp_solver="ipopt"``, ``curvature_solver="ipopt"``).
+"""IPOPT problems of the smoother (its ``"ipopt"`` solver options and the polish).
 
-The convex QP and the exact curvature-bounded NLP, built with CasADi once per problem shape
-(padded control points ``nb``, degree ``p``, region rows per point ``k``) and re-solved with
-parameters: the objective's band and linear term, and the non-zeros of the constraint rows of
-:func:`~trajopt.smoother._layout.constraint_layout` (heading rows and the region rows of a box or a
-polygon corridor).
+The convex QP (:func:`qp_ipopt`), the exact curvature-bounded NLP (:func:`curvature_nlp`) and
+the whole problem (:func:`smoother_nlp`: the QP objective and rows, optionally the exact
+curvature rows and the exact cost term of :mod:`~trajopt.smoother._nlp_cost`), built with
+CasADi once per problem shape (padded control points ``nb``, degree ``p``, region rows per
+point ``k``, and the cost window) and re-solved with parameters: the objective's band and
+linear term, the non-zeros of the constraint rows of
+:func:`~trajopt.smoother._layout.constraint_layout` (heading rows and the region rows of a box
+or a polygon corridor), the basis values at the samples and quadrature points.
 """
 
 from __future__ import annotations
