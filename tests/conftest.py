@@ -10,6 +10,10 @@
   first compiles every kernel numba's cache lacks, in two worker processes
   (:func:`trajopt._kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
+* The notebooks execute in a background thread from the end of collection on, while the
+  other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
+  last (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside
+  its test instead).
 """
 
 from __future__ import annotations
@@ -61,3 +65,41 @@ def shared_data() -> Path:
     if not (d / "movingai").is_dir() or not (d / "ros").is_dir():
         pytest.skip(f"shared map data not found at {d} (set TRAJOPT_DATA)")
     return d
+
+
+# ------------------------------------------------------------------ the notebooks
+def _notebook_items(items: list[pytest.Item]) -> list[pytest.Item]:
+    return [
+        i
+        for i in items
+        if getattr(i, "originalname", None) == "test_notebook_executes"
+        and i.module is not None
+        and i.module.__name__ == "tests.test_notebooks"
+    ]
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Run the notebook executions last: meanwhile they execute in the background."""
+    last = set(_notebook_items(items))
+    if last:
+        items[:] = [i for i in items if i not in last] + [i for i in items if i in last]
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """Start executing the selected notebooks in a background thread (tests/notebook_runner.py)."""
+    items = _notebook_items(session.items)
+    if not items:
+        return
+    from tests import notebook_runner
+
+    if notebook_runner.background_wanted():
+        notebook_runner.runner().start([i.callspec.params["path"] for i in items])
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Stop the notebook runner: drop what has not started, remove its scratch files."""
+    import sys
+
+    if "tests.notebook_runner" in sys.modules:
+        sys.modules["tests.notebook_runner"].shutdown()
