@@ -98,6 +98,28 @@ def square_clearance(
         Clearance (m), 0 inside an occupied cell or outside the map.
     """
     pts = np.asarray(pts, dtype=float).reshape(-1, 2)
+    if not math.isinf(reach):
+        return _square_clearance_within(grid, pts, reach)
+    # exact everywhere: a value found within a reach is exact (the nearest square is one of
+    # those looked at), so look near first and further only for the points not settled yet
+    out = np.empty(len(pts))
+    todo = np.arange(len(pts))
+    step = 8.0 * grid.resolution
+    far = math.hypot(grid.width, grid.height)
+    while len(todo):
+        if step >= far:
+            out[todo] = _square_clearance_within(grid, pts[todo], math.inf)
+            break
+        got = _square_clearance_within(grid, pts[todo], step)
+        done = got <= step
+        out[todo[done]] = got[done]
+        todo = todo[~done]
+        step *= 4.0
+    return out
+
+
+def _square_clearance_within(grid: astar.OccupancyGrid, pts: np.ndarray, reach: float):
+    """:func:`square_clearance` with a reach, by brute force over the cells within it."""
     res = grid.resolution
     ox, oy = grid.origin
     occ = grid.occupied
@@ -271,7 +293,32 @@ def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):
     ``1 + (cost_a + cost_b) / 2`` with a per-cell ``cost``); scipy's
     :func:`scipy.sparse.csgraph.dijkstra` solves it, so neither the search, its heuristic
     nor its landmarks are involved. Returns shape ``(ny, nx)``, ``inf`` where unreachable.
+    The graph of a grid (and cost) is built once and reused for every start.
     """
+    ny, nx = occ.shape
+    graph = _step_graph(occ, connectivity, corner_cutting, cost)
+    d = dijkstra(graph, indices=start[1] * nx + start[0])
+    return d.reshape(ny, nx)
+
+
+#: The last graphs :func:`dijkstra_costs` built, by the bytes of what defines them.
+_GRAPHS: dict[tuple, csr_matrix] = {}
+
+
+def _step_graph(occ, connectivity, corner_cutting, cost) -> csr_matrix:
+    """The explicit graph of :func:`dijkstra_costs` (cached: tests ask many starts per grid)."""
+    occ = np.asarray(occ)
+    key = (
+        occ.shape,
+        occ.dtype.str,
+        occ.tobytes(),
+        connectivity,
+        bool(corner_cutting),
+        None if cost is None else np.asarray(cost, dtype=float).tobytes(),
+    )
+    graph = _GRAPHS.get(key)
+    if graph is not None:
+        return graph
     ny, nx = occ.shape
     rows, cols, w = [], [], []
     moves = [(1, 0), (-1, 0), (0, 1), (0, -1)]
@@ -288,8 +335,10 @@ def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):
                     cols.append((iy + dy) * nx + ix + dx)
                     w.append(step)
     graph = csr_matrix((w, (rows, cols)), shape=(nx * ny, nx * ny))
-    d = dijkstra(graph, indices=start[1] * nx + start[0])
-    return d.reshape(ny, nx)
+    if len(_GRAPHS) >= 8:
+        _GRAPHS.pop(next(iter(_GRAPHS)))
+    _GRAPHS[key] = graph
+    return graph
 
 
 def check_path(path, occ, start, goal, connectivity, corner_cutting, cost=None):
