@@ -84,20 +84,27 @@ def distance_field(free, gx, gy, sx, sy, slack):  # pragma: no cover - compiled
         Whether ``(sx, sy)`` was reached.
     """
     ny, nx = free.shape
+    w = nx + 2  # padded with a blocked ring: no bounds checks in the loop
+    pf = np.zeros((ny + 2) * w, dtype=np.uint8)
+    for iy in range(ny):
+        for ix in range(nx):
+            pf[(iy + 1) * w + ix + 1] = free[iy, ix]
     big = np.int64(1) << 60
-    d = np.full(ny * nx, big, dtype=np.int64)
-    ddx = np.array([1, -1, 0, 0, 1, -1, 1, -1])
-    ddy = np.array([0, 0, 1, -1, 1, 1, -1, -1])
+    d = np.full((ny + 2) * w, big, dtype=np.int64)
+    # E, W, N, S, then NE, NW, SE, SW with the two orthogonal cells each diagonal passes
+    off = np.array([1, -1, w, -w, w + 1, w - 1, -w + 1, -w - 1], dtype=np.int64)
+    side_a = np.array([0, 0, 0, 0, 1, -1, 1, -1], dtype=np.int64)
+    side_b = np.array([0, 0, 0, 0, w, w, -w, -w], dtype=np.int64)
     cap = 1024
-    buckets = np.empty((8, cap), dtype=np.int32)
+    buckets = np.empty((8, cap), dtype=np.int64)
     counts = np.zeros(8, dtype=np.int64)
-    src = gy * nx + gx
+    src = (gy + 1) * w + gx + 1
     d[src] = 0
     buckets[0, 0] = src
     counts[0] = 1
     pending = 1
     cur = np.int64(0)
-    s = sy * nx + sx
+    s = (sy + 1) * w + sx + 1
     stop = big
     while pending > 0:
         b = cur & 7
@@ -107,25 +114,21 @@ def distance_field(free, gx, gy, sx, sy, slack):  # pragma: no cover - compiled
             u = buckets[b, counts[b]]
             if d[u] != cur:
                 continue  # stale entry
-            uy = u // nx
-            ux = u - uy * nx
             for k in range(8):
-                vx = ux + ddx[k]
-                vy = uy + ddy[k]
-                if vx < 0 or vy < 0 or vx >= nx or vy >= ny or free[vy, vx] == 0:
+                v = u + off[k]
+                if pf[v] == 0:
                     continue
-                w = 5
+                step = 5
                 if k >= 4:
-                    if free[uy, vx] == 0 or free[vy, ux] == 0:
+                    if pf[u + side_a[k]] == 0 or pf[u + side_b[k]] == 0:
                         continue
-                    w = 7
-                v = vy * nx + vx
-                nd = cur + w
+                    step = 7
+                nd = cur + step
                 if nd < d[v]:
                     d[v] = nd
                     bb = nd & 7
                     if counts[bb] == cap:
-                        nb = np.empty((8, 2 * cap), dtype=np.int32)
+                        nb = np.empty((8, 2 * cap), dtype=np.int64)
                         for i in range(8):
                             for j in range(counts[i]):
                                 nb[i, j] = buckets[i, j]
@@ -141,17 +144,17 @@ def distance_field(free, gx, gy, sx, sy, slack):  # pragma: no cover - compiled
         cur += 1
     out = np.empty((ny, nx))
     frontier = (cur + 1) / 5.0
-    for i in range(ny * nx):
-        iy = i // nx
-        ix = i - iy * nx
-        if free[iy, ix] == 0:
-            out[iy, ix] = np.inf
-        elif d[i] <= cur:
-            out[iy, ix] = d[i] / 5.0
-        elif pending > 0:
-            out[iy, ix] = frontier  # not settled: at least the frontier's distance
-        else:
-            out[iy, ix] = np.inf  # unreachable
+    for iy in range(ny):
+        for ix in range(nx):
+            di = d[(iy + 1) * w + ix + 1]
+            if free[iy, ix] == 0:
+                out[iy, ix] = np.inf
+            elif di <= cur:
+                out[iy, ix] = di / 5.0
+            elif pending > 0:
+                out[iy, ix] = frontier  # not settled: at least the frontier's distance
+            else:
+                out[iy, ix] = np.inf  # unreachable
     return out, d[s] < big
 
 

@@ -339,3 +339,36 @@ def test_random_grids_hypothesis(q):
     check_path(p, free, start, goal, radius)
     if not reverse:
         assert p.cusps == 0 and p.reverse_length == 0
+
+
+def test_distance_field_matches_dijkstra():
+    """The 2-D heuristic against scipy's Dijkstra on the same graph (steps 1 and 1.4, no
+    corner cutting); stopped early, every value stays a lower bound."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from astar.hybrid_kernel import distance_field
+
+    rng = np.random.default_rng(2)
+    free = _closed(15, 20) & (rng.random((15, 20)) > 0.25)
+    ny, nx = free.shape
+    rows, cols, w = [], [], []
+    for iy, ix in np.argwhere(free):
+        for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)):
+            vx, vy = ix + dx, iy + dy
+            if not free[vy, vx] or (dx and dy and not (free[iy, vx] and free[vy, ix])):
+                continue
+            rows.append(iy * nx + ix)
+            cols.append(vy * nx + vx)
+            w.append(1.4 if dx and dy else 1.0)
+    graph = coo_matrix((w, (rows, cols)), shape=(ny * nx, ny * nx)).tocsr()
+    gy, gx = np.argwhere(free)[0]
+    sy, sx = np.argwhere(free)[-1]
+    ref = dijkstra(graph, indices=gy * nx + gx).reshape(ny, nx)
+    ref[~free] = np.inf
+    full, reached = distance_field(free.astype(np.uint8), gx, gy, sx, sy, np.inf)
+    assert reached == bool(np.isfinite(ref[sy, sx]))
+    np.testing.assert_allclose(full, ref, rtol=1e-12)
+    part, _ = distance_field(free.astype(np.uint8), gx, gy, gx, gy, 2.0)
+    fin = np.isfinite(ref)
+    assert np.all(part[fin] <= ref[fin] + 1e-12) and np.all(np.isinf(part[~free]))
