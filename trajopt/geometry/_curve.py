@@ -128,6 +128,23 @@ class ParametricCurve(ABC):
         """Signed curvature ``(x'y'' - y'x'') / |c'|^3`` (1/m); ``inf`` where ``c' = 0``."""
         return signed_curvature(self(u, 1), self(u, 2))
 
+    def curvature_rate(self, u: np.ndarray | float) -> np.ndarray:
+        """Return ``d kappa / ds``, the signed curvature's derivative along the arc length (1/m^2).
+
+        ``(d kappa / du) / |c'|``, where ``d kappa / du = (c' x c''') / |c'|^3
+        - 3 (c' x c'') (c' . c'') / |c'|^5`` (``x`` the planar cross product); needs the
+        third derivative (a cubic B-spline is C2, its third derivative is taken on the side
+        ``__call__`` takes at a knot).
+        """
+        d1, d2, d3 = self(u, 1), self(u, 2), self(u, 3)
+        x1, y1 = d1[..., 0], d1[..., 1]
+        sp2 = x1 * x1 + y1 * y1
+        cross2 = x1 * d2[..., 1] - y1 * d2[..., 0]
+        cross3 = x1 * d3[..., 1] - y1 * d3[..., 0]
+        dot12 = x1 * d2[..., 0] + y1 * d2[..., 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return (cross3 * sp2 - 3.0 * cross2 * dot12) / (sp2 * sp2 * sp2)
+
     # ------------------------------------------------------------- arc length
     def _arc_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         table = getattr(self, "_arc_cache", None)

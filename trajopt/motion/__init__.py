@@ -7,16 +7,18 @@
   one after another (a braking re-plan);
 * :class:`OmniTrajectory`: an omnidirectional base's translation with an orientation of its
   own (built by :func:`trajopt.timing.orient`);
-* :class:`TrajectorySample` and :class:`OmniSample`, and the ROS 2 MCAP writer and reader.
+* :class:`TrajectorySample`, :class:`OmniSample` and :class:`CarSample` (a car-like
+  robot's signed speed, direction of travel and steering), and the ROS 2 MCAP writer and reader.
 """
 
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import OmniSample, Trajectory, TrajectorySample
+from trajopt.motion._trajectory import CarSample, OmniSample, Trajectory, TrajectorySample
 
 __all__ = [
+    "CarSample",
     "McapContents",
     "McapExportError",
     "OmniSample",

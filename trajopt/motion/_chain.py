@@ -34,6 +34,9 @@ from trajopt.robot._robot import Robot
 #: Largest jump (SI units) between two consecutive pieces of a chain.
 JOIN_TOL = 1e-6
 _BASE = ("t", "x", "y", "theta", "v", "omega", "a", "jerk", "a_lat", "kappa", "s")
+#: Optional sample fields a chain passes on when its pieces carry them (a car-like robot's
+#: direction of travel and steering); the wheel speeds are recomputed by ``make_sample``.
+_CARRIED = ("direction", "steer", "steer_rate")
 
 
 @dataclass(frozen=True, slots=True)
@@ -248,11 +251,15 @@ class TrajectoryChain(SampledExport):
             m = k == i
             p, t0 = self.pieces[i], self.starts[i]
             smp = p.sample(np.concatenate([flat[m] - self._t[i] + t0, [t0]]))
+            for n in _CARRIED:
+                if getattr(smp, n, None) is not None:
+                    out.setdefault(n, np.zeros(flat.shape))[m] = getattr(smp, n)[:-1]
             for n in _BASE[1:]:
                 out[n][m] = getattr(smp, n)[:-1]
             out["theta"][m] += self._theta_shift[i]
             out["s"][m] += self._s_shift[i] - smp.s[-1]
         out["t"] = flat
+        out.pop("steer", None)  # make_sample computes it from kappa
         return make_sample(self.robot, **{n: x.reshape(tt.shape) for n, x in out.items()})
 
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:

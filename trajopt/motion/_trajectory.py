@@ -46,6 +46,9 @@ SAMPLE_UNITS: dict[str, str] = {
     "vy": "m/s",
     "v_body_x": "m/s",
     "v_body_y": "m/s",
+    "direction": "1",
+    "steer": "rad",
+    "steer_rate": "rad/s",
 }
 
 
@@ -93,6 +96,47 @@ class TrajectorySample(NamedTuple):
         return {k: v for k, v in self._asdict().items() if v is not None}
 
 
+class CarSample(NamedTuple):
+    """Samples of a car-like robot's motion (``Robot(drive="ackermann")``).
+
+    The fields of :class:`TrajectorySample`, then the direction of travel and the steering.
+    Backwards (``direction = -1``) ``v``, ``a`` and ``jerk`` are signed (``v <= 0``),
+    ``theta`` is the body's orientation (the path's tangent ``+ pi``), ``kappa`` the body's
+    signed curvature ``omega / v`` and ``a_lat = omega * v``; the velocity is
+    ``v * (cos theta, sin theta)`` in both directions; ``s`` is the distance travelled.
+
+    Attributes
+    ----------
+    t, x, y, theta, v, omega, a, jerk, a_lat, kappa, s, v_left, v_right
+        As :class:`TrajectorySample` (the wheel speeds are the rear wheels').
+    direction : ``+1`` forwards, ``-1`` backwards
+    steer : steering angle ``atan(wheelbase * kappa)`` (rad), or ``None`` without a
+        ``wheelbase``
+    steer_rate : its rate ``d steer / dt`` (rad/s), or ``None`` without a ``wheelbase``
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    a: np.ndarray
+    jerk: np.ndarray
+    a_lat: np.ndarray
+    kappa: np.ndarray
+    s: np.ndarray
+    v_left: np.ndarray | None = None
+    v_right: np.ndarray | None = None
+    direction: np.ndarray | None = None
+    steer: np.ndarray | None = None
+    steer_rate: np.ndarray | None = None
+
+    def as_dict(self) -> dict[str, np.ndarray]:
+        """Return the arrays by name (the optional fields only when present)."""
+        return {k: v for k, v in self._asdict().items() if v is not None}
+
+
 class OmniSample(NamedTuple):
     """Samples of an :class:`~trajopt.motion.OmniTrajectory` (omnidirectional base).
 
@@ -131,19 +175,28 @@ class OmniSample(NamedTuple):
         return dict(self._asdict())
 
 
-def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample:
-    """Return a :class:`TrajectorySample` of read-only copies of ``arrays``.
+def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample | CarSample:
+    """Return a :class:`TrajectorySample` (:class:`CarSample` for a car) of read-only ``arrays``.
 
     ``arrays`` holds ``t``, ``x``, ``y``, ``theta``, ``v``, ``omega``, ``a``, ``jerk``,
     ``a_lat``, ``kappa`` and ``s`` (and may hold the other optional fields of
     :class:`TrajectorySample`); the wheel speeds ``v -+ omega * track_width / 2`` are added
-    when the robot is a differential drive with a track width.
+    when the robot is a differential drive (or a car-like robot: its rear wheels) with a
+    track width, and a car-like robot's steering angle ``atan(wheelbase * kappa)`` when it
+    has a wheelbase (with ``steer_rate``, given as ``dkappa_dt``: ``d kappa / dt`` (1/(m s))).
     """
+    dkappa_dt = arrays.pop("dkappa_dt", None)
+    if robot.drive == "ackermann" and robot.wheelbase is not None:
+        lk = robot.wheelbase * arrays["kappa"]
+        arrays["steer"] = np.arctan(lk)
+        if dkappa_dt is not None and "steer_rate" not in arrays:
+            arrays["steer_rate"] = robot.wheelbase * dkappa_dt / (1.0 + lk * lk)
     if robot.track_width is not None and robot.drive != "omni":
         half = 0.5 * robot.track_width
         arrays["v_left"] = arrays["v"] - arrays["omega"] * half
         arrays["v_right"] = arrays["v"] + arrays["omega"] * half
-    return TrajectorySample(**{k: readonly(x) for k, x in arrays.items()})
+    kind = CarSample if robot.drive == "ackermann" else TrajectorySample
+    return kind(**{k: readonly(x) for k, x in arrays.items()})
 
 
 class SampledExport:
@@ -415,6 +468,17 @@ class Trajectory(SampledExport):
     steps : object, optional
         The pipeline's intermediate results (``trajopt._planner.PlanSteps``) when planned by
         :func:`trajopt.plan`, else ``None``.
+    direction : {1, -1}
+        Direction of travel along ``path`` of a car-like robot's body: ``+1`` (default)
+        forwards; ``-1`` backwards: the robot's rear leads, so the samples have
+        ``v = -ds/dt <= 0`` (and ``a``, ``jerk`` negated), ``theta`` = the path's tangent
+        ``+ pi`` (the body's orientation; shifted by a multiple of ``2 pi`` so that it
+        starts in ``[-pi, pi]``), ``kappa`` = minus the path's curvature (the body's
+        ``omega / v``; ``omega`` is the tangent's turn rate, unchanged) and
+        ``a_lat = omega * v``. The phases (``phase_*``) and ``s`` stay the unsigned motion
+        along the path (distance travelled). Samples of a car-like robot
+        (``drive="ackermann"``) carry ``direction`` (and the steering angle with a
+        wheelbase).
     """
 
     path: ParametricCurve
@@ -432,8 +496,12 @@ class Trajectory(SampledExport):
     theta_grid: np.ndarray = field(default_factory=lambda: readonly([]))
     u_grid: np.ndarray = field(default_factory=lambda: readonly([]))
     steps: Any = None
+    direction: int = 1
 
     def __post_init__(self) -> None:
+        if self.direction not in (1, -1) or isinstance(self.direction, bool):
+            raise InvalidInputError(f"direction must be 1 or -1, got {self.direction!r}")
+        object.__setattr__(self, "direction", int(self.direction))
         names = ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j")
         arrays = [readonly(getattr(self, n)) for n in names]
         p = arrays[0].shape
@@ -529,8 +597,8 @@ class Trajectory(SampledExport):
             todo[todo] = moving
         return u
 
-    def sample(self, t: np.ndarray | float) -> TrajectorySample:
-        """Evaluate the trajectory at times ``t`` (vectorised).
+    def sample(self, t: np.ndarray | float) -> TrajectorySample | CarSample:
+        """Evaluate the trajectory at times ``t`` (vectorised; a car's is a :class:`CarSample`).
 
         Parameters
         ----------
@@ -555,6 +623,15 @@ class Trajectory(SampledExport):
         else:
             theta = raw
         omega = kappa * v
+        extra: dict[str, np.ndarray] = {}
+        if self.robot.drive == "ackermann":
+            d = float(self.direction)
+            extra["direction"] = np.full(np.shape(v), d)
+            if self.robot.wheelbase is not None:  # d kappa_body / dt = d * dkappa/ds * ds/dt
+                extra["dkappa_dt"] = np.asarray(path.curvature_rate(u)) * v
+            if d < 0.0:  # the body's quantities (class docstring)
+                v, a, j, kappa = -v, -a, -j, -kappa
+                theta = theta + self._reverse_shift()
         return make_sample(
             self.robot,
             t=tt,
@@ -568,7 +645,17 @@ class Trajectory(SampledExport):
             a_lat=omega * v,
             kappa=kappa,
             s=s,
+            **extra,
         )
+
+    def _reverse_shift(self) -> float:
+        """Return ``pi`` plus the multiple of ``2 pi`` that puts the body's start heading in ``[-pi, pi]``."""
+        t0 = (
+            float(self.theta_grid[0])
+            if self.theta_grid.shape[0]
+            else float(np.asarray(self.path.heading(self.path.domain[0])))
+        )
+        return math.pi - 2.0 * math.pi * round((t0 + math.pi) / (2.0 * math.pi))
 
     # ------------------------------------------------------------------ export
     def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
@@ -587,7 +674,10 @@ class Trajectory(SampledExport):
             "a": self.phase_a.tolist(),
             "jerk": self.phase_j.tolist(),
         }
-        return export_dict(self, "trajopt.Trajectory", dt, {"phases": phases})
+        extra: dict[str, Any] = {"phases": phases}
+        if self.direction != 1:
+            extra["direction"] = self.direction
+        return export_dict(self, "trajopt.Trajectory", dt, extra)
 
     def __repr__(self) -> str:
         return (

@@ -9,6 +9,7 @@ explicit inputs.
 from __future__ import annotations
 
 from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._car import plan_car
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._footprint_ladder import plan_with_footprint
 from trajopt.planning._omni import plan_omni
@@ -30,7 +31,8 @@ def run_query(
     (:func:`~trajopt.planning._pose.plan_pose`: turns in place where they are faster or
     where no curve leaves along the heading); an omnidirectional base plans the path of its
     (circumscribed) disc and turns its orientation while it drives
-    (:func:`~trajopt.planning._omni.plan_omni`).
+    (:func:`~trajopt.planning._omni.plan_omni`); a car-like robot plans pose to pose with
+    a turning radius and cusps (:func:`~trajopt.planning._car.plan_car`; no warm start).
 
     Parameters
     ----------
@@ -53,6 +55,8 @@ def run_query(
         See :meth:`trajopt.Planner.plan`.
     """
     options = options.with_budget(budget_s)
+    if options.robot.drive == "ackermann":
+        return plan_car(options, caches, request)
     if options.robot.drive == "omni":
         return plan_omni(options, caches, request, warm)
     if needs_pose_plan(options.robot, request):

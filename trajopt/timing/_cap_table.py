@@ -1,7 +1,8 @@
 """The timing's speed cap along the arc length: one lower bound per grid interval.
 
 :func:`build_cap_table` tabulates ``cap(s) = Robot.speed_cap(kappa(s))`` (with speed-limit
-zones as one more cap) on a uniform arc-length grid of spacing at most 2.5 mm, each value a
+zones, and a car-like robot's steering-rate cap of :mod:`trajopt.timing._steer_cap`, as
+more caps) on a uniform arc-length grid of spacing at most 2.5 mm, each value a
 lower bound of the cap over its whole interval (rigorous for curves with a
 ``polynomial_degree``: the method of :func:`trajopt.geometry._curvature_bound.interval_kappa_max`,
 compiled with the grid's ``u(s)`` and heading in :mod:`trajopt.timing._cap_kernel` for the
@@ -24,6 +25,7 @@ from trajopt.geometry._curve import STILL_SPEED_RATIO, ParametricCurve, signed_c
 from trajopt.robot._robot import Robot
 from trajopt.timing._cap_kernel import polynomial_tables
 from trajopt.timing._speed_limits import SpeedLimits
+from trajopt.timing._steer_cap import steer_caps
 
 GRID_SPACING = 0.0025  # m, arc-length spacing of the cap table
 MIN_INTERVALS = 64
@@ -166,6 +168,8 @@ def build_cap_table(
         )
     if zone is not None:
         ci = np.minimum(ci, zone)
+    if robot.drive == "ackermann" and robot.steer_rate_max is not None:
+        ci = np.minimum(ci, steer_caps(curve, robot, u_nodes))
     # ci = max(ci (1 - margin), min(ci, max(v_start, v_end))), the ends at least the
     # boundary speeds (up to the cap at the end nodes), its sparse table and local minima
     ci = np.array(ci, dtype=float)  # a fresh array: changed in place

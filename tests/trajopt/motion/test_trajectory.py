@@ -143,7 +143,8 @@ def test_exports(tmp_path):
     assert d["duration"] == traj.duration and d["duration_unit"] == "s"
     # v_left/v_right present with track_width; an omni motion's course, vx, ... absent
     omni_only = {"course", "vx", "vy", "v_body_x", "v_body_y"}
-    assert set(d["samples"]) == set(SAMPLE_UNITS) - omni_only
+    car_only = {"direction", "steer", "steer_rate"}  # drive="ackermann" only
+    assert set(d["samples"]) == set(SAMPLE_UNITS) - omni_only - car_only
     smp = traj.sample_uniform(0.05)
     assert np.allclose(d["samples"]["x"], smp.x)
     p = traj.to_json(tmp_path / "sub" / "traj.json", dt=0.05)

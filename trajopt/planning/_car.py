@@ -1,0 +1,438 @@
+"""Pose-to-pose plans of a car-like robot (``Robot(drive="ackermann")``).
+
+A car faces its direction of travel (or its reverse), turns no tighter than its
+``min_turning_radius`` ``R`` and cannot turn in place, so :func:`plan_car` plans in
+(x, y, heading):
+
+1. **Search.** :func:`astar.find_pose_path` (Hybrid-A* with Reeds-Shepp shots, or Dubins
+   shots when ``robot.reverse`` is False) from the start pose to the goal pose, on the raw
+   map inflated by the robot radius plus :data:`SEARCH_MARGIN_CELLS` (so that every point of
+   a free cell, not only its centre, keeps the radius: the search's poses lie anywhere in
+   their cells), with a turning radius :data:`SEARCH_RADIUS_FACTORS` times ``R`` (the
+   first factor leaves the smoother room: a segment turning at exactly ``1/R`` between
+   fixed end poses admits no other curve, and a B-spline is no circle), the next one ``R``
+   itself when the first finds no path.
+2. **Segments.** The path is split at its cusps (where the direction of travel flips; the
+   heading is continuous there, the tangent flips by ``pi``). Each segment is fitted as an
+   ordinary curve in the direction of travel: a certified polygon corridor grown around
+   its poses (:func:`~trajopt.corridor.build_polygon_corridor`), then the planner's
+   smoother with ``kappa_max = min(its own, 1/R)``, exact end points and exact end travel
+   headings (the body heading forwards, heading ``+ pi`` backwards). Where that fit fails,
+   it is fitted again in polygons grown around the poses themselves without centring (the
+   witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). Every
+   curve is the smoother's certified curve (convex-hull clearance certificate per segment)
+   and its sampled curvature (the certificate's dense samples) must be within ``1/R``;
+   nothing else is returned.
+3. **Timing.** Each segment is timed along its arc length from rest to rest
+   (:func:`trajopt.time_parameterize`: ``v = 0`` at the ends and at every cusp), backwards
+   segments with ``v_max_reverse`` as the speed limit, with the robot's curvature caps and,
+   with ``steer_rate_max``, the steering-rate cap (:mod:`trajopt.timing._steer_cap`).
+
+The result is a :class:`~trajopt.motion.TrajectoryChain` of one
+:class:`~trajopt.motion.Trajectory` per segment (``direction`` ``+1`` or ``-1``), even for a
+single segment: its samples carry the signed ``v``, the body's ``theta`` (continuous across
+cusps) and ``kappa``, ``direction`` and, with a ``wheelbase``, ``steer`` and ``steer_rate``.
+Curvature (hence steering) is continuous within a segment (the B-spline is C2); at a cusp
+the car is at rest and may steer while stopped (the chain checks position, heading, speed,
+acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
+
+Not supported (refused with :class:`~trajopt.errors.InvalidInputError`): a footprint (plan
+with its circumscribed disc radius), a moving start or end speeds other than 0, missing end
+headings, and the chapter's ``inflation="paper"``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt._validation import point
+from trajopt.corridor import PolygonCorridor, build_polygon_corridor
+from trajopt.errors import InvalidInputError, NoPathError, SmoothingError
+from trajopt.motion._chain import TrajectoryChain
+from trajopt.motion._trajectory import Trajectory
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._corridor_fit import witness_corridor
+from trajopt.planning._disc import check_endpoint
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import StageTimer
+from trajopt.robot._robot import Robot
+from trajopt.robot._state import State
+from trajopt.smoother import SmoothPath
+from trajopt.timing import time_parameterize
+
+#: Extra inflation (cells) of the search grid beyond the robot radius: half a cell's
+#: diagonal (any point of a free cell keeps the radius) plus slack for the chords between
+#: the search's poses (at most half a cell apart).
+SEARCH_MARGIN_CELLS = 0.5 * math.sqrt(2.0) + 0.05
+#: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order.
+SEARCH_RADIUS_FACTORS = (1.15, 1.0)
+#: Relative tolerance of the curvature check of each fitted segment.
+KAPPA_TOL = 1e-6
+#: Cap (s) on the smoother's time budget per segment fit.
+SEGMENT_BUDGET_S = 2.0
+#: Cap (s) on the Hybrid-A* search's time budget per try.
+SEARCH_BUDGET_S = 2.0
+
+
+@dataclass(frozen=True, slots=True)
+class CarSegment:
+    """One segment of a car's plan between cusps.
+
+    Attributes
+    ----------
+    direction : int
+        ``+1`` forwards, ``-1`` backwards.
+    first, last : int
+        Pose indices (into :attr:`CarSteps.poses`) of its ends.
+    corridor : PolygonCorridor
+        The certified corridor it was fitted in.
+    smooth_path : SmoothPath
+        The certified curve in the direction of travel (its certificate included).
+    corridor_kind : str
+        ``"polygons"`` (grown around the centred poses) or ``"witness"`` (around the poses
+        themselves, the second try).
+    """
+
+    direction: int
+    first: int
+    last: int
+    corridor: PolygonCorridor
+    smooth_path: SmoothPath
+    corridor_kind: str
+
+
+@dataclass(frozen=True, slots=True)
+class CarCorridor:
+    """The regions of every segment's corridor, in order (what the MCAP writer draws)."""
+
+    regions: tuple
+
+
+@dataclass(frozen=True, slots=True)
+class CarSteps:
+    """What each stage of a car's plan produced (``trajectory.steps``).
+
+    Attributes
+    ----------
+    raw_grid : astar.OccupancyGrid
+        The map.
+    inflated_grid : astar.OccupancyGrid
+        The grid searched (radius plus :data:`SEARCH_MARGIN_CELLS` cells).
+    pose_path : astar.PosePath
+        The Hybrid-A* path (cells; :meth:`astar.PosePath.to_world`).
+    poses : ndarray, shape (n, 3)
+        Its poses in world units ``(x, y, heading)`` (m, m, rad).
+    segments : tuple of CarSegment
+        One per stretch between cusps.
+    start, goal : tuple of float
+        The end points (m).
+    start_heading, goal_heading : float
+        The end headings (rad).
+    stages_s : dict
+        Wall time per stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
+        ``timing``, ``total``.
+    search_turning_radius : float
+        The turning radius the path was found with (m).
+    """
+
+    raw_grid: OccupancyGrid
+    inflated_grid: OccupancyGrid
+    pose_path: Any
+    poses: np.ndarray
+    segments: tuple
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    start_heading: float
+    goal_heading: float
+    stages_s: dict[str, float]
+    search_turning_radius: float
+
+    @property
+    def corridor(self) -> CarCorridor:
+        """Every segment's regions (:class:`CarCorridor`)."""
+        return CarCorridor(tuple(r for s in self.segments for r in s.corridor.regions))
+
+    @property
+    def smooth_path(self) -> SmoothPath:
+        """The first segment's curve (each segment's is in :attr:`segments`)."""
+        return self.segments[0].smooth_path
+
+
+def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanRequest) -> Any:
+    """Plan one query of a car-like robot (module docstring).
+
+    Parameters
+    ----------
+    options : PlannerOptions
+        Resolved for the map of ``caches``; ``options.robot.drive == "ackermann"``.
+    caches : PlannerCaches
+        The map.
+    request : PlanRequest
+        Start and goal points (m) with both headings (rad), at rest (a :class:`State`
+        start at rest counts as its position and heading).
+
+    Returns
+    -------
+    TrajectoryChain
+        One :class:`~trajopt.motion.Trajectory` per segment between cusps.
+
+    Raises
+    ------
+    InvalidInputError
+        A footprint, ``inflation="paper"``, a heading missing, a moving start or an end
+        speed other than 0, an end point off the map or too close to an obstacle, or one
+        blocked on the search grid.
+    NoPathError
+        No path joins the poses (an :class:`astar.NoPosePathError` as its cause; with
+        ``reverse=False`` the message says that a forward-only path was asked for).
+    SmoothingError
+        A segment has no certified curve within the curvature bound.
+    TimingError
+        A segment cannot be timed.
+    """
+    timer = StageTimer()
+    robot = options.robot
+    grid = caches.grid
+    p0, p1, h0, h1 = _ends(options, grid, request)
+    res = grid.resolution
+    with timer.stage("inflate"):
+        margin = robot.radius + SEARCH_MARGIN_CELLS * res
+        search_grid = grid.with_occupied(
+            astar.inflate(grid, margin, metric="square", outside_occupied=True).occupied
+        )
+    start = _to_cells(grid, p0, h0)
+    goal = _to_cells(grid, p1, h1)
+    for name, c, p in (("start", start, p0), ("goal", goal, p1)):
+        ix, iy = int(math.floor(c[0] + 0.5)), int(math.floor(c[1] + 0.5))
+        if search_grid.occupied[iy, ix]:
+            raise InvalidInputError(
+                f"{name} {p.tolist()} m lies in cell ({ix}, {iy}), blocked on the car's search "
+                f"grid (robot radius {robot.radius} m plus {SEARCH_MARGIN_CELLS:.3g} cells); "
+                "move it towards free space"
+            )
+    with timer.stage("search"):
+        path, radius_cells = _search(robot, search_grid, start, goal, res)
+    poses = path.to_world(grid)
+    segments: list[CarSegment] = []
+    pieces: list[Trajectory] = []
+    kmax = 1.0 / robot.min_turning_radius
+    sm = options.smoother
+    sm = dataclasses.replace(
+        sm,
+        kappa_max=kmax if sm.kappa_max is None else min(sm.kappa_max, kmax),
+        time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
+    )
+    for first, last in np.asarray(path.segments):
+        direction = int(path.directions[last])
+        seg = _fit_segment(options, grid, sm, poses, int(first), int(last), direction, timer)
+        segments.append(seg)
+        with timer.stage("timing"):
+            pieces.append(_time_segment(options, seg))
+    stages = timer.finish()
+    steps = CarSteps(
+        raw_grid=grid,
+        inflated_grid=search_grid,
+        pose_path=path,
+        poses=poses,
+        segments=tuple(segments),
+        start=(float(p0[0]), float(p0[1])),
+        goal=(float(p1[0]), float(p1[1])),
+        start_heading=h0,
+        goal_heading=h1,
+        stages_s=stages,
+        search_turning_radius=radius_cells * res,
+    )
+    stats: dict[str, Any] = {
+        "stages_s": dict(stages),
+        "car": {
+            "segments": len(segments),
+            "cusps": int(path.cusps),
+            "directions": [s.direction for s in segments],
+            "reverse_length_m": float(path.reverse_length * res),
+            "search_length_m": float(path.length * res),
+            "search_turning_radius_m": radius_cells * res,
+            "corridors": [s.corridor_kind for s in segments],
+            "search": dict(path.stats),
+        },
+        "inflation": options.inflation,
+    }
+    return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+def _ends(
+    options: PlannerOptions, grid: OccupancyGrid, request: PlanRequest
+) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Return the checked end points (m) and headings (rad) of a car's query."""
+    robot = options.robot
+    if robot.footprint is not None:
+        raise InvalidInputError(
+            "Robot(drive='ackermann') with a footprint is not supported yet: plan with a disc "
+            f"(radius={robot.circumscribed_radius:.6g} m, the footprint's circumscribed disc)"
+        )
+    if options.inflation != "exact":
+        raise InvalidInputError(
+            f"inflation={options.inflation!r} is not supported for drive='ackermann'; use 'exact'"
+        )
+    start, h0 = request.start, request.start_heading
+    if isinstance(start, State):
+        if start.v != 0.0 or start.a != 0.0 or h0 is not None:
+            raise InvalidInputError(
+                "a car-like robot (drive='ackermann') plans from rest: start must be a point "
+                f"with start_heading, or a State at rest, got a State with v={start.v!r}, "
+                f"a={start.a!r}"
+            )
+        start, h0 = start.position, start.theta
+    if request.v_start != 0.0 or request.v_end != 0.0:
+        raise InvalidInputError(
+            "a car-like robot (drive='ackermann') plans from rest to rest: v_start and v_end "
+            f"must be 0, got v_start={request.v_start!r}, v_end={request.v_end!r}"
+        )
+    missing = [
+        n for n, h in (("start_heading", h0), ("goal_heading", request.goal_heading)) if h is None
+    ]
+    if missing:
+        raise InvalidInputError(
+            f"a car-like robot (drive='ackermann') needs both end headings (rad): "
+            f"{' and '.join(missing)} {'is' if len(missing) == 1 else 'are'} None"
+        )
+    p0 = point("start", start)
+    p1 = point("goal", request.goal)
+    check_endpoint(options, grid, "start", p0)
+    check_endpoint(options, grid, "goal", p1)
+    return p0, p1, float(h0), float(request.goal_heading)
+
+
+def _to_cells(grid: OccupancyGrid, p: np.ndarray, heading: float) -> tuple[float, float, float]:
+    """Return a world pose as the search's cell pose (``world = origin + (xy + 0.5) res``)."""
+    xy = (np.asarray(p, dtype=float) - np.asarray(grid.origin, dtype=float)) / grid.resolution
+    return float(xy[0] - 0.5), float(xy[1] - 0.5), float(heading)
+
+
+def _search(
+    robot: Robot, search_grid: OccupancyGrid, start: Any, goal: Any, res: float
+) -> tuple[Any, float]:
+    """Return the Hybrid-A* path and the turning radius (cells) it was found with."""
+    r_cells = robot.min_turning_radius / res
+    failures = []
+    for factor in SEARCH_RADIUS_FACTORS:
+        try:
+            path = astar.find_pose_path(
+                search_grid,
+                start,
+                goal,
+                turning_radius=factor * r_cells,
+                reverse=robot.reverse,
+                time_budget=SEARCH_BUDGET_S,
+            )
+        except astar.NoPosePathError as exc:
+            failures.append(exc)
+            if exc.reason == "disconnected":
+                break
+            continue
+        return path, factor * r_cells
+    last = failures[-1]
+    mode = (
+        "forwards and backwards"
+        if robot.reverse
+        else "forwards only (reverse=False): no forward-only path was found; a goal only "
+        "reachable backwards needs reverse=True"
+    )
+    raise NoPathError(
+        f"no path of a car-like robot (turning radius {robot.min_turning_radius} m, radius "
+        f"{robot.radius} m) driving {mode}, from pose {_pose_m(start, search_grid)} to pose "
+        f"{_pose_m(goal, search_grid)} ({last.reason}): {last}"
+    ) from last
+
+
+def _pose_m(c: Any, grid: OccupancyGrid) -> str:
+    x = grid.origin[0] + (c[0] + 0.5) * grid.resolution
+    y = grid.origin[1] + (c[1] + 0.5) * grid.resolution
+    return f"({x:.6g} m, {y:.6g} m, {c[2]:.6g} rad)"
+
+
+def _fit_segment(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Any,
+    poses: np.ndarray,
+    first: int,
+    last: int,
+    direction: int,
+    timer: StageTimer,
+) -> CarSegment:
+    """Fit one segment in the direction of travel (module docstring, step 2)."""
+    radius = options.robot.radius
+    pts = np.ascontiguousarray(poses[first : last + 1, :2])
+    turn = 0.0 if direction > 0 else math.pi
+    h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
+    kmax = 1.0 / options.robot.min_turning_radius
+    errors: list[str] = []
+    for kind in ("polygons", "witness"):
+        try:
+            with timer.stage("corridor"):
+                if kind == "polygons":
+                    corridor = build_polygon_corridor(grid, pts, radius)
+                else:
+                    corridor = witness_corridor(grid, radius, _dense(pts, grid.resolution))
+            with timer.stage("smooth"):
+                smooth = smoother.fit(
+                    pts,
+                    corridor,
+                    raw_grid=grid,
+                    radius=radius,
+                    start=pts[0],
+                    goal=pts[-1],
+                    start_heading=h0,
+                    goal_heading=h1,
+                )
+        except (SmoothingError, InvalidInputError) as exc:
+            errors.append(f"{kind}: {exc}")
+            continue
+        cert = smooth.certificate
+        if cert is None or not cert.ok or cert.kappa_max_sampled > kmax * (1.0 + KAPPA_TOL):
+            k = None if cert is None else cert.kappa_max_sampled
+            errors.append(f"{kind}: not certified within 1/R (kappa {k})")
+            continue
+        return CarSegment(direction, first, last, corridor, smooth, kind)
+    where = "forwards" if direction > 0 else "backwards"
+    raise SmoothingError(
+        f"no certified curve with curvature <= 1/R = {kmax:.6g} 1/m for the {where} segment "
+        f"from ({pts[0, 0]:.6g}, {pts[0, 1]:.6g}) m to ({pts[-1, 0]:.6g}, {pts[-1, 1]:.6g}) "
+        f"m: {'; '.join(errors)}",
+        {"car_segment_failures": errors},
+    )
+
+
+def _dense(pts: np.ndarray, res: float) -> np.ndarray:
+    """Return the poses' polyline resampled at most an eighth of a cell apart (m)."""
+    d = np.hypot(*np.diff(pts, axis=0).T)
+    out = [pts[:1]]
+    for i, di in enumerate(d):
+        n = max(1, math.ceil(di / (res / 8.0)))
+        f = (np.arange(1, n + 1) / n)[:, None]
+        out.append(pts[i] + f * (pts[i + 1] - pts[i]))
+    return np.vstack(out)
+
+
+def _time_segment(options: PlannerOptions, seg: CarSegment) -> Trajectory:
+    """Time a segment from rest to rest; backwards with ``v_max_reverse`` (module doc)."""
+    robot = options.robot
+    limits = robot
+    if seg.direction < 0 and robot.v_max_backwards != robot.v_max:
+        limits = dataclasses.replace(robot, v_max=robot.v_max_backwards)
+    traj = time_parameterize(
+        seg.smooth_path,
+        limits,
+        v_start=0.0,
+        v_end=0.0,
+        dt=options.timing_dt,
+        speed_limits=options.speed_limits,
+    )
+    return dataclasses.replace(traj, robot=robot, direction=seg.direction)

@@ -1,0 +1,50 @@
+"""The speed cap that holds a car-like robot's steering-angle rate.
+
+A car steers with ``delta = atan(L kappa)`` (``L`` the wheelbase). Along a path timed with
+speed ``v`` the steering rate is ``d delta / dt = L (d kappa / ds) v / (1 + (L kappa)^2)``,
+so ``|d delta / dt| <= steer_rate_max`` is a speed cap,
+``v <= steer_rate_max (1 + (L kappa)^2) / (L |d kappa / ds|)``
+(:meth:`trajopt.Robot.steer_speed_cap`), folded into the timing's cap table beside the
+curvature caps. Choice: the cap of an interval of the table is the lowest of the exact
+pointwise cap at the interval's two nodes and :data:`INNER` points evenly spaced in the
+curve parameter between them, less :data:`MARGIN`: a sampled bound on a grid of spacing
+<= 2.5 mm (the cubic B-spline's ``d kappa / ds`` is smooth within its pieces and the grid is
+far finer than a piece), not the rigorous Bernstein bound of the curvature caps. The steering
+rate is a tracking limit, not a clearance guarantee.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trajopt.geometry._curve import ParametricCurve
+from trajopt.robot._robot import Robot
+
+#: Points per interval besides its nodes where the steering cap is evaluated.
+INNER = 3
+#: Relative margin below the sampled cap.
+MARGIN = 1e-3
+
+
+def steer_caps(curve: ParametricCurve, robot: Robot, u_nodes: np.ndarray) -> np.ndarray:
+    """Return the steering-rate speed cap of each interval between ``u_nodes`` (m/s).
+
+    Parameters
+    ----------
+    curve : ParametricCurve
+        The path; needs ``curvature`` and ``curvature_rate``.
+    robot : Robot
+        A car-like robot with ``steer_rate_max`` and ``wheelbase``.
+    u_nodes : ndarray, shape (n + 1,)
+        Curve parameter at the nodes of the cap table.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        A cap per interval (``inf`` where the steering does not change).
+    """
+    u = np.asarray(u_nodes, dtype=float)
+    frac = np.arange(INNER + 2, dtype=float) / (INNER + 1)
+    pts = u[:-1, None] + (u[1:] - u[:-1])[:, None] * frac[None, :]  # (n, INNER + 2)
+    cap = np.asarray(robot.steer_speed_cap(curve.curvature(pts), curve.curvature_rate(pts)))
+    return np.min(cap, axis=1) * (1.0 - MARGIN)
