@@ -1,0 +1,319 @@
+"""Car-like robots (``Robot(drive="ackermann")``) end to end through ``trajopt.plan``.
+
+Four hand-built scenes (a goal straight behind the start, a three-point turn in a dead end
+narrower than ``2 R``, a forward-only U-turn round a block, parallel parking into a slot 1.3
+car lengths long), each checked independently of the planner: end poses, curvature by
+circles through three dense points, clearance by brute force against the raw grid, motion
+along the heading by finite differences, rest at every cusp; then bad input.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+import astar
+import trajopt
+from tests.reference import square_clearance, three_point_curvature
+from trajopt.errors import InvalidInputError, NoPathError
+
+TWO_PI = 2.0 * math.pi
+
+
+def walled(width: float, height: float, res: float) -> np.ndarray:
+    """Occupancy (ny, nx) of a ``width x height`` m room with a one-cell wall round it."""
+    occ = np.zeros((round(height / res), round(width / res)), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    return occ
+
+
+def behind_scene():
+    res = 0.05
+    grid = astar.OccupancyGrid(walled(8.0, 4.0, res), res)
+    robot = trajopt.Robot(drive="ackermann", min_turning_radius=0.5, v_max_reverse=0.3)
+    return grid, robot, (4.0, 2.0), (2.5, 2.0), 0.0, 0.0
+
+
+def three_point_scene():
+    # a closed corridor 1.1 m wide (free) for R = 0.6 m: narrower than 2 R
+    res = 0.05
+    grid = astar.OccupancyGrid(walled(4.1, 1.2, res), res)
+    robot = trajopt.Robot(
+        drive="ackermann", min_turning_radius=0.6, wheelbase=0.4, steer_rate_max=1.0
+    )
+    return grid, robot, (1.5, 0.6), (1.6, 0.6), 0.0, math.pi
+
+
+def uturn_scene():
+    res = 0.05
+    occ = walled(6.0, 4.0, res)
+    occ[round(1.7 / res) : round(2.3 / res), : round(3.5 / res)] = True  # the block
+    grid = astar.OccupancyGrid(occ, res)
+    robot = trajopt.Robot(drive="ackermann", min_turning_radius=0.5, reverse=False)
+    return grid, robot, (1.0, 1.0), (1.0, 3.0), 0.0, math.pi
+
+
+CAR_RADIUS = 0.2  # half the car's width
+CAR_LENGTH = 4.4 * CAR_RADIUS  # a car 2.2 times as long as it is wide
+SLOT = 1.3 * CAR_LENGTH
+
+
+def parking_scene():
+    res = 0.025
+    occ = walled(5.0, 1.8, res)
+    occ[: round(0.65 / res), :] = True  # the kerb side: parked cars ...
+    occ[round(0.1 / res) : round(0.65 / res), round(2.0 / res) : round((2.0 + SLOT) / res)] = False
+    grid = astar.OccupancyGrid(occ, res)
+    robot = trajopt.Robot(
+        radius=CAR_RADIUS, drive="ackermann", min_turning_radius=0.5, wheelbase=0.35
+    )
+    return grid, robot, (1.0, 1.1), (2.0 + SLOT / 2.0, 0.33), 0.0, 0.0
+
+
+SCENES = {
+    "behind": behind_scene,
+    "three_point": three_point_scene,
+    "uturn": uturn_scene,
+    "parking": parking_scene,
+}
+
+
+@pytest.fixture(scope="module")
+def planned():
+    out = {}
+    for name, make in SCENES.items():
+        grid, robot, start, goal, h0, h1 = make()
+        t0 = time.perf_counter()
+        traj = trajopt.plan(grid, start, goal, robot, start_heading=h0, goal_heading=h1)
+        out[name] = (grid, robot, start, goal, h0, h1, traj, time.perf_counter() - t0)
+    return out
+
+
+def _angle_diff(a, b):
+    return np.abs(np.remainder(np.asarray(a) - b + math.pi, TWO_PI) - math.pi)
+
+
+def _dense_points(traj, spacing):
+    """Points every ``spacing`` m of arc length along each piece's curve (and its ends)."""
+    out = []
+    for piece in traj.pieces:
+        n = max(3, math.ceil(piece.length / spacing) + 1)
+        s = np.linspace(0.0, piece.length, n)
+        out.append(np.asarray(piece.path(piece.path.u_at_s(s))))
+    return out
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_end_poses_exact(planned, name):
+    grid, robot, start, goal, h0, h1, traj, _ = planned[name]
+    assert isinstance(traj, trajopt.TrajectoryChain)
+    ends = traj.sample(np.array([0.0, traj.duration]))
+    np.testing.assert_allclose([ends.x[0], ends.y[0]], start, atol=1e-9)
+    np.testing.assert_allclose([ends.x[1], ends.y[1]], goal, atol=1e-9)
+    assert _angle_diff(ends.theta[0], h0) < 1e-6
+    assert _angle_diff(ends.theta[1], h1) < 1e-6
+    np.testing.assert_array_equal(ends.v, [0.0, 0.0])
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_curvature_within_one_over_r(planned, name):
+    _, robot, *_, traj, _ = planned[name]
+    kmax = 1.0 / robot.min_turning_radius
+    for pts in _dense_points(traj, 0.002):
+        k = three_point_curvature(pts)
+        assert k.max() <= kmax * (1.0 + 1e-6), (k.max(), kmax)
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_clearance_against_raw_grid(planned, name):
+    grid, robot, *_, traj, _ = planned[name]
+    for pts in _dense_points(traj, 0.002):
+        clr = square_clearance(grid, pts, reach=robot.radius + 0.1)
+        assert clr.min() >= robot.radius - 1e-9, clr.min()
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_moves_along_its_heading_and_rests_at_cusps(planned, name):
+    _, robot, *_, traj, _ = planned[name]
+    dt = 1e-4
+    t = np.linspace(dt, traj.duration - dt, 3001)
+    smp = traj.sample(t)
+    before, after = traj.sample(t - dt), traj.sample(t + dt)
+    vel = np.stack([(after.x - before.x), (after.y - before.y)], axis=1) / (2.0 * dt)
+    along = np.stack([smp.v * np.cos(smp.theta), smp.v * np.sin(smp.theta)], axis=1)
+    np.testing.assert_allclose(vel, along, atol=2e-3)
+    # the body's curvature is omega / v, and the direction is the sign of v
+    moving = np.abs(smp.v) > 1e-3
+    np.testing.assert_allclose(smp.kappa[moving], smp.omega[moving] / smp.v[moving], rtol=1e-9)
+    assert np.all(smp.v * smp.direction >= -1e-12)
+    # v = 0 at every join (cusp) and each join flips the direction
+    joins = traj.piece_times[1:-1]
+    at = traj.sample(joins)
+    np.testing.assert_array_equal(at.v, np.zeros(len(joins)))
+    dirs = [p.direction for p in traj.pieces]
+    assert all(a != b for a, b in zip(dirs[:-1], dirs[1:], strict=True))
+    assert traj.stats["car"]["cusps"] == len(joins)
+    # the heading is continuous: no jump between dense samples
+    assert np.abs(np.diff(smp.theta)).max() < 0.05
+
+
+def test_goal_behind_reverses_with_theta_the_tangent_plus_pi(planned):
+    _, robot, _, _, _, _, traj, _ = planned["behind"]
+    smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
+    assert np.all(smp.v <= 0.0) and smp.v.min() < -0.1
+    assert np.all(smp.direction == -1)
+    assert -smp.v.min() <= robot.v_max_reverse * (1.0 + 1e-9)
+    # travel direction from finite differences is the body's heading plus pi
+    mid = slice(100, -100)
+    dx, dy = np.diff(smp.x)[mid], np.diff(smp.y)[mid]
+    tangent = np.arctan2(dy, dx)
+    assert _angle_diff(tangent, smp.theta[:-1][mid] + math.pi).max() < 1e-3
+
+
+def test_three_point_turn_has_cusps(planned):
+    _, robot, *_, traj, _ = planned["three_point"]
+    assert traj.stats["car"]["cusps"] >= 1
+    assert -1 in [p.direction for p in traj.pieces]
+    smp = traj.sample(np.linspace(0.0, traj.duration, 4001))
+    assert smp.v.min() < 0.0 < smp.v.max()
+    # the steering angle is atan(wheelbase * kappa); its rate holds steer_rate_max within
+    # each segment (it may change at a cusp, where the car is at rest)
+    np.testing.assert_allclose(smp.steer, np.arctan(robot.wheelbase * smp.kappa), atol=1e-12)
+    for i in range(len(traj.pieces)):
+        t0, t1 = traj.piece_times[i], traj.piece_times[i + 1]
+        tt = np.linspace(t0 + 1e-6, t1 - 1e-6, 4001)
+        st = traj.sample(tt).steer
+        rate = np.abs(np.diff(st)) / np.diff(tt)
+        assert rate.max() <= robot.steer_rate_max * 1.01, (i, rate.max())
+
+
+def test_forward_only_uturn_never_reverses(planned):
+    _, robot, *_, traj, _ = planned["uturn"]
+    assert not robot.reverse
+    smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
+    assert np.all(smp.v >= 0.0) and np.all(smp.direction == 1)
+    assert traj.stats["car"]["cusps"] == 0
+    assert smp.x.max() > 3.5  # round the block's end (x = 3.5 m)
+
+
+def test_parallel_parking_ends_in_the_slot(planned):
+    grid, robot, *_, traj, _ = planned["parking"]
+    assert SLOT / CAR_LENGTH == pytest.approx(1.3)
+    smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
+    assert smp.v.min() < 0.0  # it backs in
+    np.testing.assert_allclose(smp.steer, np.arctan(robot.wheelbase * smp.kappa), atol=1e-12)
+
+
+def test_plans_are_quick(planned):
+    # warm (the first scene paid numba's load): a few hundred ms each at most
+    for name, (*_, seconds) in list(planned.items())[1:]:
+        assert seconds < 3.0, (name, seconds)
+
+
+def test_exports_carry_direction(planned, tmp_path):
+    *_, traj, _ = planned["three_point"]
+    d = traj.to_dict(0.05)
+    assert set(d["samples"]["direction"]) == {-1.0, 1.0}
+    assert d["units"]["steer"] == "rad"
+    json.dumps(d)
+    path = traj.to_csv(tmp_path / "car.csv", 0.05)
+    header = path.read_text().splitlines()[0]
+    assert "direction [1]" in header and "steer [rad]" in header
+
+
+# ------------------------------------------------------------------ bad input
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"drive": "ackermann"}, "min_turning_radius is required"),
+        (
+            {"drive": "ackermann", "min_turning_radius": 0.0},
+            r"min_turning_radius must be finite and > 0",
+        ),
+        (
+            {"drive": "ackermann", "min_turning_radius": -1.0},
+            r"must be finite and > 0 \(m\), got -1",
+        ),
+        (
+            {"drive": "ackermann", "min_turning_radius": math.inf},
+            "min_turning_radius must be finite",
+        ),
+        (
+            {"drive": "ackermann", "min_turning_radius": math.nan},
+            "min_turning_radius must be finite",
+        ),
+        (
+            {"drive": "ackermann", "wheelbase": 0.3},
+            r"min_turning_radius is required .*wheelbase=0.3",
+        ),
+        ({"wheelbase": 0.3}, r"wheelbase=0.3 apply only to a car-like robot .*'differential'"),
+        ({"drive": "omni", "min_turning_radius": 1.0}, "apply only to a car-like robot"),
+        ({"reverse": False}, "reverse=False apply only to a car-like robot"),
+        (
+            {"drive": "ackermann", "min_turning_radius": 1.0, "v_max_reverse": 0.0},
+            r"v_max_reverse must be finite and > 0 \(m/s\), got 0",
+        ),
+        (
+            {"drive": "ackermann", "min_turning_radius": 1.0, "wheelbase": -0.1},
+            r"wheelbase must be finite and > 0 \(m\)",
+        ),
+        (
+            {"drive": "ackermann", "min_turning_radius": 1.0, "steer_rate_max": 1.0},
+            "steer_rate_max=1.0 rad/s needs a wheelbase",
+        ),
+        ({"drive": "ackermann", "min_turning_radius": 1.0, "reverse": 1}, "reverse must be True"),
+    ],
+)
+def test_robot_car_fields_bad_input(kwargs, match):
+    with pytest.raises(InvalidInputError, match=match):
+        trajopt.Robot(**kwargs)
+
+
+def test_other_drives_keep_their_dict():
+    assert set(trajopt.Robot().to_dict()) == {
+        "radius", "v_max", "a_max", "j_max", "a_lat_max", "omega_max", "track_width",
+        "wheel_v_max", "footprint", "drive",
+    }  # fmt: skip
+    car = trajopt.Robot(drive="ackermann", min_turning_radius=1.0).to_dict()
+    assert car["min_turning_radius"] == 1.0 and car["reverse"] is True
+
+
+@pytest.mark.parametrize(
+    ("headings", "match"),
+    [
+        ({}, "needs both end headings .*start_heading and goal_heading are None"),
+        ({"start_heading": 0.0}, "goal_heading is None"),
+        ({"goal_heading": 0.0}, "start_heading is None"),
+    ],
+)
+def test_car_query_needs_headings(headings, match):
+    grid, robot, start, goal, *_ = behind_scene()
+    with pytest.raises(InvalidInputError, match=match):
+        trajopt.plan(grid, start, goal, robot, **headings)
+
+
+def test_car_with_a_footprint_is_refused():
+    grid, _, start, goal, *_ = behind_scene()
+    robot = trajopt.Robot.rectangle(0.4, 0.2, drive="ackermann", min_turning_radius=0.5)
+    with pytest.raises(InvalidInputError, match="with a footprint is not supported"):
+        trajopt.plan(grid, start, goal, robot, start_heading=0.0, goal_heading=0.0)
+
+
+def test_forward_only_goal_behind_is_a_typed_no_path_error_fast():
+    res = 0.05
+    grid = astar.OccupancyGrid(walled(4.0, 0.6, res), res)  # a corridor too narrow to turn
+    robot = trajopt.Robot(drive="ackermann", min_turning_radius=0.5, reverse=False)
+    t0 = time.perf_counter()
+    with pytest.raises(NoPathError, match=r"forwards only \(reverse=False\)") as info:
+        trajopt.plan(grid, (3.0, 0.3), (1.0, 0.3), robot, start_heading=0.0, goal_heading=0.0)
+    assert time.perf_counter() - t0 < 1.0
+    assert "reverse=True" in str(info.value)
+    # the same query with reversing allowed is planned, backwards
+    back = dataclasses.replace(robot, reverse=True)
+    traj = trajopt.plan(grid, (3.0, 0.3), (1.0, 0.3), back, start_heading=0.0, goal_heading=0.0)
+    assert traj.sample(traj.duration / 2).v < 0.0
