@@ -83,6 +83,12 @@ def replan_from(
     (the planner passes its recent median when the caller gives none); ``grid``, an
     updated map, is applied to ``caches`` first (:meth:`PlannerCaches.update`).
     """
+    if options.robot.drive == "ackermann":
+        raise InvalidInputError(
+            "replan does not support a car-like robot (drive='ackermann') yet: it could ask "
+            "the car to turn in place; stop and plan from rest with Planner.plan (a State at "
+            "rest is a valid start)"
+        )
     lat = nonnegative("latency", latency, "s")
     t_now = number("t", t, unit="s", lo=0.0, hi=float(trajectory.duration))
     ts = t_now + lat

@@ -317,3 +317,10 @@ def test_forward_only_goal_behind_is_a_typed_no_path_error_fast():
     back = dataclasses.replace(robot, reverse=True)
     traj = trajopt.plan(grid, (3.0, 0.3), (1.0, 0.3), back, start_heading=0.0, goal_heading=0.0)
     assert traj.sample(traj.duration / 2).v < 0.0
+
+
+def test_replan_of_a_car_is_refused(planned):
+    grid, robot, start, goal, h0, h1, traj, _ = planned["three_point"]
+    planner = trajopt.Planner(grid, robot)
+    with pytest.raises(InvalidInputError, match="replan does not support a car-like robot"):
+        planner.replan(traj, traj.duration / 3)
