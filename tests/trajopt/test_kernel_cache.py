@@ -7,57 +7,35 @@
 * In a fresh numba cache: the kernels are cold, worker processes compile them into the
   cache, and a first compilation logs one notice per process (none when loading).
 * ``trajopt warm-up`` on the command line.
+
+The fresh processes these checks need start together when the module's first test runs
+(fixture ``started``) and run side by side; each test reads its own.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
-import textwrap
 
 import pytest
 
 import trajopt._kernel_cache as kernel_cache
+from tests.processes import Started
 from trajopt.cli import main
 
-
-def _run(script: str, *args: str, env: dict | None = None) -> subprocess.CompletedProcess:
-    out = subprocess.run(
-        [sys.executable, "-c", textwrap.dedent(script), *args],
-        capture_output=True,
-        text=True,
-        check=False,
-        env=env,
-    )
-    assert out.returncode == 0, out.stderr[-3000:]
-    return out
-
-
-def _fresh_cache(tmp_path) -> dict:
-    """The environment of a process with an empty numba cache (a fresh clone's)."""
-    return dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
-
-
-def test_every_dispatcher_is_in_a_kernel_module():
-    script = """
-        import importlib, json, pkgutil
-        from numba.core.dispatcher import Dispatcher
-        import astar, trajopt
-        found = {}
-        for pkg in (astar, trajopt):
-            for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
-                mod = importlib.import_module(m.name)
-                for k, v in vars(mod).items():
-                    if isinstance(v, Dispatcher) and v.py_func.__module__ == m.name:
-                        found.setdefault(m.name, []).append(k)
-        print(json.dumps(found))
-    """
-    found = json.loads(_run(script).stdout)
-    assert set(found) == set(kernel_cache.KERNEL_MODULES)
-    listed = kernel_cache.dispatchers()
-    assert sorted(listed) == sorted(f"{m}.{k}" for m, ks in found.items() for k in ks)
+EVERY_DISPATCHER = """
+    import importlib, json, pkgutil
+    from numba.core.dispatcher import Dispatcher
+    import astar, trajopt
+    found = {}
+    for pkg in (astar, trajopt):
+        for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
+            mod = importlib.import_module(m.name)
+            for k, v in vars(mod).items():
+                if isinstance(v, Dispatcher) and v.py_func.__module__ == m.name:
+                    found.setdefault(m.name, []).append(k)
+    print(json.dumps(found))
+"""
 
 
 WARM_UP_REACHES_EVERYTHING = """
@@ -104,29 +82,104 @@ WARM_UP_REACHES_EVERYTHING = """
 """
 
 
-def test_warm_up_compiles_loads_and_reaches_every_kernel():
+#: In a fresh numba cache: two workers compile the "grid" and "astar" exercises' kernels.
+FRESH_CACHE_COMPILE = """
+    import json
+    import trajopt._kernel_cache as kernel_cache
+    cold = kernel_cache.cold_kernels()
+    report = kernel_cache.compile_kernels(["grid", "astar"], workers=2)
+    print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
+                      "failed": report.failed, "left": kernel_cache.cold_kernels()}))
+"""
+
+#: A new process on the cache the workers filled: it loads, nothing compiles and nothing
+#: is logged; then a first compilation logs one line, a second one nothing.
+FRESH_CACHE_LOAD = """
+    import logging, sys
+    logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
+    import numba.core.event as ev
+    import numpy as np
+    import trajopt._kernel_cache as kernel_cache
+    from trajopt.geometry._convex_hull import convex_hull
+    rec = ev.install_recorder("numba:compile").__enter__()
+    n = kernel_cache.load_kernels(["astar.distance_transform", "astar.inflation",
+                                   "astar.search_kernels"])
+    print(n, sum(1 for e in rec.buffer if e[1].is_start))
+    print("LOADED", file=sys.stderr, flush=True)
+    convex_hull(np.random.default_rng(0).normal(size=(20, 2)))
+    convex_hull(np.random.default_rng(1).normal(size=(20, 2)))
+"""
+
+#: The exercises live in trajopt._warm_up, a name of their own: importing that module (as
+#: the compile workers do) leaves trajopt.warm_up the function.
+EXERCISES_MODULE = """
+    import types
+    import trajopt._warm_up
+    import trajopt._kernel_cache as kernel_cache
+    assert kernel_cache.warm_up_module() is trajopt._warm_up
+    from trajopt import warm_up
+    assert callable(warm_up) and not isinstance(warm_up, types.ModuleType), warm_up
+    assert warm_up is trajopt._warm_up.warm_up
+    print("ok")
+"""
+
+#: The fresh processes each test reads (the fresh-cache test starts its second one itself).
+PROCESSES = {
+    "test_every_dispatcher_is_in_a_kernel_module": EVERY_DISPATCHER,
+    "test_warm_up_compiles_loads_and_reaches_every_kernel": WARM_UP_REACHES_EVERYTHING,
+    "test_fresh_cache_workers_compile_and_a_notice_shows_once": FRESH_CACHE_COMPILE,
+    "test_the_exercises_module_does_not_shadow_trajopt_warm_up": EXERCISES_MODULE,
+}
+
+
+@pytest.fixture(scope="module")
+def fresh_cache(tmp_path_factory) -> dict:
+    """The environment of a process with an empty numba cache (a fresh clone's)."""
+    return dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba")))
+
+
+@pytest.fixture(scope="module")
+def started(request, fresh_cache):
+    """The fresh processes of the selected tests, all started at once (tests/processes.py)."""
+    names = {i.originalname for i in request.session.items if i.module is request.module}
+    runs = {
+        name: Started(script, env=fresh_cache if "fresh_cache" in name else None)
+        for name, script in PROCESSES.items()
+        if name in names
+    }
+    yield runs
+    for run in runs.values():
+        run.stop()
+
+
+def _ok(run: Started) -> str:
+    out = run.result()
+    assert out.returncode == 0, out.stderr[-3000:]
+    return out.stdout
+
+
+def test_every_dispatcher_is_in_a_kernel_module(started):
+    found = json.loads(_ok(started["test_every_dispatcher_is_in_a_kernel_module"]))
+    assert set(found) == set(kernel_cache.KERNEL_MODULES)
+    listed = kernel_cache.dispatchers()
+    assert sorted(listed) == sorted(f"{m}.{k}" for m, ks in found.items() for k in ks)
+
+
+def test_warm_up_compiles_loads_and_reaches_every_kernel(started):
     # A fresh process: after trajopt.warm_up() every kernel has a compiled signature (the
     # inline="always" ones excepted: numba inlines them into their callers, so they have none
     # of their own), and the exercises reach every dispatcher, by a call from Python or as a
     # callee of one they call (read from the kernels' code): a new kernel left out of the
     # exercises fails here even when numba's cache already holds it from another run.
-    out = json.loads(_run(WARM_UP_REACHES_EVERYTHING).stdout.splitlines()[-1])
+    run = started["test_warm_up_compiles_loads_and_reaches_every_kernel"]
+    out = json.loads(_ok(run).splitlines()[-1])
     assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt._warm_up.EXERCISES)"
     assert out["unloaded"] == [], "kernels without a compiled signature after warm_up()"
     assert out["inline_called_alone"] == []
 
 
-def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
-    env = _fresh_cache(tmp_path)
-    script = """
-        import json
-        import trajopt._kernel_cache as kernel_cache
-        cold = kernel_cache.cold_kernels()
-        report = kernel_cache.compile_kernels(["grid", "astar"], workers=2)
-        print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
-                          "failed": report.failed, "left": kernel_cache.cold_kernels()}))
-    """
-    out = json.loads(_run(script, env=env).stdout)
+def test_fresh_cache_workers_compile_and_a_notice_shows_once(started, fresh_cache):
+    out = json.loads(_ok(started["test_fresh_cache_workers_compile_and_a_notice_shows_once"]))
     grid = {
         "astar.distance_transform._transform",
         "astar.distance_transform._column_pass",
@@ -140,27 +193,11 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(tmp_path):
     assert grid <= set(out["compiled"])
     assert not grid & set(out["left"])
     assert set(out["left"]) == set(out["cold"]) - set(out["compiled"])
-    # the cache the workers filled serves a new process: it loads, nothing compiles and
-    # nothing is logged; then a first compilation logs one line, a second one nothing
-    script = """
-        import logging, sys
-        logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
-        import numba.core.event as ev
-        import numpy as np
-        import trajopt._kernel_cache as kernel_cache
-        from trajopt.geometry._convex_hull import convex_hull
-        rec = ev.install_recorder("numba:compile").__enter__()
-        n = kernel_cache.load_kernels(["astar.distance_transform", "astar.inflation",
-                                       "astar.search_kernels"])
-        print(n, sum(1 for e in rec.buffer if e[1].is_start))
-        print("LOADED", file=sys.stderr, flush=True)
-        convex_hull(np.random.default_rng(0).normal(size=(20, 2)))
-        convex_hull(np.random.default_rng(1).normal(size=(20, 2)))
-    """
-    out = _run(script, env=env)
-    loaded, compiled = map(int, out.stdout.split())
+    # the cache the workers filled serves a new process (FRESH_CACHE_LOAD)
+    run = Started(FRESH_CACHE_LOAD, env=fresh_cache)
+    loaded, compiled = map(int, _ok(run).split())
     assert loaded >= len(grid) and compiled == 0
-    before, after = out.stderr.split("LOADED")
+    before, after = run.result().stderr.split("LOADED")
     assert "compiling numerical kernels" not in before, before
     lines = [s for s in after.splitlines() if "compiling numerical kernels once" in s]
     assert len(lines) == 1, after
@@ -190,17 +227,6 @@ def test_unknown_exercise_is_an_error():
         kernel_cache.compile_kernels(["nope"], force=True)
 
 
-def test_the_exercises_module_does_not_shadow_trajopt_warm_up():
-    # the exercises live in trajopt._warm_up, a name of their own: importing that module
-    # (as the compile workers do) leaves trajopt.warm_up the function
-    script = """
-        import types
-        import trajopt._warm_up
-        import trajopt._kernel_cache as kernel_cache
-        assert kernel_cache.warm_up_module() is trajopt._warm_up
-        from trajopt import warm_up
-        assert callable(warm_up) and not isinstance(warm_up, types.ModuleType), warm_up
-        assert warm_up is trajopt._warm_up.warm_up
-        print("ok")
-    """
-    assert _run(script).stdout.strip() == "ok"
+def test_the_exercises_module_does_not_shadow_trajopt_warm_up(started):
+    run = started["test_the_exercises_module_does_not_shadow_trajopt_warm_up"]
+    assert _ok(run).strip() == "ok"  # EXERCISES_MODULE

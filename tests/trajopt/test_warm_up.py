@@ -6,14 +6,13 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import textwrap
 
 import numpy as np
 import pytest
 
 import astar
+from tests.processes import Started, selected_params
 from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
 from trajopt.analysis.scenes import warm_up_map
@@ -60,13 +59,13 @@ def test_warm_up_map_leaves_room_for_the_robot(kind):
     assert grid.occupied[:, grid.occupied.shape[1] // 2].any()  # a wall between them
 
 
-@pytest.mark.parametrize("kind", ["disc", "costmap", "rectangle", "all"])
-def test_first_plans_after_warm_up_load_no_kernel(kind):
-    # a fresh process: after warm_up(planner), the paper scene's four queries load or compile
-    # no numba kernel (counted at numba's own cache and dispatcher entry points); after
-    # warm_up() with no planner, neither do those of every planner kind nor a comparison
-    script = textwrap.dedent(
-        """
+FIRST_PLANS = ["disc", "costmap", "rectangle", "all"]
+
+#: A fresh process: after warm_up(planner), the paper scene's four queries load or compile no
+#: numba kernel (counted at numba's own cache and dispatcher entry points); after warm_up()
+#: with no planner, neither do those of every planner kind nor a comparison.
+FIRST_PLANS_SCRIPT = textwrap.dedent(
+    """
         import sys
         import numpy as np
         import numba.core.caching as caching
@@ -120,10 +119,23 @@ def test_first_plans_after_warm_up_load_no_kernel(kind):
                             w_cells=scene.w_cells)
         print("EVENTS", events)
         """
-    )
-    out = subprocess.run(
-        [sys.executable, "-c", script, kind], capture_output=True, text=True, check=False
-    )
+)
+
+
+@pytest.fixture(scope="module")
+def first_plan_runs(request):
+    """The fresh processes of the selected kinds, all started at once (tests/processes.py)."""
+    kinds = selected_params(request, "test_first_plans_after_warm_up_load_no_kernel", "kind")
+    runs = {kind: Started(FIRST_PLANS_SCRIPT, kind) for kind in kinds}
+    yield runs
+    for run in runs.values():
+        run.stop()
+
+
+@pytest.mark.parametrize("kind", FIRST_PLANS)
+def test_first_plans_after_warm_up_load_no_kernel(kind, first_plan_runs):
+    # each kind in its own fresh process (FIRST_PLANS_SCRIPT), all started by the fixture
+    out = first_plan_runs[kind].result()
     assert out.returncode == 0, out.stderr[-2000:]
     assert "EVENTS []" in out.stdout, out.stdout + out.stderr[-2000:]
 
