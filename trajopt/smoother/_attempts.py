@@ -188,6 +188,12 @@ def fit(
                 if found is not None:
                     curve, cert, fcert = found
                     rec.failure = None
+                    if refined is not None:  # the polish was of the curve replaced here
+                        refined.pop("c", None)
+                        refined["stats"] = {
+                            "status": "skipped",
+                            "reason": "the footprint rounds replaced the fast result",
+                        }
         if fcert is not None:
             rec.footprint_margin_m = fcert.min_margin_m
         if cert.ok and (fcert is None or fcert.ok):

@@ -21,7 +21,7 @@ import pytest
 import astar
 import trajopt
 from tests.cases import square_inflated
-from tests.reference import square_clearance, three_point_curvature
+from tests.reference import footprint_collides, square_clearance, three_point_curvature
 from tests.trajopt.smoother.test_cost import GOAL as HALL_GOAL
 from tests.trajopt.smoother.test_cost import RES, dense_mean_cost, l_hall
 from tests.trajopt.smoother.test_cost import START as HALL_START
@@ -369,3 +369,29 @@ def test_end_headings_hold_with_refine():
 def test_bad_refine_values_are_typed_errors(value):
     with pytest.raises(InvalidInputError, match=r"refine must be one of \(None, 'ipopt'\)"):
         Smoother(refine=value)
+
+
+def _short_halls(width: float = 0.56, res: float = 0.02, n: int = 120):
+    """Two halls of ``width`` (m) at a right angle, shorter than test_footprint_rounds'."""
+    occ = np.ones((n, n), bool)
+    w, e = int(round(width / res)), n - 20
+    occ[20 : 20 + w, 20:e] = False
+    occ[20:e, e - w : e] = False
+    return astar.OccupancyGrid(occ, res), (0.9, (20 + w / 2) * res), ((e - w / 2) * res, 1.64)
+
+
+@pytest.mark.parametrize("options", [{"qp_solver": "ipopt"}, {"refine": "ipopt"}])
+def test_footprint_with_ipopt(options):
+    """A rectangle turning between two halls: the footprint rounds (QP footprint SCP, end
+    headings pinned) with IPOPT's QP or the polish; every pose clear on dense samples."""
+    robot = trajopt.Robot.rectangle(0.7, 0.4)
+    grid, s, g = _short_halls()
+    traj = trajopt.Planner(grid, robot, smoother=Smoother(**options)).plan(s, g)
+    st = traj.steps.smooth_path.stats
+    assert traj.stats["footprint"]["rejected"] == []
+    if "qp_solver" in options:
+        assert st["solver"] == "ipopt"
+    else:
+        assert st["refine"]["status"] in ("improved", "not better", "not certified", "skipped")
+    smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
+    assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
