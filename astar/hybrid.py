@@ -520,7 +520,8 @@ def _assemble(
             continue
         k = float(skinds[i]) / radius
         raw.append([x, y, th, k, float(slens[i])])
-        x, y, th = advance(x, y, th, k, float(slens[i]))
+        # the kernel's closed form run as Python (an inlined kernel has no signature of its own)
+        x, y, th = advance.py_func(x, y, th, k, float(slens[i]))
     pieces: list[list[float]] = []
     for r in raw:
         if pieces and pieces[-1][3] == r[3] and (pieces[-1][4] < 0) == (r[4] < 0):

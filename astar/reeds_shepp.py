@@ -458,13 +458,6 @@ def car_word(
     return total * radius, n
 
 
-@njit(cache=True)
-def car_length(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf):  # pragma: no cover
-    """Length of :func:`car_word` (same arguments; the buffers are overwritten)."""
-    total, _ = car_word(x0, y0, th0, x1, y1, th1, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
-    return total
-
-
 @njit(cache=True, inline="always")
 def advance(x, y, th, kappa, s):  # pragma: no cover - compiled
     """Pose after signed arc length ``s`` at curvature ``kappa`` (closed form)."""

@@ -49,7 +49,9 @@ _log = logging.getLogger(__name__)
 #: Modules that define the compiled (numba) kernels of astar and trajopt.
 KERNEL_MODULES: tuple[str, ...] = (
     "astar.distance_transform",
+    "astar.hybrid_kernel",
     "astar.inflation",
+    "astar.reeds_shepp",
     "astar.search_kernels",
     "astar.weighted_kernel",
     "trajopt.geometry._bspline",

@@ -30,6 +30,7 @@ default planner plans the query.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -277,6 +278,21 @@ def _exercise_planners() -> None:
     planner.replan(traj, 0.3 * traj.duration, latency=0.0, reuse=False)
 
 
+def _exercise_car() -> None:
+    """Search pose to pose for a car-like robot (Hybrid-A*) both ways; the analytic curves."""
+    import astar
+
+    grid, a, b = _search_query()
+    start, goal = (float(a[0]), float(a[1]), 0.0), (float(b[0]), float(b[1]), math.pi / 2)
+    for reverse in (True, False):
+        try:
+            astar.find_pose_path(grid, start, goal, turning_radius=3.0, reverse=reverse)
+        except astar.NoPathError:  # compiled all the same
+            pass
+    astar.reeds_shepp_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
+    astar.dubins_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
+
+
 def _exercise_compare() -> None:
     """Compare the chapter's methods (:func:`trajopt.compare`)."""
     from trajopt.analysis.comparison import compare
@@ -302,6 +318,7 @@ EXERCISES: dict[str, Exercise] = {
     ),
     "planners": Exercise(_exercise_planners, after=("plan", "astar", "fallback"), seconds=1.0),
     "compare": Exercise(_exercise_compare, after=("plan",), seconds=0.5),
+    "car": Exercise(_exercise_car, seconds=8.0),
 }
 
 #: What a default plan and :func:`trajopt.compare` need (with what they depend on): the
