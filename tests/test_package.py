@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import inspect
 import subprocess
@@ -104,6 +105,13 @@ def _layer(module: str) -> int:
 
 def _imports(path: Path, prefixes: tuple[str, ...] = ("trajopt.",)) -> list[tuple[str, int]]:
     """``(imported module, line)`` of every import of ``prefixes`` outside TYPE_CHECKING."""
+    return [(n, line) for n, line in _absolute_imports(path) if n.startswith(prefixes)]
+
+
+@functools.cache
+def _absolute_imports(path: Path) -> tuple[tuple[str, int], ...]:
+    """``(imported module, line)`` of every absolute import outside TYPE_CHECKING (each file
+    is parsed once per session: two tests read every file)."""
     tree = ast.parse(path.read_text())
     guarded = {
         id(sub)
@@ -123,8 +131,8 @@ def _imports(path: Path, prefixes: tuple[str, ...] = ("trajopt.",)) -> list[tupl
             continue
         if isinstance(node, ast.ImportFrom):  # "from pkg import module" imports pkg.module
             names += [f"{node.module}.{a.name}" for a in node.names]
-        out += [(n, node.lineno) for n in names if n.startswith(prefixes)]
-    return out
+        out += [(n, node.lineno) for n in names]
+    return tuple(out)
 
 
 def test_no_import_runs_up_a_layer():
