@@ -198,14 +198,13 @@ def quadrature(term: CostTerm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     b0 = np.zeros((Q, p + 1))
     b1 = np.zeros((Q, p + 1))
     wq = np.zeros(Q)
-    # span j holds the N_GAUSS points of its knot interval; an empty interval (repeated
-    # knot) has none, so place each point by its span
-    slot = np.zeros(len(term.span), dtype=np.int64)
-    for j in np.unique(term.span):
-        at = np.flatnonzero(term.span == j)
-        if len(at) > N_GAUSS:  # pragma: no cover - one interval per span
-            raise ValueError(f"span {j} holds {len(at)} quadrature points")
-        slot[at] = N_GAUSS * j + np.arange(len(at))
+    # span j holds the N_GAUSS points of its knot interval (the points come in increasing
+    # parameter order, so by span); place each point by its span and rank within it
+    span = np.asarray(term.span, dtype=np.int64)
+    rank = np.arange(len(span)) - np.searchsorted(span, span, side="left")
+    if len(span) and rank.max() >= N_GAUSS:  # pragma: no cover - one interval per span
+        raise ValueError(f"a span holds more than {N_GAUSS} quadrature points")
+    slot = N_GAUSS * span + rank
     b0[slot], b1[slot] = term.b0, term.b1
     wq[slot] = term.scale * term.field.weight * term.wq
     return b0, b1, wq

@@ -395,3 +395,42 @@ def test_footprint_with_ipopt(options):
         assert st["refine"]["status"] in ("improved", "not better", "not certified", "skipped")
     smp = traj.sample(np.linspace(0.0, traj.duration, 3000))
     assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
+
+
+def test_nlp_cost_term_matches_a_dense_integral_off_the_origin():
+    """The IPOPT problem's cost term (its objective with the term less without) at a curve,
+    on a map whose origin is not (0, 0), against a dense trapezoid of ``s w cost |C'|`` with
+    scipy's FITPACK interpolating bicubic spline of the same smoothed cells."""
+    from scipy.interpolate import BSpline, RectBivariateSpline
+
+    grid0, cost, _ = l_hall()
+    origin = (-3.2, 1.7)
+    grid = astar.OccupancyGrid(~grid0.free, RES, origin)
+    shift = np.asarray(origin)
+    pts = np.vstack(
+        [np.linspace(HALL_START, (2.9, 1.1), 40), np.linspace((2.9, 1.1), HALL_GOAL, 40)[1:]]
+    )
+    corridor = build_polygon_corridor(grid, pts + shift, 0.2)
+    options = Smoother(qp_solver="ipopt")
+    ends = {"start": np.add(HALL_START, shift), "goal": np.add(HALL_GOAL, shift)}
+    prob, _, _ = build_problem(options, None, corridor, hs=None, hg=None, **ends)
+    asm = assemble(options, prob, 4.0)
+    qp = asm.qp
+    z = _qp.solve_qp(Smoother(), qp, x0=asm.x0).z
+    field = cost_field(cost, 2.0, grid)
+    scale = rec_scale(options, prob)
+    term = CostTerm.on_knots(field, np.asarray(corridor.origin), RES, asm.knots, 3, qp.nb, scale)
+    _, with_cost = _nlp.solve_nlp(options, qp, asm.knots, z, 60.0, cost=on_window(term, prob))
+    _, without = _nlp.solve_nlp(options, qp, asm.knots, z, 60.0)
+    # the reference: the curve in metres, the field on cell centres in metres
+    c = np.column_stack([z[: qp.n], z[qp.nb : qp.nb + qp.n]]) * RES + np.asarray(corridor.origin)
+    curve = BSpline(asm.knots * RES, c, 3)
+    ny, nx = field.cost.shape
+    xc = field.origin[0] + (np.arange(nx) + 0.5) * RES
+    yc = field.origin[1] + (np.arange(ny) + 0.5) * RES
+    spl = RectBivariateSpline(xc, yc, field.cost.T, kx=3, ky=3, s=0)
+    u = np.linspace(curve.t[3], curve.t[-4], 40001)
+    xy, d = curve(u), curve.derivative()(u)
+    f = spl(xy[:, 0], xy[:, 1], grid=False) * np.hypot(d[:, 0], d[:, 1])  # |dC/du|: unitless
+    ref = scale * 2.0 * np.trapezoid(f, u / RES)
+    assert with_cost - without == pytest.approx(ref, rel=1e-4)
