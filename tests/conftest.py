@@ -89,7 +89,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 def pytest_collection_finish(session: pytest.Session) -> None:
     """Start executing the selected notebooks in a background thread (tests/notebook_runner.py)."""
     items = _notebook_items(session.items)
-    if not items:
+    if not items or session.config.option.collectonly:
         return
     from tests import notebook_runner
 
