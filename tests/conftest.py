@@ -73,8 +73,7 @@ def _notebook_items(items: list[pytest.Item]) -> list[pytest.Item]:
         i
         for i in items
         if getattr(i, "originalname", None) == "test_notebook_executes"
-        and i.module is not None
-        and i.module.__name__ == "tests.test_notebooks"
+        and getattr(getattr(i, "module", None), "__name__", None) == "tests.test_notebooks"
     ]
 
 
