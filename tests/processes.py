@@ -54,5 +54,6 @@ def selected_params(request, test_name: str, param: str) -> list:
     return [
         i.callspec.params[param]
         for i in request.session.items
-        if getattr(i, "originalname", None) == test_name and i.module is request.module
+        if getattr(i, "originalname", None) == test_name
+        and getattr(i, "module", None) is request.module
     ]

@@ -141,7 +141,11 @@ def fresh_cache(tmp_path_factory) -> dict:
 @pytest.fixture(scope="module")
 def started(request, fresh_cache):
     """The fresh processes of the selected tests, all started at once (tests/processes.py)."""
-    names = {i.originalname for i in request.session.items if i.module is request.module}
+    names = {
+        getattr(i, "originalname", None)
+        for i in request.session.items
+        if getattr(i, "module", None) is request.module
+    }
     runs = {
         name: Started(script, env=fresh_cache if "fresh_cache" in name else None)
         for name, script in PROCESSES.items()
