@@ -14,8 +14,9 @@
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
 from trajopt.motion._omni import OmniTrajectory
+from trajopt.motion._samples import CarSample, OmniSample, TrajectorySample
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import CarSample, OmniSample, Trajectory, TrajectorySample
+from trajopt.motion._trajectory import Trajectory
 
 __all__ = [
     "CarSample",

@@ -22,13 +22,8 @@ import numpy as np
 
 from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
-from trajopt.motion._trajectory import (
-    AtRestEnds,
-    SampledExport,
-    TrajectorySample,
-    export_dict,
-    make_sample,
-)
+from trajopt.motion._samples import TrajectorySample, make_sample
+from trajopt.motion._trajectory import AtRestEnds, SampledExport, export_dict
 from trajopt.robot._robot import Robot
 
 #: Largest jump (SI units) between two consecutive pieces of a chain.

@@ -13,7 +13,7 @@ built by :func:`trajopt.timing.orient`. The motion lasts ``max(T, T_rot)``: when
 takes longer than the drive, the robot stands at the path's end (``v = 0``) while it
 finishes turning.
 
-Sampling conventions (:class:`~trajopt.motion._trajectory.OmniSample`):
+Sampling conventions (:class:`~trajopt.motion._samples.OmniSample`):
 
 * ``theta`` is the **orientation** of the body (rad, continuous and unwrapped) and ``omega``
   its rate ``d theta / dt`` (rad/s): what the base turns by. The pose of :meth:`to_poses`
@@ -46,7 +46,8 @@ import numpy as np
 
 from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
-from trajopt.motion._trajectory import OmniSample, SampledExport, Trajectory, export_dict
+from trajopt.motion._samples import OmniSample
+from trajopt.motion._trajectory import SampledExport, Trajectory, export_dict
 from trajopt.robot._robot import Robot
 from trajopt.robot._state import State
 

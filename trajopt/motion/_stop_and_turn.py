@@ -2,7 +2,7 @@
 
 Built by :func:`trajopt.timing.stop_and_turn` (the producer; its limits are described there).
 
-Sampling conventions (:class:`~trajopt.motion._trajectory.TrajectorySample`): ``v``, ``a``,
+Sampling conventions (:class:`~trajopt.motion._samples.TrajectorySample`): ``v``, ``a``,
 ``jerk`` and ``s`` describe the motion along the path (``s`` is the distance travelled, it
 never decreases); ``omega`` is ``d theta / dt``. **``kappa`` is 0 everywhere**: the path is
 straight between its vertices, and at a vertex the robot turns at rest, where the curvature
@@ -21,7 +21,8 @@ import numpy as np
 from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._curve import PolylineCurve
-from trajopt.motion._trajectory import AtRestEnds, TrajectorySample, export_dict, make_sample
+from trajopt.motion._samples import TrajectorySample, make_sample
+from trajopt.motion._trajectory import AtRestEnds, export_dict
 from trajopt.robot._robot import Robot
 
 

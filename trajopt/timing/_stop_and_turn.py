@@ -24,7 +24,7 @@ The heading is continuous and unwrapped; it is constant on every segment and cha
 while the robot is at rest. Consecutive points closer than 1e-9 m and vertices where the
 path goes straight on (turn below 1e-12 rad) are dropped before planning.
 
-Sampling conventions (:class:`~trajopt.motion._trajectory.TrajectorySample`): ``v``, ``a``,
+Sampling conventions (:class:`~trajopt.motion._samples.TrajectorySample`): ``v``, ``a``,
 ``jerk`` and ``s`` describe the motion along the path (``s`` is the distance travelled, it
 never decreases); ``omega`` is ``d theta / dt``. **``kappa`` is 0 everywhere**: the path is
 straight between its vertices, and at a vertex the robot turns at rest, where the curvature

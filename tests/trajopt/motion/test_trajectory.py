@@ -14,7 +14,8 @@ import pytest
 from tests.cases import Arc, line
 from tests.reference import integrate_jerk
 from trajopt.errors import InvalidInputError
-from trajopt.motion._trajectory import SAMPLE_UNITS, Trajectory
+from trajopt.motion._samples import SAMPLE_UNITS
+from trajopt.motion._trajectory import Trajectory
 from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
 
