@@ -203,10 +203,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     p0, p1, h0, h1 = _ends(options, grid, request)
     res = grid.resolution
     with timer.stage("inflate"):
-        margin = robot.radius + SEARCH_MARGIN_CELLS * res
-        search_grid = grid.with_occupied(
-            astar.inflate(grid, margin, metric="square", outside_occupied=True).occupied
-        )
+        search_grid = car_search_grid(robot, grid)
     start = _to_cells(grid, p0, h0)
     goal = _to_cells(grid, p1, h1)
     for name, c, p in (("start", start, p0), ("goal", goal, p1)):
@@ -264,6 +261,28 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
         "inflation": options.inflation,
     }
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+def car_search_grid(robot: Robot, grid: OccupancyGrid) -> OccupancyGrid:
+    """Return the grid a car's search runs on: ``grid`` inflated by the radius plus a margin.
+
+    Parameters
+    ----------
+    robot : Robot
+        The car (its ``radius``, m).
+    grid : astar.OccupancyGrid
+        The raw map.
+
+    Returns
+    -------
+    astar.OccupancyGrid
+        ``grid`` with every cell within ``robot.radius`` plus :data:`SEARCH_MARGIN_CELLS`
+        cells of an occupied square (or of the outside) occupied.
+    """
+    margin = robot.radius + SEARCH_MARGIN_CELLS * grid.resolution
+    return grid.with_occupied(
+        astar.inflate(grid, margin, metric="square", outside_occupied=True).occupied
+    )
 
 
 def _ends(

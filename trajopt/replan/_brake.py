@@ -214,7 +214,7 @@ def brake_turn_go(
         brake = brake_on_path(traj, t_in)
         if brake is not None:
             steps = getattr(traj, "steps", None) or getattr(trajectory, "steps", None)
-            _check_new_obstacles(robot, caches.grid, steps, brake)
+            check_new_obstacles(robot, caches.grid, steps, brake)
             pieces.append(brake)
             starts.append(0.0)
             stop = brake.sample(np.array([brake.duration]))
@@ -297,7 +297,7 @@ def _brake_go_omni(
     pieces: list[Any] = []
     if brake is not None:  # the translation brakes; the yaw rate stops beside it
         steps = translation.steps or traj.steps or getattr(trajectory, "steps", None)
-        _check_new_obstacles(robot, caches.grid, steps, brake)
+        check_new_obstacles(robot, caches.grid, steps, brake)
         stop = stop_orientation(
             brake, robot, start.theta, omega_start=start.omega, alpha_start=start.alpha
         )
@@ -411,11 +411,11 @@ def _resume(
         dt=options.timing_dt,
         speed_limits=options.speed_limits,
     )
-    _check_new_obstacles(options.robot, grid, steps, rest)
+    check_new_obstacles(options.robot, grid, steps, rest)
     return [rest]
 
 
-def _check_new_obstacles(robot: Robot, grid: OccupancyGrid, steps: Any, brake: Trajectory) -> None:
+def check_new_obstacles(robot: Robot, grid: OccupancyGrid, steps: Any, brake: Trajectory) -> None:
     """Raise :class:`TimingError` if a cell occupied since ``steps`` was planned is in reach.
 
     ``brake``: a piece driven on the old path (the stop, or the old path's resumed rest).

@@ -48,6 +48,7 @@ from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import WarmStart
 from trajopt.planning._runner import run_query
 from trajopt.replan._brake import brake_turn_go
+from trajopt.replan._car import replan_car
 from trajopt.replan._keep import (
     BLOCKED_NEAR,
     keep_omni,
@@ -83,12 +84,6 @@ def replan_from(
     (the planner passes its recent median when the caller gives none); ``grid``, an
     updated map, is applied to ``caches`` first (:meth:`PlannerCaches.update`).
     """
-    if options.robot.drive == "ackermann":
-        raise InvalidInputError(
-            "replan does not support a car-like robot (drive='ackermann') yet: it could ask "
-            "the car to turn in place; stop and plan from rest with Planner.plan (a State at "
-            "rest is a valid start)"
-        )
     lat = nonnegative("latency", latency, "s")
     t_now = number("t", t, unit="s", lo=0.0, hi=float(trajectory.duration))
     ts = t_now + lat
@@ -110,6 +105,18 @@ def replan_from(
         brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
         caches.update(grid)
+    if options.robot.drive == "ackermann":  # never a turn in place: keep, or brake and plan
+        out = replan_car(
+            options,
+            caches,
+            trajectory,
+            ts,
+            goal,
+            goal_heading=goal_heading,
+            v_end=v_end,
+            reuse=reuse,
+        )
+        return dataclasses.replace(out, stats=dict(out.stats, splice_time_s=ts, latency_s=lat))
     out, why = None, NO_REUSE
     piece, t_piece = trajectory, ts
     if isinstance(trajectory, TrajectoryChain):
