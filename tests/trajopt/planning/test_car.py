@@ -319,8 +319,10 @@ def test_forward_only_goal_behind_is_a_typed_no_path_error_fast():
     assert traj.sample(traj.duration / 2).v < 0.0
 
 
-def test_replan_of_a_car_is_refused(planned):
+def test_replan_of_a_car_on_the_same_map_keeps_its_rest(planned):
+    # re-planning a car: tests/trajopt/replan/test_replan_car.py
     grid, robot, start, goal, h0, h1, traj, _ = planned["three_point"]
     planner = trajopt.Planner(grid, robot)
-    with pytest.raises(InvalidInputError, match="replan does not support a car-like robot"):
-        planner.replan(traj, traj.duration / 3)
+    out = planner.replan(traj, traj.duration / 3, latency=0.0)
+    assert out.stats["replan"] == "kept"
+    assert out.duration == pytest.approx(traj.duration * 2 / 3, abs=1e-9)
