@@ -29,6 +29,10 @@ orientation profile (:func:`~trajopt.replan._keep.keep_omni`), and a braking re-
 the yaw rate while it brakes. A plain :class:`~trajopt.Trajectory` of an omni base faces its
 direction of travel; re-planned to a goal heading, its orientation starts with the
 direction of travel's rate and acceleration when they are within the yaw limits.
+
+A car-like robot (``drive="ackermann"``) is re-planned by :mod:`trajopt.replan._car`: it
+never turns in place and plans only from rest, so it keeps the rest, or brakes along the
+segment it drives (in its direction of travel) and plans a car path from the stopped pose.
 """
 
 from __future__ import annotations
