@@ -154,6 +154,12 @@ def replan_car(
         stop = piece.sample(np.array([tau]))
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     h_stop = float(stop.theta[0])
+    if brake is None and _at_pose(p_stop, h_stop, p_goal, goal_heading):
+        # standing at the goal pose already: nothing to drive (a rest of duration 0)
+        last = piece if tau >= piece.duration or i == 0 else trajectory.pieces[i - 1]
+        stats = dict(trajectory.stats, replan=f"planned: {why}; at the goal pose")
+        stats.update(brake_m=0.0, brake_s=0.0, turn_rad=0.0, turn_s=0.0)
+        return TrajectoryChain((last,), robot, stats, steps, (last.duration,))
     request = PlanRequest(p_stop, p_goal, start_heading=h_stop, goal_heading=goal_heading)
     where = (
         f"from rest at pose ({p_stop[0]:.6g} m, {p_stop[1]:.6g} m, {h_stop:.6g} rad)"
@@ -182,6 +188,14 @@ def replan_car(
     stages["replan_total"] = time.perf_counter() - t0
     stats["stages_s"] = stages
     return TrajectoryChain(tuple(pieces), robot, stats, out.steps)
+
+
+def _at_pose(p: tuple[float, float], h: float, goal: np.ndarray, goal_heading: float) -> bool:
+    """Whether the pose ``(p, h)`` is the goal pose (1e-9 m, 1e-9 rad modulo ``2 pi``)."""
+    return (
+        math.hypot(p[0] - float(goal[0]), p[1] - float(goal[1])) <= 1e-9
+        and abs(math.remainder(h - goal_heading, 2.0 * math.pi)) <= 1e-9
+    )
 
 
 def _check_trajectory(options: PlannerOptions, trajectory: Any) -> CarSteps:
@@ -219,8 +233,6 @@ def _keep(
     why = target_change(chain, goal, goal_heading, 0.0)
     if why:
         return None, why
-    if ts >= chain.duration:
-        return None, "at the end"
     old, new = steps.raw_grid, caches.grid
     rest = chain.after(ts)
     if old is not new:

@@ -282,3 +282,13 @@ def test_a_goal_walled_in_is_a_no_path_error_saying_where_the_car_stopped():
     occ[round(2.8 / RES), round(6.2 / RES) :] = True
     with pytest.raises(NoPathError, match=r"planned from rest at pose .* after braking"):
         planner.replan(traj, 3.0, grid=astar.OccupancyGrid(occ, RES), latency=0.0)
+
+
+def test_at_the_goal_pose_nothing_is_left_to_drive():
+    planner, traj, new, goal, h1, _ = forward_scene()
+    for kw in ({}, {"reuse": False}, {"grid": new}):
+        out = planner.replan(traj, traj.duration, latency=0.0, **kw)
+        assert out.duration == 0.0 and out.length == 0.0
+        end = out.sample(np.array([0.0]))
+        np.testing.assert_allclose([end.x[0], end.y[0]], goal, atol=1e-9)
+        assert _angle_diff(end.theta[0], h1) < 1e-9 and end.v[0] == 0.0
