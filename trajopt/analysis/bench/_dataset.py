@@ -73,6 +73,17 @@ COLUMNS: dict[str, str] = {
     "ratio_a_lat": _FLT,
     "fallback_used": _BOOL,
     "corridor": _STR,
+    # the car methods (trajopt.analysis.bench._car; NaN / -1 on the other rows)
+    "start_heading_rad": _FLT,
+    "goal_heading_rad": _FLT,
+    "turning_radius_m": _FLT,
+    "cusps": _INT,
+    "reverse_length_m": _FLT,
+    "kappa_over_kmax": _FLT,
+    "curvature_violations": _INT,
+    "heading_motion_error_rad": _FLT,
+    "end_heading_error_rad": _FLT,
+    "cusp_speed_max_mps": _FLT,
     # compute times (s) and where the row was computed
     "runtime_s": _FLT,
     "reference_search_s": _FLT,
@@ -84,6 +95,9 @@ COLUMNS: dict[str, str] = {
     "stage_timing_s": _FLT,
     "stage_fallback_s": _FLT,
     "stage_total_s": _FLT,
+    "hybrid_search_s": _FLT,
+    "hybrid_heuristic_s": _FLT,
+    "first_solution_s": _FLT,
     "worker": _STR,
 }
 #: Columns that vary from run to run (wall times, the worker): every other column of a

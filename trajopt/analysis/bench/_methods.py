@@ -17,11 +17,19 @@ Methods (:data:`METHODS`):
 * ``trajopt-kappa``: curvature-bounded, ``Smoother(kappa_max=1 / (2 radius))``;
 * ``trajopt-fallback``: ``fallback="stop_and_turn"`` (``fallback_used`` says when it
   served);
+* ``trajopt-ackermann``, ``trajopt-ackermann-forward`` (family ``"car"``, not in
+  :data:`DEFAULT_METHODS`): a car-like robot, ``Robot(radius, drive="ackermann",
+  min_turning_radius=CAR_RADIUS_FACTOR * radius, reverse=True / False)``, planned pose to
+  pose with the query's end headings (:attr:`QueryContext.start_heading`); scored by the
+  car metrics of :mod:`~trajopt.analysis.bench._car` too (cusps, reverse length, curvature
+  against ``1/R`` per stretch between cusps, motion along the heading, end headings, rest at
+  cusps);
 * ``astar``: the reference polyline itself;
 * ``bspline-fit``, ``polynomial-fit``: the chapter's plain fits of the reference, as
   :func:`trajopt.compare` runs them (``"B-spline fit"``, ``"polynomial fit"``);
 * peers (optional, :mod:`trajopt.analysis.bench._peers`): ``ompl-rrtstar``, ``ompl-bitstar``,
-  ``pmp-bspline``, ``pmp-cubic``.
+  ``pmp-bspline``, ``pmp-cubic``; and the car peers ``ompl-reedsshepp``, ``ompl-dubins``
+  (family ``"car-peer"``).
 
 A worker process keeps the context of the last maps it saw (:func:`map_context`), so a
 chunk of queries on one map loads and inflates the map once; :func:`warm_up` pays a
@@ -47,6 +55,11 @@ from trajopt.errors import BenchmarkError
 STAGES = ("inflate", "search", "corridor", "smooth", "timing", "fallback", "total")
 #: Timed-trajectory columns (from :func:`trajopt.metrics.trajectory_metrics`).
 TIMED = ("duration_s", "ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat")
+#: Minimum turning radius of the car methods, as a multiple of the robot radius (issue 36:
+#: ``R = 2 x radius``).
+CAR_RADIUS_FACTOR = 2.0
+#: Families of the methods that plan poses of a car-like robot.
+CAR_FAMILIES = ("car", "car-peer")
 
 
 @dataclass
@@ -71,6 +84,11 @@ class MapContext:
     planners: dict[str, Any] = field(default_factory=dict)
 
     @property
+    def turning_radius(self) -> float:
+        """Minimum turning radius of the car methods: ``CAR_RADIUS_FACTOR * radius`` (m)."""
+        return CAR_RADIUS_FACTOR * self.radius
+
+    @property
     def sample_spacing(self) -> float:
         """Arc-length spacing of the metric samples: 0.05 cell (m)."""
         return 0.05 * float(self.grid.resolution)
@@ -82,6 +100,15 @@ class MapContext:
             from trajopt.robot._robot import Robot
             from trajopt.smoother import Smoother
 
+            if variant.startswith("trajopt-ackermann"):
+                car = Robot(
+                    radius=self.radius,
+                    drive="ackermann",
+                    min_turning_radius=self.turning_radius,
+                    reverse=variant == "trajopt-ackermann",
+                )
+                self.planners[variant] = Planner(self.grid, car)
+                return self.planners[variant]
             robot = Robot(radius=self.radius)
             kwargs: dict[str, Any] = {
                 "trajopt": {},
@@ -118,6 +145,9 @@ class QueryContext:
         Octile-shortest A* on ``map.inflated``.
     reference : ndarray, shape (n, 2)
         Its cell centres (m).
+    start_heading, goal_heading : float
+        End headings (rad) for the car methods (NaN: none given; the car methods then
+        draw them with :func:`~trajopt.analysis.bench._suites.draw_headings`).
     """
 
     map: MapContext
@@ -127,6 +157,25 @@ class QueryContext:
     goal: np.ndarray
     reference_path: Any
     reference: np.ndarray
+    start_heading: float = math.nan
+    goal_heading: float = math.nan
+
+    @property
+    def headings(self) -> tuple[float, float]:
+        """``(start_heading, goal_heading)`` (rad); both must be finite for the car methods.
+
+        Raises
+        ------
+        BenchmarkError
+            A heading is NaN or infinite.
+        """
+        h = (float(self.start_heading), float(self.goal_heading))
+        if not all(math.isfinite(v) for v in h):
+            raise BenchmarkError(
+                f"a car method needs finite start and goal headings (rad), got {h}: give the "
+                "queries headings (bench.with_headings) or pass headings to evaluate_query"
+            )
+        return h
 
     def comparison_context(self) -> Any:
         """Return the context of one query for the plain fits.
@@ -203,6 +252,35 @@ def _trajopt(variant: str) -> MethodFn:
     return run
 
 
+def _car(variant: str) -> MethodFn:
+    def run(q: QueryContext) -> MethodOutput:
+        from trajopt.analysis.bench._car import chain_metrics
+        from trajopt.analysis.metrics import trajectory_metrics
+
+        h0, h1 = q.headings
+        planner = q.map.planner(variant)
+        t0 = time.perf_counter()
+        traj = planner.plan(q.start, q.goal, start_heading=h0, goal_heading=h1)
+        runtime = time.perf_counter() - t0
+        stats = traj.stats
+        stages = stats.get("stages_s", {})
+        search = stats.get("car", {}).get("search", {})
+        t1 = time.perf_counter()
+        kmax = 1.0 / planner.robot.min_turning_radius
+        poly, extras = chain_metrics(traj, kmax, (h0, h1), q.map.sample_spacing)
+        timed = trajectory_metrics(traj, planner.robot)
+        score = time.perf_counter() - t1
+        extras.update({k: float(timed[k]) for k in TIMED if k in timed})
+        extras["duration_s"] = float(traj.duration)
+        extras.update({f"stage_{k}_s": float(stages[k]) for k in STAGES if k in stages})
+        extras["hybrid_search_s"] = float(search.get("search_s", math.nan))
+        extras["hybrid_heuristic_s"] = float(search.get("heuristic_s", math.nan))
+        extras["corridor"] = ",".join(stats.get("car", {}).get("corridors", []))
+        return MethodOutput(poly, True, f"{len(traj.pieces)} segment(s)", extras, runtime, score)
+
+    return run
+
+
 # ======================================================================== baselines
 def _astar(q: QueryContext) -> MethodOutput:
     return MethodOutput(q.reference, True, "reference polyline", runtime_s=0.0)
@@ -248,10 +326,17 @@ METHODS: dict[str, MethodSpec] = {
         MethodSpec("ompl-bitstar", "peer", _peer("ompl-bitstar"), ("ompl",)),
         MethodSpec("pmp-bspline", "peer", _peer("pmp-bspline"), ("python_motion_planning",)),
         MethodSpec("pmp-cubic", "peer", _peer("pmp-cubic"), ("python_motion_planning",)),
+        MethodSpec("trajopt-ackermann", "car", _car("trajopt-ackermann")),
+        MethodSpec("trajopt-ackermann-forward", "car", _car("trajopt-ackermann-forward")),
+        MethodSpec("ompl-reedsshepp", "car-peer", _peer("ompl-reedsshepp"), ("ompl",)),
+        MethodSpec("ompl-dubins", "car-peer", _peer("ompl-dubins"), ("ompl",)),
     )
 }
-#: What runs when no methods are given: every method that needs no optional package.
-DEFAULT_METHODS: tuple[str, ...] = tuple(n for n, s in METHODS.items() if s.family != "peer")
+#: What runs when no methods are given: every method that needs no optional package, but
+#: the car methods (they plan poses: ``methods=[..., "trajopt-ackermann"]`` names them).
+DEFAULT_METHODS: tuple[str, ...] = tuple(
+    n for n, s in METHODS.items() if s.family not in ("peer", *CAR_FAMILIES)
+)
 
 
 def check_methods(methods: object) -> tuple[str, ...]:
@@ -303,7 +388,12 @@ def _nan_metrics(spacing: float) -> dict[str, Any]:
 
 
 def evaluate_query(
-    mctx: MapContext, start: tuple[int, int], goal: tuple[int, int], methods: tuple[str, ...]
+    mctx: MapContext,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    methods: tuple[str, ...],
+    *,
+    headings: tuple[float, float] | None = None,
 ) -> list[dict[str, Any]]:
     """Run ``methods`` on one query and score them: one dict per method, in order.
 
@@ -315,6 +405,12 @@ def evaluate_query(
     (``duration_s``, ``stage_*_s``, ...).
     When the reference search fails (an end point blocked for the radius, or no path),
     every method gets that failure: the query is infeasible for the robot.
+
+    ``headings`` (rad) are the start and goal headings the car methods plan with (default:
+    none; a car method then fails with :class:`~trajopt.errors.BenchmarkError`). The car
+    methods' rows add ``start_heading_rad``, ``goal_heading_rad``, ``turning_radius_m`` and
+    the car columns of :mod:`~trajopt.analysis.bench._car`; their per-stretch curvature
+    columns replace those of the joined polyline (a cusp is no curvature).
     """
     import astar
     from trajopt.analysis.metrics import path_metrics
@@ -341,6 +437,7 @@ def evaluate_query(
             mctx.grid.cell_to_world(goal),
             ref_path,
             np.asarray(ref, dtype=float),
+            *((math.nan, math.nan) if headings is None else (float(v) for v in headings)),
         )
     except soft as exc:
         ref_error = exc
@@ -348,6 +445,10 @@ def evaluate_query(
     rows: list[dict[str, Any]] = []
     for name in methods:
         row: dict[str, Any] = {"method": name, "reference_search_s": ref_s}
+        if METHODS[name].family in CAR_FAMILIES:
+            row["turning_radius_m"] = mctx.turning_radius
+            if headings is not None:
+                row["start_heading_rad"], row["goal_heading_rad"] = (float(v) for v in headings)
         if qctx is None:
             row.update(
                 ok=False,
@@ -400,9 +501,9 @@ def evaluate_query(
             note=out.note,
             runtime_s=float(runtime),
             score_s=score,
-            **metrics,
-            **dict(out.extras),
         )
+        row.update(metrics)
+        row.update(dict(out.extras))  # a method's own columns replace the generic ones
         rows.append(row)
     return rows
 
@@ -449,7 +550,7 @@ def warm_up(methods: object = None) -> float:
     cells = [tuple(int(v) for v in grid.world_to_cell(p)) for p in (start, goal)]
     local = tuple(m for m in names if METHODS[m].family != "peer")
     if local:
-        evaluate_query(mctx, cells[0], cells[1], local)  # type: ignore[arg-type]
+        evaluate_query(mctx, cells[0], cells[1], local, headings=(0.0, 0.0))  # type: ignore[arg-type]
     for m in names:
         for mod in METHODS[m].requires:
             importlib.import_module(mod)

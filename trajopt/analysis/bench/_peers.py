@@ -6,6 +6,18 @@
   :data:`OMPL_TIME_LIMIT_S` seconds (seeded with :data:`OMPL_SEED`), then
   ``PathSimplifier.simplifyMax`` and ``smoothBSpline``. OMPL checks motions at discrete
   states (its default resolution), as its users do.
+* ``ompl-reedsshepp``, ``ompl-dubins`` (the car peers): OMPL's ``RRTstar`` in
+  ``ReedsSheppStateSpace(R)`` (forwards and backwards) or ``DubinsStateSpace(R)`` (forwards
+  only), ``R`` the car methods' turning radius (``2 x radius``), over the map's extent, from
+  the start pose to the goal pose (the query's headings; goal threshold
+  :data:`OMPL_CAR_GOAL_TOL`); a state is valid when its cell is free on the same inflated grid,
+  motions checked every :data:`OMPL_CAR_CHECK_CELLS` cells; stopped at its first exact
+  solution or after :data:`OMPL_CAR_TIME_LIMIT_S` s (``first_solution_s``), then
+  ``simplifySolution`` (at most :data:`OMPL_CAR_SIMPLIFY_S` s; its shortcuts are Reeds-Shepp /
+  Dubins curves, so the path keeps ``1/R``). ``runtime_s`` is both. The path is interpolated
+  every :data:`OMPL_CAR_INTERPOLATE_CELLS` cells and scored by
+  :func:`~trajopt.analysis.bench._car.pose_path_metrics`; it is not timed (``duration_s`` NaN:
+  OMPL's geometric planners return no speeds), so it is compared by length.
 * ``pmp-bspline``, ``pmp-cubic``: python-motion-planning's point-based curve generators
   (``BSpline`` interpolation, degree 3, and ``CubicSpline``) through the corner points of
   the reference A* path.
@@ -34,6 +46,16 @@ from trajopt.errors import PeerUnavailableError
 OMPL_TIME_LIMIT_S = 1.0
 #: Seed of OMPL's random number generator (set before every query).
 OMPL_SEED = 1
+#: Time limit of the car peers per query (s): they stop at their first solution before it.
+OMPL_CAR_TIME_LIMIT_S = 2.0
+#: Time limit of the car peers' path simplification (s).
+OMPL_CAR_SIMPLIFY_S = 0.2
+#: Spacing of the car peers' motion validity checks (cells).
+OMPL_CAR_CHECK_CELLS = 0.2
+#: Spacing of the interpolated states the car peers are scored on (cells).
+OMPL_CAR_INTERPOLATE_CELLS = 0.05
+#: Goal threshold of the car peers (distance in their state space: m, and rad weighted).
+OMPL_CAR_GOAL_TOL = 1e-6
 _PACKAGES = {"ompl": "ompl", "python_motion_planning": "python-motion-planning"}
 
 
@@ -112,6 +134,73 @@ def _ompl(planner: str, q: Any) -> np.ndarray:
     return np.array([(st[0], st[1]) for st in path.getStates()], dtype=float)
 
 
+def _ompl_car(q: Any, reverse: bool) -> tuple[np.ndarray, dict[str, Any]]:
+    """Plan one pose query with OMPL's RRT* in a Reeds-Shepp / Dubins space (module doc)."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    from trajopt.analysis.bench._car import pose_path_metrics
+
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(OMPL_SEED)
+    h0, h1 = q.headings
+    grid = q.map.grid
+    occ = np.asarray(q.map.inflated.occupied)
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = occ.shape
+    R = float(q.map.turning_radius)
+    space = ob.ReedsSheppStateSpace(R) if reverse else ob.DubinsStateSpace(R)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, ox)
+    bounds.setHigh(0, ox + nx * res)
+    bounds.setLow(1, oy)
+    bounds.setHigh(1, oy + ny * res)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+
+    def valid(state: Any) -> bool:
+        ix = math.floor((state.getX() - ox) / res)
+        iy = math.floor((state.getY() - oy) / res)
+        return 0 <= ix < nx and 0 <= iy < ny and not occ[iy, ix]
+
+    ss.setStateValidityChecker(valid)
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(OMPL_CAR_CHECK_CELLS * res / space.getMaximumExtent())
+    a = space.allocState()
+    g = space.allocState()
+    for st, p, h in ((a, q.start, h0), (g, q.goal, h1)):
+        st.setX(float(p[0]))
+        st.setY(float(p[1]))
+        st.setYaw(float(h))
+    ss.setStartAndGoalStates(a, g, OMPL_CAR_GOAL_TOL)
+    obj = ob.PathLengthOptimizationObjective(si)
+    obj.setCostThreshold(ob.Cost(math.inf))  # stop at the first solution
+    ss.setOptimizationObjective(obj)
+    ss.setPlanner(og.RRTstar(si))
+    t0 = time.perf_counter()
+    ss.solve(OMPL_CAR_TIME_LIMIT_S)
+    first = time.perf_counter() - t0
+    kind = "Reeds-Shepp" if reverse else "Dubins"
+    if not ss.haveExactSolutionPath():
+        raise PeerFailure(f"OMPL RRT* ({kind}): no exact solution in {OMPL_CAR_TIME_LIMIT_S} s")
+    ss.simplifySolution(OMPL_CAR_SIMPLIFY_S)
+    path = ss.getSolutionPath()
+    n = max(2, math.ceil(path.length() / (OMPL_CAR_INTERPOLATE_CELLS * res)) + 1)
+    path.interpolate(n)
+    m = path.getStateCount()
+    xy = np.empty((m, 2))
+    yaw = np.empty(m)
+    for i in range(m):
+        st = path.getState(i)
+        xy[i] = st.getX(), st.getY()
+        yaw[i] = st.getYaw()
+    extras = pose_path_metrics(xy, yaw, 1.0 / R, (h0, h1))
+    extras["first_solution_s"] = first
+    return xy, extras
+
+
 def _pmp(kind: str, q: Any) -> np.ndarray:
     import python_motion_planning as pmp
 
@@ -149,8 +238,15 @@ def run(name: str, q: Any, requires: Sequence[str]) -> MethodOutput:
     for mod in requires:
         require(mod, name)
     t0 = time.perf_counter()
+    extras: dict[str, Any] = {}
     try:
-        if name.startswith("ompl-"):
+        if name in ("ompl-reedsshepp", "ompl-dubins"):
+            pts, extras = _ompl_car(q, name == "ompl-reedsshepp")
+            note = (
+                f"RRT* first solution within {OMPL_CAR_TIME_LIMIT_S} s, simplifySolution; "
+                "untimed (length only)"
+            )
+        elif name.startswith("ompl-"):
             pts = _ompl(name.removeprefix("ompl-"), q)
             note = (
                 f"{name.removeprefix('ompl-')}, {OMPL_TIME_LIMIT_S} s, simplifyMax + smoothBSpline"
@@ -168,4 +264,4 @@ def run(name: str, q: Any, requires: Sequence[str]) -> MethodOutput:
     pts = pts[keep]
     if len(pts) < 2:
         raise PeerFailure(f"{name}: the path has fewer than 2 distinct points")
-    return MethodOutput(pts, True, note, runtime_s=runtime)
+    return MethodOutput(pts, True, note, extras, runtime_s=runtime)

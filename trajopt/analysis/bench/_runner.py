@@ -45,7 +45,7 @@ from typing import Any
 
 from trajopt.analysis.bench._dataset import existing_keys, prepare, write_chunk
 from trajopt.analysis.bench._methods import check_methods, evaluate_query, map_context
-from trajopt.analysis.bench._suites import MapQueries, Query
+from trajopt.analysis.bench._suites import MapQueries, Query, draw_headings
 from trajopt.errors import BenchmarkError
 
 logger = logging.getLogger(__name__)
@@ -228,7 +228,10 @@ def run_chunk(chunk: Chunk) -> list[dict[str, Any]]:
             "resolution_m": mq.resolution_m,
             "worker": worker,
         }
-        for r in evaluate_query(mctx, q.start, q.goal, methods):
+        headings = (q.start_heading, q.goal_heading)
+        if not all(math.isfinite(h) for h in headings):
+            headings = draw_headings(mq.map_name, q.index, 0)  # only the car methods read them
+        for r in evaluate_query(mctx, q.start, q.goal, methods, headings=headings):
             rows.append({**base, **r})
     return rows
 

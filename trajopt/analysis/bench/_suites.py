@@ -18,6 +18,7 @@ scenario file written for another map size, ...). :func:`suite` returns the name
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import os
@@ -57,6 +58,10 @@ class Query:
         Cells ``(ix, iy)``, row 0 at the bottom (the project's convention).
     optimal_length_cells : float
         The scenario file's optimal length (cells); NaN for random queries.
+    start_heading, goal_heading : float
+        End headings (rad) for the methods that plan poses (the car-like robots); NaN
+        (the default) when the query has none: :func:`with_headings` draws them, and the
+        car methods draw them with :func:`draw_headings` (seed 0) when they are NaN.
     """
 
     query_id: str
@@ -65,6 +70,8 @@ class Query:
     start: tuple[int, int]
     goal: tuple[int, int]
     optimal_length_cells: float
+    start_heading: float = math.nan
+    goal_heading: float = math.nan
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,6 +99,54 @@ class MapQueries:
     radius_m: float
     resolution_m: float
     queries: tuple[Query, ...]
+
+
+def draw_headings(map_name: str, index: int, seed: int = 0) -> tuple[float, float]:
+    """Seeded random start and goal headings of one query (rad, uniform in ``[-pi, pi)``).
+
+    The generator is ``numpy.random.default_rng([seed, crc32(map_name), index])`` (the rule of
+    ``benchmarks/bench_hybrid.py``): the same headings on every machine, for every method.
+
+    Parameters
+    ----------
+    map_name : str
+        The map's file name (:attr:`MapQueries.map_name`).
+    index : int
+        The query's :attr:`Query.index` (>= 0).
+    seed : int
+        Seed (>= 0).
+
+    Returns
+    -------
+    tuple of float
+        ``(start_heading, goal_heading)`` (rad).
+    """
+    rng = np.random.default_rng([int(seed), zlib.crc32(map_name.encode()), int(index)])
+    h0, h1 = rng.uniform(-math.pi, math.pi, 2)
+    return float(h0), float(h1)
+
+
+def with_headings(sources: Sequence[MapQueries], seed: int = 0) -> list[MapQueries]:
+    """Return ``sources`` with seeded random end headings on every query (:func:`draw_headings`).
+
+    Queries and maps are otherwise unchanged (same ids, cells and order); only the pose
+    methods (``trajopt-ackermann``, ``ompl-reedsshepp``, ...) read the headings.
+
+    Raises
+    ------
+    BenchmarkError
+        ``seed`` is not an integer >= 0.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise BenchmarkError(f"seed must be an integer >= 0, got {seed!r}")
+    out = []
+    for mq in sources:
+        qs = []
+        for q in mq.queries:
+            h0, h1 = draw_headings(mq.map_name, q.index, int(seed))
+            qs.append(dataclasses.replace(q, start_heading=h0, goal_heading=h1))
+        out.append(dataclasses.replace(mq, queries=tuple(qs)))
+    return out
 
 
 def data_dir(path: str | os.PathLike[str] | None = None) -> Path:
