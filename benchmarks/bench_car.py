@@ -141,7 +141,8 @@ def report(df, cells: dict[str, int], have_ompl: bool) -> str:
                 f"{_med(1e3 * small['stage_search_s']):.1f} ms"
             )
             st = {
-                k: _med(1e3 * ok[f"stage_{k}_s"]) for k in ("inflate", "corridor", "smooth", "timing")
+                k: _med(1e3 * ok[f"stage_{k}_s"])
+                for k in ("inflate", "corridor", "smooth", "timing")
             }
             lines.append(
                 "  trajopt stages median  "
@@ -216,7 +217,9 @@ def main() -> int:
     try:
         maps = with_headings(bench.suite(args.suite, limit=args.limit), args.seed)
     except BenchmarkError as e:
-        print(f"skipped: shared data not available ({e}); set TRAJOPT_DATA (looked in {data_dir()})")
+        print(
+            f"skipped: shared data not available ({e}); set TRAJOPT_DATA (looked in {data_dir()})"
+        )
         return 0
     have_ompl = not args.no_ompl
     if have_ompl:
