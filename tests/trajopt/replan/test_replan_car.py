@@ -292,3 +292,16 @@ def test_at_the_goal_pose_nothing_is_left_to_drive():
         end = out.sample(np.array([0.0]))
         np.testing.assert_allclose([end.x[0], end.y[0]], goal, atol=1e-9)
         assert _angle_diff(end.theta[0], h1) < 1e-9 and end.v[0] == 0.0
+
+
+def test_forward_only_car_brakes_and_plans_forwards():
+    occ = walled(8.0, 4.0)
+    robot = trajopt.Robot(drive="ackermann", min_turning_radius=0.5, reverse=False)
+    planner = trajopt.Planner(astar.OccupancyGrid(occ, RES), robot)
+    traj = planner.plan((1.0, 2.0), (7.0, 2.0), start_heading=0.0, goal_heading=0.0)
+    new = with_block(occ, 4.5, 4.9, 1.6, 2.4)
+    out = planner.replan(traj, 3.0, grid=new, latency=0.0)
+    _check_brake(traj, out, 3.0, +1)
+    _check_new_plan(out, new, (7.0, 2.0), 0.0, robot)
+    smp = out.sample(np.linspace(0.0, out.duration, 2001))
+    assert np.all(smp.v >= 0.0) and np.all(smp.direction == 1)
