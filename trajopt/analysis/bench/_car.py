@@ -233,19 +233,31 @@ def pose_path_metrics(
     along = d[:, 0] * np.cos(mid) + d[:, 1] * np.sin(mid)
     moving = np.abs(along) > 1e-12
     sgn = np.sign(along)
-    # stretches between cusps: runs of one sign of the displacement along the heading
+    # stretches between cusps: runs of one sign of the displacement along the heading. A cusp
+    # lies between two samples (the interpolation need not hit it): the two displacements
+    # next to a change of sign may straddle it, so neither belongs to a stretch (nor to the
+    # motion check): a path sampled across its cusp is no curvature.
     segs, cusps, start, last = [], 0, 0, 0.0
+    keep = np.ones(len(d), dtype=bool)
+    prev = -1
     for i in np.flatnonzero(moving):
         if last != 0.0 and sgn[i] != last:
-            segs.append(xy[start : i + 1])
-            start = i
+            segs.append(xy[start : prev + 1])
+            keep[[prev, i]] = False
+            start = i + 1
             cusps += 1
-        last = sgn[i]
+        last, prev = sgn[i], i
     segs.append(xy[start:])
-    out = curvature_stats(segs, kmax)
+    out = curvature_stats([s for s in segs if len(s) >= 3], kmax)
     out["cusps"] = cusps
     out["reverse_length_m"] = float(np.sum(np.hypot(*d[along < 0].T))) if len(d) else 0.0
-    out["heading_motion_error_rad"] = motion_error(xy, yaw, np.zeros(len(d)))
+    idx = np.flatnonzero(keep)
+    err = 0.0
+    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):  # runs of kept displacements
+        if len(run):
+            sl = slice(run[0], run[-1] + 2)
+            err = max(err, motion_error(xy[sl], yaw[sl], np.zeros(len(run))))
+    out["heading_motion_error_rad"] = err
     out["end_heading_error_rad"] = float(
         np.max(np.abs(wrap(yaw[[0, -1]] - np.asarray(headings, dtype=float))))
     )
