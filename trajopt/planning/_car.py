@@ -8,10 +8,15 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    shots when ``robot.reverse`` is False) from the start pose to the goal pose, on the raw
    map inflated by the robot radius plus :data:`SEARCH_MARGIN_CELLS` (so that every point of
    a free cell, not only its centre, keeps the radius: the search's poses lie anywhere in
-   their cells), with a turning radius :data:`SEARCH_RADIUS_FACTORS` times ``R`` (the
-   first factor leaves the smoother room: a segment turning at exactly ``1/R`` between
-   fixed end poses admits no other curve, and a B-spline is no circle), the next one ``R``
-   itself when the first finds no path.
+   their cells), with a turning radius :data:`SEARCH_RADIUS_FACTORS` times ``R``: the
+   first factor leaves the smoother room (a segment turning at exactly ``1/R`` between
+   fixed end poses admits no other curve, and a B-spline is no circle); when a segment of
+   its path has no certified fit, the search runs again with gentler arcs (the second
+   factor); when the search finds no path, with ``R`` itself (larger factors are then
+   skipped). When an end point is blocked on that grid, or the margin disconnects the
+   poses or leaves no path, the same tries run on the map inflated by the radius alone
+   (the other planners' grid): end points near walls and passages the margin closes. The
+   tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 2. **Segments.** The path is split at its cusps (where the direction of travel flips; the
    heading is continuous there, the tangent flips by ``pi``). Each segment is fitted as an
    ordinary curve in the direction of travel: a certified polygon corridor grown around
@@ -45,6 +50,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -71,8 +77,11 @@ from trajopt.timing import time_parameterize
 #: diagonal (any point of a free cell keeps the radius) plus slack for the chords between
 #: the search's poses (at most half a cell apart).
 SEARCH_MARGIN_CELLS = 0.5 * math.sqrt(2.0) + 0.05
-#: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order.
-SEARCH_RADIUS_FACTORS = (1.15, 1.0)
+#: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
+#: (module docstring: a factor above one that failed to search is skipped afterwards).
+SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.0)
+#: Time (s) after which no further try (search and fits) of a car's plan starts.
+CAR_BUDGET_S = 6.0
 #: Relative tolerance of the curvature check of each fitted segment.
 KAPPA_TOL = 1e-6
 #: Cap (s) on the smoother's time budget per segment fit.
@@ -202,23 +211,8 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     grid = caches.grid
     p0, p1, h0, h1 = _ends(options, grid, request)
     res = grid.resolution
-    with timer.stage("inflate"):
-        search_grid = car_search_grid(robot, grid)
     start = _to_cells(grid, p0, h0)
     goal = _to_cells(grid, p1, h1)
-    for name, c, p in (("start", start, p0), ("goal", goal, p1)):
-        ix, iy = int(math.floor(c[0] + 0.5)), int(math.floor(c[1] + 0.5))
-        if search_grid.occupied[iy, ix]:
-            raise InvalidInputError(
-                f"{name} {p.tolist()} m lies in cell ({ix}, {iy}), blocked on the car's search "
-                f"grid (robot radius {robot.radius} m plus {SEARCH_MARGIN_CELLS:.3g} cells); "
-                "move it towards free space"
-            )
-    with timer.stage("search"):
-        path, radius_cells = _search(robot, search_grid, start, goal, res)
-    poses = path.to_world(grid)
-    segments: list[CarSegment] = []
-    pieces: list[Trajectory] = []
     kmax = 1.0 / robot.min_turning_radius
     sm = options.smoother
     sm = dataclasses.replace(
@@ -226,10 +220,64 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
         kappa_max=kmax if sm.kappa_max is None else min(sm.kappa_max, kmax),
         time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
     )
-    for first, last in np.asarray(path.segments):
-        direction = int(path.directions[last])
-        seg = _fit_segment(options, grid, sm, poses, int(first), int(last), direction, timer)
-        segments.append(seg)
+    t_end = time.perf_counter() + CAR_BUDGET_S
+    tries: list[str] = []
+    failures: list[Exception] = []
+    found = None
+    for margin in (True, False):
+        with timer.stage("inflate"):
+            search_grid = car_search_grid(robot, grid, margin=margin)
+        blocked = _blocked_end(
+            robot, search_grid, margin, (("start", start, p0), ("goal", goal, p1))
+        )
+        if blocked is not None:
+            tries.append(f"{_grid_name(margin)}: {blocked}")
+            failures.append(InvalidInputError(blocked))
+            continue
+        largest = math.inf
+        for factor in SEARCH_RADIUS_FACTORS:
+            if factor > largest or time.perf_counter() > t_end:
+                continue
+            r_cells = factor * robot.min_turning_radius / res
+            try:
+                with timer.stage("search"):
+                    path = astar.find_pose_path(
+                        search_grid,
+                        start,
+                        goal,
+                        turning_radius=r_cells,
+                        reverse=robot.reverse,
+                        time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
+                    )
+            except astar.NoPosePathError as exc:
+                tries.append(f"{_grid_name(margin)}, {factor:g} R: no path ({exc.reason})")
+                failures.append(exc)
+                if exc.reason == "disconnected":
+                    break
+                largest = min(largest, factor)
+                continue
+            poses = path.to_world(grid)
+            try:
+                segments = [
+                    _fit_segment(
+                        options, grid, sm, poses, int(a), int(b), int(path.directions[b]), timer
+                    )
+                    for a, b in np.asarray(path.segments)
+                ]
+            except SmoothingError as exc:
+                tries.append(f"{_grid_name(margin)}, {factor:g} R: a segment has no fit")
+                failures.append(exc)
+                continue
+            tries.append(f"{_grid_name(margin)}, {factor:g} R: planned")
+            found = (search_grid, path, r_cells, poses, segments)
+            break
+        if found is not None:
+            break
+    if found is None:
+        raise _failure(robot, grid, start, goal, tries, failures)
+    search_grid, path, radius_cells, poses, segments = found
+    pieces: list[Trajectory] = []
+    for seg in segments:
         with timer.stage("timing"):
             pieces.append(_time_segment(options, seg))
     stages = timer.finish()
@@ -255,6 +303,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
             "reverse_length_m": float(path.reverse_length * res),
             "search_length_m": float(path.length * res),
             "search_turning_radius_m": radius_cells * res,
+            "tries": tries,
             "corridors": [s.corridor_kind for s in segments],
             "search": dict(path.stats),
         },
@@ -263,7 +312,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
 
 
-def car_search_grid(robot: Robot, grid: OccupancyGrid) -> OccupancyGrid:
+def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> OccupancyGrid:
     """Return the grid a car's search runs on: ``grid`` inflated by the radius plus a margin.
 
     Parameters
@@ -272,17 +321,69 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid) -> OccupancyGrid:
         The car (its ``radius``, m).
     grid : astar.OccupancyGrid
         The raw map.
+    margin : bool, optional
+        False: the radius alone (the second grid the search tries; module docstring).
 
     Returns
     -------
     astar.OccupancyGrid
         ``grid`` with every cell within ``robot.radius`` plus :data:`SEARCH_MARGIN_CELLS`
-        cells of an occupied square (or of the outside) occupied.
+        cells (without ``margin``: within ``robot.radius``) of an occupied square (or of the
+        outside) occupied.
     """
-    margin = robot.radius + SEARCH_MARGIN_CELLS * grid.resolution
+    r = robot.radius + (SEARCH_MARGIN_CELLS * grid.resolution if margin else 0.0)
     return grid.with_occupied(
-        astar.inflate(grid, margin, metric="square", outside_occupied=True).occupied
+        astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
     )
+
+
+def _grid_name(margin: bool) -> str:
+    return "radius + margin grid" if margin else "radius grid"
+
+
+def _blocked_end(robot: Robot, search_grid: OccupancyGrid, margin: bool, ends: Any) -> str | None:
+    """Return why an end point's cell is blocked on ``search_grid``, or None."""
+    for name, c, p in ends:
+        ix, iy = int(math.floor(c[0] + 0.5)), int(math.floor(c[1] + 0.5))
+        if search_grid.occupied[iy, ix]:
+            extra = f" plus {SEARCH_MARGIN_CELLS:.3g} cells" if margin else ""
+            return (
+                f"{name} {p.tolist()} m lies in cell ({ix}, {iy}), blocked on the car's search "
+                f"grid (robot radius {robot.radius} m{extra}); move it towards free space"
+            )
+    return None
+
+
+def _failure(
+    robot: Robot,
+    grid: OccupancyGrid,
+    start: Any,
+    goal: Any,
+    tries: list[str],
+    failures: list[Exception],
+) -> Exception:
+    """Return the error of a car's plan that no try completed (module docstring)."""
+    fits = [f for f in failures if isinstance(f, SmoothingError)]
+    searches = [f for f in failures if isinstance(f, astar.NoPosePathError)]
+    summary = "; ".join(tries)
+    if fits:  # a path was found, and no curve fits it
+        return SmoothingError(f"{fits[-1]} (tries: {summary})", {"car_tries": tries})
+    if searches:
+        last = searches[-1]
+        mode = (
+            "forwards and backwards"
+            if robot.reverse
+            else "forwards only (reverse=False): no forward-only path was found; a goal only "
+            "reachable backwards needs reverse=True"
+        )
+        err = NoPathError(
+            f"no path of a car-like robot (turning radius {robot.min_turning_radius} m, radius "
+            f"{robot.radius} m) driving {mode}, from pose {_pose_m(start, grid)} to pose "
+            f"{_pose_m(goal, grid)} ({last.reason}): {last} (tries: {summary})"
+        )
+        err.__cause__ = last
+        return err
+    return failures[-1]
 
 
 def _ends(
@@ -332,42 +433,6 @@ def _to_cells(grid: OccupancyGrid, p: np.ndarray, heading: float) -> tuple[float
     """Return a world pose as the search's cell pose (``world = origin + (xy + 0.5) res``)."""
     xy = (np.asarray(p, dtype=float) - np.asarray(grid.origin, dtype=float)) / grid.resolution
     return float(xy[0] - 0.5), float(xy[1] - 0.5), float(heading)
-
-
-def _search(
-    robot: Robot, search_grid: OccupancyGrid, start: Any, goal: Any, res: float
-) -> tuple[Any, float]:
-    """Return the Hybrid-A* path and the turning radius (cells) it was found with."""
-    r_cells = robot.min_turning_radius / res
-    failures = []
-    for factor in SEARCH_RADIUS_FACTORS:
-        try:
-            path = astar.find_pose_path(
-                search_grid,
-                start,
-                goal,
-                turning_radius=factor * r_cells,
-                reverse=robot.reverse,
-                time_budget=SEARCH_BUDGET_S,
-            )
-        except astar.NoPosePathError as exc:
-            failures.append(exc)
-            if exc.reason == "disconnected":
-                break
-            continue
-        return path, factor * r_cells
-    last = failures[-1]
-    mode = (
-        "forwards and backwards"
-        if robot.reverse
-        else "forwards only (reverse=False): no forward-only path was found; a goal only "
-        "reachable backwards needs reverse=True"
-    )
-    raise NoPathError(
-        f"no path of a car-like robot (turning radius {robot.min_turning_radius} m, radius "
-        f"{robot.radius} m) driving {mode}, from pose {_pose_m(start, search_grid)} to pose "
-        f"{_pose_m(goal, search_grid)} ({last.reason}): {last}"
-    ) from last
 
 
 def _pose_m(c: Any, grid: OccupancyGrid) -> str:
