@@ -260,7 +260,14 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
             try:
                 segments = [
                     _fit_segment(
-                        options, grid, sm, poses, int(a), int(b), int(path.directions[b]), timer
+                        options,
+                        grid,
+                        sm,
+                        poses,
+                        (int(a), int(b)),
+                        int(path.directions[b]),
+                        _start_curvature(path, int(a), res),
+                        timer,
                     )
                     for a, b in np.asarray(path.segments)
                 ]
@@ -441,30 +448,51 @@ def _pose_m(c: Any, grid: OccupancyGrid) -> str:
     return f"({x:.6g} m, {y:.6g} m, {c[2]:.6g} rad)"
 
 
+def _start_curvature(path: Any, first: int, res: float) -> float:
+    """Return the curvature (1/m) the search's path starts pose ``first`` with.
+
+    Signed along the direction of travel: a backwards arc of body curvature ``k`` traces,
+    in its direction of travel, a curve of curvature ``-k``.
+    """
+    xy = np.asarray(path.poses[first, :2])
+    pieces = np.asarray(path.pieces)
+    i = int(np.argmin(np.hypot(*(pieces[:, :2] - xy).T)))
+    k, length = float(pieces[i, 3]), float(pieces[i, 4])
+    return (k if length >= 0.0 else -k) / res
+
+
 def _fit_segment(
     options: PlannerOptions,
     grid: OccupancyGrid,
     smoother: Any,
     poses: np.ndarray,
-    first: int,
-    last: int,
+    ends: tuple[int, int],
     direction: int,
+    kappa0: float,
     timer: StageTimer,
 ) -> CarSegment:
-    """Fit one segment in the direction of travel (module docstring, step 2)."""
+    """Fit one segment in the direction of travel (module docstring, step 2).
+
+    ``ends``: its first and last pose indices; ``kappa0``: the search path's curvature at
+    its start (1/m, along the direction of travel), the first fit's start curvature (the
+    car may steer while at rest, so the curve may start bending as the search's arc does; a
+    curve made to leave straight along a pose pinned against a wall can need a near-cusp).
+    """
+    first, last = ends
     radius = options.robot.radius
     pts = np.ascontiguousarray(poses[first : last + 1, :2])
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
     kmax = 1.0 / options.robot.min_turning_radius
     errors: list[str] = []
-    for kind in ("polygons", "witness"):
+    corridor = None
+    for kind, k_start in (("polygons", kappa0), ("polygons", None), ("witness", None)):
         try:
             with timer.stage("corridor"):
-                if kind == "polygons":
-                    corridor = build_polygon_corridor(grid, pts, radius)
-                else:
+                if kind == "witness":
                     corridor = witness_corridor(grid, radius, _dense(pts, grid.resolution))
+                elif corridor is None:  # the two polygon fits share one corridor
+                    corridor = build_polygon_corridor(grid, pts, radius)
             with timer.stage("smooth"):
                 smooth = smoother.fit(
                     pts,
@@ -475,9 +503,10 @@ def _fit_segment(
                     goal=pts[-1],
                     start_heading=h0,
                     goal_heading=h1,
+                    start_curvature=k_start,
                 )
         except (SmoothingError, InvalidInputError) as exc:
-            errors.append(f"{kind}: {exc}")
+            errors.append(f"{kind}{'' if k_start is None else ' (start curvature)'}: {exc}")
             continue
         cert = smooth.certificate
         if cert is None or not cert.ok or cert.kappa_max_sampled > kmax * (1.0 + KAPPA_TOL):

@@ -101,7 +101,7 @@ def _check_new_plan(out, grid, goal, h1, robot=CAR):
     end = out.sample(np.array([out.duration]))
     np.testing.assert_allclose([end.x[0], end.y[0]], goal, atol=1e-9)
     assert _angle_diff(end.theta[0], h1) < 1e-6
-    assert end.v[0] == 0.0
+    assert abs(end.v[0]) <= 1e-12  # at rest (a cubic phase ends at 0 up to round-off)
     kmax = 1.0 / robot.min_turning_radius
     for piece in out.pieces:
         pts = _dense(piece)
