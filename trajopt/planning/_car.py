@@ -21,8 +21,9 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    heading is continuous there, the tangent flips by ``pi``). Each segment is fitted as an
    ordinary curve in the direction of travel: a certified polygon corridor grown around
    its poses (:func:`~trajopt.corridor.build_polygon_corridor`), then the planner's
-   smoother with ``kappa_max = min(its own, 1/R)``, exact end points and exact end travel
-   headings (the body heading forwards, heading ``+ pi`` backwards). Where that fit fails,
+   smoother with ``kappa_max = min(its own, 1/R)``, exact end points, exact end travel
+   headings (the body heading forwards, heading ``+ pi`` backwards) and the search path's
+   start curvature (:func:`_fit_segment`); then without that curvature. Where those fail,
    it is fitted again in polygons grown around the poses themselves without centring (the
    witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). Every
    curve is the smoother's certified curve (convex-hull clearance certificate per segment)
