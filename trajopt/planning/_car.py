@@ -23,8 +23,10 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    its poses (:func:`~trajopt.corridor.build_polygon_corridor`), then the planner's
    smoother with ``kappa_max = min(its own, 1/R)``, exact end points, exact end travel
    headings (the body heading forwards, heading ``+ pi`` backwards) and the search path's
-   start curvature (:func:`_fit_segment`); then without that curvature. Where those fail,
-   it is fitted again in polygons grown around the poses themselves without centring (the
+   start curvature (:func:`_fit_segment`); then without that curvature; then from its end
+   to its start with the path's curvature at the end, the curve then turned round (the
+   smoother takes a start curvature, not a goal one). Where those fail, it is fitted again
+   in polygons grown around the poses themselves without centring (the
    witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). Every
    curve is the smoother's certified curve (convex-hull clearance certificate per segment)
    and its sampled curvature (the certificate's dense samples) must be within ``1/R``;
@@ -62,6 +64,7 @@ from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError
+from trajopt.geometry._bspline import BSplineCurve
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
@@ -106,8 +109,9 @@ class CarSegment:
     smooth_path : SmoothPath
         The certified curve in the direction of travel (its certificate included).
     corridor_kind : str
-        ``"polygons"`` (grown around the centred poses) or ``"witness"`` (around the poses
-        themselves, the second try).
+        ``"polygons"`` (grown around the centred poses), ``"reversed"`` (the same, fitted
+        from the segment's end with its curvature there, then turned round) or ``"witness"``
+        (around the poses themselves, the last try).
     """
 
     direction: int
@@ -487,23 +491,33 @@ def _fit_segment(
     kmax = 1.0 / options.robot.min_turning_radius
     errors: list[str] = []
     corridor = None
-    for kind, k_start in (("polygons", kappa0), ("polygons", None), ("witness", None)):
+    # the end's curvature along the direction of travel, from the last two poses (on an arc)
+    d_end = float(np.hypot(*(pts[-1] - pts[-2]))) if len(pts) > 1 else 0.0
+    k_end = (float(poses[last, 2] - poses[last - 1, 2]) / d_end) if d_end > 0.0 else 0.0
+    tries = (("polygons", kappa0), ("polygons", None), ("reversed", -k_end), ("witness", None))
+    for kind, k_start in tries:
+        # "reversed": the segment fitted from its end to its start, starting with the end's
+        # curvature (the smoother takes a start curvature, not a goal one), then turned round
+        p_fit = pts[::-1].copy() if kind == "reversed" else pts
+        hs, hg = (h1 + math.pi, h0 + math.pi) if kind == "reversed" else (h0, h1)
         try:
             with timer.stage("corridor"):
                 if kind == "witness":
                     corridor = witness_corridor(grid, radius, _dense(pts, grid.resolution))
+                elif kind == "reversed":
+                    corridor = build_polygon_corridor(grid, p_fit, radius)
                 elif corridor is None:  # the two polygon fits share one corridor
                     corridor = build_polygon_corridor(grid, pts, radius)
             with timer.stage("smooth"):
                 smooth = smoother.fit(
-                    pts,
+                    p_fit,
                     corridor,
                     raw_grid=grid,
                     radius=radius,
-                    start=pts[0],
-                    goal=pts[-1],
-                    start_heading=h0,
-                    goal_heading=h1,
+                    start=p_fit[0],
+                    goal=p_fit[-1],
+                    start_heading=hs,
+                    goal_heading=hg,
                     start_curvature=k_start,
                 )
         except (SmoothingError, InvalidInputError) as exc:
@@ -514,6 +528,8 @@ def _fit_segment(
             k = None if cert is None else cert.kappa_max_sampled
             errors.append(f"{kind}: not certified within 1/R (kappa {k})")
             continue
+        if kind == "reversed":
+            smooth = turned_round(smooth)
         return CarSegment(direction, first, last, corridor, smooth, kind)
     where = "forwards" if direction > 0 else "backwards"
     raise SmoothingError(
@@ -522,6 +538,19 @@ def _fit_segment(
         f"m: {'; '.join(errors)}",
         {"car_segment_failures": errors},
     )
+
+
+def turned_round(path: SmoothPath) -> SmoothPath:
+    """Return ``path`` traversed from its end to its start (the same certified curve).
+
+    ``C'(u) = C(t_0 + t_N - u)``: the knots mirrored and the control points reversed give
+    the same point set, spans and convex hulls, so the certificate (clearance, curvature
+    magnitude, speed) holds as it is; ``stats["turned_round"]`` marks it.
+    """
+    c = path.curve
+    t = np.asarray(c.t, dtype=float)
+    curve = BSplineCurve((t[0] + t[-1]) - t[::-1], np.asarray(c.c)[::-1], c.k)
+    return dataclasses.replace(path, curve=curve, stats=dict(path.stats, turned_round=True))
 
 
 def _dense(pts: np.ndarray, res: float) -> np.ndarray:

@@ -326,3 +326,21 @@ def test_replan_of_a_car_on_the_same_map_keeps_its_rest(planned):
     out = planner.replan(traj, traj.duration / 3, latency=0.0)
     assert out.stats["replan"] == "kept"
     assert out.duration == pytest.approx(traj.duration * 2 / 3, abs=1e-9)
+
+
+def test_a_curve_turned_round_is_the_same_curve_backwards():
+    """The reversed fit's curve: the same points in the opposite order, tangents flipped."""
+    from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+    from trajopt.planning._car import turned_round
+    from trajopt.smoother import SmoothPath
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.2], [2.0, 1.5], [2.5, 3.0], [4.0, 3.2], [5.0, 2.0]])
+    curve = BSplineCurve(clamped_uniform_knots(len(pts), 3, (0.0, 7.0)), pts, 3)
+    path = SmoothPath(curve, {"cost": 1.0})
+    back = turned_round(path)
+    u = np.linspace(0.0, 7.0, 301)
+    np.testing.assert_allclose(back(u), path(7.0 - u), atol=1e-12)
+    np.testing.assert_allclose(back(u, 1), -path(7.0 - u, 1), atol=1e-12)
+    np.testing.assert_allclose(back.curvature(u), -path.curvature(7.0 - u), atol=1e-9)
+    assert back.length == pytest.approx(path.length, rel=1e-12)
+    assert back.stats["turned_round"] and back.certificate is path.certificate
