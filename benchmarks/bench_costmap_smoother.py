@@ -73,6 +73,20 @@ def densify(pts: np.ndarray, step: float) -> np.ndarray:
     return np.vstack(out)
 
 
+def path_costs(traj, cm: astar.Costmap) -> tuple[float, float] | None:
+    """Mean cost per metre of ``traj``'s smooth curve and of its A* path (None: a fallback)."""
+    sp = getattr(traj.steps, "smooth_path", None)
+    gp = getattr(traj.steps, "grid_path", None)
+    if sp is None or gp is None:
+        return None
+    res = cm.grid.resolution
+    a, b = sp.curve.domain
+    curve = sp.curve(np.linspace(a, b, max(200, int(40 * (b - a) / res))))
+    cells = np.asarray(gp.cells, dtype=float)
+    poly = densify(np.asarray(cm.grid.origin) + (cells + 0.5) * res, 0.1 * res)
+    return mean_cost(curve, cm), mean_cost(poly, cm)
+
+
 @contextlib.contextmanager
 def cost_blind():
     """The smoother without its cost term (the behaviour before issue 34)."""
@@ -91,19 +105,13 @@ def plan_one(planner: Planner, cm: astar.Costmap, p0, p1, repeat: int = 1) -> di
     except TrajoptError as exc:
         return {"ok": False, "err": str(exc)[:120]}
     traj = runs[0]
-    sp = getattr(traj.steps, "smooth_path", None)
-    gp = getattr(traj.steps, "grid_path", None)
-    if sp is None or gp is None:
+    costs = path_costs(traj, cm)
+    if costs is None:
         return {"ok": False, "err": "no smooth path (fallback)"}
-    res = cm.grid.resolution
-    a, b = sp.curve.domain
-    curve = sp.curve(np.linspace(a, b, max(200, int(40 * (b - a) / res))))
-    cells = np.asarray(gp.cells, dtype=float)
-    poly = densify(np.asarray(cm.grid.origin) + (cells + 0.5) * res, 0.1 * res)
     return {
         "ok": True,
-        "traj": mean_cost(curve, cm),
-        "astar": mean_cost(poly, cm),
+        "traj": costs[0],
+        "astar": costs[1],
         "duration": float(traj.duration),
         "smooth_s": min(float(t.stats["stages_s"]["smooth"]) for t in runs),
     }

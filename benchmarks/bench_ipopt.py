@@ -210,7 +210,7 @@ def main(argv=None) -> int:
 
 def costmap_section(root, queries: int, seed: int) -> None:
     """The cost term by the QP rounds, by IPOPT, and the rounds polished by IPOPT."""
-    from bench_costmap_smoother import R_INS, densify, mean_cost, nav2_values
+    from bench_costmap_smoother import R_INS, nav2_values, path_costs
 
     rng = np.random.default_rng(seed)
     robot = Robot(radius=R_INS)
@@ -237,11 +237,9 @@ def costmap_section(root, queries: int, seed: int) -> None:
             if np.linalg.norm(p1 - p0) >= 2.0:
                 pairs.append((p0, p1))
         for p in planners.values():  # warm-up
-            _cost_plan(p, cm, *pairs[0], densify, mean_cost)
+            _cost_plan(p, cm, *pairs[0], path_costs)
         for p0, p1 in pairs:
-            rows.append(
-                {v: _cost_plan(p, cm, p0, p1, densify, mean_cost) for v, p in planners.items()}
-            )
+            rows.append({v: _cost_plan(p, cm, p0, p1, path_costs) for v, p in planners.items()})
     n = len(rows)
     common = [r for r in rows if all(r[v]["ok"] for v in COST_VARIANTS)]
     print(
@@ -280,28 +278,23 @@ def costmap_section(root, queries: int, seed: int) -> None:
                 print(f"{v}: {r[v]['err']}")
 
 
-def _cost_plan(planner: Planner, cm, p0, p1, densify, mean_cost) -> dict:
+def _cost_plan(planner: Planner, cm, p0, p1, path_costs) -> dict:
     """One costmap query: objective, mean costs of trajectory and A* path, duration, time."""
     try:
         traj = planner.plan(p0, p1)
     except TrajoptError as exc:
         return {"ok": False, "err": f"{type(exc).__name__}: {exc}"[:200]}
-    sp = getattr(traj.steps, "smooth_path", None)
-    gp = getattr(traj.steps, "grid_path", None)
-    if sp is None or gp is None:
+    costs = path_costs(traj, cm)
+    if costs is None:
         return {"ok": False, "err": "no smooth path (fallback)"}
-    res = cm.grid.resolution
-    a, b = sp.curve.domain
-    curve = sp.curve(np.linspace(a, b, max(200, int(40 * (b - a) / res))))
-    cells = np.asarray(gp.cells, dtype=float)
-    poly = densify(np.asarray(cm.grid.origin) + (cells + 0.5) * res, 0.1 * res)
+    sp = traj.steps.smooth_path
     st = sp.stats
     term = st.get("cost_rounds", {}).get("cost_term", 0.0)
     return {
         "ok": True,
         "objective": float(st["cost"]) + float(term),
-        "traj": mean_cost(curve, cm),
-        "astar": mean_cost(poly, cm),
+        "traj": costs[0],
+        "astar": costs[1],
         "duration": float(traj.duration),
         "smooth_s": float(traj.stats["stages_s"]["smooth"]),
         "build_s": float(st.get("build_time_s", 0.0))
