@@ -42,6 +42,10 @@ _EXPORTS: dict[str, str] = {
     "GridPath": "astar.search",
     "Landmarks": "astar.landmarks",
     "build_landmarks": "astar.landmarks",
+    "CoarseGrid": "astar.coarse_to_fine",
+    "CoarsePath": "astar.coarse_to_fine",
+    "build_coarse_grid": "astar.coarse_to_fine",
+    "find_path_coarse_to_fine": "astar.coarse_to_fine",
     # car-like robots: Hybrid-A* over (x, y, heading), Reeds-Shepp and Dubins paths
     "find_pose_path": "astar.hybrid",
     "PosePath": "astar.hybrid",
@@ -68,6 +72,12 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
+    from astar.coarse_to_fine import (
+        CoarseGrid,
+        CoarsePath,
+        build_coarse_grid,
+        find_path_coarse_to_fine,
+    )
     from astar.costmap import Costmap, from_costmap, load_costmap
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid

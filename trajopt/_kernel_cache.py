@@ -48,6 +48,7 @@ _log = logging.getLogger(__name__)
 
 #: Modules that define the compiled (numba) kernels of astar and trajopt.
 KERNEL_MODULES: tuple[str, ...] = (
+    "astar.coarse_to_fine",
     "astar.distance_transform",
     "astar.hybrid_kernel",
     "astar.inflation",

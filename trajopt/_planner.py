@@ -79,6 +79,7 @@ from trajopt.planning._options import (
     PlannerOptions,
     PlanRequest,
     Search,
+    SearchMode,
 )
 from trajopt.planning._query import PlanSteps
 from trajopt.planning._runner import run_query
@@ -139,6 +140,23 @@ class Planner:
         times, for a one-time cost on the first query after each map (about 0.1 s per
         landmark per million cells; :meth:`update_map` keeps them through changes that only
         add obstacles) and ``8 landmarks`` bytes per cell.
+    search_mode : {"auto", "exact", "coarse"}, optional
+        ``"exact"``: the optimal A* (:func:`astar.find_path`). ``"coarse"``: coarse-to-fine
+        (:func:`astar.find_path_coarse_to_fine`): an A* over blocks of about half the robot
+        radius (:meth:`~trajopt.planning._options.PlannerOptions.search_block_cells`), then
+        the fine A* in a band of blocks around its path; the path's cost is proven at most
+        ``bound`` times the optimum, with ``bound <= search_bound`` (otherwise, and when
+        the blocks or the band hold no path, the exact search runs). ``"auto"`` (default):
+        coarse-to-fine on inflated grids of at least 1.5 M cells for ends at least 16
+        blocks apart, without landmarks; exact otherwise (so maps up to about 1 M cells
+        plan exactly as before). ``stats["search_info"]`` reports the mode run, the block
+        (cells and m), the bound and its lower bound, and any fallback. The blocks are
+        computed on the first coarse search and kept through :meth:`update_map` outside
+        the changed window.
+    search_bound : float, optional
+        The largest suboptimality a coarse-to-fine search may return, ``>= 1`` (default 1.5;
+        ``inf``: any). Typical proven bounds are 1.1-1.3 while the band path's actual cost is
+        within a fraction of a percent of the optimum (``docs/concepts.md``).
     smoother : Smoother, optional
         Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
     timing_dt : float
@@ -182,6 +200,8 @@ class Planner:
         costmap_weight: float = 2.0,
         speed_limits: SpeedLimits | None = None,
         landmarks: int = 0,
+        search_mode: SearchMode = "auto",
+        search_bound: float = 1.5,
         options: PlannerOptions | None = None,
     ) -> None:
         settings = _settings(
@@ -197,6 +217,8 @@ class Planner:
             costmap_weight=costmap_weight,
             speed_limits=speed_limits,
             landmarks=landmarks,
+            search_mode=search_mode,
+            search_bound=search_bound,
         )
         self._init(grid, settings)
 
@@ -272,6 +294,16 @@ class Planner:
     def landmarks(self) -> int:
         """Number of ALT landmarks of the searches with a cost (0: none)."""
         return self.options.landmarks
+
+    @property
+    def search_mode(self) -> SearchMode:
+        """``"auto"``, ``"exact"`` or ``"coarse"`` (the coarse-to-fine search)."""
+        return self.options.search_mode
+
+    @property
+    def search_bound(self) -> float:
+        """The largest suboptimality a coarse-to-fine search may return."""
+        return self.options.search_bound
 
     # -------------------------------------------------------------- caches
     @property
@@ -483,6 +515,8 @@ def plan(
     speed_limits: SpeedLimits | None = None,
     timing_dt: float = 0.02,
     landmarks: int = 0,
+    search_mode: SearchMode = "auto",
+    search_bound: float = 1.5,
     options: PlannerOptions | None = None,
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
@@ -513,6 +547,9 @@ def plan(
         them for its one query (``landmarks + 1`` searches of the whole map), which costs
         more than the search they shorten; they pay off across the queries of one
         :class:`Planner`.
+    search_mode, search_bound : optional
+        The search: exact, coarse-to-fine with a bound, or chosen by map size (see
+        :class:`Planner`; default ``"auto"`` and 1.5).
     fallback : {None, "stop_and_turn"}
         Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
         module docstring); default ``None``: the failure raises.
@@ -545,6 +582,8 @@ def plan(
         speed_limits=speed_limits,
         timing_dt=timing_dt,
         landmarks=landmarks,
+        search_mode=search_mode,
+        search_bound=search_bound,
         options=options,
     )
     return planner.plan(

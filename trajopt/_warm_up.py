@@ -188,7 +188,7 @@ def _search_query() -> tuple[OccupancyGrid, tuple[int, int], tuple[int, int]]:
 
 
 def _exercise_search() -> None:
-    """Search without a cost (jump points), with a cost and with ALT landmarks."""
+    """Search without a cost (jump points), with a cost, with ALT landmarks, coarse-to-fine."""
     import astar
 
     grid, a, b = _search_query()
@@ -196,6 +196,10 @@ def _exercise_search() -> None:
     cost = np.ones(grid.shape)
     astar.find_path(grid, a, b, cost=cost)
     astar.find_path(grid, a, b, landmarks=astar.build_landmarks(grid, cost, 2))
+    cost.flags.writeable = False  # as the planner's search cost
+    for c in (cost, None):  # the coarse-to-fine search, with and without a cost
+        coarse = astar.build_coarse_grid(grid, 2, c)
+        astar.find_path_coarse_to_fine(coarse.update(grid, c, (0, 1, 0, 1)), a, b)
 
 
 def _exercise_astar() -> None:

@@ -9,7 +9,9 @@ falls; otherwise they are dropped and built again by the next search. The compon
 are updated from a labelling of the changed box when that settles the change
 (:func:`update_labels`), and otherwise dropped and labelled again on next use. A footprint
 robot's disc models have caches of their own (:meth:`PlannerCaches.disc`), updated with
-the map.
+the map. The blocks of the coarse-to-fine search (:attr:`PlannerCaches.coarse`) are built on
+the first coarse search and recomputed by :meth:`PlannerCaches.update` only in the blocks
+the changed window touches (:meth:`astar.CoarseGrid.update`).
 """
 
 from __future__ import annotations
@@ -56,6 +58,7 @@ class PlannerCaches:
         self._cost: np.ndarray | None = None
         self._landmarks: astar.Landmarks | None = None
         self._components: np.ndarray | None = None
+        self._coarse: astar.CoarseGrid | None = None
         self._discs: dict[float, PlannerCaches] = {}
 
     @property
@@ -99,6 +102,7 @@ class PlannerCaches:
                 cost = self._clearance_cost(self.grid)
                 if self.costmap is not None and o.search.startswith("costmap"):
                     cost += self.costmap.search_cost(o.costmap_weight)
+                cost.flags.writeable = False  # shared with the landmarks and the blocks
                 self._cost = cost
             return self._cost
 
@@ -119,6 +123,24 @@ class PlannerCaches:
     def built_landmarks(self) -> astar.Landmarks | None:
         """The landmarks if a search has built them (``None`` otherwise; builds nothing)."""
         return self._landmarks
+
+    @property
+    def coarse(self) -> astar.CoarseGrid:
+        """Blocks of the inflated grid and search cost for the coarse-to-fine search.
+
+        Blocks of :meth:`PlannerOptions.search_block_cells` cells, built on first use
+        (:func:`astar.build_coarse_grid`) and kept up to date by :meth:`update`.
+        """
+        with self._lock:
+            if self._coarse is None:
+                k = self.options.search_block_cells(self.grid.resolution)
+                self._coarse = astar.build_coarse_grid(self.inflated, k, self.search_cost)
+            return self._coarse
+
+    @property
+    def built_coarse(self) -> astar.CoarseGrid | None:
+        """The coarse-to-fine blocks if a search has built them (``None`` otherwise)."""
+        return self._coarse
 
     def disc(self, options: PlannerOptions) -> PlannerCaches:
         """Return (and keep) the caches of a disc model with ``options`` on this map."""
@@ -167,6 +189,7 @@ class PlannerCaches:
             if not same:
                 self.grid, self._inflated, self._cost = grid, None, None
                 self._components = None
+                self._coarse = None
                 had = self._landmarks is not None
                 self._landmarks = None
                 return {
@@ -204,6 +227,8 @@ class PlannerCaches:
                 _patch(cost, grid, window, reach_cost, self._clearance_cost)
                 cost.flags.writeable = False  # shared with the landmarks
                 self._cost = cost
+            if self._coarse is not None:  # built from both, so both were built
+                self._coarse = self._coarse.update(self._inflated, self._cost, window)
             state = None
             if lms is not None:
                 try:

@@ -9,6 +9,7 @@ input is explicit: the options, the map's caches, the request and a re-plan's wa
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -26,7 +27,12 @@ from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
 from trajopt.planning._fallback import polyline_fallback
-from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._options import (
+    COARSE_MIN_BLOCKS,
+    COARSE_MIN_CELLS,
+    PlannerOptions,
+    PlanRequest,
+)
 from trajopt.planning._query import PlanQuery, PlanSteps, WarmStart
 from trajopt.robot._footprint import Footprint
 from trajopt.robot._state import State
@@ -113,10 +119,12 @@ def plan_disc(
     ends = [q.start_cell, q.goal_cell]
     grid_path = None if warm is None else warm.grid_path
     reused = grid_path is not None and np.array_equal(grid_path.cells[[0, -1]], ends)
+    search_info = None
     with q.timer.stage("search"):
         if not reused:
             _check_connected(options, caches, q)
-        q.path = grid_path if reused else _search(options, caches, q)
+            grid_path, search_info = _search(options, caches, q)
+        q.path = grid_path
         if path_check is not None:
             q.path, q.inflated = path_check(caches, q)
     smooth = None
@@ -134,7 +142,7 @@ def plan_disc(
             raise
         with q.timer.stage("fallback"):
             fallback, extra = polyline_fallback(options, caches.grid, q, exc)
-        return _result(options, caches.grid, q, fallback, None, **extra)
+        return _result(options, caches.grid, q, fallback, None, search_info=search_info, **extra)
     smoother_stats = dict(smooth.stats)
     smoother_stats["rescue"] = q.rescue
     kind = "polygons" if isinstance(q.corridor, PolygonCorridor) else "boxes"
@@ -148,20 +156,67 @@ def plan_disc(
         corridor=kind,
         grid_path="reused" if reused else "searched",
         corridor_regions_kept=q.regions_kept,
+        search_info=search_info,
     )
 
 
-def _search(options: PlannerOptions, caches: PlannerCaches, q: PlanQuery) -> astar.GridPath:
-    """Return the A* path of the query on the inflated grid (typed error without one)."""
+def _search(
+    options: PlannerOptions, caches: PlannerCaches, q: PlanQuery
+) -> tuple[astar.GridPath, dict[str, Any]]:
+    """Return the A* path of the query on the inflated grid and ``stats["search_info"]``.
+
+    ``search_mode`` picks the exact search or the coarse-to-fine one
+    (:func:`astar.find_path_coarse_to_fine` on :attr:`PlannerCaches.coarse`; ``"auto"``:
+    on inflated grids of :data:`COARSE_MIN_CELLS` cells or more, for ends
+    :data:`COARSE_MIN_BLOCKS` blocks apart or more, without landmarks). Raises a typed
+    error without a path.
+    """
+    s, g = _cell(q.start_cell), _cell(q.goal_cell)
+    res = caches.grid.resolution
+    k = options.search_block_cells(res)
+    mode = options.search_mode
+    if mode == "auto":
+        ax, ay = abs(s[0] - g[0]), abs(s[1] - g[1])
+        octile = max(ax, ay) + (math.sqrt(2.0) - 1.0) * min(ax, ay)
+        coarse = (
+            caches.grid.occupied.size >= COARSE_MIN_CELLS
+            and octile >= COARSE_MIN_BLOCKS * k
+            and (options.landmarks == 0 or options.search == "shortest")
+        )
+    else:
+        coarse = mode == "coarse"
     try:
+        if coarse:
+            found = astar.find_path_coarse_to_fine(
+                caches.coarse, s, g, max_bound=options.search_bound
+            )
+            return found.path, {
+                "requested": mode,
+                "mode": found.mode,
+                "block_cells": found.block,
+                "block_m": found.block * res,
+                "bound": found.bound,
+                "lower_bound": found.lower_bound,
+                "cost": found.path.cost,
+                "fallback": found.fallback,
+                "band_cells": found.band_cells,
+                "times_s": dict(found.times_s),
+            }
         lms = caches.landmarks
-        return astar.find_path(
+        path = astar.find_path(
             q.inflated,
-            _cell(q.start_cell),
-            _cell(q.goal_cell),
+            s,
+            g,
             cost=caches.search_cost if lms is None else None,
             landmarks=lms,
         )
+        return path, {
+            "requested": mode,
+            "mode": "exact",
+            "bound": 1.0,
+            "cost": path.cost,
+            "fallback": None,
+        }
     except astar.NoPathError as exc:
         raise NoPathError(
             f"no path from start {q.start.tolist()} m to goal {q.goal.tolist()} m for a "

@@ -26,10 +26,17 @@ Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]
 Fallback = Literal["stop_and_turn"]
 CorridorKind = Literal["polygons", "boxes"]
+SearchMode = Literal["auto", "exact", "coarse"]
 INFLATIONS = ("exact", "paper")
 SEARCHES = ("clearance", "shortest", "costmap", "costmap+clearance")
 FALLBACKS = (None, "stop_and_turn")
 CORRIDORS = ("polygons", "boxes")
+SEARCH_MODES = ("auto", "exact", "coarse")
+#: ``search_mode="auto"`` searches coarse-to-fine on inflated grids of at least this many
+#: cells (smaller maps, and every map the tests and benchmarks used before, search exactly).
+COARSE_MIN_CELLS = 1_500_000
+#: ... and for queries whose ends are at least this many blocks apart (octile distance).
+COARSE_MIN_BLOCKS = 16
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,6 +69,15 @@ class PlannerOptions:
         Speed-limit zones of the timing.
     landmarks : int
         ALT landmarks of the searches with a cost, 0-64.
+    search_mode : {"auto", "exact", "coarse"}
+        ``"exact"``: the optimal A* (:func:`astar.find_path`). ``"coarse"``: coarse-to-fine
+        (:func:`astar.find_path_coarse_to_fine`, blocks of about half the robot radius),
+        at most ``search_bound`` times the optimal cost. ``"auto"``: coarse-to-fine on
+        large maps (:data:`COARSE_MIN_CELLS`) for long queries (:data:`COARSE_MIN_BLOCKS`)
+        without landmarks, exact otherwise.
+    search_bound : float
+        The largest suboptimality a coarse-to-fine search may return (``>= 1``; ``inf``:
+        any); beyond it the exact search runs.
 
     Raises
     ------
@@ -80,6 +96,8 @@ class PlannerOptions:
     costmap_weight: float = 2.0
     speed_limits: SpeedLimits | None = None
     landmarks: int = 0
+    search_mode: SearchMode = "auto"
+    search_bound: float = 1.5
 
     def __post_init__(self) -> None:
         robot = Robot() if self.robot is None else self.robot
@@ -98,6 +116,19 @@ class PlannerOptions:
         if not (isinstance(corridor, str) and corridor in CORRIDORS):
             raise InvalidInputError(f"corridor must be one of {CORRIDORS}, got {corridor!r}")
         landmarks = integer("landmarks", self.landmarks, 0, 64)
+        mode = self.search_mode
+        if not (isinstance(mode, str) and mode in SEARCH_MODES):
+            raise InvalidInputError(f"search_mode must be one of {SEARCH_MODES}, got {mode!r}")
+        bound = self.search_bound
+        if (
+            isinstance(bound, bool)
+            or not isinstance(bound, (int, float, np.integer, np.floating))
+            or not float(bound) >= 1.0
+        ):
+            raise InvalidInputError(
+                f"search_bound must be a number >= 1 (the largest accepted ratio of the "
+                f"path's cost to the optimal cost; inf: any), got {bound!r}"
+            )
         w = self.w_cells
         if w is not None and (isinstance(w, bool) or not isinstance(w, (int, np.integer)) or w < 0):
             raise InvalidInputError(f"w_cells must be an integer >= 0, got {w!r}")
@@ -116,6 +147,7 @@ class PlannerOptions:
         object.__setattr__(self, "robot", robot)
         object.__setattr__(self, "smoother", smoother)
         object.__setattr__(self, "landmarks", int(landmarks))
+        object.__setattr__(self, "search_bound", float(bound))
         object.__setattr__(self, "timing_dt", float(dt))
         object.__setattr__(self, "costmap_weight", float(self.costmap_weight))
         if w is not None:
@@ -165,6 +197,15 @@ class PlannerOptions:
             w_cells = avoidance_width(self.robot.width, grid.resolution)
         resolved = dataclasses.replace(self, search=search, w_cells=w_cells)
         return resolved, grid, costmap
+
+    def search_block_cells(self, resolution: float) -> int:
+        """Fine cells per block side of the coarse-to-fine search on a map of ``resolution`` (m).
+
+        Blocks of about half the robot radius (at least 2 cells): a passage the robot fits
+        through is then at least a block wide, and the block follows the robot, not the map's
+        cell count.
+        """
+        return max(2, int(round(0.5 * self.robot.radius / resolution)))
 
     def disc(self, radius: float, *, last: bool) -> PlannerOptions:
         """Return the options of a footprint robot's disc model of ``radius`` (m).
