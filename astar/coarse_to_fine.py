@@ -11,13 +11,14 @@ The coarse view (:class:`CoarseGrid`, built by :func:`build_coarse_grid`) cuts t
 into blocks of ``k x k`` cells (``k = block``; the blocks of the last row and column may
 stick out of the grid, their outside cells counting as occupied) and keeps per block:
 
-* ``free_all``: every fine cell of the block is free (the *conservative* view). On it, an
-  8-connected A* without corner cutting, a step between blocks ``A`` and ``B`` costing its
-  octile length times ``1 + (C[A] + C[B]) / 2`` with ``C`` = ``cost_max``, the largest fine
-  cost of the block, finds the coarse path. Its blocks join start and goal by free fine
-  cells (two side-adjacent all-free blocks share a free edge; a diagonal step needs both
-  side blocks free), so the band always holds a fine path, except near the ends (the
-  start's and goal's blocks are searched as free even when they are not).
+* ``open_east``, ``open_north``: a free fine cell of the block has a free neighbour across
+  its east (north) side. On these side connections an A* over the blocks (a diagonal step
+  needs one of its two L-shaped pairs of straight steps), a step between blocks ``A`` and
+  ``B`` costing its octile length times ``1 + (C[A] + C[B]) / 2`` with ``C`` = ``cost_mean``,
+  the mean fine cost of the block's free cells, finds the coarse path. It passes where
+  the fine grid passes, also through passages narrower than a block (requiring whole free
+  blocks, as a first version did, lost most doors of an office map); a block whose free
+  cells are split may make the band hold no fine path, and then the exact search runs.
 * ``free_any``: some fine cell of the block is free (the *optimistic* view), and
   ``near_min``, ``m(B)``: the smallest fine cost over the free cells of the 3 x 3 blocks
   around ``B``. They give the lower bound below.
@@ -45,10 +46,14 @@ two is the lower bound reported; ``bound = cost(band path) / LB >= cost / optimu
 The coarse distance runs as an A* on the blocks with the consistent heuristic
 ``max(0, Chebyshev blocks to G - 1)`` (every coarse step costs at least 1).
 
-The fine search in the band is :func:`astar.find_path`'s kernel (the same cost model and
-tie rules) on a copy of the padded free mask in which only the band's cells are free: the
-copy lives across searches, all blocked, and a search sets and clears the band's cells only,
-so its cost follows the band, not the grid. :meth:`CoarseGrid.update` recomputes the blocks
+The fine search in the band has :func:`astar.find_path`'s step rule and cost model and its
+tie rule (among equal ``f`` the larger ``g``), with a sharper heuristic: the larger of the
+octile distance and the coarse cost to the goal (a Dijkstra over the band's blocks),
+interpolated between block centres and taken 1.1 times, so that the search closes about
+two cells per path cell instead of the whole band. It is not admissible, and need not be:
+the bound above is computed afterwards. It runs on a copy of the padded free mask in which
+only the band's cells are free: the copy lives across searches, all blocked, and a search
+sets and clears the band's cells only, so its cost follows the band, not the grid. :meth:`CoarseGrid.update` recomputes the blocks
 a change of the fine grid touches and keeps the rest.
 """
 
@@ -249,7 +254,8 @@ def _band_kernel(free, width, start, goal, cost, has_cost, rec, recf, gen, field
     estimate of the cost from each block's centre to the goal (``inf`` outside the band).
     The heuristic of a cell is the larger of the octile distance and the bilinear
     interpolation of ``field`` at the cell (the own block's value where a neighbour is
-    ``inf``); it need not be admissible (the caller bounds the result). Among equal ``f``
+    ``inf``); it need not be admissible (the caller bounds the result: the field is the
+    coarse cost to the goal times :data:`_GREED`). Among equal ``f``
     the larger ``g`` is expanded first. Returns ``(found, path, expanded, cost)``.
     """
     sqrt2 = 1.4142135623730951
@@ -755,7 +761,8 @@ def find_path_coarse_to_fine(
     t0 = time.perf_counter()
     # the heuristic of the band search: the coarse cost from each band block to the goal
     to_goal, _ = _coarse_search(*arrays, g_blk, -1, band)
-    path = _band_search(coarse, (sx, sy), (gx, gy), bys, bxs, (k * to_goal).reshape(nby, nbx))
+    field = (_GREED * k * to_goal).reshape(nby, nbx)
+    path = _band_search(coarse, (sx, sy), (gx, gy), bys, bxs, field)
     times["band"] = time.perf_counter() - t0
     n_band = int(bys.size) * k * k
     if path is None:
@@ -770,6 +777,10 @@ def find_path_coarse_to_fine(
 
 
 _NO_LM = np.zeros((0, 1))
+#: The band search's heuristic is the coarse cost to the goal times this: on the willow map
+#: split to 1.7 cm it cut the closed cells from about 13 to 2 per path cell (1.0 -> 1.1) and
+#: left the cost within 1 % of the optimum; 1.25 cost 4 %. The bound is checked afterwards.
+_GREED = 1.1
 _NO_MASK = np.zeros((1, 1), dtype=np.uint8)
 _NO_LG = np.zeros(0)
 _BANDS: OrderedDict[int, np.ndarray] = OrderedDict()

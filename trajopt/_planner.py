@@ -142,7 +142,7 @@ class Planner:
         add obstacles) and ``8 landmarks`` bytes per cell.
     search_mode : {"auto", "exact", "coarse"}, optional
         ``"exact"``: the optimal A* (:func:`astar.find_path`). ``"coarse"``: coarse-to-fine
-        (:func:`astar.find_path_coarse_to_fine`): an A* over blocks of about half the robot
+        (:func:`astar.find_path_coarse_to_fine`): an A* over blocks of about the robot
         radius (:meth:`~trajopt.planning._options.PlannerOptions.search_block_cells`), then
         the fine A* in a band of blocks around its path; the path's cost is proven at most
         ``bound`` times the optimum, with ``bound <= search_bound`` (otherwise, and when
