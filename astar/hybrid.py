@@ -231,6 +231,46 @@ def _int(name: str, value: object, lo: int) -> int:
     return int(value)
 
 
+def _exact_mode(
+    raw_grid: object, clearance: object, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Return the exact mode's ``(safe, occ, clearance)`` arrays (uint8) and distance (cells).
+
+    Off (``clearance`` None): 1 x 1 placeholders and ``0.0``. ``safe`` marks the cells whose
+    centre keeps ``clearance + sqrt(2) / 2`` from every occupied square and the outside (so
+    every point of the cell keeps ``clearance``).
+    """
+    dummy = np.zeros((1, 1), dtype=np.uint8)
+    if clearance is None:
+        if raw_grid is not None:
+            raise InvalidInputError("raw_grid is used only with clearance: pass both or neither")
+        return dummy, dummy, 0.0
+    r = validation.positive_float("clearance", clearance)
+    if raw_grid is None:
+        raise InvalidInputError(f"clearance={r!r} needs raw_grid (the raw map) to measure it on")
+    if isinstance(raw_grid, OccupancyGrid):
+        occ = np.asarray(raw_grid.occupied, dtype=bool)
+    else:
+        a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
+        if a is None or a.dtype != bool or a.ndim != 2:
+            raise InvalidInputError(
+                "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
+                f"cells, got {type(raw_grid).__name__}"
+                + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
+            )
+        occ = a
+    if occ.shape != free.shape:
+        raise InvalidInputError(
+            f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
+        )
+    from astar.inflation import inflate
+
+    margin = r + math.sqrt(0.5) + 1e-9
+    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
+    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
+    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
+
+
 # --------------------------------------------------------------------------- public API
 def find_pose_path(
     grid: OccupancyGrid | np.ndarray,
@@ -251,6 +291,8 @@ def find_pose_path(
     max_expansions: int = 500_000,
     time_budget: float = 2.0,
     heuristic_weight: float = 1.5,
+    raw_grid: OccupancyGrid | np.ndarray | None = None,
+    clearance: float | None = None,
 ) -> PosePath:
     """Path of a car-like robot from a start pose to a goal pose by Hybrid-A*.
 
@@ -302,6 +344,20 @@ def find_pose_path(
         many more states; the default 1.5 solved 36 of 36 held-out queries where 1.0 solved
         32 within 1 s (``benchmarks/bench_hybrid.py``), at a cost at most 1.5 times the
         cheapest.
+    raw_grid : OccupancyGrid or ndarray of bool, shape (ny, nx), optional
+        With ``clearance``: the raw map (an ``OccupancyGrid``, or a bool array ``True`` on
+        *occupied* cells, as ``OccupancyGrid.occupied``), the same shape as ``grid``.
+    clearance : float, optional
+        Exact mode (with ``raw_grid``; finite, ``> 0``, cells): besides the cell checks on
+        ``grid``, every chord between consecutive collision samples keeps Euclidean distance
+        ``>= clearance`` from every occupied square of ``raw_grid`` and from the outside of the
+        grid (checked exactly where a cell it crosses is within ``clearance + sqrt(2) / 2``
+        cells of an obstacle), and the returned poses are those samples (arc-length spacing
+        at most 0.2 cells, ``sample_step`` ignored), so the polyline through the poses keeps
+        ``clearance``. For a ``grid`` inflated by a radius ``r`` (cell centres keep ``r``),
+        ``clearance=r`` lets the poses lie anywhere in their cells without coming closer
+        than ``r``, where a grid inflated by ``r`` plus half a cell's diagonal would block
+        the cells next to a wall.
 
     Returns
     -------
@@ -374,6 +430,7 @@ def find_pose_path(
     max_exp = _int("max_expansions", max_expansions, 1)
     budget = validation.positive_float("time_budget", time_budget)
     hw = _number("heuristic_weight", heuristic_weight, 1.0, ">= 1")
+    safe, occ, exact_r = _exact_mode(raw_grid, clearance, free)
 
     from astar.hybrid_kernel import EXHAUSTED, FOUND, TIME_BUDGET, distance_field, hybrid_kernel
 
@@ -430,6 +487,9 @@ def find_pose_path(
             deadline,
             _POLISH,
             hw,
+            safe,
+            occ,
+            exact_r,
         )
 
     out = search(prim_len, nbins, max_exp, t1 + budget)
@@ -485,7 +545,18 @@ def find_pose_path(
             stats,
         )
     path = _assemble(
-        nodes, prims, chain, skinds, slens, int(sn), kappas, prim_len, radius, step, (gx, gy, gth)
+        nodes,
+        prims,
+        chain,
+        skinds,
+        slens,
+        int(sn),
+        kappas,
+        prim_len,
+        radius,
+        step,
+        (gx, gy, gth),
+        exact_r > 0.0,
     )
     stats["total_s"] = time.perf_counter() - t0
     object.__setattr__(path, "stats", stats)
@@ -505,8 +576,14 @@ def _assemble(
     radius: float,
     step: float,
     goal: tuple[float, float, float],
+    exact: bool = False,
 ) -> PosePath:
-    """Pieces, poses, directions and segments from the kernel's chain of nodes and shot."""
+    """Pieces, poses, directions and segments from the kernel's chain of nodes and shot.
+
+    ``exact``: the poses are the kernel's own collision samples (each primitive and shot
+    segment from its start pose, ``m = ceil(|s| / _COLLISION_STEP)`` equal steps), whose
+    chords the exact mode checked.
+    """
     from astar.reeds_shepp import advance
 
     raw: list[list[float]] = []
@@ -529,10 +606,18 @@ def _assemble(
         else:
             pieces.append(list(r))
     # sample every piece from its own start pose (the kernel's node poses)
-    chunks = [np.array([pieces[0][:3]]) if pieces else np.array([nodes[0]])]
-    dirs = [np.array([-1 if pieces and pieces[0][4] < 0 else 1], dtype=np.int8)]
+    units = raw if exact else pieces
+    chunks = [np.array([units[0][:3]]) if units else np.array([nodes[0]])]
+    dirs = [np.array([-1 if units and units[0][4] < 0 else 1], dtype=np.int8)]
     ends = []
-    for px, py, pth, k, s in pieces:
+    for px, py, pth, k, s in units:
+        if exact:  # the kernel's samples (arc_clear), by its closed form
+            m = max(1, math.ceil(abs(s) / _COLLISION_STEP))
+            c = np.array([advance.py_func(px, py, pth, k, s * j / m) for j in range(1, m + 1)])
+            chunks.append(c)
+            dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
+            ends.append(sum(len(ch) for ch in chunks) - 1)
+            continue
         m = max(1, math.ceil(abs(s) / step - 1e-9))
         q = s * np.arange(1, m + 1) / m
         if k == 0.0:
@@ -561,8 +646,8 @@ def _assemble(
         )
     poses[-1] = (gx, gy, exact_th)
     cuts = [0]
-    for i in range(len(pieces) - 1):
-        if (pieces[i][4] < 0) != (pieces[i + 1][4] < 0):
+    for i in range(len(units) - 1):
+        if (units[i][4] < 0) != (units[i + 1][4] < 0):
             cuts.append(ends[i])
     cuts.append(len(poses) - 1)
     segments = np.array([[a, b] for a, b in zip(cuts[:-1], cuts[1:], strict=True)], np.int64)

@@ -223,21 +223,137 @@ def segment_clear(free, x0, y0, x1, y1):  # pragma: no cover - compiled
     return True
 
 
+@njit(cache=True, inline="always")
+def _box_sq_dist(x, y, cx, cy):  # pragma: no cover - compiled
+    """Squared distance (cells^2) from point ``(x, y)`` to the square of cell ``(cx, cy)``."""
+    dx = max(abs(x - cx) - 0.5, 0.0)
+    dy = max(abs(y - cy) - 0.5, 0.0)
+    return dx * dx + dy * dy
+
+
+@njit(cache=True, inline="always")
+def _point_seg_sq_dist(px, py, x0, y0, dx, dy, dd):  # pragma: no cover - compiled
+    """Squared distance from ``(px, py)`` to the segment ``(x0, y0) + t (dx, dy)``, t in [0, 1]."""
+    t = 0.0
+    if dd > 0.0:
+        t = min(max(((px - x0) * dx + (py - y0) * dy) / dd, 0.0), 1.0)
+    ex = x0 + t * dx - px
+    ey = y0 + t * dy - py
+    return ex * ex + ey * ey
+
+
+@njit(cache=True, inline="always")
+def _seg_hits_box(x0, y0, dx, dy, cx, cy):  # pragma: no cover - compiled
+    """Whether the segment ``(x0, y0) + t (dx, dy)``, t in [0, 1], meets cell ``(cx, cy)``'s square.
+
+    Liang-Barsky clipping against the closed square.
+    """
+    t0 = 0.0
+    t1 = 1.0
+    for k in range(4):
+        if k == 0:
+            p, q = -dx, x0 - (cx - 0.5)
+        elif k == 1:
+            p, q = dx, (cx + 0.5) - x0
+        elif k == 2:
+            p, q = -dy, y0 - (cy - 0.5)
+        else:
+            p, q = dy, (cy + 0.5) - y0
+        if p == 0.0:
+            if q < 0.0:
+                return False
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = max(t0, t)
+            else:
+                t1 = min(t1, t)
+            if t0 > t1:
+                return False
+    return True
+
+
 @njit(cache=True)
-def arc_clear(free, x, y, th, kappa, s, step):  # pragma: no cover - compiled
+def segment_clearance_ok(occ, x0, y0, x1, y1, r):  # pragma: no cover - compiled
+    """Whether the segment ``(x0, y0) -> (x1, y1)`` keeps Euclidean distance ``>= r`` (cells).
+
+    Exact: the distance from the closed segment to every occupied square of ``occ`` (cell
+    ``(ix, iy)``'s square ``[ix - 0.5, ix + 0.5] x [iy - 0.5, iy + 0.5]``) within reach, and to
+    the outside of the grid. Between a segment and a square that it does not meet, the
+    distance is the least of the end points' distances to the square and the corners'
+    distances to the segment.
+    """
+    ny, nx = occ.shape
+    # the outside of the grid: a linear distance along the segment, least at an end
+    for x, y in ((x0, y0), (x1, y1)):
+        if min(x + 0.5, nx - 0.5 - x, y + 0.5, ny - 0.5 - y) < r:
+            return False
+    r2 = r * r
+    dx = x1 - x0
+    dy = y1 - y0
+    dd = dx * dx + dy * dy
+    lo_x = max(0, int(math.ceil(min(x0, x1) - r - 0.5)))
+    hi_x = min(nx - 1, int(math.floor(max(x0, x1) + r + 0.5)))
+    lo_y = max(0, int(math.ceil(min(y0, y1) - r - 0.5)))
+    hi_y = min(ny - 1, int(math.floor(max(y0, y1) + r + 0.5)))
+    bx0 = min(x0, x1)
+    bx1 = max(x0, x1)
+    by0 = min(y0, y1)
+    by1 = max(y0, y1)
+    for iy in range(lo_y, hi_y + 1):
+        for ix in range(lo_x, hi_x + 1):
+            if occ[iy, ix] == 0:
+                continue
+            # the square against the segment's bounding box first (a lower bound)
+            gx = max(ix - 0.5 - bx1, bx0 - ix - 0.5, 0.0)
+            gy = max(iy - 0.5 - by1, by0 - iy - 0.5, 0.0)
+            if gx * gx + gy * gy >= r2:
+                continue
+            if _seg_hits_box(x0, y0, dx, dy, ix, iy):
+                return False
+            d = min(_box_sq_dist(x0, y0, ix, iy), _box_sq_dist(x1, y1, ix, iy))
+            for sx in (-0.5, 0.5):
+                for sy in (-0.5, 0.5):
+                    d = min(d, _point_seg_sq_dist(ix + sx, iy + sy, x0, y0, dx, dy, dd))
+            if d < r2:
+                return False
+    return True
+
+
+@njit(cache=True)
+def chord_clear(free, safe, occ, r, x0, y0, x1, y1):  # pragma: no cover - compiled
+    """Whether a chord between two samples is clear (:func:`segment_clear` on ``free``).
+
+    With ``r > 0`` (the exact mode of :func:`hybrid_kernel`) the chord must also keep
+    Euclidean distance ``>= r`` from the occupied squares of ``occ`` (the raw map) and the
+    outside: checked exactly (:func:`segment_clearance_ok`) unless every cell it crosses is
+    ``safe`` (every point of a safe cell keeps ``r``).
+    """
+    if not segment_clear(free, x0, y0, x1, y1):
+        return False
+    if r <= 0.0 or segment_clear(safe, x0, y0, x1, y1):
+        return True
+    return segment_clearance_ok(occ, x0, y0, x1, y1, r)
+
+
+@njit(cache=True)
+def arc_clear(free, x, y, th, kappa, s, step, safe, occ, r):  # pragma: no cover - compiled
     """Whether the arc from pose ``(x, y, th)``, curvature ``kappa``, signed length ``s`` is free.
 
     Sampled at arc-length spacing ``<= step``; between two samples the arc lies between the
     chord and the chord moved by the sagitta towards the arc's bulge (``(1 - cos(kappa ds /
     2)) / |kappa|``, below ``0.0025`` cells for ``step = 0.2`` and ``R >= 2``), and both
-    segments are traversed, so a bulge across a cell boundary is caught.
+    segments are traversed, so a bulge across a cell boundary is caught. With ``r > 0`` each
+    chord (the ``m = ceil(|s| / step)`` samples ``advance(x, y, th, kappa, s q / m)``, ``q = 0
+    .. m``, joined) also keeps Euclidean distance ``r`` from the raw map ``occ``
+    (:func:`chord_clear`).
     """
     m = max(1, int(math.ceil(abs(s) / step)))
     px = x
     py = y
     for q in range(1, m + 1):
         qx, qy, _ = advance(x, y, th, kappa, s * q / m)
-        if not segment_clear(free, px, py, qx, qy):
+        if not chord_clear(free, safe, occ, r, px, py, qx, qy):
             return False
         if kappa != 0.0:
             # offset of the arc's midpoint from the chord's, a hair longer
@@ -252,13 +368,15 @@ def arc_clear(free, x, y, th, kappa, s, step):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def word_clear(free, x, y, th, radius, kinds, lens, n, step):  # pragma: no cover - compiled
-    """Whether a Reeds-Shepp/Dubins word from pose ``(x, y, th)`` stays on free cells."""
+def word_clear(
+    free, x, y, th, radius, kinds, lens, n, step, safe, occ, r
+):  # pragma: no cover - compiled
+    """Whether a Reeds-Shepp/Dubins word from pose ``(x, y, th)`` is clear (:func:`arc_clear`)."""
     for i in range(n):
         if lens[i] == 0.0:
             continue
         kappa = kinds[i] / radius
-        if not arc_clear(free, x, y, th, kappa, lens[i], step):
+        if not arc_clear(free, x, y, th, kappa, lens[i], step, safe, occ, r):
             return False
         x, y, th = advance(x, y, th, kappa, lens[i])
     return True
@@ -370,6 +488,9 @@ def hybrid_kernel(
     deadline,  # time.perf_counter() value at which the search gives up
     polish,  # after the first path: search on for at most expansions + polish more
     hweight,  # >= 1: f = g + hweight * h (1: A*; more: weighted A*, faster, cost <= hweight x)
+    safe,  # uint8 (ny, nx): 1 where every point of the cell keeps exact_r (exact mode)
+    occ,  # uint8 (ny, nx): 1 on the raw map's occupied cells (exact mode)
+    exact_r,  # > 0: every chord keeps this Euclidean distance from occ (cells); <= 0: off
 ):  # pragma: no cover - numba
     """Run Hybrid-A* from the start pose to the goal pose (the comments give each argument).
 
@@ -516,7 +637,9 @@ def hybrid_kernel(
                         if (lens[i] < 0.0) != ((pu & 1) == 1):
                             c += cusp_penalty
                         break
-            if ug + c < best and word_clear(free, ux, uy, uth, radius, kinds, lens, n, step):
+            if ug + c < best and word_clear(
+                free, ux, uy, uth, radius, kinds, lens, n, step, safe, occ, exact_r
+            ):
                 if status != FOUND:
                     # keep searching for a cheaper path, at most as long again
                     stop_at = min(max_expansions, 2 * expansions + polish)
@@ -533,7 +656,7 @@ def hybrid_kernel(
             for di in range(ndirs):
                 d = 1.0 if di == 0 else -1.0
                 s = d * prim_len
-                if not arc_clear(free, ux, uy, uth, kappa, s, step):
+                if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
                     continue
                 cx, cy, cth = advance(ux, uy, uth, kappa, s)
                 cost = prim_len

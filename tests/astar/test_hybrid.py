@@ -273,7 +273,8 @@ def test_arc_bulge_between_samples_is_caught():
     m = math.ceil(abs(s) / 0.2)
     pts = [advance(x, y, th, k, s * q / m)[:2] for q in range(m + 1)]
     assert all(segment_clear(free, *a, *b) for a, b in zip(pts[:-1], pts[1:], strict=True))
-    assert not arc_clear(free, x, y, th, k, s, 0.2)
+    off = np.zeros((1, 1), np.uint8)
+    assert not arc_clear(free, x, y, th, k, s, 0.2, off, off, 0.0)
 
 
 POCKET = """

@@ -92,6 +92,18 @@ KAPPA_TOL = 1e-6
 SEGMENT_BUDGET_S = 2.0
 #: Cap (s) on the Hybrid-A* search's time budget per try.
 SEARCH_BUDGET_S = 2.0
+#: A stretch between cusps that turns by more than this (rad, the sum of its heading changes)
+#: is fitted in pieces (:func:`split_points`): one B-spline round a loop of the search's
+#: forward-only shots (4.7-6.6 rad on the held-out failures) left the curvature SCP without
+#: a step (its trust region collapsed), where its thirds fitted at once. A U-turn (a little
+#: over ``pi``) stays whole.
+SPLIT_TURN_RAD = 1.25 * math.pi
+#: Largest turn (rad) of each piece of a split stretch.
+PIECE_TURN_RAD = 0.6 * math.pi
+#: Slack (m) of the search's exact clearance on the radius grid: a quarter of the corridor's
+#: tolerance (``trajopt.corridor`` accepts points ``1e-9`` m closer than the radius), so that
+#: an end point exactly at the radius from a wall (a cell centre) may leave it.
+EXACT_TOL_M = 0.25e-9
 
 
 @dataclass(frozen=True, slots=True)
@@ -112,6 +124,11 @@ class CarSegment:
         ``"polygons"`` (grown around the centred poses), ``"reversed"`` (the same, fitted
         from the segment's end with its curvature there, then turned round) or ``"witness"``
         (around the poses themselves, the last try).
+    joined : bool
+        Whether it continues the previous segment in the same direction of travel (a stretch
+        between cusps that turns by more than :data:`SPLIT_TURN_RAD` is fitted in pieces;
+        the car rests at each join, as at a cusp). Its curve then starts with the previous
+        curve's end curvature where that fit succeeds (``"polygons"``).
     """
 
     direction: int
@@ -120,6 +137,7 @@ class CarSegment:
     corridor: PolygonCorridor
     smooth_path: SmoothPath
     corridor_kind: str
+    joined: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -253,6 +271,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
                         turning_radius=r_cells,
                         reverse=robot.reverse,
                         time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
+                        **_exact_clearance(robot, grid, margin),
                     )
             except astar.NoPosePathError as exc:
                 tries.append(f"{_grid_name(margin)}, {factor:g} R: no path ({exc.reason})")
@@ -263,19 +282,20 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
                 continue
             poses = path.to_world(grid)
             try:
-                segments = [
-                    _fit_segment(
-                        options,
-                        grid,
-                        sm,
-                        poses,
-                        (int(a), int(b)),
-                        int(path.directions[b]),
-                        _start_curvature(path, int(a), res),
-                        timer,
+                segments = []
+                for a, b in np.asarray(path.segments):
+                    segments.extend(
+                        _fit_run(
+                            options,
+                            grid,
+                            sm,
+                            poses,
+                            (int(a), int(b)),
+                            int(path.directions[b]),
+                            _start_curvature(path, int(a), res),
+                            timer,
+                        )
                     )
-                    for a, b in np.asarray(path.segments)
-                ]
             except SmoothingError as exc:
                 tries.append(f"{_grid_name(margin)}, {factor:g} R: a segment has no fit")
                 failures.append(exc)
@@ -347,6 +367,19 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> O
     return grid.with_occupied(
         astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
     )
+
+
+def _exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str, Any]:
+    """Return the search's exact-mode arguments on the radius grid (none on the margin grid).
+
+    On the grid inflated by the radius alone only the cell centres keep the radius; the
+    search's exact mode (:func:`astar.find_pose_path` ``clearance``) makes the polyline of
+    its poses keep it too, as the corridor requires, to within :data:`EXACT_TOL_M`.
+    """
+    if margin:
+        return {}
+    r_cells = robot.radius / grid.resolution - EXACT_TOL_M / grid.resolution
+    return {"raw_grid": grid, "clearance": r_cells}
 
 
 def _grid_name(margin: bool) -> str:
@@ -464,6 +497,67 @@ def _start_curvature(path: Any, first: int, res: float) -> float:
     i = int(np.argmin(np.hypot(*(pieces[:, :2] - xy).T)))
     k, length = float(pieces[i, 3]), float(pieces[i, 4])
     return (k if length >= 0.0 else -k) / res
+
+
+def split_points(headings: np.ndarray, first: int, last: int) -> list[int]:
+    """Return the pose indices where a stretch between cusps is cut into pieces.
+
+    ``[first, ..., last]``: no cut when the stretch turns (the sum of ``|d heading|``) by at
+    most :data:`SPLIT_TURN_RAD`; else ``n = ceil(turn / PIECE_TURN_RAD)`` pieces with equal
+    shares of the turn, each at least two poses long.
+
+    Parameters
+    ----------
+    headings : ndarray, shape (m,)
+        Unwrapped headings (rad) of the search path's poses.
+    first, last : int
+        Pose indices of the stretch's ends.
+
+    Returns
+    -------
+    list of int
+        Increasing indices from ``first`` to ``last``.
+    """
+    turn = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(headings[first : last + 1])))])
+    total = float(turn[-1])
+    if total <= SPLIT_TURN_RAD or last - first < 4:
+        return [first, last]
+    n = min(math.ceil(total / PIECE_TURN_RAD), (last - first) // 2)
+    cuts = [first]
+    for k in range(1, n):
+        i = first + int(np.searchsorted(turn, k * total / n))
+        if i - cuts[-1] >= 2 and last - i >= 2:
+            cuts.append(i)
+    cuts.append(last)
+    return cuts
+
+
+def _end_curvature(path: SmoothPath) -> float:
+    """Return a fitted curve's signed curvature (1/m) at its end, along its direction."""
+    return float(np.asarray(path.curvature(np.array([path.domain[1]])), dtype=float)[-1])
+
+
+def _fit_run(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Any,
+    poses: np.ndarray,
+    ends: tuple[int, int],
+    direction: int,
+    kappa0: float,
+    timer: StageTimer,
+) -> list[CarSegment]:
+    """Fit a stretch between cusps: one segment, or pieces when it turns much (split_points)."""
+    cuts = split_points(np.asarray(poses[:, 2]), *ends)
+    out: list[CarSegment] = []
+    k_start = kappa0
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        seg = _fit_segment(options, grid, smoother, poses, (a, b), direction, k_start, timer)
+        if out:
+            seg = dataclasses.replace(seg, joined=True)
+        out.append(seg)
+        k_start = _end_curvature(seg.smooth_path)
+    return out
 
 
 def _fit_segment(
