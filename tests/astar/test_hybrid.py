@@ -10,6 +10,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+import astar
 from astar import InvalidInputError, NoPathError, OccupancyGrid
 from astar.hybrid import NoPosePathError, PosePath, find_pose_path
 
@@ -373,3 +374,104 @@ def test_distance_field_matches_dijkstra():
     part, _ = distance_field(free.astype(np.uint8), gx, gy, gx, gy, 2.0)
     fin = np.isfinite(ref)
     assert np.all(part[fin] <= ref[fin] + 1e-12) and np.all(np.isinf(part[~free]))
+
+
+# --------------------------------------------------------------------------- exact clearance
+def _world(occ: np.ndarray) -> astar.OccupancyGrid:
+    """The raw grid with cell ``(ix, iy)``'s centre at the world point ``(ix, iy)``."""
+    return astar.OccupancyGrid(occ, 1.0, (-0.5, -0.5))
+
+
+def test_segment_clearance_against_dense_samples():
+    """segment_clearance_ok against the brute-force clearance of dense points on the segment."""
+    from astar.hybrid_kernel import segment_clearance_ok
+    from tests.reference import square_clearance
+
+    rng = np.random.default_rng(5)
+    occ = rng.random((14, 16)) < 0.15
+    grid = _world(occ)
+    occ8 = occ.astype(np.uint8)
+    seen = {True: 0, False: 0}
+    for _ in range(400):
+        a, b = rng.uniform(-0.5, 15.5, 2), rng.uniform(-0.5, 13.5, 2)
+        p0 = np.array([a[0], b[0]])
+        p1 = p0 + rng.normal(0.0, 1.0, 2)
+        r = rng.uniform(0.3, 2.5)
+        t = np.linspace(0.0, 1.0, 2001)[:, None]
+        d = square_clearance(grid, p0 + t * (p1 - p0)).min()
+        spacing = float(np.hypot(*(p1 - p0))) / 2000
+        if abs(d - r) < spacing + 1e-6:
+            continue  # too close to tell by samples
+        got = segment_clearance_ok(occ8, p0[0], p0[1], p1[0], p1[1], r)
+        assert got == (d > r), (p0, p1, r, d)
+        seen[got] += 1
+    assert min(seen.values()) > 20
+
+
+def _polyline_clearance(grid, poses, spacing=0.01):
+    from tests.reference import polyline_samples, square_clearance
+
+    return square_clearance(grid, polyline_samples(np.asarray(poses)[:, :2], spacing)).min()
+
+
+def test_exact_clearance_start_at_the_radius_from_a_wall():
+    """A start exactly the radius from a wall (a cell centre 2.5 cells from the wall's
+    squares): blocked on a grid inflated by the radius plus half a cell's diagonal; on the
+    grid inflated by the radius, the exact mode's poses and the chords between them keep the
+    radius, where the plain search's poses may come closer (anywhere in their cells)."""
+    r = 2.5
+    occ = np.zeros((20, 40), bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    occ[8:20, 18:21] = True  # a wall down from the top: the path goes round its end
+    raw = _world(occ)
+    free = ~astar.inflate(raw, r, metric="square", outside_occupied=True).occupied
+    margin = ~astar.inflate(raw, r + 0.757, metric="square", outside_occupied=True).occupied
+    start, goal = (5.0, 3.0, 0.3), (32.0, 14.0, math.pi / 2)
+    assert free[3, 5] and not margin[3, 5]
+    plain = find_pose_path(free, start, goal, turning_radius=5.0)
+    exact = find_pose_path(free, start, goal, turning_radius=5.0, raw_grid=occ, clearance=r)
+    assert _polyline_clearance(raw, plain.poses) < r - 0.05  # the plain poses cut corners
+    assert _polyline_clearance(raw, exact.poses) >= r - 1e-9
+    np.testing.assert_allclose(exact.poses[[0, -1], :2], [start[:2], goal[:2]], atol=1e-12)
+    # the poses are the collision samples: at most 0.2 cells apart
+    assert np.hypot(*np.diff(exact.poses[:, :2], axis=0).T).max() <= 0.2 + 1e-9
+
+
+def test_exact_clearance_random_grids():
+    """Every exact-mode path on random grids keeps the clearance (brute force)."""
+    rng = np.random.default_rng(11)
+    found = 0
+    for _ in range(12):
+        occ = rng.random((30, 30)) < 0.04
+        occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+        raw = _world(occ)
+        r = float(rng.uniform(1.0, 2.0))
+        free = ~astar.inflate(raw, r, metric="square", outside_occupied=True).occupied
+        cells = np.argwhere(free)
+        if len(cells) < 2:
+            continue
+        (sy, sx), (gy, gx) = cells[rng.choice(len(cells), 2, replace=False)]
+        s = (float(sx), float(sy), float(rng.uniform(-math.pi, math.pi)))
+        g = (float(gx), float(gy), float(rng.uniform(-math.pi, math.pi)))
+        try:
+            p = find_pose_path(free, s, g, turning_radius=3.0, raw_grid=raw, clearance=r)
+        except NoPathError:
+            continue
+        found += 1
+        assert _polyline_clearance(raw, p.poses) >= r - 1e-9
+    assert found >= 4
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"clearance": 1.0}, "needs raw_grid"),
+        ({"raw_grid": np.zeros((10, 20), bool)}, "only with clearance"),
+        ({"raw_grid": np.zeros((5, 5), bool), "clearance": 1.0}, "shape"),
+        ({"raw_grid": np.zeros((10, 20)), "clearance": 1.0}, "bool array True on occupied"),
+        ({"raw_grid": np.zeros((10, 20), bool), "clearance": -1.0}, "clearance"),
+    ],
+)
+def test_exact_clearance_bad_input(kwargs, match):
+    with pytest.raises(InvalidInputError, match=match):
+        find_pose_path(np.ones((10, 20), bool), (3, 5, 0), (12, 5, 0), turning_radius=2, **kwargs)

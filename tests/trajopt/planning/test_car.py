@@ -346,3 +346,49 @@ def test_a_curve_turned_round_is_the_same_curve_backwards():
     np.testing.assert_allclose(back.curvature(u), -path.curvature(7.0 - u), atol=1e-9)
     assert back.length == pytest.approx(path.length, rel=1e-12)
     assert back.stats["turned_round"] and back.certificate is path.certificate
+
+
+def test_split_points_share_the_turn():
+    """Cuts of a stretch that turns much: independent sums of the heading changes."""
+    from trajopt.planning._car import PIECE_TURN_RAD, SPLIT_TURN_RAD, split_points
+
+    straight = np.zeros(50)
+    assert split_points(straight, 0, 49) == [0, 49]
+    uturn = np.linspace(0.0, math.pi, 60)  # a U-turn stays whole
+    assert split_points(uturn, 0, 59) == [0, 59]
+    loop = np.concatenate(
+        [np.zeros(10), np.linspace(0.0, -2.0 * math.pi, 101), np.full(10, -TWO_PI)]
+    )
+    cuts = split_points(loop, 3, len(loop) - 2)
+    assert cuts[0] == 3 and cuts[-1] == len(loop) - 2
+    assert len(cuts) - 1 == math.ceil(2.0 * math.pi / PIECE_TURN_RAD)
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        turn = sum(abs(loop[i + 1] - loop[i]) for i in range(a, b))
+        assert turn <= PIECE_TURN_RAD + 2.0 * math.pi / 100 + 1e-12
+    assert SPLIT_TURN_RAD > math.pi
+
+
+def test_forward_only_loop_is_fitted_in_pieces():
+    """A goal a cell beside the start, turned by about 3 pi / 2 (held-out AR0046SR #0): the
+    forward-only path is a loop of about 6.6 rad, which no single curve fitted at the first
+    search radius; in pieces it does, at rest at each join, every piece certified."""
+    res = 0.05
+    grid = astar.OccupancyGrid(walled(4.0, 4.0, res), res)
+    robot = trajopt.Robot(radius=0.1, drive="ackermann", min_turning_radius=0.4, reverse=False)
+    start, goal, h0, h1 = (2.0, 2.0), (1.95, 2.0), -2.83, 1.7
+    traj = trajopt.Planner(grid, robot).plan(start, goal, start_heading=h0, goal_heading=h1)
+    assert traj.stats["car"]["tries"] == ["radius + margin grid, 1.15 R: planned"]
+    joined = [s.joined for s in traj.steps.segments]
+    assert joined[0] is False and sum(joined) >= 2
+    assert all(p.direction == 1 for p in traj.pieces)
+    ends = traj.sample(np.array([0.0, traj.duration]))
+    np.testing.assert_allclose([ends.x, ends.y], np.transpose([start, goal]), atol=1e-9)
+    assert _angle_diff(ends.theta[0], h0) < 1e-6 and _angle_diff(ends.theta[1], h1) < 1e-6
+    np.testing.assert_array_equal(traj.sample(traj.piece_times).v, 0.0)
+    kmax = 1.0 / robot.min_turning_radius
+    for pts in _dense_points(traj, 0.002):
+        assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)
+        assert square_clearance(grid, pts, reach=0.2).min() >= robot.radius - 1e-9
+    # the heading is continuous across the joins
+    smp = traj.sample(np.linspace(0.0, traj.duration, 4001))
+    assert np.abs(np.diff(smp.theta)).max() < 0.05
