@@ -27,7 +27,11 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    to its start with the path's curvature at the end, the curve then turned round (the
    smoother takes a start curvature, not a goal one). Where those fail, it is fitted again
    in polygons grown around the poses themselves without centring (the
-   witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). Every
+   witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). A
+   stretch that turns by more than :data:`SPLIT_TURN_RAD` and whose first fit fails is
+   fitted in pieces of at most :data:`PIECE_TURN_RAD` (before the other fits), each
+   starting with the previous piece's end curvature; the car rests at each join as at a
+   cusp (:attr:`CarSegment.joined`). Every
    curve is the smoother's certified curve (convex-hull clearance certificate per segment)
    and its sampled curvature (the certificate's dense samples) must be within ``1/R``;
    nothing else is returned.
@@ -93,11 +97,12 @@ SEGMENT_BUDGET_S = 2.0
 #: Cap (s) on the Hybrid-A* search's time budget per try.
 SEARCH_BUDGET_S = 2.0
 #: A stretch between cusps that turns by more than this (rad, the sum of its heading changes)
-#: is fitted in pieces (:func:`split_points`): one B-spline round a loop of the search's
-#: forward-only shots (4.7-6.6 rad on the held-out failures) left the curvature SCP without
-#: a step (its trust region collapsed), where its thirds fitted at once. A U-turn (a little
-#: over ``pi``) stays whole.
-SPLIT_TURN_RAD = 1.25 * math.pi
+#: and whose first fit fails is fitted in pieces (:func:`split_points`): one B-spline round
+#: a loop of the search's forward-only shots (4.7-6.6 rad on the held-out failures) left the
+#: curvature SCP without a step (its trust region collapsed), where its thirds fitted at
+#: once. Only after a failed fit: the car rests at each join, and long paths turn by tens of
+#: radians in small steps.
+SPLIT_TURN_RAD = math.pi
 #: Largest turn (rad) of each piece of a split stretch.
 PIECE_TURN_RAD = 0.6 * math.pi
 #: Slack (m) of the search's exact clearance on the radius grid: a quarter of the corridor's
@@ -547,17 +552,35 @@ def _fit_run(
     kappa0: float,
     timer: StageTimer,
 ) -> list[CarSegment]:
-    """Fit a stretch between cusps: one segment, or pieces when it turns much (split_points)."""
+    """Fit a stretch between cusps (module docstring, step 2).
+
+    As one segment (:func:`_fit_segment`); when its first fit fails and the stretch turns by
+    more than :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece starting
+    with the previous curve's end curvature; when a piece fails too, the other fits of the
+    whole stretch.
+    """
+    args = (options, grid, smoother, poses)
     cuts = split_points(np.asarray(poses[:, 2]), *ends)
+    if len(cuts) == 2:
+        return [_fit_segment(*args, ends, direction, kappa0, timer)]
+    try:
+        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=(0,))]
+    except SmoothingError:
+        pass
     out: list[CarSegment] = []
     k_start = kappa0
-    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
-        seg = _fit_segment(options, grid, smoother, poses, (a, b), direction, k_start, timer)
-        if out:
-            seg = dataclasses.replace(seg, joined=True)
-        out.append(seg)
-        k_start = _end_curvature(seg.smooth_path)
-    return out
+    try:
+        for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+            seg = _fit_segment(*args, (a, b), direction, k_start, timer)
+            out.append(dataclasses.replace(seg, joined=bool(out)))
+            k_start = _end_curvature(seg.smooth_path)
+        return out
+    except SmoothingError as exc:
+        piece_error = exc
+    try:
+        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=(1, 2, 3))]
+    except SmoothingError as exc:
+        raise SmoothingError(f"{exc}; in {len(cuts) - 1} pieces: {piece_error}", exc.stats) from exc
 
 
 def _fit_segment(
@@ -569,6 +592,7 @@ def _fit_segment(
     direction: int,
     kappa0: float,
     timer: StageTimer,
+    tries: tuple[int, ...] = (0, 1, 2, 3),
 ) -> CarSegment:
     """Fit one segment in the direction of travel (module docstring, step 2).
 
@@ -588,8 +612,8 @@ def _fit_segment(
     # the end's curvature along the direction of travel, from the last two poses (on an arc)
     d_end = float(np.hypot(*(pts[-1] - pts[-2]))) if len(pts) > 1 else 0.0
     k_end = (float(poses[last, 2] - poses[last - 1, 2]) / d_end) if d_end > 0.0 else 0.0
-    tries = (("polygons", kappa0), ("polygons", None), ("reversed", -k_end), ("witness", None))
-    for kind, k_start in tries:
+    every = (("polygons", kappa0), ("polygons", None), ("reversed", -k_end), ("witness", None))
+    for kind, k_start in (every[i] for i in tries):
         # "reversed": the segment fitted from its end to its start, starting with the end's
         # curvature (the smoother takes a start curvature, not a goal one), then turned round
         p_fit = pts[::-1].copy() if kind == "reversed" else pts

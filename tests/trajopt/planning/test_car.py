@@ -354,8 +354,8 @@ def test_split_points_share_the_turn():
 
     straight = np.zeros(50)
     assert split_points(straight, 0, 49) == [0, 49]
-    uturn = np.linspace(0.0, math.pi, 60)  # a U-turn stays whole
-    assert split_points(uturn, 0, 59) == [0, 59]
+    bend = np.linspace(0.0, 0.99 * SPLIT_TURN_RAD, 60)  # below the threshold: whole
+    assert split_points(bend, 0, 59) == [0, 59]
     loop = np.concatenate(
         [np.zeros(10), np.linspace(0.0, -2.0 * math.pi, 101), np.full(10, -TWO_PI)]
     )
@@ -365,7 +365,6 @@ def test_split_points_share_the_turn():
     for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         turn = sum(abs(loop[i + 1] - loop[i]) for i in range(a, b))
         assert turn <= PIECE_TURN_RAD + 2.0 * math.pi / 100 + 1e-12
-    assert SPLIT_TURN_RAD > math.pi
 
 
 def test_forward_only_loop_is_fitted_in_pieces():
