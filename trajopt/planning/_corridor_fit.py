@@ -65,8 +65,15 @@ def fit_in_corridor(
                     corridor = witness_corridor(grid, options.robot.radius, witness)
                     q.regions_kept = 0
                 elif kind == "polygons":
+                    # a footprint's rounds need the corridor of cells (Smoother.fit)
                     corridor, q.regions_kept = polygon_corridor(
-                        grid, options.robot.radius, path, q.start, q.goal, q.previous
+                        grid,
+                        options.robot.radius,
+                        path,
+                        q.start,
+                        q.goal,
+                        q.previous,
+                        unit_m=None if q.footprint is None else grid.resolution,
                     )
                 else:
                     corridor = box_corridor(options, grid, q.inflated, path, q.start, q.goal)
@@ -202,13 +209,15 @@ def polygon_corridor(
     p0: np.ndarray,
     p1: np.ndarray,
     previous: PlanSteps | None = None,
+    unit_m: float | None = None,
 ) -> tuple[PolygonCorridor, int]:
     """Polygons around the A* path, from the exact start to the exact goal.
 
     With a re-plan's ``previous`` steps, their polygon corridor's regions along the rest
     of the path the two share are kept when still certified
-    (:func:`~trajopt.corridor._polygons.reuse.corridor_with_rest`). Returns the corridor and
-    the number of regions kept.
+    (:func:`~trajopt.corridor._polygons.reuse.corridor_with_rest`). ``unit_m``: the
+    corridor's length unit (:func:`~trajopt.corridor.build_polygon_corridor`). Returns the
+    corridor and the number of regions kept.
     """
     centres = np.asarray(grid.cell_to_world(np.asarray(path.cells)), dtype=float)
     points = np.vstack([p0, centres.reshape(-1, 2)[1:-1], p1])
@@ -216,7 +225,7 @@ def polygon_corridor(
         out = corridor_with_rest(grid, points, radius, previous.corridor, previous.raw_grid)
         if out is not None:
             return out
-    return build_polygon_corridor(grid, points, radius), 0
+    return build_polygon_corridor(grid, points, radius, unit_m=unit_m), 0
 
 
 def box_corridor(

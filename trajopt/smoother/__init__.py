@@ -4,7 +4,7 @@
 arc length along the path) to path points ``p_r`` at their arc lengths ``u_r``:
 
     minimise   lam * sum_r |C(u_r) - p_r|^2  +  w * integral |C^(m)(u)|^2 du
-               + ell * integral |C'(u)|^2 du                                     (cell units)
+               + ell * integral |C'(u)|^2 du                                     (length units)
     subject to c_0 = start, c_{n-1} = goal,
                c_i in the intersection of the corridor regions of every span it touches,
                optional: c_1 on the start-heading ray, c_{n-2} on the reverse goal ray,
@@ -14,9 +14,12 @@ With the *fidelity* objective (default in a box corridor) ``p_r`` are the A* cel
 ``lam = 1`` and ``ell = 0``: the chapter's least-squares fidelity (equation (3)) plus the
 knot-aware integrated squared ``m``-th derivative (exact Gram matrix of the derivative
 basis). With the *taut* objective (default in a :class:`~trajopt.corridor.
-PolygonCorridor`) ``p_r`` are the corridor's path sampled once per cell, ``lam`` is small
-and the length term pulls the curve taut. Positions and parameters are divided by the grid
-resolution first, so the default weights work on every map.
+PolygonCorridor`) ``p_r`` are the corridor's path sampled once per length unit, ``lam`` is small
+and the length term pulls the curve taut. Positions and parameters are divided by the
+corridor's length unit first (:func:`~trajopt.geometry.length_unit`: the cell side, or a
+quarter of the robot's radius on maps whose cells are finer; a footprint's fit counts in
+cells), so the default weights work on every map and a fine map costs no more than a
+coarse one.
 
 The corridor constraint uses the convex-hull property: span ``j`` lies in the convex hull
 of ``c_j .. c_{j+p}``; with all of them inside the span's region the whole continuous span
@@ -41,7 +44,7 @@ curvature bound. On failure the knots are refined; when that is exhausted
 
 Modules: :mod:`~trajopt.smoother._options` (the :class:`Smoother` options),
 :mod:`~trajopt.smoother._attempts` (the attempt loop), :mod:`~trajopt.smoother._problem`
-(problem assembly in cell units), :mod:`~trajopt.smoother._basis` (B-spline basis maths),
+(problem assembly in length units), :mod:`~trajopt.smoother._basis` (B-spline basis maths),
 :mod:`~trajopt.smoother._qp` (the convex QP and its solver cache),
 :mod:`~trajopt.smoother._scp` (the curvature bound by SCP), :mod:`~trajopt.smoother._nlp`
 (IPOPT), :mod:`~trajopt.smoother._solver_builds` (the lock and the record of the solver

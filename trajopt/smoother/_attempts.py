@@ -102,7 +102,10 @@ def fit(
         raise InvalidInputError(
             f"corridor must be a Corridor or a PolygonCorridor, got {type(corridor).__name__}"
         )
-    res = corridor.resolution
+    # the length unit of the fit: the corridor's, but the footprint rounds count in cells
+    # (their corner rows are linearised within a trust region of TRUST_CELLS, tuned on
+    # cells: at coarser units their steps overshoot the rectangle's turns)
+    res = corridor.resolution if footprint is not None else corridor.unit_m
     rad = corridor.radius if radius is None else float(radius)
     if radius is not None and not (math.isfinite(rad) and rad >= 0):
         raise InvalidInputError(f"radius must be finite and >= 0 m, got {radius!r}")
@@ -132,6 +135,7 @@ def fit(
         hs=hs,
         hg=hg,
         start_kappa=ks,
+        unit_m=res,
     )
     attempts: list[AttemptRecord] = []
     h = float(options.span_cells)
@@ -157,7 +161,7 @@ def fit(
             h, margin, warm = max(0.5, h / 2), options.kappa_margin, None
             spans_tried += 1
             continue
-        check = functools.partial(_check, options, corridor, raw_grid, rad, fp, (p0, p1))
+        check = functools.partial(_check, options, corridor, res, raw_grid, rad, fp, (p0, p1))
         curve, cert, fcert = check(c_cells, t_cells, span_box)
         rec.certificate_ok = cert.ok
         if fcert is not None and not fcert.ok:  # the disc is clear, the footprint is not
@@ -175,6 +179,7 @@ def fit(
                         hs=fp.start_heading,
                         hg=fp.goal_heading,
                         start_kappa=ks,
+                        unit_m=res,
                     )
                     margin, warm = options.kappa_margin, None
                     continue
@@ -280,6 +285,7 @@ def _polished(
 def _check(
     options: Smoother,
     corridor: Corridor | PolygonCorridor,
+    res: float,
     raw_grid: Any,
     radius: float,
     fp: FootprintRounds | None,
@@ -288,13 +294,12 @@ def _check(
     t_cells: np.ndarray,
     span_box: np.ndarray,
 ) -> tuple:
-    """Return the curve of ``c_cells`` (cells) and its certificates.
+    """Return the curve of ``c_cells`` (length units ``res``, m) and its certificates.
 
     ``(curve, certificate, footprint certificate)``: the last only with a footprint
     (``fp``, :class:`~trajopt.smoother._footprint_rounds.FootprintRounds`) and when the first
     passes, else ``None``. ``ends``: the exact end points (m).
     """
-    res = corridor.resolution
     c = np.asarray(corridor.origin, dtype=float) + res * c_cells
     c[0], c[-1] = ends
     curve = BSplineCurve(t_cells * res, c, options.degree)
@@ -308,6 +313,7 @@ def _check(
         radius=radius,
         kappa_bound=options.kappa_max,
         samples_per_cell=options.samples_per_cell,
+        unit_m=res,
     )
     return curve, cert, (fp.certify(curve) if (cert.ok and fp is not None) else None)
 

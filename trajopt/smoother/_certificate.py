@@ -43,7 +43,7 @@ class Certificate:
         map (outside the map counts as occupied); exact below ``radius_m + 2`` cells,
         otherwise reported as that search window. ``None`` without a raw map.
     n_samples : int
-        Number of dense samples (spacing <= resolution / 8 along ``u``).
+        Number of dense samples (spacing <= one length unit / 8 along ``u``).
     kappa_max_sampled : float
         Largest ``|curvature|`` on the dense samples (1/m).
     kappa_bound : float or None
@@ -90,8 +90,13 @@ def certify(
     radius: float | None = None,
     kappa_bound: float | None = None,
     samples_per_cell: int = 8,
+    unit_m: float | None = None,
 ) -> Certificate:
-    """Check every guarantee of a smoothed curve (see :class:`Certificate`)."""
+    """Check every guarantee of a smoothed curve (see :class:`Certificate`).
+
+    The dense samples are ``samples_per_cell`` per ``unit_m`` (m; default the corridor's
+    length unit) of the parameter ``u`` (arc length along the path).
+    """
     failures: list[str] = []
     k = curve.k
     c = curve.c
@@ -122,7 +127,7 @@ def certify(
     end_err = float(max(np.hypot(*(ends[0] - start)), np.hypot(*(ends[1] - goal))))
     if end_err > 1e-9:
         failures.append("endpoints")
-    res = corridor.resolution
+    res = corridor.unit_m if unit_m is None else float(unit_m)
     m = max(2, int(math.ceil((u1 - u0) / res * samples_per_cell)) + 1)
     u = np.linspace(u0, u1, m)
     xy = curve(u)

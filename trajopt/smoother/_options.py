@@ -36,7 +36,10 @@ class Smoother:
     degree : int, optional
         Spline degree, 3 to 5. Default 3 (C2 curve: continuous curvature).
     smoothness_weight : float, optional
-        ``w`` of the integrated squared derivative, in cell units (>= 0). Default 50.
+        ``w`` of the integrated squared derivative, in length units (>= 0). Default 50.
+        The length unit is the corridor's (:func:`~trajopt.geometry.length_unit`): the
+        cell side, or ``radius / 4`` on maps whose cells are finer (a footprint's fit
+        counts in cells); "cells" below means this unit.
     smoothness_order : int, optional
         Derivative order ``m`` of the smoothness term, 1 .. degree - 1. Default 2.
     span_cells : float, optional

@@ -161,9 +161,9 @@ _BOX_PAD = 1e-9
 _K_SIZES = (4, 8, 12, 16, 24, 32, 48, 64)
 
 
-def polygon_targets(corridor: PolygonCorridor) -> tuple[np.ndarray, np.ndarray]:
-    """Return the corridor's path sampled about once per cell: points (m) and their arc lengths."""
-    res = corridor.resolution
+def polygon_targets(corridor: PolygonCorridor, unit_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return the corridor's path sampled once per ``unit_m``: points (m), arc lengths (m)."""
+    res = unit_m
     s_v = np.asarray(corridor.path_s, dtype=float)
     pts = np.asarray(corridor.path, dtype=float)
     s = np.unique(np.concatenate([np.arange(0.0, s_v[-1], res), s_v]))
@@ -503,8 +503,9 @@ def build_problem(
     hs: float | None,
     hg: float | None,
     start_kappa: float | None = None,
+    unit_m: float | None = None,
 ) -> tuple[Problem, np.ndarray, np.ndarray]:
-    """Return the fit in cell units, and the exact end points (m).
+    """Return the fit in length units (``Problem.res``), and the exact end points (m).
 
     Parameters
     ----------
@@ -516,6 +517,8 @@ def build_problem(
         Validated start and goal headings (rad).
     start_kappa : float or None
         Validated start curvature (1/m), with ``hs``.
+    unit_m : float or None
+        The length unit (m) the problem counts in; ``None``: ``corridor.unit_m``.
 
     Raises
     ------
@@ -523,11 +526,11 @@ def build_problem(
         An end point outside its end region, or targets that do not match the corridor.
     """
     polygons = isinstance(corridor, PolygonCorridor)
-    res = corridor.resolution
+    res = corridor.unit_m if unit_m is None else float(unit_m)
     origin = np.asarray(corridor.origin, dtype=float)
     taut = options.objective == "taut" or (options.objective == "auto" and polygons)
     if polygons:
-        targets, u_m = polygon_targets(corridor)
+        targets, u_m = polygon_targets(corridor, res)
         p0 = _end_point("start", start, corridor.path[0])
         p1 = _end_point("goal", goal, corridor.path[-1])
         for name, pt, k in (("start", p0, 0), ("goal", p1, len(corridor.regions) - 1)):

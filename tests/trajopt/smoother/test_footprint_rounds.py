@@ -114,9 +114,12 @@ def test_corner_rows_are_first_order_in_the_control_points():
     r = fp.inscribed_radius
     path = np.array([s, (g[0], s[1]), g])
     pts = np.vstack([np.linspace(path[0], path[1], 40), np.linspace(path[1], path[2], 30)[1:]])
-    corridor = build_polygon_corridor(grid, pts, r)
+    # a footprint fit counts in cells (as the planner and Smoother.fit do)
+    corridor = build_polygon_corridor(grid, pts, r, unit_m=grid.resolution)
     options = Smoother()
-    prob, _, _ = build_problem(options, None, corridor, start=s, goal=g, hs=None, hg=None)
+    prob, _, _ = build_problem(
+        options, None, corridor, start=s, goal=g, hs=None, hg=None, unit_m=grid.resolution
+    )
     asm = assemble(options, prob, 4.0)
     z = solve_qp(options, asm.qp, x0=asm.x0).z
     res, p, n, nb = grid.resolution, options.degree, asm.qp.n, asm.qp.nb
@@ -242,9 +245,12 @@ def test_scp_round_with_a_cost_field_trades_towards_lower_cost():
     fp = Footprint.rectangle(0.7, 0.4)
     r = fp.inscribed_radius
     pts = np.vstack([np.linspace(s, (g[0], s[1]), 40), np.linspace((g[0], s[1]), g, 30)[1:]])
-    corridor = build_polygon_corridor(grid, pts, r)
+    # a footprint fit counts in cells (as the planner and Smoother.fit do)
+    corridor = build_polygon_corridor(grid, pts, r, unit_m=grid.resolution)
     options = Smoother()
-    prob, _, _ = build_problem(options, None, corridor, start=s, goal=g, hs=None, hg=None)
+    prob, _, _ = build_problem(
+        options, None, corridor, start=s, goal=g, hs=None, hg=None, unit_m=grid.resolution
+    )
     asm = assemble(options, prob, 4.0)
     z = solve_qp(options, asm.qp, x0=asm.x0).z
     res, p, n = grid.resolution, options.degree, asm.qp.n

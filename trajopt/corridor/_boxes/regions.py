@@ -153,6 +153,11 @@ class Corridor:
     _dlo: np.ndarray = field(init=False, repr=False, compare=False)
     _dhi: np.ndarray = field(init=False, repr=False, compare=False)
 
+    @property
+    def unit_m(self) -> float:
+        """The length unit the smoother counts in (m): the cell side (boxes are cells)."""
+        return self.resolution
+
     def __post_init__(self) -> None:
         object.__setattr__(self, "boxes", tuple(self.boxes))
         object.__setattr__(self, "path_ranges", readonly(self.path_ranges, np.int64))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -29,6 +29,7 @@ from trajopt.corridor._polygons.regions import (
 )
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.geometry._clearance import grid_cells
+from trajopt.geometry._length_unit import length_unit
 from trajopt.geometry._obstacle_index import ObstacleIndex
 
 logger = logging.getLogger("trajopt.corridor")
@@ -38,9 +39,11 @@ MAX_SIDES = 256
 
 @dataclass(frozen=True)
 class PolygonOptions:
-    """How :func:`build_polygon_corridor` prepares the path and grows the regions (cells).
+    """How :func:`build_polygon_corridor` prepares the path and grows the regions.
 
-    Validated on construction; every value is kept as a float.
+    Validated on construction; every value is kept as a float. The values count length
+    units (:func:`~trajopt.geometry.length_unit`: the cell side, or ``radius / 6`` on maps
+    whose cells are finer), called cells below; :meth:`in_cells` converts them.
 
     Attributes
     ----------
@@ -88,6 +91,17 @@ class PolygonOptions:
         for name, value in checked.items():
             object.__setattr__(self, name, value)
 
+    def in_cells(self, cells_per_unit: float) -> PolygonOptions:
+        """Return these options with every length multiplied by ``cells_per_unit`` (>= 1).
+
+        ``self`` itself when ``cells_per_unit == 1`` (the unit is the cell).
+        """
+        if cells_per_unit == 1.0:
+            return self
+        return PolygonOptions(
+            **{f.name: getattr(self, f.name) * cells_per_unit for f in fields(self)}
+        )
+
 
 @dataclass(frozen=True)
 class GrownRegions:
@@ -125,6 +139,8 @@ class GrownRegions:
         Cell size of the map (m).
     origin : tuple of float
         World position of the map's corner ``(x, y)`` (m).
+    unit_m : float
+        The length unit the options counted (m; :func:`~trajopt.geometry.length_unit`).
     """
 
     regions: list[ConvexPolygon]
@@ -140,6 +156,7 @@ class GrownRegions:
     radius: float
     resolution: float
     origin: tuple[float, float]
+    unit_m: float
 
 
 def _path_points(path: Any, res: float, ox: float, oy: float) -> np.ndarray:
@@ -181,6 +198,7 @@ def build_polygon_corridor(
     centre_trigger_cells: float = 2.0,
     simplify_slack_cells: float = 0.3,
     open_cells: float = 2.0,
+    unit_m: float | None = None,
 ) -> PolygonCorridor:
     """Grow a chain of certified convex polygons around a path (module docstring).
 
@@ -218,6 +236,11 @@ def build_polygon_corridor(
     open_cells : float, optional
         Clearance beyond ``radius`` plus this (cells) counts as open space when simplifying
         (>= 0). Default 2.
+    unit_m : float, optional
+        The length unit (m) the options above count ("cells"), at least the map's cell
+        side. Default :func:`~trajopt.geometry.length_unit` of the map and ``radius``: the
+        cell side, or ``radius / 4`` on maps whose cells are finer, so that the corridor
+        of a path is about the same whatever the map's resolution.
 
     Returns
     -------
@@ -250,17 +273,21 @@ def build_polygon_corridor(
         simplify_slack_cells=simplify_slack_cells,
         open_cells=open_cells,
     )
-    return assemble_corridor(grow_regions(raw_grid, path, radius, options))
+    return assemble_corridor(grow_regions(raw_grid, path, radius, options, unit_m))
 
 
 def grow_regions(
-    raw_grid: Any, path: Any, radius: float, options: PolygonOptions | None = None
+    raw_grid: Any,
+    path: Any,
+    radius: float,
+    options: PolygonOptions | None = None,
+    unit_m: float | None = None,
 ) -> GrownRegions:
     """Grow and certify the regions of :func:`build_polygon_corridor`.
 
-    ``raw_grid``, ``path`` and ``radius`` as there; ``options`` its keyword options (default
-    ``PolygonOptions()``, its defaults). Raises what it raises, but does not compute the
-    chain's intervals and overlaps (:func:`assemble_corridor` does).
+    ``raw_grid``, ``path``, ``radius`` and ``unit_m`` as there; ``options`` its other
+    keyword options (default ``PolygonOptions()``, its defaults). Raises what it raises, but
+    does not compute the chain's intervals and overlaps (:func:`assemble_corridor` does).
     """
     if options is None:
         options = PolygonOptions()
@@ -268,6 +295,10 @@ def grow_regions(
         raise InvalidInputError(f"options must be a PolygonOptions, got {type(options).__name__}")
     occ, res, ox, oy = grid_cells(raw_grid)
     r = positive("radius", radius)
+    unit = length_unit(res, r) if unit_m is None else positive("unit_m", unit_m)
+    if unit < res * (1 - 1e-12):
+        raise InvalidInputError(f"unit_m must be at least the cell side {res} m, got {unit_m!r}")
+    options = options.in_cells(unit / res)
     ny, nx = occ.shape
     pts_m = _path_points(path, res, ox, oy)
     n_in = len(pts_m)
@@ -324,6 +355,7 @@ def grow_regions(
         radius=r,
         resolution=res,
         origin=(ox, oy),
+        unit_m=unit,
     )
 
 
@@ -535,6 +567,7 @@ def assemble_corridor(grown: GrownRegions) -> PolygonCorridor:
         radius=grown.radius,
         resolution=grown.resolution,
         origin=(ox, oy),
+        unit_m=grown.unit_m,
     )
 
 

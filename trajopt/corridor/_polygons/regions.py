@@ -274,6 +274,9 @@ class PolygonCorridor:
         Cell side of the map (m).
     origin : tuple of float
         Map origin (m).
+    unit_m : float or None
+        The length unit the corridor was built in and the smoother counts in (m;
+        :func:`~trajopt.geometry.length_unit`); ``None``: the cell side.
     """
 
     regions: tuple[ConvexPolygon, ...]
@@ -291,6 +294,7 @@ class PolygonCorridor:
     radius: float
     resolution: float
     origin: tuple[float, float]
+    unit_m: float | None = None
     _all_a: np.ndarray = field(init=False, repr=False, compare=False)
     _all_b: np.ndarray = field(init=False, repr=False, compare=False)
     _owner: np.ndarray = field(init=False, repr=False, compare=False)
@@ -318,6 +322,13 @@ class PolygonCorridor:
         object.__setattr__(self, "radius", float(self.radius))
         object.__setattr__(self, "resolution", float(self.resolution))
         object.__setattr__(self, "origin", (float(self.origin[0]), float(self.origin[1])))
+        unit = self.resolution if self.unit_m is None else float(self.unit_m)
+        if not (math.isfinite(unit) and unit >= self.resolution * (1 - 1e-12)):
+            raise InvalidInputError(
+                f"unit_m must be finite and >= the resolution {self.resolution!r} m, "
+                f"got {self.unit_m!r}"
+            )
+        object.__setattr__(self, "unit_m", unit)
         all_a = np.concatenate([r.A for r in self.regions])
         all_b = np.concatenate([r.b for r in self.regions])
         owner = np.repeat(np.arange(m), [r.n_sides for r in self.regions])

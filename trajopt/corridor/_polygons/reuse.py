@@ -106,7 +106,7 @@ def corridor_with_rest(
     head_pts = pts[: end + 1].copy()
     head_pts[-1] = previous.path[k0]  # the kept region's first vertex ends the head exactly
     try:
-        head = grow_regions(raw_grid, head_pts, radius)
+        head = grow_regions(raw_grid, head_pts, radius, unit_m=previous.unit_m)
     except (InvalidInputError, SmoothingError):
         return None
     try:
@@ -208,4 +208,5 @@ def _joined(
         radius=head.radius,
         resolution=head.resolution,
         origin=head.origin,
+        unit_m=head.unit_m,
     )
