@@ -15,7 +15,11 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    factor); when the search finds no path, with ``R`` itself (larger factors are then
    skipped). When an end point is blocked on that grid, or the margin disconnects the
    poses or leaves no path, the same tries run on the map inflated by the radius alone
-   (the other planners' grid): end points near walls and passages the margin closes. The
+   (the other planners' grid): end points near walls and passages the margin closes. There
+   only the cell centres keep the radius, so that search runs in its exact mode
+   (:func:`astar.find_pose_path` ``raw_grid``, ``clearance``): the chords between its
+   poses keep the radius from the raw map exactly, as the corridor requires (a pose
+   anywhere in a free cell could come up to half a cell's diagonal closer). The
    tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 2. **Segments.** The path is split at its cusps (where the direction of travel flips; the
    heading is continuous there, the tangent flips by ``pi``). Each segment is fitted as an
@@ -167,7 +171,8 @@ class CarSteps:
     poses : ndarray, shape (n, 3)
         Its poses in world units ``(x, y, heading)`` (m, m, rad).
     segments : tuple of CarSegment
-        One per stretch between cusps.
+        One per stretch between cusps, or per piece of a stretch fitted in pieces
+        (:attr:`CarSegment.joined`).
     start, goal : tuple of float
         The end points (m).
     start_heading, goal_heading : float
@@ -218,7 +223,8 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     Returns
     -------
     TrajectoryChain
-        One :class:`~trajopt.motion.Trajectory` per segment between cusps.
+        One :class:`~trajopt.motion.Trajectory` per segment (between cusps, and at the
+        joins of a stretch fitted in pieces), each from rest to rest.
 
     Raises
     ------
@@ -337,6 +343,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
             "segments": len(segments),
             "cusps": int(path.cusps),
             "directions": [s.direction for s in segments],
+            "joins": sum(s.joined for s in segments),
             "reverse_length_m": float(path.reverse_length * res),
             "search_length_m": float(path.length * res),
             "search_turning_radius_m": radius_cells * res,
