@@ -21,7 +21,7 @@ from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.geometry._clearance import polygon_clearance
+from trajopt.geometry._clearance import points_clearance, polygon_clearance
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
@@ -275,7 +275,7 @@ def _check_reachable_ends(options: PlannerOptions, grid: OccupancyGrid, q: PlanQ
                 f"{name} {p.tolist()} m lies in cell {_cell(c)}, which is blocked by the "
                 f"inflation={options.inflation!r} avoidance area (robot radius "
                 f"{options.robot.radius} m); clearance of the cell centre "
-                f"{_point_clearance(grid, grid.cell_to_world(c)):.4g} m"
+                f"{_centre_clearance(grid, c):.4g} m"
             )
     if tuple(q.start_cell) == tuple(q.goal_cell):
         raise InvalidInputError(
@@ -336,7 +336,7 @@ def check_endpoint(
         raise InvalidInputError(
             f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
         )
-    clr = _point_clearance(grid, p)
+    clr = _point_clearance(grid, p, options.robot.radius)
     if clr < options.robot.radius:
         raise InvalidInputError(
             f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
@@ -350,6 +350,16 @@ def _cell(c: np.ndarray) -> tuple[int, int]:
     return (int(c[0]), int(c[1]))
 
 
-def _point_clearance(grid: OccupancyGrid, p: np.ndarray) -> float:
-    """Exact clearance (m) of a world point from the raw map (outside occupied)."""
-    return polygon_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid)
+def _centre_clearance(grid: OccupancyGrid, c: np.ndarray) -> float:
+    """Exact clearance (m) of the centre of cell ``c`` from the raw map (outside occupied)."""
+    return polygon_clearance(np.asarray(grid.cell_to_world(c), dtype=float).reshape(1, 2), grid)
+
+
+def _point_clearance(grid: OccupancyGrid, p: np.ndarray, radius: float) -> float:
+    """Clearance (m) of a world point from the raw map (outside occupied), exact below ``radius``.
+
+    The search stops a cell beyond ``radius``: on a fine map the distance to the nearest
+    obstacle of a point in open space would take a search over far more cells.
+    """
+    window = float(radius) + float(grid.resolution)
+    return float(points_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid, window)[0])

@@ -13,7 +13,7 @@ import numpy as np
 
 from trajopt.corridor import CLEARANCE_TOL_M, Corridor, PolygonCorridor
 from trajopt.geometry._bspline import BSplineCurve
-from trajopt.geometry._clearance import points_clearance
+from trajopt.geometry._clearance import min_points_clearance
 
 #: heading continuity in the certificate: the tangent may turn at most this much between
 #: consecutive dense samples (rad; an eighth of a cell apart by default, so only a near-cusp,
@@ -150,7 +150,7 @@ def certify(
     min_clear = None
     if raw_grid is not None and radius is not None:
         window = radius + 2 * float(raw_grid.resolution)
-        min_clear = float(points_clearance(xy, raw_grid, window).min())
+        min_clear = min_points_clearance(xy, raw_grid, window)
         if min_clear < radius - 1e-9:
             failures.append("clearance")
     return Certificate(
