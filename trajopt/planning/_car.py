@@ -514,9 +514,11 @@ def _start_curvature(path: Any, first: int, res: float) -> float:
 def split_points(headings: np.ndarray, first: int, last: int) -> list[int]:
     """Return the pose indices where a stretch between cusps is cut into pieces.
 
-    ``[first, ..., last]``: no cut when the stretch turns (the sum of ``|d heading|``) by at
-    most :data:`SPLIT_TURN_RAD`; else ``n = ceil(turn / PIECE_TURN_RAD)`` pieces with equal
-    shares of the turn, each at least two poses long.
+    ``[first, last]`` (no cut) when the stretch turns (the sum of ``|d heading|``) by at most
+    :data:`SPLIT_TURN_RAD`; else greedy pieces, each as long as its headings span (largest
+    minus smallest unwrapped heading) at most :data:`PIECE_TURN_RAD` and it has at least
+    two poses: a loop is cut every ``PIECE_TURN_RAD`` of turn, a path that wiggles about
+    one direction is not cut.
 
     Parameters
     ----------
@@ -530,16 +532,18 @@ def split_points(headings: np.ndarray, first: int, last: int) -> list[int]:
     list of int
         Increasing indices from ``first`` to ``last``.
     """
-    turn = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(headings[first : last + 1])))])
-    total = float(turn[-1])
-    if total <= SPLIT_TURN_RAD or last - first < 4:
+    th = np.asarray(headings[first : last + 1], dtype=float)
+    if float(np.abs(np.diff(th)).sum()) <= SPLIT_TURN_RAD or last - first < 4:
         return [first, last]
-    n = min(math.ceil(total / PIECE_TURN_RAD), (last - first) // 2)
     cuts = [first]
-    for k in range(1, n):
-        i = first + int(np.searchsorted(turn, k * total / n))
-        if i - cuts[-1] >= 2 and last - i >= 2:
-            cuts.append(i)
+    lo = hi = float(th[0])
+    for k in range(1, len(th)):
+        lo, hi = min(lo, th[k]), max(hi, th[k])
+        if hi - lo > PIECE_TURN_RAD and k - 1 - (cuts[-1] - first) >= 2:
+            cuts.append(first + k - 1)
+            lo, hi = min(th[k - 1], th[k]), max(th[k - 1], th[k])
+    if last - cuts[-1] < 2 and len(cuts) > 1:
+        cuts.pop()  # a last piece of one step joins the one before
     cuts.append(last)
     return cuts
 

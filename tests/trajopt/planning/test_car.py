@@ -348,23 +348,24 @@ def test_a_curve_turned_round_is_the_same_curve_backwards():
     assert back.stats["turned_round"] and back.certificate is path.certificate
 
 
-def test_split_points_share_the_turn():
-    """Cuts of a stretch that turns much: independent sums of the heading changes."""
+def test_split_points_cut_loops_not_wiggles():
+    """Cuts of a stretch that turns much: each piece's headings span at most the limit."""
     from trajopt.planning._car import PIECE_TURN_RAD, SPLIT_TURN_RAD, split_points
 
     straight = np.zeros(50)
     assert split_points(straight, 0, 49) == [0, 49]
     bend = np.linspace(0.0, 0.99 * SPLIT_TURN_RAD, 60)  # below the threshold: whole
     assert split_points(bend, 0, 59) == [0, 59]
-    loop = np.concatenate(
-        [np.zeros(10), np.linspace(0.0, -2.0 * math.pi, 101), np.full(10, -TWO_PI)]
-    )
+    wiggle = 0.3 * np.sin(np.arange(200) * 0.7)  # turns by far more than pi in all
+    assert np.abs(np.diff(wiggle)).sum() > 5.0 * SPLIT_TURN_RAD
+    assert split_points(wiggle, 0, 199) == [0, 199]
+    loop = np.concatenate([np.zeros(10), np.linspace(0.0, -TWO_PI, 101), np.full(10, -TWO_PI)])
     cuts = split_points(loop, 3, len(loop) - 2)
     assert cuts[0] == 3 and cuts[-1] == len(loop) - 2
-    assert len(cuts) - 1 == math.ceil(2.0 * math.pi / PIECE_TURN_RAD)
+    assert len(cuts) - 1 == math.ceil(TWO_PI / PIECE_TURN_RAD)
     for a, b in zip(cuts[:-1], cuts[1:], strict=True):
-        turn = sum(abs(loop[i + 1] - loop[i]) for i in range(a, b))
-        assert turn <= PIECE_TURN_RAD + 2.0 * math.pi / 100 + 1e-12
+        assert b - a >= 2
+        assert np.ptp(loop[a : b + 1]) <= PIECE_TURN_RAD + 1e-12
 
 
 def test_forward_only_loop_is_fitted_in_pieces():
