@@ -27,8 +27,11 @@ from astar.costmap import Costmap
 from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
+from trajopt.geometry._length_unit import length_unit
 from trajopt.planning._options import PlannerOptions
 
+#: the clearance cost falls to zero over this many length units beyond the radius
+FALLOFF_UNITS = 3.0
 
 class PlannerCaches:
     """The per-map caches of one planner (and of its footprint robot's disc models).
@@ -161,7 +164,12 @@ class PlannerCaches:
     def _clearance_cost(self, grid: OccupancyGrid) -> np.ndarray:
         cost = np.zeros(grid.shape)
         if self.options.search in ("clearance", "costmap+clearance"):
-            cost += astar.clearance_cost(grid, self.options.robot.radius, outside_occupied=True)
+            cost += astar.clearance_cost(
+                grid,
+                self.options.robot.radius,
+                falloff_cells=falloff_cells(self.options, grid.resolution),
+                outside_occupied=True,
+            )
         return cost
 
     def update(self, grid: OccupancyGrid) -> dict[str, Any]:
@@ -359,17 +367,27 @@ def update_labels(
     return out
 
 
+def falloff_cells(options: PlannerOptions, resolution: float) -> float:
+    """Return the clearance cost's fall-off (cells): :data:`FALLOFF_UNITS` length units.
+
+    The length unit is :func:`~trajopt.geometry.length_unit` of the map and the robot: the
+    cell side, or ``radius / 4`` on finer maps, so that the search keeps the same distance
+    from walls (in metres) whatever the resolution.
+    """
+    return FALLOFF_UNITS * length_unit(resolution, options.robot.radius) / resolution
+
+
 def change_reach(options: PlannerOptions, resolution: float) -> tuple[int, int]:
     """Cells a changed cell can reach: ``(inflated grid, search cost)``.
 
     The inflated grid changes within the robot radius (plus the avoidance area with
     ``inflation="paper"``) of a changed cell, plus 2 cells of rounding; the search cost
-    within that plus the clearance cost's 3-cell fall-off, rounded up.
+    within that plus the clearance cost's fall-off (:func:`falloff_cells`), rounded up.
     """
     r_cells = int(math.ceil(options.robot.radius / resolution)) + 2
     if options.inflation == "paper":
         r_cells += options.w_cells + 1
-    return r_cells, r_cells + 5
+    return r_cells, r_cells + int(math.ceil(falloff_cells(options, resolution))) + 2
 
 
 def _grow(box: tuple[int, int, int, int], k: int, shape: tuple[int, int]):
