@@ -108,6 +108,26 @@ class OccupancyGrid:
         return OccupancyGrid(occupied, self.resolution, self.origin)
 
     # ------------------------------------------------------- conversions
+    def split(self, k: int) -> OccupancyGrid:
+        """Return the same map with every cell split into ``k x k`` cells (side ``resolution / k``).
+
+        The occupied squares cover exactly the same area and the origin is kept, so a plan
+        on the result can be compared with one on this grid (the planner's sizes follow
+        metres and the robot, not cells). ``k = 1`` returns ``self``.
+
+        Raises
+        ------
+        InvalidInputError
+            ``k`` not an integer ``>= 1``.
+        """
+        k = validation.nonnegative_int("k", k)
+        if k < 1:
+            raise InvalidInputError(f"k must be an integer >= 1, got {k}")
+        if k == 1:
+            return self
+        occ = np.repeat(np.repeat(self.occupied, k, axis=0), k, axis=1)
+        return OccupancyGrid(occ, self.resolution / k, self.origin)
+
     def world_to_cell(self, xy: np.ndarray | tuple[float, float]) -> np.ndarray:
         """Cells ``(ix, iy)`` containing world points.
 

@@ -190,3 +190,21 @@ def test_is_free_matches_brute_force(shape, seed, cells) -> None:
     expected = [0 <= ix < nx and 0 <= iy < ny and not occ[iy, ix] for ix, iy in cells]
     assert g.is_free(np.array(cells)).tolist() == expected
     assert [g.is_free(c) for c in cells] == expected
+
+
+def test_split_keeps_the_occupied_area_and_every_world_point_s_state() -> None:
+    """Every world point lies in an occupied cell of the split iff it did before."""
+    rng = np.random.default_rng(3)
+    g = OccupancyGrid(rng.random((7, 9)) < 0.3, 0.2, (-1.0, 0.5))
+    for k in (1, 2, 3):
+        s = g.split(k)
+        assert s.shape == (7 * k, 9 * k) and s.origin == g.origin
+        assert s.resolution == pytest.approx(0.2 / k)
+        assert s.occupied.sum() == k * k * g.occupied.sum()
+        pts = rng.uniform([-1.0, 0.5], [-1.0 + 1.8, 0.5 + 1.4], size=(500, 2))
+        a, b = g.world_to_cell(pts), s.world_to_cell(pts)
+        assert np.array_equal(g.occupied[a[:, 1], a[:, 0]], s.occupied[b[:, 1], b[:, 0]])
+    assert g.split(1) is g
+    for bad in (0, -2, 1.5, True):
+        with pytest.raises(InvalidInputError, match="k must"):
+            g.split(bad)
