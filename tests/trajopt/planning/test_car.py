@@ -392,3 +392,27 @@ def test_forward_only_loop_is_fitted_in_pieces():
     # the heading is continuous across the joins
     smp = traj.sample(np.linspace(0.0, traj.duration, 4001))
     assert np.abs(np.diff(smp.theta)).max() < 0.05
+
+
+def test_start_facing_a_wall_with_room_only_for_full_lock():
+    """Forward only, the start heading 114 degrees down towards a wall with room for a turn
+    of radius 1.05 R but not 1.15 R (held-out depot #5): the tight search radius fits with
+    the smoother's collocation margin raised (0.9 of 1/R cannot follow that arc); the
+    curve still keeps 1/R (three-point check) and the radius (brute force)."""
+    from trajopt.planning import _car
+
+    res, R, h0 = 0.05, 0.4, -1.9935
+    grid = astar.OccupancyGrid(walled(6.0, 3.0, res), res)
+    robot = trajopt.Robot(radius=0.1, drive="ackermann", min_turning_radius=R, reverse=False)
+    drop = R * (1.0 - math.cos(math.pi + h0))  # how far a turn of radius R drops to west
+    start, goal = (4.0, 0.15 + 1.075 * drop), (1.0, 0.4)
+    traj = trajopt.Planner(grid, robot).plan(start, goal, start_heading=h0, goal_heading=math.pi)
+    tries = traj.stats["car"]["tries"]
+    assert tries[-1] == f"radius grid, {_car.TIGHT_FACTOR:g} R: planned", tries
+    assert "radius grid, 1.15 R: no path (exhausted)" in tries
+    ends = traj.sample(np.array([0.0, traj.duration]))
+    np.testing.assert_allclose([ends.x, ends.y], np.transpose([start, goal]), atol=1e-9)
+    kmax = 1.0 / R
+    for pts in _dense_points(traj, 0.002):
+        assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)
+        assert square_clearance(grid, pts, reach=0.2).min() >= robot.radius - 1e-9
