@@ -313,6 +313,9 @@ def grow_regions(
             f"[{ox}, {ox + nx * res}] x [{oy}, {oy + ny * res}] m"
         )
     src, p = _distinct_points(pc_, n_in)
+    if unit > res:  # cells finer than the unit: about one point per unit along straight runs
+        keep = thin_runs(p, unit / res)
+        src, p = src[keep], np.ascontiguousarray(p[keep])
     reach = options.margin_cells + r_c + options.centre_cells + options.overlap_cells + 3.0
     idx = ObstacleIndex(
         occ,
@@ -369,6 +372,33 @@ def _distinct_points(pc_: np.ndarray, n_in: int) -> tuple[np.ndarray, np.ndarray
             f"path needs at least two distinct points, got {len(p)} ({n_in} given)"
         )
     return src, p
+
+
+def thin_runs(p: np.ndarray, step: float) -> np.ndarray:
+    """Return which points of a path to keep: its corners and about one per ``step`` between.
+
+    ``p`` (cell units, no repeated points); a point is a corner when the steps before and
+    after it differ. Dropping points inside a straight run changes neither the path nor the
+    clearance of its segments (a segment's clearance is the least of its pieces'), only how
+    many points the corridor's path has: about as many per metre as on a map of cells of
+    side ``step``.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        The first and last points, every corner, and the first point of every ``step`` of
+        arc length.
+    """
+    n = len(p)
+    keep = np.ones(n, dtype=bool)
+    if n <= 2:
+        return keep
+    d = np.diff(p, axis=0)
+    corner = np.any(d[1:] != d[:-1], axis=1)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
+    bucket = np.floor(s / step)
+    keep[1:-1] = corner | (bucket[1:-1] != bucket[:-2])
+    return keep
 
 
 def _grow_regions(
