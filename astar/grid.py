@@ -128,6 +128,33 @@ class OccupancyGrid:
         occ = np.repeat(np.repeat(self.occupied, k, axis=0), k, axis=1)
         return OccupancyGrid(occ, self.resolution / k, self.origin)
 
+    def coarsen(self, k: int) -> OccupancyGrid:
+        """Return the map in cells ``k`` times larger, occupied wherever any of their cells was.
+
+        Conservative: every occupied square of this grid lies inside an occupied square of
+        the result, so a path clear on the result is clear here. The last row and column of
+        blocks, when ``nx`` or ``ny`` is not a multiple of ``k``, are filled up with
+        occupied cells (the outside of the map). The origin is kept. ``k = 1`` returns
+        ``self``. The planner's memory grows with the cell count: this is the knob that
+        lowers it ``k * k`` times.
+
+        Raises
+        ------
+        InvalidInputError
+            ``k`` not an integer ``>= 1``.
+        """
+        k = validation.nonnegative_int("k", k)
+        if k < 1:
+            raise InvalidInputError(f"k must be an integer >= 1, got {k}")
+        if k == 1:
+            return self
+        ny, nx = self.shape
+        by, bx = -(-ny // k), -(-nx // k)
+        occ = np.ones((by * k, bx * k), dtype=bool)
+        occ[:ny, :nx] = self.occupied
+        blocks = occ.reshape(by, k, bx, k).any(axis=(1, 3))
+        return OccupancyGrid(blocks, self.resolution * k, self.origin)
+
     def world_to_cell(self, xy: np.ndarray | tuple[float, float]) -> np.ndarray:
         """Cells ``(ix, iy)`` containing world points.
 

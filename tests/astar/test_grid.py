@@ -208,3 +208,23 @@ def test_split_keeps_the_occupied_area_and_every_world_point_s_state() -> None:
     for bad in (0, -2, 1.5, True):
         with pytest.raises(InvalidInputError, match="k must"):
             g.split(bad)
+
+
+def test_coarsen_is_conservative_and_undoes_split() -> None:
+    """Every occupied square lies in an occupied coarse square; coarsen(split(k)) is the map."""
+    rng = np.random.default_rng(5)
+    g = OccupancyGrid(rng.random((11, 13)) < 0.15, 0.05, (0.3, -0.2))
+    assert np.array_equal(g.split(3).coarsen(3).occupied, g.occupied)
+    for k in (1, 2, 4):
+        c = g.coarsen(k)
+        assert c.shape == (-(-11 // k), -(-13 // k)) and c.resolution == pytest.approx(0.05 * k)
+        iy, ix = np.nonzero(g.occupied)
+        centres = g.cell_to_world(np.column_stack([ix, iy]))
+        cells = c.world_to_cell(centres)
+        assert c.occupied[cells[:, 1], cells[:, 0]].all()
+        # a coarse cell is free only if all its fine cells inside the map are free
+        for cy, cx in zip(*np.nonzero(~c.occupied), strict=True):
+            assert not g.occupied[cy * k : (cy + 1) * k, cx * k : (cx + 1) * k].any()
+    assert g.coarsen(1) is g
+    with pytest.raises(InvalidInputError, match="k must"):
+        g.coarsen(0)

@@ -28,10 +28,12 @@ from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._length_unit import length_unit
+from trajopt.planning._memory import check_memory
 from trajopt.planning._options import PlannerOptions
 
 #: the clearance cost falls to zero over this many length units beyond the radius
 FALLOFF_UNITS = 3.0
+
 
 class PlannerCaches:
     """The per-map caches of one planner (and of its footprint robot's disc models).
@@ -53,6 +55,7 @@ class PlannerCaches:
     """
 
     def __init__(self, grid: OccupancyGrid, costmap: Costmap | None, options: PlannerOptions):
+        check_memory(grid.shape, options)  # a map too large is refused before any work
         self.grid = grid
         self.costmap = costmap
         self.options = options
@@ -195,6 +198,7 @@ class PlannerCaches:
                 and grid.origin == old.origin
             )
             if not same:
+                check_memory(grid.shape, self.options)
                 self.grid, self._inflated, self._cost = grid, None, None
                 self._components = None
                 self._coarse = None
