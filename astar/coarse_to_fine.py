@@ -74,7 +74,7 @@ from astar.grid import OccupancyGrid, check_grid
 from astar.search import GridPath, find_path
 from astar.search_kernels import heap_pop, heap_push, unroll_path
 from astar.search_workspace import LOCK, padded_free, workspace
-from astar.weighted_kernel import _read_only
+from astar.weighted_kernel import read_only
 
 __all__ = [
     "CoarseGrid",
@@ -822,7 +822,7 @@ def _band_search(
             ws = workspace(src.shape[0])
             has_cost = coarse.cost is not None
             found, path, expanded, gcost = _band_kernel(
-                _read_only(buf), width, s, t, coarse.cost.ravel() if has_cost else _NO_LG,
+                read_only(buf), width, s, t, coarse.cost.ravel() if has_cost else _NO_LG,
                 has_cost, ws.rec, ws.recf, ws.next_gen(), field, k,
             )  # fmt: skip
         finally:

@@ -37,7 +37,7 @@ def bit_length(x):  # pragma: no cover - compiled
     return n
 
 
-def _read_only(a: np.ndarray) -> np.ndarray:
+def read_only(a: np.ndarray) -> np.ndarray:
     """Return ``a`` read-only (a read-only view when ``a`` is writable; no copy)."""
     if not a.flags.writeable:
         return a
@@ -55,18 +55,18 @@ def weighted_kernel(free, width, start, goal, conn8, cut, cost, rec, recf, gen, 
     arguments and the result are :func:`_weighted_search`'s.
     """
     return _weighted_search(
-        _read_only(free),
+        read_only(free),
         width,
         start,
         goal,
         conn8,
         cut,
-        _read_only(cost),
+        read_only(cost),
         rec,
         recf,
         gen,
-        _read_only(lm),
-        _read_only(lg),
+        read_only(lm),
+        read_only(lg),
     )
 
 
