@@ -35,8 +35,8 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    smoother takes a start curvature, not a goal one). Where those fail, it is fitted again
    in polygons grown around the poses themselves without centring (the
    witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). A
-   stretch that turns by more than :data:`SPLIT_TURN_RAD` and whose first fit fails is
-   fitted in pieces of at most :data:`PIECE_TURN_RAD` (before the other fits), each
+   stretch that turns by more than :data:`SPLIT_TURN_RAD` and that none of these fits is
+   fitted in pieces spanning at most :data:`PIECE_TURN_RAD` of heading each, each
    starting with the previous piece's end curvature; the car rests at each join as at a
    cusp (:attr:`CarSegment.joined`). Every
    curve is the smoother's certified curve (convex-hull clearance certificate per segment)
@@ -111,11 +111,11 @@ SEGMENT_BUDGET_S = 2.0
 #: Cap (s) on the Hybrid-A* search's time budget per try.
 SEARCH_BUDGET_S = 2.0
 #: A stretch between cusps that turns by more than this (rad, the sum of its heading changes)
-#: and whose first fit fails is fitted in pieces (:func:`split_points`): one B-spline round
+#: and whose fits all fail is fitted in pieces (:func:`split_points`): one B-spline round
 #: a loop of the search's forward-only shots (4.7-6.6 rad on the held-out failures) left the
 #: curvature SCP without a step (its trust region collapsed), where its thirds fitted at
-#: once. Only after a failed fit: the car rests at each join, and long paths turn by tens of
-#: radians in small steps.
+#: once. Only after the whole stretch's fits failed: the car rests at each join, and long
+#: paths turn by tens of radians in small steps.
 SPLIT_TURN_RAD = math.pi
 #: Largest turn (rad) of each piece of a split stretch.
 PIECE_TURN_RAD = 0.6 * math.pi
@@ -145,8 +145,8 @@ class CarSegment:
         (around the poses themselves, the last try).
     joined : bool
         Whether it continues the previous segment in the same direction of travel (a stretch
-        between cusps that turns by more than :data:`SPLIT_TURN_RAD` is fitted in pieces;
-        the car rests at each join, as at a cusp). Its curve then starts with the previous
+        between cusps that turns by more than :data:`SPLIT_TURN_RAD` and has no fit as a
+        whole is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
         curve's end curvature where that fit succeeds (``"polygons"``).
     """
 
@@ -576,19 +576,18 @@ def _fit_run(
 ) -> list[CarSegment]:
     """Fit a stretch between cusps (module docstring, step 2).
 
-    As one segment (:func:`_fit_segment`); when its first fit fails and the stretch turns by
-    more than :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece starting
-    with the previous curve's end curvature; when a piece fails too, the other fits of the
-    whole stretch.
+    As one segment (:func:`_fit_segment`, every fit); when those fail and the stretch turns
+    by more than :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece
+    starting with the previous curve's end curvature (the car rests at each join).
     """
     args = (options, grid, smoother, poses)
+    try:
+        return [_fit_segment(*args, ends, direction, kappa0, timer)]
+    except SmoothingError as exc:
+        whole = exc
     cuts = split_points(np.asarray(poses[:, 2]), *ends)
     if len(cuts) == 2:
-        return [_fit_segment(*args, ends, direction, kappa0, timer)]
-    try:
-        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=(0,))]
-    except SmoothingError:
-        pass
+        raise whole
     out: list[CarSegment] = []
     k_start = kappa0
     try:
@@ -596,13 +595,9 @@ def _fit_run(
             seg = _fit_segment(*args, (a, b), direction, k_start, timer)
             out.append(dataclasses.replace(seg, joined=bool(out)))
             k_start = _end_curvature(seg.smooth_path)
-        return out
     except SmoothingError as exc:
-        piece_error = exc
-    try:
-        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=(1, 2, 3))]
-    except SmoothingError as exc:
-        raise SmoothingError(f"{exc}; in {len(cuts) - 1} pieces: {piece_error}", exc.stats) from exc
+        raise SmoothingError(f"{whole}; in {len(cuts) - 1} pieces: {exc}", whole.stats) from exc
+    return out
 
 
 def _fit_segment(
