@@ -24,7 +24,8 @@ queries OMPL solved (target of issue 36: >= 98 %), the failure classes, the inde
 (collisions: clearance below the radius on dense samples against the raw map; curvature above
 ``1/R`` by circles through three points 0.05 cells apart within each stretch between cusps;
 ``|v|`` at every cusp; the angle between each displacement and the heading (or its reverse);
-the end headings), median plan time on the maps of at most 256 x 256 cells beside OMPL's time
+the end headings), the plans that rest between cusps (a stretch fitted in pieces), median
+plan time on the maps of at most 256 x 256 cells beside OMPL's time
 to its first solution, the Hybrid-A* search alone (its stage, 2-D heuristic included), cusps
 and reverse length per plan against OMPL's.
 
@@ -144,6 +145,12 @@ def report(df, cells: dict[str, int], have_ompl: bool) -> str:
                 k: _med(1e3 * ok[f"stage_{k}_s"])
                 for k in ("inflate", "corridor", "smooth", "timing")
             }
+            pieces = ok["corridor"].fillna("").str.count(",") + 1
+            rests = pieces - 1 - ok["cusps"]
+            lines.append(
+                f"  rests between cusps    {int((rests > 0).sum())} plans "
+                f"({int(rests.sum())} joins of stretches fitted in pieces)"
+            )
             lines.append(
                 "  trajopt stages median  "
                 + ", ".join(f"{k} {v:.1f} ms" for k, v in st.items())
