@@ -311,7 +311,54 @@ def _points_clearance_kernel(q, occ, w, cap):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _min_clearance_kernel(q, occ, w, cap):  # pragma: no cover - compiled
+def block_dist2(px, py, occ, blk, bs, best):  # pragma: no cover - compiled
+    """``min(best, d^2)``: ``d`` (cells) from ``(px, py)`` to the nearest occupied square.
+
+    Only squares closer than ``sqrt(best)`` matter. The map's outside counts as occupied
+    (its distance is the border distance). ``blk[by, bx]``: whether the ``bs x bs`` block
+    of cells holds an occupied one; blocks are visited in rings around the point's block
+    until a ring lies beyond ``sqrt(best)``, and only occupied blocks' cells are measured.
+    """
+    ny, nx = occ.shape
+    nby, nbx = blk.shape
+    b = max(0.0, min(px, nx - px, py, ny - py))
+    if b * b < best:
+        best = b * b
+    cbx = int(math.floor(px / bs))
+    cby = int(math.floor(py / bs))
+    j = 0
+    while True:
+        near = (j - 1) * bs  # the least distance to a block of ring j
+        if j > 0 and near > 0 and near * near >= best:
+            break
+        if cbx - j < 0 and cby - j < 0 and cbx + j >= nbx and cby + j >= nby:
+            break
+        for by in range(cby - j, cby + j + 1):
+            if by < 0 or by >= nby:
+                continue
+            edge = by == cby - j or by == cby + j
+            step = 1 if edge else 2 * j
+            bx = cbx - j
+            while bx <= cbx + j:
+                if 0 <= bx < nbx and blk[by, bx]:
+                    for gy in range(by * bs, min(ny, (by + 1) * bs)):
+                        dy = max(0.0, max(gy - py, py - (gy + 1)))
+                        if dy * dy >= best:
+                            continue
+                        for gx in range(bx * bs, min(nx, (bx + 1) * bs)):
+                            if not occ[gy, gx]:
+                                continue
+                            dx = max(0.0, max(gx - px, px - (gx + 1)))
+                            d2 = dx * dx + dy * dy
+                            if d2 < best:
+                                best = d2
+                bx += step if step > 0 else 1
+        j += 1
+    return best
+
+
+@njit(cache=True)
+def _min_clearance_kernel(q, occ, blk, bs, cap):  # pragma: no cover - compiled
     """Exact ``min_k min(d_k, cap)`` over the points ``q`` (cells), skipping what cannot win.
 
     ``d_k`` is 1-Lipschitz along the polyline of the points: a point ``s`` (cells) after one
@@ -326,11 +373,33 @@ def _min_clearance_kernel(q, occ, w, cap):  # pragma: no cover - compiled
             lb -= math.hypot(q[k, 0] - q[k - 1, 0], q[k, 1] - q[k - 1, 1])
             if lb >= best:
                 continue
-        d = math.sqrt(point_square_dist2(q[k, 0], q[k, 1], occ, w, cap * cap))
+        d = math.sqrt(block_dist2(q[k, 0], q[k, 1], occ, blk, bs, cap * cap))
         lb = d
         if d < best:
             best = d
     return best
+
+
+#: side (cells) of the occupancy blocks of :func:`min_points_clearance`
+CLEARANCE_BLOCK = 8
+#: the blocks of the last few maps, by the identity of their occupancy array
+_BLOCKS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def occupied_blocks(occ: np.ndarray, bs: int = CLEARANCE_BLOCK) -> np.ndarray:
+    """Return which ``bs x bs`` blocks of ``occ`` hold an occupied cell (cached per array)."""
+    hit = _BLOCKS.get(id(occ))
+    if hit is not None and hit[0] is occ:
+        return hit[1]
+    ny, nx = occ.shape
+    by, bx = -(-ny // bs), -(-nx // bs)
+    pad = np.zeros((by * bs, bx * bs), dtype=bool)
+    pad[:ny, :nx] = occ
+    blk = np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
+    if len(_BLOCKS) >= 4:
+        _BLOCKS.pop(next(iter(_BLOCKS)))
+    _BLOCKS[id(occ)] = (occ, blk)  # holding occ keeps its id from being reused
+    return blk
 
 
 @njit(cache=True)
@@ -440,8 +509,11 @@ def min_points_clearance(points: np.ndarray, grid: Any, window_m: float) -> floa
     Equal to ``points_clearance(points, grid, window_m).min()``, found faster: consecutive
     points are close, and a point cannot be nearer an obstacle than the previous point's
     distance minus the step between them, so most points of a sequence that stays clear
-    are never searched. The search itself reaches ``2 window_m`` (the points' lower bounds
-    then start higher, and more of them are skipped); the result is capped at ``window_m``.
+    are never searched. A searched point visits blocks of :data:`CLEARANCE_BLOCK` cells in
+    rings around it and measures only the cells of occupied blocks, so its cost follows
+    the obstacles near it, not the cell count. The search itself reaches ``2 window_m``
+    (the points' lower bounds then start higher, and more of them are skipped); the result
+    is capped at ``window_m``.
 
     Parameters
     ----------
@@ -463,8 +535,8 @@ def min_points_clearance(points: np.ndarray, grid: Any, window_m: float) -> floa
     if len(q) == 0:
         return float(window_m)
     reach = 2.0 * float(window_m) / res
-    w = int(math.ceil(reach)) + 1
-    best = _min_clearance_kernel(np.ascontiguousarray(q), occ, w, reach)
+    blk = occupied_blocks(occ)
+    best = _min_clearance_kernel(np.ascontiguousarray(q), occ, blk, CLEARANCE_BLOCK, reach)
     return min(best * res, float(window_m))
 
 
