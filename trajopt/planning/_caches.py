@@ -48,14 +48,25 @@ class PlannerCaches:
         Options resolved for the map (:meth:`PlannerOptions.for_map`); the caches depend on
         the robot radius, ``inflation``, ``w_cells``, ``search``, ``costmap_weight`` and
         ``landmarks``.
+    cell_units : bool, optional
+        Count the clearance cost's fall-off in cells, not length units (a footprint
+        robot's disc models, whose fits count in cells). Default False.
 
     Notes
     -----
     The lazy builds hold a lock, so caches may be read from several threads.
     """
 
-    def __init__(self, grid: OccupancyGrid, costmap: Costmap | None, options: PlannerOptions):
+    def __init__(
+        self,
+        grid: OccupancyGrid,
+        costmap: Costmap | None,
+        options: PlannerOptions,
+        *,
+        cell_units: bool = False,
+    ):
         check_memory(grid.shape, options)  # a map too large is refused before any work
+        self.cell_units = cell_units
         self.grid = grid
         self.costmap = costmap
         self.options = options
@@ -153,7 +164,10 @@ class PlannerCaches:
         radius = options.robot.radius
         with self._lock:
             if radius not in self._discs:
-                self._discs[radius] = PlannerCaches(self.grid, self.costmap, options)
+                # a footprint's fits count in cells (Smoother.fit), and so does its search
+                self._discs[radius] = PlannerCaches(
+                    self.grid, self.costmap, options, cell_units=True
+                )
             return self._discs[radius]
 
     def _inflate(self, grid: OccupancyGrid) -> np.ndarray:
@@ -170,7 +184,11 @@ class PlannerCaches:
             cost += astar.clearance_cost(
                 grid,
                 self.options.robot.radius,
-                falloff_cells=falloff_cells(self.options, grid.resolution),
+                falloff_cells=(
+                    FALLOFF_UNITS
+                    if self.cell_units
+                    else falloff_cells(self.options, grid.resolution)
+                ),
                 outside_occupied=True,
             )
         return cost
