@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 import astar
-from trajopt.planning._caches import component_labels
+from trajopt import PlannerOptions, Robot
+from trajopt.planning._caches import component_labels, falloff_cells
 
 RADIUS = 0.25
 
@@ -40,7 +41,10 @@ def _setup(split: int):
     inflated = g.with_occupied(
         astar.inflate(g, RADIUS, metric="square", outside_occupied=True).occupied
     )
-    cost = astar.clearance_cost(g, RADIUS, outside_occupied=True)
+    options = PlannerOptions(robot=Robot(radius=RADIUS))  # the planner's fall-off
+    cost = astar.clearance_cost(
+        g, RADIUS, falloff_cells=falloff_cells(options, g.resolution), outside_occupied=True
+    )
     cost.flags.writeable = False
     return inflated, cost
 
