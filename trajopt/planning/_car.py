@@ -35,13 +35,13 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    smoother takes a start curvature, not a goal one). Where those fail, it is fitted again
    in polygons grown around the poses themselves without centring (the
    witness corridor of :func:`~trajopt.planning._corridor_fit.witness_corridor`). A
-   stretch that turns by more than :data:`SPLIT_TURN_RAD` and that none of these fits is
-   fitted in pieces spanning at most :data:`PIECE_TURN_RAD` of heading each, each
-   starting with the previous piece's end curvature; the car rests at each join as at a
-   cusp (:attr:`CarSegment.joined`). Every
-   curve is the smoother's certified curve (convex-hull clearance certificate per segment)
-   and its sampled curvature (the certificate's dense samples) must be within ``1/R``;
-   nothing else is returned.
+   stretch that turns by more than :data:`SPLIT_TURN_RAD` and that neither the first nor
+   the reversed fit fits is fitted in pieces spanning at most :data:`PIECE_TURN_RAD` of
+   heading each (before the other whole fits), each starting with the previous piece's
+   end curvature; the car rests at each join as at a cusp (:attr:`CarSegment.joined`).
+   Every curve is the smoother's certified curve (convex-hull clearance certificate per
+   segment) and its sampled curvature (the certificate's dense samples) must be within
+   ``1/R``; nothing else is returned.
 3. **Timing.** Each segment is timed along its arc length from rest to rest
    (:func:`trajopt.time_parameterize`: ``v = 0`` at the ends and at every cusp), backwards
    segments with ``v_max_reverse`` as the speed limit, with the robot's curvature caps and,
@@ -111,12 +111,17 @@ SEGMENT_BUDGET_S = 2.0
 #: Cap (s) on the Hybrid-A* search's time budget per try.
 SEARCH_BUDGET_S = 2.0
 #: A stretch between cusps that turns by more than this (rad, the sum of its heading changes)
-#: and whose fits all fail is fitted in pieces (:func:`split_points`): one B-spline round
+#: and whose first fits fail is fitted in pieces (:func:`split_points`): one B-spline round
 #: a loop of the search's forward-only shots (4.7-6.6 rad on the held-out failures) left the
 #: curvature SCP without a step (its trust region collapsed), where its thirds fitted at
-#: once. Only after the whole stretch's fits failed: the car rests at each join, and long
-#: paths turn by tens of radians in small steps.
+#: once. Only after whole fits failed (:data:`WHOLE_FIRST`): the car rests at each join,
+#: and long paths turn by tens of radians in small steps.
 SPLIT_TURN_RAD = math.pi
+#: The fits (:func:`_fit_segment` ``tries``) of a stretch that may be split, tried before its
+#: pieces: with the search path's start curvature, and from the end with its end curvature.
+#: The others (without a start curvature, the witness corridor) come after the pieces: a
+#: failing whole fit of a long loop costs 0.4-1.9 s, its pieces 0.01-0.03 s each.
+WHOLE_FIRST = (0, 2)
 #: Largest turn (rad) of each piece of a split stretch.
 PIECE_TURN_RAD = 0.6 * math.pi
 #: Slack (m) of the search's exact clearance on the radius grid: a quarter of the corridor's
@@ -145,8 +150,8 @@ class CarSegment:
         (around the poses themselves, the last try).
     joined : bool
         Whether it continues the previous segment in the same direction of travel (a stretch
-        between cusps that turns by more than :data:`SPLIT_TURN_RAD` and has no fit as a
-        whole is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
+        between cusps that turns by more than :data:`SPLIT_TURN_RAD` and that its first
+        whole fits miss is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
         curve's end curvature where that fit succeeds (``"polygons"``).
     """
 
@@ -576,18 +581,20 @@ def _fit_run(
 ) -> list[CarSegment]:
     """Fit a stretch between cusps (module docstring, step 2).
 
-    As one segment (:func:`_fit_segment`, every fit); when those fail and the stretch turns
-    by more than :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece
-    starting with the previous curve's end curvature (the car rests at each join).
+    As one segment (:func:`_fit_segment`: first its fits with the search path's end
+    curvatures, :data:`WHOLE_FIRST`); when those fail and the stretch turns by more than
+    :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece starting with the
+    previous curve's end curvature (the car rests at each join); then the whole stretch's
+    other fits.
     """
     args = (options, grid, smoother, poses)
-    try:
-        return [_fit_segment(*args, ends, direction, kappa0, timer)]
-    except SmoothingError as exc:
-        whole = exc
     cuts = split_points(np.asarray(poses[:, 2]), *ends)
     if len(cuts) == 2:
-        raise whole
+        return [_fit_segment(*args, ends, direction, kappa0, timer)]
+    try:
+        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=WHOLE_FIRST)]
+    except SmoothingError as exc:
+        whole = exc
     out: list[CarSegment] = []
     k_start = kappa0
     try:
@@ -595,9 +602,16 @@ def _fit_run(
             seg = _fit_segment(*args, (a, b), direction, k_start, timer)
             out.append(dataclasses.replace(seg, joined=bool(out)))
             k_start = _end_curvature(seg.smooth_path)
+        return out
     except SmoothingError as exc:
-        raise SmoothingError(f"{whole}; in {len(cuts) - 1} pieces: {exc}", whole.stats) from exc
-    return out
+        pieces = exc
+    rest = tuple(i for i in range(4) if i not in WHOLE_FIRST)
+    try:
+        return [_fit_segment(*args, ends, direction, kappa0, timer, tries=rest)]
+    except SmoothingError as exc:
+        raise SmoothingError(
+            f"{whole}; in {len(cuts) - 1} pieces: {pieces}; then {exc}", exc.stats
+        ) from exc
 
 
 def _fit_segment(
