@@ -18,7 +18,7 @@ drawn on the base map) are planned by the default ``trajopt.Planner`` (robot rad
 
 ``--memory CELLS_M`` (default 15) then plans three queries on the willow site split so
 that it has at least that many million cells, in a fresh process, and prints the peak
-resident memory (``ru_maxrss``), the interpreter and libraries included.
+resident memory (``VmHWM``), the interpreter and libraries included.
 
 Run::
 
@@ -172,8 +172,22 @@ def memory_child(split: int) -> None:
     planner = trajopt.Planner(grid, trajopt.Robot(radius=RADIUS))
     for q in queries:
         planner.plan(*q)
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
-    print(f"{grid.nx * grid.ny} {peak}")
+    print(f"{grid.nx * grid.ny} {peak_rss()}")
+
+
+def peak_rss() -> int:
+    """This process's peak resident memory (bytes).
+
+    ``VmHWM`` of ``/proc/self/status`` where there is one: ``ru_maxrss`` survives ``exec``,
+    so in a child of a large parent it reports the parent's size at the fork.
+    """
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
 
 
 def main() -> None:
@@ -181,7 +195,8 @@ def main() -> None:
     ap.add_argument(
         "--sites",
         default="willow:3,depot:1",
-        help="map:base_split,... (willow is 10 cm, depot 5 cm; default willow:3,depot:1)",
+        help="map:base_split,... (willow is 10 cm, depot 5 cm; default willow:3,depot:1; "
+        "none: only the memory)",
     )
     ap.add_argument("--queries", type=int, default=12)
     ap.add_argument("--repeat", type=int, default=3)
@@ -197,7 +212,7 @@ def main() -> None:
     import trajopt
 
     trajopt.warm_up()
-    for site in args.sites.split(","):
+    for site in [] if args.sites == "none" else args.sites.split(","):
         name, base = site.split(":")
         base = int(base)
         queries = long_queries(load(name, 1), args.queries, MIN_LENGTH_M[name])
