@@ -387,7 +387,11 @@ _BLOCKS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
 
 def occupied_blocks(occ: np.ndarray, bs: int = CLEARANCE_BLOCK) -> np.ndarray:
-    """Return which ``bs x bs`` blocks of ``occ`` hold an occupied cell (cached per array)."""
+    """Return which ``bs x bs`` blocks of ``occ`` hold an occupied cell.
+
+    Cached per array when ``occ`` is read-only (an :class:`astar.OccupancyGrid`'s is), so
+    that it cannot change under the cache.
+    """
     hit = _BLOCKS.get(id(occ))
     if hit is not None and hit[0] is occ:
         return hit[1]
@@ -396,6 +400,8 @@ def occupied_blocks(occ: np.ndarray, bs: int = CLEARANCE_BLOCK) -> np.ndarray:
     pad = np.zeros((by * bs, bx * bs), dtype=bool)
     pad[:ny, :nx] = occ
     blk = np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
+    if occ.flags.writeable:
+        return blk
     if len(_BLOCKS) >= 4:
         _BLOCKS.pop(next(iter(_BLOCKS)))
     _BLOCKS[id(occ)] = (occ, blk)  # holding occ keeps its id from being reused

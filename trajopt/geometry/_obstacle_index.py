@@ -199,21 +199,73 @@ def poly_clearance(v, nv, cap, rects, meta, bstart, bids, stamp, buf):  # pragma
     return best
 
 
+#: the whole-map rectangles of the last few maps, by the identity of their occupancy array
+_MAP_RECTS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def map_rects(occ: np.ndarray) -> np.ndarray:
+    """Return the occupied cells of the whole map as rectangles, ``(R, 4)`` (cached per array).
+
+    :func:`~trajopt.geometry._clearance.merge_rects` of the whole map, kept for a
+    read-only array (the arrays of :class:`astar.OccupancyGrid` are), so it cannot change
+    under the cache.
+    """
+    hit = _MAP_RECTS.get(id(occ))
+    if hit is not None and hit[0] is occ:
+        return hit[1]
+    rects = window_rects(occ, 0, occ.shape[1], 0, occ.shape[0])
+    if occ.flags.writeable:
+        return rects
+    if len(_MAP_RECTS) >= 4:
+        _MAP_RECTS.pop(next(iter(_MAP_RECTS)))
+    _MAP_RECTS[id(occ)] = (occ, rects)  # holding occ keeps its id from being reused
+    return rects
+
+
 class ObstacleIndex:
-    """Obstacle rectangles of a map window (cell units) with a bucket grid."""
+    """Obstacle rectangles of a map window (cell units) with a bucket grid.
+
+    Parameters
+    ----------
+    occ : ndarray of bool, shape (ny, nx)
+        The raw map's occupancy.
+    x0, x1, y0, y1 : int
+        The window (cells, ends exclusive), clipped to the map.
+    bucket_cells : int, optional
+        Side of the buckets (cells). Default :data:`BUCKET_CELLS`.
+    whole_map : bool, optional
+        Take the rectangles of the whole map's decomposition (:func:`map_rects`, computed
+        once per map) that meet the window, instead of decomposing the window's cells:
+        the same obstacles, found in time that follows the rectangles, not the window's
+        cells. Default False.
+    """
 
     __slots__ = ("rects", "meta", "bstart", "bids", "stamp", "buf")
 
-    def __init__(self, occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> None:
+    def __init__(
+        self,
+        occ: np.ndarray,
+        x0: int,
+        x1: int,
+        y0: int,
+        y1: int,
+        *,
+        bucket_cells: int = BUCKET_CELLS,
+        whole_map: bool = False,
+    ) -> None:
         ny, nx = occ.shape
         x0, y0 = max(0, x0), max(0, y0)
         x1, y1 = min(nx, x1), min(ny, y1)
         if x1 <= x0 or y1 <= y0:
             rects = np.zeros((0, 4))
             x0, y0, x1, y1 = 0, 0, 1, 1
+        elif whole_map:
+            allr = map_rects(occ)
+            meet = (allr[:, 2] > x0) & (allr[:, 0] < x1) & (allr[:, 3] > y0) & (allr[:, 1] < y1)
+            rects = np.ascontiguousarray(allr[meet])
         else:
             rects = window_rects(occ, x0, x1, y0, y1)
-        bs = BUCKET_CELLS
+        bs = int(bucket_cells)
         nbx = max(1, -(-(x1 - x0) // bs))
         nby = max(1, -(-(y1 - y0) // bs))
         self.rects = rects

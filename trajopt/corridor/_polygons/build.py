@@ -30,7 +30,7 @@ from trajopt.corridor._polygons.regions import (
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.geometry._clearance import grid_cells
 from trajopt.geometry._length_unit import length_unit
-from trajopt.geometry._obstacle_index import ObstacleIndex
+from trajopt.geometry._obstacle_index import BUCKET_CELLS, ObstacleIndex
 
 logger = logging.getLogger("trajopt.corridor")
 
@@ -317,12 +317,15 @@ def grow_regions(
         keep = thin_runs(p, unit / res)
         src, p = src[keep], np.ascontiguousarray(p[keep])
     reach = options.margin_cells + r_c + options.centre_cells + options.overlap_cells + 3.0
+    fine = unit > res  # cells finer than the unit: buckets and rectangles follow the unit
     idx = ObstacleIndex(
         occ,
         int(math.floor(p[:, 0].min() - reach)),
         int(math.ceil(p[:, 0].max() + reach)) + 1,
         int(math.floor(p[:, 1].min() - reach)),
         int(math.ceil(p[:, 1].max() + reach)) + 1,
+        bucket_cells=max(BUCKET_CELLS, round(BUCKET_CELLS * unit / res)),
+        whole_map=fine and not occ.flags.writeable,
     )
     seed, seed_src, hh, vv, nvs, degen = _grow_regions(idx, p, src, pts_m, r_c, tol_c, res, options)
     # the certificate: exact clearance of every region (cell units)
