@@ -305,3 +305,20 @@ def test_forward_only_car_brakes_and_plans_forwards():
     _check_new_plan(out, new, (7.0, 2.0), 0.0, robot)
     smp = out.sample(np.linspace(0.0, out.duration, 2001))
     assert np.all(smp.v >= 0.0) and np.all(smp.direction == 1)
+
+
+def test_inside_a_stretch_fitted_in_pieces_brakes_on_its_piece():
+    """A forward-only loop fitted in pieces (the car rests at each join): a re-plan in the
+    middle of the second piece brakes along that piece's curve and plans on from rest."""
+    grid = astar.OccupancyGrid(walled(4.0, 4.0), RES)
+    robot = trajopt.Robot(radius=0.1, drive="ackermann", min_turning_radius=0.4, reverse=False)
+    planner = trajopt.Planner(grid, robot)
+    goal = (1.95, 2.0)
+    traj = planner.plan((2.0, 2.0), goal, start_heading=-2.83, goal_heading=1.7)
+    assert [s.joined for s in traj.steps.segments][1] is True
+    t0, t1 = (float(t) for t in traj.piece_times[1:3])
+    ts = 0.5 * (t0 + t1)
+    out = planner.replan(traj, ts, latency=0.0, reuse=False)
+    assert out.stats["replan"] == "braked: reuse=False" and out.stats["brake_m"] > 0.0
+    _check_splice(traj, out, ts)
+    _check_new_plan(out, grid, goal, 1.7, robot)
