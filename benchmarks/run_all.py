@@ -62,6 +62,29 @@ BENCHES: tuple[Bench, ...] = (
         ("--n", "10", "--repeat", "3"),
     ),
     Bench(
+        "search-scale",
+        "A* on fine maps: exact vs coarse-to-fine (issue 35, part 2)",
+        "bench_search_scale.py",
+        "The willow map split k x k, inflated by a 0.25 m radius with the planner's "
+        "clearance cost; long seeded queries; the exact search against "
+        "`astar.find_path_coarse_to_fine` with the planner's block on the same queries: "
+        "medians, worst times, the proven bounds and the cost against the exact search.",
+        (),
+    ),
+    Bench(
+        "scale",
+        "Fine maps: the whole plan at 1x, 2x2 and 3x3 the cells (issue 35)",
+        "bench_scale.py",
+        "The same long queries on a site at its resolution and with every cell split 2 x 2 "
+        "and 3 x 3 (the same metres): the default planner's first plan on the new map, "
+        "warm medians, worst times and stages, the ratios against the site's own "
+        "resolution, the durations' and exact clearances' differences on the same "
+        "queries, the search's proven bounds, and the peak memory of a new process "
+        "planning on the site split to at least 15 M cells.",
+        ("--queries", "8", "--repeat", "2"),
+        (),
+    ),
+    Bench(
         "timing",
         "Timing: jerk-limited timing vs TOPP-RA",
         "bench_timing.py",
