@@ -53,7 +53,8 @@ from trajopt.geometry._clearance import points_clearance
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._car import CarSteps, car_search_grid
+from trajopt.planning._car import CarSteps
+from trajopt.planning._car_tries import car_search_grid
 from trajopt.planning._disc import check_endpoint
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query

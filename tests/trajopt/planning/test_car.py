@@ -333,7 +333,7 @@ def test_replan_of_a_car_on_the_same_map_keeps_its_rest(planned):
 def test_a_curve_turned_round_is_the_same_curve_backwards():
     """The reversed fit's curve: the same points in the opposite order, tangents flipped."""
     from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
-    from trajopt.planning._car import turned_round
+    from trajopt.planning._car_fit import turned_round
     from trajopt.smoother import SmoothPath
 
     pts = np.array([[0.0, 0.0], [1.0, 0.2], [2.0, 1.5], [2.5, 3.0], [4.0, 3.2], [5.0, 2.0]])
@@ -350,7 +350,7 @@ def test_a_curve_turned_round_is_the_same_curve_backwards():
 
 def test_split_points_cut_loops_not_wiggles():
     """Cuts of a stretch that turns much: each piece's headings span at most the limit."""
-    from trajopt.planning._car import PIECE_TURN_RAD, SPLIT_TURN_RAD, split_points
+    from trajopt.planning._car_fit import PIECE_TURN_RAD, SPLIT_TURN_RAD, split_points
 
     straight = np.zeros(50)
     assert split_points(straight, 0, 49) == [0, 49]
@@ -399,7 +399,7 @@ def test_start_facing_a_wall_with_room_only_for_full_lock():
     of radius 1.05 R but not 1.15 R (held-out depot #5): the tight search radius fits with
     the smoother's collocation margin raised (0.9 of 1/R cannot follow that arc); the
     curve still keeps 1/R (three-point check) and the radius (brute force)."""
-    from trajopt.planning import _car
+    from trajopt.planning import _car_tries
 
     res, R, h0 = 0.05, 0.4, -1.9935
     grid = astar.OccupancyGrid(walled(6.0, 3.0, res), res)
@@ -408,7 +408,7 @@ def test_start_facing_a_wall_with_room_only_for_full_lock():
     start, goal = (4.0, 0.15 + 1.075 * drop), (1.0, 0.4)
     traj = trajopt.Planner(grid, robot).plan(start, goal, start_heading=h0, goal_heading=math.pi)
     tries = traj.stats["car"]["tries"]
-    assert tries[-1] == f"radius grid, {_car.TIGHT_FACTOR:g} R: planned", tries
+    assert tries[-1] == f"radius grid, {_car_tries.TIGHT_FACTOR:g} R: planned", tries
     assert "radius grid, 1.15 R: no path (exhausted)" in tries
     ends = traj.sample(np.array([0.0, traj.duration]))
     np.testing.assert_allclose([ends.x, ends.y], np.transpose([start, goal]), atol=1e-9)

@@ -1,0 +1,290 @@
+"""Fitting a car's search path, segment by segment (:mod:`trajopt.planning._car`, step 2).
+
+The search path (:func:`astar.find_pose_path`) is split at its cusps (where the direction
+of travel flips; the heading is continuous there, the tangent flips by ``pi``). Each stretch
+between cusps is fitted as an ordinary curve in the direction of travel
+(:func:`fit_run`, :func:`fit_segment`): a certified polygon corridor grown around its poses
+(:func:`~trajopt.corridor.build_polygon_corridor`), then the planner's smoother with
+``kappa_max = min(its own, 1/R)``, exact end points, exact end travel headings (the body
+heading forwards, heading ``+ pi`` backwards) and the search path's start curvature
+(:func:`start_curvature`); then without that curvature; then from its end to its start with
+the path's curvature at the end, the curve then turned round (:func:`turned_round`; the
+smoother takes a start curvature, not a goal one). Where those fail, it is fitted again in
+polygons grown around the poses themselves without centring (the witness corridor of
+:func:`~trajopt.planning._corridor_fit.witness_corridor`). A stretch that turns by more than
+:data:`SPLIT_TURN_RAD` and that neither the first nor the reversed fit fits is fitted in
+pieces spanning at most :data:`PIECE_TURN_RAD` of heading each (:func:`split_points`; before
+the other whole fits), each starting with the previous piece's end curvature; the car rests
+at each join as at a cusp (:attr:`CarSegment.joined`). Every curve is the smoother's
+certified curve (convex-hull clearance certificate per segment) and its sampled curvature
+(the certificate's dense samples) must be within ``1/R`` (to :data:`KAPPA_TOL`); nothing
+else is returned.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from astar.grid import OccupancyGrid
+from trajopt.corridor import PolygonCorridor, build_polygon_corridor
+from trajopt.errors import InvalidInputError, SmoothingError
+from trajopt.geometry._bspline import BSplineCurve
+from trajopt.planning._corridor_fit import witness_corridor
+from trajopt.planning._options import PlannerOptions
+from trajopt.planning._query import StageTimer
+from trajopt.smoother import SmoothPath
+
+#: Relative tolerance of the curvature check of each fitted segment.
+KAPPA_TOL = 1e-6
+#: A stretch between cusps that turns by more than this (rad, the sum of its heading changes)
+#: and whose first fits fail is fitted in pieces (:func:`split_points`): one B-spline round
+#: a loop of the search's forward-only shots (4.7-6.6 rad on the held-out failures) left the
+#: curvature SCP without a step (its trust region collapsed), where its thirds fitted at
+#: once. Only after whole fits failed (:data:`WHOLE_FIRST`): the car rests at each join,
+#: and long paths turn by tens of radians in small steps.
+SPLIT_TURN_RAD = math.pi
+#: The fits (:func:`fit_segment` ``tries``) of a stretch that may be split, tried before its
+#: pieces: with the search path's start curvature, and from the end with its end curvature.
+#: The others (without a start curvature, the witness corridor) come after the pieces: a
+#: failing whole fit of a long loop costs 0.4-1.9 s, its pieces 0.01-0.03 s each.
+WHOLE_FIRST = (0, 2)
+#: Largest turn (rad) of each piece of a split stretch.
+PIECE_TURN_RAD = 0.6 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class CarSegment:
+    """One segment of a car's plan between cusps.
+
+    Attributes
+    ----------
+    direction : int
+        ``+1`` forwards, ``-1`` backwards.
+    first, last : int
+        Pose indices (into :attr:`~trajopt.planning._car.CarSteps.poses`) of its ends.
+    corridor : PolygonCorridor
+        The certified corridor it was fitted in.
+    smooth_path : SmoothPath
+        The certified curve in the direction of travel (its certificate included).
+    corridor_kind : str
+        ``"polygons"`` (grown around the centred poses), ``"reversed"`` (the same, fitted
+        from the segment's end with its curvature there, then turned round) or ``"witness"``
+        (around the poses themselves, the last try).
+    joined : bool
+        Whether it continues the previous segment in the same direction of travel (a stretch
+        between cusps that turns by more than :data:`SPLIT_TURN_RAD` and that its first
+        whole fits miss is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
+        curve's end curvature where that fit succeeds (``"polygons"``).
+    """
+
+    direction: int
+    first: int
+    last: int
+    corridor: PolygonCorridor
+    smooth_path: SmoothPath
+    corridor_kind: str
+    joined: bool = False
+
+
+def start_curvature(path: Any, first: int, res: float) -> float:
+    """Return the curvature (1/m) the search's path starts pose ``first`` with.
+
+    Signed along the direction of travel: a backwards arc of body curvature ``k`` traces,
+    in its direction of travel, a curve of curvature ``-k``.
+    """
+    xy = np.asarray(path.poses[first, :2])
+    pieces = np.asarray(path.pieces)
+    i = int(np.argmin(np.hypot(*(pieces[:, :2] - xy).T)))
+    k, length = float(pieces[i, 3]), float(pieces[i, 4])
+    return (k if length >= 0.0 else -k) / res
+
+
+def split_points(headings: np.ndarray, first: int, last: int) -> list[int]:
+    """Return the pose indices where a stretch between cusps is cut into pieces.
+
+    ``[first, last]`` (no cut) when the stretch turns (the sum of ``|d heading|``) by at most
+    :data:`SPLIT_TURN_RAD`; else greedy pieces, each as long as its headings span (largest
+    minus smallest unwrapped heading) at most :data:`PIECE_TURN_RAD` and it has at least
+    two poses: a loop is cut every ``PIECE_TURN_RAD`` of turn, a path that wiggles about
+    one direction is not cut.
+
+    Parameters
+    ----------
+    headings : ndarray, shape (m,)
+        Unwrapped headings (rad) of the search path's poses.
+    first, last : int
+        Pose indices of the stretch's ends.
+
+    Returns
+    -------
+    list of int
+        Increasing indices from ``first`` to ``last``.
+    """
+    th = np.asarray(headings[first : last + 1], dtype=float)
+    if float(np.abs(np.diff(th)).sum()) <= SPLIT_TURN_RAD or last - first < 4:
+        return [first, last]
+    cuts = [first]
+    lo = hi = float(th[0])
+    for k in range(1, len(th)):
+        lo, hi = min(lo, th[k]), max(hi, th[k])
+        if hi - lo > PIECE_TURN_RAD and k - 1 - (cuts[-1] - first) >= 2:
+            cuts.append(first + k - 1)
+            lo, hi = min(th[k - 1], th[k]), max(th[k - 1], th[k])
+    if last - cuts[-1] < 2 and len(cuts) > 1:
+        cuts.pop()  # a last piece of one step joins the one before
+    cuts.append(last)
+    return cuts
+
+
+def end_curvature(path: SmoothPath) -> float:
+    """Return a fitted curve's signed curvature (1/m) at its end, along its direction."""
+    return float(np.asarray(path.curvature(np.array([path.domain[1]])), dtype=float)[-1])
+
+
+def fit_run(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Any,
+    poses: np.ndarray,
+    ends: tuple[int, int],
+    direction: int,
+    kappa0: float,
+    timer: StageTimer,
+) -> list[CarSegment]:
+    """Fit a stretch between cusps (module docstring).
+
+    As one segment (:func:`fit_segment`: first its fits with the search path's end
+    curvatures, :data:`WHOLE_FIRST`); when those fail and the stretch turns by more than
+    :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece starting with the
+    previous curve's end curvature (the car rests at each join); then the whole stretch's
+    other fits.
+    """
+    args = (options, grid, smoother, poses)
+    cuts = split_points(np.asarray(poses[:, 2]), *ends)
+    if len(cuts) == 2:
+        return [fit_segment(*args, ends, direction, kappa0, timer)]
+    try:
+        return [fit_segment(*args, ends, direction, kappa0, timer, tries=WHOLE_FIRST)]
+    except SmoothingError as exc:
+        whole = exc
+    out: list[CarSegment] = []
+    k_start = kappa0
+    try:
+        for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+            seg = fit_segment(*args, (a, b), direction, k_start, timer)
+            out.append(dataclasses.replace(seg, joined=bool(out)))
+            k_start = end_curvature(seg.smooth_path)
+        return out
+    except SmoothingError as exc:
+        pieces = exc
+    rest = tuple(i for i in range(4) if i not in WHOLE_FIRST)
+    try:
+        return [fit_segment(*args, ends, direction, kappa0, timer, tries=rest)]
+    except SmoothingError as exc:
+        raise SmoothingError(
+            f"{whole}; in {len(cuts) - 1} pieces: {pieces}; then {exc}", exc.stats
+        ) from exc
+
+
+def fit_segment(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Any,
+    poses: np.ndarray,
+    ends: tuple[int, int],
+    direction: int,
+    kappa0: float,
+    timer: StageTimer,
+    tries: tuple[int, ...] = (0, 1, 2, 3),
+) -> CarSegment:
+    """Fit one segment in the direction of travel (module docstring).
+
+    ``ends``: its first and last pose indices; ``kappa0``: the search path's curvature at
+    its start (1/m, along the direction of travel), the first fit's start curvature (the
+    car may steer while at rest, so the curve may start bending as the search's arc does; a
+    curve made to leave straight along a pose pinned against a wall can need a near-cusp).
+    """
+    first, last = ends
+    radius = options.robot.radius
+    pts = np.ascontiguousarray(poses[first : last + 1, :2])
+    turn = 0.0 if direction > 0 else math.pi
+    h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
+    kmax = 1.0 / options.robot.min_turning_radius
+    errors: list[str] = []
+    corridor = None
+    # the end's curvature along the direction of travel, from the last two poses (on an arc)
+    d_end = float(np.hypot(*(pts[-1] - pts[-2]))) if len(pts) > 1 else 0.0
+    k_end = (float(poses[last, 2] - poses[last - 1, 2]) / d_end) if d_end > 0.0 else 0.0
+    every = (("polygons", kappa0), ("polygons", None), ("reversed", -k_end), ("witness", None))
+    for kind, k_start in (every[i] for i in tries):
+        # "reversed": the segment fitted from its end to its start, starting with the end's
+        # curvature (the smoother takes a start curvature, not a goal one), then turned round
+        p_fit = pts[::-1].copy() if kind == "reversed" else pts
+        hs, hg = (h1 + math.pi, h0 + math.pi) if kind == "reversed" else (h0, h1)
+        try:
+            with timer.stage("corridor"):
+                if kind == "witness":
+                    corridor = witness_corridor(grid, radius, dense_polyline(pts, grid.resolution))
+                elif kind == "reversed":
+                    corridor = build_polygon_corridor(grid, p_fit, radius)
+                elif corridor is None:  # the two polygon fits share one corridor
+                    corridor = build_polygon_corridor(grid, pts, radius)
+            with timer.stage("smooth"):
+                smooth = smoother.fit(
+                    p_fit,
+                    corridor,
+                    raw_grid=grid,
+                    radius=radius,
+                    start=p_fit[0],
+                    goal=p_fit[-1],
+                    start_heading=hs,
+                    goal_heading=hg,
+                    start_curvature=k_start,
+                )
+        except (SmoothingError, InvalidInputError) as exc:
+            errors.append(f"{kind}{'' if k_start is None else ' (start curvature)'}: {exc}")
+            continue
+        cert = smooth.certificate
+        if cert is None or not cert.ok or cert.kappa_max_sampled > kmax * (1.0 + KAPPA_TOL):
+            k = None if cert is None else cert.kappa_max_sampled
+            errors.append(f"{kind}: not certified within 1/R (kappa {k})")
+            continue
+        if kind == "reversed":
+            smooth = turned_round(smooth)
+        return CarSegment(direction, first, last, corridor, smooth, kind)
+    where = "forwards" if direction > 0 else "backwards"
+    raise SmoothingError(
+        f"no certified curve with curvature <= 1/R = {kmax:.6g} 1/m for the {where} segment "
+        f"from ({pts[0, 0]:.6g}, {pts[0, 1]:.6g}) m to ({pts[-1, 0]:.6g}, {pts[-1, 1]:.6g}) "
+        f"m: {'; '.join(errors)}",
+        {"car_segment_failures": errors},
+    )
+
+
+def turned_round(path: SmoothPath) -> SmoothPath:
+    """Return ``path`` traversed from its end to its start (the same certified curve).
+
+    ``C'(u) = C(t_0 + t_N - u)``: the knots mirrored and the control points reversed give
+    the same point set, spans and convex hulls, so the certificate (clearance, curvature
+    magnitude, speed) holds as it is; ``stats["turned_round"]`` marks it.
+    """
+    c = path.curve
+    t = np.asarray(c.t, dtype=float)
+    curve = BSplineCurve((t[0] + t[-1]) - t[::-1], np.asarray(c.c)[::-1], c.k)
+    return dataclasses.replace(path, curve=curve, stats=dict(path.stats, turned_round=True))
+
+
+def dense_polyline(pts: np.ndarray, res: float) -> np.ndarray:
+    """Return the poses' polyline resampled at most an eighth of a cell apart (m)."""
+    d = np.hypot(*np.diff(pts, axis=0).T)
+    out = [pts[:1]]
+    for i, di in enumerate(d):
+        n = max(1, math.ceil(di / (res / 8.0)))
+        f = (np.arange(1, n + 1) / n)[:, None]
+        out.append(pts[i] + f * (pts[i + 1] - pts[i]))
+    return np.vstack(out)

@@ -1,0 +1,296 @@
+"""The tries of a car's plan: search grids, search radii and their fits, within a budget.
+
+:func:`search_and_fit` runs :func:`astar.find_pose_path` (Hybrid-A* with Reeds-Shepp
+shots, or Dubins shots when ``robot.reverse`` is False) from the start pose to the goal pose,
+on the raw map inflated by the robot radius plus :data:`SEARCH_MARGIN_CELLS`
+(:func:`car_search_grid`: every point of a free cell, not only its centre, keeps the radius:
+the search's poses lie anywhere in their cells), with a turning radius
+:data:`SEARCH_RADIUS_FACTORS` times ``R``: the first factor leaves the smoother room (a
+segment turning at exactly ``1/R`` between fixed end poses admits no other curve, and a
+B-spline is no circle); when a segment of its path has no certified fit
+(:mod:`trajopt.planning._car_fit`), the search runs again with gentler arcs (the second
+factor); when the search finds no path, with 1.05 ``R`` and then ``R`` itself (larger
+factors are then skipped), their fits with the smoother's ``kappa_margin`` raised to
+:data:`TIGHT_KAPPA_MARGIN` (a turn at nearly full lock, e.g. a start facing a wall with
+just the room to turn; the certificate's dense curvature check still holds them to
+``1/R``). When an end point is blocked on that grid, or the margin disconnects the poses or
+leaves no path, the same tries run on the map inflated by the radius alone (the other
+planners' grid): end points near walls and passages the margin closes. There only the cell
+centres keep the radius, so that search runs in its exact mode (:func:`astar.find_pose_path`
+``raw_grid``, ``clearance``; :func:`exact_clearance`): the chords between its poses keep the
+radius from the raw map exactly, as the corridor requires (a pose anywhere in a free cell
+could come up to half a cell's diagonal closer). The tries share :data:`CAR_BUDGET_S`;
+``stats["car"]["tries"]`` lists them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import astar
+from astar.grid import OccupancyGrid
+from trajopt.errors import InvalidInputError, NoPathError, SmoothingError
+from trajopt.planning._car_fit import CarSegment, fit_run, start_curvature
+from trajopt.planning._options import PlannerOptions
+from trajopt.planning._query import StageTimer
+from trajopt.robot._robot import Robot
+
+#: Extra inflation (cells) of the search grid beyond the robot radius: half a cell's
+#: diagonal (any point of a free cell keeps the radius) plus slack for the chords between
+#: the search's poses (at most half a cell apart).
+SEARCH_MARGIN_CELLS = 0.5 * math.sqrt(2.0) + 0.05
+#: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
+#: (module docstring: a factor above one that failed to search is skipped afterwards).
+SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
+#: Search radius factors at or below this fit with :data:`TIGHT_KAPPA_MARGIN`.
+TIGHT_FACTOR = 1.05
+#: The smoother's ``kappa_margin`` (bound at its collocation samples, as a fraction of
+#: ``1/R``) for the fits of a path searched at :data:`TIGHT_FACTOR` ``R`` or less: with the
+#: default 0.9 a curve cannot follow an arc of 1.02-1.05 ``R`` (held-out depot #5, forward
+#: only, a start facing a wall), with 0.99 it does.
+TIGHT_KAPPA_MARGIN = 0.99
+#: Time (s) after which no further try (search and fits) of a car's plan starts.
+CAR_BUDGET_S = 6.0
+#: Cap (s) on the Hybrid-A* search's time budget per try.
+SEARCH_BUDGET_S = 2.0
+#: Slack (m) of the search's exact clearance on the radius grid: a quarter of the corridor's
+#: tolerance (``trajopt.corridor`` accepts points ``1e-9`` m closer than the radius), so that
+#: an end point exactly at the radius from a wall (a cell centre) may leave it.
+EXACT_TOL_M = 0.25e-9
+
+
+@dataclass(frozen=True, slots=True)
+class CarFound:
+    """The try of a car's plan that completed (:func:`search_and_fit`).
+
+    Attributes
+    ----------
+    search_grid : astar.OccupancyGrid
+        The grid it searched (:func:`car_search_grid`).
+    path : astar.PosePath
+        The Hybrid-A* path (cells).
+    radius_cells : float
+        The turning radius it was searched with (cells).
+    poses : ndarray, shape (n, 3)
+        Its poses in world units ``(x, y, heading)`` (m, m, rad).
+    segments : list of CarSegment
+        The certified fits, in order.
+    tries : list of str
+        Every try made, this one last.
+    """
+
+    search_grid: OccupancyGrid
+    path: Any
+    radius_cells: float
+    poses: np.ndarray
+    segments: list[CarSegment]
+    tries: list[str]
+
+
+def search_and_fit(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    cells: tuple[tuple[float, float, float], tuple[float, float, float]],
+    points: tuple[np.ndarray, np.ndarray],
+    smoother: Any,
+    timer: StageTimer,
+) -> CarFound:
+    """Run the tries of a car's plan until one searches and fits (module docstring).
+
+    Parameters
+    ----------
+    options : PlannerOptions
+        Resolved for ``grid``; ``options.robot.drive == "ackermann"``.
+    grid : astar.OccupancyGrid
+        The raw map.
+    cells : tuple
+        The start and goal poses in cells ``(x, y, heading)`` (cells, cells, rad).
+    points : tuple of ndarray
+        The start and goal points (m), for the messages.
+    smoother : Smoother
+        The smoother of the fits (its ``kappa_max`` at most ``1/R``); its ``kappa_margin``
+        is raised to :data:`TIGHT_KAPPA_MARGIN` for the tight search radii.
+    timer : StageTimer
+        Receives the ``inflate``, ``search``, ``corridor`` and ``smooth`` stages.
+
+    Returns
+    -------
+    CarFound
+        The try that completed.
+
+    Raises
+    ------
+    InvalidInputError
+        An end point blocked on every search grid tried.
+    NoPathError
+        No path joins the poses (an :class:`astar.NoPosePathError` as its cause; with
+        ``reverse=False`` the message says that a forward-only path was asked for).
+    SmoothingError
+        A path was found and a segment of it has no certified curve within ``1/R``.
+    """
+    robot = options.robot
+    res = grid.resolution
+    start, goal = cells
+    p0, p1 = points
+    sm = smoother
+    sm_tight = dataclasses.replace(sm, kappa_margin=max(sm.kappa_margin, TIGHT_KAPPA_MARGIN))
+    t_end = time.perf_counter() + CAR_BUDGET_S
+    tries: list[str] = []
+    failures: list[Exception] = []
+    for margin in (True, False):
+        with timer.stage("inflate"):
+            search_grid = car_search_grid(robot, grid, margin=margin)
+        blocked = blocked_end(
+            robot, search_grid, margin, (("start", start, p0), ("goal", goal, p1))
+        )
+        if blocked is not None:
+            tries.append(f"{grid_name(margin)}: {blocked}")
+            failures.append(InvalidInputError(blocked))
+            continue
+        largest = math.inf
+        for factor in SEARCH_RADIUS_FACTORS:
+            if factor > largest or time.perf_counter() > t_end:
+                continue
+            r_cells = factor * robot.min_turning_radius / res
+            try:
+                with timer.stage("search"):
+                    path = astar.find_pose_path(
+                        search_grid,
+                        start,
+                        goal,
+                        turning_radius=r_cells,
+                        reverse=robot.reverse,
+                        time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
+                        **exact_clearance(robot, grid, margin),
+                    )
+            except astar.NoPosePathError as exc:
+                tries.append(f"{grid_name(margin)}, {factor:g} R: no path ({exc.reason})")
+                failures.append(exc)
+                if exc.reason == "disconnected":
+                    break
+                largest = min(largest, factor)
+                continue
+            poses = path.to_world(grid)
+            try:
+                segments = []
+                for a, b in np.asarray(path.segments):
+                    segments.extend(
+                        fit_run(
+                            options,
+                            grid,
+                            sm if factor > TIGHT_FACTOR else sm_tight,
+                            poses,
+                            (int(a), int(b)),
+                            int(path.directions[b]),
+                            start_curvature(path, int(a), res),
+                            timer,
+                        )
+                    )
+            except SmoothingError as exc:
+                tries.append(f"{grid_name(margin)}, {factor:g} R: a segment has no fit")
+                failures.append(exc)
+                continue
+            tries.append(f"{grid_name(margin)}, {factor:g} R: planned")
+            return CarFound(search_grid, path, r_cells, poses, segments, tries)
+    raise failure(robot, grid, start, goal, tries, failures)
+
+
+def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> OccupancyGrid:
+    """Return the grid a car's search runs on: ``grid`` inflated by the radius plus a margin.
+
+    Parameters
+    ----------
+    robot : Robot
+        The car (its ``radius``, m).
+    grid : astar.OccupancyGrid
+        The raw map.
+    margin : bool, optional
+        False: the radius alone (the second grid the search tries; module docstring).
+
+    Returns
+    -------
+    astar.OccupancyGrid
+        ``grid`` with every cell within ``robot.radius`` plus :data:`SEARCH_MARGIN_CELLS`
+        cells (without ``margin``: within ``robot.radius``) of an occupied square (or of the
+        outside) occupied.
+    """
+    r = robot.radius + (SEARCH_MARGIN_CELLS * grid.resolution if margin else 0.0)
+    return grid.with_occupied(
+        astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
+    )
+
+
+def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str, Any]:
+    """Return the search's exact-mode arguments on the radius grid (none on the margin grid).
+
+    On the grid inflated by the radius alone only the cell centres keep the radius; the
+    search's exact mode (:func:`astar.find_pose_path` ``clearance``) makes the polyline of
+    its poses keep it too, as the corridor requires, to within :data:`EXACT_TOL_M`.
+    """
+    if margin:
+        return {}
+    r_cells = robot.radius / grid.resolution - EXACT_TOL_M / grid.resolution
+    return {"raw_grid": grid, "clearance": r_cells}
+
+
+def grid_name(margin: bool) -> str:
+    """Return the name of a search grid in the tries' messages (with or without margin)."""
+    return "radius + margin grid" if margin else "radius grid"
+
+
+def blocked_end(robot: Robot, search_grid: OccupancyGrid, margin: bool, ends: Any) -> str | None:
+    """Return why an end point's cell is blocked on ``search_grid``, or None."""
+    for name, c, p in ends:
+        ix, iy = int(math.floor(c[0] + 0.5)), int(math.floor(c[1] + 0.5))
+        if search_grid.occupied[iy, ix]:
+            extra = f" plus {SEARCH_MARGIN_CELLS:.3g} cells" if margin else ""
+            return (
+                f"{name} {p.tolist()} m lies in cell ({ix}, {iy}), blocked on the car's search "
+                f"grid (robot radius {robot.radius} m{extra}); move it towards free space"
+            )
+    return None
+
+
+def failure(
+    robot: Robot,
+    grid: OccupancyGrid,
+    start: Any,
+    goal: Any,
+    tries: list[str],
+    failures: list[Exception],
+) -> Exception:
+    """Return the error of a car's plan that no try completed (module docstring)."""
+    fits = [f for f in failures if isinstance(f, SmoothingError)]
+    searches = [f for f in failures if isinstance(f, astar.NoPosePathError)]
+    summary = "; ".join(tries)
+    if fits:  # a path was found, and no curve fits it
+        return SmoothingError(f"{fits[-1]} (tries: {summary})", {"car_tries": tries})
+    if searches:
+        last = searches[-1]
+        mode = (
+            "forwards and backwards"
+            if robot.reverse
+            else "forwards only (reverse=False): no forward-only path was found; a goal only "
+            "reachable backwards needs reverse=True"
+        )
+        err = NoPathError(
+            f"no path of a car-like robot (turning radius {robot.min_turning_radius} m, radius "
+            f"{robot.radius} m) driving {mode}, from pose {pose_m(start, grid)} to pose "
+            f"{pose_m(goal, grid)} ({last.reason}): {last} (tries: {summary})"
+        )
+        err.__cause__ = last
+        return err
+    return failures[-1]
+
+
+def pose_m(c: Any, grid: OccupancyGrid) -> str:
+    """Return a cell pose ``(x, y, heading)`` (cells, rad) written in world units (m, rad)."""
+    x = grid.origin[0] + (c[0] + 0.5) * grid.resolution
+    y = grid.origin[1] + (c[1] + 0.5) * grid.resolution
+    return f"({x:.6g} m, {y:.6g} m, {c[2]:.6g} rad)"
