@@ -48,6 +48,7 @@ from trajopt.smoother._problem import (
     QPData,
     assemble,
     build_problem,
+    graded_knots,
     objective,
     project_heading,
 )
@@ -143,10 +144,21 @@ def fit(
     warm = None  # control points (cells) of a retry on the same knots
     fp = None if footprint is None else FootprintRounds(footprint, raw_grid, res, hs, hg)
     spans_tried = 0
+    cold: list[tuple[np.ndarray, np.ndarray]] = []  # knots of the cold attempts on ``prob``
     while spans_tried < int(options.max_attempts):
         remaining = options.time_budget_s - (time.perf_counter() - t_call)
         if remaining <= 0:
             break
+        if warm is None:
+            knots = graded_knots(prob.u[-1], prob.trans, prob.overlap, options.degree, h)
+            if any(_same_knots(knots, k) for k in cold):
+                # a refinement that leaves the knots as they were (a short stretch: each box
+                # keeps its ``degree`` spans at any span length) would repeat a failed
+                # attempt exactly (the solvers are deterministic): the next span length
+                h = max(0.5, h / 2)
+                spans_tried += 1
+                continue
+            cold.append(knots)
         rec = AttemptRecord(
             attempt=len(attempts) + 1, span_cells=h, kappa_margin=None if warm is None else margin
         )
@@ -182,6 +194,7 @@ def fit(
                         unit_m=res,
                     )
                     margin, warm = options.kappa_margin, None
+                    cold.clear()  # a new problem: its attempts are new
                     continue
                 except InvalidInputError as exc:  # the pinned heading leaves its region
                     logger.debug("footprint: end heading not pinned (%s)", exc)
@@ -257,6 +270,11 @@ def fit(
         f"(time_budget_s={options.time_budget_s}): {last}",
         stats,
     )
+
+
+def _same_knots(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Whether two ``(knots, span_box)`` pairs of :func:`graded_knots` are identical."""
+    return all(x.shape == y.shape and bool(np.array_equal(x, y)) for x, y in zip(a, b, strict=True))
 
 
 def _polished(

@@ -74,7 +74,9 @@ class Smoother:
         Wall-time budget per :meth:`fit` call (s); exceeded -> ``SmoothingError``.
         Default 5 (the first call of a new size also builds its solvers).
     max_attempts : int, optional
-        Knot refinements (span length halved each time) before giving up. Default 3. When
+        Knot refinements (span length halved each time) before giving up. Default 3. A
+        refinement that leaves the knots as they were (a short curve: each box keeps at
+        least ``degree`` spans) is skipped: it would repeat the failed attempt. When
         the certificate finds only the curvature bound broken (between the samples) and
         by at most 10 %, the same knots are first solved once more, warm started, with
         the sampled bound tightened by the excess found.
