@@ -21,6 +21,14 @@ from astar.errors import InvalidInputError
 __all__ = ["OccupancyGrid", "check_grid"]
 
 
+def _factor(k: object) -> int:
+    """Return ``k`` checked as the integer ``>= 1`` of :meth:`OccupancyGrid.split` / ``coarsen``."""
+    k = validation.nonnegative_int("k", k)
+    if k < 1:
+        raise InvalidInputError(f"k must be an integer >= 1, got {k}")
+    return k
+
+
 @dataclass(frozen=True, slots=True)
 class OccupancyGrid:
     """A 2-D occupancy grid: which cells are blocked, their size and where they are.
@@ -120,9 +128,7 @@ class OccupancyGrid:
         InvalidInputError
             ``k`` not an integer ``>= 1``.
         """
-        k = validation.nonnegative_int("k", k)
-        if k < 1:
-            raise InvalidInputError(f"k must be an integer >= 1, got {k}")
+        k = _factor(k)
         if k == 1:
             return self
         occ = np.repeat(np.repeat(self.occupied, k, axis=0), k, axis=1)
@@ -143,9 +149,7 @@ class OccupancyGrid:
         InvalidInputError
             ``k`` not an integer ``>= 1``.
         """
-        k = validation.nonnegative_int("k", k)
-        if k < 1:
-            raise InvalidInputError(f"k must be an integer >= 1, got {k}")
+        k = _factor(k)
         if k == 1:
             return self
         ny, nx = self.shape

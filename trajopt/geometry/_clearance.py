@@ -392,20 +392,34 @@ def occupied_blocks(occ: np.ndarray, bs: int = CLEARANCE_BLOCK) -> np.ndarray:
     Cached per array when ``occ`` is read-only (an :class:`astar.OccupancyGrid`'s is), so
     that it cannot change under the cache.
     """
-    hit = _BLOCKS.get(id(occ))
+
+    def build() -> np.ndarray:
+        ny, nx = occ.shape
+        by, bx = -(-ny // bs), -(-nx // bs)
+        pad = np.zeros((by * bs, bx * bs), dtype=bool)
+        pad[:ny, :nx] = occ
+        return np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
+
+    return per_map(_BLOCKS, occ, build)
+
+
+def per_map(cache: dict, occ: np.ndarray, build: Any) -> Any:
+    """Return ``build()`` for the occupancy array ``occ``, kept in ``cache`` by its identity.
+
+    Kept only for a read-only ``occ`` (an :class:`astar.OccupancyGrid`'s is), so that it
+    cannot change under the cache; the last 4 arrays are kept, each held by the cache so
+    that its identity is not reused.
+    """
+    hit = cache.get(id(occ))
     if hit is not None and hit[0] is occ:
         return hit[1]
-    ny, nx = occ.shape
-    by, bx = -(-ny // bs), -(-nx // bs)
-    pad = np.zeros((by * bs, bx * bs), dtype=bool)
-    pad[:ny, :nx] = occ
-    blk = np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
+    value = build()
     if occ.flags.writeable:
-        return blk
-    if len(_BLOCKS) >= 4:
-        _BLOCKS.pop(next(iter(_BLOCKS)))
-    _BLOCKS[id(occ)] = (occ, blk)  # holding occ keeps its id from being reused
-    return blk
+        return value
+    if len(cache) >= 4:
+        cache.pop(next(iter(cache)))
+    cache[id(occ)] = (occ, value)
+    return value
 
 
 @njit(cache=True)

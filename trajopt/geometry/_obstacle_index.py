@@ -20,6 +20,7 @@ from numba import njit
 from trajopt._kernel_cache import watch_compiles
 from trajopt.geometry._clearance import (
     border_distance,
+    per_map,
     polygon_rect_closest,
     segment_rect_distance,
     window_rects,
@@ -210,16 +211,7 @@ def map_rects(occ: np.ndarray) -> np.ndarray:
     read-only array (the arrays of :class:`astar.OccupancyGrid` are), so it cannot change
     under the cache.
     """
-    hit = _MAP_RECTS.get(id(occ))
-    if hit is not None and hit[0] is occ:
-        return hit[1]
-    rects = window_rects(occ, 0, occ.shape[1], 0, occ.shape[0])
-    if occ.flags.writeable:
-        return rects
-    if len(_MAP_RECTS) >= 4:
-        _MAP_RECTS.pop(next(iter(_MAP_RECTS)))
-    _MAP_RECTS[id(occ)] = (occ, rects)  # holding occ keeps its id from being reused
-    return rects
+    return per_map(_MAP_RECTS, occ, lambda: window_rects(occ, 0, occ.shape[1], 0, occ.shape[0]))
 
 
 class ObstacleIndex:
