@@ -37,7 +37,7 @@ import numpy as np
 from trajopt.smoother._basis import CURV_SAMPLES, band_quadratic, curvature_samples
 from trajopt.smoother._layout import constraint_layout
 from trajopt.smoother._problem import QPData
-from trajopt.smoother._qp import piqp_info, solve_working_set
+from trajopt.smoother._qp import WorkingSetSolver, piqp_info
 from trajopt.smoother._status import SolveInfo, SolveStatus
 
 if TYPE_CHECKING:
@@ -151,6 +151,7 @@ class CurvatureSCP:
         if n < self.set.ws_min_points:  # small: every sample (a cheap QP; fewer iterations)
             self.work[: self.ns_real] = True
         self.kernel = np.ones(2 * ms + 1, dtype=bool)
+        self.solve_working_set = WorkingSetSolver()
 
     # ------------------------------------------------------------------ pieces
     def objective(self, z: np.ndarray) -> float:
@@ -220,7 +221,7 @@ class CurvatureSCP:
         ubx_s = np.concatenate([ubx, np.full(S, self.set.slack_max)])
         ts = time.perf_counter()
         tc = time.process_time()
-        z, *result = solve_working_set(
+        z, *result = self.solve_working_set(
             qp.full,
             qp.g,
             self.layout,
