@@ -227,6 +227,8 @@ class TrajectoryChain(SampledExport):
         i = min(max(i, 0), len(self.pieces) - 1)
         while i < len(self.pieces) - 1 and tt >= self._t[i + 1]:
             i += 1
+        if tt >= self.duration:  # the end exactly (no rounding)
+            return i, float(self.pieces[i].duration)
         return i, tt - float(self._t[i]) + self.starts[i]
 
     def after(self, t: float) -> TrajectoryChain:
@@ -245,7 +247,9 @@ class TrajectoryChain(SampledExport):
         for i in np.unique(k):
             m = k == i
             p, t0 = self.pieces[i], self.starts[i]
-            smp = p.sample(np.concatenate([flat[m] - self._t[i] + t0, [t0]]))
+            local = flat[m] - self._t[i] + t0
+            local[flat[m] >= self._t[i + 1]] = p.duration  # its end exactly (no rounding)
+            smp = p.sample(np.concatenate([local, [t0]]))
             for n in _CARRIED:
                 if getattr(smp, n, None) is not None:
                     out.setdefault(n, np.zeros(flat.shape))[m] = getattr(smp, n)[:-1]
