@@ -14,7 +14,8 @@ problem to a cloud service) holds the first group; the cap is held by the design
 
 Method
 ------
-1. **Cap table.** One value per interval of a uniform arc-length grid (spacing <= 2.5 mm):
+1. **Cap table.** One value per interval of a uniform arc-length grid (spacing 2.5 mm;
+   at most 16 384 intervals, so longer on curves over 41 m):
    a lower bound of the cap over the interval, times ``1 - 1e-4``; speeds up to
    ``max(v_start, v_end)`` may use the cap without that factor so that boundary speeds
    equal to the cap are allowed. For a curve with a ``polynomial_degree`` (every curve of

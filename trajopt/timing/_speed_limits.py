@@ -19,7 +19,7 @@ limit through two coefficients of the costmap filter info (``base``, ``multiplie
 its centre: each interval of its arc-length cap table takes the lowest limit over every
 mask cell the curve can touch in that interval, so the trajectory holds the limit wherever
 the centre is inside a zone (it slows down just before the boundary, by at most the table
-spacing of 2.5 mm). The mask is looked up in world coordinates with its own resolution and
+spacing, 2.5 mm up to 41 m of curve). The mask is looked up in world coordinates with its own resolution and
 origin (as Nav2 does), so it may cover the map only partly or use another cell size;
 outside the mask there is no limit.
 """

@@ -8,7 +8,7 @@ so ``|d delta / dt| <= steer_rate_max`` is a speed cap,
 curvature caps. Choice: the cap of an interval of the table is the lowest of the exact
 pointwise cap at the interval's two nodes and :data:`INNER` points evenly spaced in the
 curve parameter between them, less :data:`MARGIN`: a sampled bound on a grid of spacing
-<= 2.5 mm (the cubic B-spline's ``d kappa / ds`` is smooth within its pieces and the grid is
+2.5 mm, longer on curves over 41 m (the cubic B-spline's ``d kappa / ds`` is smooth within its pieces and the grid is
 far finer than a piece), not the rigorous Bernstein bound of the curvature caps. The steering
 rate is a tracking limit, not a clearance guarantee.
 """
