@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
@@ -34,6 +35,7 @@ __all__ = ["NoPosePathError", "PosePath", "find_pose_path"]
 logger = logging.getLogger(__name__)
 
 _COLLISION_STEP = 0.2  # cells: arc-length spacing of the collision samples
+_FOOTPRINT_SLACK = 0.05  # cells: how far the body moves between a pose and its tested sample
 _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyond the start
 _RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
@@ -92,7 +94,8 @@ class PosePath:
         ``expanded`` (nodes expanded), ``nodes`` (created), ``shots`` (analytic expansions
         tried), ``heuristic_s``, ``search_s``, ``total_s`` (seconds), ``primitive_length``
         (cells) and ``heading_bins`` of the search that found the path, ``retried`` (whether
-        the finer second search ran).
+        the finer second search ran); in the footprint mode of :func:`find_pose_path` also
+        ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells).
 
     Attributes
     ----------
@@ -243,11 +246,25 @@ def _exact_mode(
     dummy = np.zeros((1, 1), dtype=np.uint8)
     if clearance is None:
         if raw_grid is not None:
-            raise InvalidInputError("raw_grid is used only with clearance: pass both or neither")
+            raise InvalidInputError(
+                "raw_grid is used only with clearance or footprint: pass it with one of them "
+                "or not at all"
+            )
         return dummy, dummy, 0.0
     r = validation.positive_float("clearance", clearance)
     if raw_grid is None:
         raise InvalidInputError(f"clearance={r!r} needs raw_grid (the raw map) to measure it on")
+    occ = _raw_occ(raw_grid, free)
+    from astar.inflation import inflate
+
+    margin = r + math.sqrt(0.5) + 1e-9
+    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
+    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
+    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
+
+
+def _raw_occ(raw_grid: object, free: np.ndarray) -> np.ndarray:
+    """Return the bool occupied mask (ny, nx) of ``raw_grid``, checked against ``free``."""
     if isinstance(raw_grid, OccupancyGrid):
         occ = np.asarray(raw_grid.occupied, dtype=bool)
     else:
@@ -263,12 +280,72 @@ def _exact_mode(
         raise InvalidInputError(
             f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
         )
-    from astar.inflation import inflate
+    return occ
 
-    margin = r + math.sqrt(0.5) + 1e-9
-    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
-    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
-    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
+
+@dataclass(frozen=True, slots=True)
+class _Footprint:
+    """The footprint mode's kernel inputs (:func:`_footprint_mode`)."""
+
+    fp: np.ndarray  # float64 (k, 4): vertices and unit outward normals, counter-clockwise
+    safe: np.ndarray  # uint8 (ny, nx): 1 where no footprint test is needed
+    occ: np.ndarray  # uint8 (ny, nx): the raw map's occupied cells
+    rho: float  # circumscribed radius (cells)
+    margin: float  # cells
+    slack: float  # cells
+
+
+def _footprint_mode(
+    footprint: object,
+    footprint_margin: object,
+    raw_grid: object,
+    clearance: object,
+    free: np.ndarray,
+    poses: tuple[tuple[str, tuple[float, float, float]], ...],
+) -> _Footprint | None:
+    """Validate the footprint mode's inputs and build its arrays; None when it is off."""
+    margin = _number("footprint_margin", footprint_margin, 0.0, ">= 0 (cells)")
+    if footprint is None:
+        if margin != 0.0:
+            raise InvalidInputError(
+                f"footprint_margin={margin!r} is used only with footprint: pass a footprint "
+                "or leave footprint_margin at 0"
+            )
+        return None
+    from astar.hybrid_footprint import footprint_polygon, footprint_radii, footprint_safe
+    from astar.hybrid_kernel import footprint_hit
+
+    fp = footprint_polygon(footprint)
+    if clearance is not None:
+        raise InvalidInputError(
+            f"footprint and clearance={clearance!r} exclude each other: the footprint mode "
+            "checks the polygon itself (grow it with footprint_margin)"
+        )
+    if raw_grid is None:
+        raise InvalidInputError(
+            f"footprint={np.asarray(footprint, dtype=np.float64).tolist()} needs raw_grid "
+            "(the raw map) to be checked against"
+        )
+    occ = np.ascontiguousarray(_raw_occ(raw_grid, free), dtype=np.uint8)
+    _, rho = footprint_radii(fp)
+    slack = _FOOTPRINT_SLACK
+    safe = footprint_safe(occ, rho + margin + slack)
+    buf = np.empty((fp.shape[0], 5))
+    for name, (x, y, th) in poses:
+        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + slack, buf))
+        if hit != -1:
+            where = (
+                "leaves the grid"
+                if hit == -2
+                else f"meets the occupied cell ({hit % occ.shape[1]}, {hit // occ.shape[1]}) "
+                "of raw_grid"
+            )
+            raise InvalidInputError(
+                f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
+                f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
+                "clear of every occupied square and inside the grid"
+            )
+    return _Footprint(fp, safe, occ, rho, margin, slack)
 
 
 # --------------------------------------------------------------------------- public API
@@ -293,6 +370,8 @@ def find_pose_path(
     heuristic_weight: float = 1.5,
     raw_grid: OccupancyGrid | np.ndarray | None = None,
     clearance: float | None = None,
+    footprint: ArrayLike | None = None,
+    footprint_margin: float = 0.0,
 ) -> PosePath:
     """Path of a car-like robot from a start pose to a goal pose by Hybrid-A*.
 
@@ -358,6 +437,32 @@ def find_pose_path(
         ``clearance=r`` lets the poses lie anywhere in their cells without coming closer
         than ``r``, where a grid inflated by ``r`` plus half a cell's diagonal would block
         the cells next to a wall.
+    footprint : array_like of float, shape (k, 2), optional
+        Footprint mode (with ``raw_grid``; excludes ``clearance``): the robot's body as a
+        convex polygon, vertices in cells in the robot frame (``x`` forwards along the
+        heading, ``y`` to the left), counter-clockwise or clockwise, ``k >= 3``, the origin
+        (the pose's point) strictly inside. The body faces the pose's heading whatever the
+        direction of travel. Every pose of the continuous path (every primitive and the
+        final shot at every arc length, not only at samples) has its footprint, rotated by
+        the heading and moved to the pose, at a distance greater than ``footprint_margin``
+        from every occupied square of ``raw_grid`` (closed squares ``[ix - 0.5, ix + 0.5] x
+        [iy - 0.5, iy + 0.5]``) and within the grid (``[-0.5, nx - 0.5] x [-0.5, ny - 0.5]``,
+        at least ``footprint_margin`` from its sides). Each arc of curvature ``kappa`` is
+        cut into equal steps of at most ``ds = 0.1 / (1 + rho |kappa|)`` cells (``rho``: the
+        farthest vertex from the origin), so that between a step's middle and any pose of
+        the step every point of the body moves at most 0.05 cells; the footprint grown by
+        ``footprint_margin + 0.05`` is tested exactly (separating axes, then the
+        polygon-to-square distance) at each step's middle. ``grid`` stays a necessary
+        condition on the centre: pass the raw map inflated by the footprint's inscribed
+        radius about the origin (a larger inflation loses paths, a smaller one only costs
+        time). Cells whose every point keeps ``rho + footprint_margin + 0.05`` from the
+        obstacles skip the polygon test. The returned poses are sampled as without
+        footprint (``sample_step``); the guarantee holds for every pose of the exact
+        ``pieces``, hence for the returned poses. The start and goal poses must pass the
+        sample test themselves (else ``InvalidInputError``).
+    footprint_margin : float, optional
+        With ``footprint``: the distance (cells, finite, ``>= 0``; default 0) the footprint
+        keeps from the obstacles and the grid's outside.
 
     Returns
     -------
@@ -369,7 +474,10 @@ def find_pose_path(
     ------
     InvalidInputError
         A parameter breaks its rule (the message names it, its value and the rule); a pose is
-        not three finite numbers, lies outside the grid or on a blocked cell.
+        not three finite numbers, lies outside the grid or on a blocked cell, or (footprint
+        mode) its grown footprint meets an obstacle or leaves the grid; ``footprint``
+        without ``raw_grid`` or with ``clearance``; ``footprint_margin`` without
+        ``footprint``.
     NoPosePathError
         (a :class:`~astar.NoPathError`) No path: ``reason`` says why: ``"disconnected"``
         (refused before searching), ``"exhausted"`` (with ``reverse=False``: no forwards-only
@@ -430,7 +538,20 @@ def find_pose_path(
     max_exp = _int("max_expansions", max_expansions, 1)
     budget = validation.positive_float("time_budget", time_budget)
     hw = _number("heuristic_weight", heuristic_weight, 1.0, ">= 1")
-    safe, occ, exact_r = _exact_mode(raw_grid, clearance, free)
+    foot = _footprint_mode(
+        footprint,
+        footprint_margin,
+        raw_grid,
+        clearance,
+        free,
+        (("start", (sx, sy, sth)), ("goal", (gx, gy, gth))),
+    )
+    if foot is None:
+        safe, occ, exact_r = _exact_mode(raw_grid, clearance, free)
+        fp, fsafe, frho, fmargin, fslack = np.zeros((0, 4)), safe, 0.0, 0.0, 0.0
+    else:
+        safe, occ, exact_r = np.zeros((1, 1), dtype=np.uint8), foot.occ, 0.0
+        fp, fsafe, frho, fmargin, fslack = foot.fp, foot.safe, foot.rho, foot.margin, foot.slack
 
     from astar.hybrid_kernel import EXHAUSTED, FOUND, TIME_BUDGET, distance_field, hybrid_kernel
 
@@ -448,6 +569,8 @@ def find_pose_path(
         "primitive_length": prim_len,
         "heading_bins": nbins,
     }
+    if foot is not None:
+        stats.update(footprint=True, footprint_margin=foot.margin, footprint_slack=foot.slack)
     if not reached:
         stats["total_s"] = time.perf_counter() - t0
         raise NoPosePathError(
@@ -490,6 +613,11 @@ def find_pose_path(
             safe,
             occ,
             exact_r,
+            fp,
+            fsafe,
+            frho,
+            fmargin,
+            fslack,
         )
 
     out = search(prim_len, nbins, max_exp, t1 + budget)

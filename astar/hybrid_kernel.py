@@ -16,6 +16,9 @@ keeps the cheapest pose that reached it, and a closed state is never reopened.
   ``<= step`` (sub-cell) and every cell that the chords between consecutive samples cross is
   tested (a supercover traversal: a chord through a cell corner tests both side cells); on an
   arc, the chord moved by the sagitta towards the bulge too (:func:`arc_clear`).
+  In the footprint mode (``fp`` not empty) every pose of the arc also keeps the robot's
+  convex footprint, rotated by the heading, ``fmargin`` cells from the raw map's occupied
+  squares and inside the grid (:func:`footprint_arc_clear`).
 * **Analytic expansion**: every few expansions (every ``max(1, floor(h / analytic_ratio))``,
   so every expansion near the goal) the Reeds-Shepp (Dubins without ``reverse``) word from the
   expanded pose to the goal pose that is cheapest *under the search's costs* (backwards
@@ -45,7 +48,14 @@ from numba import njit
 from astar.reeds_shepp import advance, car_word
 from astar.search_kernels import heap_pop, heap_push
 
-__all__ = ["distance_field", "hybrid_kernel", "word_clear"]
+__all__ = [
+    "distance_field",
+    "footprint_arc_clear",
+    "footprint_hit",
+    "footprint_word_clear",
+    "hybrid_kernel",
+    "word_clear",
+]
 
 FOUND = 1
 EXHAUSTED = 0
@@ -382,6 +392,159 @@ def word_clear(
     return True
 
 
+# --------------------------------------------------------------------------- footprint mode
+@njit(cache=True)
+def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - compiled
+    """Test the footprint at pose ``(x, y, th)``, grown by ``grow`` cells, against the raw map.
+
+    Parameters
+    ----------
+    occ : ndarray of uint8, shape (ny, nx)
+        1 on occupied cells (closed squares of side 1).
+    fsafe : ndarray of uint8, shape (ny, nx)
+        :func:`astar.hybrid_footprint.footprint_safe` for a reach of at least ``rho + grow``
+        (or zeros): a pose whose centre lies in a safe cell is clear without further test.
+    fp : ndarray of float64, shape (k, 4)
+        :func:`astar.hybrid_footprint.footprint_polygon`: counter-clockwise vertices and
+        unit outward normals, cells.
+    x, y, th : float
+        The pose: cells, radians.
+    grow : float
+        ``>= 0`` cells: the footprint's Minkowski sum with the disc of this radius is tested.
+    buf : ndarray of float64, shape (k, 5)
+        Scratch space.
+
+    Returns
+    -------
+    int
+        -1: the grown footprint is disjoint from every occupied square and inside the
+        grid; -2: it leaves the grid; otherwise ``iy * nx + ix`` of
+        an occupied square within ``grow`` of the footprint (or meeting it). Exact: a
+        square is hit iff its distance to the polygon is ``<= grow`` (0 when they meet).
+    """
+    ny, nx = occ.shape
+    cx = int(math.floor(x + 0.5))
+    cy = int(math.floor(y + 0.5))
+    if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] != 0:
+        return -1
+    c = math.cos(th)
+    s = math.sin(th)
+    k = fp.shape[0]
+    minx = np.inf
+    maxx = -np.inf
+    miny = np.inf
+    maxy = -np.inf
+    for i in range(k):
+        wx = x + c * fp[i, 0] - s * fp[i, 1]
+        wy = y + s * fp[i, 0] + c * fp[i, 1]
+        nwx = c * fp[i, 2] - s * fp[i, 3]
+        nwy = s * fp[i, 2] + c * fp[i, 3]
+        buf[i, 0] = wx
+        buf[i, 1] = wy
+        buf[i, 2] = nwx
+        buf[i, 3] = nwy
+        buf[i, 4] = nwx * wx + nwy * wy  # the polygon's support along its own edge normal
+        minx = min(minx, wx)
+        maxx = max(maxx, wx)
+        miny = min(miny, wy)
+        maxy = max(maxy, wy)
+    # the outside of the grid: the grown convex polygon is inside the rectangle iff every
+    # vertex keeps grow from its sides
+    if minx - grow < -0.5 or maxx + grow > nx - 0.5 or miny - grow < -0.5 or maxy + grow > ny - 0.5:
+        return -2
+    g2 = grow * grow
+    lo_x = max(0, int(math.ceil(minx - grow - 0.5)))
+    hi_x = min(nx - 1, int(math.floor(maxx + grow + 0.5)))
+    lo_y = max(0, int(math.ceil(miny - grow - 0.5)))
+    hi_y = min(ny - 1, int(math.floor(maxy + grow + 0.5)))
+    for iy in range(lo_y, hi_y + 1):
+        for ix in range(lo_x, hi_x + 1):
+            if occ[iy, ix] == 0:
+                continue
+            # separating axes x and y: the gaps between the polygon's box and the square
+            gx = max(ix - 0.5 - maxx, minx - ix - 0.5, 0.0)
+            gy = max(iy - 0.5 - maxy, miny - iy - 0.5, 0.0)
+            if gx * gx + gy * gy > g2:
+                continue  # the box's distance is a lower bound of the polygon's
+            sep = max(gx, gy)
+            for i in range(k):
+                # the square's least projection on the edge normal, minus the polygon's most
+                n0 = buf[i, 2]
+                n1 = buf[i, 3]
+                sep = max(sep, n0 * ix + n1 * iy - 0.5 * (abs(n0) + abs(n1)) - buf[i, 4])
+            if sep > grow:
+                continue  # a gap wider than grow along one axis
+            if sep <= 0.0:
+                return iy * nx + ix  # no separating axis: they meet
+            # disjoint convex polygons: the distance is between a vertex of one and an edge
+            # of the other
+            d2 = np.inf
+            for i in range(k):
+                dx = max(abs(buf[i, 0] - ix) - 0.5, 0.0)
+                dy = max(abs(buf[i, 1] - iy) - 0.5, 0.0)
+                d2 = min(d2, dx * dx + dy * dy)
+            for i in range(k):
+                j = i + 1 if i + 1 < k else 0
+                x0 = buf[i, 0]
+                y0 = buf[i, 1]
+                ex = buf[j, 0] - x0
+                ey = buf[j, 1] - y0
+                ee = ex * ex + ey * ey
+                for qx in (ix - 0.5, ix + 0.5):
+                    for qy in (iy - 0.5, iy + 0.5):
+                        t = min(max(((qx - x0) * ex + (qy - y0) * ey) / ee, 0.0), 1.0)
+                        ux = x0 + t * ex - qx
+                        uy = y0 + t * ey - qy
+                        d2 = min(d2, ux * ux + uy * uy)
+            if d2 <= g2:
+                return iy * nx + ix
+    return -1
+
+
+@njit(cache=True)
+def footprint_arc_clear(
+    occ, fsafe, fp, rho, x, y, th, kappa, s, margin, slack, buf
+):  # pragma: no cover - compiled
+    """Whether every pose of an arc keeps the footprint ``margin`` from the raw map.
+
+    The arc from pose ``(x, y, th)`` (cells, radians) with curvature ``kappa`` (1/cells) and
+    signed length ``s`` (cells; negative backwards: the body still faces ``th``) is cut into
+    ``m = ceil(|s| / ds_max)`` equal steps, ``ds_max = 2 slack / (1 + rho |kappa|)``, and the
+    footprint grown by ``margin + slack`` is tested (:func:`footprint_hit`) at the middle of
+    each: every pose of a step lies within ``slack`` of its middle pose's body, so the whole
+    arc, its ends included, keeps ``margin``. ``rho``: the footprint's circumscribed radius.
+    """
+    ds_max = 2.0 * slack / (1.0 + rho * abs(kappa))
+    m = max(1, int(math.ceil(abs(s) / ds_max)))
+    grow = margin + slack
+    for j in range(m):
+        qx, qy, qth = advance(x, y, th, kappa, s * (j + 0.5) / m)
+        if footprint_hit(occ, fsafe, fp, qx, qy, qth, grow, buf) != -1:
+            return False
+    return True
+
+
+@njit(cache=True)
+def footprint_word_clear(
+    occ, fsafe, fp, rho, x, y, th, radius, kinds, lens, n, margin, slack, buf
+):  # pragma: no cover - compiled
+    """Whether every pose of a Reeds-Shepp/Dubins word keeps the footprint ``margin`` clear.
+
+    The word (``n`` segments: curvature ``kinds[i] / radius``, signed length ``lens[i]``)
+    from pose ``(x, y, th)``, each segment by :func:`footprint_arc_clear`.
+    """
+    for i in range(n):
+        if lens[i] == 0.0:
+            continue
+        kappa = kinds[i] / radius
+        if not footprint_arc_clear(
+            occ, fsafe, fp, rho, x, y, th, kappa, lens[i], margin, slack, buf
+        ):
+            return False
+        x, y, th = advance(x, y, th, kappa, lens[i])
+    return True
+
+
 @njit(cache=True, inline="always")
 def _hash(key, mask):  # pragma: no cover - compiled
     h = (key * 0x9E3779B97F4A7C15) & 0x7FFFFFFFFFFFFFFF
@@ -491,6 +654,11 @@ def hybrid_kernel(
     safe,  # uint8 (ny, nx): 1 where every point of the cell keeps exact_r (exact mode)
     occ,  # uint8 (ny, nx): 1 on the raw map's occupied cells (exact mode)
     exact_r,  # > 0: every chord keeps this Euclidean distance from occ (cells); <= 0: off
+    fp,  # float64 (k, 4): footprint vertices and outward normals (footprint mode); (0, 4): off
+    fsafe,  # uint8 (ny, nx): 1 where the footprint needs no test (footprint mode)
+    frho,  # the footprint's circumscribed radius (cells)
+    fmargin,  # cells: every pose's footprint keeps this distance from occ (footprint mode)
+    fslack,  # cells: the body moves at most this far between a pose and its tested sample
 ):  # pragma: no cover - numba
     """Run Hybrid-A* from the start pose to the goal pose (the comments give each argument).
 
@@ -519,6 +687,8 @@ def hybrid_kernel(
     buf = np.zeros(5)
     shot_kinds = np.zeros(5, dtype=np.int8)
     shot_lens = np.zeros(5)
+    footprint = fp.shape[0] > 0
+    fbuf = np.empty((max(fp.shape[0], 1), 5))
 
     ncap = 4096
     px = np.empty(ncap)
@@ -637,8 +807,28 @@ def hybrid_kernel(
                         if (lens[i] < 0.0) != ((pu & 1) == 1):
                             c += cusp_penalty
                         break
-            if ug + c < best and word_clear(
-                free, ux, uy, uth, radius, kinds, lens, n, step, safe, occ, exact_r
+            if (
+                ug + c < best
+                and word_clear(free, ux, uy, uth, radius, kinds, lens, n, step, safe, occ, exact_r)
+                and (
+                    not footprint
+                    or footprint_word_clear(
+                        occ,
+                        fsafe,
+                        fp,
+                        frho,
+                        ux,
+                        uy,
+                        uth,
+                        radius,
+                        kinds,
+                        lens,
+                        n,
+                        fmargin,
+                        fslack,
+                        fbuf,
+                    )
+                )
             ):
                 if status != FOUND:
                     # keep searching for a cheaper path, at most as long again
@@ -657,6 +847,10 @@ def hybrid_kernel(
                 d = 1.0 if di == 0 else -1.0
                 s = d * prim_len
                 if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
+                    continue
+                if footprint and not footprint_arc_clear(
+                    occ, fsafe, fp, frho, ux, uy, uth, kappa, s, fmargin, fslack, fbuf
+                ):
                     continue
                 cx, cy, cth = advance(ux, uy, uth, kappa, s)
                 cost = prim_len

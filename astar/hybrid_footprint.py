@@ -1,0 +1,170 @@
+"""Oriented footprints for :func:`astar.find_pose_path`: a convex polygon against occupied squares.
+
+The footprint mode of :func:`astar.find_pose_path` (``footprint=``) checks a car-like robot
+as the convex polygon it is, rotated by the pose's heading, instead of a disc. Units are
+those of the search: **cells** (cell ``(ix, iy)`` is the closed square ``[ix - 0.5, ix + 0.5]
+x [iy - 0.5, iy + 0.5]``, its centre at ``(ix, iy)``), headings in radians. The polygon is
+given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
+
+* :func:`footprint_polygon` validates a footprint and returns it counter-clockwise with its
+  unit outward edge normals; :func:`footprint_radii` gives its inscribed and circumscribed
+  radii about the origin.
+* :func:`footprint_safe` marks the cells where no test is needed: every point of the cell
+  keeps ``rho + margin + slack`` from every occupied square and from the outside.
+
+The compiled tests live in :mod:`astar.hybrid_kernel`, beside the search that calls them (so
+that numba's cache of the search is rebuilt whenever they change):
+
+* :func:`~astar.hybrid_kernel.footprint_hit` tests one pose: the footprint grown by a
+  distance ``grow`` (its Minkowski sum with a disc) against every occupied square of the raw
+  map and the outside of the grid, exactly (separating axes, then the polygon-to-square
+  distance).
+* :func:`~astar.hybrid_kernel.footprint_arc_clear` and
+  :func:`~astar.hybrid_kernel.footprint_word_clear` test every pose of an arc (a
+  Reeds-Shepp/Dubins word), not only samples: along an arc of curvature ``kappa`` every
+  point of the body moves at most ``(1 + rho |kappa|)`` per cell of arc length (``rho``:
+  the farthest vertex from the origin), so the body at every pose within ``ds / 2`` of a
+  sample lies within ``slack = ds (1 + rho |kappa|) / 2`` of the body at the sample;
+  testing the footprint grown by ``margin + slack`` at the middle of each of ``m`` equal
+  steps of length ``ds`` covers the whole arc, its end poses included.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from astar import validation
+from astar.errors import InvalidInputError
+from astar.grid import OccupancyGrid
+
+__all__ = ["footprint_polygon", "footprint_radii", "footprint_safe"]
+
+
+def footprint_polygon(value: object) -> np.ndarray:
+    """Validate a footprint and return its vertices and outward normals, counter-clockwise.
+
+    Parameters
+    ----------
+    value : array_like of float, shape (k, 2)
+        Vertices ``(x, y)`` in cells, robot frame (``x`` forwards along the heading, ``y``
+        to the left), ``k >= 3``, in order (counter-clockwise or clockwise): a convex
+        polygon (no repeated consecutive vertices, turning one way once round; collinear
+        vertices are allowed) with the origin strictly inside.
+
+    Returns
+    -------
+    ndarray of float64, shape (k, 4)
+        Per vertex ``i``: ``(x, y, nx, ny)``, the vertex and the unit outward normal of the
+        edge from vertex ``i`` to vertex ``i + 1`` (cyclic), counter-clockwise.
+
+    Raises
+    ------
+    InvalidInputError
+        The value is not a finite ``(k, 2)`` array with ``k >= 3``, not convex, or does not
+        contain the origin strictly inside (the message names ``footprint``, the value and
+        the rule).
+    """
+    shown = validation.short_repr(value)
+    if isinstance(value, (str, bytes)):
+        raise InvalidInputError(f"footprint must be an array of vertices (k, 2), got {shown}")
+    try:
+        a = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidInputError(
+            f"footprint must be an array of vertices (k, 2) in cells, got {shown}"
+        ) from None
+    if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 3:
+        raise InvalidInputError(
+            f"footprint must have shape (k, 2) with k >= 3 vertices (cells), got shape "
+            f"{a.shape}: {shown}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise InvalidInputError(f"footprint vertices must be finite, got {a.tolist()}")
+    e = np.roll(a, -1, axis=0) - a  # edge i: vertex i -> vertex i + 1
+    size = float(np.abs(a).max())
+    elen = np.hypot(e[:, 0], e[:, 1])
+    if np.any(elen <= 1e-12 * size):
+        i = int(np.argmin(elen))
+        raise InvalidInputError(
+            f"footprint vertices {i} and {(i + 1) % len(a)} coincide ({a[i].tolist()}): "
+            f"a polygon needs distinct consecutive vertices, got {a.tolist()}"
+        )
+    en = np.roll(e, -1, axis=0)
+    cross = e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0]
+    dot = e[:, 0] * en[:, 0] + e[:, 1] * en[:, 1]
+    tol = 1e-12 * size * size
+    turns = np.arctan2(cross, dot)
+    if (
+        (np.any(cross > tol) and np.any(cross < -tol))
+        or np.any((np.abs(cross) <= tol) & (dot < 0.0))  # an edge folding back on itself
+        or abs(abs(turns.sum()) - 2 * math.pi) > 1e-6
+    ):
+        raise InvalidInputError(
+            "footprint must be a convex polygon (every turn the same way, once round), got "
+            f"{a.tolist()}"
+        )
+    if turns.sum() < 0.0:  # clockwise: reverse
+        a = a[::-1].copy()
+        e = np.roll(a, -1, axis=0) - a
+        elen = np.hypot(e[:, 0], e[:, 1])
+    normals = np.column_stack([e[:, 1], -e[:, 0]]) / elen[:, None]
+    # the origin's distance inside each edge (its support line): all > 0 for strictly inside
+    inside = normals[:, 0] * a[:, 0] + normals[:, 1] * a[:, 1]
+    if np.any(inside <= 1e-12 * size):
+        raise InvalidInputError(
+            "footprint must contain the robot's origin (0, 0) strictly inside (the pose is "
+            f"the origin), got {a.tolist()} (distance {float(inside.min()):.6g} cells inside "
+            "its nearest edge)"
+        )
+    return np.ascontiguousarray(np.column_stack([a, normals]))
+
+
+def footprint_radii(fp: np.ndarray) -> tuple[float, float]:
+    """Return ``(inscribed, circumscribed)`` radii about the origin (cells) of a footprint.
+
+    Parameters
+    ----------
+    fp : ndarray of float64, shape (k, 4)
+        A footprint from :func:`footprint_polygon`.
+
+    Returns
+    -------
+    inscribed : float
+        Distance from the origin to the nearest edge line (the largest disc about the
+        origin inside the polygon).
+    circumscribed : float
+        Distance from the origin to the farthest vertex (``rho``: the polygon lies in the
+        disc of this radius about the origin).
+    """
+    inscribed = float(np.min(fp[:, 2] * fp[:, 0] + fp[:, 3] * fp[:, 1]))
+    return inscribed, float(np.hypot(fp[:, 0], fp[:, 1]).max())
+
+
+def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
+    """Cells every point of which keeps more than ``reach`` cells from occupied squares.
+
+    Parameters
+    ----------
+    occ : ndarray of uint8 or bool, shape (ny, nx)
+        Nonzero on the raw map's occupied cells.
+    reach : float
+        Distance in cells (``>= 0``), e.g. ``rho + margin + slack``.
+
+    Returns
+    -------
+    ndarray of uint8, shape (ny, nx)
+        1 where every point of the cell's square is farther than ``reach`` from every
+        occupied square and from the outside of the grid (the cell's centre keeps ``reach +
+        sqrt(2) / 2``, plus ``1e-6`` against rounding), 0 elsewhere.
+    """
+    from astar.inflation import inflate
+
+    blocked = inflate(
+        OccupancyGrid(np.asarray(occ, dtype=bool), 1.0),
+        reach + math.sqrt(0.5) + 1e-6,
+        metric="square",
+        outside_occupied=True,
+    )
+    return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
