@@ -35,7 +35,7 @@ __all__ = ["NoPosePathError", "PosePath", "find_pose_path"]
 logger = logging.getLogger(__name__)
 
 _COLLISION_STEP = 0.2  # cells: arc-length spacing of the collision samples
-_FOOTPRINT_SLACK = 0.05  # cells: how far the body moves between a pose and its tested sample
+_FOOTPRINT_SLACK = 0.05  # cells: default of how far the body moves between a pose and its sample
 _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyond the start
 _RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
@@ -298,6 +298,7 @@ class _Footprint:
 def _footprint_mode(
     footprint: object,
     footprint_margin: object,
+    footprint_slack: object,
     raw_grid: object,
     clearance: object,
     free: np.ndarray,
@@ -305,7 +306,15 @@ def _footprint_mode(
 ) -> _Footprint | None:
     """Validate the footprint mode's inputs and build its arrays; None when it is off."""
     margin = _number("footprint_margin", footprint_margin, 0.0, ">= 0 (cells)")
+    slack = _number("footprint_slack", footprint_slack, 0.0, "> 0 (cells)")
+    if slack == 0.0:
+        raise InvalidInputError(f"footprint_slack must be finite and > 0 (cells), got {slack!r}")
     if footprint is None:
+        if slack != _FOOTPRINT_SLACK:
+            raise InvalidInputError(
+                f"footprint_slack={slack!r} is used only with footprint: pass a footprint "
+                f"or leave footprint_slack at {_FOOTPRINT_SLACK}"
+            )
         if margin != 0.0:
             raise InvalidInputError(
                 f"footprint_margin={margin!r} is used only with footprint: pass a footprint "
@@ -328,7 +337,6 @@ def _footprint_mode(
         )
     occ = np.ascontiguousarray(_raw_occ(raw_grid, free), dtype=np.uint8)
     _, rho = footprint_radii(fp)
-    slack = _FOOTPRINT_SLACK
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
     for name, (x, y, th) in poses:
@@ -372,6 +380,7 @@ def find_pose_path(
     clearance: float | None = None,
     footprint: ArrayLike | None = None,
     footprint_margin: float = 0.0,
+    footprint_slack: float = _FOOTPRINT_SLACK,
 ) -> PosePath:
     """Path of a car-like robot from a start pose to a goal pose by Hybrid-A*.
 
@@ -448,14 +457,14 @@ def find_pose_path(
         from every occupied square of ``raw_grid`` (closed squares ``[ix - 0.5, ix + 0.5] x
         [iy - 0.5, iy + 0.5]``) and within the grid (``[-0.5, nx - 0.5] x [-0.5, ny - 0.5]``,
         at least ``footprint_margin`` from its sides). Each arc of curvature ``kappa`` is
-        cut into equal steps of at most ``ds = 0.1 / (1 + rho |kappa|)`` cells (``rho``: the
-        farthest vertex from the origin), so that between a step's middle and any pose of
-        the step every point of the body moves at most 0.05 cells; the footprint grown by
-        ``footprint_margin + 0.05`` is tested exactly (separating axes, then the
+        cut into equal steps of at most ``ds = 2 footprint_slack / (1 + rho |kappa|)`` cells
+        (``rho``: the farthest vertex from the origin), so that between a step's middle and
+        any pose of the step every point of the body moves at most ``footprint_slack``; the
+        footprint grown by ``footprint_margin + footprint_slack`` is tested exactly (separating axes, then the
         polygon-to-square distance) at each step's middle. ``grid`` stays a necessary
         condition on the centre: pass the raw map inflated by the footprint's inscribed
         radius about the origin (a larger inflation loses paths, a smaller one only costs
-        time). Cells whose every point keeps ``rho + footprint_margin + 0.05`` from the
+        time). Cells whose every point keeps ``rho + footprint_margin + footprint_slack`` from the
         obstacles skip the polygon test. The returned poses are sampled as without
         footprint (``sample_step``); the guarantee holds for every pose of the exact
         ``pieces``, hence for the returned poses. The start and goal poses must pass the
@@ -463,6 +472,12 @@ def find_pose_path(
     footprint_margin : float, optional
         With ``footprint``: the distance (cells, finite, ``>= 0``; default 0) the footprint
         keeps from the obstacles and the grid's outside.
+    footprint_slack : float, optional
+        With ``footprint``: the sampling slack (cells, finite, ``> 0``; default 0.05). The
+        number of footprint tests falls as ``1 / footprint_slack``, and poses whose footprint
+        comes within ``footprint_margin + footprint_slack`` of an obstacle at a tested
+        sample are refused, so a slack is also a margin at the samples: a large body on a
+        fine grid wants a slack of a good fraction of a cell.
 
     Returns
     -------
@@ -541,6 +556,7 @@ def find_pose_path(
     foot = _footprint_mode(
         footprint,
         footprint_margin,
+        footprint_slack,
         raw_grid,
         clearance,
         free,

@@ -283,7 +283,7 @@ def _exercise_planners() -> None:
 
 
 def _exercise_car() -> None:
-    """Search pose to pose for a car-like robot (Hybrid-A*) both ways; the analytic curves."""
+    """Search pose to pose for a car-like robot (Hybrid-A*): both ways, with a footprint."""
     import astar
 
     grid, a, b = _search_query()
@@ -293,6 +293,11 @@ def _exercise_car() -> None:
             astar.find_pose_path(grid, start, goal, turning_radius=3.0, reverse=reverse)
         except astar.NoPathError:  # compiled all the same
             pass
+    body = [[-0.3, -0.3], [0.6, -0.3], [0.6, 0.3], [-0.3, 0.3]]  # the footprint mode (cells)
+    try:
+        astar.find_pose_path(grid, start, goal, turning_radius=3.0, raw_grid=grid, footprint=body)
+    except (astar.NoPathError, astar.InvalidInputError):  # compiled all the same
+        pass
     astar.reeds_shepp_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
     astar.dubins_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
 

@@ -282,6 +282,20 @@ def test_margin_is_kept():
         )
 
 
+def test_a_coarse_slack_keeps_the_guarantee():
+    """``footprint_slack=0.4``: steps eight times as long, and still every pose of the path
+    keeps the body clear (the brute force); the slack also acts as a margin at the samples,
+    so into the bay 3 cells wide (0.5 each side of the aligned body) 0.5 is refused."""
+    occ = _parking()
+    start, goal = (8.0, 6.0, 0.0), (20.0, 19.0, math.pi / 2)
+    args = (_inflated(occ, 1.0), start, goal)
+    p = find_pose_path(*args, turning_radius=3.0, raw_grid=occ, footprint=RECT, footprint_slack=0.4)
+    check_footprint_path(p, occ, RECT, start, goal)
+    assert p.stats["footprint_slack"] == 0.4
+    with pytest.raises(InvalidInputError, match=r"goal pose .*0 \+ 0.5 cells"):
+        find_pose_path(*args, turning_radius=3.0, raw_grid=occ, footprint=RECT, footprint_slack=0.5)
+
+
 def test_nose_to_the_wall():
     """The body 3.5 cells ahead of its rear origin: a goal whose nose stops 0.1 cells short
     of the wall is reached; one whose nose touches the wall is refused (though its centre is
@@ -511,6 +525,15 @@ _RAW = np.zeros((10, 20), bool)
             r"footprint_margin must be finite.*inf",
         ),
         ({"footprint_margin": 0.5}, r"footprint_margin=0\.5 is used only with footprint"),
+        (
+            {"footprint": SMALL, "raw_grid": _RAW, "footprint_slack": 0.0},
+            r"footprint_slack must be finite and > 0.*0\.0",
+        ),
+        (
+            {"footprint": SMALL, "raw_grid": _RAW, "footprint_slack": math.nan},
+            r"footprint_slack must be finite.*nan",
+        ),
+        ({"footprint_slack": 0.5}, r"footprint_slack=0\.5 is used only with footprint"),
         ({"footprint": SMALL, "raw_grid": np.zeros((5, 5), bool)}, r"raw_grid.*shape"),
         (
             {"footprint": SMALL * 8, "raw_grid": _RAW},

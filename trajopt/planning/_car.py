@@ -32,9 +32,18 @@ Curvature (hence steering) is continuous within a segment (the B-spline is C2); 
 the car is at rest and may steer while stopped (the chain checks position, heading, speed,
 acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
 
-Not supported (refused with :class:`~trajopt.errors.InvalidInputError`): a footprint (plan
-with its circumscribed disc radius), a moving start or end speeds other than 0, missing end
-headings, and the chapter's ``inflation="paper"``.
+A car with a :class:`~trajopt.robot.Footprint` (``Robot.rectangle(..., drive="ackermann")``;
+the footprint's origin is the point the plan moves, e.g. the rear axle's centre) is planned
+with its body facing its heading, forwards or backwards: its end poses must hold the body
+clear of the map (:func:`~trajopt.planning._footprint_ladder.check_end_poses`); the search
+runs in the footprint mode of :func:`astar.find_pose_path` (every pose of its arcs keeps the
+oriented body off the raw map, the centre grid inflated by the inscribed radius only as a
+necessary condition); each segment's corridor keeps the inscribed radius and its curve must
+also pass the footprint certificate, with the body along the curve's tangent forwards and
+turned by ``pi`` backwards (:func:`~trajopt.planning._car_fit.body_along`).
+
+Not supported (refused with :class:`~trajopt.errors.InvalidInputError`): a moving start or
+end speeds other than 0, missing end headings, and the chapter's ``inflation="paper"``.
 """
 
 from __future__ import annotations
@@ -54,6 +63,7 @@ from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
 from trajopt.planning._disc import check_endpoint
+from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import StageTimer
 from trajopt.robot._state import State
@@ -144,9 +154,9 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     Raises
     ------
     InvalidInputError
-        A footprint, ``inflation="paper"``, a heading missing, a moving start or an end
-        speed other than 0, an end point off the map or too close to an obstacle, or one
-        blocked on the search grid.
+        ``inflation="paper"``, a heading missing, a moving start or an end speed other than
+        0, an end point off the map or too close to an obstacle (a footprint: its body at
+        the end pose meets an obstacle), or one blocked on the search grid.
     NoPathError
         No path joins the poses (an :class:`astar.NoPosePathError` as its cause; with
         ``reverse=False`` the message says that a forward-only path was asked for).
@@ -214,11 +224,6 @@ def _ends(
 ) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Return the checked end points (m) and headings (rad) of a car's query."""
     robot = options.robot
-    if robot.footprint is not None:
-        raise InvalidInputError(
-            "Robot(drive='ackermann') with a footprint is not supported yet: plan with a disc "
-            f"(radius={robot.circumscribed_radius:.6g} m, the footprint's circumscribed disc)"
-        )
     if options.inflation != "exact":
         raise InvalidInputError(
             f"inflation={options.inflation!r} is not supported for drive='ackermann'; use 'exact'"
@@ -247,9 +252,13 @@ def _ends(
         )
     p0 = point("start", start)
     p1 = point("goal", request.goal)
-    check_endpoint(options, grid, "start", p0)
-    check_endpoint(options, grid, "goal", p1)
-    return p0, p1, float(h0), float(request.goal_heading)
+    h0, h1 = float(h0), float(request.goal_heading)
+    if robot.footprint is not None:
+        ends = dataclasses.replace(request, start=p0, start_heading=h0, goal=p1, goal_heading=h1)
+        check_end_poses(robot.footprint, grid, ends)
+    check_endpoint(options, grid, "start", p0, robot.inscribed_radius)
+    check_endpoint(options, grid, "goal", p1, robot.inscribed_radius)
+    return p0, p1, h0, h1
 
 
 def _to_cells(grid: OccupancyGrid, p: np.ndarray, heading: float) -> tuple[float, float, float]:

@@ -37,6 +37,7 @@ from trajopt.geometry._bspline import BSplineCurve
 from trajopt.planning._corridor_fit import witness_corridor
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
+from trajopt.robot._footprint import Footprint
 from trajopt.smoother import SmoothPath
 
 #: Relative tolerance of the curvature check of each fitted segment.
@@ -210,11 +211,12 @@ def fit_segment(
     curve made to leave straight along a pose pinned against a wall can need a near-cusp).
     """
     first, last = ends
-    radius = options.robot.radius
+    robot = options.robot
+    radius = robot.inscribed_radius
     pts = np.ascontiguousarray(poses[first : last + 1, :2])
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
-    kmax = 1.0 / options.robot.min_turning_radius
+    kmax = 1.0 / robot.min_turning_radius
     errors: list[str] = []
     corridor = None
     # the end's curvature along the direction of travel, from the last two poses (on an arc)
@@ -245,11 +247,16 @@ def fit_segment(
                     start_heading=hs,
                     goal_heading=hg,
                     start_curvature=k_start,
+                    footprint=body_along(robot.footprint, direction, kind == "reversed"),
                 )
         except (SmoothingError, InvalidInputError) as exc:
             errors.append(f"{kind}{'' if k_start is None else ' (start curvature)'}: {exc}")
             continue
         cert = smooth.certificate
+        fcert = smooth.footprint_certificate
+        if robot.footprint is not None and (fcert is None or not fcert.ok):
+            errors.append(f"{kind}: the footprint is not certified")
+            continue
         if cert is None or not cert.ok or cert.kappa_max_sampled > kmax * (1.0 + KAPPA_TOL):
             k = None if cert is None else cert.kappa_max_sampled
             errors.append(f"{kind}: not certified within 1/R (kappa {k})")
@@ -264,6 +271,20 @@ def fit_segment(
         f"m: {'; '.join(errors)}",
         {"car_segment_failures": errors},
     )
+
+
+def body_along(footprint: Footprint | None, direction: int, turned: bool) -> Footprint | None:
+    """Return the footprint oriented along a fitted curve's tangent (None without one).
+
+    The body faces the pose heading: along the tangent of a forwards segment's curve, against
+    it backwards, where the footprint turned by ``pi`` (its vertices negated) is the body
+    along the tangent; a curve fitted from the segment's end (``turned``) flips it again.
+    """
+    if footprint is None:
+        return None
+    if (direction > 0) != turned:
+        return footprint
+    return Footprint(-np.asarray(footprint.vertices, dtype=float))
 
 
 def turned_round(path: SmoothPath) -> SmoothPath:

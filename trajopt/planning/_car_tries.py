@@ -45,6 +45,16 @@ from trajopt.robot._robot import Robot
 #: diagonal (any point of a free cell keeps the radius) plus slack for the chords between
 #: the search's poses (at most half a cell apart).
 SEARCH_MARGIN_CELLS = 0.5 * math.sqrt(2.0) + 0.05
+#: Margin (cells) of the footprint search (:func:`exact_clearance`): the returned poses lie
+#: on the searched arcs, the chords between them at most the sagitta of a half-cell step
+#: (below 0.008 cells for ``R >= 4`` cells) off them, so with this margin the polyline
+#: through the poses keeps the inscribed radius, as the corridor requires.
+FOOTPRINT_TOL_CELLS = 0.01
+#: Sampling slack (cells) of the footprint search on the second grid (``footprint_slack``
+#: of :func:`astar.find_pose_path`; on the first grid :data:`SEARCH_MARGIN_CELLS`): the
+#: footprint tests fall as its inverse (the default 0.05 made a 35-cell car on a 2.5 cm
+#: grid expand 2 000 states a second), and poses within it of an obstacle are refused.
+FOOTPRINT_SLACK_CELLS = 0.25
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
 SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
@@ -176,6 +186,13 @@ def search_and_fit(
                     break
                 largest = min(largest, factor)
                 continue
+            except astar.InvalidInputError as exc:
+                if robot.footprint is None:
+                    raise
+                # an end pose whose footprint does not keep this grid's slack: the next grid
+                tries.append(f"{grid_name(margin)}: {exc}")
+                failures.append(InvalidInputError(str(exc)))
+                break
             poses = path.to_world(grid)
             try:
                 segments = []
@@ -221,6 +238,11 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> O
         outside) occupied.
     """
     r = robot.radius + (SEARCH_MARGIN_CELLS * grid.resolution if margin else 0.0)
+    if robot.footprint is not None:
+        # a necessary condition only (the search checks the footprint itself): a pose
+        # anywhere in a cell keeps the inscribed radius, so its centre keeps that minus
+        # half the cell's diagonal
+        r = max(0.0, robot.inscribed_radius - 0.5 * math.sqrt(2.0) * grid.resolution)
     return grid.with_occupied(
         astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
     )
@@ -229,10 +251,23 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> O
 def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str, Any]:
     """Return the search's exact-mode arguments on the radius grid (none on the margin grid).
 
+    With a footprint, on both grids: the footprint mode (:func:`astar.find_pose_path`
+    ``footprint``, the footprint in cells), where every pose of the search's arcs keeps its
+    oriented footprint :data:`FOOTPRINT_TOL_CELLS` off the raw map, tested at samples with
+    the slack :data:`SEARCH_MARGIN_CELLS` (the first grid's margin: room for the smoother)
+    or :data:`FOOTPRINT_SLACK_CELLS` (the second grid).
+
     On the grid inflated by the radius alone only the cell centres keep the radius; the
     search's exact mode (:func:`astar.find_pose_path` ``clearance``) makes the polyline of
     its poses keep it too, as the corridor requires, to within :data:`EXACT_TOL_M`.
     """
+    if robot.footprint is not None:
+        return {
+            "raw_grid": grid,
+            "footprint": np.asarray(robot.footprint.vertices, dtype=float) / grid.resolution,
+            "footprint_margin": FOOTPRINT_TOL_CELLS,
+            "footprint_slack": SEARCH_MARGIN_CELLS if margin else FOOTPRINT_SLACK_CELLS,
+        }
     if margin:
         return {}
     r_cells = robot.radius / grid.resolution - EXACT_TOL_M / grid.resolution

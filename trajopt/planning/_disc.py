@@ -315,9 +315,15 @@ def _result(
 
 
 def check_endpoint(
-    options: PlannerOptions, grid: OccupancyGrid, name: str, p: np.ndarray
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    name: str,
+    p: np.ndarray,
+    radius: float | None = None,
 ) -> np.ndarray:
     """Return the cell of an end point ``p`` (m), or raise naming why it is not valid.
+
+    ``radius`` (m): the clearance the point needs; default ``options.robot.radius``.
 
     Raises
     ------
@@ -336,11 +342,12 @@ def check_endpoint(
         raise InvalidInputError(
             f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
         )
-    clr = _point_clearance(grid, p, options.robot.radius)
-    if clr < options.robot.radius:
+    r = options.robot.radius if radius is None else radius
+    clr = _point_clearance(grid, p, r)
+    if clr < r:
         raise InvalidInputError(
             f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
-            f"edge); the robot needs at least its radius {options.robot.radius} m"
+            f"edge); the robot needs at least its radius {r} m"
         )
     return c
 

@@ -304,11 +304,11 @@ def _check_end(
     The checks :func:`~trajopt.planning._car.plan_car` makes of its ends, made here first so
     that the re-plan can tell the caller's goal from the pose where the car stopped.
     """
-    check_endpoint(options, grid, name, p)
+    check_endpoint(options, grid, name, p, options.robot.inscribed_radius)
     ix, iy = (int(c) for c in grid.world_to_cell(p))
     if search_grid.occupied[iy, ix]:
         raise InvalidInputError(
             f"{name} {p.tolist()} m lies in cell ({ix}, {iy}), blocked on the car's search "
-            f"grid (robot radius {options.robot.radius} m plus a margin); move it towards "
+            f"grid (robot radius {options.robot.inscribed_radius} m plus a margin); move it towards "
             "free space"
         )

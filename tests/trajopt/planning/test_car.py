@@ -76,11 +76,54 @@ def parking_scene():
     return grid, robot, (1.0, 1.1), (2.0 + SLOT / 2.0, 0.33), 0.0, 0.0
 
 
+BAY_WIDTH = 0.45  # m: a 0.3 m wide car with 7.5 cm each side
+
+
+def bay_grid() -> astar.OccupancyGrid:
+    """A 5 x 3 m yard whose lower third is solid but for one bay, 0.45 m wide and 0.9 m deep."""
+    res = 0.05
+    occ = walled(5.0, 3.0, res)
+    occ[: round(1.0 / res), :] = True
+    occ[round(0.1 / res) : round(1.0 / res), round(2.0 / res) : round((2.0 + BAY_WIDTH) / res)] = (
+        False
+    )
+    return astar.OccupancyGrid(occ, res)
+
+
+def body_car(**kw) -> trajopt.Robot:
+    """A rectangular car 0.6 x 0.3 m, its rear axle (the reference point) 0.1 m from the back."""
+    return trajopt.Robot.rectangle(
+        0.6, 0.3, rear_offset=0.1, drive="ackermann", min_turning_radius=0.6, **kw
+    )
+
+
+def bay_reverse_scene():
+    # backed into the bay: the rear axle 0.2 m above the bay's floor, facing out
+    return bay_grid(), body_car(wheelbase=0.4), (1.0, 2.0), (2.225, 0.3), 0.0, math.pi / 2
+
+
+def bay_forward_scene():
+    # driven nose first into the bay
+    return bay_grid(), body_car(), (1.0, 2.0), (2.225, 0.65), 0.0, -math.pi / 2
+
+
+def three_point_body_scene():
+    # the dead end of three_point_scene (1.1 m wide, narrower than 2 R = 1.2 m), a body car
+    grid, *_ = three_point_scene()
+    robot = trajopt.Robot.rectangle(
+        0.5, 0.3, rear_offset=0.1, drive="ackermann", min_turning_radius=0.6, wheelbase=0.4
+    )
+    return grid, robot, (1.5, 0.6), (1.6, 0.6), 0.0, math.pi
+
+
 SCENES = {
     "behind": behind_scene,
     "three_point": three_point_scene,
     "uturn": uturn_scene,
     "parking": parking_scene,
+    "bay_reverse": bay_reverse_scene,
+    "bay_forward": bay_forward_scene,
+    "three_point_body": three_point_body_scene,
 }
 
 
@@ -130,12 +173,60 @@ def test_curvature_within_one_over_r(planned, name):
         assert k.max() <= kmax * (1.0 + 1e-6), (k.max(), kmax)
 
 
+def _body_hits(grid, vertices, x, y, th, spacing=0.005):
+    """Poses whose body meets an occupied cell (or leaves the map), by brute force.
+
+    The body is the convex polygon ``vertices`` (robot frame, m) turned by ``th`` and moved
+    to ``(x, y)``. It meets a square iff a point of its boundary lies in the square or the
+    square lies inside it (then so does its centre): the boundary is sampled every
+    ``spacing`` m and looked up in the grid, and every occupied cell's centre is tested
+    against the polygon's half-planes.
+    """
+    v = np.asarray(vertices, dtype=float)
+    nxt = np.roll(v, -1, axis=0)
+    edge = nxt - v
+    n = np.maximum(1, np.ceil(np.hypot(*edge.T) / spacing).astype(int))
+    boundary = np.vstack(
+        [v[i] + np.linspace(0, 1, n[i], endpoint=False)[:, None] * edge[i] for i in range(len(v))]
+    )
+    area2 = np.sum(v[:, 0] * nxt[:, 1] - nxt[:, 0] * v[:, 1])
+    normal = np.column_stack([edge[:, 1], -edge[:, 0]]) * np.sign(area2)  # outward
+    offset = np.sum(normal * v, axis=1)
+    occ = np.asarray(grid.occupied)
+    ny, nx = occ.shape
+    ox, oy = grid.origin
+    res = grid.resolution
+    iy, ix = np.nonzero(occ)
+    centres = np.column_stack([ox + (ix + 0.5) * res, oy + (iy + 0.5) * res])
+    hits = np.zeros(len(x), dtype=bool)
+    for k in range(len(x)):
+        c, s_ = math.cos(th[k]), math.sin(th[k])
+        rot = np.array([[c, -s_], [s_, c]])
+        b = boundary @ rot.T + (x[k], y[k])
+        jx = np.floor((b[:, 0] - ox) / res).astype(int)
+        jy = np.floor((b[:, 1] - oy) / res).astype(int)
+        out = (jx < 0) | (jy < 0) | (jx >= nx) | (jy >= ny)
+        if out.any() or occ[jy, jx].any():
+            hits[k] = True
+            continue
+        local = (centres - (x[k], y[k])) @ rot  # into the body frame
+        hits[k] = bool(np.any(np.all(local @ normal.T <= offset, axis=1)))
+    return hits
+
+
 @pytest.mark.parametrize("name", list(SCENES))
 def test_clearance_against_raw_grid(planned, name):
     grid, robot, *_, traj, _ = planned[name]
-    for pts in _dense_points(traj, 0.002):
-        clr = square_clearance(grid, pts, reach=robot.radius + 0.1)
-        assert clr.min() >= robot.radius - 1e-9, clr.min()
+    if robot.footprint is None:
+        for pts in _dense_points(traj, 0.002):
+            clr = square_clearance(grid, pts, reach=robot.radius + 0.1)
+            assert clr.min() >= robot.radius - 1e-9, clr.min()
+        return
+    # the body along the trajectory, every 2 mm of arc length at most (v_max 1 m/s)
+    assert robot.v_max <= 1.0
+    smp = traj.sample(np.linspace(0.0, traj.duration, int(traj.duration / 0.002) + 2))
+    hits = _body_hits(grid, robot.footprint.vertices, smp.x, smp.y, smp.theta)
+    assert not hits.any(), np.column_stack([smp.t, smp.x, smp.y, smp.theta])[hits][:3]
 
 
 @pytest.mark.parametrize("name", list(SCENES))
@@ -300,11 +391,44 @@ def test_car_query_needs_headings(headings, match):
         trajopt.plan(grid, start, goal, robot, **headings)
 
 
-def test_car_with_a_footprint_is_refused():
-    grid, _, start, goal, *_ = behind_scene()
-    robot = trajopt.Robot.rectangle(0.4, 0.2, drive="ackermann", min_turning_radius=0.5)
-    with pytest.raises(InvalidInputError, match="with a footprint is not supported"):
-        trajopt.plan(grid, start, goal, robot, start_heading=0.0, goal_heading=0.0)
+def test_the_body_checker_sees_a_collision():
+    # the reference itself: the body across the bay's side wall, and wholly round one cell
+    grid = bay_grid()
+    car = body_car()
+    hits = _body_hits(grid, car.footprint.vertices, [2.225, 2.1, 1.0], [0.3, 0.3, 2.0], [0.0] * 3)
+    assert hits.tolist() == [True, True, False]
+    occ = np.zeros((40, 40), bool)
+    occ[20, 20] = True  # one cell, inside the body at (1.0, 1.0) m
+    inner = _body_hits(astar.OccupancyGrid(occ, 0.05), car.footprint.vertices, [1.0], [1.0], [0.3])
+    assert inner.tolist() == [True]
+
+
+@pytest.mark.parametrize("name", ["bay_reverse", "bay_forward"])
+def test_a_body_parks_where_its_circumscribed_disc_cannot(planned, name):
+    grid, robot, start, goal, h0, h1, traj, _ = planned[name]
+    assert 2.0 * robot.circumscribed_radius > BAY_WIDTH  # the disc does not fit the bay
+    disc = trajopt.Robot(
+        radius=robot.circumscribed_radius, drive="ackermann", min_turning_radius=0.6
+    )
+    with pytest.raises(InvalidInputError, match="goal .* from the nearest obstacle"):
+        trajopt.plan(grid, start, goal, disc, start_heading=h0, goal_heading=h1)
+    smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
+    backwards = name == "bay_reverse"
+    assert (smp.v.min() < 0.0) == backwards  # backed in, or driven in nose first
+
+
+def test_three_point_turn_of_a_body_has_cusps(planned):
+    _, robot, *_, traj, _ = planned["three_point_body"]
+    assert robot.footprint is not None and traj.stats["car"]["cusps"] >= 1
+    assert traj.stats["car"]["search"]["footprint"] is True
+
+
+def test_a_body_car_refuses_an_end_pose_its_footprint_does_not_fit():
+    grid = bay_grid()
+    with pytest.raises(InvalidInputError, match=r"goal pose .*the footprint meets an obstacle"):
+        trajopt.plan(
+            grid, (1.0, 2.0), (2.225, 0.3), body_car(), start_heading=0.0, goal_heading=0.0
+        )
 
 
 def test_forward_only_goal_behind_is_a_typed_no_path_error_fast():

@@ -325,3 +325,22 @@ def test_inside_a_stretch_fitted_in_pieces_brakes_on_its_piece(monkeypatch):
     assert out.stats["replan"] == "braked: reuse=False" and out.stats["brake_m"] > 0.0
     _check_splice(traj, out, ts)
     _check_new_plan(out, grid, goal, 1.7, robot)
+
+
+def test_a_body_car_brakes_and_plans_on_with_its_body_clear():
+    """A rectangular car backing into a bay (``tests/trajopt/planning/test_car.py``),
+    re-planned half-way without reuse: it brakes, plans on from rest, ends in the bay, and
+    the brute-force body check finds no contact along the spliced chain."""
+    from tests.trajopt.planning.test_car import _body_hits, bay_grid, body_car
+
+    grid, car = bay_grid(), body_car(wheelbase=0.4)
+    planner = trajopt.Planner(grid, car)
+    goal = (2.225, 0.3)
+    traj = planner.plan((1.0, 2.0), goal, start_heading=0.0, goal_heading=math.pi / 2)
+    ts = 0.5 * traj.duration
+    out = planner.replan(traj, ts, latency=0.0, reuse=False)
+    assert out.stats["replan"] == "braked: reuse=False"
+    _check_splice(traj, out, ts)
+    smp = out.sample(np.linspace(0.0, out.duration, int(out.duration / 0.002) + 2))
+    assert not _body_hits(grid, car.footprint.vertices, smp.x, smp.y, smp.theta).any()
+    np.testing.assert_allclose([smp.x[-1], smp.y[-1]], goal, atol=1e-9)
