@@ -359,7 +359,7 @@ def test_footprint_hit_against_dense_samples():
 
 
 def test_footprint_arc_clear_covers_the_whole_arc():
-    """footprint_arc_clear against dense poses (0.004 cells apart) near obstacles: a clear
+    """footprint_arc_clear against dense poses (0.01 cells apart) near obstacles: a clear
     verdict means no body point of any pose lies in an occupied square (sound between its
     samples), and an arc whose bodies all keep more than twice the sampling slack (0.1
     cells) is clear."""
@@ -379,11 +379,11 @@ def test_footprint_arc_clear_covers_the_whole_arc():
         safe = footprint_safe(occ8, rho + 0.05)
         boundary, interior = body_points(poly, 0.01)
         pts0 = np.concatenate([boundary, interior])
-        for _ in range(200):
+        for _ in range(100):
             x, y, th = rng.uniform(3, 16), rng.uniform(3, 16), rng.uniform(-np.pi, np.pi)
             k = float(rng.choice([0.0, 0.5, -0.5, 1 / 3, -1 / 3]))
             s = float(rng.choice([-1, 1]) * rng.uniform(0.3, 2.0))
-            m = math.ceil(abs(s) / 0.004)
+            m = math.ceil(abs(s) / 0.01)
             t = s * np.arange(m + 1) / m
             a = th + k * t
             if k == 0.0:
@@ -410,10 +410,10 @@ def test_footprint_arc_clear_covers_the_whole_arc():
                 continue
             # clearance sampled every 0.04 cells of arc: the body moves <= 0.04 (1 + rho k)
             nb = len(boundary)
-            w = np.column_stack([wx[::10, :nb].ravel(), wy[::10, :nb].ravel()])
+            w = np.column_stack([wx[::4, :nb].ravel(), wy[::4, :nb].ravel()])
             dmin = square_distance(w, occ).min()
             assert dmin <= 0.1 + 0.04 * (1 + rho * abs(k)), (x, y, th, k, s, dmin)
-    assert min(seen.values()) > 50
+    assert min(seen.values()) > 25
 
 
 # --------------------------------------------------------------------------- random maps
