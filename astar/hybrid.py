@@ -29,13 +29,13 @@ from numpy.typing import ArrayLike
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
 from astar.grid import OccupancyGrid
+from astar.hybrid_modes import DEFAULT_SLACK, exact_mode, footprint_mode
 
 __all__ = ["NoPosePathError", "PosePath", "find_pose_path"]
 
 logger = logging.getLogger(__name__)
 
 _COLLISION_STEP = 0.2  # cells: arc-length spacing of the collision samples
-_FOOTPRINT_SLACK = 0.05  # cells: default of how far the body moves between a pose and its sample
 _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyond the start
 _RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
@@ -234,128 +234,6 @@ def _int(name: str, value: object, lo: int) -> int:
     return int(value)
 
 
-def _exact_mode(
-    raw_grid: object, clearance: object, free: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """Return the exact mode's ``(safe, occ, clearance)`` arrays (uint8) and distance (cells).
-
-    Off (``clearance`` None): 1 x 1 placeholders and ``0.0``. ``safe`` marks the cells whose
-    centre keeps ``clearance + sqrt(2) / 2`` from every occupied square and the outside (so
-    every point of the cell keeps ``clearance``).
-    """
-    dummy = np.zeros((1, 1), dtype=np.uint8)
-    if clearance is None:
-        if raw_grid is not None:
-            raise InvalidInputError(
-                "raw_grid is used only with clearance or footprint: pass it with one of them "
-                "or not at all"
-            )
-        return dummy, dummy, 0.0
-    r = validation.positive_float("clearance", clearance)
-    if raw_grid is None:
-        raise InvalidInputError(f"clearance={r!r} needs raw_grid (the raw map) to measure it on")
-    occ = _raw_occ(raw_grid, free)
-    from astar.inflation import inflate
-
-    margin = r + math.sqrt(0.5) + 1e-9
-    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
-    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
-    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
-
-
-def _raw_occ(raw_grid: object, free: np.ndarray) -> np.ndarray:
-    """Return the bool occupied mask (ny, nx) of ``raw_grid``, checked against ``free``."""
-    if isinstance(raw_grid, OccupancyGrid):
-        occ = np.asarray(raw_grid.occupied, dtype=bool)
-    else:
-        a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
-        if a is None or a.dtype != bool or a.ndim != 2:
-            raise InvalidInputError(
-                "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
-                f"cells, got {type(raw_grid).__name__}"
-                + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
-            )
-        occ = a
-    if occ.shape != free.shape:
-        raise InvalidInputError(
-            f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
-        )
-    return occ
-
-
-@dataclass(frozen=True, slots=True)
-class _Footprint:
-    """The footprint mode's kernel inputs (:func:`_footprint_mode`)."""
-
-    fp: np.ndarray  # float64 (k, 4): vertices and unit outward normals, counter-clockwise
-    safe: np.ndarray  # uint8 (ny, nx): 1 where no footprint test is needed
-    occ: np.ndarray  # uint8 (ny, nx): the raw map's occupied cells
-    rho: float  # circumscribed radius (cells)
-    margin: float  # cells
-    slack: float  # cells
-
-
-def _footprint_mode(
-    footprint: object,
-    footprint_margin: object,
-    footprint_slack: object,
-    raw_grid: object,
-    clearance: object,
-    free: np.ndarray,
-    poses: tuple[tuple[str, tuple[float, float, float]], ...],
-) -> _Footprint | None:
-    """Validate the footprint mode's inputs and build its arrays; None when it is off."""
-    margin = _number("footprint_margin", footprint_margin, 0.0, ">= 0 (cells)")
-    slack = _number("footprint_slack", footprint_slack, 0.0, "> 0 (cells)")
-    if slack == 0.0:
-        raise InvalidInputError(f"footprint_slack must be finite and > 0 (cells), got {slack!r}")
-    if footprint is None:
-        if slack != _FOOTPRINT_SLACK:
-            raise InvalidInputError(
-                f"footprint_slack={slack!r} is used only with footprint: pass a footprint "
-                f"or leave footprint_slack at {_FOOTPRINT_SLACK}"
-            )
-        if margin != 0.0:
-            raise InvalidInputError(
-                f"footprint_margin={margin!r} is used only with footprint: pass a footprint "
-                "or leave footprint_margin at 0"
-            )
-        return None
-    from astar.hybrid_footprint import footprint_polygon, footprint_radii, footprint_safe
-    from astar.hybrid_kernel import footprint_hit
-
-    fp = footprint_polygon(footprint)
-    if clearance is not None:
-        raise InvalidInputError(
-            f"footprint and clearance={clearance!r} exclude each other: the footprint mode "
-            "checks the polygon itself (grow it with footprint_margin)"
-        )
-    if raw_grid is None:
-        raise InvalidInputError(
-            f"footprint={np.asarray(footprint, dtype=np.float64).tolist()} needs raw_grid "
-            "(the raw map) to be checked against"
-        )
-    occ = np.ascontiguousarray(_raw_occ(raw_grid, free), dtype=np.uint8)
-    _, rho = footprint_radii(fp)
-    safe = footprint_safe(occ, rho + margin + slack)
-    buf = np.empty((fp.shape[0], 5))
-    for name, (x, y, th) in poses:
-        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + slack, buf))
-        if hit != -1:
-            where = (
-                "leaves the grid"
-                if hit == -2
-                else f"meets the occupied cell ({hit % occ.shape[1]}, {hit // occ.shape[1]}) "
-                "of raw_grid"
-            )
-            raise InvalidInputError(
-                f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
-                f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
-                "clear of every occupied square and inside the grid"
-            )
-    return _Footprint(fp, safe, occ, rho, margin, slack)
-
-
 # --------------------------------------------------------------------------- public API
 def find_pose_path(
     grid: OccupancyGrid | np.ndarray,
@@ -380,7 +258,7 @@ def find_pose_path(
     clearance: float | None = None,
     footprint: ArrayLike | None = None,
     footprint_margin: float = 0.0,
-    footprint_slack: float = _FOOTPRINT_SLACK,
+    footprint_slack: float = DEFAULT_SLACK,
 ) -> PosePath:
     """Path of a car-like robot from a start pose to a goal pose by Hybrid-A*.
 
@@ -553,7 +431,7 @@ def find_pose_path(
     max_exp = _int("max_expansions", max_expansions, 1)
     budget = validation.positive_float("time_budget", time_budget)
     hw = _number("heuristic_weight", heuristic_weight, 1.0, ">= 1")
-    foot = _footprint_mode(
+    foot = footprint_mode(
         footprint,
         footprint_margin,
         footprint_slack,
@@ -563,7 +441,7 @@ def find_pose_path(
         (("start", (sx, sy, sth)), ("goal", (gx, gy, gth))),
     )
     if foot is None:
-        safe, occ, exact_r = _exact_mode(raw_grid, clearance, free)
+        safe, occ, exact_r = exact_mode(raw_grid, clearance, free)
         fp, fsafe, frho, fmargin, fslack = np.zeros((0, 4)), safe, 0.0, 0.0, 0.0
     else:
         safe, occ, exact_r = np.zeros((1, 1), dtype=np.uint8), foot.occ, 0.0

@@ -402,10 +402,10 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     occ : ndarray of uint8, shape (ny, nx)
         1 on occupied cells (closed squares of side 1).
     fsafe : ndarray of uint8, shape (ny, nx)
-        :func:`astar.hybrid_footprint.footprint_safe` for a reach of at least ``rho + grow``
+        :func:`astar.hybrid_modes.footprint_safe` for a reach of at least ``rho + grow``
         (or zeros): a pose whose centre lies in a safe cell is clear without further test.
     fp : ndarray of float64, shape (k, 4)
-        :func:`astar.hybrid_footprint.footprint_polygon`: counter-clockwise vertices and
+        :func:`astar.hybrid_modes.footprint_polygon`: counter-clockwise vertices and
         unit outward normals, cells.
     x, y, th : float
         The pose: cells, radians.

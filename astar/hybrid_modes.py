@@ -1,6 +1,8 @@
-"""Oriented footprints for :func:`astar.find_pose_path`: a convex polygon against occupied squares.
+"""The collision modes of :func:`astar.find_pose_path` beyond its grid: exact clearance, a footprint.
 
-The footprint mode of :func:`astar.find_pose_path` (``footprint=``) checks a car-like robot
+The exact mode (``raw_grid``, ``clearance``; :func:`exact_mode` builds its inputs) keeps the
+chords between the search's samples a Euclidean distance from the raw map's squares. The
+footprint mode of :func:`astar.find_pose_path` (``footprint=``) checks a car-like robot
 as the convex polygon it is, rotated by the pose's heading, instead of a disc. Units are
 those of the search: **cells** (cell ``(ix, iy)`` is the closed square ``[ix - 0.5, ix + 0.5]
 x [iy - 0.5, iy + 0.5]``, its centre at ``(ix, iy)``), headings in radians. The polygon is
@@ -11,6 +13,8 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
   radii about the origin.
 * :func:`footprint_safe` marks the cells where no test is needed: every point of the cell
   keeps ``rho + margin + slack`` from every occupied square and from the outside.
+* :func:`footprint_mode` validates the search's footprint arguments and builds the kernel's
+  inputs (:class:`FootprintMode`); :func:`raw_occupancy` reads the raw map of both modes.
 
 The compiled tests live in :mod:`astar.hybrid_kernel`, beside the search that calls them (so
 that numba's cache of the search is rebuilt whenever they change):
@@ -32,6 +36,7 @@ that numba's cache of the search is rebuilt whenever they change):
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,7 +44,19 @@ from astar import validation
 from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
 
-__all__ = ["footprint_polygon", "footprint_radii", "footprint_safe"]
+__all__ = [
+    "DEFAULT_SLACK",
+    "FootprintMode",
+    "exact_mode",
+    "footprint_mode",
+    "footprint_polygon",
+    "footprint_radii",
+    "footprint_safe",
+    "raw_occupancy",
+]
+
+#: Default sampling slack (cells): how far the body moves between a pose and its sample.
+DEFAULT_SLACK = 0.05
 
 
 def footprint_polygon(value: object) -> np.ndarray:
@@ -168,3 +185,122 @@ def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
         outside_occupied=True,
     )
     return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
+
+
+def raw_occupancy(raw_grid: object, free: np.ndarray) -> np.ndarray:
+    """Return the bool occupied mask (ny, nx) of ``raw_grid``, checked against ``free``."""
+    if isinstance(raw_grid, OccupancyGrid):
+        occ = np.asarray(raw_grid.occupied, dtype=bool)
+    else:
+        a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
+        if a is None or a.dtype != bool or a.ndim != 2:
+            raise InvalidInputError(
+                "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
+                f"cells, got {type(raw_grid).__name__}"
+                + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
+            )
+        occ = a
+    if occ.shape != free.shape:
+        raise InvalidInputError(
+            f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
+        )
+    return occ
+
+
+@dataclass(frozen=True, slots=True)
+class FootprintMode:
+    """The footprint mode's kernel inputs (:func:`footprint_mode`)."""
+
+    fp: np.ndarray  # float64 (k, 4): vertices and unit outward normals, counter-clockwise
+    safe: np.ndarray  # uint8 (ny, nx): 1 where no footprint test is needed
+    occ: np.ndarray  # uint8 (ny, nx): the raw map's occupied cells
+    rho: float  # circumscribed radius (cells)
+    margin: float  # cells
+    slack: float  # cells
+
+
+def footprint_mode(
+    footprint: object,
+    footprint_margin: object,
+    footprint_slack: object,
+    raw_grid: object,
+    clearance: object,
+    free: np.ndarray,
+    poses: tuple[tuple[str, tuple[float, float, float]], ...],
+) -> FootprintMode | None:
+    """Validate the footprint mode's inputs and build its arrays; None when it is off."""
+    margin = validation.nonnegative_float("footprint_margin", footprint_margin, "cells")
+    slack = validation.positive_float("footprint_slack", footprint_slack)
+    if footprint is None:
+        if slack != DEFAULT_SLACK:
+            raise InvalidInputError(
+                f"footprint_slack={slack!r} is used only with footprint: pass a footprint "
+                f"or leave footprint_slack at {DEFAULT_SLACK}"
+            )
+        if margin != 0.0:
+            raise InvalidInputError(
+                f"footprint_margin={margin!r} is used only with footprint: pass a footprint "
+                "or leave footprint_margin at 0"
+            )
+        return None
+    from astar.hybrid_kernel import footprint_hit
+
+    fp = footprint_polygon(footprint)
+    if clearance is not None:
+        raise InvalidInputError(
+            f"footprint and clearance={clearance!r} exclude each other: the footprint mode "
+            "checks the polygon itself (grow it with footprint_margin)"
+        )
+    if raw_grid is None:
+        raise InvalidInputError(
+            f"footprint={np.asarray(footprint, dtype=np.float64).tolist()} needs raw_grid "
+            "(the raw map) to be checked against"
+        )
+    occ = np.ascontiguousarray(raw_occupancy(raw_grid, free), dtype=np.uint8)
+    _, rho = footprint_radii(fp)
+    safe = footprint_safe(occ, rho + margin + slack)
+    buf = np.empty((fp.shape[0], 5))
+    for name, (x, y, th) in poses:
+        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + slack, buf))
+        if hit != -1:
+            where = (
+                "leaves the grid"
+                if hit == -2
+                else f"meets the occupied cell ({hit % occ.shape[1]}, {hit // occ.shape[1]}) "
+                "of raw_grid"
+            )
+            raise InvalidInputError(
+                f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
+                f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
+                "clear of every occupied square and inside the grid"
+            )
+    return FootprintMode(fp, safe, occ, rho, margin, slack)
+
+
+def exact_mode(
+    raw_grid: object, clearance: object, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Return the exact mode's ``(safe, occ, clearance)`` arrays (uint8) and distance (cells).
+
+    Off (``clearance`` None): 1 x 1 placeholders and ``0.0``. ``safe`` marks the cells whose
+    centre keeps ``clearance + sqrt(2) / 2`` from every occupied square and the outside (so
+    every point of the cell keeps ``clearance``).
+    """
+    dummy = np.zeros((1, 1), dtype=np.uint8)
+    if clearance is None:
+        if raw_grid is not None:
+            raise InvalidInputError(
+                "raw_grid is used only with clearance or footprint: pass it with one of them "
+                "or not at all"
+            )
+        return dummy, dummy, 0.0
+    r = validation.positive_float("clearance", clearance)
+    if raw_grid is None:
+        raise InvalidInputError(f"clearance={r!r} needs raw_grid (the raw map) to measure it on")
+    occ = raw_occupancy(raw_grid, free)
+    from astar.inflation import inflate
+
+    margin = r + math.sqrt(0.5) + 1e-9
+    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
+    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
+    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
