@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
-from trajopt.smoother._basis import band_quadratic, basis_derivs, find_spans
+from trajopt.smoother._basis import band_quadratic, basis_derivs, find_spans, gauss_legendre
 from trajopt.smoother._cost_kernels import cost_term
 
 if TYPE_CHECKING:
@@ -294,7 +294,7 @@ class CostTerm:
         n = len(t) - p - 1
         brk = np.unique(t)
         a, b = brk[:-1], brk[1:]
-        xg, wg = np.polynomial.legendre.leggauss(N_GAUSS)
+        xg, wg = gauss_legendre(N_GAUSS)
         u = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * xg[None, :]).ravel()
         wq = (0.5 * (b - a)[:, None] * wg[None, :]).ravel()
         span = find_spans(t, p, n, u)
