@@ -145,11 +145,13 @@ def report(df, cells: dict[str, int], have_ompl: bool) -> str:
                 k: _med(1e3 * ok[f"stage_{k}_s"])
                 for k in ("inflate", "corridor", "smooth", "timing")
             }
-            pieces = ok["corridor"].fillna("").str.count(",") + 1
-            rests = pieces - 1 - ok["cusps"]
+            fits = ok["corridor"].fillna("").str.count(",") + 1
+            joins = fits - 1 - ok["cusps"]  # joins of stretches fitted in pieces
+            rests = ok["rests"] if "rests" in ok else joins
             lines.append(
                 f"  rests between cusps    {int((rests > 0).sum())} plans "
-                f"({int(rests.sum())} joins of stretches fitted in pieces)"
+                f"({int(rests.sum())} of the {int(joins.sum())} joins of stretches fitted in "
+                "pieces; the others are driven through)"
             )
             lines.append(
                 "  trajopt stages median  "

@@ -314,8 +314,8 @@ def test_nose_to_the_wall():
 
 def test_footprint_hit_against_dense_samples():
     """footprint_hit against the brute-force distance of dense boundary and interior samples."""
-    from astar.hybrid_modes import footprint_polygon
     from astar.hybrid_kernel import footprint_hit
+    from astar.hybrid_modes import footprint_polygon
 
     rng = np.random.default_rng(7)
     occ = rng.random((16, 18)) < 0.12
@@ -363,8 +363,8 @@ def test_footprint_arc_clear_covers_the_whole_arc():
     verdict means no body point of any pose lies in an occupied square (sound between its
     samples), and an arc whose bodies all keep more than twice the sampling slack (0.1
     cells) is clear."""
-    from astar.hybrid_modes import footprint_polygon, footprint_radii, footprint_safe
     from astar.hybrid_kernel import footprint_arc_clear
+    from astar.hybrid_modes import footprint_polygon, footprint_radii, footprint_safe
 
     rng = np.random.default_rng(3)
     occ = rng.random((20, 20)) < 0.1

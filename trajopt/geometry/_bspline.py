@@ -158,6 +158,48 @@ class BSplineCurve(ParametricCurve):
         return f"BSplineCurve(k={self.k}, n={self.c.shape[0]}, domain={self.domain})"
 
 
+def concatenate(curves: list[BSplineCurve], tol_m: float = 1e-9) -> BSplineCurve:
+    """Return one B-spline that traces ``curves`` one after the other.
+
+    Each curve must be clamped, of the same degree ``k``, and start where the previous one
+    ends (within ``tol_m``, metres). The result has a knot of multiplicity ``k`` at each
+    join, the later curve's knots shifted to start there, and the curves' control points
+    with each shared end point once: on either side of a join it is exactly the curve it
+    came from (with that multiplicity the two sides share no basis function but the one
+    at the join, which is 1 there). It is continuous; its derivatives are whatever the
+    curves' are at the joins (a parameter speed may jump; heading and curvature are
+    continuous where the curves' are).
+
+    Raises
+    ------
+    InvalidInputError
+        No curve, degrees that differ, a curve that is not clamped, or a gap at a join.
+    """
+    if not curves:
+        raise InvalidInputError("concatenate needs at least one curve")
+    k = curves[0].k
+    knots = [np.asarray(curves[0].t)]
+    points = [np.asarray(curves[0].c)]
+    for i, cv in enumerate(curves):
+        t = np.asarray(cv.t)
+        if cv.k != k:
+            raise InvalidInputError(f"curve {i} has degree {cv.k}, curve 0 degree {k}")
+        if np.any(t[: k + 1] != t[0]) or np.any(t[-k - 1 :] != t[-1]):
+            raise InvalidInputError(f"curve {i} is not clamped (its end knots differ)")
+        if i == 0:
+            continue
+        gap = float(np.hypot(*(np.asarray(cv.c[0]) - points[-1][-1])))
+        if gap > tol_m:
+            raise InvalidInputError(
+                f"curve {i} starts {gap:.3g} m from where curve {i - 1} ends (tol_m={tol_m})"
+            )
+        shift = knots[-1][-1] - t[0]
+        knots[-1] = knots[-1][:-1]  # the join keeps k copies
+        knots.append(t[k + 1 :] + shift)
+        points.append(np.asarray(cv.c)[1:])
+    return BSplineCurve(np.concatenate(knots), np.concatenate(points), k)
+
+
 def _tail_coefficients(t: np.ndarray, c: np.ndarray, k: int, u0: float):
     """Knots and control points of the spline ``(t, c, k)`` (``k >= 0``) cut to ``[u0, ...]``.
 

@@ -15,20 +15,23 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    ``pi``). Each segment is fitted as an ordinary curve in the direction of travel in a
    certified polygon corridor, with the curvature bound ``1/R``, exact end points and exact
    end travel headings; a stretch that turns much and fits in no whole curve is fitted in
-   pieces, the car at rest at each join. Every curve is the smoother's certified curve and
+   pieces, each starting with the previous piece's end curvature where it can. Every curve is the smoother's certified curve and
    its sampled curvature must be within ``1/R``; nothing else is returned. The smoother's
    budget per fit is capped at :data:`SEGMENT_BUDGET_S`.
-3. **Timing.** Each segment is timed along its arc length from rest to rest
+3. **Timing.** Each drive (the segments between two stops: :func:`drive_groups`; the pieces
+   of a stretch whose curves meet with the same curvature are driven through, their curves
+   joined into one) is timed along its arc length from rest to rest
    (:func:`trajopt.time_parameterize`: ``v = 0`` at the ends and at every cusp), backwards
-   segments with ``v_max_reverse`` as the speed limit, with the robot's curvature caps and,
-   with ``steer_rate_max``, the steering-rate cap (:mod:`trajopt.timing._steer_cap`).
+   ones with ``v_max_reverse`` as the speed limit, with the robot's curvature caps and,
    with ``steer_rate_max``, the steering-rate cap (:mod:`trajopt.timing._steer_cap`).
 
 The result is a :class:`~trajopt.motion.TrajectoryChain` of one
-:class:`~trajopt.motion.Trajectory` per segment (``direction`` ``+1`` or ``-1``), even for a
-single segment: its samples carry the signed ``v``, the body's ``theta`` (continuous across
+:class:`~trajopt.motion.Trajectory` per drive (``direction`` ``+1`` or ``-1``), even for a
+single one: its samples carry the signed ``v``, the body's ``theta`` (continuous across
 cusps) and ``kappa``, ``direction`` and, with a ``wheelbase``, ``steer`` and ``steer_rate``.
-Curvature (hence steering) is continuous within a segment (the B-spline is C2); at a cusp
+Curvature (hence steering) is continuous within a drive (each B-spline is C2, and the
+pieces driven through meet with the same curvature, where only the steering rate may
+change); at a cusp (or a join where the curvatures differ, ``stats["car"]["rests"]``)
 the car is at rest and may steer while stopped (the chain checks position, heading, speed,
 acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
 
@@ -57,6 +60,7 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.errors import InvalidInputError
+from trajopt.geometry._bspline import concatenate
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
@@ -72,6 +76,10 @@ from trajopt.timing import time_parameterize
 
 #: Cap (s) on the smoother's time budget per segment fit.
 SEGMENT_BUDGET_S = 2.0
+#: Largest relative difference of the curvatures at a join the car drives through
+#: (:func:`drive_groups`): a piece fitted with the previous piece's end curvature matches
+#: it to 1e-10 or so; a piece fitted without it rests at the join.
+JOIN_KAPPA_TOL = 1e-6
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +106,8 @@ class CarSteps:
     segments : tuple of CarSegment
         One per stretch between cusps, or per piece of a stretch fitted in pieces
         (:attr:`~trajopt.planning._car_fit.CarSegment.joined`).
+    drives : tuple of tuple of int
+        The segments timed as each piece of the chain (:func:`drive_groups`), in order.
     start, goal : tuple of float
         The end points (m).
     start_heading, goal_heading : float
@@ -114,6 +124,7 @@ class CarSteps:
     pose_path: Any
     poses: np.ndarray
     segments: tuple
+    drives: tuple
     start: tuple[float, float]
     goal: tuple[float, float]
     start_heading: float
@@ -148,8 +159,9 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     Returns
     -------
     TrajectoryChain
-        One :class:`~trajopt.motion.Trajectory` per segment (between cusps, and at the
-        joins of a stretch fitted in pieces), each from rest to rest.
+        One :class:`~trajopt.motion.Trajectory` per drive (between cusps, and at the
+        joins of a stretch fitted in pieces whose curvatures differ), each from rest to
+        rest.
 
     Raises
     ------
@@ -182,10 +194,11 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     found = search_and_fit(options, grid, (start, goal), (p0, p1), sm, timer)
     search_grid, path, radius_cells = found.search_grid, found.path, found.radius_cells
     poses, segments, tries = found.poses, found.segments, found.tries
+    drives = drive_groups(segments)
     pieces: list[Trajectory] = []
-    for seg in segments:
+    for group in drives:
         with timer.stage("timing"):
-            pieces.append(_time_segment(options, seg))
+            pieces.append(_time_drive(options, [segments[i] for i in group]))
     stages = timer.finish()
     steps = CarSteps(
         raw_grid=grid,
@@ -193,6 +206,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
         pose_path=path,
         poses=poses,
         segments=tuple(segments),
+        drives=tuple(drives),
         start=(float(p0[0]), float(p0[1])),
         goal=(float(p1[0]), float(p1[1])),
         start_heading=h0,
@@ -207,6 +221,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
             "cusps": int(path.cusps),
             "directions": [s.direction for s in segments],
             "joins": sum(s.joined for s in segments),
+            "rests": len(drives) - 1 - int(path.cusps),
             "reverse_length_m": float(path.reverse_length * res),
             "search_length_m": float(path.length * res),
             "search_turning_radius_m": radius_cells * res,
@@ -267,14 +282,49 @@ def _to_cells(grid: OccupancyGrid, p: np.ndarray, heading: float) -> tuple[float
     return float(xy[0] - 0.5), float(xy[1] - 0.5), float(heading)
 
 
-def _time_segment(options: PlannerOptions, seg: CarSegment) -> Trajectory:
-    """Time a segment from rest to rest; backwards with ``v_max_reverse`` (module doc)."""
+def drive_groups(segments: list[CarSegment]) -> list[tuple[int, ...]]:
+    """Return the segments the car drives through without stopping, as index groups.
+
+    A segment that continues the previous one (:attr:`CarSegment.joined`, a stretch fitted
+    in pieces) joins its group when its curve starts with the previous curve's end
+    curvature (to :data:`JOIN_KAPPA_TOL`, relative to the larger of the two, or of 1e-9
+    1/m): the two curves then meet with the same point, heading and curvature, so
+    the car drives through the join (one piece of the chain, timed along both). Otherwise
+    the car rests there, as at a cusp.
+    """
+    groups: list[list[int]] = []
+    for i, seg in enumerate(segments):
+        if groups and seg.joined and _same_curvature(segments[i - 1], seg):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return [tuple(g) for g in groups]
+
+
+def _same_curvature(a: CarSegment, b: CarSegment) -> bool:
+    """Whether ``b``'s curve starts with the curvature ``a``'s ends with (drive_groups)."""
+    pa, pb = a.smooth_path, b.smooth_path
+    ka = float(np.asarray(pa.curvature(np.array([pa.domain[1]])))[0])
+    kb = float(np.asarray(pb.curvature(np.array([pb.domain[0]])))[0])
+    return abs(ka - kb) <= JOIN_KAPPA_TOL * max(abs(ka), abs(kb), 1e-9)
+
+
+def _time_drive(options: PlannerOptions, segs: list[CarSegment]) -> Trajectory:
+    """Time segments driven through (one curve: :func:`drive_groups`) from rest to rest.
+
+    Backwards with ``v_max_reverse`` (module docstring). Several segments are timed along
+    their curves joined into one (:func:`~trajopt.geometry._bspline.concatenate`).
+    """
     robot = options.robot
+    seg = segs[0]
+    path = seg.smooth_path
+    if len(segs) > 1:
+        path = concatenate([s.smooth_path.curve for s in segs])
     limits = robot
     if seg.direction < 0 and robot.v_max_backwards != robot.v_max:
         limits = dataclasses.replace(robot, v_max=robot.v_max_backwards)
     traj = time_parameterize(
-        seg.smooth_path,
+        path,
         limits,
         v_start=0.0,
         v_end=0.0,

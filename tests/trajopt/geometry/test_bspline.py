@@ -7,7 +7,7 @@ import pytest
 from scipy.interpolate import BSpline, make_lsq_spline
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
+from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots, concatenate
 
 
 def _curve(n=8, k=3, seed=0):
@@ -98,3 +98,40 @@ def test_circle_fit_curvature():
 def test_invalid(t, c, k, match):
     with pytest.raises(InvalidInputError, match=match):
         BSplineCurve(t, c, k)
+
+
+def test_concatenate_traces_each_curve_on_its_stretch():
+    """Three clamped cubics end to end: on each stretch the joined curve is that curve (scipy's
+    BSpline of it, shifted), its length the sum, its knot multiplicity 3 at the joins."""
+    rng = np.random.default_rng(7)
+    curves, start = [], rng.random(2)
+    for n, dom in [(6, (0.0, 2.0)), (4, (5.0, 5.5)), (8, (-1.0, 3.0))]:
+        c = rng.random((n, 2)) * 3.0
+        c[0] = start
+        curves.append(BSplineCurve(clamped_uniform_knots(n, 3, dom), c, 3))
+        start = c[-1]
+    joined = concatenate(curves)
+    offset = 0.0
+    for cv in curves:
+        a, b = cv.domain
+        u = np.linspace(a, b, 97)
+        ref = BSpline(np.asarray(cv.t), np.asarray(cv.c), 3)(u)
+        np.testing.assert_allclose(joined(u - a + offset), ref, atol=1e-12)
+        offset += b - a
+    assert joined.domain == (0.0, pytest.approx(offset))
+    assert joined.length == pytest.approx(sum(cv.length for cv in curves), rel=1e-12)
+    joins = np.cumsum([cv.domain[1] - cv.domain[0] for cv in curves])[:-1]
+    for u in joins:
+        assert np.count_nonzero(np.isclose(joined.t, u)) == 3
+
+
+def test_concatenate_refuses_gaps_and_mixed_degrees():
+    a = BSplineCurve(clamped_uniform_knots(4, 3), np.arange(8.0).reshape(4, 2), 3)
+    b = BSplineCurve(clamped_uniform_knots(4, 3), np.arange(8.0).reshape(4, 2) + 1.0, 3)
+    with pytest.raises(InvalidInputError, match="starts .* m from where curve 0 ends"):
+        concatenate([a, b])
+    c = BSplineCurve(clamped_uniform_knots(3, 2), np.arange(6.0).reshape(3, 2) + 6.0, 2)
+    with pytest.raises(InvalidInputError, match="degree 2"):
+        concatenate([a, c])
+    with pytest.raises(InvalidInputError, match="at least one curve"):
+        concatenate([])

@@ -248,9 +248,16 @@ def test_moves_along_its_heading_and_rests_at_cusps(planned, name):
     at = traj.sample(joins)
     np.testing.assert_array_equal(at.v, np.zeros(len(joins)))
     dirs = [p.direction for p in traj.pieces]
-    joined = [s.joined for s in traj.steps.segments]
+    segs = traj.steps.segments
+    drives = traj.steps.drives
+    assert len(drives) == len(traj.pieces)
+    assert [i for g in drives for i in g] == list(range(len(segs)))
+    # a piece starts at a cusp, or at a join the car rests at (curvatures that differ)
+    joined = [segs[g[0]].joined for g in drives]
     flips = [a != b for a, b in zip(dirs[:-1], dirs[1:], strict=True)]
     assert flips == [not j for j in joined[1:]]
+    assert all(segs[i].joined for g in drives for i in g[1:])  # driven through
+    assert traj.stats["car"]["rests"] == sum(joined[1:])
     assert traj.stats["car"]["cusps"] == sum(flips)
     # the heading is continuous: no jump between dense samples
     assert np.abs(np.diff(smp.theta)).max() < 0.05
@@ -497,8 +504,10 @@ def test_split_points_cut_loops_not_wiggles():
 def test_forward_only_loop_is_fitted_in_pieces(pieces, monkeypatch):
     """A goal a cell beside the start, turned by about 3 pi / 2 (held-out AR0046SR #0): the
     forward-only path is a loop of about 6.6 rad. Fitted whole where a curve fits it, or
-    (``pieces``: the whole fits tried first skipped, as when they fail) in pieces, at rest
-    at each join; every piece certified either way."""
+    (``pieces``: the whole fits tried first skipped, as when they fail) in pieces, each
+    starting with the previous one's end curvature, driven through as one piece of the
+    chain: the speed stays above 0 and the curvature is continuous at the joins; every
+    piece certified either way."""
     if pieces:
         monkeypatch.setattr(car_fit, "WHOLE_FIRST", ())
     res = 0.05
@@ -514,6 +523,16 @@ def test_forward_only_loop_is_fitted_in_pieces(pieces, monkeypatch):
     np.testing.assert_allclose([ends.x, ends.y], np.transpose([start, goal]), atol=1e-9)
     assert _angle_diff(ends.theta[0], h0) < 1e-6 and _angle_diff(ends.theta[1], h1) < 1e-6
     np.testing.assert_array_equal(traj.sample(traj.piece_times).v, 0.0)
+    if pieces:  # one drive through the joins: moving at each, the curvature continuous
+        assert len(traj.pieces) == 1 and traj.stats["car"]["rests"] == 0
+        ends_s = np.cumsum([s.smooth_path.length for s in traj.steps.segments])[:-1]
+        drive = traj.pieces[0]
+        t = np.linspace(0.0, drive.duration, 20001)
+        at = np.interp(ends_s, drive.sample(t).s, t)  # the times at the joins
+        for tj in at:
+            near = drive.sample(np.array([tj - 1e-4, tj + 1e-4]))
+            assert near.v.min() > 0.05
+            assert abs(near.kappa[1] - near.kappa[0]) < 1e-2  # continuous (over 2e-4 s)
     kmax = 1.0 / robot.min_turning_radius
     for pts in _dense_points(traj, 0.002):
         assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)

@@ -309,18 +309,22 @@ def test_forward_only_car_brakes_and_plans_forwards():
 
 
 def test_inside_a_stretch_fitted_in_pieces_brakes_on_its_piece(monkeypatch):
-    """A forward-only loop fitted in pieces (the car rests at each join; the whole fits
-    tried first are skipped, as when they fail): a re-plan in the middle of the second
-    piece brakes along that piece's curve and plans on from rest."""
+    """A forward-only loop fitted in pieces (the whole fits tried first are skipped, as when
+    they fail) and driven through as one drive: a re-plan in the middle of the second piece
+    brakes along the drive's curve (across the next join if need be) and plans on from
+    rest."""
     monkeypatch.setattr(car_fit, "WHOLE_FIRST", ())
     grid = astar.OccupancyGrid(walled(4.0, 4.0), RES)
     robot = trajopt.Robot(radius=0.1, drive="ackermann", min_turning_radius=0.4, reverse=False)
     planner = trajopt.Planner(grid, robot)
     goal = (1.95, 2.0)
     traj = planner.plan((2.0, 2.0), goal, start_heading=-2.83, goal_heading=1.7)
-    assert [s.joined for s in traj.steps.segments][1] is True
-    t0, t1 = (float(t) for t in traj.piece_times[1:3])
-    ts = 0.5 * (t0 + t1)
+    segs = traj.steps.segments
+    assert segs[1].joined is True and traj.steps.drives[0][:2] == (0, 1)
+    drive = traj.pieces[0]
+    t = np.linspace(0.0, drive.duration, 20001)
+    s_mid = segs[0].smooth_path.length + 0.5 * segs[1].smooth_path.length
+    ts = float(np.interp(s_mid, drive.sample(t).s, t))  # the middle of the second piece
     out = planner.replan(traj, ts, latency=0.0, reuse=False)
     assert out.stats["replan"] == "braked: reuse=False" and out.stats["brake_m"] > 0.0
     _check_splice(traj, out, ts)

@@ -84,6 +84,7 @@ COLUMNS: dict[str, str] = {
     "heading_motion_error_rad": _FLT,
     "end_heading_error_rad": _FLT,
     "cusp_speed_max_mps": _FLT,
+    "rests": _INT,
     # compute times (s) and where the row was computed
     "runtime_s": _FLT,
     "reference_search_s": _FLT,

@@ -23,7 +23,7 @@ Methods (:data:`METHODS`):
   pose with the query's end headings (:attr:`QueryContext.start_heading`); scored by the
   car metrics of :mod:`~trajopt.analysis.bench._car` too (cusps, reverse length, curvature
   against ``1/R`` per stretch between cusps, motion along the heading, end headings, rest at
-  cusps);
+  cusps), and ``rests``, the stops between cusps (``stats["car"]["rests"]``);
 * ``astar``: the reference polyline itself;
 * ``bspline-fit``, ``polynomial-fit``: the chapter's plain fits of the reference, as
   :func:`trajopt.compare` runs them (``"B-spline fit"``, ``"polynomial fit"``);
@@ -276,6 +276,7 @@ def _car(variant: str) -> MethodFn:
         extras["hybrid_search_s"] = float(search.get("search_s", math.nan))
         extras["hybrid_heuristic_s"] = float(search.get("heuristic_s", math.nan))
         extras["corridor"] = ",".join(stats.get("car", {}).get("corridors", []))
+        extras["rests"] = int(stats.get("car", {}).get("rests", -1))
         return MethodOutput(poly, True, f"{len(traj.pieces)} segment(s)", extras, runtime, score)
 
     return run
