@@ -1,4 +1,4 @@
-"""Upper bounds on the curvature of a piecewise-polynomial curve over parameter intervals.
+"""Bounds on the curvature (and its rate) of a piecewise-polynomial curve over intervals.
 
 The timing needs the largest ``|kappa|`` over every arc-length interval of its cap table,
 however narrow a curvature peak is. Sampling cannot promise that (a near-cusp of a B-spline
@@ -230,23 +230,145 @@ def kappa_bound(
         return np.zeros(m)
     if flip is None:
         flip = np.zeros(m, dtype=np.int8)
+    V = _velocity(curve, a, b, p, flip == -1)  # (zero speed, if any, at t = 0)
+    out = _plain_bound(V)
+    ends = np.flatnonzero(flip != 0)
+    if ends.size:
+        out[ends] = _zero_speed_bound(V[ends], k_free)
+    return out
+
+
+def _velocity(curve, a: np.ndarray, b: np.ndarray, p: int, rev: np.ndarray | None = None):
+    """Velocity polynomials ``V`` (m, p, 2) of ``curve`` on ``[a_i, b_i]`` in ``t`` in [0, 1].
+
+    Coefficients of the powers of ``t = (u - a) / (b - a)`` (of ``1 - t`` where ``rev``).
+    """
     h = b - a
     mid = 0.5 * (a + b)
     # Taylor coefficients of c_t in tau = t - 1/2: gamma_k = h^(k+1) c^(k+1)(mid) / k!
-    gam = np.empty((m, p, 2))
+    gam = np.empty((a.size, p, 2))
     for k in range(p):
         gam[:, k, :] = (
             np.asarray(curve(mid, k + 1), dtype=float) * (h ** (k + 1) / _fact(k))[:, None]
         )
     fwd, bwd = _shift_matrices(p)
-    V = np.einsum("ik,mkd->mid", fwd, gam)  # powers of t (zero speed, if any, at t = 0)
-    rev = flip == -1
-    if np.any(rev):
-        V[rev] = np.einsum("ik,mkd->mid", bwd, gam[rev])  # powers of 1 - t
-    out = _plain_bound(V)
-    ends = np.flatnonzero(flip != 0)
-    if ends.size:
-        out[ends] = _zero_speed_bound(V[ends], k_free)
+    V = np.einsum("ik,mkd->mid", fwd, gam)
+    if rev is not None and np.any(rev):
+        V[rev] = np.einsum("ik,mkd->mid", bwd, gam[rev])
+    return V
+
+
+def curvature_rate_bounds(
+    curve, a: np.ndarray, b: np.ndarray, degree: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Rigorous bounds on ``|kappa|`` from below and ``|d kappa / ds|`` from above.
+
+    On each ``[a_i, b_i]`` inside one polynomial piece of degree ``degree``, with ``X = V x
+    V'`` and ``S = |V|^2`` (module docstring), ``kappa = X / S^(3/2)`` and ``d kappa / ds =
+    (d kappa / dt) / |V| = N / S^3`` with ``N = X' S - 3/2 X S'``. Bernstein ranges give
+    ``|d kappa / ds| <= max |B(N)| / (min B(S))^3`` and, where ``B(X)`` keeps one sign,
+    ``|kappa| >= min |B(X)| / (max B(S))^(3/2)`` (else 0).
+
+    Returns
+    -------
+    kappa_lo, rate_hi : ndarray, shape (m,)
+        1/m and 1/m^2; ``rate_hi`` is ``inf`` where the parametric speed may vanish.
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    p = int(degree)
+    if a.size == 0 or p < 2:
+        return np.zeros(a.size), np.zeros(a.size)
+    V = _velocity(curve, a, b, p)
+    dV = _deriv(V)
+    X = _mul(V[..., 0], dV[..., 1]) - _mul(V[..., 1], dV[..., 0])
+    S = _mul(V[..., 0], V[..., 0]) + _mul(V[..., 1], V[..., 1])
+    N = _mul(_deriv(X), S) - 1.5 * _mul(X, _deriv(S))
+    bs = _bernstein(S)
+    bx = _bernstein(X)
+    s_lo, s_hi = bs.min(axis=1), bs.max(axis=1)
+    n_hi = np.abs(_bernstein(N)).max(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rate = np.where(s_lo > 0.0, n_hi / np.maximum(s_lo, 0.0) ** 3, np.inf)
+        rate = np.where(n_hi == 0.0, 0.0, rate)
+        one_sign = (bx.min(axis=1) > 0.0) | (bx.max(axis=1) < 0.0)
+        k_lo = np.where(one_sign, np.abs(bx).min(axis=1) / s_hi**1.5, 0.0)
+    return k_lo, rate
+
+
+def interval_steer_cap(
+    curve,
+    h: float,
+    n: int,
+    degree: int,
+    cap_of: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    v_free: float,
+    *,
+    rtol: float = 1e-2,
+) -> np.ndarray:
+    """Lower bound on a cap ``cap_of(|kappa|, |d kappa / ds|)`` over each ``[i h, (i + 1) h]``.
+
+    ``cap_of`` must grow with ``|kappa|`` and fall with ``|d kappa / ds|`` (the steering-rate
+    cap, :meth:`trajopt.Robot.steer_speed_cap`): the bounds of
+    :func:`curvature_rate_bounds` then bound it from below. As :func:`interval_kappa_max`,
+    the curve's polynomial pieces are bisected (top down) while a piece's cap is below
+    ``v_free`` (it may bind) and the piece spans more than ``h`` of arc length or its cap is
+    more than ``rtol`` below the lowest exact cap at three interior points; each final
+    piece's cap goes to every grid interval its exact arc-length range touches. Where the
+    parametric speed may vanish the bound is infinite and the sampled cap is used instead
+    (the library's curves never stop inside; a zero-speed end of another curve does).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Caps (m/s), ``inf`` where the curvature does not change.
+    """
+    lo, hi = (float(x) for x in curve.domain)
+    bp = np.asarray(curve.breakpoints(), dtype=float)
+    w = np.union1d([lo, hi], bp[(bp > lo) & (bp < hi)])
+    a, b = w[:-1], w[1:]
+    keep = b > a
+    a, b = a[keep], b[keep]
+    sa, sb = _s_at(curve, a), _s_at(curve, b)
+
+    def caps(a, b):
+        k_lo, rate = curvature_rate_bounds(curve, a, b, degree)
+        u = np.stack([a + 0.01 * (b - a), 0.5 * (a + b), b - 0.01 * (b - a)])
+        sampled = np.asarray(
+            cap_of(np.abs(curve.curvature(u)), np.abs(curve.curvature_rate(u))), dtype=float
+        ).min(axis=0)
+        bound = np.asarray(cap_of(k_lo, rate), dtype=float)
+        return np.where(np.isfinite(rate), bound, sampled), sampled
+
+    c_b, c_s = caps(a, b)
+    split = (c_b < v_free) & ((sb - sa > h) | (c_b < c_s * (1.0 - rtol)))
+    work = a.size
+    done = [(sa[~split], sb[~split], c_b[~split])]
+    for _ in range(MAX_DEPTH):
+        if not np.any(split) or work >= MAX_WORK:
+            break
+        la, lb, lsa, lsb = a[split], b[split], sa[split], sb[split]
+        mid = 0.5 * (la + lb)
+        smid = _s_at(curve, mid)
+        a, b = np.concatenate([la, mid]), np.concatenate([mid, lb])
+        sa, sb = np.concatenate([lsa, smid]), np.concatenate([smid, lsb])
+        c_b, c_s = caps(a, b)
+        work += a.size
+        split = (c_b < v_free) & ((sb - sa > h) | (c_b < c_s * (1.0 - rtol)))
+        done.append((sa[~split], sb[~split], c_b[~split]))
+    if np.any(split):  # out of depth or work: the (rigorous) caps as they are
+        done.append((sa[split], sb[split], c_b[split]))
+    s_a = np.concatenate([d[0] for d in done])
+    s_b = np.concatenate([d[1] for d in done])
+    c = np.concatenate([d[2] for d in done])
+    i_a = np.clip((s_a / h).astype(np.int64), 0, n - 1)
+    i_b = np.clip((s_b / h).astype(np.int64), 0, n - 1)
+    count = i_b - i_a + 1
+    idx = np.repeat(i_a, count) + (
+        np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    )
+    out = np.full(n, np.inf)
+    np.minimum.at(out, idx, np.repeat(c, count))
     return out
 
 

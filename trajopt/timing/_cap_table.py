@@ -174,7 +174,7 @@ def build_cap_table(
     if zone is not None:
         ci = np.minimum(ci, zone)
     if robot.drive == "ackermann" and robot.steer_rate_max is not None:
-        ci = np.minimum(ci, steer_caps(curve, robot, u_nodes))
+        ci = np.minimum(ci, steer_caps(curve, robot, u_nodes, h, degree))
     # ci = max(ci (1 - margin), min(ci, max(v_start, v_end))), the ends at least the
     # boundary speeds (up to the cap at the end nodes), its sparse table and local minima
     ci = np.array(ci, dtype=float)  # a fresh array: changed in place

@@ -5,28 +5,36 @@ speed ``v`` the steering rate is ``d delta / dt = L (d kappa / ds) v / (1 + (L k
 so ``|d delta / dt| <= steer_rate_max`` is a speed cap,
 ``v <= steer_rate_max (1 + (L kappa)^2) / (L |d kappa / ds|)``
 (:meth:`trajopt.Robot.steer_speed_cap`), folded into the timing's cap table beside the
-curvature caps. Choice: the cap of an interval of the table is the lowest of the exact
-pointwise cap at the interval's two nodes and :data:`INNER` points evenly spaced in the
-curve parameter between them, less :data:`MARGIN`: a sampled bound on a grid of spacing
-2.5 mm, longer on curves over 41 m (the cubic B-spline's ``d kappa / ds`` is smooth within its pieces and the grid is
-far finer than a piece), not the rigorous Bernstein bound of the curvature caps. The steering
-rate is a tracking limit, not a clearance guarantee.
+curvature caps. For a curve with a ``polynomial_degree`` (every curve of the library) the cap
+of an interval of the table is a rigorous lower bound over the whole interval
+(:func:`~trajopt.geometry._curvature_bound.interval_steer_cap`: Bernstein bounds of
+``|d kappa / ds|`` from above and ``|kappa|`` from below on bisected polynomial pieces), so
+the steering rate holds everywhere, between samples too. For other curves it is the lowest
+of the exact pointwise cap at the interval's two nodes and :data:`INNER` points evenly
+spaced in the curve parameter between them, less :data:`MARGIN` (sampled).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from trajopt.geometry._curvature_bound import interval_steer_cap
 from trajopt.geometry._curve import ParametricCurve
 from trajopt.robot._robot import Robot
 
-#: Points per interval besides its nodes where the steering cap is evaluated.
+#: Points per interval besides its nodes where the sampled steering cap is evaluated.
 INNER = 3
-#: Relative margin below the sampled cap.
+#: Relative margin below the sampled cap (curves without a polynomial degree).
 MARGIN = 1e-3
 
 
-def steer_caps(curve: ParametricCurve, robot: Robot, u_nodes: np.ndarray) -> np.ndarray:
+def steer_caps(
+    curve: ParametricCurve,
+    robot: Robot,
+    u_nodes: np.ndarray,
+    h: float | None = None,
+    degree: int | None = None,
+) -> np.ndarray:
     """Return the steering-rate speed cap of each interval between ``u_nodes`` (m/s).
 
     Parameters
@@ -37,6 +45,11 @@ def steer_caps(curve: ParametricCurve, robot: Robot, u_nodes: np.ndarray) -> np.
         A car-like robot with ``steer_rate_max`` and ``wheelbase``.
     u_nodes : ndarray, shape (n + 1,)
         Curve parameter at the nodes of the cap table.
+    h : float, optional
+        The table's arc-length spacing (m), with ``degree``.
+    degree : int, optional
+        The curve's ``polynomial_degree``: the rigorous caps (module docstring); without
+        it the sampled ones.
 
     Returns
     -------
@@ -44,6 +57,10 @@ def steer_caps(curve: ParametricCurve, robot: Robot, u_nodes: np.ndarray) -> np.
         A cap per interval (``inf`` where the steering does not change).
     """
     u = np.asarray(u_nodes, dtype=float)
+    if degree is not None and h is not None:
+        return interval_steer_cap(
+            curve, float(h), u.shape[0] - 1, int(degree), robot.steer_speed_cap, robot.v_max
+        )
     frac = np.arange(INNER + 2, dtype=float) / (INNER + 1)
     pts = u[:-1, None] + (u[1:] - u[:-1])[:, None] * frac[None, :]  # (n, INNER + 2)
     cap = np.asarray(robot.steer_speed_cap(curve.curvature(pts), curve.curvature_rate(pts)))
