@@ -136,15 +136,24 @@ def interval_kappa_max(
     s_a = np.concatenate([d[2] for d in done])
     s_b = np.concatenate([d[3] for d in done])
     k = np.concatenate([d[4] for d in done])
+    return _to_grid(s_a, s_b, k, h, n, np.maximum, 0.0)
+
+
+def _to_grid(s_a, s_b, values, h: float, n: int, ufunc, fill: float) -> np.ndarray:
+    """Spread each piece's value over the grid intervals its arc-length range touches.
+
+    Interval ``[i h, (i + 1) h]`` combines the values of every piece ``[s_a, s_b]`` that
+    touches it by ``ufunc`` (``np.maximum`` or ``np.minimum``), starting from ``fill``.
+    """
     i_a = np.clip((s_a / h).astype(np.int64), 0, n - 1)
     i_b = np.clip((s_b / h).astype(np.int64), 0, n - 1)
     count = i_b - i_a + 1
     idx = np.repeat(i_a, count) + (
         np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
     )
-    kmax = np.zeros(n)
-    np.maximum.at(kmax, idx, np.repeat(k, count))
-    return kmax
+    out = np.full(n, fill)
+    ufunc.at(out, idx, np.repeat(values, count))
+    return out
 
 
 def _s_at(curve, u: np.ndarray) -> np.ndarray:
@@ -361,15 +370,7 @@ def interval_steer_cap(
     s_a = np.concatenate([d[0] for d in done])
     s_b = np.concatenate([d[1] for d in done])
     c = np.concatenate([d[2] for d in done])
-    i_a = np.clip((s_a / h).astype(np.int64), 0, n - 1)
-    i_b = np.clip((s_b / h).astype(np.int64), 0, n - 1)
-    count = i_b - i_a + 1
-    idx = np.repeat(i_a, count) + (
-        np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
-    )
-    out = np.full(n, np.inf)
-    np.minimum.at(out, idx, np.repeat(c, count))
-    return out
+    return _to_grid(s_a, s_b, c, h, n, np.minimum, np.inf)
 
 
 def _plain_bound(V: np.ndarray) -> np.ndarray:

@@ -207,8 +207,6 @@ class WorkingSetSolver:
         self.solver = None
         self.sel: np.ndarray | None = None  # the triplets the set-up solver holds
         self.order: np.ndarray | None = None  # their positions in its CSC data
-        self.keep_row: np.ndarray | None = None
-        self.keep_col: np.ndarray | None = None
         self.G = None
 
     def __call__(
@@ -264,7 +262,7 @@ class WorkingSetSolver:
                 full, g, layout, trip, lbx, ubx, lba, uba, active, slack_penalty
             )
         self.order = rank.data.astype(np.int64) - 1
-        self.sel, self.keep_row, self.keep_col, self.G = sel, keep_row, keep_col, G
+        self.sel, self.G = sel, G
         self.solver = piqp.SparseSolver()
         self.solver.settings.verbose = False
         for name, value in SCP_QP_TOLERANCES.items():
