@@ -35,10 +35,30 @@ def walled(width: float, height: float, res: float) -> np.ndarray:
 
 
 def door_grid() -> astar.OccupancyGrid:
-    occ = walled(3.0, 2.0, 0.05)
+    """60 x 40 cells of 5 cm: a wall at x = 1.5 m with a 0.6 m door, a block below."""
+    occ = np.zeros((40, 60), bool)
     occ[:, 30] = True
-    occ[17:23, 30] = False  # a 0.3 m door at x = 1.5 m
+    occ[16:28, 30] = False
+    occ[5:12, 40:50] = True
     return astar.OccupancyGrid(occ, 0.05)
+
+
+def zigzag_grid(gap: int = 5, legs: int = 6, leg: int = 6):
+    """A staircase corridor the box corridor cannot smooth for a 0.12 m disc."""
+    size = 2 * gap + legs * leg + 10
+    occ = np.ones((size, size), bool)
+    x = y = 3
+    for k in range(legs):
+        if k % 2 == 0:
+            occ[y : y + gap, x : x + leg + gap] = False
+            x += leg
+        else:
+            occ[y : y + leg + gap, x : x + gap] = False
+            y += leg
+    res = 0.05
+    start = ((3 + gap / 2) * res + 0.004, (3 + gap / 2) * res + 0.003)
+    goal = ((x + gap / 2) * res, (y + gap / 2) * res - 0.004)
+    return astar.OccupancyGrid(occ, res), start, goal
 
 
 def bay_grid() -> astar.OccupancyGrid:
@@ -141,9 +161,9 @@ def cases() -> dict[str, Callable[[], object]]:
     def replans() -> dict[str, object]:
         planner = trajopt.Planner(grid, disc)
         traj = planner.plan(sp, targets["D"])
-        keep = planner.replan(traj, 0.3 * traj.duration)
-        moved = planner.replan(traj, 0.3 * traj.duration, goal=targets["C"])
-        back = planner.replan(traj, 0.5 * traj.duration, goal=sp)
+        keep = planner.replan(traj, 0.3 * traj.duration, latency=0.0)
+        moved = planner.replan(traj, 0.3 * traj.duration, goal=targets["C"], latency=0.0)
+        back = planner.replan(traj, 0.5 * traj.duration, goal=sp, latency=0.0)
         return {"keep": keep, "moved": moved, "back": back}
 
     out["replan_keep"] = lambda: replans()["keep"]
@@ -160,12 +180,13 @@ def cases() -> dict[str, Callable[[], object]]:
     def omni_replan() -> object:
         planner = trajopt.Planner(door, omni)
         traj = planner.plan((0.4, 1.1), (2.6, 1.1), start_heading=math.pi, goal_heading=0.0)
-        return planner.replan(traj, traj.duration / 3, goal=(2.6, 0.5))
+        return planner.replan(traj, traj.duration / 3, goal=(2.6, 1.6), latency=0.0)
 
     out["replan_omni"] = omni_replan
+    zz, zs, zg = zigzag_grid()
+    small = trajopt.Robot(radius=0.12)
     out["fallback"] = lambda: trajopt.plan(
-        grid, sp, targets["D"], disc, fallback="stop_and_turn",
-        smoother=trajopt.Smoother(kappa_max=40.0, time_budget_s=0.01),
+        zz, zs, zg, small, goal_heading=0.0, fallback="stop_and_turn", corridor="boxes"
     )
     # refusals
     out["bad_drive"] = lambda: trajopt.Robot(drive="tank")
