@@ -5,7 +5,8 @@ Pipeline: :func:`astar.inflate` -> :func:`astar.find_path` -> :func:`build_polyg
 with :func:`plan` (one query) and :class:`Planner` (many queries and re-plans on one map).
 
 **Core**: :func:`plan`, :class:`Planner` (settings as one value: :class:`PlannerOptions`),
-:class:`Robot`, :class:`Trajectory`,
+:class:`Robot` with its drive (:class:`Differential`, :class:`Omni`, :class:`Ackermann`, the
+:class:`Drive` protocol), :class:`Trajectory` (every plan is a :class:`PlanResult`),
 :class:`State`, :class:`Smoother`, the errors (:class:`TrajoptError` and its subclasses)
 and :func:`warm_up` (compile the numerical kernels ahead of time).
 
@@ -21,7 +22,7 @@ and :func:`warm_up` (compile the numerical kernels ahead of time).
 modules ``trajopt.metrics``, ``trajopt.fits``, ``trajopt.scenes``, ``trajopt.plotting``,
 ``trajopt.comparison`` and ``trajopt.bench`` (all in :mod:`trajopt.analysis`).
 
-The packages below hold the stages (``geometry``, ``robot``, ``motion``, ``corridor``,
+The packages below hold the stages (``geometry``, ``drive``, ``robot``, ``motion``, ``corridor``,
 ``smoother``, ``timing``, ``planning``, ``replan``, ``analysis``); ``docs/architecture.md``
 draws the flow. Names are imported lazily (PEP 562) so that ``import trajopt`` stays fast;
 heavy dependencies (CasADi, ruckig, matplotlib) load when first used.
@@ -43,6 +44,11 @@ _EXPORTS: dict[str, str] = {
     "Planner": "trajopt._planner",
     "PlannerOptions": "trajopt._planner",
     "Robot": "trajopt.robot",
+    "Differential": "trajopt.drive",
+    "Omni": "trajopt.drive",
+    "Ackermann": "trajopt.drive",
+    "Drive": "trajopt.drive",
+    "PlanResult": "trajopt.motion",
     "State": "trajopt.robot",
     "Trajectory": "trajopt.motion",
     "Smoother": "trajopt.smoother",
@@ -124,6 +130,7 @@ if TYPE_CHECKING:  # pragma: no cover
         build_corridor,
         build_polygon_corridor,
     )
+    from trajopt.drive import Ackermann, Differential, Drive, Omni
     from trajopt.errors import (
         IllPosedFitError,
         InvalidInputError,
@@ -135,6 +142,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.geometry import BSplineCurve, ParametricCurve
     from trajopt.motion import (
         OmniTrajectory,
+        PlanResult,
         StopAndTurnTrajectory,
         Trajectory,
         TrajectoryChain,

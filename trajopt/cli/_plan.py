@@ -202,8 +202,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         f"duration {traj.duration:.3f} s, length {traj.length:.3f} m, "
         f"planned in {1e3 * (float('nan') if total is None else total):.1f} ms"
     )
-    if robot.drive != "differential":
-        line += f", {robot.drive} drive"
+    line += f", {robot.drive.name} drive"
     if traj.stats.get("corridor"):
         line += f", corridor {traj.stats['corridor']}"
     line += _turn_note(traj.stats)
@@ -233,7 +232,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
         name = "stop and turn" if traj.stats.get("fallback") else "proposed"
-        posed = robot.drive != "differential" or (
+        posed = robot.drive.orients_body or robot.drive.signed_speed or (
             args.start_heading is not None or args.goal_heading is not None
         )
         plot_paths(

@@ -318,7 +318,7 @@ def interval_steer_cap(
     """Lower bound on a cap ``cap_of(|kappa|, |d kappa / ds|)`` over each ``[i h, (i + 1) h]``.
 
     ``cap_of`` must grow with ``|kappa|`` and fall with ``|d kappa / ds|`` (the steering-rate
-    cap, :meth:`trajopt.Robot.steer_speed_cap`): the bounds of
+    cap, :meth:`trajopt.drive.Ackermann.steer_speed_cap`): the bounds of
     :func:`curvature_rate_bounds` then bound it from below. As :func:`interval_kappa_max`,
     the curve's polynomial pieces are bisected (top down) while a piece's cap is below
     ``v_free`` (it may bind) and the piece spans more than ``h`` of arc length or its cap is

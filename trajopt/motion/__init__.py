@@ -7,6 +7,7 @@
   one after another (a braking re-plan);
 * :class:`OmniTrajectory`: an omnidirectional base's translation with an orientation of its
   own (built by :func:`trajopt.timing.orient`);
+* :class:`PlanResult`: the protocol every plan and re-plan satisfies;
 * :class:`TrajectorySample`, :class:`OmniSample` and :class:`CarSample` (a car-like
   robot's signed speed, direction of travel and steering), and the ROS 2 MCAP writer and reader.
 """
@@ -14,6 +15,7 @@
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
 from trajopt.motion._omni import OmniTrajectory
+from trajopt.motion._result import PlanResult
 from trajopt.motion._samples import CarSample, OmniSample, TrajectorySample
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.motion._trajectory import Trajectory
@@ -24,6 +26,7 @@ __all__ = [
     "McapExportError",
     "OmniSample",
     "OmniTrajectory",
+    "PlanResult",
     "StopAndTurnTrajectory",
     "Trajectory",
     "TrajectoryChain",

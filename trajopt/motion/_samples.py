@@ -173,15 +173,6 @@ def make_sample(robot: Robot, **arrays: np.ndarray) -> TrajectorySample | CarSam
     track width, and a car-like robot's steering angle ``atan(wheelbase * kappa)`` when it
     has a wheelbase (with ``steer_rate``, given as ``dkappa_dt``: ``d kappa / dt`` (1/(m s))).
     """
-    dkappa_dt = arrays.pop("dkappa_dt", None)
-    if robot.drive == "ackermann" and robot.wheelbase is not None:
-        lk = robot.wheelbase * arrays["kappa"]
-        arrays["steer"] = np.arctan(lk)
-        if dkappa_dt is not None and "steer_rate" not in arrays:
-            arrays["steer_rate"] = robot.wheelbase * dkappa_dt / (1.0 + lk * lk)
-    if robot.track_width is not None and robot.drive != "omni":
-        half = 0.5 * robot.track_width
-        arrays["v_left"] = arrays["v"] - arrays["omega"] * half
-        arrays["v_right"] = arrays["v"] + arrays["omega"] * half
-    kind = CarSample if robot.drive == "ackermann" else TrajectorySample
+    robot.drive.sample_fields(robot, arrays, arrays.pop("dkappa_dt", None))
+    kind = CarSample if robot.drive.signed_speed else TrajectorySample
     return kind(**{k: readonly(x) for k, x in arrays.items()})

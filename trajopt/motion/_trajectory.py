@@ -458,10 +458,10 @@ class Trajectory(SampledExport):
             theta = raw
         omega = kappa * v
         extra: dict[str, np.ndarray] = {}
-        if self.robot.drive == "ackermann":
+        if self.robot.drive.signed_speed:
             d = float(self.direction)
             extra["direction"] = np.full(np.shape(v), d)
-            if self.robot.wheelbase is not None:  # d kappa_body / dt = d * dkappa/ds * ds/dt
+            if self.robot.drive.steering is not None:  # d kappa_body / dt = d dkappa/ds ds/dt
                 extra["dkappa_dt"] = np.asarray(path.curvature_rate(u)) * v
             if d < 0.0:  # the body's quantities (class docstring)
                 v, a, j, kappa = -v, -a, -j, -kappa

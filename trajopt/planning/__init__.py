@@ -1,12 +1,29 @@
 """One planning query, from map and ends to a timed trajectory (the stages' driver).
 
 Internal: users call :func:`trajopt.plan` and :class:`trajopt.Planner`. The package holds
-the query record and its intermediate results (:class:`PlanSteps`), the corridor fit with
-its witness rescue, the opt-in fallback and the footprint robots' disc ladder.
+the query record and its intermediate results (:class:`PlanSteps`), the options and the
+map's caches, the one query runner (:func:`run_query`) and the stages the drives compose:
+a disc's or a footprint's plan (:func:`plan_free`), pose to pose with turns in place
+(:func:`plan_turning`), an omnidirectional base's (:func:`plan_omni`) and a car's
+(:func:`plan_car`).
 """
 
-from trajopt.planning._query import PlanSteps
+from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._car import plan_car
+from trajopt.planning._omni import plan_omni
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.planning._query import PlanSteps, WarmStart
+from trajopt.planning._runner import plan_free, plan_turning, run_query
 
 __all__ = [
+    "PlanRequest",
     "PlanSteps",
+    "PlannerCaches",
+    "PlannerOptions",
+    "WarmStart",
+    "plan_car",
+    "plan_free",
+    "plan_omni",
+    "plan_turning",
+    "run_query",
 ]

@@ -5,7 +5,7 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
 (x, y, heading):
 
 1. **Search** (:mod:`trajopt.planning._car_tries`). :func:`astar.find_pose_path`
-   (Hybrid-A* with Reeds-Shepp shots, or Dubins shots when ``robot.reverse`` is False) from
+   (Hybrid-A* with Reeds-Shepp shots, or Dubins shots when ``robot.drive.reverse`` is False) from
    the start pose to the goal pose, on the raw map inflated by the robot radius plus a
    margin, with a turning radius a little above ``R``; gentler or tighter radii and the grid
    inflated by the radius alone are the further tries, all within one budget;
@@ -184,7 +184,7 @@ def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanReques
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
     goal = _to_cells(grid, p1, h1)
-    kmax = 1.0 / robot.min_turning_radius
+    kmax = 1.0 / robot.drive.min_turning_radius
     sm = options.smoother
     sm = dataclasses.replace(
         sm,
@@ -321,8 +321,8 @@ def _time_drive(options: PlannerOptions, segs: list[CarSegment]) -> Trajectory:
     if len(segs) > 1:
         path = concatenate([s.smooth_path.curve for s in segs])
     limits = robot
-    if seg.direction < 0 and robot.v_max_backwards != robot.v_max:
-        limits = dataclasses.replace(robot, v_max=robot.v_max_backwards)
+    if seg.direction < 0 and robot.drive.v_max_backwards(robot) != robot.v_max:
+        limits = dataclasses.replace(robot, v_max=robot.drive.v_max_backwards(robot))
     traj = time_parameterize(
         path,
         limits,

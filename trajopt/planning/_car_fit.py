@@ -216,7 +216,7 @@ def fit_segment(
     pts = np.ascontiguousarray(poses[first : last + 1, :2])
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
-    kmax = 1.0 / robot.min_turning_radius
+    kmax = 1.0 / robot.drive.min_turning_radius
     errors: list[str] = []
     corridor = None
     # the end's curvature along the direction of travel, from the last two poses (on an arc)

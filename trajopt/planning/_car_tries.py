@@ -1,7 +1,7 @@
 """The tries of a car's plan: search grids, search radii and their fits, within a budget.
 
 :func:`search_and_fit` runs :func:`astar.find_pose_path` (Hybrid-A* with Reeds-Shepp
-shots, or Dubins shots when ``robot.reverse`` is False) from the start pose to the goal pose,
+shots, or Dubins shots when ``robot.drive.reverse`` is False) from the start pose to the goal pose,
 on the raw map inflated by the robot radius plus :data:`SEARCH_MARGIN_CELLS`
 (:func:`car_search_grid`: every point of a free cell, not only its centre, keeps the radius:
 the search's poses lie anywhere in their cells), with a turning radius
@@ -167,7 +167,7 @@ def search_and_fit(
         for factor in SEARCH_RADIUS_FACTORS:
             if factor > largest or time.perf_counter() > t_end:
                 continue
-            r_cells = factor * robot.min_turning_radius / res
+            r_cells = factor * robot.drive.min_turning_radius / res
             try:
                 with timer.stage("search"):
                     path = astar.find_pose_path(
@@ -175,7 +175,7 @@ def search_and_fit(
                         start,
                         goal,
                         turning_radius=r_cells,
-                        reverse=robot.reverse,
+                        reverse=robot.drive.reverse,
                         time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
                         **exact_clearance(robot, grid, margin),
                     )
@@ -310,12 +310,12 @@ def failure(
         last = searches[-1]
         mode = (
             "forwards and backwards"
-            if robot.reverse
+            if robot.drive.reverse
             else "forwards only (reverse=False): no forward-only path was found; a goal only "
             "reachable backwards needs reverse=True"
         )
         err = NoPathError(
-            f"no path of a car-like robot (turning radius {robot.min_turning_radius} m, radius "
+            f"no path of a car-like robot (turning radius {robot.drive.min_turning_radius} m, radius "
             f"{robot.radius} m) driving {mode}, from pose {pose_m(start, grid)} to pose "
             f"{pose_m(goal, grid)} ({last.reason}): {last} (tries: {summary})"
         )

@@ -22,7 +22,7 @@ from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.geometry._clearance import points_clearance, polygon_clearance
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.motion import PlanResult
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
@@ -40,7 +40,6 @@ from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
 
 #: What a query returns: a smooth trajectory, or the stop-and-turn fallback.
-PlanResult = Trajectory | StopAndTurnTrajectory
 #: A check of the grid path after the search: ``(caches, query) -> (grid path, inflated
 #: grid it was found on)`` (a footprint robot's oriented check).
 PathCheck = Callable[[PlannerCaches, PlanQuery], tuple[astar.GridPath, OccupancyGrid]]

@@ -61,10 +61,8 @@ PIN_BUDGET_S = 0.25
 TURN_PIECE_RAD = math.pi / 8
 
 
-def needs_pose_plan(robot: Robot, request: PlanRequest) -> bool:
-    """Whether :func:`plan_pose` applies: a differential drive that may turn at a given end."""
-    if robot.drive != "differential":
-        return False
+def needs_pose_plan(request: PlanRequest) -> bool:
+    """Whether :func:`plan_pose` applies: a base that turns in place, at an end it may turn."""
     return bool(_turn_ends(at_rest(request)))
 
 

@@ -9,10 +9,8 @@ explicit inputs.
 from __future__ import annotations
 
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._car import plan_car
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._footprint_ladder import plan_with_footprint
-from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._pose import needs_pose_plan, plan_pose
 from trajopt.planning._query import WarmStart
@@ -25,14 +23,14 @@ def run_query(
     warm: WarmStart | None = None,
     budget_s: float | None = None,
 ) -> PlanResult:
-    """Plan one query: a disc robot's stages, or a footprint robot's disc ladder.
+    """Plan one query with the stages the robot's drive composes (:meth:`Drive.plan`).
 
-    A differential drive given an end heading where it stands still plans pose to pose
-    (:func:`~trajopt.planning._pose.plan_pose`: turns in place where they are faster or
-    where no curve leaves along the heading); an omnidirectional base plans the path of its
+    A differential drive plans a disc robot's stages or a footprint robot's disc ladder,
+    pose to pose with turns in place where they are faster or where no curve leaves along
+    a given heading (:func:`plan_turning`); an omnidirectional base plans the path of its
     (circumscribed) disc and turns its orientation while it drives
-    (:func:`~trajopt.planning._omni.plan_omni`); a car-like robot plans pose to pose with
-    a turning radius and cusps (:func:`~trajopt.planning._car.plan_car`; no warm start).
+    (:func:`~trajopt.planning._omni.plan_omni`); a car-like robot plans pose to pose with a
+    turning radius and cusps (:func:`~trajopt.planning._car.plan_car`; no warm start).
 
     Parameters
     ----------
@@ -51,25 +49,38 @@ def run_query(
 
     Returns
     -------
-    Trajectory, StopAndTurnTrajectory, TrajectoryChain or OmniTrajectory
+    PlanResult
         See :meth:`trajopt.Planner.plan`.
     """
     options = options.with_budget(budget_s)
-    if options.robot.drive == "ackermann":
-        return plan_car(options, caches, request)
-    if options.robot.drive == "omni":
-        return plan_omni(options, caches, request, warm)
-    if needs_pose_plan(options.robot, request):
+    return options.robot.drive.plan(options, caches, request, warm)
+
+
+def plan_turning(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    warm: WarmStart | None = None,
+) -> PlanResult:
+    """Plan for a base that faces its direction of travel and turns in place at rest.
+
+    Pose to pose (:func:`~trajopt.planning._pose.plan_pose`) where a heading is given at
+    an end where the robot rests, else :func:`plan_free`.
+    """
+    if needs_pose_plan(request):
 
         def plan(req: PlanRequest, w: WarmStart | None, b: float | None) -> PlanResult:
-            return _plan(options.with_budget(b), caches, req, w)
+            return plan_free(options.with_budget(b), caches, req, w)
 
         return plan_pose(options, caches.grid, request, plan, warm)
-    return _plan(options, caches, request, warm)
+    return plan_free(options, caches, request, warm)
 
 
-def _plan(
-    options: PlannerOptions, caches: PlannerCaches, request: PlanRequest, warm: WarmStart | None
+def plan_free(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    warm: WarmStart | None = None,
 ) -> PlanResult:
     """Run a disc robot's stages, or a footprint robot's disc ladder (which starts afresh)."""
     if options.robot.footprint is not None:

@@ -1,11 +1,16 @@
 """Re-planning from a trajectory being driven: keep, re-plan, or brake, turn in place and go.
 
-Internal: users call :meth:`trajopt.Planner.replan`.
+Internal: users call :meth:`trajopt.Planner.replan`. :func:`replan_from` checks the splice
+and asks the robot's drive to re-plan: :func:`replan_moving` for a base that turns in place,
+:func:`replan_car` for a car.
 """
 
-from trajopt.replan._replan import BRAKE_AFTER_S, replan_from
+from trajopt.replan._car import replan_car
+from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, replan_moving
 
 __all__ = [
     "BRAKE_AFTER_S",
+    "replan_car",
     "replan_from",
+    "replan_moving",
 ]

@@ -223,7 +223,7 @@ def brake_turn_go(
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     try:
         # an omni base turns while it drives: its plan starts at the heading it stops with
-        h0 = float(stop.theta[0]) if robot.drive == "omni" else None
+        h0 = float(stop.theta[0]) if robot.drive.orients_body else None
         request = PlanRequest(
             p_stop, goal, start_heading=h0, goal_heading=goal_heading, v_end=v_end
         )

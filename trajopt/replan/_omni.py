@@ -94,7 +94,7 @@ def course_orientation(trajectory: Any, ts: float, robot: Robot) -> Orientation 
     starts its orientation at rest (a jump in yaw rate, as before omni re-plans continued
     it).
     """
-    if robot.drive != "omni" or type(trajectory) is not Trajectory:
+    if not robot.drive.orients_body or type(trajectory) is not Trajectory:
         return None
     smp = trajectory.sample(np.array([ts]))
     theta, kappa = float(smp.theta[0]), float(smp.kappa[0])

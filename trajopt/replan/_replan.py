@@ -47,12 +47,11 @@ from trajopt.errors import InvalidInputError, SmoothingError, TimingError, Trajo
 from trajopt.motion._chain import TrajectoryChain, TurnInPlace
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import check_endpoint
+from trajopt.planning._disc import PlanResult, check_endpoint
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import WarmStart
 from trajopt.planning._runner import run_query
 from trajopt.replan._brake import brake_turn_go
-from trajopt.replan._car import replan_car
 from trajopt.replan._keep import (
     BLOCKED_NEAR,
     keep_omni,
@@ -71,7 +70,7 @@ NO_REUSE = "reuse=False"
 def replan_from(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     t: float,
     goal: Sequence[float] | None,
     grid: OccupancyGrid | None,
@@ -81,8 +80,11 @@ def replan_from(
     v_end: float,
     reuse: bool = True,
     brake_after_s: float | None = BRAKE_AFTER_S,
-) -> Any:
+) -> PlanResult:
     """Return :meth:`~trajopt._planner.Planner.replan`'s trajectory (see there).
+
+    The robot's drive re-plans (:meth:`trajopt.drive.Drive.replan`): :func:`replan_moving`
+    for a base that turns in place, :func:`~trajopt.replan._car.replan_car` for a car.
 
     ``options`` and ``caches`` are the planner's; ``latency`` (s) is the splice's lead
     (the planner passes its recent median when the caller gives none); ``grid``, an
@@ -109,18 +111,38 @@ def replan_from(
         brake_after_s = number("brake_after_s", brake_after_s, unit="s", lo=0.0, strict=True)
     if grid is not None:
         caches.update(grid)
-    if options.robot.drive == "ackermann":  # never a turn in place: keep, or brake and plan
-        out = replan_car(
-            options,
-            caches,
-            trajectory,
-            ts,
-            goal,
-            goal_heading=goal_heading,
-            v_end=v_end,
-            reuse=reuse,
-        )
-        return dataclasses.replace(out, stats=dict(out.stats, splice_time_s=ts, latency_s=lat))
+    out = options.robot.drive.replan(
+        options,
+        caches,
+        trajectory,
+        ts,
+        goal,
+        goal_heading=goal_heading,
+        v_end=v_end,
+        reuse=reuse,
+        brake_after_s=brake_after_s,
+    )
+    return dataclasses.replace(out, stats=dict(out.stats, splice_time_s=ts, latency_s=lat))
+
+
+def replan_moving(
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    trajectory: PlanResult,
+    ts: float,
+    goal: Sequence[float],
+    *,
+    goal_heading: float | None,
+    v_end: float,
+    reuse: bool = True,
+    brake_after_s: float | None = BRAKE_AFTER_S,
+) -> PlanResult:
+    """Keep the rest, plan from the moving state at ``ts``, or brake, turn and go.
+
+    The re-plan of a base that turns in place (a differential drive, an omnidirectional
+    base; module docstring); ``stats["replan"]`` says which was done. The arguments are
+    :func:`replan_from`'s, checked.
+    """
     out, why = None, NO_REUSE
     piece, t_piece = trajectory, ts
     if isinstance(trajectory, TrajectoryChain):
@@ -144,8 +166,6 @@ def replan_from(
         stats["replan"] = "kept"
     elif not str(stats.get("replan", "")).startswith("braked"):
         stats["replan"] = f"planned: {why}"
-    stats["splice_time_s"] = ts
-    stats["latency_s"] = lat
     return dataclasses.replace(out, stats=stats)
 
 

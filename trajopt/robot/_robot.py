@@ -20,42 +20,20 @@ field                     default    meaning
 ``drive``                 differential  how the base moves (below)
 ========================  =========  =========================================================
 
-Drive types (``drive``):
-
-* ``"differential"`` (the default): the robot faces its direction of travel; it can turn in
-  place at rest, so a required start or goal heading is met by turning there when no curve
-  can leave (arrive) along it.
-* ``"omni"`` (mecanum or omni-wheel bases): the orientation is independent of the direction
-  of travel. The path is planned as for a disc (with a footprint: its circumscribed disc,
-  which holds it in every orientation) and the orientation is its own jerk-limited profile,
-  turned while driving. ``omega_max`` bounds the yaw rate of that profile and not the
-  speed along a curve, and the wheel terms (``track_width``, ``wheel_v_max``) of a
-  differential drive do not apply to its speed cap.
-* ``"ackermann"`` (car-like: forklifts, tuggers, carts): it faces its direction of travel
-  (forwards, or backwards when ``reverse``), cannot turn in place and turns no tighter than
-  ``min_turning_radius`` (required). Plans are Hybrid-A* paths (:func:`astar.find_pose_path`)
-  split at their cusps, each segment a certified curve with ``|kappa| <= 1 / R``, timed from
-  rest to rest (:mod:`trajopt.planning._car`). Its own fields:
-
-  =======================  =========  ======================================================
-  field                    default    meaning
-  =======================  =========  ======================================================
-  ``min_turning_radius``   (required) ``R`` (m): the path's curvature is at most ``1/R``
-  ``reverse``              True       may drive backwards (Reeds-Shepp); False: forwards
-                                      only (Dubins)
-  ``wheelbase``            None       ``L`` (m): samples then carry the steering angle
-                                      ``atan(L kappa)``
-  ``v_max_reverse``        None       backwards speed limit (m/s); ``None`` is ``v_max``
-  ``steer_rate_max``       None       steering-angle rate limit (rad/s), needs ``wheelbase``;
-                                      held by the timing (:meth:`Robot.steer_speed_cap`)
-  =======================  =========  ======================================================
-
-  These fields are refused with the other drives. The yaw-rate, lateral-acceleration and
-  (rear) wheel-speed caps of a differential drive apply as they are.
+The drive (``drive``) is a record that owns its fields (:mod:`trajopt.drive`):
+:class:`~trajopt.drive.Differential` (the default: faces its direction of travel, turns in
+place at rest), :class:`~trajopt.drive.Omni` (turns its body independently of the direction
+of travel) or :class:`~trajopt.drive.Ackermann` (a car: a turning radius, cusps where it
+reverses). The strings ``"differential"``, ``"omni"`` and ``"ackermann"`` are accepted as
+shorthands, a car's fields then given beside the string
+(``Robot(drive="ackermann", min_turning_radius=0.5)``); they are refused with the other
+drives. ``robot.drive`` is always the record.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
 import math
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -63,22 +41,14 @@ from typing import Any, Literal
 import numpy as np
 
 from trajopt._validation import positive
+from trajopt.drive import CAR_FIELDS, Differential, Drive, as_drive, speed_cap
 from trajopt.errors import InvalidInputError
 from trajopt.robot._footprint import Footprint
 
 #: The chapter robot's footprint radius (m): half of its 0.33 m width.
 DEFAULT_RADIUS = 0.165
-#: How a robot's base moves (:class:`Robot`'s ``drive``).
-Drive = Literal["differential", "omni", "ackermann"]
-DRIVES = ("differential", "omni", "ackermann")
-#: The fields only a car-like robot (``drive="ackermann"``) takes, and their "unset" values.
-CAR_FIELDS = {
-    "min_turning_radius": None,
-    "reverse": True,
-    "wheelbase": None,
-    "v_max_reverse": None,
-    "steer_rate_max": None,
-}
+#: A drive's string shorthand (:func:`trajopt.drive.as_drive`).
+DriveName = Literal["differential", "omni", "ackermann"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,25 +80,14 @@ class Robot:
     footprint : Footprint or array_like, shape (k, 2), optional
         A convex footprint in the robot frame (x forward, metres, the rotation centre at
         the origin, strictly inside); see :meth:`rectangle`.
-    drive : {"differential", "omni", "ackermann"}
-        How the base moves (module docstring): a differential drive faces its direction of
-        travel and turns in place at rest; an omnidirectional base turns independently of
-        it; a car-like robot (``"ackermann"``) faces its direction of travel (or its reverse)
-        and turns no tighter than ``min_turning_radius``. Default ``"differential"``.
-    min_turning_radius : float or None
-        A car-like robot's minimum turning radius ``R`` (m), finite and > 0; required with
-        ``drive="ackermann"``, refused with the other drives.
-    reverse : bool
-        Whether a car-like robot may drive backwards (default True); ``False`` gives
-        forward-only (Dubins) plans.
-    wheelbase : float or None
-        A car-like robot's wheelbase ``L`` (m, > 0): samples then carry the steering angle
-        ``atan(L kappa)`` (rad) and its rate.
-    v_max_reverse : float or None
-        A car-like robot's speed limit backwards (m/s, > 0); ``None`` is ``v_max``.
-    steer_rate_max : float or None
-        A car-like robot's steering-angle rate limit (rad/s, > 0), held by the timing as a
-        speed cap (:meth:`steer_speed_cap`); needs ``wheelbase``.
+    drive : Drive or {"differential", "omni", "ackermann"}
+        How the base moves (module docstring): :class:`~trajopt.drive.Differential` (the
+        default), :class:`~trajopt.drive.Omni` or :class:`~trajopt.drive.Ackermann`, or
+        its name as a shorthand. The attribute is always the record.
+    min_turning_radius, reverse, wheelbase, v_max_reverse, steer_rate_max
+        Only with the shorthand ``drive="ackermann"``: the fields of
+        :class:`~trajopt.drive.Ackermann` (``min_turning_radius`` required), which the robot
+        passes on to it; they are not attributes of the robot (``robot.drive`` holds them).
 
     Raises
     ------
@@ -136,10 +95,11 @@ class Robot:
         A limit is not a finite number > 0, only one of ``track_width`` and
         ``wheel_v_max`` is given, a bad footprint (non-convex, self-intersecting, fewer than
         3 vertices, the origin not inside, NaN), a radius contradicting it, or an unknown
-        ``drive``; with ``drive="ackermann"``: ``min_turning_radius`` missing, not finite
-        or <= 0, ``wheelbase``, ``v_max_reverse`` or ``steer_rate_max`` not finite or <= 0,
-        ``reverse`` not a bool, ``steer_rate_max`` without ``wheelbase``; any of those
-        fields given with another drive.
+        ``drive`` (the message lists the drives); with ``drive="ackermann"``:
+        ``min_turning_radius`` missing, not finite or <= 0, ``wheelbase``,
+        ``v_max_reverse`` or ``steer_rate_max`` not finite or <= 0, ``reverse`` not a bool,
+        ``steer_rate_max`` without ``wheelbase``; any of those fields given with another
+        drive or beside a drive record.
     """
 
     radius: float = 0.165
@@ -151,17 +111,10 @@ class Robot:
     track_width: float | None = 0.28
     wheel_v_max: float | None = 0.6
     footprint: Footprint | None = None
-    drive: Drive = "differential"
-    min_turning_radius: float | None = None
-    reverse: bool = True
-    wheelbase: float | None = None
-    v_max_reverse: float | None = None
-    steer_rate_max: float | None = None
+    drive: Drive = Differential()  # noqa: RUF009 - a frozen record
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.drive, str) and self.drive in DRIVES):
-            raise InvalidInputError(f"Robot.drive must be one of {DRIVES}, got {self.drive!r}")
-        self._check_car_fields()
+        object.__setattr__(self, "drive", as_drive(self.drive))
         fp = self.footprint
         if fp is not None and not isinstance(fp, Footprint):
             try:
@@ -188,85 +141,6 @@ class Robot:
         if self.track_width is not None:
             object.__setattr__(self, "track_width", _positive("track_width", self.track_width))
             object.__setattr__(self, "wheel_v_max", _positive("wheel_v_max", self.wheel_v_max))
-
-    def _check_car_fields(self) -> None:
-        """Validate the fields of a car-like robot (and refuse them with another drive)."""
-        if self.drive != "ackermann":
-            given = {
-                k: getattr(self, k)
-                for k, unset in CAR_FIELDS.items()
-                if getattr(self, k) is not unset and getattr(self, k) != unset
-            }
-            if given:
-                what = ", ".join(f"{k}={v!r}" for k, v in given.items())
-                raise InvalidInputError(
-                    f"Robot: {what} apply only to a car-like robot (drive='ackermann'), "
-                    f"got drive={self.drive!r}"
-                )
-            return
-        if self.min_turning_radius is None:
-            raise InvalidInputError(
-                "Robot.min_turning_radius is required with drive='ackermann' (a car-like "
-                "robot's minimum turning radius, finite and > 0 m), got None"
-                + ("" if self.wheelbase is None else f" (with wheelbase={self.wheelbase!r} m)")
-            )
-        if not isinstance(self.reverse, bool | np.bool_):
-            raise InvalidInputError(f"Robot.reverse must be True or False, got {self.reverse!r}")
-        object.__setattr__(self, "reverse", bool(self.reverse))
-        object.__setattr__(
-            self,
-            "min_turning_radius",
-            positive("Robot.min_turning_radius", self.min_turning_radius, "m"),
-        )
-        for name, unit in (
-            ("wheelbase", "m"),
-            ("v_max_reverse", "m/s"),
-            ("steer_rate_max", "rad/s"),
-        ):
-            value = getattr(self, name)
-            if value is not None:
-                object.__setattr__(self, name, positive(f"Robot.{name}", value, unit))
-        if self.steer_rate_max is not None and self.wheelbase is None:
-            raise InvalidInputError(
-                f"Robot.steer_rate_max={self.steer_rate_max!r} rad/s needs a wheelbase (the "
-                "steering angle is atan(wheelbase * kappa)), got wheelbase=None"
-            )
-
-    @property
-    def v_max_backwards(self) -> float:
-        """Speed limit backwards (m/s): ``v_max_reverse``, or ``v_max`` when it is unset."""
-        return self.v_max if self.v_max_reverse is None else float(self.v_max_reverse)
-
-    def steer_speed_cap(
-        self, kappa: np.ndarray | float, dkappa_ds: np.ndarray | float
-    ) -> np.ndarray | float:
-        """Speed limit (m/s) that holds the steering-angle rate of a car-like robot.
-
-        The steering angle is ``delta = atan(L kappa)`` (``L`` the wheelbase), so its rate
-        along a path is ``d delta / dt = L (d kappa / ds) v / (1 + (L kappa)^2)``, and
-        ``|d delta / dt| <= steer_rate_max`` holds exactly when
-        ``v <= steer_rate_max (1 + (L kappa)^2) / (L |d kappa / ds|)``. Infinite where
-        ``d kappa / ds = 0`` or without a steering-rate limit.
-
-        Parameters
-        ----------
-        kappa, dkappa_ds : float or array_like, broadcastable
-            Curvature (1/m) and its derivative along the arc length (1/m^2).
-
-        Returns
-        -------
-        float or ndarray, the broadcast shape
-        """
-        k = np.asarray(kappa, dtype=float)
-        dk = np.abs(np.asarray(dkappa_ds, dtype=float))
-        if self.steer_rate_max is None or self.wheelbase is None:
-            cap = np.full(np.broadcast(k, dk).shape, np.inf)
-        else:
-            wb = self.wheelbase
-            with np.errstate(divide="ignore", invalid="ignore"):
-                cap = self.steer_rate_max * (1.0 + (wb * k) ** 2) / (wb * dk)
-            cap = np.where(np.isnan(cap), 0.0, cap)
-        return float(cap) if cap.ndim == 0 else cap
 
     @classmethod
     def rectangle(
@@ -298,10 +172,11 @@ class Robot:
         """Curvature-dependent speed limit (m/s).
 
         ``min(v_max, sqrt(a_lat_max/|k|), omega_max/|k|, wheel_v_max/(1 + |k| track_width/2))``
-        (the wheel term only when ``track_width`` is set). An omnidirectional base
-        (``drive="omni"``) turns its body independently of the path, so only
-        ``min(v_max, sqrt(a_lat_max/|k|))`` applies to it. ``k = 0`` gives ``v_max``; an
-        infinite or NaN curvature gives 0.
+        with the terms the drive applies (:meth:`trajopt.drive.Drive.speed_terms`; the
+        same numbers the timing's cap kernel receives): the wheel term only when
+        ``track_width`` is set, and an omnidirectional base, which turns its body
+        independently of the path, only ``min(v_max, sqrt(a_lat_max/|k|))``. ``k = 0``
+        gives ``v_max``; an infinite or NaN curvature gives 0.
 
         Parameters
         ----------
@@ -312,29 +187,65 @@ class Robot:
         -------
         float or ndarray, shape of ``kappa``
         """
-        k = np.abs(np.asarray(kappa, dtype=float))
-        k = np.where(np.isnan(k), np.inf, k)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            cap = np.minimum(self.v_max, np.sqrt(self.a_lat_max / k))
-            if self.drive == "omni":
-                cap = np.where(np.isinf(k), 0.0, cap)
-                return float(cap) if cap.ndim == 0 else cap
-            cap = np.minimum(cap, self.omega_max / k)
-            if self.track_width is not None:
-                cap = np.minimum(cap, self.wheel_v_max / (1.0 + 0.5 * self.track_width * k))
-        cap = np.where(np.isinf(k), 0.0, cap)
-        if cap.ndim == 0:
-            return float(cap)
-        return cap
+        return speed_cap(self.drive.speed_terms(self), kappa)
 
     def to_dict(self) -> dict[str, Any]:
-        """Return the fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s)."""
-        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
-        if self.drive != "ackermann":  # the car's fields only for a car (older files unchanged)
-            for k in CAR_FIELDS:
-                del out[k]
+        """Return the fields as a plain dict (SI units: m, m/s, m/s^2, m/s^3, rad/s).
+
+        ``drive`` is the drive's name and its own fields follow it (a car's), so that
+        ``Robot(**robot.to_dict())`` rebuilds the robot.
+        """
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["footprint"] = None if self.footprint is None else self.footprint.to_list()
+        out["drive"] = self.drive.name
+        out.update(self.drive.fields())  # a car's fields after its drive
         return out
+
+
+def _with_car_shorthand(cls: type[Robot]) -> None:
+    """Let ``cls(drive="ackermann", min_turning_radius=...)`` pass a car's fields to its drive.
+
+    The generated ``__init__`` takes the robot's own fields; this one also takes the car's
+    fields as keywords (:data:`trajopt.drive.CAR_FIELDS`) and turns them, with the ``drive``
+    string, into the :class:`~trajopt.drive.Ackermann` record (:func:`~trajopt.drive.as_drive`:
+    refused beside another drive). A read of such a field on the robot says where it lives.
+    """
+    generated = cls.__init__
+    names = [f.name for f in dataclasses.fields(cls) if f.init]
+    at = names.index("drive")
+
+    def __init__(self: Robot, *args: Any, **kwargs: Any) -> None:
+        car = {k: kwargs.pop(k) for k in CAR_FIELDS if k in kwargs}
+        if car:
+            if len(args) > at:
+                args = (*args[:at], as_drive(args[at], car), *args[at + 1 :])
+            else:
+                kwargs["drive"] = as_drive(kwargs.get("drive", Differential.name), car)
+        generated(self, *args, **kwargs)
+
+    sig = inspect.signature(generated)
+    car_params = [
+        inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY, default=v)
+        for k, v in CAR_FIELDS.items()
+    ]
+    __init__.__signature__ = sig.replace(parameters=[*sig.parameters.values(), *car_params])
+    __init__.__doc__ = generated.__doc__
+    cls.__init__ = __init__
+
+    def moved(name: str) -> property:
+        def get(self: Robot) -> Any:
+            raise AttributeError(
+                f"Robot.{name}: a car's fields belong to its drive, read robot.drive.{name} "
+                f"(robot.drive is {self.drive!r})"
+            )
+
+        return property(get, doc=f"Not a robot field: ``robot.drive.{name}`` (a car's).")
+
+    for name in CAR_FIELDS:
+        setattr(cls, name, moved(name))
+
+
+_with_car_shorthand(Robot)
 
 
 def _positive(name: str, value: Any) -> float:

@@ -129,11 +129,7 @@ def polynomial_tables(
         coef[:, k, :] = np.asarray(curve(mid, k + 1), dtype=float) * scale[:, None]
         scale = scale * half / (k + 1)
     nodes, s_nodes, v_nodes = curve._arc_table()
-    omni = robot.drive == "omni"  # Robot.speed_cap: no yaw-rate or wheel term (tw = 0: none)
-    tw = 0.0 if omni or robot.track_width is None else float(robot.track_width)
-    wv = math.inf if omni or robot.wheel_v_max is None else float(robot.wheel_v_max)
-    om = math.inf if omni else float(robot.omega_max)
-    limits = np.array([robot.v_max, robot.a_lat_max, om, tw, wv], dtype=float)
+    limits = robot.drive.speed_terms(robot).as_array()  # the rule Robot.speed_cap applies
     s_grid = np.ascontiguousarray(s_grid, dtype=float)
     h = float(s_grid[-1]) / (s_grid.size - 1)
     u, kappa, theta, still, end_caps = _node_tables(

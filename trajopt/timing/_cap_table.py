@@ -173,7 +173,8 @@ def build_cap_table(
         )
     if zone is not None:
         ci = np.minimum(ci, zone)
-    if robot.drive == "ackermann" and robot.steer_rate_max is not None:
+    steering = robot.drive.steering
+    if steering is not None and steering.rate_max is not None:
         ci = np.minimum(ci, steer_caps(curve, robot, u_nodes, h, degree))
     # ci = max(ci (1 - margin), min(ci, max(v_start, v_end))), the ends at least the
     # boundary speeds (up to the cap at the end nodes), its sparse table and local minima

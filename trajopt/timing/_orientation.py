@@ -318,7 +318,7 @@ def _check(translation: Any, robot: Any) -> None:
         )
     if not isinstance(robot, Robot):
         raise InvalidInputError(f"robot must be a trajopt.Robot, got {type(robot).__name__}")
-    if robot.drive != "omni":
+    if not robot.drive.orients_body:
         raise InvalidInputError(
             "orient needs an omnidirectional robot: Robot.drive must be 'omni', got "
             f"{robot.drive!r} (a differential drive faces its direction of travel)"

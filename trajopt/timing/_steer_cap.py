@@ -4,7 +4,7 @@ A car steers with ``delta = atan(L kappa)`` (``L`` the wheelbase). Along a path 
 speed ``v`` the steering rate is ``d delta / dt = L (d kappa / ds) v / (1 + (L kappa)^2)``,
 so ``|d delta / dt| <= steer_rate_max`` is a speed cap,
 ``v <= steer_rate_max (1 + (L kappa)^2) / (L |d kappa / ds|)``
-(:meth:`trajopt.Robot.steer_speed_cap`), folded into the timing's cap table beside the
+(:meth:`trajopt.drive.Ackermann.steer_speed_cap`), folded into the timing's cap table beside the
 curvature caps. For a curve with a ``polynomial_degree`` (every curve of the library) the cap
 of an interval of the table is a rigorous lower bound over the whole interval
 (:func:`~trajopt.geometry._curvature_bound.interval_steer_cap`: Bernstein bounds of
@@ -59,9 +59,9 @@ def steer_caps(
     u = np.asarray(u_nodes, dtype=float)
     if degree is not None and h is not None:
         return interval_steer_cap(
-            curve, float(h), u.shape[0] - 1, int(degree), robot.steer_speed_cap, robot.v_max
+            curve, float(h), u.shape[0] - 1, int(degree), robot.drive.steer_speed_cap, robot.v_max
         )
     frac = np.arange(INNER + 2, dtype=float) / (INNER + 1)
     pts = u[:-1, None] + (u[1:] - u[:-1])[:, None] * frac[None, :]  # (n, INNER + 2)
-    cap = np.asarray(robot.steer_speed_cap(curve.curvature(pts), curve.curvature_rate(pts)))
+    cap = np.asarray(robot.drive.steer_speed_cap(curve.curvature(pts), curve.curvature_rate(pts)))
     return np.min(cap, axis=1) * (1.0 - MARGIN)

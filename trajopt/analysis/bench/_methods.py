@@ -266,7 +266,7 @@ def _car(variant: str) -> MethodFn:
         stages = stats.get("stages_s", {})
         search = stats.get("car", {}).get("search", {})
         t1 = time.perf_counter()
-        kmax = 1.0 / planner.robot.min_turning_radius
+        kmax = 1.0 / planner.robot.drive.min_turning_radius
         poly, extras = chain_metrics(traj, kmax, (h0, h1), q.map.sample_spacing)
         timed = trajectory_metrics(traj, planner.robot)
         score = time.perf_counter() - t1
