@@ -551,7 +551,7 @@ def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
         ["plan", str(door_map), *PLAN, "--radius", "0.12", "--drive", "omni", "--out", str(out)]
     )
     assert rc == 0, capsys.readouterr().err
-    assert seen[-1].drive == "omni" and seen[-1].radius == 0.12
+    assert seen[-1].drive == trajopt.Omni() and seen[-1].radius == 0.12
     assert json.loads(out.read_text())["robot"]["drive"] == "omni"
     assert "omni drive" in capsys.readouterr().out
     # with headings: the orientation turns while driving and ends exactly at the goal's
@@ -582,7 +582,7 @@ def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
     assert abs(_wrapped(theta[0] - 3.0)) <= 1e-9 and abs(_wrapped(theta[-1] + 1.5)) <= 1e-9
     assert "course [rad] (map)" in df.columns and "v_body_y [m/s]" in df.columns
     assert main(["plan", str(door_map), *PLAN, "--radius", "0.12"]) == 0
-    assert seen[-1].drive == "differential"  # the default
+    assert seen[-1].drive == trajopt.Differential()  # the default
     with pytest.raises(SystemExit):
         main(["plan", "--help"])
     help_text = capsys.readouterr().out

@@ -12,6 +12,7 @@ is (:func:`as_drive`), with the car's fields given beside the string to ``Robot`
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -369,7 +370,9 @@ def as_drive(value: Any, car: dict[str, Any] | None = None, owner: str = "Robot"
         A drive record, or its name.
     car : dict, optional
         The car's fields given beside a string (``Robot(drive="ackermann",
-        min_turning_radius=...)``); refused with another drive and beside a record.
+        min_turning_radius=...)``) or beside an :class:`Ackermann` record (they replace its
+        own, as ``dataclasses.replace(robot, reverse=False)`` does); refused with another
+        drive.
     owner : str
         Who the fields belong to, for error messages.
 
@@ -391,6 +394,8 @@ def as_drive(value: Any, car: dict[str, Any] | None = None, owner: str = "Robot"
                 f"got drive={value!r}"
             )
         return DRIVES[value]()
+    if isinstance(value, Ackermann):  # dataclasses.replace(robot, reverse=...) lands here
+        return dataclasses.replace(value, **car) if car else value
     if not isinstance(value, str) and isinstance(value, Drive):
         if given:
             raise InvalidInputError(

@@ -170,12 +170,12 @@ def test_interval_steer_cap_is_below_the_exact_cap_everywhere():
     curve = BSplineCurve(clamped_uniform_knots(9, 3, (0.0, 1.0)), rng.random((9, 2)) * 2.0, 3)
     n = 400
     h = curve.length / n
-    cap = interval_steer_cap(curve, h, n, 3, car.steer_speed_cap, car.v_max)
+    cap = interval_steer_cap(curve, h, n, 3, car.drive.steer_speed_cap, car.v_max)
     sp = BSpline(np.asarray(curve.t), np.asarray(curve.c), 3).derivative()
     u = np.linspace(*curve.domain, 400_001)
     s = cumulative_simpson(np.hypot(*sp(u).T), x=u, initial=0.0)
     k, r = _scipy_kappa_rate(curve, u)
-    exact = car.steer_speed_cap(k, r)
+    exact = car.drive.steer_speed_cap(k, r)
     i = np.clip((s / h).astype(int), 0, n - 1)
     inner = np.abs(s - np.round(s / h) * h) > 1e-7
     lowest = np.full(n, np.inf)

@@ -167,7 +167,7 @@ def test_end_poses_exact(planned, name):
 @pytest.mark.parametrize("name", list(SCENES))
 def test_curvature_within_one_over_r(planned, name):
     _, robot, *_, traj, _ = planned[name]
-    kmax = 1.0 / robot.min_turning_radius
+    kmax = 1.0 / robot.drive.min_turning_radius
     for pts in _dense_points(traj, 0.002):
         k = three_point_curvature(pts)
         assert k.max() <= kmax * (1.0 + 1e-6), (k.max(), kmax)
@@ -268,7 +268,7 @@ def test_goal_behind_reverses_with_theta_the_tangent_plus_pi(planned):
     smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
     assert np.all(smp.v <= 0.0) and smp.v.min() < -0.1
     assert np.all(smp.direction == -1)
-    assert -smp.v.min() <= robot.v_max_reverse * (1.0 + 1e-9)
+    assert -smp.v.min() <= robot.drive.v_max_reverse * (1.0 + 1e-9)
     # travel direction from finite differences is the body's heading plus pi
     mid = slice(100, -100)
     dx, dy = np.diff(smp.x)[mid], np.diff(smp.y)[mid]
@@ -286,19 +286,19 @@ def test_three_point_turn_has_cusps(planned):
     # each piece (it may change at a cusp, where the car is at rest): the cap table's caps
     # are rigorous bounds, so on 40 001 samples per piece the rate, and its finite
     # differences, stay within the limit
-    np.testing.assert_allclose(smp.steer, np.arctan(robot.wheelbase * smp.kappa), atol=1e-12)
+    np.testing.assert_allclose(smp.steer, np.arctan(robot.drive.wheelbase * smp.kappa), atol=1e-12)
     for i in range(len(traj.pieces)):
         t0, t1 = traj.piece_times[i], traj.piece_times[i + 1]
         tt = np.linspace(t0 + 1e-6, t1 - 1e-6, 40001)
         at = traj.sample(tt)
-        assert np.abs(at.steer_rate).max() <= robot.steer_rate_max * (1 + 1e-9)
+        assert np.abs(at.steer_rate).max() <= robot.drive.steer_rate_max * (1 + 1e-9)
         rate = np.abs(np.diff(at.steer)) / np.diff(tt)
-        assert rate.max() <= robot.steer_rate_max * (1 + 1e-6), (i, rate.max())
+        assert rate.max() <= robot.drive.steer_rate_max * (1 + 1e-6), (i, rate.max())
 
 
 def test_forward_only_uturn_never_reverses(planned):
     _, robot, *_, traj, _ = planned["uturn"]
-    assert not robot.reverse
+    assert not robot.drive.reverse
     smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
     assert np.all(smp.v >= 0.0) and np.all(smp.direction == 1)
     assert traj.stats["car"]["cusps"] == 0
@@ -310,7 +310,7 @@ def test_parallel_parking_ends_in_the_slot(planned):
     assert SLOT / CAR_LENGTH == pytest.approx(1.3)
     smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
     assert smp.v.min() < 0.0  # it backs in
-    np.testing.assert_allclose(smp.steer, np.arctan(robot.wheelbase * smp.kappa), atol=1e-12)
+    np.testing.assert_allclose(smp.steer, np.arctan(robot.drive.wheelbase * smp.kappa), atol=1e-12)
 
 
 def test_plans_are_quick(planned):
@@ -536,7 +536,7 @@ def test_forward_only_loop_is_fitted_in_pieces(pieces, monkeypatch):
             near = drive.sample(np.array([tj - 1e-4, tj + 1e-4]))
             assert near.v.min() > 0.05
             assert abs(near.kappa[1] - near.kappa[0]) < 1e-2  # continuous (over 2e-4 s)
-    kmax = 1.0 / robot.min_turning_radius
+    kmax = 1.0 / robot.drive.min_turning_radius
     for pts in _dense_points(traj, 0.002):
         assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)
         assert square_clearance(grid, pts, reach=0.2).min() >= robot.radius - 1e-9

@@ -103,7 +103,7 @@ def _check_new_plan(out, grid, goal, h1, robot=CAR):
     np.testing.assert_allclose([end.x[0], end.y[0]], goal, atol=1e-9)
     assert _angle_diff(end.theta[0], h1) < 1e-6
     assert abs(end.v[0]) <= 1e-12  # at rest (a cubic phase ends at 0 up to round-off)
-    kmax = 1.0 / robot.min_turning_radius
+    kmax = 1.0 / robot.drive.min_turning_radius
     for piece in out.pieces:
         pts = _dense(piece)
         assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)
@@ -122,7 +122,7 @@ def _check_no_turn_in_place(out, robot=CAR):
     # by finite differences: the heading turns by at most the distance moved over R
     moved = np.hypot(np.diff(smp.x), np.diff(smp.y))
     turned = _angle_diff(smp.theta[1:], smp.theta[:-1])
-    assert np.all(turned <= moved / robot.min_turning_radius * (1.0 + 1e-3) + 1e-9)
+    assert np.all(turned <= moved / robot.drive.min_turning_radius * (1.0 + 1e-3) + 1e-9)
     # and it moves along its heading, forwards or backwards
     assert np.all(smp.v * smp.direction >= -1e-12)
 
