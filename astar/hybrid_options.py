@@ -77,7 +77,7 @@ class HybridMotion:
 
     Examples
     --------
-    >>> HybridMotion(turning_radius=3.0, reverse=False).arc_length  # 5 bins of 5 degrees
+    >>> HybridMotion(turning_radius=3.0, reverse=False).arc_length  # 6 bins of 5 degrees: pi / 6 R
     1.5707963267948966
     """
 
