@@ -17,8 +17,8 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
 * :func:`kernel_collision` builds the search kernel's collision record
   (:class:`~astar.hybrid_kernel.KernelCollision`) of a mode given as a
   :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
-  construction), and tests the end poses' footprints; :func:`raw_occupancy` checks the raw
-  map of both modes against the grid.
+  construction), and tests the end poses' footprints; :func:`raw_occupied` reads the raw
+  map of both modes, :func:`raw_occupancy` checks it against the grid.
 
 The compiled tests live in :mod:`astar.hybrid_kernel`, beside the search that calls them (so
 that numba's cache of the search is rebuilt whenever they change):
@@ -59,6 +59,7 @@ __all__ = [
     "footprint_safe",
     "kernel_collision",
     "raw_occupancy",
+    "raw_occupied",
 ]
 
 #: Default sampling slack (cells): how far the body moves between a pose and its sample.
@@ -193,21 +194,42 @@ def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
     return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
 
 
-def raw_occupancy(occupied: np.ndarray, free: np.ndarray) -> np.ndarray:
-    """Return the raw map's occupied cells as uint8 (ny, nx), checked against ``free``'s shape.
+def raw_occupied(raw_grid: object) -> np.ndarray:
+    """Return the occupied cells of a raw map as a read-only bool array (ny, nx).
 
     Parameters
     ----------
-    occupied : ndarray of bool, shape (ny, nx)
-        :attr:`HybridCollision.raw_grid <astar.hybrid_options.HybridCollision.raw_grid>`.
-    free : ndarray of uint8, shape (ny, nx)
-        The search's free cells.
+    raw_grid : OccupancyGrid or ndarray of bool, shape (ny, nx)
+        The raw map: an ``OccupancyGrid`` (its ``occupied``, already a read-only bool
+        array, is returned as it is) or a bool array ``True`` on occupied cells (copied).
+
+    Raises
+    ------
+    InvalidInputError
+        Neither an ``OccupancyGrid`` nor a 2-D bool array.
     """
-    if occupied.shape != free.shape:
+    if isinstance(raw_grid, OccupancyGrid):
+        return raw_grid.occupied
+    a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
+    if a is None or a.dtype != bool or a.ndim != 2:
         raise InvalidInputError(
-            f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occupied.shape}"
+            "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
+            f"cells, got {type(raw_grid).__name__}"
+            + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
         )
-    return np.ascontiguousarray(occupied, dtype=np.uint8)
+    out = np.array(a, dtype=bool, copy=True)
+    out.flags.writeable = False
+    return out
+
+
+def raw_occupancy(raw_grid: object, free: np.ndarray) -> np.ndarray:
+    """Return the bool occupied mask (ny, nx) of ``raw_grid``, checked against ``free``."""
+    occ = raw_occupied(raw_grid)
+    if occ.shape != free.shape:
+        raise InvalidInputError(
+            f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
+        )
+    return occ
 
 
 def kernel_collision(
@@ -255,11 +277,10 @@ def kernel_collision(
     from astar.inflation import inflate
 
     margin = r + math.sqrt(0.5) + 1e-9
-    blocked = inflate(
-        OccupancyGrid(collision.raw_grid, 1.0), margin, metric="square", outside_occupied=True
-    )
+    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
     safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
-    return KernelCollision(step, safe, occ, r, no_fp, safe, 0.0, 0.0, 0.0)
+    occ8 = np.ascontiguousarray(occ, dtype=np.uint8)
+    return KernelCollision(step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0)
 
 
 def _footprint_inputs(
@@ -273,7 +294,7 @@ def _footprint_inputs(
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
     fp = footprint_polygon(collision.footprint)
-    occ = raw_occupancy(collision.raw_grid, free)
+    occ = np.ascontiguousarray(raw_occupancy(collision.raw_grid, free), dtype=np.uint8)
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike
 from astar import validation
 from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
-from astar.hybrid_modes import DEFAULT_SLACK, footprint_polygon
+from astar.hybrid_modes import DEFAULT_SLACK, footprint_polygon, raw_occupied
 
 __all__ = [
     "FLAT_KEYWORDS",
@@ -242,7 +242,7 @@ class HybridCollision:
         The raw map (an ``OccupancyGrid``, or a bool array ``True`` on *occupied* cells, as
         ``OccupancyGrid.occupied``), the same shape as the search's ``grid`` (checked by
         :func:`astar.find_pose_path`). Stored as a read-only bool array of the occupied
-        cells.
+        cells (an ``OccupancyGrid``'s own, a copy of an array).
     clearance : float, optional
         Exact mode (with ``raw_grid``; finite, ``> 0``, cells): besides the cell checks on
         ``grid``, every chord between consecutive collision samples keeps Euclidean distance
@@ -346,7 +346,7 @@ class HybridCollision:
                     "checked against"
                 )
         if raw_grid is not None:
-            raw_grid = _occupied(raw_grid)
+            raw_grid = raw_occupied(raw_grid)
         object.__setattr__(self, "raw_grid", raw_grid)
         object.__setattr__(self, "clearance", clearance)
         object.__setattr__(self, "footprint", footprint)
@@ -359,24 +359,6 @@ class HybridCollision:
         if self.footprint is not None:
             return "footprint"
         return "grid" if self.clearance is None else "clearance"
-
-
-def _occupied(raw_grid: object) -> np.ndarray:
-    """Return the occupied cells of ``raw_grid`` as a new read-only bool array (ny, nx)."""
-    if isinstance(raw_grid, OccupancyGrid):
-        occ = np.asarray(raw_grid.occupied, dtype=bool)
-    else:
-        a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
-        if a is None or a.dtype != bool or a.ndim != 2:
-            raise InvalidInputError(
-                "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
-                f"cells, got {type(raw_grid).__name__}"
-                + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
-            )
-        occ = a
-    out = np.array(occ, dtype=bool, copy=True)
-    out.flags.writeable = False
-    return out
 
 
 _RECORDS: dict[str, type] = {
