@@ -5,7 +5,10 @@ curvature at most ``1 / turning_radius`` from a start pose to a goal pose, forwa
 ``reverse=True``) backwards, and returns a :class:`PosePath`: poses sampled along it, the
 direction of travel at each, the segments between cusps and the exact pieces (arcs and lines)
 it is made of. The search itself is :mod:`astar.hybrid_kernel` (Dolgov et al. 2008/2010;
-parameters after Nav2 Smac Hybrid-A*), the analytic curves :mod:`astar.reeds_shepp`.
+parameters after Nav2 Smac Hybrid-A*), the analytic curves :mod:`astar.reeds_shepp`. Its
+settings are four typed records (:mod:`astar.hybrid_options`: :class:`~astar.HybridMotion`,
+:class:`~astar.HybridCosts`, :class:`~astar.HybridLimits`, :class:`~astar.HybridCollision`),
+or their fields by name.
 
 Units (those of :func:`astar.find_path`): positions, lengths and the turning radius are in
 **cells**; a position ``(x, y)`` is a point of the grid in which cell ``(ix, iy)`` is the square
