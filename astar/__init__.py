@@ -50,6 +50,10 @@ _EXPORTS: dict[str, str] = {
     "find_pose_path": "astar.hybrid",
     "PosePath": "astar.hybrid",
     "NoPosePathError": "astar.hybrid",
+    "HybridMotion": "astar.hybrid_options",
+    "HybridCosts": "astar.hybrid_options",
+    "HybridLimits": "astar.hybrid_options",
+    "HybridCollision": "astar.hybrid_options",
     "CarPath": "astar.reeds_shepp",
     "reeds_shepp_path": "astar.reeds_shepp",
     "dubins_path": "astar.reeds_shepp",
@@ -82,6 +86,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
     from astar.grid import OccupancyGrid
     from astar.hybrid import NoPosePathError, PosePath, find_pose_path
+    from astar.hybrid_options import HybridCollision, HybridCosts, HybridLimits, HybridMotion
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate
     from astar.io import from_intensity, load_map, save_map
     from astar.landmarks import Landmarks, build_landmarks

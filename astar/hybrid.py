@@ -5,7 +5,10 @@ curvature at most ``1 / turning_radius`` from a start pose to a goal pose, forwa
 ``reverse=True``) backwards, and returns a :class:`PosePath`: poses sampled along it, the
 direction of travel at each, the segments between cusps and the exact pieces (arcs and lines)
 it is made of. The search itself is :mod:`astar.hybrid_kernel` (Dolgov et al. 2008/2010;
-parameters after Nav2 Smac Hybrid-A*), the analytic curves :mod:`astar.reeds_shepp`.
+parameters after Nav2 Smac Hybrid-A*), the analytic curves :mod:`astar.reeds_shepp`. Its
+settings are four typed records (:mod:`astar.hybrid_options`: :class:`~astar.HybridMotion`,
+:class:`~astar.HybridCosts`, :class:`~astar.HybridLimits`, :class:`~astar.HybridCollision`),
+or their fields by name.
 
 Units (those of :func:`astar.find_path`): positions, lengths and the turning radius are in
 **cells**; a position ``(x, y)`` is a point of the grid in which cell ``(ix, iy)`` is the square
@@ -24,12 +27,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
 from astar.grid import OccupancyGrid
-from astar.hybrid_modes import DEFAULT_SLACK, exact_mode, footprint_mode
+from astar.hybrid_modes import kernel_collision
+from astar.hybrid_options import (
+    HybridCollision,
+    HybridCosts,
+    HybridLimits,
+    HybridMotion,
+    build_options,
+)
 
 __all__ = ["NoPosePathError", "PosePath", "find_pose_path"]
 
@@ -214,53 +223,27 @@ def _pose(name: str, value: object, free: np.ndarray) -> tuple[float, float, flo
     return float(a[0]), float(a[1]), float(a[2])
 
 
-def _number(name: str, value: object, lo: float, rule: str) -> float:
-    if isinstance(value, bool):
-        raise InvalidInputError(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v) or v < lo:
-        raise InvalidInputError(f"{name} must be finite and {rule}, got {v!r}")
-    return v
-
-
-def _int(name: str, value: object, lo: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InvalidInputError(f"{name} must be an int, got {value!r}")
-    if int(value) < lo:
-        raise InvalidInputError(f"{name} must be >= {lo}, got {int(value)}")
-    return int(value)
-
-
 # --------------------------------------------------------------------------- public API
 def find_pose_path(
     grid: OccupancyGrid | np.ndarray,
     start: tuple[float, float, float],
     goal: tuple[float, float, float],
     *,
-    turning_radius: float,
-    reverse: bool = True,
-    heading_bins: int = 72,
-    primitive_length: float | None = None,
-    curvatures: int = 3,
-    reverse_penalty: float = 2.0,
-    cusp_penalty: float = 2.0,
-    turn_penalty: float = 0.05,
-    steer_penalty: float = 0.05,
-    analytic_ratio: float = 3.5,
-    sample_step: float = 0.5,
-    max_expansions: int = 500_000,
-    time_budget: float = 2.0,
-    heuristic_weight: float = 1.5,
-    raw_grid: OccupancyGrid | np.ndarray | None = None,
-    clearance: float | None = None,
-    footprint: ArrayLike | None = None,
-    footprint_margin: float = 0.0,
-    footprint_slack: float = DEFAULT_SLACK,
+    motion: HybridMotion | None = None,
+    costs: HybridCosts | None = None,
+    limits: HybridLimits | None = None,
+    collision: HybridCollision | None = None,
+    **options: Any,
 ) -> PosePath:
     """Path of a car-like robot from a start pose to a goal pose by Hybrid-A*.
+
+    The settings come as four records (:class:`~astar.HybridMotion`,
+    :class:`~astar.HybridCosts`, :class:`~astar.HybridLimits`,
+    :class:`~astar.HybridCollision`), or their fields by name: ``find_pose_path(grid, s, g,
+    turning_radius=3.0, reverse=False)`` is ``find_pose_path(grid, s, g,
+    motion=HybridMotion(turning_radius=3.0, reverse=False))``. A record and fields of the
+    same record by name exclude each other; fields of the other records may be given by
+    name beside it.
 
     Parameters
     ----------
@@ -271,91 +254,31 @@ def find_pose_path(
         Poses ``(x, y, heading)``: ``x, y`` in cells (cell ``(ix, iy)``'s centre is
         ``(ix, iy)``), heading in radians counter-clockwise from ``+x``; inside the grid, on
         free cells.
-    turning_radius : float
-        Minimum turning radius ``R`` in cells, finite and ``> 0``.
-    reverse : bool, optional
-        True (default): forwards and backwards (Reeds-Shepp shots). False: forwards only
-        (Dubins shots).
-    heading_bins : int, optional
-        Heading bins of the discrete states (``>= 8``; default 72, 5 degrees, as Smac).
-    primitive_length : float, optional
-        Arc length of a motion primitive in cells. Default: the shortest arc of radius ``R``
-        that turns by a whole number of heading bins and is at least ``sqrt(2)`` cells long.
-    curvatures : int, optional
-        Number of primitive curvatures, odd and ``>= 3``: evenly spaced in
-        ``[-1/R, 1/R]``, zero included (3: ``{-1/R, 0, 1/R}``).
-    reverse_penalty : float, optional
-        ``>= 1``: a backwards primitive costs its length times this (Smac: 2.0).
-    cusp_penalty : float, optional
-        ``>= 0``: cost added per change of direction, in turning radii (default 2: ``2 R``).
-    turn_penalty : float, optional
-        ``>= 0``: an arc costs its length times ``1 + turn_penalty``.
-    steer_penalty : float, optional
-        ``>= 0``: a primitive whose curvature differs from the previous one's costs
-        ``1 + steer_penalty`` times more.
-    analytic_ratio : float, optional
-        ``> 0``: an analytic shot to the goal is tried every ``max(1, floor(h /
-        analytic_ratio))`` expansions, ``h`` the heuristic of the expanded node in cells
-        (Smac's analytic expansion ratio: 3.5).
-    sample_step : float, optional
-        ``> 0``: largest arc length between returned poses, cells.
-    max_expansions : int, optional
-        ``>= 1``: the search gives up after this many expansions.
-    time_budget : float, optional
-        ``> 0``: seconds; the search (not the 2-D distance field before it) gives up after
-        this long (checked every 128 expansions).
-    heuristic_weight : float, optional
-        ``>= 1``: nodes are ordered by ``g + heuristic_weight * h`` (weighted A*). 1 gives
-        the cheapest path at the search's resolution (up to the caveat below) but may expand
-        many more states; the default 1.5 solved 36 of 36 held-out queries where 1.0 solved
-        32 within 1 s (``benchmarks/bench_hybrid.py``), at a cost at most 1.5 times the
-        cheapest.
-    raw_grid : OccupancyGrid or ndarray of bool, shape (ny, nx), optional
-        With ``clearance``: the raw map (an ``OccupancyGrid``, or a bool array ``True`` on
-        *occupied* cells, as ``OccupancyGrid.occupied``), the same shape as ``grid``.
-    clearance : float, optional
-        Exact mode (with ``raw_grid``; finite, ``> 0``, cells): besides the cell checks on
-        ``grid``, every chord between consecutive collision samples keeps Euclidean distance
-        ``>= clearance`` from every occupied square of ``raw_grid`` and from the outside of the
-        grid (checked exactly where a cell it crosses is within ``clearance + sqrt(2) / 2``
-        cells of an obstacle), and the returned poses are those samples (arc-length spacing
-        at most 0.2 cells, ``sample_step`` ignored), so the polyline through the poses keeps
-        ``clearance``. For a ``grid`` inflated by a radius ``r`` (cell centres keep ``r``),
-        ``clearance=r`` lets the poses lie anywhere in their cells without coming closer
-        than ``r``, where a grid inflated by ``r`` plus half a cell's diagonal would block
-        the cells next to a wall.
-    footprint : array_like of float, shape (k, 2), optional
-        Footprint mode (with ``raw_grid``; excludes ``clearance``): the robot's body as a
-        convex polygon, vertices in cells in the robot frame (``x`` forwards along the
-        heading, ``y`` to the left), counter-clockwise or clockwise, ``k >= 3``, the origin
-        (the pose's point) strictly inside. The body faces the pose's heading whatever the
-        direction of travel. Every pose of the continuous path (every primitive and the
-        final shot at every arc length, not only at samples) has its footprint, rotated by
-        the heading and moved to the pose, at a distance greater than ``footprint_margin``
-        from every occupied square of ``raw_grid`` (closed squares ``[ix - 0.5, ix + 0.5] x
-        [iy - 0.5, iy + 0.5]``) and within the grid (``[-0.5, nx - 0.5] x [-0.5, ny - 0.5]``,
-        at least ``footprint_margin`` from its sides). Each arc of curvature ``kappa`` is
-        cut into equal steps of at most ``ds = 2 footprint_slack / (1 + rho |kappa|)`` cells
-        (``rho``: the farthest vertex from the origin), so that between a step's middle and
-        any pose of the step every point of the body moves at most ``footprint_slack``; the
-        footprint grown by ``footprint_margin + footprint_slack`` is tested exactly (separating axes, then the
-        polygon-to-square distance) at each step's middle. ``grid`` stays a necessary
-        condition on the centre: pass the raw map inflated by the footprint's inscribed
-        radius about the origin (a larger inflation loses paths, a smaller one only costs
-        time). Cells whose every point keeps ``rho + footprint_margin + footprint_slack`` from the
-        obstacles skip the polygon test. The returned poses are sampled as without
-        footprint (``sample_step``); the guarantee holds for every pose of the exact
-        ``pieces``, hence for the returned poses. The start and goal poses must pass the
-        sample test themselves (else ``InvalidInputError``).
-    footprint_margin : float, optional
-        With ``footprint``: the distance (cells, finite, ``>= 0``; default 0) the footprint
-        keeps from the obstacles and the grid's outside.
-    footprint_slack : float, optional
-        With ``footprint``: the sampling slack (cells, finite, ``> 0``; default 0.05). The
-        number of footprint tests falls as ``1 / footprint_slack``, and poses whose footprint
-        comes within ``footprint_margin + footprint_slack`` of an obstacle at a tested
-        sample are refused, so a slack is also a margin at the samples: a large body on a
-        fine grid wants a slack of a good fraction of a cell.
+    motion : HybridMotion, optional
+        The car and the primitives: ``turning_radius`` (cells, required: here or by name),
+        ``reverse`` (default True), ``heading_bins`` (72), ``primitive_length`` (cells;
+        default from the radius and the bins), ``curvatures`` (3).
+    costs : HybridCosts, optional
+        ``reverse_penalty`` (2), ``cusp_penalty`` (2 turning radii), ``turn_penalty``
+        (0.05), ``steer_penalty`` (0.05), ``analytic_ratio`` (3.5), ``heuristic_weight``
+        (1.5). Default: ``HybridCosts()``.
+    limits : HybridLimits, optional
+        ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells).
+        Default: ``HybridLimits()``.
+    collision : HybridCollision, optional
+        What the path keeps clear of besides ``grid``: nothing (the default), the raw map
+        at an exact ``clearance`` (cells), or a ``footprint`` polygon (cells) with
+        ``footprint_margin`` and ``footprint_slack``. ``raw_grid`` must have ``grid``'s
+        shape. In the footprint mode the start and goal poses' footprints, grown by the
+        margin and the slack, must keep clear of the raw map and inside the grid.
+
+    Other Parameters
+    ----------------
+    **options
+        Any field of the four records by name (``turning_radius=3.0``,
+        ``time_budget=0.5``, ``raw_grid=occ, clearance=2.0``, ...): the records are built
+        from them (:data:`astar.hybrid_options.FLAT_KEYWORDS` lists them), with the same
+        checks and errors. The records' docstrings give each field's rule and units.
 
     Returns
     -------
@@ -370,7 +293,10 @@ def find_pose_path(
         not three finite numbers, lies outside the grid or on a blocked cell, or (footprint
         mode) its grown footprint meets an obstacle or leaves the grid; ``footprint``
         without ``raw_grid`` or with ``clearance``; ``footprint_margin`` without
-        ``footprint``.
+        ``footprint``; a record of the wrong type, or a record and fields of it by name.
+    TypeError
+        A keyword that is no field of the records, or no ``motion`` and no
+        ``turning_radius``.
     NoPosePathError
         (a :class:`~astar.NoPathError`) No path: ``reason`` says why: ``"disconnected"``
         (refused before searching), ``"exhausted"`` (with ``reverse=False``: no forwards-only
@@ -408,46 +334,25 @@ def find_pose_path(
     free = _free(grid)
     sx, sy, sth = _pose("start", start, free)
     gx, gy, gth = _pose("goal", goal, free)
-    radius = validation.positive_float("turning_radius", turning_radius)
-    if not isinstance(reverse, (bool, np.bool_)):
-        raise InvalidInputError(f"reverse must be a bool, got {reverse!r}")
-    reverse = bool(reverse)
-    nbins = _int("heading_bins", heading_bins, 8)
-    nc = _int("curvatures", curvatures, 3)
-    if nc % 2 == 0:
-        raise InvalidInputError(f"curvatures must be odd (zero included), got {nc}")
-    bin_w = 2.0 * math.pi / nbins
-    if primitive_length is None:
-        turns = max(1, math.ceil(math.sqrt(2.0) / radius / bin_w - 1e-12))
-        prim_len = radius * turns * bin_w
-    else:
-        prim_len = validation.positive_float("primitive_length", primitive_length)
-    rp = _number("reverse_penalty", reverse_penalty, 1.0, ">= 1")
-    cp = _number("cusp_penalty", cusp_penalty, 0.0, ">= 0") * radius
-    tp = _number("turn_penalty", turn_penalty, 0.0, ">= 0")
-    sp = _number("steer_penalty", steer_penalty, 0.0, ">= 0")
-    ratio = validation.positive_float("analytic_ratio", analytic_ratio)
-    step = validation.positive_float("sample_step", sample_step)
-    max_exp = _int("max_expansions", max_expansions, 1)
-    budget = validation.positive_float("time_budget", time_budget)
-    hw = _number("heuristic_weight", heuristic_weight, 1.0, ">= 1")
-    foot = footprint_mode(
-        footprint,
-        footprint_margin,
-        footprint_slack,
-        raw_grid,
-        clearance,
-        free,
-        (("start", (sx, sy, sth)), ("goal", (gx, gy, gth))),
+    motion, costs, limits, collision = build_options(motion, costs, limits, collision, options)
+    radius, reverse = motion.turning_radius, motion.reverse
+    nbins, prim_len = motion.heading_bins, motion.arc_length
+    max_exp, budget = limits.max_expansions, limits.time_budget
+    kcoll = kernel_collision(
+        collision, free, _COLLISION_STEP, (("start", (sx, sy, sth)), ("goal", (gx, gy, gth)))
     )
-    if foot is None:
-        safe, occ, exact_r = exact_mode(raw_grid, clearance, free)
-        fp, fsafe, frho, fmargin, fslack = np.zeros((0, 4)), safe, 0.0, 0.0, 0.0
-    else:
-        safe, occ, exact_r = np.zeros((1, 1), dtype=np.uint8), foot.occ, 0.0
-        fp, fsafe, frho, fmargin, fslack = foot.fp, foot.safe, foot.rho, foot.margin, foot.slack
 
-    from astar.hybrid_kernel import EXHAUSTED, FOUND, TIME_BUDGET, distance_field, hybrid_kernel
+    from astar.hybrid_kernel import (
+        EXHAUSTED,
+        FOUND,
+        TIME_BUDGET,
+        KernelCosts,
+        KernelLimits,
+        KernelMotion,
+        KernelQuery,
+        distance_field,
+        hybrid_kernel,
+    )
 
     gix, giy = int(math.floor(gx + 0.5)), int(math.floor(gy + 0.5))
     six, siy = int(math.floor(sx + 0.5)), int(math.floor(sy + 0.5))
@@ -463,8 +368,12 @@ def find_pose_path(
         "primitive_length": prim_len,
         "heading_bins": nbins,
     }
-    if foot is not None:
-        stats.update(footprint=True, footprint_margin=foot.margin, footprint_slack=foot.slack)
+    if collision.footprint is not None:
+        stats.update(
+            footprint=True,
+            footprint_margin=collision.footprint_margin,
+            footprint_slack=collision.footprint_slack,
+        )
     if not reached:
         stats["total_s"] = time.perf_counter() - t0
         raise NoPosePathError(
@@ -474,45 +383,22 @@ def find_pose_path(
             "disconnected",
             stats,
         )
-    kappas = np.linspace(-1.0 / radius, 1.0 / radius, nc)
-    kappas[nc // 2] = 0.0
-    kappas = np.ascontiguousarray(kappas[np.argsort(np.abs(kappas), kind="stable")])
+    kappas = motion.primitive_curvatures()
+    query = KernelQuery(free, h2d, sx, sy, sth, gx, gy, gth)
+    kcosts = KernelCosts(
+        costs.reverse_penalty,
+        costs.cusp_penalty * radius,
+        costs.turn_penalty,
+        costs.steer_penalty,
+        costs.analytic_ratio,
+        costs.heuristic_weight,
+        max(30.0, 12.0 * radius),
+    )
 
     def search(plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
-        return hybrid_kernel(
-            free,
-            h2d,
-            sx,
-            sy,
-            sth,
-            gx,
-            gy,
-            gth,
-            radius,
-            kappas,
-            plen,
-            bins,
-            reverse,
-            rp,
-            cp,
-            tp,
-            sp,
-            ratio,
-            max(30.0, 12.0 * radius),
-            _COLLISION_STEP,
-            exp_left,
-            deadline,
-            _POLISH,
-            hw,
-            safe,
-            occ,
-            exact_r,
-            fp,
-            fsafe,
-            frho,
-            fmargin,
-            fslack,
-        )
+        kmotion = KernelMotion(radius, kappas, plen, bins, reverse)
+        klimits = KernelLimits(exp_left, deadline, _POLISH)
+        return hybrid_kernel(query, kmotion, kcosts, klimits, kcoll)
 
     out = search(prim_len, nbins, max_exp, t1 + budget)
     status, expanded, shots, retried = out[0], int(out[7]), int(out[8]), False
@@ -576,9 +462,9 @@ def find_pose_path(
         kappas,
         prim_len,
         radius,
-        step,
+        limits.sample_step,
         (gx, gy, gth),
-        exact_r > 0.0,
+        kcoll.exact_r > 0.0,
     )
     stats["total_s"] = time.perf_counter() - t0
     object.__setattr__(path, "stats", stats)

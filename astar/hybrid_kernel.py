@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -49,6 +50,11 @@ from astar.reeds_shepp import advance, car_word
 from astar.search_kernels import heap_pop, heap_push
 
 __all__ = [
+    "KernelCollision",
+    "KernelCosts",
+    "KernelLimits",
+    "KernelMotion",
+    "KernelQuery",
     "distance_field",
     "footprint_arc_clear",
     "footprint_hit",
@@ -61,6 +67,142 @@ FOUND = 1
 EXHAUSTED = 0
 MAX_EXPANSIONS = 2
 TIME_BUDGET = 3
+
+
+# The records :func:`hybrid_kernel` takes (numba reads a NamedTuple's fields as typed values;
+# :func:`astar.find_pose_path` builds them with the field types given, one compiled signature).
+class KernelQuery(NamedTuple):
+    """The grid, its heuristic field and the two poses of one :func:`hybrid_kernel` run.
+
+    Attributes
+    ----------
+    free : ndarray of uint8, shape (ny, nx)
+        1 on free cells.
+    h2d : ndarray of float64, shape (ny, nx)
+        :func:`distance_field` from the goal's cell (cells).
+    sx, sy, sth : float
+        Start pose (cells, cells, rad).
+    gx, gy, gth : float
+        Goal pose (cells, cells, rad).
+    """
+
+    free: np.ndarray
+    h2d: np.ndarray
+    sx: float
+    sy: float
+    sth: float
+    gx: float
+    gy: float
+    gth: float
+
+
+class KernelMotion(NamedTuple):
+    """The car and its motion primitives.
+
+    Attributes
+    ----------
+    radius : float
+        Turning radius ``R`` (cells).
+    curvatures : ndarray of float64, shape (nc,)
+        Signed curvatures of the primitives (1/cells).
+    prim_len : float
+        Arc length of every primitive (cells).
+    nbins : int
+        Heading bins.
+    reverse : bool
+        Backwards primitives and Reeds-Shepp shots (else forwards only, Dubins shots).
+    """
+
+    radius: float
+    curvatures: np.ndarray
+    prim_len: float
+    nbins: int
+    reverse: bool
+
+
+class KernelCosts(NamedTuple):
+    """The costs of a path and the ordering of the search.
+
+    Attributes
+    ----------
+    reverse_penalty : float
+        ``>= 1``: multiplies a backwards primitive's length.
+    cusp_penalty : float
+        ``>= 0``: cells added per change of direction.
+    turn_penalty : float
+        ``>= 0``: an arc costs its length times ``1 + turn_penalty``.
+    steer_penalty : float
+        ``>= 0``: a change of curvature costs the length times ``1 + steer_penalty`` more.
+    analytic_ratio : float
+        ``> 0``: a shot every ``max(1, h / analytic_ratio)`` expansions.
+    hweight : float
+        ``>= 1``: ``f = g + hweight * h`` (1: A*; more: weighted A*, faster, cost <=
+        ``hweight`` times the cheapest).
+    car_window : float
+        Cells: the car-length heuristic is evaluated closer than this to the goal.
+    """
+
+    reverse_penalty: float
+    cusp_penalty: float
+    turn_penalty: float
+    steer_penalty: float
+    analytic_ratio: float
+    hweight: float
+    car_window: float
+
+
+class KernelLimits(NamedTuple):
+    """When the search gives up.
+
+    Attributes
+    ----------
+    max_expansions : int
+        Expansions at most.
+    deadline : float
+        ``time.perf_counter()`` value at which the search gives up (s).
+    polish : int
+        After the first path: search on for at most ``expansions + polish`` more.
+    """
+
+    max_expansions: int
+    deadline: float
+    polish: int
+
+
+class KernelCollision(NamedTuple):
+    """The collision checks: the grid's cells, the exact clearance mode, the footprint mode.
+
+    Attributes
+    ----------
+    step : float
+        Collision sampling spacing (cells).
+    safe : ndarray of uint8, shape (ny, nx)
+        Exact mode: 1 where every point of the cell keeps ``exact_r`` (else a 1 x 1 array).
+    occ : ndarray of uint8, shape (ny, nx)
+        Exact and footprint modes: 1 on the raw map's occupied cells (else 1 x 1).
+    exact_r : float
+        ``> 0``: every chord keeps this Euclidean distance from ``occ`` (cells); ``<= 0``: off.
+    fp : ndarray of float64, shape (k, 4)
+        Footprint vertices and outward normals (footprint mode); shape (0, 4): off.
+    fsafe : ndarray of uint8, shape (ny, nx)
+        1 where the footprint needs no test (footprint mode).
+    frho : float
+        The footprint's circumscribed radius (cells).
+    fmargin : float
+        Cells: every pose's footprint keeps this distance from ``occ`` (footprint mode).
+    fslack : float
+        Cells: the body moves at most this far between a pose and its tested sample.
+    """
+
+    step: float
+    safe: np.ndarray
+    occ: np.ndarray
+    exact_r: float
+    fp: np.ndarray
+    fsafe: np.ndarray
+    frho: float
+    fmargin: float
+    fslack: float
 
 
 @njit(cache=True)
@@ -626,41 +768,21 @@ def _heuristic(
 
 
 @njit(cache=True)
-def hybrid_kernel(
-    free,  # uint8 (ny, nx): 1 on free cells
-    h2d,  # float64 (ny, nx): distance_field from the goal's cell
-    sx,  # start pose (cells, rad)
-    sy,
-    sth,
-    gx,  # goal pose
-    gy,
-    gth,
-    radius,  # turning radius R (cells)
-    curvatures,  # float64 (nc,): signed curvatures of the primitives (1/cells)
-    prim_len,  # arc length of every primitive (cells)
-    nbins,  # heading bins
-    reverse,  # backwards primitives and Reeds-Shepp (else Dubins)
-    reverse_penalty,  # >= 1, multiplies a backwards primitive's length
-    cusp_penalty,  # >= 0, cells added per change of direction
-    turn_penalty,  # >= 0, an arc costs its length times 1 + turn_penalty
-    steer_penalty,  # >= 0, a change of curvature costs the length times 1 + steer_penalty more
-    analytic_ratio,  # > 0: shot every max(1, h / analytic_ratio) expansions
-    car_window,  # cells: the car-length heuristic is evaluated closer than this to the goal
-    step,  # collision sampling spacing (cells)
-    max_expansions,
-    deadline,  # time.perf_counter() value at which the search gives up
-    polish,  # after the first path: search on for at most expansions + polish more
-    hweight,  # >= 1: f = g + hweight * h (1: A*; more: weighted A*, faster, cost <= hweight x)
-    safe,  # uint8 (ny, nx): 1 where every point of the cell keeps exact_r (exact mode)
-    occ,  # uint8 (ny, nx): 1 on the raw map's occupied cells (exact mode)
-    exact_r,  # > 0: every chord keeps this Euclidean distance from occ (cells); <= 0: off
-    fp,  # float64 (k, 4): footprint vertices and outward normals (footprint mode); (0, 4): off
-    fsafe,  # uint8 (ny, nx): 1 where the footprint needs no test (footprint mode)
-    frho,  # the footprint's circumscribed radius (cells)
-    fmargin,  # cells: every pose's footprint keeps this distance from occ (footprint mode)
-    fslack,  # cells: the body moves at most this far between a pose and its tested sample
-):  # pragma: no cover - numba
-    """Run Hybrid-A* from the start pose to the goal pose (the comments give each argument).
+def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover - numba
+    """Run Hybrid-A* from the start pose to the goal pose.
+
+    Parameters
+    ----------
+    query : KernelQuery
+        The free cells, the heuristic field, the start and goal poses.
+    motion : KernelMotion
+        Turning radius, primitive curvatures and length, heading bins, reversing.
+    costs : KernelCosts
+        Penalties, heuristic weight, analytic ratio, car-heuristic window.
+    limits : KernelLimits
+        Expansions, deadline, polish.
+    collision : KernelCollision
+        Sampling step and the inputs of the exact and footprint modes.
 
     Returns
     -------
@@ -677,6 +799,19 @@ def hybrid_kernel(
     shot_n, expansions, shots : int
         Segments of the shot, nodes expanded, analytic shots tried.
     """
+    free, h2d, sx, sy, sth, gx, gy, gth = query
+    radius, curvatures, prim_len, nbins, reverse = motion
+    (
+        reverse_penalty,
+        cusp_penalty,
+        turn_penalty,
+        steer_penalty,
+        analytic_ratio,
+        hweight,
+        car_window,
+    ) = costs
+    max_expansions, deadline, polish = limits
+    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack = collision
     two_pi = 2.0 * math.pi
     bin_w = two_pi / nbins
     ny, nx = free.shape

@@ -1,9 +1,10 @@
 """The collision modes of :func:`astar.find_pose_path` beyond its grid: exact clearance, a footprint.
 
-The exact mode (``raw_grid``, ``clearance``; :func:`exact_mode` builds its inputs) keeps the
-chords between the search's samples a Euclidean distance from the raw map's squares. The
-footprint mode of :func:`astar.find_pose_path` (``footprint=``) checks a car-like robot
-as the convex polygon it is, rotated by the pose's heading, instead of a disc. Units are
+The exact mode (``raw_grid``, ``clearance``) keeps the chords between the search's samples a
+Euclidean distance from the raw map's squares. The footprint mode (``raw_grid``,
+``footprint``) checks a car-like robot as the convex polygon it is, rotated by the pose's
+heading, instead of a disc. Both are chosen by :class:`~astar.hybrid_options.HybridCollision`
+(or the same fields by name, as keywords of :func:`astar.find_pose_path`). Units are
 those of the search: **cells** (cell ``(ix, iy)`` is the closed square ``[ix - 0.5, ix + 0.5]
 x [iy - 0.5, iy + 0.5]``, its centre at ``(ix, iy)``), headings in radians. The polygon is
 given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
@@ -13,8 +14,11 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
   radii about the origin.
 * :func:`footprint_safe` marks the cells where no test is needed: every point of the cell
   keeps ``rho + margin + slack`` from every occupied square and from the outside.
-* :func:`footprint_mode` validates the search's footprint arguments and builds the kernel's
-  inputs (:class:`FootprintMode`); :func:`raw_occupancy` reads the raw map of both modes.
+* :func:`kernel_collision` builds the search kernel's collision record
+  (:class:`~astar.hybrid_kernel.KernelCollision`) of a mode given as a
+  :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
+  construction), and tests the end poses' footprints; :func:`raw_occupied` reads the raw
+  map of both modes, :func:`raw_occupancy` checks it against the grid.
 
 The compiled tests live in :mod:`astar.hybrid_kernel`, beside the search that calls them (so
 that numba's cache of the search is rebuilt whenever they change):
@@ -36,7 +40,7 @@ that numba's cache of the search is rebuilt whenever they change):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,15 +48,18 @@ from astar import validation
 from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
 
+if TYPE_CHECKING:  # pragma: no cover
+    from astar.hybrid_kernel import KernelCollision  # numba: imported when a search runs
+    from astar.hybrid_options import HybridCollision  # it imports this module
+
 __all__ = [
     "DEFAULT_SLACK",
-    "FootprintMode",
-    "exact_mode",
-    "footprint_mode",
     "footprint_polygon",
     "footprint_radii",
     "footprint_safe",
+    "kernel_collision",
     "raw_occupancy",
+    "raw_occupied",
 ]
 
 #: Default sampling slack (cells): how far the body moves between a pose and its sample.
@@ -187,19 +194,37 @@ def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
     return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
 
 
+def raw_occupied(raw_grid: object) -> np.ndarray:
+    """Return the occupied cells of a raw map as a read-only bool array (ny, nx).
+
+    Parameters
+    ----------
+    raw_grid : OccupancyGrid or ndarray of bool, shape (ny, nx)
+        The raw map: an ``OccupancyGrid`` (its ``occupied``, already a read-only bool
+        array, is returned as it is) or a bool array ``True`` on occupied cells (copied).
+
+    Raises
+    ------
+    InvalidInputError
+        Neither an ``OccupancyGrid`` nor a 2-D bool array.
+    """
+    if isinstance(raw_grid, OccupancyGrid):
+        return raw_grid.occupied
+    a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
+    if a is None or a.dtype != bool or a.ndim != 2:
+        raise InvalidInputError(
+            "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
+            f"cells, got {type(raw_grid).__name__}"
+            + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
+        )
+    out = np.array(a, dtype=bool, copy=True)
+    out.flags.writeable = False
+    return out
+
+
 def raw_occupancy(raw_grid: object, free: np.ndarray) -> np.ndarray:
     """Return the bool occupied mask (ny, nx) of ``raw_grid``, checked against ``free``."""
-    if isinstance(raw_grid, OccupancyGrid):
-        occ = np.asarray(raw_grid.occupied, dtype=bool)
-    else:
-        a = np.asarray(raw_grid) if isinstance(raw_grid, np.ndarray) else None
-        if a is None or a.dtype != bool or a.ndim != 2:
-            raise InvalidInputError(
-                "raw_grid must be an astar.OccupancyGrid or a 2-D bool array True on occupied "
-                f"cells, got {type(raw_grid).__name__}"
-                + (f" of dtype {a.dtype} and shape {a.shape}" if a is not None else "")
-            )
-        occ = a
+    occ = raw_occupied(raw_grid)
     if occ.shape != free.shape:
         raise InvalidInputError(
             f"raw_grid must have the grid's shape {free.shape} (ny, nx), got {occ.shape}"
@@ -207,56 +232,69 @@ def raw_occupancy(raw_grid: object, free: np.ndarray) -> np.ndarray:
     return occ
 
 
-@dataclass(frozen=True, slots=True)
-class FootprintMode:
-    """The footprint mode's kernel inputs (:func:`footprint_mode`)."""
-
-    fp: np.ndarray  # float64 (k, 4): vertices and unit outward normals, counter-clockwise
-    safe: np.ndarray  # uint8 (ny, nx): 1 where no footprint test is needed
-    occ: np.ndarray  # uint8 (ny, nx): the raw map's occupied cells
-    rho: float  # circumscribed radius (cells)
-    margin: float  # cells
-    slack: float  # cells
-
-
-def footprint_mode(
-    footprint: object,
-    footprint_margin: object,
-    footprint_slack: object,
-    raw_grid: object,
-    clearance: object,
+def kernel_collision(
+    collision: HybridCollision,
     free: np.ndarray,
+    step: float,
     poses: tuple[tuple[str, tuple[float, float, float]], ...],
-) -> FootprintMode | None:
-    """Validate the footprint mode's inputs and build its arrays; None when it is off."""
-    margin = validation.nonnegative_float("footprint_margin", footprint_margin, "cells")
-    slack = validation.positive_float("footprint_slack", footprint_slack)
-    if footprint is None:
-        if slack != DEFAULT_SLACK:
-            raise InvalidInputError(
-                f"footprint_slack={slack!r} is used only with footprint: pass a footprint "
-                f"or leave footprint_slack at {DEFAULT_SLACK}"
-            )
-        if margin != 0.0:
-            raise InvalidInputError(
-                f"footprint_margin={margin!r} is used only with footprint: pass a footprint "
-                "or leave footprint_margin at 0"
-            )
-        return None
-    from astar.hybrid_kernel import footprint_hit
+) -> KernelCollision:
+    """Build the search kernel's collision record of a validated :class:`HybridCollision`.
 
-    fp = footprint_polygon(footprint)
-    if clearance is not None:
-        raise InvalidInputError(
-            f"footprint and clearance={clearance!r} exclude each other: the footprint mode "
-            "checks the polygon itself (grow it with footprint_margin)"
-        )
-    if raw_grid is None:
-        raise InvalidInputError(
-            f"footprint={np.asarray(footprint, dtype=np.float64).tolist()} needs raw_grid "
-            "(the raw map) to be checked against"
-        )
-    occ = np.ascontiguousarray(raw_occupancy(raw_grid, free), dtype=np.uint8)
+    Parameters
+    ----------
+    collision : HybridCollision
+        The collision mode (its fields are checked on construction).
+    free : ndarray of uint8, shape (ny, nx)
+        The search's free cells (``raw_grid`` must have their shape).
+    step : float
+        Collision sampling spacing along the primitives (cells).
+    poses : tuple of (str, (x, y, heading))
+        The start and goal poses by name: in the footprint mode, their footprint grown by
+        the margin and the slack must keep clear of the raw map and inside the grid.
+
+    Returns
+    -------
+    KernelCollision
+        Off modes get placeholders: 1 x 1 ``safe``/``occ``, ``exact_r = 0``, a (0, 4)
+        footprint.
+
+    Raises
+    ------
+    InvalidInputError
+        ``raw_grid`` does not have the grid's shape, or (footprint mode) an end pose's grown
+        footprint meets an occupied square or leaves the grid.
+    """
+    from astar.hybrid_kernel import KernelCollision
+
+    dummy = np.zeros((1, 1), dtype=np.uint8)
+    no_fp = np.zeros((0, 4))
+    if collision.footprint is not None:
+        return _footprint_inputs(collision, free, step, poses)
+    if collision.clearance is None:
+        return KernelCollision(step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0)
+    r = collision.clearance
+    occ = raw_occupancy(collision.raw_grid, free)
+    from astar.inflation import inflate
+
+    margin = r + math.sqrt(0.5) + 1e-9
+    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
+    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
+    occ8 = np.ascontiguousarray(occ, dtype=np.uint8)
+    return KernelCollision(step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0)
+
+
+def _footprint_inputs(
+    collision: HybridCollision,
+    free: np.ndarray,
+    step: float,
+    poses: tuple[tuple[str, tuple[float, float, float]], ...],
+) -> KernelCollision:
+    """Build the footprint mode's kernel inputs and test the end poses' footprints."""
+    from astar.hybrid_kernel import KernelCollision, footprint_hit
+
+    margin, slack = collision.footprint_margin, collision.footprint_slack
+    fp = footprint_polygon(collision.footprint)
+    occ = np.ascontiguousarray(raw_occupancy(collision.raw_grid, free), dtype=np.uint8)
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
@@ -274,33 +312,5 @@ def footprint_mode(
                 f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
                 "clear of every occupied square and inside the grid"
             )
-    return FootprintMode(fp, safe, occ, rho, margin, slack)
-
-
-def exact_mode(
-    raw_grid: object, clearance: object, free: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """Return the exact mode's ``(safe, occ, clearance)`` arrays (uint8) and distance (cells).
-
-    Off (``clearance`` None): 1 x 1 placeholders and ``0.0``. ``safe`` marks the cells whose
-    centre keeps ``clearance + sqrt(2) / 2`` from every occupied square and the outside (so
-    every point of the cell keeps ``clearance``).
-    """
     dummy = np.zeros((1, 1), dtype=np.uint8)
-    if clearance is None:
-        if raw_grid is not None:
-            raise InvalidInputError(
-                "raw_grid is used only with clearance or footprint: pass it with one of them "
-                "or not at all"
-            )
-        return dummy, dummy, 0.0
-    r = validation.positive_float("clearance", clearance)
-    if raw_grid is None:
-        raise InvalidInputError(f"clearance={r!r} needs raw_grid (the raw map) to measure it on")
-    occ = raw_occupancy(raw_grid, free)
-    from astar.inflation import inflate
-
-    margin = r + math.sqrt(0.5) + 1e-9
-    blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
-    safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
-    return safe, np.ascontiguousarray(occ, dtype=np.uint8), r
+    return KernelCollision(step, dummy, occ, 0.0, fp, safe, rho, margin, slack)

@@ -28,6 +28,8 @@ __all__ = [
     "cell",
     "cell_costs",
     "choice",
+    "float_at_least",
+    "int_at_least",
     "integer_values",
     "nonnegative_float",
     "nonnegative_int",
@@ -91,6 +93,28 @@ def nonnegative_int(name: str, value: object) -> int:
     if v < 0:
         raise InvalidInputError(f"{name} must be >= 0, got {v}")
     return v
+
+
+def float_at_least(name: str, value: object, lo: float, rule: str) -> float:
+    """Return a finite float ``>= lo``; ``rule`` (e.g. ``">= 1"``) is named in the message."""
+    if isinstance(value, bool):
+        raise InvalidInputError(f"{name} must be a number, got {value!r}")
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v) or v < lo:
+        raise InvalidInputError(f"{name} must be finite and {rule}, got {v!r}")
+    return v
+
+
+def int_at_least(name: str, value: object, lo: int) -> int:
+    """Return an ``int`` (or NumPy integer, not a bool) ``>= lo``."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InvalidInputError(f"{name} must be an int, got {value!r}")
+    if int(value) < lo:
+        raise InvalidInputError(f"{name} must be >= {lo}, got {int(value)}")
+    return int(value)
 
 
 def origin(value: object) -> tuple[float, float]:
