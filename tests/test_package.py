@@ -162,8 +162,7 @@ def _drive_composes(here: str, target: str, path: Path, line: int) -> bool:
         return False
     tree = ast.parse(path.read_text())
     return any(
-        isinstance(fn, ast.FunctionDef)
-        and fn.lineno < line <= (fn.end_lineno or fn.lineno)
+        isinstance(fn, ast.FunctionDef) and fn.lineno < line <= (fn.end_lineno or fn.lineno)
         for fn in ast.walk(tree)
     )
 
@@ -211,3 +210,71 @@ def test_no_import_circle_between_files():
         if m not in state:
             cycle = visit(m)
             assert cycle is None, " -> ".join(cycle)
+
+
+#: The result classes of trajopt.motion: stages ask a motion what it is (its flags and
+#: methods: single_curve, turning, polyline, own_orientation, playing, plan_at, ...)
+#: rather than switch on its class
+RESULT_CLASSES = {
+    "Trajectory",
+    "TrajectoryChain",
+    "TurnInPlace",
+    "StopAndTurnTrajectory",
+    "OmniTrajectory",
+}
+
+
+def _class_switches(tree: ast.AST) -> list[int]:
+    """Lines of ``isinstance(x, C)`` / ``type(x) is C`` on a result class that choose a branch.
+
+    A check whose ``if`` only raises (the type check of an argument) is not a switch.
+    """
+    validation = {
+        id(sub)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.If) and all(isinstance(b, ast.Raise) for b in node.body)
+        for sub in ast.walk(node.test)
+    }
+
+    def names(node: ast.AST) -> set[str]:
+        return {n.id for n in ast.walk(node) if isinstance(n, ast.Name)} | {
+            n.attr for n in ast.walk(node) if isinstance(n, ast.Attribute)
+        }
+
+    out = []
+    for node in ast.walk(tree):
+        if id(node) in validation:
+            continue
+        if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "isinstance":
+            if len(node.args) == 2 and names(node.args[1]) & RESULT_CLASSES:
+                out.append(node.lineno)
+        elif isinstance(node, ast.Compare) and any(
+            isinstance(op, ast.Is | ast.IsNot) for op in node.ops
+        ):
+            sides = [node.left, *node.comparators]
+            typed = any(
+                isinstance(s, ast.Call) and getattr(s.func, "id", None) == "type" for s in sides
+            )
+            if typed and any(names(s) & RESULT_CLASSES for s in sides):
+                out.append(node.lineno)
+    return out
+
+
+def test_no_switch_on_result_classes_outside_motion_and_the_drives():
+    root = Path(trajopt.__file__).parent
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        rel = path.relative_to(root)
+        if rel.parts[0] in ("motion", "drive"):
+            continue
+        found += [f"{rel}:{line}" for line in _class_switches(ast.parse(path.read_text()))]
+    assert not found, found
+
+
+def test_the_switch_check_finds_switches():
+    code = (
+        "if isinstance(t, TrajectoryChain):\n    x = 1\n"
+        "y = 2 if type(t) is Trajectory else 3\n"
+        "if not isinstance(t, Trajectory):\n    raise TypeError('t')\n"
+    )
+    assert _class_switches(ast.parse(code)) == [1, 3]

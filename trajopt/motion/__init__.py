@@ -18,7 +18,7 @@ from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._result import PlanResult
 from trajopt.motion._samples import CarSample, OmniSample, TrajectorySample
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import Trajectory
+from trajopt.motion._trajectory import Orientation, Trajectory
 
 __all__ = [
     "CarSample",
@@ -26,6 +26,7 @@ __all__ = [
     "McapExportError",
     "OmniSample",
     "OmniTrajectory",
+    "Orientation",
     "PlanResult",
     "StopAndTurnTrajectory",
     "Trajectory",

@@ -16,15 +16,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import TrajectorySample, make_sample
-from trajopt.motion._trajectory import AtRestEnds, SampledExport, export_dict
+from trajopt.motion._trajectory import AtRestEnds, Orientation, SampledExport, export_dict
 from trajopt.robot._robot import Robot
+from trajopt.robot._state import State
 
 #: Largest jump (SI units) between two consecutive pieces of a chain.
 JOIN_TOL = 1e-6
@@ -54,6 +55,8 @@ class TurnInPlace(AtRestEnds):
     stats : dict
         ``turn_rad`` (signed) and ``duration_s``.
     """
+
+    turning: ClassVar[bool] = True
 
     position: np.ndarray
     theta0: float
@@ -230,6 +233,47 @@ class TrajectoryChain(SampledExport):
         if tt >= self.duration:  # the end exactly (no rounding)
             return i, float(self.pieces[i].duration)
         return i, tt - float(self._t[i]) + self.starts[i]
+
+    def playing(self, t: float) -> tuple[SampledExport, float]:
+        """Return the piece playing at chain time ``t`` (s) and the time in it (:meth:`piece_at`)."""
+        i, tau = self.piece_at(t)
+        return self.pieces[i], tau
+
+    def plan_at(self, t: float) -> tuple[SampledExport, float]:
+        """Return the plan a re-plan at ``t`` (s) continues, and the time in it.
+
+        The chain's last piece (its plan from rest) while it plays, unless it is a turn in
+        place; else the chain itself.
+        """
+        i, tau = self.piece_at(t)
+        last = self.pieces[i]
+        if i == len(self.pieces) - 1 and not last.turning:
+            return last, tau
+        return self, t
+
+    def orientation_at(self, t: float) -> Orientation | None:
+        """Return the body's own orientation at ``t`` (s) when the piece playing has one.
+
+        The angle is the chain's (continuous across its pieces); ``None`` when the piece
+        faces its direction of travel.
+        """
+        piece, tau = self.playing(t)
+        own = piece.orientation_at(tau)
+        if own is None:
+            return None
+        theta = float(self.sample(np.array([t])).theta[0])
+        return Orientation(theta, own.omega, own.alpha)
+
+    def translation_state(self, t: float) -> State:
+        """Return the state a re-plan continues at ``t`` (s).
+
+        The translation's of a piece whose body turns on its own (its direction of travel,
+        not the body's angle), else :meth:`state_at`.
+        """
+        piece, tau = self.playing(t)
+        if piece.own_orientation:
+            return piece.translation_state(tau)
+        return self.state_at(t)
 
     def after(self, t: float) -> TrajectoryChain:
         """Return the chain from time ``t`` (s) on, with its clock starting at 0 there."""

@@ -40,14 +40,14 @@ for every trajectory, ``linear.x = v`` (the speed along the path, not ``v_body_x
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import OmniSample
-from trajopt.motion._trajectory import SampledExport, Trajectory, export_dict
+from trajopt.motion._trajectory import Orientation, SampledExport, Trajectory, export_dict
 from trajopt.robot._robot import Robot
 from trajopt.robot._state import State
 
@@ -105,6 +105,8 @@ class OmniTrajectory(SampledExport):
         non-finite, a ``turn_duration`` before the last row, non-finite headings, or an
         orientation that outlasts a translation ending in motion.
     """
+
+    own_orientation: ClassVar[bool] = True
 
     translation: Trajectory
     robot: Robot
@@ -197,6 +199,11 @@ class OmniTrajectory(SampledExport):
         """
         tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         return self.translation.motion(tt)
+
+    def orientation_at(self, t: float) -> Orientation:
+        """Return the body's orientation, yaw rate and yaw acceleration at ``t`` (s)."""
+        theta, omega, alpha, _ = (float(x) for x in self.orientation(t))
+        return Orientation(theta, omega, alpha)
 
     def orientation(self, t: np.ndarray | float) -> tuple[np.ndarray, ...]:
         """Return the orientation: ``(theta, omega, alpha, zeta)`` at times ``t`` (s).

@@ -14,7 +14,7 @@ straight between its vertices, and at a vertex the robot turns at rest, where th
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -65,6 +65,8 @@ class StopAndTurnTrajectory(AtRestEnds):
         ``trajopt._planner.PlanSteps`` when planned by :class:`trajopt.Planner`
         (its ``smooth_path`` is ``None``).
     """
+
+    polyline: ClassVar[bool] = True
 
     path: PolylineCurve
     robot: Robot

@@ -15,7 +15,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -33,16 +33,52 @@ from trajopt.robot._robot import Robot
 from trajopt.robot._state import State
 
 
+class Orientation(NamedTuple):
+    """A body's orientation (rad), yaw rate (rad/s) and yaw acceleration (rad/s^2)."""
+
+    theta: float
+    omega: float
+    alpha: float
+
+
 class SampledExport:
-    """The sampling and file export shared by every timed trajectory of :mod:`trajopt`.
+    """The sampling, file export and shape shared by every timed trajectory of :mod:`trajopt`.
 
     A subclass provides ``duration`` (s), ``sample(t)`` returning a
     :class:`TrajectorySample` and ``to_dict(dt)``; the helpers below give it
     ``sample_uniform``, ``to_poses`` and the writers ``to_json``, ``to_csv`` and
-    ``to_mcap`` (atomic writes, each naming the frame of its poses).
+    ``to_mcap`` (atomic writes, each naming the frame of its poses). What a re-plan asks
+    of a motion it answers itself: :meth:`playing` (the piece at a time),
+    :meth:`orientation_at` and :meth:`translation_state`, and the flags
+    :attr:`single_curve`, :attr:`turning`, :attr:`polyline` and :attr:`own_orientation`.
     """
 
     __slots__ = ()
+
+    #: One timed curve (a :class:`Trajectory`): it can be cut, kept and braked along.
+    single_curve: ClassVar[bool] = False
+    #: A rotation at rest (a turn in place).
+    turning: ClassVar[bool] = False
+    #: Straight segments with turns in place at rest between them (no smooth curve).
+    polyline: ClassVar[bool] = False
+    #: The body's orientation is a motion of its own, beside the translation (omni).
+    own_orientation: ClassVar[bool] = False
+
+    def playing(self, t: float) -> tuple[SampledExport, float]:
+        """Return the motion playing at time ``t`` (s) and the time in it: itself here."""
+        return self, t
+
+    def plan_at(self, t: float) -> tuple[SampledExport, float]:
+        """Return the plan a re-plan at ``t`` (s) continues, and the time in it: itself here."""
+        return self, t
+
+    def orientation_at(self, t: float) -> Orientation | None:
+        """Return the body's own orientation at ``t`` (s), or ``None`` (it faces its travel)."""
+        return None
+
+    def translation_state(self, t: float) -> State:
+        """Return the moving state a re-plan continues at ``t`` (s): :meth:`state_at` here."""
+        return self.state_at(t)  # type: ignore[attr-defined]
 
     def sample_uniform(self, dt: float) -> TrajectorySample:
         """Sample every ``dt`` seconds from 0, plus the end time ``duration``.
@@ -314,6 +350,8 @@ class Trajectory(SampledExport):
         (``drive="ackermann"``) carry ``direction`` (and the steering angle with a
         wheelbase).
     """
+
+    single_curve: ClassVar[bool] = True
 
     path: ParametricCurve
     robot: Robot

@@ -43,7 +43,6 @@ import numpy as np
 import astar
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
@@ -168,7 +167,7 @@ def plan_with_footprint(
             continue
         cert_s = 0.0
         smoother_stats = getattr(getattr(traj, "path", None), "stats", None) or {}
-        if isinstance(traj, StopAndTurnTrajectory):
+        if traj.polyline:
             cert = None  # only on the circumscribed rung: its disc holds every heading
         else:
             cert = getattr(traj.path, "footprint_certificate", None)  # the smoother's

@@ -22,8 +22,6 @@ import dataclasses
 import numpy as np
 
 from trajopt.errors import TimingError
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
@@ -77,7 +75,7 @@ def plan_omni(
     translation = plan_disc(options, caches, free, warm)
     if h0 is None and h1 is None and w0 == 0.0 and a0 == 0.0:
         return translation
-    if isinstance(translation, StopAndTurnTrajectory):  # the fallback turns at its ends
+    if translation.polyline:  # the fallback turns at its ends
         if w0 != 0.0 or a0 != 0.0:
             raise TimingError(
                 f"the stop-and-turn fallback starts at rest, but the body turns at the start "
@@ -87,7 +85,6 @@ def plan_omni(
                             goal_heading=h1, speed_limits=options.speed_limits)  # fmt: skip
         return dataclasses.replace(out, stats=dict(translation.stats),
                                    steps=_asked(translation.steps, request))  # fmt: skip
-    assert isinstance(translation, Trajectory)
     ends = translation.sample(np.array([0.0, translation.duration]))
     theta0 = float(ends.theta[0]) if h0 is None else h0
     theta1 = float(ends.theta[1]) if h1 is None else h1

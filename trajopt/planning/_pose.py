@@ -43,7 +43,7 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError, TimingError
-from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
@@ -139,7 +139,7 @@ def plan_pose(
         goal_heading=None if "goal" in turn_ends else request.goal_heading,
     )
     free = plan(free_request, warm, None)
-    if isinstance(free, StopAndTurnTrajectory):  # the fallback turns at its ends itself
+    if free.polyline:  # the fallback turns at its ends itself
         return _with_headings(free, robot, options, request)
     first = free.sample(np.array([0.0, free.duration]))
     curve_heading = {"start": float(first.theta[0]), "goal": float(first.theta[1])}
@@ -254,7 +254,7 @@ def _chain(
 def _turn_of(traj: Any, i: int) -> float:
     """Signed turn (rad) of the chain's first (``i = 0``) or last (``-1``) piece, else 0."""
     pieces = getattr(traj, "pieces", ())
-    if pieces and isinstance(pieces[i], TurnInPlace):
+    if pieces and pieces[i].turning:
         return float(pieces[i].turn_rad)
     return 0.0
 

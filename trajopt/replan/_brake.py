@@ -52,7 +52,7 @@ from astar.grid import OccupancyGrid
 from trajopt.errors import TimingError, TrajoptError
 from trajopt.geometry._clearance import points_clearance
 from trajopt.geometry._curve import CurveSegment
-from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
@@ -60,7 +60,7 @@ from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
 from trajopt.planning._runner import run_query
 from trajopt.replan._keep import target_change
-from trajopt.replan._omni import orientation_at, turn_piece
+from trajopt.replan._omni import turn_piece
 from trajopt.robot._robot import Robot
 from trajopt.timing import time_parameterize
 from trajopt.timing._greedy import advance, brake_times
@@ -192,20 +192,17 @@ def brake_turn_go(
     TrajoptError
         The plan from rest fails (its own error, with a note on the stop).
     """
-    traj, t_in = trajectory, ts
-    if isinstance(trajectory, TrajectoryChain):  # what plays at ts; earlier pieces are past
-        i, t_in = trajectory.piece_at(ts)
-        traj = trajectory.pieces[i]
+    traj, t_in = trajectory.playing(ts)  # a chain's piece; its earlier pieces are past
     robot = options.robot
-    if robot.footprint is None and isinstance(traj, OmniTrajectory):
+    if robot.footprint is None and traj.own_orientation:
         target = (goal, goal_heading, v_end)
         return _brake_go_omni(options, caches, trajectory, ts, target, error, previous)
-    if robot.footprint is not None or not isinstance(traj, (Trajectory, TurnInPlace)):
+    if robot.footprint is not None or not (traj.single_curve or traj.turning):
         raise error
     pieces: list[Any] = []
     starts: list[float] = []
     brake = None
-    if isinstance(traj, TurnInPlace):  # turning at rest: the turn is finished first
+    if traj.turning:  # turning at rest: the turn is finished first
         if t_in < traj.duration:
             pieces.append(traj)
             starts.append(t_in)
@@ -284,12 +281,10 @@ def _brake_go_omni(
     """
     goal, goal_heading, v_end = target
     robot = options.robot
-    traj, t_in = trajectory, ts
-    if isinstance(trajectory, TrajectoryChain):
-        i, t_in = trajectory.piece_at(ts)
-        traj = trajectory.pieces[i]
-    start = orientation_at(trajectory, ts)
-    assert isinstance(traj, OmniTrajectory) and start is not None
+    traj, t_in = trajectory.playing(ts)
+    start = trajectory.orientation_at(ts)
+    if start is None:  # pragma: no cover - brake_turn_go sends only a body that turns
+        raise error
     translation = traj.translation
     brake = None
     if t_in < translation.duration:

@@ -88,7 +88,7 @@ def keep_rest(
     t0 = time.perf_counter()
     steps = getattr(trajectory, "steps", None)
     smooth = getattr(steps, "smooth_path", None)
-    if not isinstance(trajectory, Trajectory) or not isinstance(smooth, SmoothPath):
+    if not trajectory.single_curve or not isinstance(smooth, SmoothPath):
         return None, "not a smoothed trajectory of a Planner"
     if options.robot.footprint is not None:
         return None, "footprint robot"

@@ -4,7 +4,7 @@ An omnidirectional base (``Robot(drive="omni")``) carries two motions
 (:class:`~trajopt.motion.OmniTrajectory`): the translation along its path, which a re-plan
 continues from its :class:`~trajopt.robot.State` (``theta`` is the direction of travel), and
 the orientation of the body, which it continues from the angle, yaw rate and yaw
-acceleration at the splice (:func:`orientation_at`; the request's ``start_heading``,
+acceleration at the splice (:meth:`~trajopt.motion.TrajectoryChain.orientation_at`; the request's ``start_heading``,
 ``start_omega`` and ``start_alpha``). These helpers read both from the trajectory being
 driven, whatever it is (an :class:`~trajopt.motion.OmniTrajectory`, a chain of a braking
 re-plan, a plain :class:`~trajopt.Trajectory` whose orientation is its direction of
@@ -15,72 +15,15 @@ travel), and give a turn at rest that does not start at rest as a
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from trajopt.errors import InvalidInputError
-from trajopt.motion._chain import TrajectoryChain, TurnInPlace
-from trajopt.motion._omni import OmniTrajectory
-from trajopt.motion._trajectory import Trajectory
+from trajopt.motion import Orientation, Trajectory, TurnInPlace
 from trajopt.robot._robot import Robot
-from trajopt.robot._state import State
 from trajopt.timing._orientation import start_rates
 from trajopt.timing._stop_and_turn import turn_limits
-
-
-class Orientation(NamedTuple):
-    """The body's orientation (rad), yaw rate (rad/s) and yaw acceleration (rad/s^2)."""
-
-    theta: float
-    omega: float
-    alpha: float
-
-
-def piece_at(trajectory: Any, ts: float) -> tuple[Any, float]:
-    """Return the trajectory playing at ``ts`` (s) and the time in it (a chain's piece)."""
-    if isinstance(trajectory, TrajectoryChain):
-        i, tau = trajectory.piece_at(ts)
-        return trajectory.pieces[i], tau
-    return trajectory, ts
-
-
-def translation_state(trajectory: Any, ts: float) -> State:
-    """Return the :class:`State` a re-plan continues: the translation's at ``ts`` (s).
-
-    For an :class:`OmniTrajectory` (also a chain's piece) ``theta`` is its direction of
-    travel, not the orientation a chain's samples give; otherwise ``trajectory.state_at``.
-    """
-    piece, tau = piece_at(trajectory, ts)
-    if isinstance(piece, OmniTrajectory):
-        return piece.state_at(tau)
-    return trajectory.state_at(ts)
-
-
-def orientation_at(trajectory: Any, ts: float) -> Orientation | None:
-    """Return the body's orientation at ``ts`` (s) of an omnidirectional base's trajectory.
-
-    Parameters
-    ----------
-    trajectory : OmniTrajectory or TrajectoryChain
-        The trajectory driven (its clock).
-    ts : float
-        The splice time (s).
-
-    Returns
-    -------
-    Orientation or None
-        For an :class:`OmniTrajectory` (or a chain whose piece at ``ts`` is one), its
-        orientation, yaw rate and yaw acceleration there; a chain's angle is the chain's
-        (continuous across its pieces). ``None`` for anything else.
-    """
-    piece, tau = piece_at(trajectory, ts)
-    if not isinstance(piece, OmniTrajectory):
-        return None
-    theta, omega, alpha, _ = (float(x) for x in piece.orientation(tau))
-    if piece is not trajectory:  # the chain's angle, continuous across its pieces
-        theta = float(trajectory.sample(np.array([ts])).theta[0])
-    return Orientation(theta, omega, alpha)
 
 
 def course_orientation(trajectory: Any, ts: float, robot: Robot) -> Orientation | None:
@@ -94,7 +37,7 @@ def course_orientation(trajectory: Any, ts: float, robot: Robot) -> Orientation 
     starts its orientation at rest (a jump in yaw rate, as before omni re-plans continued
     it).
     """
-    if not robot.drive.orients_body or type(trajectory) is not Trajectory:
+    if not robot.drive.orients_body or not trajectory.single_curve:
         return None
     smp = trajectory.sample(np.array([ts]))
     theta, kappa = float(smp.theta[0]), float(smp.kappa[0])

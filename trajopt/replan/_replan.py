@@ -44,8 +44,7 @@ from typing import Any, NamedTuple
 from astar.grid import OccupancyGrid
 from trajopt._validation import nonnegative, number, point
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
-from trajopt.motion._chain import TrajectoryChain, TurnInPlace
-from trajopt.motion._omni import OmniTrajectory
+from trajopt.motion._chain import TrajectoryChain
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, check_endpoint
 from trajopt.planning._options import PlannerOptions, PlanRequest
@@ -59,7 +58,7 @@ from trajopt.replan._keep import (
     remaining_grid_path,
     target_change,
 )
-from trajopt.replan._omni import course_orientation, orientation_at, translation_state
+from trajopt.replan._omni import course_orientation
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
 BRAKE_AFTER_S = 0.1
@@ -144,17 +143,12 @@ def replan_moving(
     :func:`replan_from`'s, checked.
     """
     out, why = None, NO_REUSE
-    piece, t_piece = trajectory, ts
-    if isinstance(trajectory, TrajectoryChain):
-        i, t_piece = trajectory.piece_at(ts)
-        last = trajectory.pieces[i]
-        if i == len(trajectory.pieces) - 1 and not isinstance(last, TurnInPlace):
-            # driving the chain's last plan: re-plan that
-            piece = trajectory.pieces[i]
-    if reuse and piece is trajectory and isinstance(trajectory, TrajectoryChain):
+    piece, t_piece = trajectory.plan_at(ts)  # a chain's last plan while it plays
+    if reuse and piece is trajectory and trajectory.playing(ts)[0] is not trajectory:
+        # a chain, before its last plan: keep the chain's rest
         out, why = _keep_chain(caches.grid, trajectory, ts, goal, goal_heading, v_end)
     elif reuse:
-        keep = keep_omni if isinstance(piece, OmniTrajectory) else keep_rest
+        keep = keep_omni if piece.own_orientation else keep_rest
         out, why = keep(
             options, caches, piece, t_piece, goal, goal_heading=goal_heading, v_end=v_end
         )
@@ -228,18 +222,17 @@ def _plan_or_brake(
             previous=previous,
         )
 
-    if isinstance(piece, TrajectoryChain):
-        i, tau = piece.piece_at(ts)
-        if isinstance(piece.pieces[i], TurnInPlace) and tau < piece.pieces[i].duration:
-            return brake(TimingError("the robot is turning in place at the splice"))
-    state = translation_state(trajectory, ts)
+    playing, tau = piece.playing(ts)
+    if playing is not piece and playing.turning and tau < playing.duration:  # a chain's turn
+        return brake(TimingError("the robot is turning in place at the splice"))
+    state = trajectory.translation_state(ts)
     path = None
     if why == BLOCKED_NEAR:  # the map changed near the rest, maybe not along its path
         path = remaining_grid_path(
             options, caches, piece.steps, caches.grid.world_to_cell(state.position)
         )
     warm = WarmStart(path, previous)
-    body = orientation_at(trajectory, ts)  # an omni base's orientation goes on
+    body = trajectory.orientation_at(ts)  # an omni base's orientation goes on
     if body is None and goal_heading is not None:
         body = course_orientation(trajectory, ts, options.robot)
     request = PlanRequest(state, goal, goal_heading=goal_heading, v_end=v_end)

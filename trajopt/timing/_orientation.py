@@ -321,7 +321,7 @@ def _check(translation: Any, robot: Any) -> None:
     if not robot.drive.orients_body:
         raise InvalidInputError(
             "orient needs an omnidirectional robot: Robot.drive must be 'omni', got "
-            f"{robot.drive!r} (a differential drive faces its direction of travel)"
+            f"{robot.drive.name!r} (a differential drive faces its direction of travel)"
         )
     for name in _TRANSLATION_LIMITS:
         have, allowed = getattr(translation.robot, name), getattr(robot, name)
