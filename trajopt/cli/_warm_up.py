@@ -41,7 +41,7 @@ def add_parser(sub: Any) -> None:
 
 def _cmd_warm_up(args: argparse.Namespace) -> int:
     import trajopt._kernel_cache as kernel_cache
-    from trajopt import warm_up
+    import trajopt._warm_up as warm
 
     if args.workers is not None and args.workers < 1:
         raise CliError(f"--workers must be >= 1, got {args.workers}")
@@ -54,7 +54,7 @@ def _cmd_warm_up(args: argparse.Namespace) -> int:
         )
     for name, error in report.failed.items():
         print(f"trajopt warm-up: exercise {name!r} failed: {error}", file=sys.stderr)
-    warm_up()
+    warm.warm_up()
     n = len(kernel_cache.kernels())
     left = kernel_cache.cold_kernels()
     print(
