@@ -8,7 +8,7 @@
   in their test with ``@example``.
 * A fresh clone (or venv, or CI runner) has no compiled numba kernels yet: the session
   first compiles every kernel numba's cache lacks, in two worker processes
-  (:func:`trajopt._kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
+  (:func:`trajopt._warm_up.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
 * The notebooks execute in a background thread from the end of collection on, while the
   other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
@@ -46,7 +46,9 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         f"trajopt: compiling {len(cold)} numba kernels first (once per environment; "
         "TRAJOPT_PRECOMPILE=0 skips)..."
     )
-    report = kernel_cache.compile_kernels()
+    import trajopt._warm_up as warm
+
+    report = warm.compile_kernels()
     say(f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s")
     for name, error in report.failed.items():
         say(f"trajopt: warm-up exercise {name!r} failed: {error}")

@@ -18,16 +18,19 @@ This module makes that visible and lets it be paid ahead of time:
   nothing. The library prints nothing; the ``trajopt`` command line shows the notice.
 * :func:`cold_kernels` lists the kernels with nothing valid in the disk cache, without
   compiling anything (it reads numba's cache index files).
-* :func:`compile_kernels` compiles them by running the warm-up exercises
-  (:data:`trajopt._warm_up.EXERCISES`: small searches, plans and timings that between them
-  call every kernel with the argument types the library uses) in worker processes, two at
-  a time on two cores; numba's cache holds one file per kernel and signature and writes
-  them atomically, so the workers fill one cache for every later process.
+* :func:`run_exercises` compiles them by running the exercises its caller gives (each an
+  :class:`Exercise`: library calls on small inputs) in worker processes, two at a time on
+  two cores; numba's cache holds one file per kernel and signature and writes them
+  atomically, so the workers fill one cache for every later process. The exercises that
+  between them call every kernel with the argument types the library uses are
+  ``trajopt._warm_up.EXERCISES``, above this module: :func:`trajopt._warm_up.compile_kernels`
+  passes them in, with the command that starts a worker serving them (:func:`serve`), so
+  this module imports nothing above the kernels.
 * :func:`load_kernels` loads every kernel's cached signatures into this process (also the
   kernels that only other kernels call, whose code is otherwise only loaded inside their
   callers).
 
-:func:`trajopt._warm_up` and ``trajopt warm-up`` combine the last two.
+:func:`trajopt.warm_up` and ``trajopt warm-up`` combine the last two.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ import sys
 import tempfile
 import time
 import traceback
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,10 +76,10 @@ KERNEL_MODULES: tuple[str, ...] = (
 #: notice's estimate.
 SECONDS_PER_KERNEL = 0.5
 
-#: Environment variable set in the worker processes of :func:`compile_kernels`.
+#: Environment variable set in the worker processes of :func:`run_exercises`.
 WORKER_ENV = "TRAJOPT_KERNEL_WORKER"
 
-#: Seconds without a line from any worker after which :func:`compile_kernels` stops them
+#: Seconds without a line from any worker after which :func:`run_exercises` stops them
 #: (a kernel compiles in seconds; the exercises' kernels then compile on first use).
 IDLE_LIMIT_S = 300.0
 
@@ -205,7 +208,7 @@ def add_compile_hook(hook: Callable[[str], None]) -> None:
 
 def _notice(d: Any) -> None:
     if os.environ.get(WORKER_ENV):
-        return  # a worker of compile_kernels: its parent reports
+        return  # a worker of run_exercises: its parent reports
     try:
         n = len(cold_kernels())
     except Exception:  # noqa: BLE001 - the notice must never break a compile
@@ -221,14 +224,29 @@ def _notice(d: Any) -> None:
 
 
 # ----------------------------------------------------------------------------- compilation
-def warm_up_module() -> Any:
-    """Return the module of the warm-up exercises, :mod:`trajopt._warm_up`."""
-    return importlib.import_module("trajopt._warm_up")
+@dataclass(frozen=True)
+class Exercise:
+    """A warm-up exercise: library calls on small inputs that compile a set of kernels.
+
+    Attributes
+    ----------
+    run : callable
+        Runs the calls (no arguments, no result).
+    after : tuple of str
+        Exercises to run first: their kernels are then loaded, not compiled again, when
+        this one runs in another worker process.
+    seconds : float
+        Rough compile time (s) when every kernel is cold: longest first.
+    """
+
+    run: Callable[[], None]
+    after: tuple[str, ...] = ()
+    seconds: float = 1.0
 
 
 @dataclass
 class CompileReport:
-    """What :func:`compile_kernels` did.
+    """What :func:`run_exercises` did.
 
     Attributes
     ----------
@@ -265,21 +283,28 @@ class CompileReport:
         return self
 
 
-def compile_kernels(
+def run_exercises(
+    table: Mapping[str, Exercise],
     exercises: Sequence[str] | None = None,
     *,
+    worker: Sequence[str],
     workers: int | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     first: Sequence[str] | None = None,
     force: bool = False,
 ) -> CompileReport:
-    """Compile the cold kernels into numba's disk cache by running the warm-up exercises.
+    """Compile the cold kernels into numba's disk cache by running exercises of ``table``.
 
     Parameters
     ----------
+    table : mapping of str to Exercise
+        The exercises by name (``trajopt._warm_up.EXERCISES``: between them they call every
+        kernel of the packages).
     exercises : sequence of str, optional
-        Names in :data:`trajopt._warm_up.EXERCISES` (with the ones they depend on); default
-        all, which call every kernel of the packages.
+        Names in ``table`` (with the ones they depend on); default all.
+    worker : sequence of str
+        The command that starts a worker process serving ``table`` (:func:`serve` on its
+        stdin and stdout), e.g. ``[sys.executable, "-m", "trajopt._warm_up", "--worker"]``.
     workers : int, optional
         Worker processes; default ``min(2, CPUs)``. ``0`` or ``1`` runs the exercises in this
         process, one after the other (the kernels are then also loaded here).
@@ -298,19 +323,22 @@ def compile_kernels(
     CompileReport
         Nothing runs (and ``seconds`` is ~0) when every kernel is already cached. An
         exercise that fails is reported, not raised: its kernels then compile on first use.
+
+    Raises
+    ------
+    InvalidInputError
+        An exercise name not in ``table``.
     """
     import threading
-
-    EXERCISES = warm_up_module().EXERCISES  # noqa: N806 - the module's constant
 
     t0 = time.perf_counter()
     cold = cold_kernels()
     report = CompileReport(cold=list(cold))
     if not cold and not force:
         return report
-    names = _with_dependencies(EXERCISES, list(EXERCISES) if exercises is None else exercises)
-    early = set(_with_dependencies(EXERCISES, first)) if first is not None else set(names)
-    names.sort(key=lambda n: (n not in early, -EXERCISES[n].seconds))  # early, longest first
+    names = _with_dependencies(table, list(table) if exercises is None else exercises)
+    early = set(_with_dependencies(table, first)) if first is not None else set(names)
+    names.sort(key=lambda n: (n not in early, -table[n].seconds))  # early, longest first
     if workers is None:
         workers = min(2, os.cpu_count() or 1)
     if os.environ.get(WORKER_ENV):
@@ -331,9 +359,9 @@ def compile_kernels(
 
     if workers >= 2:
         try:
-            pool = _Workers(min(workers, len(names)), EXERCISES, report, seen, t0)
+            pool = _Workers(min(workers, len(names)), worker, table, report, seen, t0)
         except OSError as exc:  # no subprocess here: run them in this process
-            _log.info("compile_kernels: no worker processes (%s); compiling here", exc)
+            _log.info("run_exercises: no worker processes (%s); compiling here", exc)
         else:
             report.workers = pool.n
             early_done = threading.Event()
@@ -357,7 +385,7 @@ def compile_kernels(
         for name in names:
             t1 = time.perf_counter() - t0
             try:
-                EXERCISES[name].run()
+                table[name].run()
                 report.exercises.append(name)
                 report.timeline.append((name, 0, t1, time.perf_counter() - t0))
             except Exception as exc:  # noqa: BLE001 - reported, the kernels compile later
@@ -368,7 +396,7 @@ def compile_kernels(
     return report
 
 
-def _with_dependencies(table: dict[str, Any], names: Iterable[str]) -> list[str]:
+def _with_dependencies(table: Mapping[str, Exercise], names: Iterable[str]) -> list[str]:
     """``names`` and what they depend on, dependencies first, unknown names rejected."""
     from trajopt.errors import InvalidInputError
 
@@ -391,12 +419,13 @@ def _with_dependencies(table: dict[str, Any], names: Iterable[str]) -> list[str]
 
 
 class _Workers:
-    """Worker processes that run warm-up exercises named on their stdin (:func:`_worker`)."""
+    """Worker processes that run warm-up exercises named on their stdin (:func:`serve`)."""
 
     def __init__(
         self,
         n: int,
-        table: dict[str, Any],
+        command: Sequence[str],
+        table: Mapping[str, Exercise],
         report: CompileReport,
         seen: Callable[[str], None],
         t0: float,
@@ -411,7 +440,7 @@ class _Workers:
                 self.logs.append(log)
                 self.procs.append(
                     subprocess.Popen(
-                        [sys.executable, "-m", "trajopt._kernel_cache", "--worker"],
+                        list(command),
                         stdin=subprocess.PIPE,
                         stdout=subprocess.PIPE,
                         stderr=log,
@@ -540,15 +569,25 @@ class _Workers:
             log.close()
 
 
-def _worker() -> int:
-    """Serve :func:`compile_kernels`: run the exercises named on stdin, one a line.
+def serve(table: Mapping[str, Exercise]) -> int:
+    """Serve :func:`run_exercises` as its worker: run the exercises named on stdin, one a line.
 
-    Lines to the parent go to the original stdout; anything else written to file
-    descriptor 1 (by Python or by a solver's C code) goes to stderr, the parent's log.
+    Each line to the parent (``compiled <kernel>``, ``done <exercise>``, ``failed <error>``)
+    goes to the original stdout; anything else written to file descriptor 1 (by Python or
+    by a solver's C code) goes to stderr, the parent's log.
+
+    Parameters
+    ----------
+    table : mapping of str to Exercise
+        The exercises by name (the parent's ``table``).
+
+    Returns
+    -------
+    int
+        0, once stdin is closed (the exit status of the worker).
     """
     protocol = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)
-    EXERCISES = warm_up_module().EXERCISES  # noqa: N806 - the module's constant
 
     def say(*words: str) -> None:
         protocol.write(" ".join(words) + "\n")
@@ -560,18 +599,10 @@ def _worker() -> int:
         if not name:
             continue
         try:
-            EXERCISES[name].run()
+            table[name].run()
         except Exception as exc:  # noqa: BLE001 - reported to the parent
             detail = "".join(traceback.format_exception_only(type(exc), exc)).strip()
             say("failed", detail.replace("\n", "\\n"))
         else:
             say("done", name)
     return 0
-
-
-if __name__ == "__main__":  # pragma: no cover - run by compile_kernels
-    if sys.argv[1:] == ["--worker"]:
-        from trajopt._kernel_cache import _worker as _serve
-
-        sys.exit(_serve())
-    sys.exit(f"usage: {sys.executable} -m trajopt._kernel_cache --worker (used by compile_kernels)")

@@ -57,7 +57,6 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
-import inspect
 import threading
 import time
 from collections.abc import Sequence
@@ -68,7 +67,6 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.errors import InvalidInputError
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult
@@ -115,69 +113,22 @@ class Planner:
         graded cost feeds the search (``search="costmap"``, the default for a costmap).
     robot : Robot, optional
         Size and limits; default ``Robot()`` (the chapter's robot).
-    inflation : {"exact", "paper"}
-        ``"exact"``: obstacles grown by ``robot.radius`` (square metric, certified).
-        ``"paper"``: the chapter's avoidance area of ``w_cells`` rounds on top of it.
-    w_cells : int, optional
-        ``W`` for ``inflation="paper"``; default :func:`~trajopt.robot._robot.avoidance_width`
-        (11 on the paper scene).
-    search : {"clearance", "shortest", "costmap", "costmap+clearance"}, optional
-        A* cost: clearance-aware (:func:`astar.clearance_cost`; the default for an
-        occupancy grid), plain shortest path, the costmap's graded cost
-        (:meth:`astar.Costmap.search_cost` with ``costmap_weight``; the default for a
-        costmap) or the sum of both. The costmap modes need ``grid`` to be a costmap.
-    costmap_weight : float, optional
-        ``weight`` of :meth:`astar.Costmap.search_cost` (default 2: a step through the
-        costliest graded cells costs three times its length).
-    speed_limits : SpeedLimits, optional
-        Speed-limit zones (:func:`trajopt.load_speed_mask`): the timing caps the speed by the
-        zone under the robot's centre (and the stop-and-turn fallback by the zones its
-        segments cross). The mask is looked up in world coordinates with its own resolution
-        and origin; a mask that does not overlap the map at all is refused.
-    landmarks : int, optional
-        ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`; 0, the
-        default: none). Exact either way; on large maps they cut a long search several
-        times, for a one-time cost on the first query after each map (about 0.1 s per
-        landmark per million cells; :meth:`update_map` keeps them through changes that only
-        add obstacles) and ``8 landmarks`` bytes per cell.
-    search_mode : {"auto", "exact", "coarse"}, optional
-        ``"exact"``: the optimal A* (:func:`astar.find_path`). ``"coarse"``: coarse-to-fine
-        (:func:`astar.find_path_coarse_to_fine`): an A* over blocks of about the robot
-        radius (:meth:`~trajopt.planning._options.PlannerOptions.search_block_cells`), then
-        the fine A* in a band of blocks around its path; the path's cost is proven at most
-        ``bound`` times the optimum, with ``bound <= search_bound`` (otherwise, and when
-        the blocks or the band hold no path, the exact search runs). ``"auto"`` (default):
-        coarse-to-fine on inflated grids of at least 1.5 M cells for ends at least 16
-        blocks apart, without landmarks; exact otherwise (so maps up to about 1 M cells
-        plan exactly as before). ``stats["search_info"]`` reports the mode run, the block
-        (cells and m), the bound and its lower bound, and any fallback. The blocks are
-        computed on the first coarse search and kept through :meth:`update_map` outside
-        the changed window.
-    search_bound : float, optional
-        The largest suboptimality a coarse-to-fine search may return, ``>= 1`` (default 1.5;
-        ``inf``: any). Typical proven bounds are 1.1-1.3 while the band path's actual cost is
-        within a fraction of a percent of the optimum (``docs/concepts.md``).
-    smoother : Smoother, optional
-        Smoother options (e.g. ``Smoother(kappa_max=...)``); default ``Smoother()``.
-    timing_dt : float
-        Step of the timing's forward greedy (s).
-    fallback : {None, "stop_and_turn"}
-        ``None`` (default): smoother and timing failures raise. ``"stop_and_turn"``: when
-        they fail and both end speeds are 0, return a
-        :class:`~trajopt.motion._stop_and_turn.StopAndTurnTrajectory` along the A* polyline, checked
-        against the raw map (module docstring); ``stats["fallback"]`` says so.
-    corridor : {"polygons", "boxes"}
-        ``"polygons"`` (default): convex polygons grown around the A* path in continuous
-        space (:func:`~trajopt.corridor.build_polygon_corridor`), with the taut
-        objective; where the polygon corridor cannot be built or the fit in it fails, the
-        box corridor is tried next (``stats["corridor"]`` names the one used).
-        ``"boxes"``: axis-aligned boxes of free cells only (:func:`build_corridor`). With
-        ``inflation="paper"`` the corridor is always boxes (the polygons keep the radius
-        from the raw map, not from the chapter's avoidance area).
     options : PlannerOptions, optional
-        All of the settings above (``robot`` included) as one value, e.g. to build several
-        planners, or :func:`plan` calls, alike; the keywords must then stay at their
-        defaults.
+        Every setting (``robot`` included) as one value, e.g. to build several planners,
+        or :func:`plan` calls, alike; the keywords must then stay at their defaults.
+    **settings
+        The planner's settings by name: the fields of :class:`PlannerOptions` (each one's
+        meaning, type, default and rule are documented there and only there), e.g.
+        ``Planner(grid, robot, corridor="boxes", timing_dt=0.05)``.
+
+    Raises
+    ------
+    TypeError
+        A keyword that is not a setting (the message lists the settings).
+    InvalidInputError
+        A setting of the wrong type or outside its range (:class:`PlannerOptions`), one
+        that does not fit the map (a costmap search on an occupancy grid, speed-limit
+        zones off the map), or ``options`` together with a keyword not at its default.
 
     Notes
     -----
@@ -187,40 +138,14 @@ class Planner:
 
     def __init__(
         self,
-        grid: OccupancyGrid,
+        grid: OccupancyGrid | Costmap,
         robot: Robot | None = None,
         *,
-        inflation: Inflation = "exact",
-        w_cells: int | None = None,
-        search: Search | None = None,
-        smoother: Smoother | None = None,
-        timing_dt: float = 0.02,
-        fallback: Fallback | None = None,
-        corridor: CorridorKind = "polygons",
-        costmap_weight: float = 2.0,
-        speed_limits: SpeedLimits | None = None,
-        landmarks: int = 0,
-        search_mode: SearchMode = "auto",
-        search_bound: float = 1.5,
         options: PlannerOptions | None = None,
+        **settings: Any,
     ) -> None:
-        settings = _settings(
-            options,
-            robot,
-            inflation=inflation,
-            w_cells=w_cells,
-            search=search,
-            smoother=smoother,
-            timing_dt=timing_dt,
-            fallback=fallback,
-            corridor=corridor,
-            costmap_weight=costmap_weight,
-            speed_limits=speed_limits,
-            landmarks=landmarks,
-            search_mode=search_mode,
-            search_bound=search_bound,
-        )
-        self._init(grid, settings)
+        settings["robot"] = robot
+        self._init(grid, PlannerOptions.from_keywords(options, settings, caller="trajopt.Planner"))
 
     def _init(self, grid: OccupancyGrid | Costmap, settings: PlannerOptions) -> None:
         options, raw, costmap = settings.for_map(grid)
@@ -505,19 +430,8 @@ def plan(
     goal_heading: float | None = None,
     v_start: float = 0.0,
     v_end: float = 0.0,
-    inflation: Inflation = "exact",
-    search: Search | None = None,
-    smoother: Smoother | None = None,
-    w_cells: int | None = None,
-    fallback: Fallback | None = None,
-    corridor: CorridorKind = "polygons",
-    costmap_weight: float = 2.0,
-    speed_limits: SpeedLimits | None = None,
-    timing_dt: float = 0.02,
-    landmarks: int = 0,
-    search_mode: SearchMode = "auto",
-    search_bound: float = 1.5,
     options: PlannerOptions | None = None,
+    **settings: Any,
 ) -> PlanResult:
     """Plan a timed, collision-free, smooth trajectory in one call.
 
@@ -536,31 +450,28 @@ def plan(
         Exact headings at the ends (rad).
     v_start, v_end : float
         Speeds at the ends (m/s).
-    inflation, search, smoother, w_cells, corridor, costmap_weight, speed_limits
-        See :class:`Planner`.
-    timing_dt : float
-        Step of the timing's forward greedy (s), in (0, 0.5]; default 0.02 (see
-        :class:`Planner`).
-    landmarks : int, optional
-        ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`), 0-64;
-        0, the default: none (see :class:`Planner`). Exact either way. Each call builds
-        them for its one query (``landmarks + 1`` searches of the whole map), which costs
-        more than the search they shorten; they pay off across the queries of one
-        :class:`Planner`.
-    search_mode, search_bound : optional
-        The search: exact, coarse-to-fine with a bound, or chosen by map size (see
-        :class:`Planner`; default ``"auto"`` and 1.5).
-    fallback : {None, "stop_and_turn"}
-        Opt-in fallback when the smoother or the timing fails (see :class:`Planner` and the
-        module docstring); default ``None``: the failure raises.
     options : PlannerOptions, optional
         Every setting (``robot`` included) as one value (see :class:`Planner`).
+    **settings
+        The planner's settings by name, as for :class:`Planner`: the fields of
+        :class:`PlannerOptions`, each documented there with its default (e.g.
+        ``corridor="boxes"``, ``timing_dt=0.05``, ``fallback="stop_and_turn"``). Each
+        call builds its caches for its one query: ``landmarks`` then cost more than the
+        search they shorten (they pay off across the queries of one :class:`Planner`).
 
     Returns
     -------
     Trajectory or StopAndTurnTrajectory
         ``trajectory.steps`` holds every intermediate result (:class:`PlanSteps`); the
         second type only with ``fallback="stop_and_turn"`` (``stats["fallback"]``).
+
+    Raises
+    ------
+    TypeError
+        A keyword that is neither a setting nor one of the query's (the message lists the
+        settings).
+    InvalidInputError, NoPathError, SmoothingError, TimingError
+        As :class:`Planner` and :meth:`Planner.plan`.
 
     Examples
     --------
@@ -569,22 +480,9 @@ def plan(
     >>> traj = trajopt.plan(scene.grid, scene.start, scene.goal("A"))  # doctest: +SKIP
     >>> traj.duration  # doctest: +SKIP
     """
+    settings["robot"] = robot
     planner = Planner(
-        grid,
-        robot,
-        inflation=inflation,
-        search=search,
-        smoother=smoother,
-        w_cells=w_cells,
-        fallback=fallback,
-        corridor=corridor,
-        costmap_weight=costmap_weight,
-        speed_limits=speed_limits,
-        timing_dt=timing_dt,
-        landmarks=landmarks,
-        search_mode=search_mode,
-        search_bound=search_bound,
-        options=options,
+        grid, options=PlannerOptions.from_keywords(options, settings, caller="trajopt.plan")
     )
     return planner.plan(
         start,
@@ -594,34 +492,3 @@ def plan(
         v_start=v_start,
         v_end=v_end,
     )
-
-
-def _settings(
-    options: PlannerOptions | None, robot: Robot | None, **keywords: Any
-) -> PlannerOptions:
-    """Return the settings given as ``options``, or built from the keywords.
-
-    Raises
-    ------
-    InvalidInputError
-        ``options`` is not a :class:`PlannerOptions`, or it comes with a keyword (or the
-        robot) set as well.
-    """
-    if options is None:
-        return PlannerOptions(robot=robot, **keywords)
-    if not isinstance(options, PlannerOptions):
-        raise InvalidInputError(
-            f"options must be a trajopt.PlannerOptions, got {type(options).__name__}"
-        )
-    defaults = inspect.signature(Planner.__init__).parameters
-    given = [
-        k for k, v in keywords.items() if v is not defaults[k].default and v != defaults[k].default
-    ]
-    if robot is not None:
-        given.insert(0, "robot")
-    if given:
-        raise InvalidInputError(
-            f"give the planner's settings either as options or as keywords, not both: got "
-            f"options and {', '.join(given)}"
-        )
-    return options

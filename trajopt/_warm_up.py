@@ -7,8 +7,10 @@ Two one-time costs stand before a fast plan:
   :func:`warm_up` first compiles every kernel that is not cached yet, by running the
   :data:`EXERCISES` (small searches, plans, timings, a fallback and a comparison that between
   them call every kernel with the argument types the library uses) in two worker processes
-  (:func:`trajopt._kernel_cache.compile_kernels`). ``trajopt warm-up`` does the same from a
-  shell, e.g. in a container build or a CI cache step.
+  (:func:`compile_kernels`, which hands the exercises to
+  :func:`trajopt._kernel_cache.run_exercises`; each worker is this module run as
+  ``python -m trajopt._warm_up --worker``, serving :data:`EXERCISES`). ``trajopt warm-up``
+  does the same from a shell, e.g. in a container build or a CI cache step.
 * **Once per process**: importing numba, SciPy and CasADi, initialising numba's compiler
   context, loading each compiled kernel from numba's disk cache and loading the CasADi
   solver plugins (``python benchmarks/bench_first_call.py`` prints the split). A robot
@@ -31,14 +33,16 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 import time
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
+import trajopt._kernel_cache as kernel_cache
 from astar.costmap import from_costmap
 from astar.grid import OccupancyGrid
+from trajopt._kernel_cache import CompileReport, Exercise
 from trajopt._planner import Planner
 from trajopt.analysis.scenes import WARM_UP_CELLS, warm_up_map
 from trajopt.errors import InvalidInputError
@@ -73,15 +77,14 @@ def warm_up(planner: Planner | None = None) -> float:
     Notes
     -----
     The compilation runs only when some kernel has nothing in numba's disk cache
-    (:func:`trajopt._kernel_cache.cold_kernels`), in two worker processes; an exercise that
-    fails there is logged and its kernels compile on first use instead.
+    (:func:`trajopt._kernel_cache.cold_kernels`), in two worker processes
+    (:func:`compile_kernels`); an exercise that fails there is logged and its kernels compile
+    on first use instead.
     """
-    import trajopt._kernel_cache as kernel_cache
-
     t0 = time.perf_counter()
     if planner is not None and not isinstance(planner, Planner):
         raise InvalidInputError(f"planner must be a trajopt.Planner, got {type(planner).__name__}")
-    report = kernel_cache.compile_kernels()
+    report = compile_kernels()
     for name, error in report.failed.items():
         _log.warning(
             "warm_up: exercise %r failed (its kernels compile on first use): %s", name, error
@@ -125,26 +128,6 @@ def _plan_like(planner: Planner) -> None:
 
 
 # ------------------------------------------------------------------------------ exercises
-@dataclass(frozen=True)
-class Exercise:
-    """A warm-up exercise: library calls on small inputs that compile a set of kernels.
-
-    Attributes
-    ----------
-    run : callable
-        Runs the calls (no arguments, no result).
-    after : tuple of str
-        Exercises to run first: their kernels are then loaded, not compiled again, when
-        this one runs in another worker process.
-    seconds : float
-        Rough compile time (s) when every kernel is cold: longest first.
-    """
-
-    run: Callable[[], None]
-    after: tuple[str, ...] = ()
-    seconds: float = 1.0
-
-
 def _default_query() -> tuple[Planner, tuple[float, float], tuple[float, float]]:
     grid, start, goal = warm_up_map(_default_planner())
     return Planner(grid), start, goal
@@ -333,3 +316,69 @@ EXERCISES: dict[str, Exercise] = {
 #: What a default plan and :func:`trajopt.compare` need (with what they depend on): the
 #: command line compiles these first and starts its command when they are done.
 CORE_EXERCISES: tuple[str, ...] = ("plan", "compare")
+
+
+#: The command that starts a compile worker: this module, serving :data:`EXERCISES`
+#: (:func:`trajopt._kernel_cache.serve`).
+WORKER_COMMAND: tuple[str, ...] = (sys.executable, "-m", "trajopt._warm_up", "--worker")
+
+
+def compile_kernels(
+    exercises: Sequence[str] | None = None,
+    *,
+    workers: int | None = None,
+    progress: Callable[[int, int, str], None] | None = None,
+    first: Sequence[str] | None = None,
+    force: bool = False,
+) -> CompileReport:
+    """Compile the cold kernels into numba's disk cache by running the warm-up exercises.
+
+    The exercises (:data:`EXERCISES`) run in worker processes
+    (:func:`trajopt._kernel_cache.run_exercises`, each worker started with
+    :data:`WORKER_COMMAND`).
+
+    Parameters
+    ----------
+    exercises : sequence of str, optional
+        Names in :data:`EXERCISES` (with the ones they depend on); default all, which call
+        every kernel of the packages.
+    workers : int, optional
+        Worker processes; default ``min(2, CPUs)``. ``0`` or ``1`` runs the exercises in this
+        process, one after the other (the kernels are then also loaded here).
+    progress : callable, optional
+        ``progress(done, total, kernel)`` after each cold kernel compiles (``total`` is the
+        number of cold kernels), and once at the end with ``done == total``.
+    first : sequence of str, optional
+        Exercises to run before the others; the call returns as soon as they (and those
+        they depend on) are done, while the workers go on with the rest in the background
+        (:meth:`~trajopt._kernel_cache.CompileReport.wait` waits for them). Default: return
+        when all are done.
+    force : bool
+        Run the exercises even when no kernel is cold.
+
+    Returns
+    -------
+    CompileReport
+        Nothing runs (and ``seconds`` is ~0) when every kernel is already cached. An
+        exercise that fails is reported, not raised: its kernels then compile on first use.
+
+    Raises
+    ------
+    InvalidInputError
+        An unknown exercise name.
+    """
+    return kernel_cache.run_exercises(
+        EXERCISES,
+        exercises,
+        worker=WORKER_COMMAND,
+        workers=workers,
+        progress=progress,
+        first=first,
+        force=force,
+    )
+
+
+if __name__ == "__main__":  # pragma: no cover - a worker of compile_kernels
+    if sys.argv[1:] == ["--worker"]:
+        sys.exit(kernel_cache.serve(EXERCISES))
+    sys.exit(f"usage: {sys.executable} -m trajopt._warm_up --worker (used by compile_kernels)")

@@ -86,8 +86,9 @@ WARM_UP_REACHES_EVERYTHING = """
 FRESH_CACHE_COMPILE = """
     import json
     import trajopt._kernel_cache as kernel_cache
+    import trajopt._warm_up as warm
     cold = kernel_cache.cold_kernels()
-    report = kernel_cache.compile_kernels(["grid", "astar"], workers=2)
+    report = warm.compile_kernels(["grid", "astar"], workers=2)
     print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
                       "failed": report.failed, "left": kernel_cache.cold_kernels()}))
 """
@@ -111,12 +112,11 @@ FRESH_CACHE_LOAD = """
 """
 
 #: The exercises live in trajopt._warm_up, a name of their own: importing that module (as
-#: the compile workers do) leaves trajopt.warm_up the function.
+#: the compile workers do, which run it) leaves trajopt.warm_up the function.
 EXERCISES_MODULE = """
     import types
     import trajopt._warm_up
-    import trajopt._kernel_cache as kernel_cache
-    assert kernel_cache.warm_up_module() is trajopt._warm_up
+    assert trajopt._warm_up.WORKER_COMMAND[1:] == ("-m", "trajopt._warm_up", "--worker")
     from trajopt import warm_up
     assert callable(warm_up) and not isinstance(warm_up, types.ModuleType), warm_up
     assert warm_up is trajopt._warm_up.warm_up
@@ -225,10 +225,45 @@ def test_cli_warm_up_rejects_bad_workers(workers, capsys):
 
 
 def test_unknown_exercise_is_an_error():
+    import trajopt._warm_up as warm
     from trajopt.errors import InvalidInputError
 
     with pytest.raises(InvalidInputError, match="unknown warm-up exercise 'nope'"):
-        kernel_cache.compile_kernels(["nope"], force=True)
+        warm.compile_kernels(["nope"], force=True)
+
+
+def test_the_kernel_cache_loads_only_kernel_modules_by_name():
+    """``_kernel_cache`` sits below every module that uses it: the only modules it names (and
+    loads with importlib) are the kernel modules; the warm-up exercises come from its caller
+    (``trajopt._warm_up.compile_kernels``), so no run-time import cycle closes through it."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(kernel_cache.__file__).read_text())
+    docstrings = {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, (ast.Module, ast.FunctionDef, ast.ClassDef))
+        and node.body
+        and isinstance(node.body[0], ast.Expr)
+        and isinstance(node.body[0].value, ast.Constant)
+    }
+    named = {
+        node.value
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant)
+        and isinstance(node.value, str)
+        and id(node) not in docstrings
+        and node.value.startswith(("trajopt.", "astar."))
+    }
+    assert named - {"trajopt.", "astar."} == set(kernel_cache.KERNEL_MODULES)
+    imported = {
+        a.name if isinstance(node, ast.Import) else node.module
+        for node in ast.walk(tree)
+        if isinstance(node, (ast.Import, ast.ImportFrom))
+        for a in node.names
+    }
+    assert not {m for m in imported if m and m.startswith("trajopt.")} - {"trajopt.errors"}
 
 
 def test_the_exercises_module_does_not_shadow_trajopt_warm_up(started):

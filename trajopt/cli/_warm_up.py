@@ -41,8 +41,8 @@ def add_parser(sub: Any) -> None:
 
 def _cmd_warm_up(args: argparse.Namespace) -> int:
     import trajopt._kernel_cache as kernel_cache
+    import trajopt._warm_up as warm
 
-    warm_up = kernel_cache.warm_up_module().warm_up
     if args.workers is not None and args.workers < 1:
         raise CliError(f"--workers must be >= 1, got {args.workers}")
     t0 = time.perf_counter()
@@ -54,7 +54,7 @@ def _cmd_warm_up(args: argparse.Namespace) -> int:
         )
     for name, error in report.failed.items():
         print(f"trajopt warm-up: exercise {name!r} failed: {error}", file=sys.stderr)
-    warm_up()
+    warm.warm_up()
     n = len(kernel_cache.kernels())
     left = kernel_cache.cold_kernels()
     print(
@@ -78,6 +78,8 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
     cold = kernel_cache.cold_kernels()
     if not cold:
         return kernel_cache.CompileReport()
+    import trajopt._warm_up as warm
+
     n_workers = workers if workers is not None else min(2, os.cpu_count() or 1)
     about = kernel_cache.estimate_seconds(len(cold), n_workers)
     print(
@@ -101,7 +103,7 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
             bar.set_postfix_str(kernel.rsplit(".", 1)[-1], refresh=True)
 
     try:
-        report = kernel_cache.compile_kernels(workers=n_workers, progress=progress, first=first)
+        report = warm.compile_kernels(workers=n_workers, progress=progress, first=first)
     finally:
         if bar is not None:
             bar.close()
@@ -125,13 +127,13 @@ def compile_notice(args: argparse.Namespace) -> Any:
     """
     if args.command not in _PLANNING or getattr(args, "bench_command", "run") != "run":
         return None
-    import trajopt._kernel_cache as kernel_cache
+    import trajopt._warm_up as warm
 
     notice = logging.getLogger("trajopt._kernel_cache")
     if not any(isinstance(h, _StderrLines) for h in notice.handlers):
         notice.addHandler(_StderrLines())
         notice.propagate = False
-    return _compile_kernels(kernel_cache.warm_up_module().CORE_EXERCISES, None)
+    return _compile_kernels(warm.CORE_EXERCISES, None)
 
 
 class _StderrLines(logging.StreamHandler):

@@ -1,15 +1,17 @@
 """What a planner is set up with (:class:`PlannerOptions`) and what one query asks (:class:`PlanRequest`).
 
-Both :func:`trajopt.plan` and :class:`trajopt.Planner` build their options here, so the two
-cannot disagree on a setting, its default or its validation.
+:class:`PlannerOptions` is the one definition of the planner's settings: their names, types,
+defaults, documentation and validation. :func:`trajopt.plan` and :class:`trajopt.Planner`
+take them as keywords derived from its fields (:meth:`PlannerOptions.from_keywords`), so the
+two cannot disagree on a setting, its default or its validation.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -41,43 +43,84 @@ COARSE_MIN_BLOCKS = 16
 
 @dataclass(frozen=True, slots=True)
 class PlannerOptions:
-    """A planner's settings, validated (see :class:`trajopt.Planner` for each one's meaning).
+    """A planner's settings, validated: the one definition of each setting and its default.
+
+    :class:`trajopt.Planner` and :func:`trajopt.plan` take these fields by name as keywords
+    (``Planner(grid, robot, corridor="boxes")``), or all of them as one value
+    (``Planner(grid, options=PlannerOptions(...))``); the keywords accepted are this class's
+    fields (:data:`SETTINGS`), with these defaults.
 
     Attributes
     ----------
     robot : Robot
-        Size and limits; ``None`` is ``Robot()``.
+        Size and limits; ``None`` is ``Robot()`` (the chapter's robot).
     inflation : {"exact", "paper"}
-        Obstacles grown by the radius (certified), or with the chapter's avoidance area on top.
+        ``"exact"`` (default): obstacles grown by ``robot.radius`` (square metric,
+        certified). ``"paper"``: the chapter's avoidance area of ``w_cells`` rounds on top
+        of it.
     w_cells : int or None
-        ``W`` of ``inflation="paper"`` (cells); ``None`` until :meth:`for_map` sets the
-        default :func:`~trajopt.robot.avoidance_width`.
+        ``W`` of ``inflation="paper"`` (cells, ``>= 0``); ``None`` (default) until
+        :meth:`for_map` sets the default :func:`~trajopt.robot.avoidance_width` (11 on the
+        paper scene).
     search : {"clearance", "shortest", "costmap", "costmap+clearance"} or None
-        A* cost; ``None`` until :meth:`for_map` picks ``"clearance"`` (occupancy grid) or
+        A* cost: clearance-aware (:func:`astar.clearance_cost`), plain shortest path, the
+        costmap's graded cost (:meth:`astar.Costmap.search_cost` with ``costmap_weight``) or
+        the sum of both. The costmap modes need the map to be a costmap. ``None``
+        (default) until :meth:`for_map` picks ``"clearance"`` (occupancy grid) or
         ``"costmap"`` (costmap).
     smoother : Smoother
-        Smoother options; ``None`` is ``Smoother()``.
+        Smoother options (e.g. ``Smoother(kappa_max=...)``); ``None`` is ``Smoother()``.
     timing_dt : float
-        Step of the timing's forward greedy (s), in (0, 0.5].
+        Step of the timing's forward greedy (s), in (0, 0.5]; default 0.02.
     fallback : {None, "stop_and_turn"}
-        The opt-in fallback when the smoother or the timing fails.
+        ``None`` (default): smoother and timing failures raise. ``"stop_and_turn"``: when
+        they fail and both end speeds are 0, the planner returns a
+        :class:`~trajopt.motion.StopAndTurnTrajectory` along the A* polyline, checked
+        against the raw map (:mod:`trajopt._planner`); ``stats["fallback"]`` says so.
     corridor : {"polygons", "boxes"}
-        Corridor kind tried first.
+        ``"polygons"`` (default): convex polygons grown around the A* path in continuous
+        space (:func:`~trajopt.corridor.build_polygon_corridor`), with the taut objective;
+        where the polygon corridor cannot be built or the fit in it fails, the box corridor
+        is tried next (``stats["corridor"]`` names the one used). ``"boxes"``: axis-aligned
+        boxes of free cells only (:func:`~trajopt.corridor.build_corridor`). With
+        ``inflation="paper"`` the corridor is always boxes (the polygons keep the radius
+        from the raw map, not from the chapter's avoidance area).
     costmap_weight : float
-        Weight of a costmap's graded cost in the search (:meth:`astar.Costmap.search_cost`).
+        ``weight`` of :meth:`astar.Costmap.search_cost` (default 2: a step through the
+        costliest graded cells costs three times its length).
     speed_limits : SpeedLimits or None
-        Speed-limit zones of the timing.
+        Speed-limit zones (:func:`trajopt.load_speed_mask`): the timing caps the speed by the
+        zone under the robot's centre (and the stop-and-turn fallback by the zones its
+        segments cross). The mask is looked up in world coordinates with its own resolution
+        and origin; a mask that does not overlap the map at all is refused. Default
+        ``None``: none.
     landmarks : int
-        ALT landmarks of the searches with a cost, 0-64.
+        ALT landmarks for the searches with a cost (:func:`astar.build_landmarks`), 0-64
+        (0, the default: none). Exact either way; on large maps they cut a long search
+        several times, for a one-time cost on the first query after each map (about 0.1 s
+        per landmark per million cells; :meth:`trajopt.Planner.update_map` keeps them
+        through changes that only add obstacles) and ``8 landmarks`` bytes per cell. A
+        :func:`trajopt.plan` call builds them for its one query (``landmarks + 1`` searches
+        of the whole map), which costs more than the search they shorten; they pay off
+        across the queries of one :class:`~trajopt.Planner`.
     search_mode : {"auto", "exact", "coarse"}
         ``"exact"``: the optimal A* (:func:`astar.find_path`). ``"coarse"``: coarse-to-fine
-        (:func:`astar.find_path_coarse_to_fine`, blocks of about the robot radius),
-        at most ``search_bound`` times the optimal cost. ``"auto"``: coarse-to-fine on
-        large maps (:data:`COARSE_MIN_CELLS`) for long queries (:data:`COARSE_MIN_BLOCKS`)
-        without landmarks, exact otherwise.
+        (:func:`astar.find_path_coarse_to_fine`): an A* over blocks of about the robot
+        radius (:meth:`search_block_cells`), then the fine A* in a band of blocks around its
+        path; the path's cost is proven at most ``bound`` times the optimum, with
+        ``bound <= search_bound`` (otherwise, and when the blocks or the band hold no path,
+        the exact search runs). ``"auto"`` (default): coarse-to-fine on inflated grids of
+        at least :data:`COARSE_MIN_CELLS` cells for ends at least
+        :data:`COARSE_MIN_BLOCKS` blocks apart, without landmarks; exact otherwise (so maps
+        up to about 1 M cells plan exactly). ``stats["search_info"]`` reports the mode run,
+        the block (cells and m), the bound and its lower bound, and any fallback. The
+        blocks are computed on the first coarse search and kept through
+        :meth:`trajopt.Planner.update_map` outside the changed window.
     search_bound : float
-        The largest suboptimality a coarse-to-fine search may return (``>= 1``; ``inf``:
-        any); beyond it the exact search runs.
+        The largest suboptimality a coarse-to-fine search may return, ``>= 1`` (default
+        1.5; ``inf``: any); beyond it the exact search runs. Typical proven bounds are
+        1.1-1.3 while the band path's actual cost is within a fraction of a percent of the
+        optimum (``docs/concepts.md``).
 
     Raises
     ------
@@ -152,6 +195,67 @@ class PlannerOptions:
         object.__setattr__(self, "costmap_weight", float(self.costmap_weight))
         if w is not None:
             object.__setattr__(self, "w_cells", int(w))
+
+    @classmethod
+    def from_keywords(
+        cls, options: PlannerOptions | None, settings: Mapping[str, Any], *, caller: str
+    ) -> PlannerOptions:
+        """Return the settings a call gave: ``options``, or built from the keywords.
+
+        The keywords accepted are the fields of this class (:data:`SETTINGS`), read with
+        :func:`dataclasses.fields`; their defaults are the fields' own. A keyword is *given*
+        when its value is not its field's default (``None`` for a field with a default
+        factory: ``robot``, ``smoother``).
+
+        Parameters
+        ----------
+        options : PlannerOptions or None
+            Every setting as one value; the keywords must then stay at their defaults.
+        settings : mapping of str to object
+            The keywords of the call (``robot`` among them), by name.
+        caller : str
+            The function called, for the messages (e.g. ``"trajopt.Planner"``).
+
+        Raises
+        ------
+        TypeError
+            A keyword that is not a setting (the message names it and lists the settings).
+        InvalidInputError
+            ``options`` is not a :class:`PlannerOptions`, or it comes with a keyword (or the
+            robot) set as well; a setting of the wrong type or outside its range.
+        """
+        fields = dataclasses.fields(cls)
+        unknown = [k for k in settings if k not in SETTINGS]
+        if unknown:
+            what = (
+                "unexpected keyword arguments"
+                if len(unknown) > 1
+                else "an unexpected keyword argument"
+            )
+            raise TypeError(
+                f"{caller}() got {what} "
+                f"{', '.join(repr(k) for k in unknown)}; the planner's settings "
+                f"(the fields of trajopt.PlannerOptions) are: {', '.join(SETTINGS)}"
+            )
+        if options is None:
+            return cls(**settings)
+        if not isinstance(options, PlannerOptions):
+            raise InvalidInputError(
+                f"options must be a trajopt.PlannerOptions, got {type(options).__name__}"
+            )
+        given = []
+        for f in fields:
+            if f.name not in settings:
+                continue
+            value, default = settings[f.name], _keyword_default(f)
+            if value is not default and value != default:
+                given.append(f.name)
+        if given:
+            raise InvalidInputError(
+                f"give the planner's settings either as options or as keywords, not both: got "
+                f"options and {', '.join(given)}"
+            )
+        return options
 
     def for_map(
         self, grid: OccupancyGrid | Costmap
@@ -235,6 +339,16 @@ class PlannerOptions:
         sm = self.smoother
         capped = dataclasses.replace(sm, time_budget_s=min(sm.time_budget_s, budget_s))
         return dataclasses.replace(self, smoother=capped)
+
+
+#: The planner's settings by name, in order: the fields of :class:`PlannerOptions` (the
+#: keywords :class:`trajopt.Planner` and :func:`trajopt.plan` accept).
+SETTINGS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(PlannerOptions))
+
+
+def _keyword_default(f: dataclasses.Field) -> Any:
+    """Return a setting's default as a keyword: the field's, ``None`` for a default factory."""
+    return None if f.default is dataclasses.MISSING else f.default
 
 
 @dataclass(frozen=True, slots=True)
