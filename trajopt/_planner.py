@@ -67,7 +67,6 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.motion._chain import TrajectoryChain
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult
 from trajopt.planning._options import (
@@ -352,7 +351,7 @@ class Planner:
         v_end: float = 0.0,
         reuse: bool = True,
         brake_after_s: float | None = BRAKE_AFTER_S,
-    ) -> PlanResult | TrajectoryChain:
+    ) -> PlanResult:
         """Re-plan from a trajectory being driven, splicing at ``t + latency``.
 
         The new trajectory starts at ``trajectory.state_at(t + latency)``: the same

@@ -232,8 +232,10 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         steps = traj.steps
         fig, ax = plt.subplots(figsize=(7, 7))
         name = "stop and turn" if traj.stats.get("fallback") else "proposed"
-        posed = robot.drive.orients_body or robot.drive.signed_speed or (
-            args.start_heading is not None or args.goal_heading is not None
+        posed = (
+            robot.drive.orients_body
+            or robot.drive.signed_speed
+            or (args.start_heading is not None or args.goal_heading is not None)
         )
         plot_paths(
             grid,

@@ -143,13 +143,15 @@ class CarSteps:
         return self.segments[0].smooth_path
 
 
-def plan_car(options: PlannerOptions, caches: PlannerCaches, request: PlanRequest) -> Any:
+def plan_car(
+    options: PlannerOptions, caches: PlannerCaches, request: PlanRequest
+) -> TrajectoryChain:
     """Plan one query of a car-like robot (module docstring).
 
     Parameters
     ----------
     options : PlannerOptions
-        Resolved for the map of ``caches``; ``options.robot.drive == "ackermann"``.
+        Resolved for the map of ``caches``; ``options.robot.drive`` an :class:`~trajopt.drive.Ackermann`.
     caches : PlannerCaches
         The map.
     request : PlanRequest

@@ -26,11 +26,11 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from astar.grid import OccupancyGrid
+from astar.hybrid import PosePath
 from trajopt.corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.geometry._bspline import BSplineCurve
@@ -38,7 +38,7 @@ from trajopt.planning._corridor_fit import witness_corridor
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
 from trajopt.robot._footprint import Footprint
-from trajopt.smoother import SmoothPath
+from trajopt.smoother import Smoother, SmoothPath
 
 #: Relative tolerance of the curvature check of each fitted segment.
 KAPPA_TOL = 1e-6
@@ -92,7 +92,7 @@ class CarSegment:
     joined: bool = False
 
 
-def start_curvature(path: Any, first: int, res: float) -> float:
+def start_curvature(path: PosePath, first: int, res: float) -> float:
     """Return the curvature (1/m) the search's path starts pose ``first`` with.
 
     Signed along the direction of travel: a backwards arc of body curvature ``k`` traces,
@@ -150,7 +150,7 @@ def end_curvature(path: SmoothPath) -> float:
 def fit_run(
     options: PlannerOptions,
     grid: OccupancyGrid,
-    smoother: Any,
+    smoother: Smoother,
     poses: np.ndarray,
     ends: tuple[int, int],
     direction: int,
@@ -195,7 +195,7 @@ def fit_run(
 def fit_segment(
     options: PlannerOptions,
     grid: OccupancyGrid,
-    smoother: Any,
+    smoother: Smoother,
     poses: np.ndarray,
     ends: tuple[int, int],
     direction: int,

@@ -28,10 +28,12 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import astar
 from astar.grid import OccupancyGrid
@@ -40,6 +42,7 @@ from trajopt.planning._car_fit import CarSegment, fit_run, start_curvature
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
 from trajopt.robot._robot import Robot
+from trajopt.smoother import Smoother
 
 #: Extra inflation (cells) of the search grid beyond the robot radius: half a cell's
 #: diagonal (any point of a free cell keeps the radius) plus slack for the chords between
@@ -108,7 +111,7 @@ def search_and_fit(
     grid: OccupancyGrid,
     cells: tuple[tuple[float, float, float], tuple[float, float, float]],
     points: tuple[np.ndarray, np.ndarray],
-    smoother: Any,
+    smoother: Smoother,
     timer: StageTimer,
 ) -> CarFound:
     """Run the tries of a car's plan until one searches and fits (module docstring).
@@ -279,7 +282,12 @@ def grid_name(margin: bool) -> str:
     return "radius + margin grid" if margin else "radius grid"
 
 
-def blocked_end(robot: Robot, search_grid: OccupancyGrid, margin: bool, ends: Any) -> str | None:
+def blocked_end(
+    robot: Robot,
+    search_grid: OccupancyGrid,
+    margin: bool,
+    ends: Sequence[tuple[str, ArrayLike, np.ndarray]],
+) -> str | None:
     """Return why an end point's cell is blocked on ``search_grid``, or None."""
     for name, c, p in ends:
         ix, iy = int(math.floor(c[0] + 0.5)), int(math.floor(c[1] + 0.5))
@@ -295,8 +303,8 @@ def blocked_end(robot: Robot, search_grid: OccupancyGrid, margin: bool, ends: An
 def failure(
     robot: Robot,
     grid: OccupancyGrid,
-    start: Any,
-    goal: Any,
+    start: ArrayLike,
+    goal: ArrayLike,
     tries: list[str],
     failures: list[Exception],
 ) -> Exception:
@@ -324,7 +332,7 @@ def failure(
     return failures[-1]
 
 
-def pose_m(c: Any, grid: OccupancyGrid) -> str:
+def pose_m(c: ArrayLike, grid: OccupancyGrid) -> str:
     """Return a cell pose ``(x, y, heading)`` (cells, rad) written in world units (m, rad)."""
     x = grid.origin[0] + (c[0] + 0.5) * grid.resolution
     y = grid.origin[1] + (c[1] + 0.5) * grid.resolution

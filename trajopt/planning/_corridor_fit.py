@@ -15,7 +15,6 @@ import dataclasses
 import logging
 import math
 import time
-from typing import Any
 
 import numpy as np
 
@@ -37,7 +36,7 @@ def fit_in_corridor(
     options: PlannerOptions,
     grid: OccupancyGrid,
     q: PlanQuery,
-    path: Any,
+    path: astar.GridPath,
     smoother: Smoother,
     witness: np.ndarray | None = None,
 ) -> tuple[PolygonCorridor | Corridor, SmoothPath]:
@@ -125,7 +124,7 @@ def witness_rescue(
     q: PlanQuery,
     exc: SmoothingError,
     t_start: float,
-) -> tuple[Any, PolygonCorridor | Corridor, SmoothPath]:
+) -> tuple[astar.GridPath, PolygonCorridor | Corridor, SmoothPath]:
     """Return the second try of a curvature-bounded fit, along a witness.
 
     A witness that keeps one cell more than the radius is tried first (its grid path
@@ -205,7 +204,7 @@ def witness_corridor(
 def polygon_corridor(
     grid: OccupancyGrid,
     radius: float,
-    path: Any,
+    path: astar.GridPath,
     p0: np.ndarray,
     p1: np.ndarray,
     previous: PlanSteps | None = None,
@@ -232,7 +231,7 @@ def box_corridor(
     options: PlannerOptions,
     grid: OccupancyGrid,
     inflated: OccupancyGrid,
-    path: Any,
+    path: astar.GridPath,
     p0: np.ndarray,
     p1: np.ndarray,
 ) -> Corridor:

@@ -287,10 +287,10 @@ def _result(
     options: PlannerOptions,
     grid: OccupancyGrid,
     q: PlanQuery,
-    traj: Any,
+    traj: PlanResult,
     smooth: SmoothPath | None,
     **extra: Any,
-) -> Any:
+) -> PlanResult:
     """Attach :class:`PlanSteps` and the planner's statistics (the one place that does)."""
     stages = q.timer.finish()
     steps = PlanSteps(

@@ -27,7 +27,6 @@ from __future__ import annotations
 import heapq
 import math
 import time
-from typing import Any
 
 import numpy as np
 from numba import njit
@@ -41,7 +40,7 @@ _SAMPLE = 0.125  # cells between clearance samples
 
 
 def curvature_witness(
-    raw_grid: Any,
+    raw_grid: astar.OccupancyGrid,
     radius: float,
     start: np.ndarray,
     goal: np.ndarray,
@@ -295,7 +294,7 @@ def _distance_field(occ, w, r, gx, gy):
     return dist
 
 
-def witness_grid_path(witness: np.ndarray, inflated_grid: Any) -> np.ndarray | None:
+def witness_grid_path(witness: np.ndarray, inflated_grid: astar.OccupancyGrid) -> np.ndarray | None:
     """Return a grid path of ``inflated_grid`` that follows ``witness`` (for the witness rescue).
 
     The cells the witness passes through are taken in order; those blocked in the inflated

@@ -37,12 +37,15 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError, TimingError
+from trajopt.motion import PlanResult
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
 from trajopt.planning._footprint_ladder import check_end_poses
@@ -97,9 +100,9 @@ def plan_pose(
     options: PlannerOptions,
     grid: OccupancyGrid,
     request: PlanRequest,
-    plan: Any,
+    plan: Callable[[PlanRequest, WarmStart | None, float | None], PlanResult],
     warm: WarmStart | None = None,
-) -> Any:
+) -> PlanResult:
     """Plan a query whose given end headings may be met by turning in place (module doc).
 
     Parameters
@@ -230,10 +233,14 @@ def _with_headings(
 
 
 def _chain(
-    robot: Robot, curve: Any, ends: list[str], given: dict[str, Any], heading: dict[str, float]
-) -> Any:
+    robot: Robot,
+    curve: PlanResult,
+    ends: list[str],
+    given: dict[str, float | None],
+    heading: dict[str, float],
+) -> TrajectoryChain:
     """Return the curve with turns in place at ``ends`` from/onto the given headings."""
-    pieces: list[Any] = []
+    pieces: list[PlanResult] = []
     if "start" in ends:
         p0 = _end_point(curve, "start", exact=True)
         turn = turn_in_place(p0, float(given["start"]), heading["start"], robot)
@@ -251,7 +258,7 @@ def _chain(
     return TrajectoryChain(tuple(pieces), robot, stats, getattr(curve, "steps", None))
 
 
-def _turn_of(traj: Any, i: int) -> float:
+def _turn_of(traj: PlanResult, i: int) -> float:
     """Signed turn (rad) of the chain's first (``i = 0``) or last (``-1``) piece, else 0."""
     pieces = getattr(traj, "pieces", ())
     if pieces and pieces[i].turning:
@@ -260,7 +267,7 @@ def _turn_of(traj: Any, i: int) -> float:
 
 
 def _turn_blocked(
-    robot: Robot, grid: OccupancyGrid, curve: Any, end: str, given: float, heading: float
+    robot: Robot, grid: OccupancyGrid, curve: PlanResult, end: str, given: float, heading: float
 ) -> str:
     """Why the robot cannot turn between ``given`` and ``heading`` at the curve's end ('' if it can)."""
     fp = robot.footprint
@@ -276,7 +283,9 @@ def _turn_blocked(
     )
 
 
-def turn_clear(fp: Footprint, grid: OccupancyGrid, xy: Any, theta0: float, turn: float) -> bool:
+def turn_clear(
+    fp: Footprint, grid: OccupancyGrid, xy: ArrayLike, theta0: float, turn: float
+) -> bool:
     """Whether the footprint turning in place at ``xy`` by ``turn`` (rad) from ``theta0`` is clear.
 
     Certified: the turn is cut into pieces of at most :data:`TURN_PIECE_RAD`; the convex
@@ -294,7 +303,7 @@ def turn_clear(fp: Footprint, grid: OccupancyGrid, xy: Any, theta0: float, turn:
     return bool(np.all(clr > 0.0))
 
 
-def _end_point(traj: Any, end: str, exact: bool = False) -> tuple[float, float]:
+def _end_point(traj: PlanResult, end: str, exact: bool = False) -> tuple[float, float]:
     """Return the start or end point (m), rounded to 1 um for messages unless ``exact``."""
     smp = traj.sample(np.array([0.0 if end == "start" else traj.duration]))
     x, y = float(smp.x[0]), float(smp.y[0])

@@ -52,10 +52,12 @@ from astar.grid import OccupancyGrid
 from trajopt.errors import TimingError, TrajoptError
 from trajopt.geometry._clearance import points_clearance
 from trajopt.geometry._curve import CurveSegment
+from trajopt.motion import PlanResult
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._car import CarSteps
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
 from trajopt.planning._runner import run_query
@@ -148,7 +150,7 @@ def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:
 def brake_turn_go(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     ts: float,
     goal: Sequence[float],
     *,
@@ -266,7 +268,7 @@ def brake_turn_go(
 def _brake_go_omni(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     ts: float,
     target: tuple[Sequence[float], float | None, float],
     error: TrajoptError,
@@ -347,7 +349,7 @@ def _resume_omni(
     theta_stop: float,
     p_stop: tuple[float, float],
     target: tuple[Sequence[float], float | None, float],
-) -> list[Any] | None:
+) -> list[PlanResult] | None:
     """Return the old motion's rest from the stop, from rest, if the target is the old one.
 
     The translation's rest is :func:`_resume`'s; the orientation turns from ``theta_stop``
@@ -410,7 +412,9 @@ def _resume(
     return [rest]
 
 
-def check_new_obstacles(robot: Robot, grid: OccupancyGrid, steps: Any, brake: Trajectory) -> None:
+def check_new_obstacles(
+    robot: Robot, grid: OccupancyGrid, steps: PlanSteps | CarSteps | None, brake: Trajectory
+) -> None:
     """Raise :class:`TimingError` if a cell occupied since ``steps`` was planned is in reach.
 
     ``brake``: a piece driven on the old path (the stop, or the old path's resumed rest).

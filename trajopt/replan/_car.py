@@ -42,7 +42,6 @@ import dataclasses
 import math
 import time
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 
@@ -50,6 +49,7 @@ from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError
 from trajopt.geometry._clearance import points_clearance
+from trajopt.motion import PlanResult
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._trajectory import Trajectory
 from trajopt.planning._caches import PlannerCaches
@@ -65,7 +65,7 @@ from trajopt.replan._keep import target_change
 def replan_car(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     ts: float,
     goal: Sequence[float],
     *,
@@ -199,7 +199,7 @@ def _at_pose(p: tuple[float, float], h: float, goal: np.ndarray, goal_heading: f
     )
 
 
-def _check_trajectory(options: PlannerOptions, trajectory: Any) -> CarSteps:
+def _check_trajectory(options: PlannerOptions, trajectory: PlanResult) -> CarSteps:
     """Return the car plan's steps, or refuse a trajectory a car cannot be re-planned from."""
     robot = options.robot
     steps = getattr(trajectory, "steps", None)

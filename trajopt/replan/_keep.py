@@ -27,13 +27,13 @@ import dataclasses
 import math
 import time
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 
 from astar.search import GridPath
 from trajopt._validation import point
-from trajopt.corridor import PolygonCorridor
+from trajopt.corridor import Box, ConvexPolygon, PolygonCorridor
+from trajopt.motion import PlanResult
 from trajopt.motion._chain import TrajectoryChain
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._trajectory import Trajectory
@@ -53,7 +53,7 @@ _MAX_NEAR_CHANGES = 20_000
 def keep_rest(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     ts: float,
     goal: Sequence[float] | None,
     *,
@@ -216,7 +216,7 @@ def keep_omni(
 
 
 def target_change(
-    trajectory: Any, goal: Sequence[float] | None, goal_heading: float | None, v_end: float
+    trajectory: PlanResult, goal: Sequence[float] | None, goal_heading: float | None, v_end: float
 ) -> str:
     """Why a re-plan's goal, goal heading or end speed differ from ``trajectory``'s.
 
@@ -246,7 +246,10 @@ def target_change(
 
 
 def _map_change(
-    options: PlannerOptions, caches: PlannerCaches, steps: PlanSteps, regions: list[Any]
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    steps: PlanSteps,
+    regions: list[ConvexPolygon] | list[Box],
 ) -> str:
     """Return why the map change breaks the rest of the old curve ('' when it does not)."""
     old, new = steps.raw_grid, caches.grid
@@ -355,7 +358,7 @@ def remaining_grid_path(
     )
 
 
-def trajectory_after(traj: Trajectory, ts: float, path: Any, u0: float) -> Trajectory:
+def trajectory_after(traj: Trajectory, ts: float, path: SmoothPath, u0: float) -> Trajectory:
     """Return ``traj`` from time ``ts`` on, along ``path`` (its curve cut at ``u0``).
 
     The constant-jerk phases after ``ts`` are kept as they are, shifted by ``ts`` in time

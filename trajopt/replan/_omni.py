@@ -15,18 +15,18 @@ travel), and give a turn at rest that does not start at rest as a
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from trajopt.errors import InvalidInputError
-from trajopt.motion import Orientation, Trajectory, TurnInPlace
+from trajopt.motion import Orientation, PlanResult, Trajectory, TurnInPlace
 from trajopt.robot._robot import Robot
 from trajopt.timing._orientation import start_rates
 from trajopt.timing._stop_and_turn import turn_limits
 
 
-def course_orientation(trajectory: Any, ts: float, robot: Robot) -> Orientation | None:
+def course_orientation(trajectory: PlanResult, ts: float, robot: Robot) -> Orientation | None:
     """Return the orientation of an omni base driving a plain :class:`Trajectory` at ``ts``.
 
     Without its own orientation the body faces its direction of travel: the angle is the
@@ -66,7 +66,7 @@ def _dkappa_ds(trajectory: Trajectory, s: float) -> float:
 
 
 def turn_piece(
-    position: Any, theta: float, rows: np.ndarray, duration: float, robot: Robot
+    position: ArrayLike, theta: float, rows: np.ndarray, duration: float, robot: Robot
 ) -> TurnInPlace:
     """Return a turn at rest following orientation ``rows`` as a :class:`TurnInPlace`.
 

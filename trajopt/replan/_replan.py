@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 from astar.grid import OccupancyGrid
 from trajopt._validation import nonnegative, number, point
@@ -190,13 +190,13 @@ def _keep_chain(
 def _plan_or_brake(
     options: PlannerOptions,
     caches: PlannerCaches,
-    trajectory: Any,
+    trajectory: PlanResult,
     ts: float,
-    piece: Any,
+    piece: PlanResult,
     target: _Target,
     why: str,
     brake_after_s: float | None,
-) -> Any:
+) -> PlanResult:
     """Plan from the state at ``ts``; brake, turn and go when that fails (:func:`replan_from`).
 
     The plan from the moving state gets the smoother's time budget capped at
