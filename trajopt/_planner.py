@@ -67,24 +67,16 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import PlanResult
-from trajopt.planning._options import (
-    CorridorKind,
-    Fallback,
-    Inflation,
-    PlannerOptions,
-    PlanRequest,
-    Search,
-    SearchMode,
-)
-from trajopt.planning._query import PlanSteps
-from trajopt.planning._runner import run_query
-from trajopt.replan._replan import BRAKE_AFTER_S, replan_from
-from trajopt.robot._robot import Robot
-from trajopt.robot._state import State
+from trajopt.planning import PlannerCaches
+from trajopt.planning import PlanResult
+from trajopt.planning import CorridorKind, Fallback, Inflation, PlannerOptions, PlanRequest, Search, SearchMode
+from trajopt.planning import PlanSteps
+from trajopt.planning import run_query
+from trajopt.replan import BRAKE_AFTER_S, replan_from
+from trajopt.robot import Robot
+from trajopt.robot import State
 from trajopt.smoother import Smoother
-from trajopt.timing._speed_limits import SpeedLimits
+from trajopt.timing import SpeedLimits
 
 __all__ = [
     "plan",

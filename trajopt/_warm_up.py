@@ -141,8 +141,8 @@ def _around_the_wall(planner: Planner, start, goal) -> np.ndarray:
 
 def _exercise_timing() -> None:
     """Time a cubic B-spline (an S-bend) from rest and between moving states."""
-    from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
-    from trajopt.robot._robot import Robot
+    from trajopt.geometry import BSplineCurve, clamped_uniform_knots
+    from trajopt.robot import Robot
     from trajopt.timing import time_parameterize
 
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1.0], [3.0, 1.0], [4.0, 0.0], [5.0, 0.0]])
@@ -210,9 +210,9 @@ def _exercise_grid() -> None:
 
 def _exercise_fallback() -> None:
     """Run the stop-and-turn fallback's checks and the curvature witness (their own kernels)."""
-    from trajopt.geometry._clearance import polyline_clearance
-    from trajopt.planning._feasibility import curvature_witness
-    from trajopt.timing._stop_and_turn import stop_and_turn
+    from trajopt.geometry import polyline_clearance
+    from trajopt.planning import curvature_witness
+    from trajopt.timing import stop_and_turn
 
     planner, start, goal = _default_query()
     points = _around_the_wall(planner, start, goal)
@@ -232,7 +232,7 @@ def _exercise_plan() -> None:
 
 def _exercise_footprint() -> None:
     """Plan for a rectangular robot (the footprint certificate and its rounds)."""
-    from trajopt.robot._robot import Robot
+    from trajopt.robot import Robot
 
     r = _default_planner().robot.radius
     _plan_like(Planner(_default_planner().grid, Robot.rectangle(2.2 * r, 1.4 * r)))
@@ -244,7 +244,7 @@ def _exercise_planners() -> None:
     Boxes, the chapter's inflation, shortest paths, a curvature bound, ALT landmarks; a
     re-plan that keeps the corridor and one that does not.
     """
-    from trajopt.robot._robot import Robot
+    from trajopt.robot import Robot
     from trajopt.smoother import Smoother
 
     base = _default_planner()

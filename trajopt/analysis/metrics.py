@@ -68,7 +68,7 @@ from trajopt.analysis._distances import (
     polyline_hausdorff,
 )
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._curve import ParametricCurve, PolylineCurve
+from trajopt.geometry import ParametricCurve, PolylineCurve
 
 __all__ = [
     "PathMetrics",
@@ -395,7 +395,7 @@ def _needed(rec: Any, name: str) -> np.ndarray:
 
 def _turn_limits(robot: Any) -> tuple[float, float, float]:
     """``trajopt.timing.turn_limits(robot)``; NaNs for a robot without the fields they need."""
-    from trajopt.timing._stop_and_turn import turn_limits
+    from trajopt.timing import turn_limits
 
     try:
         return tuple(float(x) for x in turn_limits(robot))  # type: ignore[return-value]

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt.geometry._curve import ParametricCurve
+from trajopt.geometry import ParametricCurve
 
 __all__ = [
     "plot_map",

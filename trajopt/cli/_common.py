@@ -185,7 +185,7 @@ def read_footprint_file(path: str) -> Any:
     import math
 
     from trajopt.errors import InvalidInputError
-    from trajopt.robot._footprint import Footprint
+    from trajopt.robot import Footprint
 
     where = f"--footprint-file {path!r}"
     file = Path(path)
@@ -247,8 +247,8 @@ def _numbers(values: Sequence[float]) -> str:
 def robot_from_args(args: argparse.Namespace):
     """Return the :class:`~trajopt.Robot` of the robot options (defaults where not given)."""
     from trajopt.errors import InvalidInputError
-    from trajopt.robot._footprint import Footprint
-    from trajopt.robot._robot import Robot
+    from trajopt.robot import Footprint
+    from trajopt.robot import Robot
 
     names = (
         "radius",

@@ -171,7 +171,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
     speed_limits = None
     if args.speed_mask:
-        from trajopt.timing._speed_limits import load_speed_mask
+        from trajopt.timing import load_speed_mask
 
         speed_limits = load_speed_mask(
             args.speed_mask,
@@ -338,7 +338,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from trajopt._planner import Planner
     from trajopt.analysis.comparison import compare
     from trajopt.analysis.scenes import paper
-    from trajopt.robot._robot import Robot
+    from trajopt.robot import Robot
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -15,6 +15,7 @@ from trajopt.corridor._boxes.build import build_corridor
 from trajopt.corridor._boxes.regions import Box, Corridor
 from trajopt.corridor._polygons.build import build_polygon_corridor
 from trajopt.corridor._polygons.regions import CLEARANCE_TOL_M, ConvexPolygon, PolygonCorridor
+from trajopt.corridor._polygons.reuse import corridor_with_rest
 
 __all__ = [
     "Box",
@@ -24,5 +25,6 @@ __all__ = [
     "PolygonCorridor",
     "build_corridor",
     "build_polygon_corridor",
+    "corridor_with_rest",
     "rotated_rect_clearance",
 ]

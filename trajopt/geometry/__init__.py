@@ -16,15 +16,50 @@ from trajopt.geometry._convex_hull import convex_hull
 from trajopt.geometry._curvature_bound import kappa_bound
 from trajopt.geometry._curve import CurveSegment, ParametricCurve, PolylineCurve
 from trajopt.geometry._length_unit import length_unit
+from trajopt.geometry._bspline import clamped_uniform_knots, concatenate, derivative_control_points
+from trajopt.geometry._clearance import box_clearance, grid_cells, min_points_clearance, point_segment_distance, point_square_dist2, points_clearance, polygon_rect_closest, polygon_rects_distance, segment_rect_distance
+from trajopt.geometry._convex_hull import monotone_chain, sort_xy
+from trajopt.geometry._curvature_bound import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO, interval_kappa_max, interval_steer_cap
+from trajopt.geometry._curve import STILL_SPEED_RATIO, signed_curvature
+from trajopt.geometry._obstacle_index import BUCKET_CELLS, ObstacleIndex, gather, point_nearest, poly_clearance, seg_clearance
 
 __all__ = [
     "BSplineCurve",
+    "BUCKET_CELLS",
     "CurveSegment",
+    "MAX_DEPTH",
+    "MAX_WORK",
+    "ObstacleIndex",
     "ParametricCurve",
     "PolylineCurve",
+    "STILL_SPEED_RATIO",
+    "TIP_M",
+    "TIP_RTOL",
+    "ZERO_SPEED_RATIO",
+    "box_clearance",
+    "clamped_uniform_knots",
+    "concatenate",
     "convex_hull",
+    "derivative_control_points",
+    "gather",
+    "grid_cells",
+    "interval_kappa_max",
+    "interval_steer_cap",
     "kappa_bound",
     "length_unit",
+    "min_points_clearance",
+    "monotone_chain",
+    "point_nearest",
+    "point_segment_distance",
+    "point_square_dist2",
+    "points_clearance",
+    "poly_clearance",
     "polygon_clearance",
+    "polygon_rect_closest",
+    "polygon_rects_distance",
     "polyline_clearance",
+    "seg_clearance",
+    "segment_rect_distance",
+    "signed_curvature",
+    "sort_xy",
 ]

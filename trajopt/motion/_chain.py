@@ -24,8 +24,8 @@ from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import TrajectorySample, make_sample
 from trajopt.motion._trajectory import AtRestEnds, Orientation, SampledExport, export_dict
-from trajopt.robot._robot import Robot
-from trajopt.robot._state import State
+from trajopt.robot import Robot
+from trajopt.robot import State
 
 #: Largest jump (SI units) between two consecutive pieces of a chain.
 JOIN_TOL = 1e-6

@@ -48,8 +48,8 @@ from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import OmniSample
 from trajopt.motion._trajectory import Orientation, SampledExport, Trajectory, export_dict
-from trajopt.robot._robot import Robot
-from trajopt.robot._state import State
+from trajopt.robot import Robot
+from trajopt.robot import State
 
 #: Units of the orientation rows' columns ``(t0, theta, omega, alpha, zeta)``.
 ORIENTATION_UNITS: dict[str, str] = {

@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from trajopt._validation import readonly
-from trajopt.robot._robot import Robot
+from trajopt.robot import Robot
 
 #: Unit of every sampled quantity.
 SAMPLE_UNITS: dict[str, str] = {

@@ -20,10 +20,10 @@ import numpy as np
 
 from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._curve import PolylineCurve
+from trajopt.geometry import PolylineCurve
 from trajopt.motion._samples import TrajectorySample, make_sample
 from trajopt.motion._trajectory import AtRestEnds, export_dict
-from trajopt.robot._robot import Robot
+from trajopt.robot import Robot
 
 
 # ====================================================================== trajectory

@@ -22,15 +22,15 @@ import numpy as np
 from astar.files import atomic_write
 from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._curve import ParametricCurve
+from trajopt.geometry import ParametricCurve
 from trajopt.motion._samples import (
     SAMPLE_UNITS,
     CarSample,
     TrajectorySample,
     make_sample,
 )
-from trajopt.robot._robot import Robot
-from trajopt.robot._state import State
+from trajopt.robot import Robot
+from trajopt.robot import State
 
 
 class Orientation(NamedTuple):

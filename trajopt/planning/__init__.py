@@ -14,13 +14,30 @@ from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
 from trajopt.planning._runner import plan_free, plan_turning, run_query
+from trajopt.planning._caches import change_reach
+from trajopt.planning._car import CarSteps
+from trajopt.planning._car_tries import car_search_grid
+from trajopt.planning._disc import PlanResult, check_endpoint
+from trajopt.planning._feasibility import curvature_witness
+from trajopt.planning._options import CorridorKind, Fallback, Inflation, Search, SearchMode
 
 __all__ = [
+    "CarSteps",
+    "CorridorKind",
+    "Fallback",
+    "Inflation",
     "PlanRequest",
+    "PlanResult",
     "PlanSteps",
     "PlannerCaches",
     "PlannerOptions",
+    "Search",
+    "SearchMode",
     "WarmStart",
+    "car_search_grid",
+    "change_reach",
+    "check_endpoint",
+    "curvature_witness",
     "plan_car",
     "plan_free",
     "plan_omni",

@@ -27,7 +27,7 @@ from astar.costmap import Costmap
 from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._length_unit import length_unit
+from trajopt.geometry import length_unit
 from trajopt.planning._memory import check_memory
 from trajopt.planning._options import PlannerOptions
 

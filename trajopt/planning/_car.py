@@ -60,9 +60,9 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._bspline import concatenate
-from trajopt.motion._chain import TrajectoryChain
-from trajopt.motion._trajectory import Trajectory
+from trajopt.geometry import concatenate
+from trajopt.motion import TrajectoryChain
+from trajopt.motion import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
@@ -70,7 +70,7 @@ from trajopt.planning._disc import check_endpoint
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import StageTimer
-from trajopt.robot._state import State
+from trajopt.robot import State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
 

@@ -33,11 +33,11 @@ from astar.grid import OccupancyGrid
 from astar.hybrid import PosePath
 from trajopt.corridor import PolygonCorridor, build_polygon_corridor
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.geometry._bspline import BSplineCurve
+from trajopt.geometry import BSplineCurve
 from trajopt.planning._corridor_fit import witness_corridor
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
-from trajopt.robot._footprint import Footprint
+from trajopt.robot import Footprint
 from trajopt.smoother import Smoother, SmoothPath
 
 #: Relative tolerance of the curvature check of each fitted segment.

@@ -41,7 +41,7 @@ from trajopt.errors import InvalidInputError, NoPathError, SmoothingError
 from trajopt.planning._car_fit import CarSegment, fit_run, start_curvature
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
-from trajopt.robot._robot import Robot
+from trajopt.robot import Robot
 from trajopt.smoother import Smoother
 
 #: Extra inflation (cells) of the search grid beyond the robot radius: half a cell's

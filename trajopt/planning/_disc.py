@@ -21,9 +21,9 @@ from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.geometry._clearance import points_clearance, polygon_clearance
+from trajopt.geometry import points_clearance, polygon_clearance
 from trajopt.motion import PlanResult
-from trajopt.motion._trajectory import Trajectory
+from trajopt.motion import Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
 from trajopt.planning._fallback import polyline_fallback
@@ -34,8 +34,8 @@ from trajopt.planning._options import (
     PlanRequest,
 )
 from trajopt.planning._query import PlanQuery, PlanSteps, WarmStart
-from trajopt.robot._footprint import Footprint
-from trajopt.robot._state import State
+from trajopt.robot import Footprint
+from trajopt.robot import State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
 

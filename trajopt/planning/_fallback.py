@@ -13,12 +13,12 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError
-from trajopt.geometry._clearance import polyline_clearance
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
+from trajopt.geometry import polyline_clearance
+from trajopt.motion import StopAndTurnTrajectory
 from trajopt.planning._corridor_fit import box_corridor
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import PlanQuery
-from trajopt.timing._stop_and_turn import stop_and_turn
+from trajopt.timing import stop_and_turn
 
 logger = logging.getLogger(__name__)
 

@@ -34,7 +34,7 @@ from numba import njit
 import astar
 from trajopt._kernel_cache import watch_compiles
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._clearance import point_square_dist2
+from trajopt.geometry import point_square_dist2
 
 _SAMPLE = 0.125  # cells between clearance samples
 

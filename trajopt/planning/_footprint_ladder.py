@@ -47,7 +47,7 @@ from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanQuery
-from trajopt.robot._footprint import Footprint, certify_footprint
+from trajopt.robot import Footprint, certify_footprint
 
 
 def radius_ladder(inscribed: float, circumscribed: float) -> list[float]:
@@ -73,7 +73,7 @@ def oriented_path_check(
     found (the certificate of the curve decides). Returns the grid path and the inflated
     grid it was found on.
     """
-    from trajopt.robot._footprint import polygons_clearance
+    from trajopt.robot import polygons_clearance
 
     raw = caches.grid
     path, grid = q.path, q.inflated
@@ -217,8 +217,8 @@ def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanReque
         Naming the end, its position and heading (or the sampled headings), and the
         clearance found.
     """
-    from trajopt.robot._footprint import polygons_clearance
-    from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
+    from trajopt.robot import polygons_clearance
+    from trajopt.smoother import END_HEADINGS, end_headings
 
     fp = footprint
     ends = (

@@ -19,10 +19,10 @@ from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
 from trajopt._validation import heading, integer, number
 from trajopt.errors import InvalidInputError
-from trajopt.robot._robot import Robot, avoidance_width
-from trajopt.robot._state import State
+from trajopt.robot import Robot, avoidance_width
+from trajopt.robot import State
 from trajopt.smoother import Smoother
-from trajopt.timing._speed_limits import SpeedLimits, check_overlap
+from trajopt.timing import SpeedLimits, check_overlap
 
 Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]

@@ -50,24 +50,24 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import TimingError, TrajoptError
-from trajopt.geometry._clearance import points_clearance
-from trajopt.geometry._curve import CurveSegment
+from trajopt.geometry import points_clearance
+from trajopt.geometry import CurveSegment
 from trajopt.motion import PlanResult
-from trajopt.motion._chain import TrajectoryChain
-from trajopt.motion._omni import OmniTrajectory
-from trajopt.motion._trajectory import Trajectory
-from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._car import CarSteps
-from trajopt.planning._options import PlannerOptions, PlanRequest
-from trajopt.planning._query import PlanSteps, WarmStart
-from trajopt.planning._runner import run_query
+from trajopt.motion import TrajectoryChain
+from trajopt.motion import OmniTrajectory
+from trajopt.motion import Trajectory
+from trajopt.planning import PlannerCaches
+from trajopt.planning import CarSteps
+from trajopt.planning import PlannerOptions, PlanRequest
+from trajopt.planning import PlanSteps, WarmStart
+from trajopt.planning import run_query
 from trajopt.replan._keep import target_change
 from trajopt.replan._omni import turn_piece
-from trajopt.robot._robot import Robot
+from trajopt.robot import Robot
 from trajopt.timing import time_parameterize
-from trajopt.timing._greedy import advance, brake_times
-from trajopt.timing._orientation import orient, stop_orientation, yaw_stop
-from trajopt.timing._stop_and_turn import turn_in_place, turn_limits
+from trajopt.timing import advance, brake_times
+from trajopt.timing import orient, stop_orientation, yaw_stop
+from trajopt.timing import turn_in_place, turn_limits
 
 
 def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:

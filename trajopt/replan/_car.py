@@ -48,16 +48,16 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt._validation import point
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError
-from trajopt.geometry._clearance import points_clearance
+from trajopt.geometry import points_clearance
 from trajopt.motion import PlanResult
-from trajopt.motion._chain import TrajectoryChain
-from trajopt.motion._trajectory import Trajectory
-from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._car import CarSteps
-from trajopt.planning._car_tries import car_search_grid
-from trajopt.planning._disc import check_endpoint
-from trajopt.planning._options import PlannerOptions, PlanRequest
-from trajopt.planning._runner import run_query
+from trajopt.motion import TrajectoryChain
+from trajopt.motion import Trajectory
+from trajopt.planning import PlannerCaches
+from trajopt.planning import CarSteps
+from trajopt.planning import car_search_grid
+from trajopt.planning import check_endpoint
+from trajopt.planning import PlannerOptions, PlanRequest
+from trajopt.planning import run_query
 from trajopt.replan._brake import brake_on_path, check_new_obstacles
 from trajopt.replan._keep import target_change
 

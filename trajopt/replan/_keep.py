@@ -34,15 +34,15 @@ from astar.search import GridPath
 from trajopt._validation import point
 from trajopt.corridor import Box, ConvexPolygon, PolygonCorridor
 from trajopt.motion import PlanResult
-from trajopt.motion._chain import TrajectoryChain
-from trajopt.motion._omni import OmniTrajectory
-from trajopt.motion._trajectory import Trajectory
-from trajopt.planning._caches import PlannerCaches, change_reach
-from trajopt.planning._options import PlannerOptions
-from trajopt.planning._query import PlanSteps
+from trajopt.motion import TrajectoryChain
+from trajopt.motion import OmniTrajectory
+from trajopt.motion import Trajectory
+from trajopt.planning import PlannerCaches, change_reach
+from trajopt.planning import PlannerOptions
+from trajopt.planning import PlanSteps
 from trajopt.replan._omni import turn_piece
 from trajopt.smoother import SmoothPath
-from trajopt.smoother._certificate import certify
+from trajopt.smoother import certify
 
 #: why :func:`keep_rest` refuses when new obstacles come near the rest of the path
 BLOCKED_NEAR = "cells blocked near the rest of the path"

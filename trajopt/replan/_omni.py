@@ -21,9 +21,9 @@ from numpy.typing import ArrayLike
 
 from trajopt.errors import InvalidInputError
 from trajopt.motion import Orientation, PlanResult, Trajectory, TurnInPlace
-from trajopt.robot._robot import Robot
-from trajopt.timing._orientation import start_rates
-from trajopt.timing._stop_and_turn import turn_limits
+from trajopt.robot import Robot
+from trajopt.timing import start_rates
+from trajopt.timing import turn_limits
 
 
 def course_orientation(trajectory: PlanResult, ts: float, robot: Robot) -> Orientation | None:

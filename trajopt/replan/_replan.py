@@ -44,12 +44,12 @@ from typing import NamedTuple
 from astar.grid import OccupancyGrid
 from trajopt._validation import nonnegative, number, point
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
-from trajopt.motion._chain import TrajectoryChain
-from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import PlanResult, check_endpoint
-from trajopt.planning._options import PlannerOptions, PlanRequest
-from trajopt.planning._query import WarmStart
-from trajopt.planning._runner import run_query
+from trajopt.motion import TrajectoryChain
+from trajopt.planning import PlannerCaches
+from trajopt.planning import PlanResult, check_endpoint
+from trajopt.planning import PlannerOptions, PlanRequest
+from trajopt.planning import WarmStart
+from trajopt.planning import run_query
 from trajopt.replan._brake import brake_turn_go
 from trajopt.replan._keep import (
     BLOCKED_NEAR,

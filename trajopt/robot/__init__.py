@@ -3,6 +3,7 @@
 from trajopt.robot._footprint import Footprint, FootprintCertificate, certify_footprint
 from trajopt.robot._robot import Robot, avoidance_width
 from trajopt.robot._state import State
+from trajopt.robot._footprint import polygons_clearance
 
 __all__ = [
     "Footprint",
@@ -11,4 +12,5 @@ __all__ = [
     "State",
     "avoidance_width",
     "certify_footprint",
+    "polygons_clearance",
 ]

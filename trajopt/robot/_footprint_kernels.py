@@ -15,8 +15,8 @@ import numpy as np
 from numba import njit
 
 from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry._convex_hull import monotone_chain, sort_xy
-from trajopt.geometry._obstacle_index import poly_clearance
+from trajopt.geometry import monotone_chain, sort_xy
+from trajopt.geometry import poly_clearance
 
 TWO_PI = 2.0 * math.pi
 

@@ -57,10 +57,12 @@ from trajopt.smoother._options import CurvatureSolver, Objective, QPSolver, Smoo
 from trajopt.smoother._path import SmoothPath
 from trajopt.smoother._problem import graded_knots
 from trajopt.smoother._status import SolveInfo, SolveStatus
+from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
 
 __all__ = [
     "Certificate",
     "CurvatureSolver",
+    "END_HEADINGS",
     "Objective",
     "QPSolver",
     "SmoothPath",
@@ -68,5 +70,6 @@ __all__ = [
     "SolveInfo",
     "SolveStatus",
     "certify",
+    "end_headings",
     "graded_knots",
 ]

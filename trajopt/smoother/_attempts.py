@@ -25,8 +25,8 @@ import numpy as np
 from trajopt._validation import heading, number
 from trajopt.corridor import Corridor, PolygonCorridor
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.geometry._bspline import BSplineCurve
-from trajopt.robot._footprint import Footprint
+from trajopt.geometry import BSplineCurve
+from trajopt.robot import Footprint
 from trajopt.smoother._basis import band_quadratic, bucket_size
 from trajopt.smoother._certificate import certify
 from trajopt.smoother._cost import (

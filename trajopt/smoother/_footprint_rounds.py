@@ -24,12 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from trajopt.robot._footprint import (
-    Footprint,
-    FootprintCertificate,
-    certify_footprint,
-    polygons_clearance,
-)
+from trajopt.robot import Footprint, FootprintCertificate, certify_footprint, polygons_clearance
 from trajopt.smoother._cost import CostField, CostTerm, cost_scale, linearised
 from trajopt.smoother._footprint_scp import FootprintSCP, corners_cells
 from trajopt.smoother._problem import Problem, assemble, project_heading

@@ -13,8 +13,8 @@ import numpy as np
 
 from trajopt._validation import choice, integer, number
 from trajopt.corridor import Corridor, PolygonCorridor
-from trajopt.geometry._bspline import BSplineCurve
-from trajopt.robot._footprint import Footprint
+from trajopt.geometry import BSplineCurve
+from trajopt.robot import Footprint
 from trajopt.smoother._path import SmoothPath
 
 QPSolver = Literal["osqp", "piqp", "ipopt"]

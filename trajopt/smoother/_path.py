@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from trajopt.geometry._bspline import BSplineCurve
-from trajopt.geometry._curve import ParametricCurve
+from trajopt.geometry import BSplineCurve
+from trajopt.geometry import ParametricCurve
 from trajopt.smoother._certificate import Certificate
 
 

@@ -448,7 +448,7 @@ def warm_imports(casadi: bool = True) -> None:
     import scipy.sparse  # noqa: F401
 
     from astar.grid import OccupancyGrid
-    from trajopt.geometry._clearance import points_clearance
+    from trajopt.geometry import points_clearance
 
     points_clearance(np.zeros((1, 2)), OccupancyGrid(np.zeros((2, 2), bool), 1.0), 1.0)
     _WARM.append("piqp")

@@ -80,16 +80,25 @@ from trajopt.timing._parameterize import time_parameterize
 from trajopt.timing._ruckig_profile import RuckigProfile
 from trajopt.timing._speed_limits import SpeedLimits, load_speed_mask
 from trajopt.timing._stop_and_turn import stop_and_turn, turn_in_place, turn_limits
+from trajopt.timing._greedy import advance, brake_times
+from trajopt.timing._orientation import start_rates, stop_orientation, yaw_stop
+from trajopt.timing._speed_limits import check_overlap
 
 __all__ = [
     "CapTable",
     "RuckigProfile",
     "SpeedLimits",
+    "advance",
+    "brake_times",
     "build_cap_table",
+    "check_overlap",
     "load_speed_mask",
     "orient",
+    "start_rates",
     "stop_and_turn",
+    "stop_orientation",
     "time_parameterize",
     "turn_in_place",
     "turn_limits",
+    "yaw_stop",
 ]

@@ -29,9 +29,9 @@ import numpy as np
 from numba import njit
 
 from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry._curvature_bound import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO
-from trajopt.geometry._curve import STILL_SPEED_RATIO, ParametricCurve
-from trajopt.robot._robot import Robot
+from trajopt.geometry import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO
+from trajopt.geometry import STILL_SPEED_RATIO, ParametricCurve
+from trajopt.robot import Robot
 from trajopt.timing._cap_cubic import bound_cubic
 from trajopt.timing._kernel_options import NO_REFCOUNT
 

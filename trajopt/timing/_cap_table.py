@@ -21,9 +21,9 @@ import numpy as np
 
 import trajopt.timing._greedy as greedy
 from trajopt.errors import TimingError
-from trajopt.geometry._curvature_bound import interval_kappa_max
-from trajopt.geometry._curve import STILL_SPEED_RATIO, ParametricCurve, signed_curvature
-from trajopt.robot._robot import Robot
+from trajopt.geometry import interval_kappa_max
+from trajopt.geometry import STILL_SPEED_RATIO, ParametricCurve, signed_curvature
+from trajopt.robot import Robot
 from trajopt.timing._cap_kernel import polynomial_tables
 from trajopt.timing._speed_limits import SpeedLimits
 from trajopt.timing._steer_cap import steer_caps

@@ -37,9 +37,9 @@ import numpy as np
 
 from trajopt._validation import number
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.motion._omni import OmniTrajectory
-from trajopt.motion._trajectory import Trajectory
-from trajopt.robot._robot import Robot
+from trajopt.motion import OmniTrajectory
+from trajopt.motion import Trajectory
+from trajopt.robot import Robot
 from trajopt.timing._stop_and_turn import turn_limits
 
 #: A turn below this (rad) is no turn: the orientation stays at its start.

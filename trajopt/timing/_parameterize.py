@@ -17,9 +17,9 @@ import numpy as np
 import trajopt.timing._greedy as greedy
 from trajopt._validation import nonnegative, number
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.geometry._curve import ParametricCurve
-from trajopt.motion._trajectory import Trajectory
-from trajopt.robot._robot import Robot
+from trajopt.geometry import ParametricCurve
+from trajopt.motion import Trajectory
+from trajopt.robot import Robot
 from trajopt.timing._cap_table import T_MIN, CapTable, build_cap_table
 from trajopt.timing._compress import compress, finish
 from trajopt.timing._ruckig_profile import RuckigProfile

@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from trajopt.geometry._curvature_bound import interval_steer_cap
-from trajopt.geometry._curve import ParametricCurve
-from trajopt.robot._robot import Robot
+from trajopt.geometry import interval_steer_cap
+from trajopt.geometry import ParametricCurve
+from trajopt.robot import Robot
 
 #: Points per interval besides its nodes where the sampled steering cap is evaluated.
 INNER = 3

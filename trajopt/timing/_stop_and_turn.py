@@ -44,10 +44,10 @@ import numpy as np
 
 from trajopt._validation import heading, short_repr
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.geometry._curve import PolylineCurve
-from trajopt.motion._chain import TurnInPlace
-from trajopt.motion._stop_and_turn import StopAndTurnTrajectory
-from trajopt.robot._robot import Robot
+from trajopt.geometry import PolylineCurve
+from trajopt.motion import TurnInPlace
+from trajopt.motion import StopAndTurnTrajectory
+from trajopt.robot import Robot
 from trajopt.timing._speed_limits import SpeedLimits
 
 logger = logging.getLogger(__name__)

@@ -97,7 +97,7 @@ class MapContext:
         """Return the planner of a trajopt variant (built once per map)."""
         if variant not in self.planners:
             from trajopt._planner import Planner
-            from trajopt.robot._robot import Robot
+            from trajopt.robot import Robot
             from trajopt.smoother import Smoother
 
             if variant.startswith("trajopt-ackermann"):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from trajopt.robot._robot import Robot
+from trajopt.robot import Robot
 
 #: The timed metrics every proposed row carries (``trajectory_metrics`` keys).
 _TIMED = ("duration_s", "ratio_v", "ratio_a", "ratio_jerk", "ratio_omega", "ratio_a_lat")

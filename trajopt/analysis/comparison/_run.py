@@ -18,7 +18,7 @@ from trajopt.analysis.comparison._registry import resolve_methods
 from trajopt.analysis.comparison._table import ComparisonTable
 from trajopt.analysis.metrics import DEFAULT_SAMPLE_SPACING, PathMetrics, path_metrics
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.robot._robot import avoidance_width
+from trajopt.robot import avoidance_width
 
 logger = logging.getLogger(__name__)
 

@@ -15,7 +15,7 @@ import numpy as np
 import trajopt._validation as validation
 from trajopt.analysis.fits._curves import FittedBSpline
 from trajopt.errors import IllPosedFitError
-from trajopt.geometry._bspline import clamped_uniform_knots
+from trajopt.geometry import clamped_uniform_knots
 
 Parameterization = Literal["uniform", "chord", "centripetal"]
 PARAMETERIZATIONS: tuple[str, ...] = ("uniform", "chord", "centripetal")

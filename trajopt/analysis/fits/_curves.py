@@ -12,8 +12,8 @@ import numpy as np
 from numpy.polynomial import chebyshev as _cheb
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._bspline import BSplineCurve
-from trajopt.geometry._curve import ParametricCurve
+from trajopt.geometry import BSplineCurve
+from trajopt.geometry import ParametricCurve
 
 
 class PolynomialCurve(ParametricCurve):

@@ -24,7 +24,7 @@ from trajopt.analysis.fits._polynomial import fit_polynomial
 from trajopt.analysis.fits._records import SweepRecord
 from trajopt.analysis.fits._robust import FIT_METHODS
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._bspline import clamped_uniform_knots
+from trajopt.geometry import clamped_uniform_knots
 
 #: Default polynomial orders of the sweep (Table 1: 3 methods x 10 orders).
 SWEEP_ORDERS: tuple[int, ...] = tuple(range(1, 11))

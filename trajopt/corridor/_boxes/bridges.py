@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from trajopt.corridor._boxes.regions import Box
-from trajopt.geometry._clearance import polygon_rects_distance
+from trajopt.geometry import polygon_rects_distance
 
 
 def occupied_squares(occ: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:

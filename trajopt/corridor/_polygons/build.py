@@ -28,9 +28,9 @@ from trajopt.corridor._polygons.regions import (
     shoelace,
 )
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.geometry._clearance import grid_cells
-from trajopt.geometry._length_unit import length_unit
-from trajopt.geometry._obstacle_index import BUCKET_CELLS, ObstacleIndex
+from trajopt.geometry import grid_cells
+from trajopt.geometry import length_unit
+from trajopt.geometry import BUCKET_CELLS, ObstacleIndex
 
 logger = logging.getLogger("trajopt.corridor")
 

@@ -12,8 +12,8 @@ import numpy as np
 from numba import njit
 
 from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry._convex_hull import monotone_chain, sort_xy
-from trajopt.geometry._obstacle_index import point_nearest, poly_clearance, seg_clearance
+from trajopt.geometry import monotone_chain, sort_xy
+from trajopt.geometry import point_nearest, poly_clearance, seg_clearance
 
 watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
 

@@ -14,12 +14,8 @@ from numba import njit
 
 from trajopt._kernel_cache import watch_compiles
 from trajopt.corridor._polygons.path_kernels import seed_points
-from trajopt.geometry._clearance import (
-    point_segment_distance,
-    polygon_rect_closest,
-    segment_rect_distance,
-)
-from trajopt.geometry._obstacle_index import gather, poly_clearance
+from trajopt.geometry import point_segment_distance, polygon_rect_closest, segment_rect_distance
+from trajopt.geometry import gather, poly_clearance
 
 watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
 
