@@ -25,7 +25,7 @@ map is measured independently of its certificate (``trajopt.metrics.point_cleara
 ``build_polygon_corridor`` on the same path, timed right after it.
 
 A second part runs on a warehouse-size map, willow at 5 cm cells (each 10 cm cell split in
-four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt._warm_up``, one
+four, 1132 x 1216 cells), robot radius 0.25 m, with warm planners (``trajopt.warmup``, one
 untimed plan), one with 6 search landmarks (``Planner(landmarks=6)``) and one without, in
 the same run: the whole ``plan`` of each query (start and goal at least 5 m apart: a new
 goal for the planner), and, with the landmarks, a re-plan to a new goal (the next query's)

@@ -8,7 +8,7 @@
   in their test with ``@example``.
 * A fresh clone (or venv, or CI runner) has no compiled numba kernels yet: the session
   first compiles every kernel numba's cache lacks, in two worker processes
-  (:func:`trajopt._warm_up.compile_kernels`, what ``trajopt warm-up`` does), instead of
+  (:func:`trajopt.warmup.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
 * The notebooks execute in a background thread from the end of collection on, while the
   other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
@@ -35,7 +35,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile the kernels numba's disk cache lacks before the first test (module docstring)."""
     if os.environ.get("TRAJOPT_PRECOMPILE", "1") == "0":
         return
-    import trajopt._kernel_cache as kernel_cache
+    import trajopt.kernel_cache as kernel_cache
 
     cold = kernel_cache.cold_kernels()
     if not cold:
@@ -46,7 +46,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         f"trajopt: compiling {len(cold)} numba kernels first (once per environment; "
         "TRAJOPT_PRECOMPILE=0 skips)..."
     )
-    import trajopt._warm_up as warm
+    import trajopt.warmup as warm
 
     report = warm.compile_kernels()
     say(f"trajopt: compiled {len(report.compiled)} kernels in {report.seconds:.1f} s")

@@ -79,7 +79,7 @@ def test_import_is_light():
 #: trajopt's layers from the bottom (docs/architecture.md): a module may import its own
 #: layer's and lower layers' modules, never a higher layer's (TYPE_CHECKING imports aside)
 LAYERS = [
-    {"errors", "_validation", "_kernel_cache"},
+    {"errors", "validation", "kernel_cache"},
     {"geometry"},
     {"drive"},
     {"robot"},
@@ -91,7 +91,7 @@ LAYERS = [
     {"replan"},
     {"_planner"},
     {"analysis"},
-    {"_warm_up"},
+    {"warmup"},
     {"cli"},
 ]
 

@@ -52,7 +52,7 @@ _EXPORTS: dict[str, str] = {
     "State": "trajopt.robot",
     "Trajectory": "trajopt.motion",
     "Smoother": "trajopt.smoother",
-    "warm_up": "trajopt._warm_up",
+    "warm_up": "trajopt.warmup",
     "TrajoptError": "trajopt.errors",
     "InvalidInputError": "trajopt.errors",
     "NoPathError": "trajopt.errors",
@@ -119,7 +119,6 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # pragma: no cover
     from trajopt import cli
     from trajopt._planner import Planner, PlannerOptions, plan
-    from trajopt._warm_up import warm_up
     from trajopt.analysis import bench, comparison, fits, metrics, plotting, scenes
     from trajopt.analysis.comparison import ComparisonTable, compare
     from trajopt.corridor import (
@@ -153,3 +152,4 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.robot import Robot, State
     from trajopt.smoother import Smoother, SmoothPath
     from trajopt.timing import SpeedLimits, load_speed_mask, stop_and_turn, time_parameterize
+    from trajopt.warmup import warm_up

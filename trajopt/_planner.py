@@ -67,14 +67,21 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.planning import PlannerCaches
-from trajopt.planning import PlanResult
-from trajopt.planning import CorridorKind, Fallback, Inflation, PlannerOptions, PlanRequest, Search, SearchMode
-from trajopt.planning import PlanSteps
-from trajopt.planning import run_query
+from trajopt.planning import (
+    CorridorKind,
+    Fallback,
+    Inflation,
+    PlannerCaches,
+    PlannerOptions,
+    PlanRequest,
+    PlanResult,
+    PlanSteps,
+    Search,
+    SearchMode,
+    run_query,
+)
 from trajopt.replan import BRAKE_AFTER_S, replan_from
-from trajopt.robot import Robot
-from trajopt.robot import State
+from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
 

@@ -1,4 +1,4 @@
-"""trajopt._kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
+"""trajopt.kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
 
 * Every numba dispatcher of astar and trajopt lives in a module of ``KERNEL_MODULES``.
 * ``trajopt.warm_up()`` leaves every kernel compiled and loaded (a signature each), and
@@ -19,7 +19,7 @@ import os
 
 import pytest
 
-import trajopt._kernel_cache as kernel_cache
+import trajopt.kernel_cache as kernel_cache
 from tests.processes import Started
 from trajopt.cli import main
 
@@ -48,7 +48,7 @@ WARM_UP_REACHES_EVERYTHING = """
         return enter(self, *args, **kws)
     Dispatcher._compile_for_args = record
     import trajopt
-    import trajopt._kernel_cache as kernel_cache
+    import trajopt.kernel_cache as kernel_cache
     trajopt.warm_up()
     every = kernel_cache.dispatchers()
     def names(code):
@@ -85,8 +85,8 @@ WARM_UP_REACHES_EVERYTHING = """
 #: In a fresh numba cache: two workers compile the "grid" and "astar" exercises' kernels.
 FRESH_CACHE_COMPILE = """
     import json
-    import trajopt._kernel_cache as kernel_cache
-    import trajopt._warm_up as warm
+    import trajopt.kernel_cache as kernel_cache
+    import trajopt.warmup as warm
     cold = kernel_cache.cold_kernels()
     report = warm.compile_kernels(["grid", "astar"], workers=2)
     print(json.dumps({"cold": cold, "compiled": report.compiled, "workers": report.workers,
@@ -100,7 +100,7 @@ FRESH_CACHE_LOAD = """
     logging.basicConfig(format="%(levelname)s %(name)s: %(message)s")
     import numba.core.event as ev
     import numpy as np
-    import trajopt._kernel_cache as kernel_cache
+    import trajopt.kernel_cache as kernel_cache
     from trajopt.geometry._convex_hull import convex_hull
     rec = ev.install_recorder("numba:compile").__enter__()
     n = kernel_cache.load_kernels(["astar.distance_transform", "astar.inflation",
@@ -111,15 +111,15 @@ FRESH_CACHE_LOAD = """
     convex_hull(np.random.default_rng(1).normal(size=(20, 2)))
 """
 
-#: The exercises live in trajopt._warm_up, a name of their own: importing that module (as
+#: The exercises live in trajopt.warmup, a name of their own: importing that module (as
 #: the compile workers do, which run it) leaves trajopt.warm_up the function.
 EXERCISES_MODULE = """
     import types
-    import trajopt._warm_up
-    assert trajopt._warm_up.WORKER_COMMAND[1:] == ("-m", "trajopt._warm_up", "--worker")
+    import trajopt.warmup
+    assert trajopt.warmup.WORKER_COMMAND[1:] == ("-m", "trajopt.warmup", "--worker")
     from trajopt import warm_up
     assert callable(warm_up) and not isinstance(warm_up, types.ModuleType), warm_up
-    assert warm_up is trajopt._warm_up.warm_up
+    assert warm_up is trajopt.warmup.warm_up
     print("ok")
 """
 
@@ -177,7 +177,7 @@ def test_warm_up_compiles_loads_and_reaches_every_kernel(started):
     # exercises fails here even when numba's cache already holds it from another run.
     run = started["test_warm_up_compiles_loads_and_reaches_every_kernel"]
     out = json.loads(_ok(run).splitlines()[-1])
-    assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt._warm_up.EXERCISES)"
+    assert out["unreached"] == [], "kernels no warm-up exercise calls (trajopt.warmup.EXERCISES)"
     assert out["unloaded"] == [], "kernels without a compiled signature after warm_up()"
     assert out["inline_called_alone"] == []
 
@@ -205,7 +205,7 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(started, fresh_cach
     assert "compiling numerical kernels" not in before, before
     lines = [s for s in after.splitlines() if "compiling numerical kernels once" in s]
     assert len(lines) == 1, after
-    assert lines[0].startswith("WARNING trajopt._kernel_cache: trajopt: compiling")
+    assert lines[0].startswith("WARNING trajopt.kernel_cache: trajopt: compiling")
     assert "trajopt warm-up" in lines[0]
 
 
@@ -225,7 +225,7 @@ def test_cli_warm_up_rejects_bad_workers(workers, capsys):
 
 
 def test_unknown_exercise_is_an_error():
-    import trajopt._warm_up as warm
+    import trajopt.warmup as warm
     from trajopt.errors import InvalidInputError
 
     with pytest.raises(InvalidInputError, match="unknown warm-up exercise 'nope'"):
@@ -233,9 +233,9 @@ def test_unknown_exercise_is_an_error():
 
 
 def test_the_kernel_cache_loads_only_kernel_modules_by_name():
-    """``_kernel_cache`` sits below every module that uses it: the only modules it names (and
+    """``kernel_cache`` sits below every module that uses it: the only modules it names (and
     loads with importlib) are the kernel modules; the warm-up exercises come from its caller
-    (``trajopt._warm_up.compile_kernels``), so no run-time import cycle closes through it."""
+    (``trajopt.warmup.compile_kernels``), so no run-time import cycle closes through it."""
     import ast
     from pathlib import Path
 

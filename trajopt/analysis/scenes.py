@@ -19,7 +19,7 @@ from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from trajopt._planner import Planner
+    from trajopt import Planner
 
 __all__ = ["Scene", "paper", "PAPER_OBSTACLES_CELLS", "WARM_UP_CELLS", "warm_up_map"]
 

@@ -247,8 +247,7 @@ def _numbers(values: Sequence[float]) -> str:
 def robot_from_args(args: argparse.Namespace):
     """Return the :class:`~trajopt.Robot` of the robot options (defaults where not given)."""
     from trajopt.errors import InvalidInputError
-    from trajopt.robot import Footprint
-    from trajopt.robot import Robot
+    from trajopt.robot import Footprint, Robot
 
     names = (
         "radius",

@@ -157,7 +157,7 @@ def add_parsers(sub: Any) -> None:
 
 # -------------------------------------------------------------------- commands
 def _cmd_plan(args: argparse.Namespace) -> int:
-    from trajopt._planner import Planner
+    from trajopt import Planner
     from trajopt.smoother import Smoother
 
     if args.out and Path(args.out).suffix.lower() not in _OUT_SUFFIXES:
@@ -335,7 +335,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from trajopt._planner import Planner
+    from trajopt import Planner
     from trajopt.analysis.comparison import compare
     from trajopt.analysis.scenes import paper
     from trajopt.robot import Robot

@@ -40,8 +40,8 @@ def add_parser(sub: Any) -> None:
 
 
 def _cmd_warm_up(args: argparse.Namespace) -> int:
-    import trajopt._kernel_cache as kernel_cache
-    import trajopt._warm_up as warm
+    import trajopt.kernel_cache as kernel_cache
+    import trajopt.warmup as warm
 
     if args.workers is not None and args.workers < 1:
         raise CliError(f"--workers must be >= 1, got {args.workers}")
@@ -73,12 +73,12 @@ def _compile_kernels(first: Sequence[str] | None, workers: int | None) -> Any:
     With ``first`` (warm-up exercises) it returns when those are compiled, the rest going on
     in the background (the report's ``wait()``).
     """
-    import trajopt._kernel_cache as kernel_cache
+    import trajopt.kernel_cache as kernel_cache
 
     cold = kernel_cache.cold_kernels()
     if not cold:
         return kernel_cache.CompileReport()
-    import trajopt._warm_up as warm
+    import trajopt.warmup as warm
 
     n_workers = workers if workers is not None else min(2, os.cpu_count() or 1)
     about = kernel_cache.estimate_seconds(len(cold), n_workers)
@@ -123,13 +123,13 @@ def compile_notice(args: argparse.Namespace) -> Any:
     they are compiled while the worker processes go on with the others (the returned
     report's ``wait()``, called when the command is done). A kernel the command needs that
     is not compiled yet compiles when first used, with the library's one-line notice (logger
-    ``trajopt._kernel_cache``) on stderr.
+    ``trajopt.kernel_cache``) on stderr.
     """
     if args.command not in _PLANNING or getattr(args, "bench_command", "run") != "run":
         return None
-    import trajopt._warm_up as warm
+    import trajopt.warmup as warm
 
-    notice = logging.getLogger("trajopt._kernel_cache")
+    notice = logging.getLogger("trajopt.kernel_cache")
     if not any(isinstance(h, _StderrLines) for h in notice.handlers):
         notice.addHandler(_StderrLines())
         notice.propagate = False

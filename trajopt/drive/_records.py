@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from trajopt._validation import positive
 from trajopt.drive._protocol import Drive, SpeedTerms, Steering
 from trajopt.errors import InvalidInputError
+from trajopt.validation import positive
 
 if TYPE_CHECKING:  # pragma: no cover
     from trajopt.motion import PlanResult

@@ -10,18 +10,52 @@
 * :func:`length_unit`: the length unit the corridor and the smoother count in.
 """
 
-from trajopt.geometry._bspline import BSplineCurve
-from trajopt.geometry._clearance import polygon_clearance, polyline_clearance
-from trajopt.geometry._convex_hull import convex_hull
-from trajopt.geometry._curvature_bound import kappa_bound
-from trajopt.geometry._curve import CurveSegment, ParametricCurve, PolylineCurve
+from trajopt.geometry._bspline import (
+    BSplineCurve,
+    clamped_uniform_knots,
+    concatenate,
+    derivative_control_points,
+)
+from trajopt.geometry._clearance import (
+    box_clearance,
+    grid_cells,
+    min_points_clearance,
+    point_segment_distance,
+    point_square_dist2,
+    points_clearance,
+    polygon_clearance,
+    polygon_rect_closest,
+    polygon_rects_distance,
+    polyline_clearance,
+    segment_rect_distance,
+)
+from trajopt.geometry._convex_hull import convex_hull, monotone_chain, sort_xy
+from trajopt.geometry._curvature_bound import (
+    MAX_DEPTH,
+    MAX_WORK,
+    TIP_M,
+    TIP_RTOL,
+    ZERO_SPEED_RATIO,
+    interval_kappa_max,
+    interval_steer_cap,
+    kappa_bound,
+)
+from trajopt.geometry._curve import (
+    STILL_SPEED_RATIO,
+    CurveSegment,
+    ParametricCurve,
+    PolylineCurve,
+    signed_curvature,
+)
 from trajopt.geometry._length_unit import length_unit
-from trajopt.geometry._bspline import clamped_uniform_knots, concatenate, derivative_control_points
-from trajopt.geometry._clearance import box_clearance, grid_cells, min_points_clearance, point_segment_distance, point_square_dist2, points_clearance, polygon_rect_closest, polygon_rects_distance, segment_rect_distance
-from trajopt.geometry._convex_hull import monotone_chain, sort_xy
-from trajopt.geometry._curvature_bound import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO, interval_kappa_max, interval_steer_cap
-from trajopt.geometry._curve import STILL_SPEED_RATIO, signed_curvature
-from trajopt.geometry._obstacle_index import BUCKET_CELLS, ObstacleIndex, gather, point_nearest, poly_clearance, seg_clearance
+from trajopt.geometry._obstacle_index import (
+    BUCKET_CELLS,
+    ObstacleIndex,
+    gather,
+    point_nearest,
+    poly_clearance,
+    seg_clearance,
+)
 
 __all__ = [
     "BSplineCurve",

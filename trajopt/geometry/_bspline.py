@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
 from trajopt.errors import InvalidInputError
 from trajopt.geometry._curve import ParametricCurve
+from trajopt.kernel_cache import watch_compiles
 
 
 class BSplineCurve(ParametricCurve):
@@ -250,7 +250,7 @@ def derivative_control_points(
     return t[1:-1], q
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -34,10 +34,10 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
 from trajopt.errors import InvalidInputError
+from trajopt.kernel_cache import watch_compiles
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 # ================================================================= kernels (cell units)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
+from trajopt.kernel_cache import watch_compiles
 
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
@@ -17,7 +17,7 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
     return p[h[: k - 1]]
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -17,7 +17,6 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
 from trajopt.geometry._clearance import (
     border_distance,
     per_map,
@@ -25,11 +24,12 @@ from trajopt.geometry._clearance import (
     segment_rect_distance,
     window_rects,
 )
+from trajopt.kernel_cache import watch_compiles
 
 BUCKET_CELLS = 8
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -20,12 +20,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import TrajectorySample, make_sample
 from trajopt.motion._trajectory import AtRestEnds, Orientation, SampledExport, export_dict
-from trajopt.robot import Robot
-from trajopt.robot import State
+from trajopt.robot import Robot, State
+from trajopt.validation import readonly
 
 #: Largest jump (SI units) between two consecutive pieces of a chain.
 JOIN_TOL = 1e-6

@@ -44,12 +44,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
 from trajopt.motion._samples import OmniSample
 from trajopt.motion._trajectory import Orientation, SampledExport, Trajectory, export_dict
-from trajopt.robot import Robot
-from trajopt.robot import State
+from trajopt.robot import Robot, State
+from trajopt.validation import number, readonly
 
 #: Units of the orientation rows' columns ``(t0, theta, omega, alpha, zeta)``.
 ORIENTATION_UNITS: dict[str, str] = {

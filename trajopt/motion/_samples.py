@@ -11,8 +11,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from trajopt._validation import readonly
 from trajopt.robot import Robot
+from trajopt.validation import readonly
 
 #: Unit of every sampled quantity.
 SAMPLE_UNITS: dict[str, str] = {

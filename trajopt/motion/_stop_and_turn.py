@@ -18,12 +18,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from trajopt._validation import readonly
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import PolylineCurve
 from trajopt.motion._samples import TrajectorySample, make_sample
 from trajopt.motion._trajectory import AtRestEnds, export_dict
 from trajopt.robot import Robot
+from trajopt.validation import readonly
 
 
 # ====================================================================== trajectory

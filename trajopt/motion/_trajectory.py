@@ -20,7 +20,6 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from astar.files import atomic_write
-from trajopt._validation import number, readonly
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import ParametricCurve
 from trajopt.motion._samples import (
@@ -29,8 +28,8 @@ from trajopt.motion._samples import (
     TrajectorySample,
     make_sample,
 )
-from trajopt.robot import Robot
-from trajopt.robot import State
+from trajopt.robot import Robot, State
+from trajopt.validation import number, readonly
 
 
 class Orientation(NamedTuple):

@@ -8,18 +8,23 @@ a disc's or a footprint's plan (:func:`plan_free`), pose to pose with turns in p
 (:func:`plan_car`).
 """
 
-from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._car import plan_car
-from trajopt.planning._omni import plan_omni
-from trajopt.planning._options import PlannerOptions, PlanRequest
-from trajopt.planning._query import PlanSteps, WarmStart
-from trajopt.planning._runner import plan_free, plan_turning, run_query
-from trajopt.planning._caches import change_reach
-from trajopt.planning._car import CarSteps
+from trajopt.planning._caches import PlannerCaches, change_reach
+from trajopt.planning._car import CarSteps, plan_car
 from trajopt.planning._car_tries import car_search_grid
 from trajopt.planning._disc import PlanResult, check_endpoint
 from trajopt.planning._feasibility import curvature_witness
-from trajopt.planning._options import CorridorKind, Fallback, Inflation, Search, SearchMode
+from trajopt.planning._omni import plan_omni
+from trajopt.planning._options import (
+    CorridorKind,
+    Fallback,
+    Inflation,
+    PlannerOptions,
+    PlanRequest,
+    Search,
+    SearchMode,
+)
+from trajopt.planning._query import PlanSteps, WarmStart
+from trajopt.planning._runner import plan_free, plan_turning, run_query
 
 __all__ = [
     "CarSteps",

@@ -58,11 +58,9 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt._validation import point
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import concatenate
-from trajopt.motion import TrajectoryChain
-from trajopt.motion import Trajectory
+from trajopt.motion import Trajectory, TrajectoryChain
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
@@ -73,6 +71,7 @@ from trajopt.planning._query import StageTimer
 from trajopt.robot import State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
+from trajopt.validation import point
 
 #: Cap (s) on the smoother's time budget per segment fit.
 SEGMENT_BUDGET_S = 2.0

@@ -20,8 +20,14 @@ import numpy as np
 
 import astar
 from astar.grid import OccupancyGrid
-from trajopt.corridor import Box, Corridor, PolygonCorridor, build_corridor, build_polygon_corridor
-from trajopt.corridor import corridor_with_rest
+from trajopt.corridor import (
+    Box,
+    Corridor,
+    PolygonCorridor,
+    build_corridor,
+    build_polygon_corridor,
+    corridor_with_rest,
+)
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError
 from trajopt.geometry import box_clearance
 from trajopt.planning._feasibility import curvature_witness, witness_grid_path

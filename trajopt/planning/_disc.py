@@ -18,12 +18,10 @@ import numpy as np
 
 import astar
 from astar.grid import OccupancyGrid
-from trajopt._validation import point
 from trajopt.corridor import PolygonCorridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
 from trajopt.geometry import points_clearance, polygon_clearance
-from trajopt.motion import PlanResult
-from trajopt.motion import Trajectory
+from trajopt.motion import PlanResult, Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
 from trajopt.planning._fallback import polyline_fallback
@@ -34,10 +32,10 @@ from trajopt.planning._options import (
     PlanRequest,
 )
 from trajopt.planning._query import PlanQuery, PlanSteps, WarmStart
-from trajopt.robot import Footprint
-from trajopt.robot import State
+from trajopt.robot import Footprint, State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
+from trajopt.validation import point
 
 #: What a query returns: a smooth trajectory, or the stop-and-turn fallback.
 #: A check of the grid path after the search: ``(caches, query) -> (grid path, inflated

@@ -32,9 +32,9 @@ import numpy as np
 from numba import njit
 
 import astar
-from trajopt._kernel_cache import watch_compiles
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import point_square_dist2
+from trajopt.kernel_cache import watch_compiles
 
 _SAMPLE = 0.125  # cells between clearance samples
 
@@ -176,7 +176,7 @@ def _sample_finish(x, y, th, goal, turn_r, psi, side) -> np.ndarray:
     return np.vstack([arc, line])
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -26,8 +26,7 @@ from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import PlanResult, plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
-from trajopt.timing import orient
-from trajopt.timing import stop_and_turn
+from trajopt.timing import orient, stop_and_turn
 
 
 def plan_omni(

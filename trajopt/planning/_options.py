@@ -17,12 +17,11 @@ import numpy as np
 
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt._validation import heading, integer, number
 from trajopt.errors import InvalidInputError
-from trajopt.robot import Robot, avoidance_width
-from trajopt.robot import State
+from trajopt.robot import Robot, State, avoidance_width
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits, check_overlap
+from trajopt.validation import heading, integer, number
 
 Inflation = Literal["exact", "paper"]
 Search = Literal["clearance", "shortest", "costmap", "costmap+clearance"]

@@ -45,15 +45,11 @@ from numpy.typing import ArrayLike
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import SmoothingError, TimingError
-from trajopt.motion import PlanResult
-from trajopt.motion import TrajectoryChain
-from trajopt.motion import StopAndTurnTrajectory
+from trajopt.motion import PlanResult, StopAndTurnTrajectory, TrajectoryChain
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import WarmStart
-from trajopt.robot import Footprint, polygons_clearance
-from trajopt.robot import Robot
-from trajopt.robot import State
+from trajopt.robot import Footprint, Robot, State, polygons_clearance
 from trajopt.timing import stop_and_turn, turn_in_place
 
 #: A pinned end heading is tried only when the turn it would save is at most this (rad).

@@ -50,24 +50,30 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import TimingError, TrajoptError
-from trajopt.geometry import points_clearance
-from trajopt.geometry import CurveSegment
-from trajopt.motion import PlanResult
-from trajopt.motion import TrajectoryChain
-from trajopt.motion import OmniTrajectory
-from trajopt.motion import Trajectory
-from trajopt.planning import PlannerCaches
-from trajopt.planning import CarSteps
-from trajopt.planning import PlannerOptions, PlanRequest
-from trajopt.planning import PlanSteps, WarmStart
-from trajopt.planning import run_query
+from trajopt.geometry import CurveSegment, points_clearance
+from trajopt.motion import OmniTrajectory, PlanResult, Trajectory, TrajectoryChain
+from trajopt.planning import (
+    CarSteps,
+    PlannerCaches,
+    PlannerOptions,
+    PlanRequest,
+    PlanSteps,
+    WarmStart,
+    run_query,
+)
 from trajopt.replan._keep import target_change
 from trajopt.replan._omni import turn_piece
 from trajopt.robot import Robot
-from trajopt.timing import time_parameterize
-from trajopt.timing import advance, brake_times
-from trajopt.timing import orient, stop_orientation, yaw_stop
-from trajopt.timing import turn_in_place, turn_limits
+from trajopt.timing import (
+    advance,
+    brake_times,
+    orient,
+    stop_orientation,
+    time_parameterize,
+    turn_in_place,
+    turn_limits,
+    yaw_stop,
+)
 
 
 def brake_on_path(traj: Trajectory, ts: float) -> Trajectory | None:

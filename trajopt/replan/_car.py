@@ -46,20 +46,21 @@ from collections.abc import Sequence
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt._validation import point
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError
 from trajopt.geometry import points_clearance
-from trajopt.motion import PlanResult
-from trajopt.motion import TrajectoryChain
-from trajopt.motion import Trajectory
-from trajopt.planning import PlannerCaches
-from trajopt.planning import CarSteps
-from trajopt.planning import car_search_grid
-from trajopt.planning import check_endpoint
-from trajopt.planning import PlannerOptions, PlanRequest
-from trajopt.planning import run_query
+from trajopt.motion import PlanResult, Trajectory, TrajectoryChain
+from trajopt.planning import (
+    CarSteps,
+    PlannerCaches,
+    PlannerOptions,
+    PlanRequest,
+    car_search_grid,
+    check_endpoint,
+    run_query,
+)
 from trajopt.replan._brake import brake_on_path, check_new_obstacles
 from trajopt.replan._keep import target_change
+from trajopt.validation import point
 
 
 def replan_car(

@@ -31,18 +31,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from astar.search import GridPath
-from trajopt._validation import point
 from trajopt.corridor import Box, ConvexPolygon, PolygonCorridor
-from trajopt.motion import PlanResult
-from trajopt.motion import TrajectoryChain
-from trajopt.motion import OmniTrajectory
-from trajopt.motion import Trajectory
-from trajopt.planning import PlannerCaches, change_reach
-from trajopt.planning import PlannerOptions
-from trajopt.planning import PlanSteps
+from trajopt.motion import OmniTrajectory, PlanResult, Trajectory, TrajectoryChain
+from trajopt.planning import PlannerCaches, PlannerOptions, PlanSteps, change_reach
 from trajopt.replan._omni import turn_piece
-from trajopt.smoother import SmoothPath
-from trajopt.smoother import certify
+from trajopt.smoother import SmoothPath, certify
+from trajopt.validation import point
 
 #: why :func:`keep_rest` refuses when new obstacles come near the rest of the path
 BLOCKED_NEAR = "cells blocked near the rest of the path"

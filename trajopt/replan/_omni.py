@@ -22,8 +22,7 @@ from numpy.typing import ArrayLike
 from trajopt.errors import InvalidInputError
 from trajopt.motion import Orientation, PlanResult, Trajectory, TurnInPlace
 from trajopt.robot import Robot
-from trajopt.timing import start_rates
-from trajopt.timing import turn_limits
+from trajopt.timing import start_rates, turn_limits
 
 
 def course_orientation(trajectory: PlanResult, ts: float, robot: Robot) -> Orientation | None:

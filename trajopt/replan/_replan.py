@@ -42,14 +42,17 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 from astar.grid import OccupancyGrid
-from trajopt._validation import nonnegative, number, point
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
 from trajopt.motion import TrajectoryChain
-from trajopt.planning import PlannerCaches
-from trajopt.planning import PlanResult, check_endpoint
-from trajopt.planning import PlannerOptions, PlanRequest
-from trajopt.planning import WarmStart
-from trajopt.planning import run_query
+from trajopt.planning import (
+    PlannerCaches,
+    PlannerOptions,
+    PlanRequest,
+    PlanResult,
+    WarmStart,
+    check_endpoint,
+    run_query,
+)
 from trajopt.replan._brake import brake_turn_go
 from trajopt.replan._keep import (
     BLOCKED_NEAR,
@@ -59,6 +62,7 @@ from trajopt.replan._keep import (
     target_change,
 )
 from trajopt.replan._omni import course_orientation
+from trajopt.validation import nonnegative, number, point
 
 #: Default smoothing time (s) after which a re-plan from a moving state brakes instead.
 BRAKE_AFTER_S = 0.1

@@ -1,9 +1,13 @@
 """The robot: its size and limits (:class:`Robot`), footprint and moving state (:class:`State`)."""
 
-from trajopt.robot._footprint import Footprint, FootprintCertificate, certify_footprint
+from trajopt.robot._footprint import (
+    Footprint,
+    FootprintCertificate,
+    certify_footprint,
+    polygons_clearance,
+)
 from trajopt.robot._robot import Robot, avoidance_width
 from trajopt.robot._state import State
-from trajopt.robot._footprint import polygons_clearance
 
 __all__ = [
     "Footprint",

@@ -24,10 +24,9 @@ from typing import Any
 import numpy as np
 
 import trajopt.robot._footprint_kernels as footprint_kernels
-from trajopt._validation import positive, short_repr
 from trajopt.errors import InvalidInputError
-from trajopt.geometry import derivative_control_points
-from trajopt.geometry import convex_hull
+from trajopt.geometry import convex_hull, derivative_control_points
+from trajopt.validation import positive, short_repr
 
 MAX_ARC_RAD = math.pi / 4  # arc pieces of at most 45 degrees: apex at 1 / cos(22.5 deg) = 1.082 r
 
@@ -270,8 +269,7 @@ def certify_footprint(
         Per span: the smallest margin over its final pieces, and the heading interval of
         its whole hodograph.
     """
-    from trajopt.geometry import grid_cells
-    from trajopt.geometry import ObstacleIndex
+    from trajopt.geometry import ObstacleIndex, grid_cells
 
     spline = getattr(curve, "curve", curve)
     pieces = _bezier_spans(spline)
@@ -329,8 +327,7 @@ def polygons_clearance(polygons: list[np.ndarray], raw_grid: Any, cap_m: float) 
     -------
     ndarray, shape (len(polygons),)
     """
-    from trajopt.geometry import grid_cells
-    from trajopt.geometry import ObstacleIndex, poly_clearance
+    from trajopt.geometry import ObstacleIndex, grid_cells, poly_clearance
 
     out = np.empty(len(polygons))
     if not polygons:

@@ -14,14 +14,13 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry import monotone_chain, sort_xy
-from trajopt.geometry import poly_clearance
+from trajopt.geometry import monotone_chain, poly_clearance, sort_xy
+from trajopt.kernel_cache import watch_compiles
 
 TWO_PI = 2.0 * math.pi
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -40,10 +40,10 @@ from typing import Any, Literal
 
 import numpy as np
 
-from trajopt._validation import positive
 from trajopt.drive import CAR_FIELDS, Differential, Drive, as_drive, speed_cap
 from trajopt.errors import InvalidInputError
 from trajopt.robot._footprint import Footprint
+from trajopt.validation import positive
 
 #: The chapter robot's footprint radius (m): half of its 0.33 m width.
 DEFAULT_RADIUS = 0.165

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from trajopt._validation import nonnegative, number
+from trajopt.validation import nonnegative, number
 
 
 @dataclass(frozen=True, slots=True)

@@ -53,11 +53,11 @@ builds both share), :mod:`~trajopt.smoother._certificate` and
 """
 
 from trajopt.smoother._certificate import Certificate, certify
+from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
 from trajopt.smoother._options import CurvatureSolver, Objective, QPSolver, Smoother
 from trajopt.smoother._path import SmoothPath
 from trajopt.smoother._problem import graded_knots
 from trajopt.smoother._status import SolveInfo, SolveStatus
-from trajopt.smoother._footprint_rounds import END_HEADINGS, end_headings
 
 __all__ = [
     "Certificate",

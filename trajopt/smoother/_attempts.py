@@ -22,7 +22,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from trajopt._validation import heading, number
 from trajopt.corridor import Corridor, PolygonCorridor
 from trajopt.errors import InvalidInputError, SmoothingError
 from trajopt.geometry import BSplineCurve
@@ -55,6 +54,7 @@ from trajopt.smoother._problem import (
 from trajopt.smoother._qp import RoundSolver, solve_qp, warm_imports
 from trajopt.smoother._scp import CurvatureSCP
 from trajopt.smoother._status import AttemptRecord, SolveInfo, SolveStatus, summarize
+from trajopt.validation import heading, number
 
 if TYPE_CHECKING:
     from trajopt.smoother._options import Smoother

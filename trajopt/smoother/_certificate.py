@@ -12,8 +12,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.corridor import CLEARANCE_TOL_M, Corridor, PolygonCorridor
-from trajopt.geometry import BSplineCurve
-from trajopt.geometry import min_points_clearance
+from trajopt.geometry import BSplineCurve, min_points_clearance
 
 #: heading continuity in the certificate: the tangent may turn at most this much between
 #: consecutive dense samples (rad; an eighth of a cell apart by default, so only a near-cusp,

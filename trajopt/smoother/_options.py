@@ -11,11 +11,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from trajopt._validation import choice, integer, number
 from trajopt.corridor import Corridor, PolygonCorridor
 from trajopt.geometry import BSplineCurve
 from trajopt.robot import Footprint
 from trajopt.smoother._path import SmoothPath
+from trajopt.validation import choice, integer, number
 
 QPSolver = Literal["osqp", "piqp", "ipopt"]
 _QP_SOLVERS = ("osqp", "piqp", "ipopt")

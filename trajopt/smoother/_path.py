@@ -7,8 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from trajopt.geometry import BSplineCurve
-from trajopt.geometry import ParametricCurve
+from trajopt.geometry import BSplineCurve, ParametricCurve
 from trajopt.smoother._certificate import Certificate
 
 

@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from trajopt._validation import point
 from trajopt.corridor import CLEARANCE_TOL_M, Corridor, PolygonCorridor
 from trajopt.errors import InvalidInputError
 from trajopt.smoother._basis import (
@@ -26,6 +25,7 @@ from trajopt.smoother._basis import (
     find_spans,
     smoothness_band,
 )
+from trajopt.validation import point
 
 if TYPE_CHECKING:
     from trajopt.smoother._options import Smoother

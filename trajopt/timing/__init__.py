@@ -75,14 +75,12 @@ robot's translation its own orientation profile, turned while it drives.
 """
 
 from trajopt.timing._cap_table import CapTable, build_cap_table
-from trajopt.timing._orientation import orient
+from trajopt.timing._greedy import advance, brake_times
+from trajopt.timing._orientation import orient, start_rates, stop_orientation, yaw_stop
 from trajopt.timing._parameterize import time_parameterize
 from trajopt.timing._ruckig_profile import RuckigProfile
-from trajopt.timing._speed_limits import SpeedLimits, load_speed_mask
+from trajopt.timing._speed_limits import SpeedLimits, check_overlap, load_speed_mask
 from trajopt.timing._stop_and_turn import stop_and_turn, turn_in_place, turn_limits
-from trajopt.timing._greedy import advance, brake_times
-from trajopt.timing._orientation import start_rates, stop_orientation, yaw_stop
-from trajopt.timing._speed_limits import check_overlap
 
 __all__ = [
     "CapTable",

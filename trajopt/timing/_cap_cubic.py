@@ -12,10 +12,10 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
+from trajopt.kernel_cache import watch_compiles
 from trajopt.timing._kernel_options import NO_REFCOUNT
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True, **NO_REFCOUNT)

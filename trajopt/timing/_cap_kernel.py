@@ -28,9 +28,16 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry import MAX_DEPTH, MAX_WORK, TIP_M, TIP_RTOL, ZERO_SPEED_RATIO
-from trajopt.geometry import STILL_SPEED_RATIO, ParametricCurve
+from trajopt.geometry import (
+    MAX_DEPTH,
+    MAX_WORK,
+    STILL_SPEED_RATIO,
+    TIP_M,
+    TIP_RTOL,
+    ZERO_SPEED_RATIO,
+    ParametricCurve,
+)
+from trajopt.kernel_cache import watch_compiles
 from trajopt.robot import Robot
 from trajopt.timing._cap_cubic import bound_cubic
 from trajopt.timing._kernel_options import NO_REFCOUNT
@@ -174,7 +181,7 @@ def polynomial_tables(
     return PolynomialTables(u=u, kappa=kappa, theta=theta, kmax=kmax, cap=cap, end_caps=end_caps)
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True, **NO_REFCOUNT)

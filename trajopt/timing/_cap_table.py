@@ -21,8 +21,12 @@ import numpy as np
 
 import trajopt.timing._greedy as greedy
 from trajopt.errors import TimingError
-from trajopt.geometry import interval_kappa_max
-from trajopt.geometry import STILL_SPEED_RATIO, ParametricCurve, signed_curvature
+from trajopt.geometry import (
+    STILL_SPEED_RATIO,
+    ParametricCurve,
+    interval_kappa_max,
+    signed_curvature,
+)
 from trajopt.robot import Robot
 from trajopt.timing._cap_kernel import polynomial_tables
 from trajopt.timing._speed_limits import SpeedLimits

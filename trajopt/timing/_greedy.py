@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
+from trajopt.kernel_cache import watch_compiles
 from trajopt.timing._kernel_options import NO_REFCOUNT
 
 #: greedy exit codes
@@ -34,7 +34,7 @@ STACK = 96  # rows of piece_ok's bisection stack
 # greedy's time. Their callers allocate (the bisection stack ``stk`` included).
 
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 class CapArrays(NamedTuple):

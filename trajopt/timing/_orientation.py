@@ -35,12 +35,11 @@ from typing import Any
 
 import numpy as np
 
-from trajopt._validation import number
 from trajopt.errors import InvalidInputError, TimingError
-from trajopt.motion import OmniTrajectory
-from trajopt.motion import Trajectory
+from trajopt.motion import OmniTrajectory, Trajectory
 from trajopt.robot import Robot
 from trajopt.timing._stop_and_turn import turn_limits
+from trajopt.validation import number
 
 #: A turn below this (rad) is no turn: the orientation stays at its start.
 MIN_TURN_RAD = 1e-12

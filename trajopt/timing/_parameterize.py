@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 
 import trajopt.timing._greedy as greedy
-from trajopt._validation import nonnegative, number
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.geometry import ParametricCurve
 from trajopt.motion import Trajectory
@@ -24,6 +23,7 @@ from trajopt.timing._cap_table import T_MIN, CapTable, build_cap_table
 from trajopt.timing._compress import compress, finish
 from trajopt.timing._ruckig_profile import RuckigProfile
 from trajopt.timing._speed_limits import SpeedLimits
+from trajopt.validation import nonnegative, number
 
 _log = logging.getLogger("trajopt.timing")
 

@@ -34,8 +34,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from trajopt._validation import number, point, positive
 from trajopt.errors import InvalidInputError
+from trajopt.validation import number, point, positive
 
 SpeedLimitType = Literal["percentage", "absolute"]
 _TYPES: tuple[str, ...] = ("percentage", "absolute")

@@ -18,8 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from trajopt.geometry import interval_steer_cap
-from trajopt.geometry import ParametricCurve
+from trajopt.geometry import ParametricCurve, interval_steer_cap
 from trajopt.robot import Robot
 
 #: Points per interval besides its nodes where the sampled steering cap is evaluated.

@@ -42,13 +42,12 @@ from typing import Any
 
 import numpy as np
 
-from trajopt._validation import heading, short_repr
 from trajopt.errors import InvalidInputError, TimingError
 from trajopt.geometry import PolylineCurve
-from trajopt.motion import TurnInPlace
-from trajopt.motion import StopAndTurnTrajectory
+from trajopt.motion import StopAndTurnTrajectory, TurnInPlace
 from trajopt.robot import Robot
 from trajopt.timing._speed_limits import SpeedLimits
+from trajopt.validation import heading, short_repr
 
 logger = logging.getLogger(__name__)
 

@@ -96,7 +96,7 @@ class MapContext:
     def planner(self, variant: str) -> Any:
         """Return the planner of a trajopt variant (built once per map)."""
         if variant not in self.planners:
-            from trajopt._planner import Planner
+            from trajopt import Planner
             from trajopt.robot import Robot
             from trajopt.smoother import Smoother
 
@@ -539,7 +539,7 @@ def warm_up(methods: object = None) -> float:
     import importlib
 
     import astar
-    from trajopt._planner import Planner
+    from trajopt import Planner
     from trajopt.analysis.scenes import warm_up_map
 
     names = check_methods(DEFAULT_METHODS if methods is None else methods)

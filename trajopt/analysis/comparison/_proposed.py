@@ -34,7 +34,7 @@ def proposed_method(ctx: Any) -> Any:
     robot = opts.pop("robot", None) or Robot(radius=ctx.robot_radius)
     headings = {k: opts.pop(k, None) for k in ("start_heading", "goal_heading")}
     t0 = time.perf_counter()
-    from trajopt._planner import Planner
+    from trajopt import Planner
 
     traj = Planner(ctx.grid, robot, **opts).plan(ctx.start, ctx.goal, **headings)
     runtime = time.perf_counter() - t0

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 import astar.errors as _astar_errors
-import trajopt._validation as validation
+import trajopt.validation as validation
 from astar.grid import OccupancyGrid
 from trajopt.analysis.comparison._records import ComparisonContext, MethodFn, MethodResult
 from trajopt.analysis.comparison._registry import resolve_methods

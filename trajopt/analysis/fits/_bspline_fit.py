@@ -12,7 +12,7 @@ from typing import Literal
 
 import numpy as np
 
-import trajopt._validation as validation
+import trajopt.validation as validation
 from trajopt.analysis.fits._curves import FittedBSpline
 from trajopt.errors import IllPosedFitError
 from trajopt.geometry import clamped_uniform_knots

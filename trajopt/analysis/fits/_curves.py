@@ -12,8 +12,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as _cheb
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry import BSplineCurve
-from trajopt.geometry import ParametricCurve
+from trajopt.geometry import BSplineCurve, ParametricCurve
 
 
 class PolynomialCurve(ParametricCurve):

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numpy.polynomial import chebyshev as _cheb
 
-import trajopt._validation as validation
+import trajopt.validation as validation
 from trajopt.analysis.fits._bspline_fit import PARAMETERIZATIONS, Parameterization, curve_parameters
 from trajopt.analysis.fits._curves import ParametricPolynomialCurve, PolynomialCurve
 from trajopt.analysis.fits._records import PolynomialFit

@@ -10,7 +10,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-import trajopt._validation as validation
+import trajopt.validation as validation
 from trajopt.analysis.fits._bspline_fit import (
     PARAMETERIZATIONS,
     allowed_message,

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from trajopt._validation import readonly
+from trajopt.validation import readonly
 
 
 @dataclass(frozen=True, slots=True)

@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 
-from trajopt._validation import nonnegative, positive
 from trajopt.corridor._polygons.path_kernels import (
     centre_path,
     junction_extensions,
@@ -28,9 +27,8 @@ from trajopt.corridor._polygons.regions import (
     shoelace,
 )
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.geometry import grid_cells
-from trajopt.geometry import length_unit
-from trajopt.geometry import BUCKET_CELLS, ObstacleIndex
+from trajopt.geometry import BUCKET_CELLS, ObstacleIndex, grid_cells, length_unit
+from trajopt.validation import nonnegative, positive
 
 logger = logging.getLogger("trajopt.corridor")
 

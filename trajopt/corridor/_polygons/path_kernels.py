@@ -11,11 +11,10 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
-from trajopt.geometry import monotone_chain, sort_xy
-from trajopt.geometry import point_nearest, poly_clearance, seg_clearance
+from trajopt.geometry import monotone_chain, point_nearest, poly_clearance, seg_clearance, sort_xy
+from trajopt.kernel_cache import watch_compiles
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -12,12 +12,17 @@ import math
 import numpy as np
 from numba import njit
 
-from trajopt._kernel_cache import watch_compiles
 from trajopt.corridor._polygons.path_kernels import seed_points
-from trajopt.geometry import point_segment_distance, polygon_rect_closest, segment_rect_distance
-from trajopt.geometry import gather, poly_clearance
+from trajopt.geometry import (
+    gather,
+    point_segment_distance,
+    poly_clearance,
+    polygon_rect_closest,
+    segment_rect_distance,
+)
+from trajopt.kernel_cache import watch_compiles
 
-watch_compiles()  # a first compilation logs one notice (trajopt._kernel_cache)
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)

@@ -8,9 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from trajopt._validation import readonly
 from trajopt.corridor._polygons.region_kernels import clip_convex
 from trajopt.errors import InvalidInputError
+from trajopt.validation import readonly
 
 #: Absolute tolerance (m) of every clearance check of this module: a region is certified
 #: when its exact clearance is at least ``radius - CLEARANCE_TOL_M``. Obstacle rows are

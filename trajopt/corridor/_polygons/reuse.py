@@ -36,8 +36,7 @@ from trajopt.corridor._polygons.build import GrownRegions, assemble_corridor, gr
 from trajopt.corridor._polygons.region_kernels import certify_all
 from trajopt.corridor._polygons.regions import CLEARANCE_TOL_M, PolygonCorridor
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.geometry import grid_cells
-from trajopt.geometry import ObstacleIndex
+from trajopt.geometry import ObstacleIndex, grid_cells
 
 
 def shared_suffix(a: np.ndarray, b: np.ndarray) -> int:

@@ -8,8 +8,8 @@ Two one-time costs stand before a fast plan:
   :data:`EXERCISES` (small searches, plans, timings, a fallback and a comparison that between
   them call every kernel with the argument types the library uses) in two worker processes
   (:func:`compile_kernels`, which hands the exercises to
-  :func:`trajopt._kernel_cache.run_exercises`; each worker is this module run as
-  ``python -m trajopt._warm_up --worker``, serving :data:`EXERCISES`). ``trajopt warm-up``
+  :func:`trajopt.kernel_cache.run_exercises`; each worker is this module run as
+  ``python -m trajopt.warmup --worker``, serving :data:`EXERCISES`). ``trajopt warm-up``
   does the same from a shell, e.g. in a container build or a CI cache step.
 * **Once per process**: importing numba, SciPy and CasADi, initialising numba's compiler
   context, loading each compiled kernel from numba's disk cache and loading the CasADi
@@ -25,7 +25,7 @@ resolution are scaled to the robot, so the warm-up takes the same short time for
 robot size. Two paths stay unloaded: the stop-and-turn fallback, which only a failed
 smoother or timing runs, may load kernels of its own the first time it is used; and
 speed-limit zones are not copied (their lookup is plain NumPy). Without a planner, every
-kernel of the library is loaded (:func:`trajopt._kernel_cache.load_kernels`) and the
+kernel of the library is loaded (:func:`trajopt.kernel_cache.load_kernels`) and the
 default planner plans the query.
 """
 
@@ -39,13 +39,13 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-import trajopt._kernel_cache as kernel_cache
+import trajopt.kernel_cache as kernel_cache
 from astar.costmap import from_costmap
 from astar.grid import OccupancyGrid
-from trajopt._kernel_cache import CompileReport, Exercise
 from trajopt._planner import Planner
 from trajopt.analysis.scenes import WARM_UP_CELLS, warm_up_map
 from trajopt.errors import InvalidInputError
+from trajopt.kernel_cache import CompileReport, Exercise
 
 _log = logging.getLogger(__name__)
 
@@ -77,7 +77,7 @@ def warm_up(planner: Planner | None = None) -> float:
     Notes
     -----
     The compilation runs only when some kernel has nothing in numba's disk cache
-    (:func:`trajopt._kernel_cache.cold_kernels`), in two worker processes
+    (:func:`trajopt.kernel_cache.cold_kernels`), in two worker processes
     (:func:`compile_kernels`); an exercise that fails there is logged and its kernels compile
     on first use instead.
     """
@@ -319,8 +319,8 @@ CORE_EXERCISES: tuple[str, ...] = ("plan", "compare")
 
 
 #: The command that starts a compile worker: this module, serving :data:`EXERCISES`
-#: (:func:`trajopt._kernel_cache.serve`).
-WORKER_COMMAND: tuple[str, ...] = (sys.executable, "-m", "trajopt._warm_up", "--worker")
+#: (:func:`trajopt.kernel_cache.serve`).
+WORKER_COMMAND: tuple[str, ...] = (sys.executable, "-m", "trajopt.warmup", "--worker")
 
 
 def compile_kernels(
@@ -334,7 +334,7 @@ def compile_kernels(
     """Compile the cold kernels into numba's disk cache by running the warm-up exercises.
 
     The exercises (:data:`EXERCISES`) run in worker processes
-    (:func:`trajopt._kernel_cache.run_exercises`, each worker started with
+    (:func:`trajopt.kernel_cache.run_exercises`, each worker started with
     :data:`WORKER_COMMAND`).
 
     Parameters
@@ -351,7 +351,7 @@ def compile_kernels(
     first : sequence of str, optional
         Exercises to run before the others; the call returns as soon as they (and those
         they depend on) are done, while the workers go on with the rest in the background
-        (:meth:`~trajopt._kernel_cache.CompileReport.wait` waits for them). Default: return
+        (:meth:`~trajopt.kernel_cache.CompileReport.wait` waits for them). Default: return
         when all are done.
     force : bool
         Run the exercises even when no kernel is cold.
@@ -381,4 +381,4 @@ def compile_kernels(
 if __name__ == "__main__":  # pragma: no cover - a worker of compile_kernels
     if sys.argv[1:] == ["--worker"]:
         sys.exit(kernel_cache.serve(EXERCISES))
-    sys.exit(f"usage: {sys.executable} -m trajopt._warm_up --worker (used by compile_kernels)")
+    sys.exit(f"usage: {sys.executable} -m trajopt.warmup --worker (used by compile_kernels)")

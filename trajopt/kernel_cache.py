@@ -10,7 +10,7 @@ compilation once: about 50 s of CPU for all kernels on a 2-core machine (numba 0
 This module makes that visible and lets it be paid ahead of time:
 
 * :func:`watch_compiles` (installed by the trajopt kernel modules when they are imported,
-  so a program that imports only ``astar`` is not told) logs one WARNING on the logger ``trajopt._kernel_cache`` the first time a kernel of the
+  so a program that imports only ``astar`` is not told) logs one WARNING on the logger ``trajopt.kernel_cache`` the first time a kernel of the
   two packages compiles in a process. WARNING, not INFO, because it explains a one-time
   latency of tens of seconds in a call that otherwise takes milliseconds, which a robot
   program should hear about and can act on (``trajopt warm-up`` in its image build); it is
@@ -23,7 +23,7 @@ This module makes that visible and lets it be paid ahead of time:
   two cores; numba's cache holds one file per kernel and signature and writes them
   atomically, so the workers fill one cache for every later process. The exercises that
   between them call every kernel with the argument types the library uses are
-  ``trajopt._warm_up.EXERCISES``, above this module: :func:`trajopt._warm_up.compile_kernels`
+  ``trajopt.warmup.EXERCISES``, above this module: :func:`trajopt.warmup.compile_kernels`
   passes them in, with the command that starts a worker serving them (:func:`serve`), so
   this module imports nothing above the kernels.
 * :func:`load_kernels` loads every kernel's cached signatures into this process (also the
@@ -298,13 +298,13 @@ def run_exercises(
     Parameters
     ----------
     table : mapping of str to Exercise
-        The exercises by name (``trajopt._warm_up.EXERCISES``: between them they call every
+        The exercises by name (``trajopt.warmup.EXERCISES``: between them they call every
         kernel of the packages).
     exercises : sequence of str, optional
         Names in ``table`` (with the ones they depend on); default all.
     worker : sequence of str
         The command that starts a worker process serving ``table`` (:func:`serve` on its
-        stdin and stdout), e.g. ``[sys.executable, "-m", "trajopt._warm_up", "--worker"]``.
+        stdin and stdout), e.g. ``[sys.executable, "-m", "trajopt.warmup", "--worker"]``.
     workers : int, optional
         Worker processes; default ``min(2, CPUs)``. ``0`` or ``1`` runs the exercises in this
         process, one after the other (the kernels are then also loaded here).
