@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 import astar
+from trajopt.corridor import build_polygon_corridor
 from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curve import ParametricCurve
 
@@ -91,3 +92,24 @@ def line(length: float, direction: float = 0.3) -> BSplineCurve:
     d = np.array([math.cos(direction), math.sin(direction)])
     c = np.linspace(0.0, length, 5)[:, None] * d[None, :]
     return BSplineCurve(t, c, 3)
+
+
+#: The cost hall of the smoother's cost tests: cell size (m), start and end (m)
+L_HALL_RES = 0.05
+L_HALL_START, L_HALL_END = (0.8, 1.1), (2.9, 3.2)
+
+
+def l_hall():
+    """An L of two 1.2 m halls; the inner corner's walls lined with a 0.35 m band of cost 1."""
+    occ = np.ones((80, 80), bool)
+    occ[10:34, 10:70] = False  # y 0.5 .. 1.7 m
+    occ[10:70, 46:70] = False  # x 2.3 .. 3.5 m
+    grid = astar.OccupancyGrid(occ, L_HALL_RES)
+    yy, xx = np.mgrid[0:80, 0:80]
+    x, y = (xx + 0.5) * L_HALL_RES, (yy + 0.5) * L_HALL_RES
+    band = ((y > 1.35) & (y < 1.7) & (x < 2.65)) | ((x > 2.3) & (x < 2.65) & (y > 1.35))
+    cost = np.where(band & ~occ, 1.0, 0.0)
+    pts = np.vstack(
+        [np.linspace(L_HALL_START, (2.9, 1.1), 40), np.linspace((2.9, 1.1), L_HALL_END, 40)[1:]]
+    )
+    return grid, cost, build_polygon_corridor(grid, pts, 0.2)

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["UNITS_PER_RADIUS", "length_unit"]
-
 #: On maps whose cells are finer than ``radius / UNITS_PER_RADIUS``, the length unit is
 #: ``radius / UNITS_PER_RADIUS``: a knot span of 4 units is then two thirds of the radius,
 #: short enough to follow gaps of one robot width (12 units), and the corridor's seeds of

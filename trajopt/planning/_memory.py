@@ -17,8 +17,6 @@ from pathlib import Path
 from trajopt.errors import InvalidInputError
 from trajopt.planning._options import PlannerOptions
 
-__all__ = ["MemoryEstimate", "available_memory", "check_memory", "estimate_memory"]
-
 #: bytes per cell with a search cost: grids 2, components 4, cost 8, search records 16,
 #: inflation and clearance-cost temporaries about 20, coarse blocks and band mask about 4
 #: (peak of the allocations traced over plans on the willow map split 2 x 2 and 4 x 4: 38

@@ -16,8 +16,6 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["cost_term_kernel"]
-
 
 @njit(cache=True, inline="always")
 def _bilinear(cost, fx, fy):  # pragma: no cover - compiled

@@ -13,39 +13,16 @@ import numpy as np
 import pytest
 
 import astar
-from trajopt.corridor import build_polygon_corridor
+from tests.cases import L_HALL_END as GOAL
+from tests.cases import L_HALL_RES as RES
+from tests.cases import L_HALL_START as START
+from tests.cases import l_hall
+from tests.reference import dense_mean_cost
 from trajopt.errors import InvalidInputError
 from trajopt.smoother import Smoother
 from trajopt.smoother._cost import CostTerm, cost_field
 from trajopt.smoother._problem import assemble, build_problem
 from trajopt.smoother._qp import solve_qp
-
-RES = 0.05
-START, GOAL = (0.8, 1.1), (2.9, 3.2)
-
-
-def l_hall():
-    """An L of two 1.2 m halls; the inner corner's walls lined with a 0.35 m band of cost 1."""
-    occ = np.ones((80, 80), bool)
-    occ[10:34, 10:70] = False  # y 0.5 .. 1.7 m
-    occ[10:70, 46:70] = False  # x 2.3 .. 3.5 m
-    grid = astar.OccupancyGrid(occ, RES)
-    yy, xx = np.mgrid[0:80, 0:80]
-    x, y = (xx + 0.5) * RES, (yy + 0.5) * RES
-    band = ((y > 1.35) & (y < 1.7) & (x < 2.65)) | ((x > 2.3) & (x < 2.65) & (y > 1.35))
-    cost = np.where(band & ~occ, 1.0, 0.0)
-    pts = np.vstack([np.linspace(START, (2.9, 1.1), 40), np.linspace((2.9, 1.1), GOAL, 40)[1:]])
-    return grid, cost, build_polygon_corridor(grid, pts, 0.2)
-
-
-def dense_mean_cost(curve, cost, grid) -> float:
-    """Mean cell cost per metre on 20000 samples (nearest cell: no interpolation)."""
-    a, b = curve.domain
-    pts = curve(np.linspace(a, b, 20001))
-    mid = 0.5 * (pts[1:] + pts[:-1])
-    d = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    ix = np.floor(mid / grid.resolution).astype(int)
-    return float(np.sum(cost[ix[:, 1], ix[:, 0]] * d) / np.sum(d))
 
 
 def test_gradient_matches_central_differences():

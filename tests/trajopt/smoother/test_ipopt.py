@@ -20,11 +20,16 @@ import pytest
 
 import astar
 import trajopt
-from tests.cases import square_inflated
-from tests.reference import footprint_collides, square_clearance, three_point_curvature
-from tests.trajopt.smoother.test_cost import GOAL as HALL_GOAL
-from tests.trajopt.smoother.test_cost import RES, dense_mean_cost, l_hall
-from tests.trajopt.smoother.test_cost import START as HALL_START
+from tests.cases import L_HALL_END as HALL_GOAL
+from tests.cases import L_HALL_RES as RES
+from tests.cases import L_HALL_START as HALL_START
+from tests.cases import l_hall, square_inflated
+from tests.reference import (
+    dense_mean_cost,
+    footprint_collides,
+    square_clearance,
+    three_point_curvature,
+)
 from trajopt.analysis import scenes
 from trajopt.analysis.bench._suites import random_queries
 from trajopt.corridor import build_polygon_corridor
