@@ -97,6 +97,8 @@ LAYERS = [
 
 
 def _layer(module: str) -> int:
+    # a name of the lazy face is its defining module's (importing it loads that module)
+    module = trajopt._EXPORTS.get(module.removeprefix("trajopt."), module)
     top = module.split(".")[1] if module.count(".") else "__init__"
     for i, names in enumerate(LAYERS):
         if top in names:

@@ -546,6 +546,7 @@ def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
             super().__init__(grid, robot, **kwargs)
 
     monkeypatch.setattr(trajopt._planner, "Planner", Spy)
+    monkeypatch.setattr(trajopt, "Planner", Spy)  # the command takes it from the face
     out = tmp_path / "omni.json"
     rc = main(
         ["plan", str(door_map), *PLAN, "--radius", "0.12", "--drive", "omni", "--out", str(out)]

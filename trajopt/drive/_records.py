@@ -396,7 +396,7 @@ def as_drive(value: Any, car: dict[str, Any] | None = None, owner: str = "Robot"
         return DRIVES[value]()
     if isinstance(value, Ackermann):  # dataclasses.replace(robot, reverse=...) lands here
         return dataclasses.replace(value, **car) if car else value
-    if not isinstance(value, str) and isinstance(value, Drive):
+    if not isinstance(value, str | type) and isinstance(value, Drive):
         if given:
             raise InvalidInputError(
                 f"{owner}: {what} are a car's fields: give them to trajopt.Ackermann(...), "
