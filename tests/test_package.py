@@ -280,3 +280,56 @@ def test_the_switch_check_finds_switches():
         "if not isinstance(t, Trajectory):\n    raise TypeError('t')\n"
     )
     assert _class_switches(ast.parse(code)) == [1, 3]
+
+
+def _package(module: str) -> str:
+    """``trajopt.<pkg>`` for a module of a package of trajopt, ``trajopt`` for a flat one."""
+    parts = module.split(".")
+    root = Path(trajopt.__file__).parent
+    if parts[0] == "trajopt" and len(parts) >= 2 and (root / parts[1]).is_dir():
+        return ".".join(parts[:2])
+    return parts[0]
+
+
+def test_packages_use_each_other_through_their_faces():
+    """No import reaches into another package's ``_`` modules (function level included)."""
+    root = Path(trajopt.__file__).parent
+    reach = []
+    for path in sorted(root.rglob("*.py")):
+        rel = path.relative_to(root.parent).with_suffix("")
+        here = ".".join(rel.parts).removesuffix(".__init__")
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.ImportFrom | ast.Import) or getattr(node, "level", 0):
+                continue
+            mods = (
+                [node.module] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
+            )
+            for mod in mods:
+                if not mod or not mod.startswith("trajopt.") or _package(mod) == _package(here):
+                    continue
+                tail = mod.split(".")[len(_package(mod).split(".")) :]
+                if any(part.startswith("_") and not part.startswith("__") for part in tail):
+                    reach.append(f"{rel}.py:{node.lineno} imports {mod}")
+    assert not reach, reach
+
+
+def test_no_drive_is_named_outside_the_drives():
+    """No comparison of a ``drive`` with a string outside ``trajopt/drive/``."""
+    root = Path(trajopt.__file__).parent
+    named = []
+    for path in sorted(root.rglob("*.py")):
+        if path.relative_to(root).parts[0] == "drive":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.Compare):
+                continue
+            sides = [node.left, *node.comparators]
+            drive = any(
+                (isinstance(x, ast.Attribute) and x.attr in ("drive", "name"))
+                or (isinstance(x, ast.Name) and x.id == "drive")
+                for x in sides
+            )
+            text = any(isinstance(x, ast.Constant) and isinstance(x.value, str) for x in sides)
+            if drive and text and "drive" in ast.unparse(node):
+                named.append(f"{path.relative_to(root)}:{node.lineno} {ast.unparse(node)}")
+    assert not named, named

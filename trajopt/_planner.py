@@ -67,6 +67,7 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
+from trajopt.motion import PlanResult
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -74,7 +75,6 @@ from trajopt.planning import (
     PlannerCaches,
     PlannerOptions,
     PlanRequest,
-    PlanResult,
     PlanSteps,
     Search,
     SearchMode,

@@ -11,7 +11,7 @@ a disc's or a footprint's plan (:func:`plan_free`), pose to pose with turns in p
 from trajopt.planning._caches import PlannerCaches, change_reach
 from trajopt.planning._car import CarSteps, plan_car
 from trajopt.planning._car_tries import car_search_grid
-from trajopt.planning._disc import PlanResult, check_endpoint
+from trajopt.planning._ends import check_endpoint
 from trajopt.planning._feasibility import curvature_witness
 from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import (
@@ -32,7 +32,6 @@ __all__ = [
     "Fallback",
     "Inflation",
     "PlanRequest",
-    "PlanResult",
     "PlanSteps",
     "PlannerCaches",
     "PlannerOptions",

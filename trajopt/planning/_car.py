@@ -64,7 +64,7 @@ from trajopt.motion import Trajectory, TrajectoryChain
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
-from trajopt.planning._disc import check_endpoint
+from trajopt.planning._ends import check_endpoint
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import StageTimer

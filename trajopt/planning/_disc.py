@@ -20,10 +20,11 @@ import astar
 from astar.grid import OccupancyGrid
 from trajopt.corridor import PolygonCorridor
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
-from trajopt.geometry import points_clearance, polygon_clearance
+from trajopt.geometry import polygon_clearance
 from trajopt.motion import PlanResult, Trajectory
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._corridor_fit import fit_in_corridor, smooth_for_speed, witness_rescue
+from trajopt.planning._ends import check_endpoint
 from trajopt.planning._fallback import polyline_fallback
 from trajopt.planning._options import (
     COARSE_MIN_BLOCKS,
@@ -311,44 +312,6 @@ def _result(
     return dataclasses.replace(traj, stats=stats, steps=steps)
 
 
-def check_endpoint(
-    options: PlannerOptions,
-    grid: OccupancyGrid,
-    name: str,
-    p: np.ndarray,
-    radius: float | None = None,
-) -> np.ndarray:
-    """Return the cell of an end point ``p`` (m), or raise naming why it is not valid.
-
-    ``radius`` (m): the clearance the point needs; default ``options.robot.radius``.
-
-    Raises
-    ------
-    InvalidInputError
-        ``p`` outside the map, on an occupied cell, or closer to an obstacle (or the map
-        edge) than the robot radius (the message gives the clearance found).
-    """
-    c = grid.world_to_cell(p)
-    if not grid.in_bounds(c):
-        ox, oy = grid.origin
-        raise InvalidInputError(
-            f"{name} {p.tolist()} m is outside the map "
-            f"[{ox}, {ox + grid.width}] x [{oy}, {oy + grid.height}] m"
-        )
-    if grid.occupied[c[1], c[0]]:
-        raise InvalidInputError(
-            f"{name} {p.tolist()} m lies on an occupied cell {_cell(c)} of the map"
-        )
-    r = options.robot.radius if radius is None else radius
-    clr = _point_clearance(grid, p, r)
-    if clr < r:
-        raise InvalidInputError(
-            f"{name} {p.tolist()} m is {clr:.4g} m from the nearest obstacle (or the map "
-            f"edge); the robot needs at least its radius {r} m"
-        )
-    return c
-
-
 def _cell(c: np.ndarray) -> tuple[int, int]:
     """Return a cell ``(ix, iy)`` as plain ints (for messages)."""
     return (int(c[0]), int(c[1]))
@@ -357,13 +320,3 @@ def _cell(c: np.ndarray) -> tuple[int, int]:
 def _centre_clearance(grid: OccupancyGrid, c: np.ndarray) -> float:
     """Exact clearance (m) of the centre of cell ``c`` from the raw map (outside occupied)."""
     return polygon_clearance(np.asarray(grid.cell_to_world(c), dtype=float).reshape(1, 2), grid)
-
-
-def _point_clearance(grid: OccupancyGrid, p: np.ndarray, radius: float) -> float:
-    """Clearance (m) of a world point from the raw map (outside occupied), exact below ``radius``.
-
-    The search stops a cell beyond ``radius``: on a fine map the distance to the nearest
-    obstacle of a point in open space would take a search over far more cells.
-    """
-    window = float(radius) + float(grid.resolution)
-    return float(points_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid, window)[0])

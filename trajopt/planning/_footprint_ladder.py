@@ -43,8 +43,9 @@ import numpy as np
 import astar
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError, TimingError
+from trajopt.motion import PlanResult
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._disc import plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanQuery
 from trajopt.robot import Footprint, certify_footprint

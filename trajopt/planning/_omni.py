@@ -22,8 +22,9 @@ import dataclasses
 import numpy as np
 
 from trajopt.errors import TimingError
+from trajopt.motion import PlanResult
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._disc import plan_disc
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import PlanSteps, WarmStart
 from trajopt.timing import orient, stop_and_turn

@@ -8,8 +8,9 @@ explicit inputs.
 
 from __future__ import annotations
 
+from trajopt.motion import PlanResult
 from trajopt.planning._caches import PlannerCaches
-from trajopt.planning._disc import PlanResult, plan_disc
+from trajopt.planning._disc import plan_disc
 from trajopt.planning._footprint_ladder import plan_with_footprint
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._pose import needs_pose_plan, plan_pose

@@ -43,12 +43,11 @@ from typing import NamedTuple
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, SmoothingError, TimingError, TrajoptError
-from trajopt.motion import TrajectoryChain
+from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.planning import (
     PlannerCaches,
     PlannerOptions,
     PlanRequest,
-    PlanResult,
     WarmStart,
     check_endpoint,
     run_query,
