@@ -315,20 +315,11 @@ class PlannerOptions:
     def disc(self, radius: float, *, last: bool) -> PlannerOptions:
         """Return the options of a footprint robot's disc model of ``radius`` (m).
 
-        The disc has the robot's limits and no footprint; it keeps the fallback only when
-        ``last`` (the circumscribed disc, which holds the footprint in every heading).
+        The disc has the robot's limits and drive and no footprint; it keeps the fallback
+        only when ``last`` (the circumscribed disc, which holds the footprint in every
+        heading).
         """
-        r = self.robot
-        disc = Robot(
-            radius=radius,
-            v_max=r.v_max,
-            a_max=r.a_max,
-            j_max=r.j_max,
-            a_lat_max=r.a_lat_max,
-            omega_max=r.omega_max,
-            track_width=r.track_width,
-            wheel_v_max=r.wheel_v_max,
-        )
+        disc = dataclasses.replace(self.robot, radius=radius, footprint=None)
         return dataclasses.replace(self, robot=disc, fallback=self.fallback if last else None)
 
     def with_budget(self, budget_s: float | None) -> PlannerOptions:
