@@ -361,7 +361,7 @@ class Planner:
         ``"braked: <why no smooth plan>"``.
 
         What it keeps of the old trajectory, what it reuses and when it brakes instead:
-        :mod:`trajopt.replan._replan`. A car-like robot (``drive="ackermann"``) is never
+        :mod:`trajopt.replan._replan`. A car-like robot (an :class:`~trajopt.drive.Ackermann` drive) is never
         turned in place: its rest is kept while clear, else it brakes along the segment it
         is driving, in its direction of travel, and a car plan (which may reverse) starts
         from the stopped pose (:mod:`trajopt.replan._car`); ``goal_heading`` is required

@@ -1,4 +1,4 @@
-"""Pose-to-pose plans of a car-like robot (``Robot(drive="ackermann")``).
+"""Pose-to-pose plans of a car-like robot (``Robot(drive=trajopt.Ackermann(...))``).
 
 A car faces its direction of travel (or its reverse), turns no tighter than its
 ``min_turning_radius`` ``R`` and cannot turn in place, so :func:`plan_car` plans in
@@ -35,7 +35,7 @@ change); at a cusp (or a join where the curvatures differ, ``stats["car"]["rests
 the car is at rest and may steer while stopped (the chain checks position, heading, speed,
 acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
 
-A car with a :class:`~trajopt.robot.Footprint` (``Robot.rectangle(..., drive="ackermann")``;
+A car with a :class:`~trajopt.robot.Footprint` (``Robot.rectangle(..., drive=trajopt.Ackermann(...))``;
 the footprint's origin is the point the plan moves, e.g. the rear axle's centre) is planned
 with its body facing its heading, forwards or backwards: its end poses must hold the body
 clear of the map (:func:`~trajopt.planning._footprint_ladder.check_end_poses`); the search

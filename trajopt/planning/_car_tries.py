@@ -119,7 +119,7 @@ def search_and_fit(
     Parameters
     ----------
     options : PlannerOptions
-        Resolved for ``grid``; ``options.robot.drive == "ackermann"``.
+        Resolved for ``grid``; ``options.robot.drive`` an :class:`~trajopt.drive.Ackermann`.
     grid : astar.OccupancyGrid
         The raw map.
     cells : tuple

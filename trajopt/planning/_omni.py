@@ -1,6 +1,6 @@
 """Plans of an omnidirectional base: the path of a disc, the orientation turned while driving.
 
-An omni base (``Robot(drive="omni")``) moves in any direction whatever its orientation. The
+An omni base (``Robot(drive=trajopt.Omni())``) moves in any direction whatever its orientation. The
 path is planned as for a disc of the robot's radius (with a footprint: its circumscribed
 disc, which holds the footprint in every orientation, so the path is clear whatever the
 orientation does), with free headings; the orientation is then its own jerk-limited profile
@@ -41,7 +41,7 @@ def plan_omni(
     Parameters
     ----------
     options : PlannerOptions
-        The planner's options (``options.robot.drive == "omni"``).
+        The planner's options (``options.robot.drive`` an :class:`~trajopt.drive.Omni`).
     caches : PlannerCaches
         The map's caches.
     request : PlanRequest

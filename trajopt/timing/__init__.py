@@ -6,7 +6,7 @@
 * the curvature-dependent speed cap ``v <= cap(s) = Robot.speed_cap(kappa(s))``, i.e.
   ``v <= v_max``, lateral acceleration ``|kappa| v^2 <= a_lat_max``, yaw rate
   ``|kappa| v <= omega_max`` and wheel speeds ``v (1 + |kappa| w/2) <= wheel_v_max`` (an
-  omnidirectional robot, ``drive="omni"``, has only the first two: its body turns
+  omnidirectional robot, ``drive=Omni()``, has only the first two: its body turns
   independently of the path, see :func:`orient`).
 
 ruckig (community edition, 1-DoF, no ``intermediate_positions``: that option sends the

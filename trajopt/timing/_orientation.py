@@ -1,6 +1,6 @@
 """The orientation of an omnidirectional base: a jerk-limited yaw profile beside the drive.
 
-An omnidirectional robot (``Robot(drive="omni")``) follows its path whatever way it faces;
+An omnidirectional robot (``Robot(drive=trajopt.Omni())``) follows its path whatever way it faces;
 :func:`orient` gives it an orientation of its own, from a start to a goal heading, turned
 while it drives:
 
