@@ -32,8 +32,13 @@ cusps) and ``kappa``, ``direction`` and, with a ``wheelbase``, ``steer`` and ``s
 Curvature (hence steering) is continuous within a drive (each B-spline is C2, and the
 pieces driven through meet with the same curvature, where only the steering rate may
 change); at a cusp (or a join where the curvatures differ, ``stats["car"]["rests"]``)
-the car is at rest and may steer while stopped (the chain checks position, heading, speed,
-acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
+the car is at rest and steers there: with a ``wheelbase`` and a ``steer_rate_max`` a
+:class:`~trajopt.motion.SteerInPlace` piece turns the steering angle at its rate limit
+wherever it differs between two drives, and before the first drive from the request's
+``start_steer`` (default 0) and after the last to its ``goal_steer`` when given
+(:func:`with_steering`); without them the steering is not modelled. The chain checks
+position, heading, speed, acceleration and yaw rate at every join (all continuous: the car
+is at rest). Its ``steps`` are a :class:`CarSteps`.
 
 A car with a :class:`~trajopt.robot.Footprint` (``Robot.rectangle(..., drive="ackermann")``;
 the footprint's origin is the point the plan moves, e.g. the rear axle's centre) is planned
@@ -60,7 +65,7 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import concatenate
-from trajopt.motion import Trajectory, TrajectoryChain
+from trajopt.motion import Trajectory, TrajectoryChain, steer_in_place
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
@@ -68,7 +73,7 @@ from trajopt.planning._ends import check_endpoint
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import StageTimer
-from trajopt.robot import State
+from trajopt.robot import Robot, State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
 from trajopt.validation import point
@@ -111,6 +116,10 @@ class CarSteps:
         The end points (m).
     start_heading, goal_heading : float
         The end headings (rad).
+    start_steer : float
+        The steering angle at the start (rad).
+    goal_steer : float or None
+        The steering angle asked for at the goal (rad), or ``None``.
     stages_s : dict
         Wall time per stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
         ``timing``, ``total``.
@@ -130,6 +139,8 @@ class CarSteps:
     goal_heading: float
     stages_s: dict[str, float]
     search_turning_radius: float
+    start_steer: float = 0.0
+    goal_steer: float | None = None
 
     @property
     def corridor(self) -> CarCorridor:
@@ -162,7 +173,7 @@ def plan_car(
     TrajectoryChain
         One :class:`~trajopt.motion.Trajectory` per drive (between cusps, and at the
         joins of a stretch fitted in pieces whose curvatures differ), each from rest to
-        rest.
+        rest, and the steering at rest between them (:func:`with_steering`).
 
     Raises
     ------
@@ -196,10 +207,11 @@ def plan_car(
     search_grid, path, radius_cells = found.search_grid, found.path, found.radius_cells
     poses, segments, tries = found.poses, found.segments, found.tries
     drives = drive_groups(segments)
-    pieces: list[Trajectory] = []
+    moves: list[Trajectory] = []
     for group in drives:
         with timer.stage("timing"):
-            pieces.append(_time_drive(options, [segments[i] for i in group]))
+            moves.append(_time_drive(options, [segments[i] for i in group]))
+    pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)
     stages = timer.finish()
     steps = CarSteps(
         raw_grid=grid,
@@ -214,6 +226,8 @@ def plan_car(
         goal_heading=h1,
         stages_s=stages,
         search_turning_radius=radius_cells * res,
+        start_steer=request.start_steer,
+        goal_steer=request.goal_steer,
     )
     stats: dict[str, Any] = {
         "stages_s": dict(stages),
@@ -228,11 +242,82 @@ def plan_car(
             "search_turning_radius_m": radius_cells * res,
             "tries": tries,
             "corridors": [s.corridor_kind for s in segments],
+            "steer_at_rest": steered,
             "search": dict(path.stats),
         },
         "inflation": options.inflation,
     }
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+#: Smallest change of the steering angle (rad) a car steers at rest for: below it the
+#: drives meet as they are (a rate of at most 1e-12 rad per sample interval).
+STEER_AT_REST_MIN_RAD = 1e-12
+
+
+def with_steering(
+    robot: Robot, drives: list[Trajectory], start_steer: float, goal_steer: float | None
+) -> tuple[list, list[dict[str, float]]]:
+    """Return a car's chain pieces: its drives with the steering at rest between them.
+
+    The steering angle of a drive is ``atan(wheelbase * kappa)`` of its body's curvature,
+    continuous within it; at its ends the car is at rest. Where the steering angle at the
+    end of one drive differs from the start of the next (a cusp, or a rest inside a stretch
+    fitted in pieces), before the first drive (from ``start_steer``) and after the last
+    (to ``goal_steer`` when given), a :class:`~trajopt.motion.SteerInPlace` turns it at
+    ``steer_rate_max`` (changes above :data:`STEER_AT_REST_MIN_RAD`). Only for a car with
+    a ``wheelbase`` and a ``steer_rate_max``: without them the steering is not modelled
+    and the drives are returned as they are.
+
+    Parameters
+    ----------
+    robot : Robot
+        The car.
+    drives : list of Trajectory
+        Its drives, each from rest to rest, in order.
+    start_steer : float
+        Steering angle at the start (rad).
+    goal_steer : float or None
+        Steering angle asked for at the goal (rad), or ``None``.
+
+    Returns
+    -------
+    pieces : list
+        The drives and the steering at rest between them, in order.
+    steered : list of dict
+        Per steering at rest: ``at`` (``"start"``, ``"cusp"``, ``"rest"`` or ``"goal"``),
+        ``steer_rad`` (signed change) and ``duration_s``.
+    """
+    steering = robot.drive.steering
+    if steering is None or steering.rate_max is None:
+        return list(drives), []
+    pieces: list = []
+    steered: list[dict[str, float]] = []
+
+    def steer(smp: Any, k: int, delta0: float, delta1: float, direction: int, at: str) -> None:
+        if abs(delta1 - delta0) <= STEER_AT_REST_MIN_RAD:
+            return
+        p = np.array([float(smp.x[k]), float(smp.y[k])])
+        piece = steer_in_place(robot, p, float(smp.theta[k]), delta0, delta1, direction)
+        pieces.append(piece)
+        steered.append({"at": at, "steer_rad": piece.steer_rad, "duration_s": piece.duration})
+
+    delta = float(start_steer)
+    for i, drive in enumerate(drives):
+        ends = drive.sample(np.array([0.0, drive.duration]))
+        first = float(np.arctan(steering.wheelbase * ends.kappa[0]))
+        at = (
+            "start"
+            if i == 0
+            else ("cusp" if drive.direction != drives[i - 1].direction else "rest")
+        )
+        steer(ends, 0, delta, first, drive.direction, at)
+        pieces.append(drive)
+        delta = float(np.arctan(steering.wheelbase * ends.kappa[1]))
+        last = ends
+    if goal_steer is not None:
+        steer(last, 1, delta, float(goal_steer), drives[-1].direction, "goal")
+    return pieces, steered
 
 
 def _ends(
