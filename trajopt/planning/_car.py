@@ -50,6 +50,17 @@ necessary condition); each segment's corridor keeps the inscribed radius and its
 also pass the footprint certificate, with the body along the curve's tangent forwards and
 turned by ``pi`` backwards (:func:`~trajopt.planning._car_fit.body_along`).
 
+**Frame.** Nothing in a plan depends on where the map's origin is: the ends are checked in
+the map's frame, then the search, the fits and the timing run in the map-local frame (the
+grid's origin subtracted, so coordinates are at most the map's size), and the result is
+moved back: each drive's curve is a :class:`~trajopt.geometry.ShiftedCurve` of its local
+curve (positions moved, heading and curvature the local curve's), the steering at rest and
+the steps' poses moved. Far from the origin (x near ``4.5e9`` m, where float64 positions
+are only about ``1e-6`` m apart) the fits' end tangents stay exact, so the chain joins with
+the same heading to the last bits; only the positions are rounded, to that spacing. With
+the origin at ``(0, 0)`` nothing is moved. Messages of the search and fits then name
+poses in the local frame (and say so).
+
 Not supported (refused with :class:`~trajopt.errors.InvalidInputError`): a moving start or
 end speeds other than 0, missing end headings, and the chapter's ``inflation="paper"``.
 """
@@ -63,8 +74,8 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt.errors import InvalidInputError
-from trajopt.geometry import concatenate
+from trajopt.errors import InvalidInputError, TrajoptError
+from trajopt.geometry import ShiftedCurve, concatenate
 from trajopt.motion import Trajectory, TrajectoryChain, steer_in_place
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
@@ -120,6 +131,10 @@ class CarSteps:
         The steering angle at the start (rad).
     goal_steer : float or None
         The steering angle asked for at the goal (rad), or ``None``.
+    origin : tuple of float
+        The map's origin (m): :attr:`segments` (their corridors and curves) are in the
+        map-local frame, this offset subtracted (:attr:`corridor` adds it back); the rest is
+        in the map's frame.
     stages_s : dict
         Wall time per stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
         ``timing``, ``total``.
@@ -141,15 +156,25 @@ class CarSteps:
     search_turning_radius: float
     start_steer: float = 0.0
     goal_steer: float | None = None
+    origin: tuple[float, float] = (0.0, 0.0)
 
     @property
     def corridor(self) -> CarCorridor:
-        """Every segment's regions (:class:`CarCorridor`)."""
-        return CarCorridor(tuple(r for s in self.segments for r in s.corridor.regions))
+        """Every segment's regions (:class:`CarCorridor`), in the map's frame."""
+        regions = tuple(r for s in self.segments for r in s.corridor.regions)
+        if self.origin != (0.0, 0.0):
+            # the certified local regions moved; not validated again (far from the origin a
+            # thin polygon's float64 area may round to 0)
+            o = np.asarray(self.origin, dtype=float)
+            regions = tuple(
+                type(r)._construct_fast(r.A, r.b + r.A @ o, r.vertices + o, r.degenerate)
+                for r in regions
+            )
+        return CarCorridor(regions)
 
     @property
     def smooth_path(self) -> SmoothPath:
-        """The first segment's curve (each segment's is in :attr:`segments`)."""
+        """The first segment's curve (each segment's is in :attr:`segments`; map-local)."""
         return self.segments[0].smooth_path
 
 
@@ -191,8 +216,13 @@ def plan_car(
     """
     timer = StageTimer()
     robot = options.robot
-    grid = caches.grid
-    p0, p1, h0, h1 = _ends(options, grid, request)
+    world = caches.grid
+    p0w, p1w, h0, h1 = _ends(options, world, request)  # checked in the map's frame
+    # everything else in the map-local frame (module docstring, "Frame")
+    origin = np.asarray(world.origin, dtype=float)
+    local = bool(np.any(origin != 0.0))
+    grid = OccupancyGrid(world.occupied, world.resolution, (0.0, 0.0)) if local else world
+    p0, p1 = (p0w - origin, p1w - origin) if local else (p0w, p1w)
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
     goal = _to_cells(grid, p1, h1)
@@ -203,7 +233,15 @@ def plan_car(
         kappa_max=kmax if sm.kappa_max is None else min(sm.kappa_max, kmax),
         time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
     )
-    found = search_and_fit(options, grid, (start, goal), (p0, p1), sm, timer)
+    try:
+        found = search_and_fit(options, grid, (start, goal), (p0w, p1w), sm, timer)
+    except TrajoptError as exc:
+        if local and exc.args:
+            exc.args = (
+                f"{exc.args[0]} (poses in m in the map-local frame, the map's origin "
+                f"{world.origin} m subtracted)",
+            ) + exc.args[1:]
+        raise
     search_grid, path, radius_cells = found.search_grid, found.path, found.radius_cells
     poses, segments, tries = found.poses, found.segments, found.tries
     drives = drive_groups(segments)
@@ -211,23 +249,28 @@ def plan_car(
     for group in drives:
         with timer.stage("timing"):
             moves.append(_time_drive(options, [segments[i] for i in group]))
+    if local:  # back in the map's frame: positions moved, the local curves' geometry kept
+        moves = [dataclasses.replace(m, path=ShiftedCurve(m.path, origin)) for m in moves]
+        search_grid = world.with_occupied(search_grid.occupied)
+        poses = poses + np.array([origin[0], origin[1], 0.0])
     pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)
     stages = timer.finish()
     steps = CarSteps(
-        raw_grid=grid,
+        raw_grid=world,
         inflated_grid=search_grid,
         pose_path=path,
         poses=poses,
         segments=tuple(segments),
         drives=tuple(drives),
-        start=(float(p0[0]), float(p0[1])),
-        goal=(float(p1[0]), float(p1[1])),
+        start=(float(p0w[0]), float(p0w[1])),
+        goal=(float(p1w[0]), float(p1w[1])),
         start_heading=h0,
         goal_heading=h1,
         stages_s=stages,
         search_turning_radius=radius_cells * res,
         start_steer=request.start_steer,
         goal_steer=request.goal_steer,
+        origin=(float(origin[0]), float(origin[1])),
     )
     stats: dict[str, Any] = {
         "stages_s": dict(stages),
