@@ -1,12 +1,13 @@
 """A car's plan does not depend on where the map's origin is (issue 45, part 5).
 
 A full-size car (4.69 x 1.94 m, wheelbase 2.8 m, R = 3.0 m, the rear axle as reference)
-backs into and drives out of bays off an aisle on a 0.1 m grid: far from the origin (x near
+backs into bays off an aisle on a 0.1 m grid: far from the origin (x near
 4.5e9 m, where float64 positions are about 1e-6 m apart) fits made in the map's frame had end
 tangents off by up to 3.5e-6 rad, and the chain refused the planner's own joins ("pieces 1
 and 2 do not join: jumps of heading"). Planned in the map-local frame, every join is exact
 to rounding; and the same case shifted by 4.5e9 m gives the same trajectory, shifted: the
-positions to their float64 spacing, everything else to the last bit.
+positions to their float64 spacing, everything else to the last bit. Then the structural
+refusals a car's plan makes before (or instead of) spending its search budget.
 """
 
 from __future__ import annotations
@@ -41,11 +42,11 @@ def aisle_yard(aisle: float, bay: float, origin=(0.0, 0.0), res: float = 0.1):
     return astar.OccupancyGrid(occ, res, origin)
 
 
-# (aisle, bay width, start, start heading, goal y, goal heading): backed in from the aisle
-# with a cusp, or driven out of the bay nose first with two
+# (aisle, bay width, start, start heading, goal y, goal heading): backed in from the aisle,
+# with a cusp (cases that plan in well under a second: the search has a time budget)
 CASES = {
     "back_in": (5.12, 2.62, (17.5, 8.15), 3.28, 1.3, math.pi / 2),
-    "out_two_cusps": (6.5, 2.44, (11.25, 9.23), 0.185, 4.3, -math.pi / 2),
+    "back_in_short": (6.58, 2.45, (10.71, 8.42), -0.119, 1.3, math.pi / 2),
 }
 
 
@@ -135,3 +136,54 @@ def test_a_shifted_curve_moves_positions_and_keeps_the_geometry():
     np.testing.assert_array_equal(
         moved.u_at_s(np.array([0.5, 2.0])), curve.u_at_s(np.array([0.5, 2.0]))
     )
+
+
+# ------------------------------------------------------------ structural refusals, fast
+def _split_room():
+    """A 6 x 4 m room cut in two by a wall at x = 3 m."""
+    from tests.trajopt.planning.test_car import walled
+
+    occ = walled(6.0, 4.0, 0.05)
+    occ[:, 60] = True
+    return astar.OccupancyGrid(occ, 0.05)
+
+
+@pytest.mark.parametrize("body", [False, True])
+def test_start_and_goal_apart_are_refused_at_once(body):
+    """Start and goal in different components of the car's search grid: a NoPathError that
+    names both poses and says why, in well under the search's budget (the search's own
+    component test, ``disconnected``, ends each try at once)."""
+    import time
+
+    from tests.trajopt.planning.test_car import body_car
+    from trajopt.errors import NoPathError
+
+    robot = (
+        body_car(wheelbase=0.4)
+        if body
+        else trajopt.Robot(radius=0.15, drive="ackermann", min_turning_radius=0.5)
+    )
+    planner = trajopt.Planner(_split_room(), robot)
+    elapsed = []
+    for _ in range(3):  # the first pays for loading the compiled search
+        t0 = time.perf_counter()
+        with pytest.raises(
+            NoPathError, match=r"pose \(1.5 m, 2 m, 0 rad\) to pose \(4.5 m"
+        ) as info:
+            planner.plan((1.5, 2.0), (4.5, 2.0), start_heading=0.0, goal_heading=0.0)
+        elapsed.append(time.perf_counter() - t0)
+    assert "disconnected" in str(info.value)
+    assert min(elapsed[1:]) < 0.05, elapsed  # the best warm run: the machine is shared
+
+
+def test_a_goal_pose_the_body_cannot_stand_at_is_refused_at_once():
+    import time
+
+    from tests.trajopt.planning.test_car import bay_grid, body_car
+    from trajopt.errors import InvalidInputError
+
+    planner = trajopt.Planner(bay_grid(), body_car())
+    t0 = time.perf_counter()
+    with pytest.raises(InvalidInputError, match=r"goal pose \(2.225, 0.3\) m, heading 0 rad"):
+        planner.plan((1.0, 2.0), (2.225, 0.3), start_heading=0.0, goal_heading=0.0)
+    assert time.perf_counter() - t0 < 0.05
