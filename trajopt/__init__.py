@@ -15,7 +15,8 @@ and :func:`warm_up` (compile the numerical kernels ahead of time).
 (:class:`ParametricCurve`, :class:`BSplineCurve`), :func:`time_parameterize` with
 :class:`SpeedLimits` (:func:`load_speed_mask`), the stop-and-turn motion
 (:func:`stop_and_turn`, :class:`StopAndTurnTrajectory`), :class:`TurnInPlace` and
-:class:`TrajectoryChain` (a differential drive's pose-to-pose plans), :class:`OmniTrajectory`
+:class:`TrajectoryChain` (a differential drive's pose-to-pose plans), :class:`SteerInPlace`
+(a car's steering at rest, at its cusps and ends), :class:`OmniTrajectory`
 (an omnidirectional base's), and the ROS 2 MCAP files (:func:`write_mcap`, :func:`read_mcap`).
 
 **Analysis**: :func:`compare` and :class:`ComparisonTable` (the chapter's table), and the
@@ -76,6 +77,7 @@ _EXPORTS: dict[str, str] = {
     "StopAndTurnTrajectory": "trajopt.motion",
     "TrajectoryChain": "trajopt.motion",
     "TurnInPlace": "trajopt.motion",
+    "SteerInPlace": "trajopt.motion",
     "OmniTrajectory": "trajopt.motion",
     "read_mcap": "trajopt.motion",
     "write_mcap": "trajopt.motion",
@@ -142,6 +144,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from trajopt.motion import (
         OmniTrajectory,
         PlanResult,
+        SteerInPlace,
         StopAndTurnTrajectory,
         Trajectory,
         TrajectoryChain,

@@ -287,6 +287,8 @@ class Planner:
         goal_heading: float | None = None,
         v_start: float = 0.0,
         v_end: float = 0.0,
+        start_steer: float = 0.0,
+        goal_steer: float | None = None,
     ) -> PlanResult:
         """Plan a timed trajectory from ``start`` to ``goal`` (world metres).
 
@@ -303,6 +305,14 @@ class Planner:
             Exact headings at the ends (rad).
         v_start, v_end : float
             Speeds at the ends (m/s).
+        start_steer : float
+            A car's steering angle at the start (rad, default 0: wheels straight). A car
+            with a ``wheelbase`` and a ``steer_rate_max`` steers at rest from it onto its
+            first drive (a :class:`~trajopt.motion.SteerInPlace` piece); other robots refuse
+            any other value.
+        goal_steer : float, optional
+            A car's steering angle at the goal (rad), steered to at rest after its last
+            drive; default: the last drive's.
 
         Returns
         -------
@@ -325,7 +335,16 @@ class Planner:
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
         """
-        request = PlanRequest(start, goal, start_heading, goal_heading, v_start, v_end)
+        request = PlanRequest(
+            start,
+            goal,
+            start_heading,
+            goal_heading,
+            v_start,
+            v_end,
+            start_steer=start_steer,
+            goal_steer=goal_steer,
+        )
         with self._lock:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
@@ -428,6 +447,8 @@ def plan(
     goal_heading: float | None = None,
     v_start: float = 0.0,
     v_end: float = 0.0,
+    start_steer: float = 0.0,
+    goal_steer: float | None = None,
     options: PlannerOptions | None = None,
     **settings: Any,
 ) -> PlanResult:
@@ -448,6 +469,8 @@ def plan(
         Exact headings at the ends (rad).
     v_start, v_end : float
         Speeds at the ends (m/s).
+    start_steer, goal_steer : float
+        A car's steering angles at the ends (rad; see :meth:`Planner.plan`).
     options : PlannerOptions, optional
         Every setting (``robot`` included) as one value (see :class:`Planner`).
     **settings
@@ -489,4 +512,6 @@ def plan(
         goal_heading=goal_heading,
         v_start=v_start,
         v_end=v_end,
+        start_steer=start_steer,
+        goal_steer=goal_steer,
     )

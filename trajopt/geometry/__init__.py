@@ -45,6 +45,7 @@ from trajopt.geometry._curve import (
     CurveSegment,
     ParametricCurve,
     PolylineCurve,
+    ShiftedCurve,
     signed_curvature,
 )
 from trajopt.geometry._length_unit import length_unit
@@ -67,6 +68,7 @@ __all__ = [
     "ParametricCurve",
     "PolylineCurve",
     "STILL_SPEED_RATIO",
+    "ShiftedCurve",
     "TIP_M",
     "TIP_RTOL",
     "ZERO_SPEED_RATIO",

@@ -427,3 +427,51 @@ class CurveSegment(ParametricCurve):
     def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
         """Evaluate the curve's ``nu``-th derivative at ``u`` clipped to the segment."""
         return self.curve(np.clip(np.asarray(u, dtype=float), *self._domain), nu)
+
+
+class ShiftedCurve(ParametricCurve):
+    """A curve moved by a constant offset, its geometry the curve's own to the last bit.
+
+    Positions are ``curve(u) + offset``; derivatives, hence heading, curvature, speed and
+    arc length, are the curve's (not recomputed from the moved positions). A plan made in
+    a map-local frame (its origin subtracted) is handed back in the map's frame this way:
+    far from the origin (x near ``4.5e9`` m, where float64 positions are only ``1e-6`` m
+    apart) the headings and curvatures stay those of the local curve.
+
+    Parameters
+    ----------
+    curve : ParametricCurve
+        The curve in its own frame.
+    offset : array_like, shape (2,)
+        Added to every position (m).
+    """
+
+    __slots__ = ("curve", "offset", "_arc_cache")
+
+    def __init__(self, curve: ParametricCurve, offset: np.ndarray) -> None:
+        self.curve = curve
+        off = np.array(offset, dtype=float).reshape(2)
+        off.flags.writeable = False
+        self.offset = off
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """The curve's parameter interval."""
+        return self.curve.domain
+
+    def breakpoints(self) -> np.ndarray:
+        """Return the curve's breakpoints."""
+        return self.curve.breakpoints()
+
+    @property
+    def polynomial_degree(self) -> int | None:
+        """The curve's own (:attr:`ParametricCurve.polynomial_degree`)."""
+        return self.curve.polynomial_degree
+
+    def _arc_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.curve._arc_table()
+
+    def __call__(self, u: np.ndarray | float, nu: int = 0) -> np.ndarray:
+        """Position (moved by ``offset``) or the curve's ``nu``-th derivative at ``u``."""
+        out = self.curve(u, nu)
+        return out + self.offset if nu == 0 else out

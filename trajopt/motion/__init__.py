@@ -5,6 +5,8 @@
   (built by :func:`trajopt.stop_and_turn`);
 * :class:`TurnInPlace` and :class:`TrajectoryChain`: a rotation at rest, and motions played
   one after another (a braking re-plan);
+* :class:`SteerInPlace` (built by :func:`steer_in_place`): a car's steering at rest, at its
+  cusps and ends;
 * :class:`OmniTrajectory`: an omnidirectional base's translation with an orientation of its
   own (built by :func:`trajopt.timing.orient`);
 * :class:`PlanResult`: the protocol every plan and re-plan satisfies;
@@ -12,7 +14,7 @@
   robot's signed speed, direction of travel and steering), and the ROS 2 MCAP writer and reader.
 """
 
-from trajopt.motion._chain import TrajectoryChain, TurnInPlace
+from trajopt.motion._chain import SteerInPlace, TrajectoryChain, TurnInPlace, steer_in_place
 from trajopt.motion._mcap import McapContents, McapExportError, read_mcap, write_mcap
 from trajopt.motion._omni import OmniTrajectory
 from trajopt.motion._result import PlanResult
@@ -28,11 +30,13 @@ __all__ = [
     "OmniTrajectory",
     "Orientation",
     "PlanResult",
+    "SteerInPlace",
     "StopAndTurnTrajectory",
     "Trajectory",
     "TrajectoryChain",
     "TrajectorySample",
     "TurnInPlace",
     "read_mcap",
+    "steer_in_place",
     "write_mcap",
 ]

@@ -1,4 +1,4 @@
-"""Trajectories played one after another, and the turn in place that joins two of them.
+"""Trajectories played one after another, and the motions at rest that join two of them.
 
 A re-plan that cannot continue smoothly from a moving robot brakes along the old path, turns
 in place and drives a plan from rest (:mod:`trajopt.replan._brake`). Its result is a
@@ -10,6 +10,11 @@ acceleration or yaw rate (checked when the chain is built).
 :class:`TurnInPlace` is a rest-to-rest rotation about the robot's centre under the limits of
 :func:`trajopt.timing._stop_and_turn.turn_limits`, sampled with the conventions of the stop-and-turn
 fallback: ``v = a = jerk = kappa = a_lat = 0`` and ``omega = d theta / dt``.
+
+:class:`SteerInPlace` is a car's steering at rest (at a cusp, at the start, at the goal):
+the steering angle turned from ``delta0`` to ``delta1`` at the constant rate
+``steer_rate_max``, its samples telling the truth (``v = omega = 0``, ``theta`` constant,
+``steer`` and ``steer_rate`` from the profile, ``kappa = tan(steer) / wheelbase``).
 """
 
 from __future__ import annotations
@@ -131,6 +136,184 @@ class TurnInPlace(AtRestEnds):
 
 
 @dataclass(frozen=True, slots=True)
+class SteerInPlace(AtRestEnds):
+    """A car's steering at rest, the angle turned at a constant rate (:func:`steer_in_place`).
+
+    The car stands at ``position`` with the body's heading ``theta``; the steering angle
+    runs linearly in time from ``delta0`` to ``delta1`` at ``rate``, so
+    ``duration = |delta1 - delta0| / rate``. The car has no steering acceleration limit
+    (:class:`~trajopt.drive.Ackermann` has none): the rate steps from 0 to ``rate`` at the
+    start and back at the end, as it may at rest.
+
+    Parameters
+    ----------
+    position : ndarray, shape (2,)
+        Where the car stands (m).
+    theta : float
+        The body's heading (rad).
+    delta0, delta1 : float
+        Steering angle at the start and at the end (rad), within ``(-pi/2, pi/2)``.
+    rate : float
+        Steering rate (rad/s, > 0): the car's ``steer_rate_max``.
+    wheelbase : float
+        ``L`` (m): the sampled curvature is ``tan(steer) / L``.
+    direction : {1, -1}
+        The direction of travel its samples carry (that of the drive it prepares, or of the
+        one before it at the goal).
+    robot : Robot
+        The car.
+    stats : dict
+        ``steer_rad`` (signed change) and ``duration_s``.
+
+    Raises
+    ------
+    InvalidInputError
+        A non-finite angle or position, an angle outside ``(-pi/2, pi/2)``, a rate or a
+        wheelbase not finite and > 0, a direction other than 1 or -1.
+    """
+
+    steering_at_rest: ClassVar[bool] = True
+
+    position: np.ndarray
+    theta: float
+    delta0: float
+    delta1: float
+    rate: float
+    wheelbase: float
+    direction: int
+    robot: Robot
+    stats: dict[str, Any] = field(default_factory=dict)
+    steps: Any = None
+    duration: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        pos = np.asarray(self.position, dtype=float)
+        if pos.shape != (2,) or not np.all(np.isfinite(pos)):
+            raise InvalidInputError(f"position must be 2 finite numbers (m), got {self.position!r}")
+        object.__setattr__(self, "position", readonly(pos))
+        for name, unit in (("theta", "rad"), ("delta0", "rad"), ("delta1", "rad")):
+            v = float(getattr(self, name))
+            if not math.isfinite(v):
+                raise InvalidInputError(f"{name} must be finite ({unit}), got {v!r}")
+            object.__setattr__(self, name, v)
+        for name in ("delta0", "delta1"):
+            if not abs(getattr(self, name)) < 0.5 * math.pi:
+                raise InvalidInputError(
+                    f"{name} must lie in (-pi/2, pi/2) rad (a steering angle), "
+                    f"got {getattr(self, name)!r}"
+                )
+        for name, unit in (("rate", "rad/s"), ("wheelbase", "m")):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0.0):
+                raise InvalidInputError(f"{name} must be finite and > 0 ({unit}), got {v!r}")
+            object.__setattr__(self, name, v)
+        if self.direction not in (1, -1) or isinstance(self.direction, bool):
+            raise InvalidInputError(f"direction must be 1 or -1, got {self.direction!r}")
+        object.__setattr__(self, "direction", int(self.direction))
+        object.__setattr__(self, "duration", abs(self.delta1 - self.delta0) / self.rate)
+
+    @property
+    def length(self) -> float:
+        """Distance travelled: 0 (m)."""
+        return 0.0
+
+    @property
+    def steer_rad(self) -> float:
+        """The signed change of the steering angle (rad)."""
+        return self.delta1 - self.delta0
+
+    def steer(self, t: np.ndarray | float) -> np.ndarray:
+        """Return the steering angle (rad) at times ``t`` (s, clipped to ``[0, duration]``)."""
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        sign = math.copysign(1.0, self.delta1 - self.delta0)
+        return np.where(tt >= self.duration, self.delta1, self.delta0 + sign * self.rate * tt)
+
+    def sample(self, t: np.ndarray | float) -> TrajectorySample:
+        """Evaluate the steering at rest at times ``t`` (s, clipped to ``[0, duration]``).
+
+        ``steer_rate`` is ``+-rate`` before the end and 0 at the end itself.
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        delta = self.steer(tt)
+        sign = math.copysign(1.0, self.delta1 - self.delta0)
+        zero = np.zeros_like(tt)
+        return make_sample(
+            self.robot,
+            t=tt,
+            x=zero + self.position[0],
+            y=zero + self.position[1],
+            theta=zero + self.theta,
+            v=zero,
+            omega=zero,
+            a=zero,
+            jerk=zero,
+            a_lat=zero,
+            kappa=np.tan(delta) / self.wheelbase,
+            s=zero,
+            direction=zero + float(self.direction),
+            steer_rate=np.where(tt >= self.duration, 0.0, sign * self.rate),
+        )
+
+    def to_dict(self, dt: float = 0.01) -> dict[str, Any]:
+        """Return a JSON-ready description (the layout of :meth:`Trajectory.to_dict`)."""
+        steer = {
+            "x": float(self.position[0]),
+            "y": float(self.position[1]),
+            "theta": self.theta,
+            "delta0": self.delta0,
+            "delta1": self.delta1,
+            "rate": self.rate,
+        }
+        return export_dict(self, "trajopt.SteerInPlace", dt, {"steer": steer})
+
+    def __repr__(self) -> str:
+        return f"SteerInPlace(steer={self.steer_rad:.4g} rad, duration={self.duration:.4g} s)"
+
+
+def steer_in_place(
+    robot: Robot, position: np.ndarray, theta: float, delta0: float, delta1: float, direction: int
+) -> SteerInPlace:
+    """Return the car's steering at rest from ``delta0`` to ``delta1`` (rad) at its limit.
+
+    Parameters
+    ----------
+    robot : Robot
+        A car whose drive has a ``wheelbase`` and a ``steer_rate_max`` (rad/s).
+    position : ndarray, shape (2,)
+        Where it stands (m).
+    theta : float
+        The body's heading (rad).
+    delta0, delta1 : float
+        Steering angles (rad).
+    direction : {1, -1}
+        The direction of travel the samples carry.
+
+    Raises
+    ------
+    InvalidInputError
+        The robot's drive has no steering-rate limit (the steering is then not modelled).
+    """
+    steering = robot.drive.steering
+    if steering is None or steering.rate_max is None:
+        raise InvalidInputError(
+            "a steering at rest needs a car with a wheelbase and a steer_rate_max, "
+            f"got drive={robot.drive!r}"
+        )
+    d = float(delta1) - float(delta0)
+    return SteerInPlace(
+        position,
+        theta,
+        delta0,
+        delta1,
+        steering.rate_max,
+        steering.wheelbase,
+        direction,
+        robot,
+        {"steer_rad": d, "duration_s": abs(d) / steering.rate_max},
+    )
+
+
+@dataclass(frozen=True, slots=True)
 class TrajectoryChain(SampledExport):
     """Timed trajectories played one after another, as one trajectory.
 
@@ -242,11 +425,11 @@ class TrajectoryChain(SampledExport):
         """Return the plan a re-plan at ``t`` (s) continues, and the time in it.
 
         The chain's last piece (its plan from rest) while it plays, unless it is a turn in
-        place; else the chain itself.
+        place or a steering at rest; else the chain itself.
         """
         i, tau = self.piece_at(t)
         last = self.pieces[i]
-        if i == len(self.pieces) - 1 and not last.turning:
+        if i == len(self.pieces) - 1 and not (last.turning or last.steering_at_rest):
             return last, tau
         return self, t
 

@@ -49,7 +49,8 @@ class SampledExport:
     ``to_mcap`` (atomic writes, each naming the frame of its poses). What a re-plan asks
     of a motion it answers itself: :meth:`playing` (the piece at a time),
     :meth:`orientation_at` and :meth:`translation_state`, and the flags
-    :attr:`single_curve`, :attr:`turning`, :attr:`polyline` and :attr:`own_orientation`.
+    :attr:`single_curve`, :attr:`turning`, :attr:`steering_at_rest`, :attr:`polyline` and
+    :attr:`own_orientation`.
     """
 
     __slots__ = ()
@@ -58,6 +59,8 @@ class SampledExport:
     single_curve: ClassVar[bool] = False
     #: A rotation at rest (a turn in place).
     turning: ClassVar[bool] = False
+    #: A car's steering at rest (the steering angle changes, nothing else moves).
+    steering_at_rest: ClassVar[bool] = False
     #: Straight segments with turns in place at rest between them (no smooth curve).
     polyline: ClassVar[bool] = False
     #: The body's orientation is a motion of its own, beside the translation (omni).

@@ -32,8 +32,13 @@ cusps) and ``kappa``, ``direction`` and, with a ``wheelbase``, ``steer`` and ``s
 Curvature (hence steering) is continuous within a drive (each B-spline is C2, and the
 pieces driven through meet with the same curvature, where only the steering rate may
 change); at a cusp (or a join where the curvatures differ, ``stats["car"]["rests"]``)
-the car is at rest and may steer while stopped (the chain checks position, heading, speed,
-acceleration and yaw rate there, not the curvature). Its ``steps`` are a :class:`CarSteps`.
+the car is at rest and steers there: with a ``wheelbase`` and a ``steer_rate_max`` a
+:class:`~trajopt.motion.SteerInPlace` piece turns the steering angle at its rate limit
+wherever it differs between two drives, and before the first drive from the request's
+``start_steer`` (default 0) and after the last to its ``goal_steer`` when given
+(:func:`with_steering`); without them the steering is not modelled. The chain checks
+position, heading, speed, acceleration and yaw rate at every join (all continuous: the car
+is at rest). Its ``steps`` are a :class:`CarSteps`.
 
 A car with a :class:`~trajopt.robot.Footprint` (``Robot.rectangle(..., drive=trajopt.Ackermann(...))``;
 the footprint's origin is the point the plan moves, e.g. the rear axle's centre) is planned
@@ -44,6 +49,17 @@ oriented body off the raw map, the centre grid inflated by the inscribed radius 
 necessary condition); each segment's corridor keeps the inscribed radius and its curve must
 also pass the footprint certificate, with the body along the curve's tangent forwards and
 turned by ``pi`` backwards (:func:`~trajopt.planning._car_fit.body_along`).
+
+**Frame.** Nothing in a plan depends on where the map's origin is: the ends are checked in
+the map's frame, then the search, the fits and the timing run in the map-local frame (the
+grid's origin subtracted, so coordinates are at most the map's size), and the result is
+moved back: each drive's curve is a :class:`~trajopt.geometry.ShiftedCurve` of its local
+curve (positions moved, heading and curvature the local curve's), the steering at rest and
+the steps' poses moved. Far from the origin (x near ``4.5e9`` m, where float64 positions
+are only about ``1e-6`` m apart) the fits' end tangents stay exact, so the chain joins with
+the same heading to the last bits; only the positions are rounded, to that spacing. With
+the origin at ``(0, 0)`` nothing is moved. Messages of the search and fits then name
+poses in the local frame (and say so).
 
 Not supported (refused with :class:`~trajopt.errors.InvalidInputError`): a moving start or
 end speeds other than 0, missing end headings, and the chapter's ``inflation="paper"``.
@@ -58,9 +74,9 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt.errors import InvalidInputError
-from trajopt.geometry import concatenate
-from trajopt.motion import Trajectory, TrajectoryChain
+from trajopt.errors import InvalidInputError, TrajoptError
+from trajopt.geometry import ShiftedCurve, concatenate
+from trajopt.motion import Trajectory, TrajectoryChain, steer_in_place
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
@@ -68,7 +84,7 @@ from trajopt.planning._ends import check_endpoint
 from trajopt.planning._footprint_ladder import check_end_poses
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._query import StageTimer
-from trajopt.robot import State
+from trajopt.robot import Robot, State
 from trajopt.smoother import SmoothPath
 from trajopt.timing import time_parameterize
 from trajopt.validation import point
@@ -111,6 +127,14 @@ class CarSteps:
         The end points (m).
     start_heading, goal_heading : float
         The end headings (rad).
+    start_steer : float
+        The steering angle at the start (rad).
+    goal_steer : float or None
+        The steering angle asked for at the goal (rad), or ``None``.
+    origin : tuple of float
+        The map's origin (m): :attr:`segments` (their corridors and curves) are in the
+        map-local frame, this offset subtracted (:attr:`corridor` adds it back); the rest is
+        in the map's frame.
     stages_s : dict
         Wall time per stage (s): ``inflate``, ``search``, ``corridor``, ``smooth``,
         ``timing``, ``total``.
@@ -130,15 +154,27 @@ class CarSteps:
     goal_heading: float
     stages_s: dict[str, float]
     search_turning_radius: float
+    start_steer: float = 0.0
+    goal_steer: float | None = None
+    origin: tuple[float, float] = (0.0, 0.0)
 
     @property
     def corridor(self) -> CarCorridor:
-        """Every segment's regions (:class:`CarCorridor`)."""
-        return CarCorridor(tuple(r for s in self.segments for r in s.corridor.regions))
+        """Every segment's regions (:class:`CarCorridor`), in the map's frame."""
+        regions = tuple(r for s in self.segments for r in s.corridor.regions)
+        if self.origin != (0.0, 0.0):
+            # the certified local regions moved; not validated again (far from the origin a
+            # thin polygon's float64 area may round to 0)
+            o = np.asarray(self.origin, dtype=float)
+            regions = tuple(
+                type(r)._construct_fast(r.A, r.b + r.A @ o, r.vertices + o, r.degenerate)
+                for r in regions
+            )
+        return CarCorridor(regions)
 
     @property
     def smooth_path(self) -> SmoothPath:
-        """The first segment's curve (each segment's is in :attr:`segments`)."""
+        """The first segment's curve (each segment's is in :attr:`segments`; map-local)."""
         return self.segments[0].smooth_path
 
 
@@ -162,7 +198,7 @@ def plan_car(
     TrajectoryChain
         One :class:`~trajopt.motion.Trajectory` per drive (between cusps, and at the
         joins of a stretch fitted in pieces whose curvatures differ), each from rest to
-        rest.
+        rest, and the steering at rest between them (:func:`with_steering`).
 
     Raises
     ------
@@ -180,8 +216,13 @@ def plan_car(
     """
     timer = StageTimer()
     robot = options.robot
-    grid = caches.grid
-    p0, p1, h0, h1 = _ends(options, grid, request)
+    world = caches.grid
+    p0w, p1w, h0, h1 = _ends(options, world, request)  # checked in the map's frame
+    # everything else in the map-local frame (module docstring, "Frame")
+    origin = np.asarray(world.origin, dtype=float)
+    local = bool(np.any(origin != 0.0))
+    grid = OccupancyGrid(world.occupied, world.resolution, (0.0, 0.0)) if local else world
+    p0, p1 = (p0w - origin, p1w - origin) if local else (p0w, p1w)
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
     goal = _to_cells(grid, p1, h1)
@@ -192,28 +233,44 @@ def plan_car(
         kappa_max=kmax if sm.kappa_max is None else min(sm.kappa_max, kmax),
         time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
     )
-    found = search_and_fit(options, grid, (start, goal), (p0, p1), sm, timer)
+    try:
+        found = search_and_fit(options, grid, (start, goal), (p0w, p1w), sm, timer)
+    except TrajoptError as exc:
+        if local and exc.args:
+            exc.args = (
+                f"{exc.args[0]} (poses in m in the map-local frame, the map's origin "
+                f"{world.origin} m subtracted)",
+            ) + exc.args[1:]
+        raise
     search_grid, path, radius_cells = found.search_grid, found.path, found.radius_cells
     poses, segments, tries = found.poses, found.segments, found.tries
     drives = drive_groups(segments)
-    pieces: list[Trajectory] = []
+    moves: list[Trajectory] = []
     for group in drives:
         with timer.stage("timing"):
-            pieces.append(_time_drive(options, [segments[i] for i in group]))
+            moves.append(_time_drive(options, [segments[i] for i in group]))
+    if local:  # back in the map's frame: positions moved, the local curves' geometry kept
+        moves = [dataclasses.replace(m, path=ShiftedCurve(m.path, origin)) for m in moves]
+        search_grid = world.with_occupied(search_grid.occupied)
+        poses = poses + np.array([origin[0], origin[1], 0.0])
+    pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)
     stages = timer.finish()
     steps = CarSteps(
-        raw_grid=grid,
+        raw_grid=world,
         inflated_grid=search_grid,
         pose_path=path,
         poses=poses,
         segments=tuple(segments),
         drives=tuple(drives),
-        start=(float(p0[0]), float(p0[1])),
-        goal=(float(p1[0]), float(p1[1])),
+        start=(float(p0w[0]), float(p0w[1])),
+        goal=(float(p1w[0]), float(p1w[1])),
         start_heading=h0,
         goal_heading=h1,
         stages_s=stages,
         search_turning_radius=radius_cells * res,
+        start_steer=request.start_steer,
+        goal_steer=request.goal_steer,
+        origin=(float(origin[0]), float(origin[1])),
     )
     stats: dict[str, Any] = {
         "stages_s": dict(stages),
@@ -228,11 +285,82 @@ def plan_car(
             "search_turning_radius_m": radius_cells * res,
             "tries": tries,
             "corridors": [s.corridor_kind for s in segments],
+            "steer_at_rest": steered,
             "search": dict(path.stats),
         },
         "inflation": options.inflation,
     }
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+#: Smallest change of the steering angle (rad) a car steers at rest for: below it the
+#: drives meet as they are (a rate of at most 1e-12 rad per sample interval).
+STEER_AT_REST_MIN_RAD = 1e-12
+
+
+def with_steering(
+    robot: Robot, drives: list[Trajectory], start_steer: float, goal_steer: float | None
+) -> tuple[list, list[dict[str, float]]]:
+    """Return a car's chain pieces: its drives with the steering at rest between them.
+
+    The steering angle of a drive is ``atan(wheelbase * kappa)`` of its body's curvature,
+    continuous within it; at its ends the car is at rest. Where the steering angle at the
+    end of one drive differs from the start of the next (a cusp, or a rest inside a stretch
+    fitted in pieces), before the first drive (from ``start_steer``) and after the last
+    (to ``goal_steer`` when given), a :class:`~trajopt.motion.SteerInPlace` turns it at
+    ``steer_rate_max`` (changes above :data:`STEER_AT_REST_MIN_RAD`). Only for a car with
+    a ``wheelbase`` and a ``steer_rate_max``: without them the steering is not modelled
+    and the drives are returned as they are.
+
+    Parameters
+    ----------
+    robot : Robot
+        The car.
+    drives : list of Trajectory
+        Its drives, each from rest to rest, in order.
+    start_steer : float
+        Steering angle at the start (rad).
+    goal_steer : float or None
+        Steering angle asked for at the goal (rad), or ``None``.
+
+    Returns
+    -------
+    pieces : list
+        The drives and the steering at rest between them, in order.
+    steered : list of dict
+        Per steering at rest: ``at`` (``"start"``, ``"cusp"``, ``"rest"`` or ``"goal"``),
+        ``steer_rad`` (signed change) and ``duration_s``.
+    """
+    steering = robot.drive.steering
+    if steering is None or steering.rate_max is None:
+        return list(drives), []
+    pieces: list = []
+    steered: list[dict[str, float]] = []
+
+    def steer(smp: Any, k: int, delta0: float, delta1: float, direction: int, at: str) -> None:
+        if abs(delta1 - delta0) <= STEER_AT_REST_MIN_RAD:
+            return
+        p = np.array([float(smp.x[k]), float(smp.y[k])])
+        piece = steer_in_place(robot, p, float(smp.theta[k]), delta0, delta1, direction)
+        pieces.append(piece)
+        steered.append({"at": at, "steer_rad": piece.steer_rad, "duration_s": piece.duration})
+
+    delta = float(start_steer)
+    for i, drive in enumerate(drives):
+        ends = drive.sample(np.array([0.0, drive.duration]))
+        first = float(np.arctan(steering.wheelbase * ends.kappa[0]))
+        at = (
+            "start"
+            if i == 0
+            else ("cusp" if drive.direction != drives[i - 1].direction else "rest")
+        )
+        steer(ends, 0, delta, first, drive.direction, at)
+        pieces.append(drive)
+        delta = float(np.arctan(steering.wheelbase * ends.kappa[1]))
+        last = ends
+    if goal_steer is not None:
+        steer(last, 1, delta, float(goal_steer), drives[-1].direction, "goal")
+    return pieces, steered
 
 
 def _ends(

@@ -1,4 +1,4 @@
-"""The ends of a query, checked against the map: :func:`check_endpoint`.
+"""The ends of a query: :func:`check_endpoint` against the map, :func:`check_steer` against the robot.
 
 Every drive's plan and re-plan checks its start and goal this way (a disc's radius, a car's
 inscribed radius), before any search.
@@ -6,12 +6,15 @@ inscribed radius), before any search.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import points_clearance
-from trajopt.planning._options import PlannerOptions
+from trajopt.planning._options import PlannerOptions, PlanRequest
+from trajopt.robot import Robot
 
 
 def check_endpoint(
@@ -60,3 +63,38 @@ def _point_clearance(grid: OccupancyGrid, p: np.ndarray, radius: float) -> float
     """
     window = float(radius) + float(grid.resolution)
     return float(points_clearance(np.asarray(p, dtype=float).reshape(1, 2), grid, window)[0])
+
+
+def check_steer(robot: Robot, request: PlanRequest) -> None:
+    """Refuse steering angles the robot cannot take at the ends of ``request``.
+
+    ``start_steer`` other than 0 and ``goal_steer`` other than ``None`` need a drive with a
+    steering geometry (a car with a ``wheelbase``), and then an angle within the car's
+    largest, ``atan(wheelbase / min_turning_radius)`` (to a relative 1e-6, the tolerance of
+    the curvature a car's curves are certified to: a re-plan starts with the steering angle
+    of the old curve where it stopped).
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the field, its value (rad) and the rule.
+    """
+    asked = {"start_steer": request.start_steer, "goal_steer": request.goal_steer}
+    asked = {k: v for k, v in asked.items() if v is not None and (k == "goal_steer" or v != 0.0)}
+    if not asked:
+        return
+    steering = robot.drive.steering
+    if steering is None:
+        what = ", ".join(f"{k}={v!r} rad" for k, v in asked.items())
+        raise InvalidInputError(
+            f"{what}: a steering angle needs a car with a wheelbase "
+            f"(trajopt.Ackermann(wheelbase=...)), got drive={robot.drive!r}"
+        )
+    radius = getattr(robot.drive, "min_turning_radius", None)
+    top = 0.5 * math.pi if radius is None else math.atan(steering.wheelbase / radius)
+    for k, v in asked.items():
+        if abs(v) > top * (1.0 + 1e-6):
+            raise InvalidInputError(
+                f"{k}={v!r} rad exceeds the car's largest steering angle "
+                f"atan(wheelbase / min_turning_radius) = {top:.6g} rad"
+            )

@@ -365,6 +365,15 @@ class PlanRequest:
         An omnidirectional base's yaw rate (rad/s) and yaw acceleration (rad/s^2) at the
         start: a re-plan continues the orientation of a body that is turning (default 0;
         finite here, within the yaw limits where the orientation is planned).
+    start_steer : float
+        A car's steering angle at the start (rad, default 0: the wheels straight), which a
+        car with a ``wheelbase`` and a ``steer_rate_max`` turns at rest onto its first
+        drive's (:func:`~trajopt.planning._car.plan_car`); finite here, within the car's
+        largest angle ``atan(wheelbase / min_turning_radius)`` there. Another drive, or a
+        car without a wheelbase, refuses any other value (:func:`check_steer`).
+    goal_steer : float or None
+        A car's steering angle asked for at the goal (rad), turned to at rest after the
+        last drive; ``None`` (default): whatever the last drive ends with.
     """
 
     start: Sequence[float] | State
@@ -375,6 +384,8 @@ class PlanRequest:
     v_end: float = 0.0
     start_omega: float = 0.0
     start_alpha: float = 0.0
+    start_steer: float = 0.0
+    goal_steer: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "start_heading", heading("start_heading", self.start_heading))
@@ -385,3 +396,5 @@ class PlanRequest:
         object.__setattr__(
             self, "start_alpha", number("start_alpha", self.start_alpha, unit="rad/s^2")
         )
+        object.__setattr__(self, "start_steer", number("start_steer", self.start_steer, unit="rad"))
+        object.__setattr__(self, "goal_steer", heading("goal_steer", self.goal_steer))

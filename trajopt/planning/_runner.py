@@ -11,6 +11,7 @@ from __future__ import annotations
 from trajopt.motion import PlanResult
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._disc import plan_disc
+from trajopt.planning._ends import check_steer
 from trajopt.planning._footprint_ladder import plan_with_footprint
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._pose import needs_pose_plan, plan_pose
@@ -40,7 +41,8 @@ def run_query(
     caches : PlannerCaches
         The map and what queries on it share.
     request : PlanRequest
-        The ends, headings and speeds.
+        The ends, headings and speeds (and a car's steering angles, checked against the
+        robot first: :func:`~trajopt.planning._ends.check_steer`).
     warm : WarmStart, optional
         A re-plan's grid path and old steps (a disc robot's; a footprint robot's ladder
         plans each rung afresh).
@@ -53,6 +55,7 @@ def run_query(
     PlanResult
         See :meth:`trajopt.Planner.plan`.
     """
+    check_steer(options.robot, request)
     options = options.with_budget(budget_s)
     return options.robot.drive.plan(options, caches, request, warm)
 

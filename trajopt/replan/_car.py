@@ -24,8 +24,11 @@ first of:
    obstacle is a :class:`~trajopt.errors.TimingError`. From the stopped pose (its position
    and the *body's* heading, not the travel tangent) a new car plan runs to the goal pose
    (Hybrid-A*, segments, certified curves, timing: it may reverse and have cusps). The two
-   join at rest (``v = a = 0``) with the same position and heading; the car never turns in
-   place. A car already at rest at the splice (at the start, at a cusp, or at the end of a
+   join at rest (``v = a = 0``) with the same position, heading and steering angle (the
+   new plan starts with the steering angle where the car stopped, and steers at rest from
+   it where it has a ``wheelbase`` and a ``steer_rate_max``; a splice while the car steers
+   at rest, a :class:`~trajopt.motion.SteerInPlace`, stops the steering there); the car
+   never turns in place. The old plan's ``goal_steer`` is kept for the same goal pose. A car already at rest at the splice (at the start, at a cusp, or at the end of a
    brake) plans from its pose directly. ``stats["replan"]`` is ``"braked: <why not kept>"``
    (or ``"planned: <why not kept>"`` at rest) and ``stats["brake_m"]``,
    ``stats["brake_s"]`` describe the stop (``turn_rad`` and ``turn_s`` are 0).
@@ -48,7 +51,7 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, NoPathError, TrajoptError
 from trajopt.geometry import points_clearance
-from trajopt.motion import PlanResult, Trajectory, TrajectoryChain
+from trajopt.motion import PlanResult, SteerInPlace, Trajectory, TrajectoryChain
 from trajopt.planning import (
     CarSteps,
     PlannerCaches,
@@ -146,7 +149,7 @@ def replan_car(
     _check_end(options, caches.grid, search_grid, "goal", p_goal)
     i, tau = trajectory.piece_at(ts)
     piece = trajectory.pieces[i]
-    brake = _brake(piece, tau)
+    brake = None if piece.steering_at_rest else _brake(piece, tau)
     pieces: list[Trajectory] = []
     if brake is not None:
         check_new_obstacles(robot, caches.grid, steps, brake)
@@ -156,13 +159,27 @@ def replan_car(
         stop = piece.sample(np.array([tau]))
     p_stop = (float(stop.x[0]), float(stop.y[0]))
     h_stop = float(stop.theta[0])
+    # the steering angle where the car stands (it may be steering at rest): the new plan's
+    steer_stop = 0.0 if getattr(stop, "steer", None) is None else float(stop.steer[0])
+    same_goal = (tuple(p_goal.tolist()), goal_heading) == (tuple(steps.goal), steps.goal_heading)
+    goal_steer = steps.goal_steer if same_goal else None
     if brake is None and _at_pose(p_stop, h_stop, p_goal, goal_heading):
-        # standing at the goal pose already: nothing to drive (a rest of duration 0)
-        last = piece if tau >= piece.duration or i == 0 else trajectory.pieces[i - 1]
+        # standing at the goal pose already: nothing to drive (a rest of duration 0), or the
+        # rest of the steering at rest being played there
         stats = dict(trajectory.stats, replan=f"planned: {why}; at the goal pose")
         stats.update(brake_m=0.0, brake_s=0.0, turn_rad=0.0, turn_s=0.0)
+        if piece.steering_at_rest and tau < piece.duration:
+            return TrajectoryChain((piece,), robot, stats, steps, (tau,))
+        last = piece if tau >= piece.duration or i == 0 else trajectory.pieces[i - 1]
         return TrajectoryChain((last,), robot, stats, steps, (last.duration,))
-    request = PlanRequest(p_stop, p_goal, start_heading=h_stop, goal_heading=goal_heading)
+    request = PlanRequest(
+        p_stop,
+        p_goal,
+        start_heading=h_stop,
+        goal_heading=goal_heading,
+        start_steer=steer_stop,
+        goal_steer=goal_steer,
+    )
     where = (
         f"from rest at pose ({p_stop[0]:.6g} m, {p_stop[1]:.6g} m, {h_stop:.6g} rad)"
         + (f" after braking {brake.length:.4g} m" if brake is not None else "")
@@ -207,12 +224,13 @@ def _check_trajectory(options: PlannerOptions, trajectory: PlanResult) -> CarSte
     if (
         not isinstance(trajectory, TrajectoryChain)
         or not isinstance(steps, CarSteps)
-        or not all(isinstance(p, Trajectory) for p in trajectory.pieces)
+        or not all(isinstance(p, Trajectory | SteerInPlace) for p in trajectory.pieces)
     ):
         raise InvalidInputError(
             "replan of a car-like robot (drive='ackermann') needs the trajectory of a car "
-            "plan (a TrajectoryChain of Trajectory segments with CarSteps, as Planner.plan "
-            f"returns for this robot), got {type(trajectory).__name__}"
+            "plan (a TrajectoryChain of Trajectory segments and SteerInPlace pieces with "
+            "CarSteps, as Planner.plan returns for this robot), got "
+            f"{type(trajectory).__name__}"
         )
     if trajectory.robot != robot:
         raise InvalidInputError(
@@ -247,6 +265,8 @@ def _keep(
         if fresh.any():
             grid = OccupancyGrid(fresh, new.resolution, new.origin)
             for piece, t_from in zip(rest.pieces, rest.starts, strict=True):
+                if piece.steering_at_rest:  # standing where a drive starts or ends
+                    continue
                 if not _clear(options.robot.radius, grid, piece, t_from):
                     return None, "cells blocked near the rest of the path"
         steps = dataclasses.replace(steps, raw_grid=new, inflated_grid=search_grid)

@@ -142,10 +142,15 @@ def _angle_diff(a, b):
     return np.abs(np.remainder(np.asarray(a) - b + math.pi, TWO_PI) - math.pi)
 
 
+def _drives(traj):
+    """The pieces of a car's chain that move (not its steering at rest)."""
+    return [p for p in traj.pieces if not p.steering_at_rest]
+
+
 def _dense_points(traj, spacing):
-    """Points every ``spacing`` m of arc length along each piece's curve (and its ends)."""
+    """Points every ``spacing`` m of arc length along each drive's curve (and its ends)."""
     out = []
-    for piece in traj.pieces:
+    for piece in _drives(traj):
         n = max(3, math.ceil(piece.length / spacing) + 1)
         s = np.linspace(0.0, piece.length, n)
         out.append(np.asarray(piece.path(piece.path.u_at_s(s))))
@@ -247,10 +252,10 @@ def test_moves_along_its_heading_and_rests_at_cusps(planned, name):
     joins = traj.piece_times[1:-1]
     at = traj.sample(joins)
     np.testing.assert_array_equal(at.v, np.zeros(len(joins)))
-    dirs = [p.direction for p in traj.pieces]
+    dirs = [p.direction for p in _drives(traj)]
     segs = traj.steps.segments
     drives = traj.steps.drives
-    assert len(drives) == len(traj.pieces)
+    assert len(drives) == len(_drives(traj))
     assert [i for g in drives for i in g] == list(range(len(segs)))
     # a piece starts at a cusp, or at a join the car rests at (curvatures that differ)
     joined = [segs[g[0]].joined for g in drives]
@@ -279,21 +284,128 @@ def test_goal_behind_reverses_with_theta_the_tangent_plus_pi(planned):
 def test_three_point_turn_has_cusps(planned):
     _, robot, *_, traj, _ = planned["three_point"]
     assert traj.stats["car"]["cusps"] >= 1
-    assert -1 in [p.direction for p in traj.pieces]
+    assert -1 in [p.direction for p in _drives(traj)]
     smp = traj.sample(np.linspace(0.0, traj.duration, 4001))
     assert smp.v.min() < 0.0 < smp.v.max()
     # the steering angle is atan(wheelbase * kappa); its rate holds steer_rate_max within
-    # each piece (it may change at a cusp, where the car is at rest): the cap table's caps
-    # are rigorous bounds, so on 40 001 samples per piece the rate, and its finite
+    # each piece (at a cusp the car steers at rest, a piece of its own): the cap table's
+    # caps are rigorous bounds, so on 40 001 samples per piece the rate, and its finite
     # differences, stay within the limit
     np.testing.assert_allclose(smp.steer, np.arctan(robot.drive.wheelbase * smp.kappa), atol=1e-12)
-    for i in range(len(traj.pieces)):
+    for i in range(len(traj.pieces)):  # the drives and the steering at rest between them
         t0, t1 = traj.piece_times[i], traj.piece_times[i + 1]
         tt = np.linspace(t0 + 1e-6, t1 - 1e-6, 40001)
         at = traj.sample(tt)
         assert np.abs(at.steer_rate).max() <= robot.drive.steer_rate_max * (1 + 1e-9)
         rate = np.abs(np.diff(at.steer)) / np.diff(tt)
         assert rate.max() <= robot.drive.steer_rate_max * (1 + 1e-6), (i, rate.max())
+
+
+STEER_RATE = 1.0  # rad/s
+
+
+def steered_car(robot):
+    """The scene's car with a wheelbase (its own, else 0.8 R) and a steering-rate limit."""
+    wb = robot.drive.wheelbase or 0.8 * robot.drive.min_turning_radius
+    drive = dataclasses.replace(robot.drive, wheelbase=wb, steer_rate_max=STEER_RATE)
+    return dataclasses.replace(robot, drive=drive)
+
+
+@pytest.fixture(scope="module")
+def steered():
+    """Every scene planned by its car with a steering-rate limit; the start steering is 0,
+    and for the odd scenes 0.3 of the largest angle with a goal steering of -0.5 of it."""
+    out = {}
+    for k, (name, make) in enumerate(SCENES.items()):
+        grid, robot, start, goal, h0, h1 = make()
+        car = steered_car(robot)
+        top = math.atan(car.drive.wheelbase / car.drive.min_turning_radius)
+        ends = {"start_steer": 0.3 * top, "goal_steer": -0.5 * top} if k % 2 else {}
+        traj = trajopt.Planner(grid, car).plan(
+            start, goal, start_heading=h0, goal_heading=h1, **ends
+        )
+        out[name] = (car, ends, traj)
+    return out
+
+
+def geometric_steer(traj, t, wheelbase):
+    """The steering angle ``atan(L kappa_body)`` at chain times ``t``, from the geometry.
+
+    While a drive plays, the curvature of its own curve at the arc length it has reached
+    (the body's: negated backwards), not the samples' ``kappa`` nor ``steer_rate``; while
+    the car stands, the steering at rest's angle (its sampled curvature, the one place the
+    steering is not seen in the path).
+    """
+    out = np.empty(len(t))
+    times = traj.piece_times
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(traj.pieces) - 1)
+    for i in np.unique(k):
+        m = k == i
+        piece, tau = traj.pieces[i], t[m] - times[i]
+        if piece.steering_at_rest:
+            kappa = np.asarray(piece.sample(tau).kappa)
+        else:
+            s = piece.motion(tau)[0]
+            kappa = piece.direction * np.asarray(piece.path.curvature(piece.path.u_at_s(s)))
+        out[m] = np.arctan(wheelbase * kappa)
+    return out
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_steering_rate_holds_across_every_join(steered, name):
+    """|d steer / dt| <= steer_rate_max everywhere, the joins included, by finite differences
+    of the geometric steering angle; the car steers at rest at every join where the angle
+    differs, and starts (and ends, when asked) with the steering angle asked for."""
+    car, ends, traj = steered[name]
+    wb = car.drive.wheelbase
+    dt = 5e-4
+    t = np.concatenate([np.arange(0.0, traj.duration, dt), [traj.duration]])
+    t = np.unique(np.concatenate([t, traj.piece_times]))  # every join exactly
+    delta = geometric_steer(traj, t, wb)
+    rate = np.abs(np.diff(delta)) / np.diff(t)
+    assert rate.max() <= STEER_RATE * (1.0 + 1e-6), (name, rate.max(), t[np.argmax(rate)])
+    assert delta[0] == pytest.approx(ends.get("start_steer", 0.0), abs=1e-9)
+    if "goal_steer" in ends:
+        assert delta[-1] == pytest.approx(ends["goal_steer"], abs=1e-9)
+    # at rest while steering: v = 0, the pose still, steer_rate the profile's
+    for i, piece in enumerate(traj.pieces):
+        if piece.steering_at_rest:
+            tt = np.linspace(traj.piece_times[i], traj.piece_times[i + 1], 50)
+            smp = traj.sample(tt)
+            assert np.all(smp.v == 0.0) and np.ptp(smp.x) == 0.0 and np.ptp(smp.theta) == 0.0
+            assert np.abs(smp.steer_rate[:-1]).max() == pytest.approx(STEER_RATE)
+    kinds = [d["at"] for d in traj.stats["car"]["steer_at_rest"]]
+    assert len(kinds) == sum(p.steering_at_rest for p in traj.pieces)
+    assert kinds.count("cusp") <= traj.stats["car"]["cusps"]
+
+
+def test_steering_at_rest_refusals():
+    grid, robot, start, goal, h0, h1 = behind_scene()
+    top = math.atan(0.4 / 0.5)
+    car = steered_car(
+        dataclasses.replace(robot, drive=dataclasses.replace(robot.drive, wheelbase=0.4))
+    )
+    with pytest.raises(InvalidInputError, match=r"start_steer=0.9 rad exceeds .* largest steering"):
+        trajopt.plan(grid, start, goal, car, start_heading=h0, goal_heading=h1, start_steer=0.9)
+    assert top < 0.9
+    with pytest.raises(
+        InvalidInputError, match=r"goal_steer=0.1 rad: a steering angle needs a car"
+    ):
+        trajopt.plan(grid, start, goal, robot, start_heading=h0, goal_heading=h1, goal_steer=0.1)
+    with pytest.raises(InvalidInputError, match="start_steer must be finite"):
+        trajopt.plan(
+            grid, start, goal, car, start_heading=h0, goal_heading=h1, start_steer=math.nan
+        )
+    disc = trajopt.Robot()
+    with pytest.raises(InvalidInputError, match="start_steer=0.2 rad: a steering angle needs"):
+        trajopt.plan(grid, start, goal, disc, start_steer=0.2)
+
+
+def test_without_a_steering_rate_limit_the_steering_is_not_modelled(planned):
+    # the parking car has a wheelbase and no steer_rate_max: no steering at rest
+    *_, traj, _ = planned["parking"]
+    assert not any(p.steering_at_rest for p in traj.pieces)
+    assert traj.stats["car"]["steer_at_rest"] == []
 
 
 def test_forward_only_uturn_never_reverses(planned):
@@ -521,7 +633,7 @@ def test_forward_only_loop_is_fitted_in_pieces(pieces, monkeypatch):
     assert traj.stats["car"]["tries"] == ["radius + margin grid, 1.15 R: planned"]
     joined = [s.joined for s in traj.steps.segments]
     assert joined[0] is False and (sum(joined) >= 2 if pieces else True)
-    assert all(p.direction == 1 for p in traj.pieces)
+    assert all(p.direction == 1 for p in _drives(traj))
     ends = traj.sample(np.array([0.0, traj.duration]))
     np.testing.assert_allclose([ends.x, ends.y], np.transpose([start, goal]), atol=1e-9)
     assert _angle_diff(ends.theta[0], h0) < 1e-6 and _angle_diff(ends.theta[1], h1) < 1e-6

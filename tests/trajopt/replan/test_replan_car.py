@@ -348,3 +348,43 @@ def test_a_body_car_brakes_and_plans_on_with_its_body_clear():
     smp = out.sample(np.linspace(0.0, out.duration, int(out.duration / 0.002) + 2))
     assert not _body_hits(grid, car.footprint.vertices, smp.x, smp.y, smp.theta).any()
     np.testing.assert_allclose([smp.x[-1], smp.y[-1]], goal, atol=1e-9)
+
+
+@pytest.mark.parametrize("where", ["start", "cusp", "goal", "keep"])
+def test_spliced_while_steering_at_rest(where):
+    """A car with a steering-rate limit steers at rest at its start, cusps and goal (a
+    :class:`trajopt.SteerInPlace`); a re-plan spliced half-way through one stands where it
+    is and starts from the steering angle reached there: the steering angle (from the
+    curvature) is continuous at the splice and its rate holds the limit on the whole re-plan,
+    by finite differences."""
+    occ = walled(4.1, 1.2)
+    grid = astar.OccupancyGrid(occ, RES)
+    robot = trajopt.Robot(
+        drive="ackermann", min_turning_radius=0.6, wheelbase=0.4, steer_rate_max=1.0
+    )
+    planner = trajopt.Planner(grid, robot)
+    traj = planner.plan(
+        (1.5, 0.6), (1.6, 0.6), start_heading=0.0, goal_heading=math.pi, goal_steer=0.3
+    )
+    at = [d["at"] for d in traj.stats["car"]["steer_at_rest"]]
+    assert at[0] == "start" and "cusp" in at and at[-1] == "goal"
+    steering = [i for i, p in enumerate(traj.pieces) if p.steering_at_rest]
+    i = {"start": steering[0], "cusp": steering[1], "goal": steering[-1], "keep": steering[1]}[
+        where
+    ]
+    ts = float(0.5 * (traj.piece_times[i] + traj.piece_times[i + 1]))
+    out = planner.replan(traj, ts, latency=0.0, reuse=where == "keep")
+    why = {"keep": "kept", "goal": "planned: reuse=False; at the goal pose"}
+    assert out.stats["replan"] == why.get(where, "planned: reuse=False")
+    _check_splice(traj, out, ts)
+    old, new = traj.sample(np.array([ts])), out.sample(np.array([0.0]))
+    assert new.steer[0] == pytest.approx(old.steer[0], abs=1e-12)
+    assert out.pieces[0].steering_at_rest  # it finishes steering where it stands
+    end = out.sample(np.array([out.duration]))
+    np.testing.assert_allclose([end.x[0], end.y[0]], (1.6, 0.6), atol=1e-9)
+    assert end.steer[0] == pytest.approx(0.3, abs=1e-12)  # the old goal_steer is kept
+    t = np.unique(np.concatenate([np.arange(0.0, out.duration, 5e-4), out.piece_times]))
+    smp = out.sample(t)
+    delta = np.arctan(robot.drive.wheelbase * np.asarray(smp.kappa))
+    assert (np.abs(np.diff(delta)) / np.diff(t)).max() <= 1.0 * (1.0 + 1e-6)
+    _check_no_turn_in_place(out, robot)

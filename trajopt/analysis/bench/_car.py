@@ -141,7 +141,8 @@ def chain_polyline(chain: Any, spacing: float) -> list[np.ndarray]:
     """Dense points of each piece of a :class:`~trajopt.motion.TrajectoryChain` (m).
 
     Points every ``spacing`` m of arc length (at most) along each piece's curve, its ends
-    included; a piece's curve runs in its direction of travel.
+    included; a piece's curve runs in its direction of travel. A car's steering at rest
+    (:class:`~trajopt.motion.SteerInPlace`) has no curve and is left out.
 
     Returns
     -------
@@ -149,6 +150,8 @@ def chain_polyline(chain: Any, spacing: float) -> list[np.ndarray]:
     """
     out = []
     for piece in chain.pieces:
+        if piece.steering_at_rest:  # standing still: no curve
+            continue
         n = max(3, math.ceil(piece.length / spacing) + 1)
         s = np.linspace(0.0, piece.length, n)
         out.append(np.asarray(piece.path(piece.path.u_at_s(s)), dtype=float))
