@@ -57,7 +57,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from trajopt_ros.node import PlannerNode, spin
 
+    from rclpy.executors import MultiThreadedExecutor
+
     rclpy.init(args=["trajopt-ros", *ros_args], signal_handler_options=SignalHandlerOptions.ALL)
+    executor = MultiThreadedExecutor(num_threads=4)
     try:
         node = PlannerNode()
     except (ParameterError, InterfaceBuildError) as exc:
@@ -65,12 +68,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         rclpy.try_shutdown()
         return EXIT_USAGE
     except Exception as exc:  # e.g. a parameter of the wrong type in the params file
+        if not rclpy.ok():  # a signal arrived during the start-up
+            return 0
         if type(exc).__module__.startswith("rclpy"):
             print(f"trajopt-ros: error: {type(exc).__name__}: {exc}", file=sys.stderr)
             rclpy.try_shutdown()
             return EXIT_USAGE
         raise
-    spin(node)
+    spin(node, executor)
     return 0
 
 

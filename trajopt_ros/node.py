@@ -612,18 +612,30 @@ class PlannerNode(Node):
         return trajopt.time_parameterize(smooth, robot, dt=self._config["planner.timing_dt"])
 
 
-def spin(node: PlannerNode) -> None:
-    """Spin ``node`` on a multi-threaded executor until shutdown (SIGINT/SIGTERM)."""
+def spin(node: PlannerNode, executor: Any = None) -> None:
+    """Spin ``node`` until shutdown (SIGINT/SIGTERM), then destroy it.
+
+    Parameters
+    ----------
+    node : PlannerNode
+    executor : rclpy.executors.Executor, optional
+        Default a :class:`~rclpy.executors.MultiThreadedExecutor` of 4 threads (services
+        and actions run beside the map and odometry callbacks).
+    """
     from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 
-    executor = MultiThreadedExecutor(num_threads=4)
-    executor.add_node(node)
     try:
+        if executor is None:
+            executor = MultiThreadedExecutor(num_threads=4)
+        executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    finally:
-        executor.shutdown(timeout_sec=0.5)
-        node.destroy_node()
+    except Exception:  # a signal between start-up and spin leaves an invalid context
         if rclpy.ok():
-            rclpy.try_shutdown()
+            raise
+    finally:
+        if executor is not None:
+            executor.shutdown(timeout_sec=0.5)
+        node.destroy_node()
+        rclpy.try_shutdown()
