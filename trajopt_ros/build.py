@@ -156,7 +156,7 @@ class InterfaceBuild:
 
 
 def cache_root() -> Path:
-    """The cache folder: ``$TRAJOPT_ROS_CACHE``, else ``$XDG_CACHE_HOME/trajopt_ros``."""
+    """Return the cache folder: ``$TRAJOPT_ROS_CACHE``, else ``$XDG_CACHE_HOME/trajopt_ros``."""
     env = os.environ.get("TRAJOPT_ROS_CACHE")
     if env:
         return Path(env)
@@ -186,7 +186,7 @@ def cache_key() -> str:
 
 
 def _tool(name: str) -> str:
-    """A build tool, preferring the one installed next to this Python (the wheels')."""
+    """Find a build tool, preferring the one installed next to this Python (the wheels')."""
     local = Path(sys.executable).parent / name
     if local.exists():
         return str(local)

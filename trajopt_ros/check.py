@@ -23,7 +23,7 @@ _TOL_M = 1e-6
 
 
 def clearance_radius(robot: Any) -> float:
-    """The clearance (m) checked: the radius of a disc robot, the inscribed one of a footprint."""
+    """Return the clearance (m) checked: the radius of a disc robot, the inscribed one of a footprint."""
     return float(robot.inscribed_radius if robot.footprint is not None else robot.radius)
 
 

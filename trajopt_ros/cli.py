@@ -53,11 +53,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_USAGE
+    from rclpy.executors import MultiThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
     from trajopt_ros.node import PlannerNode, spin
-
-    from rclpy.executors import MultiThreadedExecutor
 
     rclpy.init(args=["trajopt-ros", *ros_args], signal_handler_options=SignalHandlerOptions.ALL)
     executor = MultiThreadedExecutor(num_threads=4)

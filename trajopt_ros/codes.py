@@ -107,5 +107,5 @@ def reason_of(exc: BaseException) -> str:
 
 
 def code_for(table: dict[str, int], reason: str) -> int:
-    """The code of ``reason`` in ``table``, or the table's ``unknown`` code."""
+    """Return the code of ``reason`` in ``table``, or the table's ``unknown`` code."""
     return table.get(reason, table["unknown"])

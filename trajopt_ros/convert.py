@@ -38,13 +38,13 @@ QUATERNION_TOLERANCE = 1e-3
 
 
 def to_time(seconds: float) -> Time:
-    """A ``builtin_interfaces/Time`` from seconds since the epoch (ROS clock)."""
+    """Make a ``builtin_interfaces/Time`` from seconds since the epoch (ROS clock)."""
     ns = int(round(seconds * 1e9))
     return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
 
 def to_duration(seconds: float) -> Duration:
-    """A ``builtin_interfaces/Duration`` from seconds (>= 0)."""
+    """Make a ``builtin_interfaces/Duration`` from seconds (>= 0)."""
     ns = max(0, int(round(seconds * 1e9)))
     return Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
@@ -57,7 +57,7 @@ def from_time(stamp: Any) -> float:
 def grid_from_msg(
     msg: GridMsg, *, mode: str, threshold: int, unknown_occupied: bool
 ) -> astar.OccupancyGrid | astar.Costmap:
-    """The map a ``nav_msgs/OccupancyGrid`` holds.
+    """Read the map a ``nav_msgs/OccupancyGrid`` holds.
 
     Parameters
     ----------
@@ -131,7 +131,10 @@ def grid_from_msg(
 
 
 def pose_from_msg(
-    msg: PoseStamped, frame: str, what: str, odom: tuple[str, tuple[float, float, float]] | None = None
+    msg: PoseStamped,
+    frame: str,
+    what: str,
+    odom: tuple[str, tuple[float, float, float]] | None = None,
 ) -> tuple[float, float, float]:
     """``(x, y, yaw)`` (m, m, rad) of a ``PoseStamped`` in the planning frame.
 
@@ -196,7 +199,7 @@ def _pose(
 
 
 def path_from_msg(msg: Path, frame: str) -> np.ndarray:
-    """The poses of a ``nav_msgs/Path`` as an array ``(n, 3)`` of ``x, y, yaw``.
+    """Read the poses of a ``nav_msgs/Path`` as an array ``(n, 3)`` of ``x, y, yaw``.
 
     Raises
     ------
@@ -218,7 +221,7 @@ def _sample(traj: Any, dt: float) -> Any:
 
 
 def path_msg(traj: Any, start_time: float, frame: str, dt: float, samples: Any = None) -> Path:
-    """A ``nav_msgs/Path`` along ``traj``: a pose every ``dt`` s and at its end.
+    """Build a ``nav_msgs/Path`` along ``traj``: a pose every ``dt`` s and at its end.
 
     Parameters
     ----------
@@ -268,7 +271,7 @@ def path_msg(traj: Any, start_time: float, frame: str, dt: float, samples: Any =
 def trajectory_msg(
     traj: Any, start_time: float, frame: str, dt: float, samples: Any = None
 ) -> MultiDOFJointTrajectory:
-    """A ``trajectory_msgs/MultiDOFJointTrajectory`` of one joint ``base`` along ``traj``.
+    """Build a ``trajectory_msgs/MultiDOFJointTrajectory`` of one joint ``base`` along ``traj``.
 
     Each point holds the pose (``transforms``: translation x, y and the heading as a
     quaternion about z), the body-frame velocity (``velocities``: ``linear.x`` the speed
@@ -313,7 +316,7 @@ def trajectory_msg(
 
 
 def reference(traj: Any, t: float) -> tuple[Pose, Twist]:
-    """The pose and body-frame twist of ``traj`` at time ``t`` (s)."""
+    """Return the pose and body-frame twist of ``traj`` at time ``t`` (s)."""
     smp = traj.sample(np.array([min(max(t, 0.0), float(traj.duration))]))
     th = float(smp.theta[0])
     pose = Pose(

@@ -101,7 +101,9 @@ class PlannerNode(Node):
             self.declare_parameter(
                 p.name,
                 p.default,
-                ParameterDescriptor(description=p.description, read_only=p.name.startswith("topics.")),
+                ParameterDescriptor(
+                    description=p.description, read_only=p.name.startswith("topics.")
+                ),
             )
         self._config: NodeConfig = build_config(self._values())
         self._lock = threading.RLock()
@@ -132,12 +134,16 @@ class PlannerNode(Node):
             PoseStamped, cfg["topics.goal"], self._on_goal, 10, callback_group=self._subs_group
         )
         self._plan_pub = self.create_publisher(Path, cfg["topics.plan"], latched)
-        self._traj_pub = self.create_publisher(MultiDOFJointTrajectory, cfg["topics.trajectory"], 10)
+        self._traj_pub = self.create_publisher(
+            MultiDOFJointTrajectory, cfg["topics.trajectory"], 10
+        )
         self._marker_pub = self.create_publisher(MarkerArray, cfg["topics.markers"], latched)
         self._timer = self.create_timer(
             1.0 / cfg["replan.rate"], self._on_replan_timer, callback_group=self._subs_group
         )
-        self.create_service(GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group)
+        self.create_service(
+            GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group
+        )
         self._actions = self._create_actions()
         self.get_logger().info(
             f"ready: warm-up {self.warm_up_s:.2f} s, robot {cfg.robot.drive} "
@@ -161,8 +167,10 @@ class PlannerNode(Node):
 
     def _planner_kwargs(self, grid: Any) -> dict[str, Any]:
         kw = dict(self._config.planner_kwargs)
-        if kw["search"] is not None and kw["search"].startswith("costmap") and not isinstance(
-            grid, astar.Costmap
+        if (
+            kw["search"] is not None
+            and kw["search"].startswith("costmap")
+            and not isinstance(grid, astar.Costmap)
         ):
             kw["search"] = None  # a costmap search needs a costmap; plain maps take the default
         return kw
@@ -196,7 +204,9 @@ class PlannerNode(Node):
             (SmoothPath, "smooth_path", self._execute_smooth_path),
         ):
             out.append(
-                ActionServer(self, kind, name, execute_callback=cb, callback_group=self._serve_group)
+                ActionServer(
+                    self, kind, name, execute_callback=cb, callback_group=self._serve_group
+                )
             )
         return out
 
@@ -218,7 +228,7 @@ class PlannerNode(Node):
 
     # ------------------------------------------------------------ time and inputs
     def now_s(self) -> float:
-        """The node's clock (s)."""
+        """Return the node's clock (s)."""
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_map(self, msg: GridMsg) -> None:
@@ -239,6 +249,7 @@ class PlannerNode(Node):
         except (RequestError, astar.InvalidInputError) as exc:
             self.get_logger().error(f"map refused, keeping the previous one: {exc}")
             return
+        t_build = time.perf_counter()
         with self._lock:
             old = self._grid
             same = (
@@ -255,7 +266,12 @@ class PlannerNode(Node):
             self._planner.inflated_grid  # noqa: B018 - compute the inflation now, not at the first query
             self._grid = grid
             self._replan_due = self._running is not None
-        self.get_logger().info(f"map {grid.shape[1]} x {grid.shape[0]} cells ready")
+        build_ms = 1e3 * (time.perf_counter() - t_build)
+        stamp = from_time(msg.header.stamp)
+        lag = f", {1e3 * (self.now_s() - stamp):.1f} ms after its stamp" if stamp > 0 else ""
+        self.get_logger().info(
+            f"map {grid.shape[1]} x {grid.shape[0]} cells ready: planner in {build_ms:.1f} ms{lag}"
+        )
         if self._replan_due:
             self._maybe_replan("map changed")
 
@@ -264,7 +280,10 @@ class PlannerNode(Node):
         odom = (cfg["odom.frame_id"], cfg.odom_to_map) if cfg["odom.frame_id"] else None
         try:
             x, y, yaw = pose_from_msg(
-                PoseStamped(header=msg.header, pose=msg.pose.pose), cfg["frame_id"], "odometry", odom
+                PoseStamped(header=msg.header, pose=msg.pose.pose),
+                cfg["frame_id"],
+                "odometry",
+                odom,
             )
         except RequestError as exc:
             self.get_logger().warning(f"odometry ignored: {exc}", throttle_duration_sec=5.0)
@@ -383,12 +402,15 @@ class PlannerNode(Node):
             if t + latency >= duration:
                 return
             gx, gy, gyaw = run.goal
+            t_replan = time.perf_counter()
             try:
                 new = planner.replan(run.traj, t, goal=(gx, gy), goal_heading=gyaw, latency=latency)
             except Exception as exc:  # noqa: BLE001 - the old trajectory stays if still clear
                 reason, msg = self._fail(f"re-plan ({why})", exc)
                 if collides(run.traj, self._grid, self._config.robot, t):
-                    self._stop_running(reason, f"re-plan failed and the old trajectory collides: {msg}")
+                    self._stop_running(
+                        reason, f"re-plan failed and the old trajectory collides: {msg}"
+                    )
                 return
             if collides(new, self._grid, self._config.robot, 0.0):
                 self.get_logger().error(f"re-plan ({why}) collides with the newest map: not used")
@@ -399,8 +421,13 @@ class PlannerNode(Node):
             run.traj = new
             run.replans += 1
             run.wake.set()
-        self.get_logger().info(f"re-planned ({why}): {new.stats.get('replan', '')}")
+        replan_ms = 1e3 * (time.perf_counter() - t_replan)
+        t_pub = time.perf_counter()
         self._publish(run)
+        self.get_logger().info(
+            f"re-planned ({why}) in {replan_ms:.1f} ms, published in "
+            f"{1e3 * (time.perf_counter() - t_pub):.1f} ms: {new.stats.get('replan', '')}"
+        )
 
     # ------------------------------------------------------------ outputs
     def _publish(self, run: _Running) -> None:
@@ -436,7 +463,9 @@ class PlannerNode(Node):
             np.asarray(fp.vertices, dtype=float)
             if fp is not None
             else robot.radius
-            * np.column_stack([np.cos(np.linspace(0, 2 * np.pi, 25)), np.sin(np.linspace(0, 2 * np.pi, 25))])
+            * np.column_stack(
+                [np.cos(np.linspace(0, 2 * np.pi, 25)), np.sin(np.linspace(0, 2 * np.pi, 25))]
+            )
         )
         x0, y0, th = float(smp.x[0]), float(smp.y[0]), float(smp.theta[0])
         c, s = math.cos(th), math.sin(th)
@@ -446,12 +475,16 @@ class PlannerNode(Node):
         m.color.r, m.color.a = 1.0, 1.0
         m.pose.orientation.w = 1.0
         pts = np.vstack([ring, ring[:1]])
-        m.points = [Point(x=x0 + c * px - s * py, y=y0 + s * px + c * py) for px, py in pts.tolist()]
+        m.points = [
+            Point(x=x0 + c * px - s * py, y=y0 + s * px + c * py) for px, py in pts.tolist()
+        ]
         out.markers.append(m)
         return out
 
     # ------------------------------------------------------------ GetPlan
-    def _on_get_plan(self, request: GetPlan.Request, response: GetPlan.Response) -> GetPlan.Response:
+    def _on_get_plan(
+        self, request: GetPlan.Request, response: GetPlan.Response
+    ) -> GetPlan.Response:
         frame = self._config["frame_id"]
         response.plan.header.frame_id = frame
         try:
@@ -470,11 +503,15 @@ class PlannerNode(Node):
         kind = self._PlanTrajectory
         req = handle.request
         result = kind.Result()
-        frame, dt = self._config["frame_id"], self._config["plan.sample_interval"]
+        frame = self._config["frame_id"]
         result.path.header.frame_id = frame
         try:
             goal = pose_from_msg(req.goal, frame, "goal")
-            start = pose_from_msg(req.start, frame, "start") if req.use_start else self._start_from_odom()
+            start = (
+                pose_from_msg(req.start, frame, "start")
+                if req.use_start
+                else self._start_from_odom()
+            )
             traj, planning_s = self._plan(start, goal)
         except Exception as exc:  # noqa: BLE001 - every failure becomes a coded result
             reason, msg = self._fail("plan_trajectory", exc)
@@ -541,7 +578,11 @@ class PlannerNode(Node):
                     "invalid_planner", f"planner_id {req.planner_id!r}: this server has 'trajopt'"
                 )
             goal = pose_from_msg(req.goal, frame, "goal")
-            start = pose_from_msg(req.start, frame, "start") if req.use_start else self._start_from_odom()
+            start = (
+                pose_from_msg(req.start, frame, "start")
+                if req.use_start
+                else self._start_from_odom()
+            )
             traj, planning_s = self._plan(start, goal)
         except Exception as exc:  # noqa: BLE001 - every failure becomes Nav2's code
             reason, msg = self._fail("compute_path_to_pose", exc)
@@ -563,7 +604,8 @@ class PlannerNode(Node):
         try:
             if req.smoother_id not in ("", "trajopt"):
                 raise RequestError(
-                    "invalid_smoother", f"smoother_id {req.smoother_id!r}: this server has 'trajopt'"
+                    "invalid_smoother",
+                    f"smoother_id {req.smoother_id!r}: this server has 'trajopt'",
                 )
             poses = path_from_msg(req.path, frame)
             traj = self._smooth(poses)
@@ -589,7 +631,7 @@ class PlannerNode(Node):
         return result
 
     def _smooth(self, poses: np.ndarray) -> Any:
-        """A certified, timed curve along a given path: its corridor, the smoother, the timing."""
+        """Time a certified curve along a given path: its corridor, the smoother, the timing."""
         with self._lock:
             planner = self._planner
         if planner is None:

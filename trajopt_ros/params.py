@@ -42,7 +42,9 @@ class Parameter:
 
 
 PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("frame_id", "map", "the planning frame: the map's frame; poses in another are refused"),
+    Parameter(
+        "frame_id", "map", "the planning frame: the map's frame; poses in another are refused"
+    ),
     Parameter("robot.radius", 0.165, "radius of a disc robot (m); ignored with a footprint"),
     Parameter(
         "robot.footprint",
@@ -80,7 +82,9 @@ PARAMETERS: tuple[Parameter, ...] = (
     ),
     Parameter("map.occupied_threshold", 65, "occupancy mode: a value >= this is occupied (1-100)"),
     Parameter("map.unknown_occupied", True, "whether unknown cells (-1) are obstacles"),
-    Parameter("odom.frame_id", "", "odometry frame if not the planning frame ('' = planning frame)"),
+    Parameter(
+        "odom.frame_id", "", "odometry frame if not the planning frame ('' = planning frame)"
+    ),
     Parameter(
         "odom.to_map",
         [0.0, 0.0, 0.0],
@@ -152,7 +156,9 @@ def _name(values: dict[str, Any], name: str) -> str:
     v = values[name]
     ok = isinstance(v, str) and v != "" and all(c.isalnum() or c in "_/~" for c in v)
     if not ok or v[0].isdigit():
-        raise _fail(name, v, "must be a ROS name: letters, digits, _ and /, not starting with a digit")
+        raise _fail(
+            name, v, "must be a ROS name: letters, digits, _ and /, not starting with a digit"
+        )
     return v
 
 
@@ -184,7 +190,8 @@ def build_config(values: dict[str, Any]) -> NodeConfig:
         _name(vals, name)
     drive = _choice(vals, "robot.drive", ("differential", "omni", "ackermann"))
     limits = {
-        k: _positive(vals, f"robot.{k}") for k in ("v_max", "a_max", "j_max", "a_lat_max", "omega_max")
+        k: _positive(vals, f"robot.{k}")
+        for k in ("v_max", "a_max", "j_max", "a_lat_max", "omega_max")
     }
     robot_kw: dict[str, Any] = dict(limits, drive=drive)
     fp = vals["robot.footprint"]
@@ -194,7 +201,9 @@ def build_config(values: dict[str, Any]) -> NodeConfig:
         raise _fail("robot.footprint", fp, "must be a list of numbers x0, y0, x1, y1, ...")
     if len(fp) > 1:
         if len(fp) % 2 or len(fp) < 6:
-            raise _fail("robot.footprint", fp, "needs an even count of numbers, at least 3 vertices")
+            raise _fail(
+                "robot.footprint", fp, "needs an even count of numbers, at least 3 vertices"
+            )
         robot_kw["footprint"] = np.reshape(np.asarray(fp, dtype=float), (-1, 2))
     else:
         robot_kw["radius"] = _positive(vals, "robot.radius")

@@ -33,8 +33,6 @@ try:  # the wheels' bootstrapper sets the library path at interpreter start
 except ImportError:  # pragma: no cover - depends on the install
     HAVE_ROS = False
 
-collect_ignore_glob = [] if HAVE_ROS else ["test_node*.py"]
-
 _HELD: list = []
 
 

@@ -83,4 +83,7 @@ def wait_for(predicate, timeout: float = 10.0, what: str = "condition"):
 def call(client, request, timeout: float = 10.0):
     """Call a service and wait for the answer."""
     fut = client.call_async(request)
-    return wait_for(lambda: fut.done() and (fut.result() or True), timeout, "service answer") and fut.result()
+    return (
+        wait_for(lambda: fut.done() and (fut.result() or True), timeout, "service answer")
+        and fut.result()
+    )

@@ -9,8 +9,10 @@ import threading
 import numpy as np
 import pytest
 
-from tests.trajopt_ros import helpers as h
-from tests.trajopt_ros.conftest import NodeProcess
+pytest.importorskip("rclpy", reason="the ROS 2 wheels are not installed (pip install -e '.[ros2]')")
+
+from tests.trajopt_ros import helpers as h  # noqa: E402
+from tests.trajopt_ros.conftest import NodeProcess  # noqa: E402
 
 TOL = 1e-6
 
@@ -266,7 +268,9 @@ def test_parameters_from_yaml_and_refused_changes(served, client):
     )
     from rcl_interfaces.srv import SetParametersAtomically
 
-    atomic = client.create_client(SetParametersAtomically, "/trajopt_planner/set_parameters_atomically")
+    atomic = client.create_client(
+        SetParametersAtomically, "/trajopt_planner/set_parameters_atomically"
+    )
     assert atomic.wait_for_service(timeout_sec=10.0)
     res = h.call(atomic, SetParametersAtomically.Request(parameters=[good, bad[0]])).result
     assert not res.successful
@@ -327,9 +331,9 @@ def test_map_update_replans_running_trajectory(served, client):
     values[max(iy - 3, 0) : iy + 4, max(ix - 3, 0) : ix + 4] = 100
     assert h.clearance(old_xy, values).min() < h.RADIUS  # the old one now collides
     served["map_pub"].publish(h.grid_msg(values))
-    new = h.wait_for(
-        lambda: [p for p in plans[n_before:] if len(p.poses) > 0], 10.0, "a re-plan"
-    )[-1]
+    new = h.wait_for(lambda: [p for p in plans[n_before:] if len(p.poses) > 0], 10.0, "a re-plan")[
+        -1
+    ]
     new_xy, new_t = h.path_xy(new), h.stamps(new)
     # it continues the old one: its first pose is where the old one is at that time
     assert old_t[0] <= new_t[0] <= old_t[-1]
