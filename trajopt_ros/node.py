@@ -220,6 +220,8 @@ class PlannerNode(Node):
         with self._lock:
             old = self._config
             self._config = cfg
+            if cfg["replan.rate"] != old["replan.rate"]:
+                self._timer.timer_period_ns = int(1e9 / cfg["replan.rate"])
             if (cfg.robot, cfg.planner_kwargs) != (old.robot, old.planner_kwargs) and self._grid:
                 self._planner = trajopt.Planner(
                     self._grid, cfg.robot, **self._planner_kwargs(self._grid)
@@ -298,11 +300,11 @@ class PlannerNode(Node):
                 running = self._active_running()
                 if running is not None:
                     running.goal = goal
-                    self._replan_due = True
-                    self._maybe_replan("new goal")
-                    return
-                traj, _ = self._plan(self._start_from_odom(), goal)
-                self._start_running(traj, goal, None)
+            if running is not None:
+                self._maybe_replan("new goal")
+                return
+            traj, _ = self._plan(self._start_from_odom(), goal)
+            self._start_running(traj, goal, None)
         except Exception as exc:  # noqa: BLE001 - every failure is logged and the node serves on
             self.get_logger().error(f"goal refused ({codes.reason_of(exc)}): {exc}")
 

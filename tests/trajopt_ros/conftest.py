@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import atexit
 import fcntl
 import os
 import subprocess
@@ -89,13 +90,16 @@ class NodeProcess:
     def __init__(self, ros_env: dict[str, str], *ros_args: str, name: str = "trajopt_planner"):
         self.log = tempfile.NamedTemporaryFile("w+", prefix="trajopt-ros-node-", suffix=".log")
         args = ["--ros-args", "-r", f"__node:={name}", *ros_args]
+        # the child inherits the domain id's lock: the id stays taken while any node lives
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "trajopt_ros.cli", *args],
             stdout=self.log,
             stderr=subprocess.STDOUT,
             env=node_env(ros_env),
             cwd=str(REPO),
+            pass_fds=[fh.fileno() for fh in _HELD],
         )
+        atexit.register(self.stop)
 
     def output(self) -> str:
         self.log.flush()
@@ -107,8 +111,9 @@ class NodeProcess:
         import signal
 
         t0 = time.perf_counter()
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT if sig is None else sig)
+        if self.proc.poll() is not None:
+            return self.proc.returncode, 0.0
+        self.proc.send_signal(signal.SIGINT if sig is None else sig)
         try:
             code = self.proc.wait(timeout)
         except subprocess.TimeoutExpired:
