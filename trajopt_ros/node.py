@@ -112,7 +112,7 @@ class PlannerNode(Node):
         self._odom: tuple[float, float, float, float, float] | None = None
         self._running: _Running | None = None
         self._last_replan = -math.inf
-        self._replan_due = False
+        self._replan_due = ""  # why a deferred re-plan is due ('' = none)
         self.warm_up_s = self._warm_up()
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
@@ -267,14 +267,14 @@ class PlannerNode(Node):
                 self._planner = trajopt.Planner(grid, cfg.robot, **self._planner_kwargs(grid))
             self._planner.inflated_grid  # noqa: B018 - compute the inflation now, not at the first query
             self._grid = grid
-            self._replan_due = self._running is not None
+            due = self._running is not None
         build_ms = 1e3 * (time.perf_counter() - t_build)
         stamp = from_time(msg.header.stamp)
         lag = f", {1e3 * (self.now_s() - stamp):.1f} ms after its stamp" if stamp > 0 else ""
         self.get_logger().info(
             f"map {grid.shape[1]} x {grid.shape[0]} cells ready: planner in {build_ms:.1f} ms{lag}"
         )
-        if self._replan_due:
+        if due:
             self._maybe_replan("map changed")
 
     def _on_odom(self, msg: Odometry) -> None:
@@ -384,15 +384,15 @@ class PlannerNode(Node):
 
     def _on_replan_timer(self) -> None:
         if self._replan_due:
-            self._maybe_replan("pending")
+            self._maybe_replan(f"{self._replan_due}, deferred by replan.rate")
 
     def _maybe_replan(self, why: str) -> None:
         """Re-plan the running trajectory now, unless the rate limit defers it to the timer."""
         with self._lock:
             if time.monotonic() - self._last_replan < 1.0 / self._config["replan.rate"]:
-                self._replan_due = True
+                self._replan_due = why.split(",")[0]
                 return
-            self._replan_due = False
+            self._replan_due = ""
             run = self._active_running()
             planner = self._planner
             if run is None or planner is None:
