@@ -295,6 +295,22 @@ def test_shutdown_by_signal(ros_env, client, sig):
     node = NodeProcess(ros_env, "-r", "__ns:=/sig", name="trajopt_sig")
     srv = client.create_client(GetPlan, "/sig/get_plan")
     assert srv.wait_for_service(timeout_sec=30.0), node.output()
+    # before any map: refused with its reason, and a malformed map is refused too
+    req = GetPlan.Request(start=h.pose(1.0, 1.0), goal=h.pose(5.0, 1.0))
+    assert len(h.call(srv, req).plan.poses) == 0
+    assert "(no_map)" in node.output()
+    from nav_msgs.msg import OccupancyGrid
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    qos = QoSProfile(
+        depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+    )
+    pub = client.create_publisher(OccupancyGrid, "/sig/map", qos)
+    bad = h.grid_msg(h.wall_map())
+    bad.data = bad.data[:-1]
+    pub.publish(bad)
+    h.wait_for(lambda: "map refused" in node.output(), 10.0, "the malformed map refused")
+    assert "needed" in node.output() and len(h.call(srv, req).plan.poses) == 0
     code, seconds = node.stop(sig)
     assert code == 0, node.output()
     assert seconds < 1.5, f"shutdown took {seconds:.2f} s"
