@@ -428,7 +428,8 @@ class PlannerNode(Node):
         self._publish(run)
         self.get_logger().info(
             f"re-planned ({why}) in {replan_ms:.1f} ms, published in "
-            f"{1e3 * (time.perf_counter() - t_pub):.1f} ms: {new.stats.get('replan', '')}"
+            f"{1e3 * (time.perf_counter() - t_pub):.1f} ms (stamp {run.t0:.6f}): "
+            f"{new.stats.get('replan', '')}"
         )
 
     # ------------------------------------------------------------ outputs
