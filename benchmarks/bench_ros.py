@@ -1,0 +1,306 @@
+"""The ROS 2 node's own costs, over Fast DDS between two processes (issue #44's numbers).
+
+    python benchmarks/bench_ros.py [--requests 1000] [--repeats 30]
+
+Measures, on a 400 x 400 map (0.05 m cells, 20 m x 20 m, walls with doors):
+
+1. node start to ``get_plan`` found, with a warm kernel cache (a fresh process);
+2. map publish to planner ready (the node's log: planner built, inflation done; time since
+   the message's stamp, one machine clock);
+3. the node's share of a ``get_plan`` round trip for paths of about 100 and 500 poses: the
+   median round trip minus the median library plan time of the same query (a
+   ``trajopt.Planner`` on the same map in this process) minus the median time this client
+   takes to deserialise that response (``rclpy.serialization``);
+4. a map update while a trajectory runs to the re-planned ``/plan`` received here, minus
+   the re-plan's own wall time (the node's log);
+5. a soak: ``--requests`` ``get_plan`` calls in a row, every third one bad (cycling
+   through a goal outside the map, on a wall, NaN, another frame): every good one answered
+   with a path, every bad one with an empty path, and the node's resident memory before
+   and after (``/proc/PID/status``).
+
+Network hygiene as in the tests: LOCALHOST discovery, a domain id held by a file lock, a
+temporary log folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from tests.trajopt_ros import helpers as h  # noqa: E402
+from tests.trajopt_ros.conftest import NodeProcess, _hold_domain_id  # noqa: E402
+
+RES, N = 0.05, 400
+
+
+def big_map() -> np.ndarray:
+    v = np.zeros((N, N), np.int8)
+    for k in (100, 200, 300):  # walls along x and y, each with two doors
+        v[k : k + 4, :] = 100
+        v[:, k : k + 4] = 100
+        for d in (50, 250):
+            v[k : k + 4, d : d + 30] = 0
+            v[d : d + 30, k : k + 4] = 0
+    return v
+
+
+def grid_msg(values):
+    msg = h.grid_msg(values)
+    msg.info.resolution = RES
+    return msg
+
+
+def rss_kib(pid: int) -> int:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    return 0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--requests", type=int, default=1000)
+    ap.add_argument("--repeats", type=int, default=30)
+    args = ap.parse_args()
+    env = {
+        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        "ROS_DOMAIN_ID": str(_hold_domain_id()),
+        "ROS_LOG_DIR": tempfile.mkdtemp(prefix="trajopt-ros-bench-log-"),
+        "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp",
+    }
+    os.environ.update(env)
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import OccupancyGrid, Odometry
+    from nav_msgs.msg import Path as PathMsg
+    from nav_msgs.srv import GetPlan
+    from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.executors import MultiThreadedExecutor
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    import astar
+    import trajopt
+    from trajopt_ros.build import ensure_interfaces
+
+    ensure_interfaces()
+    rclpy.init()
+    client = rclpy.create_node("trajopt_bench")
+    ex = MultiThreadedExecutor(num_threads=2)
+    ex.add_node(client)
+    threading.Thread(target=ex.spin, daemon=True).start()
+    out: dict[str, object] = {}
+
+    # 1. start to services ready (the kernel cache is warm after the first start)
+    starts = []
+    node = None
+    for _ in range(3):
+        if node is not None:
+            node.stop()
+        t0 = time.perf_counter()
+        node = NodeProcess(env)
+        srv = client.create_client(GetPlan, "get_plan")
+        assert srv.wait_for_service(timeout_sec=60.0), node.output()
+        starts.append(time.perf_counter() - t0)
+        client.destroy_client(srv)
+    out["start_to_ready_s"] = starts
+    print("start to ready (s):", [round(x, 2) for x in starts], flush=True)
+    get_plan = client.create_client(GetPlan, "get_plan")
+    assert get_plan.wait_for_service(timeout_sec=30.0)
+
+    # 2. map publish to planner ready
+    qos = QoSProfile(
+        depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+    )
+    map_pub = client.create_publisher(OccupancyGrid, "map", qos)
+    values = big_map()
+    lags = []
+    for k in range(5):
+        v = values.copy()
+        v[5, 5 + k] = 100  # a new map each time (same shape: update_map after the first)
+        msg = grid_msg(v)
+        msg.header.stamp = client.get_clock().now().to_msg()
+        n_logs = node.output().count("cells ready")
+        map_pub.publish(msg)
+        h.wait_for(lambda n=n_logs: node.output().count("cells ready") > n, 30.0, "map ready")
+        lags.append(float(re.findall(r"([0-9.]+) ms after its stamp", node.output())[-1]))
+    out["map_to_ready_ms (first: new planner; then update_map)"] = lags
+    print("map to ready (ms):", lags, flush=True)
+    values = v
+
+    def call(start, goal):
+        t0 = time.perf_counter()
+        res = h.call(get_plan, GetPlan.Request(start=start, goal=goal), 30.0)
+        return time.perf_counter() - t0, res
+
+    # 3. node share of a get_plan round trip
+    robot = trajopt.Robot(radius=0.165)
+    grid = astar.OccupancyGrid(values >= 65, resolution=RES)
+    lib = trajopt.Planner(grid, robot)
+    put = client.create_client(SetParameters, "/trajopt_planner/set_parameters")
+    assert put.wait_for_service(timeout_sec=10.0)
+    from rcl_interfaces.srv import GetParameters
+
+    params = client.create_client(GetParameters, "/trajopt_planner/get_parameters")
+    assert params.wait_for_service(timeout_sec=10.0)
+    floor = []
+    for _ in range(args.repeats):
+        t0 = time.perf_counter()
+        h.call(params, GetParameters.Request(names=["robot.radius"]))
+        floor.append(time.perf_counter() - t0)
+    out["floor: get_parameters round trip (ms)"] = round(1e3 * statistics.median(floor), 2)
+    print("floor: get_parameters round trip (ms):", out["floor: get_parameters round trip (ms)"])
+    start, goal = (2.0, 2.0, 0.0), (2.0, 8.0, 0.0)  # through a door: a path of some 20 s
+    for interval in (0.15, 0.03):
+        p = Parameter(
+            name="plan.sample_interval",
+            value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=interval),
+        )
+        assert h.call(put, SetParameters.Request(parameters=[p])).results[0].successful
+        trips, lib_s, deser = [], [], []
+        for _ in range(args.repeats):  # interleaved, so that load from elsewhere hits both
+            dt, res = call(h.pose(*start), h.pose(*goal))
+            assert len(res.plan.poses) > 0
+            trips.append(dt)
+            t0 = time.perf_counter()
+            lib.plan(start[:2], goal[:2], start_heading=start[2], goal_heading=goal[2])
+            lib_s.append(time.perf_counter() - t0)
+        raw = serialize_message(res)
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            deserialize_message(raw, GetPlan.Response)
+            deser.append(time.perf_counter() - t0)
+        med = {
+            k: 1e3 * statistics.median(x)
+            for k, x in (("trip", trips), ("lib", lib_s), ("deser", deser))
+        }
+        out[f"get_plan {len(res.plan.poses)} poses (ms)"] = {
+            **{k: round(val, 2) for k, val in med.items()},
+            "node_share": round(med["trip"] - med["lib"] - med["deser"], 2),
+        }
+        print(
+            f"get_plan {len(res.plan.poses)} poses (ms):",
+            out[f"get_plan {len(res.plan.poses)} poses (ms)"],
+            flush=True,
+        )
+
+    # 4. map update while a trajectory runs -> re-planned /plan (rate limit lifted to 50 Hz)
+    p = Parameter(
+        name="replan.rate",
+        value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=50.0),
+    )
+    assert h.call(put, SetParameters.Request(parameters=[p])).results[0].successful
+    plans: list = []
+    got = threading.Event()
+
+    def on_plan(m):
+        plans.append((time.perf_counter(), m))
+        got.set()
+
+    client.create_subscription(PathMsg, "plan", on_plan, qos)
+    odom_pub = client.create_publisher(Odometry, "odom", 10)
+    goal_pub = client.create_publisher(PoseStamped, "goal_pose", 10)
+    h.wait_for(lambda: goal_pub.get_subscription_count() > 0, 10.0, "goal_pose subscriber")
+    extra = []
+    for k in range(5):
+        odom = Odometry()
+        odom.header.frame_id = "map"
+        odom.pose.pose = h.pose(2.0, 2.0 + 0.2 * k).pose
+        n0 = len(plans)
+        deadline = time.monotonic() + 20.0
+        while len(plans) == n0:
+            if time.monotonic() > deadline:
+                raise TimeoutError("no plan for goal_pose:\n" + node.output()[-3000:])
+            odom_pub.publish(odom)
+            goal_pub.publish(h.pose(18.0, 11.0 + 0.2 * k))
+            got.wait(2.0)
+            got.clear()
+        v = values.copy()
+        v[150 + k, 60:70] = 100  # a change in the route's first room
+        n_logs = node.output().count("re-planned (map changed")
+        t_pub = time.perf_counter()
+        map_pub.publish(grid_msg(v))
+        h.wait_for(lambda n=n_logs: node.output().count("re-planned (map changed") > n, 10.0, "log")
+        log = node.output()
+        ready_ms = float(re.findall(r"planner in ([0-9.]+) ms", log)[-1])
+        pattern = (
+            r"re-planned \(map changed[^)]*\) in ([0-9.]+) ms, published in ([0-9.]+) ms "
+            r"\(stamp ([0-9.]+)\)"
+        )
+        replan_ms, pub_ms, stamp = map(float, re.findall(pattern, log)[-1])
+
+        def received(stamp=stamp):  # the /plan message of that re-plan (its stamp is its t0)
+            for t, m in plans:
+                if abs(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec - stamp) < 2e-6:
+                    return t
+            return None
+
+        t_recv = h.wait_for(received, 10.0, "the re-planned /plan")
+        total = 1e3 * (t_recv - t_pub)
+        extra.append(
+            {
+                "total": round(total, 1),
+                "re-plan": replan_ms,
+                "beyond": round(total - replan_ms, 1),
+                "node: map + publish": round(ready_ms + pub_ms, 1),
+            }
+        )
+    out["map update to /plan beyond the re-plan (ms)"] = extra
+    print("map update to /plan beyond the re-plan (ms):", extra, flush=True)
+
+    # 5. soak
+    bad_goals = [
+        lambda: h.pose(30.0, 5.0),
+        lambda: h.pose(7.0, 5.1),  # on a wall
+        lambda: h.pose(float("nan"), 2.0),
+        lambda: h.pose(2.0, 8.0, frame="odom"),
+    ]
+    for _ in range(30):
+        call(h.pose(*start), h.pose(*goal))
+    rss0 = rss_kib(node.proc.pid)
+    good_ok = bad_ok = n_good = n_bad = 0
+    t0 = time.perf_counter()
+    for i in range(args.requests):
+        if i % 3 == 2:
+            n_bad += 1
+            _, res = call(h.pose(*start), bad_goals[(i // 3) % len(bad_goals)]())
+            bad_ok += len(res.plan.poses) == 0
+        else:
+            n_good += 1
+            gy = 7.0 + 0.4 * (i % 5)
+            _, res = call(h.pose(*start), h.pose(2.0, gy))
+            good_ok += len(res.plan.poses) > 0
+    rss1 = rss_kib(node.proc.pid)
+    out["soak"] = {
+        "requests": args.requests,
+        "good answered": f"{good_ok}/{n_good}",
+        "bad refused": f"{bad_ok}/{n_bad}",
+        "alive": node.proc.poll() is None,
+        "rss_MiB before, after": (round(rss0 / 1024, 1), round(rss1 / 1024, 1)),
+        "rss growth %": round(100.0 * (rss1 - rss0) / max(rss0, 1), 2),
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    code, secs = node.stop()
+    out["shutdown by SIGINT"] = {"exit code": code, "seconds": round(secs, 2)}
+    print("soak:", out["soak"])
+    print("shutdown by SIGINT:", out["shutdown by SIGINT"])
+    ex.shutdown()
+    rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

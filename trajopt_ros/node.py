@@ -1,0 +1,686 @@
+"""The ``trajopt_planner`` ROS 2 node: maps, odometry and goals in; plans, trajectories out.
+
+Interfaces (all names relative, so ``--ros-args -r __ns:=/robot1`` namespaces them; the
+topic names are parameters ``topics.*``):
+
+* subscriptions: ``map`` (``nav_msgs/OccupancyGrid``, reliable + transient local, depth 1),
+  ``odom`` (``nav_msgs/Odometry``), ``goal_pose`` (``geometry_msgs/PoseStamped``);
+* publications: ``plan`` (``nav_msgs/Path``, each pose stamped with the absolute time the
+  robot should be there), ``trajectory`` (``trajectory_msgs/MultiDOFJointTrajectory``) and
+  ``corridor_markers`` (``visualization_msgs/MarkerArray``), the last two built only while
+  someone subscribes;
+* service ``get_plan`` (``nav_msgs/srv/GetPlan``);
+* actions ``plan_trajectory`` (``trajopt_ros_interfaces/action/PlanTrajectory``),
+  ``compute_path_to_pose`` (``nav2_msgs/action/ComputePathToPose``) and ``smooth_path``
+  (``nav2_msgs/action/SmoothPath``).
+
+A *running* trajectory (started by ``goal_pose`` or by ``plan_trajectory`` with
+``execute``) is re-planned with :meth:`trajopt.Planner.replan` when the map or its goal
+changes, at most ``replan.rate`` times a second; a re-plan is published only when an
+independent clearance check (:func:`trajopt_ros.check.collides`) passes on the newest map.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import rclpy
+from geometry_msgs.msg import Point, PoseStamped
+from nav_msgs.msg import OccupancyGrid as GridMsg
+from nav_msgs.msg import Odometry, Path
+from nav_msgs.srv import GetPlan
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+from visualization_msgs.msg import Marker, MarkerArray
+
+import astar
+import trajopt
+from trajopt_ros import codes
+from trajopt_ros.check import collides
+from trajopt_ros.convert import (
+    from_time,
+    grid_from_msg,
+    path_from_msg,
+    path_msg,
+    pose_from_msg,
+    reference,
+    to_duration,
+    trajectory_msg,
+)
+from trajopt_ros.errors import ParameterError, RequestError
+from trajopt_ros.params import PARAMETERS, NodeConfig, build_config
+
+__all__ = ["PlannerNode", "NODE_NAME"]
+
+#: Default node name.
+NODE_NAME = "trajopt_planner"
+
+
+@dataclass
+class _Running:
+    """The trajectory being driven: ``traj`` started at ROS time ``t0`` (s)."""
+
+    traj: Any
+    t0: float
+    goal: tuple[float, float, float]
+    goal_handle: Any = None
+    replans: int = 0
+    ended: str = ""  # why it stopped early: a reason of trajopt_ros.codes
+    message: str = ""
+    wake: threading.Event = field(default_factory=threading.Event)
+
+
+class PlannerNode(Node):
+    """The planner node (module docstring); start-up warms the library first.
+
+    Parameters
+    ----------
+    node_name : str, optional
+        Default ``trajopt_planner``.
+    **kwargs
+        Passed to :class:`rclpy.node.Node` (e.g. ``parameter_overrides``).
+
+    Raises
+    ------
+    ParameterError
+        A parameter breaks its rule (the message names it, its value and the rule).
+    """
+
+    def __init__(self, node_name: str = NODE_NAME, **kwargs: Any) -> None:
+        super().__init__(node_name, **kwargs)
+        for p in PARAMETERS:
+            self.declare_parameter(
+                p.name,
+                p.default,
+                ParameterDescriptor(
+                    description=p.description, read_only=p.name.startswith("topics.")
+                ),
+            )
+        self._config: NodeConfig = build_config(self._values())
+        self._lock = threading.RLock()
+        self._planner: trajopt.Planner | None = None
+        self._grid: astar.OccupancyGrid | astar.Costmap | None = None
+        self._odom: tuple[float, float, float, float, float] | None = None
+        self._running: _Running | None = None
+        self._last_replan = -math.inf
+        self._replan_due = ""  # why a deferred re-plan is due ('' = none)
+        self.warm_up_s = self._warm_up()
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+        cfg = self._config
+        self._subs_group = MutuallyExclusiveCallbackGroup()
+        self._serve_group = ReentrantCallbackGroup()
+        latched = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        self.create_subscription(
+            GridMsg, cfg["topics.map"], self._on_map, latched, callback_group=self._subs_group
+        )
+        self.create_subscription(
+            Odometry, cfg["topics.odom"], self._on_odom, 10, callback_group=self._subs_group
+        )
+        self.create_subscription(
+            PoseStamped, cfg["topics.goal"], self._on_goal, 10, callback_group=self._subs_group
+        )
+        self._plan_pub = self.create_publisher(Path, cfg["topics.plan"], latched)
+        self._traj_pub = self.create_publisher(
+            MultiDOFJointTrajectory, cfg["topics.trajectory"], 10
+        )
+        self._marker_pub = self.create_publisher(MarkerArray, cfg["topics.markers"], latched)
+        self._timer = self.create_timer(
+            1.0 / cfg["replan.rate"], self._on_replan_timer, callback_group=self._subs_group
+        )
+        self.create_service(
+            GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group
+        )
+        self._actions = self._create_actions()
+        self.get_logger().info(
+            f"ready: warm-up {self.warm_up_s:.2f} s, robot {cfg.robot.drive} "
+            f"radius {cfg.robot.radius} m, frame {cfg['frame_id']!r}"
+        )
+
+    # ------------------------------------------------------------ set-up
+    def _values(self) -> dict[str, Any]:
+        return {p.name: self.get_parameter(p.name).value for p in PARAMETERS}
+
+    def _warm_up(self) -> float:
+        """Load kernels and build solvers on a small free map with the configured robot."""
+        t0 = time.perf_counter()
+        r = self._config.robot.radius
+        res = max(r / 4.0, 0.01)
+        n = int(math.ceil(12.0 * r / res)) + 8
+        grid = astar.OccupancyGrid(np.zeros((n, n), bool), resolution=res)
+        planner = trajopt.Planner(grid, self._config.robot, **self._planner_kwargs(grid))
+        trajopt.warm_up(planner)
+        return time.perf_counter() - t0
+
+    def _planner_kwargs(self, grid: Any) -> dict[str, Any]:
+        kw = dict(self._config.planner_kwargs)
+        if (
+            kw["search"] is not None
+            and kw["search"].startswith("costmap")
+            and not isinstance(grid, astar.Costmap)
+        ):
+            kw["search"] = None  # a costmap search needs a costmap; plain maps take the default
+        return kw
+
+    def _create_actions(self) -> list[ActionServer]:
+        from trajopt_ros.build import ensure_interfaces
+
+        ensure_interfaces()
+        from trajopt_ros_interfaces.action import PlanTrajectory
+
+        out = [
+            ActionServer(
+                self,
+                PlanTrajectory,
+                "plan_trajectory",
+                execute_callback=self._execute_plan_trajectory,
+                goal_callback=lambda _g: GoalResponse.ACCEPT,
+                cancel_callback=lambda _g: CancelResponse.ACCEPT,
+                callback_group=self._serve_group,
+            )
+        ]
+        self._PlanTrajectory = PlanTrajectory
+        try:
+            from nav2_msgs.action import ComputePathToPose, SmoothPath
+        except ImportError:  # pragma: no cover - the build provides a copy
+            self.get_logger().warning("nav2_msgs not importable: no Nav2 actions")
+            return out
+        self._ComputePathToPose, self._SmoothPath = ComputePathToPose, SmoothPath
+        for kind, name, cb in (
+            (ComputePathToPose, "compute_path_to_pose", self._execute_compute_path),
+            (SmoothPath, "smooth_path", self._execute_smooth_path),
+        ):
+            out.append(
+                ActionServer(
+                    self, kind, name, execute_callback=cb, callback_group=self._serve_group
+                )
+            )
+        return out
+
+    def _on_set_parameters(self, params: list[Any]) -> SetParametersResult:
+        values = self._values() | {p.name: p.value for p in params}
+        try:
+            cfg = build_config(values)
+        except ParameterError as exc:
+            self.get_logger().warning(f"parameters refused: {exc}")
+            return SetParametersResult(successful=False, reason=str(exc))
+        with self._lock:
+            old = self._config
+            self._config = cfg
+            if cfg["replan.rate"] != old["replan.rate"]:
+                self._timer.timer_period_ns = int(1e9 / cfg["replan.rate"])
+            if (cfg.robot, cfg.planner_kwargs) != (old.robot, old.planner_kwargs) and self._grid:
+                self._planner = trajopt.Planner(
+                    self._grid, cfg.robot, **self._planner_kwargs(self._grid)
+                )
+        return SetParametersResult(successful=True)
+
+    # ------------------------------------------------------------ time and inputs
+    def now_s(self) -> float:
+        """Return the node's clock (s)."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_map(self, msg: GridMsg) -> None:
+        cfg = self._config
+        if msg.header.frame_id.lstrip("/") not in ("", cfg["frame_id"].lstrip("/")):
+            self.get_logger().error(
+                f"map refused: frame {msg.header.frame_id!r}, the planning frame is "
+                f"{cfg['frame_id']!r}"
+            )
+            return
+        try:
+            grid = grid_from_msg(
+                msg,
+                mode=cfg["map.mode"],
+                threshold=cfg["map.occupied_threshold"],
+                unknown_occupied=cfg["map.unknown_occupied"],
+            )
+        except (RequestError, astar.InvalidInputError) as exc:
+            self.get_logger().error(f"map refused, keeping the previous one: {exc}")
+            return
+        t_build = time.perf_counter()
+        with self._lock:
+            old = self._grid
+            same = (
+                self._planner is not None
+                and isinstance(grid, astar.OccupancyGrid)
+                and isinstance(old, astar.OccupancyGrid)
+                and (old.shape, old.resolution, old.origin)
+                == (grid.shape, grid.resolution, grid.origin)
+            )
+            if same:
+                self._planner.update_map(grid)
+            else:
+                self._planner = trajopt.Planner(grid, cfg.robot, **self._planner_kwargs(grid))
+            self._planner.inflated_grid  # noqa: B018 - compute the inflation now, not at the first query
+            self._grid = grid
+            due = self._running is not None
+        build_ms = 1e3 * (time.perf_counter() - t_build)
+        stamp = from_time(msg.header.stamp)
+        lag = f", {1e3 * (self.now_s() - stamp):.1f} ms after its stamp" if stamp > 0 else ""
+        self.get_logger().info(
+            f"map {grid.shape[1]} x {grid.shape[0]} cells ready: planner in {build_ms:.1f} ms{lag}"
+        )
+        if due:
+            self._maybe_replan("map changed")
+
+    def _on_odom(self, msg: Odometry) -> None:
+        cfg = self._config
+        odom = (cfg["odom.frame_id"], cfg.odom_to_map) if cfg["odom.frame_id"] else None
+        try:
+            x, y, yaw = pose_from_msg(
+                PoseStamped(header=msg.header, pose=msg.pose.pose),
+                cfg["frame_id"],
+                "odometry",
+                odom,
+            )
+        except RequestError as exc:
+            self.get_logger().warning(f"odometry ignored: {exc}", throttle_duration_sec=5.0)
+            return
+        tw = msg.twist.twist
+        self._odom = (x, y, yaw, float(tw.linear.x), float(tw.angular.z))
+
+    def _on_goal(self, msg: PoseStamped) -> None:
+        try:
+            goal = pose_from_msg(msg, self._config["frame_id"], "goal")
+            with self._lock:
+                running = self._active_running()
+                if running is not None:
+                    running.goal = goal
+            if running is not None:
+                self._maybe_replan("new goal")
+                return
+            traj, _ = self._plan(self._start_from_odom(), goal)
+            self._start_running(traj, goal, None)
+        except Exception as exc:  # noqa: BLE001 - every failure is logged and the node serves on
+            self.get_logger().error(f"goal refused ({codes.reason_of(exc)}): {exc}")
+
+    # ------------------------------------------------------------ planning
+    def _start_from_odom(self) -> tuple[float, float, float]:
+        if self._odom is None:
+            raise RequestError("no_odometry", "no odometry received yet: the start is unknown")
+        return self._odom[:3]
+
+    def _check_end(self, planner: trajopt.Planner, xy: tuple[float, float], what: str) -> None:
+        grid = planner.grid
+        ix = math.floor((xy[0] - grid.origin[0]) / grid.resolution)
+        iy = math.floor((xy[1] - grid.origin[1]) / grid.resolution)
+        if not (0 <= ix < grid.nx and 0 <= iy < grid.ny):
+            raise RequestError(
+                f"{what}_outside_map",
+                f"{what} ({xy[0]:.3f}, {xy[1]:.3f}) m is outside the map "
+                f"[{grid.origin[0]}, {grid.origin[0] + grid.width}] x "
+                f"[{grid.origin[1]}, {grid.origin[1] + grid.height}] m",
+            )
+        if grid.occupied[iy, ix] or planner.inflated_grid.occupied[iy, ix]:
+            raise RequestError(
+                f"{what}_occupied",
+                f"{what} ({xy[0]:.3f}, {xy[1]:.3f}) m is in cell ({ix}, {iy}), occupied or "
+                f"within the robot radius {planner.robot.radius} m of an obstacle",
+            )
+
+    def _plan(
+        self, start: tuple[float, float, float], goal: tuple[float, float, float]
+    ) -> tuple[Any, float]:
+        """Plan ``start`` -> ``goal`` (x, y, yaw); returns the trajectory and the wall time (s)."""
+        with self._lock:
+            planner = self._planner
+        if planner is None:
+            raise RequestError("no_map", "no valid map received yet")
+        self._check_end(planner, start[:2], "start")
+        self._check_end(planner, goal[:2], "goal")
+        t0 = time.perf_counter()
+        traj = planner.plan(start[:2], goal[:2], start_heading=start[2], goal_heading=goal[2])
+        return traj, time.perf_counter() - t0
+
+    def _fail(self, where: str, exc: BaseException) -> tuple[str, str]:
+        reason = codes.reason_of(exc)
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        msg = f"{type(exc).__name__}: {msg}"
+        self.get_logger().warning(f"{where} refused ({reason}): {msg}")
+        return reason, msg
+
+    # ------------------------------------------------------------ running trajectory
+    def _active_running(self) -> _Running | None:
+        run = self._running
+        if run is None or self.now_s() - run.t0 >= float(run.traj.duration):
+            return None
+        return run
+
+    def _start_running(self, traj: Any, goal: tuple[float, float, float], handle: Any) -> _Running:
+        with self._lock:
+            old = self._running
+            if old is not None and old.goal_handle is not None and old.goal_handle is not handle:
+                old.ended, old.message = "preempted", "replaced by a newer goal"
+                old.wake.set()
+            run = _Running(traj=traj, t0=self.now_s(), goal=goal, goal_handle=handle)
+            self._running = run
+        self._publish(run)
+        return run
+
+    def _stop_running(self, reason: str, message: str) -> None:
+        with self._lock:
+            run, self._running = self._running, None
+        if run is not None:
+            run.ended, run.message = reason, message
+            run.wake.set()
+            empty = Path()
+            empty.header.frame_id = self._config["frame_id"]
+            empty.header.stamp = self.get_clock().now().to_msg()
+            self._plan_pub.publish(empty)
+
+    def _on_replan_timer(self) -> None:
+        if self._replan_due:
+            self._maybe_replan(f"{self._replan_due}, deferred by replan.rate")
+
+    def _maybe_replan(self, why: str) -> None:
+        """Re-plan the running trajectory now, unless the rate limit defers it to the timer."""
+        with self._lock:
+            if time.monotonic() - self._last_replan < 1.0 / self._config["replan.rate"]:
+                self._replan_due = why.split(",")[0]
+                return
+            self._replan_due = ""
+            run = self._active_running()
+            planner = self._planner
+            if run is None or planner is None:
+                return
+            self._last_replan = time.monotonic()
+            t = self.now_s() - run.t0
+            duration = float(run.traj.duration)
+            latency = max(planner.latency_s, 0.02)
+            if t + latency >= duration:
+                return
+            gx, gy, gyaw = run.goal
+            t_replan = time.perf_counter()
+            try:
+                new = planner.replan(run.traj, t, goal=(gx, gy), goal_heading=gyaw, latency=latency)
+            except Exception as exc:  # noqa: BLE001 - the old trajectory stays if still clear
+                reason, msg = self._fail(f"re-plan ({why})", exc)
+                if collides(run.traj, self._grid, self._config.robot, t):
+                    self._stop_running(
+                        reason, f"re-plan failed and the old trajectory collides: {msg}"
+                    )
+                return
+            if collides(new, self._grid, self._config.robot, 0.0):
+                self.get_logger().error(f"re-plan ({why}) collides with the newest map: not used")
+                if collides(run.traj, self._grid, self._config.robot, t):
+                    self._stop_running("unknown", "old and re-planned trajectories collide")
+                return
+            run.t0 += float(new.stats.get("splice_time_s", t + latency))
+            run.traj = new
+            run.replans += 1
+            run.wake.set()
+        replan_ms = 1e3 * (time.perf_counter() - t_replan)
+        t_pub = time.perf_counter()
+        self._publish(run)
+        self.get_logger().info(
+            f"re-planned ({why}) in {replan_ms:.1f} ms, published in "
+            f"{1e3 * (time.perf_counter() - t_pub):.1f} ms (stamp {run.t0:.6f}): "
+            f"{new.stats.get('replan', '')}"
+        )
+
+    # ------------------------------------------------------------ outputs
+    def _publish(self, run: _Running) -> None:
+        cfg = self._config
+        dt = cfg["plan.sample_interval"]
+        smp = run.traj.sample_uniform(dt)
+        self._plan_pub.publish(path_msg(run.traj, run.t0, cfg["frame_id"], dt, smp))
+        if self._traj_pub.get_subscription_count() > 0:
+            self._traj_pub.publish(trajectory_msg(run.traj, run.t0, cfg["frame_id"], dt, smp))
+        if self._marker_pub.get_subscription_count() > 0:
+            self._marker_pub.publish(self._markers(run.traj, smp))
+
+    def _markers(self, traj: Any, smp: Any) -> MarkerArray:
+        frame, stamp = self._config["frame_id"], self.get_clock().now().to_msg()
+        out = MarkerArray(markers=[Marker(action=Marker.DELETEALL, ns="corridor")])
+        steps = getattr(traj, "steps", None)
+        regions = getattr(getattr(steps, "corridor", None), "regions", None) or ()
+        for k, region in enumerate(regions):
+            verts = getattr(region, "vertices", None)
+            if verts is None:
+                continue
+            m = Marker(ns="corridor", id=k, type=Marker.LINE_STRIP, action=Marker.ADD)
+            m.header.frame_id, m.header.stamp = frame, stamp
+            m.scale.x = 0.02
+            m.color.g, m.color.b, m.color.a = 0.6, 1.0, 0.8
+            m.pose.orientation.w = 1.0
+            v = np.asarray(verts, dtype=float)
+            m.points = [Point(x=float(x), y=float(y)) for x, y in np.vstack([v, v[:1]])]
+            out.markers.append(m)
+        robot = self._config.robot
+        fp = robot.footprint
+        ring = (
+            np.asarray(fp.vertices, dtype=float)
+            if fp is not None
+            else robot.radius
+            * np.column_stack(
+                [np.cos(np.linspace(0, 2 * np.pi, 25)), np.sin(np.linspace(0, 2 * np.pi, 25))]
+            )
+        )
+        x0, y0, th = float(smp.x[0]), float(smp.y[0]), float(smp.theta[0])
+        c, s = math.cos(th), math.sin(th)
+        m = Marker(ns="footprint", id=0, type=Marker.LINE_STRIP, action=Marker.ADD)
+        m.header.frame_id, m.header.stamp = frame, stamp
+        m.scale.x = 0.02
+        m.color.r, m.color.a = 1.0, 1.0
+        m.pose.orientation.w = 1.0
+        pts = np.vstack([ring, ring[:1]])
+        m.points = [
+            Point(x=x0 + c * px - s * py, y=y0 + s * px + c * py) for px, py in pts.tolist()
+        ]
+        out.markers.append(m)
+        return out
+
+    # ------------------------------------------------------------ GetPlan
+    def _on_get_plan(
+        self, request: GetPlan.Request, response: GetPlan.Response
+    ) -> GetPlan.Response:
+        frame = self._config["frame_id"]
+        response.plan.header.frame_id = frame
+        try:
+            start = pose_from_msg(request.start, frame, "start")
+            goal = pose_from_msg(request.goal, frame, "goal")
+            traj, _ = self._plan(start, goal)
+        except Exception as exc:  # noqa: BLE001 - answered with an empty path and a logged reason
+            self._fail("get_plan", exc)
+            response.plan.header.stamp = self.get_clock().now().to_msg()
+            return response
+        response.plan = path_msg(traj, self.now_s(), frame, self._config["plan.sample_interval"])
+        return response
+
+    # ------------------------------------------------------------ PlanTrajectory
+    def _execute_plan_trajectory(self, handle: Any) -> Any:
+        kind = self._PlanTrajectory
+        req = handle.request
+        result = kind.Result()
+        frame = self._config["frame_id"]
+        result.path.header.frame_id = frame
+        try:
+            goal = pose_from_msg(req.goal, frame, "goal")
+            start = (
+                pose_from_msg(req.start, frame, "start")
+                if req.use_start
+                else self._start_from_odom()
+            )
+            traj, planning_s = self._plan(start, goal)
+        except Exception as exc:  # noqa: BLE001 - every failure becomes a coded result
+            reason, msg = self._fail("plan_trajectory", exc)
+            result.error_code, result.error_msg = codes.code_for(codes.PLAN_TRAJECTORY, reason), msg
+            handle.abort()
+            return result
+        result.planning_time = to_duration(planning_s)
+        fb = kind.Feedback(planning_time=result.planning_time)
+        if not req.execute:
+            self._fill_result(result, traj, self.now_s())
+            handle.publish_feedback(fb)
+            handle.succeed()
+            return result
+        run = self._start_running(traj, goal, handle)
+        period = 1.0 / self._config["feedback.rate"]
+        while True:
+            if handle.is_cancel_requested:
+                self._stop_running("canceled", "cancelled by the client")
+                self._fill_result(result, run.traj, run.t0, run.replans)
+                result.error_code = codes.PLAN_TRAJECTORY["canceled"]
+                result.error_msg = "cancelled by the client"
+                handle.canceled()
+                return result
+            if run.ended:
+                self._fill_result(result, run.traj, run.t0, run.replans)
+                result.error_code = codes.code_for(codes.PLAN_TRAJECTORY, run.ended)
+                result.error_msg = run.message
+                handle.abort()
+                return result
+            t = self.now_s() - run.t0
+            duration = float(run.traj.duration)
+            if t >= duration:
+                with self._lock:
+                    if self._running is run:
+                        self._running = None
+                self._fill_result(result, run.traj, run.t0, run.replans)
+                handle.succeed()
+                return result
+            fb.time_from_start = to_duration(t)
+            fb.time_remaining = to_duration(duration - t)
+            fb.reference_pose, fb.reference_twist = reference(run.traj, t)
+            fb.replans = run.replans
+            handle.publish_feedback(fb)
+            run.wake.wait(min(period, max(duration - t, 0.001)))
+            run.wake.clear()
+
+    def _fill_result(self, result: Any, traj: Any, t0: float, replans: int = 0) -> None:
+        frame, dt = self._config["frame_id"], self._config["plan.sample_interval"]
+        smp = traj.sample_uniform(dt)
+        result.path = path_msg(traj, t0, frame, dt, smp)
+        result.trajectory = trajectory_msg(traj, t0, frame, dt, smp)
+        result.duration = to_duration(float(traj.duration))
+        result.replans = replans
+
+    # ------------------------------------------------------------ Nav2 actions
+    def _execute_compute_path(self, handle: Any) -> Any:
+        req = handle.request
+        result = self._ComputePathToPose.Result()
+        frame = self._config["frame_id"]
+        result.path.header.frame_id = frame
+        try:
+            if req.planner_id not in ("", "trajopt"):
+                raise RequestError(
+                    "invalid_planner", f"planner_id {req.planner_id!r}: this server has 'trajopt'"
+                )
+            goal = pose_from_msg(req.goal, frame, "goal")
+            start = (
+                pose_from_msg(req.start, frame, "start")
+                if req.use_start
+                else self._start_from_odom()
+            )
+            traj, planning_s = self._plan(start, goal)
+        except Exception as exc:  # noqa: BLE001 - every failure becomes Nav2's code
+            reason, msg = self._fail("compute_path_to_pose", exc)
+            result.error_code = codes.code_for(codes.COMPUTE_PATH_TO_POSE, reason)
+            result.error_msg = msg
+            handle.abort()
+            return result
+        result.path = path_msg(traj, self.now_s(), frame, self._config["plan.sample_interval"])
+        result.planning_time = to_duration(planning_s)
+        handle.succeed()
+        return result
+
+    def _execute_smooth_path(self, handle: Any) -> Any:
+        req = handle.request
+        result = self._SmoothPath.Result()
+        frame = self._config["frame_id"]
+        result.path.header.frame_id = frame
+        t0 = time.perf_counter()
+        try:
+            if req.smoother_id not in ("", "trajopt"):
+                raise RequestError(
+                    "invalid_smoother",
+                    f"smoother_id {req.smoother_id!r}: this server has 'trajopt'",
+                )
+            poses = path_from_msg(req.path, frame)
+            traj = self._smooth(poses)
+            if req.check_for_collisions and collides(traj, self._grid, self._config.robot, 0.0):
+                raise RequestError("in_collision", "the smoothed path collides with the map")
+        except Exception as exc:  # noqa: BLE001 - every failure becomes Nav2's code
+            reason, msg = self._fail("smooth_path", exc)
+            result.error_code = codes.code_for(codes.SMOOTH_PATH, reason)
+            result.error_msg = msg
+            result.smoothing_duration = to_duration(time.perf_counter() - t0)
+            handle.abort()
+            return result
+        result.smoothing_duration = to_duration(time.perf_counter() - t0)
+        budget = from_time(req.max_smoothing_duration)
+        result.was_completed = True
+        if budget > 0 and from_time(result.smoothing_duration) > budget:
+            self.get_logger().warning(
+                f"smooth_path took {from_time(result.smoothing_duration):.3f} s, over its "
+                f"max_smoothing_duration {budget:.3f} s (the result is complete all the same)"
+            )
+        result.path = path_msg(traj, self.now_s(), frame, self._config["plan.sample_interval"])
+        handle.succeed()
+        return result
+
+    def _smooth(self, poses: np.ndarray) -> Any:
+        """Time a certified curve along a given path: its corridor, the smoother, the timing."""
+        with self._lock:
+            planner = self._planner
+        if planner is None:
+            raise RequestError("no_map", "no valid map received yet")
+        self._check_end(planner, tuple(poses[0, :2]), "start")
+        self._check_end(planner, tuple(poses[-1, :2]), "goal")
+        robot = planner.robot
+        pts = poses[:, :2]
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-9])
+        pts = pts[keep]
+        corridor = trajopt.build_polygon_corridor(planner.grid, pts, robot.radius)
+        smooth = planner.smoother.fit(
+            pts,
+            corridor,
+            raw_grid=planner.grid,
+            radius=robot.radius,
+            start=pts[0],
+            goal=pts[-1],
+        )
+        return trajopt.time_parameterize(smooth, robot, dt=self._config["planner.timing_dt"])
+
+
+def spin(node: PlannerNode, executor: Any = None) -> None:
+    """Spin ``node`` until shutdown (SIGINT/SIGTERM), then destroy it.
+
+    Parameters
+    ----------
+    node : PlannerNode
+    executor : rclpy.executors.Executor, optional
+        Default a :class:`~rclpy.executors.MultiThreadedExecutor` of 4 threads (services
+        and actions run beside the map and odometry callbacks).
+    """
+    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+
+    try:
+        if executor is None:
+            executor = MultiThreadedExecutor(num_threads=4)
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except Exception:  # a signal between start-up and spin leaves an invalid context
+        if rclpy.ok():
+            raise
+    finally:
+        if executor is not None:
+            executor.shutdown(timeout_sec=0.5)
+        node.destroy_node()
+        rclpy.try_shutdown()
