@@ -593,3 +593,11 @@ def test_drive_reaches_the_robot(door_map, tmp_path, capsys, monkeypatch):
         "--goal-heading RAD",
     ):
         assert opt in help_text
+
+
+def test_ros_is_handed_to_the_nodes_command_line(capsys):
+    # `trajopt ros ...` is trajopt-ros's own parser (its --ros-args are not argparse's)
+    with pytest.raises(SystemExit) as info:
+        main(["ros", "--help"])
+    assert info.value.code == 0
+    assert "usage: trajopt-ros" in capsys.readouterr().out

@@ -1,4 +1,4 @@
-"""The ``trajopt`` command line: ``plan``, ``compare``, ``demo``, ``bench`` (``run``, ``report``), ``warm-up``.
+"""The ``trajopt`` command line: ``plan``, ``compare``, ``demo``, ``bench`` (``run``, ``report``), ``warm-up``, ``ros``.
 
 Every failure the user can fix (bad arguments, unreadable maps, blocked or unreachable
 start/goal, infeasible limits) exits with code 2 and one line on stderr, no traceback.
@@ -11,7 +11,9 @@ worker processes, with a line (and a progress bar on a terminal) on stderr sayin
 Here: the parser and :func:`main`. The commands live in internal modules, one per group:
 ``_plan`` (``plan``, ``compare``, ``demo``), ``_bench`` (``bench run``, ``bench report``),
 ``_warm_up`` (``warm-up`` and the compile notice); ``_common`` holds the parser classes, the
-user-facing error and the map and robot options they share.
+user-facing error and the map and robot options they share. ``trajopt ros ...`` is the ROS 2
+node's own command line (``trajopt-ros``, in the optional ``trajopt_ros`` package: its
+``--ros-args`` are not this parser's), handed over before parsing.
 """
 
 from __future__ import annotations
@@ -45,8 +47,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``trajopt`` console script; returns the exit code."""
+    given = list(sys.argv[1:] if argv is None else argv)
+    if given[:1] == ["ros"]:  # the node's command line (pip install -e ".[ros2]")
+        try:
+            from trajopt_ros.cli import main as ros_main
+        except ImportError as exc:
+            print(
+                f"trajopt ros: error: {exc} (install the extra: pip install 'trajopt[ros2]')",
+                file=sys.stderr,
+            )
+            return EXIT_USAGE
+        return ros_main(given[1:])
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(given)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
