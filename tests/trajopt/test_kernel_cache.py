@@ -1,4 +1,4 @@
-"""trajopt._kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
+"""Tests of trajopt._kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
 
 * Every numba dispatcher of astar and trajopt lives in a module of ``KERNEL_MODULES``.
 * ``trajopt.warm_up()`` leaves every kernel compiled and loaded (a signature each), and

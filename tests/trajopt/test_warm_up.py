@@ -1,4 +1,4 @@
-"""trajopt._warm_up: the first plan after it loads no compiled kernel, for every planner kind.
+"""Tests of trajopt._warm_up: the first plan after it loads no compiled kernel, for every planner kind.
 
 ``warm_up()`` without a planner loads every kernel: then no planner kind loads one.
 (``tests/trajopt/test_kernel_cache.py`` checks that it compiles and reaches every kernel.)

@@ -1,4 +1,4 @@
-"""trajopt.bench (issue 22): Dask rows equal serial rows, resume after a kill, bad input,
+"""Tests of trajopt.analysis.bench (issue 22): Dask rows equal serial rows, resume after a kill, bad input,
 the report against brute-force counts, the peers' adapters."""
 
 from __future__ import annotations

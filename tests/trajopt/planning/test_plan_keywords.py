@@ -1,4 +1,4 @@
-"""trajopt.plan takes every option of trajopt.Planner and passes it through unchanged."""
+"""Tests of trajopt.planning: trajopt.plan takes every option of trajopt.Planner and passes it through unchanged."""
 
 from __future__ import annotations
 
