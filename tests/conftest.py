@@ -10,6 +10,10 @@
   first compiles every kernel numba's cache lacks, in two worker processes
   (:func:`trajopt._kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
+* The fresh Python processes that some test modules check (``early_processes`` in
+  ``tests/trajopt/test_warm_up.py`` and ``tests/trajopt/test_kernel_cache.py``) start when
+  collection ends and run while the other tests run (``tests/processes.py``;
+  ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's first test runs).
 * The notebooks execute in a background thread from the end of collection on, while the
   other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
   last (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside
@@ -86,9 +90,16 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
-    """Start executing the selected notebooks in a background thread (tests/notebook_runner.py)."""
+    """Start the modules' fresh processes (tests/processes.py) and the selected notebooks in a
+    background thread (tests/notebook_runner.py)."""
+    if session.config.option.collectonly:
+        return
+    from tests import processes
+
+    if processes.early_wanted():
+        processes.start_early(session.items)
     items = _notebook_items(session.items)
-    if not items or session.config.option.collectonly:
+    if not items:
         return
     from tests import notebook_runner
 
@@ -97,8 +108,11 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:
-    """Stop the notebook runner: drop what has not started, remove its scratch files."""
+    """Stop the notebook runner (drop what has not started) and the modules' processes still
+    running; remove their scratch files."""
     import sys
 
     if "tests.notebook_runner" in sys.modules:
         sys.modules["tests.notebook_runner"].shutdown()
+    if "tests.processes" in sys.modules:
+        sys.modules["tests.processes"].stop_all()
