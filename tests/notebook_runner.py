@@ -12,8 +12,10 @@ them as soon as collection has finished (``tests/conftest.py``), one notebook af
 other in a background thread, on a second core, while the other tests run;
 ``test_notebook_executes`` runs last and checks each notebook's result. The result of a
 notebook does not depend on when it runs: only the wall-time limits see the shared CPU,
-and they have a wide margin. With one usable CPU, or ``TRAJOPT_NOTEBOOKS_BACKGROUND=0``,
-each notebook runs inside its test instead, as before.
+and they have a wide margin. In the background, the kernels run with a lower priority
+(``nice``, ``tests/processes.py``'s :data:`~tests.processes.BACKGROUND_NICE`), so that the
+tests' own process keeps its core. With one usable CPU, or
+``TRAJOPT_NOTEBOOKS_BACKGROUND=0``, each notebook runs inside its test instead, as before.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from tests.processes import BACKGROUND_NICE, lower_priority
 
 NOTEBOOK_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("*.ipynb"))
@@ -70,8 +74,9 @@ def _spec_manager(kernels_dir: Path) -> Any:
     return KernelSpecManager(kernel_dirs=[str(kernels_dir)], ensure_native_kernel=False)
 
 
-def _kernel_manager_class(kernels_dir: Path) -> type:
-    """An async kernel manager whose kernel specs are those in ``kernels_dir`` only."""
+def _kernel_manager_class(kernels_dir: Path, nice: int = 0) -> type:
+    """An async kernel manager whose kernel specs are those in ``kernels_dir`` only; its
+    kernels' niceness is raised by ``nice``."""
     from jupyter_client.manager import AsyncKernelManager
     from traitlets import default
 
@@ -80,11 +85,18 @@ def _kernel_manager_class(kernels_dir: Path) -> type:
         def _kernel_spec_manager_default(self) -> Any:
             return _spec_manager(kernels_dir)
 
+        async def _async_launch_kernel(self, kernel_cmd: list[str], **kw: Any) -> None:
+            await super()._async_launch_kernel(kernel_cmd, **kw)
+            pid = getattr(self.provisioner, "pid", None)
+            if pid is not None:
+                lower_priority(pid, nice)
+
     return ThisInterpreterKernelManager
 
 
-def execute(path: Path, workdir: Path) -> Executed:
-    """Run ``path`` in a fresh kernel of this interpreter; scratch files go to ``workdir``."""
+def execute(path: Path, workdir: Path, nice: int = 0) -> Executed:
+    """Run ``path`` in a fresh kernel of this interpreter; scratch files go to ``workdir``;
+    the kernel's niceness is raised by ``nice``."""
     import nbformat
     from ipykernel.kernelspec import install
     from nbclient import NotebookClient
@@ -104,7 +116,7 @@ def execute(path: Path, workdir: Path) -> Executed:
         timeout=TIMEOUT_S,
         startup_timeout=STARTUP_TIMEOUT_S,
         kernel_name="python3",
-        kernel_manager_class=_kernel_manager_class(kernels_dir),
+        kernel_manager_class=_kernel_manager_class(kernels_dir, nice),
         resources={"metadata": {"path": str(NOTEBOOK_DIR)}},
     )
     log_path = workdir / f"{path.stem}.log"
@@ -150,7 +162,9 @@ class NotebookRunner:
                 self._executor = ThreadPoolExecutor(1, thread_name_prefix="notebooks")
             for p in paths:
                 if p not in self._futures:
-                    self._futures[p] = self._executor.submit(execute, p, self._workdir)
+                    self._futures[p] = self._executor.submit(
+                        execute, p, self._workdir, BACKGROUND_NICE
+                    )
 
     def result(self, path: Path) -> Executed:
         """The execution of ``path``: waits for the background run, or runs it here."""

@@ -13,6 +13,10 @@ module when collection ends (``tests/conftest.py``, :func:`start_early`), and th
 fixture reads them with :func:`module_processes` (which starts them itself if the session
 has not, e.g. with ``TRAJOPT_EARLY_PROCESSES=0``). What a process computes does not depend
 on when it starts: only its wall time sees the shared CPU.
+
+Processes that run in the background of other tests may start with a lower priority
+(``nice``, :data:`BACKGROUND_NICE`): the tests' own process, the one the session waits for,
+then keeps its core when the background wants more than the other one.
 """
 
 from __future__ import annotations
@@ -25,11 +29,27 @@ import tempfile
 import textwrap
 import threading
 
+#: The ``nice`` increment of background processes (POSIX; ignored elsewhere).
+BACKGROUND_NICE = 5
+
+
+def lower_priority(pid: int, nice: int) -> None:
+    """Raise the niceness of process ``pid`` by ``nice`` over this process's (POSIX only)."""
+    if nice and hasattr(os, "setpriority"):
+        try:
+            mine = os.getpriority(os.PRIO_PROCESS, 0)
+            os.setpriority(os.PRIO_PROCESS, pid, min(19, mine + nice))
+        except OSError:  # the process has ended already, or no permission: keep it as is
+            pass
+
 
 class Started:
-    """``python -c script *args``, started now; :meth:`result` waits for it."""
+    """``python -c script *args``, started now; :meth:`result` waits for it.
 
-    def __init__(self, script: str, *args: str, env: dict | None = None) -> None:
+    ``nice`` raises the niceness of the process (and so of its children) by that much.
+    """
+
+    def __init__(self, script: str, *args: str, env: dict | None = None, nice: int = 0) -> None:
         self._out = tempfile.TemporaryFile("w+")
         self._err = tempfile.TemporaryFile("w+")
         self.proc = subprocess.Popen(
@@ -39,6 +59,7 @@ class Started:
             text=True,
             env=env,
         )
+        lower_priority(self.proc.pid, nice)
         self.env = env
         self._done: subprocess.CompletedProcess | None = None
 
@@ -69,7 +90,9 @@ class StartedAfter:
     :meth:`result` and :meth:`stop` behave as :class:`Started`'s.
     """
 
-    def __init__(self, after: Started, script: str, *args: str, env: dict | None = None) -> None:
+    def __init__(
+        self, after: Started, script: str, *args: str, env: dict | None = None, nice: int = 0
+    ) -> None:
         self.env = env
         self._run: Started | None = None
         self._stopped = False
@@ -79,7 +102,7 @@ class StartedAfter:
             after.proc.wait()
             with self._lock:
                 if not self._stopped:
-                    self._run = Started(script, *args, env=env)
+                    self._run = Started(script, *args, env=env, nice=nice)
 
         self._thread = threading.Thread(target=start_when_done, daemon=True)
         self._thread.start()

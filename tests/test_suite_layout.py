@@ -23,6 +23,14 @@ def _package(path: Path) -> str | None:
     return ".".join(parts) if parts else None
 
 
+def _docstring(path: Path) -> str:
+    """The module docstring: parsed from the file's head only (the text up to its end)."""
+    text = path.read_text()
+    end = text.find('"""', text.find('"""') + 3)
+    head = text[: end + 3] if text.lstrip().startswith('"""') and end > 0 else ""
+    return (ast.get_docstring(ast.parse(head)) if head else None) or ""
+
+
 def test_there_are_test_files_in_every_package_folder():
     assert {_package(p) for p in FILES} >= {"astar", "trajopt", "trajopt.timing", None}
 
@@ -30,7 +38,7 @@ def test_there_are_test_files_in_every_package_folder():
 def test_every_test_file_names_the_package_it_tests():
     wrong = []
     for path in FILES:
-        doc = ast.get_docstring(ast.parse(path.read_text())) or ""
+        doc = _docstring(path)
         first = doc.split("\n\n")[0]
         pkg = _package(path)
         names = [pkg] if pkg is not None else ["astar", "trajopt"]

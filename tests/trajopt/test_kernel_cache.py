@@ -21,7 +21,13 @@ import os
 import pytest
 
 import trajopt._kernel_cache as kernel_cache
-from tests.processes import Started, StartedAfter, module_processes, scratch_dir
+from tests.processes import (
+    BACKGROUND_NICE,
+    Started,
+    StartedAfter,
+    module_processes,
+    scratch_dir,
+)
 from trajopt.cli import main
 
 EVERY_DISPATCHER = """
@@ -135,18 +141,23 @@ PROCESSES = {
 
 
 def early_processes(items) -> dict[str, Started]:
-    """The fresh processes of the selected tests, started when collection ends; those of a
-    fresh numba cache share one new, empty cache folder (a fresh clone's)."""
+    """The fresh processes of the selected tests, started when collection ends, with a lower
+    priority (tests/processes.py); those of a fresh numba cache share one new, empty cache
+    folder (a fresh clone's)."""
     names = {getattr(i, "originalname", None) for i in items}
     fresh_cache = dict(os.environ, NUMBA_CACHE_DIR=scratch_dir("trajopt_numba_"))
     runs: dict = {
-        name: Started(script, env=fresh_cache if "fresh_cache" in name else None)
+        name: Started(
+            script, env=fresh_cache if "fresh_cache" in name else None, nice=BACKGROUND_NICE
+        )
         for name, script in PROCESSES.items()
         if name in names
     }
     compiled = runs.get("test_fresh_cache_workers_compile_and_a_notice_shows_once")
     if compiled is not None:  # a new process on the cache the workers filled
-        runs["fresh_cache_load"] = StartedAfter(compiled, FRESH_CACHE_LOAD, env=fresh_cache)
+        runs["fresh_cache_load"] = StartedAfter(
+            compiled, FRESH_CACHE_LOAD, env=fresh_cache, nice=BACKGROUND_NICE
+        )
     return runs
 
 

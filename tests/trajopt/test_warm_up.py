@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import astar
-from tests.processes import Started, module_processes, selected_params
+from tests.processes import BACKGROUND_NICE, Started, module_processes, selected_params
 from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
 from trajopt.analysis.scenes import warm_up_map
@@ -123,9 +123,10 @@ FIRST_PLANS_SCRIPT = textwrap.dedent(
 
 
 def early_processes(items) -> dict[str, Started]:
-    """A fresh process for each selected kind, started when collection ends (tests/processes.py)."""
+    """A fresh process for each selected kind, started when collection ends with a lower
+    priority (tests/processes.py)."""
     kinds = selected_params(items, "test_first_plans_after_warm_up_load_no_kernel", "kind")
-    return {kind: Started(FIRST_PLANS_SCRIPT, kind) for kind in kinds}
+    return {kind: Started(FIRST_PLANS_SCRIPT, kind, nice=BACKGROUND_NICE) for kind in kinds}
 
 
 @pytest.fixture(scope="module")
