@@ -14,8 +14,9 @@
   ``tests/trajopt/test_warm_up.py`` and ``tests/trajopt/test_kernel_cache.py``) start when
   collection ends and run while the other tests run (``tests/processes.py``;
   ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's first test runs).
-* The notebooks execute in a background thread from the end of collection on, while the
-  other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
+* The notebooks execute in a background thread, while the other tests run, from the moment
+  their tests are collected on (when no ``-k``, ``-m`` other than the default or
+  ``--deselect`` can drop them later; else from the end of collection on); their checks (``tests/test_notebooks.py::test_notebook_executes``) run
   last (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside
   its test instead).
 """
@@ -79,6 +80,30 @@ def _notebook_items(items: list[pytest.Item]) -> list[pytest.Item]:
         if getattr(i, "originalname", None) == "test_notebook_executes"
         and getattr(getattr(i, "module", None), "__name__", None) == "tests.test_notebooks"
     ]
+
+
+def _is_notebook_item(item: pytest.Item) -> bool:
+    return bool(_notebook_items([item]))
+
+
+def _selection_is_final(config: pytest.Config) -> bool:
+    """Whether every collected test is also selected (no -k, no other -m, no --deselect)."""
+    opt = config.option
+    return (
+        not getattr(opt, "keyword", "")
+        and getattr(opt, "markexpr", "") in ("", "not slow")
+        and not getattr(opt, "deselect", None)
+        and not opt.collectonly
+    )
+
+
+def pytest_itemcollected(item: pytest.Item) -> None:
+    """Start a notebook as soon as its test is collected, when it cannot be deselected."""
+    if _is_notebook_item(item) and _selection_is_final(item.config):
+        from tests import notebook_runner
+
+        if notebook_runner.background_wanted():
+            notebook_runner.runner().start([item.callspec.params["path"]])
 
 
 @pytest.hookimpl(trylast=True)
