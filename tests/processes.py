@@ -14,14 +14,15 @@ fixture reads them with :func:`module_processes` (which starts them itself if th
 has not, e.g. with ``TRAJOPT_EARLY_PROCESSES=0``). What a process computes does not depend
 on when it starts: only its wall time sees the shared CPU.
 
-Processes that run in the background of other tests may start with a lower priority
-(``nice``, :data:`BACKGROUND_NICE`): the tests' own process, the one the session waits for,
-then keeps its core when the background wants more than the other one.
+Processes that run in the background of other tests go through one queue
+(:class:`Queued`): one at a time, with a lower priority (``nice``, :data:`BACKGROUND_NICE`),
+so that the tests' own process, the one the session waits for, keeps its core.
 """
 
 from __future__ import annotations
 
 import os
+import queue
 import shutil
 import subprocess
 import sys
@@ -30,7 +31,7 @@ import textwrap
 import threading
 
 #: The ``nice`` increment of background processes (POSIX; ignored elsewhere).
-BACKGROUND_NICE = 5
+BACKGROUND_NICE = 10
 
 
 def lower_priority(pid: int, nice: int) -> None:
@@ -82,36 +83,39 @@ class Started:
         self.result()
 
 
-class StartedAfter:
-    """``python -c script *args``, started as soon as the process ``after`` has ended.
+class Queued:
+    """``python -c script *args``, run in the background queue of the session.
 
-    A thread waits for ``after`` and then starts this one, so that a check of a process that
-    needs another one's result (a cache it filled) does not wait for the test to ask.
-    :meth:`result` and :meth:`stop` behave as :class:`Started`'s.
+    The queue runs its processes one at a time, in the order they were queued, in a thread of
+    its own, at a lower priority (``nice``): a second core works through them while the tests
+    run, without taking the tests' own core. :meth:`result` starts the process at once if the
+    queue has not reached it yet (the test needs it now), then waits for it. A process queued
+    after another one starts after that one has ended (a cache it fills, for example).
     """
 
     def __init__(
-        self, after: Started, script: str, *args: str, env: dict | None = None, nice: int = 0
+        self, script: str, *args: str, env: dict | None = None, nice: int = BACKGROUND_NICE
     ) -> None:
         self.env = env
+        self._spec = (script, args, env, nice)
         self._run: Started | None = None
         self._stopped = False
         self._lock = threading.Lock()
+        _background_queue().put(self)
 
-        def start_when_done() -> None:
-            after.proc.wait()
-            with self._lock:
-                if not self._stopped:
-                    self._run = Started(script, *args, env=env, nice=nice)
-
-        self._thread = threading.Thread(target=start_when_done, daemon=True)
-        self._thread.start()
+    def launch(self) -> Started | None:
+        """Start the process unless it has started or was stopped; the process, or None."""
+        with self._lock:
+            if self._run is None and not self._stopped:
+                script, args, env, nice = self._spec
+                self._run = Started(script, *args, env=env, nice=nice)
+            return self._run
 
     def result(self, timeout: float | None = 600.0) -> subprocess.CompletedProcess:
-        """The finished process (waits for ``after`` first)."""
-        self._thread.join(timeout)
-        assert self._run is not None, "the process was stopped before it started"
-        return self._run.result(timeout)
+        """The finished process (started now if the queue has not reached it yet)."""
+        run = self.launch()
+        assert run is not None, "the process was stopped before it started"
+        return run.result(timeout)
 
     def stop(self) -> None:
         """Kill the process if it runs, or keep it from starting."""
@@ -122,6 +126,27 @@ class StartedAfter:
             run.stop()
 
 
+_QUEUE: queue.SimpleQueue | None = None
+
+
+def _serve(jobs: queue.SimpleQueue) -> None:
+    while True:
+        job = jobs.get()
+        if job is None:
+            return
+        run = job.launch()
+        if run is not None:
+            run.proc.wait()
+
+
+def _background_queue() -> queue.SimpleQueue:
+    global _QUEUE
+    if _QUEUE is None:
+        _QUEUE = queue.SimpleQueue()
+        threading.Thread(target=_serve, args=(_QUEUE,), daemon=True, name="processes").start()
+    return _QUEUE
+
+
 def selected_params(items, test_name: str, param: str) -> list:
     """The values of ``param`` of the test items ``test_name`` among ``items``."""
     return [
@@ -130,7 +155,7 @@ def selected_params(items, test_name: str, param: str) -> list:
 
 
 # ------------------------------------------------------------ started when collection ends
-_RUNS: dict[str, dict[str, Started | StartedAfter]] = {}  # test module name -> key -> process
+_RUNS: dict[str, dict[str, Started | Queued]] = {}  # test module name -> key -> process
 _SCRATCH: list[str] = []
 
 
@@ -162,7 +187,7 @@ def start_early(items) -> None:
             _RUNS[name] = module.early_processes(_module_items(items, module))
 
 
-def module_processes(request) -> dict[str, Started | StartedAfter]:
+def module_processes(request) -> dict[str, Started | Queued]:
     """The processes of the requesting module: those started early, else started now."""
     name = request.module.__name__
     if name not in _RUNS:
@@ -172,11 +197,16 @@ def module_processes(request) -> dict[str, Started | StartedAfter]:
 
 
 def stop_all() -> None:
-    """Kill the processes still running (a failed or interrupted session), remove scratch."""
+    """Kill the processes still running (a failed or interrupted session), keep the queued
+    ones from starting, end the queue's thread, remove scratch."""
+    global _QUEUE
     for runs in _RUNS.values():
         for run in runs.values():
             run.stop()
     _RUNS.clear()
+    if _QUEUE is not None:
+        _QUEUE.put(None)
+        _QUEUE = None
     for path in _SCRATCH:
         shutil.rmtree(path, ignore_errors=True)
     _SCRATCH.clear()

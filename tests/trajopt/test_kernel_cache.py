@@ -8,9 +8,9 @@
   cache, and a first compilation logs one notice per process (none when loading).
 * ``trajopt warm-up`` on the command line.
 
-The fresh processes these checks need start together when collection ends
-(:func:`early_processes`, ``tests/processes.py``) and run side by side with the other tests;
-each test reads its own.
+The fresh processes these checks need are queued when collection ends
+(:func:`early_processes`, ``tests/processes.py``) and run one after another in the background
+of the other tests; each test reads its own.
 """
 
 from __future__ import annotations
@@ -21,13 +21,7 @@ import os
 import pytest
 
 import trajopt._kernel_cache as kernel_cache
-from tests.processes import (
-    BACKGROUND_NICE,
-    Started,
-    StartedAfter,
-    module_processes,
-    scratch_dir,
-)
+from tests.processes import Queued, module_processes, scratch_dir
 from trajopt.cli import main
 
 EVERY_DISPATCHER = """
@@ -131,7 +125,7 @@ EXERCISES_MODULE = """
 """
 
 #: The fresh processes each test reads (the fresh-cache test's second one, FRESH_CACHE_LOAD,
-#: starts when its first one has ended: :func:`early_processes`).
+#: is queued after its first one: :func:`early_processes`).
 PROCESSES = {
     "test_every_dispatcher_is_in_a_kernel_module": EVERY_DISPATCHER,
     "test_warm_up_compiles_loads_and_reaches_every_kernel": WARM_UP_REACHES_EVERYTHING,
@@ -140,34 +134,30 @@ PROCESSES = {
 }
 
 
-def early_processes(items) -> dict[str, Started]:
-    """The fresh processes of the selected tests, started when collection ends, with a lower
-    priority (tests/processes.py); those of a fresh numba cache share one new, empty cache
-    folder (a fresh clone's)."""
+def early_processes(items) -> dict[str, Queued]:
+    """The fresh processes of the selected tests, queued when collection ends
+    (tests/processes.py); those of a fresh numba cache share one new, empty cache folder (a
+    fresh clone's), and the load runs after the compile."""
     names = {getattr(i, "originalname", None) for i in items}
     fresh_cache = dict(os.environ, NUMBA_CACHE_DIR=scratch_dir("trajopt_numba_"))
     runs: dict = {
-        name: Started(
-            script, env=fresh_cache if "fresh_cache" in name else None, nice=BACKGROUND_NICE
-        )
+        name: Queued(script, env=fresh_cache if "fresh_cache" in name else None)
         for name, script in PROCESSES.items()
         if name in names
     }
     compiled = runs.get("test_fresh_cache_workers_compile_and_a_notice_shows_once")
     if compiled is not None:  # a new process on the cache the workers filled
-        runs["fresh_cache_load"] = StartedAfter(
-            compiled, FRESH_CACHE_LOAD, env=fresh_cache, nice=BACKGROUND_NICE
-        )
+        runs["fresh_cache_load"] = Queued(FRESH_CACHE_LOAD, env=fresh_cache)
     return runs
 
 
 @pytest.fixture(scope="module")
-def started(request) -> dict[str, Started | StartedAfter]:
+def started(request) -> dict[str, Queued]:
     """The fresh processes of the selected tests (:func:`early_processes`)."""
     return module_processes(request)
 
 
-def _ok(run: Started) -> str:
+def _ok(run: Queued) -> str:
     out = run.result()
     assert out.returncode == 0, out.stderr[-3000:]
     return out.stdout

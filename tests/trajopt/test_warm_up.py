@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import astar
-from tests.processes import BACKGROUND_NICE, Started, module_processes, selected_params
+from tests.processes import Queued, module_processes, selected_params
 from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
 from trajopt.analysis.scenes import warm_up_map
@@ -122,11 +122,10 @@ FIRST_PLANS_SCRIPT = textwrap.dedent(
 )
 
 
-def early_processes(items) -> dict[str, Started]:
-    """A fresh process for each selected kind, started when collection ends with a lower
-    priority (tests/processes.py)."""
+def early_processes(items) -> dict[str, Queued]:
+    """A fresh process for each selected kind, queued when collection ends (tests/processes.py)."""
     kinds = selected_params(items, "test_first_plans_after_warm_up_load_no_kernel", "kind")
-    return {kind: Started(FIRST_PLANS_SCRIPT, kind, nice=BACKGROUND_NICE) for kind in kinds}
+    return {kind: Queued(FIRST_PLANS_SCRIPT, kind) for kind in kinds}
 
 
 @pytest.fixture(scope="module")
@@ -137,7 +136,7 @@ def first_plan_runs(request):
 
 @pytest.mark.parametrize("kind", FIRST_PLANS)
 def test_first_plans_after_warm_up_load_no_kernel(kind, first_plan_runs):
-    # each kind in its own fresh process (FIRST_PLANS_SCRIPT), started when collection ended
+    # each kind in its own fresh process (FIRST_PLANS_SCRIPT), queued when collection ended
     out = first_plan_runs[kind].result()
     assert out.returncode == 0, out.stderr[-2000:]
     assert "EVENTS []" in out.stdout, out.stdout + out.stderr[-2000:]
