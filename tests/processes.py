@@ -14,13 +14,15 @@ fixture reads them with :func:`module_processes` (which starts them itself if th
 has not, e.g. with ``TRAJOPT_EARLY_PROCESSES=0``). What a process computes does not depend
 on when it starts: only its wall time sees the shared CPU.
 
-Processes that run in the background of other tests go through one queue
-(:class:`Queued`): one at a time, with a lower priority (``nice``, :data:`BACKGROUND_NICE`),
-so that the tests' own process, the one the session waits for, keeps its core.
+Processes that run in the background of other tests go through the session's one
+background lane (:class:`Queued`, :class:`BackgroundLane`), one at a time and before the
+notebooks, so that the tests' own process, the one the session waits for, keeps its core.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 import os
 import queue
 import shutil
@@ -29,28 +31,15 @@ import sys
 import tempfile
 import textwrap
 import threading
-
-#: The ``nice`` increment of background processes (POSIX; ignored elsewhere).
-BACKGROUND_NICE = 10
-
-
-def lower_priority(pid: int, nice: int) -> None:
-    """Raise the niceness of process ``pid`` by ``nice`` over this process's (POSIX only)."""
-    if nice and hasattr(os, "setpriority"):
-        try:
-            mine = os.getpriority(os.PRIO_PROCESS, 0)
-            os.setpriority(os.PRIO_PROCESS, pid, min(19, mine + nice))
-        except OSError:  # the process has ended already, or no permission: keep it as is
-            pass
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any
 
 
 class Started:
-    """``python -c script *args``, started now; :meth:`result` waits for it.
+    """``python -c script *args``, started now; :meth:`result` waits for it."""
 
-    ``nice`` raises the niceness of the process (and so of its children) by that much.
-    """
-
-    def __init__(self, script: str, *args: str, env: dict | None = None, nice: int = 0) -> None:
+    def __init__(self, script: str, *args: str, env: dict | None = None) -> None:
         self._out = tempfile.TemporaryFile("w+")
         self._err = tempfile.TemporaryFile("w+")
         self.proc = subprocess.Popen(
@@ -60,7 +49,6 @@ class Started:
             text=True,
             env=env,
         )
-        lower_priority(self.proc.pid, nice)
         self.env = env
         self._done: subprocess.CompletedProcess | None = None
 
@@ -83,36 +71,100 @@ class Started:
         self.result()
 
 
-class Queued:
-    """``python -c script *args``, run in the background queue of the session.
+class BackgroundLane:
+    """One background thread that runs jobs one at a time: the most urgent first (the lowest
+    ``priority``), in the order they came among equals.
 
-    The queue runs its processes one at a time, in the order they were queued, in a thread of
-    its own, at a lower priority (``nice``): a second core works through them while the tests
-    run, without taking the tests' own core. :meth:`result` starts the process at once if the
-    queue has not reached it yet (the test needs it now), then waits for it. A process queued
-    after another one starts after that one has ended (a cache it fills, for example).
+    The session's background work, the queued fresh processes (:class:`Queued`, priority
+    :data:`PROCESSES_FIRST`) and the notebooks (``tests/notebook_runner.py``, priority
+    :data:`NOTEBOOKS_LAST`), goes through one lane, so that it takes one core beside the
+    tests' own process and never more.
     """
 
-    def __init__(
-        self, script: str, *args: str, env: dict | None = None, nice: int = BACKGROUND_NICE
-    ) -> None:
+    def __init__(self) -> None:
+        self._jobs: queue.PriorityQueue = queue.PriorityQueue()
+        self._order = itertools.count()
+        self._thread = threading.Thread(target=self._serve, daemon=True, name="background")
+        self._thread.start()
+
+    def submit(self, priority: int, fn: Callable[[], Any]) -> Future:
+        """Queue ``fn``; its future (cancel it to drop it while it waits)."""
+        fut: Future = Future()
+        self._jobs.put((priority, next(self._order), fut, fn))
+        return fut
+
+    def _serve(self) -> None:
+        while True:
+            _, _, fut, fn = self._jobs.get()
+            if fut is None:
+                return
+            if not fut.set_running_or_notify_cancel():
+                continue
+            try:
+                fut.set_result(fn())
+            except BaseException as exc:  # handed to whoever reads the future
+                fut.set_exception(exc)
+
+    def shutdown(self) -> None:
+        """Drop the jobs not started, wait for the running one, end the thread."""
+        while True:
+            try:
+                _, _, fut, _ = self._jobs.get_nowait()
+            except queue.Empty:
+                break
+            if fut is not None:
+                fut.cancel()
+        self._jobs.put((math.inf, next(self._order), None, None))
+        self._thread.join()
+
+
+#: Priorities in the :class:`BackgroundLane`: the processes that tests read during the
+#: session before the notebooks, whose checks run last.
+PROCESSES_FIRST, NOTEBOOKS_LAST = 0, 1
+
+_LANE: BackgroundLane | None = None
+
+
+def lane() -> BackgroundLane:
+    """The session's background lane."""
+    global _LANE
+    if _LANE is None:
+        _LANE = BackgroundLane()
+    return _LANE
+
+
+class Queued:
+    """``python -c script *args``, run in the session's background lane (:func:`lane`).
+
+    The lane runs it when its turn comes, one process or notebook at a time, beside the tests;
+    :meth:`result` starts it at once if its turn has not come yet (the test needs it now), then
+    waits for it. A process queued after another one starts after that one has ended (a cache
+    it fills, for example), unless a test asks for it first.
+    """
+
+    def __init__(self, script: str, *args: str, env: dict | None = None) -> None:
         self.env = env
-        self._spec = (script, args, env, nice)
+        self._spec = (script, args, env)
         self._run: Started | None = None
         self._stopped = False
         self._lock = threading.Lock()
-        _background_queue().put(self)
+        lane().submit(PROCESSES_FIRST, self._run_in_lane)
+
+    def _run_in_lane(self) -> None:
+        run = self.launch()
+        if run is not None:
+            run.proc.wait()
 
     def launch(self) -> Started | None:
         """Start the process unless it has started or was stopped; the process, or None."""
         with self._lock:
             if self._run is None and not self._stopped:
-                script, args, env, nice = self._spec
-                self._run = Started(script, *args, env=env, nice=nice)
+                script, args, env = self._spec
+                self._run = Started(script, *args, env=env)
             return self._run
 
     def result(self, timeout: float | None = 600.0) -> subprocess.CompletedProcess:
-        """The finished process (started now if the queue has not reached it yet)."""
+        """The finished process (started now if its turn has not come yet)."""
         run = self.launch()
         assert run is not None, "the process was stopped before it started"
         return run.result(timeout)
@@ -124,27 +176,6 @@ class Queued:
             run = self._run
         if run is not None:
             run.stop()
-
-
-_QUEUE: queue.SimpleQueue | None = None
-
-
-def _serve(jobs: queue.SimpleQueue) -> None:
-    while True:
-        job = jobs.get()
-        if job is None:
-            return
-        run = job.launch()
-        if run is not None:
-            run.proc.wait()
-
-
-def _background_queue() -> queue.SimpleQueue:
-    global _QUEUE
-    if _QUEUE is None:
-        _QUEUE = queue.SimpleQueue()
-        threading.Thread(target=_serve, args=(_QUEUE,), daemon=True, name="processes").start()
-    return _QUEUE
 
 
 def selected_params(items, test_name: str, param: str) -> list:
@@ -198,15 +229,15 @@ def module_processes(request) -> dict[str, Started | Queued]:
 
 def stop_all() -> None:
     """Kill the processes still running (a failed or interrupted session), keep the queued
-    ones from starting, end the queue's thread, remove scratch."""
-    global _QUEUE
+    ones from starting, end the background lane, remove scratch."""
+    global _LANE
     for runs in _RUNS.values():
         for run in runs.values():
             run.stop()
     _RUNS.clear()
-    if _QUEUE is not None:
-        _QUEUE.put(None)
-        _QUEUE = None
+    if _LANE is not None:
+        _LANE.shutdown()
+        _LANE = None
     for path in _SCRATCH:
         shutil.rmtree(path, ignore_errors=True)
     _SCRATCH.clear()
