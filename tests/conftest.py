@@ -24,10 +24,19 @@
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+# jsonschema (imported by nbformat and nbclient for the notebook tests) registers its
+# optional "iri" format check when rfc3987_syntax is installed, whose import builds a grammar
+# for ~2.5 s while holding the GIL, so the tests stall meanwhile. No schema the tests use has
+# an "iri" format (nbformat's notebook schema has no format at all, and nbformat validates
+# without a format checker), so the test process does without it.
+if "rfc3987_syntax" not in sys.modules:
+    sys.modules["rfc3987_syntax"] = None  # type: ignore[assignment]  # ImportError on import
 
 settings.register_profile("deterministic", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
@@ -135,8 +144,6 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 def pytest_sessionfinish(session: pytest.Session) -> None:
     """Stop the notebook runner (drop what has not started) and the modules' processes still
     running; remove their scratch files."""
-    import sys
-
     if "tests.notebook_runner" in sys.modules:
         sys.modules["tests.notebook_runner"].shutdown()
     if "tests.processes" in sys.modules:
