@@ -11,14 +11,17 @@
   (:func:`trajopt._kernel_cache.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
 * The fresh Python processes that some test modules check (``early_processes`` in
-  ``tests/trajopt/test_warm_up.py`` and ``tests/trajopt/test_kernel_cache.py``) start when
-  collection ends and run while the other tests run (``tests/processes.py``;
-  ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's first test runs).
-* The notebooks execute in a background thread, while the other tests run, from the moment
-  their tests are collected on (when no ``-k``, ``-m`` other than the default or
-  ``--deselect`` can drop them later; else from the end of collection on); their checks (``tests/test_notebooks.py::test_notebook_executes``) run
-  last (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside
-  its test instead).
+  ``tests/trajopt/test_warm_up.py``, ``tests/trajopt/test_kernel_cache.py`` and
+  ``tests/trajopt/analysis/test_bench.py``) are started, or queued in the session's
+  background lane, when collection ends, and run while the other tests run
+  (``tests/processes.py``; ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's
+  first test runs).
+* The notebooks execute in the background lane too, after the queued processes, from the
+  moment their tests are collected on (when no ``-k``, ``-m`` other than the default,
+  ``--deselect``, ``--lf`` or ``--sw`` can drop them later; else from the end of collection
+  on); their checks (``tests/test_notebooks.py::test_notebook_executes``) run last
+  (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside its
+  test instead).
 """
 
 from __future__ import annotations
@@ -96,12 +99,15 @@ def _is_notebook_item(item: pytest.Item) -> bool:
 
 
 def _selection_is_final(config: pytest.Config) -> bool:
-    """Whether every collected test is also selected (no -k, no other -m, no --deselect)."""
+    """Whether every collected test is also selected (no -k, no other -m, no --deselect, no
+    --lf or --sw, which deselect too)."""
     opt = config.option
     return (
         not getattr(opt, "keyword", "")
         and getattr(opt, "markexpr", "") in ("", "not slow")
         and not getattr(opt, "deselect", None)
+        and not getattr(opt, "lf", False)
+        and not getattr(opt, "stepwise", False)
         and not opt.collectonly
     )
 
