@@ -10,19 +10,36 @@
   first compiles every kernel numba's cache lacks, in two worker processes
   (:func:`trajopt.warmup.compile_kernels`, what ``trajopt warm-up`` does), instead of
   one test after another compiling them serially. ``TRAJOPT_PRECOMPILE=0`` skips it.
-* The notebooks execute in a background thread from the end of collection on, while the
-  other tests run; their checks (``tests/test_notebooks.py::test_notebook_executes``) run
-  last (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside
-  its test instead).
+* The fresh Python processes that some test modules check (``early_processes`` in
+  ``tests/trajopt/test_warm_up.py``, ``tests/trajopt/test_kernel_cache.py`` and
+  ``tests/trajopt/analysis/test_bench.py``) are started, or queued in the session's
+  background lane, when collection ends, and run while the other tests run
+  (``tests/processes.py``; ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's
+  first test runs).
+* The notebooks execute in the background lane too, after the queued processes, from the
+  moment their tests are collected on (when no ``-k``, ``-m`` other than the default,
+  ``--deselect``, ``--lf`` or ``--sw`` can drop them later; else from the end of collection
+  on); their checks (``tests/test_notebooks.py::test_notebook_executes``) run last
+  (``tests/notebook_runner.py``; ``TRAJOPT_NOTEBOOKS_BACKGROUND=0`` runs each inside its
+  test instead).
 """
 
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+# jsonschema (imported by nbformat and nbclient for the notebook tests) registers its
+# optional "iri" format check when rfc3987_syntax is installed, whose import builds a grammar
+# for ~2.5 s while holding the GIL, so the tests stall meanwhile. No schema the tests use has
+# an "iri" format (nbformat's notebook schema has no format at all, and nbformat validates
+# without a format checker), so the test process does without it.
+if "rfc3987_syntax" not in sys.modules:
+    sys.modules["rfc3987_syntax"] = None  # type: ignore[assignment]  # ImportError on import
 
 settings.register_profile("deterministic", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
@@ -79,6 +96,33 @@ def _notebook_items(items: list[pytest.Item]) -> list[pytest.Item]:
     ]
 
 
+def _is_notebook_item(item: pytest.Item) -> bool:
+    return bool(_notebook_items([item]))
+
+
+def _selection_is_final(config: pytest.Config) -> bool:
+    """Whether every collected test is also selected (no -k, no other -m, no --deselect, no
+    --lf or --sw, which deselect too)."""
+    opt = config.option
+    return (
+        not getattr(opt, "keyword", "")
+        and getattr(opt, "markexpr", "") in ("", "not slow")
+        and not getattr(opt, "deselect", None)
+        and not getattr(opt, "lf", False)
+        and not getattr(opt, "stepwise", False)
+        and not opt.collectonly
+    )
+
+
+def pytest_itemcollected(item: pytest.Item) -> None:
+    """Start a notebook as soon as its test is collected, when it cannot be deselected."""
+    if _is_notebook_item(item) and _selection_is_final(item.config):
+        from tests import notebook_runner
+
+        if notebook_runner.background_wanted():
+            notebook_runner.runner().start([item.callspec.params["path"]])
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Run the notebook executions last: meanwhile they execute in the background."""
@@ -88,9 +132,16 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
-    """Start executing the selected notebooks in a background thread (tests/notebook_runner.py)."""
+    """Start the modules' fresh processes (tests/processes.py) and the selected notebooks in a
+    background thread (tests/notebook_runner.py)."""
+    if session.config.option.collectonly:
+        return
+    from tests import processes
+
+    if processes.early_wanted():
+        processes.start_early(session.items)
     items = _notebook_items(session.items)
-    if not items or session.config.option.collectonly:
+    if not items:
         return
     from tests import notebook_runner
 
@@ -99,8 +150,9 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:
-    """Stop the notebook runner: drop what has not started, remove its scratch files."""
-    import sys
-
+    """Stop the notebook runner (drop what has not started) and the modules' processes still
+    running; remove their scratch files."""
     if "tests.notebook_runner" in sys.modules:
         sys.modules["tests.notebook_runner"].shutdown()
+    if "tests.processes" in sys.modules:
+        sys.modules["tests.processes"].stop_all()

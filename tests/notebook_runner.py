@@ -12,21 +12,27 @@ them as soon as collection has finished (``tests/conftest.py``), one notebook af
 other in a background thread, on a second core, while the other tests run;
 ``test_notebook_executes`` runs last and checks each notebook's result. The result of a
 notebook does not depend on when it runs: only the wall-time limits see the shared CPU,
-and they have a wide margin. With one usable CPU, or ``TRAJOPT_NOTEBOOKS_BACKGROUND=0``,
-each notebook runs inside its test instead, as before.
+and they have a wide margin. The background thread is the session's background lane
+(``tests/processes.py``), which runs the fresh processes some tests read before the
+notebooks and one job at a time, so that the tests' own process keeps its core. With one
+usable CPU, or ``TRAJOPT_NOTEBOOKS_BACKGROUND=0``, each notebook runs inside its test
+instead, as before.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import tempfile
 import threading
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from tests.processes import NOTEBOOKS_LAST, lane
 
 NOTEBOOK_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("*.ipynb"))
@@ -135,22 +141,21 @@ def usable_cpus() -> int:
 
 
 class NotebookRunner:
-    """Executes notebooks once per session: in a background thread once started, else inline."""
+    """Executes notebooks once per session: in the background lane once started, else inline."""
 
     def __init__(self) -> None:
         self._workdir = Path(tempfile.mkdtemp(prefix="trajopt_notebooks_"))
         self._futures: dict[Path, Future] = {}
-        self._executor: ThreadPoolExecutor | None = None
         self._lock = threading.Lock()
 
     def start(self, paths: list[Path]) -> None:
-        """Queue ``paths`` for execution, one after another, in a background thread."""
+        """Queue ``paths`` for execution, one after another, in the background lane."""
         with self._lock:
-            if self._executor is None:
-                self._executor = ThreadPoolExecutor(1, thread_name_prefix="notebooks")
             for p in paths:
                 if p not in self._futures:
-                    self._futures[p] = self._executor.submit(execute, p, self._workdir)
+                    self._futures[p] = lane().submit(
+                        NOTEBOOKS_LAST, functools.partial(execute, p, self._workdir)
+                    )
 
     def result(self, path: Path) -> Executed:
         """The execution of ``path``: waits for the background run, or runs it here."""
@@ -171,8 +176,16 @@ class NotebookRunner:
 
     def shutdown(self) -> None:
         """Drop the notebooks not started yet, wait for the running one, remove scratch files."""
-        if self._executor is not None:
-            self._executor.shutdown(wait=True, cancel_futures=True)
+        with self._lock:
+            futures = list(self._futures.values())
+        for fut in futures:
+            fut.cancel()  # those the lane has not started
+        for fut in futures:
+            if not fut.cancelled():
+                try:
+                    fut.result()
+                except BaseException:  # reported by its test, if it ran
+                    pass
         shutil.rmtree(self._workdir, ignore_errors=True)
 
 

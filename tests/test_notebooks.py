@@ -1,4 +1,4 @@
-"""Execute every notebook in ``notebooks/`` with nbclient (issue 6, section 4).
+"""Tests of the notebooks, which use astar and trajopt: execute every notebook in ``notebooks/`` with nbclient (issue 6, section 4).
 
 Each notebook runs in a fresh ``python3`` kernel of the interpreter running the tests, with
 ``notebooks/`` as its working directory, and must finish without an error cell within

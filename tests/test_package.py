@@ -1,4 +1,4 @@
-"""Package-level checks: lazy exports resolve, import stays light."""
+"""Tests of the packages astar and trajopt as wholes: package-level checks: lazy exports resolve, import stays light."""
 
 from __future__ import annotations
 

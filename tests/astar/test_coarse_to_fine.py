@@ -1,4 +1,4 @@
-"""astar.find_path_coarse_to_fine: a proven bound against scipy's Dijkstra, its fallbacks,
+"""Tests of astar.find_path_coarse_to_fine: a proven bound against scipy's Dijkstra, its fallbacks,
 the blocks' update and its refusals."""
 
 from __future__ import annotations

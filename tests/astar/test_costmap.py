@@ -1,4 +1,4 @@
-"""Costmaps: conventions, Nav2's translation table, files, and planning on a costmap.
+"""Tests of astar's costmaps (astar.costmap): conventions, Nav2's translation table, files, and planning on a costmap.
 
 The references (``tests/reference.py``) are independent of :mod:`astar.costmap`: Nav2's
 published translation (``1 + floor(97 (c - 1) / 251)``) and inflation-layer formula are

@@ -1,4 +1,4 @@
-"""Hybrid-A* pose paths: hand-made manoeuvres, independent dense checks, bad input."""
+"""Tests of astar.hybrid: Hybrid-A* pose paths: hand-made manoeuvres, independent dense checks, bad input."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Hybrid-A* with an oriented footprint: brute-force body checks, narrow passages, bad input.
+"""Tests of astar.hybrid: Hybrid-A* with an oriented footprint: brute-force body checks, narrow passages, bad input.
 
 The reference here is deliberately naive and shares no code with the library: the path's
 exact pieces are re-integrated in closed form with numpy every 0.01 cells, and at every such

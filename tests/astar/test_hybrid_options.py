@@ -1,4 +1,4 @@
-"""The option records of astar.find_pose_path: validation per field, flat keywords = records."""
+"""Tests of astar: the option records of astar.find_pose_path: validation per field, flat keywords = records."""
 
 from __future__ import annotations
 

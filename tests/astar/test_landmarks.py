@@ -1,4 +1,4 @@
-"""ALT landmarks: their distances, exact searches with them, and the refusals.
+"""Tests of astar's ALT landmarks: their distances, exact searches with them, and the refusals.
 
 References: scipy's Dijkstra on the explicit step graph (``tests/reference.py``).
 """

@@ -1,4 +1,4 @@
-"""Reeds-Shepp and Dubins shortest paths against OMPL and against brute force."""
+"""Tests of astar.reeds_shepp: Reeds-Shepp and Dubins shortest paths against OMPL and against brute force."""
 
 from __future__ import annotations
 

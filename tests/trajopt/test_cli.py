@@ -1,4 +1,4 @@
-"""The ``trajopt`` command line: outputs, one-line errors with exit code 2, atomic files."""
+"""Tests of trajopt.cli: the ``trajopt`` command line: outputs, one-line errors with exit code 2, atomic files."""
 
 from __future__ import annotations
 

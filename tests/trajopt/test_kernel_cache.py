@@ -1,4 +1,4 @@
-"""trajopt.kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
+"""Tests of trajopt.kernel_cache: every kernel is known, warmed up and compiled once, with a notice.
 
 * Every numba dispatcher of astar and trajopt lives in a module of ``KERNEL_MODULES``.
 * ``trajopt.warm_up()`` leaves every kernel compiled and loaded (a signature each), and
@@ -8,8 +8,9 @@
   cache, and a first compilation logs one notice per process (none when loading).
 * ``trajopt warm-up`` on the command line.
 
-The fresh processes these checks need start together when the module's first test runs
-(fixture ``started``) and run side by side; each test reads its own.
+The fresh processes these checks need are queued when collection ends
+(:func:`early_processes`, ``tests/processes.py``) and run one after another in the background
+of the other tests; each test reads its own.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import os
 import pytest
 
 import trajopt.kernel_cache as kernel_cache
-from tests.processes import Started
+from tests.processes import Queued, module_processes, scratch_dir
 from trajopt.cli import main
 
 EVERY_DISPATCHER = """
@@ -123,7 +124,8 @@ EXERCISES_MODULE = """
     print("ok")
 """
 
-#: The fresh processes each test reads (the fresh-cache test starts its second one itself).
+#: The fresh processes each test reads (the fresh-cache test's second one, FRESH_CACHE_LOAD,
+#: is queued after its first one: :func:`early_processes`).
 PROCESSES = {
     "test_every_dispatcher_is_in_a_kernel_module": EVERY_DISPATCHER,
     "test_warm_up_compiles_loads_and_reaches_every_kernel": WARM_UP_REACHES_EVERYTHING,
@@ -132,31 +134,30 @@ PROCESSES = {
 }
 
 
-@pytest.fixture(scope="module")
-def fresh_cache(tmp_path_factory) -> dict:
-    """The environment of a process with an empty numba cache (a fresh clone's)."""
-    return dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba")))
-
-
-@pytest.fixture(scope="module")
-def started(request, fresh_cache):
-    """The fresh processes of the selected tests, all started at once (tests/processes.py)."""
-    names = {
-        getattr(i, "originalname", None)
-        for i in request.session.items
-        if getattr(i, "module", None) is request.module
-    }
-    runs = {
-        name: Started(script, env=fresh_cache if "fresh_cache" in name else None)
+def early_processes(items) -> dict[str, Queued]:
+    """The fresh processes of the selected tests, queued when collection ends
+    (tests/processes.py); those of a fresh numba cache share one new, empty cache folder (a
+    fresh clone's), and the load runs after the compile."""
+    names = {getattr(i, "originalname", None) for i in items}
+    fresh_cache = dict(os.environ, NUMBA_CACHE_DIR=scratch_dir("trajopt_numba_"))
+    runs: dict = {
+        name: Queued(script, env=fresh_cache if "fresh_cache" in name else None)
         for name, script in PROCESSES.items()
         if name in names
     }
-    yield runs
-    for run in runs.values():
-        run.stop()
+    compiled = runs.get("test_fresh_cache_workers_compile_and_a_notice_shows_once")
+    if compiled is not None:  # a new process on the cache the workers filled
+        runs["fresh_cache_load"] = Queued(FRESH_CACHE_LOAD, env=fresh_cache)
+    return runs
 
 
-def _ok(run: Started) -> str:
+@pytest.fixture(scope="module")
+def started(request) -> dict[str, Queued]:
+    """The fresh processes of the selected tests (:func:`early_processes`)."""
+    return module_processes(request)
+
+
+def _ok(run: Queued) -> str:
     out = run.result()
     assert out.returncode == 0, out.stderr[-3000:]
     return out.stdout
@@ -182,8 +183,9 @@ def test_warm_up_compiles_loads_and_reaches_every_kernel(started):
     assert out["inline_called_alone"] == []
 
 
-def test_fresh_cache_workers_compile_and_a_notice_shows_once(started, fresh_cache):
-    out = json.loads(_ok(started["test_fresh_cache_workers_compile_and_a_notice_shows_once"]))
+def test_fresh_cache_workers_compile_and_a_notice_shows_once(started):
+    compiled_run = started["test_fresh_cache_workers_compile_and_a_notice_shows_once"]
+    out = json.loads(_ok(compiled_run))
     grid = {
         "astar.distance_transform._transform",
         "astar.distance_transform._column_pass",
@@ -198,7 +200,7 @@ def test_fresh_cache_workers_compile_and_a_notice_shows_once(started, fresh_cach
     assert not grid & set(out["left"])
     assert set(out["left"]) == set(out["cold"]) - set(out["compiled"])
     # the cache the workers filled serves a new process (FRESH_CACHE_LOAD)
-    run = Started(FRESH_CACHE_LOAD, env=fresh_cache)
+    run = started["fresh_cache_load"]
     loaded, compiled = map(int, _ok(run).split())
     assert loaded >= len(grid) and compiled == 0
     before, after = run.result().stderr.split("LOADED")

@@ -1,4 +1,4 @@
-"""trajopt.warmup: the first plan after it loads no compiled kernel, for every planner kind.
+"""Tests of trajopt.warmup: the first plan after it loads no compiled kernel, for every planner kind.
 
 ``warm_up()`` without a planner loads every kernel: then no planner kind loads one.
 (``tests/trajopt/test_kernel_cache.py`` checks that it compiles and reaches every kernel.)
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import astar
-from tests.processes import Started, selected_params
+from tests.processes import Queued, module_processes, selected_params
 from tests.reference import point_square_distance
 from trajopt import Planner, Robot, Smoother, warm_up
 from trajopt.analysis.scenes import warm_up_map
@@ -122,19 +122,21 @@ FIRST_PLANS_SCRIPT = textwrap.dedent(
 )
 
 
+def early_processes(items) -> dict[str, Queued]:
+    """A fresh process for each selected kind, queued when collection ends (tests/processes.py)."""
+    kinds = selected_params(items, "test_first_plans_after_warm_up_load_no_kernel", "kind")
+    return {kind: Queued(FIRST_PLANS_SCRIPT, kind) for kind in kinds}
+
+
 @pytest.fixture(scope="module")
 def first_plan_runs(request):
-    """The fresh processes of the selected kinds, all started at once (tests/processes.py)."""
-    kinds = selected_params(request, "test_first_plans_after_warm_up_load_no_kernel", "kind")
-    runs = {kind: Started(FIRST_PLANS_SCRIPT, kind) for kind in kinds}
-    yield runs
-    for run in runs.values():
-        run.stop()
+    """The fresh processes of the selected kinds (:func:`early_processes`)."""
+    return module_processes(request)
 
 
 @pytest.mark.parametrize("kind", FIRST_PLANS)
 def test_first_plans_after_warm_up_load_no_kernel(kind, first_plan_runs):
-    # each kind in its own fresh process (FIRST_PLANS_SCRIPT), all started by the fixture
+    # each kind in its own fresh process (FIRST_PLANS_SCRIPT), queued when collection ended
     out = first_plan_runs[kind].result()
     assert out.returncode == 0, out.stderr[-2000:]
     assert "EVENTS []" in out.stdout, out.stdout + out.stderr[-2000:]

@@ -1,4 +1,4 @@
-"""Message conversions against references built with the generated constructors (needs ROS)."""
+"""Tests of trajopt_ros: message conversions against references built with the generated constructors (needs ROS)."""
 
 from __future__ import annotations
 

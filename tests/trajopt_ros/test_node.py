@@ -1,4 +1,4 @@
-"""The node in its own process, driven from this one over Fast DDS (conftest: hygiene)."""
+"""Tests of trajopt_ros: the node in its own process, driven from this one over Fast DDS (conftest: hygiene)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Parameter validation and the import boundary (no ROS needed)."""
+"""Tests of trajopt_ros: parameter validation and the import boundary (no ROS needed)."""
 
 from __future__ import annotations
 

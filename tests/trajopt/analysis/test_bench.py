@@ -1,4 +1,4 @@
-"""trajopt.bench (issue 22): Dask rows equal serial rows, resume after a kill, bad input,
+"""Tests of trajopt.analysis.bench (issue 22): Dask rows equal serial rows, resume after a kill, bad input,
 the report against brute-force counts, the peers' adapters."""
 
 from __future__ import annotations
@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import os
 import signal
-import subprocess
 import sys
 import threading
 import time
@@ -18,6 +17,7 @@ import pytest
 pytest.importorskip("distributed", reason="the bench extra (dask[distributed]) is missing")
 pytest.importorskip("pyarrow", reason="the bench extra (pyarrow) is missing")
 
+from tests.processes import Started, module_processes, scratch_dir
 from trajopt.analysis import bench  # noqa: E402
 from trajopt.analysis.bench._dataset import part_files  # noqa: E402
 from trajopt.analysis.bench._runner import query_cost  # noqa: E402
@@ -142,9 +142,29 @@ def test_a_worker_killed_mid_task_has_its_chunk_retried(client, sources, serial,
     assert_same_rows(bench.read_dataset(out), expected)
 
 
-def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources, tmp_path):
-    out = tmp_path / "resumed"
-    scen = shared_data / "movingai" / "scen" / "den312d.map.scen"
+#: A fresh process that runs ``trajopt bench run`` (serial, chunks of one query) in a process
+#: of its own and SIGKILLs it as soon as its first part file exists; prints the signal.
+KILLED_CLI_RUN = """
+    import signal, subprocess, sys, time
+    from trajopt.analysis.bench._dataset import part_files
+    out, cmd = sys.argv[1], sys.argv[2:]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not part_files(out) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    print(proc.wait())
+"""
+
+
+def early_processes(items) -> dict[str, Started]:
+    """The killed CLI run (:data:`KILLED_CLI_RUN`), started when collection ends
+    (tests/processes.py) when its test is selected and the shared data is there."""
+    names = {getattr(i, "originalname", None) for i in items}
+    scen = data_dir() / "movingai" / "scen" / "den312d.map.scen"
+    if "test_killed_run_resumes_without_loss_or_repeat" not in names or not scen.is_file():
+        return {}
+    out = Path(scratch_dir("trajopt_bench_killed_")) / "resumed"
     cmd = [
         sys.executable,
         "-m",
@@ -166,12 +186,15 @@ def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources,
         "--no-progress",
     ]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 60
-    while not part_files(out) and time.monotonic() < deadline:
-        time.sleep(0.02)
-    proc.send_signal(signal.SIGKILL)
-    proc.wait()
+    return {"killed_cli": Started(KILLED_CLI_RUN, str(out), *cmd, env=env)}
+
+
+def test_killed_run_resumes_without_loss_or_repeat(shared_data, serial, sources, request):
+    # the CLI run was started, and killed after its first part file, by early_processes
+    run = module_processes(request)["killed_cli"]
+    done = run.result()
+    assert done.returncode == 0 and done.stdout.split() == [str(-signal.SIGKILL)], done.stderr
+    out = Path(done.args[3])
     first = {p.name: p.read_bytes() for p in part_files(out)}
     assert 1 <= len(first) < 3, "the run should have been killed between chunks 1 and 3"
     src = [sources[0]]

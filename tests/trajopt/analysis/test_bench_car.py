@@ -1,4 +1,4 @@
-"""trajopt.bench's car methods (issue 36): ``trajopt-ackermann(-forward)``, ``ompl-reedsshepp``,
+"""Tests of trajopt.analysis.bench's car methods (issue 36): ``trajopt-ackermann(-forward)``, ``ompl-reedsshepp``,
 ``ompl-dubins``, the query headings and the car metrics, on small built-in rooms (no shared data),
 each checked against an independent reference (circles through three points of
 ``tests.reference``, closed-form arcs, brute-force clearance)."""

@@ -1,4 +1,4 @@
-"""Tests of trajopt.comparison (``trajopt.compare``): the table, the method registry, and the chapter's Section 5
+"""Tests of trajopt.analysis.comparison (``trajopt.compare``): the table, the method registry, and the chapter's Section 5
 reproduction on the paper scene (qualitative relations, no copied numbers)."""
 
 from __future__ import annotations

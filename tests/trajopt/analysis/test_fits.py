@@ -1,4 +1,4 @@
-"""Tests of trajopt.fits against independent references (numpy polyfit, brute force,
+"""Tests of trajopt.analysis.fits (``trajopt.fits``) against independent references (numpy polyfit, brute force,
 explicit B-spline design matrices) and hand cases."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Tests of trajopt.metrics on hand cases and against brute force / scipy references."""
+"""Tests of trajopt.analysis.metrics (``trajopt.metrics``) on hand cases and against brute force / scipy references."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Figures: footprints (or discs) drawn along a timed trajectory."""
+"""Tests of trajopt.analysis.plotting: figures of footprints (or discs) drawn along a timed trajectory."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tests of trajopt.scenes.paper(): the chapter's setting and the properties it promises."""
+"""Tests of trajopt.analysis.scenes (``trajopt.scenes.paper()``): the chapter's setting and the properties it promises."""
 
 from __future__ import annotations
 

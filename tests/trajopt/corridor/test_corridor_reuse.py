@@ -1,4 +1,4 @@
-"""A re-plan's polygon corridor keeps the old regions along the path the two share.
+"""Tests of trajopt.corridor: a re-plan's polygon corridor keeps the old regions along the path the two share.
 
 References: the exact polygon-to-map distance of :func:`trajopt.geometry._clearance.polygon_clearance`
 (separating axes and vertex-edge distances, not the corridor's own certificate kernels) for

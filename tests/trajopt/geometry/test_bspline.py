@@ -1,4 +1,4 @@
-"""BSplineCurve against scipy and closed forms."""
+"""Tests of trajopt.geometry: BSplineCurve against scipy and closed forms."""
 
 from __future__ import annotations
 

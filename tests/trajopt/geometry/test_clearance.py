@@ -1,4 +1,4 @@
-"""The exact clearances of :mod:`trajopt.geometry._clearance` against brute force."""
+"""Tests of trajopt.geometry: the exact clearances of :mod:`trajopt.geometry._clearance` against brute force."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""ParametricCurve geometry against closed forms (circle, line, polyline)."""
+"""Tests of trajopt.geometry: ParametricCurve geometry against closed forms (circle, line, polyline)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""ROS 2 MCAP export, checked with two independent readers.
+"""Tests of trajopt.motion: ROS 2 MCAP export (trajopt.motion._mcap), checked with two independent readers.
 
 ``mcap-ros2-support``'s decoder and ``rosbags``' deserialiser both decode the file from the
 message definitions stored in it; neither shares code with :mod:`trajopt.motion._mcap`.

@@ -1,4 +1,4 @@
-"""A car's steering at rest (:class:`trajopt.SteerInPlace`): its samples and its checks."""
+"""Tests of trajopt.motion: a car's steering at rest (:class:`trajopt.SteerInPlace`): its samples and its checks."""
 
 from __future__ import annotations
 

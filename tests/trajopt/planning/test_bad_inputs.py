@@ -1,4 +1,4 @@
-"""Bad input everywhere (issue 7, section 3): typed errors naming the field, value and rule."""
+"""Tests of trajopt.planning through the public API: bad input everywhere (issue 7, section 3): typed errors naming the field, value and rule."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Car-like robots (``Robot(drive="ackermann")``) end to end through ``trajopt.plan``.
+"""Tests of trajopt.planning: car-like robots (``Robot(drive="ackermann")``) end to end through ``trajopt.plan``.
 
 Four hand-built scenes (a goal straight behind the start, a three-point turn in a dead end
 narrower than ``2 R``, a forward-only U-turn round a block, parallel parking into a slot 1.3

@@ -1,4 +1,4 @@
-"""A car's plan does not depend on where the map's origin is (issue 45, part 5).
+"""Tests of trajopt.planning: a car's plan does not depend on where the map's origin is (issue 45, part 5).
 
 A full-size car (4.69 x 1.94 m, wheelbase 2.8 m, R = 3.0 m, the rear axle as reference)
 backs into bays off an aisle on a 0.1 m grid: far from the origin (x near

@@ -1,4 +1,4 @@
-"""Fast refusals (issue 33, part 4): component labels of the inflated grid.
+"""Tests of trajopt.planning: fast refusals (issue 33, part 4): component labels of the inflated grid.
 
 The labels (:attr:`PlannerCaches.components`) are checked against a brute-force
 breadth-first search with the search's own move rules (``tests.reference.reachable_cells``)

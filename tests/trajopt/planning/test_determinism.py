@@ -1,4 +1,4 @@
-"""Determinism (issue 7, section 4): the same inputs give the same trajectory bit for bit.
+"""Tests of trajopt.planning: determinism (issue 7, section 4): the same inputs give the same trajectory bit for bit.
 
 Every comparison here is exact (``np.array_equal``, ``==``), never ``allclose``: a planner
 whose answer depends on what it solved before cannot be replayed or debugged.

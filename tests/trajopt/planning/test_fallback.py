@@ -1,4 +1,4 @@
-"""The stop-and-turn fallback (issue 7, section 2) against independent references.
+"""Tests of trajopt.planning: the stop-and-turn fallback (issue 7, section 2) against independent references.
 
 References: ruckig's own 1-DoF answer and a closed-form rest-to-rest time for each leg and
 turn, limits on dense samples, brute-force clearance to the raw map's obstacle squares.

@@ -1,4 +1,4 @@
-"""The curvature-feasibility witness: checked by brute force, and against hand-made maps
+"""Tests of trajopt.planning: the curvature-feasibility witness: checked by brute force, and against hand-made maps
 where the answer is known (a wide room: feasible; a narrow L-bend: no curve can turn)."""
 
 from __future__ import annotations

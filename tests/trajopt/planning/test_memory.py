@@ -1,4 +1,4 @@
-"""The planner's memory estimate and the up-front refusal of maps too large for it."""
+"""Tests of trajopt.planning: the planner's memory estimate and the up-front refusal of maps too large for it."""
 
 from __future__ import annotations
 

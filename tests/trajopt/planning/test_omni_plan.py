@@ -1,4 +1,4 @@
-"""Omnidirectional bases (issue 33): the orientation turns while the base drives.
+"""Tests of trajopt.planning: omnidirectional bases (issue 33): the orientation turns while the base drives.
 
 References: the footprint's collision by point sampling
 (:func:`tests.reference.footprint_collides`), the turn limits by hand

@@ -1,4 +1,4 @@
-"""trajopt.plan / Planner: end-to-end guarantees checked by independent brute force."""
+"""Tests of trajopt.planning (trajopt.plan / Planner): end-to-end guarantees checked by independent brute force."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""trajopt.plan and trajopt.Planner take the fields of trajopt.PlannerOptions as keywords, unchanged."""
+"""Tests of trajopt.planning: trajopt.plan and trajopt.Planner take the fields of trajopt.PlannerOptions as keywords, unchanged."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Property-based test of the whole pipeline (issue 7, section 1).
+"""Tests of trajopt.planning: a property-based test of the whole pipeline (issue 7, section 1).
 
 Over random grids (20-300 cells per side, mostly small; open, random rectangles, random
 noise or both at densities 0-40 %), random robot radii and limits and random start/goal

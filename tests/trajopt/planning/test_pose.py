@@ -1,4 +1,4 @@
-"""Pose to pose (issue 33): a differential drive's end headings are met exactly.
+"""Tests of trajopt.planning: pose to pose (issue 33): a differential drive's end headings are met exactly.
 
 References: the clearance of dense samples by brute force over the occupied squares
 (:func:`tests.reference.square_clearance`), the turn limits derived by hand from the robot's

@@ -1,4 +1,4 @@
-"""Plans that do not depend on the map's resolution: a map and its cells split k x k."""
+"""Tests of trajopt.planning: plans that do not depend on the map's resolution: a map and its cells split k x k."""
 
 from __future__ import annotations
 

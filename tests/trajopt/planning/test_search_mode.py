@@ -1,4 +1,4 @@
-"""Planner search_mode / search_bound: exact as before, coarse-to-fine within its bound,
+"""Tests of trajopt.planning: Planner search_mode / search_bound: exact as before, coarse-to-fine within its bound,
 the blocks kept through update_map, bad settings refused."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Re-planning from a moving robot: the state, the C2 splice, map updates.
+"""Tests of trajopt.replan: re-planning from a moving robot: the state, the C2 splice, map updates.
 
 References: the old trajectory's own samples at the splice (continuity), the B-spline
 derivative formulas evaluated independently by ``BSplineCurve`` (start curvature), a

@@ -1,4 +1,4 @@
-"""Brake, turn in place, go: the re-plan of a moving robot that cannot go on smoothly.
+"""Tests of trajopt.replan: brake, turn in place, go: the re-plan of a moving robot that cannot go on smoothly.
 
 References: the hand formula of a jerk-limited stop from cruise (time ``v/a + a/j``,
 distance ``v T / 2`` by the profile's point symmetry), the old trajectory's own speed at the

@@ -1,4 +1,4 @@
-"""Re-planning a car-like robot (``Robot(drive="ackermann")``): keep, or brake and plan anew.
+"""Tests of trajopt.replan: re-planning a car-like robot (``Robot(drive="ackermann")``): keep, or brake and plan anew.
 
 Checked independently of the planner: the braking piece's points against a dense polyline of
 the old curve (point-to-segment distances), the end pose against the goal, curvature by

@@ -1,4 +1,4 @@
-"""What a re-plan keeps: the exact B-spline tail and the rest of the driven trajectory.
+"""Tests of trajopt.replan: what a re-plan keeps: the exact B-spline tail and the rest of the driven trajectory.
 
 References: scipy's ``BSpline`` (the tail's values and derivatives), scipy's Delaunay
 triangulation (the tail's new control points lie in the hull of the cut span's), the old

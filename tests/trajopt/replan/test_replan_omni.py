@@ -1,4 +1,4 @@
-"""Re-planning an omnidirectional base: the body's orientation goes on across the splice.
+"""Tests of trajopt.replan: re-planning an omnidirectional base: the body's orientation goes on across the splice.
 
 References: the old trajectory's own samples (the splice, and the kept rest shifted in
 time), the yaw limits by hand (``tests.reference.turn_limits_by_hand``) on finite

@@ -1,4 +1,4 @@
-"""Oriented footprints: the polygon, its swept bound, the certificate, and whole plans.
+"""Tests of trajopt.robot: oriented footprints: the polygon, its swept bound, the certificate, and whole plans.
 
 References are brute force and independent of :mod:`trajopt.robot._footprint`: dense rotations
 of the footprint for the swept bound, dense tangent samples for the heading intervals,

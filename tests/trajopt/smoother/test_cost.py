@@ -1,4 +1,4 @@
-"""The cost field in the smoother's objective (issue 34, part 2).
+"""Tests of trajopt.smoother: the cost field in the smoother's objective (issue 34, part 2).
 
 References are independent of the code under test: central finite differences of the
 objective, the mean cost measured on dense samples of the returned curve, and the

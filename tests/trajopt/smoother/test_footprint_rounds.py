@@ -1,4 +1,4 @@
-"""The footprint in the optimiser: compiled certificate kernels, the SCP rows, whole fits.
+"""Tests of trajopt.smoother: the footprint in the optimiser: compiled certificate kernels, the SCP rows, whole fits.
 
 References: brute force (minimal arcs of sorted angles, scipy's convex hull, dense poses of
 the footprint with exact polygon clearances, a point-sampling collision check), a finite

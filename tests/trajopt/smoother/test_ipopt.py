@@ -1,4 +1,4 @@
-"""IPOPT on the general constraint layout: polygon corridors, against piqp as the reference.
+"""Tests of trajopt.smoother: IPOPT on the general constraint layout: polygon corridors, against piqp as the reference.
 
 The convex corridor QP solved by IPOPT must reach piqp's optimum (the same objective value
 and control points within solver tolerance); the exact curvature-bounded NLP must hold its

@@ -1,4 +1,4 @@
-"""The smoother and the planner in polygon corridors: certified against brute force, hand
+"""Tests of trajopt.smoother: the smoother and the planner in polygon corridors: certified against brute force, hand
 cases that box corridors fail, the taut objective, bad input."""
 
 from __future__ import annotations

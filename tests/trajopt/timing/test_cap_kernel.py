@@ -1,4 +1,4 @@
-"""The timing's compiled paths against their NumPy references and independent samples.
+"""Tests of trajopt.timing: the timing's compiled paths against their NumPy references and independent samples.
 
 * ``trajopt.timing._cap_kernel``: the per-interval Bernstein bound equals
   ``curvature_bound.kappa_bound`` (the NumPy reference) within 1e-12, the grid bounds equal

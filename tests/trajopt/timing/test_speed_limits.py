@@ -1,4 +1,4 @@
-"""Speed-limit zones: Nav2's decoding rule, mask files, and trajectories that hold them.
+"""Tests of trajopt.timing: speed-limit zones: Nav2's decoding rule, mask files, and trajectories that hold them.
 
 References: the decoding rule written out by hand per value, a brute-force scan of mask
 cells for the box queries, and 1 ms samples of the timed trajectories checked against the
