@@ -80,7 +80,14 @@ def test_plan_and_planner_take_every_field_of_the_options(grid, monkeypatch):
         trajopt.plan(grid, START, GOAL, ROBOT, start_heading=0.5, v_end=0.0, **rest)
     options, args, kwargs = seen[-1]
     assert options == want and args == (START, GOAL)
-    assert kwargs == {"start_heading": 0.5, "goal_heading": None, "v_start": 0.0, "v_end": 0.0}
+    assert kwargs == {
+        "start_heading": 0.5,
+        "goal_heading": None,
+        "v_start": 0.0,
+        "v_end": 0.0,
+        "start_steer": 0.0,
+        "goal_steer": None,
+    }
 
 
 @pytest.mark.parametrize("call", ["Planner", "plan"])
