@@ -112,10 +112,15 @@ def _imports(path: Path, prefixes: tuple[str, ...] = ("trajopt.",)) -> list[tupl
 
 
 @functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The parsed file (each file is parsed once per session: several tests read every file)."""
+    return ast.parse(path.read_text())
+
+
+@functools.cache
 def _absolute_imports(path: Path) -> tuple[tuple[str, int], ...]:
-    """``(imported module, line)`` of every absolute import outside TYPE_CHECKING (each file
-    is parsed once per session: two tests read every file)."""
-    tree = ast.parse(path.read_text())
+    """``(imported module, line)`` of every absolute import outside TYPE_CHECKING."""
+    tree = _tree(path)
     guarded = {
         id(sub)
         for node in ast.walk(tree)
@@ -162,7 +167,7 @@ def _drive_composes(here: str, target: str, path: Path, line: int) -> bool:
     face = target if target in DRIVE_CALLS else target.rpartition(".")[0]
     if not here.startswith("trajopt.drive.") or face not in DRIVE_CALLS:
         return False
-    tree = ast.parse(path.read_text())
+    tree = _tree(path)
     return any(
         isinstance(fn, ast.FunctionDef) and fn.lineno < line <= (fn.end_lineno or fn.lineno)
         for fn in ast.walk(tree)
@@ -269,7 +274,7 @@ def test_no_switch_on_result_classes_outside_motion_and_the_drives():
         rel = path.relative_to(root)
         if rel.parts[0] in ("motion", "drive"):
             continue
-        found += [f"{rel}:{line}" for line in _class_switches(ast.parse(path.read_text()))]
+        found += [f"{rel}:{line}" for line in _class_switches(_tree(path))]
     assert not found, found
 
 
@@ -298,7 +303,7 @@ def test_packages_use_each_other_through_their_faces():
     for path in sorted(root.rglob("*.py")):
         rel = path.relative_to(root.parent).with_suffix("")
         here = ".".join(rel.parts).removesuffix(".__init__")
-        for node in ast.walk(ast.parse(path.read_text())):
+        for node in ast.walk(_tree(path)):
             if not isinstance(node, ast.ImportFrom | ast.Import) or getattr(node, "level", 0):
                 continue
             mods = (
@@ -320,7 +325,7 @@ def test_no_drive_is_named_outside_the_drives():
     for path in sorted(root.rglob("*.py")):
         if path.relative_to(root).parts[0] == "drive":
             continue
-        for node in ast.walk(ast.parse(path.read_text())):
+        for node in ast.walk(_tree(path)):
             if not isinstance(node, ast.Compare):
                 continue
             sides = [node.left, *node.comparators]
