@@ -55,14 +55,37 @@ import parking_cases as pc  # noqa: E402
 
 
 def failure_reason(kind: str, note: str, words: int = 6) -> str:
-    """``"ErrorType: first words [(tag)]"`` of a failure, numbers replaced by ``#``.
+    """A short class of a failure: the error type and what its message says first.
 
-    The tag is the first ``(time_budget)``, ``(exhausted)``, ... the message carries.
+    The search's refusals are told apart by their tag (``(time_budget)``, ``(exhausted)``,
+    ...), an end pose refused on the grid by "meets the occupied cell", a segment without a
+    certified curve by its direction; anything else is the type and the message's first
+    ``words`` words, numbers replaced by ``#``.
     """
-    text = re.sub(r"[-+]?\d[\d.e+-]*", "#", note.replace("\n", " "))
-    out = f"{kind}: " + " ".join(text.split()[:words])
-    tag = re.search(r"\((time_budget|exhausted|max_expansions|disconnected|expansions)\)", note)
-    return out + (f" ... ({tag.group(1)})" if tag else "")
+    head = note.split(" (tries:")[0]
+    if kind == "NoPathError":
+        tag = re.search(r"\((time_budget|exhausted|max_expansions|disconnected)\)", head)
+        if tag:
+            return f"NoPathError: the search ran out ({tag.group(1)})"
+    if kind == "InvalidInputError" and "meets the occupied cell" in head:
+        end = "goal" if head.startswith("goal") else "start"
+        return (
+            f"InvalidInputError: {end} pose refused, its footprint + margin + sampling "
+            "slack meets a grid cell"
+        )
+    if kind == "InvalidInputError" and "footprint meets an obstacle" in head:
+        end = "goal" if head.startswith("goal") else "start"
+        return f"InvalidInputError: {end} pose refused, its footprint meets a grid cell"
+    if kind == "SmoothingError" and "segment" in head:
+        seg = "backwards" if "backwards segment" in head else "forwards"
+        return f"SmoothingError: no certified curve for a {seg} segment"
+    text = re.sub(r"[-+]?\d[\d.e+-]*", "#", head.replace("\n", " "))
+    return f"{kind}: " + " ".join(text.split()[:words])
+
+
+def end_blocked_on_first_grid(note: str) -> bool:
+    """Whether a failure's tries say an end pose was refused on the first search grid."""
+    return "meets the occupied cell" in note
 
 
 def run_trajopt(case: pc.ParkingCase, grid, robot) -> dict:
@@ -85,7 +108,7 @@ def run_trajopt(case: pc.ParkingCase, grid, robot) -> dict:
             ok=False,
             runtime_s=time.perf_counter() - t0,
             failure=type(exc).__name__,
-            note=str(exc)[:300],
+            note=str(exc)[:4000],
         )
         return row
     row["runtime_s"] = time.perf_counter() - t0
@@ -247,6 +270,11 @@ def report(rows: list[dict], have_ompl: bool) -> str:
                 )
             )
             lines.append(f"  {k:3d} x {reason} [{', '.join(cats)}]")
+        blocked = int(fails["note"].map(end_blocked_on_first_grid).sum())
+        lines.append(
+            f"  ({blocked} of the {len(fails)} failures name an end pose whose footprint + "
+            "margin + slack meets a grid cell on a search grid)"
+        )
     ok = t[t["ok"]]
     if len(ok):
         lines.append(
