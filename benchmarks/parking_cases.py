@@ -589,3 +589,81 @@ def make_cases(car: Car, n: int, seed: int = 0) -> list[ParkingCase]:
     """``n`` cases, cycling through the categories and entries (parallel backwards first)."""
     kinds = [(c, e) for c in CATEGORIES for e in ENTRIES]
     return [make_case(car, *kinds[i % len(kinds)], seed, i // len(kinds)) for i in range(n)]
+
+
+# ---------------------------------------------------------------------------- witnesses
+
+
+def arc_poses(pose, kappa: float, length: float, direction: int, step: float) -> np.ndarray:
+    """Rear-axle poses along a constant-curvature move, ``step`` m of travel apart at most.
+
+    ``kappa`` (1/m, signed, 0 for a straight line) is the path's curvature in the body's
+    frame, ``direction`` +1 forwards, -1 backwards.
+    """
+    x, y, th = pose
+    n = max(2, math.ceil(length / step) + 1)
+    s = np.linspace(0.0, length, n) * direction
+    if abs(kappa) < 1e-12:
+        return np.column_stack([x + s * math.cos(th), y + s * math.sin(th), np.full(n, th)])
+    t = th + kappa * s
+    return np.column_stack(
+        [x + (np.sin(t) - math.sin(th)) / kappa, y - (np.cos(t) - math.cos(th)) / kappa, t]
+    )
+
+
+def reverse_s_entry(case: ParkingCase) -> tuple[float, float] | None:
+    """A one-manoeuvre entry into a parallel slot, if one is clear: ``(d, phi)`` (m, rad).
+
+    Built backwards from the goal: back up ``d`` inside the slot, then drive forwards out
+    on an arc of radius ``R`` towards the aisle through ``phi`` and on the opposite arc
+    through ``phi``; driven in reverse this is the textbook reverse S into the slot. The
+    first ``(d, phi)`` (``d`` from 0 in 5 cm steps, scaled, ``phi`` from 88 degrees down
+    in 2 degree steps) whose poses (body corners at most 1 cm apart) are all clear of the
+    polygons by :func:`body_overlaps` and whose last pose has the whole body above the
+    slot's row of cars is returned; None when there is none (a shorter slot needs more
+    moves, or none exists). A witness that the slot end of the case is feasible, not a
+    planner.
+    """
+    if case.category != "parallel":
+        raise ValueError(f"reverse_s_entry needs a parallel case, got {case.category!r}")
+    car = case.car
+    body = car.body()
+    R = car.turning_radius
+    rc = float(np.max(np.hypot(body[:, 0], body[:, 1])))
+    step = 0.008 / (1.0 + rc / R)
+    gx, gy, gh = case.goal
+    row_top = max(
+        float(p[:, 1].max())
+        for p in case.polygons
+        if len(p) == 4 and p[:, 1].max() < gy + 2.0 * car.width
+    )
+    side = 1.0 if math.cos(gh) > 0 else -1.0  # the aisle is at +y: turn left facing +x
+    for d in np.arange(0.0, 0.6 * car.length * (case.size - 1.0) + 1e-9, 0.05 * car.scale):
+        back = arc_poses(case.goal, 0.0, float(d), -1, step)
+        for phi in np.radians(np.arange(88.0, 8.0, -2.0)):
+            a1 = arc_poses(tuple(back[-1]), side / R, R * phi, +1, step)
+            a2 = arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, step)
+            if body_at(body, a2[-1:])[0][:, 1].min() < row_top:
+                continue
+            poses = np.vstack([back, a1, a2])
+            if not body_overlaps(body, poses, case.polygons).any():
+                return float(d), float(phi)
+    return None
+
+
+if __name__ == "__main__":
+    import argparse
+
+    ap = argparse.ArgumentParser(description="parallel slots with a clear reverse-S entry")
+    ap.add_argument("--car", choices=sorted(CARS), default="full")
+    ap.add_argument("--limit", type=int, default=40)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    found = 0
+    par = [c for c in make_cases(CARS[args.car], args.limit, args.seed) if c.category == "parallel"]
+    for c in par:
+        w = reverse_s_entry(c)
+        found += w is not None
+        how = f"d {w[0]:.2f} m, phi {math.degrees(w[1]):.0f} deg" if w else "none"
+        print(f"{c.case_id}: slot {c.size:.2f} car lengths, reverse S entry: {how}")
+    print(f"{found}/{len(par)} parallel slots have a clear one-manoeuvre (reverse S) entry")

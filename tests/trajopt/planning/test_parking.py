@@ -163,6 +163,24 @@ def test_bays_have_their_free_width():
         assert right - left == pytest.approx(c.size * FULL.width, abs=1e-9)
 
 
+def test_a_parallel_slot_has_a_reverse_s_witness():
+    # the first full-size case, a slot 1.45 car lengths long: one reverse S (two arcs at R)
+    # enters it clear of every polygon; rebuilt here and checked pose by pose
+    case = pc.make_cases(FULL, 1, seed=0)[0]
+    assert case.category == "parallel" and 1.4 < case.size < 1.5
+    d, phi = pc.reverse_s_entry(case)
+    R, side = FULL.turning_radius, 1.0 if math.cos(case.goal[2]) > 0 else -1.0
+    back = pc.arc_poses(case.goal, 0.0, d, -1, 0.004)
+    a1 = pc.arc_poses(tuple(back[-1]), side / R, R * phi, +1, 0.004)
+    a2 = pc.arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, 0.004)
+    poses = np.vstack([back, a1, a2])
+    check = pc.check_poses(FULL.body(), poses, case.polygons)
+    assert check.overlaps == 0 and check.max_corner_step <= 0.01
+    assert a2[-1, 1] - case.goal[1] == pytest.approx(2 * R * (1 - math.cos(phi)), abs=1e-9)
+    with pytest.raises(ValueError, match="parallel"):
+        pc.reverse_s_entry(pc.make_cases(FULL, 3, seed=0)[2])
+
+
 # ------------------------------------------------------------------ plans, checked exactly
 
 
