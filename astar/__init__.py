@@ -17,6 +17,7 @@ __version__ = "0.1.0"
 _EXPORTS: dict[str, str] = {
     # values and errors
     "OccupancyGrid": "astar.grid",
+    "from_polygons": "astar.grid",
     "AstarError": "astar.errors",
     "InvalidInputError": "astar.errors",
     "MapFormatError": "astar.errors",
@@ -84,7 +85,7 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from astar.costmap import Costmap, from_costmap, load_costmap
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
-    from astar.grid import OccupancyGrid
+    from astar.grid import OccupancyGrid, from_polygons
     from astar.hybrid import NoPosePathError, PosePath, find_pose_path
     from astar.hybrid_options import HybridCollision, HybridCosts, HybridLimits, HybridMotion
     from astar.inflation import avoidance_area, clearance, clearance_cost, inflate

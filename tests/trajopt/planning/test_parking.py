@@ -1,0 +1,250 @@
+"""The parking suite's exact body checker (``benchmarks/parking_cases.py``) and parking plans.
+
+The checker is tested on hand-built poses whose answer is known (a corner 1 cm into a parked
+car, 1 cm clear of it, touching it; the body inside a polygon and a polygon inside the body;
+the notch of a non-convex kerb) and against shapely on random poses; its dense sampling
+keeps every body corner within 1 cm between poses. The suite's cases hold the ranges of
+issue 45. Then scenes the planner parks today, each checked by the exact checker against
+the polygons (not the grid): the small delivery car (0.9 x 0.5 m, R = 0.6 m) on a 5 cm grid
+from ``astar.OccupancyGrid.from_polygons``, into a perpendicular bay 1.4 car widths wide,
+forwards and backwards, and a bay 1.25 car widths wide backwards.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import astar
+import trajopt
+from benchmarks import parking_cases as pc
+
+SMALL = pc.CARS["small"]
+FULL = pc.CARS["full"]
+
+
+def test_cars_are_the_issues_cars():
+    assert (FULL.length, FULL.width, FULL.rear_offset) == (4.69, 1.94, 0.96)
+    assert (FULL.turning_radius, FULL.wheelbase) == (3.0, 2.8)
+    assert (SMALL.length, SMALL.width, SMALL.turning_radius) == (0.9, 0.5, 0.6)
+    robot = FULL.robot()
+    np.testing.assert_allclose(robot.footprint.vertices, FULL.body())
+    assert robot.drive.min_turning_radius == 3.0 and robot.drive.wheelbase == 2.8
+    # the body is counter-clockwise around the rear axle, 0.96 m ahead of the rear bumper
+    b = FULL.body()
+    assert b[:, 0].min() == -0.96 and b[:, 0].max() == pytest.approx(4.69 - 0.96)
+    area2 = np.sum(b[:, 0] * np.roll(b[:, 1], -1) - np.roll(b[:, 0], -1) * b[:, 1])
+    assert area2 > 0
+
+
+# ------------------------------------------------------------------ the checker by hand
+
+PARKED = pc.rect(3.0, 0.0, 0.9, 0.5)  # a parked small car, x in [2.55, 3.45], y in [-0.25, 0.25]
+FRONT = SMALL.length - SMALL.rear_offset  # rear axle to front bumper (m)
+
+
+@pytest.mark.parametrize(
+    ("gap", "overlaps"),
+    [(0.01, False), (1e-6, False), (0.0, True), (-1e-6, True), (-0.01, True)],
+)
+def test_front_bumper_against_a_parked_car(gap, overlaps):
+    # facing +x, the front bumper gap m short of the parked car's rear (x = 2.55)
+    pose = np.array([[2.55 - gap - FRONT, 0.1, 0.0]])
+    assert pc.body_overlaps(SMALL.body(), pose, [PARKED])[0] == overlaps
+
+
+def test_a_turned_corner_into_a_parked_car():
+    # turned by -30 degrees, the front-left corner leads: put it 1 cm into (or short of) the
+    # middle of the parked car's rear edge (x = 2.55); both edges at that corner fall back
+    th = math.radians(-30.0)
+    corner = np.array([FRONT, 0.25])
+    rot = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+    for depth, want in ((0.01, True), (1e-9, True), (-0.01, False)):
+        xy = np.array([2.55 + depth, 0.0]) - rot @ corner
+        pose = np.array([[*xy, th]])
+        assert pc.body_overlaps(SMALL.body(), pose, [PARKED])[0] == want
+        clr = pc.body_clearance(SMALL.body(), pose, [PARKED])[0]
+        assert clr == (0.0 if want else pytest.approx(0.01, abs=1e-9))
+
+
+def test_containment_either_way_is_an_overlap():
+    big = pc.rect(0.0, 0.0, 10.0, 10.0)  # the body wholly inside: no edges meet
+    tiny = np.array([(0.1, -0.05), (0.2, -0.05), (0.15, 0.05)])  # wholly inside the body
+    pose = np.array([[0.0, 0.0, 0.3]])
+    assert pc.body_overlaps(SMALL.body(), pose, [big])[0]
+    assert pc.body_overlaps(SMALL.body(), pose, [tiny])[0]
+    # and the body in the hole of nothing: clear of a polygon far away
+    assert not pc.body_overlaps(SMALL.body(), pose, [tiny + 5.0])[0]
+
+
+def test_the_notch_of_a_non_convex_kerb_is_free():
+    u = pc._u_kerb(-1.0, 1.0, -1.0, 1.0, 0.2)  # a U round [-1, 1]^2, open at the top
+    inside = np.array([[-0.2, 0.0, 0.0], [0.0, -0.3, math.pi / 2], [0.0, 0.8, 1.0]])
+    assert not pc.body_overlaps(SMALL.body(), inside, [u]).any()
+    across = np.array([[0.5, 0.0, 0.0], [0.0, -0.9, 0.0]])  # through an arm, the bottom
+    assert pc.body_overlaps(SMALL.body(), across, [u]).all()
+
+
+def test_checker_agrees_with_shapely_on_random_poses():
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import Polygon
+
+    rng = np.random.default_rng(3)
+    for case in pc.make_cases(SMALL, 6, seed=5):
+        x0, y0, x1, y1 = case.bounds
+        poses = np.column_stack(
+            [rng.uniform(x0, x1, 800), rng.uniform(y0, y1, 800), rng.uniform(-4, 4, 800)]
+        )
+        mine = pc.body_overlaps(SMALL.body(), poses, case.polygons)
+        union = shapely.union_all([Polygon(p) for p in case.polygons])
+        ref = [union.intersects(Polygon(b)) for b in pc.body_at(SMALL.body(), poses)]
+        np.testing.assert_array_equal(mine, ref)
+        assert 0.05 < mine.mean() < 0.95  # both answers occur
+
+
+# ------------------------------------------------------------------ the suite
+
+
+@pytest.mark.parametrize("car", [FULL, SMALL], ids=["full", "small"])
+def test_cases_hold_the_issues_ranges(car):
+    cases = pc.make_cases(car, 18, seed=1)
+    assert [c.category for c in cases[:6]] == [
+        "parallel",
+        "parallel",
+        "perpendicular",
+        "perpendicular",
+        "angled",
+        "angled",
+    ]
+    s = car.length / 4.69
+    for c in cases:
+        assert 4.0 * s <= c.aisle <= 7.0 * s
+        if c.category == "parallel":
+            assert 1.2 <= c.size <= 1.6 and c.angle == 0.0
+        else:
+            assert 1.15 <= c.size <= 1.4
+            assert c.angle == 90.0 if c.category == "perpendicular" else 45.0 <= c.angle <= 60.0
+        poses = np.array([c.start, c.goal])
+        assert not pc.body_overlaps(car.body(), poses, c.polygons).any()
+        # every polygon is a valid obstacle, and the grid holds the goal's surroundings
+        grid = c.grid(0.1)
+        assert grid.resolution == 0.1 and grid.occupied.any()
+        if c.category != "parallel":
+            gh = c.goal[2] % (2 * math.pi)
+            into = (c.entry == "forwards") == (math.sin(gh) < 0)  # bays lie below the aisle
+            assert into
+    again = pc.make_cases(car, 18, seed=1)
+    assert [c.start for c in again] == [c.start for c in cases]
+    assert [c.start for c in pc.make_cases(car, 18, seed=2)] != [c.start for c in cases]
+
+
+def test_bays_have_their_free_width():
+    # the neighbours' facing sides are size * car width apart, measured across the bay
+    for c in pc.make_cases(FULL, 12, seed=4):
+        if c.category == "parallel":
+            continue
+        gh = c.goal[2]
+        along = np.array([math.cos(gh), math.sin(gh)])
+        across = np.array([-along[1], along[0]])
+        goal_body = pc.body_at(FULL.body(), np.array([c.goal]))[0]
+        centre = goal_body.mean(axis=0)
+        lo, hi = (goal_body @ along).min(), (goal_body @ along).max()
+        # the parked cars beside the bay: rectangles that overlap the goal body along its axis
+        cars = [
+            p
+            for p in c.polygons
+            if len(p) == 4 and (p @ along).max() > lo and (p @ along).min() < hi
+        ]
+        side = [(p - centre) @ across for p in cars]
+        left = max(t.max() for t in side if t.max() < 0)
+        right = min(t.min() for t in side if t.min() > 0)
+        assert right - left == pytest.approx(c.size * FULL.width, abs=1e-9)
+
+
+def test_a_parallel_slot_has_a_reverse_s_witness():
+    # the first full-size case, a slot 1.45 car lengths long: one reverse S (two arcs at R)
+    # enters it clear of every polygon; rebuilt here and checked pose by pose
+    case = pc.make_cases(FULL, 1, seed=0)[0]
+    assert case.category == "parallel" and 1.4 < case.size < 1.5
+    d, phi = pc.reverse_s_entry(case)
+    R, side = FULL.turning_radius, 1.0 if math.cos(case.goal[2]) > 0 else -1.0
+    back = pc.arc_poses(case.goal, 0.0, d, -1, 0.004)
+    a1 = pc.arc_poses(tuple(back[-1]), side / R, R * phi, +1, 0.004)
+    a2 = pc.arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, 0.004)
+    poses = np.vstack([back, a1, a2])
+    check = pc.check_poses(FULL.body(), poses, case.polygons)
+    assert check.overlaps == 0 and check.max_corner_step <= 0.01
+    assert a2[-1, 1] - case.goal[1] == pytest.approx(2 * R * (1 - math.cos(phi)), abs=1e-9)
+    with pytest.raises(ValueError, match="parallel"):
+        pc.reverse_s_entry(pc.make_cases(FULL, 3, seed=0)[2])
+
+
+# ------------------------------------------------------------------ plans, checked exactly
+
+
+def bay_scene(size: float, entry: str):
+    """A perpendicular bay ``size`` small-car widths wide below an aisle 1.2 m wide.
+
+    Three parked cars each side (0.15 m apart), a U-shaped kerb round the lot, a wall on
+    top; the start in the aisle 1.6 m to the left facing +x, the goal centred in the bay.
+    """
+    ln, wd = SMALL.length, SMALL.width
+    free = size * wd
+    cars = [
+        pc.rect(s * (0.5 * free + 0.5 * wd + k * (wd + 0.15)), -0.05 - 0.5 * ln, wd, ln)
+        for s in (-1.0, 1.0)
+        for k in range(3)
+    ]
+    back = -0.08 - ln - 0.1
+    polys = [*cars, pc._u_kerb(-3.0, 3.0, back, 1.2, 0.1)]
+    polys.append(np.array([(-3.1, 1.2), (3.1, 1.2), (3.1, 1.3), (-3.1, 1.3)]))
+    centre_y = -0.08 - 0.5 * ln
+    off = 0.5 * ln - SMALL.rear_offset  # rear axle to the body's centre
+    heading = -math.pi / 2 if entry == "forwards" else math.pi / 2
+    goal = (0.0, centre_y - off * math.sin(heading), heading)
+    return polys, (-3.1, back - 0.1, 3.1, 1.3), (-1.6, 0.6, 0.0), goal
+
+
+SCENES = [(1.4, "forwards"), (1.4, "backwards"), (1.25, "backwards")]
+
+
+@pytest.fixture(scope="module")
+def parked():
+    robot = SMALL.robot()
+    out = {}
+    for size, entry in SCENES:
+        polys, bounds, start, goal = bay_scene(size, entry)
+        grid = astar.OccupancyGrid.from_polygons(polys, 0.05, bounds)
+        traj = trajopt.plan(
+            grid, start[:2], goal[:2], robot, start_heading=start[2], goal_heading=goal[2]
+        )
+        out[size, entry] = (polys, start, goal, traj)
+    return out
+
+
+@pytest.mark.parametrize(("size", "entry"), SCENES)
+def test_small_car_parks_in_a_bay_with_no_overlap(parked, size, entry):
+    polys, start, goal, traj = parked[size, entry]
+    t, poses = pc.trajectory_poses(traj, SMALL.body())
+    # dense: no corner moves more than 1 cm between poses
+    corners = pc.body_at(SMALL.body(), poses)
+    assert np.hypot(*np.moveaxis(np.diff(corners, axis=0), -1, 0)).max() <= 0.01
+    np.testing.assert_allclose(poses[0], start, atol=1e-6)
+    np.testing.assert_allclose(poses[-1, :2], goal[:2], atol=1e-6)
+    assert abs(math.remainder(poses[-1, 2] - goal[2], 2 * math.pi)) < 1e-6
+    check = pc.check_poses(SMALL.body(), poses, polys)
+    assert check.overlaps == 0 and check.min_clearance > 0.0
+    # the body ends between its neighbours, below the aisle
+    end = pc.body_at(SMALL.body(), poses[-1:])[0]
+    assert end[:, 1].max() < 0.0 and np.abs(end[:, 0]).max() <= 0.5 * size * SMALL.width
+
+
+def test_checker_finds_an_obstacle_put_on_the_path(parked):
+    polys, start, goal, traj = parked[1.4, "backwards"]
+    _, poses = pc.trajectory_poses(traj, SMALL.body())
+    mid = poses[len(poses) // 2]
+    pebble = pc.rect(mid[0], mid[1], 0.02, 0.02)  # 2 cm square under the rear axle
+    check = pc.check_poses(SMALL.body(), poses, [*polys, pebble])
+    assert check.overlaps > 0 and check.min_clearance == 0.0
