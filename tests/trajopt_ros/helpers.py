@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import threading
 import time
 
 import numpy as np
@@ -81,9 +82,10 @@ def wait_for(predicate, timeout: float = 10.0, what: str = "condition"):
 
 
 def call(client, request, timeout: float = 10.0):
-    """Call a service and wait for the answer."""
+    """Call a service and wait for the answer (woken by the answer itself, not by polling)."""
+    done = threading.Event()
     fut = client.call_async(request)
-    return (
-        wait_for(lambda: fut.done() and (fut.result() or True), timeout, "service answer")
-        and fut.result()
-    )
+    fut.add_done_callback(lambda _f: done.set())
+    if not done.wait(timeout):
+        raise TimeoutError(f"service answer not met within {timeout} s")
+    return fut.result()
