@@ -111,6 +111,13 @@ class KernelMotion(NamedTuple):
         Heading bins.
     reverse : bool
         Backwards primitives and Reeds-Shepp shots (else forwards only, Dubins shots).
+    backward : bool
+        Search from the goal (the query's ``sx, sy, sth`` is then the path's *end*, its
+        ``gx, gy, gth`` the path's *start*): the search runs back in time, each primitive
+        is driven in the opposite direction to the one the path drives it in (the path's
+        backwards primitives cost ``reverse_penalty``), and the shots are words from the
+        path's start to the expanded pose (a pull-out from a parking slot, searched where
+        space is tight, whose shots land in the open).
     """
 
     radius: float
@@ -118,6 +125,7 @@ class KernelMotion(NamedTuple):
     prim_len: float
     nbins: int
     reverse: bool
+    backward: bool
 
 
 class KernelCosts(NamedTuple):
@@ -757,12 +765,23 @@ def _cheap_h(x, y, gx, gy, h2d):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _heuristic(
-    x, y, th, gx, gy, gth, h2d, radius, reverse, window, kinds, lens, buf
+    x, y, th, gx, gy, gth, h2d, radius, reverse, backward, window, kinds, lens, buf
 ):  # pragma: no cover
-    """Return the full heuristic: :func:`_cheap_h` and, near the goal, the car length."""
+    """Return the full heuristic: :func:`_cheap_h` and, near the goal, the car length.
+
+    ``backward``: the car length from ``(gx, gy, gth)`` to the pose (the path drives it that
+    way; a Dubins length is not symmetric).
+    """
     h = _cheap_h(x, y, gx, gy, h2d)
     if math.hypot(gx - x, gy - y) < window:
-        c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
+        if backward:
+            c, _ = car_word(
+                gx, gy, gth, x, y, th, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0
+            )
+        else:
+            c, _ = car_word(
+                x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0
+            )
         h = max(h, c)
     return h
 
@@ -793,14 +812,17 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     nodes : ndarray of float64, shape (n, 3)
         Poses of the nodes created (x, y, heading unwrapped).
     prims : ndarray of int32, shape (n,)
-        Primitive reaching each node: ``2 * curvature index + (1 if backwards)``; -1 at start.
+        Primitive reaching each node: ``2 * curvature index + (1 if the path drives it
+        backwards)``; -1 at start.
     shot_kinds, shot_lens : ndarray, shape (5,)
-        The analytic shot's word; ``shot_n`` segments of it.
+        The analytic shot's word (from the last node of ``chain`` to the goal pose; with
+        ``motion.backward`` from the query's ``gx, gy, gth`` to that node); ``shot_n``
+        segments of it.
     shot_n, expansions, shots : int
         Segments of the shot, nodes expanded, analytic shots tried.
     """
     free, h2d, sx, sy, sth, gx, gy, gth = query
-    radius, curvatures, prim_len, nbins, reverse = motion
+    radius, curvatures, prim_len, nbins, reverse, backward = motion
     (
         reverse_penalty,
         cusp_penalty,
@@ -860,7 +882,9 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     keys[s0] = k0
     vals[s0] = 0
     used = 1
-    h0 = _heuristic(sx, sy, sth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf)
+    h0 = _heuristic(
+        sx, sy, sth, gx, gy, gth, h2d, radius, reverse, backward, car_window, kinds, lens, buf
+    )
     hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, hweight * h0, 0.0, 0)
 
     expansions = 0
@@ -893,6 +917,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 h2d,
                 radius,
                 reverse,
+                backward,
                 car_window,
                 kinds,
                 lens,
@@ -920,13 +945,18 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         countdown -= 1
         if countdown <= 0:
             shots += 1
+            # the word as the path drives it: to the goal, or (backward) from the path's start
+            if backward:
+                ax, ay, ath, bx, by, bth = gx, gy, gth, ux, uy, uth
+            else:
+                ax, ay, ath, bx, by, bth = ux, uy, uth, gx, gy, gth
             c, n = car_word(
-                ux,
-                uy,
-                uth,
-                gx,
-                gy,
-                gth,
+                ax,
+                ay,
+                ath,
+                bx,
+                by,
+                bth,
                 radius,
                 reverse,
                 kinds,
@@ -937,14 +967,17 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 1.0 + turn_penalty,
             )
             if pu >= 0:
-                for i in range(n):
+                # a cusp where the word meets the node's primitive (its first segment after
+                # the primitive forwards, its last before the primitive driven back)
+                for j in range(n):
+                    i = n - 1 - j if backward else j
                     if lens[i] != 0.0:
                         if (lens[i] < 0.0) != ((pu & 1) == 1):
                             c += cusp_penalty
                         break
             if (
                 ug + c < best
-                and word_clear(free, ux, uy, uth, radius, kinds, lens, n, step, safe, occ, exact_r)
+                and word_clear(free, ax, ay, ath, radius, kinds, lens, n, step, safe, occ, exact_r)
                 and (
                     not footprint
                     or footprint_word_clear(
@@ -952,9 +985,9 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         fsafe,
                         fp,
                         frho,
-                        ux,
-                        uy,
-                        uth,
+                        ax,
+                        ay,
+                        ath,
                         radius,
                         kinds,
                         lens,
@@ -979,8 +1012,10 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         for ci in range(nc):
             kappa = curvatures[ci]
             for di in range(ndirs):
+                # di: the direction the path drives the primitive (0 forwards); the search
+                # drives it the other way when it runs back from the goal
                 d = 1.0 if di == 0 else -1.0
-                s = d * prim_len
+                s = -d * prim_len if backward else d * prim_len
                 if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
                     continue
                 if footprint and not footprint_arc_clear(
