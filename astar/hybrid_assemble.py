@@ -122,7 +122,9 @@ def assemble(out, kappas, prim_len, radius, step, start, goal, exact=False, back
                 c = np.array([advance.py_func(px, py, pth, k, s * j / m) for j in range(1, m + 1)])
             else:  # sampled from the other end, driven back: the same samples reversed
                 ax, ay, ath, off, sk = origin
-                c = np.array([advance.py_func(ax, ay, ath, k, sk * j / m) for j in range(m - 1, -1, -1)])
+                c = np.array(
+                    [advance.py_func(ax, ay, ath, k, sk * j / m) for j in range(m - 1, -1, -1)]
+                )
                 c[:, 2] += off
             chunks.append(c)
             dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))

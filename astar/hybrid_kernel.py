@@ -775,13 +775,9 @@ def _heuristic(
     h = _cheap_h(x, y, gx, gy, h2d)
     if math.hypot(gx - x, gy - y) < window:
         if backward:
-            c, _ = car_word(
-                gx, gy, gth, x, y, th, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0
-            )
+            c, _ = car_word(gx, gy, gth, x, y, th, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
         else:
-            c, _ = car_word(
-                x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0
-            )
+            c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
         h = max(h, c)
     return h
 

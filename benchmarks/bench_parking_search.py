@@ -72,9 +72,9 @@ def parallel_case(name, robot, length, width, rear, ratio, res) -> Case:
     occ = np.zeros((ny, nx), dtype=bool)
     occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
     occ[: round((wall + depth) / res), :] = True  # the parked cars and the kerb
-    occ[round(wall / res) : round((wall + depth) / res), round(x0 / res) : round((x0 + slot) / res)] = (
-        False
-    )
+    occ[
+        round(wall / res) : round((wall + depth) / res), round(x0 / res) : round((x0 + slot) / res)
+    ] = False
     grid = astar.OccupancyGrid(occ, res)
     start = (x0 - 1.0 * length + rear, wall + depth + 0.5 * lane, 0.0)
     goal = (x0 + 0.5 * (slot - length) + rear, wall + 0.5 * depth, 0.0)
@@ -93,9 +93,9 @@ def bay_case(name, robot, length, width, rear, ratio, aisle, res, backwards) -> 
     occ = np.zeros((ny, nx), dtype=bool)
     occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
     occ[: round((wall + depth) / res), :] = True
-    occ[round(wall / res) : round((wall + depth) / res), round(x0 / res) : round((x0 + bay) / res)] = (
-        False
-    )
+    occ[
+        round(wall / res) : round((wall + depth) / res), round(x0 / res) : round((x0 + bay) / res)
+    ] = False
     grid = astar.OccupancyGrid(occ, res)
     start = (x0 - 1.5 * length, wall + depth + 0.5 * aisle, 0.0)
     gx = x0 + 0.5 * bay
@@ -114,7 +114,9 @@ def cases() -> list[Case]:
     for tag, (ln, wd, rear, rad) in (("body", body), ("small", small)):
         robot = car(ln, wd, rear, rad)
         for ratio in (1.25, 1.3, 1.4, 1.5):
-            out.append(parallel_case(f"{tag}-parallel-{ratio:g}", robot, ln, wd, rear, ratio, 0.025))
+            out.append(
+                parallel_case(f"{tag}-parallel-{ratio:g}", robot, ln, wd, rear, ratio, 0.025)
+            )
     full = car(4.69, 1.94, 0.96, 3.0, wheelbase=2.8)
     out.append(parallel_case("full-parallel-1.3", full, 4.69, 1.94, 0.96, 1.3, 0.1))
     for backwards in (True, False):
