@@ -35,6 +35,7 @@ from astar.hybrid_assemble import COLLISION_STEP, assemble
 from astar.hybrid_modes import kernel_collision
 from astar.hybrid_options import (
     AUTO_FIRST_SHARE,
+    AUTO_PROBE,
     HybridCollision,
     HybridCosts,
     HybridLimits,
@@ -360,11 +361,11 @@ def find_pose_path(
     order = _order(limits.search_from, free, (six, siy), (gix, giy), radius)
     fields: dict[bool, np.ndarray] = {}
     reach = _DIJKSTRA_SLACK_R * radius + 50.0
-    if order[0]:  # from the goal: the 2-D distances to the start
+    if order[0][0]:  # from the goal: the 2-D distances to the start
         h2d, reached = distance_field(free, six, siy, gix, giy, reach)
     else:
         h2d, reached = distance_field(free, gix, giy, six, siy, reach)
-    fields[order[0]] = h2d
+    fields[order[0][0]] = h2d
     t1 = time.perf_counter()
     stats: dict[str, Any] = {
         "expanded": 0,
@@ -375,7 +376,7 @@ def find_pose_path(
         "total_s": 0.0,
         "primitive_length": prim_len,
         "heading_bins": nbins,
-        "search_from": "goal" if order[0] else "start",
+        "search_from": "goal" if order[0][0] else "start",
         "searches": [],
     }
     if collision.footprint is not None:
@@ -417,13 +418,13 @@ def find_pose_path(
 
     expanded = shots = 0
     retried = False
-    backward = order[0]
-    for k, backward in enumerate(order):
-        if k == 0 and len(order) == 2:
-            exp_cap = max(1, int(AUTO_FIRST_SHARE * max_exp))
+    backward = order[0][0]
+    for backward, cap in order:
+        exp_cap, deadline = max_exp - expanded, t1 + budget
+        if cap is not None:  # the first of two: a share of the budgets
+            share = max(1, int(AUTO_FIRST_SHARE * max_exp))
+            exp_cap = share if cap < 0 else min(cap, share)
             deadline = t1 + AUTO_FIRST_SHARE * budget
-        else:
-            exp_cap, deadline = max_exp - expanded, t1 + budget
         plen, bins = prim_len, nbins
         out = search(backward, plen, bins, exp_cap, deadline)
         status, n_exp = out[0], int(out[7])
@@ -504,19 +505,20 @@ def find_pose_path(
 
 def _order(
     search_from: str, free: np.ndarray, s: tuple[int, int], g: tuple[int, int], radius: float
-) -> tuple[bool, ...]:
-    """Return the searches to run, as ``backward`` flags (True: from the goal), in order.
+) -> tuple[tuple[bool, int | None], ...]:
+    """Return the searches to run in order: ``(backward, expansion cap or None)``.
 
-    ``"auto"``: first from the end whose cell is nearer a blocked cell of ``free`` (or the
-    grid's side; distances between cell centres, capped at ``2 radius`` cells, compared to
-    one cell; a tie: from the start), then from the other end.
+    ``"auto"``: from the start, then from the goal. When the goal's cell is nearer a blocked
+    cell of ``free`` (or the grid's side) than the start's (distances between cell centres,
+    capped at ``2 radius`` cells, by more than one cell), the search from the start is a
+    probe of :data:`AUTO_PROBE` expansions (a goal tight but easy to reach keeps the path
+    searched from the start), else it has :data:`AUTO_FIRST_SHARE` of the expansions.
     """
     if search_from != "auto":
-        return (search_from == "goal",)
+        return ((search_from == "goal", None),)
     cap = max(2.0, 2.0 * radius)
-    room_s = _room(free, s, cap)
-    room_g = _room(free, g, cap)
-    return (True, False) if room_g < room_s - 1.0 else (False, True)
+    tight_goal = _room(free, g, cap) < _room(free, s, cap) - 1.0
+    return ((False, AUTO_PROBE if tight_goal else -1), (True, None))
 
 
 def _room(free: np.ndarray, cell: tuple[int, int], cap: float) -> float:

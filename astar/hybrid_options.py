@@ -41,6 +41,7 @@ from astar.hybrid_modes import DEFAULT_SLACK, footprint_polygon, raw_occupied
 
 __all__ = [
     "AUTO_FIRST_SHARE",
+    "AUTO_PROBE",
     "FLAT_KEYWORDS",
     "SEARCH_FROM",
     "HybridCollision",
@@ -54,6 +55,8 @@ __all__ = [
 SEARCH_FROM = ("auto", "start", "goal")
 #: ``search_from="auto"``: the share of the budgets (seconds, expansions) of the first search.
 AUTO_FIRST_SHARE = 0.5
+#: ``search_from="auto"``: expansions of the search from the start when the goal is tighter.
+AUTO_PROBE = 1000
 
 
 @dataclass(frozen=True, slots=True)
@@ -220,13 +223,14 @@ class HybridLimits:
         shots ending at the goal. ``"goal"``: from the goal pose back in time (the path
         driven backwards from its end: a pull-out of a parking slot), its shots starting
         at the start pose; the path returned is the same kind of path, from the start to
-        the goal. ``"auto"`` (default): first from the end with less room (the smaller
-        distance from its cell to a blocked cell of the grid, capped at ``2 R``; a tie:
-        from the start), with :data:`AUTO_FIRST_SHARE` of ``time_budget`` and of
-        ``max_expansions``; when that search gives up (not when it exhausts the states),
-        from the other end with what is left. A search from the tight end lands its
-        shots in the open: parking into a slot 1.3 car lengths long takes a few thousand
-        expansions that way, and does not finish within 2 s from the lane.
+        the goal. ``"auto"`` (default): from the start with :data:`AUTO_FIRST_SHARE` of
+        ``time_budget`` and of ``max_expansions``, or, when the goal has less room than the
+        start (the distance from its cell to a blocked cell of the grid, capped at ``2 R``,
+        smaller by more than a cell), with at most :data:`AUTO_PROBE` expansions; when that
+        search gives up (not when it exhausts the states), from the goal with what is left.
+        A search from the tight end lands its shots in the open: parking into a slot 1.3
+        car lengths long takes a few thousand expansions from the slot, and does not finish
+        within 2 s from the lane.
 
     Raises
     ------
