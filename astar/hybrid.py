@@ -427,16 +427,17 @@ def find_pose_path(
             deadline = t1 + AUTO_FIRST_SHARE * budget
         plen, bins = prim_len, nbins
         out = search(backward, plen, bins, exp_cap, deadline)
-        status, n_exp = out[0], int(out[7])
+        status, n_exp = out[0], min(int(out[7]), exp_cap)  # the kernel counts the one refused
         expanded += n_exp
         shots += int(out[8])
         if status == EXHAUSTED and n_exp <= _RETRY_BELOW and max_exp > expanded:
             # a small region was exhausted (a pocket where no primitive fits?): once more with
             # primitives a third as long and three times as many heading bins
             plen, bins = prim_len / 3.0, 3 * nbins
-            out = search(backward, plen, bins, max_exp - expanded, t1 + budget)
+            left = max_exp - expanded
+            out = search(backward, plen, bins, left, t1 + budget)
             status, retried = out[0], True
-            expanded += int(out[7])
+            expanded += min(int(out[7]), left)
             shots += int(out[8])
         stats["searches"].append(
             {"from": "goal" if backward else "start", "status": int(status), "expanded": n_exp}

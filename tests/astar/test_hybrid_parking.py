@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 import astar
 from astar import InvalidInputError, NoPathError
 from astar.hybrid import find_pose_path
+from astar.hybrid_options import AUTO_PROBE
 from tests.astar.test_hybrid import check_path
 from tests.astar.test_hybrid_footprint import (
     REAR,
@@ -128,8 +129,11 @@ def _search(occ, poly, start, goal, **kw):
 def test_parallel_slot_1_3_lengths_is_parked_backwards_from_the_goal():
     occ, poly, start, goal = parallel_slot(1.3)
     p = _search(occ, poly, start, goal, time_budget=2.0)
-    assert p.stats["search_from"] == "goal"  # the slot is the tighter end
-    assert p.stats["searches"][0]["from"] == "goal" and len(p.stats["searches"]) == 1
+    # the slot is the tighter end: a probe from the start, then the search from the goal
+    assert p.stats["search_from"] == "goal"
+    probe, pull_out = p.stats["searches"]
+    assert probe == {"from": "start", "status": 2, "expanded": AUTO_PROBE}
+    assert pull_out["from"] == "goal" and pull_out["status"] == 1
     assert p.cusps >= 1 and p.reverse_length > 0.0
     check_big_body(p, occ, poly, start, goal)
     # the check is not vacuous: one more occupied cell under the body half way is caught
@@ -168,17 +172,18 @@ def test_auto_searches_from_the_start_when_the_start_is_tighter():
 
 
 def test_auto_falls_back_to_the_other_end():
-    """When the first search gives up, the other end runs with what is left of the budget."""
+    """A search that gives up passes what is left of the budget to the other end."""
     occ, poly, start, goal = parallel_slot(1.3)
-    p = _search(occ, poly, start, goal, max_expansions=2000, search_from="auto")
-    assert p.stats["search_from"] == "goal"
-    # a budget whose half is too small for the search from the goal: the start's half is
-    # searched too, and the refusal counts both
     with pytest.raises(NoPathError) as info:
         _search(occ, poly, start, goal, max_expansions=200)
     st_ = info.value.stats
-    assert [s["from"] for s in st_["searches"]] == ["goal", "start"]
-    assert st_["expanded"] == sum(s["expanded"] for s in st_["searches"]) <= 201
+    assert info.value.reason == "max_expansions"
+    assert [s["from"] for s in st_["searches"]] == ["start", "goal"]
+    assert st_["searches"][0]["expanded"] == 100  # AUTO_FIRST_SHARE of 200 (< AUTO_PROBE)
+    assert st_["expanded"] == sum(s["expanded"] for s in st_["searches"]) == 200
+    # the pull-out turned round: the start is the tighter end, searched first with half
+    p = _search(occ, poly, goal, start, max_expansions=4000)
+    assert [s["from"] for s in p.stats["searches"]] == ["start"]
 
 
 # --------------------------------------------------------------------------- random maps
