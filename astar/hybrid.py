@@ -106,7 +106,10 @@ class PosePath:
         tried), ``heuristic_s``, ``search_s``, ``total_s`` (seconds), ``primitive_length``
         (cells) and ``heading_bins`` of the search that found the path, ``retried`` (whether
         the finer second search ran); in the footprint mode of :func:`find_pose_path` also
-        ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells).
+        ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells);
+        ``search_from`` (``"start"`` or ``"goal"``: the search that returned) and
+        ``searches`` (per search run: ``from``, ``status`` (the kernel's code: 1 found, 0
+        exhausted, 2 max_expansions, 3 time_budget) and ``expanded``).
 
     Attributes
     ----------
@@ -265,7 +268,8 @@ def find_pose_path(
         (0.05), ``steer_penalty`` (0.05), ``analytic_ratio`` (3.5), ``heuristic_weight``
         (1.5). Default: ``HybridCosts()``.
     limits : HybridLimits, optional
-        ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells).
+        ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells),
+        ``search_from`` (``"auto"``: from the start, then from the goal; see Notes).
         Default: ``HybridLimits()``.
     collision : HybridCollision, optional
         What the path keeps clear of besides ``grid``: nothing (the default), the raw map
@@ -314,7 +318,16 @@ def find_pose_path(
     cheapest path (costs: length, backwards and arc weights, cusps). When the search exhausts
     a small region (at most 20 000 expansions: a pocket where no primitive fits, a dead end),
     it runs once more with primitives a third as long and three times as many heading bins,
-    within the remaining budgets. The heuristic is
+    within the remaining budgets. The search may also grow from the goal
+    (``search_from="goal"``): it drives its primitives back in time from the goal pose and
+    shoots words from the start pose, and the path it returns is the same kind of path (from
+    the start, each piece driven as the path drives it, checked the same way). With
+    ``search_from="auto"`` (the default) the search from the start runs first, with half the
+    budgets, or, when the goal's cell has less room than the start's (a parking slot, a
+    bay), as a probe of 1000 expansions; when it gives up, the search from the goal runs with
+    what is left (``stats["searches"]`` lists both, ``stats["search_from"]`` names the one
+    that returned). From the tight end the shots land in the open: that is what parks a car
+    into a slot with many short moves. The heuristic is
     ``max(h2d, Euclidean distance, Reeds-Shepp/Dubins length)``, all lower bounds of the
     length: ``h2d`` is a Dijkstra distance from the goal's cell on the free grid (steps 1 and
     1.4, below the octile ``sqrt(2)``; computed up to ``20 R + 50`` cells beyond the start,
@@ -406,8 +419,9 @@ def find_pose_path(
     )
 
     def search(backward: bool, plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
-        if backward not in fields:
-            fields[backward] = distance_field(free, six, siy, gix, giy, reach)[0]
+        if backward not in fields:  # 2-D distances to the search's target
+            src, dst = ((six, siy), (gix, giy)) if backward else ((gix, giy), (six, siy))
+            fields[backward] = distance_field(free, *src, *dst, reach)[0]
         if backward:  # the search's root is the goal, its target the start
             query = KernelQuery(free, fields[backward], gx, gy, gth, sx, sy, sth)
         else:

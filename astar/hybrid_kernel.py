@@ -27,6 +27,11 @@ keeps the cheapest pose that reached it, and a closed state is never reopened.
   exactly at the goal pose. The search then goes on, for at most as many expansions again
   (plus ``polish``), while an open node could still lead to a cheaper path (its ``f``, a lower
   bound of the cost, is below the best path's cost), and returns the cheapest path found.
+* **From the goal** (``motion.backward``): the query's first pose is the path's end and its
+  second the path's start; the search drives each primitive the opposite way to the path
+  (so the path's costs still apply: its backwards primitives cost ``reverse_penalty``), its
+  shots are words from the path's start to the expanded pose, and its heuristic measures
+  the car length that way (a Dubins length is not symmetric).
 * **Heuristic**: ``max(h2d, euclid, car)``: ``h2d`` a lower bound of the 8-connected shortest
   distance on the free grid from the goal's cell (:func:`distance_field`, no corner cutting,
   as Smac's 2-D heuristic), ``car`` the obstacle-free Reeds-Shepp/Dubins length, evaluated
