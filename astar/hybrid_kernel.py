@@ -555,7 +555,13 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     Parameters
     ----------
     occ : ndarray of uint8, shape (ny, nx)
-        1 on occupied cells (closed squares of side 1).
+        Nonzero on occupied cells (closed squares of side 1): 1 on an occupied cell with a
+        free cell among its 8 neighbours, 2 (:func:`astar.hybrid_modes.edge_occupancy`) on
+        one whose 8 neighbours are occupied or outside, which is not tested but for the
+        cell of the pose's centre: a connected body that contains a point of a free square
+        and meets an occupied square meets one of value 1 (where it first enters the
+        occupied squares, along a path in the body from that point), so the test stays
+        exact. Plain 0/1 maps work as they are.
     fsafe : ndarray of uint8, shape (ny, nx)
         :func:`astar.hybrid_modes.footprint_safe` for a reach of at least ``rho + grow``
         (or zeros): a pose whose centre lies in a safe cell is clear without further test.
@@ -607,6 +613,8 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     # vertex keeps grow from its sides
     if minx - grow < -0.5 or maxx + grow > nx - 0.5 or miny - grow < -0.5 or maxy + grow > ny - 0.5:
         return -2
+    if occ[cy, cx] != 0:  # inside the grid: the centre's cell is in the body
+        return cy * nx + cx
     g2 = grow * grow
     lo_x = max(0, int(math.ceil(minx - grow - 0.5)))
     hi_x = min(nx - 1, int(math.floor(maxx + grow + 0.5)))
@@ -614,8 +622,8 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     hi_y = min(ny - 1, int(math.floor(maxy + grow + 0.5)))
     for iy in range(lo_y, hi_y + 1):
         for ix in range(lo_x, hi_x + 1):
-            if occ[iy, ix] == 0:
-                continue
+            if occ[iy, ix] != 1:
+                continue  # free, or occupied with occupied neighbours only (see occ)
             # separating axes x and y: the gaps between the polygon's box and the square
             gx = max(ix - 0.5 - maxx, minx - ix - 0.5, 0.0)
             gy = max(iy - 0.5 - maxy, miny - iy - 0.5, 0.0)

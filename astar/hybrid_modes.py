@@ -54,6 +54,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "DEFAULT_SLACK",
+    "edge_occupancy",
     "footprint_polygon",
     "footprint_radii",
     "footprint_safe",
@@ -194,6 +195,29 @@ def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
     return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
 
 
+def edge_occupancy(occ: np.ndarray) -> np.ndarray:
+    """Occupied cells marked by whether a free cell touches them (the footprint test's map).
+
+    Parameters
+    ----------
+    occ : ndarray of bool, shape (ny, nx)
+        True on occupied cells.
+
+    Returns
+    -------
+    ndarray of uint8, shape (ny, nx)
+        0 on free cells, 1 on occupied cells with a free cell among their 8 neighbours, 2
+        on occupied cells whose 8 neighbours are occupied or outside the grid (inside a
+        solid block: :func:`~astar.hybrid_kernel.footprint_hit` skips them, exactly).
+    """
+    from scipy.ndimage import binary_dilation
+
+    occ = np.asarray(occ, dtype=bool)
+    near_free = binary_dilation(~occ, structure=np.ones((3, 3), bool))
+    out = np.where(occ, np.where(near_free, 1, 2), 0).astype(np.uint8)
+    return np.ascontiguousarray(out)
+
+
 def raw_occupied(raw_grid: object) -> np.ndarray:
     """Return the occupied cells of a raw map as a read-only bool array (ny, nx).
 
@@ -294,7 +318,7 @@ def _footprint_inputs(
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
     fp = footprint_polygon(collision.footprint)
-    occ = np.ascontiguousarray(raw_occupancy(collision.raw_grid, free), dtype=np.uint8)
+    occ = edge_occupancy(raw_occupancy(collision.raw_grid, free))
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))

@@ -299,3 +299,33 @@ def test_search_from_bad_input():
         find_pose_path(free, (5, 5, 0.0), (12, 5, 0.0), turning_radius=3.0, search_from="end")
     with pytest.raises(InvalidInputError, match="search_from"):
         astar.HybridLimits(search_from=None)
+
+
+def test_edge_occupancy_gives_the_same_footprint_test():
+    """Solid blocks tested by their rim only (:func:`astar.hybrid_modes.edge_occupancy`):
+    the same answer as the full map, at random poses, centres inside blocks included."""
+    from astar.hybrid_kernel import footprint_hit
+    from astar.hybrid_modes import edge_occupancy, footprint_polygon
+
+    rng = np.random.default_rng(7)
+    occ = np.zeros((40, 50), bool)
+    for _ in range(8):
+        x0, y0 = rng.integers(0, 45), rng.integers(0, 35)
+        occ[y0 : y0 + rng.integers(2, 12), x0 : x0 + rng.integers(2, 12)] = True
+    edge = edge_occupancy(occ)
+    assert set(np.unique(edge)) == {0, 1, 2}
+    assert np.array_equal(edge != 0, occ)
+    full = occ.astype(np.uint8)
+    nosafe = np.zeros_like(full)
+    seen = {True: 0, False: 0}
+    for poly in (REAR * 2.0, SMALL * 3.0, REAR):
+        fp = footprint_polygon(poly)
+        buf = np.empty((len(fp), 5))
+        for _ in range(800):
+            x, y = rng.uniform(-0.5, 49.5), rng.uniform(-0.5, 39.5)
+            th, grow = rng.uniform(-np.pi, np.pi), float(rng.choice([0.0, 0.4]))
+            a = footprint_hit(full, nosafe, fp, x, y, th, grow, buf)
+            b = footprint_hit(edge, nosafe, fp, x, y, th, grow, buf)
+            assert (a == -1) == (b == -1) and (a == -2) == (b == -2), (x, y, th, grow)
+            seen[a == -1] += 1
+    assert min(seen.values()) > 100
