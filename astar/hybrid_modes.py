@@ -14,6 +14,9 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
   radii about the origin.
 * :func:`footprint_safe` marks the cells where no test is needed: every point of the cell
   keeps ``rho + margin + slack`` from every occupied square and from the outside.
+* :func:`edge_occupancy` marks the occupied cells inside solid blocks (all 8 neighbours
+  occupied or outside), which the footprint test skips, exactly (a body reaching one
+  crosses the block's rim first).
 * :func:`kernel_collision` builds the search kernel's collision record
   (:class:`~astar.hybrid_kernel.KernelCollision`) of a mode given as a
   :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
