@@ -37,7 +37,9 @@ that numba's cache of the search is rebuilt whenever they change):
   the farthest vertex from the origin), so the body at every pose within ``ds / 2`` of a
   sample lies within ``slack = ds (1 + rho |kappa|) / 2`` of the body at the sample;
   testing the footprint grown by ``margin + slack`` at the middle of each of ``m`` equal
-  steps of length ``ds`` covers the whole arc, its end poses included.
+  steps of length ``ds`` covers the whole arc, its end poses included (and one test at the
+  arc's middle, the footprint grown by ``margin`` plus the whole arc's sweep, covers it in
+  open space).
 """
 
 from __future__ import annotations

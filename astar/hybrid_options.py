@@ -299,7 +299,10 @@ class HybridCollision:
         (``rho``: the farthest vertex from the origin), so that between a step's middle and
         any pose of the step every point of the body moves at most ``footprint_slack``; the
         footprint grown by ``footprint_margin + footprint_slack`` is tested exactly
-        (separating axes, then the polygon-to-square distance) at each step's middle. The
+        (separating axes, then the polygon-to-square distance) at each step's middle (an arc
+        of more than one step is first tested once whole: the footprint grown by ``margin``
+        plus the arc's sweep ``|s| (1 + rho |kappa|) / 2`` at its middle; clear, it needs no
+        steps). The
         search's ``grid`` stays a necessary condition on the centre: pass the raw map
         inflated by the footprint's inscribed radius about the origin (a larger inflation
         loses paths, a smaller one only costs time). Cells whose every point keeps ``rho +
