@@ -31,8 +31,11 @@ import numpy as np
 from astar import validation
 from astar.errors import InvalidInputError, NoPathError
 from astar.grid import OccupancyGrid
+from astar.hybrid_assemble import COLLISION_STEP, assemble
 from astar.hybrid_modes import kernel_collision
 from astar.hybrid_options import (
+    AUTO_FIRST_SHARE,
+    AUTO_PROBE,
     HybridCollision,
     HybridCosts,
     HybridLimits,
@@ -44,7 +47,6 @@ __all__ = ["NoPosePathError", "PosePath", "find_pose_path"]
 
 logger = logging.getLogger(__name__)
 
-_COLLISION_STEP = 0.2  # cells: arc-length spacing of the collision samples
 _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyond the start
 _RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
@@ -104,7 +106,10 @@ class PosePath:
         tried), ``heuristic_s``, ``search_s``, ``total_s`` (seconds), ``primitive_length``
         (cells) and ``heading_bins`` of the search that found the path, ``retried`` (whether
         the finer second search ran); in the footprint mode of :func:`find_pose_path` also
-        ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells).
+        ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells);
+        ``search_from`` (``"start"`` or ``"goal"``: the search that returned) and
+        ``searches`` (per search run: ``from``, ``status`` (the kernel's code: 1 found, 0
+        exhausted, 2 max_expansions, 3 time_budget) and ``expanded``).
 
     Attributes
     ----------
@@ -263,7 +268,8 @@ def find_pose_path(
         (0.05), ``steer_penalty`` (0.05), ``analytic_ratio`` (3.5), ``heuristic_weight``
         (1.5). Default: ``HybridCosts()``.
     limits : HybridLimits, optional
-        ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells).
+        ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells),
+        ``search_from`` (``"auto"``: from the start, then from the goal; see Notes).
         Default: ``HybridLimits()``.
     collision : HybridCollision, optional
         What the path keeps clear of besides ``grid``: nothing (the default), the raw map
@@ -312,7 +318,16 @@ def find_pose_path(
     cheapest path (costs: length, backwards and arc weights, cusps). When the search exhausts
     a small region (at most 20 000 expansions: a pocket where no primitive fits, a dead end),
     it runs once more with primitives a third as long and three times as many heading bins,
-    within the remaining budgets. The heuristic is
+    within the remaining budgets. The search may also grow from the goal
+    (``search_from="goal"``): it drives its primitives back in time from the goal pose and
+    shoots words from the start pose, and the path it returns is the same kind of path (from
+    the start, each piece driven as the path drives it, checked the same way). With
+    ``search_from="auto"`` (the default) the search from the start runs first, with half the
+    budgets, or, when the goal's cell has less room than the start's (a parking slot, a
+    bay), as a probe of 1000 expansions; when it gives up, the search from the goal runs with
+    what is left (``stats["searches"]`` lists both, ``stats["search_from"]`` names the one
+    that returned). From the tight end the shots land in the open: that is what parks a car
+    into a slot with many short moves. The heuristic is
     ``max(h2d, Euclidean distance, Reeds-Shepp/Dubins length)``, all lower bounds of the
     length: ``h2d`` is a Dijkstra distance from the goal's cell on the free grid (steps 1 and
     1.4, below the octile ``sqrt(2)``; computed up to ``20 R + 50`` cells beyond the start,
@@ -339,7 +354,7 @@ def find_pose_path(
     nbins, prim_len = motion.heading_bins, motion.arc_length
     max_exp, budget = limits.max_expansions, limits.time_budget
     kcoll = kernel_collision(
-        collision, free, _COLLISION_STEP, (("start", (sx, sy, sth)), ("goal", (gx, gy, gth)))
+        collision, free, COLLISION_STEP, (("start", (sx, sy, sth)), ("goal", (gx, gy, gth)))
     )
 
     from astar.hybrid_kernel import (
@@ -356,7 +371,14 @@ def find_pose_path(
 
     gix, giy = int(math.floor(gx + 0.5)), int(math.floor(gy + 0.5))
     six, siy = int(math.floor(sx + 0.5)), int(math.floor(sy + 0.5))
-    h2d, reached = distance_field(free, gix, giy, six, siy, _DIJKSTRA_SLACK_R * radius + 50.0)
+    order = _order(limits.search_from, free, (six, siy), (gix, giy), radius)
+    fields: dict[bool, np.ndarray] = {}
+    reach = _DIJKSTRA_SLACK_R * radius + 50.0
+    if order[0][0]:  # from the goal: the 2-D distances to the start
+        h2d, reached = distance_field(free, six, siy, gix, giy, reach)
+    else:
+        h2d, reached = distance_field(free, gix, giy, six, siy, reach)
+    fields[order[0][0]] = h2d
     t1 = time.perf_counter()
     stats: dict[str, Any] = {
         "expanded": 0,
@@ -367,6 +389,8 @@ def find_pose_path(
         "total_s": 0.0,
         "primitive_length": prim_len,
         "heading_bins": nbins,
+        "search_from": "goal" if order[0][0] else "start",
+        "searches": [],
     }
     if collision.footprint is not None:
         stats.update(
@@ -384,7 +408,6 @@ def find_pose_path(
             stats,
         )
     kappas = motion.primitive_curvatures()
-    query = KernelQuery(free, h2d, sx, sy, sth, gx, gy, gth)
     kcosts = KernelCosts(
         costs.reverse_penalty,
         costs.cusp_penalty * radius,
@@ -395,23 +418,47 @@ def find_pose_path(
         max(30.0, 12.0 * radius),
     )
 
-    def search(plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
-        kmotion = KernelMotion(radius, kappas, plen, bins, reverse)
+    def search(backward: bool, plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
+        if backward not in fields:  # 2-D distances to the search's target
+            src, dst = ((six, siy), (gix, giy)) if backward else ((gix, giy), (six, siy))
+            fields[backward] = distance_field(free, *src, *dst, reach)[0]
+        if backward:  # the search's root is the goal, its target the start
+            query = KernelQuery(free, fields[backward], gx, gy, gth, sx, sy, sth)
+        else:
+            query = KernelQuery(free, fields[backward], sx, sy, sth, gx, gy, gth)
+        kmotion = KernelMotion(radius, kappas, plen, bins, reverse, backward)
         klimits = KernelLimits(exp_left, deadline, _POLISH)
         return hybrid_kernel(query, kmotion, kcosts, klimits, kcoll)
 
-    out = search(prim_len, nbins, max_exp, t1 + budget)
-    status, expanded, shots, retried = out[0], int(out[7]), int(out[8]), False
-    if status == EXHAUSTED and expanded <= _RETRY_BELOW and max_exp > expanded:
-        # a small region was exhausted (a pocket where no primitive fits?): once more with
-        # primitives a third as long and three times as many heading bins
-        out = search(prim_len / 3.0, 3 * nbins, max_exp - expanded, t1 + budget)
-        status, retried = out[0], True
-        expanded += int(out[7])
+    expanded = shots = 0
+    retried = False
+    backward = order[0][0]
+    for backward, cap in order:
+        exp_cap, deadline = max_exp - expanded, t1 + budget
+        if cap is not None:  # the first of two: a share of the budgets
+            share = max(1, int(AUTO_FIRST_SHARE * max_exp))
+            exp_cap = share if cap < 0 else min(cap, share)
+            deadline = t1 + AUTO_FIRST_SHARE * budget
+        plen, bins = prim_len, nbins
+        out = search(backward, plen, bins, exp_cap, deadline)
+        status, n_exp = out[0], min(int(out[7]), exp_cap)  # the kernel counts the one refused
+        expanded += n_exp
         shots += int(out[8])
-        if status == FOUND:
-            prim_len, nbins = prim_len / 3.0, 3 * nbins
-    _, chain, nodes, prims, skinds, slens, sn = out[:7]
+        if status == EXHAUSTED and n_exp <= _RETRY_BELOW and max_exp > expanded:
+            # a small region was exhausted (a pocket where no primitive fits?): once more with
+            # primitives a third as long and three times as many heading bins
+            plen, bins = prim_len / 3.0, 3 * nbins
+            left = max_exp - expanded
+            out = search(backward, plen, bins, left, t1 + budget)
+            status, retried = out[0], True
+            expanded += min(int(out[7]), left)
+            shots += int(out[8])
+        stats["searches"].append(
+            {"from": "goal" if backward else "start", "status": int(status), "expanded": n_exp}
+        )
+        if status in (FOUND, EXHAUSTED) or expanded >= max_exp:
+            break  # found, or no path at all: the other end's states are the same
+    nodes = out[2]
     t2 = time.perf_counter()
     stats.update(
         expanded=expanded,
@@ -419,8 +466,9 @@ def find_pose_path(
         shots=shots,
         search_s=t2 - t1,
         retried=retried,
-        primitive_length=prim_len,
-        heading_bins=nbins,
+        primitive_length=plen if status == FOUND else prim_len,
+        heading_bins=bins if status == FOUND else nbins,
+        search_from="goal" if backward else "start",
     )
     if status != FOUND:
         stats["total_s"] = time.perf_counter() - t0
@@ -452,112 +500,51 @@ def find_pose_path(
             reason,
             stats,
         )
-    path = _assemble(
-        nodes,
-        prims,
-        chain,
-        skinds,
-        slens,
-        int(sn),
+    arrays = assemble(
+        out,
         kappas,
-        prim_len,
+        plen,
         radius,
         limits.sample_step,
+        (sx, sy, sth),
         (gx, gy, gth),
         kcoll.exact_r > 0.0,
+        backward,
     )
+    path = PosePath(*arrays, radius)
     stats["total_s"] = time.perf_counter() - t0
     object.__setattr__(path, "stats", stats)
     logger.debug("find_pose_path: %r, stats %s", path, stats)
     return path
 
 
-def _assemble(
-    nodes: np.ndarray,
-    prims: np.ndarray,
-    chain: np.ndarray,
-    skinds: np.ndarray,
-    slens: np.ndarray,
-    sn: int,
-    kappas: np.ndarray,
-    prim_len: float,
-    radius: float,
-    step: float,
-    goal: tuple[float, float, float],
-    exact: bool = False,
-) -> PosePath:
-    """Pieces, poses, directions and segments from the kernel's chain of nodes and shot.
+def _order(
+    search_from: str, free: np.ndarray, s: tuple[int, int], g: tuple[int, int], radius: float
+) -> tuple[tuple[bool, int | None], ...]:
+    """Return the searches to run in order: ``(backward, expansion cap or None)``.
 
-    ``exact``: the poses are the kernel's own collision samples (each primitive and shot
-    segment from its start pose, ``m = ceil(|s| / _COLLISION_STEP)`` equal steps), whose
-    chords the exact mode checked.
+    ``"auto"``: from the start, then from the goal. When the goal's cell is nearer a blocked
+    cell of ``free`` (or the grid's side) than the start's (distances between cell centres,
+    capped at ``2 radius`` cells, by more than one cell), the search from the start is a
+    probe of :data:`AUTO_PROBE` expansions (a goal tight but easy to reach keeps the path
+    searched from the start), else it has :data:`AUTO_FIRST_SHARE` of the expansions.
     """
-    from astar.reeds_shepp import advance
+    if search_from != "auto":
+        return ((search_from == "goal", None),)
+    cap = max(2.0, 2.0 * radius)
+    tight_goal = _room(free, g, cap) < _room(free, s, cap) - 1.0
+    return ((False, AUTO_PROBE if tight_goal else -1), (True, None))
 
-    raw: list[list[float]] = []
-    for a, b in zip(chain[:-1], chain[1:], strict=True):
-        p = int(prims[b])
-        s = -prim_len if p & 1 else prim_len
-        raw.append([*nodes[a], float(kappas[p >> 1]), s])
-    x, y, th = (float(v) for v in nodes[chain[-1]])
-    for i in range(sn):
-        if slens[i] == 0.0:
-            continue
-        k = float(skinds[i]) / radius
-        raw.append([x, y, th, k, float(slens[i])])
-        # the kernel's closed form run as Python (an inlined kernel has no signature of its own)
-        x, y, th = advance.py_func(x, y, th, k, float(slens[i]))
-    pieces: list[list[float]] = []
-    for r in raw:
-        if pieces and pieces[-1][3] == r[3] and (pieces[-1][4] < 0) == (r[4] < 0):
-            pieces[-1][4] += r[4]
-        else:
-            pieces.append(list(r))
-    # sample every piece from its own start pose (the kernel's node poses)
-    units = raw if exact else pieces
-    chunks = [np.array([units[0][:3]]) if units else np.array([nodes[0]])]
-    dirs = [np.array([-1 if units and units[0][4] < 0 else 1], dtype=np.int8)]
-    ends = []
-    for px, py, pth, k, s in units:
-        if exact:  # the kernel's samples (arc_clear), by its closed form
-            m = max(1, math.ceil(abs(s) / _COLLISION_STEP))
-            c = np.array([advance.py_func(px, py, pth, k, s * j / m) for j in range(1, m + 1)])
-            chunks.append(c)
-            dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
-            ends.append(sum(len(ch) for ch in chunks) - 1)
-            continue
-        m = max(1, math.ceil(abs(s) / step - 1e-9))
-        q = s * np.arange(1, m + 1) / m
-        if k == 0.0:
-            c = np.column_stack([px + q * math.cos(pth), py + q * math.sin(pth), np.full(m, pth)])
-        else:
-            th1 = pth + k * q
-            c = np.column_stack(
-                [
-                    px + (np.sin(th1) - math.sin(pth)) / k,
-                    py - (np.cos(th1) - math.cos(pth)) / k,
-                    th1,
-                ]
-            )
-        chunks.append(c)
-        dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
-        ends.append(sum(len(ch) for ch in chunks) - 1)
-    poses = np.concatenate(chunks)
-    directions = np.concatenate(dirs)
-    # the end pose exactly (the word lands on it to rounding, ~1e-12 cells)
-    gx, gy, gth = goal
-    end_th = poses[-1, 2]
-    exact_th = gth + 2.0 * math.pi * round((end_th - gth) / (2.0 * math.pi))
-    if math.hypot(poses[-1, 0] - gx, poses[-1, 1] - gy) > 1e-6 or abs(end_th - exact_th) > 1e-6:
-        raise RuntimeError(  # pragma: no cover - an internal error, not bad input
-            f"internal error: the path ends at {poses[-1].tolist()}, not at the goal {goal}"
-        )
-    poses[-1] = (gx, gy, exact_th)
-    cuts = [0]
-    for i in range(len(units) - 1):
-        if (units[i][4] < 0) != (units[i + 1][4] < 0):
-            cuts.append(ends[i])
-    cuts.append(len(poses) - 1)
-    segments = np.array([[a, b] for a, b in zip(cuts[:-1], cuts[1:], strict=True)], np.int64)
-    arr = np.array(pieces, dtype=np.float64).reshape(-1, 5)
-    return PosePath(poses, directions, segments, arr, radius)
+
+def _room(free: np.ndarray, cell: tuple[int, int], cap: float) -> float:
+    """Distance (cells) from ``cell``'s centre to the nearest blocked cell's, at most ``cap``."""
+    ny, nx = free.shape
+    ix, iy = cell
+    w = int(math.ceil(cap))
+    x0, x1 = max(0, ix - w), min(nx, ix + w + 1)
+    y0, y1 = max(0, iy - w), min(ny, iy + w + 1)
+    room = float(min(cap, ix + 1, nx - ix, iy + 1, ny - iy))  # the outside of the grid
+    by, bx = np.nonzero(free[y0:y1, x0:x1] == 0)
+    if bx.size:
+        room = min(room, float(np.hypot(bx + x0 - ix, by + y0 - iy).min()))
+    return room

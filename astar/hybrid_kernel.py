@@ -27,6 +27,11 @@ keeps the cheapest pose that reached it, and a closed state is never reopened.
   exactly at the goal pose. The search then goes on, for at most as many expansions again
   (plus ``polish``), while an open node could still lead to a cheaper path (its ``f``, a lower
   bound of the cost, is below the best path's cost), and returns the cheapest path found.
+* **From the goal** (``motion.backward``): the query's first pose is the path's end and its
+  second the path's start; the search drives each primitive the opposite way to the path
+  (so the path's costs still apply: its backwards primitives cost ``reverse_penalty``), its
+  shots are words from the path's start to the expanded pose, and its heuristic measures
+  the car length that way (a Dubins length is not symmetric).
 * **Heuristic**: ``max(h2d, euclid, car)``: ``h2d`` a lower bound of the 8-connected shortest
   distance on the free grid from the goal's cell (:func:`distance_field`, no corner cutting,
   as Smac's 2-D heuristic), ``car`` the obstacle-free Reeds-Shepp/Dubins length, evaluated
@@ -111,6 +116,13 @@ class KernelMotion(NamedTuple):
         Heading bins.
     reverse : bool
         Backwards primitives and Reeds-Shepp shots (else forwards only, Dubins shots).
+    backward : bool
+        Search from the goal (the query's ``sx, sy, sth`` is then the path's *end*, its
+        ``gx, gy, gth`` the path's *start*): the search runs back in time, each primitive
+        is driven in the opposite direction to the one the path drives it in (the path's
+        backwards primitives cost ``reverse_penalty``), and the shots are words from the
+        path's start to the expanded pose (a pull-out from a parking slot, searched where
+        space is tight, whose shots land in the open).
     """
 
     radius: float
@@ -118,6 +130,7 @@ class KernelMotion(NamedTuple):
     prim_len: float
     nbins: int
     reverse: bool
+    backward: bool
 
 
 class KernelCosts(NamedTuple):
@@ -542,7 +555,13 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     Parameters
     ----------
     occ : ndarray of uint8, shape (ny, nx)
-        1 on occupied cells (closed squares of side 1).
+        Nonzero on occupied cells (closed squares of side 1): 1 on an occupied cell with a
+        free cell among its 8 neighbours, 2 (:func:`astar.hybrid_modes.edge_occupancy`) on
+        one whose 8 neighbours are occupied or outside, which is not tested but for the
+        cell of the pose's centre: a connected body that contains a point of a free square
+        and meets an occupied square meets one of value 1 (where it first enters the
+        occupied squares, along a path in the body from that point), so the test stays
+        exact. Plain 0/1 maps work as they are.
     fsafe : ndarray of uint8, shape (ny, nx)
         :func:`astar.hybrid_modes.footprint_safe` for a reach of at least ``rho + grow``
         (or zeros): a pose whose centre lies in a safe cell is clear without further test.
@@ -594,6 +613,8 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     # vertex keeps grow from its sides
     if minx - grow < -0.5 or maxx + grow > nx - 0.5 or miny - grow < -0.5 or maxy + grow > ny - 0.5:
         return -2
+    if occ[cy, cx] != 0:  # inside the grid: the centre's cell is in the body
+        return cy * nx + cx
     g2 = grow * grow
     lo_x = max(0, int(math.ceil(minx - grow - 0.5)))
     hi_x = min(nx - 1, int(math.floor(maxx + grow + 0.5)))
@@ -601,8 +622,8 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     hi_y = min(ny - 1, int(math.floor(maxy + grow + 0.5)))
     for iy in range(lo_y, hi_y + 1):
         for ix in range(lo_x, hi_x + 1):
-            if occ[iy, ix] == 0:
-                continue
+            if occ[iy, ix] != 1:
+                continue  # free, or occupied with occupied neighbours only (see occ)
             # separating axes x and y: the gaps between the polygon's box and the square
             gx = max(ix - 0.5 - maxx, minx - ix - 0.5, 0.0)
             gy = max(iy - 0.5 - maxy, miny - iy - 0.5, 0.0)
@@ -655,9 +676,25 @@ def footprint_arc_clear(
     footprint grown by ``margin + slack`` is tested (:func:`footprint_hit`) at the middle of
     each: every pose of a step lies within ``slack`` of its middle pose's body, so the whole
     arc, its ends included, keeps ``margin``. ``rho``: the footprint's circumscribed radius.
+    With ``m > 1`` the footprint grown by ``margin + |s| (1 + rho |kappa|) / 2`` is tested at
+    the arc's middle first (one step covering the whole arc; only where ``fsafe``, made for
+    a smaller growth, does not answer for the middle's cell); when it is clear, so is the
+    arc.
     """
     ds_max = 2.0 * slack / (1.0 + rho * abs(kappa))
     m = max(1, int(math.ceil(abs(s) / ds_max)))
+    if m > 1:
+        # one test of the whole arc first: every pose lies within |s| / 2 of its middle, so
+        # within |s| (1 + rho |kappa|) / 2 of the middle pose's body (clear in open space);
+        # not where fsafe (made for the smaller grow margin + slack) would answer for it
+        qx, qy, qth = advance(x, y, th, kappa, 0.5 * s)
+        cx = int(math.floor(qx + 0.5))
+        cy = int(math.floor(qy + 0.5))
+        ny, nx = occ.shape
+        if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] == 0:
+            sweep = 0.5 * abs(s) * (1.0 + rho * abs(kappa))
+            if footprint_hit(occ, fsafe, fp, qx, qy, qth, margin + sweep, buf) == -1:
+                return True
     grow = margin + slack
     for j in range(m):
         qx, qy, qth = advance(x, y, th, kappa, s * (j + 0.5) / m)
@@ -757,12 +794,19 @@ def _cheap_h(x, y, gx, gy, h2d):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _heuristic(
-    x, y, th, gx, gy, gth, h2d, radius, reverse, window, kinds, lens, buf
+    x, y, th, gx, gy, gth, h2d, radius, reverse, backward, window, kinds, lens, buf
 ):  # pragma: no cover
-    """Return the full heuristic: :func:`_cheap_h` and, near the goal, the car length."""
+    """Return the full heuristic: :func:`_cheap_h` and, near the goal, the car length.
+
+    ``backward``: the car length from ``(gx, gy, gth)`` to the pose (the path drives it that
+    way; a Dubins length is not symmetric).
+    """
     h = _cheap_h(x, y, gx, gy, h2d)
     if math.hypot(gx - x, gy - y) < window:
-        c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
+        if backward:
+            c, _ = car_word(gx, gy, gth, x, y, th, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
+        else:
+            c, _ = car_word(x, y, th, gx, gy, gth, radius, reverse, kinds, lens, buf, 1.0, 0.0, 1.0)
         h = max(h, c)
     return h
 
@@ -793,14 +837,17 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     nodes : ndarray of float64, shape (n, 3)
         Poses of the nodes created (x, y, heading unwrapped).
     prims : ndarray of int32, shape (n,)
-        Primitive reaching each node: ``2 * curvature index + (1 if backwards)``; -1 at start.
+        Primitive reaching each node: ``2 * curvature index + (1 if the path drives it
+        backwards)``; -1 at start.
     shot_kinds, shot_lens : ndarray, shape (5,)
-        The analytic shot's word; ``shot_n`` segments of it.
+        The analytic shot's word (from the last node of ``chain`` to the goal pose; with
+        ``motion.backward`` from the query's ``gx, gy, gth`` to that node); ``shot_n``
+        segments of it.
     shot_n, expansions, shots : int
         Segments of the shot, nodes expanded, analytic shots tried.
     """
     free, h2d, sx, sy, sth, gx, gy, gth = query
-    radius, curvatures, prim_len, nbins, reverse = motion
+    radius, curvatures, prim_len, nbins, reverse, backward = motion
     (
         reverse_penalty,
         cusp_penalty,
@@ -860,7 +907,9 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     keys[s0] = k0
     vals[s0] = 0
     used = 1
-    h0 = _heuristic(sx, sy, sth, gx, gy, gth, h2d, radius, reverse, car_window, kinds, lens, buf)
+    h0 = _heuristic(
+        sx, sy, sth, gx, gy, gth, h2d, radius, reverse, backward, car_window, kinds, lens, buf
+    )
     hf, hg, hn, size, hcap = heap_push(hf, hg, hn, size, hcap, hweight * h0, 0.0, 0)
 
     expansions = 0
@@ -893,6 +942,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 h2d,
                 radius,
                 reverse,
+                backward,
                 car_window,
                 kinds,
                 lens,
@@ -920,13 +970,18 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         countdown -= 1
         if countdown <= 0:
             shots += 1
+            # the word as the path drives it: to the goal, or (backward) from the path's start
+            if backward:
+                ax, ay, ath, bx, by, bth = gx, gy, gth, ux, uy, uth
+            else:
+                ax, ay, ath, bx, by, bth = ux, uy, uth, gx, gy, gth
             c, n = car_word(
-                ux,
-                uy,
-                uth,
-                gx,
-                gy,
-                gth,
+                ax,
+                ay,
+                ath,
+                bx,
+                by,
+                bth,
                 radius,
                 reverse,
                 kinds,
@@ -937,14 +992,17 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 1.0 + turn_penalty,
             )
             if pu >= 0:
-                for i in range(n):
+                # a cusp where the word meets the node's primitive (its first segment after
+                # the primitive forwards, its last before the primitive driven back)
+                for j in range(n):
+                    i = n - 1 - j if backward else j
                     if lens[i] != 0.0:
                         if (lens[i] < 0.0) != ((pu & 1) == 1):
                             c += cusp_penalty
                         break
             if (
                 ug + c < best
-                and word_clear(free, ux, uy, uth, radius, kinds, lens, n, step, safe, occ, exact_r)
+                and word_clear(free, ax, ay, ath, radius, kinds, lens, n, step, safe, occ, exact_r)
                 and (
                     not footprint
                     or footprint_word_clear(
@@ -952,9 +1010,9 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         fsafe,
                         fp,
                         frho,
-                        ux,
-                        uy,
-                        uth,
+                        ax,
+                        ay,
+                        ath,
                         radius,
                         kinds,
                         lens,
@@ -979,8 +1037,10 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         for ci in range(nc):
             kappa = curvatures[ci]
             for di in range(ndirs):
+                # di: the direction the path drives the primitive (0 forwards); the search
+                # drives it the other way when it runs back from the goal
                 d = 1.0 if di == 0 else -1.0
-                s = d * prim_len
+                s = -d * prim_len if backward else d * prim_len
                 if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
                     continue
                 if footprint and not footprint_arc_clear(

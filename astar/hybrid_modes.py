@@ -14,6 +14,9 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
   radii about the origin.
 * :func:`footprint_safe` marks the cells where no test is needed: every point of the cell
   keeps ``rho + margin + slack`` from every occupied square and from the outside.
+* :func:`edge_occupancy` marks the occupied cells inside solid blocks (all 8 neighbours
+  occupied or outside), which the footprint test skips, exactly (a body reaching one
+  crosses the block's rim first).
 * :func:`kernel_collision` builds the search kernel's collision record
   (:class:`~astar.hybrid_kernel.KernelCollision`) of a mode given as a
   :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
@@ -34,7 +37,9 @@ that numba's cache of the search is rebuilt whenever they change):
   the farthest vertex from the origin), so the body at every pose within ``ds / 2`` of a
   sample lies within ``slack = ds (1 + rho |kappa|) / 2`` of the body at the sample;
   testing the footprint grown by ``margin + slack`` at the middle of each of ``m`` equal
-  steps of length ``ds`` covers the whole arc, its end poses included.
+  steps of length ``ds`` covers the whole arc, its end poses included (and one test at the
+  arc's middle, the footprint grown by ``margin`` plus the whole arc's sweep, covers it in
+  open space).
 """
 
 from __future__ import annotations
@@ -54,6 +59,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "DEFAULT_SLACK",
+    "edge_occupancy",
     "footprint_polygon",
     "footprint_radii",
     "footprint_safe",
@@ -194,6 +200,29 @@ def footprint_safe(occ: np.ndarray, reach: float) -> np.ndarray:
     return np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
 
 
+def edge_occupancy(occ: np.ndarray) -> np.ndarray:
+    """Occupied cells marked by whether a free cell touches them (the footprint test's map).
+
+    Parameters
+    ----------
+    occ : ndarray of bool, shape (ny, nx)
+        True on occupied cells.
+
+    Returns
+    -------
+    ndarray of uint8, shape (ny, nx)
+        0 on free cells, 1 on occupied cells with a free cell among their 8 neighbours, 2
+        on occupied cells whose 8 neighbours are occupied or outside the grid (inside a
+        solid block: :func:`~astar.hybrid_kernel.footprint_hit` skips them, exactly).
+    """
+    from scipy.ndimage import binary_dilation
+
+    occ = np.asarray(occ, dtype=bool)
+    near_free = binary_dilation(~occ, structure=np.ones((3, 3), bool))
+    out = np.where(occ, np.where(near_free, 1, 2), 0).astype(np.uint8)
+    return np.ascontiguousarray(out)
+
+
 def raw_occupied(raw_grid: object) -> np.ndarray:
     """Return the occupied cells of a raw map as a read-only bool array (ny, nx).
 
@@ -294,7 +323,7 @@ def _footprint_inputs(
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
     fp = footprint_polygon(collision.footprint)
-    occ = np.ascontiguousarray(raw_occupancy(collision.raw_grid, free), dtype=np.uint8)
+    occ = edge_occupancy(raw_occupancy(collision.raw_grid, free))
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))

@@ -40,13 +40,23 @@ from astar.grid import OccupancyGrid
 from astar.hybrid_modes import DEFAULT_SLACK, footprint_polygon, raw_occupied
 
 __all__ = [
+    "AUTO_FIRST_SHARE",
+    "AUTO_PROBE",
     "FLAT_KEYWORDS",
+    "SEARCH_FROM",
     "HybridCollision",
     "HybridCosts",
     "HybridLimits",
     "HybridMotion",
     "build_options",
 ]
+
+#: The values of :attr:`HybridLimits.search_from`.
+SEARCH_FROM = ("auto", "start", "goal")
+#: ``search_from="auto"``: the share of the budgets (seconds, expansions) of the first search.
+AUTO_FIRST_SHARE = 0.5
+#: ``search_from="auto"``: expansions of the search from the start when the goal is tighter.
+AUTO_PROBE = 1000
 
 
 @dataclass(frozen=True, slots=True)
@@ -208,6 +218,19 @@ class HybridLimits:
     sample_step : float, optional
         ``> 0``: largest arc length between returned poses, cells (ignored in the exact
         clearance mode, whose poses are the collision samples, at most 0.2 cells apart).
+    search_from : {"auto", "start", "goal"}, optional
+        Where the search grows from. ``"start"``: from the start pose towards the goal, its
+        shots ending at the goal. ``"goal"``: from the goal pose back in time (the path
+        driven backwards from its end: a pull-out of a parking slot), its shots starting
+        at the start pose; the path returned is the same kind of path, from the start to
+        the goal. ``"auto"`` (default): from the start with :data:`AUTO_FIRST_SHARE` of
+        ``time_budget`` and of ``max_expansions``, or, when the goal has less room than the
+        start (the distance from its cell to a blocked cell of the grid, capped at ``2 R``,
+        smaller by more than a cell), with at most :data:`AUTO_PROBE` expansions; when that
+        search gives up (not when it exhausts the states), from the goal with what is left.
+        A search from the tight end lands its shots in the open: parking into a slot 1.3
+        car lengths long takes a few thousand expansions from the slot, and does not finish
+        within 2 s from the lane.
 
     Raises
     ------
@@ -218,11 +241,17 @@ class HybridLimits:
     max_expansions: int = 500_000
     time_budget: float = 2.0
     sample_step: float = 0.5
+    search_from: str = "auto"
 
     def __post_init__(self) -> None:
         max_exp = validation.int_at_least("max_expansions", self.max_expansions, 1)
         budget = validation.positive_float("time_budget", self.time_budget)
         step = validation.positive_float("sample_step", self.sample_step)
+        if self.search_from not in SEARCH_FROM:
+            raise InvalidInputError(
+                f"search_from must be one of {', '.join(map(repr, SEARCH_FROM))}, got "
+                f"{validation.short_repr(self.search_from)}"
+            )
         object.__setattr__(self, "max_expansions", max_exp)
         object.__setattr__(self, "time_budget", budget)
         object.__setattr__(self, "sample_step", step)
@@ -270,7 +299,10 @@ class HybridCollision:
         (``rho``: the farthest vertex from the origin), so that between a step's middle and
         any pose of the step every point of the body moves at most ``footprint_slack``; the
         footprint grown by ``footprint_margin + footprint_slack`` is tested exactly
-        (separating axes, then the polygon-to-square distance) at each step's middle. The
+        (separating axes, then the polygon-to-square distance) at each step's middle (an arc
+        of more than one step is first tested once whole: the footprint grown by ``margin``
+        plus the arc's sweep ``|s| (1 + rho |kappa|) / 2`` at its middle; clear, it needs no
+        steps). The
         search's ``grid`` stays a necessary condition on the centre: pass the raw map
         inflated by the footprint's inscribed radius about the origin (a larger inflation
         loses paths, a smaller one only costs time). Cells whose every point keeps ``rho +

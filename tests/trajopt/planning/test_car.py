@@ -1,8 +1,9 @@
 """Tests of trajopt.planning: car-like robots (``Robot(drive="ackermann")``) end to end through ``trajopt.plan``.
 
-Four hand-built scenes (a goal straight behind the start, a three-point turn in a dead end
+Hand-built scenes (a goal straight behind the start, a three-point turn in a dead end
 narrower than ``2 R``, a forward-only U-turn round a block, parallel parking into a slot 1.3
-car lengths long), each checked independently of the planner: end poses, curvature by
+car lengths long as a disc and as a 0.88 x 0.4 m body, body cars into bays, a full-size car
+into a perpendicular bay backwards and forwards), each checked independently of the planner: end poses, curvature by
 circles through three dense points, clearance by brute force against the raw grid, motion
 along the heading by finite differences, rest at every cusp; then bad input.
 """
@@ -116,6 +117,64 @@ def three_point_body_scene():
     return grid, robot, (1.5, 0.6), (1.6, 0.6), 0.0, math.pi
 
 
+# a 0.88 x 0.4 m car (rear axle 0.18 m from its back, R = 0.5 m) backed into the parking
+# scene's slot, 1.3 of its lengths long: the body, not a disc
+PARK_CAR = (CAR_LENGTH, 2.0 * CAR_RADIUS, 0.18)
+
+
+def parallel_body_scene():
+    grid, *_ = parking_scene()
+    length, width, rear = PARK_CAR
+    robot = trajopt.Robot.rectangle(
+        length,
+        width,
+        rear_offset=rear,
+        drive=trajopt.Ackermann(min_turning_radius=0.5, wheelbase=0.35),
+    )
+    goal = (2.0 + 0.5 * (SLOT - length) + rear, 0.1 + 0.5 * 0.55)
+    return grid, robot, (1.0, 1.1), goal, 0.0, 0.0
+
+
+# a full-size car of the public parking cases: 4.69 x 1.94 m, rear axle 0.96 m from its back,
+# wheelbase 2.8 m, R = 3.0 m; a perpendicular bay 1.3 car widths wide off a 5.5 m aisle, 0.1 m
+# cells
+FULL_CAR = (4.69, 1.94, 0.96)
+FULL_BAY = 1.3 * FULL_CAR[1]
+
+
+def full_bay_grid() -> astar.OccupancyGrid:
+    """A 22 x 11 m yard: parked cars 5.2 m deep below a 5.5 m aisle, one bay free at x = 9 m."""
+    res = 0.1
+    occ = walled(22.0, 11.0, res)
+    occ[: round(5.3 / res), :] = True
+    occ[1 : round(5.3 / res), round(9.0 / res) : round((9.0 + FULL_BAY) / res)] = False
+    return astar.OccupancyGrid(occ, res)
+
+
+def full_car() -> trajopt.Robot:
+    length, width, rear = FULL_CAR
+    return trajopt.Robot.rectangle(
+        length,
+        width,
+        rear_offset=rear,
+        drive=trajopt.Ackermann(min_turning_radius=3.0, wheelbase=2.8),
+    )
+
+
+def full_bay_reverse_scene():
+    # backed in, facing out of the bay: its rear edge 0.3 m from the bay's end
+    _, _, rear = FULL_CAR
+    x = 9.0 + 0.5 * FULL_BAY
+    return full_bay_grid(), full_car(), (3.0, 8.05), (x, 0.4 + rear), 0.0, math.pi / 2
+
+
+def full_bay_forward_scene():
+    # driven nose first: its front edge 0.3 m from the bay's end
+    length, _, rear = FULL_CAR
+    x = 9.0 + 0.5 * FULL_BAY
+    return full_bay_grid(), full_car(), (3.0, 8.05), (x, 0.4 + length - rear), 0.0, -math.pi / 2
+
+
 SCENES = {
     "behind": behind_scene,
     "three_point": three_point_scene,
@@ -124,6 +183,9 @@ SCENES = {
     "bay_reverse": bay_reverse_scene,
     "bay_forward": bay_forward_scene,
     "three_point_body": three_point_body_scene,
+    "parallel_body": parallel_body_scene,
+    "full_bay_reverse": full_bay_reverse_scene,
+    "full_bay_forward": full_bay_forward_scene,
 }
 
 
@@ -184,8 +246,9 @@ def _body_hits(grid, vertices, x, y, th, spacing=0.005):
     The body is the convex polygon ``vertices`` (robot frame, m) turned by ``th`` and moved
     to ``(x, y)``. It meets a square iff a point of its boundary lies in the square or the
     square lies inside it (then so does its centre): the boundary is sampled every
-    ``spacing`` m and looked up in the grid, and every occupied cell's centre is tested
-    against the polygon's half-planes.
+    ``spacing`` m and looked up in the grid, and every occupied cell's centre within the
+    body's circumscribed radius plus a cell of the pose is tested against the polygon's
+    half-planes.
     """
     v = np.asarray(vertices, dtype=float)
     nxt = np.roll(v, -1, axis=0)
@@ -201,8 +264,7 @@ def _body_hits(grid, vertices, x, y, th, spacing=0.005):
     ny, nx = occ.shape
     ox, oy = grid.origin
     res = grid.resolution
-    iy, ix = np.nonzero(occ)
-    centres = np.column_stack([ox + (ix + 0.5) * res, oy + (iy + 0.5) * res])
+    reach = float(np.hypot(v[:, 0], v[:, 1]).max()) + res
     hits = np.zeros(len(x), dtype=bool)
     for k in range(len(x)):
         c, s_ = math.cos(th[k]), math.sin(th[k])
@@ -214,7 +276,14 @@ def _body_hits(grid, vertices, x, y, th, spacing=0.005):
         if out.any() or occ[jy, jx].any():
             hits[k] = True
             continue
-        local = (centres - (x[k], y[k])) @ rot  # into the body frame
+        # the occupied cells of the window round the body (no centre farther lies inside)
+        i0 = max(0, int((x[k] - reach - ox) / res))
+        i1 = min(nx, int((x[k] + reach - ox) / res) + 2)
+        j0 = max(0, int((y[k] - reach - oy) / res))
+        j1 = min(ny, int((y[k] + reach - oy) / res) + 2)
+        wy, wx = np.nonzero(occ[j0:j1, i0:i1])
+        near = np.column_stack([ox + (wx + i0 + 0.5) * res, oy + (wy + j0 + 0.5) * res])
+        local = (near - (x[k], y[k])) @ rot  # into the body frame
         hits[k] = bool(np.any(np.all(local @ normal.T <= offset, axis=1)))
     return hits
 
@@ -227,9 +296,10 @@ def test_clearance_against_raw_grid(planned, name):
             clr = square_clearance(grid, pts, reach=robot.radius + 0.1)
             assert clr.min() >= robot.radius - 1e-9, clr.min()
         return
-    # the body along the trajectory, every 2 mm of arc length at most (v_max 1 m/s)
-    assert robot.v_max <= 1.0
-    smp = traj.sample(np.linspace(0.0, traj.duration, int(traj.duration / 0.002) + 2))
+    # the body along the trajectory, every 2 mm of arc length at most (|v| <= v_max)
+    v_top = max(robot.v_max, robot.drive.v_max_reverse or 0.0)
+    smp = traj.sample(np.linspace(0.0, traj.duration, int(traj.duration * v_top / 0.002) + 2))
+    assert np.abs(np.diff(smp.s)).max() <= 0.002 + 1e-9
     hits = _body_hits(grid, robot.footprint.vertices, smp.x, smp.y, smp.theta)
     assert not hits.any(), np.column_stack([smp.t, smp.x, smp.y, smp.theta])[hits][:3]
 
@@ -537,6 +607,31 @@ def test_a_body_parks_where_its_circumscribed_disc_cannot(planned, name):
     smp = traj.sample(np.linspace(0.0, traj.duration, 2001))
     backwards = name == "bay_reverse"
     assert (smp.v.min() < 0.0) == backwards  # backed in, or driven in nose first
+
+
+def test_a_body_backs_into_a_parallel_slot_1_3_lengths_long(planned):
+    """The 0.88 x 0.4 m body (not a disc) into the parking scene's slot, 1.3 of its lengths
+    long: the search from the slot (``search_from="auto"``) pulls it out, reversed; the
+    body check above finds no contact, and it enters the slot backwards."""
+    grid, robot, start, goal, h0, h1, traj, _ = planned["parallel_body"]
+    assert robot.footprint is not None and SLOT / PARK_CAR[0] == pytest.approx(1.3)
+    search = traj.stats["car"]["search"]
+    assert search["footprint"] is True and search["search_from"] == "goal"
+    smp = traj.sample(np.linspace(0.0, traj.duration, 4001))
+    below = np.nonzero(smp.y < 0.65)[0]  # the rear axle crosses the parked cars' line
+    assert smp.v[below[0] - 1] < 0.0  # backwards
+    np.testing.assert_allclose(smp.steer, np.arctan(robot.drive.wheelbase * smp.kappa), atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["full_bay_reverse", "full_bay_forward"])
+def test_a_full_size_car_parks_in_a_perpendicular_bay(planned, name):
+    """The 4.69 x 1.94 m car (R = 3 m) into a bay 1.3 of its widths wide off a 5.5 m aisle,
+    backed in or nose first (the last drive's direction), in well under a second."""
+    grid, robot, start, goal, h0, h1, traj, seconds = planned[name]
+    assert FULL_BAY / FULL_CAR[1] == pytest.approx(1.3)
+    assert traj.pieces[-1].direction == (-1 if name == "full_bay_reverse" else 1)
+    assert traj.stats["car"]["search"]["footprint"] is True
+    assert seconds < 1.0, seconds
 
 
 def test_three_point_turn_of_a_body_has_cusps(planned):

@@ -1,0 +1,167 @@
+"""The path of :func:`astar.find_pose_path` from its search kernel's nodes and shot.
+
+:func:`assemble` turns the chain of nodes and the analytic shot that
+:func:`astar.hybrid_kernel.hybrid_kernel` returns into the exact pieces (arcs and lines),
+the sampled poses, their directions of travel and the segments between cusps, for a search
+from the start (the chain first, then the shot to the goal) and for a search from the goal
+(the shot from the start first, then the chain driven back from its last node to the goal).
+Units: cells and radians, as :mod:`astar.hybrid`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["COLLISION_STEP", "assemble"]
+
+#: Cells: the arc-length spacing of the kernel's collision samples (exact mode: the poses).
+COLLISION_STEP = 0.2
+
+
+def _units(out, kappas, prim_len, radius, start, backward):
+    """Return the path's primitives and shot segments in driving order.
+
+    Each unit is ``(piece, origin)``: ``piece = [x, y, heading, curvature, signed length]``
+    from its start pose, ``origin`` None, or for a primitive the search drove the other way
+    (``backward``) the kernel's ``(x, y, heading, curvature, signed length)`` from which its
+    collision samples were taken (exact mode: the same samples, in reverse order).
+    """
+    from astar.reeds_shepp import advance
+
+    _, chain, nodes, prims, skinds, slens, sn = out[:7]
+    sn = int(sn)
+    shot = []
+    if backward:
+        x, y, th = start
+    else:
+        x, y, th = (float(v) for v in nodes[chain[-1]])
+    for i in range(sn):
+        if slens[i] == 0.0:
+            continue
+        k = float(skinds[i]) / radius
+        shot.append(([x, y, th, k, float(slens[i])], None))
+        # the kernel's closed form run as Python (an inlined kernel has no signature of its own)
+        x, y, th = advance.py_func(x, y, th, k, float(slens[i]))
+    edges = list(zip(chain[:-1], chain[1:], strict=True))
+    if not backward:
+        prim = []
+        for a, b in edges:
+            p = int(prims[b])
+            s = -prim_len if p & 1 else prim_len
+            prim.append(([*map(float, nodes[a]), float(kappas[p >> 1]), s], None))
+        return prim + shot
+    # from the goal: the shot ends at the chain's last node (heading unwrapped from the start's,
+    # the nodes' from the goal's): shift the nodes' headings by the whole turns between them
+    off = 2.0 * math.pi * round((th - float(nodes[chain[-1], 2])) / (2.0 * math.pi))
+    prim = []
+    for a, b in reversed(edges):
+        p = int(prims[b])
+        s = -prim_len if p & 1 else prim_len  # as the path drives it: from b back to a
+        k = float(kappas[p >> 1])
+        bx, by, bth = (float(v) for v in nodes[b])
+        ax, ay, ath = (float(v) for v in nodes[a])
+        prim.append(([bx, by, bth + off, k, s], (ax, ay, ath, off, -s)))
+    return shot + prim
+
+
+def assemble(out, kappas, prim_len, radius, step, start, goal, exact=False, backward=False):
+    """Pieces, poses, directions and segments of the path the kernel found.
+
+    Parameters
+    ----------
+    out : tuple
+        :func:`astar.hybrid_kernel.hybrid_kernel`'s return value (status FOUND).
+    kappas : ndarray of float64
+        The primitives' curvatures (1/cells).
+    prim_len, radius, step : float
+        Primitive length, turning radius and the poses' largest spacing (cells).
+    start, goal : tuple of float
+        The path's end poses ``(x, y, heading)`` (cells, rad), as given.
+    exact : bool, optional
+        The poses are the kernel's own collision samples (each primitive and shot segment
+        from the pose the kernel sampled it from, ``m = ceil(|s| / COLLISION_STEP)`` equal
+        steps), whose chords the exact mode checked.
+    backward : bool, optional
+        The kernel searched from the goal (:class:`~astar.hybrid_kernel.KernelMotion`).
+
+    Returns
+    -------
+    poses : ndarray of float64, shape (n, 3)
+    directions : ndarray of int8, shape (n,)
+    segments : ndarray of int64, shape (s, 2)
+    pieces : ndarray of float64, shape (m, 5)
+        As :class:`astar.PosePath`'s fields.
+
+    Raises
+    ------
+    RuntimeError
+        The path does not end at the goal pose (an internal error).
+    """
+    from astar.reeds_shepp import advance
+
+    units = _units(out, kappas, prim_len, radius, start, backward)
+    raw = [u[0] for u in units]
+    pieces: list[list[float]] = []
+    for r in raw:
+        if pieces and pieces[-1][3] == r[3] and (pieces[-1][4] < 0) == (r[4] < 0):
+            pieces[-1][4] += r[4]
+        else:
+            pieces.append(list(r))
+    # sample every piece from its own start pose (the kernel's node poses)
+    drive = units if exact else [(p, None) for p in pieces]
+    first = drive[0][0][:3] if drive else list(start)
+    chunks = [np.array([first])]
+    dirs = [np.array([-1 if drive and drive[0][0][4] < 0 else 1], dtype=np.int8)]
+    ends = []
+    for (px, py, pth, k, s), origin in drive:
+        if exact:  # the kernel's samples (arc_clear), by its closed form
+            m = max(1, math.ceil(abs(s) / COLLISION_STEP))
+            if origin is None:
+                c = np.array([advance.py_func(px, py, pth, k, s * j / m) for j in range(1, m + 1)])
+            else:  # sampled from the other end, driven back: the same samples reversed
+                ax, ay, ath, off, sk = origin
+                c = np.array(
+                    [advance.py_func(ax, ay, ath, k, sk * j / m) for j in range(m - 1, -1, -1)]
+                )
+                c[:, 2] += off
+            chunks.append(c)
+            dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
+            ends.append(sum(len(ch) for ch in chunks) - 1)
+            continue
+        m = max(1, math.ceil(abs(s) / step - 1e-9))
+        q = s * np.arange(1, m + 1) / m
+        if k == 0.0:
+            c = np.column_stack([px + q * math.cos(pth), py + q * math.sin(pth), np.full(m, pth)])
+        else:
+            th1 = pth + k * q
+            c = np.column_stack(
+                [
+                    px + (np.sin(th1) - math.sin(pth)) / k,
+                    py - (np.cos(th1) - math.cos(pth)) / k,
+                    th1,
+                ]
+            )
+        chunks.append(c)
+        dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
+        ends.append(sum(len(ch) for ch in chunks) - 1)
+    poses = np.concatenate(chunks)
+    directions = np.concatenate(dirs)
+    # the end pose exactly (the word lands on it to rounding, ~1e-12 cells)
+    gx, gy, gth = goal
+    end_th = poses[-1, 2]
+    exact_th = gth + 2.0 * math.pi * round((end_th - gth) / (2.0 * math.pi))
+    if math.hypot(poses[-1, 0] - gx, poses[-1, 1] - gy) > 1e-6 or abs(end_th - exact_th) > 1e-6:
+        raise RuntimeError(  # pragma: no cover - an internal error, not bad input
+            f"internal error: the path ends at {poses[-1].tolist()}, not at the goal {goal}"
+        )
+    poses[-1] = (gx, gy, exact_th)
+    cuts = [0]
+    for i in range(len(drive) - 1):
+        if (drive[i][0][4] < 0) != (drive[i + 1][0][4] < 0):
+            cuts.append(ends[i])
+    cuts.append(len(poses) - 1)
+    segments = np.array([[a, b] for a, b in zip(cuts[:-1], cuts[1:], strict=True)], np.int64)
+    arr = np.array(pieces, dtype=np.float64).reshape(-1, 5)
+    return poses, directions, segments, arr
