@@ -1,4 +1,4 @@
-"""Hybrid-A* searched from the goal (``search_from``): parking bodies, checked by brute force.
+"""Tests of astar: hybrid-A* searched from the goal (``search_from``): parking bodies, checked by brute force.
 
 The search from the goal drives its primitives back in time and shoots from the start pose;
 its path must be the same kind of path as a search from the start: it starts exactly at the

@@ -1,4 +1,4 @@
-"""``astar.OccupancyGrid.from_polygons``: conservative, exact rasterisation of polygons.
+"""Tests of astar: ``astar.OccupancyGrid.from_polygons``: conservative, exact rasterisation of polygons.
 
 Checked against independent references: shapely's exact polygon-vs-box intersection (every
 cell, closed squares), dense point sampling of the polygons (every sampled point's cell must

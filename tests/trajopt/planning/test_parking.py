@@ -1,4 +1,4 @@
-"""The parking suite's exact body checker (``benchmarks/parking_cases.py``) and parking plans.
+"""Tests of trajopt.planning: the parking suite's exact body checker (``benchmarks/parking_cases.py``) and parking plans.
 
 The checker is tested on hand-built poses whose answer is known (a corner 1 cm into a parked
 car, 1 cm clear of it, touching it; the body inside a polygon and a polygon inside the body;
