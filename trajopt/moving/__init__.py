@@ -1,0 +1,26 @@
+"""Moving obstacles: predictions, the continuous-time certificate, re-timing along a path.
+
+* :class:`MovingObstacle`: a disc or convex polygon on a piecewise-linear predicted track;
+* :func:`certify_movers` (:class:`MoverCertificate`): a proof, by interval bounds over time,
+  that a timed trajectory keeps its distance from every mover at every instant;
+* :func:`retime_for_movers`: the same path re-timed (waits at the start and at one stop) so
+  that the movers pass, certified; :class:`trajopt.errors.BlockedError` when no speed
+  profile along the path avoids them;
+* :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.
+"""
+
+from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._retime import retime_for_movers
+from trajopt.moving._st_grid import STGrid, reachable, st_grid
+
+__all__ = [
+    "MoverCertificate",
+    "MovingObstacle",
+    "STGrid",
+    "certify_movers",
+    "check_movers",
+    "reachable",
+    "retime_for_movers",
+    "st_grid",
+]

@@ -1,0 +1,154 @@
+"""The movers' forbidden regions of the ``(s, t)`` plane along a fixed path, on a grid.
+
+Nodes ``s_i = i ds`` along the path (the last one at ``L``) and times ``t_k = k dt``. A node
+``(k, i)`` is forbidden when the robot centre at ``C(s_i)`` is closer to a mover at ``t_k``
+than the limit ``robot radius + mover radius(t_k) + margin`` plus an ``inflation`` (m):
+
+* the **sufficient** grid inflates by ``ds/2 + (V + u) dt/2 + growth dt/2`` (``V`` the robot's
+  speed bound, ``u`` the mover's shape speed bound): a profile whose nearest node at every
+  grid time is free keeps the limit at every instant in between (the robot is within
+  ``ds/2 + V dt/2`` of that node, the mover's shape within ``u dt/2`` of its place at ``t_k``);
+* the **necessary** grid deflates by ``ds/2``: a forbidden node is forbidden for every ``s``
+  within ``ds/2`` of it at that instant, so a profile through it is truly unsafe.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from trajopt.moving._certificate import point_polygon_distance, shape_at
+from trajopt.moving._obstacle import MovingObstacle
+
+
+@dataclass(frozen=True, slots=True)
+class STGrid:
+    """Forbidden nodes of the ``(s, t)`` plane.
+
+    Attributes
+    ----------
+    s : ndarray, shape (n,)
+        Arc-length nodes (m), ``s[0] = 0``, ``s[-1] = L``.
+    t : ndarray, shape (K,)
+        Times (s), ``t[k] = k dt``.
+    ds, dt : float
+        Spacings (m, s).
+    blocked : ndarray of bool, shape (K, n)
+        Forbidden nodes.
+    who : ndarray of int, shape (K, n)
+        Index of the first mover forbidding each node, -1 where free.
+    """
+
+    s: np.ndarray
+    t: np.ndarray
+    ds: float
+    dt: float
+    blocked: np.ndarray
+    who: np.ndarray
+
+    def index(self, s: np.ndarray) -> np.ndarray:
+        """Nearest node index of arc lengths ``s`` (m)."""
+        return np.clip(np.rint(np.asarray(s) / self.ds), 0, self.s.shape[0] - 1).astype(np.int64)
+
+
+def path_points(path: object, s: np.ndarray) -> np.ndarray:
+    """Points of ``path`` at arc lengths ``s`` (m), shape (n, 2)."""
+    return np.asarray(path(path.u_at_s(s)), dtype=float)  # type: ignore[operator, attr-defined]
+
+
+def st_grid(
+    path: object,
+    length: float,
+    movers: Sequence[MovingObstacle],
+    limit: float,
+    *,
+    ds: float,
+    dt: float,
+    horizon: float,
+    speed: float,
+    sufficient: bool,
+) -> STGrid:
+    """Build the forbidden grid (module docstring).
+
+    Parameters
+    ----------
+    path : ParametricCurve
+        The path, arc length ``length`` (m).
+    movers : sequence of MovingObstacle
+    limit : float
+        Robot radius plus margin (m); each mover adds its radius.
+    ds, dt : float
+        Requested spacings (m, s); ``ds`` is adjusted to divide ``length``.
+    horizon : float
+        Last time (s) of the grid.
+    speed : float
+        The robot's speed bound ``V`` (m/s).
+    sufficient : bool
+        Inflate (a safe under-approximation of the free space) or deflate (a necessary one).
+    """
+    n = max(2, int(math.ceil(length / ds)) + 1)
+    s = np.linspace(0.0, length, n)
+    ds = float(s[1] - s[0])
+    kk = max(2, int(math.ceil(horizon / dt)) + 1)
+    t = np.arange(kk) * dt
+    pts = path_points(path, s)
+    blocked = np.zeros((kk, n), dtype=bool)
+    who = np.full((kk, n), -1, dtype=np.int16)
+    for j, m in enumerate(movers):
+        if sufficient:
+            pad = 0.5 * ds + 0.5 * dt * (speed + m.shape_speed_max() + m.growth)
+        else:
+            pad = -0.5 * ds
+        lim = limit + m.radius_at(t) + pad  # (K,)
+        hit = np.zeros((kk, n), dtype=bool)
+        if m.vertices is None:
+            c = m.position_at(t)
+            for a in range(0, kk, 256):
+                b = min(kk, a + 256)
+                d = np.hypot(pts[None, :, 0] - c[a:b, None, 0], pts[None, :, 1] - c[a:b, None, 1])
+                hit[a:b] = d < lim[a:b, None]
+        else:
+            shapes = shape_at(m, t)  # (K, m, 2)
+            for k in range(kk):
+                w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
+                hit[k] = point_polygon_distance(pts, w) < lim[k]
+        who[hit & ~blocked] = j
+        blocked |= hit
+    return STGrid(s=s, t=t, ds=ds, dt=float(dt), blocked=blocked, who=who)
+
+
+def reachable(grid: STGrid, speed: float) -> tuple[bool, int, int]:
+    """Sweep the nodes a non-decreasing ``s(t)`` with speed ``<= speed`` can occupy.
+
+    A relaxation: from node ``i`` at ``t_k`` the robot may be at any free node ``j`` with
+    ``i <= j <= i + m`` at ``t_{k+1}`` (``m = ceil(speed dt / ds) + 1``), whatever lies between.
+
+    Returns
+    -------
+    ok : bool
+        The goal node is reachable at the last time.
+    k : int
+        The first time index where nothing is reachable (or the last one).
+    i : int
+        The furthest reachable node before that (the place where the robot is stopped).
+    """
+    fb = grid.blocked
+    kk, n = fb.shape
+    m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
+    idx = np.arange(n)
+    reach = np.zeros(n, dtype=bool)
+    reach[0] = not fb[0, 0]
+    last_i = 0
+    if not reach[0]:
+        return False, 0, 0
+    for k in range(1, kk):
+        lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
+        nxt = ~fb[k] & (idx - lastr <= m)
+        if not nxt.any():
+            return False, k, last_i
+        reach = nxt
+        last_i = int(np.max(np.flatnonzero(reach)))
+    return bool(reach[-1]), kk - 1, last_i
