@@ -67,7 +67,9 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
+from trajopt.errors import InvalidInputError
 from trajopt.motion import PlanResult
+from trajopt.moving import MovingObstacle, check_movers, retime_for_movers
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -289,6 +291,8 @@ class Planner:
         v_end: float = 0.0,
         start_steer: float = 0.0,
         goal_steer: float | None = None,
+        moving_obstacles: Sequence[MovingObstacle] | None = None,
+        mover_margin: float = 0.0,
     ) -> PlanResult:
         """Plan a timed trajectory from ``start`` to ``goal`` (world metres).
 
@@ -313,6 +317,17 @@ class Planner:
         goal_steer : float, optional
             A car's steering angle at the goal (rad), steered to at rest after its last
             drive; default: the last drive's.
+        moving_obstacles : sequence of MovingObstacle, optional
+            Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
+            ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
+            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: waits at the
+            start and at one stop) and certified at every instant until the last prediction
+            ends (``stats["moving"]``). Covered: a disc robot (no footprint) of the
+            differential or omni drive whose plan is one curve from rest to rest (no end
+            headings, no moving start); other queries with movers raise
+            :class:`~trajopt.errors.InvalidInputError`.
+        mover_margin : float
+            Extra distance to every mover (m), >= 0.
 
         Returns
         -------
@@ -334,7 +349,11 @@ class Planner:
             From the smoother or the timing (with their statistics); with the fallback
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
+        BlockedError
+            A mover blocks the path: no re-timing along it avoids the mover (named, with
+            the time).
         """
+        movers = check_movers(moving_obstacles)
         request = PlanRequest(
             start,
             goal,
@@ -348,6 +367,8 @@ class Planner:
         with self._lock:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
+            if movers:
+                out = _retime(out, movers, mover_margin, self.options.robot)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -449,6 +470,8 @@ def plan(
     v_end: float = 0.0,
     start_steer: float = 0.0,
     goal_steer: float | None = None,
+    moving_obstacles: Sequence[MovingObstacle] | None = None,
+    mover_margin: float = 0.0,
     options: PlannerOptions | None = None,
     **settings: Any,
 ) -> PlanResult:
@@ -471,6 +494,9 @@ def plan(
         Speeds at the ends (m/s).
     start_steer, goal_steer : float
         A car's steering angles at the ends (rad; see :meth:`Planner.plan`).
+    moving_obstacles : sequence of MovingObstacle, optional
+        Predicted movers; ``mover_margin`` (m) the extra distance to them (see
+        :meth:`Planner.plan`).
     options : PlannerOptions, optional
         Every setting (``robot`` included) as one value (see :class:`Planner`).
     **settings
@@ -514,4 +540,20 @@ def plan(
         v_end=v_end,
         start_steer=start_steer,
         goal_steer=goal_steer,
+        moving_obstacles=moving_obstacles,
+        mover_margin=mover_margin,
     )
+
+
+def _retime(
+    out: PlanResult, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot
+) -> PlanResult:
+    """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
+    signed = robot.drive.signed_speed  # a car's: not covered yet
+    if robot.footprint is not None or signed or not out.single_curve or out.v_start != 0.0:
+        raise InvalidInputError(
+            "moving_obstacles are covered for a disc robot's plan along one curve from rest "
+            "(differential or omni drive, no end headings, no moving start); this query "
+            f"gave a {type(out).__name__} (footprint: {robot.footprint is not None})"
+        )
+    return retime_for_movers(out, movers, margin=margin)  # type: ignore[arg-type]

@@ -222,6 +222,8 @@ def retime_for_movers(
             "retime_for_movers needs a trajectory from rest to rest, got "
             f"v_start={traj.v_start!r} m/s, v_end={traj.v_end!r} m/s"
         )
+    if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0.0):
+        raise InvalidInputError(f"margin must be a finite number >= 0 m, got {margin!r}")
     for name, val in (("dt", dt), ("ds", ds)):
         if not (isinstance(val, (int, float)) and math.isfinite(val) and val > 0.0):
             raise InvalidInputError(f"{name} must be a finite number > 0, got {val!r}")

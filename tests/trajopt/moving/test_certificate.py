@@ -114,10 +114,14 @@ def test_a_grazing_mover_touches_at_the_limit(line, offset):
 
 def test_following_at_the_limit_is_proven_fast(line):
     """A mover alongside the robot at exactly the limit: the second-order bound closes it."""
-    m = MovingObstacle.constant_velocity((0.0, ROBOT.radius + 0.2), (0.2, 0.0), radius=0.2, horizon=15.0)
+    m = MovingObstacle.constant_velocity(
+        (0.0, ROBOT.radius + 0.2), (0.2, 0.0), radius=0.2, horizon=15.0
+    )
     cert = certify_movers(line, [m])
     assert cert.ok and cert.intervals < 5000
-    closer = MovingObstacle.constant_velocity((0.0, ROBOT.radius + 0.199), (0.2, 0.0), radius=0.2, horizon=15.0)
+    closer = MovingObstacle.constant_velocity(
+        (0.0, ROBOT.radius + 0.199), (0.2, 0.0), radius=0.2, horizon=15.0
+    )
     bad = certify_movers(line, [closer])
     assert bad.verdict == "violated" and slack(line, closer, bad.witness_t)[0] < 0.0
 

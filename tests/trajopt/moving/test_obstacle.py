@@ -18,7 +18,9 @@ def test_exported_from_the_face():
 
 
 def test_constant_velocity_moves_then_stays():
-    m = MovingObstacle.constant_velocity((1.0, 2.0), (0.5, -0.25), radius=0.3, horizon=4.0, growth=0.1)
+    m = MovingObstacle.constant_velocity(
+        (1.0, 2.0), (0.5, -0.25), radius=0.3, horizon=4.0, growth=0.1
+    )
     np.testing.assert_allclose(m.position_at(0.0), [1.0, 2.0])
     np.testing.assert_allclose(m.position_at(2.0), [2.0, 1.5])
     np.testing.assert_allclose(m.position_at([4.0, 9.0]), [[3.0, 1.0], [3.0, 1.0]])
@@ -31,7 +33,11 @@ def test_constant_velocity_moves_then_stays():
 def test_waypoints_are_linear_and_a_polygon_turns():
     sq = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
     m = MovingObstacle.from_waypoints(
-        [0.0, 2.0, 3.0], [(0, 0), (2, 0), (2, 1)], radius=0.0, headings=[0, 0, math.pi / 2], vertices=sq
+        [0.0, 2.0, 3.0],
+        [(0, 0), (2, 0), (2, 1)],
+        radius=0.0,
+        headings=[0, 0, math.pi / 2],
+        vertices=sq,
     )
     np.testing.assert_allclose(m.position_at([1.0, 2.5, 7.0]), [[1, 0], [2, 0.5], [2, 1]])
     assert m.pose_at(2.5)[1] == pytest.approx(math.pi / 4)

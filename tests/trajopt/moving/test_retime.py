@@ -51,7 +51,9 @@ def test_a_clear_trajectory_is_kept(line6):
 
 def test_the_robot_waits_for_a_crossing_mover(line6):
     # crosses x = 3 at t ~ 6.7 s, when the static plan is there
-    m = MovingObstacle.constant_velocity((3.0, -2.0), (0.0, 0.3), radius=0.3, horizon=20.0, name="walker")
+    m = MovingObstacle.constant_velocity(
+        (3.0, -2.0), (0.0, 0.3), radius=0.3, horizon=20.0, name="walker"
+    )
     assert not certify_movers(line6, [m]).ok
     out = retime_for_movers(line6, [m])
     _check(out, [m], line6)
@@ -64,8 +66,12 @@ def test_the_robot_leaves_the_start_then_stops_to_let_a_mover_pass(line6):
     # one mover crosses x = 4.5 at t ~ 8.6 s, when the static plan is there; another runs over
     # the start at t = 5 s: waiting at the start long enough is unsafe, so the robot
     # drives, stops short of x = 4.5 and waits
-    cross = MovingObstacle.constant_velocity((4.5, -3.0), (0.0, 0.35), radius=0.3, horizon=24.0, name="cross")
-    sweep = MovingObstacle.constant_velocity((0.0, -2.5), (0.0, 0.5), radius=0.3, horizon=24.0, name="sweep")
+    cross = MovingObstacle.constant_velocity(
+        (4.5, -3.0), (0.0, 0.35), radius=0.3, horizon=24.0, name="cross"
+    )
+    sweep = MovingObstacle.constant_velocity(
+        (0.0, -2.5), (0.0, 0.5), radius=0.3, horizon=24.0, name="sweep"
+    )
     assert not certify_movers(line6, [cross]).ok and certify_movers(line6, [sweep]).ok
     out = retime_for_movers(line6, [cross, sweep])
     _check(out, [cross, sweep], line6)
@@ -75,7 +81,9 @@ def test_the_robot_leaves_the_start_then_stops_to_let_a_mover_pass(line6):
 
 
 def test_head_on_in_a_corridor_is_blocked_fast(line6):
-    m = MovingObstacle.constant_velocity((6.5, 0.0), (-0.4, 0.0), radius=0.3, horizon=30.0, name="forklift")
+    m = MovingObstacle.constant_velocity(
+        (6.5, 0.0), (-0.4, 0.0), radius=0.3, horizon=30.0, name="forklift"
+    )
     t0 = time.perf_counter()
     with pytest.raises(BlockedError) as err:
         retime_for_movers(line6, [m])
@@ -86,12 +94,16 @@ def test_head_on_in_a_corridor_is_blocked_fast(line6):
 
 
 def test_a_mover_that_stops_on_the_path_blocks(line6):
-    m = MovingObstacle.from_waypoints([0.0, 4.0], [(3.0, -2.0), (3.0, 0.0)], radius=0.3, name="parked")
+    m = MovingObstacle.from_waypoints(
+        [0.0, 4.0], [(3.0, -2.0), (3.0, 0.0)], radius=0.3, name="parked"
+    )
     with pytest.raises(BlockedError, match="parked"):
         retime_for_movers(line6, [m])
 
 
 def test_a_mover_on_the_robot_at_the_start_is_refused(line6):
-    m = MovingObstacle.constant_velocity((0.2, 0.1), (0.0, 1.0), radius=0.3, horizon=5.0, name="toe")
+    m = MovingObstacle.constant_velocity(
+        (0.2, 0.1), (0.0, 1.0), radius=0.3, horizon=5.0, name="toe"
+    )
     with pytest.raises(InvalidInputError, match="'toe' overlaps the robot at t = 0"):
         retime_for_movers(line6, [m])

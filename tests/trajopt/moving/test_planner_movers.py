@@ -1,0 +1,82 @@
+"""Tests of trajopt.moving: Planner.plan with moving_obstacles (disc robots, differential and omni).
+
+An empty list gives today's plan bit for bit; a mover crossing the planned path is let pass
+(the same path, re-timed, certified and checked on 1 ms samples and by brute force); what is
+not covered yet is refused with a typed error.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import trajopt
+from tests.trajopt.moving.reference import brute_min, dense_min
+from trajopt.errors import BlockedError, InvalidInputError
+
+
+@pytest.fixture(scope="module")
+def planned(scene):
+    planner = trajopt.Planner(scene.grid, trajopt.Robot())
+    return planner, planner.plan(scene.start, scene.goal("A"))
+
+
+def _same(a, b):
+    for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert a.duration == b.duration
+    assert np.array_equal(a.path.curve.c, b.path.curve.c)
+
+
+def test_no_movers_is_todays_plan(scene, planned):
+    planner, base = planned
+    for movers in (None, []):
+        _same(planner.plan(scene.start, scene.goal("A"), moving_obstacles=movers), base)
+    assert "moving" not in base.stats
+
+
+def _crossing(traj, name="walker", speed=0.4):
+    """A mover crossing the planned path at its middle, at the time the robot is there."""
+    t_c = 0.5 * traj.duration
+    smp = traj.sample(np.array([t_c]))
+    p = np.array([smp.x[0], smp.y[0]])
+    n = np.array([-math.sin(smp.theta[0]), math.cos(smp.theta[0])])
+    return trajopt.MovingObstacle.from_waypoints(
+        [t_c - 4.0, t_c + 4.0], [p - 4.0 * speed * n, p + 4.0 * speed * n], radius=0.2, name=name
+    )
+
+
+@pytest.mark.parametrize("drive", [trajopt.Differential(), trajopt.Omni()])
+def test_a_crossing_mover_is_let_pass_on_the_same_path(scene, drive):
+    planner = trajopt.Planner(scene.grid, trajopt.Robot(drive=drive))
+    base = planner.plan(scene.start, scene.goal("A"))
+    mover = _crossing(base)
+    assert not trajopt.certify_movers(base, [mover]).ok
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover], mover_margin=0.05)
+    assert np.array_equal(out.path.curve.c, base.path.curve.c)
+    assert out.stats["moving"]["certificate"]["ok"]
+    assert trajopt.certify_movers(out, [mover], margin=0.05).ok
+    assert dense_min(out, [mover], margin=0.05)[0] >= -1e-6
+    assert brute_min(out, [mover], margin=0.05) >= -1e-6
+    assert out.duration > base.duration
+
+
+def test_a_mover_parked_on_the_path_blocks(scene, planned):
+    planner, base = planned
+    smp = base.sample(np.array([0.5 * base.duration]))
+    parked = trajopt.MovingObstacle.from_waypoints(
+        [0.0], [(smp.x[0], smp.y[0])], radius=0.2, name="cart"
+    )
+    with pytest.raises(BlockedError, match="'cart'"):
+        planner.plan(scene.start, scene.goal("A"), moving_obstacles=[parked])
+
+
+def test_queries_not_covered_are_refused(scene, planned):
+    planner, base = planned
+    mover = _crossing(base)
+    with pytest.raises(InvalidInputError, match="moving_obstacles"):
+        planner.plan(scene.start, scene.goal("A"), v_start=0.2, moving_obstacles=[mover])
+    with pytest.raises(InvalidInputError, match="MovingObstacle"):
+        planner.plan(scene.start, scene.goal("A"), moving_obstacles=[(1.0, 2.0)])
