@@ -320,8 +320,8 @@ class Planner:
         moving_obstacles : sequence of MovingObstacle, optional
             Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
             ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
-            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: waits at the
-            start and at one stop) and certified at every instant until the last prediction
+            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at the
+            start and at stops on the way) and certified at every instant until the last prediction
             ends (``stats["moving"]``). Covered: a disc robot (no footprint) of the
             differential or omni drive whose plan is one curve from rest to rest (no end
             headings, no moving start); other queries with movers raise

@@ -3,7 +3,7 @@
 * :class:`MovingObstacle`: a disc or convex polygon on a piecewise-linear predicted track;
 * :func:`certify_movers` (:class:`MoverCertificate`): a proof, by interval bounds over time,
   that a timed trajectory keeps its distance from every mover at every instant;
-* :func:`retime_for_movers`: the same path re-timed (waits at the start and at one stop) so
+* :func:`retime_for_movers`: the same path re-timed (rests at the start and at stops on the way) so
   that the movers pass, certified; :class:`trajopt.errors.BlockedError` when no speed
   profile along the path avoids them;
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.

@@ -120,11 +120,30 @@ def st_grid(
     return STGrid(s=s, t=t, ds=ds, dt=float(dt), blocked=blocked, who=who)
 
 
-def reachable(grid: STGrid, speed: float) -> tuple[bool, int, int]:
+def reach_bound(t: np.ndarray, v_max: float, a_max: float, j_max: float) -> np.ndarray:
+    """Return an upper bound (m) of ``s(t)`` for any motion from rest under the limits, at ``t`` (s).
+
+    ``a <= min(a_max, j_max t)``, so ``v <= min(v_max, integral of that)``, and ``s`` is at
+    most the integral of this increasing bound, taken as an upper Riemann sum on 1 ms steps.
+    """
+    t = np.asarray(t, dtype=float)
+    h = 1e-3
+    tt = np.arange(0.0, float(np.max(t, initial=0.0)) + 2.0 * h, h)
+    t1 = a_max / j_max
+    vel = np.where(tt <= t1, 0.5 * j_max * tt * tt, 0.5 * a_max * t1 + a_max * (tt - t1))
+    vel = np.minimum(v_max, vel)
+    s = np.concatenate([[0.0], np.cumsum(vel[1:] * h)])  # right sums of an increasing bound
+    k = np.minimum(np.ceil(t / h - 1e-12).astype(np.int64), tt.shape[0] - 1)
+    return s[k]
+
+
+def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tuple[bool, int, int]:
     """Sweep the nodes a non-decreasing ``s(t)`` with speed ``<= speed`` can occupy.
 
     A relaxation: from node ``i`` at ``t_k`` the robot may be at any free node ``j`` with
-    ``i <= j <= i + m`` at ``t_{k+1}`` (``m = ceil(speed dt / ds) + 1``), whatever lies between.
+    ``i <= j <= i + m`` at ``t_{k+1}`` (``m = ceil(speed dt / ds) + 1``), whatever lies between,
+    and (given ``s_up``, shape (K,), an upper bound of ``s(t_k)`` in m) not beyond
+    ``s_up[k] + ds/2``.
 
     Returns
     -------
@@ -147,6 +166,8 @@ def reachable(grid: STGrid, speed: float) -> tuple[bool, int, int]:
     for k in range(1, kk):
         lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
         nxt = ~fb[k] & (idx - lastr <= m)
+        if s_up is not None:
+            nxt &= grid.s <= s_up[k] + 0.5 * grid.ds
         if not nxt.any():
             return False, k, last_i
         reach = nxt
