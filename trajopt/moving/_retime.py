@@ -182,7 +182,7 @@ def retime_for_movers(
             speed=vmax,
             sufficient=True,
         )
-        found = search(grid, drives, vmax)
+        found = search(grid, drives, vmax, float(robot.a_max))
         if found is None:
             break
         parts, _, label = found

@@ -75,6 +75,15 @@ def stop_points(grid: STGrid) -> list[float]:
     return [0.0, *keep, length]
 
 
+def least_time(d: float, v_top: float, a_top: float) -> float:
+    """Return a lower bound (s) of a rest-to-rest drive over ``d`` (m): bang-bang, no jerk limit."""
+    if d <= 0.0:
+        return 0.0
+    if d <= v_top * v_top / a_top:
+        return 2.0 * math.sqrt(d / a_top)
+    return d / v_top + v_top / a_top
+
+
 def _rest_closure(arrive: np.ndarray, blocked_col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Resting times after the arrivals ``arrive`` while the node stays free; each one's arrival."""
     idx = np.arange(arrive.shape[0])
@@ -87,6 +96,7 @@ def search(
     grid: STGrid,
     drive: Callable[[float, float], Piece | None],
     v_top: float,
+    a_top: float,
 ) -> tuple[list[tuple[float, Piece | None, float]], float, str] | None:
     """Return the earliest arrival's schedule (module docstring), or ``None``.
 
@@ -97,8 +107,9 @@ def search(
     drive : callable
         ``drive(s0, s1)``: the rest-to-rest drive over ``[s0, s1]`` (m), ``None`` when it
         cannot be timed.
-    v_top : float
-        The robot's top speed (m/s): drives that cannot beat the best arrival are not timed.
+    v_top, a_top : float
+        The robot's top speed (m/s) and acceleration (m/s^2): a drive whose
+        :func:`least_time` bound cannot beat the best arrival is not timed.
 
     Returns
     -------
@@ -129,9 +140,10 @@ def search(
             continue
         first = int(np.argmax(rest))
         for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
-            lower = first * dt + (stops[-1] - stops[w]) / v_top  # any arrival through v
+            via = 0.0 if v == w_n - 1 else least_time(stops[-1] - stops[v], v_top, a_top)
+            lower = first * dt + least_time(stops[v] - stops[w], v_top, a_top) + via
             if best is not None and lower >= best[0]:
-                break
+                continue
             piece = drive(stops[w], stops[v])
             if piece is None:
                 continue

@@ -80,3 +80,40 @@ def test_queries_not_covered_are_refused(scene, planned):
         planner.plan(scene.start, scene.goal("A"), v_start=0.2, moving_obstacles=[mover])
     with pytest.raises(InvalidInputError, match="MovingObstacle"):
         planner.plan(scene.start, scene.goal("A"), moving_obstacles=[(1.0, 2.0)])
+
+
+@pytest.mark.parametrize("closer", [0.0, 1e-3])
+def test_a_parked_mover_grazing_the_path(scene, planned, closer):
+    """Touching at the limit keeps today's plan; a millimetre closer blocks the path."""
+    planner, base = planned
+    path = base.path
+    s = np.linspace(0.0, base.length, 40001)
+    pts = np.asarray(path(path.u_at_s(s)))
+    # beside the middle of the path, 0.6 m off its normal, on the side its curve turns away from
+    i = s.shape[0] // 2
+    smp = base.sample(np.array([0.5 * base.duration]))
+    normal = np.array([-math.sin(smp.theta[0]), math.cos(smp.theta[0])])
+    side = -1.0 if smp.kappa[0] > 0 else 1.0
+    p = pts[i] + side * 0.6 * normal
+    d = np.hypot(*(pts - p).T)
+    j = int(np.argmin(d))
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = s[max(j - 1, 0)], s[min(j + 1, s.shape[0] - 1)]
+    res = minimize_scalar(
+        lambda x: float(np.hypot(*(np.asarray(path(path.u_at_s(x))) - p))),
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
+    radius = float(res.fun) - base.robot.radius + closer
+    mover = trajopt.MovingObstacle.from_waypoints([0.0], [p], radius=radius, name="post")
+    assert brute_min(base, [mover]) == pytest.approx(-closer, abs=1e-7)
+    if closer == 0.0:
+        out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover])
+        _same(out, base)
+        assert out.stats["moving"]["plan"] == "as planned"
+        assert -1e-6 <= out.stats["moving"]["certificate"]["slack_m"] <= 1e-7
+    else:
+        with pytest.raises(BlockedError, match="'post'"):
+            planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover])

@@ -10,6 +10,8 @@ import time
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from tests.trajopt.moving.reference import brute_min, dense_min
 from trajopt.errors import BlockedError, InvalidInputError
@@ -107,3 +109,44 @@ def test_a_mover_on_the_robot_at_the_start_is_refused(line6):
     )
     with pytest.raises(InvalidInputError, match="'toe' overlaps the robot at t = 0"):
         retime_for_movers(line6, [m])
+
+
+def test_a_turning_polygon_mover_is_let_pass(line6):
+    cart = MovingObstacle.from_waypoints(
+        [0.0, 12.0],
+        [(3.0, -2.4), (3.0, 3.6)],
+        radius=0.05,
+        headings=[0.0, 1.5],
+        vertices=[(-0.4, -0.25), (0.4, -0.25), (0.4, 0.25), (-0.4, 0.25)],
+        name="cart",
+    )
+    assert not certify_movers(line6, [cart]).ok
+    out = retime_for_movers(line6, [cart], margin=0.02)
+    assert certify_movers(out, [cart], margin=0.02).ok
+    assert dense_min(out, [cart], margin=0.02)[0] >= -1e-6
+    assert brute_min(out, [cart], margin=0.02) >= -1e-6
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0.5, 5.5), st.floats(-3.0, 3.0), st.floats(-0.5, 0.5), st.floats(0.1, 0.4)
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_random_crossings_are_certified_or_typed_errors(line6, specs):
+    movers = [
+        MovingObstacle.constant_velocity(
+            (x, y), (vx, -np.sign(y) * 0.4), radius=r, horizon=15.0, name=f"m{i}"
+        )
+        for i, (x, y, vx, r) in enumerate(specs)
+    ]
+    try:
+        out = retime_for_movers(line6, movers)
+    except (BlockedError, InvalidInputError):
+        return
+    assert certify_movers(out, movers).ok
+    assert dense_min(out, movers)[0] >= -1e-6
