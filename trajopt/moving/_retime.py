@@ -21,6 +21,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -97,7 +98,8 @@ def _blocked(grid: STGrid, movers: Sequence[MovingObstacle], robot: Any) -> None
     what = "stays on the path" if k == grid.t.shape[0] - 1 else "leaves no way past"
     raise BlockedError(
         f"moving obstacle {name!r} blocks the path: from t = {t:.3f} s it {what} "
-        f"(robot at s <= {grid.s[i]:.3f} m of {grid.s[-1]:.3f} m, no motion under v_max={speed:.3g} m/s and the acceleration limits gets past)",
+        f"(robot at s <= {grid.s[i]:.3f} m of {grid.s[-1]:.3f} m; no motion along the path "
+        f"under v_max={speed:.3g} m/s and the acceleration limits gets past)",
         mover=name,
         t=t,
     )
@@ -127,9 +129,10 @@ def retime_for_movers(
     Returns
     -------
     Trajectory
-        ``traj`` itself when it is already clear, else the same path re-timed with rests;
-        ``stats["moving"]`` holds the certificate, the plan (``"as planned"`` or
-        ``"wait k0 s, stop at s_w m until t2 s"``) and the wall time (s). Its certificate
+        ``traj``'s motion when it is already clear, else the same path re-timed with rests
+        (a new value either way; ``traj`` is not changed). ``stats["moving"]`` holds the
+        certificate, the plan (``"as planned"`` or ``"wait 1.250 s at the start, stop at
+        s = 2.100 m until t = 7.800 s"``) and the wall time (s). Its certificate
         (:func:`certify_movers`) holds at every instant until the last prediction ends.
 
     Raises
@@ -198,7 +201,6 @@ def retime_for_movers(
             duration=duration,
             v_start=0.0,
             v_end=0.0,
-            stats=dict(traj.stats),
             theta_grid_s=traj.theta_grid_s,
             theta_grid=traj.theta_grid,
             u_grid=traj.u_grid,
@@ -219,7 +221,9 @@ def retime_for_movers(
 
 
 def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajectory:
-    traj.stats["moving"] = {
+    """Return ``traj`` as a new value whose ``stats["moving"]`` describes the re-timing."""
+    stats = dict(traj.stats)
+    stats["moving"] = {
         "plan": label,
         "certificate": {
             "ok": cert.ok,
@@ -230,4 +234,4 @@ def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajec
         },
         "time_s": time.perf_counter() - t_all,
     }
-    return traj
+    return dataclasses.replace(traj, stats=stats)
