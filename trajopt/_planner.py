@@ -69,7 +69,7 @@ from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, check_movers, retime_for_movers
+from trajopt.moving import MovingObstacle, check_movers, retime_plan
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -320,11 +320,13 @@ class Planner:
         moving_obstacles : sequence of MovingObstacle, optional
             Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
             ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
-            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at the
-            start and at stops on the way) and certified at every instant until the last prediction
-            ends (``stats["moving"]``). Covered: a disc robot (no footprint) of the
-            differential or omni drive whose plan is one curve from rest to rest (no end
-            headings, no moving start); other queries with movers raise
+            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at
+            the start and at stops on the way) and certified at every instant until the
+            last prediction ends (``stats["moving"]``). Covered: a disc robot (no
+            footprint) of the differential or omni drive whose plan is one curve from rest
+            to rest, with a differential drive's turns in place at its ends
+            (:func:`trajopt.moving.retime_plan`); other queries with movers (a footprint, a
+            car, an omni orientation profile, a moving start) raise
             :class:`~trajopt.errors.InvalidInputError`.
         mover_margin : float
             Extra distance to every mover (m), >= 0.
@@ -550,10 +552,10 @@ def _retime(
 ) -> PlanResult:
     """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
     signed = robot.drive.signed_speed  # a car's: not covered yet
-    if robot.footprint is not None or signed or not out.single_curve or out.v_start != 0.0:
+    if robot.footprint is not None or signed or out.v_start != 0.0:
         raise InvalidInputError(
-            "moving_obstacles are covered for a disc robot's plan along one curve from rest "
-            "(differential or omni drive, no end headings, no moving start); this query "
-            f"gave a {type(out).__name__} (footprint: {robot.footprint is not None})"
+            "moving_obstacles are covered for a disc robot's plan from rest (differential or "
+            f"omni drive); this query gave a {type(out).__name__} (footprint: "
+            f"{robot.footprint is not None}, v_start: {out.v_start})"
         )
-    return retime_for_movers(out, movers, margin=margin)  # type: ignore[arg-type]
+    return retime_plan(out, movers, margin=margin)

@@ -31,7 +31,7 @@ import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError, TimingError
 from trajopt.geometry import CurveSegment
-from trajopt.motion import Trajectory
+from trajopt.motion import Trajectory, TrajectoryChain
 from trajopt.moving._certificate import (
     certify_movers,
     check_movers,
@@ -112,6 +112,7 @@ def retime_for_movers(
     margin: float = 0.0,
     dt: float = 0.05,
     ds: float = 0.02,
+    not_before: float = 0.0,
 ) -> Trajectory:
     """Re-time ``traj`` along its path so that it keeps clear of the movers (module docstring).
 
@@ -125,6 +126,9 @@ def retime_for_movers(
         Extra distance to every mover (m), >= 0.
     dt, ds : float
         The ``(s, t)`` grid's spacings (s, m).
+    not_before : float
+        The robot rests at the start until this time (s), >= 0 (a turn in place there):
+        the result starts with a rest at least that long.
 
     Returns
     -------
@@ -158,12 +162,18 @@ def retime_for_movers(
     for name, val in (("dt", dt), ("ds", ds)):
         if not (isinstance(val, (int, float)) and math.isfinite(val) and val > 0.0):
             raise InvalidInputError(f"{name} must be a finite number > 0, got {val!r}")
+    if not (isinstance(not_before, (int, float)) and math.isfinite(not_before) and not_before >= 0):
+        raise InvalidInputError(f"not_before must be a finite number >= 0 s, got {not_before!r}")
     limit = float(traj.robot.radius) + float(margin)
     _overlap_at_start(traj, movers, limit)
+    path, length, robot = traj.path, float(traj.length), traj.robot
+    if not_before > 0.0:  # the plan as it is, after the rest
+        whole = _piece_of(traj, 0.0, length)
+        rows, duration = compose([(0.0, None, 0.0), (float(not_before), whole, 0.0)], length)
+        traj = _timed(traj, rows, duration)
     cert = certify_movers(traj, movers, margin=margin)
     if cert.ok:
         return _with_stats(traj, cert, "as planned", t_all)
-    path, length, robot = traj.path, float(traj.length), traj.robot
     vmax = float(robot.v_max)
     t_last = max(m.t_last for m in movers)
     horizon = max(t_last, 0.0) + 2.0 * traj.duration + 2.0
@@ -185,28 +195,13 @@ def retime_for_movers(
             speed=vmax,
             sufficient=True,
         )
-        found = search(grid, drives, vmax, float(robot.a_max))
+        k_min = int(math.ceil(not_before / step - 1e-9))
+        found = search(grid, drives, vmax, float(robot.a_max), k_min)
         if found is None:
             break
         parts, _, label = found
         rows, duration = compose(parts, length)
-        out = Trajectory(
-            path=path,
-            robot=robot,
-            phase_t=rows[:, 0],
-            phase_s=rows[:, 1],
-            phase_v=rows[:, 2],
-            phase_a=rows[:, 3],
-            phase_j=rows[:, 4],
-            duration=duration,
-            v_start=0.0,
-            v_end=0.0,
-            theta_grid_s=traj.theta_grid_s,
-            theta_grid=traj.theta_grid,
-            u_grid=traj.u_grid,
-            steps=traj.steps,
-            direction=traj.direction,
-        )
+        out = _timed(traj, rows, duration)
         cert = certify_movers(out, movers, margin=margin)
         if cert.ok:
             return _with_stats(out, cert, label, t_all)
@@ -217,6 +212,72 @@ def retime_for_movers(
         f"obstacle {first!r} (near t = {cert.witness_t:.3f} s) within {horizon:.3g} s",
         mover=first,
         t=cert.witness_t,
+    )
+
+
+def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
+    """Return ``traj``'s path with the phase rows ``(t, s, v, a, j)``, shape (p, 5), from rest to rest."""
+    return Trajectory(
+        path=traj.path,
+        robot=traj.robot,
+        phase_t=rows[:, 0],
+        phase_s=rows[:, 1],
+        phase_v=rows[:, 2],
+        phase_a=rows[:, 3],
+        phase_j=rows[:, 4],
+        duration=duration,
+        v_start=0.0,
+        v_end=0.0,
+        stats=dict(traj.stats),
+        theta_grid_s=traj.theta_grid_s,
+        theta_grid=traj.theta_grid,
+        u_grid=traj.u_grid,
+        steps=traj.steps,
+        direction=traj.direction,
+    )
+
+
+def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 0.0) -> Any:
+    """Re-time a plan for movers: one curve, or turns in place, one curve, turns in place.
+
+    A :class:`trajopt.Trajectory` goes to :func:`retime_for_movers`. A
+    :class:`trajopt.TrajectoryChain` of turns in place at the start, one curve and turns in
+    place at the goal (a differential drive's pose-to-pose plan) keeps its turns: the robot
+    stands at the start while it turns (``not_before`` = their duration), and at the goal
+    while it turns there (the certificate covers standing at the goal). The result's pieces
+    are the old turns and the re-timed curve, on one clock with the movers'.
+
+    Raises
+    ------
+    InvalidInputError
+        Any other plan (a chain of several curves, a car's steering, an omni orientation).
+    """
+    if plan.single_curve:
+        return retime_for_movers(plan, movers, margin=margin)
+    pieces = tuple(getattr(plan, "pieces", ()))
+    curves = [i for i, p in enumerate(pieces) if p.single_curve]
+    if len(curves) != 1 or not all(p.turning for p in pieces if not p.single_curve):
+        raise InvalidInputError(
+            "moving obstacles are covered for one curve with turns in place at its ends, got "
+            f"{type(plan).__name__} of {[type(p).__name__ for p in pieces]}"
+        )
+    if any(plan.starts):
+        raise InvalidInputError(
+            "moving obstacles: a chain that starts inside a piece is not covered"
+        )
+    i = curves[0]
+    lead = float(sum(p.duration for p in pieces[:i]))
+    curve = retime_for_movers(pieces[i], movers, margin=margin, not_before=lead)
+    starts = [0.0] * len(pieces)
+    starts[i] = lead
+    stats = dict(plan.stats)
+    stats["moving"] = curve.stats["moving"]
+    return TrajectoryChain(
+        pieces=(*pieces[:i], curve, *pieces[i + 1 :]),
+        robot=plan.robot,
+        stats=stats,
+        steps=plan.steps,
+        starts=tuple(starts),
     )
 
 

@@ -97,6 +97,7 @@ def search(
     drive: Callable[[float, float], Piece | None],
     v_top: float,
     a_top: float,
+    k_min: int = 0,
 ) -> tuple[list[tuple[float, Piece | None, float]], float, str] | None:
     """Return the earliest arrival's schedule (module docstring), or ``None``.
 
@@ -110,6 +111,9 @@ def search(
     v_top, a_top : float
         The robot's top speed (m/s) and acceleration (m/s^2): a drive whose
         :func:`least_time` bound cannot beat the best arrival is not timed.
+    k_min : int
+        The first grid time at which the robot may leave the start (it rests there before:
+        a turn in place).
 
     Returns
     -------
@@ -136,6 +140,8 @@ def search(
     for w in range(w_n - 1):
         rest, since = _rest_closure(arrivals[w], fb[:, nodes[w]])
         resting.append((rest, since))
+        if w == 0:
+            rest = rest & (np.arange(kk) >= k_min)
         if not rest.any():
             continue
         first = int(np.argmax(rest))

@@ -117,3 +117,26 @@ def test_a_parked_mover_grazing_the_path(scene, planned, closer):
     else:
         with pytest.raises(BlockedError, match="'post'"):
             planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover])
+
+
+@pytest.mark.parametrize("headings", [{"goal_heading": 3.0}, {"start_heading": 3.0}])
+def test_turns_in_place_are_rests_of_the_re_timed_chain(scene, planned, headings):
+    planner, _ = planned
+    base = planner.plan(scene.start, scene.goal("A"), **headings)
+    assert not base.single_curve  # a turn in place at one end
+    curve = next(p for p in base.pieces if p.single_curve)
+    lead = sum(p.duration for p in base.pieces[: base.pieces.index(curve)])
+    # the mover crosses the curve's middle when the robot is there, on the chain's clock
+    mover = _crossing(curve)
+    mover = trajopt.MovingObstacle.from_waypoints(
+        mover.times + lead, mover.positions, radius=mover.radius, name="walker"
+    )
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover], **headings)
+    assert [type(p).__name__ for p in out.pieces] == [type(p).__name__ for p in base.pieces]
+    assert out.duration > base.duration and out.stats["moving"]["certificate"]["ok"]
+    # the chain's own samples, independently of the certificate: every 1 ms, and brute force
+    assert dense_min(out, [mover])[0] >= -1e-6
+    assert brute_min(out, [mover]) >= -1e-6
+    t = np.arange(0.0, out.duration, 1e-3)
+    smp = out.sample(t)
+    assert np.max(np.abs(np.diff(smp.v))) < 1e-3 and np.max(np.abs(np.diff(smp.theta))) < 1e-2
