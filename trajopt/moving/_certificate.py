@@ -19,6 +19,9 @@ docs/concepts.md, "Moving obstacles"):
   (``|P''| = |C'' v^2 + C' a| <= kappa v^2 + |a|``, the mover's own second derivative is 0),
   so ``dist(t) >= min_{|tau| <= h} |D + w tau| - |E|``.
 
+A :class:`trajopt.TrajectoryChain` is certified piece by piece on its clock: a curve as above,
+a motion at rest (a turn in place) as a robot standing still (``rho_P = 0``).
+
 An interval whose bound clears the limit (within ``tol``) is accepted; one whose midpoint
 is closer than the limit by more than ``tol / 2`` is a proven violation (a witness);
 otherwise it is bisected. Bisection ends: once the bound's loss is below ``tol / 2`` an
@@ -158,13 +161,69 @@ def _kappa_max(curve: Any) -> float:
     return float(np.max(k)) if k.size else 0.0
 
 
-def _check_trajectory(traj: Any) -> None:
-    for name in ("motion", "sample", "duration", "robot", "phase_t", "phase_v", "path"):
-        if not hasattr(traj, name):
+class _Curve:
+    """The robot on one timed curve, played from global time ``offset`` on its own clock."""
+
+    def __init__(self, traj: Any, offset: float) -> None:
+        self.traj, self.offset = traj, float(offset)
+        vmax, amax = _profile_bounds(traj)
+        self.c2 = _kappa_max(traj.path) * vmax * vmax + amax  # |P''| (m/s^2), inf if unknown
+
+    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
+        tr, off = self.traj, self.offset
+        s0 = tr.motion(t0 - off)[0]
+        s1 = tr.motion(t1 - off)[0]
+        smp = tr.sample(tm - off)
+        p = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
+        sm = np.asarray(smp.s, dtype=float)
+        rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
+        th, v = np.asarray(smp.theta, dtype=float), np.asarray(smp.v, dtype=float)
+        return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
+
+
+class _Still:
+    """The robot standing at ``point`` (a turn in place or a steering at rest of a disc)."""
+
+    c2 = 0.0
+
+    def __init__(self, point: np.ndarray) -> None:
+        self.point = np.asarray(point, dtype=float).reshape(2)
+
+    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return the position (m), shape (n, 2), a zero bound and a zero velocity."""
+        n = tm.shape[0]
+        return np.broadcast_to(self.point, (n, 2)), np.zeros(n), np.zeros((n, 2))
+
+
+def _windows(traj: Any) -> list[tuple[Any, float, float]]:
+    """Return ``(motion model, t0, t1)`` (s) covering the trajectory's time, in order."""
+    if getattr(traj, "single_curve", False):
+        for name in ("motion", "sample", "duration", "robot", "phase_t", "phase_v", "path"):
+            if not hasattr(traj, name):
+                raise InvalidInputError(f"trajectory must be a trajopt.Trajectory (no {name!r})")
+        return [(_Curve(traj, 0.0), 0.0, float(traj.duration))]
+    pieces = getattr(traj, "pieces", None)
+    if pieces is None or not hasattr(traj, "piece_times"):
+        raise InvalidInputError(
+            "trajectory must be a trajopt.Trajectory or a TrajectoryChain of curves and motions "
+            f"at rest, got {type(traj).__name__}"
+        )
+    out = []
+    times = np.asarray(traj.piece_times, dtype=float)
+    for i, pc in enumerate(pieces):
+        a, b = float(times[i]), float(times[i + 1])
+        if pc.single_curve:
+            out.append((_Curve(pc, a - float(traj.starts[i])), a, b))
+        elif pc.turning or pc.steering_at_rest:
+            smp = pc.sample(np.array([0.0]))
+            out.append((_Still(np.array([smp.x[0], smp.y[0]])), a, b))
+        else:
             raise InvalidInputError(
-                "trajectory must be a trajopt.Trajectory (one timed curve, with "
-                f"{name!r}), got {type(traj).__name__}"
+                f"the certificate covers curves and motions at rest, got a {type(pc).__name__} "
+                f"(piece {i})"
             )
+    return out
 
 
 def check_movers(movers: Sequence[MovingObstacle] | None) -> tuple[MovingObstacle, ...]:
@@ -196,8 +255,10 @@ def certify_movers(
 
     Parameters
     ----------
-    traj : trajopt.Trajectory
-        One timed curve (its ``motion`` is ``s(t)``, its ``sample`` the pose).
+    traj : trajopt.Trajectory or trajopt.TrajectoryChain
+        One timed curve (its ``motion`` is ``s(t)``, its ``sample`` the pose), or a chain of
+        such curves and motions at rest (turns in place, a car's steering at rest: a disc
+        robot stands still during them).
     movers : sequence of MovingObstacle
         The predictions, in the trajectory's clock.
     margin : float
@@ -211,50 +272,53 @@ def certify_movers(
     -------
     MoverCertificate
     """
-    _check_trajectory(traj)
     movers = check_movers(movers)
     if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0.0):
         raise InvalidInputError(f"margin must be a finite number >= 0 m, got {margin!r}")
     if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0.0):
         raise InvalidInputError(f"tol must be a finite number > 0 m, got {tol!r}")
+    if not hasattr(traj, "robot") or not hasattr(traj, "duration"):
+        raise InvalidInputError(
+            f"trajectory must be a trajopt.Trajectory or TrajectoryChain, got {type(traj).__name__}"
+        )
+    windows = _windows(traj)
     r_rob = float(traj.robot.radius if robot_radius is None else robot_radius)
     horizon = max([float(traj.duration)] + [m.t_last for m in movers])
     if not movers:
         return MoverCertificate(True, "clear", math.inf, "", 0.0, horizon, tol, 0)
-    vmax, amax = _profile_bounds(traj)
-    c2 = _kappa_max(traj.path) * vmax * vmax + amax  # |P''| bound (m/s^2), inf if unknown
+    model, a_last, _ = windows[-1]
+    windows[-1] = (model, a_last, horizon)  # the robot then stands at the goal
     best = (math.inf, "", 0.0)
     total = 0
     for mover in movers:
-        cuts = [0.0, horizon, float(traj.duration)]
-        cuts += [t for t in mover.times.tolist() if 0.0 < t < horizon]
-        knots = np.unique(np.clip(np.asarray(cuts), 0.0, horizon))
-        t0s, t1s = [], []
-        for a, b in zip(knots[:-1], knots[1:], strict=True):
-            n = max(1, int(math.ceil((b - a) / COVER_DT)))
-            e = np.linspace(a, b, n + 1)
-            t0s.append(e[:-1])
-            t1s.append(e[1:])
-        if not t0s:  # a zero-length horizon: one instant
-            t0s, t1s = [np.zeros(1)], [np.zeros(1)]
-        verdict, slack, wt, count = _certify_one(
-            traj, mover, np.concatenate(t0s), np.concatenate(t1s), r_rob + margin, c2, tol
-        )
-        total += count
-        if verdict != "clear":
-            return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
-        if slack < best[0]:
-            best = (slack, mover.name, wt)
+        for model, a, b in windows:
+            cuts = [a, b] + [t for t in mover.times.tolist() if a < t < b]
+            knots = np.unique(np.asarray(cuts))
+            t0s, t1s = [], []
+            for u, w in zip(knots[:-1], knots[1:], strict=True):
+                n = max(1, int(math.ceil((w - u) / COVER_DT)))
+                e = np.linspace(u, w, n + 1)
+                t0s.append(e[:-1])
+                t1s.append(e[1:])
+            if not t0s:  # a zero-length window: one instant
+                t0s, t1s = [np.full(1, a)], [np.full(1, a)]
+            verdict, slack, wt, count = _certify_one(
+                model, mover, np.concatenate(t0s), np.concatenate(t1s), r_rob + margin, tol
+            )
+            total += count
+            if verdict != "clear":
+                return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
+            if slack < best[0]:
+                best = (slack, mover.name, wt)
     return MoverCertificate(True, "clear", best[0], best[1], best[2], horizon, tol, total)
 
 
 def _certify_one(
-    traj: Any,
+    model: Any,
     mover: MovingObstacle,
     t0: np.ndarray,
     t1: np.ndarray,
     extra: float,
-    c2: float,
     tol: float,
 ) -> tuple[str, float, float, int]:
     """Bisect ``[t0, t1]`` intervals for one mover: ``(verdict, slack, time, intervals)``."""
@@ -269,31 +333,23 @@ def _certify_one(
             return "undecided", proven, proven_t, count
         tm = 0.5 * (t0 + t1)
         h = 0.5 * (t1 - t0)
-        s0 = traj.motion(t0)[0]
-        s1 = traj.motion(t1)[0]
-        smp = traj.sample(tm)
-        p = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
-        sm = np.asarray(smp.s, dtype=float)
-        rho_p = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
+        p, rho_p, v_rob = model.at(t0, tm, t1)
         vel, w = _segment_rates(mover, tm)
         rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach * np.abs(w)) * h
         dist_m = point_polygon_distance(p, shape_at(mover, tm))
         lim_mid = extra + mover.radius_at(tm)
         lim_hi = extra + mover.radius_at(t1)
         lower = dist_m - rho_p - rho_m - lim_hi
-        if disc and math.isfinite(c2):
+        if disc and math.isfinite(model.c2):
             # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
-            centre = mover.position_at(tm)
-            d = p - centre
-            theta = np.asarray(smp.theta, dtype=float)
-            v = np.asarray(smp.v, dtype=float)
-            rel = np.stack([v * np.cos(theta), v * np.sin(theta)], axis=-1) - vel
+            d = p - mover.position_at(tm)
+            rel = v_rob - vel
             rr = np.sum(rel * rel, axis=1)
             with np.errstate(divide="ignore", invalid="ignore"):
                 tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
             tau = np.clip(tau, -h, h)
             near = d + tau[:, None] * rel
-            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * model.c2 * h * h - 1e-12 - lim_hi
             lower = np.maximum(lower, lower2)
         slack_mid = dist_m - lim_mid
         bad = slack_mid < -0.5 * tol

@@ -11,9 +11,11 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import trajopt
-from tests.trajopt.moving.reference import brute_min, dense_min
+from tests.trajopt.moving.reference import brute_min, dense_min, slack
 from trajopt.errors import BlockedError, InvalidInputError
 
 
@@ -131,7 +133,10 @@ def test_turns_in_place_are_rests_of_the_re_timed_chain(scene, planned, headings
     mover = trajopt.MovingObstacle.from_waypoints(
         mover.times + lead, mover.positions, radius=mover.radius, name="walker"
     )
+    bad = trajopt.certify_movers(base, [mover])  # the chain itself: its turn is a rest
+    assert bad.verdict == "violated" and slack(base, mover, bad.witness_t)[0] < 0.0
     out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover], **headings)
+    assert trajopt.certify_movers(out, [mover]).ok
     assert [type(p).__name__ for p in out.pieces] == [type(p).__name__ for p in base.pieces]
     assert out.duration > base.duration and out.stats["moving"]["certificate"]["ok"]
     # the chain's own samples, independently of the certificate: every 1 ms, and brute force
@@ -140,3 +145,37 @@ def test_turns_in_place_are_rests_of_the_re_timed_chain(scene, planned, headings
     t = np.arange(0.0, out.duration, 1e-3)
     smp = out.sample(t)
     assert np.max(np.abs(np.diff(smp.v))) < 1e-3 and np.max(np.abs(np.diff(smp.theta))) < 1e-2
+
+
+@pytest.fixture(scope="module")
+def chain(scene, planned):
+    planner, _ = planned
+    return planner.plan(scene.start, scene.goal("A"), start_heading=3.0, goal_heading=3.0)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
+@given(
+    st.floats(0.0, 1.0),
+    st.floats(-math.pi, math.pi),
+    st.floats(0.1, 1.2),
+    st.floats(0.05, 0.4),
+    st.floats(-0.4, 0.4),
+)
+def test_the_chain_certificate_against_dense_samples(chain, frac, angle, speed, radius, miss):
+    """Random straight movers passing a random point of a turn-drive-turn chain."""
+    assert [p.turning for p in chain.pieces] == [True, False, True]
+    t_c = frac * chain.duration
+    smp = chain.sample(np.array([t_c]))
+    v = speed * np.array([math.cos(angle), math.sin(angle)])
+    p = np.array([smp.x[0], smp.y[0]]) + miss * np.array([-v[1], v[0]]) / speed
+    mover = trajopt.MovingObstacle.from_waypoints(
+        [t_c - 5.0, t_c + 5.0], [p - 5.0 * v, p + 5.0 * v], radius=radius
+    )
+    cert = trajopt.certify_movers(chain, [mover])
+    truth = min(dense_min(chain, [mover], dt=2e-3)[0], brute_min(chain, [mover]))
+    if cert.ok:
+        assert truth >= -1e-6
+    else:
+        assert slack(chain, mover, cert.witness_t)[0] < -0.5e-6
+    if truth > 1e-4:
+        assert cert.ok
