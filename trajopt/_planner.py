@@ -86,6 +86,7 @@ from trajopt.replan import BRAKE_AFTER_S, replan_from
 from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
+from trajopt.validation import nonnegative
 
 __all__ = [
     "plan",
@@ -329,7 +330,7 @@ class Planner:
             car, an omni orientation profile, a moving start) raise
             :class:`~trajopt.errors.InvalidInputError`.
         mover_margin : float
-            Extra distance to every mover (m), >= 0.
+            Extra distance to every mover (m), >= 0 (checked even without movers).
 
         Returns
         -------
@@ -356,6 +357,7 @@ class Planner:
             the time).
         """
         movers = check_movers(moving_obstacles)
+        margin = nonnegative("mover_margin", mover_margin, "m")
         request = PlanRequest(
             start,
             goal,
@@ -370,7 +372,7 @@ class Planner:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
             if movers:
-                out = _retime(out, movers, mover_margin, self.options.robot)
+                out = _retime(out, movers, margin, self.options.robot)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -533,6 +535,15 @@ def plan(
     planner = Planner(
         grid, options=PlannerOptions.from_keywords(options, settings, caller="trajopt.plan")
     )
+    # the movers' keywords go on only when given: without them the call is today's
+    moving = (
+        {}
+        if moving_obstacles is None and mover_margin == 0.0
+        else {
+            "moving_obstacles": moving_obstacles,
+            "mover_margin": mover_margin,
+        }
+    )
     return planner.plan(
         start,
         goal,
@@ -542,8 +553,7 @@ def plan(
         v_end=v_end,
         start_steer=start_steer,
         goal_steer=goal_steer,
-        moving_obstacles=moving_obstacles,
-        mover_margin=mover_margin,
+        **moving,
     )
 
 
