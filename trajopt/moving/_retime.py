@@ -247,8 +247,25 @@ def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 
     while it turns there (the certificate covers standing at the goal). The result's pieces
     are the old turns and the re-timed curve, on one clock with the movers'.
 
+    Parameters
+    ----------
+    plan : Trajectory or TrajectoryChain
+        A disc robot's plan from rest to rest.
+    movers : sequence of MovingObstacle
+        The predictions (seconds from the plan's ``t = 0``).
+    margin : float
+        Extra distance to every mover (m), >= 0.
+
+    Returns
+    -------
+    Trajectory or TrajectoryChain
+        Of the plan's kind, certified (:func:`certify_movers`); ``stats["moving"]`` as in
+        :func:`retime_for_movers`.
+
     Raises
     ------
+    BlockedError
+        As :func:`retime_for_movers`.
     InvalidInputError
         Any other plan (a chain of several curves, a car's steering, an omni orientation).
     """

@@ -88,6 +88,10 @@ def st_grid(
         The robot's speed bound ``V`` (m/s).
     sufficient : bool
         Inflate (a safe under-approximation of the free space) or deflate (a necessary one).
+
+    Returns
+    -------
+    STGrid
     """
     n = max(2, int(math.ceil(length / ds)) + 1)
     s = np.linspace(0.0, length, n)
