@@ -19,6 +19,13 @@ docs/concepts.md, "Moving obstacles"):
   (``|P''| = |C'' v^2 + C' a| <= kappa v^2 + |a|``, the mover's own second derivative is 0),
   so ``dist(t) >= min_{|tau| <= h} |D + w tau| - |E|``.
 
+A robot with a :class:`~trajopt.robot.Footprint` (convex, turned by the heading) is its
+polygon: the distance between two convex polygons (separating axes, then vertex to edge) at
+``tm``, less the footprint's motion ``rho_P + R dtheta`` (``R`` its farthest vertex, ``dtheta
+<= kappa_max rho_P`` the tangent's turn along the arc, at most ``pi``) and the mover's; the
+bound of its circumscribed disc is taken too, and alone while it turns in place. First order
+only.
+
 A :class:`trajopt.TrajectoryChain` is certified piece by piece on its clock: a curve as above,
 a motion at rest (a turn in place) as a robot standing still (``rho_P = 0``).
 
@@ -102,6 +109,30 @@ def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
     return np.where(inside, 0.0, dist)
 
 
+def convex_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Return the distance (m) between convex CCW polygons ``a`` (n, ma, 2) and ``b`` (n, mb, 2); 0 on overlap.
+
+    Separating axes (every edge normal of both) decide overlap; separated convex polygons are
+    closest at a vertex of one and an edge of the other.
+    """
+    if a.shape[1] == 1:
+        return point_polygon_distance(a[:, 0], b)
+    if b.shape[1] == 1:
+        return point_polygon_distance(b[:, 0], a)
+    separated = np.zeros(a.shape[0], dtype=bool)
+    for p, q in ((a, b), (b, a)):
+        e = np.roll(p, -1, axis=1) - p
+        normal = np.stack([e[..., 1], -e[..., 0]], axis=-1)  # outward for CCW
+        rel = q[:, None, :, :] - p[:, :, None, :]  # (n, edges, vertices of q, 2)
+        proj = np.einsum("nevk,nek->nev", rel, normal)
+        separated |= np.any(np.min(proj, axis=2) > 0.0, axis=1)
+    d = np.full(a.shape[0], np.inf)
+    for p, q in ((a, b), (b, a)):
+        for i in range(p.shape[1]):
+            d = np.minimum(d, point_polygon_distance(p[:, i], q))
+    return np.where(separated, d, 0.0)
+
+
 def shape_at(mover: MovingObstacle, t: np.ndarray) -> np.ndarray:
     """Return the mover's polygon (vertices in the world) at times ``t``, shape (n, m, 2)."""
     c, h = mover.pose_at(t)
@@ -167,7 +198,8 @@ class _Curve:
     def __init__(self, traj: Any, offset: float) -> None:
         self.traj, self.offset = traj, float(offset)
         vmax, amax = _profile_bounds(traj)
-        self.c2 = _kappa_max(traj.path) * vmax * vmax + amax  # |P''| (m/s^2), inf if unknown
+        self.kappa = _kappa_max(traj.path)  # the heading turns at most kappa per metre
+        self.c2 = self.kappa * vmax * vmax + amax  # |P''| (m/s^2), inf if unknown
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
@@ -179,21 +211,36 @@ class _Curve:
         sm = np.asarray(smp.s, dtype=float)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
         th, v = np.asarray(smp.theta, dtype=float), np.asarray(smp.v, dtype=float)
+        self.theta, self.turn = th, np.minimum(self.kappa * rho, math.pi)
         return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
 
 
 class _Still:
-    """The robot standing at ``point`` (a turn in place or a steering at rest of a disc)."""
+    """The robot standing still, played from global time ``offset`` (a turn in place).
+
+    Its position is fixed; its heading is sampled but not bounded between samples (a
+    footprint counts by its circumscribed disc there).
+    """
 
     c2 = 0.0
 
-    def __init__(self, point: np.ndarray) -> None:
-        self.point = np.asarray(point, dtype=float).reshape(2)
+    def __init__(self, piece: Any, offset: float) -> None:
+        self.piece, self.offset = piece, float(offset)
+        smp = piece.sample(np.array([0.0]))
+        self.point = np.array([smp.x[0], smp.y[0]], dtype=float)
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), a zero bound and a zero velocity."""
         n = tm.shape[0]
+        self.theta = np.asarray(self.piece.sample(tm - self.offset).theta, dtype=float)
+        self.turn = np.full(n, math.pi)
         return np.broadcast_to(self.point, (n, 2)), np.zeros(n), np.zeros((n, 2))
+
+
+def _ccw(v: np.ndarray) -> np.ndarray:
+    """Return the polygon ``v`` (m, 2) counter-clockwise."""
+    area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+    return v if area2 > 0.0 else v[::-1].copy()
 
 
 def _windows(traj: Any) -> list[tuple[Any, float, float]]:
@@ -216,8 +263,7 @@ def _windows(traj: Any) -> list[tuple[Any, float, float]]:
         if pc.single_curve:
             out.append((_Curve(pc, a - float(traj.starts[i])), a, b))
         elif pc.turning or pc.steering_at_rest:
-            smp = pc.sample(np.array([0.0]))
-            out.append((_Still(np.array([smp.x[0], smp.y[0]])), a, b))
+            out.append((_Still(pc, a - float(traj.starts[i])), a, b))
         else:
             raise InvalidInputError(
                 f"the certificate covers curves and motions at rest, got a {type(pc).__name__} "
@@ -266,7 +312,8 @@ def certify_movers(
     tol : float
         Tolerance (m), > 0: ``ok`` proves every distance >= limit - ``tol``.
     robot_radius : float, optional
-        The robot disc's radius (m); default ``traj.robot.radius``.
+        Certify a disc of this radius (m) instead of the robot; default the robot's own
+        shape: its footprint when it has one, else the disc of ``traj.robot.radius``.
 
     Returns
     -------
@@ -283,6 +330,8 @@ def certify_movers(
         )
     windows = _windows(traj)
     r_rob = float(traj.robot.radius if robot_radius is None else robot_radius)
+    footprint = traj.robot.footprint if robot_radius is None else None
+    body = None if footprint is None else _ccw(np.asarray(footprint.vertices, dtype=float))
     horizon = max([float(traj.duration)] + [m.t_last for m in movers])
     if not movers:
         return MoverCertificate(True, "clear", math.inf, "", 0.0, horizon, tol, 0)
@@ -303,7 +352,13 @@ def certify_movers(
             if not t0s:  # a zero-length window: one instant
                 t0s, t1s = [np.full(1, a)], [np.full(1, a)]
             verdict, slack, wt, count = _certify_one(
-                model, mover, np.concatenate(t0s), np.concatenate(t1s), r_rob + margin, tol
+                model,
+                mover,
+                np.concatenate(t0s),
+                np.concatenate(t1s),
+                (margin if body is not None else r_rob + margin),
+                tol,
+                body,
             )
             total += count
             if verdict != "clear":
@@ -320,8 +375,13 @@ def _certify_one(
     t1: np.ndarray,
     extra: float,
     tol: float,
+    body: np.ndarray | None = None,
 ) -> tuple[str, float, float, int]:
-    """Bisect ``[t0, t1]`` intervals for one mover: ``(verdict, slack, time, intervals)``."""
+    """Bisect ``[t0, t1]`` intervals for one mover: ``(verdict, slack, time, intervals)``.
+
+    ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
+    a disc (whose radius is in ``extra``).
+    """
     disc = mover.vertices is None
     reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
     proven = math.inf
@@ -336,11 +396,25 @@ def _certify_one(
         p, rho_p, v_rob = model.at(t0, tm, t1)
         vel, w = _segment_rates(mover, tm)
         rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach * np.abs(w)) * h
-        dist_m = point_polygon_distance(p, shape_at(mover, tm))
+        shape = shape_at(mover, tm)
+        dist_m = point_polygon_distance(p, shape)
         lim_mid = extra + mover.radius_at(tm)
         lim_hi = extra + mover.radius_at(t1)
         lower = dist_m - rho_p - rho_m - lim_hi
-        if disc and math.isfinite(model.c2):
+        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
+            reach_b = float(np.max(np.hypot(body[:, 0], body[:, 1])))
+            c, sn = np.cos(model.theta)[:, None], np.sin(model.theta)[:, None]
+            poly = np.stack(
+                [
+                    p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+                    p[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+                ],
+                axis=-1,
+            )
+            dist_m = convex_distance(poly, shape)
+            lower_poly = dist_m - rho_p - reach_b * model.turn - rho_m - lim_hi
+            lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
+        elif disc and math.isfinite(model.c2):
             # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
             d = p - mover.position_at(tm)
             rel = v_rob - vel

@@ -66,7 +66,7 @@ def cases(draw):
     return ys, length, movers
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(cases())
 def test_never_passes_a_violation_and_passes_clear_cases(case):
     ys, length, movers = case
