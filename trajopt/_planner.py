@@ -323,11 +323,11 @@ class Planner:
             ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
             plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at
             the start and at stops on the way) and certified at every instant until the
-            last prediction ends (``stats["moving"]``). Covered: a disc robot (no
-            footprint) of the differential or omni drive whose plan is one curve from rest
-            to rest, with a differential drive's turns in place at its ends
-            (:func:`trajopt.moving.retime_plan`); other queries with movers (a footprint, a
-            car, an omni orientation profile, a moving start) raise
+            last prediction ends (``stats["moving"]``). Covered: the differential and
+            omni drives (a disc or a footprint robot) whose plan is one curve from rest to
+            rest, with a differential drive's turns in place at its ends
+            (:func:`trajopt.moving.retime_plan`); other queries with movers (a car, an omni
+            orientation profile, a moving start) raise
             :class:`~trajopt.errors.InvalidInputError`.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
@@ -562,10 +562,9 @@ def _retime(
 ) -> PlanResult:
     """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
     signed = robot.drive.signed_speed  # a car's: not covered yet
-    if robot.footprint is not None or signed or out.v_start != 0.0:
+    if signed or out.v_start != 0.0:
         raise InvalidInputError(
-            "moving_obstacles are covered for a disc robot's plan from rest (differential or "
-            f"omni drive); this query gave a {type(out).__name__} (footprint: "
-            f"{robot.footprint is not None}, v_start: {out.v_start})"
+            "moving_obstacles are covered for a plan from rest of the differential or omni "
+            f"drive; this query gave a {type(out).__name__} with v_start={out.v_start}"
         )
     return retime_plan(out, movers, margin=margin)

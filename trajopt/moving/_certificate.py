@@ -110,27 +110,33 @@ def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 def convex_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Return the distance (m) between convex CCW polygons ``a`` (n, ma, 2) and ``b`` (n, mb, 2); 0 on overlap.
+    """Return the signed distance (m) of convex CCW polygons ``a`` (n, ma, 2) and ``b`` (n, mb, 2).
 
-    Separating axes (every edge normal of both) decide overlap; separated convex polygons are
-    closest at a vertex of one and an edge of the other.
+    Separated polygons: their distance (closest at a vertex of one and an edge of the other).
+    Overlapping ones: minus the penetration depth, the shortest translation that separates
+    them, found along the edge normals of both (separating axes; a polygon of one vertex is a
+    point and has none). This signed distance is 1-Lipschitz in the Hausdorff distance of
+    either polygon (it is the signed distance of the origin to ``b - a``).
     """
-    if a.shape[1] == 1:
-        return point_polygon_distance(a[:, 0], b)
-    if b.shape[1] == 1:
-        return point_polygon_distance(b[:, 0], a)
     separated = np.zeros(a.shape[0], dtype=bool)
+    depth = np.full(a.shape[0], np.inf)
     for p, q in ((a, b), (b, a)):
+        if p.shape[1] < 3:
+            continue
         e = np.roll(p, -1, axis=1) - p
         normal = np.stack([e[..., 1], -e[..., 0]], axis=-1)  # outward for CCW
-        rel = q[:, None, :, :] - p[:, :, None, :]  # (n, edges, vertices of q, 2)
-        proj = np.einsum("nevk,nek->nev", rel, normal)
-        separated |= np.any(np.min(proj, axis=2) > 0.0, axis=1)
+        normal /= np.maximum(np.linalg.norm(normal, axis=-1, keepdims=True), 1e-300)
+        proj_q = np.einsum("nevk,nek->nev", q[:, None, :, :] - p[:, :, None, :], normal)
+        proj_p = np.einsum("nevk,nek->nev", p[:, None, :, :] - p[:, :, None, :], normal)
+        gap = np.min(proj_q, axis=2)  # > 0: this edge's line separates them
+        separated |= np.any(gap > 0.0, axis=1)
+        through = np.minimum(-gap, np.max(proj_q, axis=2) - np.min(proj_p, axis=2))
+        depth = np.minimum(depth, np.min(through, axis=1))
     d = np.full(a.shape[0], np.inf)
     for p, q in ((a, b), (b, a)):
         for i in range(p.shape[1]):
             d = np.minimum(d, point_polygon_distance(p[:, i], q))
-    return np.where(separated, d, 0.0)
+    return np.where(separated | ~np.isfinite(depth), d, -depth)
 
 
 def shape_at(mover: MovingObstacle, t: np.ndarray) -> np.ndarray:
@@ -173,7 +179,7 @@ def _profile_bounds(traj: Any) -> tuple[float, float]:
     return vmax, amax
 
 
-def _kappa_max(curve: Any) -> float:
+def kappa_max(curve: Any) -> float:
     """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
     deg = getattr(curve, "polynomial_degree", None)
     if deg is None:
@@ -198,7 +204,7 @@ class _Curve:
     def __init__(self, traj: Any, offset: float) -> None:
         self.traj, self.offset = traj, float(offset)
         vmax, amax = _profile_bounds(traj)
-        self.kappa = _kappa_max(traj.path)  # the heading turns at most kappa per metre
+        self.kappa = kappa_max(traj.path)  # the heading turns at most kappa per metre
         self.c2 = self.kappa * vmax * vmax + amax  # |P''| (m/s^2), inf if unknown
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -237,7 +243,7 @@ class _Still:
         return np.broadcast_to(self.point, (n, 2)), np.zeros(n), np.zeros((n, 2))
 
 
-def _ccw(v: np.ndarray) -> np.ndarray:
+def ccw(v: np.ndarray) -> np.ndarray:
     """Return the polygon ``v`` (m, 2) counter-clockwise."""
     area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
     return v if area2 > 0.0 else v[::-1].copy()
@@ -331,7 +337,7 @@ def certify_movers(
     windows = _windows(traj)
     r_rob = float(traj.robot.radius if robot_radius is None else robot_radius)
     footprint = traj.robot.footprint if robot_radius is None else None
-    body = None if footprint is None else _ccw(np.asarray(footprint.vertices, dtype=float))
+    body = None if footprint is None else ccw(np.asarray(footprint.vertices, dtype=float))
     horizon = max([float(traj.duration)] + [m.t_last for m in movers])
     if not movers:
         return MoverCertificate(True, "clear", math.inf, "", 0.0, horizon, tol, 0)

@@ -33,9 +33,11 @@ from trajopt.errors import BlockedError, InvalidInputError, TimingError
 from trajopt.geometry import CurveSegment
 from trajopt.motion import Trajectory, TrajectoryChain
 from trajopt.moving._certificate import (
+    ccw,
     certify_movers,
     check_movers,
-    point_polygon_distance,
+    convex_distance,
+    kappa_max,
     shape_at,
 )
 from trajopt.moving._obstacle import MovingObstacle
@@ -71,15 +73,39 @@ def _drives(traj: Trajectory) -> Callable[[float, float], Piece | None]:
     return drive
 
 
-def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], limit: float) -> None:
-    p0 = np.asarray(traj.path(traj.path.domain[0]), dtype=float).reshape(1, 2)
+def _robot_shape(traj: Trajectory, margin: float) -> tuple[float, np.ndarray | None, float]:
+    """Return ``(limit, body, stretch)`` for the grids (:func:`st_grid`).
+
+    A disc robot: its radius plus the margin. A footprint robot: the margin, its CCW polygon
+    and ``1 + R kappa_max``; on a path with no curvature bound, its circumscribed disc.
+    """
+    fp = traj.robot.footprint
+    if fp is None:
+        return float(traj.robot.radius) + margin, None, 1.0
+    body = ccw(np.asarray(fp.vertices, dtype=float))
+    reach = float(np.max(np.hypot(body[:, 0], body[:, 1])))
+    kappa = kappa_max(traj.path)
+    if not math.isfinite(kappa):
+        return reach + margin, None, 1.0
+    return margin, body, 1.0 + reach * kappa
+
+
+def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float) -> None:
+    smp = traj.sample(np.zeros(1))
+    p0 = np.array([[smp.x[0], smp.y[0]]], dtype=float)
+    robot: np.ndarray = p0[:, None, :]
+    fp = traj.robot.footprint
+    if fp is not None:
+        v = ccw(np.asarray(fp.vertices, dtype=float))
+        c, sn = math.cos(float(smp.theta[0])), math.sin(float(smp.theta[0]))
+        robot = (p0 + v @ np.array([[c, sn], [-sn, c]]))[None]
     for m in movers:
-        d = float(point_polygon_distance(p0, shape_at(m, np.zeros(1)))[0])
-        need = limit + float(m.radius_at(0.0))
+        d = float(convex_distance(robot, shape_at(m, np.zeros(1)))[0])
+        need = margin + float(m.radius_at(0.0)) + (traj.robot.radius if fp is None else 0.0)
         if d < need:
             raise InvalidInputError(
                 f"moving obstacle {m.name!r} overlaps the robot at t = 0: distance {d:.6g} m "
-                f"< {need:.6g} m (robot radius + its radius + margin)"
+                f"< {need:.6g} m (robot, its radius and the margin)"
             )
 
 
@@ -164,8 +190,8 @@ def retime_for_movers(
             raise InvalidInputError(f"{name} must be a finite number > 0, got {val!r}")
     if not (isinstance(not_before, (int, float)) and math.isfinite(not_before) and not_before >= 0):
         raise InvalidInputError(f"not_before must be a finite number >= 0 s, got {not_before!r}")
-    limit = float(traj.robot.radius) + float(margin)
-    _overlap_at_start(traj, movers, limit)
+    limit, body, stretch = _robot_shape(traj, float(margin))
+    _overlap_at_start(traj, movers, float(margin))
     path, length, robot = traj.path, float(traj.length), traj.robot
     if not_before > 0.0:  # the plan as it is, after the rest
         whole = _piece_of(traj, 0.0, length)
@@ -178,7 +204,17 @@ def retime_for_movers(
     t_last = max(m.t_last for m in movers)
     horizon = max(t_last, 0.0) + 2.0 * traj.duration + 2.0
     nec = st_grid(
-        path, length, movers, limit, ds=ds, dt=dt, horizon=horizon, speed=vmax, sufficient=False
+        path,
+        length,
+        movers,
+        limit,
+        ds=ds,
+        dt=dt,
+        horizon=horizon,
+        speed=vmax,
+        sufficient=False,
+        body=body,
+        stretch=stretch,
     )
     _blocked(nec, movers, robot)
     step = float(dt)
@@ -194,6 +230,8 @@ def retime_for_movers(
             horizon=horizon,
             speed=vmax,
             sufficient=True,
+            body=body,
+            stretch=stretch,
         )
         k_min = int(math.ceil(not_before / step - 1e-9))
         found = search(grid, drives, vmax, float(robot.a_max), k_min)

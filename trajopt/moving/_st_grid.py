@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trajopt.moving._certificate import point_polygon_distance, shape_at
+from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._obstacle import MovingObstacle
 
 
@@ -70,6 +70,8 @@ def st_grid(
     horizon: float,
     speed: float,
     sufficient: bool,
+    body: np.ndarray | None = None,
+    stretch: float = 1.0,
 ) -> STGrid:
     """Build the forbidden grid (module docstring).
 
@@ -79,7 +81,8 @@ def st_grid(
         The path, arc length ``length`` (m).
     movers : sequence of MovingObstacle
     limit : float
-        Robot radius plus margin (m); each mover adds its radius.
+        Robot radius plus margin (m), or the margin alone with a ``body``; each mover adds
+        its radius.
     ds, dt : float
         Requested spacings (m, s); ``ds`` is adjusted to divide ``length``.
     horizon : float
@@ -88,6 +91,12 @@ def st_grid(
         The robot's speed bound ``V`` (m/s).
     sufficient : bool
         Inflate (a safe under-approximation of the free space) or deflate (a necessary one).
+    body : ndarray, shape (m, 2), optional
+        The robot's convex footprint (robot frame, CCW, m), turned by the path's heading at
+        each node; ``None``: a disc robot.
+    stretch : float
+        With a ``body``: ``1 + R kappa_max`` (``R`` its farthest vertex), the bound of how far
+        the footprint moves per metre of arc length; the pads scale the robot's share by it.
 
     Returns
     -------
@@ -99,16 +108,34 @@ def st_grid(
     kk = max(2, int(math.ceil(horizon / dt)) + 1)
     t = np.arange(kk) * dt
     pts = path_points(path, s)
+    polys = None
+    if body is not None:
+        th = np.asarray(path.heading(path.u_at_s(s)), dtype=float)  # type: ignore[attr-defined]
+        c, sn = np.cos(th)[:, None], np.sin(th)[:, None]
+        polys = np.stack(
+            [
+                pts[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+                pts[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+            ],
+            axis=-1,
+        )
+    else:
+        stretch = 1.0
     blocked = np.zeros((kk, n), dtype=bool)
     who = np.full((kk, n), -1, dtype=np.int16)
     for j, m in enumerate(movers):
         if sufficient:
-            pad = 0.5 * ds + 0.5 * dt * (speed + m.shape_speed_max() + m.growth)
+            pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
         else:
-            pad = -0.5 * ds
+            pad = -0.5 * ds * stretch
         lim = limit + m.radius_at(t) + pad  # (K,)
         hit = np.zeros((kk, n), dtype=bool)
-        if m.vertices is None:
+        if polys is not None:
+            shapes = shape_at(m, t)
+            for k in range(kk):
+                w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
+                hit[k] = convex_distance(polys, w) < lim[k]
+        elif m.vertices is None:
             c = m.position_at(t)
             for a in range(0, kk, 256):
                 b = min(kk, a + 256)

@@ -12,6 +12,7 @@ import shapely
 from hypothesis import HealthCheck, assume, given, settings
 from scipy.optimize import minimize_scalar
 
+import trajopt
 from tests.trajopt.moving.test_certificate import SQUARE, _curve, cases
 from trajopt.errors import TimingError
 from trajopt.geometry import PolylineCurve
@@ -27,7 +28,7 @@ def _slack(traj, mover, t, margin=0.0):
     t = np.atleast_1d(np.asarray(t, dtype=float))
     smp = traj.sample(t)
     c, s = np.cos(smp.theta)[:, None], np.sin(smp.theta)[:, None]
-    b = np.asarray(BODY)
+    b = np.asarray(traj.robot.footprint.vertices)
     robot = shapely.polygons(
         np.stack(
             [
@@ -52,22 +53,31 @@ def _slack(traj, mover, t, margin=0.0):
                 axis=-1,
             )
         )
-    return shapely.distance(robot, other) - mover.radius_at(t) - margin
+    d = shapely.distance(robot, other)
+    # an overlap counts below zero (touching is zero): a point deep inside by its depth, two
+    # polygons by the square root of their common area (a sign, not a depth)
+    if mover.vertices is None:
+        inside = shapely.contains_properly(robot, other)
+        d = np.where(inside, -shapely.distance(shapely.boundary(robot), other), d)
+    else:
+        area = shapely.area(shapely.intersection(robot, other))
+        d = np.where(area > 1e-14, -np.sqrt(area), d)
+    return d - mover.radius_at(t) - margin
 
 
-def _truth(traj, movers):
+def _truth(traj, movers, margin=0.0):
     end = max([traj.duration] + [m.t_last for m in movers])
     t = np.append(np.arange(0.0, end, 1e-3), end)
     best = np.inf
     for m in movers:
-        sl = _slack(traj, m, t)
+        sl = _slack(traj, m, t, margin)
         best = min(best, float(sl.min()))
         coarse = sl[::10]
         tc = t[::10]
         idx = np.flatnonzero((coarse <= np.roll(coarse, 1)) & (coarse <= np.roll(coarse, -1)))
         for i in idx[np.argsort(coarse[idx])[:4]]:
             r = minimize_scalar(
-                lambda x, m=m: float(_slack(traj, m, x)[0]),
+                lambda x, m=m: float(_slack(traj, m, x, margin)[0]),
                 bounds=(max(0.0, tc[i] - 0.01), min(end, tc[i] + 0.01)),
                 method="bounded",
                 options={"xatol": 1e-9},
@@ -108,3 +118,27 @@ def test_the_footprint_not_its_disc_counts():
     # the disc model of the same robot is refused at once
     disc = ROBOT.footprint.circumscribed_radius
     assert not certify_movers(line, [box], margin=gap - 1e-3, robot_radius=disc).ok
+
+
+def test_a_footprint_robot_lets_a_mover_pass(scene):
+    robot = Robot(
+        footprint=Footprint(vertices=[(-0.12, -0.1), (0.2, -0.1), (0.2, 0.1), (-0.12, 0.1)])
+    )
+    planner = trajopt.Planner(scene.grid, robot)
+    base = planner.plan(scene.start, scene.goal("A"))
+    t_c = 0.5 * base.duration
+    smp = base.sample(np.array([t_c]))
+    p = np.array([smp.x[0], smp.y[0]])
+    n = np.array([-np.sin(smp.theta[0]), np.cos(smp.theta[0])])
+    cart = MovingObstacle.from_waypoints(
+        [t_c - 4.0, t_c + 4.0],
+        [p - 1.6 * n, p + 1.6 * n],
+        radius=0.02,
+        vertices=SQUARE,
+        name="cart",
+    )
+    assert not certify_movers(base, [cart]).ok
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[cart], mover_margin=0.02)
+    assert out.stats["moving"]["certificate"]["ok"] and out.duration > base.duration
+    assert certify_movers(out, [cart], margin=0.02).ok
+    assert _truth(out, [cart], margin=0.02) >= -1e-6
