@@ -10,6 +10,10 @@ than the limit ``robot radius + mover radius(t_k) + margin`` plus an ``inflation
   ``ds/2 + V dt/2`` of that node, the mover's shape within ``u dt/2`` of its place at ``t_k``);
 * the **necessary** grid deflates by ``ds/2``: a forbidden node is forbidden for every ``s``
   within ``ds/2`` of it at that instant, so a profile through it is truly unsafe.
+
+A footprint robot is its convex polygon at each node, turned by the path's heading there; it
+moves at most ``(1 + R kappa_max)`` per metre of arc, so the robot's share of both pads is
+multiplied by that ``stretch``.
 """
 
 from __future__ import annotations
