@@ -303,7 +303,8 @@ def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 
     Raises
     ------
     BlockedError
-        As :func:`retime_for_movers`.
+        As :func:`retime_for_movers`; or a footprint turning in place meets a mover (the
+        whole chain is certified).
     InvalidInputError
         Any other plan (a chain of several curves, a car's steering, an omni orientation).
     """
@@ -326,14 +327,37 @@ def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 
     starts = [0.0] * len(pieces)
     starts[i] = lead
     stats = dict(plan.stats)
-    stats["moving"] = curve.stats["moving"]
-    return TrajectoryChain(
+    stats["moving"] = dict(curve.stats["moving"])
+    out = TrajectoryChain(
         pieces=(*pieces[:i], curve, *pieces[i + 1 :]),
         robot=plan.robot,
         stats=stats,
         steps=plan.steps,
         starts=tuple(starts),
     )
+    # the chain's own certificate: a footprint sweeps more while it turns in place than the
+    # curve's rests at its end headings
+    cert = certify_movers(out, movers, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the robot turning in place near "
+            f"t = {cert.witness_t:.3f} s ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    stats["moving"]["certificate"] = _cert_stats(cert)
+    return out
+
+
+def _cert_stats(cert: Any) -> dict[str, Any]:
+    """Return the certificate's summary for ``stats["moving"]``."""
+    return {
+        "ok": cert.ok,
+        "slack_m": cert.slack,
+        "mover": cert.mover,
+        "horizon_s": cert.horizon,
+        "intervals": cert.intervals,
+    }
 
 
 def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajectory:
@@ -341,13 +365,7 @@ def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajec
     stats = dict(traj.stats)
     stats["moving"] = {
         "plan": label,
-        "certificate": {
-            "ok": cert.ok,
-            "slack_m": cert.slack,
-            "mover": cert.mover,
-            "horizon_s": cert.horizon,
-            "intervals": cert.intervals,
-        },
+        "certificate": _cert_stats(cert),
         "time_s": time.perf_counter() - t_all,
     }
     return dataclasses.replace(traj, stats=stats)
