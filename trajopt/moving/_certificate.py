@@ -191,10 +191,16 @@ def kappa_max(curve: Any) -> float:
         return 0.0 if br.shape[0] == 2 else math.inf
     a, b = br[:-1], br[1:]
     keep = b > a
-    try:
-        k = kappa_bound(curve, a[keep], b[keep], int(deg))
-    except (ValueError, FloatingPointError, ZeroDivisionError):
-        return math.inf
+    a, b = a[keep], b[keep]
+    k = np.zeros(0)
+    for split in (1, 8, 64):  # the Bernstein bound tightens on shorter intervals
+        e = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, split + 1)[None, :]
+        try:
+            k = kappa_bound(curve, e[:, :-1].ravel(), e[:, 1:].ravel(), int(deg))
+        except (ValueError, FloatingPointError, ZeroDivisionError):
+            return math.inf
+        if np.all(np.isfinite(k)):
+            break
     return float(np.max(k)) if k.size else 0.0
 
 
