@@ -179,29 +179,65 @@ def _profile_bounds(traj: Any) -> tuple[float, float]:
     return vmax, amax
 
 
-def kappa_max(curve: Any) -> float:
-    """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
+def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(s_edges, k)``: rigorous |curvature| bounds (1/m) ``k[i]`` on ``[s_edges[i], s_edges[i+1]]`` (m).
+
+    Bernstein bounds (:func:`trajopt.geometry.kappa_bound`) on each polynomial piece, split
+    in 8 or 64 where a piece's bound is infinite; ``([0, L], [inf])`` when there is none (a
+    curve without a polynomial degree, a polyline with corners).
+    """
+    length = float(curve.length)
+    none = (np.array([0.0, length]), np.array([math.inf]))
     deg = getattr(curve, "polynomial_degree", None)
     if deg is None:
-        return math.inf
+        return none
     br = np.asarray(curve.breakpoints(), dtype=float)
     if br.shape[0] < 2:
-        return math.inf
+        return none
     if deg < 2:  # straight pieces: no curvature inside, corners between them
-        return 0.0 if br.shape[0] == 2 else math.inf
+        return (np.array([0.0, length]), np.zeros(1)) if br.shape[0] == 2 else none
     a, b = br[:-1], br[1:]
     keep = b > a
     a, b = a[keep], b[keep]
-    k = np.zeros(0)
+    k, e = np.full(1, math.inf), np.stack([a, b], axis=1)
     for split in (1, 8, 64):  # the Bernstein bound tightens on shorter intervals
         e = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, split + 1)[None, :]
         try:
             k = kappa_bound(curve, e[:, :-1].ravel(), e[:, 1:].ravel(), int(deg))
         except (ValueError, FloatingPointError, ZeroDivisionError):
-            return math.inf
+            return none
         if np.all(np.isfinite(k)):
             break
-    return float(np.max(k)) if k.size else 0.0
+    u = np.append(e[:, :-1].ravel(), e[-1, -1])
+    s_edges = np.asarray(curve.s_at_u(u), dtype=float)
+    s_edges[0], s_edges[-1] = 0.0, length
+    return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
+
+
+def kappa_max(curve: Any) -> float:
+    """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
+    return float(np.max(kappa_table(curve)[1]))
+
+
+class _RangeMax:
+    """Maxima of ``values`` over index ranges in O(1) (a sparse table)."""
+
+    def __init__(self, values: np.ndarray) -> None:
+        self.levels = [np.asarray(values, dtype=float)]
+        while 2 ** len(self.levels) <= values.shape[0]:
+            prev, w = self.levels[-1], 2 ** (len(self.levels) - 1)
+            self.levels.append(np.maximum(prev[:-w], prev[w:]))
+
+    def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
+        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise."""
+        n = i1 - i0 + 1
+        lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
+        out = np.empty(i0.shape)
+        for j in np.unique(lev):
+            sel = lev == j
+            arr = self.levels[int(j)]
+            out[sel] = np.maximum(arr[i0[sel]], arr[i1[sel] - 2 ** int(j) + 1])
+        return out
 
 
 class _Curve:
@@ -209,9 +245,11 @@ class _Curve:
 
     def __init__(self, traj: Any, offset: float) -> None:
         self.traj, self.offset = traj, float(offset)
-        vmax, amax = _profile_bounds(traj)
-        self.kappa = kappa_max(traj.path)  # the heading turns at most kappa per metre
-        self.c2 = self.kappa * vmax * vmax + amax  # |P''| (m/s^2), inf if unknown
+        self.vmax, self.amax = _profile_bounds(traj)
+        # the heading turns at most kappa per metre: bounds per arc-length interval
+        self.s_edges, k = kappa_table(traj.path)
+        self.kmax = _RangeMax(k)
+        self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
@@ -223,7 +261,12 @@ class _Curve:
         sm = np.asarray(smp.s, dtype=float)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
         th, v = np.asarray(smp.theta, dtype=float), np.asarray(smp.v, dtype=float)
-        self.theta, self.turn = th, np.minimum(self.kappa * rho, math.pi)
+        last = self.s_edges.shape[0] - 2
+        i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
+        i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)
+        kap = self.kmax(i0, np.maximum(i0, i1))  # |kappa| on the arc [s0, s1] (1/m)
+        self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
+        self.c2_local = kap * self.vmax**2 + self.amax
         return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
 
 
@@ -235,6 +278,7 @@ class _Still:
     """
 
     c2 = 0.0
+    c2_local = 0.0
 
     def __init__(self, piece: Any, offset: float) -> None:
         self.piece, self.offset = piece, float(offset)
@@ -426,7 +470,7 @@ def _certify_one(
             dist_m = convex_distance(poly, shape)
             lower_poly = dist_m - rho_p - reach_b * model.turn - rho_m - lim_hi
             lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
-        elif disc and math.isfinite(model.c2):
+        elif disc:
             # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
             d = p - mover.position_at(tm)
             rel = v_rob - vel
@@ -435,8 +479,9 @@ def _certify_one(
                 tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
             tau = np.clip(tau, -h, h)
             near = d + tau[:, None] * rel
-            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * model.c2 * h * h - 1e-12 - lim_hi
-            lower = np.maximum(lower, lower2)
+            c2 = model.c2_local
+            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
         slack_mid = dist_m - lim_mid
         bad = slack_mid < -0.5 * tol
         if np.any(bad):
