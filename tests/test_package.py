@@ -87,6 +87,7 @@ LAYERS = [
     {"corridor"},
     {"smoother"},
     {"timing"},
+    {"moving"},
     {"planning"},
     {"replan"},
     {"_planner"},

@@ -10,6 +10,10 @@ with :func:`plan` (one query) and :class:`Planner` (many queries and re-plans on
 :class:`State`, :class:`Smoother`, the errors (:class:`TrajoptError` and its subclasses)
 and :func:`warm_up` (compile the numerical kernels ahead of time).
 
+**Moving obstacles**: :class:`MovingObstacle` (a predicted disc or convex polygon),
+:func:`certify_movers` (a continuous-time proof of the distance to them) and
+:func:`retime_for_movers` (the same path re-timed so that they pass; :class:`BlockedError`).
+
 **Stages**, for users who compose them: the corridors (:class:`PolygonCorridor` of
 :class:`ConvexPolygon`, :class:`Corridor` of :class:`Box`), :class:`SmoothPath`, the curves
 (:class:`ParametricCurve`, :class:`BSplineCurve`), :func:`time_parameterize` with
@@ -24,7 +28,7 @@ modules ``trajopt.metrics``, ``trajopt.fits``, ``trajopt.scenes``, ``trajopt.plo
 ``trajopt.comparison`` and ``trajopt.bench`` (all in :mod:`trajopt.analysis`).
 
 The packages below hold the stages (``geometry``, ``drive``, ``robot``, ``motion``, ``corridor``,
-``smoother``, ``timing``, ``planning``, ``replan``, ``analysis``); ``docs/architecture.md``
+``smoother``, ``timing``, ``moving``, ``planning``, ``replan``, ``analysis``); ``docs/architecture.md``
 draws the flow. Names are imported lazily (PEP 562) so that ``import trajopt`` stays fast;
 heavy dependencies (CasADi, ruckig, matplotlib) load when first used.
 """
@@ -52,6 +56,9 @@ _EXPORTS: dict[str, str] = {
     "PlanResult": "trajopt.motion",
     "State": "trajopt.robot",
     "Trajectory": "trajopt.motion",
+    "MovingObstacle": "trajopt.moving",
+    "certify_movers": "trajopt.moving",
+    "retime_for_movers": "trajopt.moving",
     "Smoother": "trajopt.smoother",
     "warm_up": "trajopt.warmup",
     "TrajoptError": "trajopt.errors",
@@ -59,6 +66,7 @@ _EXPORTS: dict[str, str] = {
     "NoPathError": "trajopt.errors",
     "SmoothingError": "trajopt.errors",
     "TimingError": "trajopt.errors",
+    "BlockedError": "trajopt.errors",
     "IllPosedFitError": "trajopt.errors",
     # stages
     "ParametricCurve": "trajopt.geometry",
@@ -133,6 +141,7 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from trajopt.drive import Ackermann, Differential, Drive, Omni
     from trajopt.errors import (
+        BlockedError,
         IllPosedFitError,
         InvalidInputError,
         NoPathError,
@@ -152,6 +161,7 @@ if TYPE_CHECKING:  # pragma: no cover
         read_mcap,
         write_mcap,
     )
+    from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers
     from trajopt.robot import Robot, State
     from trajopt.smoother import Smoother, SmoothPath
     from trajopt.timing import SpeedLimits, load_speed_mask, stop_and_turn, time_parameterize

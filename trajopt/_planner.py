@@ -67,7 +67,9 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
+from trajopt.errors import InvalidInputError
 from trajopt.motion import PlanResult
+from trajopt.moving import MovingObstacle, check_movers, retime_plan
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -84,6 +86,7 @@ from trajopt.replan import BRAKE_AFTER_S, replan_from
 from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
+from trajopt.validation import nonnegative
 
 __all__ = [
     "plan",
@@ -289,6 +292,8 @@ class Planner:
         v_end: float = 0.0,
         start_steer: float = 0.0,
         goal_steer: float | None = None,
+        moving_obstacles: Sequence[MovingObstacle] | None = None,
+        mover_margin: float = 0.0,
     ) -> PlanResult:
         """Plan a timed trajectory from ``start`` to ``goal`` (world metres).
 
@@ -313,6 +318,19 @@ class Planner:
         goal_steer : float, optional
             A car's steering angle at the goal (rad), steered to at rest after its last
             drive; default: the last drive's.
+        moving_obstacles : sequence of MovingObstacle, optional
+            Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
+            ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
+            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at
+            the start and at stops on the way) and certified at every instant until the
+            last prediction ends (``stats["moving"]``). Covered: the differential and
+            omni drives (a disc or a footprint robot) whose plan is one curve from rest to
+            rest, with a differential drive's turns in place at its ends
+            (:func:`trajopt.moving.retime_plan`); other queries with movers (a car, an omni
+            orientation profile, a moving start) raise
+            :class:`~trajopt.errors.InvalidInputError`.
+        mover_margin : float
+            Extra distance to every mover (m), >= 0 (checked even without movers).
 
         Returns
         -------
@@ -334,7 +352,12 @@ class Planner:
             From the smoother or the timing (with their statistics); with the fallback
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
+        BlockedError
+            A mover blocks the path: no re-timing along it avoids the mover (named, with
+            the time).
         """
+        movers = check_movers(moving_obstacles)
+        margin = nonnegative("mover_margin", mover_margin, "m")
         request = PlanRequest(
             start,
             goal,
@@ -348,6 +371,8 @@ class Planner:
         with self._lock:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
+            if movers:
+                out = _retime(out, movers, margin, self.options.robot)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -449,6 +474,8 @@ def plan(
     v_end: float = 0.0,
     start_steer: float = 0.0,
     goal_steer: float | None = None,
+    moving_obstacles: Sequence[MovingObstacle] | None = None,
+    mover_margin: float = 0.0,
     options: PlannerOptions | None = None,
     **settings: Any,
 ) -> PlanResult:
@@ -471,6 +498,9 @@ def plan(
         Speeds at the ends (m/s).
     start_steer, goal_steer : float
         A car's steering angles at the ends (rad; see :meth:`Planner.plan`).
+    moving_obstacles : sequence of MovingObstacle, optional
+        Predicted movers; ``mover_margin`` (m) the extra distance to them (see
+        :meth:`Planner.plan`).
     options : PlannerOptions, optional
         Every setting (``robot`` included) as one value (see :class:`Planner`).
     **settings
@@ -505,6 +535,15 @@ def plan(
     planner = Planner(
         grid, options=PlannerOptions.from_keywords(options, settings, caller="trajopt.plan")
     )
+    # the movers' keywords go on only when given: without them the call is today's
+    moving = (
+        {}
+        if moving_obstacles is None and mover_margin == 0.0
+        else {
+            "moving_obstacles": moving_obstacles,
+            "mover_margin": mover_margin,
+        }
+    )
     return planner.plan(
         start,
         goal,
@@ -514,4 +553,18 @@ def plan(
         v_end=v_end,
         start_steer=start_steer,
         goal_steer=goal_steer,
+        **moving,
     )
+
+
+def _retime(
+    out: PlanResult, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot
+) -> PlanResult:
+    """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
+    signed = robot.drive.signed_speed  # a car's: not covered yet
+    if signed or out.v_start != 0.0:
+        raise InvalidInputError(
+            "moving_obstacles are covered for a plan from rest of the differential or omni "
+            f"drive; this query gave a {type(out).__name__} with v_start={out.v_start}"
+        )
+    return retime_plan(out, movers, margin=margin)

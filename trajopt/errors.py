@@ -19,6 +19,7 @@ __all__ = [
     "NoPathError",
     "SmoothingError",
     "TimingError",
+    "BlockedError",
     "BenchmarkError",
     "PeerUnavailableError",
 ]
@@ -65,6 +66,23 @@ class SmoothingError(TrajoptError):
 
 class TimingError(TrajoptError):
     """The time parameterisation cannot meet the requested boundary speeds or limits."""
+
+
+class BlockedError(TrajoptError):
+    """A moving obstacle blocks the way: no motion avoids it within its prediction.
+
+    Attributes
+    ----------
+    mover : str
+        The name of the blocking :class:`trajopt.MovingObstacle`.
+    t : float
+        The time (s, the trajectory's clock) from which nothing avoids it.
+    """
+
+    def __init__(self, message: str, mover: str = "", t: float = 0.0) -> None:
+        super().__init__(message)
+        self.mover = mover
+        self.t = float(t)
 
 
 class BenchmarkError(InvalidInputError):

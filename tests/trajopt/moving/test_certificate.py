@@ -1,0 +1,153 @@
+"""Tests of trajopt.moving: the continuous-time certificate against dense sampling and a brute force.
+
+The certificate must never pass a case where the 1 ms samples or the brute force (a bounded
+scalar minimisation around each sampled local minimum) find the robot closer than the limit by
+more than its tolerance, must pass every case the brute force finds clear by a margin, and its
+witness of a violation must be a real one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from tests.trajopt.moving.reference import brute_min, dense_min, slack
+from trajopt.errors import InvalidInputError, TimingError
+from trajopt.geometry import BSplineCurve, PolylineCurve, clamped_uniform_knots
+from trajopt.moving import MovingObstacle, certify_movers
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+
+ROBOT = Robot(v_max=0.8, a_max=0.8, j_max=3.0)
+SQUARE = [(-0.3, -0.2), (0.3, -0.2), (0.3, 0.2), (-0.3, 0.2)]
+
+
+@pytest.fixture(scope="module")
+def line():
+    return time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [4.0, 0.0]])), ROBOT)
+
+
+def _curve(ys, length):
+    n = len(ys) + 2
+    x = np.linspace(0.0, length, n)
+    y = np.concatenate([[0.0], ys, [0.0]])
+    y[1] = 0.0  # a straight start and end: no curvature at the ends
+    return BSplineCurve(clamped_uniform_knots(n, 3), np.column_stack([x, y]), 3)
+
+
+@st.composite
+def cases(draw):
+    ys = draw(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=5))
+    length = draw(st.floats(2.0, 5.0))
+    movers = []
+    for i in range(draw(st.integers(1, 2))):
+        t_a = draw(st.floats(0.0, 6.0))
+        p = np.array([draw(st.floats(-1.0, length + 1.0)), draw(st.floats(-2.0, 2.0))])
+        v = np.array([draw(st.floats(-0.8, 0.8)), draw(st.floats(-0.8, 0.8))])
+        radius = draw(st.floats(0.0, 0.4))
+        growth = draw(st.sampled_from([0.0, 0.0, 0.02]))
+        poly = draw(st.booleans())
+        turn = draw(st.floats(-1.0, 1.0)) if poly else 0.0
+        movers.append(
+            MovingObstacle.from_waypoints(
+                [t_a, t_a + 3.0, t_a + 6.0],
+                [p, p + 3.0 * v, p + 3.0 * v + 3.0 * v[::-1]],
+                radius=radius,
+                growth=growth,
+                headings=[0.0, turn, 2 * turn],
+                vertices=SQUARE if poly else None,
+                name=f"m{i}",
+            )
+        )
+    return ys, length, movers
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(cases())
+def test_never_passes_a_violation_and_passes_clear_cases(case):
+    ys, length, movers = case
+    try:
+        traj = time_parameterize(_curve(ys, length), ROBOT)
+    except TimingError:
+        assume(False)
+    cert = certify_movers(traj, movers, tol=1e-6)
+    truth = min(brute_min(traj, movers), dense_min(traj, movers, dt=2e-3)[0])
+    assert cert.verdict in ("clear", "violated")
+    if cert.ok:
+        assert truth >= -1e-6 - 1e-9
+        assert cert.slack <= truth + 1e-9  # a lower bound of the true smallest slack
+    else:
+        m = next(m for m in movers if m.name == cert.mover)
+        assert slack(traj, m, cert.witness_t)[0] < -0.5e-6 + 1e-12
+    if truth > 1e-4:
+        assert cert.ok
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-3, -1e-3, -2e-6])
+def test_a_grazing_mover_touches_at_the_limit(line, offset):
+    """A mover crossing the robot's line so that the closest approach is limit + offset."""
+    t_c = 3.0
+    p = np.array([float(line.motion(t_c)[0]), 0.0])
+    v_rob = float(line.motion(t_c)[1])
+    # moving with the robot along x at its speed at t_c and across it: closest at t_c
+    r = 0.25
+    d = ROBOT.radius + r + offset
+    vel = np.array([v_rob, 0.0])
+    mover = MovingObstacle.from_waypoints(
+        [t_c - 0.5, t_c, t_c + 0.5],
+        [p + (0.0, d + 0.5) - 0.5 * vel, p + (0.0, d), p + (0.0, d + 0.5) + 0.5 * vel],
+        radius=r,
+    )
+    cert = certify_movers(line, [mover], tol=1e-6)
+    assert brute_min(line, [mover]) == pytest.approx(offset, abs=1e-9)
+    assert dense_min(line, [mover])[0] == pytest.approx(offset, abs=1e-9)
+    assert cert.ok == (offset >= 0.0)  # touching is allowed, 2 micrometres closer is not
+    if cert.ok:
+        assert -1e-6 <= cert.slack <= offset + 1e-9
+    else:
+        assert slack(line, mover, cert.witness_t)[0] < -0.5e-6
+
+
+def test_following_at_the_limit_is_proven_fast(line):
+    """A mover alongside the robot at exactly the limit: the second-order bound closes it."""
+    m = MovingObstacle.constant_velocity(
+        (0.0, ROBOT.radius + 0.2), (0.2, 0.0), radius=0.2, horizon=15.0
+    )
+    cert = certify_movers(line, [m])
+    assert cert.ok and cert.intervals < 5000
+    closer = MovingObstacle.constant_velocity(
+        (0.0, ROBOT.radius + 0.199), (0.2, 0.0), radius=0.2, horizon=15.0
+    )
+    bad = certify_movers(line, [closer])
+    assert bad.verdict == "violated" and slack(line, closer, bad.witness_t)[0] < 0.0
+
+
+def test_standing_at_the_goal_until_the_prediction_ends(line):
+    """Arriving before a mover runs over the goal is not safe."""
+    late = MovingObstacle.constant_velocity((4.0, -3.0), (0.0, 0.3), radius=0.2, horizon=20.0)
+    cert = certify_movers(line, [late])
+    assert late.position_at(10.0)[1] == pytest.approx(0.0) and line.duration < 10.0
+    assert not cert.ok and cert.witness_t > line.duration
+    assert cert.horizon == 20.0
+
+
+def test_polygon_mover_and_margin(line):
+    box = MovingObstacle.from_waypoints([0.0], [(2.0, 0.8)], radius=0.0, vertices=SQUARE)
+    gap = 0.6 - ROBOT.radius  # the box's lower edge is at y = 0.6
+    assert certify_movers(line, [box], margin=gap - 1e-3).ok
+    assert not certify_movers(line, [box], margin=gap + 1e-3).ok
+
+
+def test_bad_arguments(line):
+    m = MovingObstacle.constant_velocity((0, 5), (0, 0), radius=0.1, horizon=1.0)
+    with pytest.raises(InvalidInputError, match="margin"):
+        certify_movers(line, [m], margin=-1.0)
+    with pytest.raises(InvalidInputError, match="moving_obstacles"):
+        certify_movers(line, m)
+    with pytest.raises(InvalidInputError, match="Trajectory"):
+        certify_movers("traj", [m])
+    assert certify_movers(line, []).ok and math.isinf(certify_movers(line, []).slack)

@@ -1,0 +1,153 @@
+"""Tests of trajopt.moving: re-timing along the path (wait, stop, pass before) and BlockedError.
+
+Every returned trajectory is certified and checked against 1 ms samples and the brute force;
+its speed profile is continuous and keeps the robot's limits.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tests.trajopt.moving.reference import brute_min, dense_min
+from trajopt.errors import BlockedError, InvalidInputError
+from trajopt.geometry import PolylineCurve
+from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+
+ROBOT = Robot(v_max=0.6, a_max=0.6, j_max=2.0)
+
+
+@pytest.fixture(scope="module")
+def line6():
+    return time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [6.0, 0.0]])), ROBOT)
+
+
+def _check(traj, movers, static):
+    """Certified, clear on 1 ms samples and by brute force, same path, continuous limits."""
+    assert traj.path is static.path
+    cert = certify_movers(traj, movers)
+    assert cert.ok
+    assert dense_min(traj, movers)[0] >= -1e-6
+    assert brute_min(traj, movers) >= -1e-6
+    t = np.arange(0.0, traj.duration, 1e-3)
+    s, v, a, j = traj.motion(t)
+    assert np.all(np.diff(s) >= -1e-12) and np.all(v >= -1e-9)
+    assert np.max(np.abs(np.diff(v))) < ROBOT.a_max * 1e-3 * 1.01  # no speed jump
+    assert np.max(np.abs(np.diff(a))) < ROBOT.j_max * 1e-3 * 1.01  # no acceleration jump
+    assert np.max(v) <= ROBOT.v_max * (1 + 1e-9) and np.max(np.abs(a)) <= ROBOT.a_max * (1 + 1e-9)
+    assert traj.motion(traj.duration)[0] == pytest.approx(static.length)
+
+
+def test_a_clear_trajectory_is_kept(line6):
+    late = MovingObstacle.constant_velocity((3.0, -3.0), (0.0, 0.2), radius=0.3, horizon=10.0)
+    assert late.position_at(10.0)[1] < -0.9
+    out = retime_for_movers(line6, [late])
+    assert out.stats["moving"]["plan"] == "as planned" and "moving" not in line6.stats
+    assert np.array_equal(out.phase_t, line6.phase_t) and out.duration == line6.duration
+
+
+def test_the_robot_waits_for_a_crossing_mover(line6):
+    # crosses x = 3 at t ~ 6.7 s, when the static plan is there
+    m = MovingObstacle.constant_velocity(
+        (3.0, -2.0), (0.0, 0.3), radius=0.3, horizon=20.0, name="walker"
+    )
+    assert not certify_movers(line6, [m]).ok
+    out = retime_for_movers(line6, [m])
+    _check(out, [m], line6)
+    assert out.duration > line6.duration
+    assert out.stats["moving"]["certificate"]["ok"]
+    assert "wait" in out.stats["moving"]["plan"]
+
+
+def test_the_robot_leaves_the_start_then_stops_to_let_a_mover_pass(line6):
+    # one mover crosses x = 4.5 at t ~ 8.6 s, when the static plan is there; another runs over
+    # the start at t = 5 s: waiting at the start long enough is unsafe, so the robot
+    # drives, stops short of x = 4.5 and waits
+    cross = MovingObstacle.constant_velocity(
+        (4.5, -3.0), (0.0, 0.35), radius=0.3, horizon=24.0, name="cross"
+    )
+    sweep = MovingObstacle.constant_velocity(
+        (0.0, -2.5), (0.0, 0.5), radius=0.3, horizon=24.0, name="sweep"
+    )
+    assert not certify_movers(line6, [cross]).ok and certify_movers(line6, [sweep]).ok
+    out = retime_for_movers(line6, [cross, sweep])
+    _check(out, [cross, sweep], line6)
+    assert "stop at" in out.stats["moving"]["plan"]
+    s_stop = float(out.stats["moving"]["plan"].split("s = ")[1].split(" m")[0])
+    assert 0.5 < s_stop < 4.5
+
+
+def test_head_on_in_a_corridor_is_blocked_fast(line6):
+    m = MovingObstacle.constant_velocity(
+        (6.5, 0.0), (-0.4, 0.0), radius=0.3, horizon=30.0, name="forklift"
+    )
+    t0 = time.perf_counter()
+    with pytest.raises(BlockedError) as err:
+        retime_for_movers(line6, [m])
+    assert time.perf_counter() - t0 < 0.5
+    assert err.value.mover == "forklift" and "'forklift'" in str(err.value)
+    # the forklift reaches the robot's start (s = 0) at about (6.5 - 0.465) / 0.4 s
+    assert 0.0 < err.value.t <= (6.5 - 0.465) / 0.4 + 0.1
+
+
+def test_a_mover_that_stops_on_the_path_blocks(line6):
+    m = MovingObstacle.from_waypoints(
+        [0.0, 4.0], [(3.0, -2.0), (3.0, 0.0)], radius=0.3, name="parked"
+    )
+    with pytest.raises(BlockedError, match="parked"):
+        retime_for_movers(line6, [m])
+
+
+def test_a_mover_on_the_robot_at_the_start_is_refused(line6):
+    m = MovingObstacle.constant_velocity(
+        (0.2, 0.1), (0.0, 1.0), radius=0.3, horizon=5.0, name="toe"
+    )
+    with pytest.raises(InvalidInputError, match="'toe' overlaps the robot at t = 0"):
+        retime_for_movers(line6, [m])
+
+
+def test_a_turning_polygon_mover_is_let_pass(line6):
+    cart = MovingObstacle.from_waypoints(
+        [0.0, 12.0],
+        [(3.0, -2.4), (3.0, 3.6)],
+        radius=0.05,
+        headings=[0.0, 1.5],
+        vertices=[(-0.4, -0.25), (0.4, -0.25), (0.4, 0.25), (-0.4, 0.25)],
+        name="cart",
+    )
+    assert not certify_movers(line6, [cart]).ok
+    out = retime_for_movers(line6, [cart], margin=0.02)
+    assert certify_movers(out, [cart], margin=0.02).ok
+    assert dense_min(out, [cart], margin=0.02)[0] >= -1e-6
+    assert brute_min(out, [cart], margin=0.02) >= -1e-6
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0.5, 5.5), st.floats(-3.0, 3.0), st.floats(-0.5, 0.5), st.floats(0.1, 0.4)
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_random_crossings_are_certified_or_typed_errors(line6, specs):
+    movers = [
+        MovingObstacle.constant_velocity(
+            (x, y), (vx, -np.sign(y) * 0.4), radius=r, horizon=15.0, name=f"m{i}"
+        )
+        for i, (x, y, vx, r) in enumerate(specs)
+    ]
+    try:
+        out = retime_for_movers(line6, movers)
+    except (BlockedError, InvalidInputError):
+        return
+    assert certify_movers(out, movers).ok
+    assert dense_min(out, movers)[0] >= -1e-6

@@ -1,0 +1,499 @@
+"""The continuous-time certificate of a timed trajectory against predicted moving obstacles.
+
+:func:`certify_movers` decides, for every instant ``t`` of ``[0, T]`` with
+``T = max(duration, last prediction time)`` (the robot stands at its goal after
+``duration``), whether the distance between the robot's centre and each mover's shape is at
+least ``robot.radius + radius(t) + margin``, by interval bounds over time (theorem in
+docs/concepts.md, "Moving obstacles"):
+
+* the robot's centre is ``P(t) = C(s(t))`` with ``C`` parametrised by arc length
+  (``|C'| = 1``) and ``s`` non-decreasing, so on ``[t0, t1]`` with midpoint ``tm``,
+  ``|P(t) - P(tm)| <= rho_P = max(s(tm) - s(t0), s(t1) - s(tm))``;
+* a mover is linear in time between its waypoints (the intervals are cut at its times), so
+  every point of its shape moves by at most ``rho_M = (|c'| + reach |h'|) h`` in ``|t - tm| <= h``,
+  and the shape's rounding is at most ``radius(t1)`` (it only grows);
+* the distance from a point to a convex set is 1-Lipschitz in the point and in the set's
+  Hausdorff distance: ``dist(t) >= dist(tm) - rho_P - rho_M`` (a first-order bound);
+* for a disc mover, second order: ``P(t) - M(t) = D + w (t - tm) + E`` with ``D`` and ``w``
+  the relative position and velocity at ``tm`` and ``|E| <= (kappa_max V^2 + A) h^2 / 2``
+  (``|P''| = |C'' v^2 + C' a| <= kappa v^2 + |a|``, the mover's own second derivative is 0),
+  so ``dist(t) >= min_{|tau| <= h} |D + w tau| - |E|``.
+
+A robot with a :class:`~trajopt.robot.Footprint` (convex, turned by the heading) is its
+polygon: the distance between two convex polygons (separating axes, then vertex to edge) at
+``tm``, less the footprint's motion ``rho_P + R dtheta`` (``R`` its farthest vertex, ``dtheta
+<= kappa_max rho_P`` the tangent's turn along the arc, at most ``pi``) and the mover's; the
+bound of its circumscribed disc is taken too, and alone while it turns in place. First order
+only.
+
+A :class:`trajopt.TrajectoryChain` is certified piece by piece on its clock: a curve as above,
+a motion at rest (a turn in place) as a robot standing still (``rho_P = 0``).
+
+An interval whose bound clears the limit (within ``tol``) is accepted; one whose midpoint
+is closer than the limit by more than ``tol / 2`` is a proven violation (a witness);
+otherwise it is bisected. Bisection ends: once the bound's loss is below ``tol / 2`` an
+interval is either accepted or a witness.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import InvalidInputError
+from trajopt.geometry import kappa_bound
+from trajopt.moving._obstacle import MovingObstacle
+
+#: Bisection budget (intervals evaluated per mover) before the certificate gives up undecided.
+MAX_INTERVALS = 400_000
+#: Initial time step of the interval cover (s).
+COVER_DT = 0.05
+
+
+@dataclass(frozen=True, slots=True)
+class MoverCertificate:
+    """The verdict of :func:`certify_movers`.
+
+    Attributes
+    ----------
+    ok : bool
+        Proven: at every instant of ``[0, horizon]`` every mover's distance is at least its
+        limit minus ``tol``.
+    verdict : {"clear", "violated", "undecided"}
+        ``"violated"``: ``witness_t`` is an instant where a mover is closer than its limit by
+        more than ``tol / 2``; ``"undecided"``: the bisection budget ran out.
+    slack : float
+        Proven lower bound (m) of ``distance - limit`` over all instants and movers when
+        ``ok`` (can be down to ``-tol``), else the worst sampled slack.
+    mover : str
+        Name of the mover of the smallest slack (or of the witness).
+    witness_t : float
+        Time (s) of the smallest sampled slack (the witness when violated).
+    horizon : float
+        The end of the certified time range (s).
+    tol : float
+        The tolerance (m).
+    intervals : int
+        Number of time intervals evaluated.
+    """
+
+    ok: bool
+    verdict: str
+    slack: float
+    mover: str
+    witness_t: float
+    horizon: float
+    tol: float
+    intervals: int
+
+
+def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Distance (m) from points ``p`` (n, 2) to convex CCW polygons ``w`` (n, m, 2); 0 inside."""
+    if w.shape[1] == 1:
+        d = p - w[:, 0]
+        return np.hypot(d[:, 0], d[:, 1])
+    a = w
+    b = np.roll(w, -1, axis=1)
+    e = b - a
+    q = p[:, None, :] - a
+    ee = np.maximum(np.sum(e * e, axis=2), 1e-300)
+    lam = np.clip(np.sum(q * e, axis=2) / ee, 0.0, 1.0)
+    r = q - lam[..., None] * e
+    dist = np.min(np.hypot(r[..., 0], r[..., 1]), axis=1)
+    cross = e[..., 0] * q[..., 1] - e[..., 1] * q[..., 0]
+    inside = np.all(cross >= 0.0, axis=1)
+    return np.where(inside, 0.0, dist)
+
+
+def convex_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Return the signed distance (m) of convex CCW polygons ``a`` (n, ma, 2) and ``b`` (n, mb, 2).
+
+    Separated polygons: their distance (closest at a vertex of one and an edge of the other).
+    Overlapping ones: minus the penetration depth, the shortest translation that separates
+    them, found along the edge normals of both (separating axes; a polygon of one vertex is a
+    point and has none). This signed distance is 1-Lipschitz in the Hausdorff distance of
+    either polygon (it is the signed distance of the origin to ``b - a``).
+    """
+    separated = np.zeros(a.shape[0], dtype=bool)
+    depth = np.full(a.shape[0], np.inf)
+    for p, q in ((a, b), (b, a)):
+        if p.shape[1] < 3:
+            continue
+        e = np.roll(p, -1, axis=1) - p
+        normal = np.stack([e[..., 1], -e[..., 0]], axis=-1)  # outward for CCW
+        normal /= np.maximum(np.linalg.norm(normal, axis=-1, keepdims=True), 1e-300)
+        proj_q = np.einsum("nevk,nek->nev", q[:, None, :, :] - p[:, :, None, :], normal)
+        proj_p = np.einsum("nevk,nek->nev", p[:, None, :, :] - p[:, :, None, :], normal)
+        gap = np.min(proj_q, axis=2)  # > 0: this edge's line separates them
+        separated |= np.any(gap > 0.0, axis=1)
+        through = np.minimum(-gap, np.max(proj_q, axis=2) - np.min(proj_p, axis=2))
+        depth = np.minimum(depth, np.min(through, axis=1))
+    d = np.full(a.shape[0], np.inf)
+    for p, q in ((a, b), (b, a)):
+        for i in range(p.shape[1]):
+            d = np.minimum(d, point_polygon_distance(p[:, i], q))
+    return np.where(separated | ~np.isfinite(depth), d, -depth)
+
+
+def shape_at(mover: MovingObstacle, t: np.ndarray) -> np.ndarray:
+    """Return the mover's polygon (vertices in the world) at times ``t``, shape (n, m, 2)."""
+    c, h = mover.pose_at(t)
+    v = mover.shape_vertices
+    ch, sh = np.cos(h)[:, None], np.sin(h)[:, None]
+    x = c[:, 0:1] + ch * v[None, :, 0] - sh * v[None, :, 1]
+    y = c[:, 1:2] + sh * v[None, :, 0] + ch * v[None, :, 1]
+    return np.stack([x, y], axis=-1)
+
+
+def _segment_rates(mover: MovingObstacle, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return the velocity (m/s), shape (n, 2), and turn rate (rad/s), shape (n,), on the segment holding each ``t``."""
+    tk = mover.times
+    n = t.shape[0]
+    if tk.shape[0] < 2:
+        return np.zeros((n, 2)), np.zeros(n)
+    k = np.searchsorted(tk, t, side="right") - 1
+    inside = (k >= 0) & (k < tk.shape[0] - 1)
+    kk = np.clip(k, 0, tk.shape[0] - 2)
+    dt = tk[kk + 1] - tk[kk]
+    vel = (mover.positions[kk + 1] - mover.positions[kk]) / dt[:, None]
+    w = (mover.headings[kk + 1] - mover.headings[kk]) / dt
+    return np.where(inside[:, None], vel, 0.0), np.where(inside, w, 0.0)
+
+
+def _profile_bounds(traj: Any) -> tuple[float, float]:
+    """``(V, A)``: bounds of the speed (m/s) and |acceleration| (m/s^2) of ``s(t)`` over its phases."""
+    pt, pv, pa, pj = traj.phase_t, traj.phase_v, traj.phase_a, traj.phase_j
+    dur = np.append(np.diff(pt), traj.duration - pt[-1]).clip(0.0)
+    a_end = pa + pj * dur
+    v_end = pv + dur * (pa + 0.5 * pj * dur)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = np.where(pj != 0.0, -pa / pj, -1.0)
+    inner = (tau > 0.0) & (tau < dur)
+    v_peak = np.where(inner, pv + tau * (pa + 0.5 * pj * tau), 0.0)
+    vmax = float(np.max(np.abs(np.concatenate([pv, v_end, v_peak, [traj.v_end]]))))
+    amax = float(np.max(np.abs(np.concatenate([pa, a_end]))))
+    return vmax, amax
+
+
+def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(s_edges, k)``: rigorous |curvature| bounds (1/m) ``k[i]`` on ``[s_edges[i], s_edges[i+1]]`` (m).
+
+    Bernstein bounds (:func:`trajopt.geometry.kappa_bound`) on each polynomial piece, split
+    in 8 or 64 where a piece's bound is infinite; ``([0, L], [inf])`` when there is none (a
+    curve without a polynomial degree, a polyline with corners).
+    """
+    length = float(curve.length)
+    none = (np.array([0.0, length]), np.array([math.inf]))
+    deg = getattr(curve, "polynomial_degree", None)
+    if deg is None:
+        return none
+    br = np.asarray(curve.breakpoints(), dtype=float)
+    if br.shape[0] < 2:
+        return none
+    if deg < 2:  # straight pieces: no curvature inside, corners between them
+        return (np.array([0.0, length]), np.zeros(1)) if br.shape[0] == 2 else none
+    a, b = br[:-1], br[1:]
+    keep = b > a
+    a, b = a[keep], b[keep]
+    k, e = np.full(1, math.inf), np.stack([a, b], axis=1)
+    for split in (1, 8, 64):  # the Bernstein bound tightens on shorter intervals
+        e = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, split + 1)[None, :]
+        try:
+            k = kappa_bound(curve, e[:, :-1].ravel(), e[:, 1:].ravel(), int(deg))
+        except (ValueError, FloatingPointError, ZeroDivisionError):
+            return none
+        if np.all(np.isfinite(k)):
+            break
+    u = np.append(e[:, :-1].ravel(), e[-1, -1])
+    s_edges = np.asarray(curve.s_at_u(u), dtype=float)
+    s_edges[0], s_edges[-1] = 0.0, length
+    return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
+
+
+def kappa_max(curve: Any) -> float:
+    """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
+    return float(np.max(kappa_table(curve)[1]))
+
+
+class _RangeMax:
+    """Maxima of ``values`` over index ranges in O(1) (a sparse table)."""
+
+    def __init__(self, values: np.ndarray) -> None:
+        self.levels = [np.asarray(values, dtype=float)]
+        while 2 ** len(self.levels) <= values.shape[0]:
+            prev, w = self.levels[-1], 2 ** (len(self.levels) - 1)
+            self.levels.append(np.maximum(prev[:-w], prev[w:]))
+
+    def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
+        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise."""
+        n = i1 - i0 + 1
+        lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
+        out = np.empty(i0.shape)
+        for j in np.unique(lev):
+            sel = lev == j
+            arr = self.levels[int(j)]
+            out[sel] = np.maximum(arr[i0[sel]], arr[i1[sel] - 2 ** int(j) + 1])
+        return out
+
+
+class _Curve:
+    """The robot on one timed curve, played from global time ``offset`` on its own clock."""
+
+    def __init__(self, traj: Any, offset: float) -> None:
+        self.traj, self.offset = traj, float(offset)
+        self.vmax, self.amax = _profile_bounds(traj)
+        # the heading turns at most kappa per metre: bounds per arc-length interval
+        self.s_edges, k = kappa_table(traj.path)
+        self.kmax = _RangeMax(k)
+        self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
+
+    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
+        tr, off = self.traj, self.offset
+        s0 = tr.motion(t0 - off)[0]
+        s1 = tr.motion(t1 - off)[0]
+        smp = tr.sample(tm - off)
+        p = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
+        sm = np.asarray(smp.s, dtype=float)
+        rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
+        th, v = np.asarray(smp.theta, dtype=float), np.asarray(smp.v, dtype=float)
+        last = self.s_edges.shape[0] - 2
+        i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
+        i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)
+        kap = self.kmax(i0, np.maximum(i0, i1))  # |kappa| on the arc [s0, s1] (1/m)
+        self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
+        self.c2_local = kap * self.vmax**2 + self.amax
+        return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
+
+
+class _Still:
+    """The robot standing still, played from global time ``offset`` (a turn in place).
+
+    Its position is fixed; its heading is sampled but not bounded between samples (a
+    footprint counts by its circumscribed disc there).
+    """
+
+    c2 = 0.0
+    c2_local = 0.0
+
+    def __init__(self, piece: Any, offset: float) -> None:
+        self.piece, self.offset = piece, float(offset)
+        smp = piece.sample(np.array([0.0]))
+        self.point = np.array([smp.x[0], smp.y[0]], dtype=float)
+
+    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return the position (m), shape (n, 2), a zero bound and a zero velocity."""
+        n = tm.shape[0]
+        self.theta = np.asarray(self.piece.sample(tm - self.offset).theta, dtype=float)
+        self.turn = np.full(n, math.pi)
+        return np.broadcast_to(self.point, (n, 2)), np.zeros(n), np.zeros((n, 2))
+
+
+def ccw(v: np.ndarray) -> np.ndarray:
+    """Return the polygon ``v`` (m, 2) counter-clockwise."""
+    area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+    return v if area2 > 0.0 else v[::-1].copy()
+
+
+def _windows(traj: Any) -> list[tuple[Any, float, float]]:
+    """Return ``(motion model, t0, t1)`` (s) covering the trajectory's time, in order."""
+    if getattr(traj, "single_curve", False):
+        for name in ("motion", "sample", "duration", "robot", "phase_t", "phase_v", "path"):
+            if not hasattr(traj, name):
+                raise InvalidInputError(f"trajectory must be a trajopt.Trajectory (no {name!r})")
+        return [(_Curve(traj, 0.0), 0.0, float(traj.duration))]
+    pieces = getattr(traj, "pieces", None)
+    if pieces is None or not hasattr(traj, "piece_times"):
+        raise InvalidInputError(
+            "trajectory must be a trajopt.Trajectory or a TrajectoryChain of curves and motions "
+            f"at rest, got {type(traj).__name__}"
+        )
+    out = []
+    times = np.asarray(traj.piece_times, dtype=float)
+    for i, pc in enumerate(pieces):
+        a, b = float(times[i]), float(times[i + 1])
+        if pc.single_curve:
+            out.append((_Curve(pc, a - float(traj.starts[i])), a, b))
+        elif pc.turning or pc.steering_at_rest:
+            out.append((_Still(pc, a - float(traj.starts[i])), a, b))
+        else:
+            raise InvalidInputError(
+                f"the certificate covers curves and motions at rest, got a {type(pc).__name__} "
+                f"(piece {i})"
+            )
+    return out
+
+
+def check_movers(movers: Sequence[MovingObstacle] | None) -> tuple[MovingObstacle, ...]:
+    """Return ``movers`` as a tuple, refusing anything but :class:`MovingObstacle` values."""
+    if movers is None:
+        return ()
+    if isinstance(movers, MovingObstacle):
+        raise InvalidInputError(
+            "moving_obstacles must be a sequence of MovingObstacle, got one obstacle"
+        )
+    out = tuple(movers)
+    for i, m in enumerate(out):
+        if not isinstance(m, MovingObstacle):
+            raise InvalidInputError(
+                f"moving_obstacles[{i}] must be a trajopt.MovingObstacle, got {type(m).__name__}"
+            )
+    return out
+
+
+def certify_movers(
+    traj: Any,
+    movers: Sequence[MovingObstacle],
+    *,
+    margin: float = 0.0,
+    tol: float = 1e-6,
+    robot_radius: float | None = None,
+) -> MoverCertificate:
+    """Certify a timed disc robot against moving obstacles at every instant (module docstring).
+
+    Parameters
+    ----------
+    traj : trajopt.Trajectory or trajopt.TrajectoryChain
+        One timed curve (its ``motion`` is ``s(t)``, its ``sample`` the pose), or a chain of
+        such curves and motions at rest (turns in place, a car's steering at rest: a disc
+        robot stands still during them).
+    movers : sequence of MovingObstacle
+        The predictions, in the trajectory's clock.
+    margin : float
+        Extra distance (m), >= 0.
+    tol : float
+        Tolerance (m), > 0: ``ok`` proves every distance >= limit - ``tol``.
+    robot_radius : float, optional
+        Certify a disc of this radius (m) instead of the robot; default the robot's own
+        shape: its footprint when it has one, else the disc of ``traj.robot.radius``.
+
+    Returns
+    -------
+    MoverCertificate
+    """
+    movers = check_movers(movers)
+    if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0.0):
+        raise InvalidInputError(f"margin must be a finite number >= 0 m, got {margin!r}")
+    if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0.0):
+        raise InvalidInputError(f"tol must be a finite number > 0 m, got {tol!r}")
+    if not hasattr(traj, "robot") or not hasattr(traj, "duration"):
+        raise InvalidInputError(
+            f"trajectory must be a trajopt.Trajectory or TrajectoryChain, got {type(traj).__name__}"
+        )
+    windows = _windows(traj)
+    r_rob = float(traj.robot.radius if robot_radius is None else robot_radius)
+    footprint = traj.robot.footprint if robot_radius is None else None
+    body = None if footprint is None else ccw(np.asarray(footprint.vertices, dtype=float))
+    horizon = max([float(traj.duration)] + [m.t_last for m in movers])
+    if not movers:
+        return MoverCertificate(True, "clear", math.inf, "", 0.0, horizon, tol, 0)
+    model, a_last, _ = windows[-1]
+    windows[-1] = (model, a_last, horizon)  # the robot then stands at the goal
+    best = (math.inf, "", 0.0)
+    total = 0
+    for mover in movers:
+        for model, a, b in windows:
+            cuts = [a, b] + [t for t in mover.times.tolist() if a < t < b]
+            knots = np.unique(np.asarray(cuts))
+            t0s, t1s = [], []
+            for u, w in zip(knots[:-1], knots[1:], strict=True):
+                n = max(1, int(math.ceil((w - u) / COVER_DT)))
+                e = np.linspace(u, w, n + 1)
+                t0s.append(e[:-1])
+                t1s.append(e[1:])
+            if not t0s:  # a zero-length window: one instant
+                t0s, t1s = [np.full(1, a)], [np.full(1, a)]
+            verdict, slack, wt, count = _certify_one(
+                model,
+                mover,
+                np.concatenate(t0s),
+                np.concatenate(t1s),
+                (margin if body is not None else r_rob + margin),
+                tol,
+                body,
+            )
+            total += count
+            if verdict != "clear":
+                return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
+            if slack < best[0]:
+                best = (slack, mover.name, wt)
+    return MoverCertificate(True, "clear", best[0], best[1], best[2], horizon, tol, total)
+
+
+def _certify_one(
+    model: Any,
+    mover: MovingObstacle,
+    t0: np.ndarray,
+    t1: np.ndarray,
+    extra: float,
+    tol: float,
+    body: np.ndarray | None = None,
+) -> tuple[str, float, float, int]:
+    """Bisect ``[t0, t1]`` intervals for one mover: ``(verdict, slack, time, intervals)``.
+
+    ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
+    a disc (whose radius is in ``extra``).
+    """
+    disc = mover.vertices is None
+    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
+    proven = math.inf
+    proven_t = 0.0
+    count = 0
+    while t0.size:
+        count += t0.size
+        if count > MAX_INTERVALS:
+            return "undecided", proven, proven_t, count
+        tm = 0.5 * (t0 + t1)
+        h = 0.5 * (t1 - t0)
+        p, rho_p, v_rob = model.at(t0, tm, t1)
+        vel, w = _segment_rates(mover, tm)
+        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach * np.abs(w)) * h
+        shape = shape_at(mover, tm)
+        dist_m = point_polygon_distance(p, shape)
+        lim_mid = extra + mover.radius_at(tm)
+        lim_hi = extra + mover.radius_at(t1)
+        lower = dist_m - rho_p - rho_m - lim_hi
+        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
+            reach_b = float(np.max(np.hypot(body[:, 0], body[:, 1])))
+            c, sn = np.cos(model.theta)[:, None], np.sin(model.theta)[:, None]
+            poly = np.stack(
+                [
+                    p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+                    p[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+                ],
+                axis=-1,
+            )
+            dist_m = convex_distance(poly, shape)
+            lower_poly = dist_m - rho_p - reach_b * model.turn - rho_m - lim_hi
+            lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
+        elif disc:
+            # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
+            d = p - mover.position_at(tm)
+            rel = v_rob - vel
+            rr = np.sum(rel * rel, axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
+            tau = np.clip(tau, -h, h)
+            near = d + tau[:, None] * rel
+            c2 = model.c2_local
+            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
+        slack_mid = dist_m - lim_mid
+        bad = slack_mid < -0.5 * tol
+        if np.any(bad):
+            i = int(np.argmin(np.where(bad, slack_mid, np.inf)))
+            return "violated", float(slack_mid[i]), float(tm[i]), count
+        done = lower >= -tol
+        if np.any(done):
+            i = int(np.argmin(np.where(done, lower, np.inf)))
+            if lower[i] < proven:
+                proven, proven_t = float(lower[i]), float(tm[i])
+        split = ~done
+        a, m, b = t0[split], tm[split], t1[split]
+        t0 = np.concatenate([a, m])
+        t1 = np.concatenate([m, b])
+    return "clear", proven, proven_t, count

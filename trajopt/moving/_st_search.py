@@ -1,0 +1,211 @@
+"""The fastest way through the ``(s, t)`` grid by rest-to-rest drives between stops.
+
+The profiles searched: the robot rests at the start, drives time-optimally (the jerk-limited
+timing of the path's piece, rest to rest) to a stop, rests there, drives on to a later stop,
+..., and finally to the goal, where it stands. Stops are the path's start and end, the node in
+front of each forbidden region and evenly spaced ones. A dynamic programme over the stops in
+order of arc length keeps, for every stop and grid time, whether the robot can be resting
+there then (and how it got there): a drive from stop ``a`` starting at ``t_k`` is allowed when
+its nearest node at every grid time is free on the sufficient grid (:mod:`._st_grid`), a rest
+while its node stays free. The earliest exact arrival at the goal, with the goal free from then
+on, wins. One drive from the start to the goal after a wait is the special case ``pass after``;
+no wait is ``pass before``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from trajopt.moving._st_grid import STGrid
+
+#: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
+N_EVEN_STOPS = 10
+
+
+@dataclass(frozen=True, slots=True)
+class Piece:
+    """Phases ``(t, s, v, a, j)``, shape (p, 5), of a rest-to-rest drive over ``[s0, s1]`` (m).
+
+    Times from the drive's own start (s); ``duration`` (s).
+    """
+
+    rows: np.ndarray
+    duration: float
+    s0: float
+    s1: float
+
+    def s_at(self, t: np.ndarray) -> np.ndarray:
+        """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends."""
+        tt = np.clip(t, 0.0, self.duration)
+        k = np.searchsorted(self.rows[:, 0], tt, side="right") - 1
+        k = np.clip(k, 0, self.rows.shape[0] - 1)
+        tau = tt - self.rows[k, 0]
+        r = self.rows[k]
+        s = r[:, 1] + tau * (r[:, 2] + tau * (0.5 * r[:, 3] + tau * r[:, 4] / 6.0))
+        return np.where(tt >= self.duration, self.s1, np.clip(s, self.s0, self.s1))
+
+
+def ok_starts(grid: STGrid, idx: np.ndarray) -> np.ndarray:
+    """Return ``ok[k]``: a drive whose grid samples are the nodes ``idx`` is free from ``t_k``."""
+    fb = grid.blocked
+    kk = fb.shape[0]
+    pad = np.concatenate([fb, np.repeat(fb[-1:], idx.shape[0], axis=0)])
+    ok = np.ones(kk, dtype=bool)
+    for j, i in enumerate(idx):
+        ok &= ~pad[j : j + kk, i]
+    return ok
+
+
+def stop_points(grid: STGrid) -> list[float]:
+    """Return the stops (m): start, the node in front of each forbidden region, even ones, goal."""
+    length = float(grid.s[-1])
+    cols = grid.blocked.any(axis=0)
+    fronts = np.flatnonzero(cols[1:] & ~cols[:-1])  # the last free node before a forbidden run
+    inner = [float(grid.s[i]) for i in fronts]
+    inner += np.linspace(0.0, length, N_EVEN_STOPS + 2)[1:-1].tolist()
+    gap = 2.0 * grid.ds
+    keep: list[float] = []
+    for p in sorted(inner):
+        if gap < p < length - gap and (not keep or p - keep[-1] > gap):
+            keep.append(p)
+    return [0.0, *keep, length]
+
+
+def least_time(d: float, v_top: float, a_top: float) -> float:
+    """Return a lower bound (s) of a rest-to-rest drive over ``d`` (m): bang-bang, no jerk limit."""
+    if d <= 0.0:
+        return 0.0
+    if d <= v_top * v_top / a_top:
+        return 2.0 * math.sqrt(d / a_top)
+    return d / v_top + v_top / a_top
+
+
+def _rest_closure(arrive: np.ndarray, blocked_col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Resting times after the arrivals ``arrive`` while the node stays free; each one's arrival."""
+    idx = np.arange(arrive.shape[0])
+    last_arr = np.maximum.accumulate(np.where(arrive, idx, -1))
+    last_blk = np.maximum.accumulate(np.where(blocked_col, idx, -1))
+    return (last_arr >= 0) & (last_arr > last_blk), last_arr
+
+
+def search(
+    grid: STGrid,
+    drive: Callable[[float, float], Piece | None],
+    v_top: float,
+    a_top: float,
+    k_min: int = 0,
+) -> tuple[list[tuple[float, Piece | None, float]], float, str] | None:
+    """Return the earliest arrival's schedule (module docstring), or ``None``.
+
+    Parameters
+    ----------
+    grid : STGrid
+        The sufficient grid.
+    drive : callable
+        ``drive(s0, s1)``: the rest-to-rest drive over ``[s0, s1]`` (m), ``None`` when it
+        cannot be timed.
+    v_top, a_top : float
+        The robot's top speed (m/s) and acceleration (m/s^2): a drive whose
+        :func:`least_time` bound cannot beat the best arrival is not timed.
+    k_min : int
+        The first grid time at which the robot may leave the start (it rests there before:
+        a turn in place).
+
+    Returns
+    -------
+    parts : list of (float, Piece or None, float)
+        ``(start time (s), drive, or None for a rest, the rest's arc length (m))``, in order.
+    arrival : float
+        The arrival time at the goal (s).
+    label : str
+        The plan in words (its waits and stops).
+    """
+    fb, dt = grid.blocked, grid.dt
+    kk = fb.shape[0]
+    stops = stop_points(grid)
+    nodes = grid.index(np.asarray(stops))
+    w_n = len(stops)
+    goal_col = fb[:, -1]
+    last_goal = int(np.max(np.flatnonzero(goal_col))) if goal_col.any() else -1
+    # arrivals[w][k]: the robot comes to rest at stop w at t_k; parent (stop, start index, piece)
+    arrivals = [np.zeros(kk, dtype=bool) for _ in range(w_n)]
+    parents: list[dict[int, tuple[int, int, Piece]]] = [{} for _ in range(w_n)]
+    arrivals[0][0] = not fb[0, nodes[0]]
+    resting: list[tuple[np.ndarray, np.ndarray]] = []
+    best: tuple[float, int, int, Piece] | None = None  # (arrival, from stop, start k, drive)
+    for w in range(w_n - 1):
+        rest, since = _rest_closure(arrivals[w], fb[:, nodes[w]])
+        resting.append((rest, since))
+        if w == 0:
+            rest = rest & (np.arange(kk) >= k_min)
+        if not rest.any():
+            continue
+        first = int(np.argmax(rest))
+        for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
+            via = 0.0 if v == w_n - 1 else least_time(stops[-1] - stops[v], v_top, a_top)
+            lower = first * dt + least_time(stops[v] - stops[w], v_top, a_top) + via
+            if best is not None and lower >= best[0]:
+                continue
+            piece = drive(stops[w], stops[v])
+            if piece is None:
+                continue
+            n = int(math.ceil(piece.duration / dt - 1e-9))
+            ok = ok_starts(grid, grid.index(piece.s_at(np.arange(n + 1) * dt))) & rest
+            if v == w_n - 1:
+                ok &= np.arange(kk) + n > last_goal
+                if ok.any():
+                    k = int(np.argmax(ok))
+                    t_arr = k * dt + piece.duration
+                    if best is None or t_arr < best[0]:
+                        best = (t_arr, w, k, piece)
+                continue
+            ks = np.flatnonzero(ok[: max(0, kk - n)])
+            new = ks[~arrivals[v][ks + n]]
+            arrivals[v][new + n] = True
+            for k in new.tolist():
+                parents[v][k + n] = (w, k, piece)
+    if best is None:
+        return None
+    t_arr, w, k, piece = best
+    chain: list[tuple[int, Piece]] = [(k, piece)]
+    while w > 0:
+        k_arr = int(resting[w][1][k])
+        w, k, piece = parents[w][k_arr]
+        chain.append((k, piece))
+    chain.reverse()
+    parts: list[tuple[float, Piece | None, float]] = [(0.0, None, 0.0)]
+    words = [f"wait {chain[0][0] * dt:.3f} s at the start"]
+    for k, pc in chain:
+        parts.append((k * dt, pc, pc.s0))
+        parts.append((k * dt + pc.duration, None, pc.s1))
+        if pc.s0 > 0.0:
+            words.append(f"stop at s = {pc.s0:.3f} m until t = {k * dt:.3f} s")
+    parts.pop()  # the goal's rest is the trajectory's end
+    label = ", ".join(words)
+    return parts, t_arr, label
+
+
+def compose(
+    parts: list[tuple[float, Piece | None, float]], length: float
+) -> tuple[np.ndarray, float]:
+    """Return the phase rows, shape (p, 5), of a schedule from :func:`search`, and its duration (s)."""
+    rows = []
+    t_end = 0.0
+    for t0, pc, s_rest in parts:
+        if pc is None:
+            rows.append(np.array([[t0, s_rest, 0.0, 0.0, 0.0]]))
+            continue
+        r = pc.rows.copy()
+        r[:, 0] += t0
+        rows.append(r)
+        t_end = t0 + pc.duration
+    out = np.concatenate(rows)
+    keep = np.append(np.diff(out[:, 0]) > 0.0, True)  # a zero-length rest goes
+    keep[0] = True
+    out = out[keep]
+    out[:, 1] = np.clip(np.maximum.accumulate(out[:, 1]), 0.0, length)
+    return out, t_end
