@@ -12,72 +12,14 @@ from hypothesis import strategies as st
 
 import astar
 from astar import InvalidInputError, NoPathError, OccupancyGrid
-from astar.hybrid import NoPosePathError, PosePath, find_pose_path
+from astar.hybrid import NoPosePathError, find_pose_path
+from tests.astar.hybrid_checks import check_path
+from tests.astar.hybrid_checks import polyline_clearance as _polyline_clearance
+from tests.astar.hybrid_checks import world as _world
 
 
 def _wrap(a):
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
-
-
-def check_path(p: PosePath, free: np.ndarray, start, goal, radius: float) -> None:
-    """Independent checks of a returned path against the grid and the car's rules."""
-    free = np.asarray(free, bool)
-    ny, nx = free.shape
-    pc = p.pieces
-    assert pc.shape[1] == 5 and pc.shape[0] >= 1
-    # curvature of every piece within 1/R; no empty pieces
-    assert np.all(np.abs(pc[:, 3]) <= 1.0 / radius * (1 + 1e-12))
-    assert np.all(pc[:, 4] != 0.0)
-    # dense resampling of the pieces (0.01 cells), by a midpoint integration of our own
-    pts = []
-    x, y, th = pc[0, :3]
-    assert np.allclose([x, y], start[:2], atol=1e-12) and abs(_wrap(th - start[2])) < 1e-12
-    for px, py, pth, k, s in pc:
-        # each piece starts where the previous one ended
-        assert math.hypot(px - x, py - y) < 1e-9 and abs(_wrap(pth - th)) < 1e-9
-        m = max(1, int(abs(s) / 0.01))
-        ds = s / m
-        # the chord of each step: length 2 sin(k ds / 2) / k along the mid-step heading
-        chord = ds if k == 0 else 2.0 * math.sin(0.5 * k * ds) / k
-        x, y, th = px, py, pth
-        for _ in range(m):
-            thm = th + 0.5 * k * ds
-            x += chord * math.cos(thm)
-            y += chord * math.sin(thm)
-            th += k * ds
-            pts.append((x, y))
-    pts = np.array(pts)
-    ix = np.floor(pts[:, 0] + 0.5).astype(int)
-    iy = np.floor(pts[:, 1] + 0.5).astype(int)
-    inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
-    assert inside.all(), "the path leaves the grid"
-    assert free[iy, ix].all(), f"collision at {pts[~free[iy, ix]][:3].tolist()}"
-    # the integration lands on the goal; the returned end pose is the goal exactly
-    assert math.hypot(x - goal[0], y - goal[1]) < 1e-9 and abs(_wrap(th - goal[2])) < 1e-9
-    assert p.poses[-1, 0] == goal[0] and p.poses[-1, 1] == goal[1]
-    assert abs(_wrap(p.poses[-1, 2] - goal[2])) < 1e-12
-    assert np.all(p.poses[0] == np.asarray(start, float))
-    # poses: motion along the heading (forwards or backwards as `directions` says)
-    d = np.diff(p.poses[:, :2], axis=0)
-    step = np.hypot(d[:, 0], d[:, 1])
-    mid = p.poses[:-1, 2] + 0.5 * np.diff(p.poses[:, 2])
-    along = d[:, 0] * np.cos(mid) + d[:, 1] * np.sin(mid)
-    assert np.all(np.sign(along[step > 1e-9]) == p.directions[1:][step > 1e-9])
-    assert np.allclose(np.abs(along), step, rtol=1e-6, atol=1e-9)
-    # curvature from the poses: a chord c of an arc of radius >= R turns by <= 2 asin(c / 2R)
-    turn = np.abs(np.diff(p.poses[:, 2]))
-    assert np.all(turn <= 2 * np.arcsin(np.minimum(1.0, step / (2 * radius))) * (1 + 1e-9) + 1e-12)
-    # segments: contiguous, shared cusp poses, one direction each, flips between them
-    seg = p.segments
-    assert seg[0, 0] == 0 and seg[-1, 1] == len(p) - 1
-    assert np.all(seg[1:, 0] == seg[:-1, 1])
-    for a, b in seg:
-        assert len(set(p.directions[a + 1 : b + 1].tolist())) == 1
-    dirs = [p.directions[b] for _, b in seg]
-    assert all(u != v for u, v in zip(dirs[:-1], dirs[1:], strict=True))
-    assert p.cusps == len(seg) - 1 == int(np.count_nonzero(np.diff(np.sign(pc[:, 4]))))
-    assert p.length == pytest.approx(np.abs(pc[:, 4]).sum())
-    assert p.reverse_length == pytest.approx(-pc[pc[:, 4] < 0, 4].sum())
 
 
 def _closed(ny, nx):
@@ -377,9 +319,6 @@ def test_distance_field_matches_dijkstra():
 
 
 # --------------------------------------------------------------------------- exact clearance
-def _world(occ: np.ndarray) -> astar.OccupancyGrid:
-    """The raw grid with cell ``(ix, iy)``'s centre at the world point ``(ix, iy)``."""
-    return astar.OccupancyGrid(occ, 1.0, (-0.5, -0.5))
 
 
 def test_segment_clearance_against_dense_samples():
@@ -406,12 +345,6 @@ def test_segment_clearance_against_dense_samples():
         assert got == (d > r), (p0, p1, r, d)
         seen[got] += 1
     assert min(seen.values()) > 20
-
-
-def _polyline_clearance(grid, poses, spacing=0.01):
-    from tests.reference import polyline_samples, square_clearance
-
-    return square_clearance(grid, polyline_samples(np.asarray(poses)[:, :2], spacing)).min()
 
 
 def test_exact_clearance_start_at_the_radius_from_a_wall():

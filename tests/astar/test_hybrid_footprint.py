@@ -16,139 +16,25 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-import astar
 from astar import InvalidInputError, NoPathError
-from astar.hybrid import NoPosePathError, PosePath, find_pose_path
+from astar.hybrid import NoPosePathError, find_pose_path
+from tests.astar.hybrid_checks import (
+    REAR,
+    SMALL,
+    body_collisions,
+    body_points,
+    check_footprint_path,
+    dense_poses,
+    square_distance,
+)
+from tests.astar.hybrid_checks import inflated as _inflated
+from tests.astar.hybrid_checks import wrap as _wrap
 
 RECT = np.array([[-2.0, -1.0], [2.0, -1.0], [2.0, 1.0], [-2.0, 1.0]])  # 4 x 2, origin centred
 RECT_RHO = math.hypot(2.0, 1.0)
-SMALL = np.array([[-0.5, -0.5], [1.5, -0.5], [1.5, 0.5], [-0.5, 0.5]])  # 2 x 1, origin at the rear
-REAR = np.array([[-0.5, -1.0], [3.5, -1.0], [3.5, 1.0], [-0.5, 1.0]])  # origin at the rear
-TOL = 1e-9  # cells: rounding of the closed forms
-
-
-def _wrap(a):
-    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
-
-
-def _inflated(occ: np.ndarray, r: float) -> np.ndarray:
-    """Free cells whose centre keeps ``r`` from every occupied square (and the outside)."""
-    g = astar.OccupancyGrid(occ, 1.0)
-    return ~astar.inflate(g, r, metric="square", outside_occupied=True).occupied
 
 
 # --------------------------------------------------------------------------- the reference
-def dense_poses(p: PosePath, spacing: float = 0.01) -> np.ndarray:
-    """Poses ``(x, y, heading)`` along the exact pieces, at most ``spacing`` apart (own closed form)."""
-    out = [p.pieces[0, :3][None, :]]
-    x, y, th = p.pieces[0, :3]
-    for px, py, pth, k, s in p.pieces:
-        assert math.hypot(px - x, py - y) < 1e-9 and abs(_wrap(pth - th)) < 1e-9
-        m = max(1, math.ceil(abs(s) / spacing))
-        t = s * np.arange(1, m + 1) / m
-        if k == 0.0:
-            q = np.column_stack([px + t * math.cos(pth), py + t * math.sin(pth), np.full(m, pth)])
-        else:
-            a = pth + k * t
-            q = np.column_stack(
-                [px + (np.sin(a) - math.sin(pth)) / k, py - (np.cos(a) - math.cos(pth)) / k, a]
-            )
-        out.append(q)
-        x, y, th = q[-1]
-    return np.concatenate(out)
-
-
-def body_points(
-    poly: np.ndarray, spacing: float = 0.01, inner: float = 0.1
-) -> tuple[np.ndarray, np.ndarray]:
-    """Boundary samples ``spacing`` apart and interior grid points ``inner`` apart (robot frame).
-
-    The interior grid only has to catch an occupied square lying wholly inside the body (any
-    other square that meets the body meets its boundary): a closed unit square contains a
-    point of any grid of spacing < 1, so 0.1 is plenty.
-    """
-    poly = np.asarray(poly, float)
-    edges = []
-    for a, b in zip(poly, np.roll(poly, -1, axis=0), strict=True):
-        m = max(1, math.ceil(np.hypot(*(b - a)) / spacing))
-        edges.append(a + (b - a) * (np.arange(m) / m)[:, None])
-    boundary = np.concatenate(edges)
-    lo, hi = poly.min(axis=0), poly.max(axis=0)
-    gx, gy = np.meshgrid(np.arange(lo[0], hi[0], inner), np.arange(lo[1], hi[1], inner))
-    pts = np.column_stack([gx.ravel(), gy.ravel()])
-    # inside: on the inner side of every edge (either orientation)
-    e = np.roll(poly, -1, axis=0) - poly
-    cross = e[:, 0][None] * (pts[:, 1][:, None] - poly[:, 1][None]) - e[:, 1][None] * (
-        pts[:, 0][:, None] - poly[:, 0][None]
-    )
-    inside = np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
-    return boundary, pts[inside]
-
-
-def square_distance(pts: np.ndarray, occ: np.ndarray, cells=None) -> np.ndarray:
-    """Distance (cells) from each point to the nearest occupied square or the grid's outside.
-
-    ``cells``: ``(ix, iy)`` arrays of the occupied cells to consider (default: all).
-    """
-    ny, nx = occ.shape
-    iy, ix = np.nonzero(occ) if cells is None else (cells[1], cells[0])
-    out = np.minimum.reduce(
-        [pts[:, 0] + 0.5, nx - 0.5 - pts[:, 0], pts[:, 1] + 0.5, ny - 0.5 - pts[:, 1]]
-    )
-    out = np.maximum(out, 0.0)
-    for j in range(0, len(ix), 256):
-        dx = np.maximum(np.abs(pts[:, 0][:, None] - ix[j : j + 256][None]) - 0.5, 0.0)
-        dy = np.maximum(np.abs(pts[:, 1][:, None] - iy[j : j + 256][None]) - 0.5, 0.0)
-        out = np.minimum(out, np.hypot(dx, dy).min(axis=1))
-    return out
-
-
-def body_collisions(
-    poses: np.ndarray, poly: np.ndarray, occ: np.ndarray, margin: float = 0.0
-) -> np.ndarray:
-    """Indices of the poses whose body meets an occupied square or leaves the grid.
-
-    A pose is tested point by point when its centre is within ``rho + margin + 0.02`` of an
-    obstacle or the outside (farther, no body point can be: every point lies within ``rho``
-    of the centre). No point may lie in an occupied square or outside the grid; with
-    ``margin > 0`` the boundary points must also keep more than ``margin`` (less ``TOL``)
-    from the squares and the outside.
-    """
-    ny, nx = occ.shape
-    boundary, interior = body_points(poly)
-    rho = float(np.hypot(poly[:, 0], poly[:, 1]).max())
-    near = np.nonzero(square_distance(poses[:, :2], occ) <= rho + margin + 0.02)[0]
-    pad = np.ones((ny + 2, nx + 2), bool)
-    pad[1:-1, 1:-1] = occ
-    oy, ox = np.nonzero(occ)
-    bad = []
-    for i in near:
-        x, y, th = poses[i]
-        c, s = math.cos(th), math.sin(th)
-        rot = np.array([[c, -s], [s, c]])
-        b = boundary @ rot.T + (x, y)
-        pts = np.concatenate([b, interior @ rot.T + (x, y)])
-        jx = np.clip(np.floor(pts[:, 0] + 0.5).astype(int) + 1, 0, nx + 1)
-        jy = np.clip(np.floor(pts[:, 1] + 0.5).astype(int) + 1, 0, ny + 1)
-        hit = bool(pad[jy, jx].any())
-        if margin > 0.0 and not hit:
-            reach = rho + margin + 1.0
-            k = (np.abs(ox - x) <= reach) & (np.abs(oy - y) <= reach)
-            hit = bool((square_distance(b, occ, (ox[k], oy[k])) <= margin - TOL).any())
-        if hit:
-            bad.append(i)
-    return np.array(bad, dtype=int)
-
-
-def check_footprint_path(p, occ, poly, start, goal, margin=0.0):
-    poses = dense_poses(p)
-    np.testing.assert_allclose(poses[0], start, atol=1e-12)
-    assert math.hypot(poses[-1, 0] - goal[0], poses[-1, 1] - goal[1]) < 1e-9
-    assert abs(_wrap(poses[-1, 2] - goal[2])) < 1e-9
-    assert p.poses[-1, 0] == goal[0] and p.poses[-1, 1] == goal[1]
-    assert p.stats["footprint"] is True and p.stats["footprint_margin"] == margin
-    bad = body_collisions(poses, poly, occ, margin)
-    assert len(bad) == 0, f"the body collides at {poses[bad[:3]].tolist()}"
 
 
 # --------------------------------------------------------------------------- hand maps
@@ -459,6 +345,32 @@ def test_random_maps_bodies_are_clear(q):
         assume(False)
         return
     check_footprint_path(p, occ, poly, start, goal)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_maps())
+def test_random_maps_from_the_goal_bodies_are_clear(q):
+    occ, start, goal, radius, reverse, poly = q
+    try:
+        p = find_pose_path(
+            _inflated(occ, 0.5),
+            start,
+            goal,
+            turning_radius=radius,
+            reverse=reverse,
+            raw_grid=occ,
+            footprint=poly,
+            max_expansions=20_000,
+            time_budget=1.0,
+            search_from="goal",
+        )
+    except NoPathError:
+        assume(False)
+        return
+    assert p.stats["search_from"] == "goal"
+    check_footprint_path(p, occ, poly, start, goal)
+    if not reverse:
+        assert np.all(p.pieces[:, 4] > 0.0)
 
 
 def test_without_footprint_nothing_changes():

@@ -16,22 +16,16 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
-from hypothesis import strategies as st
 
 import astar
 from astar import InvalidInputError, NoPathError
 from astar.hybrid import find_pose_path
 from astar.hybrid_options import AUTO_PROBE
-from tests.astar.test_hybrid import check_path
-from tests.astar.test_hybrid_footprint import (
-    REAR,
-    SMALL,
-    _inflated,
-    _wrap,
-    check_footprint_path,
-    dense_poses,
-)
+from tests.astar.hybrid_checks import REAR, SMALL, check_path, dense_poses
+from tests.astar.hybrid_checks import inflated as _inflated
+from tests.astar.hybrid_checks import polyline_clearance as _polyline_clearance
+from tests.astar.hybrid_checks import world as _world
+from tests.astar.hybrid_checks import wrap as _wrap
 
 RES = 0.025  # m per cell
 LENGTH, WIDTH, REAR_M, R_M = 0.88, 0.4, 0.18, 0.5
@@ -187,52 +181,6 @@ def test_auto_falls_back_to_the_other_end():
 
 
 # --------------------------------------------------------------------------- random maps
-@st.composite
-def _maps(draw):
-    occ = np.zeros((30, 30), bool)
-    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
-    for _ in range(draw(st.integers(1, 6))):
-        x0, y0 = draw(st.integers(1, 27)), draw(st.integers(1, 27))
-        w, h = draw(st.integers(1, 6)), draw(st.integers(1, 6))
-        occ[y0 : y0 + h, x0 : x0 + w] = True
-    poly = draw(st.sampled_from([SMALL, REAR]))
-    rho = float(np.hypot(poly[:, 0], poly[:, 1]).max())
-    wide = _inflated(occ, rho + 0.1)
-    cells = np.argwhere(wide)
-    assume(len(cells) >= 2)
-    i, j = draw(st.lists(st.integers(0, len(cells) - 1), min_size=2, max_size=2, unique=True))
-    hs = draw(st.lists(st.floats(-math.pi, math.pi), min_size=2, max_size=2))
-    start = (float(cells[i][1]), float(cells[i][0]), hs[0])
-    goal = (float(cells[j][1]), float(cells[j][0]), hs[1])
-    radius = draw(st.sampled_from([2.0, 3.0]))
-    reverse = draw(st.booleans())
-    return occ, start, goal, radius, reverse, poly
-
-
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(_maps())
-def test_random_maps_from_the_goal_bodies_are_clear(q):
-    occ, start, goal, radius, reverse, poly = q
-    try:
-        p = find_pose_path(
-            _inflated(occ, 0.5),
-            start,
-            goal,
-            turning_radius=radius,
-            reverse=reverse,
-            raw_grid=occ,
-            footprint=poly,
-            max_expansions=20_000,
-            time_budget=1.0,
-            search_from="goal",
-        )
-    except NoPathError:
-        assume(False)
-        return
-    assert p.stats["search_from"] == "goal"
-    check_footprint_path(p, occ, poly, start, goal)
-    if not reverse:
-        assert np.all(p.pieces[:, 4] > 0.0)
 
 
 @pytest.mark.parametrize("reverse", [True, False])
@@ -264,8 +212,6 @@ def test_random_grids_from_the_goal_disc(reverse):
 def test_exact_clearance_from_the_goal_keeps_the_clearance():
     """The exact mode's poses are its collision samples, from the goal too: the polyline
     through them keeps the clearance (brute force against the raw squares)."""
-    from tests.astar.test_hybrid import _polyline_clearance, _world
-
     rng = np.random.default_rng(3)
     found = 0
     for _ in range(12):
