@@ -33,7 +33,7 @@ from trajopt.errors import InvalidInputError
 from trajopt.geometry import rounded_polygon
 from trajopt.moving import MovingObstacle, check_movers
 
-__all__ = ["Animation", "animate_on", "mover_outline", "MAX_FRAMES", "ENCODERS"]
+__all__ = ["Animation", "animate_on", "mover_outline", "MAX_FRAMES", "ENCODERS", "MOVER_COLORS"]
 
 logger = logging.getLogger(__name__)
 
@@ -42,7 +42,8 @@ MAX_FRAMES = 3000
 #: File suffix -> the matplotlib writer that encodes it (``.html``: no encoder needed).
 ENCODERS = {".mp4": "ffmpeg", ".gif": "pillow", ".html": "html"}
 
-_MOVER_COLORS = ("tab:red", "tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+#: Colours of the movers, in order (repeated beyond six).
+MOVER_COLORS = ("tab:red", "tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 
 
 def mover_outline(mover: MovingObstacle, t: float, *, arc_points: int = 48) -> np.ndarray:
@@ -321,7 +322,7 @@ def animate_on(
         alpha=0.35,
         label="robot path",
     )
-    colors = [_MOVER_COLORS[j % len(_MOVER_COLORS)] for j in range(len(movers))]
+    colors = [MOVER_COLORS[j % len(MOVER_COLORS)] for j in range(len(movers))]
     for m, color in zip(movers, colors, strict=True):
         ax.plot(
             m.positions[:, 0],

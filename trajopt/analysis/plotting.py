@@ -5,7 +5,8 @@ robot's footprint (or disc) at regular times along a timed trajectory, its headi
 arrows with the turns in place marked, and time plots of a trajectory with its limits.
 With predicted moving obstacles: :func:`animate` (the robot and the movers over time, as
 an mp4, a gif or an HTML player; :mod:`trajopt.analysis.animation`) and :func:`plot_st`
-(the movers' forbidden regions of the ``(s, t)`` plane and the chosen profile ``s(t)``).
+(the movers' forbidden regions of the ``(s, t)`` plane and the chosen profile ``s(t)``;
+:mod:`trajopt.analysis.st_diagram`).
 
 matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
 Every function returns the matplotlib objects it drew on, for further styling.
@@ -20,6 +21,7 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.analysis.animation import Animation, animate_on
+from trajopt.analysis.st_diagram import ST_MAX_NODES, plot_st
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import ParametricCurve
 from trajopt.moving import MovingObstacle, check_movers
@@ -32,6 +34,8 @@ __all__ = [
     "plot_profiles",
     "path_points",
     "animate",
+    "plot_st",
+    "ST_MAX_NODES",
 ]
 
 #: Most poses :func:`plot_footprints` draws; a smaller ``every_s`` is refused.
