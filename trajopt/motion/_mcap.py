@@ -14,6 +14,8 @@ topic               type                              content
 ``/corridor``       ``visualization_msgs/msg/MarkerArray``  one closed ``LINE_STRIP`` per region
 ``/pose``           ``geometry_msgs/msg/PoseStamped`` one per sample, stamped at its time
 ``/twist``          ``geometry_msgs/msg/TwistStamped`` ``linear.x = v``, ``angular.z = omega``
+``/movers``         ``visualization_msgs/msg/MarkerArray``  each mover's shape at each time (below)
+``/movers/predicted`` ``visualization_msgs/msg/MarkerArray``  each mover's predicted track
 ==================  ================================  =============================================
 
 The maps and the corridor come from ``trajectory.steps`` (a trajectory returned by
@@ -24,6 +26,17 @@ omnidirectional base's twist is its body-frame velocity ``linear.x = v_body_x``,
 ``linear.y = v_body_y`` and its orientation rate).
 Every message is logged at its header stamp: ``start_time`` (s since the Unix epoch,
 default 0) plus the sample time; the map, path and corridor at ``start_time``.
+
+With ``movers`` (:class:`trajopt.MovingObstacle`), two more topics: ``/movers/predicted``
+once at ``start_time``, one ``LINE_STRIP`` per mover (namespace ``"predicted"``, id its
+index, ``text`` its name) through its waypoints in ``frame_id``; and ``/movers`` every
+``dt`` from ``t = 0`` to the later of the trajectory's end and the last prediction time
+(the end included), one closed ``LINE_STRIP`` per mover (namespace ``"movers"``, id its
+index, ``text`` its name) whose ``pose`` is the mover's reference point and heading at that
+time and whose ``points`` are its shape's outline in its own frame: the convex polygon (or
+the point of a disc) rounded by ``radius_at(t)``
+(:func:`trajopt.geometry.rounded_polygon`). Without movers the file is the same, byte for
+byte, as before they existed.
 
 The file is written atomically (a temporary file beside it, then a rename): a failure
 leaves no partial file. :func:`read_mcap` reads such a file back.
@@ -45,6 +58,7 @@ import numpy as np
 from astar.files import atomic_write
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, TrajoptError
+from trajopt.geometry import rounded_polygon
 
 #: Topic -> ROS 2 message type written by :func:`write_mcap`.
 TOPICS: dict[str, str] = {
@@ -55,6 +69,16 @@ TOPICS: dict[str, str] = {
     "/pose": "geometry_msgs/msg/PoseStamped",
     "/twist": "geometry_msgs/msg/TwistStamped",
 }
+#: Topic -> ROS 2 message type added by :func:`write_mcap` when it is given movers.
+MOVER_TOPICS: dict[str, str] = {
+    "/movers": "visualization_msgs/msg/MarkerArray",
+    "/movers/predicted": "visualization_msgs/msg/MarkerArray",
+}
+
+#: Colours ``(r, g, b)`` of the movers' markers, in order (repeated beyond four).
+MOVER_RGB = ((0.84, 0.15, 0.16), (1.0, 0.5, 0.05), (0.55, 0.34, 0.29), (0.89, 0.47, 0.76))
+#: Points per full turn of a mover outline's arcs.
+MOVER_ARC_POINTS = 32
 
 
 class McapExportError(TrajoptError, OSError):
@@ -197,33 +221,102 @@ def _encode_path(ns0: int, stamps, frame_id: str, x, y, qz, qw) -> bytes:
     return w.data()
 
 
+def _marker(
+    w: _Cdr,
+    ns: int,
+    frame_id: str,
+    namespace: str,
+    ident: int,
+    pose: tuple[float, float, float, float],
+    width: float,
+    rgba: tuple[float, float, float, float],
+    points: np.ndarray,
+    text: str = "",
+) -> None:
+    """Append one ``LINE_STRIP`` marker (``points`` (k, 2) in the marker's pose frame)."""
+    w.header(ns, frame_id)
+    w.string(namespace)
+    w.pack("iii", 4, ident, 4, 0)  # id, LINE_STRIP, ADD
+    w.pose(*pose)
+    w.pack("3d", 8, width, 0.0, 0.0)  # scale.x: line width (m)
+    w.pack("4f", 4, *rgba)
+    w.pack("iI", 4, 0, 0)  # lifetime 0: forever
+    w.pack("?", 1, False)
+    w.pack("I", 4, len(points))
+    for px, py in points:
+        w.pack("3d", 8, float(px), float(py), 0.0)
+    w.pack("I", 4, 0)  # colors
+    w.string("")  # texture_resource
+    w.header(0, "")  # texture.header
+    w.string("")  # texture.format
+    w.byte_seq(b"")  # texture.data
+    w.pack("I", 4, 0)  # uv_coordinates
+    w.string(text)
+    w.string("")  # mesh_resource
+    w.string("")  # mesh_file.filename
+    w.byte_seq(b"")  # mesh_file.data
+    w.pack("?", 1, False)
+
+
+def _closed(poly: np.ndarray) -> np.ndarray:
+    return np.vstack([poly, poly[:1]]) if len(poly) > 1 else poly
+
+
 def _encode_markers(polygons: list[np.ndarray], ns: int, frame_id: str) -> bytes:
     w = _Cdr()
     w.pack("I", 4, len(polygons))
     for k, poly in enumerate(polygons):
-        w.header(ns, frame_id)
-        w.string("corridor")
-        w.pack("iii", 4, k, 4, 0)  # id, LINE_STRIP, ADD
-        w.pose(0.0, 0.0, 0.0, 1.0)
-        w.pack("3d", 8, 0.01, 0.0, 0.0)  # scale.x: line width (m)
-        w.pack("4f", 4, 0.1, 0.45, 0.85, 1.0)
-        w.pack("iI", 4, 0, 0)  # lifetime 0: forever
-        w.pack("?", 1, False)
-        closed = np.vstack([poly, poly[:1]]) if len(poly) > 1 else poly
-        w.pack("I", 4, len(closed))
-        for px, py in closed:
-            w.pack("3d", 8, float(px), float(py), 0.0)
-        w.pack("I", 4, 0)  # colors
-        w.string("")  # texture_resource
-        w.header(0, "")  # texture.header
-        w.string("")  # texture.format
-        w.byte_seq(b"")  # texture.data
-        w.pack("I", 4, 0)  # uv_coordinates
-        w.string("")  # text
-        w.string("")  # mesh_resource
-        w.string("")  # mesh_file.filename
-        w.byte_seq(b"")  # mesh_file.data
-        w.pack("?", 1, False)
+        _marker(w, ns, frame_id, "corridor", k, (0.0, 0.0, 0.0, 1.0), 0.01,
+                (0.1, 0.45, 0.85, 1.0), _closed(poly))  # fmt: skip
+    return w.data()
+
+
+def _check_movers(movers: Any) -> tuple[Any, ...]:
+    """Return the movers as a tuple; each must be a :class:`trajopt.MovingObstacle` (its interface)."""
+    if movers is None:
+        return ()
+    try:
+        out = tuple(movers)
+    except TypeError:
+        raise InvalidInputError(
+            f"movers must be a sequence of trajopt.MovingObstacle, got {type(movers).__name__}"
+        ) from None
+    need = ("pose_at", "radius_at", "shape_vertices", "positions", "t_last", "name")
+    for i, m in enumerate(out):
+        if not all(hasattr(m, a) for a in need):
+            raise InvalidInputError(
+                f"movers[{i}] must be a trajopt.MovingObstacle, got {type(m).__name__}"
+            )
+    return out
+
+
+def _encode_predicted(movers: tuple[Any, ...], ns: int, frame_id: str) -> bytes:
+    w = _Cdr()
+    w.pack("I", 4, len(movers))
+    for j, m in enumerate(movers):
+        pts = np.asarray(m.positions, dtype=float)
+        if len(pts) == 1:  # a line strip needs two points
+            pts = np.vstack([pts, pts])
+        rgb = MOVER_RGB[j % len(MOVER_RGB)]
+        _marker(w, ns, frame_id, "predicted", j, (0.0, 0.0, 0.0, 1.0), 0.01, (*rgb, 0.5), pts,
+                m.name)  # fmt: skip
+    return w.data()
+
+
+def _encode_movers_at(movers: tuple[Any, ...], t: float, ns: int, frame_id: str) -> bytes:
+    w = _Cdr()
+    w.pack("I", 4, len(movers))
+    for j, m in enumerate(movers):
+        c, h = m.pose_at(t)
+        half = 0.5 * float(h)
+        outline = rounded_polygon(
+            np.asarray(m.shape_vertices, dtype=float),
+            float(m.radius_at(t)),
+            arc_points=MOVER_ARC_POINTS,
+        )
+        rgb = MOVER_RGB[j % len(MOVER_RGB)]
+        pose = (float(c[0]), float(c[1]), math.sin(half), math.cos(half))
+        _marker(w, ns, frame_id, "movers", j, pose, 0.02, (*rgb, 1.0), _closed(outline), m.name)
     return w.data()
 
 
@@ -236,8 +329,9 @@ def write_mcap(
     frame_id: str = "map",
     child_frame_id: str = "base_link",
     start_time: float = 0.0,
+    movers: Any = None,
 ) -> Path:
-    """Write a timed trajectory (and its map and corridor) as a ROS 2 MCAP file.
+    """Write a timed trajectory (and its map, corridor and movers) as a ROS 2 MCAP file.
 
     Parameters
     ----------
@@ -252,6 +346,9 @@ def write_mcap(
         The fixed frame of poses, maps and markers, and the robot frame of the twists.
     start_time : float, optional
         Stamp of ``t = 0`` in seconds since the Unix epoch (finite, ``>= 0``).
+    movers : sequence of MovingObstacle, optional
+        Predicted moving obstacles (the trajectory's clock): ``/movers`` and
+        ``/movers/predicted`` (module docstring). ``None`` or empty: neither topic.
 
     Returns
     -------
@@ -261,7 +358,7 @@ def write_mcap(
     Raises
     ------
     InvalidInputError
-        A bad ``dt``, ``start_time`` or frame name.
+        A bad ``dt``, ``start_time``, frame name or mover.
     McapExportError
         The file cannot be written (the message names it and the cause), or the ``mcap``
         package is missing.
@@ -281,6 +378,7 @@ def write_mcap(
         raise McapExportError(
             "writing MCAP needs the 'mcap' package: pip install 'trajopt[ros]'"
         ) from None
+    movers = _check_movers(movers)
     smp = trajectory.sample_uniform(dt)
     whole = math.floor(start_time)
     ns0 = int(whole) * 1_000_000_000 + int(round((start_time - whole) * 1e9))
@@ -296,6 +394,13 @@ def write_mcap(
         vy = np.asarray(smp.v_body_y, dtype=float)
     om = np.asarray(smp.omega, dtype=float)
     steps = getattr(trajectory, "steps", None)
+    m_times = np.zeros(0)
+    if movers:  # every dt until the later of the trajectory's end and the last prediction
+        m_end = max([float(trajectory.duration)] + [float(m.t_last) for m in movers])
+        m_times = float(dt) * np.arange(int(math.floor(m_end / float(dt) + 1e-9)) + 1)
+        if m_end - m_times[-1] > 1e-9 * max(1.0, m_end):
+            m_times = np.append(m_times, m_end)
+    m_stamps = ns0 + np.rint(m_times * 1e9).astype(np.int64)
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as f:
@@ -305,7 +410,7 @@ def write_mcap(
             channels: dict[str, int] = {}
 
             def channel(topic: str) -> int:
-                dtype = TOPICS[topic]
+                dtype = TOPICS[topic] if topic in TOPICS else MOVER_TOPICS[topic]
                 if dtype not in schema_ids:
                     schema_ids[dtype] = mw.register_schema(
                         name=dtype,
@@ -342,9 +447,28 @@ def write_mcap(
                     publish_time=ns0,
                     data=_encode_markers(polys, ns0, frame_id),
                 )
+            if movers:
+                mw.add_message(
+                    channel("/movers/predicted"),
+                    log_time=ns0,
+                    publish_time=ns0,
+                    data=_encode_predicted(movers, ns0, frame_id),
+                )
+            done = 0  # mover frames written, in time order with the poses
+
+            def movers_until(ns_last: int) -> None:
+                nonlocal done
+                while done < len(m_stamps) and m_stamps[done] <= ns_last:
+                    ns = int(m_stamps[done])
+                    data = _encode_movers_at(movers, float(m_times[done]), ns, frame_id)
+                    c = channels["/movers"] if "/movers" in channels else channel("/movers")
+                    mw.add_message(c, log_time=ns, publish_time=ns, data=data, sequence=done)
+                    done += 1
+
             c_pose, c_twist = channel("/pose"), channel("/twist")
             for k in range(len(stamps)):
                 ns = int(stamps[k])
+                movers_until(ns)
                 w = _Cdr()
                 _encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
                 mw.add_message(c_pose, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
@@ -352,6 +476,7 @@ def write_mcap(
                 w.header(ns, child_frame_id)
                 w.pack("6d", 8, v[k], vy[k], 0.0, 0.0, 0.0, om[k])
                 mw.add_message(c_twist, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
+            movers_until(int(m_stamps[-1]) if len(m_stamps) else ns0)
             mw.finish()
 
     target = Path(path)
@@ -398,6 +523,11 @@ class McapContents:
         The corridor regions' closed outlines from ``/corridor``.
     frame_id, child_frame_id : str
         Frames of the poses and of the twists.
+    movers : dict of str to ndarray, shape (n, 3) each
+        Per mover name, from ``/movers``: its marker poses ``(t, x, y)`` (``t`` in s since
+        the first pose's stamp; x, y in m).
+    predicted : dict of str to ndarray, shape (k, 2) each
+        Per mover name, its predicted track from ``/movers/predicted`` (m).
     """
 
     stamps_ns: np.ndarray
@@ -412,6 +542,8 @@ class McapContents:
     corridor: list[np.ndarray] = field(default_factory=list)
     frame_id: str = ""
     child_frame_id: str = ""
+    movers: dict[str, np.ndarray] = field(default_factory=dict)
+    predicted: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def read_mcap(path: str | os.PathLike[str]) -> McapContents:
@@ -444,6 +576,8 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
     path_rows: list[tuple[float, float, float]] = []
     maps: dict[str, OccupancyGrid] = {}
     corridor: list[np.ndarray] = []
+    mover_rows: dict[str, list[tuple[int, float, float]]] = {}
+    predicted: dict[str, np.ndarray] = {}
     frames = {"frame_id": "", "child_frame_id": ""}
     try:
         with open(p, "rb") as f:
@@ -491,6 +625,19 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
                 elif topic == "/corridor":
                     for m in ros.markers:
                         corridor.append(np.array([[q.x, q.y] for q in m.points], dtype=float))
+                elif topic == "/movers":
+                    for m in ros.markers:
+                        st = m.header.stamp
+                        mover_rows.setdefault(m.text, []).append(
+                            (
+                                st.sec * 1_000_000_000 + st.nanosec,
+                                m.pose.position.x,
+                                m.pose.position.y,
+                            )
+                        )
+                elif topic == "/movers/predicted":
+                    for m in ros.markers:
+                        predicted[m.text] = np.array([[q.x, q.y] for q in m.points], dtype=float)
     except OSError as exc:
         raise McapExportError(f"{p}: cannot read the MCAP file: {exc}") from exc
     except Exception as exc:  # the mcap reader raises its own types on malformed files
@@ -508,6 +655,12 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
     del arr
     theta = np.unwrap(2.0 * np.arctan2(xyq[:, 2], xyq[:, 3]))
     tw = np.array(twists, dtype=float)
+    movers = {}
+    for name, rows in mover_rows.items():
+        rows.sort()
+        ns = np.array([r[0] for r in rows], dtype=np.int64)
+        xy = np.array([r[1:] for r in rows], dtype=float)
+        movers[name] = np.column_stack([(ns - stamps[0]) / 1e9, xy])
     return McapContents(
         stamps_ns=stamps,
         t=(stamps - stamps[0]) / 1e9,
@@ -521,4 +674,6 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
         corridor=corridor,
         frame_id=frames["frame_id"],
         child_frame_id=frames["child_frame_id"],
+        movers=movers,
+        predicted=predicted,
     )
