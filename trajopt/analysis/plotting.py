@@ -548,6 +548,7 @@ def animate(
             ax.set_xlabel("x [m]")
             ax.set_ylabel("y [m]")
             ax.set_aspect("equal")
+        fig.tight_layout()
         return animate_on(
             ax, trajectory, movers, robot, fps=fps, speed=speed, t_end=t_end, path=path, dpi=dpi
         )

@@ -65,6 +65,7 @@ def plot_st(
     ds: float | None = None,
     dt: float | None = None,
     t_end: float | None = None,
+    label: str = "s(t), chosen",
     ax: Any = None,
 ) -> tuple[Any, Any]:
     """Draw the ``(s, t)`` diagram: the movers' forbidden regions along the path, and ``s(t)``.
@@ -93,6 +94,8 @@ def plot_st(
     t_end : float, optional
         The last time drawn (s), > 0; default the later of the trajectory's end and the
         movers' last prediction times.
+    label : str
+        Legend label of the profile.
     ax : matplotlib Axes, optional
 
     Returns
@@ -181,14 +184,14 @@ def plot_st(
     mesh.set_gid("forbidden")
     t_line = np.union1d(grid.t, np.linspace(0.0, end, 2001))
     smp = trajectory.sample(np.minimum(t_line, duration))
-    (line,) = ax.plot(t_line, np.asarray(smp.s, dtype=float), "k-", lw=1.6, label="s(t), chosen")
+    (line,) = ax.plot(t_line, np.asarray(smp.s, dtype=float), "k-", lw=1.6, label=label)
     line.set_gid("profile")
     ax.axhline(length, ls="--", color="0.4", lw=0.8, label=f"goal, s = {length:.2f} m")
     handles = [line, *ax.get_lines()[-1:]]
     handles += [
         Patch(color=c, alpha=0.6, label=m.name) for m, c in zip(movers, colors, strict=False)
     ]
-    ax.legend(handles=handles, loc="upper left", fontsize="small")
+    ax.legend(handles=handles, loc="best", fontsize="small")
     ax.set_xlim(0.0, end)
     ax.set_ylim(-0.02 * length, 1.05 * length)
     ax.set_xlabel("time t [s]")
