@@ -30,8 +30,8 @@ default 0) plus the sample time; the map, path and corridor at ``start_time``.
 With ``movers`` (:class:`trajopt.MovingObstacle`), two more topics: ``/movers/predicted``
 once at ``start_time``, one ``LINE_STRIP`` per mover (namespace ``"predicted"``, id its
 index, ``text`` its name) through its waypoints in ``frame_id``; and ``/movers`` every
-``dt`` from ``t = 0`` to the later of the trajectory's end and the last prediction time
-(the end included), one closed ``LINE_STRIP`` per mover (namespace ``"movers"``, id its
+``movers_dt`` (default ``dt``) from ``t = 0`` to the later of the trajectory's end and the
+last prediction time (the end included), one closed ``LINE_STRIP`` per mover (namespace ``"movers"``, id its
 index, ``text`` its name) whose ``pose`` is the mover's reference point and heading at that
 time and whose ``points`` are its shape's outline in its own frame: the convex polygon (or
 the point of a disc) rounded by ``radius_at(t)``
@@ -46,6 +46,7 @@ Needs the ``mcap`` and ``mcap-ros2-support`` packages (``pip install trajopt[ros
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import struct
@@ -243,8 +244,21 @@ def _marker(
     w.pack("iI", 4, 0, 0)  # lifetime 0: forever
     w.pack("?", 1, False)
     w.pack("I", 4, len(points))
-    for px, py in points:
-        w.pack("3d", 8, float(px), float(py), 0.0)
+    if len(points):  # geometry_msgs/Point[]: (x, y, 0) after one alignment to 8
+        xyz = np.zeros((len(points), 3))
+        xyz[:, :2] = points
+        w.pack(f"{3 * len(points)}d", 8, *xyz.ravel().tolist())
+    w.buf += _marker_tail(text)
+
+
+@functools.lru_cache(maxsize=256)
+def _marker_tail(text: str) -> bytes:
+    """Return the fields of a marker after its points, for a ``text``: constant bytes.
+
+    They start 4-aligned (after 8-byte points, or after the 4-byte count) and need no
+    alignment above 4, so their encoding does not depend on where they start.
+    """
+    w = _Cdr()
     w.pack("I", 4, 0)  # colors
     w.string("")  # texture_resource
     w.header(0, "")  # texture.header
@@ -256,6 +270,7 @@ def _marker(
     w.string("")  # mesh_file.filename
     w.byte_seq(b"")  # mesh_file.data
     w.pack("?", 1, False)
+    return bytes(w.buf[4:])
 
 
 def _closed(poly: np.ndarray) -> np.ndarray:
@@ -303,20 +318,47 @@ def _encode_predicted(movers: tuple[Any, ...], ns: int, frame_id: str) -> bytes:
     return w.data()
 
 
-def _encode_movers_at(movers: tuple[Any, ...], t: float, ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.pack("I", 4, len(movers))
-    for j, m in enumerate(movers):
-        c, h = m.pose_at(t)
-        half = 0.5 * float(h)
-        outline = rounded_polygon(
-            np.asarray(m.shape_vertices, dtype=float),
-            float(m.radius_at(t)),
-            arc_points=MOVER_ARC_POINTS,
+@dataclass(frozen=True)
+class _MoverFrames:
+    """A mover sampled at the frame times: reference points (m), headings (rad), outlines.
+
+    Its outline at radius ``r`` is ``base + r * spread`` (the rounded polygon's points move
+    along fixed unit directions as the radius grows; :func:`trajopt.geometry.rounded_polygon`).
+    """
+
+    name: str
+    centre: np.ndarray  # (n, 2)
+    heading: np.ndarray  # (n,)
+    radius: np.ndarray  # (n,)
+    base: np.ndarray  # (k, 2), closed
+    spread: np.ndarray  # (k, 2), closed
+
+    @classmethod
+    def of(cls, mover: Any, times: np.ndarray) -> _MoverFrames:
+        c, h = mover.pose_at(times)
+        v = np.asarray(mover.shape_vertices, dtype=float)
+        one = _closed(rounded_polygon(v, 1.0, arc_points=MOVER_ARC_POINTS))
+        two = _closed(rounded_polygon(v, 2.0, arc_points=MOVER_ARC_POINTS))
+        return cls(
+            name=str(mover.name),
+            centre=np.asarray(c, dtype=float).reshape(-1, 2),
+            heading=np.asarray(h, dtype=float).reshape(-1),
+            radius=np.asarray(mover.radius_at(times), dtype=float).reshape(-1),
+            base=2.0 * one - two,
+            spread=two - one,
         )
+
+
+def _encode_movers_at(frames: list[_MoverFrames], k: int, ns: int, frame_id: str) -> bytes:
+    """Encode every mover's marker at frame ``k`` (stamp ``ns``)."""
+    w = _Cdr()
+    w.pack("I", 4, len(frames))
+    for j, f in enumerate(frames):
+        half = 0.5 * float(f.heading[k])
+        pose = (float(f.centre[k, 0]), float(f.centre[k, 1]), math.sin(half), math.cos(half))
+        outline = f.base + float(f.radius[k]) * f.spread
         rgb = MOVER_RGB[j % len(MOVER_RGB)]
-        pose = (float(c[0]), float(c[1]), math.sin(half), math.cos(half))
-        _marker(w, ns, frame_id, "movers", j, pose, 0.02, (*rgb, 1.0), _closed(outline), m.name)
+        _marker(w, ns, frame_id, "movers", j, pose, 0.02, (*rgb, 1.0), outline, f.name)
     return w.data()
 
 
@@ -330,6 +372,7 @@ def write_mcap(
     child_frame_id: str = "base_link",
     start_time: float = 0.0,
     movers: Any = None,
+    movers_dt: float | None = None,
 ) -> Path:
     """Write a timed trajectory (and its map, corridor and movers) as a ROS 2 MCAP file.
 
@@ -349,6 +392,11 @@ def write_mcap(
     movers : sequence of MovingObstacle, optional
         Predicted moving obstacles (the trajectory's clock): ``/movers`` and
         ``/movers/predicted`` (module docstring). ``None`` or empty: neither topic.
+    movers_dt : float, optional
+        Spacing (s, > 0) of the ``/movers`` messages; default ``dt``. A viewer shows each
+        mover's latest marker until the next, so 0.05-0.1 s is smooth enough and keeps the
+        file small (the markers of 10 movers every 10 ms take several times the space of
+        the robot's topics).
 
     Returns
     -------
@@ -379,6 +427,13 @@ def write_mcap(
             "writing MCAP needs the 'mcap' package: pip install 'trajopt[ros]'"
         ) from None
     movers = _check_movers(movers)
+    step_m = float(dt) if movers_dt is None else movers_dt
+    if (
+        isinstance(step_m, bool)
+        or not isinstance(step_m, int | float)
+        or not (math.isfinite(step_m) and step_m > 0.0)
+    ):
+        raise InvalidInputError(f"movers_dt must be a finite number > 0 (s), got {movers_dt!r}")
     smp = trajectory.sample_uniform(dt)
     whole = math.floor(start_time)
     ns0 = int(whole) * 1_000_000_000 + int(round((start_time - whole) * 1e9))
@@ -397,10 +452,11 @@ def write_mcap(
     m_times = np.zeros(0)
     if movers:  # every dt until the later of the trajectory's end and the last prediction
         m_end = max([float(trajectory.duration)] + [float(m.t_last) for m in movers])
-        m_times = float(dt) * np.arange(int(math.floor(m_end / float(dt) + 1e-9)) + 1)
+        m_times = step_m * np.arange(int(math.floor(m_end / step_m + 1e-9)) + 1)
         if m_end - m_times[-1] > 1e-9 * max(1.0, m_end):
             m_times = np.append(m_times, m_end)
     m_stamps = ns0 + np.rint(m_times * 1e9).astype(np.int64)
+    m_frames = [_MoverFrames.of(m, m_times) for m in movers]
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as f:
@@ -460,7 +516,7 @@ def write_mcap(
                 nonlocal done
                 while done < len(m_stamps) and m_stamps[done] <= ns_last:
                     ns = int(m_stamps[done])
-                    data = _encode_movers_at(movers, float(m_times[done]), ns, frame_id)
+                    data = _encode_movers_at(m_frames, done, ns, frame_id)
                     c = channels["/movers"] if "/movers" in channels else channel("/movers")
                     mw.add_message(c, log_time=ns, publish_time=ns, data=data, sequence=done)
                     done += 1

@@ -118,6 +118,18 @@ def test_mover_markers_follow_the_prediction(line, movers, tmp_path):
     assert len(back.x) == len(line.sample_uniform(dt).t)  # the robot's topics as without movers
 
 
+def test_movers_dt_spaces_the_mover_frames(line, movers, tmp_path):
+    path = line.to_mcap(tmp_path / "m.mcap", dt=0.01, movers=movers, movers_dt=0.25)
+    back = read_mcap(path)
+    t = back.movers["cart"][:, 0]
+    end = max(line.duration, movers[1].times[-1])
+    assert np.allclose(np.diff(t[:-1]), 0.25) and t[-1] == pytest.approx(end)
+    assert np.allclose(np.diff(back.t[:-1]), 0.01)  # the robot's poses keep dt
+    for bad in (0.0, -1.0, float("nan"), "0.1"):
+        with pytest.raises(InvalidInputError, match="movers_dt"):
+            write_mcap(line, tmp_path / "x.mcap", movers=movers, movers_dt=bad)
+
+
 def test_a_bad_mover_is_named(line, tmp_path):
     with pytest.raises(InvalidInputError, match=r"movers\[1\]"):
         write_mcap(line, tmp_path / "x.mcap", movers=[_walker_only(), (1.0, 2.0)])
