@@ -46,10 +46,8 @@ Needs the ``mcap`` and ``mcap-ros2-support`` packages (``pip install trajopt[ros
 
 from __future__ import annotations
 
-import functools
 import math
 import os
-import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -59,7 +57,16 @@ import numpy as np
 from astar.files import atomic_write
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, TrajoptError
-from trajopt.geometry import rounded_polygon
+from trajopt.motion._cdr import (
+    CdrWriter,
+    MoverFrames,
+    encode_grid,
+    encode_markers,
+    encode_movers_at,
+    encode_path,
+    encode_pose_stamped,
+    encode_predicted,
+)
 
 #: Topic -> ROS 2 message type written by :func:`write_mcap`.
 TOPICS: dict[str, str] = {
@@ -75,11 +82,6 @@ MOVER_TOPICS: dict[str, str] = {
     "/movers": "visualization_msgs/msg/MarkerArray",
     "/movers/predicted": "visualization_msgs/msg/MarkerArray",
 }
-
-#: Colours ``(r, g, b)`` of the movers' markers, in order (repeated beyond four).
-MOVER_RGB = ((0.84, 0.15, 0.16), (1.0, 0.5, 0.05), (0.55, 0.34, 0.29), (0.89, 0.47, 0.76))
-#: Points per full turn of a mover outline's arcs.
-MOVER_ARC_POINTS = 32
 
 
 class McapExportError(TrajoptError, OSError):
@@ -152,140 +154,6 @@ def message_definition(datatype: str) -> str:
     return "\n".join(parts) + "\n"
 
 
-# ============================================================== CDR encoding
-class _Cdr:
-    """Little-endian CDR (XCDR1) writer.
-
-    Primitives aligned to their size from the start of the payload (after the 4-byte
-    encapsulation header).
-    """
-
-    __slots__ = ("buf",)
-
-    def __init__(self) -> None:
-        self.buf = bytearray(b"\x00\x01\x00\x00")
-
-    def _align(self, n: int) -> None:
-        pad = (-(len(self.buf) - 4)) % n
-        if pad:
-            self.buf += b"\x00" * pad
-
-    def pack(self, fmt: str, size: int, *values: Any) -> None:
-        self._align(size)
-        self.buf += struct.pack("<" + fmt, *values)
-
-    def string(self, s: str) -> None:
-        data = s.encode("utf-8") + b"\x00"
-        self.pack("I", 4, len(data))
-        self.buf += data
-
-    def byte_seq(self, data: bytes) -> None:
-        self.pack("I", 4, len(data))
-        self.buf += data
-
-    def time(self, ns: int) -> None:
-        self.pack("iI", 4, ns // 1_000_000_000, ns % 1_000_000_000)
-
-    def header(self, ns: int, frame_id: str) -> None:
-        self.time(ns)
-        self.string(frame_id)
-
-    def pose(self, x: float, y: float, qz: float, qw: float) -> None:
-        self.pack("7d", 8, x, y, 0.0, 0.0, 0.0, qz, qw)
-
-    def data(self) -> bytes:
-        return bytes(self.buf)
-
-
-def _encode_grid(grid: OccupancyGrid, ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.header(ns, frame_id)
-    w.time(ns)
-    ny, nx = grid.shape
-    w.pack("fII", 4, float(grid.resolution), nx, ny)
-    w.pose(float(grid.origin[0]), float(grid.origin[1]), 0.0, 1.0)
-    w.byte_seq(np.where(grid.occupied, 100, 0).astype(np.int8).tobytes())
-    return w.data()
-
-
-def _encode_pose_stamped(w: _Cdr, ns: int, frame_id: str, x, y, qz, qw) -> None:
-    w.header(ns, frame_id)
-    w.pose(x, y, qz, qw)
-
-
-def _encode_path(ns0: int, stamps, frame_id: str, x, y, qz, qw) -> bytes:
-    w = _Cdr()
-    w.header(ns0, frame_id)
-    w.pack("I", 4, len(stamps))
-    for k in range(len(stamps)):
-        _encode_pose_stamped(w, int(stamps[k]), frame_id, x[k], y[k], qz[k], qw[k])
-    return w.data()
-
-
-def _marker(
-    w: _Cdr,
-    ns: int,
-    frame_id: str,
-    namespace: str,
-    ident: int,
-    pose: tuple[float, float, float, float],
-    width: float,
-    rgba: tuple[float, float, float, float],
-    points: np.ndarray,
-    text: str = "",
-) -> None:
-    """Append one ``LINE_STRIP`` marker (``points`` (k, 2) in the marker's pose frame)."""
-    w.header(ns, frame_id)
-    w.string(namespace)
-    w.pack("iii", 4, ident, 4, 0)  # id, LINE_STRIP, ADD
-    w.pose(*pose)
-    w.pack("3d", 8, width, 0.0, 0.0)  # scale.x: line width (m)
-    w.pack("4f", 4, *rgba)
-    w.pack("iI", 4, 0, 0)  # lifetime 0: forever
-    w.pack("?", 1, False)
-    w.pack("I", 4, len(points))
-    if len(points):  # geometry_msgs/Point[]: (x, y, 0) after one alignment to 8
-        xyz = np.zeros((len(points), 3))
-        xyz[:, :2] = points
-        w.pack(f"{3 * len(points)}d", 8, *xyz.ravel().tolist())
-    w.buf += _marker_tail(text)
-
-
-@functools.lru_cache(maxsize=256)
-def _marker_tail(text: str) -> bytes:
-    """Return the fields of a marker after its points, for a ``text``: constant bytes.
-
-    They start 4-aligned (after 8-byte points, or after the 4-byte count) and need no
-    alignment above 4, so their encoding does not depend on where they start.
-    """
-    w = _Cdr()
-    w.pack("I", 4, 0)  # colors
-    w.string("")  # texture_resource
-    w.header(0, "")  # texture.header
-    w.string("")  # texture.format
-    w.byte_seq(b"")  # texture.data
-    w.pack("I", 4, 0)  # uv_coordinates
-    w.string(text)
-    w.string("")  # mesh_resource
-    w.string("")  # mesh_file.filename
-    w.byte_seq(b"")  # mesh_file.data
-    w.pack("?", 1, False)
-    return bytes(w.buf[4:])
-
-
-def _closed(poly: np.ndarray) -> np.ndarray:
-    return np.vstack([poly, poly[:1]]) if len(poly) > 1 else poly
-
-
-def _encode_markers(polygons: list[np.ndarray], ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.pack("I", 4, len(polygons))
-    for k, poly in enumerate(polygons):
-        _marker(w, ns, frame_id, "corridor", k, (0.0, 0.0, 0.0, 1.0), 0.01,
-                (0.1, 0.45, 0.85, 1.0), _closed(poly))  # fmt: skip
-    return w.data()
-
-
 def _check_movers(movers: Any) -> tuple[Any, ...]:
     """Return the movers as a tuple; each must be a :class:`trajopt.MovingObstacle` (its interface)."""
     if movers is None:
@@ -303,63 +171,6 @@ def _check_movers(movers: Any) -> tuple[Any, ...]:
                 f"movers[{i}] must be a trajopt.MovingObstacle, got {type(m).__name__}"
             )
     return out
-
-
-def _encode_predicted(movers: tuple[Any, ...], ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.pack("I", 4, len(movers))
-    for j, m in enumerate(movers):
-        pts = np.asarray(m.positions, dtype=float)
-        if len(pts) == 1:  # a line strip needs two points
-            pts = np.vstack([pts, pts])
-        rgb = MOVER_RGB[j % len(MOVER_RGB)]
-        _marker(w, ns, frame_id, "predicted", j, (0.0, 0.0, 0.0, 1.0), 0.01, (*rgb, 0.5), pts,
-                m.name)  # fmt: skip
-    return w.data()
-
-
-@dataclass(frozen=True)
-class _MoverFrames:
-    """A mover sampled at the frame times: reference points (m), headings (rad), outlines.
-
-    Its outline at radius ``r`` is ``base + r * spread`` (the rounded polygon's points move
-    along fixed unit directions as the radius grows; :func:`trajopt.geometry.rounded_polygon`).
-    """
-
-    name: str
-    centre: np.ndarray  # (n, 2)
-    heading: np.ndarray  # (n,)
-    radius: np.ndarray  # (n,)
-    base: np.ndarray  # (k, 2), closed
-    spread: np.ndarray  # (k, 2), closed
-
-    @classmethod
-    def of(cls, mover: Any, times: np.ndarray) -> _MoverFrames:
-        c, h = mover.pose_at(times)
-        v = np.asarray(mover.shape_vertices, dtype=float)
-        one = _closed(rounded_polygon(v, 1.0, arc_points=MOVER_ARC_POINTS))
-        two = _closed(rounded_polygon(v, 2.0, arc_points=MOVER_ARC_POINTS))
-        return cls(
-            name=str(mover.name),
-            centre=np.asarray(c, dtype=float).reshape(-1, 2),
-            heading=np.asarray(h, dtype=float).reshape(-1),
-            radius=np.asarray(mover.radius_at(times), dtype=float).reshape(-1),
-            base=2.0 * one - two,
-            spread=two - one,
-        )
-
-
-def _encode_movers_at(frames: list[_MoverFrames], k: int, ns: int, frame_id: str) -> bytes:
-    """Encode every mover's marker at frame ``k`` (stamp ``ns``)."""
-    w = _Cdr()
-    w.pack("I", 4, len(frames))
-    for j, f in enumerate(frames):
-        half = 0.5 * float(f.heading[k])
-        pose = (float(f.centre[k, 0]), float(f.centre[k, 1]), math.sin(half), math.cos(half))
-        outline = f.base + float(f.radius[k]) * f.spread
-        rgb = MOVER_RGB[j % len(MOVER_RGB)]
-        _marker(w, ns, frame_id, "movers", j, pose, 0.02, (*rgb, 1.0), outline, f.name)
-    return w.data()
 
 
 # ============================================================== write
@@ -456,7 +267,7 @@ def write_mcap(
         if m_end - m_times[-1] > 1e-9 * max(1.0, m_end):
             m_times = np.append(m_times, m_end)
     m_stamps = ns0 + np.rint(m_times * 1e9).astype(np.int64)
-    m_frames = [_MoverFrames.of(m, m_times) for m in movers]
+    m_frames = [MoverFrames.of(m, m_times) for m in movers]
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as f:
@@ -487,13 +298,13 @@ def write_mcap(
                         channel(topic),
                         log_time=ns0,
                         publish_time=ns0,
-                        data=_encode_grid(grid, ns0, frame_id),
+                        data=encode_grid(grid, ns0, frame_id),
                     )
             mw.add_message(
                 channel("/plan"),
                 log_time=ns0,
                 publish_time=ns0,
-                data=_encode_path(ns0, stamps, frame_id, x, y, qz, qw),
+                data=encode_path(ns0, stamps, frame_id, x, y, qz, qw),
             )
             if steps is not None and steps.corridor is not None:
                 polys = _corridor_polygons(steps.corridor)
@@ -501,14 +312,14 @@ def write_mcap(
                     channel("/corridor"),
                     log_time=ns0,
                     publish_time=ns0,
-                    data=_encode_markers(polys, ns0, frame_id),
+                    data=encode_markers(polys, ns0, frame_id),
                 )
             if movers:
                 mw.add_message(
                     channel("/movers/predicted"),
                     log_time=ns0,
                     publish_time=ns0,
-                    data=_encode_predicted(movers, ns0, frame_id),
+                    data=encode_predicted(movers, ns0, frame_id),
                 )
             done = 0  # mover frames written, in time order with the poses
 
@@ -516,7 +327,7 @@ def write_mcap(
                 nonlocal done
                 while done < len(m_stamps) and m_stamps[done] <= ns_last:
                     ns = int(m_stamps[done])
-                    data = _encode_movers_at(m_frames, done, ns, frame_id)
+                    data = encode_movers_at(m_frames, done, ns, frame_id)
                     c = channels["/movers"] if "/movers" in channels else channel("/movers")
                     mw.add_message(c, log_time=ns, publish_time=ns, data=data, sequence=done)
                     done += 1
@@ -525,10 +336,10 @@ def write_mcap(
             for k in range(len(stamps)):
                 ns = int(stamps[k])
                 movers_until(ns)
-                w = _Cdr()
-                _encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
+                w = CdrWriter()
+                encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
                 mw.add_message(c_pose, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
-                w = _Cdr()
+                w = CdrWriter()
                 w.header(ns, child_frame_id)
                 w.pack("6d", 8, v[k], vy[k], 0.0, 0.0, 0.0, om[k])
                 mw.add_message(c_twist, log_time=ns, publish_time=ns, data=w.data(), sequence=k)

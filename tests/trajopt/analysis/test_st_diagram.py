@@ -1,4 +1,4 @@
-"""Tests of trajopt.plotting.plot_st: the movers' forbidden (s, t) cells and the chosen profile.
+"""Tests of trajopt.analysis (plotting.plot_st): the movers' forbidden (s, t) cells and s(t).
 
 The path is a straight line along y = 0, so the robot's centre at arc length ``s`` is
 ``(s, 0)`` here, independently of the library; the movers' centres are interpolated from

@@ -1,4 +1,4 @@
-"""Tests of the movers in the MCAP export: ``/movers`` and ``/movers/predicted`` markers.
+"""Tests of trajopt.motion: the movers in the MCAP export, ``/movers`` and ``/movers/predicted``.
 
 The file is decoded by ``mcap-ros2-support`` (from the definitions stored in it); each
 marker is checked against the mover's prediction computed here (``np.interp`` on its
