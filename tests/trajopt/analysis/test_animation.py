@@ -8,6 +8,7 @@ player is checked with the encoder hidden.
 
 from __future__ import annotations
 
+import gc
 import math
 import warnings
 
@@ -24,6 +25,13 @@ matplotlib.use("Agg")
 pytestmark = pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
 
 BOX = [[-0.3, -0.15], [0.3, -0.15], [0.3, 0.15], [-0.3, 0.15]]
+
+
+@pytest.fixture(autouse=True)
+def _collect_animations():
+    """Collect each test's unrendered animations while their warning is filtered."""
+    yield
+    gc.collect()
 
 
 @pytest.fixture(scope="module")
