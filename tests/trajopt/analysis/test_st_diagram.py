@@ -102,6 +102,27 @@ def test_a_footprint_robot(crossing):
         plt.close(fig)
 
 
+def test_a_chain_with_a_turn_in_place_rests_at_s_zero(crossing):
+    import matplotlib.pyplot as plt
+
+    _, walker = crossing
+    robot = trajopt.Robot(radius=0.2)
+    line = trajopt.time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [4.0, 0.0]])), robot)
+    turn = trajopt.timing.turn_in_place((0.0, 0.0), np.pi / 2, 0.0, robot)
+    chain = trajopt.TrajectoryChain((turn, line), robot)
+    fig, ax = trajopt.plotting.plot_st(chain, [walker], ds=0.05, dt=0.1)
+    try:
+        t, s = _artist(ax, "profile").get_data()
+        assert turn.duration > 0.5
+        assert np.all(s[t <= turn.duration] == 0.0) and np.all(s[t > turn.duration + 0.1] > 0)
+        assert s[-1] == pytest.approx(4.0)
+    finally:
+        plt.close(fig)
+    on = trajopt.time_parameterize(PolylineCurve(np.array([[4.0, 0.0], [6.0, 0.0]])), robot)
+    with pytest.raises(InvalidInputError, match="one path"):
+        trajopt.plotting.plot_st(trajopt.TrajectoryChain((line, on), robot), [walker])
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [
