@@ -120,7 +120,7 @@ def waiting_witness(grid, static, start, goal, movers, margin: float, *, h: floa
     T = float(traj.duration)
     K = int(math.ceil(T / h))
     p = positions(traj, np.arange(K + 1) * h)
-    last = max(float(m.times[-1]) for m in movers)
+    last = max([0.0] + [float(m.times[-1]) for m in movers])
     J = int(math.ceil(max(last, 0.0) / h)) + 1  # waits 0 .. J h
     tg = np.arange(J + K + 2) * h
     limit = robot.radius + margin
@@ -199,7 +199,7 @@ def grid_optimum(static, movers, margin: float, *, dt: float = 0.05, extra: floa
     to_coarse = np.minimum(np.rint(n_s / c).astype(int), coarse.shape[0] - 1)
     limit = robot.radius + margin
     needs = [(m, (vmax + mover_rate(m)) * dt / 2 + 0.5 * c + TOL) for m in movers]
-    last = max(float(m.times[-1]) for m in movers)
+    last = max([0.0] + [float(m.times[-1]) for m in movers])
     goal = track.point(track.length)[None]
     tf = np.arange(0.0, last + 2e-3, 1e-3)
     goal_bad = np.zeros(tf.size, bool)
