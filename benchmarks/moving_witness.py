@@ -237,3 +237,58 @@ def grid_optimum(static, movers, margin: float, *, dt: float = 0.05, extra: floa
         if t1 > goal_free_after and R[0, near_goal:].any():
             return t1
     return None
+
+
+def path_blocked(static, movers, margin: float, *, ds: float = 0.01, dt: float = 0.01) -> bool:
+    """Whether no motion along ``static``'s path gets the robot to its goal clear of the movers.
+
+    A proof by a relaxation: any non-decreasing ``s(t)`` with ``ds/dt <= v_max`` that starts
+    at rest at ``t = 0`` and stays within the reach of a robot accelerating at ``a_max``
+    (``s(t) <= a_max t^2 / 2`` until ``v_max``, then ``v_max`` on; a jerk limit only lowers
+    it); no other limit. The path is cut into cells of
+    ``ds``; at each time ``j dt`` the robot's cell is one whose centre is not closer to a
+    mover than ``limit - ds / 2 - 10 um`` (else every point of the cell collides: the path's
+    point is 1-Lipschitz in arc length; 10 um covers the polyline of the track), and from one
+    time to the next the cell index grows by at most ``floor(v_max dt / ds) + 1``. The goal's
+    cell must be reached after the last sampled time the goal itself collides. The sweep runs
+    until every prediction has ended and the robot could have driven the whole path again
+    (after the last prediction nothing moves, so nothing new becomes reachable).
+
+    Returns
+    -------
+    bool
+        ``True`` only when no such motion exists (so no motion of the real robot along the
+        path does); ``False`` when the relaxation gets through.
+    """
+    robot = static.robot
+    vmax, amax = float(robot.v_max), float(robot.a_max)
+    track = PathTrack(static)
+    n = int(math.floor(track.length / ds)) + 1
+    centres = track.point(np.minimum((np.arange(n) + 0.5) * ds, track.length))
+    goal = track.point(track.length)[None]
+    limit = robot.radius + margin
+    step = int(math.floor(vmax * dt / ds)) + 1
+    last = max([0.0] + [float(m.times[-1]) for m in movers])
+    steps = int(math.ceil((last + track.length / vmax + 1.0) / dt))
+    reach = np.zeros(n, bool)
+    reach[0] = True
+    goal_hit = -1.0
+    for j in range(1, steps + 1):
+        t = j * dt
+        tt = np.full(n, t)
+        csum = np.r_[0, np.cumsum(reach)]
+        lo = np.maximum(np.arange(n) - step, 0)
+        new = csum[np.arange(n) + 1] - csum[lo] > 0
+        t_up = vmax / amax
+        s_up = 0.5 * amax * t * t if t < t_up else 0.5 * vmax * t_up + vmax * (t - t_up)
+        new[int(math.floor(s_up / ds)) + 1 :] = False
+        for m in movers:
+            new &= slack_at(centres, m, tt, limit) >= -(0.5 * ds + 1e-5)
+            if slack_at(goal, m, np.full(1, t), limit)[0] < 0.0:
+                goal_hit = t
+        reach = new
+        if not reach.any():
+            return True
+        if reach[-1] and t > goal_hit and t > last:
+            return False
+    return True
