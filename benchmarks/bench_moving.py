@@ -18,7 +18,9 @@ its dynamics model is in that module: constant accelerations, no jerk limit). Su
 counted on the scenarios that have a witness (``wit``: either witness; ``wait``: the
 waiting one, ``latt``: the lattice one), and again on those witnessed along the static
 path itself (``path``: the lattice's, or a waiting witness that did not plan again: what a
-re-timing along the path can reach); ``later`` counts those where the planner's
+re-timing along the path can reach); ``proven``: refusals where
+:func:`benchmarks.moving_witness.path_blocked` proves that no motion along the static path
+exists (a relaxation: speed and acceleration bounds only); ``later`` counts those where the planner's
 arrival is later than the waiting witness's (by more than 1 ms); the lattice ratio is the
 planner's arrival over the lattice optimum's (``static/lattice``: the same ratio for the
 static plan without movers, the models' gap).
@@ -55,7 +57,7 @@ import astar  # noqa: E402
 import trajopt  # noqa: E402
 from benchmarks.bench_replan import queries, ros_dir  # noqa: E402
 from benchmarks.moving_cases import KINDS, make_movers  # noqa: E402
-from benchmarks.moving_witness import grid_optimum, waiting_witness  # noqa: E402
+from benchmarks.moving_witness import grid_optimum, path_blocked, waiting_witness  # noqa: E402
 from tests.trajopt.moving.reference import check_trajectory  # noqa: E402
 
 MAPS = ("smoothers_world", "depot")
@@ -119,6 +121,8 @@ def run_scenario(planner, grid, static, start, goal, movers, dp_dt):
     row["wait"] = None if w is None else w.arrival
     row["same_path"] = w is not None and not w.replanned
     row["lattice"] = grid_optimum(static, movers, MARGIN, dt=dp_dt)
+    if out is None:
+        row["proven"] = path_blocked(static, movers, MARGIN, ds=0.02, dt=0.02)
     return row
 
 
@@ -130,6 +134,7 @@ def kind_line(kind, rows, gap):
     viol = sum(r["outcome"] == "violated" for r in rows)
     unproven = sum(r["outcome"] == "unproven" for r in rows)
     blocked = sum(r["outcome"] == "blocked" for r in rows)
+    proven = sum(r["outcome"] == "blocked" and r["proven"] for r in rows)
     errs = sum(r["outcome"].startswith("error") for r in rows)
     ratio = [r["arrival"] / r["lattice"] for r in rows if "arrival" in r and r["lattice"]]
     both = [r for r in rows if "arrival" in r and r["wait"] is not None]
@@ -142,15 +147,17 @@ def kind_line(kind, rows, gap):
         f"{kind:11s} {len(rows):5d} {len(wit):4d} "
         f"{sum(r['wait'] is not None for r in rows):4d} "
         f"{sum(r['lattice'] is not None for r in rows):4d} {succ:7.1f} {len(path):4d} "
-        f"{succ_path:7.1f} {blocked:7d} {errs:4d} "
+        f"{succ_path:7.1f} {blocked:7d} {proven:6d} {errs:4d} "
         f"{viol:5d} {unproven:8d} {med(ratio):7.3f} {max(ratio, default=math.nan):7.3f} "
-        f"{len(later):3d}/{len(both):<3d} {max(later, default=0.0):6.3f} "
+        f"{len(later):3d}/{len(both):<3d} {med(later):6.3f} {max(later, default=0.0):6.3f} "
         f"{med(plan_ms):7.1f} {pct(plan_ms, 95):7.1f} {med(ref_ms):7.1f} {med(gap):6.3f}"
     )
 
 
 def retime_part(maps, n_queries, seed):
     """Re-time latency when only the predictions change (module docstring)."""
+    if n_queries <= 0:
+        return
     print(
         "\nre-time when only the predictions change: 10 movers (mixed), predictions shifted "
         "by up to 0.3 s and 0.1 m, three times per query"
@@ -208,15 +215,18 @@ def retime_part(maps, n_queries, seed):
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--per-kind", type=int, default=10, help="scenarios per kind and map")
-    ap.add_argument("--retime", type=int, default=15, help="queries per map, re-time part")
+    ap.add_argument("--per-kind", type=int, help="scenarios per kind and map (default 10)")
+    ap.add_argument("--retime", type=int, help="queries per map, re-time part (default 15)")
     ap.add_argument("--max-movers", type=int, default=10)
     ap.add_argument("--dp-dt", type=float, default=0.05, help="lattice time step (s)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--quick", action="store_true", help="2 per kind, 3 re-time queries, one map")
+    ap.add_argument(
+        "--quick", action="store_true", help="one map; 2 per kind, 3 re-time queries unless given"
+    )
     args = ap.parse_args(argv)
-    if args.quick:
-        args.per_kind, args.retime = 2, 3
+    quick = (2, 3) if args.quick else (10, 15)
+    args.per_kind = quick[0] if args.per_kind is None else args.per_kind
+    args.retime = quick[1] if args.retime is None else args.retime
     d = ros_dir()
     if d is None:
         return 1
@@ -258,8 +268,8 @@ def main(argv: list[str] | None = None) -> int:
                 )
     print(
         f"\n{'kind':11s} {'scen':>5s} {'wit':>4s} {'wait':>4s} {'latt':>4s} {'succ %':>7s} {'path':>4s} {'succ %':>7s} "
-        f"{'blocked':>7s} {'err':>4s} {'viol':>5s} {'unproven':>8s} {'/latt':>7s} {'max':>7s} "
-        f"{'later':>7s} {'by s':>6s} {'plan ms':>7s} {'p95':>7s} {'refuse':>7s} {'gap':>6s}"
+        f"{'blocked':>7s} {'proven':>6s} {'err':>4s} {'viol':>5s} {'unproven':>8s} {'/latt':>7s} {'max':>7s} "
+        f"{'later':>7s} {'med s':>6s} {'max s':>6s} {'plan ms':>7s} {'p95':>7s} {'refuse':>7s} {'gap':>6s}"
     )
     for kind, rs in rows.items():
         kind_line(kind, rs, gap)
