@@ -155,8 +155,7 @@ def waiting_witness(grid, static, start, goal, movers, margin: float, *, h: floa
 def _speed_cap(static, track: PathTrack) -> np.ndarray:
     """The curvature's speed cap (m/s) at the track's points (module docstring)."""
     robot = static.robot
-    kappa = np.abs(np.asarray(static.sample(track.t).kappa, dtype=float))
-    kappa = np.maximum(kappa[np.r_[True, np.diff(track.s) > 0]], 1e-12)[: track.s.size]
+    kappa = np.maximum(np.abs(np.asarray(static.sample(track.t).kappa, dtype=float)), 1e-12)
     cap = np.minimum(robot.v_max, np.sqrt(robot.a_lat_max / kappa))
     cap = np.minimum(cap, robot.omega_max / kappa)
     if isinstance(robot.drive, trajopt.Differential):

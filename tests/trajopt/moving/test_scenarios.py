@@ -141,6 +141,8 @@ def test_a_crossing_mover_grazing_the_motion(scene, paper, closer):
         probe.times, probe.positions, radius=radius, name="grazer"
     )
     assert brute_min(static, [mover], margin=MARGIN) == pytest.approx(-closer, abs=1e-7)
+    # the independent check agrees on the static plan: touching passes, closer is caught
+    assert check_trajectory(static, [mover], margin=MARGIN).ok == (closer == 0.0)
     if closer == 0.0:
         out = planner.plan(
             scene.start, scene.goal("A"), moving_obstacles=[mover], mover_margin=MARGIN
@@ -158,3 +160,5 @@ def test_a_crossing_mover_grazing_the_motion(scene, paper, closer):
     assert out.duration > static.duration
     chk = check_trajectory(out, [mover], margin=MARGIN, grid=scene.grid)
     assert chk.ok and chk.mover_slack >= -1e-6
+    # the relaxation behind path_blocked lets a certified motion along the path through
+    assert not path_blocked(static, [mover], MARGIN, ds=0.02, dt=0.02)
