@@ -85,6 +85,7 @@ def _room(seed: int) -> astar.OccupancyGrid:
             st.floats(0.3, 1.5),
             st.floats(0.05, 0.4),
             st.floats(1.5, 5.0),
+            st.sampled_from([0.0, 0.0, 0.02]),
         ),
         min_size=1,
         max_size=4,
@@ -92,7 +93,7 @@ def _room(seed: int) -> astar.OccupancyGrid:
 )
 def test_random_movers_never_give_a_violation(seed, specs):
     """Movers crossing the static plan at a random point near the time the robot is there,
-    from any direction, going on for 1.5-5 m past it, then standing."""
+    from any direction, going on for 1.5-5 m past it, then standing; some of them growing."""
     grid = _room(seed)
     planner = trajopt.Planner(grid, trajopt.Robot())
     try:
@@ -100,7 +101,7 @@ def test_random_movers_never_give_a_violation(seed, specs):
     except TrajoptError:
         return
     movers = []
-    for i, (frac, off, ang, speed, radius, on) in enumerate(specs):
+    for i, (frac, off, ang, speed, radius, on, growth) in enumerate(specs):
         t_c = frac * static.duration
         smp = static.sample(np.array([t_c]))
         v = speed * np.array([math.cos(ang), math.sin(ang)])
@@ -110,7 +111,7 @@ def test_random_movers_never_give_a_violation(seed, specs):
         assume(math.dist(start, (0.35, 1.5)) > static.robot.radius + radius + MARGIN + 0.05)
         movers.append(
             trajopt.MovingObstacle.constant_velocity(
-                start, v, radius=radius, horizon=t_m + on / speed, name=f"m{i}"
+                start, v, radius=radius, horizon=t_m + on / speed, growth=growth, name=f"m{i}"
             )
         )
     try:
@@ -164,3 +165,34 @@ def test_a_crossing_mover_grazing_the_motion(scene, paper, closer):
     assert chk.ok and chk.mover_slack >= -1e-6
     # the relaxation behind path_blocked lets a certified motion along the path through
     assert not path_blocked(static, [mover], MARGIN, ds=0.02, dt=0.02)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
+@given(
+    st.floats(0.0, 1.0),
+    st.floats(-math.pi, math.pi),
+    st.floats(0.3, 1.5),
+    st.floats(-0.3, 0.3),
+    st.sampled_from([0.0, 0.03]),
+)
+def test_the_check_agrees_with_the_brute_force(paper, frac, angle, speed, miss, growth):
+    """The independent check against the brute force of the reference (10 ms samples and a
+    bounded minimisation round every local minimum) on the static plan and a straight mover."""
+    _, static = paper
+    t_c = frac * static.duration
+    smp = static.sample(np.array([t_c]))
+    v = speed * np.array([math.cos(angle), math.sin(angle)])
+    p = np.array([smp.x[0], smp.y[0]]) + miss * np.array([-v[1], v[0]]) / speed
+    t0 = max(t_c - 4.0, 0.0)
+    mover = trajopt.MovingObstacle.from_waypoints(
+        [t0, t_c + 4.0], [p - (t_c - t0) * v, p + 4.0 * v], radius=0.1, growth=growth
+    )
+    chk = check_trajectory(static, [mover], margin=MARGIN)
+    truth = brute_min(static, [mover], margin=MARGIN)
+    assert chk.mover_slack >= truth - 1e-9  # samples never see closer than the minimum
+    if chk.ok:
+        assert truth >= -1e-6
+    if truth < -1e-5:
+        assert not chk.ok  # a sample below, or a bound that cannot be closed
+    if truth > 1e-5:
+        assert chk.ok
