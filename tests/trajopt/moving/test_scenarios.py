@@ -1,4 +1,4 @@
-"""Scenario tests of Planner.plan with moving obstacles, judged by independent checks.
+"""Tests of trajopt.moving on scenarios: Planner.plan with movers, judged by independent checks.
 
 Each kind of :mod:`benchmarks.moving_cases` on the paper scene: the returned plan passes
 :func:`tests.trajopt.moving.reference.check_trajectory` (1 ms samples over the trajectory and
