@@ -9,6 +9,7 @@ failed interface build (one line on stderr naming the cause).
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from collections.abc import Sequence
 
@@ -74,6 +75,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             rclpy.try_shutdown()
             return EXIT_USAGE
         raise
+    # The library's modules, compiled kernels and solvers live as long as the process: moved
+    # out of the cyclic collector's reach, they are no longer scanned by each full collection
+    # (70-160 ms each here, every few dozen requests, landing on one request or map update).
+    gc.collect()
+    gc.freeze()
     spin(node, executor)
     return 0
 

@@ -72,6 +72,7 @@ class _Running:
     traj: Any
     t0: float
     goal: tuple[float, float, float]
+    map_gen: int
     goal_handle: Any = None
     replans: int = 0
     ended: str = ""  # why it stopped early: a reason of trajopt_ros.codes
@@ -111,6 +112,7 @@ class PlannerNode(Node):
         self._grid: astar.OccupancyGrid | astar.Costmap | None = None
         self._odom: tuple[float, float, float, float, float] | None = None
         self._running: _Running | None = None
+        self._map_gen = 0  # +1 per accepted map; a plan carries the generation it was made on
         self._last_replan = -math.inf
         self._replan_due = ""  # why a deferred re-plan is due ('' = none)
         self.warm_up_s = self._warm_up()
@@ -138,9 +140,11 @@ class PlannerNode(Node):
             MultiDOFJointTrajectory, cfg["topics.trajectory"], 10
         )
         self._marker_pub = self.create_publisher(MarkerArray, cfg["topics.markers"], latched)
+        # a one-shot timer (cancelled while idle) for a re-plan the rate limit defers
         self._timer = self.create_timer(
             1.0 / cfg["replan.rate"], self._on_replan_timer, callback_group=self._subs_group
         )
+        self._timer.cancel()
         self.create_service(
             GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group
         )
@@ -220,8 +224,6 @@ class PlannerNode(Node):
         with self._lock:
             old = self._config
             self._config = cfg
-            if cfg["replan.rate"] != old["replan.rate"]:
-                self._timer.timer_period_ns = int(1e9 / cfg["replan.rate"])
             if (cfg.robot, cfg.planner_kwargs) != (old.robot, old.planner_kwargs) and self._grid:
                 self._planner = trajopt.Planner(
                     self._grid, cfg.robot, **self._planner_kwargs(self._grid)
@@ -234,6 +236,7 @@ class PlannerNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_map(self, msg: GridMsg) -> None:
+        t_received = time.time()
         cfg = self._config
         if msg.header.frame_id.lstrip("/") not in ("", cfg["frame_id"].lstrip("/")):
             self.get_logger().error(
@@ -267,12 +270,20 @@ class PlannerNode(Node):
                 self._planner = trajopt.Planner(grid, cfg.robot, **self._planner_kwargs(grid))
             self._planner.inflated_grid  # noqa: B018 - compute the inflation now, not at the first query
             self._grid = grid
+            self._map_gen += 1
+            gen = self._map_gen
             due = self._running is not None
         build_ms = 1e3 * (time.perf_counter() - t_build)
         stamp = from_time(msg.header.stamp)
-        lag = f", {1e3 * (self.now_s() - stamp):.1f} ms after its stamp" if stamp > 0 else ""
+        lag = (
+            f", received {1e3 * (t_received - stamp):.1f} ms and ready "
+            f"{1e3 * (time.time() - stamp):.1f} ms after its stamp"
+            if stamp > 0
+            else ""
+        )
         self.get_logger().info(
-            f"map {grid.shape[1]} x {grid.shape[0]} cells ready: planner in {build_ms:.1f} ms{lag}"
+            f"map {gen} ({grid.shape[1]} x {grid.shape[0]} cells) ready: planner in "
+            f"{build_ms:.1f} ms{lag} (received at {t_received:.6f})"
         )
         if due:
             self._maybe_replan("map changed")
@@ -303,8 +314,9 @@ class PlannerNode(Node):
             if running is not None:
                 self._maybe_replan("new goal")
                 return
-            traj, _ = self._plan(self._start_from_odom(), goal)
-            self._start_running(traj, goal, None)
+            start = self._start_from_odom()
+            traj, _, gen = self._plan(start, goal)
+            self._start_running(traj, gen, start, goal, None)
         except Exception as exc:  # noqa: BLE001 - every failure is logged and the node serves on
             self.get_logger().error(f"goal refused ({codes.reason_of(exc)}): {exc}")
 
@@ -334,17 +346,21 @@ class PlannerNode(Node):
 
     def _plan(
         self, start: tuple[float, float, float], goal: tuple[float, float, float]
-    ) -> tuple[Any, float]:
-        """Plan ``start`` -> ``goal`` (x, y, yaw); returns the trajectory and the wall time (s)."""
+    ) -> tuple[Any, float, int]:
+        """Plan ``start`` -> ``goal`` (x, y, yaw) on the newest map.
+
+        Returns the trajectory, the library's plan time (s) and the map generation it was
+        made on. The plan holds the node's lock: no map replaces the planner's meanwhile.
+        """
         with self._lock:
             planner = self._planner
-        if planner is None:
-            raise RequestError("no_map", "no valid map received yet")
-        self._check_end(planner, start[:2], "start")
-        self._check_end(planner, goal[:2], "goal")
-        t0 = time.perf_counter()
-        traj = planner.plan(start[:2], goal[:2], start_heading=start[2], goal_heading=goal[2])
-        return traj, time.perf_counter() - t0
+            if planner is None:
+                raise RequestError("no_map", "no valid map received yet")
+            self._check_end(planner, start[:2], "start")
+            self._check_end(planner, goal[:2], "goal")
+            t0 = time.perf_counter()
+            traj = planner.plan(start[:2], goal[:2], start_heading=start[2], goal_heading=goal[2])
+            return traj, time.perf_counter() - t0, self._map_gen
 
     def _fail(self, where: str, exc: BaseException) -> tuple[str, str]:
         reason = codes.reason_of(exc)
@@ -360,36 +376,63 @@ class PlannerNode(Node):
             return None
         return run
 
-    def _start_running(self, traj: Any, goal: tuple[float, float, float], handle: Any) -> _Running:
+    def _start_running(
+        self,
+        traj: Any,
+        gen: int,
+        start: tuple[float, float, float],
+        goal: tuple[float, float, float],
+        handle: Any,
+    ) -> _Running:
+        """Drive ``traj`` (made on map generation ``gen``) from now and publish it.
+
+        All of it under the node's lock, as every publication on ``plan``: plans reach
+        ``plan`` in the order of the maps they were made on. A trajectory made on a map that
+        has been replaced since is planned again on the newest one before it is published.
+        """
         with self._lock:
+            if gen != self._map_gen:
+                self.get_logger().info(
+                    f"plan made on map {gen}, map {self._map_gen} arrived meanwhile: planning again"
+                )
+                traj, _, gen = self._plan(start, goal)
             old = self._running
             if old is not None and old.goal_handle is not None and old.goal_handle is not handle:
                 old.ended, old.message = "preempted", "replaced by a newer goal"
                 old.wake.set()
-            run = _Running(traj=traj, t0=self.now_s(), goal=goal, goal_handle=handle)
+            run = _Running(traj=traj, t0=self.now_s(), goal=goal, map_gen=gen, goal_handle=handle)
             self._running = run
-        self._publish(run)
+            self._publish(run)
         return run
 
     def _stop_running(self, reason: str, message: str) -> None:
         with self._lock:
             run, self._running = self._running, None
-        if run is not None:
-            run.ended, run.message = reason, message
-            run.wake.set()
-            empty = Path()
-            empty.header.frame_id = self._config["frame_id"]
-            empty.header.stamp = self.get_clock().now().to_msg()
-            self._plan_pub.publish(empty)
+            if run is not None:
+                run.ended, run.message = reason, message
+                run.wake.set()
+                empty = Path()
+                empty.header.frame_id = self._config["frame_id"]
+                empty.header.stamp = self.get_clock().now().to_msg()
+                self._plan_pub.publish(empty)
 
     def _on_replan_timer(self) -> None:
+        self._timer.cancel()
         if self._replan_due:
             self._maybe_replan(f"{self._replan_due}, deferred by replan.rate")
 
     def _maybe_replan(self, why: str) -> None:
-        """Re-plan the running trajectory now, unless the rate limit defers it to the timer."""
+        """Re-plan the running trajectory now, or when the rate limit ``replan.rate`` allows.
+
+        A deferred re-plan runs on a one-shot timer at the earliest time the limit allows.
+        The re-plan and its publication hold the node's lock (ordered with map updates).
+        """
         with self._lock:
-            if time.monotonic() - self._last_replan < 1.0 / self._config["replan.rate"]:
+            wait = self._last_replan + 1.0 / self._config["replan.rate"] - time.monotonic()
+            if wait > 0:
+                if not self._replan_due:
+                    self._timer.timer_period_ns = max(int(wait * 1e9), 1_000_000)
+                    self._timer.reset()
                 self._replan_due = why.split(",")[0]
                 return
             self._replan_due = ""
@@ -421,14 +464,17 @@ class PlannerNode(Node):
                 return
             run.t0 += float(new.stats.get("splice_time_s", t + latency))
             run.traj = new
+            run.map_gen = self._map_gen
             run.replans += 1
             run.wake.set()
-        replan_ms = 1e3 * (time.perf_counter() - t_replan)
-        t_pub = time.perf_counter()
-        self._publish(run)
+            replan_ms = 1e3 * (time.perf_counter() - t_replan)
+            t_pub = time.perf_counter()
+            self._publish(run)
+            pub_ms = 1e3 * (time.perf_counter() - t_pub)
+            published = time.time()
         self.get_logger().info(
-            f"re-planned ({why}) in {replan_ms:.1f} ms, published in "
-            f"{1e3 * (time.perf_counter() - t_pub):.1f} ms (stamp {run.t0:.6f}): "
+            f"re-planned ({why}) on map {run.map_gen} in {replan_ms:.1f} ms, published in "
+            f"{pub_ms:.1f} ms (stamp {run.t0:.6f}, published at {published:.6f}): "
             f"{new.stats.get('replan', '')}"
         )
 
@@ -488,17 +534,23 @@ class PlannerNode(Node):
     def _on_get_plan(
         self, request: GetPlan.Request, response: GetPlan.Response
     ) -> GetPlan.Response:
+        t_in = time.perf_counter()
         frame = self._config["frame_id"]
         response.plan.header.frame_id = frame
         try:
             start = pose_from_msg(request.start, frame, "start")
             goal = pose_from_msg(request.goal, frame, "goal")
-            traj, _ = self._plan(start, goal)
+            traj, plan_s, gen = self._plan(start, goal)
         except Exception as exc:  # noqa: BLE001 - answered with an empty path and a logged reason
             self._fail("get_plan", exc)
             response.plan.header.stamp = self.get_clock().now().to_msg()
             return response
         response.plan = path_msg(traj, self.now_s(), frame, self._config["plan.sample_interval"])
+        total_ms = 1e3 * (time.perf_counter() - t_in)
+        self.get_logger().info(
+            f"get_plan: {len(response.plan.poses)} poses on map {gen}, library plan "
+            f"{1e3 * plan_s:.3f} ms, callback {total_ms:.3f} ms"
+        )
         return response
 
     # ------------------------------------------------------------ PlanTrajectory
@@ -515,7 +567,7 @@ class PlannerNode(Node):
                 if req.use_start
                 else self._start_from_odom()
             )
-            traj, planning_s = self._plan(start, goal)
+            traj, planning_s, gen = self._plan(start, goal)
         except Exception as exc:  # noqa: BLE001 - every failure becomes a coded result
             reason, msg = self._fail("plan_trajectory", exc)
             result.error_code, result.error_msg = codes.code_for(codes.PLAN_TRAJECTORY, reason), msg
@@ -528,7 +580,13 @@ class PlannerNode(Node):
             handle.publish_feedback(fb)
             handle.succeed()
             return result
-        run = self._start_running(traj, goal, handle)
+        try:
+            run = self._start_running(traj, gen, start, goal, handle)
+        except Exception as exc:  # noqa: BLE001 - a plan again on a newer map can fail too
+            reason, msg = self._fail("plan_trajectory", exc)
+            result.error_code, result.error_msg = codes.code_for(codes.PLAN_TRAJECTORY, reason), msg
+            handle.abort()
+            return result
         period = 1.0 / self._config["feedback.rate"]
         while True:
             if handle.is_cancel_requested:
@@ -586,7 +644,7 @@ class PlannerNode(Node):
                 if req.use_start
                 else self._start_from_odom()
             )
-            traj, planning_s = self._plan(start, goal)
+            traj, planning_s, _ = self._plan(start, goal)
         except Exception as exc:  # noqa: BLE001 - every failure becomes Nav2's code
             reason, msg = self._fail("compute_path_to_pose", exc)
             result.error_code = codes.code_for(codes.COMPUTE_PATH_TO_POSE, reason)
@@ -635,8 +693,11 @@ class PlannerNode(Node):
 
     def _smooth(self, poses: np.ndarray) -> Any:
         """Time a certified curve along a given path: its corridor, the smoother, the timing."""
-        with self._lock:
-            planner = self._planner
+        with self._lock:  # no map update meanwhile, as for a plan
+            return self._smooth_locked(poses)
+
+    def _smooth_locked(self, poses: np.ndarray) -> Any:
+        planner = self._planner
         if planner is None:
             raise RequestError("no_map", "no valid map received yet")
         self._check_end(planner, tuple(poses[0, :2]), "start")
