@@ -120,7 +120,8 @@ def main() -> int:
         if node is not None:
             node.stop()
         t0 = time.perf_counter()
-        node = NodeProcess(env)
+        # debug level: the node logs each get_plan's library time (its share counts the log)
+        node = NodeProcess(env, "--log-level", "trajopt_planner:=debug")
         srv = client.create_client(GetPlan, "get_plan")
         assert srv.wait_for_service(timeout_sec=60.0), node.output()
         starts.append(time.perf_counter() - t0)
@@ -153,9 +154,14 @@ def main() -> int:
     values = v
 
     def call(start, goal):
+        start.header.stamp = to_time(time.time())  # the node logs when its callback began
         t0 = time.perf_counter()
         res = h.call(get_plan, GetPlan.Request(start=start, goal=goal), 30.0)
         return time.perf_counter() - t0, res
+
+    def cpu_s(pid: int) -> float:  # user + system CPU time of a process (s)
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
     # 3. node share of a get_plan round trip, from the library time the node logs per request
     put = client.create_client(SetParameters, "/trajopt_planner/set_parameters")
@@ -171,31 +177,39 @@ def main() -> int:
 
     start, goal = (2.0, 2.0, 0.0), (2.0, 8.0, 0.0)  # through a door: a path of some 20 s
     logged = re.compile(
-        r"get_plan: (\d+) poses on map \d+, library plan ([0-9.]+) ms, callback ([0-9.]+) ms"
+        r"get_plan: (\d+) poses on map \d+, library plan ([0-9.]+) ms \(CPU ([0-9.]+) ms\), "
+        r"callback ([0-9.]+) ms \(from ([0-9.]+)\)"
     )
     if "share" in parts:
         floor = []
+        c0 = cpu_s(node.proc.pid)
         for _ in range(args.repeats):
             t0 = time.perf_counter()
             h.call(params, GetParameters.Request(names=["robot.radius"]))
             floor.append(time.perf_counter() - t0)
-        out["floor: get_parameters round trip (ms)"] = round(1e3 * statistics.median(floor), 2)
-        print(
-            "floor: get_parameters round trip (ms):", out["floor: get_parameters round trip (ms)"]
-        )
+        floor_cpu = (cpu_s(node.proc.pid) - c0) / args.repeats
+        out["floor: get_parameters round trip (ms)"] = {
+            "trip": round(1e3 * statistics.median(floor), 2),
+            "node CPU per request": round(1e3 * floor_cpu, 2),
+        }
+        print("floor: get_parameters (ms):", out["floor: get_parameters round trip (ms)"])
     for interval in (0.15, 0.03) if "share" in parts else ():
         set_param("plan.sample_interval", interval)
         # the first plan of a size is not timed; its answer is what the client deserialises
         raw = serialize_message(call(h.pose(*start), h.pose(*goal))[1])
         n_logged = len(logged.findall(node.output()))
-        trips, deser = [], []
+        trips, deser, sent, back = [], [], [], []
+        c0 = cpu_s(node.proc.pid)
         for _ in range(args.repeats):  # each round trip with this client's deserialisation
+            sent.append(time.time())
             dt, res = call(h.pose(*start), h.pose(*goal))
+            back.append(time.time())
             assert len(res.plan.poses) > 0
             trips.append(dt)
             t0 = time.perf_counter()
             deserialize_message(raw, GetPlan.Response)
             deser.append(time.perf_counter() - t0)
+        node_cpu = (cpu_s(node.proc.pid) - c0) / args.repeats
         want = len(trips)
         rows = h.wait_for(
             lambda n=n_logged, want=want: (
@@ -205,7 +219,9 @@ def main() -> int:
             "the node's get_plan log lines",
         )
         lib = [1e-3 * float(r[1]) for r in rows]
-        cb = [1e-3 * float(r[2]) for r in rows]
+        lib_cpu = [1e-3 * float(r[2]) for r in rows]
+        cb = [1e-3 * float(r[3]) for r in rows]
+        began = [float(r[4]) for r in rows]
         share = [t - lib_t - d for t, lib_t, d in zip(trips, lib, deser, strict=True)]
         med = {
             k: round(1e3 * statistics.median(x), 2)
@@ -213,10 +229,18 @@ def main() -> int:
                 ("trip", trips),
                 ("library (node-logged)", lib),
                 ("client deser", deser),
-                ("node callback", cb),
                 ("node share", share),
+                ("request to callback", [b - s for b, s in zip(began, sent, strict=True)]),
+                ("node callback", cb),
+                ("callback besides the plan", [c - x for c, x in zip(cb, lib, strict=True)]),
+                (
+                    "callback end to answer here",
+                    [e - b - c for e, b, c in zip(back, began, cb, strict=True)],
+                ),
             )
         }
+        med["node CPU per request"] = round(1e3 * node_cpu, 2)
+        med["node CPU besides the plan"] = round(1e3 * (node_cpu - statistics.mean(lib_cpu)), 2)
         key = f"get_plan {len(res.plan.poses)} poses (ms)"
         out[key] = med
         print(key, med, flush=True)

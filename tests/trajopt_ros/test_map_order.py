@@ -90,13 +90,13 @@ def test_map_arriving_between_plan_and_publication_is_planned_again(node):
 
     node._plan = plan_then_map_update
     node._on_goal(h.pose(*GOAL))
-    first = made[0][0].sample_uniform(0.05)
+    first = made[0].traj.sample_uniform(0.05)
     old_xy = np.column_stack([first.x, first.y])
     assert h.clearance(old_xy, new_map).min() < h.RADIUS  # the first plan hits the new wall
     # one publication: the plan made again on map 2, not the one made on map 1
     ((newest, made_on, path),) = node._plan_pub.sent
     assert newest == made_on == 2 and node._running.map_gen == 2
-    assert [m[2] for m in made] == [1, 2]
+    assert [m.map_gen for m in made] == [1, 2]
     np.testing.assert_allclose(h.path_xy(path)[[0, -1]], [START, GOAL], atol=TOL)
     assert clear_on(path, new_map)
 
