@@ -139,3 +139,35 @@ def test_map_arriving_during_a_plan_reaches_plan_after_it(node):
     assert node._running.map_gen == 2
     np.testing.assert_allclose(h.path_xy(final)[-1], GOAL, atol=TOL)
     assert clear_on(final, new_map)
+
+
+def test_rate_limited_replan_runs_once_when_the_limit_allows(node):
+    """A re-plan the rate limit defers runs on the one-shot timer, not before 1 / rate."""
+    import time
+
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+
+    assert node.set_parameters([Parameter("replan.rate", value=2.0)])[0].successful
+    node._on_goal(h.pose(*GOAL))
+    t_first = time.monotonic()
+    node._maybe_replan("map changed")  # the first re-plan runs at once
+    assert node._running.replans == 1
+    node._maybe_replan("map changed")  # the next within 1 / rate = 0.5 s is deferred
+    assert node._replan_due == "map changed" and node._running.replans == 1
+    node._maybe_replan("new goal")  # a second request while one waits: still one re-plan
+    executor = SingleThreadedExecutor(context=node.context)
+    executor.add_node(node)
+    try:
+        while node._running.replans == 1:
+            assert time.monotonic() - t_first < 10.0, "the deferred re-plan never ran"
+            executor.spin_once(timeout_sec=0.1)
+        t_replan = time.monotonic()
+        for _ in range(10):  # nothing more is due: the timer stays cancelled
+            executor.spin_once(timeout_sec=0.1)
+    finally:
+        executor.remove_node(node)
+        executor.shutdown()
+    assert t_replan - t_first >= 0.5
+    assert node._running.replans == 2 and node._replan_due == ""
+    assert len(node._plan_pub.sent) == 3
