@@ -9,7 +9,6 @@ failed interface build (one line on stderr naming the cause).
 from __future__ import annotations
 
 import argparse
-import gc
 import sys
 from collections.abc import Sequence
 
@@ -62,7 +61,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     rclpy.init(args=["trajopt-ros", *ros_args], signal_handler_options=SignalHandlerOptions.ALL)
     executor = MultiThreadedExecutor(num_threads=4)
     try:
-        node = PlannerNode()
+        node = PlannerNode(freeze_gc=True)  # this process runs the node and nothing else
     except (ParameterError, InterfaceBuildError) as exc:
         print(f"trajopt-ros: error: {type(exc).__name__}: {exc}", file=sys.stderr)
         rclpy.try_shutdown()
@@ -75,11 +74,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             rclpy.try_shutdown()
             return EXIT_USAGE
         raise
-    # The library's modules, compiled kernels and solvers live as long as the process: moved
-    # out of the cyclic collector's reach, they are no longer scanned by each full collection
-    # (70-160 ms each here, every few dozen requests, landing on one request or map update).
-    gc.collect()
-    gc.freeze()
     spin(node, executor)
     return 0
 

@@ -22,6 +22,7 @@ independent clearance check (:func:`trajopt_ros.check.collides`) passes on the n
 
 from __future__ import annotations
 
+import gc
 import math
 import threading
 import time
@@ -96,6 +97,12 @@ class PlannerNode(Node):
     ----------
     node_name : str, optional
         Default ``trajopt_planner``.
+    freeze_gc : bool, optional
+        After the warm-up, before any service or subscription exists, collect garbage and
+        move every object then alive out of the cyclic collector's reach (``gc.freeze``):
+        the library's modules, kernels and solvers live as long as the process, and a full
+        collection scanning them took 70-160 ms, every few dozen requests. For a process
+        that runs this node (the ``trajopt-ros`` command); default False.
     **kwargs
         Passed to :class:`rclpy.node.Node` (e.g. ``parameter_overrides``).
 
@@ -105,7 +112,9 @@ class PlannerNode(Node):
         A parameter breaks its rule (the message names it, its value and the rule).
     """
 
-    def __init__(self, node_name: str = NODE_NAME, **kwargs: Any) -> None:
+    def __init__(
+        self, node_name: str = NODE_NAME, *, freeze_gc: bool = False, **kwargs: Any
+    ) -> None:
         super().__init__(node_name, **kwargs)
         for p in PARAMETERS:
             self.declare_parameter(
@@ -125,6 +134,9 @@ class PlannerNode(Node):
         self._last_replan = -math.inf
         self._replan_due = ""  # why a deferred re-plan is due ('' = none)
         self.warm_up_s = self._warm_up()
+        if freeze_gc:
+            gc.collect()
+            gc.freeze()
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
         cfg = self._config
