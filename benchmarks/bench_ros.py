@@ -117,8 +117,13 @@ def main() -> int:
     starts = []
     node = None
     for _ in range(3 if "start" in parts else 1):
-        if node is not None:
+        if node is not None:  # stopped, and gone from this client's graph
             node.stop()
+            h.wait_for(
+                lambda: "/get_plan" not in dict(client.get_service_names_and_types()),
+                30.0,
+                "the stopped node's get_plan gone from the graph",
+            )
         t0 = time.perf_counter()
         # debug level: the node logs each get_plan's library time (its share counts the log)
         node = NodeProcess(env, "--log-level", "trajopt_planner:=debug")
