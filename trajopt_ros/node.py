@@ -22,6 +22,7 @@ independent clearance check (:func:`trajopt_ros.check.collides`) passes on the n
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import math
 import threading
@@ -694,7 +695,8 @@ class PlannerNode(Node):
                     f"smoother_id {req.smoother_id!r}: this server has 'trajopt'",
                 )
             poses = path_from_msg(req.path, frame)
-            traj = self._smooth(poses)
+            budget = from_time(req.max_smoothing_duration)
+            traj = self._smooth(poses, t0 + budget if budget > 0 else None)
             if req.check_for_collisions and collides(traj, self._grid, self._config.robot, 0.0):
                 raise RequestError("in_collision", "the smoothed path collides with the map")
         except Exception as exc:  # noqa: BLE001 - every failure becomes Nav2's code
@@ -705,23 +707,22 @@ class PlannerNode(Node):
             handle.abort()
             return result
         result.smoothing_duration = to_duration(time.perf_counter() - t0)
-        budget = from_time(req.max_smoothing_duration)
         result.was_completed = True
-        if budget > 0 and from_time(result.smoothing_duration) > budget:
-            self.get_logger().warning(
-                f"smooth_path took {from_time(result.smoothing_duration):.3f} s, over its "
-                f"max_smoothing_duration {budget:.3f} s (the result is complete all the same)"
-            )
         result.path = path_msg(traj, self.now_s(), frame, self._config["plan.sample_interval"])
         handle.succeed()
         return result
 
-    def _smooth(self, poses: np.ndarray) -> Any:
-        """Time a certified curve along a given path: its corridor, the smoother, the timing."""
-        with self._lock:  # no map update meanwhile, as for a plan
-            return self._smooth_locked(poses)
+    def _smooth(self, poses: np.ndarray, deadline: float | None = None) -> Any:
+        """Time a certified curve along a given path: its corridor, the smoother, the timing.
 
-    def _smooth_locked(self, poses: np.ndarray) -> Any:
+        ``deadline`` (``time.perf_counter`` seconds, or None) bounds the fit: the smoother's
+        ``time_budget_s`` becomes the time left, and a fit that fails at or after the
+        deadline, or no time left before it, raises ``RequestError("timeout")``.
+        """
+        with self._lock:  # no map update meanwhile, as for a plan
+            return self._smooth_locked(poses, deadline)
+
+    def _smooth_locked(self, poses: np.ndarray, deadline: float | None) -> Any:
         planner = self._planner
         if planner is None:
             raise RequestError("no_map", "no valid map received yet")
@@ -732,14 +733,31 @@ class PlannerNode(Node):
         keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-9])
         pts = pts[keep]
         corridor = trajopt.build_polygon_corridor(planner.grid, pts, robot.radius)
-        smooth = planner.smoother.fit(
-            pts,
-            corridor,
-            raw_grid=planner.grid,
-            radius=robot.radius,
-            start=pts[0],
-            goal=pts[-1],
-        )
+        smoother = planner.smoother
+        if deadline is not None:
+            left = deadline - time.perf_counter()
+            if left <= 0:
+                raise RequestError(
+                    "timeout", "max_smoothing_duration passed before the fit could start"
+                )
+            smoother = dataclasses.replace(
+                smoother, time_budget_s=min(smoother.time_budget_s, left)
+            )
+        try:
+            smooth = smoother.fit(
+                pts,
+                corridor,
+                raw_grid=planner.grid,
+                radius=robot.radius,
+                start=pts[0],
+                goal=pts[-1],
+            )
+        except trajopt.SmoothingError as exc:
+            if deadline is not None and time.perf_counter() >= deadline:
+                raise RequestError(
+                    "timeout", f"the fit stopped at max_smoothing_duration: {exc}"
+                ) from exc
+            raise
         return trajopt.time_parameterize(smooth, robot, dt=self._config["planner.timing_dt"])
 
 
