@@ -141,7 +141,15 @@ def main() -> int:
         depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
     )
     map_pub = client.create_publisher(OccupancyGrid, "map", qos)
+    # matched first: a map published before would wait for discovery (transient local)
+    h.wait_for(lambda: map_pub.get_subscription_count() > 0, 30.0, "the node's map subscription")
     values = big_map()
+    # an untimed first map of another size: the first sample of a new writer can wait for
+    # the node's side of discovery and a heartbeat (about 100 ms here), which is DDS's, not
+    # the node's; the 400 x 400 map after it still builds a new planner (another shape)
+    n_logs = node.output().count(") ready: planner in")
+    map_pub.publish(grid_msg(values[:200, :200].copy()))
+    h.wait_for(lambda: node.output().count(") ready: planner in") > n_logs, 30.0, "map ready")
     lags = []
     for k in range(5 if "map" in parts else 1):
         v = values.copy()

@@ -167,10 +167,12 @@ class PlannerNode(Node):
             1.0 / cfg["replan.rate"], self._on_replan_timer, callback_group=self._subs_group
         )
         self._timer.cancel()
+        self._actions = self._create_actions()
+        # last, the service clients wait for (the actions' set-up takes 0.1-0.2 s: a client
+        # that found get_plan earlier sent its first map before the node could spin)
         self.create_service(
             GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group
         )
-        self._actions = self._create_actions()
         self.get_logger().info(
             f"ready: warm-up {self.warm_up_s:.2f} s, robot {cfg.robot.drive} "
             f"radius {cfg.robot.radius} m, frame {cfg['frame_id']!r}"
