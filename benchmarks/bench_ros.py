@@ -6,7 +6,8 @@ Measures, on a 400 x 400 map (0.05 m cells, 20 m x 20 m, walls with doors):
 
 1. ``start``: node start to ``get_plan`` found, with a warm kernel cache (a fresh process);
 2. ``map``: map publish to planner ready (the node's log: planner built, inflation done;
-   time since the message's stamp, one machine clock);
+   time since the message's stamp, one machine clock), after an untimed smaller map (the
+   first sample of a new publisher waits for discovery);
 3. ``share``: the node's share of a ``get_plan`` round trip for paths of about 100 and 500
    poses, per request: the round trip minus the library's plan time the node logged for
    that request minus the time this client takes to deserialise that response
@@ -22,8 +23,9 @@ Measures, on a 400 x 400 map (0.05 m cells, 20 m x 20 m, walls with doors):
    with a path, every bad one with an empty path, and the node's resident memory before
    and after (``/proc/PID/status``); then the shutdown on SIGINT.
 
-Network hygiene as in the tests: LOCALHOST discovery, a domain id held by a file lock, a
-temporary log folder.
+The node runs with ``--log-level trajopt_planner:=debug``: it logs each ``get_plan``'s
+library time (wall and CPU) and when its callback began. Network hygiene as in the tests:
+LOCALHOST discovery, a domain id held by a file lock, a temporary log folder.
 """
 
 from __future__ import annotations

@@ -102,7 +102,7 @@ class PlannerNode(Node):
         After the warm-up, before any service or subscription exists, collect garbage and
         move every object then alive out of the cyclic collector's reach (``gc.freeze``):
         the library's modules, kernels and solvers live as long as the process, and a full
-        collection scanning them took 70-160 ms, every few dozen requests. For a process
+        collection scanning them took 70-180 ms, every few dozen requests. For a process
         that runs this node (the ``trajopt-ros`` command); default False.
     **kwargs
         Passed to :class:`rclpy.node.Node` (e.g. ``parameter_overrides``).
