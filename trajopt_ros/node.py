@@ -39,6 +39,7 @@ from nav_msgs.srv import GetPlan
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.lifecycle import LifecycleNodeMixin, TransitionCallbackReturn
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from trajectory_msgs.msg import MultiDOFJointTrajectory
@@ -61,7 +62,7 @@ from trajopt_ros.convert import (
 from trajopt_ros.errors import ParameterError, RequestError
 from trajopt_ros.params import PARAMETERS, NodeConfig, build_config
 
-__all__ = ["PlannerNode", "NODE_NAME"]
+__all__ = ["PlannerNode", "ManagedPlannerNode", "NODE_NAME"]
 
 #: Default node name.
 NODE_NAME = "trajopt_planner"
@@ -117,6 +118,13 @@ class PlannerNode(Node):
         self, node_name: str = NODE_NAME, *, freeze_gc: bool = False, **kwargs: Any
     ) -> None:
         super().__init__(node_name, **kwargs)
+        self._declare()
+        self._configure(freeze_gc)
+        self._create_interfaces()
+
+    # ------------------------------------------------------------ set-up
+    def _declare(self) -> None:
+        """Declare the parameters and set the state of a node without a map."""
         for p in PARAMETERS:
             self.declare_parameter(
                 p.name,
@@ -125,8 +133,13 @@ class PlannerNode(Node):
                     description=p.description, read_only=p.name.startswith("topics.")
                 ),
             )
-        self._config: NodeConfig = build_config(self._values())
+        self._config: NodeConfig | None = None
         self._lock = threading.RLock()
+        self._interfaces: list[tuple[str, Any]] = []  # (kind, entity) while they exist
+        self._reset_state()
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+    def _reset_state(self) -> None:
         self._planner: trajopt.Planner | None = None
         self._grid: astar.OccupancyGrid | astar.Costmap | None = None
         self._odom: tuple[float, float, float, float, float] | None = None
@@ -134,12 +147,17 @@ class PlannerNode(Node):
         self._map_gen = 0  # +1 per accepted map; a plan carries the generation it was made on
         self._last_replan = -math.inf
         self._replan_due = ""  # why a deferred re-plan is due ('' = none)
+
+    def _configure(self, freeze_gc: bool) -> None:
+        """Check the parameters (:class:`ParameterError`) and warm the library up."""
+        self._config = build_config(self._values())
         self.warm_up_s = self._warm_up()
         if freeze_gc:
             gc.collect()
             gc.freeze()
-        self.add_on_set_parameters_callback(self._on_set_parameters)
 
+    def _create_interfaces(self) -> None:
+        """Create the subscriptions, publishers, timer, actions and ``get_plan`` (last)."""
         cfg = self._config
         self._subs_group = MutuallyExclusiveCallbackGroup()
         self._serve_group = ReentrantCallbackGroup()
@@ -148,37 +166,54 @@ class PlannerNode(Node):
             reliability=ReliabilityPolicy.RELIABLE,
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
-        self.create_subscription(
-            GridMsg, cfg["topics.map"], self._on_map, latched, callback_group=self._subs_group
-        )
-        self.create_subscription(
-            Odometry, cfg["topics.odom"], self._on_odom, 10, callback_group=self._subs_group
-        )
-        self.create_subscription(
-            PoseStamped, cfg["topics.goal"], self._on_goal, 10, callback_group=self._subs_group
-        )
+        made = self._interfaces
+        for kind, topic, cb, qos in (
+            (GridMsg, cfg["topics.map"], self._on_map, latched),
+            (Odometry, cfg["topics.odom"], self._on_odom, 10),
+            (PoseStamped, cfg["topics.goal"], self._on_goal, 10),
+        ):
+            sub = self.create_subscription(kind, topic, cb, qos, callback_group=self._subs_group)
+            made.append(("subscription", sub))
         self._plan_pub = self.create_publisher(Path, cfg["topics.plan"], latched)
         self._traj_pub = self.create_publisher(
             MultiDOFJointTrajectory, cfg["topics.trajectory"], 10
         )
         self._marker_pub = self.create_publisher(MarkerArray, cfg["topics.markers"], latched)
+        made += [("publisher", self._plan_pub), ("publisher", self._traj_pub)]
+        made.append(("publisher", self._marker_pub))
         # a one-shot timer (cancelled while idle) for a re-plan the rate limit defers
         self._timer = self.create_timer(
             1.0 / cfg["replan.rate"], self._on_replan_timer, callback_group=self._subs_group
         )
         self._timer.cancel()
-        self._actions = self._create_actions()
+        made.append(("timer", self._timer))
+        made += [("action", a) for a in self._create_actions()]
         # last, the service clients wait for (the actions' set-up takes 0.1-0.2 s: a client
         # that found get_plan earlier sent its first map before the node could spin)
-        self.create_service(
+        srv = self.create_service(
             GetPlan, "get_plan", self._on_get_plan, callback_group=self._serve_group
         )
+        made.append(("service", srv))
         self.get_logger().info(
             f"ready: warm-up {self.warm_up_s:.2f} s, robot {cfg.robot.drive} "
             f"radius {cfg.robot.radius} m, frame {cfg['frame_id']!r}"
         )
 
-    # ------------------------------------------------------------ set-up
+    def _destroy_interfaces(self) -> None:
+        """Stop a running trajectory and destroy the interfaces, ``get_plan`` first."""
+        if self._interfaces:
+            self._stop_running("canceled", "the node stops serving")
+        destroy = {
+            "subscription": self.destroy_subscription,
+            "publisher": self.destroy_publisher,
+            "timer": self.destroy_timer,
+            "service": self.destroy_service,
+            "action": lambda a: a.destroy(),
+        }
+        while self._interfaces:
+            kind, entity = self._interfaces.pop()
+            destroy[kind](entity)
+
     def _values(self) -> dict[str, Any]:
         return {p.name: self.get_parameter(p.name).value for p in PARAMETERS}
 
@@ -248,6 +283,8 @@ class PlannerNode(Node):
         with self._lock:
             old = self._config
             self._config = cfg
+            if old is None:  # a managed node not configured yet: checked, kept for later
+                return SetParametersResult(successful=True)
             if (cfg.robot, cfg.planner_kwargs) != (old.robot, old.planner_kwargs) and self._grid:
                 self._planner = trajopt.Planner(
                     self._grid, cfg.robot, **self._planner_kwargs(self._grid)
@@ -761,6 +798,69 @@ class PlannerNode(Node):
                 ) from exc
             raise
         return trajopt.time_parameterize(smooth, robot, dt=self._config["planner.timing_dt"])
+
+
+class ManagedPlannerNode(LifecycleNodeMixin, PlannerNode):
+    """The planner node as a managed (lifecycle) node: the same interfaces, made by transitions.
+
+    Created *unconfigured*, with its parameters declared and the lifecycle services
+    (``~/change_state``, ``~/get_state``, ...) only. ``configure`` checks the parameters
+    (a bad one fails the transition with its reason logged) and warms the library up;
+    ``activate`` creates the subscriptions, publishers, actions and ``get_plan``;
+    ``deactivate`` stops a running trajectory (an empty ``plan``) and destroys them;
+    ``cleanup`` forgets the map, the odometry and the planner; ``shutdown`` does all of it.
+
+    Parameters
+    ----------
+    node_name : str, optional
+        Default ``trajopt_planner``.
+    freeze_gc : bool, optional
+        As :class:`PlannerNode`, at the end of ``configure``.
+    **kwargs
+        Passed to :class:`rclpy.node.Node`.
+    """
+
+    def __init__(
+        self, node_name: str = NODE_NAME, *, freeze_gc: bool = False, **kwargs: Any
+    ) -> None:
+        Node.__init__(self, node_name, **kwargs)
+        LifecycleNodeMixin.__init__(self, enable_communication_interface=True)
+        self._freeze_gc = freeze_gc
+        self._declare()
+
+    def on_configure(self, state: Any) -> TransitionCallbackReturn:
+        """Check the parameters and warm the library up (FAILURE with a bad one)."""
+        try:
+            self._configure(self._freeze_gc)
+        except ParameterError as exc:
+            self.get_logger().error(f"configure failed: {exc}")
+            return TransitionCallbackReturn.FAILURE
+        self.get_logger().info(f"configured: warm-up {self.warm_up_s:.2f} s")
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state: Any) -> TransitionCallbackReturn:
+        """Create the interfaces, ``get_plan`` last."""
+        self._create_interfaces()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_deactivate(self, state: Any) -> TransitionCallbackReturn:
+        """Stop a running trajectory and destroy the interfaces."""
+        self._destroy_interfaces()
+        self.get_logger().info("deactivated: no interfaces")
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_cleanup(self, state: Any) -> TransitionCallbackReturn:
+        """Forget the map, the odometry, the planner and the running trajectory."""
+        with self._lock:
+            self._reset_state()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: Any) -> TransitionCallbackReturn:
+        """Deactivate (if active) and clean up."""
+        self._destroy_interfaces()
+        with self._lock:
+            self._reset_state()
+        return TransitionCallbackReturn.SUCCESS
 
 
 def spin(node: PlannerNode, executor: Any = None) -> None:
