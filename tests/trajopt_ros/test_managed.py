@@ -1,4 +1,4 @@
-"""The managed (lifecycle) node, ``trajopt-ros --managed``, driven through its transitions.
+"""Tests of trajopt_ros: the managed node (``trajopt-ros --managed``) through its transitions.
 
 One node process, started with a bad parameter: ``configure`` fails with the reason logged
 and the node stays unconfigured; the parameter set right, ``configure`` and ``activate``

@@ -1,4 +1,4 @@
-"""Map updates and ``/plan`` publications are ordered: no plan made on a replaced map is published.
+"""Tests of trajopt_ros: maps and ``plan`` publications ordered, no plan of a replaced map sent.
 
 The node runs in this process (no executor: its callbacks are called directly, from two
 threads where a race is staged), so that a map update can be delivered at the exact moment
