@@ -24,6 +24,8 @@ from trajopt.moving._st_grid import STGrid
 
 #: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
 N_EVEN_STOPS = 10
+#: The fronts of the forbidden regions are rounded back to multiples of this many nodes.
+STOP_LATTICE = 5
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,7 +73,10 @@ def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:
     length = float(grid.s[-1])
     cols = grid.busy
     fronts = np.flatnonzero(cols[1:] & ~cols[:-1])  # the last free node before a forbidden run
-    inner = [float(grid.s[i]) for i in fronts] + [float(x) for x in extra]
+    # on a lattice of STOP_LATTICE nodes (rounded back, still in front): new predictions
+    # often give the same stops, whose drives are then cached
+    lattice = np.unique((fronts // STOP_LATTICE) * STOP_LATTICE)
+    inner = [float(grid.s[i]) for i in lattice] + [float(x) for x in extra]
     inner += np.linspace(0.0, length, N_EVEN_STOPS + 2)[1:-1].tolist()
     gap = 2.0 * grid.ds
     keep: list[float] = []
