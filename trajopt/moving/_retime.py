@@ -298,15 +298,19 @@ def retime_for_movers(
     points = tables.nodes(s_nodes, ds_used)
     launch, brake_at = None, None
     if moving:
+        brake_at = float(braking_distance(v0, a0, float(robot.a_max), float(robot.j_max)))
         first = {length: _piece_of(traj, 0.0, length)}
 
         def launch(s1: float) -> Piece | None:
+            if s1 < brake_at - 1e-9:  # closer than the robot can stop
+                return None
             if s1 not in first:
                 piece = tables.move((0.0, v0, a0), s1)
+                if piece is None:
+                    piece = _follow_then_stop(traj, tables, s1)
                 first[s1] = tables.segment(0.0, s1, v0, a0) if piece is None else piece
             return first[s1]
 
-        brake_at = _braking_distance(v0, a0, float(robot.a_max), float(robot.j_max))
     step = float(dt)
     for _ in range(3):
         grid = st_grid(
@@ -344,30 +348,70 @@ def retime_for_movers(
     )
 
 
-def _braking_distance(v0: float, a0: float, a_max: float, j_max: float) -> float:
+def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:
+    """Return ``traj``'s motion until it must brake, then its shortest stop at ``s1`` (m).
+
+    The latest time ``tau`` (on two grids of 256, the second inside the bracket of the first)
+    whose state still stops by ``s1`` (:func:`braking_distance`), then ruckig's stop to rest
+    at ``s1`` under the speed at ``tau``; ``None`` when that stop leaves the cap table (the
+    caller times the piece of the path then).
+    """
+    robot = traj.robot
+    a_max, j_max = float(robot.a_max), float(robot.j_max)
+    lo, hi = 0.0, float(traj.duration)
+    for _ in range(2):
+        tau = np.linspace(lo, hi, 256)
+        s, v, a, _ = traj.motion(tau)
+        ok = s1 - s - braking_distance(v, a, a_max, j_max) >= 0.0
+        if not ok[0]:
+            return None
+        i = int(np.argmin(ok)) - 1 if not ok.all() else tau.shape[0] - 1
+        lo, hi = float(tau[i]), float(tau[min(i + 1, tau.shape[0] - 1)])
+    s, v, a, _ = (float(x) for x in traj.motion(lo))
+    rows = tables.rk.solve((s, v, a), (s1, 0.0, 0.0), max(v, 1e-9))
+    if rows is None or not tables.table.rows_ok(rows):
+        return None
+    keep = traj.phase_t < lo
+    head = np.column_stack([traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j])[
+        keep
+    ]
+    tail = rows[:, :5].copy()
+    tail[:, 0] += lo
+    duration = float(lo + rows[-1, 0] + rows[-1, 5])
+    return Piece(np.concatenate([head, tail]), duration, 0.0, float(s1))
+
+
+def braking_distance(
+    v0: np.ndarray | float, a0: np.ndarray | float, a_max: float, j_max: float
+) -> np.ndarray:
     """Return the distance (m) a robot at speed ``v0`` (m/s), acceleration ``a0`` needs to stop.
 
     The shortest jerk-limited stop: the acceleration goes at ``-j_max`` to ``-a_p`` (held
     there when ``a_p = a_max``), then at ``+j_max`` back to 0, with ``a_p`` such that the
     speed ends at 0 (``a_p^2 = j_max v0 + a0^2 / 2`` without the hold); from a state already
-    braking hard enough, only the last ramp.
+    braking hard enough (``a0 < 0``, ``a0^2 / (2 j_max) >= v0``), only the last ramp.
+    Vectorised over ``v0`` and ``a0``.
     """
+    v0 = np.asarray(v0, dtype=float)
+    a0 = np.asarray(a0, dtype=float)
     jj = j_max
-    if a0 < 0.0 and a0 * a0 / (2.0 * jj) >= v0:
-        phases = [(-a0 / jj, jj)]
-    else:
-        a_p = math.sqrt(jj * v0 + 0.5 * a0 * a0)
-        hold = 0.0
-        if a_p > a_max:
-            a_p = a_max
-            hold = max(0.0, (v0 + a0 * a0 / (2.0 * jj) - a_p * a_p / jj) / a_p)
-        phases = [((a0 + a_p) / jj, -jj), (hold, 0.0), (a_p / jj, jj)]
-    s, v, a = 0.0, v0, a0
-    for tau, j in phases:
-        s += tau * (v + tau * (0.5 * a + tau * j / 6.0))
-        v += tau * (a + 0.5 * j * tau)
-        a += j * tau
-    return max(s, 0.0)
+    ramp_only = (a0 < 0.0) & (a0 * a0 / (2.0 * jj) >= v0)
+    a_p = np.sqrt(np.maximum(jj * v0 + 0.5 * a0 * a0, 0.0))
+    hold = np.where(
+        a_p > a_max, np.maximum(0.0, (v0 + a0 * a0 / (2.0 * jj) - a_max * a_max / jj) / a_max), 0.0
+    )
+    a_p = np.minimum(a_p, a_max)
+    t1 = np.where(ramp_only, 0.0, (a0 + a_p) / jj)
+    t3 = np.where(ramp_only, -a0 / jj, a_p / jj)
+    hold = np.where(ramp_only, 0.0, hold)
+    a_hold = np.where(ramp_only, a0, -a_p)
+    s, v, a = np.zeros_like(v0), v0, a0
+    for tau, j in ((t1, -jj), (hold, 0.0), (t3, jj)):
+        aa = np.where(j == 0.0, a_hold, a) if j == 0.0 else a
+        s = s + tau * (v + tau * (0.5 * aa + tau * j / 6.0))
+        v = v + tau * (aa + 0.5 * j * tau)
+        a = aa + j * tau
+    return np.maximum(s, 0.0)
 
 
 def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
