@@ -13,7 +13,9 @@ exported with ``git show`` into a temporary package and imported beside this tre
 movers are this tree's :class:`trajopt.MovingObstacle`, the rest of ``trajopt`` is shared).
 The two run one after the other on each set, so that both see the same machine load.
 
-It prints the wall-time median and p99 (ms) of both, over all sets and over the sets that
+It prints the median and p99 (ms) of the wall time of both and of the CPU time of this
+tree (``time.process_time``: on a shared machine the wall time also counts the time the
+process waits for a core), over all sets and over the sets that
 were really re-timed (not returned as planned, no :class:`~trajopt.errors.BlockedError`),
 the first set of each plan (this tree builds the path's tables then: ``cold``) apart from
 the later ones (``warm``: the tables of the same path are reused); the arrival times of the
@@ -147,19 +149,21 @@ def dense_slack(traj, ms) -> float:
 
 
 def run(fn, traj, ms):
-    t0 = time.perf_counter()
+    """Return ``((wall s, cpu s), result or None, plan or error name)`` of ``fn(traj, ms)``."""
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         out = fn(traj, ms)
     except (BlockedError, InvalidInputError) as exc:
-        return time.perf_counter() - t0, None, type(exc).__name__
-    wall = time.perf_counter() - t0
-    return wall, out, out.stats["moving"]["plan"]
+        return (time.perf_counter() - t0, time.process_time() - c0), None, type(exc).__name__
+    took = (time.perf_counter() - t0, time.process_time() - c0)
+    return took, out, out.stats["moving"]["plan"]
 
 
-def stats(xs: list[float]) -> str:
+def stats(xs: list[tuple[float, float]], which: int) -> str:
+    """Median and p99 (ms) of the wall (``which = 0``) or CPU (1) times ``xs``."""
     if not xs:
-        return "   -      -  "
-    a = 1e3 * np.asarray(xs)
+        return f"{'-':>6s} {'-':>7s}"
+    a = 1e3 * np.asarray([x[which] for x in xs])
     return f"{np.median(a):6.1f} {np.percentile(a, 99):7.1f}"
 
 
@@ -207,13 +211,15 @@ def main(argv: list[str] | None = None) -> int:
             f"re-timed: this tree {n_new}, before {n_old}; BlockedError (this tree): {blocked}"
         )
         print(
-            f"{'wall time (ms)':34s} {'median':>6s} {'p99':>7s}   {'before: median':>14s} {'p99':>7s}"
+            f"{'(ms)':26s} {'wall: median':>12s} {'p99':>7s} {'cpu: median':>12s} {'p99':>7s}"
+            f"   {'before wall: median':>19s} {'p99':>7s}"
         )
         for label, src in (("all sets", rows), ("re-timed sets", retimed)):
             for phase in ("warm", "cold"):
+                new, old = src["new_" + phase], src["old_" + phase]
                 print(
-                    f"{label + ', ' + phase:34s} {stats(src['new_' + phase])}   "
-                    f"{stats(src['old_' + phase]):>22s}"
+                    f"{label + ', ' + phase:26s} {stats(new, 0):>20s} {stats(new, 1):>20s}"
+                    f"   {stats(old, 0):>27s}"
                 )
         if ratios:
             r = np.asarray(ratios)

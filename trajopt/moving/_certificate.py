@@ -214,9 +214,26 @@ def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
 
 
+#: The curvature tables of the last curves certified (curve, table), most recent last.
+_KAPPA_TABLES: list[tuple[Any, tuple[np.ndarray, np.ndarray]]] = []
+_KAPPA_KEPT = 4
+
+
+def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return :func:`kappa_table` of ``curve``, reused for the last few curves (the same object)."""
+    for i, (c, tab) in enumerate(_KAPPA_TABLES):
+        if c is curve:
+            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
+            return tab
+    tab = kappa_table(curve)
+    _KAPPA_TABLES.append((curve, tab))
+    del _KAPPA_TABLES[:-_KAPPA_KEPT]
+    return tab
+
+
 def kappa_max(curve: Any) -> float:
     """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
-    return float(np.max(kappa_table(curve)[1]))
+    return float(np.max(kappa_table_of(curve)[1]))
 
 
 class _RangeMax:
@@ -247,7 +264,7 @@ class _Curve:
         self.traj, self.offset = traj, float(offset)
         self.vmax, self.amax = _profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
-        self.s_edges, k = kappa_table(traj.path)
+        self.s_edges, k = kappa_table_of(traj.path)
         self.kmax = _RangeMax(k)
         self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
         self.length = float(traj.length)
@@ -457,19 +474,19 @@ def _certify_discs(
     holding it; the robot is evaluated once per distinct interval. Returns ``(verdict,
     slack, mover name, time, intervals)``.
     """
-    knots, owner = [], []
+    knots, owner, xs, ys, firsts, lasts = [], [], [], [], [], []
     for j, m in enumerate(movers):
         tk = m.times
-        kn = np.unique(np.concatenate([[a, b], tk[(tk > a) & (tk < b)]]))
+        kn = np.concatenate([[a], tk[(tk > a) & (tk < b)], [b]])  # sorted: times increase
         knots.append(kn)
         owner.append(np.full(kn.shape[0], j))
+        xs.append(np.interp(kn, tk, m.positions[:, 0]))
+        ys.append(np.interp(kn, tk, m.positions[:, 1]))
+        firsts.append(np.full(kn.shape[0], tk[0]))
+        lasts.append(np.full(kn.shape[0], tk[-1]))
     kn, ow = np.concatenate(knots), np.concatenate(owner)
-    pos = np.empty((kn.shape[0], 2))
-    first, last = np.empty(kn.shape[0]), np.empty(kn.shape[0])
-    for j, m in enumerate(movers):
-        sel = ow == j
-        pos[sel] = m.position_at(kn[sel])
-        first[sel], last[sel] = m.times[0], m.t_last
+    pos = np.stack([np.concatenate(xs), np.concatenate(ys)], axis=1)
+    first, last = np.concatenate(firsts), np.concatenate(lasts)
     # segments between consecutive knots of one mover: its centre is A + V t there
     seg = np.flatnonzero(ow[1:] == ow[:-1])
     u, w = kn[seg], kn[seg + 1]

@@ -273,19 +273,20 @@ def _disc_runs(
     rows = []  # (mover, u, w, centre at u, velocity, radius + limit + pad at u, growth)
     for j, m, pad in discs:
         tk = m.times
-        knots = np.unique(np.concatenate([[0.0, t_end], tk[(tk > 0.0) & (tk < t_end)]]))
+        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
         u, w = knots[:-1], knots[1:]
         mid = 0.5 * (u + w)
-        c_u = m.position_at(u)
+        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
         inside = (mid > tk[0]) & (mid < tk[-1])
-        vel = np.where(inside[:, None], (m.position_at(w) - c_u) / (w - u)[:, None], 0.0)
+        span = w - u
+        vx = np.where(inside, np.diff(px) / span, 0.0)
+        vy = np.where(inside, np.diff(py) / span, 0.0)
         grow = np.where(mid < m.t_last, m.growth, 0.0)
-        r_u = limit + pad + m.radius_at(u)
-        for q in range(u.shape[0]):
-            rows.append(
-                (j, u[q], w[q], c_u[q, 0], c_u[q, 1], vel[q, 0], vel[q, 1], r_u[q], grow[q])
-            )
-    arr = np.array(rows, dtype=float)
+        r_u = limit + pad + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0))
+        rows.append(
+            np.column_stack([np.full(u.shape, j), u, w, px[:-1], py[:-1], vx, vy, r_u, grow])
+        )
+    arr = np.concatenate(rows)
     owner = arr[:, 0].astype(np.int64)
     u, w = arr[:, 1:2], arr[:, 2:3]
     vx, vy, rr, g = arr[:, 5:6], arr[:, 6:7], arr[:, 7:8], arr[:, 8:9]
