@@ -362,6 +362,10 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
     and (given ``s_up``, shape (K,), an upper bound of ``s(t_k)`` in m) not beyond
     ``s_up[k] + ds/2``.
 
+    Once the grid's rows no longer change (after the last run starts or ends) and neither
+    does the bound, a step that leaves the reachable nodes as they were is a fixed point:
+    the sweep stops there with the answer of the last time.
+
     Returns
     -------
     ok : bool
@@ -373,6 +377,10 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
     """
     fb = grid.blocked
     kk, n = fb.shape
+    ends = np.concatenate([grid.lo, np.where(grid.hi >= FOREVER, 0, grid.hi + 1), [0]])
+    k_static = int(np.max(ends))
+    if s_up is not None:
+        k_static = max(k_static, int(np.searchsorted(s_up, grid.s[-1] + 0.5 * grid.ds)))
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
     idx = np.arange(n)
     reach = np.zeros(n, dtype=bool)
@@ -387,6 +395,8 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
             nxt &= grid.s <= s_up[k] + 0.5 * grid.ds
         if not nxt.any():
             return False, k, last_i
+        if k > k_static and np.array_equal(nxt, reach):
+            break
         reach = nxt
         last_i = int(np.max(np.flatnonzero(reach)))
     return bool(reach[-1]), kk - 1, last_i

@@ -197,6 +197,7 @@ def search(
     nodes = grid.index(np.asarray(stops))
     w_n = len(stops)
     sa = np.asarray(stops)
+    steps = np.arange(kk)
     lt = least_times(sa[None, :] - sa[:, None], v_top, a_top, j_top)  # lt[w, v]: w -> v
     goal_col = grid.column(int(nodes[-1]))
     last_goal = int(np.max(np.flatnonzero(goal_col))) if goal_col.any() else -1
@@ -219,7 +220,7 @@ def search(
             since = np.zeros(kk, dtype=np.int64)
         resting.append((rest, since))
         if w == 0:
-            rest = rest & (np.arange(kk) >= (0 if moving else k_min))
+            rest = rest & (steps >= (0 if moving else k_min))
         if not rest.any():
             continue
         first = int(np.argmax(rest))
@@ -234,7 +235,7 @@ def search(
             n = idx.shape[0] - 1
             ok = ok_starts(grid, idx) & rest
             if v == w_n - 1:
-                ok &= np.arange(kk) + n > last_goal
+                ok &= steps + n > last_goal
                 if ok.any():
                     k = int(np.argmax(ok))
                     t_arr = k * dt + piece.duration
