@@ -4,19 +4,23 @@
 
 1. if the trajectory as it is passes :func:`certify_movers`, it is returned unchanged (the
    time-optimal timing passes before, or never meets, every mover);
-2. the movers' forbidden regions of the ``(s, t)`` plane on a grid (:mod:`._st_grid`). A sweep
-   of the nodes a non-decreasing ``s(t)`` with ``v <= v_max`` can occupy on the *necessary*
-   grid decides that the movers block the path: :class:`BlockedError` naming the mover in
-   front of the robot and the time;
-3. a search over a family of jerk-limited profiles on the *sufficient* grid
-   (:mod:`._st_search`): rest at the start, drive (time-optimally,
-   :func:`trajopt.time_parameterize` on the path's piece, rest to rest) to a stop, rest
-   there, ..., drive to the goal and stand there; a dynamic programme over the stops finds
-   the earliest arrival;
-4. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
+2. the movers' forbidden regions of the ``(s, t)`` plane on the *sufficient* grid
+   (:mod:`._st_grid`) and a search over a family of jerk-limited profiles on it
+   (:mod:`._st_search`): rest at the start, drive time-optimally (ruckig's rest-to-rest
+   profile under the path's speed cap table, :class:`_PathTables`) to a stop, rest there,
+   ..., drive to the goal and stand there; a dynamic programme over the stops finds the
+   earliest arrival. From a moving start the first drive leaves at once from the start state
+   (to the goal, or braking to rest at a stop);
+3. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
    phases of zero speed) and is certified by :func:`certify_movers`; a failed certificate
    (the grid's inflation is a proof for the grid, so only numerical slips) retries with a
-   finer time step.
+   finer time step;
+4. when nothing is found, a sweep of the nodes a non-decreasing ``s(t)`` with ``v <= v_max``
+   can occupy on the *necessary* grid names the mover that blocks the path and the time
+   (:class:`BlockedError`).
+
+The cap table, the grid's node points and the rest-to-rest drives of the last few paths are
+kept (:data:`_TABLES`): new predictions for the same path reuse them.
 """
 
 from __future__ import annotations
@@ -276,6 +280,7 @@ def retime_for_movers(
     limit, body, stretch = _robot_shape(traj, float(margin))
     _overlap_at_start(traj, movers, float(margin))
     path, length, robot = traj.path, float(traj.length), traj.robot
+    plan = traj  # without the rest below: its drive (0, L) is the plan's own
     if not_before > 0.0:  # the plan as it is, after the rest
         whole = _piece_of(traj, 0.0, length)
         rows, duration = compose([(0.0, None, 0.0), (float(not_before), whole, 0.0)], length)
@@ -286,7 +291,7 @@ def retime_for_movers(
     vmax = float(robot.v_max)
     t_last = max(m.t_last for m in movers)
     horizon = max(t_last, 0.0) + 2.0 * traj.duration + 2.0
-    tables = _tables(traj)
+    tables = _tables(plan)
     grid_args = {
         "ds": ds,
         "horizon": horizon,
