@@ -131,3 +131,23 @@ def test_shift_movers_keeps_every_instant():
         tau = np.linspace(0.0, 10.0, 1001)
         np.testing.assert_allclose(s.position_at(tau), m.position_at(tau + ts), atol=1e-12)
         np.testing.assert_allclose(s.radius_at(tau), m.radius_at(tau + ts), atol=1e-12)
+
+
+def test_a_new_goal_is_planned_then_re_timed(driven, scene):
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    static = planner.replan(traj, 1.0, goal=scene.goal("B"), latency=LATENCY)
+    assert static.stats["replan"].startswith("planned")
+    # crossing the new plan's middle when it is there, on the driven plan's clock
+    m = _crossing(static, 0.5 * static.duration)
+    mover = trajopt.MovingObstacle.from_waypoints(
+        m.times + ts, m.positions, radius=m.radius, name="walker"
+    )
+    assert _slack_on_movers_clock(static, [mover], ts) < 0.0
+    new = planner.replan(traj, 1.0, goal=scene.goal("B"), latency=LATENCY, moving_obstacles=[mover])
+    assert new.stats["moving"]["replan"] == static.stats["replan"]
+    assert np.array_equal(new.path.curve.c, static.path.curve.c)
+    a, b = traj.state_at(ts), new.state_at(0.0)
+    assert math.hypot(a.x - b.x, a.y - b.y) < 1e-9 and abs(a.v - b.v) < 1e-9
+    assert abs(a.a - b.a) < 1e-9
+    assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
