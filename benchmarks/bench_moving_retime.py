@@ -13,6 +13,12 @@ exported with ``git show`` into a temporary package and imported beside this tre
 movers are this tree's :class:`trajopt.MovingObstacle`, the rest of ``trajopt`` is shared).
 The two run one after the other on each set, so that both see the same machine load.
 
+Each set is also given to ``Planner.replan(traj, 2.0, latency=0, moving_obstacles=...)``
+(the robot 2 s into the plan: the kept rest re-timed from the moving state, its predictions
+on the plan's clock); it prints that re-plan's wall and CPU time, its re-timing's own time
+(``stats["moving"]["time_s"]``) and the smallest slack of its results on 1 ms samples (the
+movers shifted to the re-plan's clock).
+
 It prints the median and p99 (ms) of the wall time of both and of the CPU time of this
 tree (``time.process_time``: on a shared machine the wall time also counts the time the
 process waits for a core), over all sets and over the sets that
@@ -45,6 +51,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +65,7 @@ from trajopt.errors import BlockedError, InvalidInputError, TrajoptError  # noqa
 MAPS = ("smoothers_world", "depot")
 BEFORE = "3379fc7"  # trajopt.moving before the speed-up
 MODULES = ("_certificate", "_st_grid", "_st_search", "_retime")
+REPLAN_AT = 2.0  # s into each plan: the re-plan for the same sets of predictions
 
 
 def data_dir() -> Path:
@@ -89,12 +97,12 @@ def load_before(rev: str, tmp: Path):
     return importlib.import_module("moving_before._retime").retime_for_movers
 
 
-def plans(name: str, n: int, rng: np.random.Generator) -> list[trajopt.Trajectory]:
-    """``n`` plans of one curve from rest to rest with a path of 10-20 m on the map ``name``."""
+def plans(name: str, n: int, rng: np.random.Generator) -> list[tuple[trajopt.Planner, Any]]:
+    """``n`` plans (with their planner) of one curve from rest to rest, paths of 10-20 m."""
     grid = astar.load_map(data_dir() / "ros" / f"{name}.yaml")
     planner = trajopt.Planner(grid, trajopt.Robot(radius=0.2))
     free = np.argwhere(~astar.inflate(grid, 0.35, metric="square", outside_occupied=True).occupied)
-    out: list[trajopt.Trajectory] = []
+    out: list[tuple[trajopt.Planner, Any]] = []
     for _ in range(100 * n):
         if len(out) == n:
             break
@@ -107,7 +115,7 @@ def plans(name: str, n: int, rng: np.random.Generator) -> list[trajopt.Trajector
         except TrajoptError:
             continue
         if traj.single_curve and 10.0 <= traj.length <= 20.0:
-            out.append(traj)
+            out.append((planner, traj))
     return out
 
 
@@ -132,6 +140,20 @@ def movers(traj: trajopt.Trajectory, rng: np.random.Generator, n: int = 10) -> l
         if math.hypot(start[0] - p0.x[0], start[1] - p0.y[0]) > m.radius + 0.3:
             out.append(m)
     return out
+
+
+def replan(planner, traj, ms):
+    """Re-plan ``traj`` at ``REPLAN_AT`` s for the movers ``ms``: ``(times, plan, re-time s,
+    what the re-plan did, smallest slack)``, ``plan = None`` on a BlockedError."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    try:
+        out = planner.replan(traj, REPLAN_AT, latency=0.0, moving_obstacles=ms)
+    except BlockedError:
+        return (time.perf_counter() - t0, time.process_time() - c0), None, 0.0, "", math.inf
+    took = (time.perf_counter() - t0, time.process_time() - c0)
+    mv = out.stats["moving"]
+    shifted = trajopt.replan.shift_movers(ms, REPLAN_AT)
+    return took, mv["plan"], mv["time_s"], mv["replan"], dense_slack(out, shifted)
 
 
 def dense_slack(traj, ms) -> float:
@@ -186,10 +208,12 @@ def main(argv: list[str] | None = None) -> int:
         retimed = {k: [] for k in ("new_cold", "new_warm", "old_cold", "old_warm")}
         ratios: list[float] = []
         worst, n_sets, n_new, n_old, blocked = math.inf, 0, 0, 0, 0
+        replans: list[tuple] = []
         for name in MAPS:
-            for traj in plans(name, args.plans, rng):
+            for planner, traj in plans(name, args.plans, rng):
                 for k in range(args.sets):
                     ms = movers(traj, rng)
+                    replans.append(replan(planner, traj, ms))
                     phase = "cold" if k == 0 else "warm"
                     w_new, out_new, what_new = run(retime_for_movers, traj, ms)
                     w_old, out_old, what_old = run(before, traj, ms)
@@ -228,6 +252,20 @@ def main(argv: list[str] | None = None) -> int:
                 f"{np.median(r):.3f}, min {r.min():.3f}, max {r.max():.3f}"
             )
         print(f"independent check, smallest slack on 1 ms samples (this tree): {worst:.2e} m")
+        done = [r for r in replans if r[1] is not None]
+        moved = [r for r in done if r[1] != "as planned"]
+        print(
+            f"Planner.replan(traj, {REPLAN_AT} s, latency=0, moving_obstacles=...) on the same "
+            f"sets: {len(done)} returned ({len(moved)} re-timed, "
+            f"{sum(r[3] == 'kept' for r in done)} kept their path), "
+            f"{len(replans) - len(done)} BlockedError; whole re-plan wall median "
+            f"{stats([r[0] for r in done], 0)[:6].strip()} ms, cpu "
+            f"{stats([r[0] for r in done], 1)[:6].strip()} ms; its re-time (stats['moving']"
+            f"['time_s']) over the re-timed ones: median "
+            f"{1e3 * np.median([r[2] for r in moved]) if moved else math.nan:.1f} ms, p99 "
+            f"{1e3 * np.percentile([r[2] for r in moved], 99) if moved else math.nan:.1f} ms; "
+            f"smallest slack on 1 ms samples {min([r[4] for r in done], default=math.inf):.2e} m"
+        )
     return 0
 
 

@@ -55,6 +55,24 @@ def _piece_of(tr: Any, s0: float, s1: float) -> Piece:
     return Piece(rows, float(tr.duration), s0, s1)
 
 
+#: Relative speed tolerance of the cap test of ruckig's rows: the timing's own profiles reach
+#: the cap table's value plus ruckig's velocity margin (1e-9 m/s), and a motion that starts in
+#: such a state must pass.
+CAP_TOLERANCE = 1e-7
+
+
+def _under_caps(table: Any, rows: np.ndarray) -> bool:
+    """Return whether ruckig rows ``(t0, s0, v0, a0, jerk, duration)`` stay under ``table``'s caps.
+
+    :meth:`trajopt.timing.CapTable.rows_ok` of the same motion with its speed scaled by
+    ``1 - CAP_TOLERANCE`` (speed, acceleration and jerk of every row; its arc lengths move by
+    at most that fraction of the distance).
+    """
+    low = np.array(rows, dtype=float)
+    low[:, 2:5] *= 1.0 - CAP_TOLERANCE
+    return bool(table.rows_ok(low))
+
+
 def _piece_of_rows(rows: np.ndarray | None, s1: float) -> Piece | None:
     """Return a :class:`Piece` of ruckig rows ``(t0, s0, v0, a0, jerk, duration)``, or ``None``."""
     if rows is None or rows.shape[0] == 0:
@@ -96,7 +114,7 @@ class _PathTables:
         tb, rk = self.table, self.rk
         for vcap in (self.vtop, tb.range_min(state[0], s1)):
             rows = rk.solve(state, (s1, 0.0, 0.0), vcap)
-            if rows is not None and tb.rows_ok(rows):
+            if rows is not None and _under_caps(tb, rows):
                 return _piece_of_rows(rows, s1)
         return None
 
@@ -366,15 +384,15 @@ def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece
     lo, hi = 0.0, float(traj.duration)
     for _ in range(2):
         tau = np.linspace(lo, hi, 256)
-        s, v, a, _ = traj.motion(tau)
+        s, v, a = _state(traj, tau)
         ok = s1 - s - braking_distance(v, a, a_max, j_max) >= 0.0
         if not ok[0]:
             return None
         i = int(np.argmin(ok)) - 1 if not ok.all() else tau.shape[0] - 1
         lo, hi = float(tau[i]), float(tau[min(i + 1, tau.shape[0] - 1)])
-    s, v, a, _ = (float(x) for x in traj.motion(lo))
+    s, v, a = (float(x[0]) for x in _state(traj, np.array([lo])))
     rows = tables.rk.solve((s, v, a), (s1, 0.0, 0.0), max(v, 1e-9))
-    if rows is None or not tables.table.rows_ok(rows):
+    if rows is None or not _under_caps(tables.table, rows):
         return None
     keep = traj.phase_t < lo
     head = np.column_stack([traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j])[
@@ -384,6 +402,20 @@ def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece
     tail[:, 0] += lo
     duration = float(lo + rows[-1, 0] + rows[-1, 5])
     return Piece(np.concatenate([head, tail]), duration, 0.0, float(s1))
+
+
+def _state(traj: Trajectory, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return ``(s, v, a)`` of ``traj``'s phases at times ``t`` in ``[0, duration]`` (s).
+
+    ``traj.motion`` without its clipping to the path's length (which costs an arc-length
+    evaluation of the path per call).
+    """
+    pt = traj.phase_t
+    k = np.clip(np.searchsorted(pt, t, side="right") - 1, 0, pt.shape[0] - 1)
+    tau = t - pt[k]
+    j, a0, v0 = traj.phase_j[k], traj.phase_a[k], traj.phase_v[k]
+    s = traj.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
+    return s, np.maximum(v0 + tau * (a0 + 0.5 * j * tau), 0.0), a0 + j * tau
 
 
 def braking_distance(
