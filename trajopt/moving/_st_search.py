@@ -51,13 +51,13 @@ class Piece:
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
         """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends."""
-        tt = np.clip(t, 0.0, self.duration)
-        k = np.searchsorted(self.rows[:, 0], tt, side="right") - 1
-        k = np.clip(k, 0, self.rows.shape[0] - 1)
-        tau = tt - self.rows[k, 0]
-        r = self.rows[k]
-        s = r[:, 1] + tau * (r[:, 2] + tau * (0.5 * r[:, 3] + tau * r[:, 4] / 6.0))
-        return np.where(tt >= self.duration, self.s1, np.clip(s, self.s0, self.s1))
+        tt = np.minimum(np.maximum(t, 0.0), self.duration)
+        rows = self.rows
+        k = np.maximum(np.searchsorted(rows[:, 0], tt, side="right") - 1, 0)
+        tau = tt - rows[k, 0]
+        s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
+        s = np.minimum(np.maximum(s, self.s0), self.s1)
+        return np.where(tt >= self.duration, self.s1, s)
 
 
 def ok_starts(grid: STGrid, idx: np.ndarray) -> np.ndarray:
@@ -225,8 +225,11 @@ def search(
             continue
         first = int(np.argmax(rest))
         for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
-            lower = first * dt + lt[w, v] + lt[v, w_n - 1]
-            if best is not None and lower >= best[0] and not (moving and w == 0):
+            if moving and w == 0:  # from a speed: at least the distance at the top speed
+                lower = (stops[v] - stops[0]) / v_top + lt[v, w_n - 1]
+            else:
+                lower = first * dt + lt[w, v] + lt[v, w_n - 1]
+            if best is not None and lower >= best[0]:
                 continue
             piece = launch(stops[v]) if moving and w == 0 else drive(stops[w], stops[v])
             if piece is None:
