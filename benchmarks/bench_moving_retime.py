@@ -143,13 +143,17 @@ def movers(traj: trajopt.Trajectory, rng: np.random.Generator, n: int = 10) -> l
 
 
 def replan(planner, traj, ms):
-    """Re-plan ``traj`` at ``REPLAN_AT`` s for the movers ``ms``: ``(times, plan, re-time s,
-    what the re-plan did, smallest slack)``, ``plan = None`` on a BlockedError."""
+    """Re-plan ``traj`` at ``REPLAN_AT`` s for the movers ``ms``.
+
+    Returns ``(times, plan, re-time s, what the re-plan did, smallest slack)``; ``plan`` is
+    ``None`` on a typed refusal, whose name is then the fourth field.
+    """
     t0, c0 = time.perf_counter(), time.process_time()
     try:
         out = planner.replan(traj, REPLAN_AT, latency=0.0, moving_obstacles=ms)
-    except BlockedError:
-        return (time.perf_counter() - t0, time.process_time() - c0), None, 0.0, "", math.inf
+    except (BlockedError, InvalidInputError) as exc:  # a mover over the robot at the splice
+        took = (time.perf_counter() - t0, time.process_time() - c0)
+        return took, None, 0.0, type(exc).__name__, math.inf
     took = (time.perf_counter() - t0, time.process_time() - c0)
     mv = out.stats["moving"]
     shifted = trajopt.replan.shift_movers(ms, REPLAN_AT)
@@ -258,7 +262,9 @@ def main(argv: list[str] | None = None) -> int:
             f"Planner.replan(traj, {REPLAN_AT} s, latency=0, moving_obstacles=...) on the same "
             f"sets: {len(done)} returned ({len(moved)} re-timed, "
             f"{sum(r[3] == 'kept' for r in done)} kept their path), "
-            f"{len(replans) - len(done)} BlockedError; whole re-plan wall median "
+            f"{sum(r[3] == 'BlockedError' for r in replans)} BlockedError, "
+            f"{sum(r[3] == 'InvalidInputError' for r in replans)} InvalidInputError (a mover "
+            "over the robot at the splice); whole re-plan wall median "
             f"{stats([r[0] for r in done], 0)[:6].strip()} ms, cpu "
             f"{stats([r[0] for r in done], 1)[:6].strip()} ms; its re-time (stats['moving']"
             f"['time_s']) over the re-timed ones: median "
