@@ -46,7 +46,8 @@ from trajopt.moving._certificate import (
 )
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._st_grid import STGrid, grid_nodes, reach_bound, reachable, st_grid
-from trajopt.moving._st_search import Piece, compose, search
+from trajopt.moving._st_search import Piece, compose, describe, parts_of, search
+from trajopt.moving._tighten import FINE_DS, FineWindows, bisect_start, tail_occupancy, tighten
 from trajopt.timing import RuckigProfile, build_cap_table, time_parameterize
 
 
@@ -95,6 +96,7 @@ class _PathTables:
         self.rk = RuckigProfile(float(robot.a_max), float(robot.j_max))
         self.drives: dict[tuple[float, float], Piece | None] = {}
         self.points: dict[float, np.ndarray] = {}
+        self.key: tuple[Any, ...] = (id(path),)
 
     def nodes(self, s: np.ndarray, ds: float) -> np.ndarray:
         """Return the path's points (m), shape (n, 2), at the grid nodes ``s`` of spacing ``ds``."""
@@ -144,13 +146,29 @@ _TABLES: list[_PathTables] = []
 _TABLES_KEPT = 4
 
 
+def geometry_key(path: Any) -> tuple[Any, ...]:
+    """Return a key equal for two paths of the same geometry and parameter.
+
+    A B-spline (or a path holding one as ``curve``, :class:`trajopt.smoother.SmoothPath`):
+    its degree, knots and control points, byte for byte (a re-plan that keeps its rest cuts a
+    new curve object of the same geometry at the same splice). Any other path: its identity.
+    """
+    curve = getattr(path, "curve", path)
+    knots, ctrl, deg = (getattr(curve, name, None) for name in ("t", "c", "k"))
+    if isinstance(knots, np.ndarray) and isinstance(ctrl, np.ndarray) and isinstance(deg, int):
+        return (type(path), type(curve), deg, knots.tobytes(), ctrl.shape, ctrl.tobytes())
+    return (id(path),)
+
+
 def _tables(traj: Trajectory) -> _PathTables:
     """Return the :class:`_PathTables` of ``traj``'s path and robot (built or reused)."""
+    key = geometry_key(traj.path)
     for i, tb in enumerate(_TABLES):
-        if tb.path is traj.path and tb.robot == traj.robot:
+        if (tb.path is traj.path or tb.key == key) and tb.robot == traj.robot:
             _TABLES.append(_TABLES.pop(i))
             return tb
     tb = _PathTables(traj.path, traj.robot, float(traj.length))
+    tb.key = key
     if traj.v_start == 0.0 and traj.phase_a[0] == 0.0:  # the plan itself: the drive (0, L)
         tb.drives[(0.0, tb.length)] = _piece_of(traj, 0.0, tb.length)
     _TABLES.append(tb)
@@ -357,8 +375,17 @@ def retime_for_movers(
         out = _timed(traj, rows, duration)
         cert = certify_movers(out, movers, margin=margin)
         if cert.ok:
+            schedule = [(t0, pc) for t0, pc, _ in parts if pc is not None]
+            better = _tightened(traj, schedule, movers, margin, not_before, moving, tables, grid)
+            if better is not None:
+                out, cert, label = better
             return _with_stats(out, cert, label, t_all)
         step *= 0.5
+    if not moving and found is None:  # the one drive after a wait, launched exactly
+        whole = _tightened(traj, [], movers, margin, not_before, moving, tables, grid)
+        if whole is not None:
+            out, cert, label = whole
+            return _with_stats(out, cert, label, t_all)
     # why: the necessary grid names the mover that leaves no way past, when one does
     nec = st_grid(path, length, movers, limit, dt=dt, sufficient=False, points=points, **grid_args)
     _blocked(nec, movers, robot, v0)
@@ -369,6 +396,87 @@ def retime_for_movers(
         mover=first_name,
         t=cert.witness_t,
     )
+
+
+def _tightened(
+    traj: Trajectory,
+    schedule: list[tuple[float, Piece]],
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    not_before: float,
+    moving: bool,
+    tables: _PathTables,
+    grid: STGrid,
+) -> tuple[Trajectory, Any, str] | None:
+    """Return the schedule with shorter rests, certified, or ``None`` (:mod:`._tighten`).
+
+    Tries, earliest arrival first: the schedule with every rest as short as the fine windows
+    allow, and (from rest) the path's one drive launched at the earliest time they allow;
+    the first that :func:`certify_movers` accepts. Other shapes than a disc robot and disc
+    movers: the wait at the start bisected over certificates. An empty ``schedule``: only
+    the one drive, at any launch up to the grid's horizon.
+    """
+    length = tables.length
+
+    def timed(sched: list[tuple[float, Piece]]) -> Trajectory:
+        rows, duration = compose(parts_of(sched, moving), length)
+        return _timed(traj, rows, duration)
+
+    def arrival(sched: list[tuple[float, Piece]]) -> float:
+        return sched[-1][0] + sched[-1][1].duration if sched else math.inf
+
+    candidates: list[list[tuple[float, Piece]]] = []
+    disc = traj.robot.footprint is None and all(m.vertices is None for m in movers)
+    if disc:
+        fine = _fine_windows(tables, grid, movers, float(traj.robot.radius) + margin)
+        if schedule:
+            candidates.append(tighten(fine, schedule, math.inf if moving else not_before, length))
+        whole = None if moving else tables.drive(0.0, length)
+        if whole is not None:
+            t_max = min(arrival(schedule), float(grid.t[-1])) - whole.duration
+            occ = tail_occupancy(fine, [(0.0, whole)], 0, length)
+            launch = fine.earliest(occ, not_before, t_max)
+            if launch is not None:
+                candidates.append([(launch, whole)])
+    elif schedule and not moving and schedule[0][0] > not_before:
+
+        def ok(t1: float) -> bool:
+            sched = [(t - schedule[0][0] + t1, pc) for t, pc in schedule]
+            return bool(certify_movers(timed(sched), movers, margin=margin).ok)
+
+        t1 = bisect_start(ok, max(not_before, schedule[0][0] - grid.dt), schedule[0][0])
+        candidates.append([(t - schedule[0][0] + t1, pc) for t, pc in schedule])
+    for sched in sorted(candidates, key=arrival):
+        if sched == schedule or arrival(sched) >= arrival(schedule):
+            continue
+        out = timed(sched)
+        cert = certify_movers(out, movers, margin=margin)
+        if cert.ok:
+            return out, cert, describe(sched, moving, length)
+    return None
+
+
+def _fine_windows(
+    tables: _PathTables, grid: STGrid, movers: Sequence[MovingObstacle], limit: float
+) -> FineWindows:
+    """Return the movers' windows at the path's fine nodes, near the grid's forbidden nodes.
+
+    A fine node can have a window of a mover only when its nearest node of the sufficient
+    ``grid`` has a run of that mover (its pad covers the fine pad and the motion between
+    grid times, while the fine spacing is at most ``dt`` times the speed); the neighbours of
+    such nodes are taken as well.
+    """
+    length = tables.length
+    h = min(FINE_DS, grid.dt * float(tables.robot.v_max))
+    s, h = grid_nodes(length, h)
+    pts = tables.nodes(s, h)
+    n = grid.s.shape[0]
+    col = np.repeat(np.arange(n), np.diff(grid.ptr))
+    near = np.zeros((len(movers), n), dtype=bool)
+    near[grid.owner, col] = True
+    near[:, 1:] |= near[:, :-1].copy()
+    near[:, :-1] |= near[:, 1:].copy()
+    return FineWindows(s, pts, movers, limit, near[:, grid.index(s)])
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:

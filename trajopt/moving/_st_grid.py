@@ -290,8 +290,34 @@ def _disc_runs(
     owner = arr[:, 0].astype(np.int64)
     u, w = arr[:, 1:2], arr[:, 2:3]
     vx, vy, rr, g = arr[:, 5:6], arr[:, 6:7], arr[:, 7:8], arr[:, 8:9]
-    dx = pts[None, :, 0] - arr[:, 3:4]
-    dy = pts[None, :, 1] - arr[:, 4:5]
+    t_lo, t_hi = _inside(
+        pts[None, :, 0] - arr[:, 3:4], pts[None, :, 1] - arr[:, 4:5], vx, vy, rr, g
+    )
+    big = np.inf
+    eps = EPS_T if sufficient else -EPS_T
+    ta = u + np.nan_to_num(t_lo, nan=big, posinf=big, neginf=-big) - eps
+    tb = u + np.nan_to_num(t_hi, nan=-big, posinf=big, neginf=-big) + eps
+    k_lo = np.maximum(np.ceil(u / dt - 1e-9), np.floor(np.clip(ta, -1.0, t_end + dt) / dt) + 1)
+    k_hi = np.minimum(np.floor(w / dt + 1e-9), np.ceil(np.clip(tb, -dt, t_end + dt) / dt) - 1)
+    pi, ci = np.nonzero(k_lo <= k_hi)
+    return (
+        ci.astype(np.int64),
+        k_lo[pi, ci].astype(np.int64),
+        k_hi[pi, ci].astype(np.int64),
+        owner[pi],
+    )
+
+
+def _inside(
+    dx: np.ndarray, dy: np.ndarray, vx: np.ndarray, vy: np.ndarray, rr: np.ndarray, g: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return the times ``(t_lo, t_hi)`` (s, from a piece's start) a point is inside a mover's limit.
+
+    The point at ``D = (dx, dy)`` from the mover's centre at the piece's start, the centre
+    moving at ``V = (vx, vy)`` (m/s), the limit ``rr + g tau`` (m): ``|D - V tau| < rr + g tau``
+    on the open interval ``(t_lo, t_hi)`` (``t_lo > t_hi`` or infinite ends when empty or
+    unbounded; NaN where undefined). Broadcasts.
+    """
     # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
     a = vx * vx + vy * vy - g * g
     b = -2.0 * (dx * vx + dy * vy + rr * g)
@@ -318,18 +344,57 @@ def _disc_runs(
         )
         # the limit must be positive: rr + g tau > 0
         t_lo = np.where(g > 0, np.maximum(t_lo, -rr / g), np.where(rr > 0, t_lo, big))
-    eps = EPS_T if sufficient else -EPS_T
-    ta = u + np.nan_to_num(t_lo, nan=big, posinf=big, neginf=-big) - eps
-    tb = u + np.nan_to_num(t_hi, nan=-big, posinf=big, neginf=-big) + eps
-    k_lo = np.maximum(np.ceil(u / dt - 1e-9), np.floor(np.clip(ta, -1.0, t_end + dt) / dt) + 1)
-    k_hi = np.minimum(np.floor(w / dt + 1e-9), np.ceil(np.clip(tb, -dt, t_end + dt) / dt) - 1)
-    pi, ci = np.nonzero(k_lo <= k_hi)
-    return (
-        ci.astype(np.int64),
-        k_lo[pi, ci].astype(np.int64),
-        k_hi[pi, ci].astype(np.int64),
-        owner[pi],
+    return t_lo, t_hi
+
+
+def disc_windows(
+    pts: np.ndarray, mover: MovingObstacle, limit: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return when each point is closer to a disc mover than ``limit`` plus its radius.
+
+    Exact (closed form, module docstring) over the mover's whole prediction and after it
+    (the mover stands where it was last, forever).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    mover : MovingObstacle
+        A disc mover.
+    limit : float
+        The distance to keep besides the mover's radius (m).
+
+    Returns
+    -------
+    point : ndarray of int, shape (r,)
+        The point of each window.
+    lo, hi : ndarray, shape (r,)
+        The open time interval (s) of each window; ``hi = inf`` for one that lasts.
+    """
+    tk = mover.times
+    t_end = max(float(tk[-1]), 0.0) + 1.0
+    knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
+    u, w = knots[:-1], knots[1:]
+    mid = 0.5 * (u + w)
+    px, py = (
+        np.interp(knots, tk, mover.positions[:, 0]),
+        np.interp(knots, tk, mover.positions[:, 1]),
     )
+    inside = (mid > tk[0]) & (mid < tk[-1])
+    span = w - u
+    vx = np.where(inside, np.diff(px) / span, 0.0)[:, None]
+    vy = np.where(inside, np.diff(py) / span, 0.0)[:, None]
+    g = np.where(mid < mover.t_last, mover.growth, 0.0)[:, None]
+    rr = (limit + mover.radius + mover.growth * np.clip(u, 0.0, max(mover.t_last, 0.0)))[:, None]
+    t_lo, t_hi = _inside(
+        pts[None, :, 0] - px[:-1, None], pts[None, :, 1] - py[:-1, None], vx, vy, rr, g
+    )
+    u2, w2 = u[:, None], w[:, None]
+    w2 = np.where(w2 >= t_end, np.inf, w2)  # the last piece: the mover stands, forever
+    lo = np.maximum(u2 + np.nan_to_num(t_lo, nan=np.inf), u2)
+    hi = np.minimum(u2 + np.nan_to_num(t_hi, nan=-np.inf), w2)
+    seg, pi = np.nonzero(lo < hi)
+    return pi.astype(np.int64), lo[seg, pi], hi[seg, pi]
 
 
 def reach_bound(

@@ -266,20 +266,37 @@ def search(
         )
         chain.append((k, piece))
     chain.reverse()
+    schedule = [(k * dt, pc) for k, pc in chain]
+    return parts_of(schedule, moving), t_arr, describe(schedule, moving, stops[-1])
+
+
+def parts_of(
+    schedule: Sequence[tuple[float, Piece]], moving: bool
+) -> list[tuple[float, Piece | None, float]]:
+    """Return :func:`search`'s ``parts`` of drives launched at the given times (s).
+
+    The robot rests before each launch (at the start only when not ``moving``: a moving
+    robot's first drive leaves at ``t = 0``) and, after the last drive, at the goal.
+    """
     parts: list[tuple[float, Piece | None, float]] = [] if moving else [(0.0, None, 0.0)]
-    words = [] if moving else [f"wait {chain[0][0] * dt:.3f} s at the start"]
-    for i, (k, pc) in enumerate(chain):
-        parts.append((k * dt, pc, pc.s0))
-        parts.append((k * dt + pc.duration, None, pc.s1))
+    for t0, pc in schedule:
+        parts.append((t0, pc, pc.s0))
+        parts.append((t0 + pc.duration, None, pc.s1))
+    parts.pop()  # the goal's rest is the trajectory's end
+    return parts
+
+
+def describe(schedule: Sequence[tuple[float, Piece]], moving: bool, length: float) -> str:
+    """Return the plan of drives launched at the given times (s) in words (its waits and stops)."""
+    words = [] if moving else [f"wait {schedule[0][0]:.3f} s at the start"]
+    for i, (t0, pc) in enumerate(schedule):
         if moving and i == 0:
             words.append(
-                "drive on to the goal" if pc.s1 >= stops[-1] else f"brake to s = {pc.s1:.3f} m"
+                "drive on to the goal" if pc.s1 >= length else f"brake to s = {pc.s1:.3f} m"
             )
         elif pc.s0 > 0.0:
-            words.append(f"stop at s = {pc.s0:.3f} m until t = {k * dt:.3f} s")
-    parts.pop()  # the goal's rest is the trajectory's end
-    label = ", ".join(words)
-    return parts, t_arr, label
+            words.append(f"stop at s = {pc.s0:.3f} m until t = {t0:.3f} s")
+    return ", ".join(words)
 
 
 def compose(

@@ -67,13 +67,13 @@ def test_the_robot_waits_for_a_crossing_mover(line6):
 
 def test_the_robot_leaves_the_start_then_stops_to_let_a_mover_pass(line6):
     # one mover crosses x = 4.5 at t ~ 8.6 s, when the static plan is there; another runs over
-    # the start at t = 5 s: waiting at the start long enough is unsafe, so the robot
-    # drives, stops short of x = 4.5 and waits
+    # the start from t ~ 2 s: waiting at the start until the first has passed (~2 s) is
+    # unsafe, so the robot drives, stops short of x = 4.5 and waits
     cross = MovingObstacle.constant_velocity(
         (4.5, -3.0), (0.0, 0.35), radius=0.3, horizon=24.0, name="cross"
     )
     sweep = MovingObstacle.constant_velocity(
-        (0.0, -2.5), (0.0, 0.5), radius=0.3, horizon=24.0, name="sweep"
+        (0.0, -1.5), (0.0, 0.5), radius=0.3, horizon=24.0, name="sweep"
     )
     assert not certify_movers(line6, [cross]).ok and certify_movers(line6, [sweep]).ok
     out = retime_for_movers(line6, [cross, sweep])
