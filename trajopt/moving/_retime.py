@@ -97,6 +97,7 @@ class _PathTables:
         self.drives: dict[tuple[float, float], Piece | None] = {}
         self.points: dict[float, np.ndarray] = {}
         self.key: tuple[Any, ...] = (id(path),)
+        self.launches: dict[tuple[Any, ...], dict[float, Piece | None]] = {}
 
     def nodes(self, s: np.ndarray, ds: float) -> np.ndarray:
         """Return the path's points (m), shape (n, 2), at the grid nodes ``s`` of spacing ``ds``."""
@@ -132,6 +133,21 @@ class _PathTables:
             return None
         return _piece_of(tr, s0, s1)
 
+    def launches_from(self, traj: Trajectory) -> dict[float, Piece | None]:
+        """Return the kept launches (motions to rest at ``s1``, by ``s1``) of a moving start.
+
+        Keyed by ``traj``'s timing, byte for byte (a re-plan at the same splice gives the same
+        kept rest); the last :data:`_LAUNCHES_KEPT` timings are kept. Holds ``traj`` itself as
+        the launch to the goal.
+        """
+        phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
+        key = (float(traj.duration), *(np.asarray(x, dtype=float).tobytes() for x in phases))
+        if key not in self.launches:
+            self.launches[key] = {self.length: _piece_of(traj, 0.0, self.length)}
+            while len(self.launches) > _LAUNCHES_KEPT:
+                del self.launches[next(iter(self.launches))]
+        return self.launches[key]
+
     def drive(self, s0: float, s1: float) -> Piece | None:
         """Return the rest-to-rest drive over ``[s0, s1]`` (m) (cached)."""
         key = (s0, s1)
@@ -140,6 +156,9 @@ class _PathTables:
             self.drives[key] = self.segment(s0, s1) if piece is None else piece
         return self.drives[key]
 
+
+#: Timings of a moving start whose launches a path's tables keep.
+_LAUNCHES_KEPT = 4
 
 #: The tables of the last paths re-timed (most recent last).
 _TABLES: list[_PathTables] = []
@@ -340,7 +359,7 @@ def retime_for_movers(
     launch, brake_at = None, None
     if moving:
         brake_at = float(braking_distance(v0, a0, float(robot.a_max), float(robot.j_max)))
-        first = {length: _piece_of(traj, 0.0, length)}
+        first = tables.launches_from(traj)
 
         def launch(s1: float) -> Piece | None:
             if s1 < brake_at - 1e-9:  # closer than the robot can stop
@@ -370,22 +389,15 @@ def retime_for_movers(
         )
         if found is None:
             break
-        parts, _, label = found
-        rows, duration = compose(parts, length)
-        out = _timed(traj, rows, duration)
-        cert = certify_movers(out, movers, margin=margin)
-        if cert.ok:
-            schedule = [(t0, pc) for t0, pc, _ in parts if pc is not None]
-            better = _tightened(traj, schedule, movers, margin, not_before, moving, tables, grid)
-            if better is not None:
-                out, cert, label = better
-            return _with_stats(out, cert, label, t_all)
+        schedule = [(t0, pc) for t0, pc, _ in found[0] if pc is not None]
+        done = _tightened(traj, schedule, movers, margin, not_before, moving, tables, grid)
+        if done is not None:
+            return _with_stats(*done, t_all)
         step *= 0.5
     if not moving and found is None:  # the one drive after a wait, launched exactly
-        whole = _tightened(traj, [], movers, margin, not_before, moving, tables, grid)
-        if whole is not None:
-            out, cert, label = whole
-            return _with_stats(out, cert, label, t_all)
+        done = _tightened(traj, [], movers, margin, not_before, moving, tables, grid)
+        if done is not None:
+            return _with_stats(*done, t_all)
     # why: the necessary grid names the mover that leaves no way past, when one does
     nec = st_grid(path, length, movers, limit, dt=dt, sufficient=False, points=points, **grid_args)
     _blocked(nec, movers, robot, v0)
@@ -408,11 +420,12 @@ def _tightened(
     tables: _PathTables,
     grid: STGrid,
 ) -> tuple[Trajectory, Any, str] | None:
-    """Return the schedule with shorter rests, certified, or ``None`` (:mod:`._tighten`).
+    """Return the schedule, its rests shortened, as a certified trajectory, or ``None``.
 
     Tries, earliest arrival first: the schedule with every rest as short as the fine windows
-    allow, and (from rest) the path's one drive launched at the earliest time they allow;
-    the first that :func:`certify_movers` accepts. Other shapes than a disc robot and disc
+    allow (:mod:`._tighten`), (from rest) the path's one drive launched at the earliest time
+    they allow, and the schedule as it is; the first that :func:`certify_movers` accepts,
+    with its certificate and its plan in words. Other shapes than a disc robot and disc
     movers: the wait at the start bisected over certificates. An empty ``schedule``: only
     the one drive, at any launch up to the grid's horizon.
     """
@@ -446,9 +459,14 @@ def _tightened(
 
         t1 = bisect_start(ok, max(not_before, schedule[0][0] - grid.dt), schedule[0][0])
         candidates.append([(t - schedule[0][0] + t1, pc) for t, pc in schedule])
-    for sched in sorted(candidates, key=arrival):
-        if sched == schedule or arrival(sched) >= arrival(schedule):
+    if schedule:
+        candidates.append(schedule)
+    seen: set[tuple[tuple[float, int], ...]] = set()
+    for sched in sorted(candidates, key=arrival):  # stable: the schedule as it is last
+        key = tuple((t, id(pc)) for t, pc in sched)
+        if key in seen:
             continue
+        seen.add(key)
         out = timed(sched)
         cert = certify_movers(out, movers, margin=margin)
         if cert.ok:

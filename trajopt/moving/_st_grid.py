@@ -348,21 +348,26 @@ def _inside(
 
 
 def disc_windows(
-    pts: np.ndarray, mover: MovingObstacle, limit: float
+    pts: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    limit: float,
+    near: Sequence[np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Return when each point is closer to a disc mover than ``limit`` plus its radius.
+    """Return when points are closer to disc movers than ``limit`` plus their radius.
 
-    Exact (closed form, module docstring) over the mover's whole prediction and after it
+    Exact (closed form, module docstring) over each mover's whole prediction and after it
     (the mover stands where it was last, forever).
 
     Parameters
     ----------
     pts : ndarray, shape (n, 2)
         Points (m).
-    mover : MovingObstacle
-        A disc mover.
+    movers : sequence of MovingObstacle
+        Disc movers.
     limit : float
-        The distance to keep besides the mover's radius (m).
+        The distance to keep besides a mover's radius (m).
+    near : sequence of ndarray of int, optional
+        For each mover, the indices of the points to test; default all.
 
     Returns
     -------
@@ -371,30 +376,45 @@ def disc_windows(
     lo, hi : ndarray, shape (r,)
         The open time interval (s) of each window; ``hi = inf`` for one that lasts.
     """
-    tk = mover.times
-    t_end = max(float(tk[-1]), 0.0) + 1.0
-    knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
-    u, w = knots[:-1], knots[1:]
-    mid = 0.5 * (u + w)
-    px, py = (
-        np.interp(knots, tk, mover.positions[:, 0]),
-        np.interp(knots, tk, mover.positions[:, 1]),
-    )
-    inside = (mid > tk[0]) & (mid < tk[-1])
-    span = w - u
-    vx = np.where(inside, np.diff(px) / span, 0.0)[:, None]
-    vy = np.where(inside, np.diff(py) / span, 0.0)[:, None]
-    g = np.where(mid < mover.t_last, mover.growth, 0.0)[:, None]
-    rr = (limit + mover.radius + mover.growth * np.clip(u, 0.0, max(mover.t_last, 0.0)))[:, None]
-    t_lo, t_hi = _inside(
-        pts[None, :, 0] - px[:-1, None], pts[None, :, 1] - py[:-1, None], vx, vy, rr, g
-    )
-    u2, w2 = u[:, None], w[:, None]
-    w2 = np.where(w2 >= t_end, np.inf, w2)  # the last piece: the mover stands, forever
-    lo = np.maximum(u2 + np.nan_to_num(t_lo, nan=np.inf), u2)
-    hi = np.minimum(u2 + np.nan_to_num(t_hi, nan=-np.inf), w2)
-    seg, pi = np.nonzero(lo < hi)
-    return pi.astype(np.int64), lo[seg, pi], hi[seg, pi]
+    cols: list[list[np.ndarray]] = [[] for _ in range(8)]  # point, u, w, dx, dy, vx, vy, rr
+    grow = []
+    for j, m in enumerate(movers):
+        sel = np.arange(pts.shape[0]) if near is None else np.asarray(near[j], dtype=np.int64)
+        if sel.size == 0:
+            continue
+        tk = m.times
+        t_end = max(float(tk[-1]), 0.0) + 1.0
+        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
+        u, w = knots[:-1], knots[1:]
+        mid = 0.5 * (u + w)
+        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
+        inside = (mid > tk[0]) & (mid < tk[-1])
+        span = w - u
+        per = (
+            np.broadcast_to(sel, (u.size, sel.size)),
+            u[:, None],
+            np.where(w >= t_end, np.inf, w)[:, None],  # the last piece: the mover stands
+            pts[sel, 0][None, :] - px[:-1, None],
+            pts[sel, 1][None, :] - py[:-1, None],
+            np.where(inside, np.diff(px) / span, 0.0)[:, None],
+            np.where(inside, np.diff(py) / span, 0.0)[:, None],
+            (limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)))[:, None],
+        )
+        shape = (u.size, sel.size)
+        for c, x in zip(cols, per, strict=True):
+            c.append(np.broadcast_to(x, shape).ravel())
+        grow.append(
+            np.broadcast_to(np.where(mid < m.t_last, m.growth, 0.0)[:, None], shape).ravel()
+        )
+    if not grow:
+        empty = np.zeros(0)
+        return np.zeros(0, dtype=np.int64), empty, empty
+    point, u, w, dx, dy, vx, vy, rr = (np.concatenate(c) for c in cols)
+    t_lo, t_hi = _inside(dx, dy, vx, vy, rr, np.concatenate(grow))
+    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
+    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
+    keep = lo < hi
+    return point[keep].astype(np.int64), lo[keep], hi[keep]
 
 
 def reach_bound(

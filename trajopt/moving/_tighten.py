@@ -71,19 +71,10 @@ class FineWindows:
         near: np.ndarray | None = None,
     ) -> None:
         self.s, self.h = s, float(s[1] - s[0])
-        nodes, lo, hi = [], [], []
-        for j, m in enumerate(movers):
-            sel = np.arange(s.shape[0]) if near is None else np.flatnonzero(near[j])
-            if sel.size == 0:
-                continue
-            pi, a, b = disc_windows(pts[sel], m, limit + 0.5 * self.h)
-            nodes.append(sel[pi])
-            lo.append(a)
-            hi.append(b)
-        node = np.concatenate(nodes) if nodes else np.zeros(0, dtype=np.int64)
+        sel = None if near is None else [np.flatnonzero(row) for row in near]
+        node, lo, hi = disc_windows(pts, movers, limit + 0.5 * self.h, sel)
         order = np.argsort(node, kind="stable")
-        self.lo = np.concatenate(lo)[order] if lo else np.zeros(0)
-        self.hi = np.concatenate(hi)[order] if hi else np.zeros(0)
+        node, self.lo, self.hi = node[order], lo[order], hi[order]
         counts = np.bincount(node, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
 
