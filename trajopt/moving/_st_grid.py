@@ -371,12 +371,12 @@ def disc_windows(
 
     Returns
     -------
-    point : ndarray of int, shape (r,)
-        The point of each window.
+    mover, point : ndarray of int, shape (r,)
+        The mover and the point of each window.
     lo, hi : ndarray, shape (r,)
         The open time interval (s) of each window; ``hi = inf`` for one that lasts.
     """
-    cols: list[list[np.ndarray]] = [[] for _ in range(8)]  # point, u, w, dx, dy, vx, vy, rr
+    cols: list[list[np.ndarray]] = [[] for _ in range(9)]  # point, u, w, dx, dy, vx, vy, rr, j
     grow = []
     for j, m in enumerate(movers):
         sel = np.arange(pts.shape[0]) if near is None else np.asarray(near[j], dtype=np.int64)
@@ -399,6 +399,7 @@ def disc_windows(
             np.where(inside, np.diff(px) / span, 0.0)[:, None],
             np.where(inside, np.diff(py) / span, 0.0)[:, None],
             (limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)))[:, None],
+            np.array([[j]]),
         )
         shape = (u.size, sel.size)
         for c, x in zip(cols, per, strict=True):
@@ -408,13 +409,13 @@ def disc_windows(
         )
     if not grow:
         empty = np.zeros(0)
-        return np.zeros(0, dtype=np.int64), empty, empty
-    point, u, w, dx, dy, vx, vy, rr = (np.concatenate(c) for c in cols)
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), empty, empty
+    point, u, w, dx, dy, vx, vy, rr, who = (np.concatenate(c) for c in cols)
     t_lo, t_hi = _inside(dx, dy, vx, vy, rr, np.concatenate(grow))
     lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
     hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
     keep = lo < hi
-    return point[keep].astype(np.int64), lo[keep], hi[keep]
+    return who[keep].astype(np.int64), point[keep].astype(np.int64), lo[keep], hi[keep]
 
 
 def reach_bound(

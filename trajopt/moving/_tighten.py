@@ -37,6 +37,9 @@ FINE_DS = 0.005
 SAMPLE_DT = 2e-3
 #: A launch is placed this far (s) past the end of a forbidden interval.
 EPS_L = 1e-6
+#: The refinement's time step (s) and how far before the launch (s) a deciding interval ends.
+REFINE_DT = 2.5e-4
+REFINE_S = 0.02
 #: Bisection steps of :func:`bisect_start`.
 BISECT_STEPS = 5
 
@@ -60,6 +63,11 @@ class FineWindows:
         Robot radius plus margin (m).
     near : ndarray of bool, shape (movers, n), optional
         The nodes each mover can come near (a filter); default all.
+    where : callable, optional
+        ``where(s)``: the path's points (m), shape (m, 2), at arc lengths ``s`` (m), shape
+        (m,); with it, :meth:`earliest` refines the windows that decide the launch.
+    speed : float
+        The robot's speed bound (m/s), for the refinement's samples.
     """
 
     def __init__(
@@ -69,12 +77,15 @@ class FineWindows:
         movers: Sequence[MovingObstacle],
         limit: float,
         near: np.ndarray | None = None,
+        where: Callable[[np.ndarray], np.ndarray] | None = None,
+        speed: float = 0.0,
     ) -> None:
         self.s, self.h = s, float(s[1] - s[0])
+        self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
         sel = None if near is None else [np.flatnonzero(row) for row in near]
-        node, lo, hi = disc_windows(pts, movers, limit + 0.5 * self.h, sel)
+        owner, node, lo, hi = disc_windows(pts, movers, limit + 0.5 * self.h, sel)
         order = np.argsort(node, kind="stable")
-        node, self.lo, self.hi = node[order], lo[order], hi[order]
+        node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
         counts = np.bincount(node, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
 
@@ -108,12 +119,20 @@ class FineWindows:
         return idx[has], a[has], b[has]
 
     def earliest(
-        self, occupancy: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]], lo: float, hi: float
+        self,
+        occupancy: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray]],
+        lo: float,
+        hi: float,
+        s_of: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> float | None:
         """Return the earliest launch ``L`` in ``[lo, hi]`` (s) meeting no window, or ``None``.
 
         ``occupancy``: ``(node, a, b)`` arrays, the motion near node ``i`` during
-        ``[L + a, L + b]``.
+        ``[L + a, L + b]``. With ``s_of`` (the motion's arc length (m) at its times from the
+        launch, s) and the path's points (``where``), the intervals that decide ``L`` (those
+        ending within :data:`REFINE_S` before it) are replaced by the exact ones of the
+        motion's own points on samples every :data:`REFINE_DT` (the robot's share of the pad
+        ``speed REFINE_DT / 2`` instead of ``h / 2`` and the drive samples), twice.
         """
         node = np.concatenate([o[0] for o in occupancy])
         a = np.concatenate([o[1] for o in occupancy])
@@ -129,15 +148,81 @@ class FineWindows:
         f_hi = self.hi[run] - a[which]
         keep = f_hi > lo
         f_lo, f_hi = f_lo[keep], f_hi[keep]
-        order = np.argsort(f_lo, kind="stable")
-        f_lo, f_hi = f_lo[order], f_hi[order]
-        cur = lo
-        # the first interval that starts after everything before it (and lo) has ended
-        reach = np.maximum(np.maximum.accumulate(f_hi) + EPS_L, lo)
-        prev = np.concatenate([[lo], reach[:-1]])
-        gap = np.flatnonzero(f_lo >= prev)
-        cur = float(prev[gap[0]]) if gap.size else float(reach[-1]) if reach.size else lo
+        span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
+        cur = _sweep(f_lo, f_hi, lo)
+        if s_of is None or self.where is None:
+            return cur if cur <= hi else None
+        extra_lo, extra_hi = np.zeros(0), np.zeros(0)
+        for _ in range(2):
+            if cur > hi:
+                break
+            bind = (f_hi >= cur - REFINE_S) & (f_lo < cur)
+            if not bind.any():
+                break
+            x_lo, x_hi = self._exact(span_a[bind], span_b[bind], owner[bind], s_of)
+            f_lo, f_hi = f_lo[~bind], f_hi[~bind]
+            span_a, span_b, owner = span_a[~bind], span_b[~bind], owner[~bind]
+            extra_lo, extra_hi = np.append(extra_lo, x_lo), np.append(extra_hi, x_hi)
+            new = _sweep(np.append(f_lo, extra_lo), np.append(f_hi, extra_hi), lo)
+            if new >= cur:
+                break
+            cur = new
         return cur if cur <= hi else None
+
+    def _exact(
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        owner: np.ndarray,
+        s_of: Callable[[np.ndarray], np.ndarray],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Return the launches (open intervals, s) at which the motion meets the movers.
+
+        During ``[a_j, b_j]`` (s from the launch) against mover ``owner_j``, from the motion's
+        own points every :data:`REFINE_DT` (s).
+        """
+        n = np.maximum(np.ceil((b - a) / REFINE_DT).astype(np.int64), 1) + 1
+        idx = np.repeat(np.arange(a.shape[0]), n)
+        step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        tau = np.minimum(a[idx] + step * REFINE_DT, b[idx])
+        pts = self.where(s_of(tau))
+        who = owner[idx]
+        sel = [np.flatnonzero(who == j) for j in range(len(self.movers))]
+        pad = 0.5 * REFINE_DT
+        _, pi, w_lo, w_hi = disc_windows(pts, self.movers, self.limit + self.speed * pad, sel)
+        return w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
+
+
+def _sweep(f_lo: np.ndarray, f_hi: np.ndarray, lo: float) -> float:
+    """Return the least ``L >= lo`` (s) inside none of the open intervals ``(f_lo, f_hi)``."""
+    keep = f_hi > lo
+    f_lo, f_hi = f_lo[keep], f_hi[keep]
+    if f_lo.size == 0:
+        return lo
+    order = np.argsort(f_lo, kind="stable")
+    f_lo, f_hi = f_lo[order], f_hi[order]
+    # the first interval that starts after everything before it (and lo) has ended
+    reach = np.maximum(np.maximum.accumulate(f_hi) + EPS_L, lo)
+    prev = np.concatenate([[lo], reach[:-1]])
+    gap = np.flatnonzero(f_lo >= prev)
+    return float(prev[gap[0]]) if gap.size else float(reach[-1])
+
+
+def tail_s(schedule: Schedule, k: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Return ``s(tau)`` (m) of ``schedule[k:]`` at times ``tau`` (s) from its launch."""
+    t0 = schedule[k][0]
+    offs = np.array([t - t0 for t, _ in schedule[k:]])
+    pieces = [pc for _, pc in schedule[k:]]
+
+    def s_of(tau: np.ndarray) -> np.ndarray:
+        j = np.clip(np.searchsorted(offs, tau, side="right") - 1, 0, len(pieces) - 1)
+        out = np.empty(tau.shape)
+        for i in np.unique(j):
+            m = j == i
+            out[m] = pieces[i].s_at(tau[m] - offs[i])  # after its end: at rest there
+        return out
+
+    return s_of
 
 
 def tail_occupancy(
@@ -183,7 +268,7 @@ def tighten(fine: FineWindows, schedule: Schedule, first: float, length: float) 
         t_k = out[k][0]
         if not lo < t_k:
             continue
-        best = fine.earliest(tail_occupancy(fine, out, k, length), lo, t_k)
+        best = fine.earliest(tail_occupancy(fine, out, k, length), lo, t_k, tail_s(out, k))
         if best is not None and best < t_k:
             shift = t_k - best
             out[k:] = [(t - shift, pc) for t, pc in out[k:]]

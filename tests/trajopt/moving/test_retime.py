@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.trajopt.moving.reference import brute_min, dense_min
+from tests.trajopt.moving.reference import brute_min, dense_min, mover_rate, positions, slack_at
 from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.geometry import PolylineCurve
 from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers
@@ -151,3 +151,77 @@ def test_random_crossings_are_certified_or_typed_errors(line6, specs):
         return
     assert certify_movers(out, movers).ok
     assert dense_min(out, movers)[0] >= -1e-6
+
+
+def _wait_witness(static, movers, h=0.01, dt=0.005):
+    """Earliest wait ``w`` on a grid of ``h`` (s) after which driving ``static`` as it is stays clear.
+
+    Brute force, written here again: the robot rests at the start until ``w``, drives
+    ``static``'s own timing, then stands at the goal; the distance to every mover minus the
+    limit, on samples every ``dt`` (s), must be at least what the robot and the mover can
+    close in ``dt / 2`` (a sound bound between samples). Waits up to the last prediction (the
+    movers stand after it). Returns the arrival ``w + duration`` (s), or ``None``.
+    """
+    robot_v = float(static.robot.v_max)
+    limit = float(static.robot.radius)
+    big_t = float(static.duration)
+    tau = np.append(np.arange(0.0, big_t, dt), big_t)
+    p = positions(static, tau)
+    t_last = max(float(m.times[-1]) for m in movers)
+    tt = np.arange(0.0, t_last + big_t + 1.0, dt)
+    start_bad, goal_bad = np.zeros(tt.size, bool), np.zeros(tt.size, bool)
+    for m in movers:
+        u = mover_rate(m)
+        start_bad |= slack_at(np.repeat(p[:1], tt.size, 0), m, tt, limit) < u * dt / 2
+        goal_bad |= slack_at(np.repeat(p[-1:], tt.size, 0), m, tt, limit) < u * dt / 2
+    # the last prediction is over by tt[-1]: a mover over the goal then stays there
+    if goal_bad[-1]:
+        return None
+    t_start_bad = tt[np.argmax(start_bad)] if start_bad.any() else np.inf
+    t_goal_bad = tt[np.flatnonzero(goal_bad)[-1]] if goal_bad.any() else -np.inf
+    for w in np.arange(0.0, t_last + h, h):
+        if w + dt / 2 >= t_start_bad:  # the start is no longer safe to rest at
+            return None
+        if w + big_t <= t_goal_bad + dt / 2:
+            continue
+        if all(
+            np.all(slack_at(p, m, tau + w, limit) >= (robot_v + mover_rate(m)) * dt / 2)
+            for m in movers
+        ):
+            return w + big_t
+    return None
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0.8, 5.2),  # where it crosses the line (m)
+            st.floats(0.5, 12.0),  # when (s)
+            st.floats(0.3, 1.5),  # its speed (m/s)
+            st.floats(0.5, 2.6),  # its direction against the line (rad)
+            st.floats(0.1, 0.4),  # its radius (m)
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_never_later_than_a_brute_force_wait_at_the_start(line6, spec):
+    movers = []
+    for i, (x, tc, v, ang, r) in enumerate(spec):
+        vel = v * np.array([np.cos(ang), np.sin(ang)])
+        start = np.array([x, 0.0]) - vel * tc
+        m = MovingObstacle.constant_velocity(start, vel, radius=r, horizon=tc + 6.0, name=f"m{i}")
+        if np.hypot(*start) < r + ROBOT.radius + 0.05:
+            return  # over the robot at t = 0: a typed error, tested elsewhere
+        movers.append(m)
+    witness = _wait_witness(line6, movers)
+    try:
+        out = retime_for_movers(line6, movers)
+    except BlockedError:
+        assert witness is None
+        return
+    cert = certify_movers(out, movers)
+    assert cert.ok and dense_min(out, movers)[0] >= -1e-6
+    if witness is not None:
+        assert out.duration <= witness + 1e-9
