@@ -48,7 +48,14 @@ from trajopt.moving._certificate import (
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._st_grid import STGrid, grid_nodes, reach_bound, reachable, st_grid
 from trajopt.moving._st_search import Piece, compose, describe, parts_of, search
-from trajopt.moving._tighten import FINE_DS, FineWindows, bisect_start, tail_occupancy, tighten
+from trajopt.moving._tighten import (
+    FINE_DS,
+    FineWindows,
+    bisect_start,
+    tail_occupancy,
+    tail_s,
+    tighten,
+)
 from trajopt.timing import RuckigProfile, build_cap_table, time_parameterize
 
 
@@ -444,12 +451,13 @@ def _tightened(
     if disc:
         fine = _fine_windows(tables, grid, movers, float(traj.robot.radius) + margin)
         if schedule:
-            candidates.append(tighten(fine, schedule, math.inf if moving else not_before, length))
+            candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
         whole = None if moving else tables.drive(0.0, length)
         if whole is not None:
             t_max = min(arrival(schedule), float(grid.t[-1])) - whole.duration
-            occ = tail_occupancy(fine, [(0.0, whole)], 0, length)
-            launch = fine.earliest(occ, not_before, t_max)
+            one = [(0.0, whole)]
+            drives, rests = tail_occupancy(fine, one, 0)
+            launch = fine.earliest(drives, not_before, t_max, tail_s(one, 0), rests)
             if launch is not None:
                 candidates.append([(launch, whole)])
     elif schedule and not moving and schedule[0][0] > not_before:

@@ -40,6 +40,8 @@ EPS_L = 1e-6
 #: The refinement's time step (s) and how far before the launch (s) a deciding interval ends.
 REFINE_DT = 2.5e-4
 REFINE_S = 0.02
+#: The pad (m) of a rest's point against the path's evaluation (its arc length interpolated).
+POINT_PAD = 1e-4
 #: Bisection steps of :func:`bisect_start`.
 BISECT_STEPS = 5
 
@@ -82,6 +84,7 @@ class FineWindows:
     ) -> None:
         self.s, self.h = s, float(s[1] - s[0])
         self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
+        self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         sel = None if near is None else [np.flatnonzero(row) for row in near]
         owner, node, lo, hi = disc_windows(pts, movers, limit + 0.5 * self.h, sel)
         order = np.argsort(node, kind="stable")
@@ -124,6 +127,7 @@ class FineWindows:
         lo: float,
         hi: float,
         s_of: Callable[[np.ndarray], np.ndarray] | None = None,
+        rests: Sequence[tuple[float, float, float]] = (),
     ) -> float | None:
         """Return the earliest launch ``L`` in ``[lo, hi]`` (s) meeting no window, or ``None``.
 
@@ -133,14 +137,20 @@ class FineWindows:
         ending within :data:`REFINE_S` before it) are replaced by the exact ones of the
         motion's own points on samples every :data:`REFINE_DT` (the robot's share of the pad
         ``speed REFINE_DT / 2`` instead of ``h / 2`` and the drive samples), twice.
+        ``rests``: ``(s, a, b)``, the motion at rest at ``s`` (m) during ``[L + a, L + b]``,
+        against the exact windows of the path's point there (:meth:`point_windows`).
         """
+        r_lo, r_hi = [np.zeros(0)], [np.zeros(0)]
+        for s_r, a_r, b_r in rests:
+            w_lo, w_hi = self.point_windows(s_r)
+            r_lo.append(w_lo - b_r)
+            r_hi.append(w_hi - a_r)
+        rest_lo, rest_hi = np.concatenate(r_lo), np.concatenate(r_hi)
         node = np.concatenate([o[0] for o in occupancy])
         a = np.concatenate([o[1] for o in occupancy])
         b = np.concatenate([o[2] for o in occupancy])
         counts = self.ptr[node + 1] - self.ptr[node]
         total = int(counts.sum())
-        if total == 0:
-            return lo
         which = np.repeat(np.arange(node.shape[0]), counts)
         first = np.repeat(self.ptr[node], counts)
         run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
@@ -149,10 +159,10 @@ class FineWindows:
         keep = f_hi > lo
         f_lo, f_hi = f_lo[keep], f_hi[keep]
         span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
-        cur = _sweep(f_lo, f_hi, lo)
+        cur = _sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
         if s_of is None or self.where is None:
             return cur if cur <= hi else None
-        extra_lo, extra_hi = np.zeros(0), np.zeros(0)
+        extra_lo, extra_hi = rest_lo, rest_hi
         for _ in range(2):
             if cur > hi:
                 break
@@ -168,6 +178,23 @@ class FineWindows:
                 break
             cur = new
         return cur if cur <= hi else None
+
+    def point_windows(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Return the windows (s) of the path's point at ``s`` (m): exact, the limit plus 0.1 mm.
+
+        Kept by ``s`` (a rest's place); the point is the path's at ``s`` (``where``), else
+        the nearest fine node's with the pad ``h/2``.
+        """
+        if s not in self._points:
+            if self.where is None:
+                i = int(np.clip(np.rint(s / self.h), 0, self.s.shape[0] - 1))
+                run = slice(int(self.ptr[i]), int(self.ptr[i + 1]))
+                lo, hi = self.lo[run], self.hi[run]
+            else:
+                pt = self.where(np.array([s]))
+                _, _, lo, hi = disc_windows(pt, self.movers, self.limit + POINT_PAD)
+            self._points[s] = (lo, hi)
+        return self._points[s]
 
     def _exact(
         self,
@@ -226,24 +253,27 @@ def tail_s(schedule: Schedule, k: int) -> Callable[[np.ndarray], np.ndarray]:
 
 
 def tail_occupancy(
-    fine: FineWindows, schedule: Schedule, k: int, length: float
-) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Return the occupancy of ``schedule[k:]`` and the standing at the goal, from its launch."""
+    fine: FineWindows, schedule: Schedule, k: int
+) -> tuple[list[tuple[np.ndarray, np.ndarray, np.ndarray]], list[tuple[float, float, float]]]:
+    """Return the occupancy of ``schedule[k:]`` and the standing at the goal, from its launch.
+
+    The drives' ``(node, a, b)`` arrays (:meth:`FineWindows.drive_occupancy`) and the rests'
+    ``(s, a, b)``: at rest at ``s`` (m) during ``[a, b]`` (s), ``b = inf`` at the goal.
+    """
     t0 = schedule[k][0]
-    out = []
+    drives, rests = [], []
     for j in range(k, len(schedule)):
         tj, pc = schedule[j]
         node, a, b = fine.drive_occupancy(pc)
-        out.append((node, a + (tj - t0), b + (tj - t0)))
+        drives.append((node, a + (tj - t0), b + (tj - t0)))
         end = tj + pc.duration - t0
         nxt = schedule[j + 1][0] - t0 if j + 1 < len(schedule) else math.inf
-        if nxt > end or nxt == math.inf:
-            idx = fine.node_range(pc.s1, pc.s1)
-            out.append((idx, np.full(idx.shape, end), np.full(idx.shape, nxt)))
-    return out
+        if nxt > end:
+            rests.append((pc.s1, end, nxt))
+    return drives, rests
 
 
-def tighten(fine: FineWindows, schedule: Schedule, first: float, length: float) -> Schedule:
+def tighten(fine: FineWindows, schedule: Schedule, first: float) -> Schedule:
     """Return ``schedule`` with every rest as short as the fine windows allow (module docstring).
 
     Parameters
@@ -254,8 +284,6 @@ def tighten(fine: FineWindows, schedule: Schedule, first: float, length: float) 
     first : float
         The earliest launch of the first drive (s): the end of a rest that must stay (a
         turn in place), or ``inf`` when the first drive's launch is fixed (a moving start).
-    length : float
-        The path's length (m).
 
     Returns
     -------
@@ -268,7 +296,8 @@ def tighten(fine: FineWindows, schedule: Schedule, first: float, length: float) 
         t_k = out[k][0]
         if not lo < t_k:
             continue
-        best = fine.earliest(tail_occupancy(fine, out, k, length), lo, t_k, tail_s(out, k))
+        drives, rests = tail_occupancy(fine, out, k)
+        best = fine.earliest(drives, lo, t_k, tail_s(out, k), rests)
         if best is not None and best < t_k:
             shift = t_k - best
             out[k:] = [(t - shift, pc) for t, pc in out[k:]]
