@@ -349,10 +349,10 @@ def _inside(
 
 def disc_windows(
     pts: np.ndarray,
-    movers: Sequence[MovingObstacle],
+    movers: Sequence[MovingObstacle] | np.ndarray,
     limit: float,
-    near: Sequence[np.ndarray] | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    near: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Return when points are closer to disc movers than ``limit`` plus their radius.
 
     Exact (closed form, module docstring) over each mover's whole prediction and after it
@@ -362,12 +362,13 @@ def disc_windows(
     ----------
     pts : ndarray, shape (n, 2)
         Points (m).
-    movers : sequence of MovingObstacle
-        Disc movers.
+    movers : sequence of MovingObstacle, or ndarray
+        Disc movers, or their pieces from :func:`mover_pieces` (with a limit in; ``limit``
+        is then added to it).
     limit : float
         The distance to keep besides a mover's radius (m).
-    near : sequence of ndarray of int, optional
-        For each mover, the indices of the points to test; default all.
+    near : ndarray of bool, shape (movers, n), optional
+        Which points to test against each mover; default all.
 
     Returns
     -------
@@ -376,12 +377,32 @@ def disc_windows(
     lo, hi : ndarray, shape (r,)
         The open time interval (s) of each window; ``hi = inf`` for one that lasts.
     """
-    cols: list[list[np.ndarray]] = [[] for _ in range(9)]  # point, u, w, dx, dy, vx, vy, rr, j
-    grow = []
+    rows = movers if isinstance(movers, np.ndarray) else mover_pieces(movers, 0.0)
+    who = rows[:, 0].astype(np.int64)
+    if near is None:
+        seg, pi = np.divmod(np.arange(rows.shape[0] * pts.shape[0]), pts.shape[0])
+    else:
+        seg, pi = np.nonzero(near[who])
+    r = rows[seg]
+    u, w = r[:, 1], r[:, 2]
+    t_lo, t_hi = _inside(
+        pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
+    )
+    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
+    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
+    keep = lo < hi
+    return who[seg[keep]], pi[keep].astype(np.int64), lo[keep], hi[keep]
+
+
+def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
+    """Return the linear pieces of disc movers' tracks, shape (p, 9), for :func:`disc_windows`.
+
+    Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
+    last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
+    ``limit`` plus the radius is ``r + g (t - u)`` (m).
+    """
+    out = []
     for j, m in enumerate(movers):
-        sel = np.arange(pts.shape[0]) if near is None else np.asarray(near[j], dtype=np.int64)
-        if sel.size == 0:
-            continue
         tk = m.times
         t_end = max(float(tk[-1]), 0.0) + 1.0
         knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
@@ -390,32 +411,22 @@ def disc_windows(
         px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
         inside = (mid > tk[0]) & (mid < tk[-1])
         span = w - u
-        per = (
-            np.broadcast_to(sel, (u.size, sel.size)),
-            u[:, None],
-            np.where(w >= t_end, np.inf, w)[:, None],  # the last piece: the mover stands
-            pts[sel, 0][None, :] - px[:-1, None],
-            pts[sel, 1][None, :] - py[:-1, None],
-            np.where(inside, np.diff(px) / span, 0.0)[:, None],
-            np.where(inside, np.diff(py) / span, 0.0)[:, None],
-            (limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)))[:, None],
-            np.array([[j]]),
+        out.append(
+            np.column_stack(
+                [
+                    np.full(u.shape, float(j)),
+                    u,
+                    np.where(w >= t_end, np.inf, w),
+                    px[:-1],
+                    py[:-1],
+                    np.where(inside, np.diff(px) / span, 0.0),
+                    np.where(inside, np.diff(py) / span, 0.0),
+                    limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)),
+                    np.where(mid < m.t_last, m.growth, 0.0),
+                ]
+            )
         )
-        shape = (u.size, sel.size)
-        for c, x in zip(cols, per, strict=True):
-            c.append(np.broadcast_to(x, shape).ravel())
-        grow.append(
-            np.broadcast_to(np.where(mid < m.t_last, m.growth, 0.0)[:, None], shape).ravel()
-        )
-    if not grow:
-        empty = np.zeros(0)
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), empty, empty
-    point, u, w, dx, dy, vx, vy, rr, who = (np.concatenate(c) for c in cols)
-    t_lo, t_hi = _inside(dx, dy, vx, vy, rr, np.concatenate(grow))
-    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
-    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
-    keep = lo < hi
-    return who[keep].astype(np.int64), point[keep].astype(np.int64), lo[keep], hi[keep]
+    return np.concatenate(out) if out else np.zeros((0, 9))
 
 
 def reach_bound(

@@ -28,7 +28,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_grid import disc_windows
+from trajopt.moving._st_grid import disc_windows, mover_pieces
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -85,8 +85,8 @@ class FineWindows:
         self.s, self.h = s, float(s[1] - s[0])
         self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
         self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-        sel = None if near is None else [np.flatnonzero(row) for row in near]
-        owner, node, lo, hi = disc_windows(pts, movers, limit + 0.5 * self.h, sel)
+        self.pieces = mover_pieces(movers, limit)
+        owner, node, lo, hi = disc_windows(pts, self.pieces, 0.5 * self.h, near)
         order = np.argsort(node, kind="stable")
         node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
         counts = np.bincount(node, minlength=s.shape[0])
@@ -192,7 +192,7 @@ class FineWindows:
                 lo, hi = self.lo[run], self.hi[run]
             else:
                 pt = self.where(np.array([s]))
-                _, _, lo, hi = disc_windows(pt, self.movers, self.limit + POINT_PAD)
+                _, _, lo, hi = disc_windows(pt, self.pieces, POINT_PAD)
             self._points[s] = (lo, hi)
         return self._points[s]
 
@@ -213,10 +213,10 @@ class FineWindows:
         step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
         tau = np.minimum(a[idx] + step * REFINE_DT, b[idx])
         pts = self.where(s_of(tau))
-        who = owner[idx]
-        sel = [np.flatnonzero(who == j) for j in range(len(self.movers))]
+        near = np.zeros((len(self.movers), tau.shape[0]), dtype=bool)
+        near[owner[idx], np.arange(tau.shape[0])] = True
         pad = 0.5 * REFINE_DT
-        _, pi, w_lo, w_hi = disc_windows(pts, self.movers, self.limit + self.speed * pad, sel)
+        _, pi, w_lo, w_hi = disc_windows(pts, self.pieces, self.speed * pad, near)
         return w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
 
 
