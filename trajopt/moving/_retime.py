@@ -11,16 +11,25 @@
    ..., drive to the goal and stand there; a dynamic programme over the stops finds the
    earliest arrival. From a moving start the first drive leaves at once from the start state
    (to the goal, or braking to rest at a stop);
-3. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
-   phases of zero speed) and is certified by :func:`certify_movers`; a failed certificate
-   (the grid's inflation is a proof for the grid, so only numerical slips) retries with a
-   finer time step;
-4. when nothing is found, a sweep of the nodes a non-decreasing ``s(t)`` with ``v <= v_max``
+3. the rests are shortened (:mod:`._tighten`): each drive, with everything after it, is
+   launched as early as the movers' exact windows at fine nodes allow (the wait at the
+   start first, then the waits at stops), and from rest the path's one drive (the plan's
+   own timing) is launched at the earliest time they allow, the earlier arrival of the two
+   tried first;
+4. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
+   phases of zero speed) and is certified by :func:`certify_movers`, which decides: the
+   profile before step 3 when the shortened one fails; when both fail (the grid's
+   inflation is a proof for the grid, so only numerical slips) the search retries with a
+   finer time step. When the search finds nothing, the path's one drive after the earliest
+   wait the fine windows allow is tried;
+5. when nothing is found, a sweep of the nodes a non-decreasing ``s(t)`` with ``v <= v_max``
    can occupy on the *necessary* grid names the mover that blocks the path and the time
    (:class:`BlockedError`).
 
-The cap table, the grid's node points and the rest-to-rest drives of the last few paths are
-kept (:data:`_TABLES`): new predictions for the same path reuse them.
+The cap table, the grid's node points, the rest-to-rest drives and a moving start's
+launches of the last few paths are kept (:data:`_TABLES`), found again by the path's
+geometry (:func:`geometry_key`): new predictions for the same path reuse them, also when the
+path is a new object of the same geometry (a re-plan that keeps its rest at the same splice).
 """
 
 from __future__ import annotations

@@ -225,3 +225,29 @@ def test_never_later_than_a_brute_force_wait_at_the_start(line6, spec):
     assert cert.ok and dense_min(out, movers)[0] >= -1e-6
     if witness is not None:
         assert out.duration <= witness + 1e-9
+
+
+def test_a_path_of_the_same_geometry_re_times_as_when_cold():
+    # a re-plan that keeps its rest hands over a new curve object of the same geometry: the
+    # re-timing reuses the old path's tables and must give what a cold re-timing gives
+    from trajopt.geometry import BSplineCurve
+    from trajopt.moving import _retime
+
+    t = np.array([0.0, 0.0, 0.0, 0.0, 2.0, 4.0, 6.0, 6.0, 6.0, 6.0])
+    c = np.array([[0.0, 0.0], [1.0, 0.2], [2.5, -0.2], [3.5, 0.3], [5.0, 0.0], [6.0, 0.1]])
+    m = MovingObstacle.constant_velocity(
+        (3.0, -2.0), (0.0, 0.35), radius=0.3, horizon=25.0, name="walker"
+    )
+    first = time_parameterize(BSplineCurve(t, c, 3), ROBOT)
+    assert not certify_movers(first, [m]).ok
+    warm_up = retime_for_movers(first, [m])
+    again = time_parameterize(BSplineCurve(t.copy(), c.copy(), 3), ROBOT)
+    assert again.path is not first.path
+    warm = retime_for_movers(again, [m])
+    _retime._TABLES.clear()
+    cold = retime_for_movers(again, [m])
+    assert warm.path is again.path and certify_movers(warm, [m]).ok
+    for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
+        assert np.array_equal(getattr(warm, name), getattr(cold, name))
+        assert np.array_equal(getattr(warm, name), getattr(warm_up, name))
+    assert dense_min(warm, [m])[0] >= -1e-6
