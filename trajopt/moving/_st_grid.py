@@ -352,6 +352,7 @@ def disc_windows(
     movers: Sequence[MovingObstacle] | np.ndarray,
     limit: float,
     near: np.ndarray | None = None,
+    pairs: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Return when points are closer to disc movers than ``limit`` plus their radius.
 
@@ -369,6 +370,8 @@ def disc_windows(
         The distance to keep besides a mover's radius (m).
     near : ndarray of bool, shape (movers, n), optional
         Which points to test against each mover; default all.
+    pairs : (ndarray of int, ndarray of int), optional
+        Instead: which piece (row of the pieces) to test against which point.
 
     Returns
     -------
@@ -379,7 +382,9 @@ def disc_windows(
     """
     rows = movers if isinstance(movers, np.ndarray) else mover_pieces(movers, 0.0)
     who = rows[:, 0].astype(np.int64)
-    if near is None:
+    if pairs is not None:
+        seg, pi = pairs
+    elif near is None:
         seg, pi = np.divmod(np.arange(rows.shape[0] * pts.shape[0]), pts.shape[0])
     else:
         seg, pi = np.nonzero(near[who])

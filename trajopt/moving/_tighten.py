@@ -32,14 +32,14 @@ from trajopt.moving._st_grid import disc_windows, mover_pieces
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
-FINE_DS = 0.005
+FINE_DS = 0.01
 #: Time step (s) of the drives' samples that bound when the robot is near a node.
 SAMPLE_DT = 2e-3
 #: A launch is placed this far (s) past the end of a forbidden interval.
 EPS_L = 1e-6
 #: The refinement's time step (s) and how far before the launch (s) a deciding interval ends.
 REFINE_DT = 2.5e-4
-REFINE_S = 0.02
+REFINE_S = 0.04
 #: The pad (m) of a rest's point against the path's evaluation (its arc length interpolated).
 POINT_PAD = 1e-4
 #: Bisection steps of :func:`bisect_start`.
@@ -63,8 +63,9 @@ class FineWindows:
         Disc movers.
     limit : float
         Robot radius plus margin (m).
-    near : ndarray of bool, shape (movers, n), optional
-        The nodes each mover can come near (a filter); default all.
+    pairs : (ndarray of int, ndarray of int), optional
+        Which piece of the movers' tracks (:func:`._st_grid.mover_pieces` of ``movers`` and
+        ``limit``) can come near which node (a filter); default all.
     where : callable, optional
         ``where(s)``: the path's points (m), shape (m, 2), at arc lengths ``s`` (m), shape
         (m,); with it, :meth:`earliest` refines the windows that decide the launch.
@@ -78,7 +79,7 @@ class FineWindows:
         pts: np.ndarray,
         movers: Sequence[MovingObstacle],
         limit: float,
-        near: np.ndarray | None = None,
+        pairs: tuple[np.ndarray, np.ndarray] | None = None,
         where: Callable[[np.ndarray], np.ndarray] | None = None,
         speed: float = 0.0,
     ) -> None:
@@ -86,7 +87,7 @@ class FineWindows:
         self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
         self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self.pieces = mover_pieces(movers, limit)
-        owner, node, lo, hi = disc_windows(pts, self.pieces, 0.5 * self.h, near)
+        owner, node, lo, hi = disc_windows(pts, self.pieces, 0.5 * self.h, pairs=pairs)
         order = np.argsort(node, kind="stable")
         node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
         counts = np.bincount(node, minlength=s.shape[0])
@@ -169,7 +170,7 @@ class FineWindows:
             bind = (f_hi >= cur - REFINE_S) & (f_lo < cur)
             if not bind.any():
                 break
-            x_lo, x_hi = self._exact(span_a[bind], span_b[bind], owner[bind], s_of)
+            x_lo, x_hi = self._exact(span_a[bind], span_b[bind], owner[bind], s_of, lo, cur)
             f_lo, f_hi = f_lo[~bind], f_hi[~bind]
             span_a, span_b, owner = span_a[~bind], span_b[~bind], owner[~bind]
             extra_lo, extra_hi = np.append(extra_lo, x_lo), np.append(extra_hi, x_hi)
@@ -202,22 +203,50 @@ class FineWindows:
         b: np.ndarray,
         owner: np.ndarray,
         s_of: Callable[[np.ndarray], np.ndarray],
+        lo: float,
+        hi: float,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return the launches (open intervals, s) at which the motion meets the movers.
 
         During ``[a_j, b_j]`` (s from the launch) against mover ``owner_j``, from the motion's
-        own points every :data:`REFINE_DT` (s).
+        own points every :data:`REFINE_DT` (s); complete for launches in ``[lo, hi]`` (s)
+        (only the pieces of the tracks those launches can meet are tested).
         """
         n = np.maximum(np.ceil((b - a) / REFINE_DT).astype(np.int64), 1) + 1
         idx = np.repeat(np.arange(a.shape[0]), n)
         step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
         tau = np.minimum(a[idx] + step * REFINE_DT, b[idx])
         pts = self.where(s_of(tau))
-        near = np.zeros((len(self.movers), tau.shape[0]), dtype=bool)
-        near[owner[idx], np.arange(tau.shape[0])] = True
         pad = 0.5 * REFINE_DT
-        _, pi, w_lo, w_hi = disc_windows(pts, self.pieces, self.speed * pad, near)
+        pairs = pieces_meeting(self.pieces, owner[idx], tau + lo - pad, tau + hi + pad)
+        _, pi, w_lo, w_hi = disc_windows(pts, self.pieces, self.speed * pad, pairs=pairs)
         return w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
+
+
+def pieces_meeting(
+    pieces: np.ndarray, owner: np.ndarray, t_lo: np.ndarray, t_hi: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(piece, item)``: the pieces of mover ``owner[i]`` whose span meets ``[t_lo[i], t_hi[i]]``.
+
+    ``pieces`` from :func:`._st_grid.mover_pieces` (in order of mover and time); ``t_hi`` may
+    be ``inf``.
+    """
+    who = pieces[:, 0].astype(np.int64)
+    m = int(who[-1]) + 1 if who.size else 0
+    nseg = np.bincount(who, minlength=m)
+    seg0 = np.cumsum(nseg) - nseg
+    big = 4.0 * (float(np.max(pieces[:, 1], initial=0.0)) + 10.0)
+    cap = 0.5 * big
+    lo_t = np.clip(t_lo, -cap, cap)
+    hi_t = np.clip(t_hi, -cap, cap)
+    a = np.searchsorted(who * big + np.minimum(pieces[:, 2], cap), owner * big + lo_t)
+    b = np.searchsorted(who * big + pieces[:, 1], owner * big + hi_t, side="right")
+    a = np.maximum(a, seg0[owner])
+    b = np.minimum(b, seg0[owner] + nseg[owner])
+    cnt = np.maximum(b - a, 0)
+    item = np.repeat(np.arange(owner.shape[0]), cnt)
+    seg = np.repeat(a, cnt) + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    return seg, item
 
 
 def _sweep(f_lo: np.ndarray, f_hi: np.ndarray, lo: float) -> float:
