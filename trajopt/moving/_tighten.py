@@ -12,12 +12,15 @@ exactly in time. Fine nodes ``s_i`` along the path (spacing ``h``, at most
 ``C(s_i)``, so it keeps its limit when ``C(s_i)`` keeps the limit plus ``h/2``, whose
 violation times are the closed-form windows of :func:`._st_grid.disc_windows`. A motion
 starting at ``L`` occupies node ``i`` during ``[L + a, L + b]`` (``[a, b]`` from dense
-samples of the drives, widened to the samples around it, the rests' and the goal's standing
-exactly); it meets a window ``(lo, hi)`` iff ``lo - b < L < hi - a``. The earliest ``L`` of
-the allowed range outside all of these intervals is the launch. The fine test is
-sufficient, and :func:`trajopt.certify_movers` decides on the result: the caller keeps the
-untightened schedule when it fails. Other shapes (a footprint robot, a polygon mover)
-bisect the wait at the start over certificates (:func:`bisect_start`).
+samples of the drives, widened to the samples around it); it meets a window ``(lo, hi)``
+iff ``lo - b < L < hi - a``. The rests and the standing at the goal are tested at the
+path's point itself (:meth:`FineWindows.point_windows`). The earliest ``L`` of the allowed
+range outside all of these intervals is the launch; the intervals that decide it are then
+computed again from the motion's own points on samples every :data:`REFINE_DT`
+(:meth:`FineWindows.earliest`). The test is sufficient, and :func:`trajopt.certify_movers`
+decides on the result: the caller keeps the untightened schedule when it fails. Other
+shapes (a footprint robot, a polygon mover) bisect the wait at the start over certificates
+(:func:`bisect_start`).
 """
 
 from __future__ import annotations
