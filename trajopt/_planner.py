@@ -57,6 +57,7 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
+import dataclasses
 import threading
 import time
 from collections.abc import Sequence
@@ -67,9 +68,9 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.errors import InvalidInputError
+from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, check_movers, retime_plan
+from trajopt.moving import MovingObstacle, check_movers, reroute, retime_chain
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -372,7 +373,7 @@ class Planner:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
             if movers:
-                out = _retime(out, movers, margin, self.options.robot)
+                out = _retime(out, movers, margin, self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -558,13 +559,55 @@ def plan(
 
 
 def _retime(
-    out: PlanResult, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot
+    out: PlanResult,
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
 ) -> PlanResult:
-    """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
-    signed = robot.drive.signed_speed  # a car's: not covered yet
-    if signed or out.v_start != 0.0:
+    """Re-time a plan for movers, or re-route it (:meth:`Planner.plan`); refuse what is not covered.
+
+    The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`); when that
+    is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
+    swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
+    planner's options, on caches derived from the planner's for the marked map).
+    """
+    if out.v_start != 0.0:
         raise InvalidInputError(
-            "moving_obstacles are covered for a plan from rest of the differential or omni "
-            f"drive; this query gave a {type(out).__name__} with v_start={out.v_start}"
+            "moving_obstacles are covered for a plan from rest; this query gave a "
+            f"{type(out).__name__} with v_start={out.v_start} m/s"
         )
-    return retime_plan(out, movers, margin=margin)
+    if out.polyline:
+        raise InvalidInputError(
+            "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
+            f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
+        )
+    try:
+        return retime_chain(out, movers, margin=margin)
+    except BlockedError as exc:
+        blocked = exc
+    inflated = np.asarray(caches.inflated.occupied)
+    smp = out.sample(np.array([0.0]))
+    ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
+    labels = caches.components
+    free = ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
+
+    def plan_leg(
+        grid: OccupancyGrid,
+        p0: np.ndarray | None,
+        p1: np.ndarray | None,
+        heading: float | None,
+    ) -> PlanResult:
+        leg = request
+        if p0 is not None:
+            leg = dataclasses.replace(
+                leg, start=(float(p0[0]), float(p0[1])), start_heading=heading
+            )
+        if p1 is not None:
+            leg = dataclasses.replace(
+                leg, goal=(float(p1[0]), float(p1[1])), goal_heading=None, goal_steer=None
+            )
+        return run_query(options, caches.derived(grid), leg)
+
+    return reroute(out, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg)
