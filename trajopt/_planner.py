@@ -584,9 +584,12 @@ def _retime(
             f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
         )
     try:
-        return retime_chain(out, movers, margin=margin)
+        kept = retime_chain(out, movers, margin=margin)
     except BlockedError as exc:
         blocked = exc
+    else:
+        kept.stats["moving"]["route"] = "retimed"
+        return kept
     inflated = np.asarray(caches.inflated.occupied)
     smp = out.sample(np.array([0.0]))
     ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
