@@ -590,11 +590,13 @@ def _retime(
     else:
         kept.stats["moving"]["route"] = "retimed"
         return kept
-    inflated = np.asarray(caches.inflated.occupied)
-    smp = out.sample(np.array([0.0]))
-    ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
-    labels = caches.components
-    free = ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
+
+    def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
+        inflated = np.asarray(caches.inflated.occupied)
+        smp = out.sample(np.array([0.0]))
+        ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
+        labels = caches.components
+        return ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
 
     def plan_leg(
         grid: OccupancyGrid,

@@ -7,10 +7,11 @@ head-on along a corridor (Fraichard's incompleteness of the path-speed split). W
 ``plan_leg`` on a map the movers' swept regions are marked on (:mod:`._swept`), then re-timed
 for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 
-1. ``"rerouted"``: the same query on the map with the blocking mover's swept region over
-   ``[t, t_last]`` marked (``t`` the time from which it blocks; grown by the margin; the
-   planner inflates it by the robot's radius as any obstacle): a way round where it stops, or
-   round the rest of its track;
+1. ``"rerouted"``: the same query on the map with the blocking mover's whole swept region
+   marked (grown by the margin; the planner inflates it by the robot's radius as any
+   obstacle): a way that never meets it, so its re-timing is mostly the certificate alone;
+   then with its region over ``[t, t_last]`` only (``t`` the time from which it blocks): a
+   way round where it stops, or round the rest of its track;
 2. ``"rerouted"``: the same query with every mover's final place marked (where each stands
    after its prediction ends): a route that no mover stays on; the re-timing waits at the
    start while a mover still passes (the waiting witness of the issue);
@@ -72,7 +73,7 @@ def reroute(
     blocked: BlockedError,
     *,
     grid: OccupancyGrid,
-    free: np.ndarray,
+    free: Callable[[], np.ndarray],
     plan_leg: PlanLeg,
 ) -> Any:
     """Return a certified plan by another route or a wait at a safe place (module docstring).
@@ -89,9 +90,10 @@ def reroute(
         What the re-timing of ``plan`` raised (its ``mover`` and ``t``).
     grid : astar.OccupancyGrid
         The raw map.
-    free : ndarray of bool, shape (ny, nx)
-        Where the robot's centre may stand on the static map (the planner's inflated grid
-        free cells, in the start's connected part).
+    free : callable
+        ``free()``: where the robot's centre may stand on the static map, bool, shape
+        (ny, nx) (the planner's inflated grid's free cells in the start's connected part);
+        called only when a wait at a safe place is tried.
     plan_leg : callable
         ``plan_leg(grid, start, goal, start_heading)`` (:data:`PlanLeg`).
 
@@ -144,22 +146,26 @@ def reroute(
 
     who = by_name.get(blocked.mover)
     if who is not None:
-        t_from = min(max(blocked.t, 0.0), max(who.t_last, 0.0))
-        out = attempt(
-            f"around {who.name!r} from t = {t_from:.3f} s",
-            detour([(who, t_from, max(who.t_last, t_from))]),
-            "rerouted",
-        )
-        if out is not None:
-            return out
+        t_end = max(who.t_last, 0.0)
+        t_from = min(max(blocked.t, 0.0), t_end)
+        spans = [(min(0.0, float(who.times[0])), "")]
+        if t_from > 0.0:
+            spans.append((t_from, f" from t = {t_from:.3f} s"))
+        for t0, when in spans:
+            out = attempt(
+                f"around {who.name!r}{when}", detour([(who, t0, max(t_end, t0))]), "rerouted"
+            )
+            if out is not None:
+                return out
     finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
     out = attempt("around every mover's final place", detour(finals), "rerouted")
     if out is not None:
         return out
     if robot.drive.turns_in_place and not robot.drive.signed_speed:
-        places = safe_places(grid, free, movers, robot.radius + margin, p0, p1, t_last)
+        room = free()
+        places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
         places = [
-            p for p in places if _joined_at_last(grid, free, movers, robot.radius + margin, p, p1)
+            p for p in places if _joined_at_last(grid, room, movers, robot.radius + margin, p, p1)
         ]
         for place in places:
             out = attempt(

@@ -110,10 +110,16 @@ def mark_swept(
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
     for p, r in keep:
-        cx = ox + (np.arange(nx) + 0.5) * res
-        cy = oy + (np.arange(ny) + 0.5) * res
+        ix0 = max(0, int(math.floor((float(p[0]) - r - ox) / res)))
+        ix1 = min(nx - 1, int(math.floor((float(p[0]) + r - ox) / res)))
+        iy0 = max(0, int(math.floor((float(p[1]) - r - oy) / res)))
+        iy1 = min(ny - 1, int(math.floor((float(p[1]) + r - oy) / res)))
+        if ix0 > ix1 or iy0 > iy1:
+            continue
+        cx = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
+        cy = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
         near = np.hypot(cx[None, :] - float(p[0]), cy[:, None] - float(p[1])) <= r
-        add &= ~near
+        add[iy0 : iy1 + 1, ix0 : ix1 + 1] &= ~near
     occ = np.asarray(grid.occupied)
     new = add & ~occ
     if not new.any():
