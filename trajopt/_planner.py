@@ -322,14 +322,18 @@ class Planner:
         moving_obstacles : sequence of MovingObstacle, optional
             Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
             ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
-            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at
-            the start and at stops on the way) and certified at every instant until the
-            last prediction ends (``stats["moving"]``). Covered: the differential and
-            omni drives (a disc or a footprint robot) whose plan is one curve from rest to
-            rest, with a differential drive's turns in place at its ends
-            (:func:`trajopt.moving.retime_plan`); other queries with movers (a car, an omni
-            orientation profile, a moving start) raise
-            :class:`~trajopt.errors.InvalidInputError`.
+            plan is re-timed along its path on one clock (:func:`trajopt.moving.retime_chain`:
+            rests at the start and at stops on the way; a differential drive's turns in
+            place and a car's steering at rest as rests, a car's drives between cusps each
+            from rest to rest, an omni orientation rebuilt on the re-timed translation) and
+            certified at every instant until the last prediction ends. When no re-timing
+            along the path avoids a mover, another route is planned on the map with the
+            movers' swept regions marked, or the robot waits at a safe place
+            (:func:`trajopt.moving.reroute`). ``stats["moving"]``: ``route``
+            (``"retimed"``, ``"rerouted"`` or ``"waited"``), ``plan`` in words, the
+            certificate and the wall times. Refused with
+            :class:`~trajopt.errors.InvalidInputError`: a moving start (``v_start > 0``)
+            and the stop-and-turn fallback's polyline.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
 
@@ -339,7 +343,10 @@ class Planner:
             With ``trajectory.steps`` (:class:`PlanSteps`) and per-stage wall times in
             ``trajectory.stats["stages_s"]``. A :class:`~trajopt.motion._stop_and_turn.StopAndTurnTrajectory`
             (``stats["fallback"] == "stop_and_turn"``) only with the planner's ``fallback``
-            option, when the smoother or the timing failed.
+            option, when the smoother or the timing failed. With movers, the plan's own kind
+            re-timed (a :class:`~trajopt.motion.TrajectoryChain` keeps its pieces, an
+            :class:`~trajopt.motion.OmniTrajectory` its orientation), or a re-route's plan; a
+            wait at a safe place is one :class:`~trajopt.motion.TrajectoryChain` of both legs.
 
         Raises
         ------
@@ -354,8 +361,8 @@ class Planner:
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
         BlockedError
-            A mover blocks the path: no re-timing along it avoids the mover (named, with
-            the time).
+            A mover blocks the way: no re-timing along the path avoids it and no re-route
+            tried does (the mover and the time named, each re-route's reason appended).
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
