@@ -16,7 +16,7 @@
 """
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
-from trajopt.moving._chain import retime_chain, shift_clock
+from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._reroute import reroute
 from trajopt.moving._retime import retime_for_movers, retime_plan
@@ -38,4 +38,5 @@ __all__ = [
     "shift_clock",
     "st_grid",
     "swept_mask",
+    "truncate",
 ]

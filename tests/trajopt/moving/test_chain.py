@@ -119,3 +119,51 @@ def test_an_omni_orientation_follows_the_re_timed_translation(scene, omni_planne
     assert np.abs(smp.omega).max() <= w_lim * (1 + 1e-6)
     assert np.abs(np.diff(smp.omega) / np.diff(t)).max() <= a_lim * (1 + 1e-3)
     assert np.abs(np.diff(smp.theta)).max() <= w_lim * (t[1] - t[0]) * (1 + 1e-6)
+
+
+def test_a_car_need_not_stand_at_a_cusp_it_has_left():
+    """A mover crossing the first cusp after the car has left it costs no time."""
+    grid, robot, start, goal, h0, h1 = three_point_scene()
+    planner = trajopt.Planner(grid, robot)
+    base = planner.plan(start, goal, start_heading=h0, goal_heading=h1)
+    j = next(k for k, p in enumerate(base.pieces) if p.single_curve)
+    cusp = base.sample(np.array([base.piece_times[j + 1]]))
+    p = np.array([cusp.x[0], cusp.y[0]])
+    t_late = base.duration + 3.0
+    late = trajopt.MovingObstacle.from_waypoints(
+        [t_late - 3.0, t_late + 3.0], [p - (0.0, 1.5), p + (0.0, 1.5)], radius=0.1, name="late"
+    )
+    early = _crossing_at(base, 0.5 * (base.piece_times[j] + base.piece_times[j + 1]))
+    alone = planner.plan(start, goal, start_heading=h0, goal_heading=h1, moving_obstacles=[early])
+    both = planner.plan(
+        start, goal, start_heading=h0, goal_heading=h1, moving_obstacles=[early, late]
+    )
+    assert alone.duration > base.duration
+    assert both.duration == pytest.approx(alone.duration, abs=1e-9)
+    _checked(both, [early, late])
+
+
+def test_truncate_agrees_until_its_end():
+    m = trajopt.MovingObstacle.from_waypoints(
+        [0.5, 2.0, 4.0], [(0, 0), (1, 2), (3, 1)], radius=0.1, growth=0.05, headings=[0, 1, 3]
+    )
+    for t_end in (0.2, 0.5, 1.3, 3.9, 5.0):
+        cut = trajopt.moving.truncate(m, t_end)
+        t = np.linspace(-1.0, t_end, 301)
+        for a, b in zip(cut.pose_at(t), m.pose_at(t), strict=True):
+            np.testing.assert_allclose(a, b, atol=1e-12)
+        np.testing.assert_allclose(cut.radius_at(t), m.radius_at(t), atol=1e-12)
+        later = cut.pose_at(np.array([t_end, t_end + 7.0]))[0]
+        np.testing.assert_allclose(later[0], later[1], atol=0)
+
+
+def test_shift_clock_is_the_same_prediction():
+    m = trajopt.MovingObstacle.from_waypoints(
+        [0.5, 2.0, 4.0], [(0, 0), (1, 2), (3, 1)], radius=0.1, growth=0.05, headings=[0, 1, 3]
+    )
+    for t0 in (0.0, 1.0, 3.0, 6.0):
+        sh = trajopt.moving.shift_clock(m, t0)
+        tau = np.linspace(0.0, 8.0, 401)
+        for a, b in zip(sh.pose_at(tau), m.pose_at(tau + t0), strict=True):
+            np.testing.assert_allclose(a, b, atol=1e-12)
+        np.testing.assert_allclose(sh.radius_at(tau), m.radius_at(tau + t0), atol=1e-12)
