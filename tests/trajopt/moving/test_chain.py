@@ -40,11 +40,21 @@ def _checked(out, movers, margin=0.0):
     assert brute_min(out, movers, margin=margin) >= -1e-6
 
 
-@pytest.mark.parametrize("make", [three_point_scene, behind_scene])
-def test_a_car_lets_a_crossing_mover_pass(make):
-    grid, robot, start, goal, h0, h1 = make()
-    planner = trajopt.Planner(grid, robot)
-    base = planner.plan(start, goal, start_heading=h0, goal_heading=h1)
+@pytest.fixture(scope="module")
+def cars():
+    """The three-point turn (cusps, steering at rest) and the goal behind (reversing)."""
+    out = {}
+    for make in (three_point_scene, behind_scene):
+        grid, robot, start, goal, h0, h1 = make()
+        planner = trajopt.Planner(grid, robot)
+        base = planner.plan(start, goal, start_heading=h0, goal_heading=h1)
+        out[make.__name__] = (planner, robot, start, goal, h0, h1, base)
+    return out
+
+
+@pytest.mark.parametrize("name", ["three_point_scene", "behind_scene"])
+def test_a_car_lets_a_crossing_mover_pass(cars, name):
+    planner, robot, start, goal, h0, h1, base = cars[name]
     mover = _crossing_at(base, 0.5 * base.duration)
     assert not trajopt.certify_movers(base, [mover]).ok
     out = planner.plan(start, goal, start_heading=h0, goal_heading=h1, moving_obstacles=[mover])
@@ -121,11 +131,9 @@ def test_an_omni_orientation_follows_the_re_timed_translation(scene, omni_planne
     assert np.abs(np.diff(smp.theta)).max() <= w_lim * (t[1] - t[0]) * (1 + 1e-6)
 
 
-def test_a_car_need_not_stand_at_a_cusp_it_has_left():
+def test_a_car_need_not_stand_at_a_cusp_it_has_left(cars):
     """A mover crossing the first cusp after the car has left it costs no time."""
-    grid, robot, start, goal, h0, h1 = three_point_scene()
-    planner = trajopt.Planner(grid, robot)
-    base = planner.plan(start, goal, start_heading=h0, goal_heading=h1)
+    planner, _, start, goal, h0, h1, base = cars["three_point_scene"]
     j = next(k for k, p in enumerate(base.pieces) if p.single_curve)
     cusp = base.sample(np.array([base.piece_times[j + 1]]))
     p = np.array([cusp.x[0], cusp.y[0]])

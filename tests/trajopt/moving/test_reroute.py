@@ -194,7 +194,7 @@ def test_swept_mask_covers_the_shape_at_dense_times():
     assert not mask[0:4, 70:80].any()  # far from the track
 
 
-@settings(max_examples=8, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
 @given(
     st.lists(
         st.tuples(
