@@ -15,14 +15,15 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 2. ``"rerouted"``: the same query with every mover's final place marked (where each stands
    after its prediction ends): a route that no mover stays on; the re-timing waits at the
    start while a mover still passes (the waiting witness of the issue);
-3. ``"waited"`` (a robot that turns in place): drive to a **safe place**, wait there until the
-   way is clear, drive to the goal. A safe place is a cell where the robot's centre may stand
+3. ``"waited"`` (a robot that turns in place: differential or omni): drive to a **safe
+   place**, wait there until the way is clear, drive to the goal. A safe place is a cell where the robot's centre may stand
    on the static map and that keeps the robot's radius plus the margin from every mover's
    whole swept region; the candidates, at least a metre apart, are those with the shortest
    straight-line detour ``|start - p| + |p - goal|``. The first leg is re-timed for the movers
    (standing at the safe place is safe whenever it arrives), the second leg, from the first's
    end heading (a turn in place), on the clock from the first's arrival
-   (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified whole.
+   (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified whole (with an omni
+   orientation, by the two legs' certificates on their clocks).
 
 A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
 (its reason kept). When none works, the original :class:`BlockedError` is raised again (it
@@ -267,6 +268,36 @@ def _wait_at(
         starts = _starts(first) + _starts(second)
         stats = dict(second.stats)
         chain = TrajectoryChain(tuple(pieces), first.robot, stats, second.steps, tuple(starts))
+        summary = _certificate(chain, first, second, movers, margin, t1)
+        stats["moving"] = {
+            "plan": (
+                f"to ({place[0]:.2f}, {place[1]:.2f}) m: {first.stats['moving']['plan']}; "
+                f"on at t = {t1:.3f} s: {second.stats['moving']['plan']}"
+            ),
+            "certificate": summary,
+            "time_s": first.stats["moving"]["time_s"] + second.stats["moving"]["time_s"],
+        }
+        return chain
+
+    return run
+
+
+def _certificate(
+    chain: TrajectoryChain,
+    first: Any,
+    second: Any,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    t1: float,
+) -> dict[str, Any]:
+    """Return the certificate summary of both legs as one chain (raise when it fails).
+
+    A chain of curves and motions at rest is certified whole (:func:`certify_movers`). One
+    with an omni orientation (which the certificate does not take) is proved by its legs'
+    certificates: the first leg's until the last prediction ends with the robot standing at
+    the safe place, the second's on the clock from ``t1`` (s), its arrival there.
+    """
+    if not any(p.own_orientation for p in chain.pieces):
         cert = certify_movers(chain, movers, margin=margin)
         if not cert.ok:
             raise BlockedError(
@@ -274,23 +305,25 @@ def _wait_at(
                 mover=cert.mover,
                 t=cert.witness_t,
             )
-        stats["moving"] = {
-            "plan": (
-                f"to ({place[0]:.2f}, {place[1]:.2f}) m: {first.stats['moving']['plan']}; "
-                f"on at t = {t1:.3f} s: {second.stats['moving']['plan']}"
-            ),
-            "certificate": {
-                "ok": cert.ok,
-                "slack_m": cert.slack,
-                "mover": cert.mover,
-                "horizon_s": cert.horizon,
-                "intervals": cert.intervals,
-            },
-            "time_s": 0.0,
+        return {
+            "ok": cert.ok,
+            "slack_m": cert.slack,
+            "mover": cert.mover,
+            "horizon_s": cert.horizon,
+            "intervals": cert.intervals,
         }
-        return chain
-
-    return run
+    a = first.stats["moving"]["certificate"]
+    b = second.stats["moving"]["certificate"]
+    if not (a["ok"] and b["ok"]):  # each leg's re-timing raises first; kept as a guard
+        raise BlockedError("a leg's certificate failed", mover=a["mover"] or b["mover"], t=t1)
+    worst = a if a["slack_m"] <= b["slack_m"] else b
+    return {
+        "ok": True,
+        "slack_m": worst["slack_m"],
+        "mover": worst["mover"],
+        "horizon_s": max(a["horizon_s"], t1 + b["horizon_s"]),
+        "intervals": a["intervals"] + b["intervals"],
+    }
 
 
 def _pieces(plan: Any) -> list[Any]:

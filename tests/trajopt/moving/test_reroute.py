@@ -1,7 +1,7 @@
 """Tests of trajopt.moving.reroute through Planner.plan: another route, or a wait at a safe place.
 
-Hand-built maps (5 cm cells): a corridor with a side bay (a head-on mover: the robot must
-yield in the bay), a loop of two corridors (a cart stops on the short one: the robot goes
+Hand-built maps (5 cm cells): a corridor with a side bay (a head-on mover: the robot, differential or
+omni with its own orientation, must yield in the bay), a loop of two corridors (a cart stops on the short one: the robot goes
 round by the long one) and a plain corridor (a cart drives into it and stops: no way,
 BlockedError naming the cart). Every returned plan is checked by the independent references (1 ms samples, brute
 force) and its samples against the map's occupied squares.
@@ -61,12 +61,16 @@ def _check(out, movers, grid, margin):
 @pytest.fixture(scope="module")
 def bay():
     """A 1 m corridor along y = 2 with a bay on its north side at x = 5.5-6.5."""
-    grid = _grid((80, 240), [(0.5, 11.5, 1.5, 2.5), (5.5, 6.5, 2.5, 3.6)])
-    return grid, trajopt.Planner(grid, trajopt.Robot())
+    return _grid((80, 240), [(0.5, 11.5, 1.5, 2.5), (5.5, 6.5, 2.5, 3.6)])
 
 
-def test_head_on_in_a_corridor_yields_in_the_bay(bay):
-    grid, planner = bay
+@pytest.mark.parametrize(
+    ("drive", "headings"),
+    [("differential", {}), ("omni", {"start_heading": -0.5, "goal_heading": 1.0})],
+)
+def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
+    grid = bay
+    planner = trajopt.Planner(grid, trajopt.Robot(drive=drive))
     start, goal = (1.0, 2.0), (11.0, 2.0)
     base = planner.plan(start, goal)
     forklift = trajopt.MovingObstacle.constant_velocity(
@@ -74,9 +78,18 @@ def test_head_on_in_a_corridor_yields_in_the_bay(bay):
     )
     with pytest.raises(BlockedError):  # no re-timing along the corridor lets it pass
         trajopt.retime_for_movers(base, [forklift], margin=0.02)
-    out = planner.plan(start, goal, moving_obstacles=[forklift], mover_margin=0.02)
-    assert out.stats["moving"]["route"] in ("waited", "rerouted")
-    _check(out, [forklift], grid, 0.02)
+    out = planner.plan(start, goal, moving_obstacles=[forklift], mover_margin=0.02, **headings)
+    assert out.stats["moving"]["route"] == "waited"
+    if headings:  # an omni base's orientation: its own, from the start's to the goal's
+        assert all(p.own_orientation for p in out.pieces)
+        ends = out.sample(np.array([0.0, out.duration])).theta
+        np.testing.assert_allclose(ends, [-0.5, 1.0], atol=1e-9)
+        assert out.stats["moving"]["certificate"]["ok"]
+        assert dense_min(out, [forklift], margin=0.02)[0] >= -1e-6
+        assert brute_min(out, [forklift], margin=0.02) >= -1e-6
+        assert _static_clearance(out, grid) >= out.robot.radius - 1e-6
+    else:
+        _check(out, [forklift], grid, 0.02)
     # the robot stands aside at the bay (north of the corridor) when the forklift passes it
     t_pass = (13.0 - 6.0) / 0.5
     smp = out.sample(np.array([t_pass]))
