@@ -70,7 +70,7 @@ from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
 from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, check_movers, reroute, retime_chain
+from trajopt.moving import MovingObstacle, check_movers, parked_on_path, reroute, retime_chain
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -575,8 +575,9 @@ def _retime(
 ) -> PlanResult:
     """Re-time a plan for movers, or re-route it (:meth:`Planner.plan`); refuse what is not covered.
 
-    The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`); when that
-    is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
+    The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`), unless a
+    mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`); when
+    it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
     swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
     planner's options, on caches derived from the planner's for the marked map).
     """
@@ -590,13 +591,15 @@ def _retime(
             "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
             f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
         )
-    try:
-        kept = retime_chain(out, movers, margin=margin)
-    except BlockedError as exc:
-        blocked = exc
-    else:
-        kept.stats["moving"]["route"] = "retimed"
-        return kept
+    blocked = parked_on_path(out, movers, margin)  # a quick proof, before the search's
+    if blocked is None:
+        try:
+            kept = retime_chain(out, movers, margin=margin)
+        except BlockedError as exc:
+            blocked = exc
+        else:
+            kept.stats["moving"]["route"] = "retimed"
+            return kept
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
         inflated = np.asarray(caches.inflated.occupied)

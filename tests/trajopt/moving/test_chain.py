@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import trajopt
+import trajopt.moving
 from tests.trajopt.moving.reference import brute_min, dense_min
 from tests.trajopt.planning.test_car import behind_scene, three_point_scene, uturn_scene
 from trajopt.timing import turn_limits

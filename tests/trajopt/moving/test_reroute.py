@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import trajopt
+import trajopt.moving
 from astar.grid import OccupancyGrid
 from tests.trajopt.moving.reference import brute_min, dense_min
 from trajopt.errors import BlockedError
