@@ -1,8 +1,12 @@
-"""Figures: the map with avoidance area, corridor and paths.
+"""Figures: the map with avoidance area, corridor and paths; moving obstacles over time.
 
 Figures: the map with avoidance area, corridor and paths (the chapter's Figures 7-11), the
 robot's footprint (or disc) at regular times along a timed trajectory, its heading as
 arrows with the turns in place marked, and time plots of a trajectory with its limits.
+With predicted moving obstacles: :func:`animate` (the robot and the movers over time, as
+an mp4, a gif or an HTML player; :mod:`trajopt.analysis.animation`) and :func:`plot_st`
+(the movers' forbidden regions of the ``(s, t)`` plane and the chosen profile ``s(t)``;
+:mod:`trajopt.analysis.st_diagram`).
 
 matplotlib is imported inside each function, so ``import trajopt`` never pulls it in.
 Every function returns the matplotlib objects it drew on, for further styling.
@@ -16,7 +20,11 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
+from trajopt.analysis.animation import Animation, animate_on
+from trajopt.analysis.st_diagram import ST_MAX_NODES, plot_st
+from trajopt.errors import InvalidInputError
 from trajopt.geometry import ParametricCurve
+from trajopt.moving import MovingObstacle, check_movers
 
 __all__ = [
     "plot_map",
@@ -25,6 +33,9 @@ __all__ = [
     "plot_headings",
     "plot_profiles",
     "path_points",
+    "animate",
+    "plot_st",
+    "ST_MAX_NODES",
 ]
 
 #: Most poses :func:`plot_footprints` draws; a smaller ``every_s`` is refused.
@@ -454,3 +465,93 @@ def plot_profiles(trajectory: Any, robot: Any = None, *, n: int = 1000) -> tuple
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
     return fig, axes
+
+
+def animate(
+    trajectory: Any,
+    grid: OccupancyGrid | None = None,
+    movers: Sequence[MovingObstacle] = (),
+    robot: Any = None,
+    *,
+    fps: float = 10.0,
+    speed: float = 1.0,
+    t_end: float | None = None,
+    path: Any = None,
+    dpi: float = 80.0,
+    figsize: tuple[float, float] = (6.0, 6.0),
+    inflated: OccupancyGrid | None = None,
+) -> Animation:
+    """Animate the robot and the moving obstacles over time on the map.
+
+    Each frame shows the robot (its footprint, or the disc of its radius, at the
+    trajectory's pose at time ``t``, with a heading tick) and every mover's shape at ``t``
+    (its disc or convex polygon rounded by ``radius_at(t)``), over the map, the faint path
+    and the movers' faint predicted tracks (:func:`trajopt.analysis.animation.animate_on`).
+    Times are the trajectory's clock (s); lengths are metres.
+
+    Parameters
+    ----------
+    trajectory : Trajectory or TrajectoryChain
+        The timed motion (``duration`` in s, ``sample(t)`` giving ``x, y`` in m and
+        ``theta`` in rad).
+    grid : OccupancyGrid, optional
+        The map drawn below (:func:`plot_map`); ``None``: plain axes in metres.
+    movers : sequence of MovingObstacle
+        The predicted movers, in the trajectory's clock.
+    robot : Robot, optional
+        The shape drawn; default ``trajectory.robot``.
+    fps : float
+        Frames per second of playback (> 0).
+    speed : float
+        Seconds of the trajectory's clock per second of playback (> 0).
+    t_end : float, optional
+        The last frame's time (s); default the later of the trajectory's end and the movers'
+        last prediction times (the robot stands at its goal meanwhile).
+    path : str or os.PathLike, optional
+        Save to this file: ``.mp4`` (needs the ffmpeg encoder), ``.gif`` (pillow) or
+        ``.html`` (the player). When the encoder is missing
+        (``matplotlib.animation.writers.is_available``) the HTML player is written beside
+        it (suffix ``.html``) with a ``UserWarning``. ``None``: nothing saved.
+    dpi : float
+        Resolution of the frames, saved and in the player (dots per inch).
+    figsize : (float, float)
+        Figure size (inches).
+    inflated : OccupancyGrid, optional
+        Shaded as the avoidance area (:func:`plot_map`).
+
+    Returns
+    -------
+    Animation
+        Shown in Jupyter as the HTML player (or the gif or mp4 written); its ``animation``
+        is the matplotlib ``FuncAnimation``, its ``times`` the frame times (s).
+
+    Raises
+    ------
+    InvalidInputError
+        A bad ``fps``, ``speed``, ``t_end``, ``dpi``, ``figsize`` or ``path`` suffix, too
+        many frames, a mover that is not a ``MovingObstacle``, or no robot.
+    """
+    import matplotlib.pyplot as plt
+
+    try:
+        size = tuple(float(v) for v in figsize)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"figsize must be two numbers of inches, got {figsize!r}") from None
+    if len(size) != 2 or not all(np.isfinite(size)) or min(size) <= 0.0:
+        raise InvalidInputError(f"figsize must be two finite numbers > 0 (inches), got {figsize!r}")
+    check_movers(movers)  # before any figure is made
+    fig, ax = plt.subplots(figsize=size)
+    try:
+        if grid is not None:
+            plot_map(grid, inflated=inflated, ax=ax)
+        else:
+            ax.set_xlabel("x [m]")
+            ax.set_ylabel("y [m]")
+            ax.set_aspect("equal")
+        fig.tight_layout()
+        return animate_on(
+            ax, trajectory, movers, robot, fps=fps, speed=speed, t_end=t_end, path=path, dpi=dpi
+        )
+    except BaseException:
+        plt.close(fig)
+        raise

@@ -7,7 +7,8 @@
 * :func:`polygon_clearance`, :func:`polyline_clearance`: exact distances from the raw map
   (occupied cells taken as closed squares);
 * :func:`convex_hull`;
-* :func:`length_unit`: the length unit the corridor and the smoother count in.
+* :func:`length_unit`: the length unit the corridor and the smoother count in;
+* :func:`rounded_polygon`: the outline of a convex polygon rounded by a radius (a mover's shape).
 """
 
 from trajopt.geometry._bspline import (
@@ -57,6 +58,7 @@ from trajopt.geometry._obstacle_index import (
     poly_clearance,
     seg_clearance,
 )
+from trajopt.geometry._rounded_polygon import rounded_polygon
 
 __all__ = [
     "BSplineCurve",
@@ -94,6 +96,7 @@ __all__ = [
     "polygon_rect_closest",
     "polygon_rects_distance",
     "polyline_clearance",
+    "rounded_polygon",
     "seg_clearance",
     "segment_rect_distance",
     "signed_curvature",

@@ -14,6 +14,8 @@ topic               type                              content
 ``/corridor``       ``visualization_msgs/msg/MarkerArray``  one closed ``LINE_STRIP`` per region
 ``/pose``           ``geometry_msgs/msg/PoseStamped`` one per sample, stamped at its time
 ``/twist``          ``geometry_msgs/msg/TwistStamped`` ``linear.x = v``, ``angular.z = omega``
+``/movers``         ``visualization_msgs/msg/MarkerArray``  each mover's shape at each time (below)
+``/movers/predicted`` ``visualization_msgs/msg/MarkerArray``  each mover's predicted track
 ==================  ================================  =============================================
 
 The maps and the corridor come from ``trajectory.steps`` (a trajectory returned by
@@ -25,6 +27,17 @@ omnidirectional base's twist is its body-frame velocity ``linear.x = v_body_x``,
 Every message is logged at its header stamp: ``start_time`` (s since the Unix epoch,
 default 0) plus the sample time; the map, path and corridor at ``start_time``.
 
+With ``movers`` (:class:`trajopt.MovingObstacle`), two more topics: ``/movers/predicted``
+once at ``start_time``, one ``LINE_STRIP`` per mover (namespace ``"predicted"``, id its
+index, ``text`` its name) through its waypoints in ``frame_id``; and ``/movers`` every
+``movers_dt`` (default ``dt``) from ``t = 0`` to the later of the trajectory's end and the
+last prediction time (the end included), one closed ``LINE_STRIP`` per mover (namespace ``"movers"``, id its
+index, ``text`` its name) whose ``pose`` is the mover's reference point and heading at that
+time and whose ``points`` are its shape's outline in its own frame: the convex polygon (or
+the point of a disc) rounded by ``radius_at(t)``
+(:func:`trajopt.geometry.rounded_polygon`). Without movers the file is the same, byte for
+byte, as before they existed.
+
 The file is written atomically (a temporary file beside it, then a rename): a failure
 leaves no partial file. :func:`read_mcap` reads such a file back.
 
@@ -35,7 +48,6 @@ from __future__ import annotations
 
 import math
 import os
-import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,6 +57,16 @@ import numpy as np
 from astar.files import atomic_write
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, TrajoptError
+from trajopt.motion._cdr import (
+    CdrWriter,
+    MoverFrames,
+    encode_grid,
+    encode_markers,
+    encode_movers_at,
+    encode_path,
+    encode_pose_stamped,
+    encode_predicted,
+)
 
 #: Topic -> ROS 2 message type written by :func:`write_mcap`.
 TOPICS: dict[str, str] = {
@@ -54,6 +76,11 @@ TOPICS: dict[str, str] = {
     "/corridor": "visualization_msgs/msg/MarkerArray",
     "/pose": "geometry_msgs/msg/PoseStamped",
     "/twist": "geometry_msgs/msg/TwistStamped",
+}
+#: Topic -> ROS 2 message type added by :func:`write_mcap` when it is given movers.
+MOVER_TOPICS: dict[str, str] = {
+    "/movers": "visualization_msgs/msg/MarkerArray",
+    "/movers/predicted": "visualization_msgs/msg/MarkerArray",
 }
 
 
@@ -127,104 +154,23 @@ def message_definition(datatype: str) -> str:
     return "\n".join(parts) + "\n"
 
 
-# ============================================================== CDR encoding
-class _Cdr:
-    """Little-endian CDR (XCDR1) writer.
-
-    Primitives aligned to their size from the start of the payload (after the 4-byte
-    encapsulation header).
-    """
-
-    __slots__ = ("buf",)
-
-    def __init__(self) -> None:
-        self.buf = bytearray(b"\x00\x01\x00\x00")
-
-    def _align(self, n: int) -> None:
-        pad = (-(len(self.buf) - 4)) % n
-        if pad:
-            self.buf += b"\x00" * pad
-
-    def pack(self, fmt: str, size: int, *values: Any) -> None:
-        self._align(size)
-        self.buf += struct.pack("<" + fmt, *values)
-
-    def string(self, s: str) -> None:
-        data = s.encode("utf-8") + b"\x00"
-        self.pack("I", 4, len(data))
-        self.buf += data
-
-    def byte_seq(self, data: bytes) -> None:
-        self.pack("I", 4, len(data))
-        self.buf += data
-
-    def time(self, ns: int) -> None:
-        self.pack("iI", 4, ns // 1_000_000_000, ns % 1_000_000_000)
-
-    def header(self, ns: int, frame_id: str) -> None:
-        self.time(ns)
-        self.string(frame_id)
-
-    def pose(self, x: float, y: float, qz: float, qw: float) -> None:
-        self.pack("7d", 8, x, y, 0.0, 0.0, 0.0, qz, qw)
-
-    def data(self) -> bytes:
-        return bytes(self.buf)
-
-
-def _encode_grid(grid: OccupancyGrid, ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.header(ns, frame_id)
-    w.time(ns)
-    ny, nx = grid.shape
-    w.pack("fII", 4, float(grid.resolution), nx, ny)
-    w.pose(float(grid.origin[0]), float(grid.origin[1]), 0.0, 1.0)
-    w.byte_seq(np.where(grid.occupied, 100, 0).astype(np.int8).tobytes())
-    return w.data()
-
-
-def _encode_pose_stamped(w: _Cdr, ns: int, frame_id: str, x, y, qz, qw) -> None:
-    w.header(ns, frame_id)
-    w.pose(x, y, qz, qw)
-
-
-def _encode_path(ns0: int, stamps, frame_id: str, x, y, qz, qw) -> bytes:
-    w = _Cdr()
-    w.header(ns0, frame_id)
-    w.pack("I", 4, len(stamps))
-    for k in range(len(stamps)):
-        _encode_pose_stamped(w, int(stamps[k]), frame_id, x[k], y[k], qz[k], qw[k])
-    return w.data()
-
-
-def _encode_markers(polygons: list[np.ndarray], ns: int, frame_id: str) -> bytes:
-    w = _Cdr()
-    w.pack("I", 4, len(polygons))
-    for k, poly in enumerate(polygons):
-        w.header(ns, frame_id)
-        w.string("corridor")
-        w.pack("iii", 4, k, 4, 0)  # id, LINE_STRIP, ADD
-        w.pose(0.0, 0.0, 0.0, 1.0)
-        w.pack("3d", 8, 0.01, 0.0, 0.0)  # scale.x: line width (m)
-        w.pack("4f", 4, 0.1, 0.45, 0.85, 1.0)
-        w.pack("iI", 4, 0, 0)  # lifetime 0: forever
-        w.pack("?", 1, False)
-        closed = np.vstack([poly, poly[:1]]) if len(poly) > 1 else poly
-        w.pack("I", 4, len(closed))
-        for px, py in closed:
-            w.pack("3d", 8, float(px), float(py), 0.0)
-        w.pack("I", 4, 0)  # colors
-        w.string("")  # texture_resource
-        w.header(0, "")  # texture.header
-        w.string("")  # texture.format
-        w.byte_seq(b"")  # texture.data
-        w.pack("I", 4, 0)  # uv_coordinates
-        w.string("")  # text
-        w.string("")  # mesh_resource
-        w.string("")  # mesh_file.filename
-        w.byte_seq(b"")  # mesh_file.data
-        w.pack("?", 1, False)
-    return w.data()
+def _check_movers(movers: Any) -> tuple[Any, ...]:
+    """Return the movers as a tuple; each must be a :class:`trajopt.MovingObstacle` (its interface)."""
+    if movers is None:
+        return ()
+    try:
+        out = tuple(movers)
+    except TypeError:
+        raise InvalidInputError(
+            f"movers must be a sequence of trajopt.MovingObstacle, got {type(movers).__name__}"
+        ) from None
+    need = ("pose_at", "radius_at", "shape_vertices", "positions", "t_last", "name")
+    for i, m in enumerate(out):
+        if not all(hasattr(m, a) for a in need):
+            raise InvalidInputError(
+                f"movers[{i}] must be a trajopt.MovingObstacle, got {type(m).__name__}"
+            )
+    return out
 
 
 # ============================================================== write
@@ -236,8 +182,10 @@ def write_mcap(
     frame_id: str = "map",
     child_frame_id: str = "base_link",
     start_time: float = 0.0,
+    movers: Any = None,
+    movers_dt: float | None = None,
 ) -> Path:
-    """Write a timed trajectory (and its map and corridor) as a ROS 2 MCAP file.
+    """Write a timed trajectory (and its map, corridor and movers) as a ROS 2 MCAP file.
 
     Parameters
     ----------
@@ -252,6 +200,14 @@ def write_mcap(
         The fixed frame of poses, maps and markers, and the robot frame of the twists.
     start_time : float, optional
         Stamp of ``t = 0`` in seconds since the Unix epoch (finite, ``>= 0``).
+    movers : sequence of MovingObstacle, optional
+        Predicted moving obstacles (the trajectory's clock): ``/movers`` and
+        ``/movers/predicted`` (module docstring). ``None`` or empty: neither topic.
+    movers_dt : float, optional
+        Spacing (s, > 0) of the ``/movers`` messages; default ``dt``. A viewer shows each
+        mover's latest marker until the next, so 0.05-0.1 s is smooth enough and keeps the
+        file small (the markers of 10 movers every 10 ms take several times the space of
+        the robot's topics).
 
     Returns
     -------
@@ -261,7 +217,7 @@ def write_mcap(
     Raises
     ------
     InvalidInputError
-        A bad ``dt``, ``start_time`` or frame name.
+        A bad ``dt``, ``start_time``, frame name or mover.
     McapExportError
         The file cannot be written (the message names it and the cause), or the ``mcap``
         package is missing.
@@ -281,6 +237,14 @@ def write_mcap(
         raise McapExportError(
             "writing MCAP needs the 'mcap' package: pip install 'trajopt[ros]'"
         ) from None
+    movers = _check_movers(movers)
+    step_m = float(dt) if movers_dt is None else movers_dt
+    if (
+        isinstance(step_m, bool)
+        or not isinstance(step_m, int | float)
+        or not (math.isfinite(step_m) and step_m > 0.0)
+    ):
+        raise InvalidInputError(f"movers_dt must be a finite number > 0 (s), got {movers_dt!r}")
     smp = trajectory.sample_uniform(dt)
     whole = math.floor(start_time)
     ns0 = int(whole) * 1_000_000_000 + int(round((start_time - whole) * 1e9))
@@ -296,6 +260,14 @@ def write_mcap(
         vy = np.asarray(smp.v_body_y, dtype=float)
     om = np.asarray(smp.omega, dtype=float)
     steps = getattr(trajectory, "steps", None)
+    m_times = np.zeros(0)
+    if movers:  # every dt until the later of the trajectory's end and the last prediction
+        m_end = max([float(trajectory.duration)] + [float(m.t_last) for m in movers])
+        m_times = step_m * np.arange(int(math.floor(m_end / step_m + 1e-9)) + 1)
+        if m_end - m_times[-1] > 1e-9 * max(1.0, m_end):
+            m_times = np.append(m_times, m_end)
+    m_stamps = ns0 + np.rint(m_times * 1e9).astype(np.int64)
+    m_frames = [MoverFrames.of(m, m_times) for m in movers]
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as f:
@@ -305,7 +277,7 @@ def write_mcap(
             channels: dict[str, int] = {}
 
             def channel(topic: str) -> int:
-                dtype = TOPICS[topic]
+                dtype = TOPICS[topic] if topic in TOPICS else MOVER_TOPICS[topic]
                 if dtype not in schema_ids:
                     schema_ids[dtype] = mw.register_schema(
                         name=dtype,
@@ -326,13 +298,13 @@ def write_mcap(
                         channel(topic),
                         log_time=ns0,
                         publish_time=ns0,
-                        data=_encode_grid(grid, ns0, frame_id),
+                        data=encode_grid(grid, ns0, frame_id),
                     )
             mw.add_message(
                 channel("/plan"),
                 log_time=ns0,
                 publish_time=ns0,
-                data=_encode_path(ns0, stamps, frame_id, x, y, qz, qw),
+                data=encode_path(ns0, stamps, frame_id, x, y, qz, qw),
             )
             if steps is not None and steps.corridor is not None:
                 polys = _corridor_polygons(steps.corridor)
@@ -340,18 +312,38 @@ def write_mcap(
                     channel("/corridor"),
                     log_time=ns0,
                     publish_time=ns0,
-                    data=_encode_markers(polys, ns0, frame_id),
+                    data=encode_markers(polys, ns0, frame_id),
                 )
+            if movers:
+                mw.add_message(
+                    channel("/movers/predicted"),
+                    log_time=ns0,
+                    publish_time=ns0,
+                    data=encode_predicted(movers, ns0, frame_id),
+                )
+            done = 0  # mover frames written, in time order with the poses
+
+            def movers_until(ns_last: int) -> None:
+                nonlocal done
+                while done < len(m_stamps) and m_stamps[done] <= ns_last:
+                    ns = int(m_stamps[done])
+                    data = encode_movers_at(m_frames, done, ns, frame_id)
+                    c = channels["/movers"] if "/movers" in channels else channel("/movers")
+                    mw.add_message(c, log_time=ns, publish_time=ns, data=data, sequence=done)
+                    done += 1
+
             c_pose, c_twist = channel("/pose"), channel("/twist")
             for k in range(len(stamps)):
                 ns = int(stamps[k])
-                w = _Cdr()
-                _encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
+                movers_until(ns)
+                w = CdrWriter()
+                encode_pose_stamped(w, ns, frame_id, x[k], y[k], qz[k], qw[k])
                 mw.add_message(c_pose, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
-                w = _Cdr()
+                w = CdrWriter()
                 w.header(ns, child_frame_id)
                 w.pack("6d", 8, v[k], vy[k], 0.0, 0.0, 0.0, om[k])
                 mw.add_message(c_twist, log_time=ns, publish_time=ns, data=w.data(), sequence=k)
+            movers_until(int(m_stamps[-1]) if len(m_stamps) else ns0)
             mw.finish()
 
     target = Path(path)
@@ -398,6 +390,11 @@ class McapContents:
         The corridor regions' closed outlines from ``/corridor``.
     frame_id, child_frame_id : str
         Frames of the poses and of the twists.
+    movers : dict of str to ndarray, shape (n, 3) each
+        Per mover name, from ``/movers``: its marker poses ``(t, x, y)`` (``t`` in s since
+        the first pose's stamp; x, y in m).
+    predicted : dict of str to ndarray, shape (k, 2) each
+        Per mover name, its predicted track from ``/movers/predicted`` (m).
     """
 
     stamps_ns: np.ndarray
@@ -412,6 +409,8 @@ class McapContents:
     corridor: list[np.ndarray] = field(default_factory=list)
     frame_id: str = ""
     child_frame_id: str = ""
+    movers: dict[str, np.ndarray] = field(default_factory=dict)
+    predicted: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def read_mcap(path: str | os.PathLike[str]) -> McapContents:
@@ -444,6 +443,8 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
     path_rows: list[tuple[float, float, float]] = []
     maps: dict[str, OccupancyGrid] = {}
     corridor: list[np.ndarray] = []
+    mover_rows: dict[str, list[tuple[int, float, float]]] = {}
+    predicted: dict[str, np.ndarray] = {}
     frames = {"frame_id": "", "child_frame_id": ""}
     try:
         with open(p, "rb") as f:
@@ -491,6 +492,19 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
                 elif topic == "/corridor":
                     for m in ros.markers:
                         corridor.append(np.array([[q.x, q.y] for q in m.points], dtype=float))
+                elif topic == "/movers":
+                    for m in ros.markers:
+                        st = m.header.stamp
+                        mover_rows.setdefault(m.text, []).append(
+                            (
+                                st.sec * 1_000_000_000 + st.nanosec,
+                                m.pose.position.x,
+                                m.pose.position.y,
+                            )
+                        )
+                elif topic == "/movers/predicted":
+                    for m in ros.markers:
+                        predicted[m.text] = np.array([[q.x, q.y] for q in m.points], dtype=float)
     except OSError as exc:
         raise McapExportError(f"{p}: cannot read the MCAP file: {exc}") from exc
     except Exception as exc:  # the mcap reader raises its own types on malformed files
@@ -508,6 +522,12 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
     del arr
     theta = np.unwrap(2.0 * np.arctan2(xyq[:, 2], xyq[:, 3]))
     tw = np.array(twists, dtype=float)
+    movers = {}
+    for name, rows in mover_rows.items():
+        rows.sort()
+        ns = np.array([r[0] for r in rows], dtype=np.int64)
+        xy = np.array([r[1:] for r in rows], dtype=float)
+        movers[name] = np.column_stack([(ns - stamps[0]) / 1e9, xy])
     return McapContents(
         stamps_ns=stamps,
         t=(stamps - stamps[0]) / 1e9,
@@ -521,4 +541,6 @@ def read_mcap(path: str | os.PathLike[str]) -> McapContents:
         corridor=corridor,
         frame_id=frames["frame_id"],
         child_frame_id=frames["child_frame_id"],
+        movers=movers,
+        predicted=predicted,
     )

@@ -86,6 +86,8 @@ class PlanResult(Protocol):
         frame_id: str = "map",
         child_frame_id: str = "base_link",
         start_time: float = 0.0,
+        movers: Any = None,
+        movers_dt: float | None = None,
     ) -> Path:
-        """Write a ROS 2 MCAP file."""
+        """Write a ROS 2 MCAP file (with ``movers``: their markers)."""
         ...

@@ -209,10 +209,14 @@ class SampledExport:
         frame_id: str = "map",
         child_frame_id: str = "base_link",
         start_time: float = 0.0,
+        movers: Any = None,
+        movers_dt: float | None = None,
     ) -> Path:
         """Write a ROS 2 MCAP file: maps, path, corridor, stamped poses and twists.
 
-        See :func:`trajopt.motion._mcap.write_mcap` (topics, types, frames and stamps).
+        See :func:`trajopt.motion._mcap.write_mcap` (topics, types, frames and stamps);
+        ``movers`` (predicted :class:`trajopt.MovingObstacle`) adds their markers, every
+        ``movers_dt`` seconds (default ``dt``).
         """
         from trajopt.motion._mcap import write_mcap
 
@@ -223,6 +227,8 @@ class SampledExport:
             frame_id=frame_id,
             child_frame_id=child_frame_id,
             start_time=start_time,
+            movers=movers,
+            movers_dt=movers_dt,
         )
 
 

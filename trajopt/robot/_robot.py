@@ -83,11 +83,11 @@ class Robot:
     drive : Drive or {"differential", "omni", "ackermann"}
         How the base moves (module docstring): :class:`~trajopt.drive.Differential` (the
         default), :class:`~trajopt.drive.Omni` or :class:`~trajopt.drive.Ackermann`, or
-        its name as a shorthand. The attribute is always the record.
-    min_turning_radius, reverse, wheelbase, v_max_reverse, steer_rate_max
-        Only with the shorthand ``drive="ackermann"``: the fields of
-        :class:`~trajopt.drive.Ackermann` (``min_turning_radius`` required), which the robot
-        passes on to it; they are not attributes of the robot (``robot.drive`` holds them).
+        its name as a shorthand. The attribute is always the record. With the shorthand
+        ``drive="ackermann"`` the keywords ``min_turning_radius`` (required), ``reverse``,
+        ``wheelbase``, ``v_max_reverse`` and ``steer_rate_max`` are the fields of
+        :class:`~trajopt.drive.Ackermann`, which the robot passes on to it; they are not
+        attributes of the robot (``robot.drive`` holds them).
 
     Raises
     ------

@@ -150,7 +150,7 @@ def test_atomic_and_typed_failures(planned, tmp_path, monkeypatch):
     def boom(*args, **kwargs):
         raise OSError("disk full")
 
-    monkeypatch.setattr(rm, "_encode_path", boom)
+    monkeypatch.setattr(rm, "encode_path", boom)
     with pytest.raises(McapExportError, match="disk full"):
         planned.to_mcap(good, dt=0.1)
     assert good.read_bytes() == before  # the old file is intact
