@@ -7,18 +7,19 @@ head-on along a corridor (Fraichard's incompleteness of the path-speed split). W
 ``plan_leg`` on a map the movers' swept regions are marked on (:mod:`._swept`), then re-timed
 for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 
-1. ``"rerouted"``: the same query on the map with the blocking mover's whole swept region
-   marked (grown by the margin; the planner inflates it by the robot's radius as any
-   obstacle): a way that never meets it, so its re-timing is mostly the certificate alone;
-   then with its region over ``[t, t_last]`` only (``t`` the time from which it blocks): a
-   way round where it stops, or round the rest of its track;
-2. ``"rerouted"``: the same query with every mover's final place marked (where each stands
-   after its prediction ends): a route that no mover stays on; the re-timing waits at the
-   start while a mover still passes (the waiting witness of the issue);
+1. ``"rerouted"``: the same query on the map with every mover's final place marked (where
+   each stands after its prediction ends; grown by the margin, and the planner inflates it by
+   the robot's radius as any obstacle): a route that no mover stays on; its re-timing waits
+   at the start, or on the way, while a mover still passes (the waiting witness of the
+   issue). Of the candidates, the one that keeps closest to the static plan;
+2. ``"rerouted"``: the same query with the blocking mover's whole swept region marked: a way
+   that never meets it, so its re-timing is mostly the certificate alone; then with its region
+   over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
+   stops, or round the rest of its track;
 3. ``"waited"`` (a robot that turns in place: differential or omni): drive to a **safe
-   place**, wait there until the way is clear, drive to the goal. A safe place is a cell where the robot's centre may stand
-   on the static map and that keeps the robot's radius plus the margin from every mover's
-   whole swept region; the candidates, at least a metre apart, are those with the shortest
+   place**, wait there until the way is clear, drive to the goal. A safe place is a cell
+   where the robot's centre may stand on the static map and that keeps the robot's radius
+   plus the margin from every mover's whole swept region; the candidates, at least a metre apart, are those with the shortest
    straight-line detour ``|start - p| + |p - goal|``. The first leg is re-timed for the movers
    (standing at the safe place is safe whenever it arrives), the second leg, from the first's
    end heading (a turn in place), on the clock from the first's arrival
@@ -145,6 +146,10 @@ def reroute(
 
         return run
 
+    finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
+    out = attempt("around every mover's final place", detour(finals), "rerouted")
+    if out is not None:
+        return out
     who = by_name.get(blocked.mover)
     if who is not None:
         t_end = max(who.t_last, 0.0)
@@ -158,10 +163,6 @@ def reroute(
             )
             if out is not None:
                 return out
-    finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
-    out = attempt("around every mover's final place", detour(finals), "rerouted")
-    if out is not None:
-        return out
     if robot.drive.turns_in_place and not robot.drive.signed_speed:
         room = free()
         places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
