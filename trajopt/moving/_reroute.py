@@ -11,7 +11,7 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    each stands after its prediction ends; grown by the margin, and the planner inflates it by
    the robot's radius as any obstacle): a route that no mover stays on; its re-timing waits
    at the start, or on the way, while a mover still passes (the waiting witness of the
-   issue). Of the candidates, the one that keeps closest to the static plan;
+   issue), usually the smallest detour;
 2. ``"rerouted"``: the same query with the blocking mover's whole swept region marked: a way
    that never meets it, so its re-timing is mostly the certificate alone; then with its region
    over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
