@@ -83,7 +83,7 @@ from trajopt.planning import (
     SearchMode,
     run_query,
 )
-from trajopt.replan import BRAKE_AFTER_S, replan_from
+from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
 from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
@@ -402,6 +402,8 @@ class Planner:
         v_end: float = 0.0,
         reuse: bool = True,
         brake_after_s: float | None = BRAKE_AFTER_S,
+        moving_obstacles: Sequence[MovingObstacle] | None = None,
+        mover_margin: float = 0.0,
     ) -> PlanResult:
         """Re-plan from a trajectory being driven, splicing at ``t + latency``.
 
@@ -441,15 +443,34 @@ class Planner:
             ``False``: plan anew from the state, keeping nothing of the old plan.
         brake_after_s : float or None, optional
             Smoothing time (s) before the robot brakes instead; ``None``: never brake.
+        moving_obstacles : sequence of MovingObstacle, optional
+            Predicted movers, their times on ``trajectory``'s clock (the clock of ``t``;
+            for a plan of :meth:`plan`, seconds from its start). ``None`` or empty: the
+            re-plan as without them. Otherwise the re-plan's result is re-timed for them
+            from the splice state (:func:`trajopt.replan.retime_replan`): when only
+            the predictions changed, the kept rest keeps its path and only its timing
+            changes. The result's ``t = 0`` is the splice ``ts = t + latency`` of that
+            clock; ``stats["moving"]`` holds the re-timing (``plan``, ``certificate``,
+            ``time_s``), ``clock_offset_s`` (``ts``: a mover time ``T`` is ``T - ts`` on the
+            result's clock, which the predictions of a later re-plan of the result use) and
+            ``replan`` (what was kept or planned).
+        mover_margin : float
+            Extra distance to every mover (m), >= 0 (checked even without movers).
 
         Raises
         ------
         InvalidInputError
             ``t + latency`` outside ``[0, duration]``, a negative latency, no goal given
-            for a trajectory without ``steps``.
+            for a trajectory without ``steps``; with movers, ``v_end > 0`` or a mover over
+            the robot at the splice.
         TimingError, SmoothingError, NoPathError
             As :meth:`plan`; ``TimingError``: it must brake and cannot stop in time.
+        BlockedError
+            A mover blocks the rest of the way: no re-timing of the re-plan avoids it (named,
+            its time on the movers' clock).
         """
+        movers = check_movers(moving_obstacles)
+        margin = nonnegative("mover_margin", mover_margin, "m")
         with self._lock:
             t0 = time.perf_counter()
             lat = self.latency_s if latency is None else latency
@@ -466,6 +487,8 @@ class Planner:
                 reuse=reuse,
                 brake_after_s=brake_after_s,
             )
+            if movers:
+                out = retime_replan(out, movers, margin, float(out.stats["splice_time_s"]))
             self._latencies.append(time.perf_counter() - t0)
             return out
 

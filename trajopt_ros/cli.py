@@ -1,6 +1,7 @@
 """The ``trajopt-ros`` command (also ``trajopt ros``).
 
-``trajopt-ros [--ros-args ...]`` runs the node; ``trajopt-ros build-interfaces [--force]``
+``trajopt-ros [--managed] [--ros-args ...]`` runs the node (``--managed``: as a lifecycle
+node, :class:`~trajopt_ros.node.ManagedPlannerNode`); ``trajopt-ros build-interfaces [--force]``
 builds (or finds cached) the interface packages and prints where and how long it took.
 Exit codes: 0 after a clean shutdown (SIGINT/SIGTERM), 2 for invalid parameters or a
 failed interface build (one line on stderr naming the cause).
@@ -31,6 +32,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("command", nargs="?", choices=["run", "build-interfaces"], default="run")
     parser.add_argument("--force", action="store_true", help="build-interfaces: build again")
+    parser.add_argument(
+        "--managed",
+        action="store_true",
+        help="run: a managed (lifecycle) node, unconfigured until told by ~/change_state",
+    )
     opts = parser.parse_args(args)
     from trajopt_ros.errors import InterfaceBuildError, ParameterError
 
@@ -56,12 +62,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     from rclpy.executors import MultiThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
-    from trajopt_ros.node import PlannerNode, spin
+    from trajopt_ros.node import ManagedPlannerNode, PlannerNode, spin
 
     rclpy.init(args=["trajopt-ros", *ros_args], signal_handler_options=SignalHandlerOptions.ALL)
     executor = MultiThreadedExecutor(num_threads=4)
     try:
-        node = PlannerNode()
+        kind = ManagedPlannerNode if opts.managed else PlannerNode
+        node = kind(freeze_gc=True)  # this process runs the node and nothing else
     except (ParameterError, InterfaceBuildError) as exc:
         print(f"trajopt-ros: error: {type(exc).__name__}: {exc}", file=sys.stderr)
         rclpy.try_shutdown()

@@ -66,6 +66,7 @@ SMOOTH_PATH: dict[str, int] = {
     "none": 0,
     "unknown": 500,
     "invalid_smoother": 501,
+    "timeout": 502,  # max_smoothing_duration reached
     "in_collision": 503,  # SMOOTHED_PATH_IN_COLLISION
     "no_path": 504,  # FAILED_TO_SMOOTH_PATH
     "smoothing_failed": 504,

@@ -23,8 +23,10 @@ class RequestError(TrajoptRosError, ValueError):
     Attributes
     ----------
     reason : str
-        The failure's name, one of :data:`trajopt_ros.codes.REASONS` (``"no_map"``,
-        ``"frame_mismatch"``, ``"invalid_pose"``, ...).
+        The failure's name: one of :data:`trajopt_ros.codes.REASONS` (``"no_map"``,
+        ``"frame_mismatch"``, ``"invalid_pose"``, ...), or one that only Nav2's actions
+        have a code for (``"invalid_planner"``, ``"invalid_smoother"``, ``"in_collision"``,
+        ``"timeout"``).
     """
 
     def __init__(self, reason: str, message: str) -> None:

@@ -87,9 +87,15 @@ def interfaces(ros_env):
 class NodeProcess:
     """``trajopt-ros`` in its own process, with its output in a temporary file."""
 
-    def __init__(self, ros_env: dict[str, str], *ros_args: str, name: str = "trajopt_planner"):
+    def __init__(
+        self,
+        ros_env: dict[str, str],
+        *ros_args: str,
+        name: str = "trajopt_planner",
+        cli_args: tuple[str, ...] = (),
+    ):
         self.log = tempfile.NamedTemporaryFile("w+", prefix="trajopt-ros-node-", suffix=".log")
-        args = ["--ros-args", "-r", f"__node:={name}", *ros_args]
+        args = [*cli_args, "--ros-args", "-r", f"__node:={name}", *ros_args]
         # the child inherits the domain id's lock: the id stays taken while any node lives
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "trajopt_ros.cli", *args],

@@ -51,7 +51,7 @@ from trajopt.moving._obstacle import MovingObstacle
 #: Bisection budget (intervals evaluated per mover) before the certificate gives up undecided.
 MAX_INTERVALS = 400_000
 #: Initial time step of the interval cover (s).
-COVER_DT = 0.05
+COVER_DT = 0.5
 
 
 @dataclass(frozen=True, slots=True)
@@ -214,9 +214,26 @@ def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
 
 
+#: The curvature tables of the last curves certified (curve, table), most recent last.
+_KAPPA_TABLES: list[tuple[Any, tuple[np.ndarray, np.ndarray]]] = []
+_KAPPA_KEPT = 4
+
+
+def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return :func:`kappa_table` of ``curve``, reused for the last few curves (the same object)."""
+    for i, (c, tab) in enumerate(_KAPPA_TABLES):
+        if c is curve:
+            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
+            return tab
+    tab = kappa_table(curve)
+    _KAPPA_TABLES.append((curve, tab))
+    del _KAPPA_TABLES[:-_KAPPA_KEPT]
+    return tab
+
+
 def kappa_max(curve: Any) -> float:
     """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
-    return float(np.max(kappa_table(curve)[1]))
+    return float(np.max(kappa_table_of(curve)[1]))
 
 
 class _RangeMax:
@@ -247,15 +264,27 @@ class _Curve:
         self.traj, self.offset = traj, float(offset)
         self.vmax, self.amax = _profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
-        self.s_edges, k = kappa_table(traj.path)
+        self.s_edges, k = kappa_table_of(traj.path)
         self.kmax = _RangeMax(k)
         self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
+        self.length = float(traj.length)
+        self.phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
+
+    def s_at(self, t: np.ndarray) -> np.ndarray:
+        """Return the arc length (m) at the curve's own times ``t`` (s): ``traj.motion``'s ``s``."""
+        pt, ps, pv, pa, pj = self.phases
+        dur = self.traj.duration
+        tt = np.clip(t, 0.0, dur)
+        k = np.clip(np.searchsorted(pt, tt, side="right") - 1, 0, pt.shape[0] - 1)
+        tau = tt - pt[k]
+        s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
+        return np.where(tt >= dur, self.length, np.clip(s, 0.0, self.length))
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
         tr, off = self.traj, self.offset
-        s0 = tr.motion(t0 - off)[0]
-        s1 = tr.motion(t1 - off)[0]
+        s0 = self.s_at(t0 - off)
+        s1 = self.s_at(t1 - off)
         smp = tr.sample(tm - off)
         p = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
         sm = np.asarray(smp.s, dtype=float)
@@ -393,35 +422,154 @@ def certify_movers(
         return MoverCertificate(True, "clear", math.inf, "", 0.0, horizon, tol, 0)
     model, a_last, _ = windows[-1]
     windows[-1] = (model, a_last, horizon)  # the robot then stands at the goal
+    extra = margin if body is not None else r_rob + margin
+    discs = [m for m in movers if m.vertices is None]
+    polygons = [m for m in movers if m.vertices is not None]
     best = (math.inf, "", 0.0)
     total = 0
-    for mover in movers:
-        for model, a, b in windows:
-            cuts = [a, b] + [t for t in mover.times.tolist() if a < t < b]
-            knots = np.unique(np.asarray(cuts))
-            t0s, t1s = [], []
-            for u, w in zip(knots[:-1], knots[1:], strict=True):
-                n = max(1, int(math.ceil((w - u) / COVER_DT)))
-                e = np.linspace(u, w, n + 1)
-                t0s.append(e[:-1])
-                t1s.append(e[1:])
-            if not t0s:  # a zero-length window: one instant
-                t0s, t1s = [np.full(1, a)], [np.full(1, a)]
-            verdict, slack, wt, count = _certify_one(
-                model,
-                mover,
-                np.concatenate(t0s),
-                np.concatenate(t1s),
-                (margin if body is not None else r_rob + margin),
-                tol,
-                body,
-            )
+    for model, a, b in windows:
+        if discs and b > a:
+            verdict, slack, who, wt, count = _certify_discs(model, discs, a, b, extra, tol, body)
+            total += count
+            if verdict != "clear":
+                return MoverCertificate(False, verdict, slack, who, wt, horizon, tol, total)
+            best = min(best, (slack, who, wt))
+        for mover in polygons if b > a else movers:
+            t0, t1 = _cover(a, b, mover.times)
+            verdict, slack, wt, count = _certify_one(model, mover, t0, t1, extra, tol, body)
             total += count
             if verdict != "clear":
                 return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
-            if slack < best[0]:
-                best = (slack, mover.name, wt)
+            best = min(best, (slack, mover.name, wt))
     return MoverCertificate(True, "clear", best[0], best[1], best[2], horizon, tol, total)
+
+
+def _cover(a: float, b: float, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Intervals ``(t0, t1)`` (s) of at most :data:`COVER_DT` covering ``[a, b]``, cut at ``times``."""
+    knots = np.unique(np.concatenate([[a, b], times[(times > a) & (times < b)]]))
+    if knots.shape[0] < 2:  # a zero-length window: one instant
+        return np.full(1, a), np.full(1, a)
+    n = np.maximum(1, np.ceil(np.diff(knots) / COVER_DT).astype(np.int64))
+    k = np.repeat(np.arange(n.shape[0]), n)
+    j = np.arange(k.shape[0]) - np.repeat(np.cumsum(n) - n, n)
+    width = np.diff(knots)[k] / n[k]
+    t0 = knots[k] + j * width
+    t1 = np.where(j == n[k] - 1, knots[k + 1], t0 + width)
+    return t0, t1
+
+
+def _certify_discs(
+    model: Any,
+    movers: Sequence[MovingObstacle],
+    a: float,
+    b: float,
+    extra: float,
+    tol: float,
+    body: np.ndarray | None,
+) -> tuple[str, float, str, float, int]:
+    """Bisect the intervals of ``[a, b]`` for all disc movers at once.
+
+    The same bounds as :func:`_certify_one`, vectorised over the movers: each interval keeps
+    its mover's index and the line ``A + V t`` its centre follows on the waypoint segment
+    holding it; the robot is evaluated once per distinct interval. Returns ``(verdict,
+    slack, mover name, time, intervals)``.
+    """
+    knots, owner, xs, ys, firsts, lasts = [], [], [], [], [], []
+    for j, m in enumerate(movers):
+        tk = m.times
+        kn = np.concatenate([[a], tk[(tk > a) & (tk < b)], [b]])  # sorted: times increase
+        knots.append(kn)
+        owner.append(np.full(kn.shape[0], j))
+        xs.append(np.interp(kn, tk, m.positions[:, 0]))
+        ys.append(np.interp(kn, tk, m.positions[:, 1]))
+        firsts.append(np.full(kn.shape[0], tk[0]))
+        lasts.append(np.full(kn.shape[0], tk[-1]))
+    kn, ow = np.concatenate(knots), np.concatenate(owner)
+    pos = np.stack([np.concatenate(xs), np.concatenate(ys)], axis=1)
+    first, last = np.concatenate(firsts), np.concatenate(lasts)
+    # segments between consecutive knots of one mover: its centre is A + V t there
+    seg = np.flatnonzero(ow[1:] == ow[:-1])
+    u, w = kn[seg], kn[seg + 1]
+    moving = (u >= first[seg]) & (w <= last[seg]) & (w > u)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_seg = np.where(moving[:, None], (pos[seg + 1] - pos[seg]) / (w - u)[:, None], 0.0)
+    a_seg = pos[seg] - v_seg * u[:, None]
+    n = np.maximum(1, np.ceil((w - u) / COVER_DT).astype(np.int64))
+    k = np.repeat(np.arange(seg.shape[0]), n)
+    i = np.arange(k.shape[0]) - np.repeat(np.cumsum(n) - n, n)
+    width = (w - u)[k] / n[k]
+    t0 = u[k] + i * width
+    t1 = np.where(i == n[k] - 1, w[k], t0 + width)
+    mj, vel, anchor = ow[seg][k], v_seg[k], a_seg[k]
+    rad0 = np.array([m.radius for m in movers])[mj]
+    grow = np.array([m.growth for m in movers])[mj]
+    t_last = np.array([max(m.t_last, 0.0) for m in movers])[mj]
+    reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
+    proven, proven_t, proven_j = math.inf, 0.0, 0
+    count, budget = 0, MAX_INTERVALS * len(movers)
+    while t0.size:
+        count += t0.size
+        if count > budget:
+            return "undecided", proven, movers[proven_j].name, proven_t, count
+        tm = 0.5 * (t0 + t1)
+        h = 0.5 * (t1 - t0)
+        # the robot once per distinct interval (the movers share the cover and its halves)
+        uniq, inv = np.unique(t0 + 1j * t1, return_inverse=True)
+        inv = inv.reshape(-1)
+        u0, u1 = uniq.real, uniq.imag
+        p, rho_p, v_rob = (x[inv] for x in model.at(u0, 0.5 * (u0 + u1), u1))
+        theta, turn = model.theta[inv], model.turn[inv]
+        c2 = np.broadcast_to(model.c2_local, u0.shape)[inv]
+        centre = anchor + vel * tm[:, None]
+        speed_m = np.hypot(vel[:, 0], vel[:, 1])
+        rho_m = speed_m * h
+        lim_mid = extra + rad0 + grow * np.clip(tm, 0.0, t_last)
+        lim_hi = extra + rad0 + grow * np.clip(t1, 0.0, t_last)
+        d = p - centre
+        dist_m = np.hypot(d[:, 0], d[:, 1])
+        lower = dist_m - rho_p - rho_m - lim_hi
+        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
+            c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
+            poly = np.stack(
+                [
+                    p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+                    p[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+                ],
+                axis=-1,
+            )
+            dist_m = convex_distance(poly, centre[:, None, :])
+            lower_poly = dist_m - rho_p - reach_b * turn - rho_m - lim_hi
+            lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
+        else:
+            # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
+            rel = v_rob - vel
+            rr = np.sum(rel * rel, axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
+            tau = np.clip(tau, -h, h)
+            near = d + tau[:, None] * rel
+            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
+        slack_mid = dist_m - lim_mid
+        bad = slack_mid < -0.5 * tol
+        if np.any(bad):
+            i = int(np.argmin(np.where(bad, slack_mid, np.inf)))
+            return "violated", float(slack_mid[i]), movers[mj[i]].name, float(tm[i]), count
+        done = lower >= -tol
+        if np.any(done):
+            i = int(np.argmin(np.where(done, lower, np.inf)))
+            if lower[i] < proven:
+                proven, proven_t, proven_j = float(lower[i]), float(tm[i]), int(mj[i])
+        split = ~done
+        t0 = np.concatenate([t0[split], tm[split]])
+        t1 = np.concatenate([tm[split], t1[split]])
+        mj = np.concatenate([mj[split], mj[split]])
+        vel = np.concatenate([vel[split], vel[split]])
+        anchor = np.concatenate([anchor[split], anchor[split]])
+        rad0 = np.concatenate([rad0[split], rad0[split]])
+        grow = np.concatenate([grow[split], grow[split]])
+        t_last = np.concatenate([t_last[split], t_last[split]])
+    return "clear", proven, movers[proven_j].name if movers else "", proven_t, count
 
 
 def _certify_one(

@@ -4,19 +4,23 @@
 
 1. if the trajectory as it is passes :func:`certify_movers`, it is returned unchanged (the
    time-optimal timing passes before, or never meets, every mover);
-2. the movers' forbidden regions of the ``(s, t)`` plane on a grid (:mod:`._st_grid`). A sweep
-   of the nodes a non-decreasing ``s(t)`` with ``v <= v_max`` can occupy on the *necessary*
-   grid decides that the movers block the path: :class:`BlockedError` naming the mover in
-   front of the robot and the time;
-3. a search over a family of jerk-limited profiles on the *sufficient* grid
-   (:mod:`._st_search`): rest at the start, drive (time-optimally,
-   :func:`trajopt.time_parameterize` on the path's piece, rest to rest) to a stop, rest
-   there, ..., drive to the goal and stand there; a dynamic programme over the stops finds
-   the earliest arrival;
-4. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
+2. the movers' forbidden regions of the ``(s, t)`` plane on the *sufficient* grid
+   (:mod:`._st_grid`) and a search over a family of jerk-limited profiles on it
+   (:mod:`._st_search`): rest at the start, drive time-optimally (ruckig's rest-to-rest
+   profile under the path's speed cap table, :class:`_PathTables`) to a stop, rest there,
+   ..., drive to the goal and stand there; a dynamic programme over the stops finds the
+   earliest arrival. From a moving start the first drive leaves at once from the start state
+   (to the goal, or braking to rest at a stop);
+3. the chosen profile becomes one :class:`trajopt.Trajectory` on the same path (its rests are
    phases of zero speed) and is certified by :func:`certify_movers`; a failed certificate
    (the grid's inflation is a proof for the grid, so only numerical slips) retries with a
-   finer time step.
+   finer time step;
+4. when nothing is found, a sweep of the nodes a non-decreasing ``s(t)`` with ``v <= v_max``
+   can occupy on the *necessary* grid names the mover that blocks the path and the time
+   (:class:`BlockedError`).
+
+The cap table, the grid's node points and the rest-to-rest drives of the last few paths are
+kept (:data:`_TABLES`): new predictions for the same path reuse them.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -41,9 +45,9 @@ from trajopt.moving._certificate import (
     shape_at,
 )
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_grid import STGrid, reach_bound, reachable, st_grid
+from trajopt.moving._st_grid import STGrid, grid_nodes, reach_bound, reachable, st_grid
 from trajopt.moving._st_search import Piece, compose, search
-from trajopt.timing import time_parameterize
+from trajopt.timing import RuckigProfile, build_cap_table, time_parameterize
 
 
 def _piece_of(tr: Any, s0: float, s1: float) -> Piece:
@@ -51,26 +55,107 @@ def _piece_of(tr: Any, s0: float, s1: float) -> Piece:
     return Piece(rows, float(tr.duration), s0, s1)
 
 
-def _drives(traj: Trajectory) -> Callable[[float, float], Piece | None]:
-    """Return ``drive(s0, s1)``: the path's piece timed from rest to rest (cached)."""
-    path, robot, length = traj.path, traj.robot, float(traj.length)
-    u_lo, u_hi = path.domain
-    cache: dict[tuple[float, float], Piece | None] = {(0.0, length): _piece_of(traj, 0.0, length)}
+#: Relative speed tolerance of the cap test of ruckig's rows: the timing's own profiles reach
+#: the cap table's value plus ruckig's velocity margin (1e-9 m/s), and a motion that starts in
+#: such a state must pass.
+CAP_TOLERANCE = 1e-7
 
-    def drive(s0: float, s1: float) -> Piece | None:
+
+def _under_caps(table: Any, rows: np.ndarray) -> bool:
+    """Return whether ruckig rows ``(t0, s0, v0, a0, jerk, duration)`` stay under ``table``'s caps.
+
+    :meth:`trajopt.timing.CapTable.rows_ok` of the same motion with its speed scaled by
+    ``1 - CAP_TOLERANCE`` (speed, acceleration and jerk of every row; its arc lengths move by
+    at most that fraction of the distance).
+    """
+    low = np.array(rows, dtype=float)
+    low[:, 2:5] *= 1.0 - CAP_TOLERANCE
+    return bool(table.rows_ok(low))
+
+
+def _piece_of_rows(rows: np.ndarray | None, s1: float) -> Piece | None:
+    """Return a :class:`Piece` of ruckig rows ``(t0, s0, v0, a0, jerk, duration)``, or ``None``."""
+    if rows is None or rows.shape[0] == 0:
+        return None
+    duration = float(rows[-1, 0] + rows[-1, 5])
+    return Piece(np.ascontiguousarray(rows[:, :5]), duration, float(rows[0, 1]), float(s1))
+
+
+class _PathTables:
+    """What a path's re-timings share: its speed cap table, grid points, rest-to-rest drives.
+
+    Kept for the last few paths (:data:`_TABLES`): re-timing the same path for new
+    predictions (a re-plan that keeps its path) reuses them.
+    """
+
+    def __init__(self, path: Any, robot: Any, length: float) -> None:
+        self.path, self.robot, self.length = path, robot, length
+        self.table = build_cap_table(path, robot, length, 0.0, 0.0)
+        self.vtop = self.table.vtop
+        self.rk = RuckigProfile(float(robot.a_max), float(robot.j_max))
+        self.drives: dict[tuple[float, float], Piece | None] = {}
+        self.points: dict[float, np.ndarray] = {}
+
+    def nodes(self, s: np.ndarray, ds: float) -> np.ndarray:
+        """Return the path's points (m), shape (n, 2), at the grid nodes ``s`` of spacing ``ds``."""
+        if ds not in self.points:
+            tb = self.table
+            u = np.interp(s, tb.s_nodes, tb.u_nodes)
+            self.points[ds] = np.asarray(self.path(u), dtype=float)
+        return self.points[ds]
+
+    def move(self, state: tuple[float, float, float], s1: float) -> Piece | None:
+        """Return the time-optimal jerk-limited motion from ``state`` ``(s, v, a)`` to rest at ``s1``.
+
+        Ruckig's profile under the highest cap when it stays under the cap table, else under
+        the lowest cap over ``[s, s1]``; ``None`` when neither does (a fall-back times the
+        piece of the path then).
+        """
+        tb, rk = self.table, self.rk
+        for vcap in (self.vtop, tb.range_min(state[0], s1)):
+            rows = rk.solve(state, (s1, 0.0, 0.0), vcap)
+            if rows is not None and _under_caps(tb, rows):
+                return _piece_of_rows(rows, s1)
+        return None
+
+    def segment(self, s0: float, s1: float, v0: float = 0.0, a0: float = 0.0) -> Piece | None:
+        """Return the path's piece ``[s0, s1]`` timed by :func:`trajopt.time_parameterize`."""
+        path = self.path
+        u_lo, u_hi = path.domain
+        ua = u_lo if s0 <= 0.0 else float(path.u_at_s(s0))
+        ub = u_hi if s1 >= self.length else float(path.u_at_s(s1))
+        try:
+            tr = time_parameterize(CurveSegment(path, ua, ub), self.robot, v_start=v0, a_start=a0)
+        except (TimingError, InvalidInputError, ValueError):
+            return None
+        return _piece_of(tr, s0, s1)
+
+    def drive(self, s0: float, s1: float) -> Piece | None:
+        """Return the rest-to-rest drive over ``[s0, s1]`` (m) (cached)."""
         key = (s0, s1)
-        if key not in cache:
-            ua = u_lo if s0 <= 0.0 else float(path.u_at_s(s0))
-            ub = u_hi if s1 >= length else float(path.u_at_s(s1))
-            try:
-                tr = time_parameterize(CurveSegment(path, ua, ub), robot)
-            except (TimingError, InvalidInputError, ValueError):
-                cache[key] = None
-            else:
-                cache[key] = _piece_of(tr, s0, s1)
-        return cache[key]
+        if key not in self.drives:
+            piece = self.move((s0, 0.0, 0.0), s1)
+            self.drives[key] = self.segment(s0, s1) if piece is None else piece
+        return self.drives[key]
 
-    return drive
+
+#: The tables of the last paths re-timed (most recent last).
+_TABLES: list[_PathTables] = []
+_TABLES_KEPT = 4
+
+
+def _tables(traj: Trajectory) -> _PathTables:
+    """Return the :class:`_PathTables` of ``traj``'s path and robot (built or reused)."""
+    for i, tb in enumerate(_TABLES):
+        if tb.path is traj.path and tb.robot == traj.robot:
+            _TABLES.append(_TABLES.pop(i))
+            return tb
+    tb = _PathTables(traj.path, traj.robot, float(traj.length))
+    if traj.v_start == 0.0 and traj.phase_a[0] == 0.0:  # the plan itself: the drive (0, L)
+        tb.drives[(0.0, tb.length)] = _piece_of(traj, 0.0, tb.length)
+    _TABLES.append(tb)
+    del _TABLES[:-_TABLES_KEPT]
+    return tb
 
 
 def _robot_shape(traj: Trajectory, margin: float) -> tuple[float, np.ndarray | None, float]:
@@ -91,14 +176,22 @@ def _robot_shape(traj: Trajectory, margin: float) -> tuple[float, np.ndarray | N
 
 
 def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float) -> None:
-    smp = traj.sample(np.zeros(1))
-    p0 = np.array([[smp.x[0], smp.y[0]]], dtype=float)
+    u0 = traj.path.domain[0]
+    p0 = np.asarray(traj.path(u0), dtype=float).reshape(1, 2)
     robot: np.ndarray = p0[:, None, :]
     fp = traj.robot.footprint
     if fp is not None:
         v = ccw(np.asarray(fp.vertices, dtype=float))
-        c, sn = math.cos(float(smp.theta[0])), math.sin(float(smp.theta[0]))
+        theta = float(traj.sample(np.zeros(1)).theta[0])
+        c, sn = math.cos(theta), math.sin(theta)
         robot = (p0 + v @ np.array([[c, sn], [-sn, c]]))[None]
+    disc = [m for m in movers if m.vertices is None]
+    if fp is None and disc:  # one vectorised test first: most movers are far
+        c = np.array([m.position_at(0.0) for m in disc])
+        r = np.array([float(m.radius_at(0.0)) for m in disc])
+        gap = np.hypot(c[:, 0] - p0[0, 0], c[:, 1] - p0[0, 1]) - r - traj.robot.radius - margin
+        if np.all(gap > 1e-9) and len(disc) == len(movers):
+            return
     for m in movers:
         d = float(convex_distance(robot, shape_at(m, np.zeros(1)))[0])
         need = margin + float(m.radius_at(0.0)) + (traj.robot.radius if fp is None else 0.0)
@@ -109,9 +202,9 @@ def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float
             )
 
 
-def _blocked(grid: STGrid, movers: Sequence[MovingObstacle], robot: Any) -> None:
-    speed = float(robot.v_max)
-    s_up = reach_bound(grid.t, speed, float(robot.a_max), float(robot.j_max))
+def _blocked(grid: STGrid, movers: Sequence[MovingObstacle], robot: Any, v0: float = 0.0) -> None:
+    speed = max(float(robot.v_max), v0)
+    s_up = reach_bound(grid.t, speed, float(robot.a_max), float(robot.j_max), v0)
     ok, k, i = reachable(grid, speed, s_up)
     if ok:
         return
@@ -145,7 +238,10 @@ def retime_for_movers(
     Parameters
     ----------
     traj : Trajectory
-        A disc robot's timed curve from rest to rest (``v_start = v_end = 0``).
+        A disc or footprint robot's timed curve ending at rest (``v_end = 0``). It may start
+        moving (``v_start > 0`` or a non-zero acceleration at ``t = 0``, e.g. the rest of a
+        trajectory being driven): the re-timed motion then starts from that state (it cannot
+        rest at once; it may brake to a stop and wait there).
     movers : sequence of MovingObstacle
         The predictions (seconds from the trajectory's ``t = 0``).
     margin : float
@@ -154,34 +250,36 @@ def retime_for_movers(
         The ``(s, t)`` grid's spacings (s, m).
     not_before : float
         The robot rests at the start until this time (s), >= 0 (a turn in place there):
-        the result starts with a rest at least that long.
+        the result starts with a rest at least that long. Only for a start at rest.
 
     Returns
     -------
     Trajectory
         ``traj``'s motion when it is already clear, else the same path re-timed with rests
-        (a new value either way; ``traj`` is not changed). ``stats["moving"]`` holds the
-        certificate, the plan (``"as planned"`` or ``"wait 1.250 s at the start, stop at
-        s = 2.100 m until t = 7.800 s"``) and the wall time (s). Its certificate
-        (:func:`certify_movers`) holds at every instant until the last prediction ends.
+        (a new value either way; ``traj`` is not changed), with ``traj``'s start state.
+        ``stats["moving"]`` holds the certificate, the plan (``"as planned"``, ``"wait
+        1.250 s at the start, stop at s = 2.100 m until t = 7.800 s"`` or, from a moving
+        start, ``"brake to s = 0.400 m, stop at s = 0.400 m until t = 3.100 s"``) and the
+        wall time (s). Its certificate (:func:`certify_movers`) holds at every instant until
+        the last prediction ends.
 
     Raises
     ------
     BlockedError
-        No non-decreasing ``s(t)`` with speed ``<= v_max`` avoids a mover within the grid's
-        horizon (the mover and the time are named), or no profile of the family does.
+        No profile of the family avoids the movers; the mover and the time are named (from
+        the necessary grid when no non-decreasing ``s(t)`` with speed ``<= v_max`` gets
+        past a mover within the grid's horizon).
     InvalidInputError
-        A mover overlaps the robot at ``t = 0``; a trajectory that does not start and end at
-        rest; bad spacings.
+        A mover overlaps the robot at ``t = 0``; a trajectory that does not end at rest;
+        ``not_before > 0`` with a moving start; bad spacings.
     """
     t_all = time.perf_counter()
     movers = check_movers(movers)
     if not isinstance(traj, Trajectory):
         raise InvalidInputError(f"traj must be a trajopt.Trajectory, got {type(traj).__name__}")
-    if traj.v_start != 0.0 or traj.v_end != 0.0 or traj.phase_a[0] != 0.0:
+    if traj.v_end != 0.0:
         raise InvalidInputError(
-            "retime_for_movers needs a trajectory from rest to rest, got "
-            f"v_start={traj.v_start!r} m/s, v_end={traj.v_end!r} m/s"
+            f"retime_for_movers needs a trajectory that ends at rest, got v_end={traj.v_end!r} m/s"
         )
     if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0.0):
         raise InvalidInputError(f"margin must be a finite number >= 0 m, got {margin!r}")
@@ -190,9 +288,17 @@ def retime_for_movers(
             raise InvalidInputError(f"{name} must be a finite number > 0, got {val!r}")
     if not (isinstance(not_before, (int, float)) and math.isfinite(not_before) and not_before >= 0):
         raise InvalidInputError(f"not_before must be a finite number >= 0 s, got {not_before!r}")
+    v0, a0 = float(traj.v_start), float(traj.phase_a[0])
+    moving = v0 != 0.0 or a0 != 0.0
+    if moving and not_before > 0.0:
+        raise InvalidInputError(
+            f"not_before must be 0 for a trajectory that starts moving (v_start={v0!r} m/s, "
+            f"a={a0!r} m/s^2), got {not_before!r} s"
+        )
     limit, body, stretch = _robot_shape(traj, float(margin))
     _overlap_at_start(traj, movers, float(margin))
     path, length, robot = traj.path, float(traj.length), traj.robot
+    plan = traj  # without the rest below: its drive (0, L) is the plan's own
     if not_before > 0.0:  # the plan as it is, after the rest
         whole = _piece_of(traj, 0.0, length)
         rows, duration = compose([(0.0, None, 0.0), (float(not_before), whole, 0.0)], length)
@@ -203,38 +309,47 @@ def retime_for_movers(
     vmax = float(robot.v_max)
     t_last = max(m.t_last for m in movers)
     horizon = max(t_last, 0.0) + 2.0 * traj.duration + 2.0
-    nec = st_grid(
-        path,
-        length,
-        movers,
-        limit,
-        ds=ds,
-        dt=dt,
-        horizon=horizon,
-        speed=vmax,
-        sufficient=False,
-        body=body,
-        stretch=stretch,
-    )
-    _blocked(nec, movers, robot)
+    tables = _tables(plan)
+    grid_args = {
+        "ds": ds,
+        "horizon": horizon,
+        "speed": max(vmax, v0),
+        "body": body,
+        "stretch": stretch,
+    }
+    s_nodes, ds_used = grid_nodes(length, ds)
+    points = tables.nodes(s_nodes, ds_used)
+    launch, brake_at = None, None
+    if moving:
+        brake_at = float(braking_distance(v0, a0, float(robot.a_max), float(robot.j_max)))
+        first = {length: _piece_of(traj, 0.0, length)}
+
+        def launch(s1: float) -> Piece | None:
+            if s1 < brake_at - 1e-9:  # closer than the robot can stop
+                return None
+            if s1 not in first:
+                piece = tables.move((0.0, v0, a0), s1)
+                if piece is None:
+                    piece = _follow_then_stop(traj, tables, s1)
+                first[s1] = tables.segment(0.0, s1, v0, a0) if piece is None else piece
+            return first[s1]
+
     step = float(dt)
-    drives = _drives(traj)
     for _ in range(3):
         grid = st_grid(
-            path,
-            length,
-            movers,
-            limit,
-            ds=ds,
-            dt=step,
-            horizon=horizon,
-            speed=vmax,
-            sufficient=True,
-            body=body,
-            stretch=stretch,
+            path, length, movers, limit, dt=step, sufficient=True, points=points, **grid_args
         )
         k_min = int(math.ceil(not_before / step - 1e-9))
-        found = search(grid, drives, vmax, float(robot.a_max), k_min)
+        found = search(
+            grid,
+            tables.drive,
+            vmax,
+            float(robot.a_max),
+            k_min,
+            float(robot.j_max),
+            launch=launch,
+            brake_at=brake_at,
+        )
         if found is None:
             break
         parts, _, label = found
@@ -244,13 +359,96 @@ def retime_for_movers(
         if cert.ok:
             return _with_stats(out, cert, label, t_all)
         step *= 0.5
-    first = cert.mover or movers[0].name
+    # why: the necessary grid names the mover that leaves no way past, when one does
+    nec = st_grid(path, length, movers, limit, dt=dt, sufficient=False, points=points, **grid_args)
+    _blocked(nec, movers, robot, v0)
+    first_name = cert.mover or movers[0].name
     raise BlockedError(
         f"no re-timing along the path (rests at the start and at stops) avoids moving "
-        f"obstacle {first!r} (near t = {cert.witness_t:.3f} s) within {horizon:.3g} s",
-        mover=first,
+        f"obstacle {first_name!r} (near t = {cert.witness_t:.3f} s) within {horizon:.3g} s",
+        mover=first_name,
         t=cert.witness_t,
     )
+
+
+def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:
+    """Return ``traj``'s motion until it must brake, then its shortest stop at ``s1`` (m).
+
+    The latest time ``tau`` (on two grids of 256, the second inside the bracket of the first)
+    whose state still stops by ``s1`` (:func:`braking_distance`), then ruckig's stop to rest
+    at ``s1`` under the speed at ``tau``; ``None`` when that stop leaves the cap table (the
+    caller times the piece of the path then).
+    """
+    robot = traj.robot
+    a_max, j_max = float(robot.a_max), float(robot.j_max)
+    lo, hi = 0.0, float(traj.duration)
+    for _ in range(2):
+        tau = np.linspace(lo, hi, 256)
+        s, v, a = _state(traj, tau)
+        ok = s1 - s - braking_distance(v, a, a_max, j_max) >= 0.0
+        if not ok[0]:
+            return None
+        i = int(np.argmin(ok)) - 1 if not ok.all() else tau.shape[0] - 1
+        lo, hi = float(tau[i]), float(tau[min(i + 1, tau.shape[0] - 1)])
+    s, v, a = (float(x[0]) for x in _state(traj, np.array([lo])))
+    rows = tables.rk.solve((s, v, a), (s1, 0.0, 0.0), max(v, 1e-9))
+    if rows is None or not _under_caps(tables.table, rows):
+        return None
+    keep = traj.phase_t < lo
+    head = np.column_stack([traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j])[
+        keep
+    ]
+    tail = rows[:, :5].copy()
+    tail[:, 0] += lo
+    duration = float(lo + rows[-1, 0] + rows[-1, 5])
+    return Piece(np.concatenate([head, tail]), duration, 0.0, float(s1))
+
+
+def _state(traj: Trajectory, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return ``(s, v, a)`` of ``traj``'s phases at times ``t`` in ``[0, duration]`` (s).
+
+    ``traj.motion`` without its clipping to the path's length (which costs an arc-length
+    evaluation of the path per call).
+    """
+    pt = traj.phase_t
+    k = np.clip(np.searchsorted(pt, t, side="right") - 1, 0, pt.shape[0] - 1)
+    tau = t - pt[k]
+    j, a0, v0 = traj.phase_j[k], traj.phase_a[k], traj.phase_v[k]
+    s = traj.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
+    return s, np.maximum(v0 + tau * (a0 + 0.5 * j * tau), 0.0), a0 + j * tau
+
+
+def braking_distance(
+    v0: np.ndarray | float, a0: np.ndarray | float, a_max: float, j_max: float
+) -> np.ndarray:
+    """Return the distance (m) a robot at speed ``v0`` (m/s), acceleration ``a0`` needs to stop.
+
+    The shortest jerk-limited stop: the acceleration goes at ``-j_max`` to ``-a_p`` (held
+    there when ``a_p = a_max``), then at ``+j_max`` back to 0, with ``a_p`` such that the
+    speed ends at 0 (``a_p^2 = j_max v0 + a0^2 / 2`` without the hold); from a state already
+    braking hard enough (``a0 < 0``, ``a0^2 / (2 j_max) >= v0``), only the last ramp.
+    Vectorised over ``v0`` and ``a0``.
+    """
+    v0 = np.asarray(v0, dtype=float)
+    a0 = np.asarray(a0, dtype=float)
+    jj = j_max
+    ramp_only = (a0 < 0.0) & (a0 * a0 / (2.0 * jj) >= v0)
+    a_p = np.sqrt(np.maximum(jj * v0 + 0.5 * a0 * a0, 0.0))
+    hold = np.where(
+        a_p > a_max, np.maximum(0.0, (v0 + a0 * a0 / (2.0 * jj) - a_max * a_max / jj) / a_max), 0.0
+    )
+    a_p = np.minimum(a_p, a_max)
+    t1 = np.where(ramp_only, 0.0, (a0 + a_p) / jj)
+    t3 = np.where(ramp_only, -a0 / jj, a_p / jj)
+    hold = np.where(ramp_only, 0.0, hold)
+    a_hold = np.where(ramp_only, a0, -a_p)
+    s, v, a = np.zeros_like(v0), v0, a0
+    for tau, j in ((t1, -jj), (hold, 0.0), (t3, jj)):
+        aa = np.where(j == 0.0, a_hold, a) if j == 0.0 else a
+        s = s + tau * (v + tau * (0.5 * aa + tau * j / 6.0))
+        v = v + tau * (aa + 0.5 * j * tau)
+        a = aa + j * tau
+    return np.maximum(s, 0.0)
 
 
 def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
@@ -264,7 +462,7 @@ def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
         phase_a=rows[:, 3],
         phase_j=rows[:, 4],
         duration=duration,
-        v_start=0.0,
+        v_start=traj.v_start,
         v_end=0.0,
         stats=dict(traj.stats),
         theta_grid_s=traj.theta_grid_s,

@@ -11,6 +11,14 @@ than the limit ``robot radius + mover radius(t_k) + margin`` plus an ``inflation
 * the **necessary** grid deflates by ``ds/2``: a forbidden node is forbidden for every ``s``
   within ``ds/2`` of it at that instant, so a profile through it is truly unsafe.
 
+The grid is stored as *runs*: for every node, the intervals of time indices during which it
+is forbidden (and by which mover). A disc mover against a disc robot gives them in closed
+form: on each piece of its track between waypoint times its centre ``c(t)`` and radius are
+linear in ``t``, so ``|C(s_i) - c(t)| - lim(t)`` is convex in ``t`` and its negative set is
+one interval, the roots of a quadratic; the node is forbidden exactly at the grid times inside
+it (widened by 1 ns on the sufficient grid, narrowed on the necessary one, against rounding).
+Other shapes (a polygon mover, a footprint robot) are evaluated at every node and grid time.
+
 A footprint robot is its convex polygon at each node, turned by the path's heading there; it
 moves at most ``(1 + R kappa_max)`` per metre of arc, so the robot's share of both pads is
 multiplied by that ``stretch``.
@@ -20,17 +28,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._obstacle import MovingObstacle
 
+#: A run's end index standing for "until after the grid's last time" (the movers then stand).
+FOREVER = 1 << 40
+#: Widening (sufficient) or narrowing (necessary) of the closed-form intervals (s).
+EPS_T = 1e-9
 
-@dataclass(frozen=True, slots=True)
+
 class STGrid:
-    """Forbidden nodes of the ``(s, t)`` plane.
+    """Forbidden nodes of the ``(s, t)`` plane, as runs of time indices per node.
 
     Attributes
     ----------
@@ -40,22 +51,99 @@ class STGrid:
         Times (s), ``t[k] = k dt``.
     ds, dt : float
         Spacings (m, s).
-    blocked : ndarray of bool, shape (K, n)
-        Forbidden nodes.
-    who : ndarray of int, shape (K, n)
-        Index of the first mover forbidding each node, -1 where free.
+    ptr : ndarray of int, shape (n + 1,)
+        The runs of node ``i`` are ``ptr[i]:ptr[i + 1]``.
+    lo, hi : ndarray of int, shape (r,)
+        First and last forbidden time index of each run (inclusive); ``hi == FOREVER`` when
+        the run reaches the grid's last time (the node stays forbidden after it).
+    owner : ndarray of int, shape (r,)
+        Index of the mover of each run.
     """
 
-    s: np.ndarray
-    t: np.ndarray
-    ds: float
-    dt: float
-    blocked: np.ndarray
-    who: np.ndarray
+    def __init__(
+        self,
+        s: np.ndarray,
+        t: np.ndarray,
+        ds: float,
+        dt: float,
+        col: np.ndarray,
+        lo: np.ndarray,
+        hi: np.ndarray,
+        owner: np.ndarray,
+    ) -> None:
+        self.s, self.t, self.ds, self.dt = s, t, float(ds), float(dt)
+        order = np.argsort(col, kind="stable")
+        self.lo, self.hi, self.owner = lo[order], hi[order], owner[order]
+        counts = np.bincount(col, minlength=s.shape[0])
+        self.ptr = np.concatenate([[0], np.cumsum(counts)])
+        self._dense: tuple[np.ndarray, np.ndarray] | None = None
 
     def index(self, s: np.ndarray) -> np.ndarray:
         """Nearest node index of arc lengths ``s`` (m)."""
         return np.clip(np.rint(np.asarray(s) / self.ds), 0, self.s.shape[0] - 1).astype(np.int64)
+
+    @property
+    def busy(self) -> np.ndarray:
+        """Nodes forbidden at some time, bool, shape (n,)."""
+        return np.diff(self.ptr) > 0
+
+    def column(self, i: int) -> np.ndarray:
+        """Forbidden times of node ``i``, bool, shape (K,)."""
+        a, b = int(self.ptr[i]), int(self.ptr[i + 1])
+        return self._paint(self.lo[a:b], self.hi[a:b])
+
+    def _paint(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        kk = self.t.shape[0]
+        lo = np.maximum(lo, 0)
+        hi = np.minimum(hi, kk - 1)
+        keep = lo <= hi
+        diff = np.bincount(lo[keep], minlength=kk)
+        diff[:kk] -= np.bincount(hi[keep] + 1, minlength=kk + 1)[:kk]
+        return np.cumsum(diff[:kk]) > 0
+
+    def blocked_starts(self, idx: np.ndarray) -> np.ndarray:
+        """Return ``bad[k]``: a motion at node ``idx[j]`` at time index ``k + j`` meets a run.
+
+        Parameters
+        ----------
+        idx : ndarray of int, shape (m,)
+            The node of the motion at each grid step after its start.
+
+        Returns
+        -------
+        ndarray of bool, shape (K,)
+        """
+        counts = self.ptr[idx + 1] - self.ptr[idx]
+        total = int(counts.sum())
+        if total == 0:
+            return np.zeros(self.t.shape[0], dtype=bool)
+        step = np.repeat(np.arange(idx.shape[0]), counts)
+        first = np.repeat(self.ptr[idx], counts)
+        run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        return self._paint(self.lo[run] - step, self.hi[run] - step)
+
+    def _dense_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._dense is None:
+            kk, n = self.t.shape[0], self.s.shape[0]
+            blocked = np.zeros((kk, n), dtype=bool)
+            who = np.full((kk, n), -1, dtype=np.int16)
+            col = np.repeat(np.arange(n), np.diff(self.ptr))
+            for r in np.argsort(self.owner, kind="stable")[::-1]:  # the first mover wins
+                a, b = self.lo[r], min(self.hi[r], kk - 1)
+                blocked[a : b + 1, col[r]] = True
+                who[a : b + 1, col[r]] = self.owner[r]
+            self._dense = (blocked, who)
+        return self._dense
+
+    @property
+    def blocked(self) -> np.ndarray:
+        """Forbidden nodes, bool, shape (K, n) (built on first use)."""
+        return self._dense_grid()[0]
+
+    @property
+    def who(self) -> np.ndarray:
+        """Index of the first mover forbidding each node, -1 where free, shape (K, n)."""
+        return self._dense_grid()[1]
 
 
 def path_points(path: object, s: np.ndarray) -> np.ndarray:
@@ -76,6 +164,7 @@ def st_grid(
     sufficient: bool,
     body: np.ndarray | None = None,
     stretch: float = 1.0,
+    points: np.ndarray | None = None,
 ) -> STGrid:
     """Build the forbidden grid (module docstring).
 
@@ -101,17 +190,18 @@ def st_grid(
     stretch : float
         With a ``body``: ``1 + R kappa_max`` (``R`` its farthest vertex), the bound of how far
         the footprint moves per metre of arc length; the pads scale the robot's share by it.
+    points : ndarray, shape (n, 2), optional
+        The path's points at the nodes (m), when the caller has them (:func:`grid_nodes`).
 
     Returns
     -------
     STGrid
     """
-    n = max(2, int(math.ceil(length / ds)) + 1)
-    s = np.linspace(0.0, length, n)
-    ds = float(s[1] - s[0])
+    s, ds = grid_nodes(length, ds)
+    n = s.shape[0]
     kk = max(2, int(math.ceil(horizon / dt)) + 1)
     t = np.arange(kk) * dt
-    pts = path_points(path, s)
+    pts = path_points(path, s) if points is None else points
     polys = None
     if body is not None:
         th = np.asarray(path.heading(path.u_at_s(s)), dtype=float)  # type: ignore[attr-defined]
@@ -125,43 +215,135 @@ def st_grid(
         )
     else:
         stretch = 1.0
-    blocked = np.zeros((kk, n), dtype=bool)
-    who = np.full((kk, n), -1, dtype=np.int16)
+    runs: list[tuple[np.ndarray, ...]] = []
+    discs: list[tuple[int, MovingObstacle, float]] = []
     for j, m in enumerate(movers):
         if sufficient:
             pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
         else:
             pad = -0.5 * ds * stretch
+        if polys is None and m.vertices is None:
+            discs.append((j, m, pad))
+            continue
         lim = limit + m.radius_at(t) + pad  # (K,)
         hit = np.zeros((kk, n), dtype=bool)
-        if polys is not None:
-            shapes = shape_at(m, t)
-            for k in range(kk):
-                w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
+        shapes = shape_at(m, t)  # (K, m, 2)
+        for k in range(kk):
+            w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
+            if polys is not None:
                 hit[k] = convex_distance(polys, w) < lim[k]
-        elif m.vertices is None:
-            c = m.position_at(t)
-            for a in range(0, kk, 256):
-                b = min(kk, a + 256)
-                d = np.hypot(pts[None, :, 0] - c[a:b, None, 0], pts[None, :, 1] - c[a:b, None, 1])
-                hit[a:b] = d < lim[a:b, None]
-        else:
-            shapes = shape_at(m, t)  # (K, m, 2)
-            for k in range(kk):
-                w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
+            else:
                 hit[k] = point_polygon_distance(pts, w) < lim[k]
-        who[hit & ~blocked] = j
-        blocked |= hit
-    return STGrid(s=s, t=t, ds=ds, dt=float(dt), blocked=blocked, who=who)
+        runs.append(_runs_of(hit, j))
+    if discs:
+        runs.append(_disc_runs(pts, discs, limit, t, sufficient))
+    if runs:
+        col, lo, hi, owner = (np.concatenate(x) for x in zip(*runs, strict=True))
+    else:
+        col = lo = hi = owner = np.zeros(0, dtype=np.int64)
+    hi = np.where(hi >= kk - 1, FOREVER, hi)
+    return STGrid(s, t, ds, float(dt), col, lo, hi, owner)
 
 
-def reach_bound(t: np.ndarray, v_max: float, a_max: float, j_max: float) -> np.ndarray:
-    """Return an upper bound (m) of ``s(t)`` for any motion from rest under the limits, at ``t`` (s).
+def grid_nodes(length: float, ds: float) -> tuple[np.ndarray, float]:
+    """Return the nodes (m), shape (n,), of a path of ``length`` (m) for a requested ``ds``, and the spacing used."""
+    n = max(2, int(math.ceil(length / ds)) + 1)
+    s = np.linspace(0.0, length, n)
+    return s, float(s[1] - s[0])
 
-    ``a <= min(a_max, j_max t)``, so ``v <= min(v_max, integral of that)``, and ``s`` is at
-    most the integral of this increasing bound, taken as an upper Riemann sum on 1 ms steps.
+
+def _runs_of(hit: np.ndarray, j: int) -> tuple[np.ndarray, ...]:
+    """Return the runs ``(node, first, last, mover)`` of mover ``j``'s dense ``hit`` (K, n)."""
+    h = np.pad(hit.T, ((0, 0), (1, 1)))
+    d = np.diff(h.astype(np.int8), axis=1)
+    ci, k0 = np.nonzero(d == 1)
+    _, k1 = np.nonzero(d == -1)
+    return ci, k0, k1 - 1, np.full(ci.shape[0], j)
+
+
+def _disc_runs(
+    pts: np.ndarray,
+    discs: list[tuple[int, MovingObstacle, float]],
+    limit: float,
+    t: np.ndarray,
+    sufficient: bool,
+) -> tuple[np.ndarray, ...]:
+    """Return the runs of disc movers against a disc robot, in closed form (module docstring)."""
+    dt, t_end = float(t[1] - t[0]), float(t[-1])
+    rows = []  # (mover, u, w, centre at u, velocity, radius + limit + pad at u, growth)
+    for j, m, pad in discs:
+        tk = m.times
+        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
+        u, w = knots[:-1], knots[1:]
+        mid = 0.5 * (u + w)
+        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
+        inside = (mid > tk[0]) & (mid < tk[-1])
+        span = w - u
+        vx = np.where(inside, np.diff(px) / span, 0.0)
+        vy = np.where(inside, np.diff(py) / span, 0.0)
+        grow = np.where(mid < m.t_last, m.growth, 0.0)
+        r_u = limit + pad + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0))
+        rows.append(
+            np.column_stack([np.full(u.shape, j), u, w, px[:-1], py[:-1], vx, vy, r_u, grow])
+        )
+    arr = np.concatenate(rows)
+    owner = arr[:, 0].astype(np.int64)
+    u, w = arr[:, 1:2], arr[:, 2:3]
+    vx, vy, rr, g = arr[:, 5:6], arr[:, 6:7], arr[:, 7:8], arr[:, 8:9]
+    dx = pts[None, :, 0] - arr[:, 3:4]
+    dy = pts[None, :, 1] - arr[:, 4:5]
+    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
+    a = vx * vx + vy * vy - g * g
+    b = -2.0 * (dx * vx + dy * vy + rr * g)
+    c = dx * dx + dy * dy - rr * rr
+    big = np.inf
+    with np.errstate(divide="ignore", invalid="ignore"):
+        disc = b * b - 4.0 * a * c
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        r1 = np.where(b > 0, (-b - sq) / (2.0 * a), 2.0 * c / (-b + sq))
+        r2 = np.where(b > 0, 2.0 * c / (-b - sq), (-b + sq) / (2.0 * a))
+        lo_q = np.minimum(r1, r2)
+        hi_q = np.maximum(r1, r2)
+        flat = np.abs(a) <= 1e-12
+        lin = -c / b
+        t_lo = np.where(
+            flat,
+            np.where(b < 0, lin, np.where((b == 0) & (c < 0), -big, -big)),
+            np.where(a > 0, np.where(disc > 0, lo_q, big), np.where(disc > 0, hi_q, -big)),
+        )
+        t_hi = np.where(
+            flat,
+            np.where(b > 0, lin, np.where((b == 0) & (c >= 0), -big, big)),
+            np.where(a > 0, np.where(disc > 0, hi_q, -big), big),
+        )
+        # the limit must be positive: rr + g tau > 0
+        t_lo = np.where(g > 0, np.maximum(t_lo, -rr / g), np.where(rr > 0, t_lo, big))
+    eps = EPS_T if sufficient else -EPS_T
+    ta = u + np.nan_to_num(t_lo, nan=big, posinf=big, neginf=-big) - eps
+    tb = u + np.nan_to_num(t_hi, nan=-big, posinf=big, neginf=-big) + eps
+    k_lo = np.maximum(np.ceil(u / dt - 1e-9), np.floor(np.clip(ta, -1.0, t_end + dt) / dt) + 1)
+    k_hi = np.minimum(np.floor(w / dt + 1e-9), np.ceil(np.clip(tb, -dt, t_end + dt) / dt) - 1)
+    pi, ci = np.nonzero(k_lo <= k_hi)
+    return (
+        ci.astype(np.int64),
+        k_lo[pi, ci].astype(np.int64),
+        k_hi[pi, ci].astype(np.int64),
+        owner[pi],
+    )
+
+
+def reach_bound(
+    t: np.ndarray, v_max: float, a_max: float, j_max: float, v0: float = 0.0
+) -> np.ndarray:
+    """Return an upper bound (m) of ``s(t)`` for any motion under the limits, at ``t`` (s).
+
+    From rest: ``a <= min(a_max, j_max t)``, so ``v <= min(v_max, integral of that)``, and
+    ``s`` is at most the integral of this increasing bound, taken as an upper Riemann sum on
+    1 ms steps. From a speed ``v0 > 0`` (m/s): ``max(v_max, v0) t``.
     """
     t = np.asarray(t, dtype=float)
+    if v0 > 0.0:
+        return max(v_max, v0) * t
     h = 1e-3
     tt = np.arange(0.0, float(np.max(t, initial=0.0)) + 2.0 * h, h)
     t1 = a_max / j_max
@@ -180,6 +362,10 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
     and (given ``s_up``, shape (K,), an upper bound of ``s(t_k)`` in m) not beyond
     ``s_up[k] + ds/2``.
 
+    Once the grid's rows no longer change (after the last run starts or ends) and neither
+    does the bound, a step that leaves the reachable nodes as they were is a fixed point:
+    the sweep stops there with the answer of the last time.
+
     Returns
     -------
     ok : bool
@@ -191,6 +377,10 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
     """
     fb = grid.blocked
     kk, n = fb.shape
+    ends = np.concatenate([grid.lo, np.where(grid.hi >= FOREVER, 0, grid.hi + 1), [0]])
+    k_static = int(np.max(ends))
+    if s_up is not None:
+        k_static = max(k_static, int(np.searchsorted(s_up, grid.s[-1] + 0.5 * grid.ds)))
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
     idx = np.arange(n)
     reach = np.zeros(n, dtype=bool)
@@ -205,6 +395,8 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
             nxt &= grid.s <= s_up[k] + 0.5 * grid.ds
         if not nxt.any():
             return False, k, last_i
+        if k > k_static and np.array_equal(nxt, reach):
+            break
         reach = nxt
         last_i = int(np.max(np.flatnonzero(reach)))
     return bool(reach[-1]), kk - 1, last_i

@@ -15,8 +15,8 @@ no wait is ``pass before``.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,6 +24,8 @@ from trajopt.moving._st_grid import STGrid
 
 #: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
 N_EVEN_STOPS = 10
+#: The fronts of the forbidden regions are rounded back to multiples of this many nodes.
+STOP_LATTICE = 5
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,35 +39,44 @@ class Piece:
     duration: float
     s0: float
     s1: float
+    memo: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def nodes(self, grid: STGrid) -> np.ndarray:
+        """Return the grid node (index) of the drive at each grid step from its start, shape (m,)."""
+        key = (grid.dt, grid.ds, grid.s.shape[0])
+        if key not in self.memo:
+            n = int(math.ceil(self.duration / grid.dt - 1e-9))
+            self.memo[key] = grid.index(self.s_at(np.arange(n + 1) * grid.dt))
+        return self.memo[key]
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
         """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends."""
-        tt = np.clip(t, 0.0, self.duration)
-        k = np.searchsorted(self.rows[:, 0], tt, side="right") - 1
-        k = np.clip(k, 0, self.rows.shape[0] - 1)
-        tau = tt - self.rows[k, 0]
-        r = self.rows[k]
-        s = r[:, 1] + tau * (r[:, 2] + tau * (0.5 * r[:, 3] + tau * r[:, 4] / 6.0))
-        return np.where(tt >= self.duration, self.s1, np.clip(s, self.s0, self.s1))
+        tt = np.minimum(np.maximum(t, 0.0), self.duration)
+        rows = self.rows
+        k = np.maximum(np.searchsorted(rows[:, 0], tt, side="right") - 1, 0)
+        tau = tt - rows[k, 0]
+        s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
+        s = np.minimum(np.maximum(s, self.s0), self.s1)
+        return np.where(tt >= self.duration, self.s1, s)
 
 
 def ok_starts(grid: STGrid, idx: np.ndarray) -> np.ndarray:
     """Return ``ok[k]``: a drive whose grid samples are the nodes ``idx`` is free from ``t_k``."""
-    fb = grid.blocked
-    kk = fb.shape[0]
-    pad = np.concatenate([fb, np.repeat(fb[-1:], idx.shape[0], axis=0)])
-    ok = np.ones(kk, dtype=bool)
-    for j, i in enumerate(idx):
-        ok &= ~pad[j : j + kk, i]
-    return ok
+    return ~grid.blocked_starts(idx)
 
 
-def stop_points(grid: STGrid) -> list[float]:
-    """Return the stops (m): start, the node in front of each forbidden region, even ones, goal."""
+def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:
+    """Return the stops (m): start, the node in front of each forbidden region, even ones, goal.
+
+    ``extra``: more stops (m), e.g. where a moving robot comes to rest braking at once.
+    """
     length = float(grid.s[-1])
-    cols = grid.blocked.any(axis=0)
+    cols = grid.busy
     fronts = np.flatnonzero(cols[1:] & ~cols[:-1])  # the last free node before a forbidden run
-    inner = [float(grid.s[i]) for i in fronts]
+    # on a lattice of STOP_LATTICE nodes (rounded back, still in front): new predictions
+    # often give the same stops, whose drives are then cached
+    lattice = np.unique((fronts // STOP_LATTICE) * STOP_LATTICE)
+    inner = [float(grid.s[i]) for i in lattice] + [float(x) for x in extra]
     inner += np.linspace(0.0, length, N_EVEN_STOPS + 2)[1:-1].tolist()
     gap = 2.0 * grid.ds
     keep: list[float] = []
@@ -75,13 +86,57 @@ def stop_points(grid: STGrid) -> list[float]:
     return [0.0, *keep, length]
 
 
-def least_time(d: float, v_top: float, a_top: float) -> float:
-    """Return a lower bound (s) of a rest-to-rest drive over ``d`` (m): bang-bang, no jerk limit."""
+def least_time(d: float, v_top: float, a_top: float, j_top: float = math.inf) -> float:
+    """Return the least time (s) of a rest-to-rest drive over ``d`` (m) under the limits.
+
+    The jerk-limited S-curve (with ``j_top = inf``: bang-bang), a lower bound of any drive
+    along a path whose speed cap is at most ``v_top``.
+    """
     if d <= 0.0:
         return 0.0
-    if d <= v_top * v_top / a_top:
-        return 2.0 * math.sqrt(d / a_top)
-    return d / v_top + v_top / a_top
+    if not math.isfinite(j_top):
+        if d <= v_top * v_top / a_top:
+            return 2.0 * math.sqrt(d / a_top)
+        return d / v_top + v_top / a_top
+
+    def ramp(v: float) -> tuple[float, float]:  # time and distance from rest to v
+        if v <= a_top * a_top / j_top:
+            t = 2.0 * math.sqrt(v / j_top)
+        else:
+            t = v / a_top + a_top / j_top
+        return t, 0.5 * v * t
+
+    t_up, d_up = ramp(v_top)
+    if 2.0 * d_up <= d:
+        return 2.0 * t_up + (d - 2.0 * d_up) / v_top
+    # the peak speed v < v_top: 2 d_up(v) = d
+    a, j = a_top, j_top
+    v = 0.5 * a * (-a / j + math.sqrt(a * a / (j * j) + 4.0 * d / a))
+    if v < a * a / j:  # no phase at a_top: 2 v sqrt(v / j) = d
+        v = (0.5 * d) ** (2.0 / 3.0) * j ** (1.0 / 3.0)
+    return 2.0 * ramp(min(v, v_top))[0]
+
+
+def least_times(d: np.ndarray, v_top: float, a_top: float, j_top: float) -> np.ndarray:
+    """Return :func:`least_time` of every distance in ``d`` (m), vectorised (s)."""
+    d = np.maximum(np.asarray(d, dtype=float), 0.0)
+    if not math.isfinite(j_top):
+        return np.where(
+            d <= v_top * v_top / a_top,
+            2.0 * np.sqrt(d / a_top),
+            d / v_top + v_top / a_top,
+        )
+    a, j = a_top, j_top
+
+    def ramp_t(v: np.ndarray) -> np.ndarray:
+        return np.where(v <= a * a / j, 2.0 * np.sqrt(v / j), v / a + a / j)
+
+    t_up = float(ramp_t(np.array(v_top)))
+    d_up = 0.5 * v_top * t_up
+    v = 0.5 * a * (-a / j + np.sqrt(a * a / (j * j) + 4.0 * d / a))
+    v = np.where(v < a * a / j, (0.5 * d) ** (2.0 / 3.0) * j ** (1.0 / 3.0), v)
+    short = 2.0 * ramp_t(np.minimum(v, v_top))
+    return np.where(2.0 * d_up <= d, 2.0 * t_up + (d - 2.0 * d_up) / v_top, short)
 
 
 def _rest_closure(arrive: np.ndarray, blocked_col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -98,6 +153,9 @@ def search(
     v_top: float,
     a_top: float,
     k_min: int = 0,
+    j_top: float = math.inf,
+    launch: Callable[[float], Piece | None] | None = None,
+    brake_at: float | None = None,
 ) -> tuple[list[tuple[float, Piece | None, float]], float, str] | None:
     """Return the earliest arrival's schedule (module docstring), or ``None``.
 
@@ -114,6 +172,14 @@ def search(
     k_min : int
         The first grid time at which the robot may leave the start (it rests there before:
         a turn in place).
+    j_top : float
+        The robot's jerk limit (m/s^3), for the same bound; default none.
+    launch : callable, optional
+        A robot moving at ``t = 0``: ``launch(s1)`` is its motion from its state at ``s = 0``
+        to rest at ``s1`` (m) (``None`` when it cannot stop there). It cannot rest at the
+        start: its first drive is a launch, at ``t = 0``.
+    brake_at : float, optional
+        With ``launch``: where it comes to rest braking at once (m), one more stop.
 
     Returns
     -------
@@ -124,39 +190,55 @@ def search(
     label : str
         The plan in words (its waits and stops).
     """
-    fb, dt = grid.blocked, grid.dt
-    kk = fb.shape[0]
-    stops = stop_points(grid)
+    dt = grid.dt
+    kk = grid.t.shape[0]
+    moving = launch is not None
+    stops = stop_points(grid, () if brake_at is None else (brake_at,))
     nodes = grid.index(np.asarray(stops))
     w_n = len(stops)
-    goal_col = fb[:, -1]
+    sa = np.asarray(stops)
+    steps = np.arange(kk)
+    lt = least_times(sa[None, :] - sa[:, None], v_top, a_top, j_top)  # lt[w, v]: w -> v
+    goal_col = grid.column(int(nodes[-1]))
     last_goal = int(np.max(np.flatnonzero(goal_col))) if goal_col.any() else -1
     # arrivals[w][k]: the robot comes to rest at stop w at t_k; parent (stop, start index, piece)
     arrivals = [np.zeros(kk, dtype=bool) for _ in range(w_n)]
-    parents: list[dict[int, tuple[int, int, Piece]]] = [{} for _ in range(w_n)]
-    arrivals[0][0] = not fb[0, nodes[0]]
+    parent_w = np.full((w_n, kk), -1, dtype=np.int64)
+    parent_k = np.full((w_n, kk), -1, dtype=np.int64)
+    parent_p = np.full((w_n, kk), -1, dtype=np.int64)
+    pieces: list[Piece] = []
+    start_col = grid.column(int(nodes[0]))
+    arrivals[0][0] = not start_col[0]
     resting: list[tuple[np.ndarray, np.ndarray]] = []
-    best: tuple[float, int, int, Piece] | None = None  # (arrival, from stop, start k, drive)
+    best: tuple[float, int, int, Piece] | None = None  # (arrival, from stop, start index, drive)
     for w in range(w_n - 1):
-        rest, since = _rest_closure(arrivals[w], fb[:, nodes[w]])
+        col = start_col if w == 0 else grid.column(int(nodes[w]))
+        rest, since = _rest_closure(arrivals[w], col)
+        if w == 0 and moving:  # no rest: the launch leaves at t = 0
+            rest = np.zeros(kk, dtype=bool)
+            rest[0] = arrivals[0][0]
+            since = np.zeros(kk, dtype=np.int64)
         resting.append((rest, since))
         if w == 0:
-            rest = rest & (np.arange(kk) >= k_min)
+            rest = rest & (steps >= (0 if moving else k_min))
         if not rest.any():
             continue
         first = int(np.argmax(rest))
         for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
-            via = 0.0 if v == w_n - 1 else least_time(stops[-1] - stops[v], v_top, a_top)
-            lower = first * dt + least_time(stops[v] - stops[w], v_top, a_top) + via
+            if moving and w == 0:  # from a speed: at least the distance at the top speed
+                lower = (stops[v] - stops[0]) / v_top + lt[v, w_n - 1]
+            else:
+                lower = first * dt + lt[w, v] + lt[v, w_n - 1]
             if best is not None and lower >= best[0]:
                 continue
-            piece = drive(stops[w], stops[v])
+            piece = launch(stops[v]) if moving and w == 0 else drive(stops[w], stops[v])
             if piece is None:
                 continue
-            n = int(math.ceil(piece.duration / dt - 1e-9))
-            ok = ok_starts(grid, grid.index(piece.s_at(np.arange(n + 1) * dt))) & rest
+            idx = piece.nodes(grid)
+            n = idx.shape[0] - 1
+            ok = ok_starts(grid, idx) & rest
             if v == w_n - 1:
-                ok &= np.arange(kk) + n > last_goal
+                ok &= steps + n > last_goal
                 if ok.any():
                     k = int(np.argmax(ok))
                     t_arr = k * dt + piece.duration
@@ -165,24 +247,35 @@ def search(
                 continue
             ks = np.flatnonzero(ok[: max(0, kk - n)])
             new = ks[~arrivals[v][ks + n]]
-            arrivals[v][new + n] = True
-            for k in new.tolist():
-                parents[v][k + n] = (w, k, piece)
+            if new.size:
+                arrivals[v][new + n] = True
+                parent_w[v, new + n] = w
+                parent_k[v, new + n] = new
+                parent_p[v, new + n] = len(pieces)
+                pieces.append(piece)
     if best is None:
         return None
     t_arr, w, k, piece = best
     chain: list[tuple[int, Piece]] = [(k, piece)]
     while w > 0:
         k_arr = int(resting[w][1][k])
-        w, k, piece = parents[w][k_arr]
+        w, k, piece = (
+            int(parent_w[w, k_arr]),
+            int(parent_k[w, k_arr]),
+            pieces[parent_p[w, k_arr]],
+        )
         chain.append((k, piece))
     chain.reverse()
-    parts: list[tuple[float, Piece | None, float]] = [(0.0, None, 0.0)]
-    words = [f"wait {chain[0][0] * dt:.3f} s at the start"]
-    for k, pc in chain:
+    parts: list[tuple[float, Piece | None, float]] = [] if moving else [(0.0, None, 0.0)]
+    words = [] if moving else [f"wait {chain[0][0] * dt:.3f} s at the start"]
+    for i, (k, pc) in enumerate(chain):
         parts.append((k * dt, pc, pc.s0))
         parts.append((k * dt + pc.duration, None, pc.s1))
-        if pc.s0 > 0.0:
+        if moving and i == 0:
+            words.append(
+                "drive on to the goal" if pc.s1 >= stops[-1] else f"brake to s = {pc.s1:.3f} m"
+            )
+        elif pc.s0 > 0.0:
             words.append(f"stop at s = {pc.s0:.3f} m until t = {k * dt:.3f} s")
     parts.pop()  # the goal's rest is the trajectory's end
     label = ", ".join(words)

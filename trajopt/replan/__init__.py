@@ -2,10 +2,12 @@
 
 Internal: users call :meth:`trajopt.Planner.replan`. :func:`replan_from` checks the splice
 and asks the robot's drive to re-plan: :func:`replan_moving` for a base that turns in place,
-:func:`replan_car` for a car.
+:func:`replan_car` for a car. With predicted movers, :func:`retime_replan` re-times the
+result for them (:mod:`trajopt.replan._moving`).
 """
 
 from trajopt.replan._car import replan_car
+from trajopt.replan._moving import retime_replan, shift_movers
 from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, replan_moving
 
 __all__ = [
@@ -13,4 +15,6 @@ __all__ = [
     "replan_car",
     "replan_from",
     "replan_moving",
+    "retime_replan",
+    "shift_movers",
 ]

@@ -1,0 +1,141 @@
+"""Tests of trajopt.moving's (s, t) grid: the closed-form runs against distances at every node.
+
+The reference evaluates the distance of every node of the path to every disc mover at every
+grid time, written out here (node points from the path, the mover's track by np.interp, its
+radius from its fields); the grid's runs must forbid exactly those nodes, except within 1e-6 m
+of the limit (rounding). The runs' queries (a drive's blocked start times, a node's column)
+are checked against the dense grid, and the reachability sweep's early stop against a full
+sweep.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from trajopt.geometry import PolylineCurve
+from trajopt.moving import MovingObstacle, reachable, st_grid
+
+PATH = PolylineCurve(np.array([[0.0, 0.0], [3.0, 0.0], [5.0, 2.0]]))
+LIMIT, DS, DT, V = 0.2, 0.02, 0.05, 0.5
+
+
+def _movers():
+    return [
+        MovingObstacle.constant_velocity((1.0, -2.0), (0.1, 0.5), radius=0.3, horizon=12.0),
+        # a waypoint track starting late, growing
+        MovingObstacle.from_waypoints(
+            [1.0, 4.0, 9.0], [(4.0, -1.0), (3.5, 1.5), (2.0, 0.5)], radius=0.2, growth=0.05
+        ),
+        # standing still and growing faster than it moves (the quadratic's a < 0)
+        MovingObstacle.from_waypoints([2.5], [(2.0, 0.6)], radius=0.1, growth=0.3),
+        MovingObstacle.from_waypoints(
+            [0.0, 30.0], [(4.5, 0.5), (5.5, 0.5)], radius=0.1, growth=0.2
+        ),
+    ]
+
+
+def _dense(grid, movers, sufficient):
+    pts = np.asarray(PATH(PATH.u_at_s(grid.s)))
+    ref = np.zeros((grid.t.shape[0], grid.s.shape[0]), bool)
+    near = np.zeros_like(ref)
+    for m in movers:
+        if sufficient:
+            pad = 0.5 * (grid.ds + DT * V) + 0.5 * DT * (m.shape_speed_max() + m.growth)
+        else:
+            pad = -0.5 * grid.ds
+        c = np.stack([np.interp(grid.t, m.times, m.positions[:, i]) for i in (0, 1)], axis=-1)
+        d = np.hypot(pts[None, :, 0] - c[:, None, 0], pts[None, :, 1] - c[:, None, 1])
+        lim = LIMIT + m.radius + m.growth * np.clip(grid.t, 0.0, m.t_last) + pad
+        ref |= d < lim[:, None]
+        near |= np.abs(d - lim[:, None]) < 1e-6
+    return ref, near
+
+
+@pytest.mark.parametrize("sufficient", [True, False])
+def test_closed_form_runs_match_the_distances(sufficient):
+    movers = _movers()
+    g = st_grid(
+        PATH,
+        PATH.length,
+        movers,
+        LIMIT,
+        ds=DS,
+        dt=DT,
+        horizon=20.0,
+        speed=V,
+        sufficient=sufficient,
+    )
+    ref, near = _dense(g, movers, sufficient)
+    assert ref.any()
+    assert not np.any((g.blocked != ref) & ~near)
+    for i in (0, 57, g.s.shape[0] - 1):
+        assert np.array_equal(g.column(i), g.blocked[:, i])
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.integers(0, 200),
+    st.lists(st.integers(0, 3), min_size=1, max_size=60),
+)
+def test_blocked_starts_against_the_dense_grid(first, steps):
+    g = st_grid(
+        PATH,
+        PATH.length,
+        _movers(),
+        LIMIT,
+        ds=DS,
+        dt=DT,
+        horizon=20.0,
+        speed=V,
+        sufficient=True,
+    )
+    n = g.s.shape[0]
+    idx = np.minimum(first + np.cumsum(steps), n - 1)
+    got = g.blocked_starts(idx)
+    kk = g.t.shape[0]
+    dense = g.blocked
+    want = np.zeros(kk, bool)
+    for k in range(kk):
+        for j, i in enumerate(idx):
+            # after the grid's last time a node stays as it was then
+            if dense[min(k + j, kk - 1), i]:
+                want[k] = True
+                break
+    assert np.array_equal(got, want)
+
+
+def _full_sweep(grid, speed):
+    fb = grid.blocked
+    kk, n = fb.shape
+    m = int(np.ceil(speed * grid.dt / grid.ds)) + 1
+    idx = np.arange(n)
+    reach = np.zeros(n, bool)
+    reach[0] = not fb[0, 0]
+    for k in range(1, kk):
+        lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
+        reach = ~fb[k] & (idx - lastr <= m)
+        if not reach.any():
+            return False
+    return bool(reach[-1])
+
+
+@pytest.mark.parametrize("radius", [0.15, 0.3])
+def test_the_sweep_stops_at_its_fixed_point_with_the_full_answer(radius):
+    # parked 0.4 m beside the path from t = 0: blocking iff 0.4 < LIMIT + radius - ds/2
+    parked = MovingObstacle.from_waypoints([0.0], [(2.0, -0.4)], radius=radius, name="parked")
+    g = st_grid(
+        PATH,
+        PATH.length,
+        [parked],
+        LIMIT,
+        ds=DS,
+        dt=DT,
+        horizon=40.0,
+        speed=V,
+        sufficient=False,
+    )
+    assert reachable(g, V)[0] == _full_sweep(g, V)
+    assert reachable(g, V)[0] == (0.4 >= LIMIT + radius - 0.5 * g.ds)
