@@ -300,7 +300,7 @@ def kernel_collision(
     if collision.footprint is not None:
         return _footprint_inputs(collision, free, step, poses)
     if collision.clearance is None:
-        return KernelCollision(step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0)
+        return KernelCollision(step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0, 0.0)
     r = collision.clearance
     occ = raw_occupancy(collision.raw_grid, free)
     from astar.inflation import inflate
@@ -309,7 +309,7 @@ def kernel_collision(
     blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
     safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
     occ8 = np.ascontiguousarray(occ, dtype=np.uint8)
-    return KernelCollision(step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0)
+    return KernelCollision(step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0, 0.0)
 
 
 def _footprint_inputs(
@@ -322,13 +322,14 @@ def _footprint_inputs(
     from astar.hybrid_kernel import KernelCollision, footprint_hit
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
+    min_slack = collision.footprint_min_slack
     fp = footprint_polygon(collision.footprint)
     occ = edge_occupancy(raw_occupancy(collision.raw_grid, free))
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
     for name, (x, y, th) in poses:
-        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + slack, buf))
+        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + min_slack, buf))
         if hit != -1:
             where = (
                 "leaves the grid"
@@ -338,8 +339,8 @@ def _footprint_inputs(
             )
             raise InvalidInputError(
                 f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
-                f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
+                f"the least sampling slack ({margin:g} + {min_slack:g} cells) {where}; it must keep "
                 "clear of every occupied square and inside the grid"
             )
     dummy = np.zeros((1, 1), dtype=np.uint8)
-    return KernelCollision(step, dummy, occ, 0.0, fp, safe, rho, margin, slack)
+    return KernelCollision(step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack)

@@ -58,6 +58,20 @@ FOOTPRINT_TOL_CELLS = 0.01
 #: footprint tests fall as its inverse (the default 0.05 made a 35-cell car on a 2.5 cm
 #: grid expand 2 000 states a second), and poses within it of an obstacle are refused.
 FOOTPRINT_SLACK_CELLS = 0.25
+#: Least sampling slack (cells) of the footprint search (``footprint_min_slack`` of
+#: :func:`astar.find_pose_path`): a sample test that fails near an obstacle is refined
+#: down to it, so end poses and manoeuvres within the slack above of a (conservative,
+#: rasterised) obstacle cell are kept, and only there do the tests cost more.
+FOOTPRINT_MIN_SLACK_CELLS = 0.05
+#: Radius of the search's fine states about the end poses (``fine_radius`` of
+#: :func:`astar.find_pose_path`: its second run after a small region was exhausted), in
+#: body lengths (the footprint's extent along its heading): a parking slot or a bay. Half
+#: a length parked 3 of 4 parallel slots of the suite that one pose per cell and heading
+#: bin could not leave, a whole length ran out of time on them.
+FINE_RADIUS_BODIES = 0.5
+#: ``fine_factor`` of the search: sub-cells per cell side, heading-bin and primitive
+#: refinement within :data:`FINE_RADIUS_BODIES` of the end poses.
+FINE_FACTOR = 3
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
 SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
@@ -265,11 +279,15 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
     its poses keep it too, as the corridor requires, to within :data:`EXACT_TOL_M`.
     """
     if robot.footprint is not None:
+        fp = np.asarray(robot.footprint.vertices, dtype=float) / grid.resolution
         return {
             "raw_grid": grid,
-            "footprint": np.asarray(robot.footprint.vertices, dtype=float) / grid.resolution,
+            "footprint": fp,
             "footprint_margin": FOOTPRINT_TOL_CELLS,
             "footprint_slack": SEARCH_MARGIN_CELLS if margin else FOOTPRINT_SLACK_CELLS,
+            "footprint_min_slack": FOOTPRINT_MIN_SLACK_CELLS,
+            "fine_radius": FINE_RADIUS_BODIES * float(np.ptp(fp[:, 0])),
+            "fine_factor": FINE_FACTOR,
         }
     if margin:
         return {}
