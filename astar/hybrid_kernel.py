@@ -927,7 +927,6 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     ) = costs
     max_expansions, deadline, polish = limits
     step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack, fmin_slack = collision
-    two_pi = 2.0 * math.pi
     ny, nx = free.shape
     nc = curvatures.shape[0]
     ndirs = 2 if reverse else 1

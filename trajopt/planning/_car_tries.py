@@ -58,16 +58,19 @@ FOOTPRINT_TOL_CELLS = 0.01
 #: footprint tests fall as its inverse (the default 0.05 made a 35-cell car on a 2.5 cm
 #: grid expand 2 000 states a second), and poses within it of an obstacle are refused.
 FOOTPRINT_SLACK_CELLS = 0.25
-#: Least sampling slack (cells) of the footprint search (``footprint_min_slack`` of
-#: :func:`astar.find_pose_path`): a sample test that fails near an obstacle is refined
-#: down to it, so end poses and manoeuvres within the slack above of a (conservative,
-#: rasterised) obstacle cell are kept, and only there do the tests cost more.
+#: Least sampling slack (cells) of the footprint search on the second grid
+#: (``footprint_min_slack`` of :func:`astar.find_pose_path`; the first grid keeps its
+#: slack whole, room for the smoother): a sample test that fails near an obstacle is
+#: refined down to it, so end poses and manoeuvres within :data:`FOOTPRINT_SLACK_CELLS` of
+#: a (conservative, rasterised) obstacle cell are kept, and only there do the tests cost
+#: more.
 FOOTPRINT_MIN_SLACK_CELLS = 0.05
 #: Radius of the search's fine states about the end poses (``fine_radius`` of
 #: :func:`astar.find_pose_path`: its second run after a small region was exhausted), in
-#: body lengths (the footprint's extent along its heading): a parking slot or a bay. Half
-#: a length parked 3 of 4 parallel slots of the suite that one pose per cell and heading
-#: bin could not leave, a whole length ran out of time on them.
+#: body lengths (the footprint's extent along its heading): a parking slot or a bay. In
+#: the search alone, half a length led out of 2 of 3 parallel slots of the parking suite
+#: that one pose per cell and heading bin could not leave (1.2-1.5 s), a whole length
+#: took 2.2-2.8 s.
 FINE_RADIUS_BODIES = 0.5
 #: ``fine_factor`` of the search: sub-cells per cell side, heading-bin and primitive
 #: refinement within :data:`FINE_RADIUS_BODIES` of the end poses.
@@ -272,7 +275,10 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
     ``footprint``, the footprint in cells), where every pose of the search's arcs keeps its
     oriented footprint :data:`FOOTPRINT_TOL_CELLS` off the raw map, tested at samples with
     the slack :data:`SEARCH_MARGIN_CELLS` (the first grid's margin: room for the smoother)
-    or :data:`FOOTPRINT_SLACK_CELLS` (the second grid).
+    or :data:`FOOTPRINT_SLACK_CELLS` refined down to :data:`FOOTPRINT_MIN_SLACK_CELLS`
+    near obstacles (the second grid); a search that exhausts a small region runs again
+    with finer states and shorter primitives within :data:`FINE_RADIUS_BODIES` of the end
+    poses (``fine_radius``, ``fine_factor`` :data:`FINE_FACTOR`).
 
     On the grid inflated by the radius alone only the cell centres keep the radius; the
     search's exact mode (:func:`astar.find_pose_path` ``clearance``) makes the polyline of
@@ -285,7 +291,7 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
             "footprint": fp,
             "footprint_margin": FOOTPRINT_TOL_CELLS,
             "footprint_slack": SEARCH_MARGIN_CELLS if margin else FOOTPRINT_SLACK_CELLS,
-            "footprint_min_slack": FOOTPRINT_MIN_SLACK_CELLS,
+            "footprint_min_slack": None if margin else FOOTPRINT_MIN_SLACK_CELLS,
             "fine_radius": FINE_RADIUS_BODIES * float(np.ptp(fp[:, 0])),
             "fine_factor": FINE_FACTOR,
         }
