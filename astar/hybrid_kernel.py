@@ -217,6 +217,11 @@ class KernelCollision(NamedTuple):
     fmin_slack : float
         Cells: the least slack a failed sample test is refined to
         (:func:`footprint_arc_clear`; ``>= fslack``: no refinement).
+    fdist : ndarray of float64, shape (ny, nx)
+        Footprint mode: a lower bound of every point's distance to the occupied squares
+        and the outside (:func:`footprint_discs_clear`; else 1 x 1).
+    discs : ndarray of float64, shape (n, 3)
+        Footprint mode: discs covering the footprint (``(0, 3)``: no quick test).
     """
 
     step: float
@@ -229,6 +234,8 @@ class KernelCollision(NamedTuple):
     fmargin: float
     fslack: float
     fmin_slack: float
+    fdist: np.ndarray
+    discs: np.ndarray
 
 
 @njit(cache=True)
@@ -678,8 +685,46 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
 
 
 @njit(cache=True)
+def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - compiled
+    """Return True when the footprint's discs show it clear (a quick sufficient test).
+
+    ``discs`` (``(n, 3)``: centre in the robot frame and radius, cells) cover the footprint
+    (:func:`astar.hybrid_modes.footprint_discs`); ``fdist`` is a lower bound of the
+    distance from any point of a cell to the occupied squares and the grid's outside
+    (:func:`astar.hybrid_modes.clearance_bound`). When every disc's centre, at pose
+    ``(x, y, th)``, lies in the grid with a bound above its radius plus ``grow``, the grown
+    discs, hence the grown footprint, keep clear: True. False means "not shown": test
+    exactly (:func:`footprint_hit`). No discs: False.
+    """
+    n = discs.shape[0]
+    if n == 0:
+        return False
+    ny, nx = fdist.shape
+    c = math.cos(th)
+    s = math.sin(th)
+    for i in range(n):
+        px = x + c * discs[i, 0] - s * discs[i, 1]
+        py = y + s * discs[i, 0] + c * discs[i, 1]
+        ix = int(math.floor(px + 0.5))
+        iy = int(math.floor(py + 0.5))
+        if ix < 0 or iy < 0 or ix >= nx or iy >= ny:
+            return False
+        if fdist[iy, ix] <= discs[i, 2] + grow:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _fp_clear(occ, fsafe, fp, fdist, discs, x, y, th, grow, buf):  # pragma: no cover
+    """Return whether the footprint grown by ``grow`` is clear: quick test, else exact."""
+    return footprint_discs_clear(fdist, discs, x, y, th, grow) or (
+        footprint_hit(occ, fsafe, fp, x, y, th, grow, buf) == -1
+    )
+
+
+@njit(cache=True)
 def footprint_arc_clear(
-    occ, fsafe, fp, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
+    occ, fsafe, fp, fdist, discs, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
 ):  # pragma: no cover - compiled
     """Whether every pose of an arc keeps the footprint ``margin`` from the raw map.
 
@@ -696,7 +741,8 @@ def footprint_arc_clear(
     at the least slack. With ``m > 1`` the footprint grown by ``margin + |s| (1 + rho
     |kappa|) / 2`` is tested at the arc's middle first (one step covering the whole arc;
     only where ``fsafe``, made for a smaller growth, does not answer for the middle's cell);
-    when it is clear, so is the arc.
+    when it is clear, so is the arc. Each test tries :func:`footprint_discs_clear` (``fdist``,
+    ``discs``) first, :func:`footprint_hit` when it does not answer.
     """
     ds_max = 2.0 * slack / (1.0 + rho * abs(kappa))
     m = max(1, int(math.ceil(abs(s) / ds_max)))
@@ -710,16 +756,18 @@ def footprint_arc_clear(
         ny, nx = occ.shape
         if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] == 0:
             sweep = 0.5 * abs(s) * (1.0 + rho * abs(kappa))
-            if footprint_hit(occ, fsafe, fp, qx, qy, qth, margin + sweep, buf) == -1:
+            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sweep, buf):
                 return True
     grow = margin + slack
     half = 0.5 * s / m
     for j in range(m):
         mid = s * (j + 0.5) / m
         qx, qy, qth = advance(x, y, th, kappa, mid)
-        if footprint_hit(occ, fsafe, fp, qx, qy, qth, grow, buf) == -1:
+        if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, grow, buf):
             continue
-        if 0.5 * slack < min_slack or footprint_hit(occ, fsafe, fp, qx, qy, qth, margin, buf) != -1:
+        if 0.5 * slack < min_slack or not _fp_clear(
+            occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf
+        ):
             return False
         # halve the step (a stack of (middle, half length, slack)), down to min_slack
         stack = np.empty((64, 3))
@@ -732,11 +780,11 @@ def footprint_arc_clear(
             top -= 1
             c, h, sl = stack[top, 0], stack[top, 1], stack[top, 2]
             qx, qy, qth = advance(x, y, th, kappa, c)
-            if footprint_hit(occ, fsafe, fp, qx, qy, qth, margin + sl, buf) == -1:
+            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sl, buf):
                 continue
             if 0.5 * sl < min_slack or top + 2 > 64:
                 return False
-            if footprint_hit(occ, fsafe, fp, qx, qy, qth, margin, buf) != -1:
+            if not _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf):
                 return False
             stack[top, 0] = c - 0.5 * h
             stack[top + 1, 0] = c + 0.5 * h
@@ -748,7 +796,23 @@ def footprint_arc_clear(
 
 @njit(cache=True)
 def footprint_word_clear(
-    occ, fsafe, fp, rho, x, y, th, radius, kinds, lens, n, margin, slack, min_slack, buf
+    occ,
+    fsafe,
+    fp,
+    fdist,
+    discs,
+    rho,
+    x,
+    y,
+    th,
+    radius,
+    kinds,
+    lens,
+    n,
+    margin,
+    slack,
+    min_slack,
+    buf,
 ):  # pragma: no cover - compiled
     """Whether every pose of a Reeds-Shepp/Dubins word keeps the footprint ``margin`` clear.
 
@@ -760,7 +824,21 @@ def footprint_word_clear(
             continue
         kappa = kinds[i] / radius
         if not footprint_arc_clear(
-            occ, fsafe, fp, rho, x, y, th, kappa, lens[i], margin, slack, min_slack, buf
+            occ,
+            fsafe,
+            fp,
+            fdist,
+            discs,
+            rho,
+            x,
+            y,
+            th,
+            kappa,
+            lens[i],
+            margin,
+            slack,
+            min_slack,
+            buf,
         ):
             return False
         x, y, th = advance(x, y, th, kappa, lens[i])
@@ -926,7 +1004,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         car_window,
     ) = costs
     max_expansions, deadline, polish = limits
-    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack, fmin_slack = collision
+    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack, fmin_slack, fdist, discs = collision
     ny, nx = free.shape
     nc = curvatures.shape[0]
     ndirs = 2 if reverse else 1
@@ -1075,6 +1153,8 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         occ,
                         fsafe,
                         fp,
+                        fdist,
+                        discs,
                         frho,
                         ax,
                         ay,
@@ -1115,7 +1195,21 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
             if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
                 continue
             if footprint and not footprint_arc_clear(
-                occ, fsafe, fp, frho, ux, uy, uth, kappa, s, fmargin, fslack, fmin_slack, fbuf
+                occ,
+                fsafe,
+                fp,
+                fdist,
+                discs,
+                frho,
+                ux,
+                uy,
+                uth,
+                kappa,
+                s,
+                fmargin,
+                fslack,
+                fmin_slack,
+                fbuf,
             ):
                 continue
             cx, cy, cth = advance(ux, uy, uth, kappa, s)
