@@ -79,8 +79,12 @@ FINE_FACTOR = 3
 #: manoeuvre drives backwards and changes direction often, and Smac's defaults (a cusp at
 #: 2 turning radii, backwards at twice the length, the heuristic weighted 1.5) made the
 #: search expand every state a cusp fewer reaches first. On 7 parking cases of the suite
-#: that ran the second grid's search out of 3 s, these planned 5 (0.3-2.6 s).
+#: that ran the second grid's search out of 3 s, these planned 5 (0.3-2.6 s). Tried after
+#: the default costs (:func:`cost_variants`).
 FOOTPRINT_COSTS = {"cusp_penalty": 0.5, "reverse_penalty": 1.2, "heuristic_weight": 2.5}
+#: Cap (s) on the search of a car with a body at the default costs, before
+#: :data:`FOOTPRINT_COSTS`.
+FOOTPRINT_DEFAULT_BUDGET_S = 0.5
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
 SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
@@ -194,31 +198,43 @@ def search_and_fit(
             if factor > largest or time.perf_counter() > t_end:
                 continue
             r_cells = factor * robot.drive.min_turning_radius / res
-            try:
-                with timer.stage("search"):
-                    path = astar.find_pose_path(
-                        search_grid,
-                        start,
-                        goal,
-                        turning_radius=r_cells,
-                        reverse=robot.drive.reverse,
-                        time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
-                        **exact_clearance(robot, grid, margin),
-                    )
-            except astar.NoPosePathError as exc:
-                tries.append(f"{grid_name(margin)}, {factor:g} R: no path ({exc.reason})")
-                failures.append(exc)
-                if exc.reason == "disconnected":
+            path = None
+            stop = False
+            for name, costs, cap in cost_variants(robot):
+                if time.perf_counter() > t_end:
                     break
+                try:
+                    with timer.stage("search"):
+                        path = astar.find_pose_path(
+                            search_grid,
+                            start,
+                            goal,
+                            turning_radius=r_cells,
+                            reverse=robot.drive.reverse,
+                            time_budget=max(0.05, min(cap, t_end - time.perf_counter())),
+                            **exact_clearance(robot, grid, margin),
+                            **costs,
+                        )
+                    break
+                except astar.NoPosePathError as exc:
+                    tries.append(f"{grid_name(margin)}, {factor:g} R{name}: no path ({exc.reason})")
+                    failures.append(exc)
+                    if exc.reason == "disconnected":
+                        stop = True
+                        break
+                except astar.InvalidInputError as exc:
+                    if robot.footprint is None:
+                        raise
+                    # an end pose whose footprint does not keep this grid's slack: next grid
+                    tries.append(f"{grid_name(margin)}: {exc}")
+                    failures.append(InvalidInputError(str(exc)))
+                    stop = True
+                    break
+            if stop:
+                break
+            if path is None:
                 largest = min(largest, factor)
                 continue
-            except astar.InvalidInputError as exc:
-                if robot.footprint is None:
-                    raise
-                # an end pose whose footprint does not keep this grid's slack: the next grid
-                tries.append(f"{grid_name(margin)}: {exc}")
-                failures.append(InvalidInputError(str(exc)))
-                break
             poses = path.to_world(grid)
             try:
                 segments = []
@@ -236,12 +252,28 @@ def search_and_fit(
                         )
                     )
             except SmoothingError as exc:
-                tries.append(f"{grid_name(margin)}, {factor:g} R: a segment has no fit")
+                tries.append(f"{grid_name(margin)}, {factor:g} R{name}: a segment has no fit")
                 failures.append(exc)
                 continue
-            tries.append(f"{grid_name(margin)}, {factor:g} R: planned")
+            tries.append(f"{grid_name(margin)}, {factor:g} R{name}: planned")
             return CarFound(search_grid, path, r_cells, poses, segments, tries)
     raise failure(robot, grid, start, goal, tries, failures)
+
+
+def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, float], float], ...]:
+    """Return the search costs a try runs with, in order: ``(name, costs, budget cap (s))``.
+
+    A disc: the search's default costs, :data:`SEARCH_BUDGET_S`. A car with a body: the
+    default costs for :data:`FOOTPRINT_DEFAULT_BUDGET_S` (the paths they find where they
+    find one quickly: drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
+    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`.
+    """
+    if robot.footprint is None:
+        return (("", {}, SEARCH_BUDGET_S),)
+    return (
+        ("", {}, FOOTPRINT_DEFAULT_BUDGET_S),
+        (", parking costs", FOOTPRINT_COSTS, SEARCH_BUDGET_S),
+    )
 
 
 def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> OccupancyGrid:
@@ -300,7 +332,6 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
             "footprint_min_slack": None if margin else FOOTPRINT_MIN_SLACK_CELLS,
             "fine_radius": FINE_RADIUS_BODIES * float(np.ptp(fp[:, 0])),
             "fine_factor": FINE_FACTOR,
-            **FOOTPRINT_COSTS,
         }
     if margin:
         return {}
