@@ -82,8 +82,10 @@ FINE_FACTOR = 3
 #: that ran the second grid's search out of 3 s, these planned 5 (0.3-2.6 s). Tried after
 #: the default costs (:func:`cost_variants`).
 FOOTPRINT_COSTS = {"cusp_penalty": 0.5, "reverse_penalty": 1.2, "heuristic_weight": 2.5}
-#: Cap (s) on the search of a car with a body at the default costs, before
-#: :data:`FOOTPRINT_COSTS`.
+#: Caps on the search of a car with a body at the default costs, before
+#: :data:`FOOTPRINT_COSTS`: expansions (the cap that decides, so that the path does not
+#: depend on the machine's load; about 0.25 s) and seconds.
+FOOTPRINT_DEFAULT_EXPANSIONS = 5000
 FOOTPRINT_DEFAULT_BUDGET_S = 0.5
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
@@ -260,18 +262,19 @@ def search_and_fit(
     raise failure(robot, grid, start, goal, tries, failures)
 
 
-def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, float], float], ...]:
+def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]:
     """Return the search costs a try runs with, in order: ``(name, costs, budget cap (s))``.
 
     A disc: the search's default costs, :data:`SEARCH_BUDGET_S`. A car with a body: the
-    default costs for :data:`FOOTPRINT_DEFAULT_BUDGET_S` (the paths they find where they
-    find one quickly: drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
+    default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (at most
+    :data:`FOOTPRINT_DEFAULT_BUDGET_S`; the paths they find where they find one quickly:
+    drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
     (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`.
     """
     if robot.footprint is None:
         return (("", {}, SEARCH_BUDGET_S),)
     return (
-        ("", {}, FOOTPRINT_DEFAULT_BUDGET_S),
+        ("", {"max_expansions": FOOTPRINT_DEFAULT_EXPANSIONS}, FOOTPRINT_DEFAULT_BUDGET_S),
         (", parking costs", FOOTPRINT_COSTS, SEARCH_BUDGET_S),
     )
 
