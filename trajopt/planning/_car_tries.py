@@ -19,8 +19,12 @@ planners' grid): end points near walls and passages the margin closes. There onl
 centres keep the radius, so that search runs in its exact mode (:func:`astar.find_pose_path`
 ``raw_grid``, ``clearance``; :func:`exact_clearance`): the chords between its poses keep the
 radius from the raw map exactly, as the corridor requires (a pose anywhere in a free cell
-could come up to half a cell's diagonal closer). The tries share :data:`CAR_BUDGET_S`;
-``stats["car"]["tries"]`` lists them.
+could come up to half a cell's diagonal closer). A car with a body searches each radius
+with the default costs first, capped at :data:`FOOTPRINT_DEFAULT_EXPANSIONS`, then with
+:data:`FOOTPRINT_COSTS` (:func:`cost_variants`), and goes on to the second grid as soon as
+the first grid's first radius finds no path (there the sampling slack is refined near
+obstacles and a slot it cannot leave is searched with finer states: :func:`exact_clearance`).
+The tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 """
 
 from __future__ import annotations
@@ -235,6 +239,8 @@ def search_and_fit(
             if stop:
                 break
             if path is None:
+                if robot.footprint is not None and margin:
+                    break  # a body: the second grid (refined slack, fine states) next
                 largest = min(largest, factor)
                 continue
             poses = path.to_world(grid)
