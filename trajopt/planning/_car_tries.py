@@ -62,6 +62,11 @@ FOOTPRINT_TOL_CELLS = 0.01
 #: footprint tests fall as its inverse (the default 0.05 made a 35-cell car on a 2.5 cm
 #: grid expand 2 000 states a second), and poses within it of an obstacle are refused.
 FOOTPRINT_SLACK_CELLS = 0.25
+#: The second grid's sampling slack is at least this (m): on cells finer than 0.1 m the
+#: slack in cells grows, so that the number of footprint tests per metre of a manoeuvre
+#: stays that of 0.1 m cells (the refinement to :data:`FOOTPRINT_MIN_SLACK_CELLS` keeps
+#: the tight places).
+FOOTPRINT_SLACK_M = 0.025
 #: Least sampling slack (cells) of the footprint search on the second grid
 #: (``footprint_min_slack`` of :func:`astar.find_pose_path`; the first grid keeps its
 #: slack whole, room for the smoother): a sample test that fails near an obstacle is
@@ -337,7 +342,11 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
             "raw_grid": grid,
             "footprint": fp,
             "footprint_margin": FOOTPRINT_TOL_CELLS,
-            "footprint_slack": SEARCH_MARGIN_CELLS if margin else FOOTPRINT_SLACK_CELLS,
+            "footprint_slack": (
+                SEARCH_MARGIN_CELLS
+                if margin
+                else max(FOOTPRINT_SLACK_CELLS, FOOTPRINT_SLACK_M / grid.resolution)
+            ),
             "footprint_min_slack": None if margin else FOOTPRINT_MIN_SLACK_CELLS,
             "fine_radius": FINE_RADIUS_BODIES * float(np.ptp(fp[:, 0])),
             "fine_factor": FINE_FACTOR,
