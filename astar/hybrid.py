@@ -318,7 +318,9 @@ def find_pose_path(
     cheapest path (costs: length, backwards and arc weights, cusps). When the search exhausts
     a small region (at most 20 000 expansions: a pocket where no primitive fits, a dead end),
     it runs once more with primitives a third as long and three times as many heading bins,
-    within the remaining budgets. The search may also grow from the goal
+    within the remaining budgets (with ``fine_radius``: the same primitives and states, and
+    within ``fine_radius`` of the end poses finer states and shorter primitives besides,
+    :class:`~astar.HybridMotion`). The search may also grow from the goal
     (``search_from="goal"``): it drives its primitives back in time from the goal pose and
     shoots words from the start pose, and the path it returns is the same kind of path (from
     the start, each piece driven as the path drives it, checked the same way). With
@@ -418,7 +420,9 @@ def find_pose_path(
         max(30.0, 12.0 * radius),
     )
 
-    def search(backward: bool, plen: float, bins: int, exp_left: int, deadline: float) -> tuple:
+    def search(
+        backward: bool, plen: float, bins: int, exp_left: int, deadline: float, fine: bool = False
+    ) -> tuple:
         if backward not in fields:  # 2-D distances to the search's target
             src, dst = ((six, siy), (gix, giy)) if backward else ((gix, giy), (six, siy))
             fields[backward] = distance_field(free, *src, *dst, reach)[0]
@@ -426,7 +430,16 @@ def find_pose_path(
             query = KernelQuery(free, fields[backward], gx, gy, gth, sx, sy, sth)
         else:
             query = KernelQuery(free, fields[backward], sx, sy, sth, gx, gy, gth)
-        kmotion = KernelMotion(radius, kappas, plen, bins, reverse, backward)
+        kmotion = KernelMotion(
+            radius,
+            kappas,
+            plen,
+            bins,
+            reverse,
+            backward,
+            motion.fine_radius if fine else 0.0,
+            motion.fine_factor,
+        )
         klimits = KernelLimits(exp_left, deadline, _POLISH)
         return hybrid_kernel(query, kmotion, kcosts, klimits, kcoll)
 
@@ -447,9 +460,12 @@ def find_pose_path(
         if status == EXHAUSTED and n_exp <= _RETRY_BELOW and max_exp > expanded:
             # a small region was exhausted (a pocket where no primitive fits?): once more with
             # primitives a third as long and three times as many heading bins
-            plen, bins = prim_len / 3.0, 3 * nbins
             left = max_exp - expanded
-            out = search(backward, plen, bins, left, t1 + budget)
+            if motion.fine_radius > 0.0:  # finer states and primitives near the ends only
+                out = search(backward, prim_len, nbins, left, t1 + budget, fine=True)
+            else:
+                plen, bins = prim_len / 3.0, 3 * nbins
+                out = search(backward, plen, bins, left, t1 + budget)
             status, retried = out[0], True
             expanded += min(int(out[7]), left)
             shots += int(out[8])
@@ -479,7 +495,14 @@ def find_pose_path(
                 f"every reachable (x, y, heading) state was expanded ({expanded}) driving {mode} "
                 f"with turning radius {radius:g} cells"
             )
-            if retried:
+            if retried and motion.fine_radius > 0.0:
+                f = motion.fine_factor
+                why += (
+                    f", and again with {f} x {f} sub-cells, {f * nbins} heading bins and "
+                    f"primitives of {prim_len / f:.3g} cells within {motion.fine_radius:.3g} "
+                    "cells of the end poses"
+                )
+            elif retried:
                 why += (
                     f", and again with primitives of {prim_len / 3.0:.3g} cells and {3 * nbins} "
                     "heading bins"
@@ -510,6 +533,7 @@ def find_pose_path(
         (gx, gy, gth),
         kcoll.exact_r > 0.0,
         backward,
+        motion.fine_factor,
     )
     path = PosePath(*arrays, radius)
     stats["total_s"] = time.perf_counter() - t0

@@ -20,7 +20,14 @@ __all__ = ["COLLISION_STEP", "assemble"]
 COLLISION_STEP = 0.2
 
 
-def _units(out, kappas, prim_len, radius, start, backward):
+def _prim(p, kappas, prim_len, fine_f):
+    """Return a kernel primitive code's ``(curvature, length, backwards)`` (cells)."""
+    nc = len(kappas)
+    li, rest = divmod(p, 2 * nc)
+    return float(kappas[rest >> 1]), (prim_len / fine_f if li else prim_len), bool(p & 1)
+
+
+def _units(out, kappas, prim_len, radius, start, backward, fine_f=1):
     """Return the path's primitives and shot segments in driving order.
 
     Each unit is ``(piece, origin)``: ``piece = [x, y, heading, curvature, signed length]``
@@ -48,25 +55,25 @@ def _units(out, kappas, prim_len, radius, start, backward):
     if not backward:
         prim = []
         for a, b in edges:
-            p = int(prims[b])
-            s = -prim_len if p & 1 else prim_len
-            prim.append(([*map(float, nodes[a]), float(kappas[p >> 1]), s], None))
+            k, ln, back = _prim(int(prims[b]), kappas, prim_len, fine_f)
+            prim.append(([*map(float, nodes[a]), k, -ln if back else ln], None))
         return prim + shot
     # from the goal: the shot ends at the chain's last node (heading unwrapped from the start's,
     # the nodes' from the goal's): shift the nodes' headings by the whole turns between them
     off = 2.0 * math.pi * round((th - float(nodes[chain[-1], 2])) / (2.0 * math.pi))
     prim = []
     for a, b in reversed(edges):
-        p = int(prims[b])
-        s = -prim_len if p & 1 else prim_len  # as the path drives it: from b back to a
-        k = float(kappas[p >> 1])
+        k, ln, back = _prim(int(prims[b]), kappas, prim_len, fine_f)
+        s = -ln if back else ln  # as the path drives it: from b back to a
         bx, by, bth = (float(v) for v in nodes[b])
         ax, ay, ath = (float(v) for v in nodes[a])
         prim.append(([bx, by, bth + off, k, s], (ax, ay, ath, off, -s)))
     return shot + prim
 
 
-def assemble(out, kappas, prim_len, radius, step, start, goal, exact=False, backward=False):
+def assemble(
+    out, kappas, prim_len, radius, step, start, goal, exact=False, backward=False, fine_f=1
+):
     """Pieces, poses, directions and segments of the path the kernel found.
 
     Parameters
@@ -85,6 +92,8 @@ def assemble(out, kappas, prim_len, radius, step, start, goal, exact=False, back
         steps), whose chords the exact mode checked.
     backward : bool, optional
         The kernel searched from the goal (:class:`~astar.hybrid_kernel.KernelMotion`).
+    fine_f : int, optional
+        The kernel's ``fine_f``: its fine primitives are ``prim_len / fine_f`` long.
 
     Returns
     -------
@@ -101,7 +110,7 @@ def assemble(out, kappas, prim_len, radius, step, start, goal, exact=False, back
     """
     from astar.reeds_shepp import advance
 
-    units = _units(out, kappas, prim_len, radius, start, backward)
+    units = _units(out, kappas, prim_len, radius, start, backward, fine_f)
     raw = [u[0] for u in units]
     pieces: list[list[float]] = []
     for r in raw:

@@ -123,6 +123,13 @@ class KernelMotion(NamedTuple):
         backwards primitives cost ``reverse_penalty``), and the shots are words from the
         path's start to the expanded pose (a pull-out from a parking slot, searched where
         space is tight, whose shots land in the open).
+    fine_r : float
+        Cells: within this distance of either end pose the states are finer
+        (:func:`state_key`: ``fine_f`` x ``fine_f`` sub-cells per cell and ``fine_f``
+        times the heading bins) and primitives ``prim_len / fine_f`` long are expanded
+        besides the others; ``<= 0``: off.
+    fine_f : int
+        ``>= 1``: the refinement factor of the fine states and primitives.
     """
 
     radius: float
@@ -131,6 +138,8 @@ class KernelMotion(NamedTuple):
     nbins: int
     reverse: bool
     backward: bool
+    fine_r: float
+    fine_f: int
 
 
 class KernelCosts(NamedTuple):
@@ -205,6 +214,14 @@ class KernelCollision(NamedTuple):
         Cells: every pose's footprint keeps this distance from ``occ`` (footprint mode).
     fslack : float
         Cells: the body moves at most this far between a pose and its tested sample.
+    fmin_slack : float
+        Cells: the least slack a failed sample test is refined to
+        (:func:`footprint_arc_clear`; ``>= fslack``: no refinement).
+    fdist : ndarray of float64, shape (ny, nx)
+        Footprint mode: a lower bound of every point's distance to the occupied squares
+        and the outside (:func:`footprint_discs_clear`; else 1 x 1).
+    discs : ndarray of float64, shape (n, 3)
+        Footprint mode: discs covering the footprint (``(0, 3)``: no quick test).
     """
 
     step: float
@@ -216,6 +233,9 @@ class KernelCollision(NamedTuple):
     frho: float
     fmargin: float
     fslack: float
+    fmin_slack: float
+    fdist: np.ndarray
+    discs: np.ndarray
 
 
 @njit(cache=True)
@@ -665,8 +685,46 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
 
 
 @njit(cache=True)
+def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - compiled
+    """Return True when the footprint's discs show it clear (a quick sufficient test).
+
+    ``discs`` (``(n, 3)``: centre in the robot frame and radius, cells) cover the footprint
+    (:func:`astar.hybrid_modes.footprint_discs`); ``fdist`` is a lower bound of the
+    distance from any point of a cell to the occupied squares and the grid's outside
+    (:func:`astar.hybrid_modes.clearance_bound`). When every disc's centre, at pose
+    ``(x, y, th)``, lies in the grid with a bound above its radius plus ``grow``, the grown
+    discs, hence the grown footprint, keep clear: True. False means "not shown": test
+    exactly (:func:`footprint_hit`). No discs: False.
+    """
+    n = discs.shape[0]
+    if n == 0:
+        return False
+    ny, nx = fdist.shape
+    c = math.cos(th)
+    s = math.sin(th)
+    for i in range(n):
+        px = x + c * discs[i, 0] - s * discs[i, 1]
+        py = y + s * discs[i, 0] + c * discs[i, 1]
+        ix = int(math.floor(px + 0.5))
+        iy = int(math.floor(py + 0.5))
+        if ix < 0 or iy < 0 or ix >= nx or iy >= ny:
+            return False
+        if fdist[iy, ix] <= discs[i, 2] + grow:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _fp_clear(occ, fsafe, fp, fdist, discs, x, y, th, grow, buf):  # pragma: no cover
+    """Return whether the footprint grown by ``grow`` is clear: quick test, else exact."""
+    return footprint_discs_clear(fdist, discs, x, y, th, grow) or (
+        footprint_hit(occ, fsafe, fp, x, y, th, grow, buf) == -1
+    )
+
+
+@njit(cache=True)
 def footprint_arc_clear(
-    occ, fsafe, fp, rho, x, y, th, kappa, s, margin, slack, buf
+    occ, fsafe, fp, fdist, discs, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
 ):  # pragma: no cover - compiled
     """Whether every pose of an arc keeps the footprint ``margin`` from the raw map.
 
@@ -676,10 +734,15 @@ def footprint_arc_clear(
     footprint grown by ``margin + slack`` is tested (:func:`footprint_hit`) at the middle of
     each: every pose of a step lies within ``slack`` of its middle pose's body, so the whole
     arc, its ends included, keeps ``margin``. ``rho``: the footprint's circumscribed radius.
-    With ``m > 1`` the footprint grown by ``margin + |s| (1 + rho |kappa|) / 2`` is tested at
-    the arc's middle first (one step covering the whole arc; only where ``fsafe``, made for
-    a smaller growth, does not answer for the middle's cell); when it is clear, so is the
-    arc.
+    A step whose test fails, while the footprint grown by ``margin`` alone at its middle is
+    clear, is halved and each half tested with half the slack (every pose of a half lies
+    within half the slack of its middle), recursively while the slack stays at least
+    ``min_slack`` (``min_slack >= slack``: no halving); the arc is refused when a test fails
+    at the least slack. With ``m > 1`` the footprint grown by ``margin + |s| (1 + rho
+    |kappa|) / 2`` is tested at the arc's middle first (one step covering the whole arc;
+    only where ``fsafe``, made for a smaller growth, does not answer for the middle's cell);
+    when it is clear, so is the arc. Each test tries :func:`footprint_discs_clear` (``fdist``,
+    ``discs``) first, :func:`footprint_hit` when it does not answer.
     """
     ds_max = 2.0 * slack / (1.0 + rho * abs(kappa))
     m = max(1, int(math.ceil(abs(s) / ds_max)))
@@ -693,19 +756,63 @@ def footprint_arc_clear(
         ny, nx = occ.shape
         if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] == 0:
             sweep = 0.5 * abs(s) * (1.0 + rho * abs(kappa))
-            if footprint_hit(occ, fsafe, fp, qx, qy, qth, margin + sweep, buf) == -1:
+            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sweep, buf):
                 return True
     grow = margin + slack
+    half = 0.5 * s / m
     for j in range(m):
-        qx, qy, qth = advance(x, y, th, kappa, s * (j + 0.5) / m)
-        if footprint_hit(occ, fsafe, fp, qx, qy, qth, grow, buf) != -1:
+        mid = s * (j + 0.5) / m
+        qx, qy, qth = advance(x, y, th, kappa, mid)
+        if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, grow, buf):
+            continue
+        if 0.5 * slack < min_slack or not _fp_clear(
+            occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf
+        ):
             return False
+        # halve the step (a stack of (middle, half length, slack)), down to min_slack
+        stack = np.empty((64, 3))
+        stack[0, 0] = mid - 0.5 * half
+        stack[1, 0] = mid + 0.5 * half
+        stack[0, 1] = stack[1, 1] = 0.5 * half
+        stack[0, 2] = stack[1, 2] = 0.5 * slack
+        top = 2
+        while top > 0:
+            top -= 1
+            c, h, sl = stack[top, 0], stack[top, 1], stack[top, 2]
+            qx, qy, qth = advance(x, y, th, kappa, c)
+            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sl, buf):
+                continue
+            if 0.5 * sl < min_slack or top + 2 > 64:
+                return False
+            if not _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf):
+                return False
+            stack[top, 0] = c - 0.5 * h
+            stack[top + 1, 0] = c + 0.5 * h
+            stack[top, 1] = stack[top + 1, 1] = 0.5 * h
+            stack[top, 2] = stack[top + 1, 2] = 0.5 * sl
+            top += 2
     return True
 
 
 @njit(cache=True)
 def footprint_word_clear(
-    occ, fsafe, fp, rho, x, y, th, radius, kinds, lens, n, margin, slack, buf
+    occ,
+    fsafe,
+    fp,
+    fdist,
+    discs,
+    rho,
+    x,
+    y,
+    th,
+    radius,
+    kinds,
+    lens,
+    n,
+    margin,
+    slack,
+    min_slack,
+    buf,
 ):  # pragma: no cover - compiled
     """Whether every pose of a Reeds-Shepp/Dubins word keeps the footprint ``margin`` clear.
 
@@ -717,7 +824,21 @@ def footprint_word_clear(
             continue
         kappa = kinds[i] / radius
         if not footprint_arc_clear(
-            occ, fsafe, fp, rho, x, y, th, kappa, lens[i], margin, slack, buf
+            occ,
+            fsafe,
+            fp,
+            fdist,
+            discs,
+            rho,
+            x,
+            y,
+            th,
+            kappa,
+            lens[i],
+            margin,
+            slack,
+            min_slack,
+            buf,
         ):
             return False
         x, y, th = advance(x, y, th, kappa, lens[i])
@@ -784,6 +905,30 @@ def _now():  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
+def state_key(x, y, th, nx, nbins, fine, f):  # pragma: no cover - compiled
+    """Return the discrete state of a pose: its cell and heading bin, or a finer one.
+
+    Coarse (``fine`` False): ``(cell, bin)`` with ``nbins`` bins, the key even. Fine: the
+    ``f`` x ``f`` sub-cell of the pose and one of ``f nbins`` bins, the key odd (the two
+    kinds never share a key).
+    """
+    if not fine:
+        b = int(math.floor(th / (2.0 * math.pi / nbins) + 0.5)) % nbins
+        return ((int(math.floor(y + 0.5)) * nx + int(math.floor(x + 0.5))) * nbins + b) * 2
+    fb = f * nbins
+    b = int(math.floor(th / (2.0 * math.pi / fb) + 0.5)) % fb
+    ix = int(math.floor((x + 0.5) * f))
+    iy = int(math.floor((y + 0.5) * f))
+    return ((iy * nx * f + ix) * fb + b) * 2 + 1
+
+
+@njit(cache=True, inline="always")
+def _near_ends(x, y, sx, sy, gx, gy, r):  # pragma: no cover - compiled
+    """Whether ``(x, y)`` lies within ``r`` cells of ``(sx, sy)`` or ``(gx, gy)``."""
+    return r > 0.0 and (math.hypot(x - sx, y - sy) < r or math.hypot(x - gx, y - gy) < r)
+
+
+@njit(cache=True, inline="always")
 def _cheap_h(x, y, gx, gy, h2d):  # pragma: no cover - compiled
     """Return ``max(h2d of the pose's cell, Euclidean distance to the goal)`` (cells)."""
     ny, nx = h2d.shape
@@ -837,8 +982,9 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     nodes : ndarray of float64, shape (n, 3)
         Poses of the nodes created (x, y, heading unwrapped).
     prims : ndarray of int32, shape (n,)
-        Primitive reaching each node: ``2 * curvature index + (1 if the path drives it
-        backwards)``; -1 at start.
+        Primitive reaching each node: ``2 nc li + 2 * curvature index + (1 if the path
+        drives it backwards)``, ``li`` 1 for a fine primitive (``prim_len / fine_f`` long),
+        else 0, ``nc`` the number of curvatures; -1 at start.
     shot_kinds, shot_lens : ndarray, shape (5,)
         The analytic shot's word (from the last node of ``chain`` to the goal pose; with
         ``motion.backward`` from the query's ``gx, gy, gth`` to that node); ``shot_n``
@@ -847,7 +993,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         Segments of the shot, nodes expanded, analytic shots tried.
     """
     free, h2d, sx, sy, sth, gx, gy, gth = query
-    radius, curvatures, prim_len, nbins, reverse, backward = motion
+    radius, curvatures, prim_len, nbins, reverse, backward, fine_r, fine_f = motion
     (
         reverse_penalty,
         cusp_penalty,
@@ -858,9 +1004,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         car_window,
     ) = costs
     max_expansions, deadline, polish = limits
-    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack = collision
-    two_pi = 2.0 * math.pi
-    bin_w = two_pi / nbins
+    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack, fmin_slack, fdist, discs = collision
     ny, nx = free.shape
     nc = curvatures.shape[0]
     ndirs = 2 if reverse else 1
@@ -893,8 +1037,8 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
     size = 0
 
     # start node
-    b0 = int(math.floor(sth / bin_w + 0.5)) % nbins
-    k0 = (int(math.floor(sy + 0.5)) * nx + int(math.floor(sx + 0.5))) * nbins + b0
+    k0 = state_key(sx, sy, sth, nx, nbins, _near_ends(sx, sy, sx, sy, gx, gy, fine_r), fine_f)
+    fine_len = prim_len / fine_f
     px[0] = sx
     py[0] = sy
     pth[0] = sth
@@ -1009,6 +1153,8 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         occ,
                         fsafe,
                         fp,
+                        fdist,
+                        discs,
                         frho,
                         ax,
                         ay,
@@ -1019,6 +1165,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         n,
                         fmargin,
                         fslack,
+                        fmin_slack,
                         fbuf,
                     )
                 )
@@ -1034,67 +1181,86 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                     shot_kinds[i] = kinds[i]
                     shot_lens[i] = lens[i]
             countdown = max(1, int((fu - ug) / hweight / analytic_ratio))
-        for ci in range(nc):
+        nlen = 2 if fine_f > 1 and _near_ends(ux, uy, sx, sy, gx, gy, fine_r) else 1
+        for pi in range(nc * ndirs * nlen):
+            li = pi // (nc * ndirs)  # 0: prim_len, 1: the fine primitives' length
+            ci = (pi // ndirs) % nc
+            di = pi % ndirs
             kappa = curvatures[ci]
-            for di in range(ndirs):
-                # di: the direction the path drives the primitive (0 forwards); the search
-                # drives it the other way when it runs back from the goal
-                d = 1.0 if di == 0 else -1.0
-                s = -d * prim_len if backward else d * prim_len
-                if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
+            plen = prim_len if li == 0 else fine_len
+            # di: the direction the path drives the primitive (0 forwards); the search
+            # drives it the other way when it runs back from the goal
+            d = 1.0 if di == 0 else -1.0
+            s = -d * plen if backward else d * plen
+            if not arc_clear(free, ux, uy, uth, kappa, s, step, safe, occ, exact_r):
+                continue
+            if footprint and not footprint_arc_clear(
+                occ,
+                fsafe,
+                fp,
+                fdist,
+                discs,
+                frho,
+                ux,
+                uy,
+                uth,
+                kappa,
+                s,
+                fmargin,
+                fslack,
+                fmin_slack,
+                fbuf,
+            ):
+                continue
+            cx, cy, cth = advance(ux, uy, uth, kappa, s)
+            cost = plen
+            if di == 1:
+                cost *= reverse_penalty
+            if kappa != 0.0:
+                cost *= 1.0 + turn_penalty
+            if pu >= 0:
+                if curvatures[(pu % (2 * nc)) >> 1] != kappa:
+                    cost *= 1.0 + steer_penalty
+                if (pu & 1) != di:
+                    cost += cusp_penalty
+            cg = ug + cost
+            ck = state_key(
+                cx, cy, cth, nx, nbins, _near_ends(cx, cy, sx, sy, gx, gy, fine_r), fine_f
+            )
+            sl = _slot(keys, ck)
+            if keys[sl] == ck:
+                v = vals[sl]
+                if closed[v] != 0 or cg >= pg[v]:
                     continue
-                if footprint and not footprint_arc_clear(
-                    occ, fsafe, fp, frho, ux, uy, uth, kappa, s, fmargin, fslack, fbuf
-                ):
-                    continue
-                cx, cy, cth = advance(ux, uy, uth, kappa, s)
-                cost = prim_len
-                if di == 1:
-                    cost *= reverse_penalty
-                if kappa != 0.0:
-                    cost *= 1.0 + turn_penalty
-                if pu >= 0:
-                    if curvatures[pu >> 1] != kappa:
-                        cost *= 1.0 + steer_penalty
-                    if (pu & 1) != di:
-                        cost += cusp_penalty
-                cg = ug + cost
-                b = int(math.floor(cth / bin_w + 0.5)) % nbins
-                ck = (int(math.floor(cy + 0.5)) * nx + int(math.floor(cx + 0.5))) * nbins + b
-                sl = _slot(keys, ck)
-                if keys[sl] == ck:
-                    v = vals[sl]
-                    if closed[v] != 0 or cg >= pg[v]:
-                        continue
-                if nn == px.shape[0]:
-                    px = _grow_f(px)
-                    py = _grow_f(py)
-                    pth = _grow_f(pth)
-                    pg = _grow_f(pg)
-                    par = _grow_i(par)
-                    prim = _grow_i(prim)
-                    keyof = _grow_i(keyof)
-                    closed = _grow_b(closed)
-                    lazy = _grow_b(lazy)
-                w = nn
-                nn += 1
-                px[w] = cx
-                py[w] = cy
-                pth[w] = cth
-                pg[w] = cg
-                par[w] = u
-                prim[w] = 2 * ci + di
-                keyof[w] = ck
-                if keys[sl] != ck:
-                    keys[sl] = ck
-                    used += 1
-                vals[sl] = w
-                if 2 * used > keys.shape[0]:
-                    keys, vals = _rehash(keys, vals)
-                lazy[w] = 1
-                hf, hg, hn, size, hcap = heap_push(
-                    hf, hg, hn, size, hcap, cg + hweight * _cheap_h(cx, cy, gx, gy, h2d), cg, w
-                )
+            if nn == px.shape[0]:
+                px = _grow_f(px)
+                py = _grow_f(py)
+                pth = _grow_f(pth)
+                pg = _grow_f(pg)
+                par = _grow_i(par)
+                prim = _grow_i(prim)
+                keyof = _grow_i(keyof)
+                closed = _grow_b(closed)
+                lazy = _grow_b(lazy)
+            w = nn
+            nn += 1
+            px[w] = cx
+            py[w] = cy
+            pth[w] = cth
+            pg[w] = cg
+            par[w] = u
+            prim[w] = 2 * nc * li + 2 * ci + di
+            keyof[w] = ck
+            if keys[sl] != ck:
+                keys[sl] = ck
+                used += 1
+            vals[sl] = w
+            if 2 * used > keys.shape[0]:
+                keys, vals = _rehash(keys, vals)
+            lazy[w] = 1
+            hf, hg, hn, size, hcap = heap_push(
+                hf, hg, hn, size, hcap, cg + hweight * _cheap_h(cx, cy, gx, gy, h2d), cg, w
+            )
 
     nodes = np.empty((nn, 3))
     for i in range(nn):

@@ -59,6 +59,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "DEFAULT_SLACK",
+    "clearance_bound",
+    "footprint_discs",
     "edge_occupancy",
     "footprint_polygon",
     "footprint_radii",
@@ -70,6 +72,70 @@ __all__ = [
 
 #: Default sampling slack (cells): how far the body moves between a pose and its sample.
 DEFAULT_SLACK = 0.05
+#: Discs per footprint width along its length (:func:`footprint_discs`).
+DISCS_PER_WIDTH = 8
+
+
+def footprint_discs(fp: np.ndarray) -> np.ndarray:
+    """Return discs whose union covers a footprint (the quick test of the footprint mode).
+
+    The footprint's bounding box in the robot frame, ``[x0, x1] x [y0, y1]``, is cut along
+    its longer side into ``n = ceil(DISCS_PER_WIDTH * long / short)`` equal boxes, each
+    covered by the disc about its centre through its corners: the union covers the box,
+    hence the footprint, and grown by ``g`` they cover the footprint grown by ``g``.
+
+    Parameters
+    ----------
+    fp : ndarray of float64, shape (k, 4)
+        A footprint from :func:`footprint_polygon` (cells).
+
+    Returns
+    -------
+    ndarray of float64, shape (n, 3)
+        Per disc its centre ``(x, y)`` in the robot frame and its radius (cells).
+    """
+    x0, x1 = float(fp[:, 0].min()), float(fp[:, 0].max())
+    y0, y1 = float(fp[:, 1].min()), float(fp[:, 1].max())
+    along_x = x1 - x0 >= y1 - y0
+    long, short = (x1 - x0, y1 - y0) if along_x else (y1 - y0, x1 - x0)
+    n = max(1, math.ceil(DISCS_PER_WIDTH * long / short))
+    w = long / n
+    r = math.hypot(0.5 * w, 0.5 * short)
+    t = (np.arange(n) + 0.5) * w
+    if along_x:
+        centres = np.column_stack([x0 + t, np.full(n, 0.5 * (y0 + y1))])
+    else:
+        centres = np.column_stack([np.full(n, 0.5 * (x0 + x1)), y0 + t])
+    return np.ascontiguousarray(np.column_stack([centres, np.full(n, r * (1.0 + 1e-12))]))
+
+
+def clearance_bound(occ: np.ndarray) -> np.ndarray:
+    """Return a lower bound of the distance from any point of each cell to the obstacles.
+
+    The obstacles are the occupied squares of ``occ`` and the outside of the grid (a ring of
+    occupied cells round it). With ``E`` the Euclidean distance between the cell's centre
+    and the nearest obstacle cell's centre (:func:`scipy.ndimage.distance_transform_edt`),
+    a point ``p`` of the cell is at least ``E - sqrt(2)`` from every obstacle square (half a
+    diagonal from ``p`` to its cell's centre, half a diagonal from a square's centre to its
+    points).
+
+    Parameters
+    ----------
+    occ : ndarray of bool or uint8, shape (ny, nx)
+        Nonzero on occupied cells.
+
+    Returns
+    -------
+    ndarray of float64, shape (ny, nx)
+        The bound (cells); ``<= 0`` on and next to obstacles.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    occ = np.asarray(occ) != 0
+    pad = np.zeros((occ.shape[0] + 2, occ.shape[1] + 2), dtype=bool)  # the ring: occupied
+    pad[1:-1, 1:-1] = ~occ  # True where free: the distances to the nearest False
+    e = distance_transform_edt(pad)[1:-1, 1:-1]
+    return np.ascontiguousarray(e - math.sqrt(2.0) - 1e-9)
 
 
 def footprint_polygon(value: object) -> np.ndarray:
@@ -300,7 +366,10 @@ def kernel_collision(
     if collision.footprint is not None:
         return _footprint_inputs(collision, free, step, poses)
     if collision.clearance is None:
-        return KernelCollision(step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0)
+        no_discs = np.zeros((0, 3))
+        return KernelCollision(
+            step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0, 0.0, np.zeros((1, 1)), no_discs
+        )
     r = collision.clearance
     occ = raw_occupancy(collision.raw_grid, free)
     from astar.inflation import inflate
@@ -309,7 +378,10 @@ def kernel_collision(
     blocked = inflate(OccupancyGrid(occ, 1.0), margin, metric="square", outside_occupied=True)
     safe = np.ascontiguousarray(~np.asarray(blocked.occupied), dtype=np.uint8)
     occ8 = np.ascontiguousarray(occ, dtype=np.uint8)
-    return KernelCollision(step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0)
+    no_discs = np.zeros((0, 3))
+    return KernelCollision(
+        step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0, 0.0, np.zeros((1, 1)), no_discs
+    )
 
 
 def _footprint_inputs(
@@ -322,13 +394,14 @@ def _footprint_inputs(
     from astar.hybrid_kernel import KernelCollision, footprint_hit
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
+    min_slack = collision.footprint_min_slack
     fp = footprint_polygon(collision.footprint)
     occ = edge_occupancy(raw_occupancy(collision.raw_grid, free))
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
     for name, (x, y, th) in poses:
-        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + slack, buf))
+        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + min_slack, buf))
         if hit != -1:
             where = (
                 "leaves the grid"
@@ -338,8 +411,12 @@ def _footprint_inputs(
             )
             raise InvalidInputError(
                 f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
-                f"the sampling slack ({margin:g} + {slack:g} cells) {where}; it must keep "
+                f"the least sampling slack ({margin:g} + {min_slack:g} cells) {where}; it must keep "
                 "clear of every occupied square and inside the grid"
             )
     dummy = np.zeros((1, 1), dtype=np.uint8)
-    return KernelCollision(step, dummy, occ, 0.0, fp, safe, rho, margin, slack)
+    fdist = clearance_bound(occ)
+    discs = footprint_discs(fp)
+    return KernelCollision(
+        step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack, fdist, discs
+    )

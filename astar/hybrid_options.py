@@ -79,6 +79,17 @@ class HybridMotion:
     curvatures : int, optional
         Number of primitive curvatures, odd and ``>= 3``: evenly spaced in
         ``[-1/R, 1/R]``, zero included (3: ``{-1/R, 0, 1/R}``).
+    fine_radius : float, optional
+        Cells, finite, ``>= 0`` (default 0: off). When a search exhausts a small region (a
+        pocket, a slot: :func:`astar.find_pose_path`'s Notes), its second run keeps the
+        primitives and states and, within this distance of the start or the
+        goal pose (a parking slot, a bay), a discrete state is a ``fine_factor`` x
+        ``fine_factor`` sub-cell and one of ``fine_factor`` times as many heading bins, so
+        that poses a fraction of a cell apart are kept apart, and primitives
+        ``fine_factor`` times shorter are expanded besides the others: the many short
+        moves of a manoeuvre in a tight space.
+    fine_factor : int, optional
+        ``>= 1`` (default 3): the refinement of :attr:`fine_radius`'s states and primitives.
 
     Raises
     ------
@@ -96,6 +107,8 @@ class HybridMotion:
     heading_bins: int = 72
     primitive_length: float | None = None
     curvatures: int = 3
+    fine_radius: float = 0.0
+    fine_factor: int = 3
 
     def __post_init__(self) -> None:
         radius = validation.positive_float("turning_radius", self.turning_radius)
@@ -113,6 +126,11 @@ class HybridMotion:
         object.__setattr__(self, "heading_bins", nbins)
         object.__setattr__(self, "curvatures", nc)
         object.__setattr__(self, "primitive_length", plen)
+        fine_r = validation.nonnegative_float("fine_radius", self.fine_radius, "cells")
+        object.__setattr__(self, "fine_radius", fine_r)
+        object.__setattr__(
+            self, "fine_factor", validation.int_at_least("fine_factor", self.fine_factor, 1)
+        )
 
     @property
     def arc_length(self) -> float:
@@ -320,14 +338,23 @@ class HybridCollision:
         comes within ``footprint_margin + footprint_slack`` of an obstacle at a tested
         sample are refused, so a slack is also a margin at the samples: a large body on a
         fine grid wants a slack of a good fraction of a cell.
+    footprint_min_slack : float, optional
+        With ``footprint``: the least sampling slack (cells, finite, ``> 0``, at most
+        ``footprint_slack``; default None: ``footprint_slack``, no refinement). A step
+        whose test fails while the body at its middle keeps ``footprint_margin`` is halved,
+        each half tested with half the slack, and so on down to this slack: poses within
+        ``footprint_margin + footprint_min_slack`` of an obstacle are refused, and only
+        near obstacles does the test cost more (a slot, a bay). The start and goal poses
+        are tested with this slack.
 
     Raises
     ------
     InvalidInputError
         A field breaks its rule (the message names it, its value and the rule); ``raw_grid``
         without ``clearance`` or ``footprint``; ``clearance`` or ``footprint`` without
-        ``raw_grid``; ``footprint`` with ``clearance``; ``footprint_margin`` or
-        ``footprint_slack`` without ``footprint``.
+        ``raw_grid``; ``footprint`` with ``clearance``; ``footprint_margin``,
+        ``footprint_slack`` or ``footprint_min_slack`` without ``footprint``;
+        ``footprint_min_slack`` above ``footprint_slack``.
     """
 
     raw_grid: OccupancyGrid | np.ndarray | None = None
@@ -335,10 +362,18 @@ class HybridCollision:
     footprint: ArrayLike | None = None
     footprint_margin: float = 0.0
     footprint_slack: float = DEFAULT_SLACK
+    footprint_min_slack: float | None = None
 
     def __post_init__(self) -> None:
         margin = validation.nonnegative_float("footprint_margin", self.footprint_margin, "cells")
         slack = validation.positive_float("footprint_slack", self.footprint_slack)
+        min_slack = self.footprint_min_slack
+        if min_slack is not None:
+            min_slack = validation.positive_float("footprint_min_slack", min_slack)
+            if min_slack > slack:
+                raise InvalidInputError(
+                    f"footprint_min_slack={min_slack!r} must be at most footprint_slack={slack!r}"
+                )
         raw_grid, clearance, footprint = self.raw_grid, self.clearance, self.footprint
         if footprint is None:
             if slack != DEFAULT_SLACK:
@@ -350,6 +385,11 @@ class HybridCollision:
                 raise InvalidInputError(
                     f"footprint_margin={margin!r} is used only with footprint: pass a "
                     "footprint or leave footprint_margin at 0"
+                )
+            if min_slack is not None:
+                raise InvalidInputError(
+                    f"footprint_min_slack={min_slack!r} is used only with footprint: pass a "
+                    "footprint or leave footprint_min_slack at None"
                 )
             if clearance is None:
                 if raw_grid is not None:
@@ -384,6 +424,7 @@ class HybridCollision:
         object.__setattr__(self, "footprint", footprint)
         object.__setattr__(self, "footprint_margin", margin)
         object.__setattr__(self, "footprint_slack", slack)
+        object.__setattr__(self, "footprint_min_slack", slack if min_slack is None else min_slack)
 
     @property
     def mode(self) -> str:

@@ -57,6 +57,7 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
+import dataclasses
 import threading
 import time
 from collections.abc import Sequence
@@ -67,9 +68,9 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.errors import InvalidInputError
+from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, check_movers, retime_plan
+from trajopt.moving import MovingObstacle, check_movers, parked_on_path, reroute, retime_chain
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -321,14 +322,18 @@ class Planner:
         moving_obstacles : sequence of MovingObstacle, optional
             Predicted movers (:class:`trajopt.MovingObstacle`, times from this plan's
             ``t = 0``). ``None`` or empty: the plan as without them. Otherwise the static
-            plan is re-timed along its path (:func:`trajopt.retime_for_movers`: rests at
-            the start and at stops on the way) and certified at every instant until the
-            last prediction ends (``stats["moving"]``). Covered: the differential and
-            omni drives (a disc or a footprint robot) whose plan is one curve from rest to
-            rest, with a differential drive's turns in place at its ends
-            (:func:`trajopt.moving.retime_plan`); other queries with movers (a car, an omni
-            orientation profile, a moving start) raise
-            :class:`~trajopt.errors.InvalidInputError`.
+            plan is re-timed along its path on one clock (:func:`trajopt.moving.retime_chain`:
+            rests at the start and at stops on the way; a differential drive's turns in
+            place and a car's steering at rest as rests, a car's drives between cusps each
+            from rest to rest, an omni orientation rebuilt on the re-timed translation) and
+            certified at every instant until the last prediction ends. When no re-timing
+            along the path avoids a mover, another route is planned on the map with the
+            movers' swept regions marked, or the robot waits at a safe place
+            (:func:`trajopt.moving.reroute`). ``stats["moving"]``: ``route``
+            (``"retimed"``, ``"rerouted"`` or ``"waited"``), ``plan`` in words, the
+            certificate and the wall times. Refused with
+            :class:`~trajopt.errors.InvalidInputError`: a moving start (``v_start > 0``)
+            and the stop-and-turn fallback's polyline.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
 
@@ -338,7 +343,10 @@ class Planner:
             With ``trajectory.steps`` (:class:`PlanSteps`) and per-stage wall times in
             ``trajectory.stats["stages_s"]``. A :class:`~trajopt.motion._stop_and_turn.StopAndTurnTrajectory`
             (``stats["fallback"] == "stop_and_turn"``) only with the planner's ``fallback``
-            option, when the smoother or the timing failed.
+            option, when the smoother or the timing failed. With movers, the plan's own kind
+            re-timed (a :class:`~trajopt.motion.TrajectoryChain` keeps its pieces, an
+            :class:`~trajopt.motion.OmniTrajectory` its orientation), or a re-route's plan; a
+            wait at a safe place is one :class:`~trajopt.motion.TrajectoryChain` of both legs.
 
         Raises
         ------
@@ -353,8 +361,8 @@ class Planner:
             enabled, only when ``v_start`` or ``v_end`` is not 0 or the A* polyline fails
             its clearance check.
         BlockedError
-            A mover blocks the path: no re-timing along it avoids the mover (named, with
-            the time).
+            A mover blocks the way: no re-timing along the path avoids it and no re-route
+            tried does (the mover and the time named, each re-route's reason appended).
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
@@ -372,7 +380,7 @@ class Planner:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
             if movers:
-                out = _retime(out, movers, margin, self.options.robot)
+                out = _retime(out, movers, margin, self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -581,13 +589,63 @@ def plan(
 
 
 def _retime(
-    out: PlanResult, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot
+    out: PlanResult,
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
 ) -> PlanResult:
-    """Re-time a plan for movers (:meth:`Planner.plan`); refuse what is not covered yet."""
-    signed = robot.drive.signed_speed  # a car's: not covered yet
-    if signed or out.v_start != 0.0:
+    """Re-time a plan for movers, or re-route it (:meth:`Planner.plan`); refuse what is not covered.
+
+    The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`), unless a
+    mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`); when
+    it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
+    swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
+    planner's options, on caches derived from the planner's for the marked map).
+    """
+    if out.v_start != 0.0:
         raise InvalidInputError(
-            "moving_obstacles are covered for a plan from rest of the differential or omni "
-            f"drive; this query gave a {type(out).__name__} with v_start={out.v_start}"
+            "moving_obstacles are covered for a plan from rest; this query gave a "
+            f"{type(out).__name__} with v_start={out.v_start} m/s"
         )
-    return retime_plan(out, movers, margin=margin)
+    if out.polyline:
+        raise InvalidInputError(
+            "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
+            f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
+        )
+    blocked = parked_on_path(out, movers, margin)  # a quick proof, before the search's
+    if blocked is None:
+        try:
+            kept = retime_chain(out, movers, margin=margin)
+        except BlockedError as exc:
+            blocked = exc
+        else:
+            kept.stats["moving"]["route"] = "retimed"
+            return kept
+
+    def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
+        inflated = np.asarray(caches.inflated.occupied)
+        smp = out.sample(np.array([0.0]))
+        ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
+        labels = caches.components
+        return ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
+
+    def plan_leg(
+        grid: OccupancyGrid,
+        p0: np.ndarray | None,
+        p1: np.ndarray | None,
+        heading: float | None,
+    ) -> PlanResult:
+        leg = request
+        if p0 is not None:
+            leg = dataclasses.replace(
+                leg, start=(float(p0[0]), float(p0[1])), start_heading=heading
+            )
+        if p1 is not None:
+            leg = dataclasses.replace(
+                leg, goal=(float(p1[0]), float(p1[1])), goal_heading=None, goal_steer=None
+            )
+        return run_query(options, caches.derived(grid), leg)
+
+    return reroute(out, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg)

@@ -244,13 +244,50 @@ def test_footprint_hit_against_dense_samples():
     assert min(seen.values()) > 20
 
 
-def test_footprint_arc_clear_covers_the_whole_arc():
+def test_footprint_discs_clear_is_sound():
+    """The discs' quick test never calls a pose clear that the exact test (footprint_hit)
+    does not, on random maps, poses and growths; and it does answer in open space."""
+    from astar.hybrid_kernel import footprint_discs_clear, footprint_hit
+    from astar.hybrid_modes import clearance_bound, footprint_discs, footprint_polygon
+
+    rng = np.random.default_rng(5)
+    answered = 0
+    for trial in range(6):
+        occ = rng.random((40, 40)) < (0.02 if trial % 2 else 0.005)
+        occ8 = occ.astype(np.uint8)
+        fdist = clearance_bound(occ8)
+        nosafe = np.zeros_like(occ8)
+        for poly in (SMALL, RECT, 3.0 * RECT):
+            fp = footprint_polygon(poly)
+            discs = footprint_discs(fp)
+            # the discs cover the polygon: its vertices lie in their union
+            for vx, vy in fp[:, :2]:
+                assert np.any(np.hypot(discs[:, 0] - vx, discs[:, 1] - vy) <= discs[:, 2])
+            for _ in range(300):
+                x, y = rng.uniform(-2, 42, 2)
+                th = rng.uniform(-np.pi, np.pi)
+                grow = float(rng.choice([0.0, 0.3, 1.0]))
+                if footprint_discs_clear(fdist, discs, x, y, th, grow):
+                    answered += 1
+                    buf = np.empty((len(fp), 5))
+                    assert footprint_hit(occ8, nosafe, fp, x, y, th, grow, buf) == -1
+    assert answered > 200
+
+
+@pytest.mark.parametrize("slack, min_slack", [(0.05, 0.05), (0.4, 0.025)])
+def test_footprint_arc_clear_covers_the_whole_arc(slack, min_slack):
     """footprint_arc_clear against dense poses (0.01 cells apart) near obstacles: a clear
     verdict means no body point of any pose lies in an occupied square (sound between its
-    samples), and an arc whose bodies all keep more than twice the sampling slack (0.1
-    cells) is clear."""
+    samples), and an arc whose bodies all keep more than twice the least sampling slack
+    (0.1 cells; 0.05 cells when a slack of 0.4 is halved down to 0.025) is clear."""
     from astar.hybrid_kernel import footprint_arc_clear
-    from astar.hybrid_modes import footprint_polygon, footprint_radii, footprint_safe
+    from astar.hybrid_modes import (
+        clearance_bound,
+        footprint_discs,
+        footprint_polygon,
+        footprint_radii,
+        footprint_safe,
+    )
 
     rng = np.random.default_rng(3)
     occ = rng.random((20, 20)) < 0.1
@@ -262,7 +299,8 @@ def test_footprint_arc_clear_covers_the_whole_arc():
     for poly in (SMALL, RECT):
         fp = footprint_polygon(poly)
         rho = footprint_radii(fp)[1]
-        safe = footprint_safe(occ8, rho + 0.05)
+        safe = footprint_safe(occ8, rho + slack)
+        fdist, discs = clearance_bound(occ8), footprint_discs(fp)
         boundary, interior = body_points(poly, 0.01)
         pts0 = np.concatenate([boundary, interior])
         for _ in range(100):
@@ -279,7 +317,21 @@ def test_footprint_arc_clear_covers_the_whole_arc():
                     [x + (np.sin(a) - math.sin(th)) / k, y - (np.cos(a) - math.cos(th)) / k, a]
                 )
             got = footprint_arc_clear(
-                occ8, safe, fp, rho, x, y, th, k, s, 0.0, 0.05, np.empty((len(fp), 5))
+                occ8,
+                safe,
+                fp,
+                fdist,
+                discs,
+                rho,
+                x,
+                y,
+                th,
+                k,
+                s,
+                0.0,
+                slack,
+                min_slack,
+                np.empty((len(fp), 5)),
             )
             c, sn = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
             wx = poses[:, :1] + c * pts0[:, 0] - sn * pts0[:, 1]  # (poses, points)
@@ -298,7 +350,7 @@ def test_footprint_arc_clear_covers_the_whole_arc():
             nb = len(boundary)
             w = np.column_stack([wx[::4, :nb].ravel(), wy[::4, :nb].ravel()])
             dmin = square_distance(w, occ).min()
-            assert dmin <= 0.1 + 0.04 * (1 + rho * abs(k)), (x, y, th, k, s, dmin)
+            assert dmin <= 2 * min_slack + 0.04 * (1 + rho * abs(k)), (x, y, th, k, s, dmin)
     assert min(seen.values()) > 25
 
 

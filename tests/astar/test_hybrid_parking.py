@@ -275,3 +275,34 @@ def test_edge_occupancy_gives_the_same_footprint_test():
             assert (a == -1) == (b == -1) and (a == -2) == (b == -2), (x, y, th, grow)
             seen[a == -1] += 1
     assert min(seen.values()) > 100
+
+
+def test_fine_states_near_the_ends_park_a_slot_1_2_lengths():
+    """A slot 1.2 car lengths long: the pull-out from the goal exhausts its states at one
+    pose per cell and heading bin; the second run, with 3 x 3 sub-cells, three times the
+    heading bins and primitives a third as long within half a car length of the ends,
+    leads out of it. The path passes the brute-force body check."""
+    occ, poly, start, goal = parallel_slot(1.2)
+    p = _search(occ, poly, start, goal, time_budget=4.0, fine_radius=0.5 * LENGTH / RES)
+    assert p.stats["retried"] and p.stats["search_from"] == "goal"
+    assert p.cusps >= 1
+    check_big_body(p, occ, poly, start, goal)
+
+
+def test_min_slack_admits_an_end_pose_the_slack_refuses():
+    """An end pose whose body keeps 0.3 cells from the raw map (the parked car behind it):
+    refused with a slack of 0.76 cells, searched from with footprint_min_slack 0.05 (failed
+    samples refined); the path passes the brute-force body check, and a pose within the
+    least slack is still refused."""
+    occ, poly, start, goal = parallel_slot(1.5)
+    # move the goal back until its body is 0.3 cells from the parked car behind the slot
+    back = np.nonzero(~occ[1])[0][0] - 0.5  # the slot's back end (its first free column)
+    body_back = goal[0] + poly[:, 0].min()
+    goal = (goal[0] - (body_back - back - 0.3), goal[1], goal[2])
+    with pytest.raises(InvalidInputError, match="least sampling slack"):
+        _search(occ, poly, start, goal, time_budget=3.0)
+    p = _search(occ, poly, start, goal, time_budget=3.0, footprint_min_slack=0.05)
+    check_big_body(p, occ, poly, start, goal)
+    too_close = (goal[0] - 0.27, goal[1], goal[2])  # 0.03 cells: within 0.01 + 0.05
+    with pytest.raises(InvalidInputError, match="least sampling slack"):
+        _search(occ, poly, start, too_close, time_budget=3.0, footprint_min_slack=0.05)

@@ -7,13 +7,23 @@
   that the movers pass, certified; :class:`trajopt.errors.BlockedError` when no speed
   profile along the path avoids them;
 * :func:`retime_plan`: the same for a plan with turns in place at its ends;
+* :func:`retime_chain`: any plan from rest on one clock (curves, turns in place, a car's
+  drives between cusps and steering at rest, an omni orientation); :func:`shift_clock`;
+* :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it;
+* :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
+  path avoids the movers; :func:`swept_mask`, :func:`mark_swept`: a mover's swept region on
+  a grid;
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.
 """
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
+from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._parked import parked_on_path, settle_time
+from trajopt.moving._reroute import reroute
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
+from trajopt.moving._swept import mark_swept, swept_mask
 
 __all__ = [
     "MoverCertificate",
@@ -21,8 +31,16 @@ __all__ = [
     "STGrid",
     "certify_movers",
     "check_movers",
+    "mark_swept",
+    "parked_on_path",
     "reachable",
+    "reroute",
+    "retime_chain",
     "retime_for_movers",
     "retime_plan",
+    "settle_time",
+    "shift_clock",
     "st_grid",
+    "swept_mask",
+    "truncate",
 ]

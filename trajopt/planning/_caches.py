@@ -193,6 +193,42 @@ class PlannerCaches:
             )
         return cost
 
+    def derived(self, grid: OccupancyGrid) -> PlannerCaches:
+        """Return the caches of a changed map of the same frame, leaving these untouched.
+
+        The new caches start from what these have built (the inflated grid, the clearance
+        cost, the component labels, the coarse blocks, the landmarks: values that
+        :meth:`update` replaces rather than changes) and are then updated to ``grid``
+        (:meth:`update`: recomputed only where the change reaches). A footprint robot's disc
+        models are derived the same way. A re-route plans on such a map (the movers' swept
+        regions marked, :func:`trajopt.moving.reroute`).
+
+        Parameters
+        ----------
+        grid : astar.OccupancyGrid
+            The changed map (same shape, resolution and origin, else everything is rebuilt;
+            on a costmap's planner the caches are built afresh, the costmap's graded cost
+            being part of the search cost).
+        """
+        if self.costmap is not None:
+            return PlannerCaches(grid, self.costmap, self.options, cell_units=self.cell_units)
+        with self._lock:
+            out = PlannerCaches.__new__(PlannerCaches)
+            out.cell_units = self.cell_units
+            out.grid = self.grid
+            out.costmap = None
+            out.options = self.options
+            out._lock = threading.RLock()
+            out._inflated = self._inflated
+            out._cost = self._cost
+            out._landmarks = self._landmarks
+            out._components = self._components
+            out._coarse = self._coarse
+            out._discs = {}
+            out.update(grid)
+            out._discs = {r: d.derived(grid) for r, d in self._discs.items()}
+            return out
+
     def update(self, grid: OccupancyGrid) -> dict[str, Any]:
         """Replace the raw map, recomputing the caches only where the change reaches.
 

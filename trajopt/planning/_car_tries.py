@@ -19,8 +19,12 @@ planners' grid): end points near walls and passages the margin closes. There onl
 centres keep the radius, so that search runs in its exact mode (:func:`astar.find_pose_path`
 ``raw_grid``, ``clearance``; :func:`exact_clearance`): the chords between its poses keep the
 radius from the raw map exactly, as the corridor requires (a pose anywhere in a free cell
-could come up to half a cell's diagonal closer). The tries share :data:`CAR_BUDGET_S`;
-``stats["car"]["tries"]`` lists them.
+could come up to half a cell's diagonal closer). A car with a body searches each radius
+with the default costs first, capped at :data:`FOOTPRINT_DEFAULT_EXPANSIONS`, then with
+:data:`FOOTPRINT_COSTS` (:func:`cost_variants`), and goes on to the second grid as soon as
+the first grid's first radius finds no path (there the sampling slack is refined near
+obstacles: :func:`exact_clearance`).
+The tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 """
 
 from __future__ import annotations
@@ -58,6 +62,30 @@ FOOTPRINT_TOL_CELLS = 0.01
 #: footprint tests fall as its inverse (the default 0.05 made a 35-cell car on a 2.5 cm
 #: grid expand 2 000 states a second), and poses within it of an obstacle are refused.
 FOOTPRINT_SLACK_CELLS = 0.25
+#: The second grid's sampling slack is at least this (m): on cells finer than 0.1 m the
+#: slack in cells grows, so that the number of footprint tests per metre of a manoeuvre
+#: stays that of 0.1 m cells (the refinement to :data:`FOOTPRINT_MIN_SLACK_CELLS` keeps
+#: the tight places).
+FOOTPRINT_SLACK_M = 0.025
+#: Least sampling slack (cells) of the footprint search on the second grid
+#: (``footprint_min_slack`` of :func:`astar.find_pose_path`; the first grid keeps its
+#: slack whole, room for the smoother): a sample test that fails near an obstacle is
+#: refined down to it, so end poses and manoeuvres within :data:`FOOTPRINT_SLACK_CELLS` of
+#: a (conservative, rasterised) obstacle cell are kept, and only there do the tests cost
+#: more.
+FOOTPRINT_MIN_SLACK_CELLS = 0.05
+#: Costs of the search of a car with a body (``astar.HybridCosts`` fields): a parking
+#: manoeuvre drives backwards and changes direction often, and Smac's defaults (a cusp at
+#: 2 turning radii, backwards at twice the length, the heuristic weighted 1.5) made the
+#: search expand every state a cusp fewer reaches first. On 7 parking cases of the suite
+#: that ran the second grid's search out of 3 s, these planned 5 (0.3-2.6 s). Tried after
+#: the default costs (:func:`cost_variants`).
+FOOTPRINT_COSTS = {"cusp_penalty": 0.5, "reverse_penalty": 1.2, "heuristic_weight": 2.5}
+#: Caps on the search of a car with a body at the default costs, before
+#: :data:`FOOTPRINT_COSTS`: expansions (the cap that decides, so that the path does not
+#: depend on the machine's load; about 0.25 s) and seconds.
+FOOTPRINT_DEFAULT_EXPANSIONS = 5000
+FOOTPRINT_DEFAULT_BUDGET_S = 0.5
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
 SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
@@ -171,31 +199,45 @@ def search_and_fit(
             if factor > largest or time.perf_counter() > t_end:
                 continue
             r_cells = factor * robot.drive.min_turning_radius / res
-            try:
-                with timer.stage("search"):
-                    path = astar.find_pose_path(
-                        search_grid,
-                        start,
-                        goal,
-                        turning_radius=r_cells,
-                        reverse=robot.drive.reverse,
-                        time_budget=max(0.05, min(SEARCH_BUDGET_S, t_end - time.perf_counter())),
-                        **exact_clearance(robot, grid, margin),
-                    )
-            except astar.NoPosePathError as exc:
-                tries.append(f"{grid_name(margin)}, {factor:g} R: no path ({exc.reason})")
-                failures.append(exc)
-                if exc.reason == "disconnected":
+            path = None
+            stop = False
+            for name, costs, cap in cost_variants(robot):
+                if time.perf_counter() > t_end:
                     break
+                try:
+                    with timer.stage("search"):
+                        path = astar.find_pose_path(
+                            search_grid,
+                            start,
+                            goal,
+                            turning_radius=r_cells,
+                            reverse=robot.drive.reverse,
+                            time_budget=max(0.05, min(cap, t_end - time.perf_counter())),
+                            **exact_clearance(robot, grid, margin),
+                            **costs,
+                        )
+                    break
+                except astar.NoPosePathError as exc:
+                    tries.append(f"{grid_name(margin)}, {factor:g} R{name}: no path ({exc.reason})")
+                    failures.append(exc)
+                    if exc.reason == "disconnected":
+                        stop = True
+                        break
+                except astar.InvalidInputError as exc:
+                    if robot.footprint is None:
+                        raise
+                    # an end pose whose footprint does not keep this grid's slack: next grid
+                    tries.append(f"{grid_name(margin)}: {exc}")
+                    failures.append(InvalidInputError(str(exc)))
+                    stop = True
+                    break
+            if stop:
+                break
+            if path is None:
+                if robot.footprint is not None and margin:
+                    break  # a body: the second grid (its slack refined near obstacles) next
                 largest = min(largest, factor)
                 continue
-            except astar.InvalidInputError as exc:
-                if robot.footprint is None:
-                    raise
-                # an end pose whose footprint does not keep this grid's slack: the next grid
-                tries.append(f"{grid_name(margin)}: {exc}")
-                failures.append(InvalidInputError(str(exc)))
-                break
             poses = path.to_world(grid)
             try:
                 segments = []
@@ -213,12 +255,29 @@ def search_and_fit(
                         )
                     )
             except SmoothingError as exc:
-                tries.append(f"{grid_name(margin)}, {factor:g} R: a segment has no fit")
+                tries.append(f"{grid_name(margin)}, {factor:g} R{name}: a segment has no fit")
                 failures.append(exc)
                 continue
-            tries.append(f"{grid_name(margin)}, {factor:g} R: planned")
+            tries.append(f"{grid_name(margin)}, {factor:g} R{name}: planned")
             return CarFound(search_grid, path, r_cells, poses, segments, tries)
     raise failure(robot, grid, start, goal, tries, failures)
+
+
+def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]:
+    """Return the search costs a try runs with, in order: ``(name, costs, budget cap (s))``.
+
+    A disc: the search's default costs, :data:`SEARCH_BUDGET_S`. A car with a body: the
+    default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (at most
+    :data:`FOOTPRINT_DEFAULT_BUDGET_S`; the paths they find where they find one quickly:
+    drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
+    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`.
+    """
+    if robot.footprint is None:
+        return (("", {}, SEARCH_BUDGET_S),)
+    return (
+        ("", {"max_expansions": FOOTPRINT_DEFAULT_EXPANSIONS}, FOOTPRINT_DEFAULT_BUDGET_S),
+        (", parking costs", FOOTPRINT_COSTS, SEARCH_BUDGET_S),
+    )
 
 
 def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> OccupancyGrid:
@@ -258,18 +317,29 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
     ``footprint``, the footprint in cells), where every pose of the search's arcs keeps its
     oriented footprint :data:`FOOTPRINT_TOL_CELLS` off the raw map, tested at samples with
     the slack :data:`SEARCH_MARGIN_CELLS` (the first grid's margin: room for the smoother)
-    or :data:`FOOTPRINT_SLACK_CELLS` (the second grid).
+    or :data:`FOOTPRINT_SLACK_CELLS` refined down to :data:`FOOTPRINT_MIN_SLACK_CELLS`
+    near obstacles (the second grid). The search's ``fine_radius`` (finer states near the
+    end poses when a small region is exhausted, instead of finer primitives everywhere) is
+    not used: on the parking suite at 0.1 m (half a body length, factor 3) it planned one
+    case more of 40 (a slot 1.23 car lengths long, 20 cusps) at 1.4x the median and 1.9x
+    the p95 plan time.
 
     On the grid inflated by the radius alone only the cell centres keep the radius; the
     search's exact mode (:func:`astar.find_pose_path` ``clearance``) makes the polyline of
     its poses keep it too, as the corridor requires, to within :data:`EXACT_TOL_M`.
     """
     if robot.footprint is not None:
+        fp = np.asarray(robot.footprint.vertices, dtype=float) / grid.resolution
         return {
             "raw_grid": grid,
-            "footprint": np.asarray(robot.footprint.vertices, dtype=float) / grid.resolution,
+            "footprint": fp,
             "footprint_margin": FOOTPRINT_TOL_CELLS,
-            "footprint_slack": SEARCH_MARGIN_CELLS if margin else FOOTPRINT_SLACK_CELLS,
+            "footprint_slack": (
+                SEARCH_MARGIN_CELLS
+                if margin
+                else max(FOOTPRINT_SLACK_CELLS, FOOTPRINT_SLACK_M / grid.resolution)
+            ),
+            "footprint_min_slack": None if margin else FOOTPRINT_MIN_SLACK_CELLS,
         }
     if margin:
         return {}

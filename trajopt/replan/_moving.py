@@ -29,7 +29,7 @@ import time
 from collections.abc import Sequence
 
 from trajopt.errors import BlockedError, InvalidInputError
-from trajopt.motion import PlanResult, Trajectory
+from trajopt.motion import PlanResult
 from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers
 
 
@@ -109,7 +109,7 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
-    if type(out) is Trajectory and out.direction == 1:
+    if out.single_curve and out.direction == 1:
         try:
             timed = retime_for_movers(out, shifted, margin=margin)
         except BlockedError as exc:  # its time back on the movers' clock

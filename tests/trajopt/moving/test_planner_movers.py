@@ -65,14 +65,17 @@ def test_a_crossing_mover_is_let_pass_on_the_same_path(scene, drive):
     assert out.duration > base.duration
 
 
-def test_a_mover_parked_on_the_path_blocks(scene, planned):
+def test_a_mover_parked_on_the_path_blocks_it_and_is_driven_round(scene, planned):
     planner, base = planned
     smp = base.sample(np.array([0.5 * base.duration]))
     parked = trajopt.MovingObstacle.from_waypoints(
         [0.0], [(smp.x[0], smp.y[0])], radius=0.2, name="cart"
     )
     with pytest.raises(BlockedError, match="'cart'"):
-        planner.plan(scene.start, scene.goal("A"), moving_obstacles=[parked])
+        trajopt.retime_for_movers(base, [parked])
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[parked])
+    assert out.stats["moving"]["route"] == "rerouted"
+    assert dense_min(out, [parked])[0] >= -1e-6
 
 
 def test_queries_not_covered_are_refused(scene, planned):
@@ -118,7 +121,10 @@ def test_a_parked_mover_grazing_the_path(scene, planned, closer):
         assert -1e-6 <= out.stats["moving"]["certificate"]["slack_m"] <= 1e-7
     else:
         with pytest.raises(BlockedError, match="'post'"):
-            planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover])
+            trajopt.retime_for_movers(base, [mover])
+        out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover])
+        assert out.stats["moving"]["route"] == "rerouted"
+        assert dense_min(out, [mover])[0] >= -1e-6
 
 
 @pytest.mark.parametrize("headings", [{"goal_heading": 3.0}, {"start_heading": 3.0}])

@@ -1,4 +1,4 @@
-"""Tests of Planner.replan with moving obstacles: re-timing the spliced trajectory for new predictions.
+"""Tests of trajopt.moving through Planner.replan: re-timing the spliced trajectory for new predictions.
 
 References: the old trajectory's own state at the splice (continuity), the re-plan without the
 keyword (an empty list is identical), and an independent slack computed here on the movers'

@@ -4,7 +4,8 @@ Each kind of :mod:`benchmarks.moving_cases` on the paper scene: the returned pla
 :func:`tests.trajopt.moving.reference.check_trajectory` (1 ms samples over the trajectory and
 the standing at the goal, plus the Lipschitz bound between them, the map's squares
 included), or the planner raises :class:`BlockedError` where
-:func:`benchmarks.moving_witness.path_blocked` proves that no motion along the path exists.
+:func:`benchmarks.moving_witness.path_blocked` proves that no motion along the path exists; a
+mover stopping on the path blocks it (proven) and is driven round.
 Random movers on random small grids never give a violation, only typed errors; a mover that
 exactly grazes the planned motion is touched, one a millimetre closer is avoided.
 """
@@ -51,12 +52,16 @@ def test_each_kind_is_certified_or_proven_blocked(scene, paper, kind):
     assert out.duration >= static.duration - 1e-9
 
 
-def test_a_mover_stopping_on_the_path_is_proven_blocked(scene, paper):
+def test_a_mover_stopping_on_the_path_is_proven_blocked_and_driven_round(scene, paper):
     planner, static = paper
     movers = make_movers(static, "stopping", 1, seed=1)
     with pytest.raises(BlockedError, match="'stopping-0'"):
-        planner.plan(scene.start, scene.goal("A"), moving_obstacles=movers, mover_margin=MARGIN)
+        trajopt.retime_for_movers(static, movers, margin=MARGIN)
     assert path_blocked(static, movers, MARGIN, ds=0.02, dt=0.02)
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=movers, mover_margin=MARGIN)
+    assert out.stats["moving"]["route"] in ("rerouted", "waited")
+    chk = check_trajectory(out, movers, margin=MARGIN, grid=scene.grid)
+    assert chk.ok, chk
 
 
 def _room(seed: int) -> astar.OccupancyGrid:

@@ -7,7 +7,8 @@ keeps every body corner within 1 cm between poses. The suite's cases hold the ra
 issue 45. Then scenes the planner parks today, each checked by the exact checker against
 the polygons (not the grid): the small delivery car (0.9 x 0.5 m, R = 0.6 m) on a 5 cm grid
 from ``astar.OccupancyGrid.from_polygons``, into a perpendicular bay 1.4 car widths wide,
-forwards and backwards, and a bay 1.25 car widths wide backwards.
+forwards and backwards, and a bay 1.25 car widths wide backwards; the full-size car (4.69 x
+1.94 m, R = 3 m) on a 0.1 m grid into two cases of the seeded suite.
 """
 
 from __future__ import annotations
@@ -248,3 +249,31 @@ def test_checker_finds_an_obstacle_put_on_the_path(parked):
     pebble = pc.rect(mid[0], mid[1], 0.02, 0.02)  # 2 cm square under the rear axle
     check = pc.check_poses(SMALL.body(), poses, [*polys, pebble])
     assert check.overlaps > 0 and check.min_clearance == 0.0
+
+
+@pytest.mark.parametrize(
+    ("category", "entry", "index"),
+    # an angled bay 1.16 car widths wide whose goal body keeps less than the first grid's
+    # slack from a rasterised cell (refused before the slack was refined), and a parallel
+    # slot 1.40 car lengths long entered forwards (4.7 s before the parking costs, when it
+    # planned at all)
+    [("angled", "backwards", 2), ("parallel", "forwards", 1)],
+)
+def test_full_size_car_parks_a_suite_case_with_no_overlap(category, entry, index):
+    """Two cases of the seeded suite (``bench_parking.py``), full-size car at 0.1 m: the
+    plan ends exactly at the goal and the exact polygon check finds no overlap."""
+    case = pc.make_case(FULL, category, entry, 0, index)
+    traj = trajopt.plan(
+        case.grid(0.1),
+        case.start[:2],
+        case.goal[:2],
+        FULL.robot(),
+        start_heading=case.start[2],
+        goal_heading=case.goal[2],
+    )
+    _, poses = pc.trajectory_poses(traj, FULL.body())
+    np.testing.assert_allclose(poses[0], case.start, atol=1e-6)
+    np.testing.assert_allclose(poses[-1, :2], case.goal[:2], atol=1e-6)
+    assert abs(math.remainder(poses[-1, 2] - case.goal[2], 2 * math.pi)) < 1e-6
+    check = pc.check_poses(FULL.body(), poses, case.polygons)
+    assert check.overlaps == 0 and check.min_clearance > 0.0

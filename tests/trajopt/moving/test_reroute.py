@@ -1,0 +1,244 @@
+"""Tests of trajopt.moving.reroute through Planner.plan: another route, or a wait at a safe place.
+
+Hand-built maps (5 cm cells): a corridor with a side bay (a head-on mover: the robot, differential or
+omni with its own orientation, must yield in the bay), a loop of two corridors (a cart stops on the short one: the robot goes
+round by the long one) and a plain corridor (a cart drives into it and stops: no way,
+BlockedError naming the cart). Every returned plan is checked by the independent references (1 ms samples, brute
+force) and its samples against the map's occupied squares.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import trajopt
+import trajopt.moving
+from astar.grid import OccupancyGrid
+from tests.trajopt.moving.reference import brute_min, dense_min
+from trajopt.errors import BlockedError
+
+RES = 0.05
+
+
+def _grid(shape, rooms):
+    occ = np.ones(shape, dtype=bool)
+    for x0, x1, y0, y1 in rooms:
+        occ[round(y0 / RES) : round(y1 / RES), round(x0 / RES) : round(x1 / RES)] = False
+    return OccupancyGrid(occ, RES, (0.0, 0.0))
+
+
+def _static_clearance(traj, grid, dt=0.02):
+    """Smallest distance (m) from the sampled centre to an occupied cell's square."""
+    t = np.append(np.arange(0.0, traj.duration, dt), traj.duration)
+    smp = traj.sample(t)
+    p = np.stack([smp.x, smp.y], axis=1)
+    occ = np.asarray(grid.occupied)
+    free = ~occ
+    # occupied cells with a free 4-neighbour: the squares a free point is closest to
+    edge = occ & (
+        np.roll(free, 1, 0) | np.roll(free, -1, 0) | np.roll(free, 1, 1) | np.roll(free, -1, 1)
+    )
+    iy, ix = np.nonzero(edge)
+    lo = np.stack([ix, iy], axis=1) * RES
+    best = np.inf
+    for a in range(0, p.shape[0], 200):
+        q = p[a : a + 200, None, :]
+        d = np.maximum(np.maximum(lo[None] - q, q - (lo[None] + RES)), 0.0)
+        best = min(best, float(np.min(np.hypot(d[..., 0], d[..., 1]))))
+    return best
+
+
+def _check(out, movers, grid, margin):
+    assert trajopt.certify_movers(out, movers, margin=margin).ok
+    assert out.stats["moving"]["certificate"]["ok"]
+    assert dense_min(out, movers, margin=margin)[0] >= -1e-6
+    assert brute_min(out, movers, margin=margin) >= -1e-6
+    assert _static_clearance(out, grid) >= out.robot.radius - 1e-6
+
+
+@pytest.fixture(scope="module")
+def bay():
+    """A 1 m corridor along y = 2 with a bay on its north side at x = 5.5-6.5."""
+    return _grid((80, 240), [(0.5, 11.5, 1.5, 2.5), (5.5, 6.5, 2.5, 3.6)])
+
+
+@pytest.mark.parametrize(
+    ("drive", "headings"),
+    [("differential", {}), ("omni", {"start_heading": -0.5, "goal_heading": 1.0})],
+)
+def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
+    grid = bay
+    planner = trajopt.Planner(grid, trajopt.Robot(drive=drive))
+    start, goal = (1.0, 2.0), (11.0, 2.0)
+    base = planner.plan(start, goal)
+    forklift = trajopt.MovingObstacle.constant_velocity(
+        (13.0, 2.0), (-0.5, 0.0), radius=0.2, horizon=30.0, name="forklift"
+    )
+    with pytest.raises(BlockedError):  # no re-timing along the corridor lets it pass
+        trajopt.retime_for_movers(base, [forklift], margin=0.02)
+    out = planner.plan(start, goal, moving_obstacles=[forklift], mover_margin=0.02, **headings)
+    assert out.stats["moving"]["route"] == "waited"
+    if headings:  # an omni base's orientation: its own, from the start's to the goal's
+        assert all(p.own_orientation for p in out.pieces)
+        ends = out.sample(np.array([0.0, out.duration])).theta
+        np.testing.assert_allclose(ends, [-0.5, 1.0], atol=1e-9)
+        assert out.stats["moving"]["certificate"]["ok"]
+        assert dense_min(out, [forklift], margin=0.02)[0] >= -1e-6
+        assert brute_min(out, [forklift], margin=0.02) >= -1e-6
+        assert _static_clearance(out, grid) >= out.robot.radius - 1e-6
+    else:
+        _check(out, [forklift], grid, 0.02)
+    # the robot stands aside at the bay (north of the corridor) when the forklift passes it
+    t_pass = (13.0 - 6.0) / 0.5
+    smp = out.sample(np.array([t_pass]))
+    assert smp.y[0] > 2.0 + 0.2 + 0.165 and 5.5 < smp.x[0] < 6.5
+    end = out.sample(np.array([out.duration]))
+    assert np.hypot(end.x[0] - goal[0], end.y[0] - goal[1]) < 1e-6
+
+
+@pytest.fixture(scope="module")
+def loop():
+    """Two 1 m corridors (y = 1 and y = 4) joined at both ends, and a niche at x = 6."""
+    grid = _grid(
+        (100, 240),
+        [
+            (0.5, 11.5, 0.5, 1.5),
+            (0.5, 11.5, 3.5, 4.5),
+            (0.5, 1.5, 0.5, 4.5),
+            (10.5, 11.5, 0.5, 4.5),
+            (5.5, 6.5, 1.5, 2.3),
+        ],
+    )
+    return grid, trajopt.Planner(grid, trajopt.Robot())
+
+
+def test_a_cart_that_stops_on_the_path_is_driven_round(loop):
+    grid, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    base = planner.plan(start, goal)
+    assert np.max(base.sample(np.linspace(0, base.duration, 200)).y) < 1.5  # the short way
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 3.0], [(6.0, 2.0), (6.0, 1.0)], radius=0.25, name="cart"
+    )
+    out = planner.plan(start, goal, moving_obstacles=[cart], mover_margin=0.05)
+    assert out.stats["moving"]["route"] == "rerouted"
+    assert out.stats["moving"]["reroute"][-1]["result"] == "ok"
+    _check(out, [cart], grid, 0.05)
+    assert np.max(out.sample(np.linspace(0, out.duration, 400)).y) > 3.5  # the long way
+    # the cart stays: once it stands, the robot keeps its distance at every later instant too
+    assert out.stats["moving"]["certificate"]["horizon_s"] >= 3.0
+
+
+def test_a_cart_that_stops_in_the_only_corridor_blocks():
+    grid = _grid((60, 240), [(0.5, 11.5, 1.0, 2.0)])
+    planner = trajopt.Planner(grid, trajopt.Robot())
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 4.0], [(9.0, 1.5), (6.0, 1.5)], radius=0.25, name="cart"
+    )
+    with pytest.raises(BlockedError, match="'cart'") as info:
+        planner.plan((1.0, 1.5), (11.0, 1.5), moving_obstacles=[cart])
+    assert info.value.mover == "cart" and info.value.t >= 0.0
+    assert "no re-route either" in str(info.value)
+
+
+def test_a_mover_that_has_passed_needs_no_reroute(loop):
+    """Re-timing comes first: a mover the robot can wait for is waited for on the same path."""
+    _, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    base = planner.plan(start, goal)
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 6.0, 9.0], [(6.0, 2.0), (6.0, 1.0), (6.0, 2.0)], radius=0.25, name="cart"
+    )
+    out = planner.plan(start, goal, moving_obstacles=[cart])
+    assert out.stats["moving"]["route"] == "retimed"
+    assert np.array_equal(out.path.curve.c, base.path.curve.c)
+
+
+def test_derived_caches_equal_fresh_caches_and_leave_the_planner_alone(loop):
+    """A re-route's caches: built from the planner's, equal to a fresh build of the marked map."""
+    grid, planner = loop
+    planner.plan((1.0, 1.0), (11.0, 1.0))  # builds the inflated grid, cost, components
+    caches = planner.caches
+    before = (np.array(caches.inflated.occupied), np.array(caches.search_cost))
+    cart = trajopt.MovingObstacle.from_waypoints([0.0], [(6.0, 1.0)], radius=0.25, name="cart")
+    marked = trajopt.moving.mark_swept(grid, [(cart, 0.0, 0.0)], 0.05)
+    derived = caches.derived(marked)
+    fresh = type(caches)(marked, None, caches.options)
+    assert np.array_equal(derived.inflated.occupied, fresh.inflated.occupied)
+    assert np.allclose(derived.search_cost, fresh.search_cost, rtol=0, atol=1e-12)
+    a, b = derived.components, fresh.components
+    pairs = np.unique(np.stack([a.ravel(), b.ravel()]), axis=1)  # the same partition
+    assert np.unique(pairs[0]).size == pairs.shape[1] == np.unique(pairs[1]).size
+    assert np.array_equal(caches.inflated.occupied, before[0])
+    assert np.array_equal(caches.search_cost, before[1])
+    assert caches.grid is grid
+
+
+def test_swept_mask_covers_the_shape_at_dense_times():
+    """Every cell a disc or polygon mover touches at 1 ms samples is marked (and not far more)."""
+    grid = _grid((60, 80), [(0.0, 4.0, 0.0, 3.0)])
+    poly = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0, 3.0],
+        [(0.5, 0.5), (2.5, 1.5), (3.0, 2.5)],
+        radius=0.05,
+        headings=[0.0, 1.0, 2.5],
+        vertices=[(-0.2, -0.1), (0.3, -0.1), (0.3, 0.1), (-0.2, 0.1)],
+        growth=0.02,
+    )
+    mask = trajopt.moving.swept_mask(grid, poly, 0.5, 2.5, 0.1)
+    t = np.linspace(0.5, 2.5, 2001)
+    c, h = poly.pose_at(t)
+    v = poly.vertices
+    # points of the grown shape: its vertices and the circle of radius rounding + grow round them
+    ang = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)
+    r = (poly.radius_at(t) + 0.1)[:, None, None]
+    world = c[:, None, :] + np.stack(
+        [np.cos(h)[:, None] * v[:, 0] - np.sin(h)[:, None] * v[:, 1],
+         np.sin(h)[:, None] * v[:, 0] + np.cos(h)[:, None] * v[:, 1]], axis=-1
+    )  # fmt: skip
+    pts = (world[:, :, None, :] + r[..., None] * np.stack([np.cos(ang), np.sin(ang)], -1)).reshape(
+        -1, 2
+    )
+    cells = grid.world_to_cell(pts)
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < 80) & (cells[:, 1] >= 0) & (cells[:, 1] < 60)
+    assert mask[cells[inside, 1], cells[inside, 0]].all()
+    assert not mask[0:4, 70:80].any()  # far from the track
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(1.0, 11.0),
+            st.sampled_from([1.0, 4.0]),
+            st.floats(0.0, 15.0),
+            st.floats(-0.6, 0.6),
+            st.floats(0.1, 0.35),
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_random_movers_on_the_loop_never_violate(loop, movers):
+    """Movers that walk along a corridor and stop: a certified plan, or a typed BlockedError."""
+    grid, planner = loop
+    obs = [
+        trajopt.MovingObstacle.from_waypoints(
+            [t0, t0 + 4.0], [(x, y), (x + 4.0 * v, y)], radius=r, name=f"m{i}"
+        )
+        for i, (x, y, t0, v, r) in enumerate(movers)
+    ]
+    if any(
+        np.hypot(m.positions[0, 0] - 1.0, m.positions[0, 1] - 1.0) < m.radius + 0.2 for m in obs
+    ):
+        return  # a mover on the robot at t = 0 is refused (InvalidInputError), not planned
+    try:
+        out = planner.plan((1.0, 1.0), (11.0, 1.0), moving_obstacles=obs, mover_margin=0.02)
+    except BlockedError as exc:
+        assert exc.mover in {m.name for m in obs}
+        return
+    assert dense_min(out, obs, dt=2e-3, margin=0.02)[0] >= -1e-6
+    assert _static_clearance(out, grid, dt=0.02) >= out.robot.radius - 1e-6

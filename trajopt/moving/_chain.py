@@ -1,0 +1,295 @@
+"""Re-time a whole plan for movers on one clock: curves, motions at rest, an omni orientation.
+
+:func:`retime_chain` covers every plan from rest that the planner returns for a differential,
+omnidirectional or car-like robot (not the stop-and-turn fallback's polyline):
+
+* a :class:`trajopt.Trajectory`: :func:`~trajopt.moving.retime_for_movers`;
+* a :class:`trajopt.TrajectoryChain` of curves from rest to rest and motions at rest (a
+  differential drive's turns in place, a car's steering at rest at its cusps and ends; a car's
+  drives between cusps, forwards or backwards): the pieces are re-timed **in order on one
+  clock**. A curve starting at chain time ``t_c`` is re-timed against the movers seen from
+  ``t_c`` (:func:`shift_clock`), resting at its start at least as long as the motions at rest
+  just before it last (``not_before``; they are played during that rest, so ``v = 0`` at every
+  cusp); a backwards drive with the car's ``v_max_reverse``. A curve that another follows
+  need only keep clear until it ends (the rest after it is the next curve's start, which that
+  curve's re-timing certifies): it is re-timed against the predictions ended there
+  (:func:`truncate`); the last curve with the robot standing at the goal until the last
+  prediction ends. When a later curve is then blocked (leaving early led into a trap), the
+  pieces are re-timed again with every curve standing at its end until the last prediction
+  ends. The pieces are re-timed one after another (greedy: safe, not complete);
+  the whole chain is then certified again (:func:`~trajopt.moving.certify_movers`). A chain
+  that passes the certificate as it is stays as it is;
+* an :class:`trajopt.OmniTrajectory` (an omni base's own orientation): its translation is
+  re-timed as the robot's circumscribed disc (the body may face any way), and the orientation
+  profile is built again on the re-timed translation (:func:`trajopt.timing.orient`, from the
+  same start orientation to the same end orientation, within the yaw limits): the body turns
+  while the base drives or rests, the turn never outlasting what it would alone.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import BlockedError, InvalidInputError
+from trajopt.motion import Trajectory, TrajectoryChain
+from trajopt.moving._certificate import certify_movers
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._retime import retime_for_movers
+from trajopt.timing import orient
+
+
+def shift_clock(mover: MovingObstacle, t0: float) -> MovingObstacle:
+    """Return ``mover`` seen on a clock whose ``0`` is ``t0`` (s) of its own.
+
+    Its waypoint times move by ``-t0``; its radius becomes the radius it has at ``t0`` (its
+    growth up to then), so ``radius_at`` agrees with the original's at every ``t >= 0`` of the
+    new clock.
+    """
+    t_last = max(mover.t_last, 0.0)
+    grown = mover.radius + mover.growth * min(max(float(t0), 0.0), t_last)
+    return MovingObstacle(
+        times=mover.times - float(t0),
+        positions=mover.positions,
+        headings=mover.headings,
+        radius=grown,
+        growth=mover.growth,
+        vertices=mover.vertices,
+        name=mover.name,
+    )
+
+
+def truncate(mover: MovingObstacle, t_end: float) -> MovingObstacle:
+    """Return ``mover`` with its prediction ended at ``t_end`` (s): it stands there afterwards.
+
+    Equal to ``mover`` at every ``t <= t_end`` (position, heading and radius); a re-timing
+    that ends by ``t_end`` and is certified against it is certified against ``mover`` over
+    ``[0, t_end]``.
+    """
+    if t_end >= mover.t_last:
+        return mover
+    keep = mover.times < t_end
+    c, h = mover.pose_at(np.array([t_end]))
+    return MovingObstacle(
+        times=np.append(mover.times[keep], t_end),
+        positions=np.concatenate([mover.positions[keep], c]),
+        headings=np.append(mover.headings[keep], h),
+        radius=mover.radius,
+        growth=mover.growth,
+        vertices=mover.vertices,
+        name=mover.name,
+    )
+
+
+def flat_pieces(plan: Any) -> list[Any]:
+    """Return a plan's pieces in order (nested chains opened): curves and motions at rest.
+
+    Raises
+    ------
+    InvalidInputError
+        A piece that is neither (the stop-and-turn fallback's polyline, an omni orientation
+        inside a chain) or a chain that starts inside a piece.
+    """
+    if plan.single_curve or plan.turning or plan.steering_at_rest:
+        return [plan]
+    pieces = getattr(plan, "pieces", None)
+    if pieces is None:
+        raise InvalidInputError(
+            "moving obstacles are covered for curves, turns in place, a car's steering at rest "
+            f"and an omni orientation, got a {type(plan).__name__}"
+        )
+    if any(plan.starts):
+        raise InvalidInputError(
+            "moving obstacles: a chain that starts inside a piece is not covered"
+        )
+    return [q for p in pieces for q in flat_pieces(p)]
+
+
+def _retime_curve(
+    curve: Trajectory, movers: Sequence[MovingObstacle], margin: float, not_before: float
+) -> Trajectory:
+    """Re-time one curve from rest to rest; a car's backwards drive under ``v_max_reverse``."""
+    robot = curve.robot
+    backwards = getattr(robot.drive, "v_max_backwards", None)
+    limits = robot
+    if curve.direction < 0 and backwards is not None and backwards(robot) != robot.v_max:
+        limits = dataclasses.replace(robot, v_max=backwards(robot))
+    if limits is robot:
+        return retime_for_movers(curve, movers, margin=margin, not_before=not_before)
+    out = retime_for_movers(
+        dataclasses.replace(curve, robot=limits), movers, margin=margin, not_before=not_before
+    )
+    return dataclasses.replace(out, robot=robot)
+
+
+#: Tries of :func:`_retime_leg` with the predictions ended at a later time each.
+LEG_TRIES = 3
+
+
+def _retime_leg(
+    curve: Trajectory, movers: Sequence[MovingObstacle], margin: float, not_before: float
+) -> Trajectory:
+    """Re-time a curve that another curve follows: it must keep clear only until it ends.
+
+    The robot then rests there as the next curve's start, which that curve's re-timing
+    certifies. So the curve is re-timed against the predictions ended at ``t_end``
+    (:func:`truncate`), first the curve's own end as planned; a re-timing that ends by
+    ``t_end`` holds against the true predictions until it ends. One that ends later is tried
+    again with ``t_end`` at its end (:data:`LEG_TRIES` in all); then the curve is re-timed
+    against the whole predictions (standing at its end until the last one ends).
+    """
+    t_end = not_before + float(curve.duration)
+    for _ in range(LEG_TRIES):
+        cut = [truncate(m, t_end) for m in movers]
+        try:
+            out = _retime_curve(curve, cut, margin, not_before)
+        except BlockedError:
+            out = None
+        if out is not None and out.duration <= t_end:
+            return out
+        t_end = max(2.0 * t_end, float(out.duration) if out is not None else 0.0)
+    return _retime_curve(curve, movers, margin, not_before)
+
+
+def _cert_stats(cert: Any) -> dict[str, Any]:
+    return {
+        "ok": cert.ok,
+        "slack_m": cert.slack,
+        "mover": cert.mover,
+        "horizon_s": cert.horizon,
+        "intervals": cert.intervals,
+    }
+
+
+def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 0.0) -> Any:
+    """Re-time a plan from rest for the movers, on one clock (module docstring).
+
+    Parameters
+    ----------
+    plan : Trajectory, TrajectoryChain or OmniTrajectory
+        A plan from rest to rest: one curve, or curves and motions at rest, or an omni
+        translation with its orientation.
+    movers : sequence of MovingObstacle
+        The predictions (seconds from the plan's ``t = 0``).
+    margin : float
+        Extra distance to every mover (m), >= 0.
+
+    Returns
+    -------
+    Trajectory, TrajectoryChain or OmniTrajectory
+        Of the plan's kind (a chain keeps its pieces in order), certified at every instant
+        until the last prediction ends. ``stats["moving"]``: ``plan`` (each curve's re-timing
+        in words, ``"; "``-joined), ``certificate`` (:func:`certify_movers`' summary) and
+        ``time_s``.
+
+    Raises
+    ------
+    BlockedError
+        A curve cannot be re-timed around a mover (:func:`retime_for_movers`), or the chain
+        as a whole fails its certificate.
+    InvalidInputError
+        A plan not covered (the stop-and-turn fallback's polyline), a moving start, a mover
+        overlapping the robot at ``t = 0``.
+    """
+    t_all = time.perf_counter()
+    if plan.own_orientation:
+        return _retime_omni(plan, movers, margin, t_all)
+    if plan.single_curve:
+        return retime_for_movers(plan, movers, margin=margin)
+    pieces = flat_pieces(plan)
+    cert = certify_movers(plan, movers, margin=margin)
+    if cert.ok:  # as planned: every piece clear of every mover, standing at the goal too
+        stats = dict(plan.stats)
+        stats["moving"] = {
+            "plan": "as planned",
+            "certificate": _cert_stats(cert),
+            "time_s": time.perf_counter() - t_all,
+        }
+        return dataclasses.replace(plan, stats=stats)
+    try:
+        chain, labels = _in_order(plan, pieces, movers, margin, early=True)
+    except BlockedError:  # leaving early led into a trap: every leg stands at its end till the last
+        chain, labels = _in_order(plan, pieces, movers, margin, early=False)
+    cert = certify_movers(chain, movers, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the robot near t = {cert.witness_t:.3f} s "
+            f"while it stands still in the re-timed chain ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    chain.stats["moving"] = {
+        "plan": "; ".join(labels) if labels else "as planned",
+        "certificate": _cert_stats(cert),
+        "time_s": time.perf_counter() - t_all,
+    }
+    return chain
+
+
+def _in_order(
+    plan: Any, pieces: list[Any], movers: Sequence[MovingObstacle], margin: float, early: bool
+) -> tuple[TrajectoryChain, list[str]]:
+    """Re-time the curves in order on one clock; ``early``: each leg clear only until it ends.
+
+    With ``early`` a curve that another follows is re-timed by :func:`_retime_leg` (it may
+    leave its start as soon as it is clear until its end); without, as the last one (standing
+    at its end until the last prediction ends: it never arrives where a mover will still come,
+    which a later curve could not escape). Returns the chain and each curve's plan in words.
+    """
+    last = max(i for i, p in enumerate(pieces) if p.single_curve)
+    out: list[Any] = []
+    starts: list[float] = []
+    labels: list[str] = []
+    pending: list[Any] = []
+    t_cur = lead = 0.0
+    for i, piece in enumerate(pieces):
+        if not piece.single_curve:
+            pending.append(piece)
+            lead += float(piece.duration)
+            continue
+        seen = [shift_clock(m, t_cur) for m in movers] if t_cur > 0.0 else list(movers)
+        curve = (
+            _retime_leg(piece, seen, margin, lead)
+            if early and i != last
+            else _retime_curve(piece, seen, margin, lead)
+        )
+        labels.append(str(curve.stats["moving"]["plan"]))
+        out += pending
+        starts += [0.0] * len(pending)
+        out.append(curve)
+        starts.append(lead)
+        t_cur += float(curve.duration)
+        pending, lead = [], 0.0
+    out += pending
+    starts += [0.0] * len(pending)
+    chain = TrajectoryChain(tuple(out), plan.robot, dict(plan.stats), plan.steps, tuple(starts))
+    return chain, labels
+
+
+def _retime_omni(plan: Any, movers: Sequence[MovingObstacle], margin: float, t_all: float) -> Any:
+    """Re-time an omni translation as its circumscribed disc and orient it again."""
+    tr = plan.translation
+    robot = plan.robot
+    disc = dataclasses.replace(tr.robot, footprint=None) if tr.robot.footprint else tr.robot
+    moved = retime_for_movers(dataclasses.replace(tr, robot=disc), movers, margin=margin)
+    moved = dataclasses.replace(moved, robot=tr.robot)
+    out = orient(moved, robot, plan.theta_start, plan.theta_end)
+    cert = certify_movers(moved, movers, margin=margin, robot_radius=float(robot.radius))
+    if not cert.ok:  # the re-timing certified the same disc; only a numerical slip lands here
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-timed omni translation near "
+            f"t = {cert.witness_t:.3f} s ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    stats = dict(out.stats)
+    stats["moving"] = {
+        "plan": str(moved.stats["moving"]["plan"]),
+        "certificate": _cert_stats(cert),
+        "time_s": time.perf_counter() - t_all,
+    }
+    return dataclasses.replace(out, stats=stats, steps=plan.steps)

@@ -1,0 +1,111 @@
+"""A quick proof that a mover parked on the path blocks it: :func:`parked_on_path`.
+
+A mover whose prediction ends standing still (its last waypoints equal) stays there for ever
+(:class:`~trajopt.moving.MovingObstacle`). If, from the time ``t_stop`` it stands, its shape is
+closer than the limit to some point ``C(s*)`` of the path, and no motion from rest under the
+robot's limits can be beyond ``s*`` by ``t_stop`` (``s* > reach(t_stop)``, the bound
+:func:`~trajopt.moving._st_grid.reach_bound` of ``s(t)``), then every re-timing of the path
+passes ``C(s*)`` (or stands there, at the goal) after ``t_stop``, closer than the limit: no
+re-timing avoids it. The robot is taken as its inscribed disc (inside a footprint, so a
+footprint is at least as close), the limit at ``t_stop`` (the radius only grows), and the
+distance is exact at the sampled points (one point suffices). A plan of several pieces is its
+curves end to end (rests and turns in place add no distance, so the reach bound holds for the
+arc length summed over the pieces).
+
+It decides in a few milliseconds what the ``(s, t)`` re-timing decides after its search fails;
+the planner tries it first and re-routes at once (:func:`~trajopt.moving.reroute`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import BlockedError
+from trajopt.moving._certificate import point_polygon_distance, shape_at
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._st_grid import reach_bound
+
+#: Arc-length spacing (m) of the path points checked.
+PARKED_DS = 0.02
+
+
+def settle_time(mover: MovingObstacle) -> float:
+    """Return the time (s) from which the mover stands still for ever (its pose no longer changes).
+
+    The first time of the run of last waypoints equal to the last one (position and heading);
+    ``-inf`` for a mover that never moves.
+    """
+    p, h = mover.positions, mover.headings
+    k = p.shape[0] - 1
+    while k > 0 and np.array_equal(p[k - 1], p[-1]) and h[k - 1] == h[-1]:
+        k -= 1
+    return -np.inf if k == 0 else float(mover.times[k])
+
+
+def _curves(plan: Any) -> list[Any]:
+    if plan.own_orientation:
+        return [plan.translation]
+    if plan.single_curve:
+        return [plan]
+    out = []
+    for p in getattr(plan, "pieces", ()):
+        out += _curves(p) if (p.single_curve or getattr(p, "pieces", None) is not None) else []
+    return out
+
+
+def parked_on_path(
+    plan: Any, movers: Sequence[MovingObstacle], margin: float = 0.0
+) -> BlockedError | None:
+    """Return a :class:`BlockedError` when a parked mover provably blocks the plan's path.
+
+    Parameters
+    ----------
+    plan : PlanResult
+        A plan from rest (one curve, a chain, an omni translation).
+    movers : sequence of MovingObstacle
+        The predictions (the plan's clock).
+    margin : float
+        Extra distance (m).
+
+    Returns
+    -------
+    BlockedError or None
+        The error (the mover, the time it stands from, the point of the path) to raise, or
+        ``None`` when this proof finds nothing (the path may still be blocked).
+    """
+    curves = _curves(plan)
+    if not curves or not movers:
+        return None
+    robot = plan.robot
+    pts, s_all, off = [], [], 0.0
+    for c in curves:
+        n = max(2, int(np.ceil(c.length / PARKED_DS)) + 1)
+        s = np.linspace(0.0, c.length, n)
+        pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float))
+        s_all.append(s + off)
+        off += float(c.length)
+    p = np.concatenate(pts)
+    s_cum = np.concatenate(s_all)
+    back = getattr(robot.drive, "v_max_backwards", None)
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    for m in movers:
+        t_stop = max(settle_time(m), 0.0)
+        shape = shape_at(m, np.array([t_stop]))
+        d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
+        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
+        reach = float(reach_bound(np.array([t_stop]), v_top, robot.a_max, robot.j_max)[0])
+        hit = (d < limit) & (s_cum > reach)
+        if hit.any():
+            i = int(np.argmax(hit))
+            return BlockedError(
+                f"moving obstacle {m.name!r} stands on the path from t = {t_stop:.3f} s "
+                f"(at s = {s_cum[i]:.3f} m of {off:.3f} m, {d[i]:.3f} m < {limit:.3f} m), "
+                f"before the robot can get past it (at most {reach:.3f} m along by then under "
+                f"v_max={v_top:.3g} m/s and the acceleration limits)",
+                mover=m.name,
+                t=t_stop,
+            )
+    return None

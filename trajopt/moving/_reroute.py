@@ -1,0 +1,339 @@
+"""A new route when no re-timing along the planned path avoids the movers.
+
+A speed profile along a fixed path cannot avoid a mover that stops on it, or one that comes
+head-on along a corridor (Fraichard's incompleteness of the path-speed split). When
+:func:`~trajopt.moving.retime_chain` raises :class:`~trajopt.errors.BlockedError`,
+:func:`reroute` tries a few other plans, in this order, each planned by the caller's
+``plan_leg`` on a map the movers' swept regions are marked on (:mod:`._swept`), then re-timed
+for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
+
+1. ``"rerouted"``: the same query on the map with every mover's final place marked (where
+   each stands after its prediction ends; grown by the margin, and the planner inflates it by
+   the robot's radius as any obstacle): a route that no mover stays on; its re-timing waits
+   at the start, or on the way, while a mover still passes (the waiting witness of the
+   issue), usually the smallest detour;
+2. ``"rerouted"``: the same query with the blocking mover's whole swept region marked: a way
+   that never meets it, so its re-timing is mostly the certificate alone; then with its region
+   over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
+   stops, or round the rest of its track;
+3. ``"waited"`` (a robot that turns in place: differential or omni): drive to a **safe
+   place**, wait there until the way is clear, drive to the goal. A safe place is a cell
+   where the robot's centre may stand on the static map and that keeps the robot's radius
+   plus the margin from every mover's whole swept region; the candidates, at least a metre apart, are those with the shortest
+   straight-line detour ``|start - p| + |p - goal|``. The first leg is re-timed for the movers
+   (standing at the safe place is safe whenever it arrives), the second leg, from the first's
+   end heading (a turn in place), on the clock from the first's arrival
+   (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified whole (with an omni
+   orientation, by the two legs' certificates on their clocks).
+
+A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
+(its reason kept). When none works, the original :class:`BlockedError` is raised again (it
+names the mover and the time) with the reasons appended.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from astar.grid import OccupancyGrid
+from trajopt.errors import BlockedError, TrajoptError
+from trajopt.motion import TrajectoryChain
+from trajopt.moving._certificate import certify_movers
+from trajopt.moving._chain import retime_chain, shift_clock
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._swept import mark_swept, swept_mask
+
+#: Safe places tried (option 3).
+N_SAFE_PLACES = 2
+#: Smallest distance (m) between two safe places tried.
+SAFE_PLACE_SPACING = 1.0
+
+#: ``plan_leg(grid, start, goal, start_heading)``: a plan from rest to rest on ``grid`` (the
+#: planner's stages and options), raising a :class:`TrajoptError` when it fails. ``start``
+#: ``None``: the query's start (with its heading); else a point (m) left with
+#: ``start_heading`` (rad). ``goal`` ``None``: the query's goal (with its heading); else a
+#: point (m) reached with a free heading.
+PlanLeg = Callable[[OccupancyGrid, "np.ndarray | None", "np.ndarray | None", "float | None"], Any]
+
+
+def _ends(plan: Any) -> tuple[np.ndarray, np.ndarray, float, float]:
+    smp = plan.sample(np.array([0.0, plan.duration]))
+    p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
+    p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
+    return p0, p1, float(smp.theta[0]), float(smp.theta[1])
+
+
+def reroute(
+    plan: Any,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    blocked: BlockedError,
+    *,
+    grid: OccupancyGrid,
+    free: Callable[[], np.ndarray],
+    plan_leg: PlanLeg,
+) -> Any:
+    """Return a certified plan by another route or a wait at a safe place (module docstring).
+
+    Parameters
+    ----------
+    plan : PlanResult
+        The static plan whose re-timing was blocked (its ends are the query's).
+    movers : sequence of MovingObstacle
+        The predictions.
+    margin : float
+        Extra distance to every mover (m).
+    blocked : BlockedError
+        What the re-timing of ``plan`` raised (its ``mover`` and ``t``).
+    grid : astar.OccupancyGrid
+        The raw map.
+    free : callable
+        ``free()``: where the robot's centre may stand on the static map, bool, shape
+        (ny, nx) (the planner's inflated grid's free cells in the start's connected part);
+        called only when a wait at a safe place is tried.
+    plan_leg : callable
+        ``plan_leg(grid, start, goal, start_heading)`` (:data:`PlanLeg`).
+
+    Returns
+    -------
+    PlanResult
+        Certified; ``stats["moving"]["route"]`` is ``"rerouted"`` or ``"waited"``,
+        ``stats["moving"]["reroute"]`` lists the candidates tried (``what``, ``result``) and
+        the wall time.
+
+    Raises
+    ------
+    BlockedError
+        No candidate works: ``blocked``'s mover and time, the candidates' reasons appended.
+    """
+    t_all = time.perf_counter()
+    p0, p1, _, _ = _ends(plan)
+    robot = plan.robot
+    keep = [(p0, robot.radius + 2.0 * grid.resolution), (p1, robot.radius + 2.0 * grid.resolution)]
+    by_name = {m.name: m for m in movers}
+    tried: list[dict[str, str]] = []
+    t_last = max(max(m.t_last for m in movers), 0.0)
+
+    def attempt(what: str, run: Callable[[], Any], route: str) -> Any:
+        try:
+            out = run()
+        except TrajoptError as exc:
+            tried.append({"what": what, "result": f"{type(exc).__name__}: {exc}"})
+            return None
+        tried.append({"what": what, "result": "ok"})
+        stats = out.stats
+        stats["moving"] = dict(stats["moving"], route=route, reroute=list(tried))
+        stats["moving"]["reroute_time_s"] = time.perf_counter() - t_all
+        return out
+
+    marked_maps: list[OccupancyGrid] = []
+
+    def detour(regions: list[tuple[MovingObstacle, float, float]]) -> Callable[[], Any]:
+        def run() -> Any:
+            marked = mark_swept(grid, regions, margin, keep)
+            if marked is None:
+                raise BlockedError("the marked region adds no cell to the map")
+            if any(np.array_equal(marked.occupied, m.occupied) for m in marked_maps):
+                raise BlockedError("the same map as a candidate tried before")
+            marked_maps.append(marked)
+            leg = plan_leg(marked, None, None, None)
+            return retime_chain(leg, movers, margin=margin)
+
+        return run
+
+    finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
+    out = attempt("around every mover's final place", detour(finals), "rerouted")
+    if out is not None:
+        return out
+    who = by_name.get(blocked.mover)
+    if who is not None:
+        t_end = max(who.t_last, 0.0)
+        t_from = min(max(blocked.t, 0.0), t_end)
+        spans = [(min(0.0, float(who.times[0])), "")]
+        if t_from > 0.0:
+            spans.append((t_from, f" from t = {t_from:.3f} s"))
+        for t0, when in spans:
+            out = attempt(
+                f"around {who.name!r}{when}", detour([(who, t0, max(t_end, t0))]), "rerouted"
+            )
+            if out is not None:
+                return out
+    if robot.drive.turns_in_place and not robot.drive.signed_speed:
+        room = free()
+        places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
+        places = [
+            p for p in places if _joined_at_last(grid, room, movers, robot.radius + margin, p, p1)
+        ]
+        for place in places:
+            out = attempt(
+                f"wait at ({place[0]:.2f}, {place[1]:.2f}) m",
+                _wait_at(place, movers, margin, grid, plan_leg),
+                "waited",
+            )
+            if out is not None:
+                return out
+    reasons = "; ".join(f"{c['what']}: {c['result']}" for c in tried)
+    raise BlockedError(
+        f"{blocked} (no re-route either: {reasons or 'none tried'})",
+        mover=blocked.mover,
+        t=blocked.t,
+    ) from blocked
+
+
+def safe_places(
+    grid: OccupancyGrid,
+    free: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    clearance: float,
+    p0: np.ndarray,
+    p1: np.ndarray,
+    t_last: float,
+) -> list[np.ndarray]:
+    """Return up to :data:`N_SAFE_PLACES` places (m) clear of every mover at every time.
+
+    Cell centres free in ``free`` whose cell keeps ``clearance`` (m) from every mover's
+    swept region over ``[0, t_last]`` (:func:`swept_mask`), by the shortest detour
+    ``|p0 - p| + |p - p1|``, at least :data:`SAFE_PLACE_SPACING` apart.
+    """
+    unsafe = np.zeros(grid.shape, dtype=bool)
+    for m in movers:
+        unsafe |= swept_mask(grid, m, min(0.0, float(m.times[0])), t_last, clearance)
+    ok = free & ~unsafe
+    iy, ix = np.nonzero(ok)
+    if iy.size == 0:
+        return []
+    res = float(grid.resolution)
+    pts = np.asarray(grid.origin, dtype=float) + (np.stack([ix, iy], axis=1) + 0.5) * res
+    cost = np.hypot(*(pts - p0).T) + np.hypot(*(pts - p1).T)
+    order = np.argsort(cost, kind="stable")
+    out: list[np.ndarray] = []
+    for i in order[:20000]:
+        p = pts[i]
+        if all(math.hypot(*(p - q)) >= SAFE_PLACE_SPACING for q in out):
+            out.append(p)
+            if len(out) == N_SAFE_PLACES:
+                break
+    return out
+
+
+def _joined_at_last(
+    grid: OccupancyGrid,
+    free: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    clearance: float,
+    place: np.ndarray,
+    goal: np.ndarray,
+) -> bool:
+    """Whether ``place`` and ``goal`` are joined once every mover stands at its final place.
+
+    4-connected free cells of ``free`` less every mover's final shape grown by ``clearance``
+    (the planner's search joins exactly the 4-connected free cells). A wait helps only where
+    the way on stays open after the movers have passed.
+    """
+    from scipy import ndimage  # only a re-route pays its import
+
+    open_ = np.array(free)
+    for m in movers:
+        t = max(m.t_last, 0.0)
+        open_ &= ~swept_mask(grid, m, t, t, clearance)
+    labels, _ = ndimage.label(open_)
+    cells = grid.world_to_cell(np.stack([place, goal]))
+    ny, nx = grid.shape
+    if np.any(cells < 0) or np.any(cells[:, 0] >= nx) or np.any(cells[:, 1] >= ny):
+        return False
+    a = labels[cells[0, 1], cells[0, 0]]
+    b = labels[cells[1, 1], cells[1, 0]]
+    return bool(a > 0 and a == b)
+
+
+def _wait_at(
+    place: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    grid: OccupancyGrid,
+    plan_leg: PlanLeg,
+) -> Callable[[], Any]:
+    def run() -> Any:
+        first = retime_chain(plan_leg(grid, None, place, None), movers, margin=margin)
+        t1 = float(first.duration)
+        heading = float(first.sample(np.array([t1])).theta[0])
+        seen = [shift_clock(m, t1) for m in movers]
+        second = plan_leg(grid, place, None, heading)
+        second = retime_chain(second, seen, margin=margin)
+        pieces = _pieces(first) + _pieces(second)
+        starts = _starts(first) + _starts(second)
+        stats = dict(second.stats)
+        chain = TrajectoryChain(tuple(pieces), first.robot, stats, second.steps, tuple(starts))
+        summary = _certificate(chain, first, second, movers, margin, t1)
+        stats["moving"] = {
+            "plan": (
+                f"to ({place[0]:.2f}, {place[1]:.2f}) m: {first.stats['moving']['plan']}; "
+                f"on at t = {t1:.3f} s: {second.stats['moving']['plan']}"
+            ),
+            "certificate": summary,
+            "time_s": first.stats["moving"]["time_s"] + second.stats["moving"]["time_s"],
+        }
+        return chain
+
+    return run
+
+
+def _certificate(
+    chain: TrajectoryChain,
+    first: Any,
+    second: Any,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    t1: float,
+) -> dict[str, Any]:
+    """Return the certificate summary of both legs as one chain (raise when it fails).
+
+    A chain of curves and motions at rest is certified whole (:func:`certify_movers`). One
+    with an omni orientation (which the certificate does not take) is proved by its legs'
+    certificates: the first leg's until the last prediction ends with the robot standing at
+    the safe place, the second's on the clock from ``t1`` (s), its arrival there.
+    """
+    if not any(p.own_orientation for p in chain.pieces):
+        cert = certify_movers(chain, movers, margin=margin)
+        if not cert.ok:
+            raise BlockedError(
+                f"the two legs meet {cert.mover!r} near t = {cert.witness_t:.3f} s",
+                mover=cert.mover,
+                t=cert.witness_t,
+            )
+        return {
+            "ok": cert.ok,
+            "slack_m": cert.slack,
+            "mover": cert.mover,
+            "horizon_s": cert.horizon,
+            "intervals": cert.intervals,
+        }
+    a = first.stats["moving"]["certificate"]
+    b = second.stats["moving"]["certificate"]
+    if not (a["ok"] and b["ok"]):  # each leg's re-timing raises first; kept as a guard
+        raise BlockedError("a leg's certificate failed", mover=a["mover"] or b["mover"], t=t1)
+    worst = a if a["slack_m"] <= b["slack_m"] else b
+    return {
+        "ok": True,
+        "slack_m": worst["slack_m"],
+        "mover": worst["mover"],
+        "horizon_s": max(a["horizon_s"], t1 + b["horizon_s"]),
+        "intervals": a["intervals"] + b["intervals"],
+    }
+
+
+def _pieces(plan: Any) -> list[Any]:
+    """Return a re-timed plan's pieces (a flat chain's, or the one curve)."""
+    return list(plan.pieces) if getattr(plan, "pieces", None) is not None else [plan]
+
+
+def _starts(plan: Any) -> list[float]:
+    """Return each flat piece's start time in it (a chain's ``starts``; 0 for one curve)."""
+    if getattr(plan, "pieces", None) is None:
+        return [0.0]
+    return [float(s) for s in plan.starts]

@@ -1,0 +1,127 @@
+"""The region a predicted mover sweeps over a time interval, marked on an occupancy grid.
+
+A re-route (:mod:`._reroute`) plans a new path that keeps off where a mover will be: the cells
+its shape covers at some instant of ``[t0, t1]``, grown by a distance (the margin: the planner
+inflates the marked map by the robot's radius as it inflates any map). The shape is bounded by
+its circumscribed disc (its reference point's farthest vertex plus its rounding, the rounding
+taken at ``t1``, where it is largest); the reference point moves linearly between waypoints,
+so over a waypoint segment the discs sweep a capsule. A cell is marked when its square meets
+the grown capsule (its centre within the capsule's radius plus half the cell's diagonal): the
+marked cells cover the swept region, never less.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from astar.grid import OccupancyGrid
+from trajopt.moving._obstacle import MovingObstacle
+
+
+def track(mover: MovingObstacle, t0: float, t1: float) -> np.ndarray:
+    """Return the reference point's polyline over ``[t0, t1]`` (s), shape (k, 2) (m), k >= 1."""
+    inner = [t for t in mover.times.tolist() if t0 < t < t1]
+    times = np.asarray([t0, *inner, t1] if t1 > t0 else [t0], dtype=float)
+    return mover.position_at(times)
+
+
+def swept_mask(
+    grid: OccupancyGrid, mover: MovingObstacle, t0: float, t1: float, grow: float
+) -> np.ndarray:
+    """Return the cells the mover's shape, grown by ``grow`` (m), covers at some ``t`` in ``[t0, t1]``.
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        The map whose cells are marked (its shape, resolution and origin).
+    mover : MovingObstacle
+        The prediction (after its last time it stands where it was last).
+    t0, t1 : float
+        The time interval (s), ``t0 <= t1``.
+    grow : float
+        Distance added around the shape (m), >= 0.
+
+    Returns
+    -------
+    ndarray of bool, shape (ny, nx)
+        ``mask[iy, ix]``: the cell's square meets the grown swept region.
+    """
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
+    radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
+    pts = track(mover, float(t0), float(t1))
+    mask = np.zeros((ny, nx), dtype=bool)
+    segs = zip(pts[:-1], pts[1:], strict=True) if pts.shape[0] > 1 else [(pts[0], pts[0])]
+    for a, b in segs:
+        lo = np.minimum(a, b) - radius
+        hi = np.maximum(a, b) + radius
+        ix0 = max(0, int(math.floor((lo[0] - ox) / res)))
+        ix1 = min(nx - 1, int(math.floor((hi[0] - ox) / res)))
+        iy0 = max(0, int(math.floor((lo[1] - oy) / res)))
+        iy1 = min(ny - 1, int(math.floor((hi[1] - oy) / res)))
+        if ix0 > ix1 or iy0 > iy1:
+            continue
+        cx = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
+        cy = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
+        px = cx[None, :] - a[0]
+        py = cy[:, None] - a[1]
+        d = b - a
+        dd = float(d @ d)
+        lam = np.clip((px * d[0] + py * d[1]) / dd, 0.0, 1.0) if dd > 0.0 else 0.0
+        dist = np.hypot(px - lam * d[0], py - lam * d[1])
+        mask[iy0 : iy1 + 1, ix0 : ix1 + 1] |= dist <= radius
+    return mask
+
+
+def mark_swept(
+    grid: OccupancyGrid,
+    regions: Sequence[tuple[MovingObstacle, float, float]],
+    grow: float,
+    keep: Sequence[tuple[np.ndarray, float]] = (),
+) -> OccupancyGrid | None:
+    """Return ``grid`` with the swept regions marked occupied, or ``None`` when none adds a cell.
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        The raw map.
+    regions : sequence of (MovingObstacle, float, float)
+        Each mover and its time interval ``[t0, t1]`` (s).
+    grow : float
+        Distance added around each shape (m): the margin to the movers.
+    keep : sequence of (ndarray, float)
+        Points (m, shape (2,)) and radii (m) whose cells stay as in ``grid`` (the robot's
+        start and goal, which a plan must be able to stand on).
+
+    Returns
+    -------
+    astar.OccupancyGrid or None
+        The marked map (same shape, resolution and origin).
+    """
+    add = np.zeros(grid.shape, dtype=bool)
+    for mover, t0, t1 in regions:
+        add |= swept_mask(grid, mover, t0, t1, grow)
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    for p, r in keep:
+        ix0 = max(0, int(math.floor((float(p[0]) - r - ox) / res)))
+        ix1 = min(nx - 1, int(math.floor((float(p[0]) + r - ox) / res)))
+        iy0 = max(0, int(math.floor((float(p[1]) - r - oy) / res)))
+        iy1 = min(ny - 1, int(math.floor((float(p[1]) + r - oy) / res)))
+        if ix0 > ix1 or iy0 > iy1:
+            continue
+        cx = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
+        cy = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
+        near = np.hypot(cx[None, :] - float(p[0]), cy[:, None] - float(p[1])) <= r
+        add[iy0 : iy1 + 1, ix0 : ix1 + 1] &= ~near
+    occ = np.asarray(grid.occupied)
+    new = add & ~occ
+    if not new.any():
+        return None
+    return grid.with_occupied(occ | new)
