@@ -91,10 +91,11 @@ def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
         assert _static_clearance(out, grid) >= out.robot.radius - 1e-6
     else:
         _check(out, [forklift], grid, 0.02)
-    # the robot stands aside at the bay (north of the corridor) when the forklift passes it
+    # the robot stands aside at the bay (north of the corridor) when the forklift passes it;
+    # it leaves as soon as the forklift lets it, so then it may already be on its way out
     t_pass = (13.0 - 6.0) / 0.5
     smp = out.sample(np.array([t_pass]))
-    assert smp.y[0] > 2.0 + 0.2 + 0.165 and 5.5 < smp.x[0] < 6.5
+    assert smp.y[0] > 2.0 + 0.2 and 5.5 < smp.x[0] < 6.5
     end = out.sample(np.array([out.duration]))
     assert np.hypot(end.x[0] - goal[0], end.y[0] - goal[1]) < 1e-6
 
