@@ -336,6 +336,9 @@ class Planner:
             and the stop-and-turn fallback's polyline.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
+            Movers with the planner's ``speed_limits`` zones raise
+            :class:`~trajopt.errors.InvalidInputError`: the re-timing caps the speed by the
+            robot's limits and the path's curvature only, not by the zones.
 
         Returns
         -------
@@ -366,6 +369,7 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
+        _movers_covered(movers, self.options)
         request = PlanRequest(
             start,
             goal,
@@ -456,6 +460,9 @@ class Planner:
             ``replan`` (what was kept or planned).
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
+            Movers with the planner's ``speed_limits`` zones raise
+            :class:`~trajopt.errors.InvalidInputError`: the re-timing caps the speed by the
+            robot's limits and the path's curvature only, not by the zones.
 
         Raises
         ------
@@ -471,6 +478,7 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
+        _movers_covered(movers, self.options)
         with self._lock:
             t0 = time.perf_counter()
             lat = self.latency_s if latency is None else latency
@@ -586,6 +594,16 @@ def plan(
         goal_steer=goal_steer,
         **moving,
     )
+
+
+def _movers_covered(movers: tuple[MovingObstacle, ...], options: PlannerOptions) -> None:
+    """Refuse movers where the re-timing would not keep a limit: speed-limit zones."""
+    if movers and options.speed_limits is not None:
+        raise InvalidInputError(
+            "moving_obstacles are not covered with speed_limits zones (the re-timing caps "
+            "the speed by the robot's limits and the path's curvature only): plan without "
+            "one or the other"
+        )
 
 
 def _retime(

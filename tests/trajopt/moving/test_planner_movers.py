@@ -87,6 +87,19 @@ def test_queries_not_covered_are_refused(scene, planned):
         planner.plan(scene.start, scene.goal("A"), moving_obstacles=[(1.0, 2.0)])
 
 
+def test_movers_with_speed_limit_zones_are_refused(scene, planned):
+    _, base = planned
+    g = scene.grid
+    ny, nx = np.asarray(g.occupied).shape
+    zones = trajopt.SpeedLimits.from_mask(
+        np.full((ny, nx), 50), g.resolution, tuple(g.origin), type="percentage"
+    )
+    planner = trajopt.Planner(g, trajopt.Robot(), speed_limits=zones)
+    planner.plan(scene.start, scene.goal("A"))  # the zones alone plan
+    with pytest.raises(InvalidInputError, match="speed_limits"):
+        planner.plan(scene.start, scene.goal("A"), moving_obstacles=[_crossing(base)])
+
+
 @pytest.mark.parametrize("closer", [0.0, 1e-3])
 def test_a_parked_mover_grazing_the_path(scene, planned, closer):
     """Touching at the limit keeps today's plan; a millimetre closer blocks the path."""
