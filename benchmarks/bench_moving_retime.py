@@ -156,7 +156,7 @@ def replan(planner, traj, ms):
         return took, None, 0.0, type(exc).__name__, math.inf
     took = (time.perf_counter() - t0, time.process_time() - c0)
     mv = out.stats["moving"]
-    shifted = trajopt.replan.shift_movers(ms, REPLAN_AT)
+    shifted = [trajopt.moving.shift_clock(m, REPLAN_AT) for m in ms]
     return took, mv["plan"], mv["time_s"], mv["replan"], dense_slack(out, shifted)
 
 

@@ -7,7 +7,7 @@ result for them (:mod:`trajopt.replan._moving`).
 """
 
 from trajopt.replan._car import replan_car
-from trajopt.replan._moving import retime_replan, shift_movers
+from trajopt.replan._moving import retime_replan
 from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, replan_moving
 
 __all__ = [
@@ -16,5 +16,4 @@ __all__ = [
     "replan_from",
     "replan_moving",
     "retime_replan",
-    "shift_movers",
 ]

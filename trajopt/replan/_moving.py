@@ -8,7 +8,7 @@ or brake, turn and go), then hands the result to :func:`retime_replan`.
 from its ``t = 0``, the clock of the ``t`` given to ``replan`` (for a plan of
 :meth:`~trajopt._planner.Planner.plan`, the plan's start). The re-plan's result starts at the
 splice ``ts = t + latency`` on that clock: its own time ``tau`` is ``ts + tau`` there. The
-movers are shifted to the result's clock (:func:`shift_movers`: times ``- ts``; a radius
+movers are shifted to the result's clock (:func:`trajopt.moving.shift_clock`: times ``- ts``; a radius
 that grows with the prediction time keeps its value at every instant), and the result's
 ``stats["moving"]["clock_offset_s"]`` is ``ts``. Predictions for a later re-plan of the
 result are on the result's clock.
@@ -30,41 +30,7 @@ from collections.abc import Sequence
 
 from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers
-
-
-def shift_movers(movers: Sequence[MovingObstacle], ts: float) -> tuple[MovingObstacle, ...]:
-    """Return the movers on a clock that starts at ``ts`` (s) of theirs.
-
-    Times become ``times - ts``. A growing radius ``radius + growth clip(t, 0, t_last)`` is
-    the same at every instant ``t >= ts``: the shifted mover's radius is
-    ``radius + growth min(ts, t_last)``, with the same growth, until its (shifted) last time.
-
-    Parameters
-    ----------
-    movers : sequence of MovingObstacle
-    ts : float
-        The new clock's origin on the old one (s), >= 0.
-
-    Returns
-    -------
-    tuple of MovingObstacle
-    """
-    out = []
-    for m in movers:
-        grown = m.growth * min(max(ts, 0.0), max(m.t_last, 0.0))
-        out.append(
-            MovingObstacle(
-                times=m.times - ts,
-                positions=m.positions,
-                headings=m.headings,
-                radius=m.radius + grown,
-                growth=m.growth,
-                vertices=m.vertices,
-                name=m.name,
-            )
-        )
-    return tuple(out)
+from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers, shift_clock
 
 
 def retime_replan(
@@ -103,7 +69,7 @@ def retime_replan(
         A mover overlaps the robot at the splice; an end speed ``v_end > 0``.
     """
     t0 = time.perf_counter()
-    shifted = shift_movers(movers, ts)
+    shifted = tuple(shift_clock(m, ts) for m in movers)
     if out.v_end != 0.0:
         raise InvalidInputError(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "

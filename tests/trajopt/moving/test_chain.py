@@ -170,7 +170,7 @@ def test_shift_clock_is_the_same_prediction():
     m = trajopt.MovingObstacle.from_waypoints(
         [0.5, 2.0, 4.0], [(0, 0), (1, 2), (3, 1)], radius=0.1, growth=0.05, headings=[0, 1, 3]
     )
-    for t0 in (0.0, 1.0, 3.0, 6.0):
+    for t0 in (0.0, 1.0, 3.0, 4.5, 6.0, 8.0):
         sh = trajopt.moving.shift_clock(m, t0)
         tau = np.linspace(0.0, 8.0, 401)
         for a, b in zip(sh.pose_at(tau), m.pose_at(tau + t0), strict=True):

@@ -91,7 +91,7 @@ def test_new_predictions_re_time_the_kept_rest(driven, t, growth):
     assert abs(a.v - b.v) < 1e-9 and abs(a.a - b.a) < 1e-9
     # clear at every instant: 1 ms samples on the movers' clock, and the brute force
     assert _slack_on_movers_clock(new, [mover], ts, margin=0.05) >= -1e-6
-    shifted = trajopt.replan.shift_movers([mover], ts)
+    shifted = [trajopt.moving.shift_clock(mover, ts)]
     assert brute_min(new, shifted, margin=0.05) >= -1e-6
     t_s = np.arange(0.0, new.duration, 1e-3)
     _, v, acc, _ = new.motion(t_s)
@@ -120,17 +120,6 @@ def test_a_mover_parked_on_the_rest_blocks(driven):
     with pytest.raises(BlockedError, match="'cart'") as err:
         planner.replan(traj, 1.0, latency=LATENCY, moving_obstacles=[parked])
     assert err.value.mover == "cart" and err.value.t >= ts
-
-
-def test_shift_movers_keeps_every_instant():
-    m = trajopt.MovingObstacle.from_waypoints(
-        [1.0, 3.0, 6.0], [(0, 0), (2, 1), (2, 4)], radius=0.3, growth=0.1
-    )
-    for ts in (0.0, 2.0, 4.5, 8.0):
-        (s,) = trajopt.replan.shift_movers([m], ts)
-        tau = np.linspace(0.0, 10.0, 1001)
-        np.testing.assert_allclose(s.position_at(tau), m.position_at(tau + ts), atol=1e-12)
-        np.testing.assert_allclose(s.radius_at(tau), m.radius_at(tau + ts), atol=1e-12)
 
 
 def test_a_new_goal_is_planned_then_re_timed(driven, scene):
