@@ -714,9 +714,12 @@ if __name__ == "__main__":
         default=None,
         help="also count the entries clear of the conservative grid's cells at this resolution",
     )
+    ap.add_argument("--cases", type=str, default=None, help="only these case ids (comma-separated)")
     args = ap.parse_args()
     found = 0
     par = [c for c in make_cases(CARS[args.car], args.limit, args.seed) if c.category == "parallel"]
+    if args.cases:
+        par = [c for c in par if c.case_id in args.cases.split(",")]
     for c in par:
         w = reverse_s_entry(c)
         found += w is not None
