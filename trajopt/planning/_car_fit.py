@@ -88,8 +88,10 @@ class CarSegment:
     joined : bool
         Whether it continues the previous segment in the same direction of travel (a stretch
         between cusps that turns by more than :data:`SPLIT_TURN_RAD` and that its first
-        whole fits miss is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
-        curve's end curvature where that fit succeeds (``"polygons"``).
+        whole fits miss is fitted in pieces, and one that no fit fits is halved:
+        :func:`fit_run`). Its curve then starts with the previous curve's end curvature
+        where that fit succeeds (``"polygons"``) and the car drives through the join;
+        otherwise it rests there, as at a cusp.
     """
 
     direction: int
