@@ -33,7 +33,8 @@ and p95 plan time, cusps per plan (trajopt vs OMPL), OMPL's planned % and overla
 trajopt's failure reasons (error type and the first words of the message).
 
 Run: ``python benchmarks/bench_parking.py [--limit 40] [--resolution 0.1] [--car full|small]
-[--seed 0] [--ompl-time 1.5] [--ompl-planner bitstar|rrtstar] [--no-ompl] [--out rows.csv|rows.parquet]``.
+[--seed 0] [--ompl-time 1.5] [--ompl-planner bitstar|rrtstar] [--no-ompl] [--out rows.csv|rows.parquet]
+[--cases 3,17,full-parallel-forwards-1]`` (``--cases``: a subset of the suite to iterate on).
 """
 
 from __future__ import annotations
@@ -308,6 +309,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ompl-planner", choices=("bitstar", "rrtstar"), default="bitstar")
     ap.add_argument("--no-ompl", action="store_true")
     ap.add_argument("--out", type=Path, default=None, help="rows as .csv or .parquet")
+    ap.add_argument(
+        "--cases",
+        type=str,
+        default=None,
+        help="only these cases of the suite: comma-separated indices (0-based) or case ids",
+    )
     args = ap.parse_args(argv)
 
     import trajopt  # noqa: F401 - imported before timing
@@ -315,6 +322,9 @@ def main(argv: list[str] | None = None) -> int:
     car = pc.CARS[args.car]
     robot = car.robot()
     cases = pc.make_cases(car, args.limit, args.seed)
+    if args.cases:
+        picks = [w.strip() for w in args.cases.split(",") if w.strip()]
+        cases = [c for i, c in enumerate(cases) if str(i) in picks or c.case_id in picks]
     have_ompl = not args.no_ompl
     if have_ompl:
         try:

@@ -611,6 +611,56 @@ def arc_poses(pose, kappa: float, length: float, direction: int, step: float) ->
     )
 
 
+def cell_squares(case: ParkingCase, resolution: float, reach: float) -> list[np.ndarray]:
+    """The occupied cells of ``case.grid(resolution)`` within ``reach`` (m, per axis) of the
+    goal, as square polygons: what a planner that sees only the conservative grid avoids."""
+    g = case.grid(resolution)
+    ox, oy = g.origin
+    gx, gy, _ = case.goal
+    out = []
+    for i, j in np.argwhere(np.asarray(g.occupied)):
+        cx, cy = ox + (j + 0.5) * resolution, oy + (i + 0.5) * resolution
+        if abs(cx - gx) < reach and abs(cy - gy) < reach:
+            out.append(rect(cx, cy, resolution, resolution))
+    return out
+
+
+def reverse_s_entries(case: ParkingCase, obstacles=None) -> tuple[int, int]:
+    """Count the one-manoeuvre entries of :func:`reverse_s_entry`'s family that are clear.
+
+    Every ``(d, phi)`` of the family (``d`` in 5 cm steps, scaled, ``phi`` 88 down to 10
+    degrees in 2 degree steps) with arcs of radius ``R``, the body corners at most 1 cm
+    apart: how many are clear of the polygons, and how many of those are also clear of
+    ``obstacles`` (other polygons, e.g. :func:`cell_squares`; the same count without).
+    """
+    car = case.car
+    body = car.body()
+    R = car.turning_radius
+    rc = float(np.max(np.hypot(body[:, 0], body[:, 1])))
+    step = 0.01 / (1.0 + rc / R)
+    gx, gy, gh = case.goal
+    row_top = max(
+        float(p[:, 1].max())
+        for p in case.polygons
+        if len(p) == 4 and p[:, 1].max() < gy + 2.0 * car.width
+    )
+    side = 1.0 if math.cos(gh) > 0 else -1.0
+    clear = both = 0
+    for d in np.arange(0.0, 0.6 * car.length * (case.size - 1.0) + 1e-9, 0.05 * car.scale):
+        back = arc_poses(case.goal, 0.0, float(d), -1, step)
+        for phi in np.radians(np.arange(88.0, 8.0, -2.0)):
+            a1 = arc_poses(tuple(back[-1]), side / R, R * phi, +1, step)
+            a2 = arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, step)
+            if body_at(body, a2[-1:])[0][:, 1].min() < row_top:
+                continue
+            poses = np.vstack([back, a1, a2])
+            if body_overlaps(body, poses, case.polygons).any():
+                continue
+            clear += 1
+            both += obstacles is None or not body_overlaps(body, poses, obstacles).any()
+    return clear, both
+
+
 def reverse_s_entry(case: ParkingCase) -> tuple[float, float] | None:
     """A one-manoeuvre entry into a parallel slot, if one is clear: ``(d, phi)`` (m, rad).
 
@@ -658,12 +708,28 @@ if __name__ == "__main__":
     ap.add_argument("--car", choices=sorted(CARS), default="full")
     ap.add_argument("--limit", type=int, default=40)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--resolution",
+        type=float,
+        default=None,
+        help="also count the entries clear of the conservative grid's cells at this resolution",
+    )
+    ap.add_argument("--cases", type=str, default=None, help="only these case ids (comma-separated)")
     args = ap.parse_args()
     found = 0
     par = [c for c in make_cases(CARS[args.car], args.limit, args.seed) if c.category == "parallel"]
+    if args.cases:
+        par = [c for c in par if c.case_id in args.cases.split(",")]
     for c in par:
         w = reverse_s_entry(c)
         found += w is not None
         how = f"d {w[0]:.2f} m, phi {math.degrees(w[1]):.0f} deg" if w else "none"
-        print(f"{c.case_id}: slot {c.size:.2f} car lengths, reverse S entry: {how}")
+        line = f"{c.case_id}: slot {c.size:.2f} car lengths, reverse S entry: {how}"
+        if args.resolution is not None and w is not None:
+            cells = cell_squares(c, args.resolution, 3.0 * c.car.length)
+            n, m = reverse_s_entries(c, cells)
+            line += (
+                f"; of the family {n} clear of the polygons, {m} of the {args.resolution} m cells"
+            )
+        print(line, flush=True)
     print(f"{found}/{len(par)} parallel slots have a clear one-manoeuvre (reverse S) entry")

@@ -15,7 +15,8 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    ``pi``). Each segment is fitted as an ordinary curve in the direction of travel in a
    certified polygon corridor, with the curvature bound ``1/R``, exact end points and exact
    end travel headings; a stretch that turns much and fits in no whole curve is fitted in
-   pieces, each starting with the previous piece's end curvature where it can. Every curve is the smoother's certified curve and
+   pieces, each starting with the previous piece's end curvature where it can, and one that no
+   fit fits is halved at its middle pose (twice at most). Every curve is the smoother's certified curve and
    its sampled curvature must be within ``1/R``; nothing else is returned. The smoother's
    budget per fit is capped at :data:`SEGMENT_BUDGET_S`.
 3. **Timing.** Each drive (the segments between two stops: :func:`drive_groups`; the pieces

@@ -15,7 +15,9 @@ polygons grown around the poses themselves without centring (the witness corrido
 :data:`SPLIT_TURN_RAD` and that neither the first nor the reversed fit fits is fitted in
 pieces spanning at most :data:`PIECE_TURN_RAD` of heading each (:func:`split_points`; before
 the other whole fits), each starting with the previous piece's end curvature; the car rests
-at each join as at a cusp (:attr:`CarSegment.joined`). Every curve is the smoother's
+at each join as at a cusp (:attr:`CarSegment.joined`). A stretch that no fit fits at all is
+halved at its middle pose and its halves fitted the same way (:data:`HALVING_DEPTH`; the car
+rests at the join where their curvatures differ). Every curve is the smoother's
 certified curve (convex-hull clearance certificate per segment) and its sampled curvature
 (the certificate's dense samples) must be within ``1/R`` (to :data:`KAPPA_TOL`); nothing
 else is returned.
@@ -56,6 +58,13 @@ SPLIT_TURN_RAD = math.pi
 WHOLE_FIRST = (0, 2)
 #: Largest turn (rad) of each piece of a split stretch.
 PIECE_TURN_RAD = 0.6 * math.pi
+#: How many times a stretch whose fits all fail is halved at its middle pose
+#: (:func:`fit_run`): a backwards segment into a parking slot whose curve left the body's
+#: certificate no margin near the slot (footprint certificate at 0 m) or whose curvature
+#: SCP did not converge fitted as two or four shorter curves.
+HALVING_DEPTH = 2
+#: Fewest steps (pose index differences) of a stretch that is halved.
+HALVING_MIN_POSES = 4
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,8 +88,10 @@ class CarSegment:
     joined : bool
         Whether it continues the previous segment in the same direction of travel (a stretch
         between cusps that turns by more than :data:`SPLIT_TURN_RAD` and that its first
-        whole fits miss is fitted in pieces; the car rests at each join, as at a cusp). Its curve then starts with the previous
-        curve's end curvature where that fit succeeds (``"polygons"``).
+        whole fits miss is fitted in pieces, and one that no fit fits is halved:
+        :func:`fit_run`). Its curve then starts with the previous curve's end curvature
+        where that fit succeeds (``"polygons"``) and the car drives through the join;
+        otherwise it rests there, as at a cusp.
     """
 
     direction: int
@@ -156,6 +167,7 @@ def fit_run(
     direction: int,
     kappa0: float,
     timer: StageTimer,
+    depth: int = 0,
 ) -> list[CarSegment]:
     """Fit a stretch between cusps (module docstring).
 
@@ -163,8 +175,57 @@ def fit_run(
     curvatures, :data:`WHOLE_FIRST`); when those fail and the stretch turns by more than
     :data:`SPLIT_TURN_RAD`, in pieces (:func:`split_points`), each piece starting with the
     previous curve's end curvature (the car rests at each join); then the whole stretch's
-    other fits.
+    other fits. When every one of those fails, the stretch is halved at its middle pose
+    and each half fitted the same way (down to :data:`HALVING_DEPTH` halvings, halves of
+    at least :data:`HALVING_MIN_POSES` steps), the second half starting with the first
+    half's end curvature where it can: the search's pose there is exact (its body clear,
+    its heading the curves' common tangent), and each half is a shorter curve held closer
+    to the search's arcs. Where the curvatures differ the car rests at the join and steers
+    there (as at a cusp).
+
+    ``depth``: how many halvings led to this stretch.
     """
+    try:
+        return _fit_whole_or_turns(options, grid, smoother, poses, ends, direction, kappa0, timer)
+    except SmoothingError as exc:
+        first, last = ends
+        if depth >= HALVING_DEPTH or last - first < HALVING_MIN_POSES:
+            raise
+        failed = exc
+    # halves at the middle pose (its exact pose and heading from the search), the car
+    # resting there unless the second half starts with the first's end curvature
+    mid = (ends[0] + ends[1]) // 2
+    try:
+        left = fit_run(
+            options, grid, smoother, poses, (ends[0], mid), direction, kappa0, timer, depth + 1
+        )
+        right = fit_run(
+            options,
+            grid,
+            smoother,
+            poses,
+            (mid, ends[1]),
+            direction,
+            end_curvature(left[-1].smooth_path),
+            timer,
+            depth + 1,
+        )
+    except SmoothingError as exc:
+        raise SmoothingError(f"{failed}; halved at pose {mid}: {exc}", exc.stats) from exc
+    return left + [dataclasses.replace(right[0], joined=True)] + right[1:]
+
+
+def _fit_whole_or_turns(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Smoother,
+    poses: np.ndarray,
+    ends: tuple[int, int],
+    direction: int,
+    kappa0: float,
+    timer: StageTimer,
+) -> list[CarSegment]:
+    """Fit a stretch as one segment, or in pieces of :data:`PIECE_TURN_RAD` (:func:`fit_run`)."""
     args = (options, grid, smoother, poses)
     cuts = split_points(np.asarray(poses[:, 2]), *ends)
     if len(cuts) == 2:

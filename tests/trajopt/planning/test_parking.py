@@ -277,3 +277,34 @@ def test_full_size_car_parks_a_suite_case_with_no_overlap(category, entry, index
     assert abs(math.remainder(poses[-1, 2] - case.goal[2], 2 * math.pi)) < 1e-6
     check = pc.check_poses(FULL.body(), poses, case.polygons)
     assert check.overlaps == 0 and check.min_clearance > 0.0
+
+
+def test_full_size_car_fits_a_backwards_segment_in_halves():
+    """A perpendicular bay 1.40 car widths wide entered backwards (suite case
+    ``full-perpendicular-backwards-4``): no single certified curve fits the backwards
+    segment into the bay (the body's certificate keeps no margin near the slot, or the
+    curvature SCP does not converge), its halves at the search's middle pose do. The car
+    rests at the join; the exact polygon check finds no overlap, and finite differences of
+    the geometric steering angle keep the steering rate at every join."""
+    from tests.trajopt.planning.test_car import geometric_steer
+
+    case = pc.make_case(FULL, "perpendicular", "backwards", 0, 4)
+    robot = FULL.robot()
+    traj = trajopt.plan(
+        case.grid(0.1),
+        case.start[:2],
+        case.goal[:2],
+        robot,
+        start_heading=case.start[2],
+        goal_heading=case.goal[2],
+    )
+    car = traj.stats["car"]
+    assert car["segments"] > car["cusps"] + 1 and car["joins"] >= 1
+    _, poses = pc.trajectory_poses(traj, FULL.body())
+    np.testing.assert_allclose(poses[-1, :2], case.goal[:2], atol=1e-6)
+    check = pc.check_poses(FULL.body(), poses, case.polygons)
+    assert check.overlaps == 0 and check.min_clearance > 0.0
+    t = np.unique(np.concatenate([np.arange(0.0, traj.duration, 2e-3), traj.piece_times]))
+    delta = geometric_steer(traj, t, FULL.wheelbase)
+    rate = np.abs(np.diff(delta)) / np.diff(t)
+    assert rate.max() <= robot.drive.steering.rate_max * (1.0 + 1e-6)
