@@ -90,6 +90,16 @@ class MoverCertificate:
     tol: float
     intervals: int
 
+    def summary(self) -> dict[str, Any]:
+        """Return the verdict as ``stats["moving"]["certificate"]`` holds it (plain values)."""
+        return {
+            "ok": self.ok,
+            "slack_m": self.slack,
+            "mover": self.mover,
+            "horizon_s": self.horizon,
+            "intervals": self.intervals,
+        }
+
 
 def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Distance (m) from points ``p`` (n, 2) to convex CCW polygons ``w`` (n, m, 2); 0 inside."""

@@ -155,16 +155,6 @@ def _retime_leg(
     return _retime_curve(curve, movers, margin, not_before)
 
 
-def _cert_stats(cert: Any) -> dict[str, Any]:
-    return {
-        "ok": cert.ok,
-        "slack_m": cert.slack,
-        "mover": cert.mover,
-        "horizon_s": cert.horizon,
-        "intervals": cert.intervals,
-    }
-
-
 def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 0.0) -> Any:
     """Re-time a plan from rest for the movers, on one clock (module docstring).
 
@@ -206,7 +196,7 @@ def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float =
         stats = dict(plan.stats)
         stats["moving"] = {
             "plan": "as planned",
-            "certificate": _cert_stats(cert),
+            "certificate": cert.summary(),
             "time_s": time.perf_counter() - t_all,
         }
         return dataclasses.replace(plan, stats=stats)
@@ -224,7 +214,7 @@ def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float =
         )
     chain.stats["moving"] = {
         "plan": "; ".join(labels) if labels else "as planned",
-        "certificate": _cert_stats(cert),
+        "certificate": cert.summary(),
         "time_s": time.perf_counter() - t_all,
     }
     return chain
@@ -289,7 +279,7 @@ def _retime_omni(plan: Any, movers: Sequence[MovingObstacle], margin: float, t_a
     stats = dict(out.stats)
     stats["moving"] = {
         "plan": str(moved.stats["moving"]["plan"]),
-        "certificate": _cert_stats(cert),
+        "certificate": cert.summary(),
         "time_s": time.perf_counter() - t_all,
     }
     return dataclasses.replace(out, stats=stats, steps=plan.steps)

@@ -668,19 +668,8 @@ def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 
             mover=cert.mover,
             t=cert.witness_t,
         )
-    stats["moving"]["certificate"] = _cert_stats(cert)
+    stats["moving"]["certificate"] = cert.summary()
     return out
-
-
-def _cert_stats(cert: Any) -> dict[str, Any]:
-    """Return the certificate's summary for ``stats["moving"]``."""
-    return {
-        "ok": cert.ok,
-        "slack_m": cert.slack,
-        "mover": cert.mover,
-        "horizon_s": cert.horizon,
-        "intervals": cert.intervals,
-    }
 
 
 def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajectory:
@@ -688,7 +677,7 @@ def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajec
     stats = dict(traj.stats)
     stats["moving"] = {
         "plan": label,
-        "certificate": _cert_stats(cert),
+        "certificate": cert.summary(),
         "time_s": time.perf_counter() - t_all,
     }
     return dataclasses.replace(traj, stats=stats)
