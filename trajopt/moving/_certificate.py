@@ -101,6 +101,22 @@ class MoverCertificate:
         }
 
 
+def second_order_lower(d: np.ndarray, rel: np.ndarray, h: float, c2: np.ndarray) -> np.ndarray:
+    """Lower bound (m) of the centres' distance over ``|tau| <= h`` about each interval's middle.
+
+    ``d`` (n, 2): the robot's centre minus the mover's at the middles (m); ``rel`` (n, 2):
+    their relative velocity (m/s); ``c2`` (n,): the bound on the robot's acceleration (m/s²).
+    The distance of ``d + rel tau`` minimised over ``tau`` in ``[-h, h]`` (closed form), minus
+    ``c2 h² / 2`` (the robot's deviation from its tangent) and a rounding allowance of 1e-12 m.
+    """
+    rr = np.sum(rel * rel, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
+    tau = np.clip(tau, -h, h)
+    near = d + tau[:, None] * rel
+    return np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12
+
+
 def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Distance (m) from points ``p`` (n, 2) to convex CCW polygons ``w`` (n, m, 2); 0 inside."""
     if w.shape[1] == 1:
@@ -552,13 +568,7 @@ def _certify_discs(
             lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
         else:
             # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
-            rel = v_rob - vel
-            rr = np.sum(rel * rel, axis=1)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
-            tau = np.clip(tau, -h, h)
-            near = d + tau[:, None] * rel
-            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower2 = second_order_lower(d, v_rob - vel, h, c2) - lim_hi
             lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
         slack_mid = dist_m - lim_mid
         bad = slack_mid < -0.5 * tol
@@ -631,14 +641,7 @@ def _certify_one(
         elif disc:
             # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
             d = p - mover.position_at(tm)
-            rel = v_rob - vel
-            rr = np.sum(rel * rel, axis=1)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tau = np.where(rr > 0.0, -np.sum(d * rel, axis=1) / rr, 0.0)
-            tau = np.clip(tau, -h, h)
-            near = d + tau[:, None] * rel
-            c2 = model.c2_local
-            lower2 = np.hypot(near[:, 0], near[:, 1]) - 0.5 * c2 * h * h - 1e-12 - lim_hi
+            lower2 = second_order_lower(d, v_rob - vel, h, model.c2_local) - lim_hi
             lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
         slack_mid = dist_m - lim_mid
         bad = slack_mid < -0.5 * tol
