@@ -39,6 +39,7 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -112,7 +113,8 @@ def main() -> int:
     client = rclpy.create_node("trajopt_bench")
     ex = MultiThreadedExecutor(num_threads=2)
     ex.add_node(client)
-    threading.Thread(target=ex.spin, daemon=True).start()
+    spinner = threading.Thread(target=ex.spin, daemon=True)
+    spinner.start()
     out: dict[str, object] = {}
 
     # 1. start to services ready (the kernel cache is warm after the first start)
@@ -351,8 +353,7 @@ def main() -> int:
     if "soak" not in parts:
         code, secs = node.stop()
         print("shutdown by SIGINT:", {"exit code": code, "seconds": round(secs, 2)})
-        ex.shutdown()
-        rclpy.try_shutdown()
+        _stop_client(ex, spinner, client)
         return 0
     for _ in range(30):
         call(h.pose(*start), h.pose(*goal))
@@ -383,9 +384,22 @@ def main() -> int:
     out["shutdown by SIGINT"] = {"exit code": code, "seconds": round(secs, 2)}
     print("soak:", out["soak"])
     print("shutdown by SIGINT:", out["shutdown by SIGINT"])
-    ex.shutdown()
-    rclpy.try_shutdown()
+    _stop_client(ex, spinner, client)
     return 0
+
+
+def _stop_client(ex: Any, spinner: threading.Thread, client: Any) -> None:
+    """Stop the client's executor, wait for its spinning thread, then shut rclpy down.
+
+    The thread is joined before the interpreter exits: a thread still inside rclpy's C++ code
+    at exit aborts the process (``terminate called without an active exception``).
+    """
+    import rclpy
+
+    ex.shutdown()
+    spinner.join(timeout=5.0)
+    client.destroy_node()
+    rclpy.try_shutdown()
 
 
 if __name__ == "__main__":
