@@ -16,10 +16,17 @@ result are on the result's clock.
 **What is re-timed.** A result of one curve that ends at rest (the kept rest when only the
 predictions changed, or a plan from the moving state to a new goal or on a new map) keeps its
 path and is re-timed from its start state (speed and acceleration at the splice) by
-:func:`trajopt.retime_for_movers`: milliseconds, no new path. Any other result (a brake, turn
-and go chain, an omni base's own orientation, a car's plan) is certified as it is
-(:func:`trajopt.certify_movers`). ``BlockedError`` from either propagates: a re-route around
-the blocking mover belongs where it is raised (module :mod:`trajopt.moving`'s re-routing).
+:func:`trajopt.retime_for_movers`: milliseconds, no new path. A chain (brake, turn and go; a
+car's brake and plan from the stopped pose; the rest of such a chain) is split where it
+first starts a piece at rest (:func:`split_at_rest`): the head before it (a brake from the
+splice state, the end of a turn in place playing at the splice) is played as it is, since
+the robot is committed to it until it stops; the tail, a plan from rest, is re-timed by
+:func:`trajopt.moving.retime_chain` on the movers' clock seen from the head's end (turns in
+place, a car's drives between cusps, an omni orientation). Whatever is returned is certified
+whole (:func:`trajopt.certify_movers` against the shifted movers); a result with no piece
+from rest after its head (an omni base's own orientation from the moving state) is only
+certified. ``BlockedError`` from the re-timing or the certificate propagates (its time on
+the movers' clock).
 """
 
 from __future__ import annotations
@@ -27,10 +34,17 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Sequence
+from typing import Any
 
 from trajopt.errors import BlockedError, InvalidInputError
-from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers, shift_clock
+from trajopt.motion import PlanResult, TrajectoryChain
+from trajopt.moving import (
+    MovingObstacle,
+    certify_movers,
+    retime_chain,
+    retime_for_movers,
+    shift_clock,
+)
 
 
 def retime_replan(
@@ -79,32 +93,30 @@ def retime_replan(
         try:
             timed = retime_for_movers(out, shifted, margin=margin)
         except BlockedError as exc:  # its time back on the movers' clock
-            raise BlockedError(
-                f"{exc} (times from the splice, at t = {ts:.3f} s of the movers' clock)",
-                mover=exc.mover,
-                t=exc.t + ts,
-            ) from exc
+            raise _on_movers_clock(exc, ts) from exc
         moving = dict(timed.stats["moving"])
     else:
-        cert = certify_movers(out, shifted, margin=margin)
+        head, tail = split_at_rest(out)
+        if tail:
+            timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
+        else:
+            timed, moving = out, {"plan": "as planned"}
+        cert = certify_movers(timed, shifted, margin=margin)
         if not cert.ok:
             raise BlockedError(
                 f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
                 f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
-                "movers' clock, and only a single curve ending at rest is re-timed",
+                f"movers' clock ({'before it stops' if tail else 'it does not stop on the way'}"
+                ": only what follows a stop is re-timed)",
                 mover=cert.mover,
                 t=cert.witness_t + ts,
             )
-        timed = out
-        moving = {
-            "plan": "as planned",
-            "certificate": {
-                "ok": cert.ok,
-                "slack_m": cert.slack,
-                "mover": cert.mover,
-                "horizon_s": cert.horizon,
-                "intervals": cert.intervals,
-            },
+        moving["certificate"] = {
+            "ok": cert.ok,
+            "slack_m": cert.slack,
+            "mover": cert.mover,
+            "horizon_s": cert.horizon,
+            "intervals": cert.intervals,
         }
     moving.update(
         time_s=time.perf_counter() - t0,
@@ -112,3 +124,77 @@ def retime_replan(
         replan=out.stats.get("replan"),
     )
     return dataclasses.replace(timed, stats=dict(timed.stats, moving=moving))
+
+
+def _on_movers_clock(exc: BlockedError, t0: float) -> BlockedError:
+    """``exc`` with its time ``t0`` later: from the result's clock to the movers' clock."""
+    return BlockedError(
+        f"{exc} (times from the splice, at t = {t0:.3f} s of the movers' clock)",
+        mover=exc.mover,
+        t=exc.t + t0,
+    )
+
+
+def split_at_rest(out: PlanResult) -> tuple[list[tuple[Any, float]], list[Any]]:
+    """Split a re-plan's result where it first starts a piece at rest, from there on whole.
+
+    Returns the head, ``(piece, start)`` pairs played as they are (a brake from the splice
+    state, the end of a turn in place playing at the splice: the robot is committed to them),
+    and the tail, the pieces that follow, each played whole from rest (empty when the result
+    does not start a piece at rest after its head: one curve from the moving state, an omni
+    base's own orientation).
+    """
+    if not isinstance(out, TrajectoryChain):
+        return [(out, 0.0)], []
+    starts = out.starts or (0.0,) * len(out.pieces)
+    head: list[tuple[Any, float]] = []
+    for i, (piece, t_in) in enumerate(zip(out.pieces, starts, strict=True)):
+        if t_in == 0.0 and float(piece.v_start) == 0.0 and not isinstance(piece, TrajectoryChain):
+            return head, list(out.pieces[i:])
+        head.append((piece, float(t_in)))
+    return head, []
+
+
+def _retime_tail(
+    out: TrajectoryChain,
+    head: list[tuple[Any, float]],
+    tail: list[Any],
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+) -> tuple[TrajectoryChain, dict[str, Any]]:
+    """Re-time the pieces that follow the head on the clock where the head ends.
+
+    The tail, a plan from rest, is re-timed by :func:`trajopt.moving.retime_chain` against
+    the movers seen from the head's end (``ts`` plus the head's duration on the movers'
+    clock); the head stays as it is. ``BlockedError`` is given the movers' clock.
+    """
+    t_head = sum(float(p.duration) - t_in for p, t_in in head)
+    plan = (
+        tail[0]
+        if len(tail) == 1
+        else TrajectoryChain(tuple(tail), out.robot, dict(out.stats), out.steps)
+    )
+    seen = [shift_clock(m, ts + t_head) for m in movers]
+    try:
+        timed = retime_chain(plan, seen, margin=margin)
+    except BlockedError as exc:
+        raise _on_movers_clock(exc, ts + t_head) from exc
+    if isinstance(timed, TrajectoryChain):
+        rest = list(timed.pieces)
+        rest_starts = list(timed.starts or (0.0,) * len(timed.pieces))
+    else:
+        rest, rest_starts = [timed], [0.0]
+    chain = TrajectoryChain(
+        tuple([p for p, _ in head] + rest),
+        out.robot,
+        dict(out.stats),
+        out.steps,
+        tuple([t for _, t in head] + rest_starts),
+    )
+    moving = {
+        "plan": f"kept {t_head:.3f} s to a stop, then: {timed.stats['moving']['plan']}",
+        "head_s": t_head,
+    }
+    return chain, moving

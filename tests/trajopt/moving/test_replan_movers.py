@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import trajopt
-from tests.trajopt.moving.reference import brute_min
+from tests.trajopt.moving.reference import brute_min, check_trajectory, dense_min
 from trajopt.errors import BlockedError
 
 LATENCY = 0.05
@@ -140,3 +140,48 @@ def test_a_new_goal_is_planned_then_re_timed(driven, scene):
     assert math.hypot(a.x - b.x, a.y - b.y) < 1e-9 and abs(a.v - b.v) < 1e-9
     assert abs(a.a - b.a) < 1e-9
     assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
+
+
+def _splice_equal(traj, new, ts):
+    a, b = traj.state_at(ts), new.state_at(0.0)
+    assert math.hypot(a.x - b.x, a.y - b.y) < 1e-9
+    assert abs(math.remainder(a.theta - b.theta, 2 * math.pi)) < 1e-9
+    assert abs(a.v - b.v) < 1e-9 and abs(a.a - b.a) < 1e-9
+
+
+def test_a_brake_turn_go_is_re_timed_after_the_stop(driven, scene):
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    static = planner.replan(traj, 1.0, goal=scene.goal("D"), latency=LATENCY)
+    assert [type(p) for p in static.pieces] == [
+        trajopt.Trajectory,
+        trajopt.TurnInPlace,
+        trajopt.Trajectory,
+    ]
+    # crossing the go piece's middle when it is there, on the driven plan's clock
+    t_go = float(static.piece_times[2])
+    m = _crossing(static, 0.5 * (t_go + static.duration))
+    mover = trajopt.MovingObstacle.from_waypoints(
+        m.times + ts, m.positions, radius=m.radius, name="walker"
+    )
+    shifted = [trajopt.moving.shift_clock(mover, ts)]
+    assert dense_min(static, shifted)[0] < 0.0  # the chain as planned would hit it
+    new = planner.replan(traj, 1.0, goal=scene.goal("D"), latency=LATENCY, moving_obstacles=[mover])
+    moving = new.stats["moving"]
+    assert moving["certificate"]["ok"] and moving["plan"].startswith("kept")
+    assert new.duration > static.duration
+    # the brake is kept as it is (the robot cannot be re-timed before it stops)
+    brake = static.pieces[0]
+    assert moving["head_s"] == pytest.approx(brake.duration)
+    assert new.pieces[0].duration == brake.duration
+    t = np.linspace(0.0, brake.duration, 200)
+    a, b = new.sample(t), static.sample(t)
+    for name in ("x", "y", "theta", "v", "a"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    # the same turn and path after it, only later
+    assert np.array_equal(new.pieces[-1].path.curve.c, static.pieces[-1].path.curve.c)
+    _splice_equal(traj, new, ts)
+    # clear at every instant: 1 ms samples on the movers' clock, the independent check
+    assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
+    assert dense_min(new, shifted)[0] >= -1e-6
+    assert check_trajectory(new, shifted).ok
