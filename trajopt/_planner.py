@@ -496,7 +496,29 @@ class Planner:
                 brake_after_s=brake_after_s,
             )
             if movers:
-                out = retime_replan(out, movers, margin, float(out.stats["splice_time_s"]))
+
+                def from_stop(
+                    p: tuple[float, float],
+                    heading: float,
+                    steer: float,
+                    seen: Sequence[MovingObstacle],
+                ) -> PlanResult:  # a plan from the stop, as plan's with movers
+                    steps = out.steps
+                    if steps is None:
+                        raise InvalidInputError("the re-plan has no steps: no goal to go on to")
+                    request = PlanRequest(
+                        p,
+                        tuple(steps.goal),
+                        start_heading=heading,
+                        goal_heading=steps.goal_heading,
+                        start_steer=steer,
+                        goal_steer=getattr(steps, "goal_steer", None),
+                    )
+                    static = run_query(self.options, self.caches, request)
+                    return _retime(static, tuple(seen), margin, self.options, self.caches, request)
+
+                ts = float(out.stats["splice_time_s"])
+                out = retime_replan(out, movers, margin, ts, from_stop)
             self._latencies.append(time.perf_counter() - t0)
             return out
 

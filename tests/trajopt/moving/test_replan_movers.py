@@ -110,16 +110,43 @@ def test_a_mover_far_away_keeps_the_rest_as_it_is(driven):
         assert np.array_equal(getattr(new, name), getattr(base, name))
 
 
-def test_a_mover_parked_on_the_rest_blocks(driven):
+def test_a_mover_parked_on_the_rest_stops_and_re_routes(driven, scene):
     planner, traj = driven
     ts = 1.0 + LATENCY
     smp = traj.sample(np.array([0.5 * (ts + traj.duration)]))
     parked = trajopt.MovingObstacle.from_waypoints(
         [0.0], [(smp.x[0], smp.y[0])], radius=0.2, name="cart"
     )
+    shifted = [trajopt.moving.shift_clock(parked, ts)]
+    static = planner.replan(traj, 1.0, latency=LATENCY)
+    assert dense_min(static, shifted)[0] < 0.0  # the kept rest runs into the cart
+    new = planner.replan(traj, 1.0, latency=LATENCY, moving_obstacles=[parked])
+    moving = new.stats["moving"]
+    assert moving["route"].startswith("stopped: ") and "'cart'" in moving["blocked"]
+    assert moving["certificate"]["ok"] and new.stats["replan"] == "kept"
+    _splice_equal(traj, new, ts)
+    # braked to a stop on the old path, then on another way to the same goal
+    stop = new.state_at(moving["head_s"])
+    assert stop.v == 0.0 and stop.a == pytest.approx(0.0, abs=1e-9)
+    end = new.state_at(new.duration)
+    assert math.hypot(end.x - traj.steps.goal[0], end.y - traj.steps.goal[1]) < 1e-9
+    # clear of the cart and of the map at every instant: the independent check
+    assert _slack_on_movers_clock(new, [parked], ts) >= -1e-6
+    check = check_trajectory(new, shifted, grid=scene.grid)
+    assert check.ok and check.static_slack >= -1e-6
+    t = np.arange(0.0, new.duration, 1e-3)
+    assert np.abs(new.sample(t).v).max() <= new.robot.v_max * (1 + 1e-9)
+
+
+def test_a_mover_parked_on_the_goal_blocks_every_way(driven):
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    goal = traj.steps.goal
+    parked = trajopt.MovingObstacle.from_waypoints([0.0], [goal], radius=0.2, name="cart")
     with pytest.raises(BlockedError, match="'cart'") as err:
         planner.replan(traj, 1.0, latency=LATENCY, moving_obstacles=[parked])
     assert err.value.mover == "cart" and err.value.t >= ts
+    assert "no way on from there" in str(err.value)
 
 
 def test_a_new_goal_is_planned_then_re_timed(driven, scene):
