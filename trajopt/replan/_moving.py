@@ -25,8 +25,18 @@ the robot is committed to it until it stops; the tail, a plan from rest, is re-t
 place, a car's drives between cusps, an omni orientation). Whatever is returned is certified
 whole (:func:`trajopt.certify_movers` against the shifted movers); a result with no piece
 from rest after its head (an omni base's own orientation from the moving state) is only
-certified. ``BlockedError`` from the re-timing or the certificate propagates (its time on
-the movers' clock).
+certified.
+
+**When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
+the robot stops, since it is moving at the splice. One curve from the moving state is braked
+along its path (:func:`~trajopt.replan._brake.brake_on_path`); a chain keeps its head, which
+ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
+from the stop, as :meth:`~trajopt._planner.Planner.plan` does with movers (the static plan
+re-timed, else re-routed around the blocking mover's swept region, or a wait at a safe
+place: :func:`trajopt.moving.reroute`). The stop and that plan are certified whole against
+the shifted movers. ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
+``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
+plan from the stop works or the robot meets a mover while it stops.
 """
 
 from __future__ import annotations
