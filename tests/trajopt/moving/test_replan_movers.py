@@ -1,9 +1,11 @@
-"""Tests of trajopt.moving through Planner.replan: re-timing the spliced trajectory for new predictions.
+"""Tests of trajopt.moving through Planner.replan: re-timing the spliced trajectory for new predictions, or stopping and re-routing.
 
 References: the old trajectory's own state at the splice (continuity), the re-plan without the
-keyword (an empty list is identical), and an independent slack computed here on the movers'
-own clock (the re-plan's samples at ``tau`` against each mover at ``ts + tau``, its radius
-from its fields) on 1 ms samples plus the brute force of reference.py on the shifted movers.
+keyword (an empty list is identical; the brake of a chain sampled against the re-plan without
+movers), and an independent slack computed here on the movers' own clock (the re-plan's
+samples at ``tau`` against each mover at ``ts + tau``, its radius from its fields) on 1 ms
+samples, plus reference.py's dense samples, brute force and ``check_trajectory`` (1 ms
+samples with the Lipschitz bound, the static map's clearance) on the shifted movers.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import pytest
 
 import trajopt
 from tests.trajopt.moving.reference import brute_min, check_trajectory, dense_min
+from tests.trajopt.replan.test_replan_car import forward_scene
 from trajopt.errors import BlockedError
 
 LATENCY = 0.05
@@ -212,3 +215,58 @@ def test_a_brake_turn_go_is_re_timed_after_the_stop(driven, scene):
     assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
     assert dense_min(new, shifted)[0] >= -1e-6
     assert check_trajectory(new, shifted).ok
+
+
+def test_a_brake_turn_go_blocked_after_its_stop_re_routes_from_the_stop(driven, scene):
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    static = planner.replan(traj, 1.0, goal=scene.goal("D"), latency=LATENCY)
+    t_go = float(static.piece_times[2])
+    smp = static.sample(np.array([0.5 * (t_go + static.duration)]))
+    parked = trajopt.MovingObstacle.from_waypoints(
+        [0.0], [(smp.x[0], smp.y[0])], radius=0.2, name="cart"
+    )
+    shifted = [trajopt.moving.shift_clock(parked, ts)]
+    assert dense_min(static, shifted)[0] < 0.0
+    new = planner.replan(
+        traj, 1.0, goal=scene.goal("D"), latency=LATENCY, moving_obstacles=[parked]
+    )
+    moving = new.stats["moving"]
+    assert moving["route"] == "stopped: rerouted" and moving["certificate"]["ok"]
+    # the brake kept as planned, the robot at rest where it ends
+    brake = static.pieces[0]
+    assert moving["head_s"] == pytest.approx(brake.duration)
+    t = np.linspace(0.0, brake.duration, 200)
+    a, b = new.sample(t), static.sample(t)
+    for name in ("x", "y", "theta", "v", "a"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    _splice_equal(traj, new, ts)
+    end = new.state_at(new.duration)
+    assert math.hypot(end.x - scene.goal("D")[0], end.y - scene.goal("D")[1]) < 1e-9
+    assert _slack_on_movers_clock(new, [parked], ts) >= -1e-6
+    check = check_trajectory(new, shifted, grid=scene.grid)
+    assert check.ok and check.static_slack >= -1e-6
+
+
+def test_a_car_braked_and_planned_from_the_stop_is_re_timed():
+    planner, traj, grid, goal, _, t = forward_scene()
+    ts = t + LATENCY
+    static = planner.replan(traj, t, grid=grid, latency=LATENCY)
+    assert static.stats["replan"].startswith("braked")
+    t_stop = float(static.piece_times[1])  # the brake's end: the car plan from rest follows
+    m = _crossing(static, 0.5 * (t_stop + static.duration))
+    mover = trajopt.MovingObstacle.from_waypoints(
+        m.times + ts, m.positions, radius=m.radius, name="walker"
+    )
+    shifted = [trajopt.moving.shift_clock(mover, ts)]
+    assert dense_min(static, shifted)[0] < 0.0
+    new = planner.replan(traj, t, grid=grid, latency=LATENCY, moving_obstacles=[mover])
+    moving = new.stats["moving"]
+    assert moving["route"] == "retimed" and moving["plan"].startswith("kept")
+    assert moving["head_s"] == pytest.approx(t_stop) and new.duration > static.duration
+    _splice_equal(traj, new, ts)
+    end = new.state_at(new.duration)
+    assert math.hypot(end.x - goal[0], end.y - goal[1]) < 1e-6 and end.v == 0.0
+    assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
+    check = check_trajectory(new, shifted, grid=grid)
+    assert check.ok and check.static_slack >= -1e-6
