@@ -502,6 +502,7 @@ class Planner:
                 brake_after_s=brake_after_s,
             )
             if movers:
+                steps = out.steps
 
                 def from_stop(
                     p: tuple[float, float],
@@ -509,7 +510,6 @@ class Planner:
                     steer: float,
                     seen: Sequence[MovingObstacle],
                 ) -> PlanResult:  # a plan from the stop, as plan's with movers
-                    steps = out.steps
                     if steps is None:
                         raise InvalidInputError("the re-plan has no steps: no goal to go on to")
                     request = PlanRequest(

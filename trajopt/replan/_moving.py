@@ -291,7 +291,7 @@ def _stop_and_go_on(
         )
     except TrajoptError as exc:
         mover, t = blocked.mover, blocked.t
-        if isinstance(exc, BlockedError) and exc.mover is not None:
+        if isinstance(exc, BlockedError) and exc.mover is not None and exc.t is not None:
             mover, t = exc.mover, exc.t + ts + t_head
         raise BlockedError(
             f"{blocked}; stopped at ({p_stop[0]:.3f}, {p_stop[1]:.3f}) m after "
