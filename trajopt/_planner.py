@@ -451,12 +451,17 @@ class Planner:
             Predicted movers, their times on ``trajectory``'s clock (the clock of ``t``;
             for a plan of :meth:`plan`, seconds from its start). ``None`` or empty: the
             re-plan as without them. Otherwise the re-plan's result is re-timed for them
-            from the splice state (:func:`trajopt.replan.retime_replan`): when only
-            the predictions changed, the kept rest keeps its path and only its timing
-            changes. The result's ``t = 0`` is the splice ``ts = t + latency`` of that
-            clock; ``stats["moving"]`` holds the re-timing (``plan``, ``certificate``,
-            ``time_s``), ``clock_offset_s`` (``ts``: a mover time ``T`` is ``T - ts`` on the
-            result's clock, which the predictions of a later re-plan of the result use) and
+            (:func:`trajopt.replan.retime_replan`): one curve from the splice state; a
+            chain after its part that ends in a stop (the brake), on one clock
+            (:func:`trajopt.moving.retime_chain`). When only the predictions changed, the
+            kept rest keeps its path and only its timing changes. When no re-timing avoids
+            the movers, the robot brakes to a stop and plans on from there as :meth:`plan`
+            does with movers (re-timed, else re-routed or a wait at a safe place). The
+            result is certified whole; its ``t = 0`` is the splice ``ts = t + latency`` of
+            that clock; ``stats["moving"]`` holds the re-timing (``plan``, ``certificate``,
+            ``time_s``), ``route`` (``"retimed"`` or ``"stopped: <plan's route>"``),
+            ``clock_offset_s`` (``ts``: a mover time ``T`` is ``T - ts`` on the result's
+            clock, which the predictions of a later re-plan of the result use) and
             ``replan`` (what was kept or planned).
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
@@ -473,8 +478,9 @@ class Planner:
         TimingError, SmoothingError, NoPathError
             As :meth:`plan`; ``TimingError``: it must brake and cannot stop in time.
         BlockedError
-            A mover blocks the rest of the way: no re-timing of the re-plan avoids it (named,
-            its time on the movers' clock).
+            A mover blocks the rest of the way: no re-timing of the re-plan avoids it and no
+            plan from a stop does either, or it meets the robot while it stops (named, its
+            time on the movers' clock).
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
@@ -496,7 +502,29 @@ class Planner:
                 brake_after_s=brake_after_s,
             )
             if movers:
-                out = retime_replan(out, movers, margin, float(out.stats["splice_time_s"]))
+                steps = out.steps
+
+                def from_stop(
+                    p: tuple[float, float],
+                    heading: float,
+                    steer: float,
+                    seen: Sequence[MovingObstacle],
+                ) -> PlanResult:  # a plan from the stop, as plan's with movers
+                    if steps is None:
+                        raise InvalidInputError("the re-plan has no steps: no goal to go on to")
+                    request = PlanRequest(
+                        p,
+                        tuple(steps.goal),
+                        start_heading=heading,
+                        goal_heading=steps.goal_heading,
+                        start_steer=steer,
+                        goal_steer=getattr(steps, "goal_steer", None),
+                    )
+                    static = run_query(self.options, self.caches, request)
+                    return _retime(static, tuple(seen), margin, self.options, self.caches, request)
+
+                ts = float(out.stats["splice_time_s"])
+                out = retime_replan(out, movers, margin, ts, from_stop)
             self._latencies.append(time.perf_counter() - t0)
             return out
 

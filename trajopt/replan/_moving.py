@@ -16,21 +16,48 @@ result are on the result's clock.
 **What is re-timed.** A result of one curve that ends at rest (the kept rest when only the
 predictions changed, or a plan from the moving state to a new goal or on a new map) keeps its
 path and is re-timed from its start state (speed and acceleration at the splice) by
-:func:`trajopt.retime_for_movers`: milliseconds, no new path. Any other result (a brake, turn
-and go chain, an omni base's own orientation, a car's plan) is certified as it is
-(:func:`trajopt.certify_movers`). ``BlockedError`` from either propagates: a re-route around
-the blocking mover belongs where it is raised (module :mod:`trajopt.moving`'s re-routing).
+:func:`trajopt.retime_for_movers`: milliseconds, no new path. A chain (brake, turn and go; a
+car's brake and plan from the stopped pose; the rest of such a chain) is split where it
+first starts a piece at rest (:func:`split_at_rest`): the head before it (a brake from the
+splice state, the end of a turn in place playing at the splice) is played as it is, since
+the robot is committed to it until it stops; the tail, a plan from rest, is re-timed by
+:func:`trajopt.moving.retime_chain` on the movers' clock seen from the head's end (turns in
+place, a car's drives between cusps, an omni orientation). Whatever is returned is certified
+whole (:func:`trajopt.certify_movers` against the shifted movers); a result with no piece
+from rest after its head (an omni base's own orientation from the moving state) is only
+certified.
+
+**When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
+the robot stops, since it is moving at the splice. One curve from the moving state is braked
+along its path (:func:`~trajopt.replan._brake.brake_on_path`); a chain keeps its head, which
+ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
+from the stop, as :meth:`~trajopt._planner.Planner.plan` does with movers (the static plan
+re-timed, else re-routed around the blocking mover's swept region, or a wait at a safe
+place: :func:`trajopt.moving.reroute`). The stop and that plan are certified whole against
+the shifted movers. ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
+``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
+plan from the stop works or the robot meets a mover while it stops.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
-from trajopt.errors import BlockedError, InvalidInputError
-from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, certify_movers, retime_for_movers, shift_clock
+import numpy as np
+
+from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
+from trajopt.motion import PlanResult, TrajectoryChain
+from trajopt.moving import (
+    MovingObstacle,
+    certify_movers,
+    retime_chain,
+    retime_for_movers,
+    shift_clock,
+)
+from trajopt.replan._brake import brake_on_path
 
 
 def retime_replan(
@@ -38,8 +65,9 @@ def retime_replan(
     movers: Sequence[MovingObstacle],
     margin: float,
     ts: float,
+    from_stop: FromStop | None = None,
 ) -> PlanResult:
-    """Re-time a re-plan's result for the movers (module docstring).
+    """Re-time a re-plan's result for the movers, or stop and go on another way (module docstring).
 
     Parameters
     ----------
@@ -51,20 +79,28 @@ def retime_replan(
         Extra distance to every mover (m), >= 0.
     ts : float
         The splice time on that clock (s).
+    from_stop : callable, optional
+        ``from_stop(position, heading, steer, movers)`` (:data:`FromStop`): a plan from rest
+        at a stop to the goal for the movers seen from the stop (re-timed, else re-routed,
+        certified), or a ``TrajoptError``; ``None``: no re-route (``BlockedError`` as the
+        re-timing raised it).
 
     Returns
     -------
     Trajectory or other PlanResult
-        ``out`` re-timed (or ``out`` itself, certified), with ``stats["moving"]``: the
-        re-timing's ``plan``, ``certificate`` and ``time_s``, plus ``clock_offset_s`` (``ts``)
-        and ``replan`` (what the re-plan did before: ``stats["replan"]``).
+        ``out`` re-timed (or ``out`` itself, certified), or stopped and re-routed, with
+        ``stats["moving"]``: the re-timing's ``plan``, ``certificate`` and ``time_s``,
+        ``route`` (``"retimed"``, or ``"stopped: <route>"``: braked to a stop and planned on
+        from there, ``<route>`` that plan's ``"retimed"``, ``"rerouted"`` or ``"waited"``),
+        plus ``clock_offset_s`` (``ts``) and ``replan`` (what the re-plan did before:
+        ``stats["replan"]``).
 
     Raises
     ------
     BlockedError
-        No re-timing along the result's path avoids a mover, or a result that is not
-        re-timed fails the certificate (the mover is named; its ``t`` is on the movers'
-        clock).
+        No re-timing along the result's path avoids a mover and no way on from a stop does
+        either, or the part played before the stop meets a mover (the mover is named; its
+        ``t`` is on the movers' clock).
     InvalidInputError
         A mover overlaps the robot at the splice; an end speed ``v_end > 0``.
     """
@@ -75,40 +111,233 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
-    if out.single_curve and out.direction == 1:
-        try:
-            timed = retime_for_movers(out, shifted, margin=margin)
-        except BlockedError as exc:  # its time back on the movers' clock
-            raise BlockedError(
-                f"{exc} (times from the splice, at t = {ts:.3f} s of the movers' clock)",
-                mover=exc.mover,
-                t=exc.t + ts,
-            ) from exc
-        moving = dict(timed.stats["moving"])
-    else:
-        cert = certify_movers(out, shifted, margin=margin)
-        if not cert.ok:
-            raise BlockedError(
-                f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
-                f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
-                "movers' clock, and only a single curve ending at rest is re-timed",
-                mover=cert.mover,
-                t=cert.witness_t + ts,
-            )
-        timed = out
-        moving = {
-            "plan": "as planned",
-            "certificate": {
-                "ok": cert.ok,
-                "slack_m": cert.slack,
-                "mover": cert.mover,
-                "horizon_s": cert.horizon,
-                "intervals": cert.intervals,
-            },
-        }
+    try:
+        timed, moving = _retimed(out, movers, margin, ts, shifted)
+        moving["route"] = "retimed"
+    except BlockedError as exc:
+        if from_stop is None:
+            raise
+        timed, moving = _stop_and_go_on(out, movers, margin, ts, shifted, from_stop, exc)
     moving.update(
         time_s=time.perf_counter() - t0,
         clock_offset_s=float(ts),
         replan=out.stats.get("replan"),
     )
     return dataclasses.replace(timed, stats=dict(timed.stats, moving=moving))
+
+
+def _retimed(
+    out: PlanResult,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+) -> tuple[PlanResult, dict[str, Any]]:
+    """Re-time the result along its own path (module docstring); ``BlockedError`` if not."""
+    if out.single_curve and out.direction == 1:
+        try:
+            timed = retime_for_movers(out, shifted, margin=margin)
+        except BlockedError as exc:  # its time back on the movers' clock
+            raise _on_movers_clock(exc, ts) from exc
+        moving = dict(timed.stats["moving"])
+    else:
+        head, tail = split_at_rest(out)
+        if tail:
+            timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
+        else:
+            timed, moving = out, {"plan": "as planned"}
+        cert = certify_movers(timed, shifted, margin=margin)
+        if not cert.ok:
+            raise BlockedError(
+                f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
+                f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
+                f"movers' clock ({'before it stops' if tail else 'it does not stop on the way'}"
+                ": only what follows a stop is re-timed)",
+                mover=cert.mover,
+                t=cert.witness_t + ts,
+            )
+        moving["certificate"] = _cert_stats(cert)
+    return timed, moving
+
+
+def _on_movers_clock(exc: BlockedError, t0: float) -> BlockedError:
+    """``exc`` with its time ``t0`` later: from the result's clock to the movers' clock."""
+    return BlockedError(
+        f"{exc} (times from the splice, at t = {t0:.3f} s of the movers' clock)",
+        mover=exc.mover,
+        t=exc.t + t0,
+    )
+
+
+def split_at_rest(out: PlanResult) -> tuple[list[tuple[Any, float]], list[Any]]:
+    """Split a re-plan's result where it first starts a piece at rest, from there on whole.
+
+    Returns the head, ``(piece, start)`` pairs played as they are (a brake from the splice
+    state, the end of a turn in place playing at the splice: the robot is committed to them),
+    and the tail, the pieces that follow, each played whole from rest (empty when the result
+    does not start a piece at rest after its head: one curve from the moving state, an omni
+    base's own orientation).
+    """
+    if getattr(out, "pieces", None) is None:
+        return [(out, 0.0)], []
+    pieces, starts = played(out)
+    head: list[tuple[Any, float]] = []
+    for i, (piece, t_in) in enumerate(zip(pieces, starts, strict=True)):
+        whole = getattr(piece, "pieces", None) is None  # a nested chain is not split
+        if t_in == 0.0 and float(piece.v_start) == 0.0 and whole:
+            return head, pieces[i:]
+        head.append((piece, t_in))
+    return head, []
+
+
+def played(plan: Any) -> tuple[list[Any], list[float]]:
+    """Return a plan's pieces and the time within each where it starts playing (one piece: itself)."""
+    pieces = getattr(plan, "pieces", None)
+    if pieces is None:
+        return [plan], [0.0]
+    return list(pieces), [float(t) for t in (plan.starts or (0.0,) * len(pieces))]
+
+
+def _retime_tail(
+    out: TrajectoryChain,
+    head: list[tuple[Any, float]],
+    tail: list[Any],
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+) -> tuple[TrajectoryChain, dict[str, Any]]:
+    """Re-time the pieces that follow the head on the clock where the head ends.
+
+    The tail, a plan from rest, is re-timed by :func:`trajopt.moving.retime_chain` against
+    the movers seen from the head's end (``ts`` plus the head's duration on the movers'
+    clock); the head stays as it is. ``BlockedError`` is given the movers' clock.
+    """
+    t_head = sum(float(p.duration) - t_in for p, t_in in head)
+    plan = (
+        tail[0]
+        if len(tail) == 1
+        else TrajectoryChain(tuple(tail), out.robot, dict(out.stats), out.steps)
+    )
+    seen = [shift_clock(m, ts + t_head) for m in movers]
+    try:
+        timed = retime_chain(plan, seen, margin=margin)
+    except BlockedError as exc:
+        raise _on_movers_clock(exc, ts + t_head) from exc
+    rest, rest_starts = played(timed)
+    chain = TrajectoryChain(
+        tuple([p for p, _ in head] + rest),
+        out.robot,
+        dict(out.stats),
+        out.steps,
+        tuple([t for _, t in head] + rest_starts),
+    )
+    moving = {
+        "plan": f"kept {t_head:.3f} s to a stop, then: {timed.stats['moving']['plan']}",
+        "head_s": t_head,
+    }
+    return chain, moving
+
+
+#: ``from_stop(position, heading, steer, movers)``: a plan from rest at ``position`` (m,
+#: shape (2,)) with ``heading`` (rad) and a car's ``steer`` (rad) to the re-plan's goal,
+#: re-timed for ``movers`` (seen from the stop), else re-routed around them, certified;
+#: raises ``TrajoptError`` otherwise.
+FromStop = Callable[[tuple[float, float], float, float, Sequence[MovingObstacle]], PlanResult]
+
+
+def _stop_and_go_on(
+    out: PlanResult,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+    from_stop: FromStop,
+    blocked: BlockedError,
+) -> tuple[PlanResult, dict[str, Any]]:
+    """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
+
+    One curve from the moving state is braked along its path
+    (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
+    keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
+    plans on for the movers seen from there (``ts`` plus the stop's time); the head and that
+    plan are certified whole against ``shifted``. ``BlockedError`` (the mover named, its time
+    on the movers' clock) when no stop applies, no plan from the stop works or the head meets
+    a mover.
+    """
+    head: list[tuple[Any, float]] = []
+    if getattr(out, "pieces", None) is not None:
+        head, tail = split_at_rest(out)
+        if not tail:
+            raise blocked
+        stop = tail[0].sample(np.array([0.0]))
+    elif out.single_curve and out.direction == 1:
+        try:
+            brake = brake_on_path(out, 0.0)
+        except TrajoptError as exc:  # no stop on the path: nowhere to plan on from
+            raise blocked from exc
+        if brake is not None:
+            head.append((brake, 0.0))
+        stop = (brake or out).sample(np.array([brake.duration if brake else 0.0]))
+    else:
+        raise blocked
+    t_head = sum(float(p.duration) - t_in for p, t_in in head)
+    seen = [shift_clock(m, ts + t_head) for m in movers]
+    steer = getattr(stop, "steer", None)
+    p_stop = (float(stop.x[0]), float(stop.y[0]))
+    try:
+        rest = from_stop(
+            p_stop, float(stop.theta[0]), 0.0 if steer is None else float(steer[0]), seen
+        )
+    except TrajoptError as exc:
+        mover, t = blocked.mover, blocked.t
+        if isinstance(exc, BlockedError) and exc.mover is not None and exc.t is not None:
+            mover, t = exc.mover, exc.t + ts + t_head
+        raise BlockedError(
+            f"{blocked}; stopped at ({p_stop[0]:.3f}, {p_stop[1]:.3f}) m after "
+            f"{t_head:.3f} s, no way on from there: {type(exc).__name__}: {exc}",
+            mover=mover,
+            t=t,
+        ) from exc
+    pieces, starts = played(rest)
+    stats = dict(rest.stats, replan=out.stats.get("replan"))
+    for key in ("splice_time_s", "latency_s"):
+        if key in out.stats:
+            stats[key] = out.stats[key]
+    whole = TrajectoryChain(
+        tuple([p for p, _ in head] + pieces),
+        out.robot,
+        stats,
+        rest.steps,
+        tuple([t for _, t in head] + starts),
+    )
+    cert = certify_movers(whole, shifted, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"{blocked}; moving obstacle {cert.mover!r} meets the robot at "
+            f"t = {cert.witness_t + ts:.3f} s of the movers' clock while it stops",
+            mover=cert.mover,
+            t=cert.witness_t + ts,
+        ) from blocked
+    done = rest.stats["moving"]
+    moving = {
+        "plan": f"stopped in {t_head:.3f} s, then: {done.get('plan')}",
+        "route": f"stopped: {done.get('route', 'retimed')}",
+        "blocked": str(blocked),
+        "head_s": t_head,
+        "certificate": _cert_stats(cert),
+    }
+    for key in ("reroute", "reroute_time_s"):
+        if key in done:
+            moving[key] = done[key]
+    return whole, moving
+
+
+def _cert_stats(cert: Any) -> dict[str, Any]:
+    return {
+        "ok": cert.ok,
+        "slack_m": cert.slack,
+        "mover": cert.mover,
+        "horizon_s": cert.horizon,
+        "intervals": cert.intervals,
+    }
