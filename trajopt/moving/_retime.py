@@ -277,9 +277,13 @@ def _blocked(grid: STGrid, movers: Sequence[MovingObstacle], robot: Any, v0: flo
     j = max(j, 0)
     name = movers[j].name
     t = float(grid.t[k])
-    what = "stays on the path" if k == grid.t.shape[0] - 1 else "leaves no way past"
+    what = (
+        f"still stands on it at t = {t:.3f} s, the end of the times searched"
+        if k == grid.t.shape[0] - 1
+        else f"leaves no way past from t = {t:.3f} s"
+    )
     raise BlockedError(
-        f"moving obstacle {name!r} blocks the path: from t = {t:.3f} s it {what} "
+        f"moving obstacle {name!r} blocks the path: it {what} "
         f"(robot at s <= {grid.s[i]:.3f} m of {grid.s[-1]:.3f} m; no motion along the path "
         f"under v_max={speed:.3g} m/s and the acceleration limits gets past)",
         mover=name,

@@ -156,7 +156,7 @@ def _retimed(
                 mover=cert.mover,
                 t=cert.witness_t + ts,
             )
-        moving["certificate"] = _cert_stats(cert)
+        moving["certificate"] = cert.summary()
     return timed, moving
 
 
@@ -325,19 +325,9 @@ def _stop_and_go_on(
         "route": f"stopped: {done.get('route', 'retimed')}",
         "blocked": str(blocked),
         "head_s": t_head,
-        "certificate": _cert_stats(cert),
+        "certificate": cert.summary(),
     }
     for key in ("reroute", "reroute_time_s"):
         if key in done:
             moving[key] = done[key]
     return whole, moving
-
-
-def _cert_stats(cert: Any) -> dict[str, Any]:
-    return {
-        "ok": cert.ok,
-        "slack_m": cert.slack,
-        "mover": cert.mover,
-        "horizon_s": cert.horizon,
-        "intervals": cert.intervals,
-    }
