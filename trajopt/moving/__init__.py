@@ -10,6 +10,7 @@
 * :func:`retime_chain`: any plan from rest on one clock (curves, turns in place, a car's
   drives between cusps and steering at rest, an omni orientation); :func:`shift_clock`;
 * :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it;
+  :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers;
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
   path avoids the movers; :func:`swept_mask`, :func:`mark_swept`: a mover's swept region on
   a grid;
@@ -18,6 +19,7 @@
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
 from trajopt.moving._chain import retime_chain, shift_clock, truncate
+from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import parked_on_path, settle_time
 from trajopt.moving._reroute import reroute
@@ -32,6 +34,7 @@ __all__ = [
     "certify_movers",
     "check_movers",
     "mark_swept",
+    "no_way_past",
     "parked_on_path",
     "reachable",
     "reroute",
