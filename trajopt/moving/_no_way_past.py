@@ -4,21 +4,23 @@ A re-timing keeps the path and changes only ``s(t)``: from rest at ``s = 0``, no
 with speed at most ``V`` (the robot's top speed, forwards or backwards) and ``s(t)`` at most
 the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from rest. This proof
 drops everything else (the acceleration and the path's curvature caps between grid times,
-what lies between two nodes) and sweeps the nodes such an ``s(t)`` can occupy on the
-*necessary* ``(s, t)`` grid (:func:`~trajopt.moving.st_grid` with ``sufficient=False``, in
-closed form for disc movers): from node ``i`` at ``t_k`` the robot may be at any free node
-``j``, ``i <= j <= i + ceil(V dt / ds) + 1``, at ``t_{k+1}``, not beyond
-``reach_bound(t_{k+1}) + ds/2``. A truly safe motion's nearest node at every grid time is
-free on the necessary grid (deflated by ``ds/2``), so it stays inside the swept set; the path
-is blocked when the set empties at some grid time (a mover coming head-on leaves no way
-past), or when, after the movers stop changing and the reach bound passes the goal, one step
-leaves the set as it was without the goal in it (a fixed point: no later time helps).
+what lies between two nodes) and sweeps, node by node along the path, the times such an
+``s(t)`` can be at each node of the *necessary* ``(s, t)`` grid (:func:`~trajopt.moving.st_grid`
+with ``sufficient=False``, in closed form for disc movers): node ``j`` can be entered at
+``t_k`` from a node ``i``, ``j - m <= i < j`` (``m = ceil(V dt / ds) + 1``), where the robot
+can be at ``t_{k-1}``, when it is free then and not beyond ``reach_bound(t_k) + ds/2``; the
+robot then may stay until the node's free interval ends. A truly safe motion's nearest node at
+every grid time is free on the necessary grid (deflated by ``ds/2``) and moves at most ``m``
+nodes a step, so it stays inside the swept times; the path is blocked when the goal node has
+none (a mover coming head-on leaves no way past). The grid's last time is after every mover's
+last change, so its last row holds for ever, and the cost is that of the nodes and the
+movers' windows at them, not of the time horizon.
 
 The robot is its inscribed disc (inside a footprint, so a footprint is at least as close),
 and a plan of several pieces is its curves end to end (rests and turns in place add no
-distance, see :func:`~trajopt.moving.parked_on_path`). The proof gives up (returns ``None``)
-as soon as the goal node is reachable: it only ever claims "blocked", and the ``(s, t)``
-search of :func:`~trajopt.moving.retime_chain` decides the rest.
+distance, see :func:`~trajopt.moving.parked_on_path`). The proof only ever claims "blocked";
+when the goal node is reachable the ``(s, t)`` search of :func:`~trajopt.moving.retime_chain`
+decides.
 """
 
 from __future__ import annotations
@@ -55,67 +57,62 @@ def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _dense(grid: STGrid) -> np.ndarray:
-    """Return the necessary grid's forbidden nodes, bool, shape (K, n), from its runs at once."""
-    kk, n = grid.t.shape[0], grid.s.shape[0]
-    col = np.repeat(np.arange(n), np.diff(grid.ptr))
-    diff = np.zeros((kk + 1, n), dtype=np.int32)
-    lo = np.clip(grid.lo, 0, kk)
-    hi = np.minimum(grid.hi, kk - 1) + 1
-    np.add.at(diff, (lo, col), 1)
-    np.add.at(diff, (hi, col), -1)
-    return np.cumsum(diff[:kk], axis=0) > 0
+def _free(grid: STGrid, j: int, k_from: int) -> list[tuple[int, float]]:
+    """Return the free time-index intervals ``[a, b]`` of node ``j`` from ``k_from`` on (``b`` may be inf)."""
+    p, q = int(grid.ptr[j]), int(grid.ptr[j + 1])
+    out, at = [], k_from
+    for lo, hi in sorted(zip(grid.lo[p:q].tolist(), grid.hi[p:q].tolist(), strict=True)):
+        if lo > at:
+            out.append((at, lo - 1))
+        at = max(at, hi + 1)
+        if at >= FOREVER:
+            return out
+    out.append((at, math.inf))
+    return out
 
 
-def sweep(
-    grid: STGrid, speed: float, s_up: np.ndarray, k_static: int
-) -> tuple[bool | None, int, int]:
-    """Sweep the nodes a non-decreasing ``s(t)`` with speed ``<= speed`` can occupy (module docstring).
+def sweep(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, float]]]:
+    """Return, for each node, the time-index intervals a relaxed ``s(t)`` can be there (module docstring).
+
+    Node by node: node ``j`` can be entered at ``t_k`` from a node ``i``, ``j - m <= i < j``
+    (``m = ceil(speed dt / ds) + 1``), where the robot can be at ``t_{k-1}``, when ``j`` is
+    free at ``t_k`` and within ``s_up[k] + ds/2``, and the robot then stays there until the
+    free interval ends: each node's reachable times are a few intervals, the tails of its free
+    ones.
 
     Parameters
     ----------
     grid : STGrid
-        A necessary grid.
+        A necessary grid whose last time is after every mover's last change (the rows are the
+        same after it, for ever).
     speed : float
         The speed bound (m/s).
     s_up : ndarray, shape (K,)
-        An upper bound (m) of ``s(t_k)``.
-    k_static : int
-        A time index after which neither the grid's rows nor the bound change.
+        A non-decreasing upper bound (m) of ``s(t_k)``, at least the path's length at the
+        last time.
 
     Returns
     -------
-    blocked : bool or None
-        ``True`` when no such ``s(t)`` reaches the goal, ``None`` when the goal node is
-        reachable at some grid time or the grid ends first (nothing proven).
-    k : int
-        The time index where the set emptied or became fixed.
-    i : int
-        The furthest reachable node before that (m's node index).
+    list of list of (int, float)
+        ``reach[j]``: the intervals ``[a, b]`` of time indices (``b`` inf: for ever); empty
+        when the node is never reachable.
     """
-    fb = _dense(grid)
-    kk, n = fb.shape
+    n = grid.s.shape[0]
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
-    idx = np.arange(n)
-    reach = np.zeros(n, dtype=bool)
-    reach[0] = not fb[0, 0]
-    if not reach[0]:
-        return True, 0, 0
-    cap = np.searchsorted(grid.s, s_up + 0.5 * grid.ds, side="right")  # nodes allowed at t_k
-    last_i = 0
-    for k in range(1, kk):
-        lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
-        nxt = ~fb[k] & (idx - lastr <= m)
-        nxt[int(cap[k]) :] = False
-        if not nxt.any():
-            return True, k, last_i
-        if nxt[-1]:
-            return None, k, n - 1
-        if k > k_static and np.array_equal(nxt, reach):
-            return True, k, last_i
-        reach = nxt
-        last_i = int(np.max(np.flatnonzero(reach)))
-    return None, kk - 1, last_i
+    k_cap = np.searchsorted(s_up + 0.5 * grid.ds, grid.s, side="left").tolist()
+    reach: list[list[tuple[int, float]]] = []
+    first = _free(grid, 0, 0)
+    reach.append([first[0]] if first and first[0][0] == 0 else [])
+    for j in range(1, n):
+        came = [(a + 1, b + 1) for i in range(max(0, j - m), j) for a, b in reach[i]]
+        got = []
+        if came:
+            for a, b in _free(grid, j, int(k_cap[j])):
+                e = min((max(a, p) for p, q in came if p <= b and q >= a), default=None)
+                if e is not None:
+                    got.append((e, b))
+        reach.append(got)
+    return reach
 
 
 def no_way_past(
@@ -174,20 +171,21 @@ def no_way_past(
         points=_points(curves, s),
     )
     s_up = reach_bound(grid.t, v_top, a_max, j_max)
-    ends = np.concatenate([grid.lo, np.where(grid.hi >= FOREVER, 0, grid.hi + 1), [0]])
-    k_static = max(int(np.max(ends)), int(np.searchsorted(s_up, length + 0.5 * ds_used)))
-    blocked, k, i = sweep(grid, v_top, s_up, k_static)
-    if not blocked:
+    if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
+    reach = sweep(grid, v_top, s_up)
+    if reach[-1]:
+        return None
+    i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0
+    k = int(min(max((b for _, b in reach[i]), default=0.0) + 1, grid.t.shape[0] - 1))
     a, b = int(grid.ptr[i]), int(grid.ptr[-1])
     live = (grid.lo[a:b] <= k) & (grid.hi[a:b] >= k)  # runs at or after the robot's place then
-    j = int(grid.owner[a:b][live][0]) if live.any() else 0
+    j = int(grid.owner[a:b][live][0]) if live.any() else int(grid.owner[0])
     t = float(grid.t[k])
-    what = "leaves no way past" if k < k_static else "stays on the path"
     return BlockedError(
-        f"moving obstacle {movers[j].name!r} blocks the path: from t = {t:.3f} s it {what} "
-        f"(robot at s <= {grid.s[i]:.3f} m of {length:.3f} m; no motion along the path under "
-        f"v_max={v_top:.3g} m/s and the acceleration limits gets past)",
+        f"moving obstacle {movers[j].name!r} blocks the path: from t = {t:.3f} s it leaves no "
+        f"way past (robot at s <= {grid.s[i]:.3f} m of {length:.3f} m; no motion along the "
+        f"path under v_max={v_top:.3g} m/s and the acceleration limits gets past)",
         mover=movers[j].name,
         t=t,
     )
