@@ -209,6 +209,33 @@ def test_swept_mask_covers_the_shape_at_dense_times():
     assert not mask[0:4, 70:80].any()  # far from the track
 
 
+@pytest.mark.parametrize("t0, t1", [(0.0, 4.0), (1.3, 1.3), (2.2, 9.0)])
+def test_swept_mask_is_the_cells_near_the_track(t0, t1):
+    """The marked cells are those whose centre is within the grown radius plus half a cell's
+    diagonal of the track polyline (brute force over every cell, partly off the map)."""
+    grid = _grid((50, 70), [])
+    m = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 1.0, 2.5, 4.0], [(-0.3, 0.4), (1.2, 1.9), (3.1, 1.0), (3.1, 2.6)], radius=0.15
+    )
+    mask = trajopt.moving.swept_mask(grid, m, t0, t1, 0.05)
+    res = float(grid.resolution)
+    radius = 0.15 + 0.05 + res * np.sqrt(0.5)
+    iy, ix = np.mgrid[0:50, 0:70]
+    c = np.asarray(grid.origin) + (np.stack([ix, iy], -1) + 0.5) * res  # (50, 70, 2)
+    ts = np.concatenate([[t0], m.times[(m.times > t0) & (m.times < t1)], [t1]])
+    pts = m.position_at(ts)
+    best = np.full((50, 70), np.inf)
+    for a, b in zip(pts[:-1], pts[1:], strict=True):
+        d = b - a
+        lam = np.clip(((c - a) @ d) / max(float(d @ d), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.hypot(*(c - a - lam[..., None] * d).transpose(2, 0, 1)))
+    expect = best <= radius
+    # equal but for cells within rounding of the boundary
+    differ = mask != expect
+    assert np.all(np.abs(best[differ] - radius) < 1e-9)
+    assert expect.sum() > 20
+
+
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
 @given(
     st.lists(
