@@ -12,7 +12,7 @@
 * :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it;
   :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers;
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
-  path avoids the movers; :func:`swept_mask`, :func:`mark_swept`: a mover's swept region on
+  path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal); :func:`swept_mask`, :func:`mark_swept`: a mover's swept region on
   a grid;
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.
 """
@@ -22,7 +22,7 @@ from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import parked_on_path, settle_time
-from trajopt.moving._reroute import reroute
+from trajopt.moving._reroute import goal_taken, reroute
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
 from trajopt.moving._swept import mark_swept, swept_mask
@@ -33,6 +33,7 @@ __all__ = [
     "STGrid",
     "certify_movers",
     "check_movers",
+    "goal_taken",
     "mark_swept",
     "no_way_past",
     "parked_on_path",

@@ -9,6 +9,8 @@ force) and its samples against the map's occupied squares.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -143,6 +145,25 @@ def test_a_cart_that_stops_in_the_only_corridor_blocks():
         planner.plan((1.0, 1.5), (11.0, 1.5), moving_obstacles=[cart])
     assert info.value.mover == "cart" and info.value.t >= 0.0
     assert "no re-route either" in str(info.value)
+
+
+def test_a_walker_that_ends_on_the_goal_blocks_every_route(loop):
+    """Head-on in the short corridor, then back to the goal and standing there: the long way
+    round ends where it stands too, so no route is planned."""
+    _, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 8.0, 16.0], [(11.0, 1.0), (3.0, 1.0), (11.0, 1.0)], radius=0.2, name="walker"
+    )
+    with pytest.raises(BlockedError, match="stands on the goal") as info:
+        planner.plan(start, goal, moving_obstacles=[walker], mover_margin=0.02)
+    assert info.value.mover == "walker"
+    # by hand: the robot standing at the goal and the walker's last place overlap
+    assert math.dist(goal, walker.positions[-1]) < trajopt.Robot().radius + 0.2
+    beside = trajopt.MovingObstacle.from_waypoints([0.0], [(11.0, 1.6)], radius=0.2)
+    r = trajopt.Robot().inscribed_radius + 0.02
+    assert trajopt.moving.goal_taken([beside], np.array(goal), r) is None  # 0.6 > 0.185 + 0.2
+    assert trajopt.moving.goal_taken([walker], np.array(goal), r) is walker
 
 
 def test_a_mover_that_has_passed_needs_no_reroute(loop):
