@@ -57,11 +57,10 @@ def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _free(grid: STGrid, j: int, k_from: int) -> list[tuple[int, float]]:
-    """Return the free time-index intervals ``[a, b]`` of node ``j`` from ``k_from`` on (``b`` may be inf)."""
-    p, q = int(grid.ptr[j]), int(grid.ptr[j + 1])
+def _free(runs: list[tuple[int, int]], k_from: int) -> list[tuple[int, float]]:
+    """Return a node's free time-index intervals ``[a, b]`` (``b`` may be inf) from ``k_from`` on."""
     out, at = [], k_from
-    for lo, hi in sorted(zip(grid.lo[p:q].tolist(), grid.hi[p:q].tolist(), strict=True)):
+    for lo, hi in sorted(runs):
         if lo > at:
             out.append((at, lo - 1))
         at = max(at, hi + 1)
@@ -100,14 +99,16 @@ def sweep(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, 
     n = grid.s.shape[0]
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
     k_cap = np.searchsorted(s_up + 0.5 * grid.ds, grid.s, side="left").tolist()
+    ptr = grid.ptr.tolist()
+    runs = list(zip(grid.lo.tolist(), grid.hi.tolist(), strict=True))
     reach: list[list[tuple[int, float]]] = []
-    first = _free(grid, 0, 0)
+    first = _free(runs[ptr[0] : ptr[1]], 0)
     reach.append([first[0]] if first and first[0][0] == 0 else [])
     for j in range(1, n):
         came = [(a + 1, b + 1) for i in range(max(0, j - m), j) for a, b in reach[i]]
         got = []
         if came:
-            for a, b in _free(grid, j, int(k_cap[j])):
+            for a, b in _free(runs[ptr[j] : ptr[j + 1]], k_cap[j]):
                 e = min((max(a, p) for p, q in came if p <= b and q >= a), default=None)
                 if e is not None:
                     got.append((e, b))
