@@ -14,7 +14,9 @@ every grid time is free on the necessary grid (deflated by ``ds/2``) and moves a
 nodes a step, so it stays inside the swept times; the path is blocked when the goal node has
 none (a mover coming head-on leaves no way past). The grid's last time is after every mover's
 last change, so its last row holds for ever, and the cost is that of the nodes and the
-movers' windows at them, not of the time horizon.
+movers' windows at them, not of the time horizon. When no mover ever comes to the start node
+and none stays on the path, the robot may wait at the start until every mover has left the
+path and then drive: the sweep is skipped (nothing to prove).
 
 The robot is its inscribed disc (inside a footprint, so a footprint is at least as close),
 and a plan of several pieces is its curves end to end (rests and turns in place add no
@@ -171,6 +173,8 @@ def no_way_past(
         sufficient=False,
         points=_points(curves, s),
     )
+    if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
+        return None  # waiting at the start until every mover has left the path gets past
     s_up = reach_bound(grid.t, v_top, a_max, j_max)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
