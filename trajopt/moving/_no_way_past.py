@@ -72,7 +72,7 @@ def _free(runs: list[tuple[int, int]], k_from: int) -> list[tuple[int, float]]:
     return out
 
 
-def sweep(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, float]]]:
+def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, float]]]:
     """Return, for each node, the time-index intervals a relaxed ``s(t)`` can be there (module docstring).
 
     Node by node: node ``j`` can be entered at ``t_k`` from a node ``i``, ``j - m <= i < j``
@@ -178,7 +178,7 @@ def no_way_past(
     s_up = reach_bound(grid.t, v_top, a_max, j_max)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
-    reach = sweep(grid, v_top, s_up)
+    reach = reachable_times(grid, v_top, s_up)
     if reach[-1]:
         return None
     i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0

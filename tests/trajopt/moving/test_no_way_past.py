@@ -19,6 +19,9 @@ import trajopt.moving
 from tests.trajopt.moving.reference import dense_min
 from trajopt.errors import BlockedError, InvalidInputError
 
+#: A run that lasts (trajopt.moving.STGrid).
+FOREVER = 1 << 40
+
 
 @pytest.fixture(scope="module")
 def base(scene):
@@ -112,3 +115,50 @@ def test_a_polygon_head_on_is_claimed(base):
     assert isinstance(proof, BlockedError) and proof.mover == "box"
     with pytest.raises(BlockedError):
         trajopt.retime_for_movers(base, [mover])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_node_sweep_equals_a_time_step_sweep(seed):
+    """On random forbidden runs, the times the node sweep gives each node are exactly those of
+    a brute-force sweep over the dense grid, time step by time step (the grid's last row
+    repeated until nothing changes)."""
+    rng = np.random.default_rng(seed)
+    n, kk, ds, dt, speed = 40, 60, 0.04, 0.05, 0.5
+    r = int(rng.integers(20, 60))
+    col = rng.integers(0, n, r)
+    lo = rng.integers(0, kk, r)
+    hi = np.minimum(lo + rng.integers(0, 15, r), kk - 1)
+    hi = np.where(hi >= kk - 1, FOREVER, hi)
+    if seed < 3:  # a wall across the path from some time on: often blocked
+        col = np.concatenate([col, np.arange(15, 20)])
+        lo = np.concatenate([lo, np.full(5, 10 + 5 * seed)])
+        hi = np.concatenate([hi, np.full(5, FOREVER)])
+    grid = trajopt.moving.STGrid(
+        np.arange(n) * ds, np.arange(kk) * dt, ds, dt, col, lo, hi, np.zeros(col.shape[0], int)
+    )
+    s_up = np.minimum(np.arange(kk) * dt * speed * 1.5, (n - 1) * ds)
+    s_up[-1] = (n - 1) * ds
+    reach = trajopt.moving.reachable_times(grid, speed, s_up)
+    # brute force
+    extra = 3 * n
+    blocked = np.zeros((kk + extra, n), dtype=bool)
+    for c, a, b in zip(col, lo, hi, strict=True):
+        blocked[a : (kk + extra if b >= FOREVER else b + 1), c] = True
+    cap = np.concatenate([s_up, np.full(extra, s_up[-1])]) + 0.5 * ds
+    m = int(np.ceil(speed * dt / ds)) + 1
+    now = np.zeros(n, dtype=bool)
+    now[0] = not blocked[0, 0]
+    seen = [now]
+    for k in range(1, kk + extra):
+        nxt = np.zeros(n, dtype=bool)
+        for j in range(n):
+            lo_i = max(0, j - m)
+            nxt[j] = (not blocked[k, j]) and j * ds <= cap[k] and bool(now[lo_i : j + 1].any())
+        now = nxt
+        seen.append(now)
+    seen = np.array(seen)  # (kk + extra, n)
+    for j in range(n):
+        got = np.zeros(kk + extra, dtype=bool)
+        for a, b in reach[j]:
+            got[a : (kk + extra if b == np.inf else int(b) + 1)] = True
+        assert np.array_equal(got, seen[:, j]), j
