@@ -4,7 +4,8 @@ Checked against the re-timing's own search (which must find no way either whenev
 claims one is blocked) on random movers crossing the path, and against re-timings written out
 here: the static plan started after any delay (0-30 s) and played at a slower pace meets the
 mover on 5 ms samples. Movers coming head-on along the path are claimed; a mover that crosses
-the path once and leaves is not (a wait lets it pass).
+the path once and leaves is not (a wait lets it pass). The node-by-node sweep
+(``reachable_times``) gives exactly the times of a brute-force time-step sweep of the dense grid.
 """
 
 from __future__ import annotations
