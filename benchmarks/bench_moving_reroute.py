@@ -7,7 +7,9 @@ plain plan, timed), then with one mover that blocks its path, two kinds:
 * ``stop``: a cart (radius 0.25 m) drives in from 1 m beside the plan's middle and stops on
   it after 2 s (it stays there);
 * ``head-on``: a mover (radius 0.2 m) drives the plan's path backwards from the goal at
-  0.5 m/s, starting at once, and stays at the start's side once its prediction ends.
+  0.5 m/s, starting at once, and stays at the start's side once its prediction ends;
+* ``trapped``: the same mover, which then drives the path forwards again at 0.5 m/s and stays
+  on the goal: no route works, the query ends in a :class:`BlockedError`.
 
 For each it records the outcome (``stats["moving"]["route"]``: ``retimed``, ``rerouted``,
 ``waited``; or ``BlockedError``), the wall time, and checks every returned plan with the
@@ -16,7 +18,13 @@ The ratio is each query's time with the mover over its plain plan's; the issue's
 re-route within 2x a plain plan. ``reroute ms`` is the share after the re-timing along the
 static path was found blocked (``stats["moving"]["reroute_time_s"]``: marking the map,
 planning and re-timing the new route), and ``rr ratio`` its ratio to the plain plan; the
-rest is the static plan and the blocked re-timing. The machine is shared: times are noisy.
+rest is the static plan and the proof that it is blocked. ``proof ms`` is the quick proofs
+the planner runs on the static plan before re-routing (:func:`trajopt.moving.parked_on_path`,
+then :func:`trajopt.moving.no_way_past` when it finds nothing), timed here on the same static
+plan; ``raise ms`` (``trapped``) is the time from that proof to the :class:`BlockedError`:
+the query's time less its plain plan's and the proof's (a difference of wall times, so
+noisy). ``cpu ms`` is the query's CPU time (``time.process_time``). The machine is shared:
+times are noisy.
 
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
@@ -84,6 +92,25 @@ def head_on_mover(base):
     return trajopt.MovingObstacle.from_waypoints(t, pts, radius=0.2, name="walker")
 
 
+def trapped_mover(base):
+    s = np.linspace(0.0, base.length, 60)
+    pts = np.asarray(base.path(base.path.u_at_s(s)))
+    t_back = (base.length - s[::-1]) / 0.5
+    t_fwd = t_back[-1] + s[1:] / 0.5
+    return trajopt.MovingObstacle.from_waypoints(
+        np.concatenate([t_back, t_fwd]), np.concatenate([pts[::-1], pts[1:]]), radius=0.2,
+        name="walker",
+    )  # fmt: skip
+
+
+def proof_time(base, mover):
+    """Wall time (s) of the planner's quick proofs on the static plan."""
+    t0 = time.perf_counter()
+    if trajopt.moving.parked_on_path(base, [mover], 0.02) is None:
+        trajopt.moving.no_way_past(base, [mover], 0.02)
+    return time.perf_counter() - t0
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--queries", type=int, default=6, help="queries per map")
@@ -99,15 +126,19 @@ def main() -> None:
     print(
         f"{'map':18s} {'kind':8s} {'n':>3s} {'retimed':>7s} {'rerouted':>8s} {'waited':>6s} "
         f"{'blocked':>7s} {'plain ms':>8s} {'mover ms':>8s} {'ratio med':>9s} {'ratio max':>9s} "
-        f"{'reroute ms':>10s} {'rr ratio':>8s} {'worst slack':>11s}"
+        f"{'reroute ms':>10s} {'rr ratio':>8s} {'worst slack':>11s} {'proof ms':>8s} "
+        f"{'cpu ms':>7s} {'raise ms':>8s}"
     )
     ratios_all: dict[str, list[float]] = {}
+    raises: list[float] = []
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
         planner = trajopt.Planner(grid, robot)
         qs = queries(grid, robot, args.queries, rng)
+        kinds = (("stop", stop_mover), ("head-on", head_on_mover), ("trapped", trapped_mover))
         rows = {k: {"n": 0, "t0": [], "t1": [], "ratio": [], "rr": [], "rr_ratio": [],
-                    "slack": math.inf, "out": {}} for k in ("stop", "head-on")}  # fmt: skip
+                    "slack": math.inf, "out": {}, "proof": [], "cpu": [], "raise": []}
+                for k, _ in kinds}  # fmt: skip
         for p0, p1 in qs:
             try:
                 planner.plan(p0, p1)  # warm (the first plan of a map pays its caches)
@@ -116,9 +147,11 @@ def main() -> None:
                 plain = time.perf_counter() - t0
             except TrajoptError:
                 continue
-            for kind, make in (("stop", stop_mover), ("head-on", head_on_mover)):
+            for kind, make in kinds:
                 row = rows[kind]
                 mover = make(base)
+                proof = proof_time(base, mover)
+                c0 = time.process_time()
                 t0 = time.perf_counter()
                 try:
                     out = planner.plan(p0, p1, moving_obstacles=[mover], mover_margin=0.02)
@@ -129,6 +162,10 @@ def main() -> None:
                     what = type(exc).__name__
                     out = None
                 took = time.perf_counter() - t0
+                row["cpu"].append(1e3 * (time.process_time() - c0))
+                row["proof"].append(1e3 * proof)
+                if out is None and what == "blocked":
+                    row["raise"].append(1e3 * (took - plain - proof))
                 if out is not None:
                     what = out.stats["moving"]["route"]
                     row["slack"] = min(row["slack"], dense_min(out, [mover], margin=0.02)[0])
@@ -143,6 +180,7 @@ def main() -> None:
                     row["ratio"].append(took / plain)
                     ratios_all.setdefault(kind, []).append(took / plain)
         for kind, row in rows.items():
+            raises += row["raise"]
             if not row["n"]:
                 continue
             o = row["out"]
@@ -154,8 +192,15 @@ def main() -> None:
                 f"{(statistics.median(r) if r else math.nan):9.2f} {(max(r) if r else math.nan):9.2f} "
                 f"{(statistics.median(row['rr']) if r else math.nan):10.1f} "
                 f"{(statistics.median(row['rr_ratio']) if r else math.nan):8.2f} "
-                f"{row['slack']:11.4f}"
+                f"{row['slack']:11.4f} {statistics.median(row['proof']):8.1f} "
+                f"{statistics.median(row['cpu']):7.1f} "
+                f"{(statistics.median(row['raise']) if row['raise'] else math.nan):8.1f}"
             )
+    if raises:
+        print(
+            f"all maps, from the proof to the BlockedError: median {statistics.median(raises):.1f} "
+            f"ms, max {max(raises):.1f} ms over {len(raises)} queries"
+        )
     for kind, r in ratios_all.items():
         print(
             f"all maps, {kind}: re-route / plain plan, median {statistics.median(r):.2f}x, "

@@ -70,7 +70,14 @@ from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
 from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import MovingObstacle, check_movers, parked_on_path, reroute, retime_chain
+from trajopt.moving import (
+    MovingObstacle,
+    check_movers,
+    no_way_past,
+    parked_on_path,
+    reroute,
+    retime_chain,
+)
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -645,7 +652,8 @@ def _retime(
     """Re-time a plan for movers, or re-route it (:meth:`Planner.plan`); refuse what is not covered.
 
     The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`), unless a
-    mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`); when
+    mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`) or no
+    re-timing provably gets past the movers (:func:`trajopt.moving.no_way_past`); when
     it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
     swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
     planner's options, on caches derived from the planner's for the marked map).
@@ -660,7 +668,9 @@ def _retime(
             "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
             f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
         )
-    blocked = parked_on_path(out, movers, margin)  # a quick proof, before the search's
+    blocked = parked_on_path(out, movers, margin)  # quick proofs, before the search's
+    if blocked is None:
+        blocked = no_way_past(out, movers, margin)
     if blocked is None:
         try:
             kept = retime_chain(out, movers, margin=margin)

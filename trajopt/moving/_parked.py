@@ -45,14 +45,15 @@ def settle_time(mover: MovingObstacle) -> float:
     return -np.inf if k == 0 else float(mover.times[k])
 
 
-def _curves(plan: Any) -> list[Any]:
+def path_curves(plan: Any) -> list[Any]:
+    """Return the curves of a plan end to end (one curve, a chain's curves, an omni translation)."""
     if plan.own_orientation:
         return [plan.translation]
     if plan.single_curve:
         return [plan]
     out = []
     for p in getattr(plan, "pieces", ()):
-        out += _curves(p) if (p.single_curve or getattr(p, "pieces", None) is not None) else []
+        out += path_curves(p) if (p.single_curve or getattr(p, "pieces", None) is not None) else []
     return out
 
 
@@ -76,7 +77,7 @@ def parked_on_path(
         The error (the mover, the time it stands from, the point of the path) to raise, or
         ``None`` when this proof finds nothing (the path may still be blocked).
     """
-    curves = _curves(plan)
+    curves = path_curves(plan)
     if not curves or not movers:
         return None
     robot = plan.robot

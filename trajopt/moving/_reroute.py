@@ -28,7 +28,9 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 
 A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
 (its reason kept). When none works, the original :class:`BlockedError` is raised again (it
-names the mover and the time) with the reasons appended.
+names the mover and the time) with the reasons appended. None is tried when a mover ends
+standing on the goal (its final shape closer than the robot's inscribed radius plus the margin
+to the goal point, for ever): every route ends there (:func:`goal_taken`).
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.errors import BlockedError, TrajoptError
 from trajopt.motion import TrajectoryChain
-from trajopt.moving._certificate import certify_movers
+from trajopt.moving._certificate import certify_movers, point_polygon_distance, shape_at
 from trajopt.moving._chain import retime_chain, shift_clock
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._swept import mark_swept, swept_mask
@@ -118,6 +120,14 @@ def reroute(
     by_name = {m.name: m for m in movers}
     tried: list[dict[str, str]] = []
     t_last = max(max(m.t_last for m in movers), 0.0)
+    taken = goal_taken(movers, p1, float(robot.inscribed_radius) + margin)
+    if taken is not None:
+        raise BlockedError(
+            f"{blocked} (no re-route either: {taken.name!r} stands on the goal from "
+            f"t = {max(taken.t_last, 0.0):.3f} s, where every route ends)",
+            mover=blocked.mover,
+            t=blocked.t,
+        ) from blocked
 
     def attempt(what: str, run: Callable[[], Any], route: str) -> Any:
         try:
@@ -183,6 +193,24 @@ def reroute(
         mover=blocked.mover,
         t=blocked.t,
     ) from blocked
+
+
+def goal_taken(
+    movers: Sequence[MovingObstacle], goal: np.ndarray, limit: float
+) -> MovingObstacle | None:
+    """Return a mover that stands on ``goal`` for ever, or ``None``.
+
+    After its last prediction time a mover stands still with its last shape and radius; it is
+    on the goal when that shape is closer than ``limit`` plus its radius (m) to ``goal`` (m,
+    shape (2,)). A robot standing at the goal (any plan, from its arrival on) then meets it.
+    """
+    p = np.asarray(goal, dtype=float).reshape(1, 2)
+    for m in movers:
+        t = np.array([max(m.t_last, 0.0)])
+        d = float(point_polygon_distance(p, shape_at(m, t))[0])
+        if d < limit + float(m.radius_at(t[0])):
+            return m
+    return None
 
 
 def safe_places(

@@ -56,25 +56,34 @@ def swept_mask(
     radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
     pts = track(mover, float(t0), float(t1))
     mask = np.zeros((ny, nx), dtype=bool)
-    segs = zip(pts[:-1], pts[1:], strict=True) if pts.shape[0] > 1 else [(pts[0], pts[0])]
-    for a, b in segs:
-        lo = np.minimum(a, b) - radius
-        hi = np.maximum(a, b) + radius
-        ix0 = max(0, int(math.floor((lo[0] - ox) / res)))
-        ix1 = min(nx - 1, int(math.floor((hi[0] - ox) / res)))
-        iy0 = max(0, int(math.floor((lo[1] - oy) / res)))
-        iy1 = min(ny - 1, int(math.floor((hi[1] - oy) / res)))
-        if ix0 > ix1 or iy0 > iy1:
-            continue
-        cx = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
-        cy = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
-        px = cx[None, :] - a[0]
-        py = cy[:, None] - a[1]
-        d = b - a
-        dd = float(d @ d)
-        lam = np.clip((px * d[0] + py * d[1]) / dd, 0.0, 1.0) if dd > 0.0 else 0.0
-        dist = np.hypot(px - lam * d[0], py - lam * d[1])
-        mask[iy0 : iy1 + 1, ix0 : ix1 + 1] |= dist <= radius
+    a = pts[:-1] if pts.shape[0] > 1 else pts
+    b = pts[1:] if pts.shape[0] > 1 else pts
+    lo = np.minimum(a, b) - radius
+    hi = np.maximum(a, b) + radius
+    ix0 = np.maximum(0, np.floor((lo[:, 0] - ox) / res).astype(np.int64))
+    ix1 = np.minimum(nx - 1, np.floor((hi[:, 0] - ox) / res).astype(np.int64))
+    iy0 = np.maximum(0, np.floor((lo[:, 1] - oy) / res).astype(np.int64))
+    iy1 = np.minimum(ny - 1, np.floor((hi[:, 1] - oy) / res).astype(np.int64))
+    w = np.maximum(ix1 - ix0 + 1, 0)
+    h = np.maximum(iy1 - iy0 + 1, 0)
+    count = w * h  # the cells of each segment's box, all segments at once
+    if not count.any():
+        return mask
+    seg = np.repeat(np.arange(count.shape[0]), count)
+    k = np.arange(seg.shape[0]) - np.repeat(np.cumsum(count) - count, count)
+    ix = ix0[seg] + k % w[seg]
+    iy = iy0[seg] + k // w[seg]
+    px = (ox + (ix + 0.5) * res) - a[seg, 0]
+    py = (oy + (iy + 0.5) * res) - a[seg, 1]
+    d = b - a
+    dd = np.einsum("ij,ij->i", d, d)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.where(
+            dd[seg] > 0.0, np.clip((px * d[seg, 0] + py * d[seg, 1]) / dd[seg], 0.0, 1.0), 0.0
+        )
+    dist = np.hypot(px - lam * d[seg, 0], py - lam * d[seg, 1])
+    hit = dist <= radius
+    mask[iy[hit], ix[hit]] = True
     return mask
 
 

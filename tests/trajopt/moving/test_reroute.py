@@ -9,6 +9,8 @@ force) and its samples against the map's occupied squares.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -145,6 +147,25 @@ def test_a_cart_that_stops_in_the_only_corridor_blocks():
     assert "no re-route either" in str(info.value)
 
 
+def test_a_walker_that_ends_on_the_goal_blocks_every_route(loop):
+    """Head-on in the short corridor, then back to the goal and standing there: the long way
+    round ends where it stands too, so no route is planned."""
+    _, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 8.0, 16.0], [(11.0, 1.0), (3.0, 1.0), (11.0, 1.0)], radius=0.2, name="walker"
+    )
+    with pytest.raises(BlockedError, match="stands on the goal") as info:
+        planner.plan(start, goal, moving_obstacles=[walker], mover_margin=0.02)
+    assert info.value.mover == "walker"
+    # by hand: the robot standing at the goal and the walker's last place overlap
+    assert math.dist(goal, walker.positions[-1]) < trajopt.Robot().radius + 0.2
+    beside = trajopt.MovingObstacle.from_waypoints([0.0], [(11.0, 1.6)], radius=0.2)
+    r = trajopt.Robot().inscribed_radius + 0.02
+    assert trajopt.moving.goal_taken([beside], np.array(goal), r) is None  # 0.6 > 0.185 + 0.2
+    assert trajopt.moving.goal_taken([walker], np.array(goal), r) is walker
+
+
 def test_a_mover_that_has_passed_needs_no_reroute(loop):
     """Re-timing comes first: a mover the robot can wait for is waited for on the same path."""
     _, planner = loop
@@ -207,6 +228,33 @@ def test_swept_mask_covers_the_shape_at_dense_times():
     inside = (cells[:, 0] >= 0) & (cells[:, 0] < 80) & (cells[:, 1] >= 0) & (cells[:, 1] < 60)
     assert mask[cells[inside, 1], cells[inside, 0]].all()
     assert not mask[0:4, 70:80].any()  # far from the track
+
+
+@pytest.mark.parametrize("t0, t1", [(0.0, 4.0), (1.3, 1.3), (2.2, 9.0)])
+def test_swept_mask_is_the_cells_near_the_track(t0, t1):
+    """The marked cells are those whose centre is within the grown radius plus half a cell's
+    diagonal of the track polyline (brute force over every cell, partly off the map)."""
+    grid = _grid((50, 70), [])
+    m = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 1.0, 2.5, 4.0], [(-0.3, 0.4), (1.2, 1.9), (3.1, 1.0), (3.1, 2.6)], radius=0.15
+    )
+    mask = trajopt.moving.swept_mask(grid, m, t0, t1, 0.05)
+    res = float(grid.resolution)
+    radius = 0.15 + 0.05 + res * np.sqrt(0.5)
+    iy, ix = np.mgrid[0:50, 0:70]
+    c = np.asarray(grid.origin) + (np.stack([ix, iy], -1) + 0.5) * res  # (50, 70, 2)
+    ts = np.concatenate([[t0], m.times[(m.times > t0) & (m.times < t1)], [t1]])
+    pts = m.position_at(ts)
+    best = np.full((50, 70), np.inf)
+    for a, b in zip(pts[:-1], pts[1:], strict=True):
+        d = b - a
+        lam = np.clip(((c - a) @ d) / max(float(d @ d), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.hypot(*(c - a - lam[..., None] * d).transpose(2, 0, 1)))
+    expect = best <= radius
+    # equal but for cells within rounding of the boundary
+    differ = mask != expect
+    assert np.all(np.abs(best[differ] - radius) < 1e-9)
+    assert expect.sum() > 20
 
 
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))

@@ -1,0 +1,165 @@
+"""Tests of trajopt.moving.no_way_past: the quick proof that no re-timing gets past the movers.
+
+Checked against the re-timing's own search (which must find no way either whenever the proof
+claims one is blocked) on random movers crossing the path, and against re-timings written out
+here: the static plan started after any delay (0-30 s) and played at a slower pace meets the
+mover on 5 ms samples. Movers coming head-on along the path are claimed; a mover that crosses
+the path once and leaves is not (a wait lets it pass). The node-by-node sweep
+(``reachable_times``) gives exactly the times of a brute-force time-step sweep of the dense grid.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import trajopt
+import trajopt.moving
+from tests.trajopt.moving.reference import dense_min
+from trajopt.errors import BlockedError, InvalidInputError
+
+#: A run that lasts (trajopt.moving.STGrid).
+FOREVER = 1 << 40
+
+
+@pytest.fixture(scope="module")
+def base(scene):
+    return trajopt.Planner(scene.grid, trajopt.Robot()).plan(scene.start, scene.goal("A"))
+
+
+class _Delayed:
+    """The plan started after ``delay`` (s) and played ``pace`` times as fast (a re-timing)."""
+
+    def __init__(self, traj, delay, pace):
+        self.traj, self.delay, self.pace, self.robot = traj, delay, pace, traj.robot
+        self.duration = delay + traj.duration / pace
+
+    def sample(self, t):
+        return self.traj.sample(np.clip((np.asarray(t) - self.delay) * self.pace, 0.0, None))
+
+
+def _head_on(base, speed, radius=0.2):
+    s = np.linspace(0.0, base.length, 60)
+    pts = np.asarray(base.path(base.path.u_at_s(s)))[::-1]
+    t = (base.length - s[::-1]) / speed
+    return trajopt.MovingObstacle.from_waypoints(t, pts, radius=radius, name="walker")
+
+
+@pytest.mark.parametrize("speed", [0.2, 0.5, 1.5])
+def test_head_on_is_claimed_and_the_search_agrees(base, speed):
+    mover = _head_on(base, speed)
+    proof = trajopt.moving.no_way_past(base, [mover], 0.02)
+    assert isinstance(proof, BlockedError) and proof.mover == "walker"
+    with pytest.raises(BlockedError):
+        trajopt.retime_for_movers(base, [mover], margin=0.02)
+    for delay in (0.0, 2.0, 10.0, 30.0):
+        for pace in (1.0, 0.5):
+            assert dense_min(_Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
+
+
+def test_a_crossing_mover_that_leaves_is_not_claimed(base):
+    smp = base.sample(np.array([0.5 * base.duration]))
+    p = np.array([smp.x[0], smp.y[0]])
+    n = np.array([-math.sin(smp.theta[0]), math.cos(smp.theta[0])])
+    mover = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 8.0], [p - 2.0 * n, p + 2.0 * n], radius=0.2, name="crosser"
+    )
+    assert trajopt.moving.no_way_past(base, [mover]) is None
+    trajopt.retime_for_movers(base, [mover])  # a wait lets it pass: no BlockedError
+
+
+def test_a_claim_is_never_wrong(base):
+    # movers on straight runs crossing the path at random places, angles, speeds and times
+    rng = np.random.default_rng(7)
+    claims = unclaimed = 0
+    for _ in range(40):
+        smp = base.sample(np.array([rng.uniform(0.05, 1.0) * base.duration]))
+        p = np.array([smp.x[0], smp.y[0]])
+        angle, run, duration = (
+            rng.uniform(0, 2 * math.pi),
+            rng.uniform(0.5, 6),
+            rng.uniform(0.5, 15),
+        )
+        when, radius = rng.uniform(), rng.uniform(0.05, 0.4)
+        d = np.array([math.cos(angle), math.sin(angle)])
+        mover = trajopt.MovingObstacle.from_waypoints(
+            [0.0, duration], [p - d * run * when, p + d * run * (1.0 - when)], radius=radius
+        )
+        try:
+            trajopt.retime_for_movers(base, [mover])
+            blocked = False
+        except InvalidInputError:  # over the robot at t = 0: refused
+            continue
+        except BlockedError:
+            blocked = True
+        proof = trajopt.moving.no_way_past(base, [mover])
+        if proof is None:
+            unclaimed += 1
+            continue
+        claims += 1
+        assert blocked, f"claimed blocked, but a certified re-timing exists: {proof}"
+        for delay in (0.0, 3.0, 10.0, 30.0):
+            for pace in (1.0, 0.5):
+                assert dense_min(_Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
+    assert claims >= 5 and unclaimed >= 5, (claims, unclaimed)
+
+
+def test_a_polygon_head_on_is_claimed(base):
+    s = np.linspace(0.0, base.length, 30)
+    pts = np.asarray(base.path(base.path.u_at_s(s)))[::-1]
+    t = (base.length - s[::-1]) / 0.5
+    square = np.array([(-0.15, -0.15), (0.15, -0.15), (0.15, 0.15), (-0.15, 0.15)])
+    mover = trajopt.MovingObstacle.from_waypoints(t, pts, radius=0.0, vertices=square, name="box")
+    proof = trajopt.moving.no_way_past(base, [mover], ds=0.05, dt=0.1)
+    assert isinstance(proof, BlockedError) and proof.mover == "box"
+    with pytest.raises(BlockedError):
+        trajopt.retime_for_movers(base, [mover])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_node_sweep_equals_a_time_step_sweep(seed):
+    """On random forbidden runs, the times the node sweep gives each node are exactly those of
+    a brute-force sweep over the dense grid, time step by time step (the grid's last row
+    repeated until nothing changes)."""
+    rng = np.random.default_rng(seed)
+    n, kk, ds, dt, speed = 40, 60, 0.04, 0.05, 0.5
+    r = int(rng.integers(20, 60))
+    col = rng.integers(0, n, r)
+    lo = rng.integers(0, kk, r)
+    hi = np.minimum(lo + rng.integers(0, 15, r), kk - 1)
+    hi = np.where(hi >= kk - 1, FOREVER, hi)
+    if seed < 3:  # a wall across the path from some time on: often blocked
+        col = np.concatenate([col, np.arange(15, 20)])
+        lo = np.concatenate([lo, np.full(5, 10 + 5 * seed)])
+        hi = np.concatenate([hi, np.full(5, FOREVER)])
+    grid = trajopt.moving.STGrid(
+        np.arange(n) * ds, np.arange(kk) * dt, ds, dt, col, lo, hi, np.zeros(col.shape[0], int)
+    )
+    s_up = np.minimum(np.arange(kk) * dt * speed * 1.5, (n - 1) * ds)
+    s_up[-1] = (n - 1) * ds
+    reach = trajopt.moving.reachable_times(grid, speed, s_up)
+    # brute force
+    extra = 3 * n
+    blocked = np.zeros((kk + extra, n), dtype=bool)
+    for c, a, b in zip(col, lo, hi, strict=True):
+        blocked[a : (kk + extra if b >= FOREVER else b + 1), c] = True
+    cap = np.concatenate([s_up, np.full(extra, s_up[-1])]) + 0.5 * ds
+    m = int(np.ceil(speed * dt / ds)) + 1
+    now = np.zeros(n, dtype=bool)
+    now[0] = not blocked[0, 0]
+    seen = [now]
+    for k in range(1, kk + extra):
+        nxt = np.zeros(n, dtype=bool)
+        for j in range(n):
+            lo_i = max(0, j - m)
+            nxt[j] = (not blocked[k, j]) and j * ds <= cap[k] and bool(now[lo_i : j + 1].any())
+        now = nxt
+        seen.append(now)
+    seen = np.array(seen)  # (kk + extra, n)
+    for j in range(n):
+        got = np.zeros(kk + extra, dtype=bool)
+        for a, b in reach[j]:
+            got[a : (kk + extra if b == np.inf else int(b) + 1)] = True
+        assert np.array_equal(got, seen[:, j]), j

@@ -1,0 +1,196 @@
+"""A quick proof that no re-timing along the path gets past the movers: :func:`no_way_past`.
+
+A re-timing keeps the path and changes only ``s(t)``: from rest at ``s = 0``, non-decreasing,
+with speed at most ``V`` (the robot's top speed, forwards or backwards) and ``s(t)`` at most
+the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from rest. This proof
+drops everything else (the acceleration and the path's curvature caps between grid times,
+what lies between two nodes) and sweeps, node by node along the path, the times such an
+``s(t)`` can be at each node of the *necessary* ``(s, t)`` grid (:func:`~trajopt.moving.st_grid`
+with ``sufficient=False``, in closed form for disc movers): node ``j`` can be entered at
+``t_k`` from a node ``i``, ``j - m <= i < j`` (``m = ceil(V dt / ds) + 1``), where the robot
+can be at ``t_{k-1}``, when it is free then and not beyond ``reach_bound(t_k) + ds/2``; the
+robot then may stay until the node's free interval ends. A truly safe motion's nearest node at
+every grid time is free on the necessary grid (deflated by ``ds/2``) and moves at most ``m``
+nodes a step, so it stays inside the swept times; the path is blocked when the goal node has
+none (a mover coming head-on leaves no way past). The grid's last time is after every mover's
+last change, so its last row holds for ever, and the cost is that of the nodes and the
+movers' windows at them, not of the time horizon. When no mover ever comes to the start node
+and none stays on the path, the robot may wait at the start until every mover has left the
+path and then drive: the sweep is skipped (nothing to prove).
+
+The robot is its inscribed disc (inside a footprint, so a footprint is at least as close),
+and a plan of several pieces is its curves end to end (rests and turns in place add no
+distance, see :func:`~trajopt.moving.parked_on_path`). The proof only ever claims "blocked";
+when the goal node is reachable the ``(s, t)`` search of :func:`~trajopt.moving.retime_chain`
+decides.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from trajopt.errors import BlockedError
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._parked import path_curves
+from trajopt.moving._st_grid import FOREVER, STGrid, grid_nodes, reach_bound, st_grid
+
+#: Arc-length spacing (m) of the necessary grid's nodes.
+PROOF_DS = 0.04
+#: Time step (s) of the necessary grid.
+PROOF_DT = 0.05
+
+
+def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
+    """Points (m), shape (n, 2), at arc lengths ``s`` (m) along the curves end to end."""
+    ends = np.cumsum([float(c.length) for c in curves])
+    which = np.minimum(np.searchsorted(ends, s, side="left"), len(curves) - 1)
+    out = np.empty((s.shape[0], 2))
+    start = 0.0
+    for j, c in enumerate(curves):
+        sel = which == j
+        if sel.any():
+            local = np.clip(s[sel] - start, 0.0, float(c.length))
+            out[sel] = np.asarray(c.path(c.path.u_at_s(local)), dtype=float).reshape(-1, 2)
+        start = float(ends[j])
+    return out
+
+
+def _free(runs: list[tuple[int, int]], k_from: int) -> list[tuple[int, float]]:
+    """Return a node's free time-index intervals ``[a, b]`` (``b`` may be inf) from ``k_from`` on."""
+    out, at = [], k_from
+    for lo, hi in sorted(runs):
+        if lo > at:
+            out.append((at, lo - 1))
+        at = max(at, hi + 1)
+        if at >= FOREVER:
+            return out
+    out.append((at, math.inf))
+    return out
+
+
+def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, float]]]:
+    """Return, for each node, the time-index intervals a relaxed ``s(t)`` can be there (module docstring).
+
+    Node by node: node ``j`` can be entered at ``t_k`` from a node ``i``, ``j - m <= i < j``
+    (``m = ceil(speed dt / ds) + 1``), where the robot can be at ``t_{k-1}``, when ``j`` is
+    free at ``t_k`` and within ``s_up[k] + ds/2``, and the robot then stays there until the
+    free interval ends: each node's reachable times are a few intervals, the tails of its free
+    ones.
+
+    Parameters
+    ----------
+    grid : STGrid
+        A necessary grid whose last time is after every mover's last change (the rows are the
+        same after it, for ever).
+    speed : float
+        The speed bound (m/s).
+    s_up : ndarray, shape (K,)
+        A non-decreasing upper bound (m) of ``s(t_k)``, at least the path's length at the
+        last time.
+
+    Returns
+    -------
+    list of list of (int, float)
+        ``reach[j]``: the intervals ``[a, b]`` of time indices (``b`` inf: for ever); empty
+        when the node is never reachable.
+    """
+    n = grid.s.shape[0]
+    m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
+    k_cap = np.searchsorted(s_up + 0.5 * grid.ds, grid.s, side="left").tolist()
+    ptr = grid.ptr.tolist()
+    runs = list(zip(grid.lo.tolist(), grid.hi.tolist(), strict=True))
+    reach: list[list[tuple[int, float]]] = []
+    first = _free(runs[ptr[0] : ptr[1]], 0)
+    reach.append([first[0]] if first and first[0][0] == 0 else [])
+    for j in range(1, n):
+        came = [(a + 1, b + 1) for i in range(max(0, j - m), j) for a, b in reach[i]]
+        got = []
+        if came:
+            for a, b in _free(runs[ptr[j] : ptr[j + 1]], k_cap[j]):
+                e = min((max(a, p) for p, q in came if p <= b and q >= a), default=None)
+                if e is not None:
+                    got.append((e, b))
+        reach.append(got)
+    return reach
+
+
+def no_way_past(
+    plan: Any,
+    movers: Sequence[MovingObstacle],
+    margin: float = 0.0,
+    *,
+    ds: float = PROOF_DS,
+    dt: float = PROOF_DT,
+) -> BlockedError | None:
+    """Return a :class:`BlockedError` when no re-timing along the plan's path avoids the movers.
+
+    Parameters
+    ----------
+    plan : PlanResult
+        A plan from rest (one curve, a chain, an omni translation).
+    movers : sequence of MovingObstacle
+        The predictions (the plan's clock).
+    margin : float
+        Extra distance (m).
+    ds, dt : float
+        The necessary grid's spacings (m, s); any values give a proof, finer ones a
+        stronger one.
+
+    Returns
+    -------
+    BlockedError or None
+        The error (the mover that leaves no way past, the time) to raise, or ``None`` when
+        this proof finds nothing (the path may still be blocked).
+    """
+    curves = path_curves(plan)
+    if not curves or not movers:
+        return None
+    robot = plan.robot
+    length = float(sum(float(c.length) for c in curves))
+    if length <= 0.0:
+        return None
+    back = getattr(robot.drive, "v_max_backwards", None)
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    a_max, j_max = float(robot.a_max), float(robot.j_max)
+    t_last = max(max(float(m.t_last) for m in movers), 0.0)
+    t_goal = length / v_top + v_top / a_max + a_max / j_max  # reach_bound passes L by then
+    horizon = t_last + t_goal + 4.0 * dt
+    s, ds_used = grid_nodes(length, ds)
+    limit = float(robot.inscribed_radius) + float(margin)
+    grid = st_grid(
+        None,
+        length,
+        movers,
+        limit,
+        ds=ds,
+        dt=dt,
+        horizon=horizon,
+        speed=v_top,
+        sufficient=False,
+        points=_points(curves, s),
+    )
+    if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
+        return None  # waiting at the start until every mover has left the path gets past
+    s_up = reach_bound(grid.t, v_top, a_max, j_max)
+    if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
+        return None
+    reach = reachable_times(grid, v_top, s_up)
+    if reach[-1]:
+        return None
+    i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0
+    k = int(min(max((b for _, b in reach[i]), default=0.0) + 1, grid.t.shape[0] - 1))
+    a, b = int(grid.ptr[i]), int(grid.ptr[-1])
+    live = (grid.lo[a:b] <= k) & (grid.hi[a:b] >= k)  # runs at or after the robot's place then
+    j = int(grid.owner[a:b][live][0]) if live.any() else int(grid.owner[0])
+    t = float(grid.t[k])
+    return BlockedError(
+        f"moving obstacle {movers[j].name!r} blocks the path: from t = {t:.3f} s it leaves no "
+        f"way past (robot at s <= {grid.s[i]:.3f} m of {length:.3f} m; no motion along the "
+        f"path under v_max={v_top:.3g} m/s and the acceleration limits gets past)",
+        mover=movers[j].name,
+        t=t,
+    )
