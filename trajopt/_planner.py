@@ -57,7 +57,6 @@ the raw map (the outside counts as occupied) and re-raises the error below the r
 from __future__ import annotations
 
 import collections
-import dataclasses
 import threading
 import time
 from collections.abc import Sequence
@@ -68,16 +67,9 @@ import numpy as np
 import astar
 from astar.costmap import Costmap
 from astar.grid import OccupancyGrid
-from trajopt.errors import BlockedError, InvalidInputError
+from trajopt.errors import InvalidInputError
 from trajopt.motion import PlanResult
-from trajopt.moving import (
-    MovingObstacle,
-    check_movers,
-    no_way_past,
-    parked_on_path,
-    reroute,
-    retime_chain,
-)
+from trajopt.moving import MovingObstacle, check_movers
 from trajopt.planning import (
     CorridorKind,
     Fallback,
@@ -88,6 +80,8 @@ from trajopt.planning import (
     PlanSteps,
     Search,
     SearchMode,
+    movers_covered,
+    plan_for_movers,
     run_query,
 )
 from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
@@ -376,7 +370,7 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
-        _movers_covered(movers, self.options)
+        movers_covered(movers, self.options)
         request = PlanRequest(
             start,
             goal,
@@ -391,7 +385,7 @@ class Planner:
             t0 = time.perf_counter()
             out = run_query(self.options, self.caches, request)
             if movers:
-                out = _retime(out, movers, margin, self.options, self.caches, request)
+                out = plan_for_movers(out, movers, margin, self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -491,7 +485,7 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
-        _movers_covered(movers, self.options)
+        movers_covered(movers, self.options)
         with self._lock:
             t0 = time.perf_counter()
             lat = self.latency_s if latency is None else latency
@@ -528,7 +522,9 @@ class Planner:
                         goal_steer=getattr(steps, "goal_steer", None),
                     )
                     static = run_query(self.options, self.caches, request)
-                    return _retime(static, tuple(seen), margin, self.options, self.caches, request)
+                    return plan_for_movers(
+                        static, tuple(seen), margin, self.options, self.caches, request
+                    )
 
                 ts = float(out.stats["splice_time_s"])
                 out = retime_replan(out, movers, margin, ts, from_stop)
@@ -629,79 +625,3 @@ def plan(
         goal_steer=goal_steer,
         **moving,
     )
-
-
-def _movers_covered(movers: tuple[MovingObstacle, ...], options: PlannerOptions) -> None:
-    """Refuse movers where the re-timing would not keep a limit: speed-limit zones."""
-    if movers and options.speed_limits is not None:
-        raise InvalidInputError(
-            "moving_obstacles are not covered with speed_limits zones (the re-timing caps "
-            "the speed by the robot's limits and the path's curvature only): plan without "
-            "one or the other"
-        )
-
-
-def _retime(
-    out: PlanResult,
-    movers: tuple[MovingObstacle, ...],
-    margin: float,
-    options: PlannerOptions,
-    caches: PlannerCaches,
-    request: PlanRequest,
-) -> PlanResult:
-    """Re-time a plan for movers, or re-route it (:meth:`Planner.plan`); refuse what is not covered.
-
-    The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`), unless a
-    mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`) or no
-    re-timing provably gets past the movers (:func:`trajopt.moving.no_way_past`); when
-    it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
-    swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
-    planner's options, on caches derived from the planner's for the marked map).
-    """
-    if out.v_start != 0.0:
-        raise InvalidInputError(
-            "moving_obstacles are covered for a plan from rest; this query gave a "
-            f"{type(out).__name__} with v_start={out.v_start} m/s"
-        )
-    if out.polyline:
-        raise InvalidInputError(
-            "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
-            f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
-        )
-    blocked = parked_on_path(out, movers, margin)  # quick proofs, before the search's
-    if blocked is None:
-        blocked = no_way_past(out, movers, margin)
-    if blocked is None:
-        try:
-            kept = retime_chain(out, movers, margin=margin)
-        except BlockedError as exc:
-            blocked = exc
-        else:
-            kept.stats["moving"]["route"] = "retimed"
-            return kept
-
-    def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
-        inflated = np.asarray(caches.inflated.occupied)
-        smp = out.sample(np.array([0.0]))
-        ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
-        labels = caches.components
-        return ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
-
-    def plan_leg(
-        grid: OccupancyGrid,
-        p0: np.ndarray | None,
-        p1: np.ndarray | None,
-        heading: float | None,
-    ) -> PlanResult:
-        leg = request
-        if p0 is not None:
-            leg = dataclasses.replace(
-                leg, start=(float(p0[0]), float(p0[1])), start_heading=heading
-            )
-        if p1 is not None:
-            leg = dataclasses.replace(
-                leg, goal=(float(p1[0]), float(p1[1])), goal_heading=None, goal_steer=None
-            )
-        return run_query(options, caches.derived(grid), leg)
-
-    return reroute(out, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg)

@@ -334,13 +334,7 @@ def _certificate(
                 mover=cert.mover,
                 t=cert.witness_t,
             )
-        return {
-            "ok": cert.ok,
-            "slack_m": cert.slack,
-            "mover": cert.mover,
-            "horizon_s": cert.horizon,
-            "intervals": cert.intervals,
-        }
+        return cert.summary()
     a = first.stats["moving"]["certificate"]
     b = second.stats["moving"]["certificate"]
     if not (a["ok"] and b["ok"]):  # each leg's re-timing raises first; kept as a guard
