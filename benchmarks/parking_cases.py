@@ -625,62 +625,23 @@ def cell_squares(case: ParkingCase, resolution: float, reach: float) -> list[np.
     return out
 
 
-def reverse_s_entries(case: ParkingCase, obstacles=None) -> tuple[int, int]:
-    """Count the one-manoeuvre entries of :func:`reverse_s_entry`'s family that are clear.
+def reverse_s_family(case: ParkingCase, spacing: float):
+    """Yield the one-manoeuvre entries into a parallel slot: ``(d, phi, poses)`` (m, rad, (n, 3)).
 
-    Every ``(d, phi)`` of the family (``d`` in 5 cm steps, scaled, ``phi`` 88 down to 10
-    degrees in 2 degree steps) with arcs of radius ``R``, the body corners at most 1 cm
-    apart: how many are clear of the polygons, and how many of those are also clear of
-    ``obstacles`` (other polygons, e.g. :func:`cell_squares`; the same count without).
-    """
-    car = case.car
-    body = car.body()
-    R = car.turning_radius
-    rc = float(np.max(np.hypot(body[:, 0], body[:, 1])))
-    step = 0.01 / (1.0 + rc / R)
-    gx, gy, gh = case.goal
-    row_top = max(
-        float(p[:, 1].max())
-        for p in case.polygons
-        if len(p) == 4 and p[:, 1].max() < gy + 2.0 * car.width
-    )
-    side = 1.0 if math.cos(gh) > 0 else -1.0
-    clear = both = 0
-    for d in np.arange(0.0, 0.6 * car.length * (case.size - 1.0) + 1e-9, 0.05 * car.scale):
-        back = arc_poses(case.goal, 0.0, float(d), -1, step)
-        for phi in np.radians(np.arange(88.0, 8.0, -2.0)):
-            a1 = arc_poses(tuple(back[-1]), side / R, R * phi, +1, step)
-            a2 = arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, step)
-            if body_at(body, a2[-1:])[0][:, 1].min() < row_top:
-                continue
-            poses = np.vstack([back, a1, a2])
-            if body_overlaps(body, poses, case.polygons).any():
-                continue
-            clear += 1
-            both += obstacles is None or not body_overlaps(body, poses, obstacles).any()
-    return clear, both
-
-
-def reverse_s_entry(case: ParkingCase) -> tuple[float, float] | None:
-    """A one-manoeuvre entry into a parallel slot, if one is clear: ``(d, phi)`` (m, rad).
-
-    Built backwards from the goal: back up ``d`` inside the slot, then drive forwards out
-    on an arc of radius ``R`` towards the aisle through ``phi`` and on the opposite arc
-    through ``phi``; driven in reverse this is the textbook reverse S into the slot. The
-    first ``(d, phi)`` (``d`` from 0 in 5 cm steps, scaled, ``phi`` from 88 degrees down
-    in 2 degree steps) whose poses (body corners at most 1 cm apart) are all clear of the
-    polygons by :func:`body_overlaps` and whose last pose has the whole body above the
-    slot's row of cars is returned; None when there is none (a shorter slot needs more
-    moves, or none exists). A witness that the slot end of the case is feasible, not a
-    planner.
+    Built backwards from the goal: back up ``d`` inside the slot, then drive forwards out on
+    an arc of radius ``R`` towards the aisle through ``phi`` and on the opposite arc through
+    ``phi``; driven in reverse this is the textbook reverse S into the slot. ``d`` from 0 in
+    5 cm steps (scaled), ``phi`` from 88 degrees down to 10 in 2 degree steps; the poses'
+    body corners at most ``spacing`` (m) apart; only entries whose last pose has the whole
+    body above the slot's row of cars (in the aisle).
     """
     if case.category != "parallel":
-        raise ValueError(f"reverse_s_entry needs a parallel case, got {case.category!r}")
+        raise ValueError(f"a reverse-S entry needs a parallel case, got {case.category!r}")
     car = case.car
     body = car.body()
     R = car.turning_radius
     rc = float(np.max(np.hypot(body[:, 0], body[:, 1])))
-    step = 0.008 / (1.0 + rc / R)
+    step = spacing / (1.0 + rc / R)
     gx, gy, gh = case.goal
     row_top = max(
         float(p[:, 1].max())
@@ -695,9 +656,37 @@ def reverse_s_entry(case: ParkingCase) -> tuple[float, float] | None:
             a2 = arc_poses(tuple(a1[-1]), -side / R, R * phi, +1, step)
             if body_at(body, a2[-1:])[0][:, 1].min() < row_top:
                 continue
-            poses = np.vstack([back, a1, a2])
-            if not body_overlaps(body, poses, case.polygons).any():
-                return float(d), float(phi)
+            yield float(d), float(phi), np.vstack([back, a1, a2])
+
+
+def reverse_s_entries(case: ParkingCase, obstacles=None) -> tuple[int, int]:
+    """Count the entries of :func:`reverse_s_family` (corners 1 cm apart) that are clear.
+
+    How many are clear of the polygons, and how many of those are also clear of
+    ``obstacles`` (other polygons, e.g. :func:`cell_squares`; the same count without).
+    """
+    body = case.car.body()
+    clear = both = 0
+    for _, _, poses in reverse_s_family(case, 0.01):
+        if body_overlaps(body, poses, case.polygons).any():
+            continue
+        clear += 1
+        both += obstacles is None or not body_overlaps(body, poses, obstacles).any()
+    return clear, both
+
+
+def reverse_s_entry(case: ParkingCase) -> tuple[float, float] | None:
+    """A one-manoeuvre entry into a parallel slot, if one is clear: ``(d, phi)`` (m, rad).
+
+    The first entry of :func:`reverse_s_family` (corners 8 mm apart) whose poses are all
+    clear of the polygons by :func:`body_overlaps`; None when there is none (a shorter slot
+    needs more moves, or none exists). A witness that the slot end of the case is feasible,
+    not a planner.
+    """
+    body = case.car.body()
+    for d, phi, poses in reverse_s_family(case, 0.008):
+        if not body_overlaps(body, poses, case.polygons).any():
+            return d, phi
     return None
 
 
