@@ -80,7 +80,6 @@ from trajopt.planning import (
     PlanSteps,
     Search,
     SearchMode,
-    movers_covered,
     plan_for_movers,
     run_query,
 )
@@ -337,9 +336,6 @@ class Planner:
             and the stop-and-turn fallback's polyline.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
-            Movers with the planner's ``speed_limits`` zones raise
-            :class:`~trajopt.errors.InvalidInputError`: the re-timing caps the speed by the
-            robot's limits and the path's curvature only, not by the zones.
 
         Returns
         -------
@@ -370,7 +366,6 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
-        movers_covered(movers, self.options)
         request = PlanRequest(
             start,
             goal,
@@ -466,9 +461,6 @@ class Planner:
             ``replan`` (what was kept or planned).
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
-            Movers with the planner's ``speed_limits`` zones raise
-            :class:`~trajopt.errors.InvalidInputError`: the re-timing caps the speed by the
-            robot's limits and the path's curvature only, not by the zones.
 
         Raises
         ------
@@ -485,7 +477,6 @@ class Planner:
         """
         movers = check_movers(moving_obstacles)
         margin = nonnegative("mover_margin", mover_margin, "m")
-        movers_covered(movers, self.options)
         with self._lock:
             t0 = time.perf_counter()
             lat = self.latency_s if latency is None else latency

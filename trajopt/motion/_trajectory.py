@@ -357,6 +357,9 @@ class Trajectory(SampledExport):
         along the path (distance travelled). Samples of a car-like robot
         (``drive="ackermann"``) carry ``direction`` (and the steering angle with a
         wheelbase).
+    speed_limits : trajopt.SpeedLimits, optional
+        The speed-limit zones the timing holds besides the robot's limits (``None``: none),
+        kept so that a re-timing of the same path (:mod:`trajopt.moving`) holds them too.
     """
 
     single_curve: ClassVar[bool] = True
@@ -377,6 +380,7 @@ class Trajectory(SampledExport):
     u_grid: np.ndarray = field(default_factory=lambda: readonly([]))
     steps: Any = None
     direction: int = 1
+    speed_limits: Any = None
 
     def __post_init__(self) -> None:
         if self.direction not in (1, -1) or isinstance(self.direction, bool):

@@ -115,9 +115,10 @@ class _PathTables:
     predictions (a re-plan that keeps its path) reuses them.
     """
 
-    def __init__(self, path: Any, robot: Any, length: float) -> None:
+    def __init__(self, path: Any, robot: Any, length: float, speed_limits: Any = None) -> None:
         self.path, self.robot, self.length = path, robot, length
-        self.table = build_cap_table(path, robot, length, 0.0, 0.0)
+        self.speed_limits = speed_limits  # the zones the drives hold besides the robot's caps
+        self.table = build_cap_table(path, robot, length, 0.0, 0.0, speed_limits)
         self.vtop = self.table.vtop
         self.rk = RuckigProfile(float(robot.a_max), float(robot.j_max))
         self.drives: dict[tuple[float, float], Piece | None] = {}
@@ -154,7 +155,13 @@ class _PathTables:
         ua = u_lo if s0 <= 0.0 else float(path.u_at_s(s0))
         ub = u_hi if s1 >= self.length else float(path.u_at_s(s1))
         try:
-            tr = time_parameterize(CurveSegment(path, ua, ub), self.robot, v_start=v0, a_start=a0)
+            tr = time_parameterize(
+                CurveSegment(path, ua, ub),
+                self.robot,
+                v_start=v0,
+                a_start=a0,
+                speed_limits=self.speed_limits,
+            )
         except (TimingError, InvalidInputError, ValueError):
             return None
         return _piece_of(tr, s0, s1)
@@ -206,13 +213,15 @@ def geometry_key(path: Any) -> tuple[Any, ...]:
 
 
 def _tables(traj: Trajectory) -> _PathTables:
-    """Return the :class:`_PathTables` of ``traj``'s path and robot (built or reused)."""
+    """Return the :class:`_PathTables` of ``traj``'s path, robot and speed-limit zones (built or reused)."""
     key = geometry_key(traj.path)
+    zones = traj.speed_limits
     for i, tb in enumerate(_TABLES):
-        if (tb.path is traj.path or tb.key == key) and tb.robot == traj.robot:
+        same = tb.path is traj.path or tb.key == key
+        if same and tb.robot == traj.robot and tb.speed_limits is zones:
             _TABLES.append(_TABLES.pop(i))
             return tb
-    tb = _PathTables(traj.path, traj.robot, float(traj.length))
+    tb = _PathTables(traj.path, traj.robot, float(traj.length), zones)
     tb.key = key
     if traj.v_start == 0.0 and traj.phase_a[0] == 0.0:  # the plan itself: the drive (0, L)
         tb.drives[(0.0, tb.length)] = _piece_of(traj, 0.0, tb.length)
@@ -599,6 +608,7 @@ def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
         u_grid=traj.u_grid,
         steps=traj.steps,
         direction=traj.direction,
+        speed_limits=traj.speed_limits,
     )
 
 

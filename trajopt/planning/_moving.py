@@ -1,10 +1,9 @@
 """A plan among predicted movers: the static plan re-timed, or re-routed when blocked.
 
-:func:`movers_covered` refuses what the re-timing does not cover (speed-limit zones);
 :func:`plan_for_movers` turns a static plan of :func:`~trajopt.planning.run_query` into one
 certified against the movers (:mod:`trajopt.moving`), planning the re-route's legs with the
 same options on caches derived from the planner's. :meth:`trajopt.Planner.plan` and
-:meth:`trajopt.Planner.replan` call them.
+:meth:`trajopt.Planner.replan` call it.
 """
 
 from __future__ import annotations
@@ -26,16 +25,6 @@ from trajopt.moving import (
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query
-
-
-def movers_covered(movers: tuple[MovingObstacle, ...], options: PlannerOptions) -> None:
-    """Refuse movers where the re-timing would not keep a limit: speed-limit zones."""
-    if movers and options.speed_limits is not None:
-        raise InvalidInputError(
-            "moving_obstacles are not covered with speed_limits zones (the re-timing caps "
-            "the speed by the robot's limits and the path's curvature only): plan without "
-            "one or the other"
-        )
 
 
 def plan_for_movers(

@@ -385,4 +385,5 @@ def trajectory_after(traj: Trajectory, ts: float, path: SmoothPath, u0: float) -
         theta_grid=np.concatenate([[theta0], traj.theta_grid[ahead]]),
         u_grid=u_grid,
         steps=traj.steps,
+        speed_limits=traj.speed_limits,
     )

@@ -183,6 +183,7 @@ def time_parameterize(
         theta_grid_s=table.s_nodes,
         theta_grid=table.theta,
         u_grid=table.u_nodes,
+        speed_limits=speed_limits,
     )
 
 

@@ -87,17 +87,24 @@ def test_queries_not_covered_are_refused(scene, planned):
         planner.plan(scene.start, scene.goal("A"), moving_obstacles=[(1.0, 2.0)])
 
 
-def test_movers_with_speed_limit_zones_are_refused(scene, planned):
-    _, base = planned
+def test_the_re_timing_holds_the_speed_limit_zones(scene):
     g = scene.grid
     ny, nx = np.asarray(g.occupied).shape
-    zones = trajopt.SpeedLimits.from_mask(
-        np.full((ny, nx), 50), g.resolution, tuple(g.origin), type="percentage"
-    )
-    planner = trajopt.Planner(g, trajopt.Robot(), speed_limits=zones)
-    planner.plan(scene.start, scene.goal("A"))  # the zones alone plan
-    with pytest.raises(InvalidInputError, match="speed_limits"):
-        planner.plan(scene.start, scene.goal("A"), moving_obstacles=[_crossing(base)])
+    half = np.zeros((ny, nx), dtype=int)
+    half[:, : nx // 2] = 50  # the left half at 50 % of v_max
+    zones = trajopt.SpeedLimits.from_mask(half, g.resolution, tuple(g.origin), type="percentage")
+    robot = trajopt.Robot()
+    planner = trajopt.Planner(g, robot, speed_limits=zones)
+    base = planner.plan(scene.start, scene.goal("A"))
+    mover = _crossing(base)
+    out = planner.plan(scene.start, scene.goal("A"), moving_obstacles=[mover], mover_margin=0.05)
+    assert out.stats["moving"]["plan"] != "as planned"  # re-timed, not the plan as it was
+    assert dense_min(out, [mover], margin=0.05)[0] >= -1e-6
+    smp = out.sample(np.linspace(0.0, out.duration, 20001))
+    xy = np.column_stack([smp.x, smp.y])
+    cap = zones.cap_at(xy, robot.v_max)  # each sample's zone, independently of the timing
+    assert np.any(cap < robot.v_max) and np.any(np.abs(smp.v) > 0.26)
+    assert np.all(np.abs(smp.v) <= cap + 1e-6)
 
 
 @pytest.mark.parametrize("closer", [0.0, 1e-3])
