@@ -246,12 +246,20 @@ def plan_car(
     search_grid, path, radius_cells = found.search_grid, found.path, found.radius_cells
     poses, segments, tries = found.poses, found.segments, found.tries
     drives = drive_groups(segments)
+    zones = options.speed_limits
+    timing = options  # the zones moved into the local frame with the curves
+    if local and zones is not None:
+        z0 = (zones.origin[0] - origin[0], zones.origin[1] - origin[1])
+        timing = dataclasses.replace(options, speed_limits=dataclasses.replace(zones, origin=z0))
     moves: list[Trajectory] = []
     for group in drives:
         with timer.stage("timing"):
-            moves.append(_time_drive(options, [segments[i] for i in group]))
+            moves.append(_time_drive(timing, [segments[i] for i in group]))
     if local:  # back in the map's frame: positions moved, the local curves' geometry kept
-        moves = [dataclasses.replace(m, path=ShiftedCurve(m.path, origin)) for m in moves]
+        moves = [
+            dataclasses.replace(m, path=ShiftedCurve(m.path, origin), speed_limits=zones)
+            for m in moves
+        ]
         search_grid = world.with_occupied(search_grid.occupied)
         poses = poses + np.array([origin[0], origin[1], 0.0])
     pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)

@@ -774,3 +774,23 @@ def test_start_facing_a_wall_with_room_only_for_full_lock():
     for pts in _dense_points(traj, 0.002):
         assert three_point_curvature(pts).max() <= kmax * (1.0 + 1e-6)
         assert square_clearance(grid, pts, reach=0.2).min() >= robot.radius - 1e-9
+
+
+def test_speed_limit_zones_hold_in_the_map_frame_far_from_the_origin():
+    # the car plans in the map-local frame; the zones (world frame) must cap the speed where
+    # they lie in the world: each 1 ms sample's speed against its zone's cap, computed here
+    grid0, robot, p0, p1, h0, h1 = behind_scene()
+    off = np.array([1000.0, -500.0])
+    grid = astar.OccupancyGrid(grid0.occupied, grid0.resolution, tuple(off))
+    ny, nx = np.asarray(grid.occupied).shape
+    mask = np.zeros((ny, nx), dtype=int)
+    mask[:, : nx // 2] = 40  # the western half at 40 % of v_max
+    zones = trajopt.SpeedLimits.from_mask(mask, grid.resolution, tuple(off), type="percentage")
+    traj = trajopt.plan(
+        grid, tuple(off + p0), tuple(off + p1), robot=robot, start_heading=h0,
+        goal_heading=h1, speed_limits=zones,
+    )  # fmt: skip
+    smp = traj.sample(np.arange(0.0, traj.duration, 1e-3))
+    cap = zones.cap_at(np.column_stack([smp.x, smp.y]), robot.v_max)
+    assert np.any(cap < robot.v_max) and np.any(np.isinf(cap))  # both halves driven
+    assert np.all(np.abs(smp.v) <= cap + 1e-6)
