@@ -267,3 +267,14 @@ def check_trajectory(traj, movers, *, margin=0.0, grid=None, dt=1e-3, tol=1e-6) 
         dt=dt,
         tol=tol,
     )
+
+
+class Delayed:
+    """The plan started after ``delay`` (s) and played ``pace`` times as fast (a re-timing)."""
+
+    def __init__(self, traj, delay, pace):
+        self.traj, self.delay, self.pace, self.robot = traj, delay, pace, traj.robot
+        self.duration = delay + traj.duration / pace
+
+    def sample(self, t):
+        return self.traj.sample(np.clip((np.asarray(t) - self.delay) * self.pace, 0.0, None))

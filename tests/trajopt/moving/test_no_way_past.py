@@ -17,7 +17,7 @@ import pytest
 
 import trajopt
 import trajopt.moving
-from tests.trajopt.moving.reference import dense_min
+from tests.trajopt.moving.reference import Delayed, dense_min
 from trajopt.errors import BlockedError, InvalidInputError
 
 #: A run that lasts (trajopt.moving.STGrid).
@@ -27,17 +27,6 @@ FOREVER = 1 << 40
 @pytest.fixture(scope="module")
 def base(scene):
     return trajopt.Planner(scene.grid, trajopt.Robot()).plan(scene.start, scene.goal("A"))
-
-
-class _Delayed:
-    """The plan started after ``delay`` (s) and played ``pace`` times as fast (a re-timing)."""
-
-    def __init__(self, traj, delay, pace):
-        self.traj, self.delay, self.pace, self.robot = traj, delay, pace, traj.robot
-        self.duration = delay + traj.duration / pace
-
-    def sample(self, t):
-        return self.traj.sample(np.clip((np.asarray(t) - self.delay) * self.pace, 0.0, None))
 
 
 def _head_on(base, speed, radius=0.2):
@@ -56,7 +45,7 @@ def test_head_on_is_claimed_and_the_search_agrees(base, speed):
         trajopt.retime_for_movers(base, [mover], margin=0.02)
     for delay in (0.0, 2.0, 10.0, 30.0):
         for pace in (1.0, 0.5):
-            assert dense_min(_Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
+            assert dense_min(Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
 
 
 def test_a_crossing_mover_that_leaves_is_not_claimed(base):
@@ -102,7 +91,7 @@ def test_a_claim_is_never_wrong(base):
         assert blocked, f"claimed blocked, but a certified re-timing exists: {proof}"
         for delay in (0.0, 3.0, 10.0, 30.0):
             for pace in (1.0, 0.5):
-                assert dense_min(_Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
+                assert dense_min(Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
     assert claims >= 5 and unclaimed >= 5, (claims, unclaimed)
 
 

@@ -17,24 +17,13 @@ from hypothesis import strategies as st
 
 import trajopt
 import trajopt.moving
-from tests.trajopt.moving.reference import dense_min
+from tests.trajopt.moving.reference import Delayed, dense_min
 from trajopt.errors import BlockedError
 
 
 @pytest.fixture(scope="module")
 def base(scene):
     return trajopt.Planner(scene.grid, trajopt.Robot()).plan(scene.start, scene.goal("A"))
-
-
-class _Delayed:
-    """The plan started after ``delay`` (s) and played ``pace`` times as fast (a re-timing)."""
-
-    def __init__(self, traj, delay, pace):
-        self.traj, self.delay, self.pace, self.robot = traj, delay, pace, traj.robot
-        self.duration = delay + traj.duration / pace
-
-    def sample(self, t):
-        return self.traj.sample(np.clip((np.asarray(t) - self.delay) * self.pace, 0.0, None))
 
 
 def test_settle_time():
@@ -65,7 +54,7 @@ def test_a_proof_is_never_wrong(base, frac, side, t_stop, radius):
         trajopt.retime_for_movers(base, [mover])
     for delay in (0.0, 3.0, 10.0, 30.0):
         for pace in (1.0, 0.5):
-            assert dense_min(_Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
+            assert dense_min(Delayed(base, delay, pace), [mover], dt=5e-3)[0] < 0.0
 
 
 def test_parked_beside_or_late_is_not_claimed(base):
