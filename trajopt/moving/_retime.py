@@ -56,10 +56,8 @@ from trajopt.moving._certificate import (
 )
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._st_grid import (
-    FOREVER,
     STGrid,
     grid_nodes,
-    mover_pieces,
     reach_bound,
     reachable,
     st_grid,
@@ -69,7 +67,6 @@ from trajopt.moving._tighten import (
     FINE_DS,
     FineWindows,
     bisect_start,
-    pieces_meeting,
     tail_occupancy,
     tail_s,
     tighten,
@@ -517,43 +514,20 @@ def _tightened(
 def _fine_windows(
     tables: _PathTables, grid: STGrid, movers: Sequence[MovingObstacle], limit: float
 ) -> FineWindows:
-    """Return the movers' windows at the path's fine nodes, near the grid's forbidden nodes.
+    """Return the movers' windows at the path's fine nodes (spacing at most ``dt`` times the speed).
 
-    A fine node can have a window of a piece of a mover's track only when its nearest node
-    of the sufficient ``grid`` has a run of that mover within the piece's time span (give or
-    take a grid step): the grid's pad covers the fine pad and the motion between grid times
-    while the fine spacing is at most ``dt`` times the speed. The neighbours of such nodes
-    are taken as well.
+    Only the pairs of a piece of a track and a fine node that can come within the limit are
+    solved (:func:`._st_grid.near_pairs`, an exact filter).
     """
-    length = tables.length
     h = min(FINE_DS, grid.dt * float(tables.robot.v_max))
-    s, h = grid_nodes(length, h)
+    s, h = grid_nodes(tables.length, h)
     pts = tables.nodes(s, h)
-    pieces = mover_pieces(movers, limit)
-    n = grid.s.shape[0]
-    col = np.repeat(np.arange(n), np.diff(grid.ptr))
-    t_hi = np.where(grid.hi >= FOREVER, np.inf, (grid.hi + 1.5) * grid.dt)
-    seg, run = pieces_meeting(pieces, grid.owner, (grid.lo - 1.5) * grid.dt, t_hi)
-    key = np.unique(col[run] * pieces.shape[0] + seg)
-    c, sg = np.divmod(key, pieces.shape[0])
-    near = np.unique(
-        np.concatenate([key, key[c > 0] - pieces.shape[0], key[c < n - 1] + pieces.shape[0]])
-    )
-    c, sg = np.divmod(near, pieces.shape[0])  # with each node's neighbours
-    coarse = grid.index(s)  # the fine nodes of coarse node c: first[c]:last[c], disjoint
-    first = np.searchsorted(coarse, np.arange(n), side="left")
-    last = np.searchsorted(coarse, np.arange(n), side="right")
-    cnt = last[c] - first[c]
-    fine = (
-        np.repeat(first[c], cnt) + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-    )
-    pairs = (np.repeat(sg, cnt), fine)
     tb = tables.table
 
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)
 
-    return FineWindows(s, pts, movers, limit, pairs, where, float(tables.robot.v_max))
+    return FineWindows(s, pts, movers, limit, None, where, float(tables.robot.v_max))
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:

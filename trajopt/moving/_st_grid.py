@@ -268,7 +268,11 @@ def _disc_runs(
     t: np.ndarray,
     sufficient: bool,
 ) -> tuple[np.ndarray, ...]:
-    """Return the runs of disc movers against a disc robot, in closed form (module docstring)."""
+    """Return the runs of disc movers against a disc robot, in closed form (module docstring).
+
+    Only the pairs of a track's piece and a node that :func:`near_pairs` keeps are solved:
+    the others are farther apart than the piece's largest limit at every instant of it.
+    """
     dt, t_end = float(t[1] - t[0]), float(t[-1])
     rows = []  # (mover, u, w, centre at u, velocity, radius + limit + pad at u, growth)
     for j, m, pad in discs:
@@ -287,11 +291,12 @@ def _disc_runs(
             np.column_stack([np.full(u.shape, j), u, w, px[:-1], py[:-1], vx, vy, r_u, grow])
         )
     arr = np.concatenate(rows)
-    owner = arr[:, 0].astype(np.int64)
-    u, w = arr[:, 1:2], arr[:, 2:3]
-    vx, vy, rr, g = arr[:, 5:6], arr[:, 6:7], arr[:, 7:8], arr[:, 8:9]
+    seg, pi = near_pairs(pts, arr, 0.0)
+    r = arr[seg]
+    owner = r[:, 0].astype(np.int64)
+    u, w = r[:, 1], r[:, 2]
     t_lo, t_hi = _inside(
-        pts[None, :, 0] - arr[:, 3:4], pts[None, :, 1] - arr[:, 4:5], vx, vy, rr, g
+        pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7], r[:, 8]
     )
     big = np.inf
     eps = EPS_T if sufficient else -EPS_T
@@ -299,13 +304,89 @@ def _disc_runs(
     tb = u + np.nan_to_num(t_hi, nan=-big, posinf=big, neginf=-big) + eps
     k_lo = np.maximum(np.ceil(u / dt - 1e-9), np.floor(np.clip(ta, -1.0, t_end + dt) / dt) + 1)
     k_hi = np.minimum(np.floor(w / dt + 1e-9), np.ceil(np.clip(tb, -dt, t_end + dt) / dt) - 1)
-    pi, ci = np.nonzero(k_lo <= k_hi)
+    keep = k_lo <= k_hi
     return (
-        ci.astype(np.int64),
-        k_lo[pi, ci].astype(np.int64),
-        k_hi[pi, ci].astype(np.int64),
-        owner[pi],
+        pi[keep].astype(np.int64),
+        k_lo[keep].astype(np.int64),
+        k_hi[keep].astype(np.int64),
+        owner[keep],
     )
+
+
+#: Consecutive points per box of :func:`near_pairs`'s first test.
+BOX = 8
+#: :func:`near_pairs` keeps the pairs within this much (m) of the limit (against rounding).
+NEAR_SLACK = 1e-6
+
+
+def near_pairs(pts: np.ndarray, pieces: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(piece, point)``: the pairs whose distance can come under the limit.
+
+    A piece of a track (a row of :func:`mover_pieces`, ``limit`` added to its ``r``) moves
+    its centre along the segment from ``c(u)`` to ``c(w)``, and its limit is at most
+    ``R = r + max(g, 0) (w - u)`` over it. A point farther than ``R`` from that segment is
+    farther than the limit from the centre at every instant of the piece, so it has no
+    window there: every pair left out is at least ``R + NEAR_SLACK`` apart (an exact filter,
+    checked by brute force in the tests). First the points are boxed in runs of
+    :data:`BOX` (consecutive path points are near each other) and each piece's segment box,
+    grown by ``R``, against those boxes; then each remaining pair's point-to-segment distance.
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    pieces : ndarray, shape (p, 9)
+        Rows ``(mover, u, w, x, y, vx, vy, r, g)`` (:func:`mover_pieces`); ``w`` may be
+        ``inf`` for a piece that stands still.
+    limit : float
+        Added to every row's ``r`` (m).
+
+    Returns
+    -------
+    piece, point : ndarray of int, shape (q,)
+    """
+    n, p = pts.shape[0], pieces.shape[0]
+    if n == 0 or p == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    span = pieces[:, 2] - pieces[:, 1]
+    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
+    run = np.where(still, 0.0, span)  # a standing piece may last forever
+    a = pieces[:, 3:5]
+    b = a + pieces[:, 5:7] * run[:, None]
+    with np.errstate(invalid="ignore"):
+        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
+    reach = pieces[:, 7] + limit + grow + NEAR_SLACK
+    starts = np.arange(0, n, BOX)
+    lo = np.minimum.reduceat(pts, starts, axis=0)
+    hi = np.maximum.reduceat(pts, starts, axis=0)
+    p_lo = np.minimum(a, b) - reach[:, None]
+    p_hi = np.maximum(a, b) + reach[:, None]
+    hit = (
+        (p_lo[:, None, 0] <= hi[None, :, 0])
+        & (p_hi[:, None, 0] >= lo[None, :, 0])
+        & (p_lo[:, None, 1] <= hi[None, :, 1])
+        & (p_hi[:, None, 1] >= lo[None, :, 1])
+    )
+    seg, box = np.nonzero(hit)
+    first = starts[box]
+    cnt = np.minimum(first + BOX, n) - first
+    total = int(cnt.sum())
+    seg = np.repeat(seg, cnt)
+    point = np.repeat(first - np.cumsum(cnt) + cnt, cnt) + np.arange(total)
+    ax, ay = a[:, 0], a[:, 1]
+    dx, dy = b[:, 0] - ax, b[:, 1] - ay
+    dd = dx * dx + dy * dy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
+    qx = pts[:, 0][point] - ax[seg]
+    qy = pts[:, 1][point] - ay[seg]
+    sx, sy = dx[seg], dy[seg]
+    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
+    qx -= f * sx
+    qy -= f * sy
+    r = reach[seg]
+    keep = ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
+    return seg[keep], point[keep]
 
 
 def _inside(
@@ -369,7 +450,8 @@ def disc_windows(
     limit : float
         The distance to keep besides a mover's radius (m).
     near : ndarray of bool, shape (movers, n), optional
-        Which points to test against each mover; default all.
+        Which points to test against each mover; default the pairs of a piece and a point
+        that :func:`near_pairs` keeps (the others have no window).
     pairs : (ndarray of int, ndarray of int), optional
         Instead: which piece (row of the pieces) to test against which point.
 
@@ -385,7 +467,7 @@ def disc_windows(
     if pairs is not None:
         seg, pi = pairs
     elif near is None:
-        seg, pi = np.divmod(np.arange(rows.shape[0] * pts.shape[0]), pts.shape[0])
+        seg, pi = near_pairs(pts, rows, limit)
     else:
         seg, pi = np.nonzero(near[who])
     r = rows[seg]

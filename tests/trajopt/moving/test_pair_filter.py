@@ -1,0 +1,90 @@
+"""Tests of the pair filter of the closed-form windows (``near_pairs``) against brute force.
+
+A pair of a piece of a mover's track and a point that the filter leaves out must be farther
+than the piece's limit at every instant of the piece: checked on dense samples of the
+piece's centre and limit (written out here from the piece's row). The windows computed on
+the kept pairs must be exactly those computed on every pair.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from trajopt.moving import MovingObstacle
+from trajopt.moving._st_grid import disc_windows, mover_pieces, near_pairs
+
+
+def _movers(rng, n):
+    out = []
+    for j in range(n):
+        k = int(rng.integers(1, 6))
+        times = np.sort(rng.uniform(-1.0, 12.0, size=k)) + np.arange(k) * 1e-3
+        pos = rng.uniform(-3.0, 3.0, size=(k, 2))
+        out.append(
+            MovingObstacle.from_waypoints(
+                times,
+                pos,
+                radius=float(rng.uniform(0.05, 0.5)),
+                growth=float(rng.choice([0.0, 0.0, rng.uniform(0.0, 0.3)])),
+                name=f"m{j}",
+            )
+        )
+    return out
+
+
+def _points(rng, n):
+    # a wiggly polyline sampled densely, as path nodes are
+    steps = rng.normal(scale=0.05, size=(n, 2)) + np.array([0.03, 0.0])
+    return np.cumsum(steps, axis=0) + rng.uniform(-2.0, 0.0, size=2)
+
+
+def _min_gap(pts, row, limit):
+    """Least ``|point - centre(t)| - limit(t)`` over 2001 samples of the piece (brute force)."""
+    u, w = row[1], row[2]
+    w_end = u + 50.0 if not np.isfinite(w) else w
+    tau = np.linspace(0.0, w_end - u, 2001)
+    cx, cy = row[3] + row[5] * tau, row[4] + row[6] * tau
+    lim = row[7] + limit + row[8] * tau
+    d = np.hypot(pts[:, None, 0] - cx[None, :], pts[:, None, 1] - cy[None, :]) - lim[None, :]
+    return d.min(axis=1)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10_000), st.integers(1, 6), st.integers(1, 90))
+def test_a_left_out_pair_never_comes_under_the_limit(seed, n_movers, n_points):
+    rng = np.random.default_rng(seed)
+    movers = _movers(rng, n_movers)
+    pts = _points(rng, n_points)
+    limit = float(rng.uniform(0.0, 0.4))
+    pieces = mover_pieces(movers, 0.25)
+    seg, pi = near_pairs(pts, pieces, limit)
+    kept = np.zeros((pieces.shape[0], pts.shape[0]), bool)
+    kept[seg, pi] = True
+    assert np.unique(seg * pts.shape[0] + pi).shape[0] == seg.shape[0]  # no pair twice
+    for p in range(pieces.shape[0]):
+        gap = _min_gap(pts, pieces[p], limit)
+        left_out = ~kept[p]
+        assert np.all(gap[left_out] > 0.0), (p, gap[left_out].min())
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10_000), st.integers(1, 6), st.integers(1, 90))
+def test_windows_on_the_kept_pairs_equal_those_on_every_pair(seed, n_movers, n_points):
+    rng = np.random.default_rng(seed)
+    movers = _movers(rng, n_movers)
+    pts = _points(rng, n_points)
+    limit = float(rng.uniform(0.0, 0.4))
+    pieces = mover_pieces(movers, 0.25)
+    every = np.ones((n_movers, n_points), bool)
+    got = disc_windows(pts, pieces, limit)
+    want = disc_windows(pts, pieces, limit, near=every)
+
+    def key(w):
+        who, pt, lo, hi = w
+        order = np.lexsort((hi, lo, pt, who))
+        return who[order], pt[order], lo[order], hi[order]
+
+    for a, b in zip(key(got), key(want), strict=True):
+        assert np.array_equal(a, b)
