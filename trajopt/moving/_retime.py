@@ -187,6 +187,9 @@ class _PathTables:
         return self.drives[key]
 
 
+#: How much (s) the fine windows' time band is widened (:func:`_fine_windows`).
+BAND_PAD = 0.05
+
 #: Timings of a moving start whose launches a path's tables keep.
 _LAUNCHES_KEPT = 4
 
@@ -477,7 +480,10 @@ def _tightened(
     candidates: list[list[tuple[float, Piece]]] = []
     disc = traj.robot.footprint is None and all(m.vertices is None for m in movers)
     if disc:
-        fine = _fine_windows(tables, grid, movers, float(traj.robot.radius) + margin)
+        speed = max(float(traj.robot.v_max), abs(float(traj.v_start)))
+        t_to = arrival(schedule) if schedule else float(grid.t[-1])
+        limit = float(traj.robot.radius) + margin
+        fine = _fine_windows(tables, grid, movers, limit, (not_before, t_to, speed))
         if schedule:
             candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
         whole = None if moving else tables.drive(0.0, length)
@@ -512,22 +518,39 @@ def _tightened(
 
 
 def _fine_windows(
-    tables: _PathTables, grid: STGrid, movers: Sequence[MovingObstacle], limit: float
+    tables: _PathTables,
+    grid: STGrid,
+    movers: Sequence[MovingObstacle],
+    limit: float,
+    span: tuple[float, float, float],
 ) -> FineWindows:
     """Return the movers' windows at the path's fine nodes (spacing at most ``dt`` times the speed).
 
     Only the pairs of a piece of a track and a fine node that can come within the limit are
-    solved (:func:`._st_grid.near_pairs`, an exact filter).
+    solved (:func:`._st_grid.near_pairs`, an exact filter), and only for the times the
+    motions asked about can be near the node: ``span = (t_from, t_to, V)``, the robot leaves
+    the start no earlier than ``t_from`` (s), arrives at the goal no later than ``t_to`` (s)
+    and drives at most ``V`` (m/s), so it is within ``h/2`` of ``s_i`` only between
+    ``t_from + (s_i - h/2) / V`` and ``t_to - (L - s_i - h/2) / V``; the band is widened by
+    :data:`BAND_PAD` (the drives' samples reach a step beyond) and ``V`` by 1 %. A window
+    left out by a wrong bound would only make a launch too early, which the certificate
+    refuses (the caller then keeps the untightened schedule).
     """
     h = min(FINE_DS, grid.dt * float(tables.robot.v_max))
     s, h = grid_nodes(tables.length, h)
     pts = tables.nodes(s, h)
     tb = tables.table
+    t_from, t_to, speed = span
+    v = 1.01 * speed
+    band = (
+        t_from + np.maximum(s - 0.5 * h, 0.0) / v - BAND_PAD,
+        t_to - np.maximum(tables.length - s - 0.5 * h, 0.0) / v + BAND_PAD,
+    )
 
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)
 
-    return FineWindows(s, pts, movers, limit, None, where, float(tables.robot.v_max))
+    return FineWindows(s, pts, movers, limit, band, where, float(tables.robot.v_max))
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:

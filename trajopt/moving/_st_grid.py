@@ -319,7 +319,12 @@ BOX = 8
 NEAR_SLACK = 1e-6
 
 
-def near_pairs(pts: np.ndarray, pieces: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray]:
+def near_pairs(
+    pts: np.ndarray,
+    pieces: np.ndarray,
+    limit: float,
+    band: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Return ``(piece, point)``: the pairs whose distance can come under the limit.
 
     A piece of a track (a row of :func:`mover_pieces`, ``limit`` added to its ``r``) moves
@@ -340,6 +345,9 @@ def near_pairs(pts: np.ndarray, pieces: np.ndarray, limit: float) -> tuple[np.nd
         ``inf`` for a piece that stands still.
     limit : float
         Added to every row's ``r`` (m).
+    band : (ndarray, ndarray), optional
+        Per point, shape (n,) each: only the times (s) from ``band[0]`` to ``band[1]``
+        matter; a piece whose span ``[u, w]`` misses them is left out for that point too.
 
     Returns
     -------
@@ -348,14 +356,7 @@ def near_pairs(pts: np.ndarray, pieces: np.ndarray, limit: float) -> tuple[np.nd
     n, p = pts.shape[0], pieces.shape[0]
     if n == 0 or p == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    span = pieces[:, 2] - pieces[:, 1]
-    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
-    run = np.where(still, 0.0, span)  # a standing piece may last forever
-    a = pieces[:, 3:5]
-    b = a + pieces[:, 5:7] * run[:, None]
-    with np.errstate(invalid="ignore"):
-        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
-    reach = pieces[:, 7] + limit + grow + NEAR_SLACK
+    a, b, reach = _swept(pieces, limit)
     starts = np.arange(0, n, BOX)
     lo = np.minimum.reduceat(pts, starts, axis=0)
     hi = np.maximum.reduceat(pts, starts, axis=0)
@@ -367,25 +368,19 @@ def near_pairs(pts: np.ndarray, pieces: np.ndarray, limit: float) -> tuple[np.nd
         & (p_lo[:, None, 1] <= hi[None, :, 1])
         & (p_hi[:, None, 1] >= lo[None, :, 1])
     )
+    if band is not None:
+        b_lo = np.minimum.reduceat(band[0], starts)
+        b_hi = np.maximum.reduceat(band[1], starts)
+        hit &= (pieces[:, 1, None] <= b_hi[None, :]) & (pieces[:, 2, None] >= b_lo[None, :])
     seg, box = np.nonzero(hit)
     first = starts[box]
     cnt = np.minimum(first + BOX, n) - first
     total = int(cnt.sum())
     seg = np.repeat(seg, cnt)
     point = np.repeat(first - np.cumsum(cnt) + cnt, cnt) + np.arange(total)
-    ax, ay = a[:, 0], a[:, 1]
-    dx, dy = b[:, 0] - ax, b[:, 1] - ay
-    dd = dx * dx + dy * dy
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
-    qx = pts[:, 0][point] - ax[seg]
-    qy = pts[:, 1][point] - ay[seg]
-    sx, sy = dx[seg], dy[seg]
-    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
-    qx -= f * sx
-    qy -= f * sy
-    r = reach[seg]
-    keep = ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
+    keep = _close(pts, a, b, reach, seg, point)
+    if band is not None:
+        keep &= (pieces[seg, 1] <= band[1][point]) & (pieces[seg, 2] >= band[0][point])
     return seg[keep], point[keep]
 
 
@@ -426,6 +421,54 @@ def _inside(
         # the limit must be positive: rr + g tau > 0
         t_lo = np.where(g > 0, np.maximum(t_lo, -rr / g), np.where(rr > 0, t_lo, big))
     return t_lo, t_hi
+
+
+def close_pairs(
+    pts: np.ndarray, pieces: np.ndarray, limit: float, seg: np.ndarray, point: np.ndarray
+) -> np.ndarray:
+    """Return which pairs ``(pieces[seg], pts[point])`` :func:`near_pairs` would keep (bool).
+
+    The point-to-segment test alone (module docstring of :func:`near_pairs`), for pairs
+    chosen otherwise (e.g. by time).
+    """
+    a, b, reach = _swept(pieces, limit)
+    return _close(pts, a, b, reach, seg, point)
+
+
+def _swept(pieces: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return each piece's segment ends ``a, b`` (m), shape (p, 2), and its reach (m), shape (p,)."""
+    span = pieces[:, 2] - pieces[:, 1]
+    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
+    run = np.where(still, 0.0, span)  # a standing piece may last forever
+    a = pieces[:, 3:5]
+    b = a + pieces[:, 5:7] * run[:, None]
+    with np.errstate(invalid="ignore"):
+        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
+    return a, b, pieces[:, 7] + limit + grow + NEAR_SLACK
+
+
+def _close(
+    pts: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    reach: np.ndarray,
+    seg: np.ndarray,
+    point: np.ndarray,
+) -> np.ndarray:
+    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool)."""
+    ax, ay = a[:, 0], a[:, 1]
+    dx, dy = b[:, 0] - ax, b[:, 1] - ay
+    dd = dx * dx + dy * dy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
+    qx = pts[:, 0][point] - ax[seg]
+    qy = pts[:, 1][point] - ay[seg]
+    sx, sy = dx[seg], dy[seg]
+    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
+    qx -= f * sx
+    qy -= f * sy
+    r = reach[seg]
+    return ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
 
 
 def disc_windows(

@@ -32,7 +32,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_grid import disc_windows, mover_pieces
+from trajopt.moving._st_grid import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -67,9 +67,10 @@ class FineWindows:
         Disc movers.
     limit : float
         Robot radius plus margin (m).
-    pairs : (ndarray of int, ndarray of int), optional
-        Which piece of the movers' tracks (:func:`._st_grid.mover_pieces` of ``movers`` and
-        ``limit``) can come near which node (a filter); default all.
+    band : (ndarray, ndarray), optional
+        Per node, shape (n,) each: the times (s) between which the motions asked about can
+        be within ``h/2`` of it (their launches, samples and refinement included); windows
+        of the pieces of the tracks outside them are left out. Default: all times.
     where : callable, optional
         ``where(s)``: the path's points (m), shape (m, 2), at arc lengths ``s`` (m), shape
         (m,); with it, :meth:`earliest` refines the windows that decide the launch.
@@ -83,7 +84,7 @@ class FineWindows:
         pts: np.ndarray,
         movers: Sequence[MovingObstacle],
         limit: float,
-        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+        band: tuple[np.ndarray, np.ndarray] | None = None,
         where: Callable[[np.ndarray], np.ndarray] | None = None,
         speed: float = 0.0,
     ) -> None:
@@ -91,6 +92,7 @@ class FineWindows:
         self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
         self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self.pieces = mover_pieces(movers, limit)
+        pairs = near_pairs(pts, self.pieces, 0.5 * self.h, band)
         owner, node, lo, hi = disc_windows(pts, self.pieces, 0.5 * self.h, pairs=pairs)
         order = np.argsort(node, kind="stable")
         node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
@@ -214,17 +216,43 @@ class FineWindows:
 
         During ``[a_j, b_j]`` (s from the launch) against mover ``owner_j``, from the motion's
         own points every :data:`REFINE_DT` (s); complete for launches in ``[lo, hi]`` (s)
-        (only the pieces of the tracks those launches can meet are tested).
+        (only the pieces of the tracks those launches can meet in time, and whose segment
+        comes within the limit of the point, :func:`._st_grid.close_pairs`, are solved).
+        The spans of one mover are merged first (neighbouring nodes' spans overlap, and a
+        node has a window per piece of a track), each merged span sampled once.
         """
+        a, b, owner = merged_spans(a, b, owner)
         n = np.maximum(np.ceil((b - a) / REFINE_DT).astype(np.int64), 1) + 1
         idx = np.repeat(np.arange(a.shape[0]), n)
         step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
         tau = np.minimum(a[idx] + step * REFINE_DT, b[idx])
         pts = self.where(s_of(tau))
         pad = 0.5 * REFINE_DT
-        pairs = pieces_meeting(self.pieces, owner[idx], tau + lo - pad, tau + hi + pad)
+        seg, item = pieces_meeting(self.pieces, owner[idx], tau + lo - pad, tau + hi + pad)
+        near = close_pairs(pts, self.pieces, self.speed * pad, seg, item)
+        pairs = (seg[near], item[near])
         _, pi, w_lo, w_hi = disc_windows(pts, self.pieces, self.speed * pad, pairs=pairs)
         return w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
+
+
+def merged_spans(
+    a: np.ndarray, b: np.ndarray, owner: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the union of the spans ``[a_j, b_j]`` (s) of each ``owner``, as ``(a, b, owner)``.
+
+    Sorted by owner, then time; overlapping or touching spans of one owner become one.
+    """
+    if a.size == 0:
+        return a, b, owner
+    order = np.lexsort((a, owner))
+    a, b, owner = a[order], b[order], owner[order]
+    big = 2.0 * (float(np.max(np.abs(b))) + float(np.max(np.abs(a))) + 1.0)
+    key = owner * big + b  # a cumulative maximum that restarts with each owner
+    ends = np.maximum.accumulate(key) - owner * big
+    new = np.ones(a.shape[0], dtype=bool)
+    new[1:] = (owner[1:] != owner[:-1]) | (a[1:] > ends[:-1])
+    first = np.flatnonzero(new)
+    return a[first], np.maximum.reduceat(b, first), owner[first]
 
 
 def pieces_meeting(

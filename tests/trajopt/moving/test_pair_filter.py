@@ -3,7 +3,8 @@
 A pair of a piece of a mover's track and a point that the filter leaves out must be farther
 than the piece's limit at every instant of the piece: checked on dense samples of the
 piece's centre and limit (written out here from the piece's row). The windows computed on
-the kept pairs must be exactly those computed on every pair.
+the kept pairs must be exactly those computed on every pair. The merged spans of the
+tightening's refinement must cover exactly the union of the spans, per mover.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from hypothesis import strategies as st
 
 from trajopt.moving import MovingObstacle
 from trajopt.moving._st_grid import disc_windows, mover_pieces, near_pairs
+from trajopt.moving._tighten import merged_spans
 
 
 def _movers(rng, n):
@@ -88,3 +90,27 @@ def test_windows_on_the_kept_pairs_equal_those_on_every_pair(seed, n_movers, n_p
 
     for a, b in zip(key(got), key(want), strict=True):
         assert np.array_equal(a, b)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 3), st.integers(0, 40), st.integers(0, 15)),
+        min_size=1,
+        max_size=30,
+    )
+)
+def test_merged_spans_are_the_union_of_each_owners_spans(spans):
+    owner = np.array([o for o, _, _ in spans], dtype=np.int64)
+    a = np.array([x * 0.25 for _, x, _ in spans])
+    b = a + np.array([d * 0.25 for _, _, d in spans])
+    ma, mb, mo = merged_spans(a, b, owner)
+    grid = np.arange(0.0, 14.0, 0.125)  # multiples of the ends' step and between them
+    for o in np.unique(owner):
+        sel = owner == o
+        want = np.any((grid[:, None] >= a[sel]) & (grid[:, None] <= b[sel]), axis=1)
+        got_sel = mo == o
+        got = np.any((grid[:, None] >= ma[got_sel]) & (grid[:, None] <= mb[got_sel]), axis=1)
+        assert np.array_equal(got, want)
+        # disjoint and in order: each merged span starts after the previous one ended
+        assert np.all(ma[got_sel][1:] > mb[got_sel][:-1])
