@@ -38,6 +38,8 @@ from trajopt.moving._obstacle import MovingObstacle
 FOREVER = 1 << 40
 #: Widening (sufficient) or narrowing (necessary) of the closed-form intervals (s).
 EPS_T = 1e-9
+#: A step offset that empties a run's range of blocked starts (beyond ``FOREVER``).
+_NEVER = 1 << 50
 
 
 class STGrid:
@@ -58,6 +60,8 @@ class STGrid:
         the run reaches the grid's last time (the node stays forbidden after it).
     owner : ndarray of int, shape (r,)
         Index of the mover of each run.
+    col : ndarray of int, shape (r,)
+        The node of each run.
     """
 
     def __init__(
@@ -76,7 +80,9 @@ class STGrid:
         self.lo, self.hi, self.owner = lo[order], hi[order], owner[order]
         counts = np.bincount(col, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
+        self.col = np.repeat(np.arange(s.shape[0]), counts)
         self._dense: tuple[np.ndarray, np.ndarray] | None = None
+        self._merged: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def index(self, s: np.ndarray) -> np.ndarray:
         """Nearest node index of arc lengths ``s`` (m)."""
@@ -89,8 +95,35 @@ class STGrid:
 
     def column(self, i: int) -> np.ndarray:
         """Forbidden times of node ``i``, bool, shape (K,)."""
-        a, b = int(self.ptr[i]), int(self.ptr[i + 1])
-        return self._paint(self.lo[a:b], self.hi[a:b])
+        ptr, _, lo, hi = self.merged
+        a, b = int(ptr[i]), int(ptr[i + 1])
+        return self._paint(lo[a:b], hi[a:b])
+
+    @property
+    def merged(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The runs of all movers merged per node: ``(ptr, col, lo, hi)`` (built on first use).
+
+        The same forbidden nodes as the runs of each mover, with overlapping or adjacent runs
+        of a node (of any movers: a mover's runs at a node are split where its track's pieces
+        meet) made one; ``ptr`` of shape (n + 1,), the others (q,), in order of node and time.
+        """
+        if self._merged is None:
+            kk, n = self.t.shape[0], self.s.shape[0]
+            order = np.argsort(self.col * (kk + 1) + self.lo, kind="stable")
+            c, lo, hi = self.col[order], self.lo[order], self.hi[order]
+            top = np.int64(FOREVER)
+            ends = np.maximum.accumulate(c * (2 * top) + np.minimum(hi, top)) - c * (2 * top)
+            new = np.ones(c.shape[0], dtype=bool)
+            new[1:] = (c[1:] != c[:-1]) | (lo[1:] > ends[:-1] + 1)
+            first = np.flatnonzero(new)
+            if first.size:
+                hi = np.maximum.reduceat(hi, first)
+            else:
+                hi = hi[first]
+            c, lo = c[first], lo[first]
+            ptr = np.concatenate([[0], np.cumsum(np.bincount(c, minlength=n))])
+            self._merged = (ptr, c, lo, hi)
+        return self._merged
 
     def _paint(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         kk = self.t.shape[0]
@@ -112,15 +145,37 @@ class STGrid:
         Returns
         -------
         ndarray of bool, shape (K,)
+
+        Notes
+        -----
+        A non-decreasing ``idx`` (a motion along the path) is at node ``i`` exactly at the
+        steps ``first_i..last_i``, so a run ``[lo, hi]`` of that node blocks the starts
+        ``lo - last_i..hi - first_i``: the runs of the nodes from ``idx[0]`` to ``idx[-1]``
+        are taken as one slice (a node passed between grid times gets an empty range).
         """
-        counts = self.ptr[idx + 1] - self.ptr[idx]
+        idx = np.asarray(idx, dtype=np.int64)
+        ptr, m_col, m_lo, m_hi = self.merged
+        if idx.size and np.all(idx[1:] >= idx[:-1]):
+            i0, i1 = int(idx[0]), int(idx[-1])
+            a, b = int(ptr[i0]), int(ptr[i1 + 1])
+            if a == b:
+                return np.zeros(self.t.shape[0], dtype=bool)
+            change = np.flatnonzero(idx[1:] != idx[:-1])
+            nodes = np.append(idx[change], i1) - i0
+            first = np.full(i1 - i0 + 1, _NEVER)
+            last = np.full(i1 - i0 + 1, -_NEVER)
+            first[nodes] = np.append(0, change + 1)
+            last[nodes] = np.append(change, idx.shape[0] - 1)
+            col = m_col[a:b] - i0
+            return self._paint(m_lo[a:b] - last[col], m_hi[a:b] - first[col])
+        counts = ptr[idx + 1] - ptr[idx]
         total = int(counts.sum())
         if total == 0:
             return np.zeros(self.t.shape[0], dtype=bool)
         step = np.repeat(np.arange(idx.shape[0]), counts)
-        first = np.repeat(self.ptr[idx], counts)
+        first = np.repeat(ptr[idx], counts)
         run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-        return self._paint(self.lo[run] - step, self.hi[run] - step)
+        return self._paint(m_lo[run] - step, m_hi[run] - step)
 
     def _dense_grid(self) -> tuple[np.ndarray, np.ndarray]:
         if self._dense is None:

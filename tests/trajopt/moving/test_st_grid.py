@@ -93,18 +93,20 @@ def test_blocked_starts_against_the_dense_grid(first, steps):
         sufficient=True,
     )
     n = g.s.shape[0]
-    idx = np.minimum(first + np.cumsum(steps), n - 1)
-    got = g.blocked_starts(idx)
     kk = g.t.shape[0]
     dense = g.blocked
-    want = np.zeros(kk, bool)
-    for k in range(kk):
-        for j, i in enumerate(idx):
-            # after the grid's last time a node stays as it was then
-            if dense[min(k + j, kk - 1), i]:
-                want[k] = True
-                break
-    assert np.array_equal(got, want)
+    forward = np.minimum(first + np.cumsum(steps), n - 1)
+    # a motion along the path (non-decreasing nodes) and one that is not
+    for idx in (forward, forward[::-1]):
+        got = g.blocked_starts(idx)
+        want = np.zeros(kk, bool)
+        for k in range(kk):
+            for j, i in enumerate(idx):
+                # after the grid's last time a node stays as it was then
+                if dense[min(k + j, kk - 1), i]:
+                    want[k] = True
+                    break
+        assert np.array_equal(got, want)
 
 
 def _full_sweep(grid, speed):
