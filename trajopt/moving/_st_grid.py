@@ -449,6 +449,7 @@ def _inside(
     on the open interval ``(t_lo, t_hi)`` (``t_lo > t_hi`` or infinite ends when empty or
     unbounded; NaN where undefined). Broadcasts.
     """
+    dx, dy, vx, vy, rr, g = np.broadcast_arrays(dx, dy, vx, vy, rr, g)
     # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
     a = vx * vx + vy * vy - g * g
     b = -2.0 * (dx * vx + dy * vy + rr * g)
@@ -456,25 +457,26 @@ def _inside(
     big = np.inf
     with np.errstate(divide="ignore", invalid="ignore"):
         disc = b * b - 4.0 * a * c
+        two = disc > 0
         sq = np.sqrt(np.maximum(disc, 0.0))
-        r1 = np.where(b > 0, (-b - sq) / (2.0 * a), 2.0 * c / (-b + sq))
-        r2 = np.where(b > 0, 2.0 * c / (-b - sq), (-b + sq) / (2.0 * a))
-        lo_q = np.minimum(r1, r2)
-        hi_q = np.maximum(r1, r2)
+        # the roots q / a and c / q, q = -(b + sign(b) sq) / 2 (no cancellation)
+        q = -0.5 * (b + np.where(b > 0, sq, -sq))
+        r1, r2 = q / a, c / q
+        up = a > 0
+        t_lo = np.where(two, np.where(up, np.minimum(r1, r2), np.maximum(r1, r2)), 0.0)
+        t_lo[~two] = np.where(up, big, -big)[~two]
+        t_hi = np.where(up, np.where(two, np.maximum(r1, r2), -big), big)
         flat = np.abs(a) <= 1e-12
-        lin = -c / b
-        t_lo = np.where(
-            flat,
-            np.where(b < 0, lin, np.where((b == 0) & (c < 0), -big, -big)),
-            np.where(a > 0, np.where(disc > 0, lo_q, big), np.where(disc > 0, hi_q, -big)),
-        )
-        t_hi = np.where(
-            flat,
-            np.where(b > 0, lin, np.where((b == 0) & (c >= 0), -big, big)),
-            np.where(a > 0, np.where(disc > 0, hi_q, -big), big),
-        )
+        if flat.any():
+            bf, cf = b[flat], c[flat]
+            lin = -cf / bf
+            t_lo[flat] = np.where(bf < 0, lin, -big)
+            t_hi[flat] = np.where(bf > 0, lin, np.where((bf == 0) & (cf >= 0), -big, big))
         # the limit must be positive: rr + g tau > 0
-        t_lo = np.where(g > 0, np.maximum(t_lo, -rr / g), np.where(rr > 0, t_lo, big))
+        grows = g > 0
+        if grows.any():
+            t_lo = np.where(grows, np.maximum(t_lo, -rr / g), t_lo)
+        t_lo = np.where(grows | (rr > 0), t_lo, big)
     return t_lo, t_hi
 
 
