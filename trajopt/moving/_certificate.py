@@ -240,19 +240,44 @@ def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
 
 
-#: The curvature tables of the last curves certified (curve, table), most recent last.
-_KAPPA_TABLES: list[tuple[Any, tuple[np.ndarray, np.ndarray]]] = []
+def geometry_key(path: Any) -> tuple[Any, ...]:
+    """Return a key equal for two paths of the same geometry and parameter.
+
+    A B-spline (or a path holding one as ``curve``, :class:`trajopt.smoother.SmoothPath`):
+    its degree, knots and control points, byte for byte (a re-plan that keeps its rest cuts a
+    new curve object of the same geometry at the same splice). Any other path: its identity
+    (whoever keeps the key keeps the path too, so that the identity is not reused).
+    """
+    curve = getattr(path, "curve", path)
+    knots, ctrl, deg = (getattr(curve, name, None) for name in ("t", "c", "k"))
+    if isinstance(knots, np.ndarray) and isinstance(ctrl, np.ndarray) and isinstance(deg, int):
+        return (type(path), type(curve), deg, knots.tobytes(), ctrl.shape, ctrl.tobytes())
+    return (id(path),)
+
+
+#: The curvature tables of the last curves certified (curve, its key, table), most recent last.
+_KAPPA_TABLES: list[tuple[Any, tuple[Any, ...], tuple[np.ndarray, np.ndarray]]] = []
 _KAPPA_KEPT = 4
 
 
 def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Return :func:`kappa_table` of ``curve``, reused for the last few curves (the same object)."""
-    for i, (c, tab) in enumerate(_KAPPA_TABLES):
+    """Return :func:`kappa_table` of ``curve``, reused for the last few curves.
+
+    Found by the object, else by its geometry (:func:`geometry_key`, its domain and length):
+    a re-plan's kept rest is a new curve object of the same geometry.
+    """
+    for i, (c, _, tab) in enumerate(_KAPPA_TABLES):
         if c is curve:
             _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
             return tab
+    dom = getattr(curve, "domain", None)
+    key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
+    for i, (_, k, tab) in enumerate(_KAPPA_TABLES):
+        if k == key:
+            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
+            return tab
     tab = kappa_table(curve)
-    _KAPPA_TABLES.append((curve, tab))
+    _KAPPA_TABLES.append((curve, key, tab))
     del _KAPPA_TABLES[:-_KAPPA_KEPT]
     return tab
 

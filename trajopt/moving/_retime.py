@@ -51,6 +51,7 @@ from trajopt.moving._certificate import (
     certify_movers,
     check_movers,
     convex_distance,
+    geometry_key,
     kappa_max,
     shape_at,
 )
@@ -196,20 +197,6 @@ _LAUNCHES_KEPT = 4
 #: The tables of the last paths re-timed (most recent last).
 _TABLES: list[_PathTables] = []
 _TABLES_KEPT = 4
-
-
-def geometry_key(path: Any) -> tuple[Any, ...]:
-    """Return a key equal for two paths of the same geometry and parameter.
-
-    A B-spline (or a path holding one as ``curve``, :class:`trajopt.smoother.SmoothPath`):
-    its degree, knots and control points, byte for byte (a re-plan that keeps its rest cuts a
-    new curve object of the same geometry at the same splice). Any other path: its identity.
-    """
-    curve = getattr(path, "curve", path)
-    knots, ctrl, deg = (getattr(curve, name, None) for name in ("t", "c", "k"))
-    if isinstance(knots, np.ndarray) and isinstance(ctrl, np.ndarray) and isinstance(deg, int):
-        return (type(path), type(curve), deg, knots.tobytes(), ctrl.shape, ctrl.tobytes())
-    return (id(path),)
 
 
 def _tables(traj: Trajectory) -> _PathTables:
@@ -487,6 +474,8 @@ def _tightened(
         if schedule:
             candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
         whole = None if moving else tables.drive(0.0, length)
+        if len(schedule) == 1 and schedule[0][1] is whole:
+            whole = None  # the tightened schedule is this drive at its earliest launch
         if whole is not None:
             t_max = min(arrival(schedule), float(grid.t[-1])) - whole.duration
             one = [(0.0, whole)]
