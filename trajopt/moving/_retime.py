@@ -516,7 +516,7 @@ def _fine_windows(
     """Return the movers' windows at the path's fine nodes (spacing at most ``dt`` times the speed).
 
     Only the pairs of a piece of a track and a fine node that can come within the limit are
-    solved (:func:`._st_grid.near_pairs`, an exact filter), and only for the times the
+    solved (:func:`._disc_windows.near_pairs`, an exact filter), and only for the times the
     motions asked about can be near the node: ``span = (t_from, t_to, V)``, the robot leaves
     the start no earlier than ``t_from`` (s), arrives at the goal no later than ``t_to`` (s)
     and drives at most ``V`` (m/s), so it is within ``h/2`` of ``s_i`` only between

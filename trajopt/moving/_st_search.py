@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from trajopt.moving._st_grid import STGrid
+from trajopt.moving._st_grid import STGrid, visits
 
 #: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
 N_EVEN_STOPS = 10
@@ -49,6 +49,13 @@ class Piece:
             self.memo[key] = grid.index(self.s_at(np.arange(n + 1) * grid.dt))
         return self.memo[key]
 
+    def visits(self, grid: STGrid) -> tuple[int, np.ndarray, np.ndarray]:
+        """Return :func:`._st_grid.visits` of :meth:`nodes` (kept on the piece)."""
+        key = ("visits", grid.dt, grid.ds, grid.s.shape[0])
+        if key not in self.memo:
+            self.memo[key] = visits(self.nodes(grid))
+        return self.memo[key]
+
     def s_at(self, t: np.ndarray) -> np.ndarray:
         """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends."""
         tt = np.minimum(np.maximum(t, 0.0), self.duration)
@@ -58,11 +65,6 @@ class Piece:
         s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
         s = np.minimum(np.maximum(s, self.s0), self.s1)
         return np.where(tt >= self.duration, self.s1, s)
-
-
-def ok_starts(grid: STGrid, idx: np.ndarray) -> np.ndarray:
-    """Return ``ok[k]``: a drive whose grid samples are the nodes ``idx`` is free from ``t_k``."""
-    return ~grid.blocked_starts(idx)
 
 
 def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:
@@ -224,6 +226,7 @@ def search(
         if not rest.any():
             continue
         first = int(np.argmax(rest))
+        batch: list[tuple[int, Piece]] = []  # the drives to stops, tested together
         for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
             if moving and w == 0:  # from a speed: at least the distance at the top speed
                 lower = (stops[v] - stops[0]) / v_top + lt[v, w_n - 1]
@@ -234,17 +237,21 @@ def search(
             piece = launch(stops[v]) if moving and w == 0 else drive(stops[w], stops[v])
             if piece is None:
                 continue
-            idx = piece.nodes(grid)
-            n = idx.shape[0] - 1
-            ok = ok_starts(grid, idx) & rest
-            if v == w_n - 1:
-                ok &= steps + n > last_goal
-                if ok.any():
-                    k = int(np.argmax(ok))
-                    t_arr = k * dt + piece.duration
-                    if best is None or t_arr < best[0]:
-                        best = (t_arr, w, k, piece)
+            if v < w_n - 1:
+                batch.append((v, piece))
                 continue
+            n = piece.nodes(grid).shape[0] - 1
+            ok = ~grid.blocked_starts_many([piece.visits(grid)])[0] & rest
+            ok &= steps + n > last_goal
+            if ok.any():
+                k = int(np.argmax(ok))
+                t_arr = k * dt + piece.duration
+                if best is None or t_arr < best[0]:
+                    best = (t_arr, w, k, piece)
+        bad = grid.blocked_starts_many([pc.visits(grid) for _, pc in batch])
+        for (v, piece), bad_v in zip(batch, bad, strict=True):
+            n = piece.nodes(grid).shape[0] - 1
+            ok = ~bad_v & rest
             ks = np.flatnonzero(ok[: max(0, kk - n)])
             new = ks[~arrivals[v][ks + n]]
             if new.size:

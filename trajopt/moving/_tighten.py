@@ -10,7 +10,7 @@ leaving a stop, without changing the drives themselves: only rests get shorter.
 exactly in time. Fine nodes ``s_i`` along the path (spacing ``h``, at most
 :data:`FINE_DS`): while ``|s - s_i| <= h/2`` the robot centre is within ``h/2`` of
 ``C(s_i)``, so it keeps its limit when ``C(s_i)`` keeps the limit plus ``h/2``, whose
-violation times are the closed-form windows of :func:`._st_grid.disc_windows`. A motion
+violation times are the closed-form windows of :func:`._disc_windows.disc_windows`. A motion
 starting at ``L`` occupies node ``i`` during ``[L + a, L + b]`` (``[a, b]`` from dense
 samples of the drives, widened to the samples around it); it meets a window ``(lo, hi)``
 iff ``lo - b < L < hi - a``. The rests and the standing at the goal are tested at the
@@ -31,8 +31,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from trajopt.moving._disc_windows import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_grid import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -217,7 +217,7 @@ class FineWindows:
         During ``[a_j, b_j]`` (s from the launch) against mover ``owner_j``, from the motion's
         own points every :data:`REFINE_DT` (s); complete for launches in ``[lo, hi]`` (s)
         (only the pieces of the tracks those launches can meet in time, and whose segment
-        comes within the limit of the point, :func:`._st_grid.close_pairs`, are solved).
+        comes within the limit of the point, :func:`._disc_windows.close_pairs`, are solved).
         The spans of one mover are merged first (neighbouring nodes' spans overlap, and a
         node has a window per piece of a track), each merged span sampled once.
         """
@@ -260,7 +260,7 @@ def pieces_meeting(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Return ``(piece, item)``: the pieces of mover ``owner[i]`` whose span meets ``[t_lo[i], t_hi[i]]``.
 
-    ``pieces`` from :func:`._st_grid.mover_pieces` (in order of mover and time); ``t_hi`` may
+    ``pieces`` from :func:`._disc_windows.mover_pieces` (in order of mover and time); ``t_hi`` may
     be ``inf``.
     """
     who = pieces[:, 0].astype(np.int64)

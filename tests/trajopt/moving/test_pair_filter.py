@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._st_grid import disc_windows, mover_pieces, near_pairs
+from trajopt.moving._disc_windows import disc_windows, mover_pieces, near_pairs
 from trajopt.moving._tighten import merged_spans
 
 

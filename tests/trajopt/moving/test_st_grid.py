@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from trajopt.geometry import PolylineCurve
 from trajopt.moving import MovingObstacle, reachable, st_grid
+from trajopt.moving._st_grid import visits
 
 PATH = PolylineCurve(np.array([[0.0, 0.0], [3.0, 0.0], [5.0, 2.0]]))
 LIMIT, DS, DT, V = 0.2, 0.02, 0.05, 0.5
@@ -95,18 +96,26 @@ def test_blocked_starts_against_the_dense_grid(first, steps):
     n = g.s.shape[0]
     kk = g.t.shape[0]
     dense = g.blocked
-    forward = np.minimum(first + np.cumsum(steps), n - 1)
-    # a motion along the path (non-decreasing nodes) and one that is not
-    for idx in (forward, forward[::-1]):
-        got = g.blocked_starts(idx)
-        want = np.zeros(kk, bool)
+
+    def want(idx):
+        out = np.zeros(kk, bool)
         for k in range(kk):
             for j, i in enumerate(idx):
                 # after the grid's last time a node stays as it was then
                 if dense[min(k + j, kk - 1), i]:
-                    want[k] = True
+                    out[k] = True
                     break
-        assert np.array_equal(got, want)
+        return out
+
+    forward = np.minimum(first + np.cumsum(steps), n - 1)
+    # a motion along the path (non-decreasing nodes) and one that is not
+    for idx in (forward, forward[::-1]):
+        assert np.array_equal(g.blocked_starts(idx), want(idx))
+    # several motions along the path at once
+    others = [forward, np.minimum(forward + 7, n - 1), forward[: max(1, len(forward) // 2)]]
+    many = g.blocked_starts_many([visits(idx) for idx in others])
+    for idx, row in zip(others, many, strict=True):
+        assert np.array_equal(row, want(idx))
 
 
 def _full_sweep(grid, speed):

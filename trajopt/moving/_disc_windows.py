@@ -1,0 +1,264 @@
+"""When points are within disc movers' limits: closed-form time windows, and a pair filter.
+
+A disc mover's centre is linear in time on each piece of its track between waypoint times
+(:func:`mover_pieces`), and so is its limit (its radius, growing, plus what the robot
+keeps), so the times a point is within the limit are one interval per piece, the roots of
+a quadratic (:func:`inside_times`, :func:`disc_windows`). Most pairs of a piece and a
+point never come that close: :func:`near_pairs` (and :func:`close_pairs` for pairs chosen
+otherwise) keeps only those whose distance can come under the limit, an exact filter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from trajopt.moving._obstacle import MovingObstacle
+
+#: Consecutive points per box of :func:`near_pairs`'s first test.
+BOX = 8
+#: :func:`near_pairs` keeps the pairs within this much (m) of the limit (against rounding).
+NEAR_SLACK = 1e-6
+
+
+def near_pairs(
+    pts: np.ndarray,
+    pieces: np.ndarray,
+    limit: float,
+    band: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(piece, point)``: the pairs whose distance can come under the limit.
+
+    A piece of a track (a row of :func:`mover_pieces`, ``limit`` added to its ``r``) moves
+    its centre along the segment from ``c(u)`` to ``c(w)``, and its limit is at most
+    ``R = r + max(g, 0) (w - u)`` over it. A point farther than ``R`` from that segment is
+    farther than the limit from the centre at every instant of the piece, so it has no
+    window there: every pair left out is at least ``R + NEAR_SLACK`` apart (an exact filter,
+    checked by brute force in the tests). First the points are boxed in runs of
+    :data:`BOX` (consecutive path points are near each other) and each piece's segment box,
+    grown by ``R``, against those boxes; then each remaining pair's point-to-segment distance.
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    pieces : ndarray, shape (p, 9)
+        Rows ``(mover, u, w, x, y, vx, vy, r, g)`` (:func:`mover_pieces`); ``w`` may be
+        ``inf`` for a piece that stands still.
+    limit : float
+        Added to every row's ``r`` (m).
+    band : (ndarray, ndarray), optional
+        Per point, shape (n,) each: only the times (s) from ``band[0]`` to ``band[1]``
+        matter; a piece whose span ``[u, w]`` misses them is left out for that point too.
+
+    Returns
+    -------
+    piece, point : ndarray of int, shape (q,)
+    """
+    n, p = pts.shape[0], pieces.shape[0]
+    if n == 0 or p == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    a, b, reach = _swept(pieces, limit)
+    starts = np.arange(0, n, BOX)
+    lo = np.minimum.reduceat(pts, starts, axis=0)
+    hi = np.maximum.reduceat(pts, starts, axis=0)
+    p_lo = np.minimum(a, b) - reach[:, None]
+    p_hi = np.maximum(a, b) + reach[:, None]
+    hit = (
+        (p_lo[:, None, 0] <= hi[None, :, 0])
+        & (p_hi[:, None, 0] >= lo[None, :, 0])
+        & (p_lo[:, None, 1] <= hi[None, :, 1])
+        & (p_hi[:, None, 1] >= lo[None, :, 1])
+    )
+    if band is not None:
+        b_lo = np.minimum.reduceat(band[0], starts)
+        b_hi = np.maximum.reduceat(band[1], starts)
+        hit &= (pieces[:, 1, None] <= b_hi[None, :]) & (pieces[:, 2, None] >= b_lo[None, :])
+    seg, box = np.nonzero(hit)
+    first = starts[box]
+    cnt = np.minimum(first + BOX, n) - first
+    total = int(cnt.sum())
+    seg = np.repeat(seg, cnt)
+    point = np.repeat(first - np.cumsum(cnt) + cnt, cnt) + np.arange(total)
+    keep = _close(pts, a, b, reach, seg, point)
+    if band is not None:
+        keep &= (pieces[seg, 1] <= band[1][point]) & (pieces[seg, 2] >= band[0][point])
+    return seg[keep], point[keep]
+
+
+def inside_times(
+    dx: np.ndarray, dy: np.ndarray, vx: np.ndarray, vy: np.ndarray, rr: np.ndarray, g: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return the times ``(t_lo, t_hi)`` (s, from a piece's start) a point is inside a mover's limit.
+
+    The point at ``D = (dx, dy)`` from the mover's centre at the piece's start, the centre
+    moving at ``V = (vx, vy)`` (m/s), the limit ``rr + g tau`` (m): ``|D - V tau| < rr + g tau``
+    on the open interval ``(t_lo, t_hi)`` (``t_lo > t_hi`` or infinite ends when empty or
+    unbounded; NaN where undefined). Broadcasts.
+    """
+    dx, dy, vx, vy, rr, g = np.broadcast_arrays(dx, dy, vx, vy, rr, g)
+    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
+    a = vx * vx + vy * vy - g * g
+    b = -2.0 * (dx * vx + dy * vy + rr * g)
+    c = dx * dx + dy * dy - rr * rr
+    big = np.inf
+    with np.errstate(divide="ignore", invalid="ignore"):
+        disc = b * b - 4.0 * a * c
+        two = disc > 0
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        # the roots q / a and c / q, q = -(b + sign(b) sq) / 2 (no cancellation)
+        q = -0.5 * (b + np.where(b > 0, sq, -sq))
+        r1, r2 = q / a, c / q
+        up = a > 0
+        t_lo = np.where(two, np.where(up, np.minimum(r1, r2), np.maximum(r1, r2)), 0.0)
+        t_lo[~two] = np.where(up, big, -big)[~two]
+        t_hi = np.where(up, np.where(two, np.maximum(r1, r2), -big), big)
+        flat = np.abs(a) <= 1e-12
+        if flat.any():
+            bf, cf = b[flat], c[flat]
+            lin = -cf / bf
+            t_lo[flat] = np.where(bf < 0, lin, -big)
+            t_hi[flat] = np.where(bf > 0, lin, np.where((bf == 0) & (cf >= 0), -big, big))
+        # the limit must be positive: rr + g tau > 0
+        grows = g > 0
+        if grows.any():
+            t_lo = np.where(grows, np.maximum(t_lo, -rr / g), t_lo)
+        t_lo = np.where(grows | (rr > 0), t_lo, big)
+    return t_lo, t_hi
+
+
+def close_pairs(
+    pts: np.ndarray, pieces: np.ndarray, limit: float, seg: np.ndarray, point: np.ndarray
+) -> np.ndarray:
+    """Return which pairs ``(pieces[seg], pts[point])`` :func:`near_pairs` would keep (bool).
+
+    The point-to-segment test alone (the docstring of :func:`near_pairs`), for pairs
+    chosen otherwise (e.g. by time).
+    """
+    a, b, reach = _swept(pieces, limit)
+    return _close(pts, a, b, reach, seg, point)
+
+
+def _swept(pieces: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return each piece's segment ends ``a, b`` (m), shape (p, 2), and its reach (m), shape (p,)."""
+    span = pieces[:, 2] - pieces[:, 1]
+    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
+    run = np.where(still, 0.0, span)  # a standing piece may last forever
+    a = pieces[:, 3:5]
+    b = a + pieces[:, 5:7] * run[:, None]
+    with np.errstate(invalid="ignore"):
+        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
+    return a, b, pieces[:, 7] + limit + grow + NEAR_SLACK
+
+
+def _close(
+    pts: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    reach: np.ndarray,
+    seg: np.ndarray,
+    point: np.ndarray,
+) -> np.ndarray:
+    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool)."""
+    ax, ay = a[:, 0], a[:, 1]
+    dx, dy = b[:, 0] - ax, b[:, 1] - ay
+    dd = dx * dx + dy * dy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
+    qx = pts[:, 0][point] - ax[seg]
+    qy = pts[:, 1][point] - ay[seg]
+    sx, sy = dx[seg], dy[seg]
+    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
+    qx -= f * sx
+    qy -= f * sy
+    r = reach[seg]
+    return ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
+
+
+def disc_windows(
+    pts: np.ndarray,
+    movers: Sequence[MovingObstacle] | np.ndarray,
+    limit: float,
+    near: np.ndarray | None = None,
+    pairs: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Return when points are closer to disc movers than ``limit`` plus their radius.
+
+    Exact (closed form, module docstring) over each mover's whole prediction and after it
+    (the mover stands where it was last, forever).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    movers : sequence of MovingObstacle, or ndarray
+        Disc movers, or their pieces from :func:`mover_pieces` (with a limit in; ``limit``
+        is then added to it).
+    limit : float
+        The distance to keep besides a mover's radius (m).
+    near : ndarray of bool, shape (movers, n), optional
+        Which points to test against each mover; default the pairs of a piece and a point
+        that :func:`near_pairs` keeps (the others have no window).
+    pairs : (ndarray of int, ndarray of int), optional
+        Instead: which piece (row of the pieces) to test against which point.
+
+    Returns
+    -------
+    mover, point : ndarray of int, shape (r,)
+        The mover and the point of each window.
+    lo, hi : ndarray, shape (r,)
+        The open time interval (s) of each window; ``hi = inf`` for one that lasts.
+    """
+    rows = movers if isinstance(movers, np.ndarray) else mover_pieces(movers, 0.0)
+    who = rows[:, 0].astype(np.int64)
+    if pairs is not None:
+        seg, pi = pairs
+    elif near is None:
+        seg, pi = near_pairs(pts, rows, limit)
+    else:
+        seg, pi = np.nonzero(near[who])
+    r = rows[seg]
+    u, w = r[:, 1], r[:, 2]
+    t_lo, t_hi = inside_times(
+        pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
+    )
+    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
+    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
+    keep = lo < hi
+    return who[seg[keep]], pi[keep].astype(np.int64), lo[keep], hi[keep]
+
+
+def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
+    """Return the linear pieces of disc movers' tracks, shape (p, 9), for :func:`disc_windows`.
+
+    Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
+    last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
+    ``limit`` plus the radius is ``r + g (t - u)`` (m).
+    """
+    out = []
+    for j, m in enumerate(movers):
+        tk = m.times
+        t_end = max(float(tk[-1]), 0.0) + 1.0
+        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
+        u, w = knots[:-1], knots[1:]
+        mid = 0.5 * (u + w)
+        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
+        inside = (mid > tk[0]) & (mid < tk[-1])
+        span = w - u
+        out.append(
+            np.column_stack(
+                [
+                    np.full(u.shape, float(j)),
+                    u,
+                    np.where(w >= t_end, np.inf, w),
+                    px[:-1],
+                    py[:-1],
+                    np.where(inside, np.diff(px) / span, 0.0),
+                    np.where(inside, np.diff(py) / span, 0.0),
+                    limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)),
+                    np.where(mid < m.t_last, m.growth, 0.0),
+                ]
+            )
+        )
+    return np.concatenate(out) if out else np.zeros((0, 9))
