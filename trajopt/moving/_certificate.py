@@ -31,8 +31,12 @@ a motion at rest (a turn in place) as a robot standing still (``rho_P = 0``).
 
 An interval whose bound clears the limit (within ``tol``) is accepted; one whose midpoint
 is closer than the limit by more than ``tol / 2`` is a proven violation (a witness);
-otherwise it is bisected. Bisection ends: once the bound's loss is below ``tol / 2`` an
-interval is either accepted or a witness.
+otherwise it is split in :data:`SPLIT` equal parts (disc movers: a level of splitting costs
+one evaluation of the robot whatever its size, so fewer, wider levels), in halves for a
+polygon mover. The splitting ends: once the bound's loss is below ``tol / 2`` an interval is
+either accepted or a witness. Before that, a disc mover's interval whose box of the robot's
+positions (:class:`._path_bounds.PathBoxes`) is farther from the box of the mover's centre than the largest
+limit is accepted at once, the gap less the limit its bound.
 """
 
 from __future__ import annotations
@@ -45,13 +49,15 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry import kappa_bound
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
 
 #: Bisection budget (intervals evaluated per mover) before the certificate gives up undecided.
 MAX_INTERVALS = 400_000
 #: Initial time step of the interval cover (s).
 COVER_DT = 0.5
+#: Parts an undecided interval is split in (disc movers; one mover's polygon: halves).
+SPLIT = 4
 
 
 @dataclass(frozen=True, slots=True)
@@ -205,109 +211,6 @@ def _profile_bounds(traj: Any) -> tuple[float, float]:
     return vmax, amax
 
 
-def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(s_edges, k)``: rigorous |curvature| bounds (1/m) ``k[i]`` on ``[s_edges[i], s_edges[i+1]]`` (m).
-
-    Bernstein bounds (:func:`trajopt.geometry.kappa_bound`) on each polynomial piece, split
-    in 8 or 64 where a piece's bound is infinite; ``([0, L], [inf])`` when there is none (a
-    curve without a polynomial degree, a polyline with corners).
-    """
-    length = float(curve.length)
-    none = (np.array([0.0, length]), np.array([math.inf]))
-    deg = getattr(curve, "polynomial_degree", None)
-    if deg is None:
-        return none
-    br = np.asarray(curve.breakpoints(), dtype=float)
-    if br.shape[0] < 2:
-        return none
-    if deg < 2:  # straight pieces: no curvature inside, corners between them
-        return (np.array([0.0, length]), np.zeros(1)) if br.shape[0] == 2 else none
-    a, b = br[:-1], br[1:]
-    keep = b > a
-    a, b = a[keep], b[keep]
-    k, e = np.full(1, math.inf), np.stack([a, b], axis=1)
-    for split in (1, 8, 64):  # the Bernstein bound tightens on shorter intervals
-        e = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, split + 1)[None, :]
-        try:
-            k = kappa_bound(curve, e[:, :-1].ravel(), e[:, 1:].ravel(), int(deg))
-        except (ValueError, FloatingPointError, ZeroDivisionError):
-            return none
-        if np.all(np.isfinite(k)):
-            break
-    u = np.append(e[:, :-1].ravel(), e[-1, -1])
-    s_edges = np.asarray(curve.s_at_u(u), dtype=float)
-    s_edges[0], s_edges[-1] = 0.0, length
-    return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
-
-
-def geometry_key(path: Any) -> tuple[Any, ...]:
-    """Return a key equal for two paths of the same geometry and parameter.
-
-    A B-spline (or a path holding one as ``curve``, :class:`trajopt.smoother.SmoothPath`):
-    its degree, knots and control points, byte for byte (a re-plan that keeps its rest cuts a
-    new curve object of the same geometry at the same splice). Any other path: its identity
-    (whoever keeps the key keeps the path too, so that the identity is not reused).
-    """
-    curve = getattr(path, "curve", path)
-    knots, ctrl, deg = (getattr(curve, name, None) for name in ("t", "c", "k"))
-    if isinstance(knots, np.ndarray) and isinstance(ctrl, np.ndarray) and isinstance(deg, int):
-        return (type(path), type(curve), deg, knots.tobytes(), ctrl.shape, ctrl.tobytes())
-    return (id(path),)
-
-
-#: The curvature tables of the last curves certified (curve, its key, table), most recent last.
-_KAPPA_TABLES: list[tuple[Any, tuple[Any, ...], tuple[np.ndarray, np.ndarray]]] = []
-_KAPPA_KEPT = 4
-
-
-def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Return :func:`kappa_table` of ``curve``, reused for the last few curves.
-
-    Found by the object, else by its geometry (:func:`geometry_key`, its domain and length):
-    a re-plan's kept rest is a new curve object of the same geometry.
-    """
-    for i, (c, _, tab) in enumerate(_KAPPA_TABLES):
-        if c is curve:
-            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
-            return tab
-    dom = getattr(curve, "domain", None)
-    key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
-    for i, (_, k, tab) in enumerate(_KAPPA_TABLES):
-        if k == key:
-            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
-            return tab
-    tab = kappa_table(curve)
-    _KAPPA_TABLES.append((curve, key, tab))
-    del _KAPPA_TABLES[:-_KAPPA_KEPT]
-    return tab
-
-
-def kappa_max(curve: Any) -> float:
-    """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
-    return float(np.max(kappa_table_of(curve)[1]))
-
-
-class _RangeMax:
-    """Maxima of ``values`` over index ranges in O(1) (a sparse table)."""
-
-    def __init__(self, values: np.ndarray) -> None:
-        self.levels = [np.asarray(values, dtype=float)]
-        while 2 ** len(self.levels) <= values.shape[0]:
-            prev, w = self.levels[-1], 2 ** (len(self.levels) - 1)
-            self.levels.append(np.maximum(prev[:-w], prev[w:]))
-
-    def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
-        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise."""
-        n = i1 - i0 + 1
-        lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
-        out = np.empty(i0.shape)
-        for j in np.unique(lev):
-            sel = lev == j
-            arr = self.levels[int(j)]
-            out[sel] = np.maximum(arr[i0[sel]], arr[i1[sel] - 2 ** int(j) + 1])
-        return out
-
-
 class _Curve:
     """The robot on one timed curve, played from global time ``offset`` on its own clock."""
 
@@ -316,7 +219,7 @@ class _Curve:
         self.vmax, self.amax = _profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
         self.s_edges, k = kappa_table_of(traj.path)
-        self.kmax = _RangeMax(k)
+        self.kmax = RangeMax(k)
         self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
         self.length = float(traj.length)
         self.phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
@@ -330,6 +233,12 @@ class _Curve:
         tau = tt - pt[k]
         s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
         return np.where(tt >= dur, self.length, np.clip(s, 0.0, self.length))
+
+    def box(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return ``(x_min, x_max, y_min, y_max)`` (m): a box holding the robot's reference point during ``[t0, t1]``."""
+        s0 = self.s_at(t0 - self.offset)
+        s1 = self.s_at(t1 - self.offset)
+        return path_boxes_of(self.traj.path).box(s0, s1)
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
@@ -364,6 +273,11 @@ class _Still:
         self.piece, self.offset = piece, float(offset)
         smp = piece.sample(np.array([0.0]))
         self.point = np.array([smp.x[0], smp.y[0]], dtype=float)
+
+    def box(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return ``(x_min, x_max, y_min, y_max)`` (m): the point where it stands, for each interval."""
+        x, y = (np.full(t0.shape, float(c)) for c in self.point)
+        return x, x, y, y
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), a zero bound and a zero velocity."""
@@ -518,7 +432,7 @@ def _certify_discs(
     tol: float,
     body: np.ndarray | None,
 ) -> tuple[str, float, str, float, int]:
-    """Bisect the intervals of ``[a, b]`` for all disc movers at once.
+    """Split the intervals of ``[a, b]`` for all disc movers at once (in :data:`SPLIT` parts).
 
     The same bounds as :func:`_certify_one`, vectorised over the movers: each interval keeps
     its mover's index and the line ``A + V t`` its centre follows on the waypoint segment
@@ -557,8 +471,31 @@ def _certify_discs(
     t_last = np.array([max(m.t_last, 0.0) for m in movers])[mj]
     reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
     proven, proven_t, proven_j = math.inf, 0.0, 0
-    count, budget = 0, MAX_INTERVALS * len(movers)
+    count, budget = t0.size, MAX_INTERVALS * len(movers)
+    # far apart: the robot's box during the interval (its reference point; a footprint lies
+    # within reach_b of it) against the box of the mover's centre there, whose gap less the
+    # largest limit is a lower bound of the slack
+    rx0, rx1, ry0, ry1 = model.box(t0, t1)
+    c0, c1 = anchor + vel * t0[:, None], anchor + vel * t1[:, None]
+    gx = np.maximum(
+        np.maximum(np.minimum(c0[:, 0], c1[:, 0]) - rx1, rx0 - np.maximum(c0[:, 0], c1[:, 0])), 0.0
+    )
+    gy = np.maximum(
+        np.maximum(np.minimum(c0[:, 1], c1[:, 1]) - ry1, ry0 - np.maximum(c0[:, 1], c1[:, 1])), 0.0
+    )
+    lower = np.hypot(gx, gy) - reach_b - (extra + rad0 + grow * np.clip(t1, 0.0, t_last))
+    far = lower >= 0.0
+    if np.any(far):
+        i = int(np.argmin(np.where(far, lower, np.inf)))
+        proven, proven_t, proven_j = float(lower[i]), float(0.5 * (t0[i] + t1[i])), int(mj[i])
+        near = ~far
+        t0, t1, mj, vel, anchor = t0[near], t1[near], mj[near], vel[near], anchor[near]
+        rad0, grow, t_last = rad0[near], grow[near], t_last[near]
+    first_level = True
     while t0.size:
+        if not first_level:
+            count += t0.size
+        first_level = False
         count += t0.size
         if count > budget:
             return "undecided", proven, movers[proven_j].name, proven_t, count
@@ -605,15 +542,15 @@ def _certify_discs(
             i = int(np.argmin(np.where(done, lower, np.inf)))
             if lower[i] < proven:
                 proven, proven_t, proven_j = float(lower[i]), float(tm[i]), int(mj[i])
-        split = ~done
-        t0 = np.concatenate([t0[split], tm[split]])
-        t1 = np.concatenate([tm[split], t1[split]])
-        mj = np.concatenate([mj[split], mj[split]])
-        vel = np.concatenate([vel[split], vel[split]])
-        anchor = np.concatenate([anchor[split], anchor[split]])
-        rad0 = np.concatenate([rad0[split], rad0[split]])
-        grow = np.concatenate([grow[split], grow[split]])
-        t_last = np.concatenate([t_last[split], t_last[split]])
+        # each undecided interval in SPLIT equal parts (a level costs one evaluation of the
+        # robot, whatever its size: fewer, wider levels)
+        split = np.repeat(np.flatnonzero(~done), SPLIT)
+        part = np.tile(np.arange(SPLIT), split.shape[0] // SPLIT)
+        a, width = t0[split], (t1 - t0)[split]
+        t1 = np.where(part == SPLIT - 1, t1[split], a + width * ((part + 1) / SPLIT))
+        t0 = np.where(part == 0, a, a + width * (part / SPLIT))
+        mj, vel, anchor = mj[split], vel[split], anchor[split]
+        rad0, grow, t_last = rad0[split], grow[split], t_last[split]
     return "clear", proven, movers[proven_j].name if movers else "", proven_t, count
 
 

@@ -28,7 +28,7 @@
 
 The cap table, the grid's node points, the rest-to-rest drives and a moving start's
 launches of the last few paths are kept (:data:`_TABLES`), found again by the path's
-geometry (:func:`geometry_key`): new predictions for the same path reuse them, also when the
+geometry (:func:`._path_bounds.geometry_key`): new predictions for the same path reuse them, also when the
 path is a new object of the same geometry (a re-plan that keeps its rest at the same splice).
 """
 
@@ -51,11 +51,10 @@ from trajopt.moving._certificate import (
     certify_movers,
     check_movers,
     convex_distance,
-    geometry_key,
-    kappa_max,
     shape_at,
 )
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._path_bounds import geometry_key, kappa_max
 from trajopt.moving._st_grid import (
     STGrid,
     grid_nodes,

@@ -1,0 +1,79 @@
+"""Tests of the certificate's filter of far intervals: the boxes of a path over arc ranges.
+
+Every point of the path over an arc-length range, sampled densely (the path's own
+``u_at_s``), must lie in the box :class:`PathBoxes` gives for that range; and a certificate
+over movers most of which are far from the robot (the filter's case) must agree with the
+dense samples and the brute force of the reference.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tests.trajopt.moving.reference import brute_min, dense_min
+from trajopt.geometry import BSplineCurve, PolylineCurve, clamped_uniform_knots
+from trajopt.moving import MovingObstacle, certify_movers
+from trajopt.moving._path_bounds import PathBoxes
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+
+ROBOT = Robot(v_max=0.8, a_max=0.8, j_max=3.0)
+
+
+def _wiggle(ys, length):
+    n = len(ys) + 2
+    x = np.linspace(0.0, length, n)
+    y = np.concatenate([[0.0], ys, [0.0]])
+    return BSplineCurve(clamped_uniform_knots(n, 3), np.column_stack([x, y]), 3)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=8),
+    st.floats(1.0, 30.0),
+    st.booleans(),
+    st.lists(st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 0.2)), min_size=1, max_size=6),
+)
+def test_the_box_of_an_arc_range_holds_every_point_of_it(ys, length, polyline, ranges):
+    if polyline:
+        pts = np.column_stack([np.linspace(0.0, length, len(ys) + 2), [0.0, *ys, 0.0]])
+        path = PolylineCurve(pts)
+    else:
+        path = _wiggle(ys, length)
+    boxes = PathBoxes(path)
+    total = float(path.length)
+    for f0, df in ranges:
+        s0 = f0 * total
+        s1 = min(total, s0 + df * total)
+        s = np.linspace(s0, s1, 400)
+        p = np.asarray(path(path.u_at_s(s)))
+        x0, x1, y0, y1 = (float(v[0]) for v in boxes.box(np.array([s0]), np.array([s1])))
+        assert np.all(p[:, 0] >= x0) and np.all(p[:, 0] <= x1)
+        assert np.all(p[:, 1] >= y0) and np.all(p[:, 1] <= y1)
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10_000))
+def test_the_certificate_with_far_movers_agrees_with_the_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    traj = time_parameterize(_wiggle(rng.uniform(-1.0, 1.0, 4), 6.0), ROBOT)
+    movers = []
+    for j in range(8):  # tracks of several pieces: seven away from the path, one anywhere
+        times = np.sort(rng.uniform(0.0, 9.0, 6)) + np.arange(6) * 1e-3
+        side = np.full((6, 1), rng.choice([-1.0, 1.0]) if j else 1.0)
+        low, high = ([-2.0, 2.2], [8.0, 5.0]) if j else ([-1.0, -2.0], [7.0, 2.0])
+        pos = rng.uniform(low, high, size=(6, 2)) * np.hstack([np.ones((6, 1)), side])
+        movers.append(
+            MovingObstacle.from_waypoints(
+                times, pos, radius=float(rng.uniform(0.05, 0.3)), name=f"m{j}"
+            )
+        )
+    cert = certify_movers(traj, movers, margin=0.05)
+    lowest = min(dense_min(traj, movers, margin=0.05)[0], brute_min(traj, movers, margin=0.05))
+    if cert.ok:
+        assert lowest >= -cert.tol
+        assert cert.slack <= lowest + 1e-9  # a lower bound of the true slack
+    else:
+        assert cert.verdict == "violated" and lowest < -0.5 * cert.tol

@@ -1,0 +1,171 @@
+"""Bounds of a path over arc-length ranges, kept per path geometry: curvature and boxes.
+
+:func:`kappa_table` bounds the curvature on arc-length intervals (Bernstein bounds on the
+polynomial pieces), :class:`PathBoxes` the points over arc-length ranges; both are kept for
+the last few paths (:func:`kappa_table_of`, :func:`path_boxes_of`), found again by the
+object or by its geometry (:func:`geometry_key`): a re-plan's kept rest is a new curve object
+of the same geometry. :class:`RangeMax` answers maxima over index ranges.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from trajopt.geometry import kappa_bound
+
+
+def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(s_edges, k)``: rigorous |curvature| bounds (1/m) ``k[i]`` on ``[s_edges[i], s_edges[i+1]]`` (m).
+
+    Bernstein bounds (:func:`trajopt.geometry.kappa_bound`) on each polynomial piece, split
+    in 8 or 64 where a piece's bound is infinite; ``([0, L], [inf])`` when there is none (a
+    curve without a polynomial degree, a polyline with corners).
+    """
+    length = float(curve.length)
+    none = (np.array([0.0, length]), np.array([math.inf]))
+    deg = getattr(curve, "polynomial_degree", None)
+    if deg is None:
+        return none
+    br = np.asarray(curve.breakpoints(), dtype=float)
+    if br.shape[0] < 2:
+        return none
+    if deg < 2:  # straight pieces: no curvature inside, corners between them
+        return (np.array([0.0, length]), np.zeros(1)) if br.shape[0] == 2 else none
+    a, b = br[:-1], br[1:]
+    keep = b > a
+    a, b = a[keep], b[keep]
+    k, e = np.full(1, math.inf), np.stack([a, b], axis=1)
+    for split in (1, 8, 64):  # the Bernstein bound tightens on shorter intervals
+        e = a[:, None] + (b - a)[:, None] * np.linspace(0.0, 1.0, split + 1)[None, :]
+        try:
+            k = kappa_bound(curve, e[:, :-1].ravel(), e[:, 1:].ravel(), int(deg))
+        except (ValueError, FloatingPointError, ZeroDivisionError):
+            return none
+        if np.all(np.isfinite(k)):
+            break
+    u = np.append(e[:, :-1].ravel(), e[-1, -1])
+    s_edges = np.asarray(curve.s_at_u(u), dtype=float)
+    s_edges[0], s_edges[-1] = 0.0, length
+    return np.maximum.accumulate(s_edges), np.asarray(k, dtype=float)
+
+
+def geometry_key(path: Any) -> tuple[Any, ...]:
+    """Return a key equal for two paths of the same geometry and parameter.
+
+    A B-spline (or a path holding one as ``curve``, :class:`trajopt.smoother.SmoothPath`):
+    its degree, knots and control points, byte for byte (a re-plan that keeps its rest cuts a
+    new curve object of the same geometry at the same splice). Any other path: its identity
+    (whoever keeps the key keeps the path too, so that the identity is not reused).
+    """
+    curve = getattr(path, "curve", path)
+    knots, ctrl, deg = (getattr(curve, name, None) for name in ("t", "c", "k"))
+    if isinstance(knots, np.ndarray) and isinstance(ctrl, np.ndarray) and isinstance(deg, int):
+        return (type(path), type(curve), deg, knots.tobytes(), ctrl.shape, ctrl.tobytes())
+    return (id(path),)
+
+
+#: The curvature tables of the last curves certified (curve, its key, table), most recent last.
+_KAPPA_TABLES: list[tuple[Any, tuple[Any, ...], tuple[np.ndarray, np.ndarray]]] = []
+_KAPPA_KEPT = 4
+
+
+def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return :func:`kappa_table` of ``curve``, reused for the last few curves.
+
+    Found by the object, else by its geometry (:func:`geometry_key`, its domain and length):
+    a re-plan's kept rest is a new curve object of the same geometry.
+    """
+    for i, (c, _, tab) in enumerate(_KAPPA_TABLES):
+        if c is curve:
+            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
+            return tab
+    dom = getattr(curve, "domain", None)
+    key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
+    for i, (_, k, tab) in enumerate(_KAPPA_TABLES):
+        if k == key:
+            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
+            return tab
+    tab = kappa_table(curve)
+    _KAPPA_TABLES.append((curve, key, tab))
+    del _KAPPA_TABLES[:-_KAPPA_KEPT]
+    return tab
+
+
+def kappa_max(curve: Any) -> float:
+    """Return a rigorous bound of the curve's |curvature| (1/m), ``inf`` when none is available."""
+    return float(np.max(kappa_table_of(curve)[1]))
+
+
+class PathBoxes:
+    """Boxes that hold a path's points over arc-length ranges (a filter of far intervals).
+
+    The path at ``n`` evenly spaced parameters ``u_k`` (about 2 cm of arc apart): its points
+    ``P_k`` and their arc lengths ``s_k = path.s_at_u(u_k)`` (the function the trajectory's
+    ``s`` is defined by). A point of arc length ``s`` with ``s_k <= s <= s_{k+1}`` is within
+    ``(s_{k+1} - s_k) / 2`` of ``P_k`` or ``P_{k+1}`` (an arc is no shorter than its chord),
+    so the box of the samples from the last ``s_k <= s0`` to the first ``s_k >= s1``, grown by
+    the largest half gap (plus 1 um against rounding), holds the path over ``[s0, s1]``.
+    """
+
+    def __init__(self, path: Any) -> None:
+        lo, hi = (float(x) for x in path.domain)
+        n = int(min(4096, max(64, math.ceil(float(path.length) / 0.02) + 1)))
+        u = np.linspace(lo, hi, n)
+        pts = np.asarray(path(u), dtype=float)
+        self.s = np.maximum.accumulate(np.asarray(path.s_at_u(u), dtype=float))
+        self.pad = 0.5 * float(np.max(np.diff(self.s), initial=0.0)) + 1e-6
+        self.ranges = [RangeMax(v) for v in (-pts[:, 0], pts[:, 0], -pts[:, 1], pts[:, 1])]
+
+    def box(self, s0: np.ndarray, s1: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return ``(x_min, x_max, y_min, y_max)`` (m) of the path over ``[s0, s1]`` (m), elementwise."""
+        last = self.s.shape[0] - 1
+        i0 = np.clip(np.searchsorted(self.s, s0, side="right") - 1, 0, last)
+        i1 = np.maximum(np.clip(np.searchsorted(self.s, s1, side="left"), 0, last), i0)
+        x0, x1, y0, y1 = (r(i0, i1) for r in self.ranges)
+        return -x0 - self.pad, x1 + self.pad, -y0 - self.pad, y1 + self.pad
+
+
+#: The path boxes of the last curves certified (curve, its key, boxes), most recent last.
+_BOXES: list[tuple[Any, tuple[Any, ...], PathBoxes]] = []
+
+
+def path_boxes_of(curve: Any) -> PathBoxes:
+    """Return :class:`PathBoxes` of ``curve``, reused as :func:`kappa_table_of` reuses its tables."""
+    for i, (c, _, boxes) in enumerate(_BOXES):
+        if c is curve:
+            _BOXES.append(_BOXES.pop(i))
+            return boxes
+    dom = getattr(curve, "domain", None)
+    key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
+    for i, (_, k, boxes) in enumerate(_BOXES):
+        if k == key:
+            _BOXES.append(_BOXES.pop(i))
+            return boxes
+    boxes = PathBoxes(curve)
+    _BOXES.append((curve, key, boxes))
+    del _BOXES[:-_KAPPA_KEPT]
+    return boxes
+
+
+class RangeMax:
+    """Maxima of ``values`` over index ranges in O(1) (a sparse table)."""
+
+    def __init__(self, values: np.ndarray) -> None:
+        self.levels = [np.asarray(values, dtype=float)]
+        while 2 ** len(self.levels) <= values.shape[0]:
+            prev, w = self.levels[-1], 2 ** (len(self.levels) - 1)
+            self.levels.append(np.maximum(prev[:-w], prev[w:]))
+
+    def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
+        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise."""
+        n = i1 - i0 + 1
+        lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
+        out = np.empty(i0.shape)
+        for j in np.unique(lev):
+            sel = lev == j
+            arr = self.levels[int(j)]
+            out[sel] = np.maximum(arr[i0[sel]], arr[i1[sel] - 2 ** int(j) + 1])
+        return out
