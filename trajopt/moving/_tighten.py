@@ -44,6 +44,9 @@ EPS_L = 1e-6
 #: The refinement's time step (s) and how far before the launch (s) a deciding interval ends.
 REFINE_DT = 2.5e-4
 REFINE_S = 0.04
+#: The refinement is exact for the launches this long (s) before the launch it refines; the
+#: replaced intervals stay as they were for the earlier ones.
+REFINE_SPAN = 0.25
 #: The pad (m) of a rest's point against the path's evaluation (its arc length interpolated).
 POINT_PAD = 1e-4
 #: Bisection steps of :func:`bisect_start`.
@@ -143,7 +146,9 @@ class FineWindows:
         launch, s) and the path's points (``where``), the intervals that decide ``L`` (those
         ending within :data:`REFINE_S` before it) are replaced by the exact ones of the
         motion's own points on samples every :data:`REFINE_DT` (the robot's share of the pad
-        ``speed REFINE_DT / 2`` instead of ``h / 2`` and the drive samples), twice.
+        ``speed REFINE_DT / 2`` instead of ``h / 2`` and the drive samples), twice: for the
+        launches up to :data:`REFINE_SPAN` before it (the replaced intervals, cut there, stay
+        for the earlier ones).
         ``rests``: ``(s, a, b)``, the motion at rest at ``s`` (m) during ``[L + a, L + b]``,
         against the exact windows of the path's point there (:meth:`point_windows`).
         """
@@ -176,7 +181,12 @@ class FineWindows:
             bind = (f_hi >= cur - REFINE_S) & (f_lo < cur)
             if not bind.any():
                 break
-            x_lo, x_hi = self._exact(span_a[bind], span_b[bind], owner[bind], s_of, lo, cur)
+            # exact for the launches in [lo_x, cur]; below lo_x the replaced intervals stay
+            lo_x = max(lo, cur - REFINE_SPAN)
+            x_lo, x_hi = self._exact(span_a[bind], span_b[bind], owner[bind], s_of, lo_x, cur)
+            below = bind & (f_lo < lo_x)
+            x_lo = np.concatenate([x_lo, f_lo[below]])
+            x_hi = np.concatenate([x_hi, np.minimum(f_hi[below], lo_x)])
             f_lo, f_hi = f_lo[~bind], f_hi[~bind]
             span_a, span_b, owner = span_a[~bind], span_b[~bind], owner[~bind]
             extra_lo, extra_hi = np.append(extra_lo, x_lo), np.append(extra_hi, x_hi)
