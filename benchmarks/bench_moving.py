@@ -30,7 +30,9 @@ Re-time when only the predictions change: on each map, ``--retime`` queries with
 0.3 s, position by up to 0.1 m), three times, and the new predictions go in through
 ``Planner.replan(trajectory, t, moving_obstacles=...)`` when the planner has it (``t`` =
 0.5 s, latency 0; found from its signature), else ``trajopt.retime_for_movers`` on the static plan's path (the script says which).
-Every re-timed trajectory is checked as above.
+Every re-timed trajectory is checked as above. The times are also given apart for the
+target's case, no new path (``stats["moving"]["route"] == "retimed"``: the kept rest as
+planned, or re-timed along its path), and for the re-plans that stopped and planned again.
 
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
@@ -168,6 +170,7 @@ def retime_part(maps, n_queries, seed):
     has = "moving_obstacles" in inspect.signature(trajopt.Planner.replan).parameters
     via = "replan" if has else "retime_for_movers"
     times_ok, times_blocked, errors, bad, n_checked = [], [], {}, 0, 0
+    routes: list[tuple[str, str]] = []  # (stats["moving"]["route"], its plan) of each
     for mi, (_, grid) in enumerate(maps):
         planner = trajopt.Planner(grid, robot)
         rng = np.random.default_rng([seed, 7, mi])
@@ -195,6 +198,8 @@ def retime_part(maps, n_queries, seed):
                     errors[type(exc).__name__] = errors.get(type(exc).__name__, 0) + 1
                     continue
                 times_ok.append(time.perf_counter() - t0)
+                route = out.stats.get("moving", {}).get("route", "retimed")
+                routes.append((route, out.stats.get("moving", {}).get("plan", "")))
                 clock = float(out.stats.get("splice_time_s", 0.0)) if via == "replan" else 0.0
                 chk = check_trajectory(out, on_clock(new, clock), margin=MARGIN, grid=grid)
                 n_checked += 1
@@ -211,6 +216,21 @@ def retime_part(maps, n_queries, seed):
         f"{len(times_blocked)} blocked, refusal median "
         f"{med([1e3 * t for t in times_blocked]):.2f} ms; other errors {errors or 0}; "
         f"checked {n_checked}, failing the check {bad}"
+    )
+    # the target's case: no new path (the kept rest re-timed along its path), apart from the
+    # re-plans that stopped and planned again (a new path), and within it the two groups
+    same = [m for m, (r, _) in zip(ms, routes, strict=True) if r == "retimed"]
+    kept = [m for m, (r, p) in zip(ms, routes, strict=True) if r == "retimed" and p == "as planned"]
+    moved = [
+        m for m, (r, p) in zip(ms, routes, strict=True) if r == "retimed" and p != "as planned"
+    ]
+    other = [m for m, (r, _) in zip(ms, routes, strict=True) if r != "retimed"]
+    print(
+        f"  no new path (route 'retimed'): {len(same)}, median {med(same):.2f} ms, p99 "
+        f"{pct(same, 99):.2f} ms, max {max(same, default=math.nan):.2f} ms (kept as planned: "
+        f"{len(kept)}, median {med(kept):.2f} ms; re-timed: {len(moved)}, median "
+        f"{med(moved):.2f} ms, p90 {pct(moved, 90):.2f} ms); stopped and planned again (a "
+        f"new path): {len(other)}, median {med(other):.2f} ms"
     )
 
 
