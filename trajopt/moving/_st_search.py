@@ -67,6 +67,41 @@ class Piece:
         return np.where(tt >= self.duration, self.s1, s)
 
 
+def fill_visits(pieces: Sequence[Piece], grid: STGrid) -> None:
+    """Compute :meth:`Piece.nodes` and :meth:`Piece.visits` of several drives at once (kept on each).
+
+    The drives' rows are put one after another on a clock that gives each drive its own
+    span (drive ``i`` at ``i T``, ``T`` a power of two above every duration), so that one
+    search finds the row of every grid step of every drive.
+    """
+    key = (grid.dt, grid.ds, grid.s.shape[0])
+    todo = [pc for pc in pieces if key not in pc.memo]
+    if not todo:
+        return
+    dt = grid.dt
+    dur = np.array([pc.duration for pc in todo])
+    steps = np.ceil(dur / dt - 1e-9).astype(np.int64) + 1
+    span = 2.0 ** math.ceil(math.log2(float(np.max(dur)) + 2.0))
+    rows = np.concatenate([pc.rows for pc in todo])
+    per = np.array([pc.rows.shape[0] for pc in todo])
+    first_row = np.cumsum(per) - per
+    who = np.repeat(np.arange(len(todo)), steps)
+    t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) * dt
+    tt = np.minimum(t, dur[who])
+    clock = np.repeat(np.arange(len(todo)), per) * span + rows[:, 0]
+    k = np.searchsorted(clock, who * span + tt, side="right") - 1
+    k = np.maximum(k, first_row[who])
+    tau = tt - rows[k, 0]
+    s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
+    s0 = np.array([pc.s0 for pc in todo])[who]
+    s1 = np.array([pc.s1 for pc in todo])[who]
+    s = np.where(tt >= dur[who], s1, np.minimum(np.maximum(s, s0), s1))
+    idx = grid.index(s)
+    for pc, nodes in zip(todo, np.split(idx, np.cumsum(steps)[:-1]), strict=True):
+        pc.memo[key] = nodes
+        pc.memo[("visits", *key)] = visits(nodes)
+
+
 def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:
     """Return the stops (m): start, the node in front of each forbidden region, even ones, goal.
 
@@ -248,6 +283,7 @@ def search(
                 t_arr = k * dt + piece.duration
                 if best is None or t_arr < best[0]:
                     best = (t_arr, w, k, piece)
+        fill_visits([pc for _, pc in batch], grid)
         bad = grid.blocked_starts_many([pc.visits(grid) for _, pc in batch])
         for (v, piece), bad_v in zip(batch, bad, strict=True):
             n = piece.nodes(grid).shape[0] - 1

@@ -15,9 +15,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from trajopt.geometry import PolylineCurve
+from trajopt.geometry import CurveSegment, PolylineCurve
 from trajopt.moving import MovingObstacle, reachable, st_grid
 from trajopt.moving._st_grid import visits
+from trajopt.moving._st_search import Piece, fill_visits
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
 
 PATH = PolylineCurve(np.array([[0.0, 0.0], [3.0, 0.0], [5.0, 2.0]]))
 LIMIT, DS, DT, V = 0.2, 0.02, 0.05, 0.5
@@ -150,3 +153,27 @@ def test_the_sweep_stops_at_its_fixed_point_with_the_full_answer(radius):
     )
     assert reachable(g, V)[0] == _full_sweep(g, V)
     assert reachable(g, V)[0] == (0.4 >= LIMIT + radius - 0.5 * g.ds)
+
+
+def test_the_visits_of_several_drives_at_once_equal_each_drives_own():
+    g = st_grid(
+        PATH, PATH.length, _movers(), LIMIT, ds=DS, dt=DT, horizon=20.0, speed=V, sufficient=True
+    )
+    robot = Robot(v_max=V, a_max=0.5, j_max=2.0)
+    pieces, reference = [], []
+    for u0, u1 in ((0.0, 0.3), (0.2, 1.0), (0.5, 0.55), (0.0, 1.0)):
+        lo, hi = PATH.domain
+        a, b = lo + u0 * (hi - lo), lo + u1 * (hi - lo)
+        tr = time_parameterize(CurveSegment(PATH, a, b), robot)
+        s0 = float(PATH.s_at_u(a))
+        rows = np.column_stack([tr.phase_t, tr.phase_s + s0, tr.phase_v, tr.phase_a, tr.phase_j])
+        pc = Piece(rows, float(tr.duration), s0, s0 + float(tr.length))
+        n = int(np.ceil(pc.duration / DT - 1e-9))
+        reference.append(g.index(pc.s_at(np.arange(n + 1) * DT)))  # the drive alone
+        pieces.append(pc)
+    fill_visits(pieces, g)
+    for pc, want in zip(pieces, reference, strict=True):
+        assert np.array_equal(pc.nodes(g), want)
+        i0, first, last = pc.visits(g)
+        for j, i in enumerate(want):  # at node i at step j: within its range of steps
+            assert first[i - i0] <= j <= last[i - i0]
