@@ -40,7 +40,7 @@ FOREVER = 1 << 40
 #: Widening (sufficient) or narrowing (necessary) of the closed-form intervals (s).
 EPS_T = 1e-9
 #: A step offset that empties a run's range of blocked starts (beyond ``FOREVER``).
-_NEVER = 1 << 50
+NEVER_STEP = 1 << 50
 
 
 class STGrid:
@@ -233,8 +233,8 @@ def visits(idx: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
     i0, i1 = int(idx[0]), int(idx[-1])
     change = np.flatnonzero(idx[1:] != idx[:-1])
     nodes = np.append(idx[change], i1) - i0
-    first = np.full(i1 - i0 + 1, _NEVER)
-    last = np.full(i1 - i0 + 1, -_NEVER)
+    first = np.full(i1 - i0 + 1, NEVER_STEP)
+    last = np.full(i1 - i0 + 1, -NEVER_STEP)
     first[nodes] = np.append(0, change + 1)
     last[nodes] = np.append(change, idx.shape[0] - 1)
     return i0, first, last

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from trajopt.moving._st_grid import STGrid, visits
+from trajopt.moving._st_grid import NEVER_STEP, STGrid, visits
 
 #: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
 N_EVEN_STOPS = 10
@@ -97,9 +97,28 @@ def fill_visits(pieces: Sequence[Piece], grid: STGrid) -> None:
     s1 = np.array([pc.s1 for pc in todo])[who]
     s = np.where(tt >= dur[who], s1, np.minimum(np.maximum(s, s0), s1))
     idx = grid.index(s)
-    for pc, nodes in zip(todo, np.split(idx, np.cumsum(steps)[:-1]), strict=True):
-        pc.memo[key] = nodes
-        pc.memo[("visits", *key)] = visits(nodes)
+    # the visits of every drive at once (:func:`._st_grid.visits`): each drive's nodes are
+    # non-decreasing, so a node's first and last steps are where its run of steps starts
+    # and ends
+    ends = np.cumsum(steps)
+    starts = ends - steps
+    i0 = idx[starts]
+    size = idx[ends - 1] - i0 + 1
+    base = np.cumsum(size) - size
+    rel = idx - i0[who] + base[who]
+    j = np.arange(idx.shape[0]) - starts[who]
+    run_start = np.ones(idx.shape[0], dtype=bool)
+    run_start[1:] = (idx[1:] != idx[:-1]) | (who[1:] != who[:-1])
+    run_end = np.roll(run_start, -1)
+    run_end[-1] = True
+    first = np.full(int(size.sum()), NEVER_STEP)
+    last = np.full(int(size.sum()), -NEVER_STEP)
+    first[rel[run_start]] = j[run_start]
+    last[rel[run_end]] = j[run_end]
+    for i, pc in enumerate(todo):
+        pc.memo[key] = idx[starts[i] : ends[i]]
+        sl = slice(int(base[i]), int(base[i] + size[i]))
+        pc.memo[("visits", *key)] = (int(i0[i]), first[sl], last[sl])
 
 
 def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:

@@ -175,5 +175,7 @@ def test_the_visits_of_several_drives_at_once_equal_each_drives_own():
     for pc, want in zip(pieces, reference, strict=True):
         assert np.array_equal(pc.nodes(g), want)
         i0, first, last = pc.visits(g)
+        w0, w_first, w_last = visits(want)  # the drive's own visits
+        assert i0 == w0 and np.array_equal(first, w_first) and np.array_equal(last, w_last)
         for j, i in enumerate(want):  # at node i at step j: within its range of steps
             assert first[i - i0] <= j <= last[i - i0]
