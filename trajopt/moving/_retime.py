@@ -399,7 +399,15 @@ def retime_for_movers(
     step = float(dt)
     for _ in range(3):
         grid = st_grid(
-            path, length, movers, limit, dt=step, sufficient=True, points=points, **grid_args
+            path,
+            length,
+            movers,
+            limit,
+            dt=step,
+            sufficient=True,
+            points=points,
+            leave=0.0 if moving else float(not_before),
+            **grid_args,
         )
         k_min = int(math.ceil(not_before / step - 1e-9))
         found = search(

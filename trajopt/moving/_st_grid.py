@@ -259,6 +259,7 @@ def st_grid(
     body: np.ndarray | None = None,
     stretch: float = 1.0,
     points: np.ndarray | None = None,
+    leave: float | None = None,
 ) -> STGrid:
     """Build the forbidden grid (module docstring).
 
@@ -286,6 +287,11 @@ def st_grid(
         the footprint moves per metre of arc length; the pads scale the robot's share by it.
     points : ndarray, shape (n, 2), optional
         The path's points at the nodes (m), when the caller has them (:func:`grid_nodes`).
+    leave : float, optional
+        The robot leaves ``s = 0`` no earlier than this (s) and drives at most ``speed``: it
+        cannot be nearest to node ``s_i`` before ``leave + (s_i - ds/2) / speed``, and a disc
+        mover's pieces of track that end a grid step before that are not solved for the
+        node (their runs could not meet the robot). Default: all times.
 
     Returns
     -------
@@ -330,7 +336,10 @@ def st_grid(
                 hit[k] = point_polygon_distance(pts, w) < lim[k]
         runs.append(_runs_of(hit, j))
     if discs:
-        runs.append(_disc_runs(pts, discs, limit, t, sufficient))
+        after = None
+        if leave is not None:
+            after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
+        runs.append(_disc_runs(pts, discs, limit, t, sufficient, after))
     if runs:
         col, lo, hi, owner = (np.concatenate(x) for x in zip(*runs, strict=True))
     else:
@@ -361,8 +370,12 @@ def _disc_runs(
     limit: float,
     t: np.ndarray,
     sufficient: bool,
+    after: np.ndarray | None = None,
 ) -> tuple[np.ndarray, ...]:
     """Return the runs of disc movers against a disc robot, in closed form (module docstring).
+
+    ``after``: per node (s), shape (n,), the runs before it are not needed (the pieces of
+    track that end before it are left out for that node).
 
     Only the pairs of a track's piece and a node that :func:`._disc_windows.near_pairs` keeps are solved:
     the others are farther apart than the piece's largest limit at every instant of it.
@@ -385,7 +398,8 @@ def _disc_runs(
             np.column_stack([np.full(u.shape, j), u, w, px[:-1], py[:-1], vx, vy, r_u, grow])
         )
     arr = np.concatenate(rows)
-    seg, pi = near_pairs(pts, arr, 0.0)
+    band = None if after is None else (after, np.full(after.shape, np.inf))
+    seg, pi = near_pairs(pts, arr, 0.0, band)
     r = arr[seg]
     owner = r[:, 0].astype(np.int64)
     u, w = r[:, 1], r[:, 2]
