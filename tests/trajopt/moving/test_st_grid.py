@@ -179,3 +179,15 @@ def test_the_visits_of_several_drives_at_once_equal_each_drives_own():
         assert i0 == w0 and np.array_equal(first, w_first) and np.array_equal(last, w_last)
         for j, i in enumerate(want):  # at node i at step j: within its range of steps
             assert first[i - i0] <= j <= last[i - i0]
+
+
+@pytest.mark.parametrize("leave", [0.0, 1.5])
+def test_a_grid_that_leaves_out_the_times_before_the_robot_can_come_is_the_same_after(leave):
+    args = dict(ds=DS, dt=DT, horizon=20.0, speed=V, sufficient=True)
+    full = st_grid(PATH, PATH.length, _movers(), LIMIT, **args)
+    part = st_grid(PATH, PATH.length, _movers(), LIMIT, leave=leave, **args)
+    # the robot is nearest to node i at t_k only if t_k >= leave + (s_i - ds/2) / V
+    reach = full.t[:, None] >= leave + np.maximum(full.s[None, :] - 0.5 * full.ds, 0.0) / V
+    assert np.array_equal(part.blocked & reach, full.blocked & reach)
+    assert not np.any(part.blocked & ~full.blocked)  # only runs left out, never added
+    assert np.any(full.blocked & ~reach)  # the case leaves something out
