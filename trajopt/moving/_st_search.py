@@ -286,6 +286,8 @@ def search(
                 lower = (stops[v] - stops[0]) / v_top + lt[v, w_n - 1]
             else:
                 lower = first * dt + lt[w, v] + lt[v, w_n - 1]
+            # an arrival comes after the goal's last forbidden time, less a step
+            lower = max(lower, last_goal * dt)
             if best is not None and lower >= best[0]:
                 continue
             piece = launch(stops[v]) if moving and w == 0 else drive(stops[w], stops[v])
