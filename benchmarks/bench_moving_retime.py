@@ -64,7 +64,6 @@ from trajopt.errors import BlockedError, InvalidInputError, TrajoptError  # noqa
 
 MAPS = ("smoothers_world", "depot")
 BEFORE = "3379fc7"  # trajopt.moving before the speed-up
-MODULES = ("_certificate", "_st_grid", "_st_search", "_retime")
 REPLAN_AT = 2.0  # s into each plan: the re-plan for the same sets of predictions
 
 
@@ -78,7 +77,18 @@ def load_before(rev: str, tmp: Path):
     pkg = tmp / "moving_before"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
-    for mod in MODULES:
+    listing = subprocess.run(
+        ["git", "ls-tree", "--name-only", f"{rev}:trajopt/moving/"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
+    # every private module of the package at rev but the obstacle class (this tree's)
+    mods = [f[:-3] for f in listing if f.startswith("_") and f.endswith(".py")]
+    mods = [m for m in mods if m not in ("__init__", "_obstacle")]
+    pattern = r"trajopt\.moving\.(" + "|".join(mods) + r")\b"
+    for mod in mods:
         src = subprocess.run(
             ["git", "show", f"{rev}:trajopt/moving/{mod}.py"],
             cwd=ROOT,
@@ -86,13 +96,8 @@ def load_before(rev: str, tmp: Path):
             text=True,
             check=True,
         ).stdout
-        # its sibling modules from the temporary package; the obstacle class stays this tree's
-        src = re.sub(
-            r"trajopt\.moving\.(_certificate|_st_grid|_st_search|_retime)\b",
-            r"moving_before.\1",
-            src,
-        )
-        (pkg / f"{mod}.py").write_text(src)
+        # its sibling modules from the temporary package
+        (pkg / f"{mod}.py").write_text(re.sub(pattern, r"moving_before.\1", src))
     sys.path.insert(0, str(tmp))
     return importlib.import_module("moving_before._retime").retime_for_movers
 
