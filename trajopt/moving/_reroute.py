@@ -63,15 +63,10 @@ SAFE_PLACE_SPACING = 1.0
 PlanLeg = Callable[[OccupancyGrid, "np.ndarray | None", "np.ndarray | None", "float | None"], Any]
 
 
-def _ends(plan: Any) -> tuple[np.ndarray, np.ndarray, float, float]:
-    smp = plan.sample(np.array([0.0, plan.duration]))
-    p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
-    p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
-    return p0, p1, float(smp.theta[0]), float(smp.theta[1])
-
-
 def reroute(
-    plan: Any,
+    start: np.ndarray,
+    goal: np.ndarray,
+    robot: Any,
     movers: Sequence[MovingObstacle],
     margin: float,
     blocked: BlockedError,
@@ -84,14 +79,17 @@ def reroute(
 
     Parameters
     ----------
-    plan : PlanResult
-        The static plan whose re-timing was blocked (its ends are the query's).
+    start, goal : ndarray, shape (2,)
+        The query's ends (m): those of the static plan whose re-timing is blocked.
+    robot : Robot
+        The robot (its radius, drive and limits).
     movers : sequence of MovingObstacle
         The predictions.
     margin : float
         Extra distance to every mover (m).
     blocked : BlockedError
-        What the re-timing of ``plan`` raised (its ``mover`` and ``t``).
+        The proof that the static plan's path is blocked, or what its re-timing raised (its
+        ``mover`` and ``t``).
     grid : astar.OccupancyGrid
         The raw map.
     free : callable
@@ -114,8 +112,8 @@ def reroute(
         No candidate works: ``blocked``'s mover and time, the candidates' reasons appended.
     """
     t_all = time.perf_counter()
-    p0, p1, _, _ = _ends(plan)
-    robot = plan.robot
+    p0 = np.asarray(start, dtype=float).reshape(2)
+    p1 = np.asarray(goal, dtype=float).reshape(2)
     keep = [(p0, robot.radius + 2.0 * grid.resolution), (p1, robot.radius + 2.0 * grid.resolution)]
     by_name = {m.name: m for m in movers}
     tried: list[dict[str, str]] = []
