@@ -55,24 +55,12 @@ N_SAFE_PLACES = 2
 #: Smallest distance (m) between two safe places tried.
 SAFE_PLACE_SPACING = 1.0
 
-#: ``plan_leg(grid, start, goal, start_heading, movers)``: a plan from rest to rest on ``grid``
-#: (the planner's stages and options), raising a :class:`TrajoptError` when it fails.
-#: ``start`` ``None``: the query's start (with its heading); else a point (m) left with
+#: ``plan_leg(grid, start, goal, start_heading)``: a plan from rest to rest on ``grid`` (the
+#: planner's stages and options), raising a :class:`TrajoptError` when it fails. ``start``
+#: ``None``: the query's start (with its heading); else a point (m) left with
 #: ``start_heading`` (rad). ``goal`` ``None``: the query's goal (with its heading); else a
-#: point (m) reached with a free heading. ``movers``: those the leg is then re-timed for, on
-#: its own clock; the planner may run the quick proofs that no re-timing gets past them
-#: (:func:`~trajopt.moving.parked_on_path`, :func:`~trajopt.moving.no_way_past`) on its curve
-#: before timing it, raising their :class:`BlockedError` (the re-timing would raise one too).
-PlanLeg = Callable[
-    [
-        OccupancyGrid,
-        "np.ndarray | None",
-        "np.ndarray | None",
-        "float | None",
-        Sequence[MovingObstacle],
-    ],
-    Any,
-]
+#: point (m) reached with a free heading.
+PlanLeg = Callable[[OccupancyGrid, "np.ndarray | None", "np.ndarray | None", "float | None"], Any]
 
 
 def reroute(
@@ -109,7 +97,7 @@ def reroute(
         (ny, nx) (the planner's inflated grid's free cells in the start's connected part);
         called only when a wait at a safe place is tried.
     plan_leg : callable
-        ``plan_leg(grid, start, goal, start_heading, movers)`` (:data:`PlanLeg`).
+        ``plan_leg(grid, start, goal, start_heading)`` (:data:`PlanLeg`).
 
     Returns
     -------
@@ -161,7 +149,7 @@ def reroute(
             if any(np.array_equal(marked.occupied, m.occupied) for m in marked_maps):
                 raise BlockedError("the same map as a candidate tried before")
             marked_maps.append(marked)
-            leg = plan_leg(marked, None, None, None, movers)
+            leg = plan_leg(marked, None, None, None)
             return retime_chain(leg, movers, margin=margin)
 
         return run
@@ -297,11 +285,11 @@ def _wait_at(
     plan_leg: PlanLeg,
 ) -> Callable[[], Any]:
     def run() -> Any:
-        first = retime_chain(plan_leg(grid, None, place, None, movers), movers, margin=margin)
+        first = retime_chain(plan_leg(grid, None, place, None), movers, margin=margin)
         t1 = float(first.duration)
         heading = float(first.sample(np.array([t1])).theta[0])
         seen = [shift_clock(m, t1) for m in movers]
-        second = plan_leg(grid, place, None, heading, seen)
+        second = plan_leg(grid, place, None, heading)
         second = retime_chain(second, seen, margin=margin)
         pieces = _pieces(first) + _pieces(second)
         starts = _starts(first) + _starts(second)

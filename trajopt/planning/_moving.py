@@ -9,7 +9,6 @@ same options on caches derived from the planner's. :meth:`trajopt.Planner.plan` 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -232,7 +231,6 @@ def _reroute(
         a: np.ndarray | None,
         b: np.ndarray | None,
         heading: float | None,
-        seen: Sequence[MovingObstacle],
     ) -> PlanResult:
         leg = request
         if a is not None:
@@ -241,12 +239,7 @@ def _reroute(
             leg = dataclasses.replace(
                 leg, goal=(float(b[0]), float(b[1])), goal_heading=None, goal_steer=None
             )
-        if _one_curve(robot, leg):  # a leg proved blocked is refused before its timing
-            leg = dataclasses.replace(leg, check_curve=_CurveProof(tuple(seen), margin, robot))
-        try:
-            return run_query(options, caches.derived(grid), leg)
-        except _PathBlocked as stop:
-            raise stop.blocked from None
+        return run_query(options, caches.derived(grid), leg)
 
     return reroute(
         p0, p1, robot, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg
