@@ -131,7 +131,8 @@ def plan_among_movers(
     Returns
     -------
     PlanResult
-        As :func:`plan_for_movers`.
+        As :func:`plan_for_movers`; a re-route's ``stats["moving"]["blocked_before_timing"]``
+        tells whether the static plan was proved blocked before its timing.
     """
     proof = None
     asked = request
@@ -141,10 +142,12 @@ def plan_among_movers(
     try:
         out = run_query(options, caches, asked)
     except _PathBlocked as stop:
-        curve = stop.curve
-        ends = np.asarray(curve(curve.u_at_s(np.array([0.0, float(curve.length)]))), dtype=float)
-        return _reroute(ends[0], ends[1], options.robot, movers, margin, stop.blocked, options,
-                        caches, request)  # fmt: skip
+        p0, p1 = _curve_ends(stop.curve)
+        out = _reroute(
+            p0, p1, options.robot, movers, margin, stop.blocked, options, caches, request
+        )
+        out.stats["moving"]["blocked_before_timing"] = True
+        return out
     return plan_for_movers(
         out, movers, margin, options, caches, request, proved=proof is not None and proof.ran
     )
@@ -201,10 +204,21 @@ def plan_for_movers(
         else:
             kept.stats["moving"]["route"] = "retimed"
             return kept
-    smp = out.sample(np.array([0.0, out.duration]))
-    p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
-    p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
-    return _reroute(p0, p1, out.robot, movers, margin, blocked, options, caches, request)
+    if out.single_curve and _one_curve(out.robot, request):  # as the proofs before the timing
+        p0, p1 = _curve_ends(out.path)
+    else:
+        smp = out.sample(np.array([0.0, out.duration]))
+        p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
+        p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
+    out = _reroute(p0, p1, out.robot, movers, margin, blocked, options, caches, request)
+    out.stats["moving"]["blocked_before_timing"] = False
+    return out
+
+
+def _curve_ends(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return a curve's first and last points (m), each shape (2,)."""
+    ends = np.asarray(curve(curve.u_at_s(np.array([0.0, float(curve.length)]))), dtype=float)
+    return ends[0].copy(), ends[1].copy()
 
 
 def _reroute(

@@ -179,6 +179,87 @@ def test_a_mover_that_has_passed_needs_no_reroute(loop):
     assert np.array_equal(out.path.curve.c, base.path.curve.c)
 
 
+def _after_timing(planner, start, goal, movers, margin):
+    """The plan among movers with every proof on the timed static plan (no early proof)."""
+    from trajopt.planning import PlanRequest, plan_for_movers, run_query
+
+    request = PlanRequest(start, goal)
+    static = run_query(planner.options, planner.caches, request)
+    return plan_for_movers(static, tuple(movers), margin, planner.options, planner.caches, request)
+
+
+def _same_plan(a, b):
+    assert type(a) is type(b)
+    assert a.stats["moving"]["route"] == b.stats["moving"]["route"]
+    assert a.stats["moving"]["plan"] == b.stats["moving"]["plan"]
+    assert a.duration == b.duration
+    t = np.linspace(0.0, a.duration, 301)
+    sa, sb = a.sample(t), b.sample(t)
+    for f in ("x", "y", "theta", "v"):
+        assert np.array_equal(getattr(sa, f), getattr(sb, f)), f
+
+
+@pytest.mark.parametrize("kind", ["stops", "head-on", "passes"])
+def test_proofs_before_the_timing_give_the_plan_of_the_proofs_after_it(loop, kind):
+    """A blocked static curve is re-routed without its timing, to the same plan as before."""
+    grid, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    planner.plan(start, goal)  # the caches built, as for both plans below
+    movers = {
+        "stops": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 3.0], [(6.0, 2.0), (6.0, 1.0)], radius=0.25, name="cart"
+            )
+        ],
+        "head-on": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 20.0], [(11.0, 1.0), (1.0, 1.0)], radius=0.2, name="walker"
+            )
+        ],
+        "passes": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 6.0, 9.0], [(6.0, 2.0), (6.0, 1.0), (6.0, 2.0)], radius=0.25, name="cart"
+            )
+        ],
+    }[kind]
+    early = planner.plan(start, goal, moving_obstacles=movers, mover_margin=0.02)
+    late = _after_timing(planner, start, goal, movers, 0.02)
+    _same_plan(early, late)
+    if kind == "passes":
+        assert early.stats["moving"]["route"] == "retimed"
+        assert "blocked_before_timing" not in early.stats["moving"]
+    else:  # the quick proofs hold on the curve: its timing was skipped
+        assert early.stats["moving"]["route"] == "rerouted"
+        assert early.stats["moving"]["blocked_before_timing"] is True
+        assert late.stats["moving"]["blocked_before_timing"] is False
+        _check(early, movers, grid, 0.02)
+
+
+def test_check_curve_sees_the_curve_the_plan_is_timed_on(loop):
+    """``PlanRequest.check_curve``: called once, on the returned plan's path, before timing."""
+    from trajopt.planning import PlanRequest, run_query
+
+    _, planner = loop
+    seen = []
+    request = PlanRequest((1.0, 1.0), (11.0, 1.0), check_curve=seen.append)
+    out = run_query(planner.options, planner.caches, request)
+    assert len(seen) == 1 and seen[0] is out.path
+    assert request == PlanRequest((1.0, 1.0), (11.0, 1.0))  # not part of the equality
+
+    class Stop(Exception):
+        pass
+
+    def refuse(curve):
+        raise Stop
+
+    with pytest.raises(Stop):
+        run_query(
+            planner.options,
+            planner.caches,
+            PlanRequest((1.0, 1.0), (11.0, 1.0), check_curve=refuse),
+        )
+
+
 def test_derived_caches_equal_fresh_caches_and_leave_the_planner_alone(loop):
     """A re-route's caches: built from the planner's, equal to a fresh build of the marked map."""
     grid, planner = loop
