@@ -245,13 +245,20 @@ def _reroute(
         a: np.ndarray | None,
         b: np.ndarray | None,
         heading: float | None,
+        goal_heading: float | None = None,
+        start_steer: float = 0.0,
     ) -> PlanResult:
         leg = request
         if a is not None:
-            leg = dataclasses.replace(leg, start=(float(a[0]), float(a[1])), start_heading=heading)
+            leg = dataclasses.replace(
+                leg,
+                start=(float(a[0]), float(a[1])),
+                start_heading=heading,
+                start_steer=start_steer,
+            )
         if b is not None:
             leg = dataclasses.replace(
-                leg, goal=(float(b[0]), float(b[1])), goal_heading=None, goal_steer=None
+                leg, goal=(float(b[0]), float(b[1])), goal_heading=goal_heading, goal_steer=None
             )
         return run_query(options, caches.derived(grid), leg)
 

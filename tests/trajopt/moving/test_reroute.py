@@ -102,6 +102,50 @@ def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
     assert np.hypot(end.x[0] - goal[0], end.y[0] - goal[1]) < 1e-6
 
 
+def test_a_car_waits_at_a_safe_place_with_a_heading():
+    """A car (no turn in place) meets a forklift head-on in a corridor with a side room: no
+    route avoids it, so it pulls aside facing on, waits, and drives on; the two legs join in
+    position, heading and steering."""
+    grid = _grid((120, 240), [(0.5, 11.5, 1.4, 2.6), (4.5, 8.5, 2.6, 5.0)])
+    robot = trajopt.Robot(
+        drive="ackermann", min_turning_radius=0.6, radius=0.2, wheelbase=0.3, steer_rate_max=1.0
+    )
+    planner = trajopt.Planner(grid, robot)
+    start, goal = (1.0, 2.0), (11.0, 2.0)
+    forklift = trajopt.MovingObstacle.constant_velocity(
+        (13.0, 2.0), (-0.5, 0.0), radius=0.2, horizon=30.0, name="forklift"
+    )
+    out = planner.plan(
+        start, goal, start_heading=0.0, goal_heading=0.0, moving_obstacles=[forklift],
+        mover_margin=0.02,
+    )  # fmt: skip
+    assert out.stats["moving"]["route"] == "waited"
+    last = out.stats["moving"]["reroute"][-1]
+    assert last["result"] == "ok" and "heading" in last["what"]
+    _check(out, [forklift], grid, 0.02)
+    dt = 1e-3
+    smp = out.sample(np.append(np.arange(0.0, out.duration, dt), out.duration))
+    step = np.hypot(np.diff(smp.x), np.diff(smp.y))
+    assert np.max(step) <= robot.v_max * dt * (1 + 1e-6) + 1e-9  # no jump at the join
+    assert np.max(np.abs(np.diff(np.unwrap(smp.theta)))) < 0.01  # |omega| dt, no jump
+    assert np.max(np.abs(np.diff(smp.steer))) <= 1.0 * dt + 1e-9  # steer_rate_max dt
+    for k, (p, h) in ((0, (start, 0.0)), (-1, (goal, 0.0))):
+        assert math.dist((smp.x[k], smp.y[k]), p) < 1e-6
+        assert abs(math.remainder(smp.theta[k] - h, 2 * math.pi)) < 1e-6
+    # it stood still on the way, aside: out of the forklift's lane (y <= 2.2, plus the car's
+    # radius and the margin)
+    t = smp.t
+    rest = (smp.v == 0.0) & (t > 1.0) & (t < out.duration - 1.0)
+    assert rest.any() and np.all(smp.y[rest] > 2.0 + 0.2 + 0.2 + 0.02)
+
+
+def test_car_headings_face_on_then_along_the_way_in():
+    place, p0, p1 = np.array([0.0, 0.0]), np.array([-1.0, 0.0]), np.array([0.0, 2.0])
+    assert trajopt.moving.car_headings(place, p0, p1) == pytest.approx([math.pi / 2, 0.0])
+    # both agree (on the straight line from the start to the goal): one heading
+    assert trajopt.moving.car_headings(place, p0, np.array([3.0, 0.0])) == [0.0]
+
+
 @pytest.fixture(scope="module")
 def loop():
     """Two 1 m corridors (y = 1 and y = 4) joined at both ends, and a niche at x = 6."""
