@@ -36,12 +36,16 @@ planned, or re-timed along its path), and for the re-plans that stopped and plan
 and the CPU time of the first (``time.process_time``: on a shared machine the wall time
 also counts the waits for a core).
 
+``--shape`` sets the movers' shapes in both parts: discs (the default), carts (convex
+rectangles heading along their motion, :mod:`benchmarks.moving_cases`) or a random mix.
+
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
 
     python benchmarks/bench_moving.py
     python benchmarks/bench_moving.py --quick
     python benchmarks/bench_moving.py --per-kind 20 --retime 30 --seed 1
+    python benchmarks/bench_moving.py --shape polygon
 """
 
 from __future__ import annotations
@@ -61,7 +65,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import astar  # noqa: E402
 import trajopt  # noqa: E402
 from benchmarks.bench_replan import queries, ros_dir  # noqa: E402
-from benchmarks.moving_cases import KINDS, make_movers  # noqa: E402
+from benchmarks.moving_cases import KINDS, SHAPES, make_movers  # noqa: E402
 from benchmarks.moving_witness import grid_optimum, path_blocked, waiting_witness  # noqa: E402
 from tests.trajopt.moving.reference import check_trajectory  # noqa: E402
 
@@ -84,7 +88,13 @@ def shifted(m, rng):
     keep = np.r_[True, np.diff(times) > 1e-9]
     pos = m.positions[keep] + rng.uniform(-0.1, 0.1, size=2)
     return trajopt.MovingObstacle.from_waypoints(
-        times[keep], pos, radius=m.radius, growth=m.growth, name=m.name
+        times[keep],
+        pos,
+        radius=m.radius,
+        growth=m.growth,
+        headings=m.headings[keep],
+        vertices=m.vertices,
+        name=m.name,
     )
 
 
@@ -97,11 +107,19 @@ def on_clock(movers, t0):
         times = m.times - t0
         k = max(int(np.searchsorted(times, 0.0, side="right")) - 1, 0)
         p0 = [np.interp(0.0, times, m.positions[:, i]) for i in (0, 1)]
+        h0 = np.interp(0.0, times, m.headings)
         t = np.r_[0.0, times[k + 1 :]] if times[-1] > 0 else np.zeros(1)
         p = np.vstack([p0, m.positions[k + 1 :]]) if times[-1] > 0 else np.array([p0])
+        h = np.r_[h0, m.headings[k + 1 :]] if times[-1] > 0 else np.array([h0])
         out.append(
             trajopt.MovingObstacle.from_waypoints(
-                t, p, radius=m.radius + m.growth * max(t0, 0.0), growth=m.growth, name=m.name
+                t,
+                p,
+                radius=m.radius + m.growth * max(t0, 0.0),
+                growth=m.growth,
+                headings=h,
+                vertices=m.vertices,
+                name=m.name,
             )
         )
     return out
@@ -159,13 +177,13 @@ def kind_line(kind, rows, gap):
     )
 
 
-def retime_part(maps, n_queries, seed):
+def retime_part(maps, n_queries, seed, shape="disc"):
     """Re-time latency when only the predictions change (module docstring)."""
     if n_queries <= 0:
         return
     print(
-        "\nre-time when only the predictions change: 10 movers (mixed), predictions shifted "
-        "by up to 0.3 s and 0.1 m, three times per query"
+        f"\nre-time when only the predictions change: 10 movers (mixed kinds, {shape} shapes), "
+        "predictions shifted by up to 0.3 s and 0.1 m, three times per query"
     )
     robot = trajopt.Robot(radius=0.2)
     # the re-plan with movers where the planner has it, else the re-timing on the path
@@ -180,7 +198,9 @@ def retime_part(maps, n_queries, seed):
         for qi, (start, goal) in enumerate(queries(grid, robot, n_queries, rng)):
             try:
                 static = planner.plan(start, goal)
-                movers = make_movers(static, "mixed", 10, seed * 100_000 + mi * 1000 + qi)
+                movers = make_movers(
+                    static, "mixed", 10, seed * 100_000 + mi * 1000 + qi, shape=shape
+                )
                 first = planner.plan(start, goal, moving_obstacles=movers, mover_margin=MARGIN)
             except trajopt.TrajoptError:
                 continue
@@ -249,6 +269,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dp-dt", type=float, default=0.05, help="lattice time step (s)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument(
+        "--shape",
+        choices=SHAPES,
+        default="disc",
+        help="the movers' shapes: discs, carts (convex polygons) or a random mix",
+    )
+    ap.add_argument(
         "--quick", action="store_true", help="one map; 2 per kind, 3 re-time queries unless given"
     )
     args = ap.parse_args(argv)
@@ -264,7 +290,8 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"robot radius {robot.radius} m, v_max {robot.v_max} m/s, a_max {robot.a_max} m/s^2; "
         f"mover margin {MARGIN} m; maps {', '.join(names)}; {args.per_kind} scenarios per "
-        f"kind and map, 1-{args.max_movers} movers; lattice dt {args.dp_dt} s"
+        f"kind and map, 1-{args.max_movers} movers ({args.shape} shapes); lattice dt "
+        f"{args.dp_dt} s"
     )
     rows = {k: [] for k in (*KINDS, "mixed")}
     gap, plain_ms = [], []
@@ -290,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
                 start, goal, static = statics[(i + ki) % len(statics)]
                 n = 1 + i % args.max_movers
                 seed = args.seed * 100_000 + mi * 10_000 + ki * 1000 + i
-                movers = make_movers(static, kind, n, seed, margin=MARGIN)
+                movers = make_movers(static, kind, n, seed, margin=MARGIN, shape=args.shape)
                 rows[kind].append(
                     run_scenario(planner, grid, static, start, goal, movers, args.dp_dt)
                 )
@@ -306,7 +333,7 @@ def main(argv: list[str] | None = None) -> int:
         f"plain plans (no movers) of the same queries: median {med(plain_ms[1:]):.1f} ms, "
         f"p95 {pct(plain_ms[1:], 95):.1f} ms (the first, cold, left out)"
     )
-    retime_part(maps, args.retime, args.seed)
+    retime_part(maps, args.retime, args.seed, args.shape)
     return 0
 
 

@@ -26,6 +26,15 @@ the query's time less its plain plan's and the proof's (a difference of wall tim
 noisy). ``cpu ms`` is the query's CPU time (``time.process_time``). The machine is shared:
 times are noisy.
 
+A second table splits the re-routes' wall time (medians, ms; ``x plain``: each part over the
+query's plain plan): ``static`` (the static plan and the proof that it is blocked: the
+query's time less ``reroute ms``; the timing is skipped where the proof holds on the curve,
+``stats["moving"]["blocked_before_timing"]``, counted in ``early``), ``leg`` (the
+returned route's own plan, its ``stats["stages_s"]``: ``search``, ``smooth`` with the
+corridor, ``timing``), ``retime`` (its re-timing and certificate for the movers,
+``stats["moving"]["time_s"]``) and ``other`` (the rest of ``reroute ms``: marking the map,
+the derived caches, candidates tried before).
+
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
 
@@ -111,6 +120,53 @@ def proof_time(base, mover):
     return time.perf_counter() - t0
 
 
+def split(out, took: float, plain: float) -> dict[str, float]:
+    """The parts (ms) of a re-routed query's wall time ``took`` (s); ``x``: over ``plain``."""
+    mv = out.stats["moving"]
+    rr = mv["reroute_time_s"]
+    st = out.stats["stages_s"]
+    leg = st["total"]
+    parts = {
+        "static": took - rr,
+        "search": st.get("search", 0.0),
+        "smooth": st.get("smooth", 0.0) + st.get("corridor", 0.0),
+        "timing": st.get("timing", 0.0),
+        "leg": leg,
+        "retime": mv["time_s"],
+        "other": rr - leg - mv["time_s"],
+    }
+    out_ms = {k: 1e3 * v for k, v in parts.items()}
+    out_ms.update({f"x {k}": v / plain for k, v in parts.items() if k in PARTS_X})
+    out_ms["early"] = float(bool(mv.get("blocked_before_timing")))
+    return out_ms
+
+
+#: The parts also given as a ratio to the plain plan.
+PARTS_X = ("static", "leg", "retime", "other")
+
+
+def print_split(split_rows) -> None:
+    """Print the second table: the medians of each re-route kind's parts."""
+    if not split_rows:
+        return
+    keys = ("static", "search", "smooth", "timing", "leg", "retime", "other")
+    print()
+    print(
+        f"{'re-routes: ms':18s} {'kind':8s} {'n':>3s} {'early':>5s} "
+        + " ".join(f"{k:>7s}" for k in keys)
+        + " "
+        + " ".join(f"{'x ' + k:>8s}" for k in PARTS_X)
+    )
+    for name, kind, parts in split_rows:
+        n = len(parts["leg"])
+        print(
+            f"{name:18s} {kind:8s} {n:3d} {int(sum(parts['early'])):5d} "
+            + " ".join(f"{statistics.median(parts[k]):7.1f}" for k in keys)
+            + " "
+            + " ".join(f"{statistics.median(parts['x ' + k]):8.2f}" for k in PARTS_X)
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--queries", type=int, default=6, help="queries per map")
@@ -130,6 +186,7 @@ def main() -> None:
         f"{'cpu ms':>7s} {'raise ms':>8s}"
     )
     ratios_all: dict[str, list[float]] = {}
+    split_rows: list[tuple[str, str, dict[str, list[float]]]] = []
     raises: list[float] = []
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
@@ -173,6 +230,10 @@ def main() -> None:
                 row["out"][what] = row["out"].get(what, 0) + 1
                 row["t0"].append(1e3 * plain)
                 row["t1"].append(1e3 * took)
+                if what == "rerouted":
+                    parts = split(out, took, plain)
+                    for key, val in parts.items():
+                        row.setdefault("parts", {}).setdefault(key, []).append(val)
                 if what in ("rerouted", "waited"):
                     rr = out.stats["moving"]["reroute_time_s"]
                     row["rr"].append(1e3 * rr)
@@ -196,6 +257,10 @@ def main() -> None:
                 f"{statistics.median(row['cpu']):7.1f} "
                 f"{(statistics.median(row['raise']) if row['raise'] else math.nan):8.1f}"
             )
+        for kind, row in rows.items():
+            if row.get("parts"):
+                split_rows.append((name, kind, row["parts"]))
+    print_split(split_rows)
     if raises:
         print(
             f"all maps, from the proof to the BlockedError: median {statistics.median(raises):.1f} "

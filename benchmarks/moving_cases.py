@@ -1,7 +1,11 @@
 """Seeded moving-obstacle scenarios placed from a static plan (issue 46), for the benchmark and tests.
 
-Every mover is placed from the static plan's own motion so that it meets the robot (a disc
-mover, radius 0.15-0.35 m, speed 0.3-1.5 m/s; its prediction starts at ``t = 0``):
+Every mover is placed from the static plan's own motion so that it meets the robot (speed
+0.3-1.5 m/s; its prediction starts at ``t = 0``). Its shape (``shape``): a disc of radius
+0.15-0.35 m (``"disc"``), or a cart (``"polygon"``): a rectangle 0.5-1.2 m long and 0.4-0.7 m
+wide, rounded by 0.05 m, heading along its motion (at each waypoint the direction of the
+segment that leaves it; turning linearly in time between waypoints, the shorter way);
+``"mixed"`` draws each mover's shape at random. The kinds:
 
 * ``crossing``: crosses the path at a random point of its middle 70 %, at 60-120 degrees
   to it, reaching that point within 1 s of the time the static plan gets there, and goes
@@ -34,10 +38,14 @@ import numpy as np
 import trajopt
 
 KINDS = ("crossing", "head-on", "following", "overtaking", "stopping")
+#: the movers' shapes (module docstring)
+SHAPES = ("disc", "polygon", "mixed")
 #: the kinds a ``mixed`` scenario draws from (each mover its own)
 MIXED = ("crossing", "head-on", "following", "overtaking")
 SPEED = (0.3, 1.5)
 RADIUS = (0.15, 0.35)
+#: a cart's length and width (m) and rounding (m)
+CART_LENGTH, CART_WIDTH, CART_ROUNDING = (0.5, 1.2), (0.4, 0.7), 0.05
 
 
 @dataclass(frozen=True)
@@ -109,8 +117,40 @@ def _route(points: np.ndarray, at: int, t_at: float, speed: float):
     return times, points
 
 
-def draw_mover(track: PathTrack, kind: str, rng: np.random.Generator, name: str):
-    """One mover of ``kind`` (module docstring) placed from ``track``."""
+def headings_along(positions: np.ndarray) -> np.ndarray:
+    """Headings (rad, unwrapped, shape (k,)) along waypoints ``positions`` (m, shape (k, 2)).
+
+    At each waypoint the direction of the segment that leaves it (the last one keeps the last
+    segment's); unwrapped, so that the linear interpolation between two waypoints turns the
+    shorter way.
+    """
+    d = np.diff(positions, axis=0)
+    if d.shape[0] == 0:
+        return np.zeros(1)
+    h = np.arctan2(d[:, 1], d[:, 0])
+    return np.unwrap(np.r_[h, h[-1]])
+
+
+def cart(rng: np.random.Generator) -> np.ndarray:
+    """A cart's rectangle in its own frame (m, shape (4, 2), counter-clockwise), seeded."""
+    half_l = 0.5 * float(rng.uniform(*CART_LENGTH))
+    half_w = 0.5 * float(rng.uniform(*CART_WIDTH))
+    return np.array([[-half_l, -half_w], [half_l, -half_w], [half_l, half_w], [-half_l, half_w]])
+
+
+def reach(mover) -> float:
+    """How far the mover's shape reaches from its reference point (m): radius plus vertices."""
+    if mover.vertices is None:
+        return float(mover.radius)
+    return float(mover.radius) + float(np.max(np.hypot(*np.asarray(mover.vertices).T)))
+
+
+def draw_mover(
+    track: PathTrack, kind: str, rng: np.random.Generator, name: str, shape: str = "disc"
+):
+    """One mover of ``kind`` and ``shape`` (module docstring) placed from ``track``."""
+    if shape not in SHAPES:
+        raise ValueError(f"shape must be one of {SHAPES}, got {shape!r}")
     radius = float(rng.uniform(*RADIUS))
     sign = float(rng.choice([-1.0, 1.0]))
     L = track.length
@@ -154,7 +194,18 @@ def draw_mover(track: PathTrack, kind: str, rng: np.random.Generator, name: str)
         times, pos = _route(np.vstack([enter, p]), 1, t_c, speed)
     else:
         raise ValueError(f"kind must be one of {KINDS + ('mixed',)}, got {kind!r}")
-    return trajopt.MovingObstacle.from_waypoints(times, pos, radius=radius, name=name)
+    if shape == "mixed":
+        shape = str(rng.choice(("disc", "polygon")))
+    if shape == "disc":
+        return trajopt.MovingObstacle.from_waypoints(times, pos, radius=radius, name=name)
+    return trajopt.MovingObstacle.from_waypoints(
+        times,
+        pos,
+        radius=CART_ROUNDING,
+        vertices=cart(rng),
+        headings=headings_along(np.asarray(pos, dtype=float)),
+        name=name,
+    )
 
 
 def kinds_of(kind: str, n: int, rng: np.random.Generator) -> list[str]:
@@ -166,7 +217,7 @@ def kinds_of(kind: str, n: int, rng: np.random.Generator) -> list[str]:
     return [kind] + ["crossing"] * (n - 1)
 
 
-def make_movers(traj, kind: str, n: int, seed: int, *, margin: float = 0.0):
+def make_movers(traj, kind: str, n: int, seed: int, *, margin: float = 0.0, shape: str = "disc"):
     """``n`` movers of a ``kind`` scenario around the static plan ``traj`` (seeded).
 
     Parameters
@@ -181,7 +232,10 @@ def make_movers(traj, kind: str, n: int, seed: int, *, margin: float = 0.0):
         Seed of ``numpy.random.default_rng``.
     margin : float
         The mover margin (m) the scenario is run with: a mover is drawn again while it starts
-        closer than ``robot radius + its radius + margin + 0.1`` m to the robot.
+        closer than ``robot radius + its reach + margin + 0.1`` m to the robot (its reach:
+        :func:`reach`).
+    shape : str
+        One of :data:`SHAPES` (module docstring); the default ``"disc"``.
 
     Returns
     -------
@@ -195,9 +249,9 @@ def make_movers(traj, kind: str, n: int, seed: int, *, margin: float = 0.0):
     out = []
     for i, k in enumerate(kinds_of(kind, n, rng)):
         for _ in range(50):
-            m = draw_mover(track, k, rng, f"{k}-{i}")
+            m = draw_mover(track, k, rng, f"{k}-{i}", shape)
             gap = float(np.hypot(*(m.positions[0] - start)))
-            if gap >= traj.robot.radius + m.radius + margin + 0.1:
+            if gap >= traj.robot.radius + reach(m) + margin + 0.1:
                 out.append(m)
                 break
     return tuple(out)

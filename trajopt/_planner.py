@@ -80,7 +80,7 @@ from trajopt.planning import (
     PlanSteps,
     Search,
     SearchMode,
-    plan_for_movers,
+    plan_among_movers,
     run_query,
 )
 from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
@@ -378,9 +378,10 @@ class Planner:
         )
         with self._lock:
             t0 = time.perf_counter()
-            out = run_query(self.options, self.caches, request)
             if movers:
-                out = plan_for_movers(out, movers, margin, self.options, self.caches, request)
+                out = plan_among_movers(movers, margin, self.options, self.caches, request)
+            else:
+                out = run_query(self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
 
@@ -512,9 +513,8 @@ class Planner:
                         start_steer=steer,
                         goal_steer=getattr(steps, "goal_steer", None),
                     )
-                    static = run_query(self.options, self.caches, request)
-                    return plan_for_movers(
-                        static, tuple(seen), margin, self.options, self.caches, request
+                    return plan_among_movers(
+                        tuple(seen), margin, self.options, self.caches, request
                     )
 
                 ts = float(out.stats["splice_time_s"])

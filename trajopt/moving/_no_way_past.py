@@ -79,7 +79,8 @@ def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[t
     (``m = ceil(speed dt / ds) + 1``), where the robot can be at ``t_{k-1}``, when ``j`` is
     free at ``t_k`` and within ``s_up[k] + ds/2``, and the robot then stays there until the
     free interval ends: each node's reachable times are a few intervals, the tails of its free
-    ones.
+    ones. Once ``m`` nodes in a row are never reachable, no node after them is (each is
+    entered only from the ``m`` before it): the sweep stops there.
 
     Parameters
     ----------
@@ -107,6 +108,9 @@ def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[t
     first = _free(runs[ptr[0] : ptr[1]], 0)
     reach.append([first[0]] if first and first[0][0] == 0 else [])
     for j in range(1, n):
+        if j >= m and not any(reach[j - m : j]):  # no way into j, nor into any node after it
+            reach += [[] for _ in range(n - j)]
+            break
         came = [(a + 1, b + 1) for i in range(max(0, j - m), j) for a, b in reach[i]]
         got = []
         if came:

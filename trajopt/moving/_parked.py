@@ -81,6 +81,14 @@ def parked_on_path(
     if not curves or not movers:
         return None
     robot = plan.robot
+    back = getattr(robot.drive, "v_max_backwards", None)
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    t_stops = [max(settle_time(m), 0.0) for m in movers]
+    reaches = [
+        float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max)[0]) for t in t_stops
+    ]
+    if min(reaches) >= sum(float(c.length) for c in curves):
+        return None  # the robot may be past the whole path before any mover stands still
     pts, s_all, off = [], [], 0.0
     for c in curves:
         n = max(2, int(np.ceil(c.length / PARKED_DS)) + 1)
@@ -90,14 +98,12 @@ def parked_on_path(
         off += float(c.length)
     p = np.concatenate(pts)
     s_cum = np.concatenate(s_all)
-    back = getattr(robot.drive, "v_max_backwards", None)
-    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
-    for m in movers:
-        t_stop = max(settle_time(m), 0.0)
+    for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
+        if reach >= off:
+            continue  # no point of the path lies beyond it
         shape = shape_at(m, np.array([t_stop]))
         d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
         limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
-        reach = float(reach_bound(np.array([t_stop]), v_top, robot.a_max, robot.j_max)[0])
         hit = (d < limit) & (s_cum > reach)
         if hit.any():
             i = int(np.argmax(hit))

@@ -16,15 +16,17 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    that never meets it, so its re-timing is mostly the certificate alone; then with its region
    over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
    stops, or round the rest of its track;
-3. ``"waited"`` (a robot that turns in place: differential or omni): drive to a **safe
-   place**, wait there until the way is clear, drive to the goal. A safe place is a cell
+3. ``"waited"``: drive to a **safe place**, wait there until the way is clear, drive to the
+   goal. A safe place is a cell
    where the robot's centre may stand on the static map and that keeps the robot's radius
    plus the margin from every mover's whole swept region; the candidates, at least a metre apart, are those with the shortest
    straight-line detour ``|start - p| + |p - goal|``. The first leg is re-timed for the movers
    (standing at the safe place is safe whenever it arrives), the second leg, from the first's
    end heading (a turn in place), on the clock from the first's arrival
    (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified whole (with an omni
-   orientation, by the two legs' certificates on their clocks).
+   orientation, by the two legs' certificates on their clocks). A car, which cannot turn in
+   place, stands there with a heading (:func:`car_headings`: towards the goal, else along its
+   way in); the second leg leaves with the first's end heading and last steering angle.
 
 A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
 (its reason kept). When none works, the original :class:`BlockedError` is raised again (it
@@ -55,23 +57,19 @@ N_SAFE_PLACES = 2
 #: Smallest distance (m) between two safe places tried.
 SAFE_PLACE_SPACING = 1.0
 
-#: ``plan_leg(grid, start, goal, start_heading)``: a plan from rest to rest on ``grid`` (the
-#: planner's stages and options), raising a :class:`TrajoptError` when it fails. ``start``
-#: ``None``: the query's start (with its heading); else a point (m) left with
-#: ``start_heading`` (rad). ``goal`` ``None``: the query's goal (with its heading); else a
-#: point (m) reached with a free heading.
-PlanLeg = Callable[[OccupancyGrid, "np.ndarray | None", "np.ndarray | None", "float | None"], Any]
-
-
-def _ends(plan: Any) -> tuple[np.ndarray, np.ndarray, float, float]:
-    smp = plan.sample(np.array([0.0, plan.duration]))
-    p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
-    p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
-    return p0, p1, float(smp.theta[0]), float(smp.theta[1])
+#: ``plan_leg(grid, start, goal, start_heading, goal_heading=None, start_steer=0.0)``: a plan
+#: from rest to rest on ``grid`` (the planner's stages and options), raising a
+#: :class:`TrajoptError` when it fails. ``start`` ``None``: the query's start (with its
+#: heading and steering); else a point (m) left with ``start_heading`` (rad) and a car's
+#: steering angle ``start_steer`` (rad). ``goal`` ``None``: the query's goal (with its heading);
+#: else a point (m) reached with ``goal_heading`` (rad; ``None``: free, a car needs one).
+PlanLeg = Callable[..., Any]
 
 
 def reroute(
-    plan: Any,
+    start: np.ndarray,
+    goal: np.ndarray,
+    robot: Any,
     movers: Sequence[MovingObstacle],
     margin: float,
     blocked: BlockedError,
@@ -84,14 +82,17 @@ def reroute(
 
     Parameters
     ----------
-    plan : PlanResult
-        The static plan whose re-timing was blocked (its ends are the query's).
+    start, goal : ndarray, shape (2,)
+        The query's ends (m): those of the static plan whose re-timing is blocked.
+    robot : Robot
+        The robot (its radius, drive and limits).
     movers : sequence of MovingObstacle
         The predictions.
     margin : float
         Extra distance to every mover (m).
     blocked : BlockedError
-        What the re-timing of ``plan`` raised (its ``mover`` and ``t``).
+        The proof that the static plan's path is blocked, or what its re-timing raised (its
+        ``mover`` and ``t``).
     grid : astar.OccupancyGrid
         The raw map.
     free : callable
@@ -99,7 +100,8 @@ def reroute(
         (ny, nx) (the planner's inflated grid's free cells in the start's connected part);
         called only when a wait at a safe place is tried.
     plan_leg : callable
-        ``plan_leg(grid, start, goal, start_heading)`` (:data:`PlanLeg`).
+        ``plan_leg(grid, start, goal, start_heading, goal_heading, start_steer)``
+        (:data:`PlanLeg`).
 
     Returns
     -------
@@ -114,8 +116,8 @@ def reroute(
         No candidate works: ``blocked``'s mover and time, the candidates' reasons appended.
     """
     t_all = time.perf_counter()
-    p0, p1, _, _ = _ends(plan)
-    robot = plan.robot
+    p0 = np.asarray(start, dtype=float).reshape(2)
+    p1 = np.asarray(goal, dtype=float).reshape(2)
     keep = [(p0, robot.radius + 2.0 * grid.resolution), (p1, robot.radius + 2.0 * grid.resolution)]
     by_name = {m.name: m for m in movers}
     tried: list[dict[str, str]] = []
@@ -173,20 +175,23 @@ def reroute(
             )
             if out is not None:
                 return out
-    if robot.drive.turns_in_place and not robot.drive.signed_speed:
+    turns = robot.drive.turns_in_place and not robot.drive.signed_speed
+    if turns or not robot.drive.turns_in_place:  # a car stands at the place with a heading
         room = free()
         places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
         places = [
             p for p in places if _joined_at_last(grid, room, movers, robot.radius + margin, p, p1)
         ]
         for place in places:
-            out = attempt(
-                f"wait at ({place[0]:.2f}, {place[1]:.2f}) m",
-                _wait_at(place, movers, margin, grid, plan_leg),
-                "waited",
-            )
-            if out is not None:
-                return out
+            for heading in [None] if turns else car_headings(place, p0, p1):
+                at = "" if heading is None else f", heading {heading:.3f} rad"
+                out = attempt(
+                    f"wait at ({place[0]:.2f}, {place[1]:.2f}) m{at}",
+                    _wait_at(place, heading, movers, margin, grid, plan_leg),
+                    "waited",
+                )
+                if out is not None:
+                    return out
     reasons = "; ".join(f"{c['what']}: {c['result']}" for c in tried)
     raise BlockedError(
         f"{blocked} (no re-route either: {reasons or 'none tried'})",
@@ -279,19 +284,41 @@ def _joined_at_last(
     return bool(a > 0 and a == b)
 
 
+def car_headings(place: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> list[float]:
+    """Return the headings (rad) a car is to stand with at a safe place, in the order tried.
+
+    Facing on towards the goal (it then drives off forwards), then along the way it came from
+    the start (it drives in forwards); one of them when both agree within a degree.
+    """
+    out: list[float] = []
+    for a, b in ((place, p1), (p0, place)):
+        d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
+        if math.hypot(*d) == 0.0:
+            continue
+        h = math.atan2(float(d[1]), float(d[0]))
+        if all(abs(math.remainder(h - g, 2.0 * math.pi)) > math.radians(1.0) for g in out):
+            out.append(h)
+    return out
+
+
 def _wait_at(
     place: np.ndarray,
+    heading: float | None,
     movers: Sequence[MovingObstacle],
     margin: float,
     grid: OccupancyGrid,
     plan_leg: PlanLeg,
 ) -> Callable[[], Any]:
+    """Return the wait at ``place`` (a car stands there with ``heading``, rad; else free)."""
+
     def run() -> Any:
-        first = retime_chain(plan_leg(grid, None, place, None), movers, margin=margin)
+        first = plan_leg(grid, None, place, None, heading, 0.0)
+        first = retime_chain(first, movers, margin=margin)
         t1 = float(first.duration)
-        heading = float(first.sample(np.array([t1])).theta[0])
+        end = first.sample(np.array([t1]))
+        steer = 0.0 if getattr(end, "steer", None) is None else float(end.steer[0])
         seen = [shift_clock(m, t1) for m in movers]
-        second = plan_leg(grid, place, None, heading)
+        second = plan_leg(grid, place, None, float(end.theta[0]), None, steer)
         second = retime_chain(second, seen, margin=margin)
         pieces = _pieces(first) + _pieces(second)
         starts = _starts(first) + _starts(second)

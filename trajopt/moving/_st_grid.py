@@ -30,6 +30,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._disc_windows import inside_times, near_pairs
@@ -298,7 +299,6 @@ def st_grid(
     STGrid
     """
     s, ds = grid_nodes(length, ds)
-    n = s.shape[0]
     kk = max(2, int(math.ceil(horizon / dt)) + 1)
     t = np.arange(kk) * dt
     pts = path_points(path, s) if points is None else points
@@ -317,6 +317,7 @@ def st_grid(
         stretch = 1.0
     runs: list[tuple[np.ndarray, ...]] = []
     discs: list[tuple[int, MovingObstacle, float]] = []
+    tree: cKDTree | None = None
     for j, m in enumerate(movers):
         if sufficient:
             pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
@@ -325,16 +326,10 @@ def st_grid(
         if polys is None and m.vertices is None:
             discs.append((j, m, pad))
             continue
-        lim = limit + m.radius_at(t) + pad  # (K,)
-        hit = np.zeros((kk, n), dtype=bool)
-        shapes = shape_at(m, t)  # (K, m, 2)
-        for k in range(kk):
-            w = np.broadcast_to(shapes[k], (n, *shapes[k].shape))
-            if polys is not None:
-                hit[k] = convex_distance(polys, w) < lim[k]
-            else:
-                hit[k] = point_polygon_distance(pts, w) < lim[k]
-        runs.append(_runs_of(hit, j))
+        if tree is None:
+            tree = cKDTree(pts)
+        lim = limit + m.radius_at(t) + pad
+        runs.append(_runs_of(_shape_hits(pts, polys, m, t, lim, tree), j))
     if discs:
         after = None
         if leave is not None:
@@ -346,6 +341,42 @@ def st_grid(
         col = lo = hi = owner = np.zeros(0, dtype=np.int64)
     hi = np.where(hi >= kk - 1, FOREVER, hi)
     return STGrid(s, t, ds, float(dt), col, lo, hi, owner)
+
+
+def _shape_hits(
+    pts: np.ndarray,
+    polys: np.ndarray | None,
+    mover: MovingObstacle,
+    t: np.ndarray,
+    lim: np.ndarray,
+    tree: cKDTree,
+) -> np.ndarray:
+    """Return whether each node is closer than ``lim[k]`` (m) to ``mover``'s shape at ``t[k]``, shape (K, n).
+
+    The robot is the point ``pts[i]`` (m, shape (n, 2)), or the convex polygon ``polys[i]``
+    (shape (n, mb, 2)) with a footprint; ``tree`` is the k-d tree of ``pts``. An exact filter
+    first: both shapes lie within their reaches (the farthest vertex from the reference
+    point) of the mover's reference point and of the node, so their (signed) distance is at
+    least the reference points' distance minus both reaches, and a pair farther apart than
+    ``lim + both reaches`` is clear. The k-d tree finds the other pairs; only they are
+    measured (:func:`point_polygon_distance` or :func:`convex_distance`), in one batch.
+    """
+    centre, _ = mover.pose_at(t)  # (K, 2)
+    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
+    if polys is not None:
+        reach += float(np.max(np.hypot(*(polys - pts[:, None, :]).reshape(-1, 2).T)))
+    hit = np.zeros((t.shape[0], pts.shape[0]), dtype=bool)
+    # 1 nm above the bound: rounding of the reaches never drops a pair the exact test hits
+    near = tree.query_ball_point(centre, np.maximum(lim + reach + 1e-9, 0.0))
+    counts = np.fromiter((len(c) for c in near), dtype=np.int64, count=len(near))
+    if counts.sum() == 0:
+        return hit
+    kk = np.repeat(np.arange(t.shape[0]), counts)
+    ii = np.fromiter((i for c in near for i in c), dtype=np.int64, count=int(counts.sum()))
+    w = shape_at(mover, t[kk])  # (p, m, 2)
+    d = point_polygon_distance(pts[ii], w) if polys is None else convex_distance(polys[ii], w)
+    hit[kk, ii] = d < lim[kk]
+    return hit
 
 
 def grid_nodes(length: float, ds: float) -> tuple[np.ndarray, float]:

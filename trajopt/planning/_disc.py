@@ -128,6 +128,8 @@ def plan_disc(
     smooth = None
     try:
         smooth = _smooth(options, caches.grid, q)
+        if request.check_curve is not None and footprint is None and path_check is None:
+            request.check_curve(smooth)
         try:
             traj = _time(options, q, smooth)
         except TimingError:

@@ -9,6 +9,8 @@ same options on caches derived from the planner's. :meth:`trajopt.Planner.plan` 
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -25,6 +27,130 @@ from trajopt.moving import (
 from trajopt.planning._caches import PlannerCaches
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query
+from trajopt.robot import Robot, State
+
+
+@dataclass(frozen=True)
+class _Curve:
+    """A certified curve as the proofs read a plan: one curve of ``robot``, not yet timed."""
+
+    path: Any
+    robot: Robot
+    own_orientation: bool = False
+    single_curve: bool = True
+
+    @property
+    def length(self) -> float:
+        return float(self.path.length)
+
+
+class _PathBlocked(Exception):
+    """Raised through the stages by :class:`_CurveProof` when the curve is proved blocked."""
+
+    def __init__(self, blocked: BlockedError, curve: Any):
+        super().__init__(str(blocked))
+        self.blocked = blocked
+        self.curve = curve
+
+
+class _CurveProof:
+    """``request.check_curve`` of a plan among movers: the quick proofs on the curve."""
+
+    def __init__(self, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot):
+        self.movers, self.margin, self.robot = movers, margin, robot
+        self.ran = False
+
+    def __call__(self, curve: Any) -> None:
+        blocked = _quick_proofs(_Curve(curve, self.robot), self.movers, self.margin)
+        self.ran = True
+        if blocked is not None:
+            raise _PathBlocked(blocked, curve)
+
+
+def _quick_proofs(
+    plan: Any, movers: tuple[MovingObstacle, ...], margin: float
+) -> BlockedError | None:
+    """Return the first quick proof that the plan's path is blocked, or ``None``."""
+    blocked = parked_on_path(plan, movers, margin)
+    if blocked is None:
+        blocked = no_way_past(plan, movers, margin)
+    return blocked
+
+
+def _one_curve(robot: Robot, request: PlanRequest) -> bool:
+    """Whether the static plan is the certified curve of the disc stages, timed from rest.
+
+    A differential drive's disc robot (it turns in place, faces its travel, drives forwards)
+    with no heading given and at rest at both ends plans one curve (:func:`~trajopt.planning.plan_turning` runs the disc stages,
+    :func:`~trajopt.planning._disc.plan_disc`, once, on this request).
+    """
+    drive = robot.drive
+    return (
+        drive.turns_in_place
+        and not drive.orients_body
+        and not drive.signed_speed
+        and robot.footprint is None
+        and not isinstance(request.start, State)
+        and request.start_heading is None
+        and request.goal_heading is None
+        and request.v_start == 0.0
+        and request.v_end == 0.0
+    )
+
+
+def plan_among_movers(
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+) -> PlanResult:
+    """Plan a query among movers (:meth:`trajopt.Planner.plan` with ``moving_obstacles``).
+
+    The static plan (:func:`~trajopt.planning.run_query`) made into one certified against
+    the movers by :func:`plan_for_movers`. For a single curve (:func:`_one_curve`) the quick
+    proofs (:func:`trajopt.moving.parked_on_path`, :func:`trajopt.moving.no_way_past`) run
+    on the certified curve before the timing (``request.check_curve``): they read only the
+    path and the robot's limits, so they decide there what they decide on the timed plan,
+    and a path they prove blocked is re-routed at once (:func:`trajopt.moving.reroute`)
+    without timing it.
+
+    Parameters
+    ----------
+    movers : tuple of MovingObstacle
+        The predictions (checked, non-empty).
+    margin : float
+        Extra distance to every mover (m).
+    options : PlannerOptions
+        The planner's options.
+    caches : PlannerCaches
+        The planner's caches of the map.
+    request : PlanRequest
+        The query.
+
+    Returns
+    -------
+    PlanResult
+        As :func:`plan_for_movers`; a re-route's ``stats["moving"]["blocked_before_timing"]``
+        tells whether the static plan was proved blocked before its timing.
+    """
+    proof = None
+    asked = request
+    if _one_curve(options.robot, request):
+        proof = _CurveProof(movers, margin, options.robot)
+        asked = dataclasses.replace(request, check_curve=proof)
+    try:
+        out = run_query(options, caches, asked)
+    except _PathBlocked as stop:
+        p0, p1 = _curve_ends(stop.curve)
+        out = _reroute(
+            p0, p1, options.robot, movers, margin, stop.blocked, options, caches, request
+        )
+        out.stats["moving"]["blocked_before_timing"] = True
+        return out
+    return plan_for_movers(
+        out, movers, margin, options, caches, request, proved=proof is not None and proof.ran
+    )
 
 
 def plan_for_movers(
@@ -34,8 +160,10 @@ def plan_for_movers(
     options: PlannerOptions,
     caches: PlannerCaches,
     request: PlanRequest,
+    *,
+    proved: bool = False,
 ) -> PlanResult:
-    """Re-time a plan for movers, or re-route it (:meth:`trajopt.Planner.plan`); refuse what is not covered.
+    """Re-time a plan for movers, or re-route it; refuse what is not covered.
 
     The static plan is re-timed on one clock (:func:`trajopt.moving.retime_chain`), unless a
     mover parked on its path provably blocks it (:func:`trajopt.moving.parked_on_path`) or no
@@ -43,6 +171,19 @@ def plan_for_movers(
     it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
     swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
     planner's options, on caches derived from the planner's for the marked map).
+
+    Parameters
+    ----------
+    out : PlanResult
+        The static plan of ``request``.
+    movers : tuple of MovingObstacle
+        The predictions.
+    margin : float
+        Extra distance to every mover (m).
+    options, caches, request
+        The planner's options and caches, and the query (its legs are planned with them).
+    proved : bool
+        The quick proofs already ran on ``out``'s path and found nothing (skipped here).
     """
     if out.v_start != 0.0:
         raise InvalidInputError(
@@ -54,9 +195,7 @@ def plan_for_movers(
             "moving_obstacles are not covered for the stop-and-turn fallback's polyline "
             f"(stats['fallback'] = {out.stats.get('fallback')!r}): plan without the fallback"
         )
-    blocked = parked_on_path(out, movers, margin)  # quick proofs, before the search's
-    if blocked is None:
-        blocked = no_way_past(out, movers, margin)
+    blocked = None if proved else _quick_proofs(out, movers, margin)  # before the search's
     if blocked is None:
         try:
             kept = retime_chain(out, movers, margin=margin)
@@ -65,29 +204,64 @@ def plan_for_movers(
         else:
             kept.stats["moving"]["route"] = "retimed"
             return kept
+    if out.single_curve and _one_curve(out.robot, request):  # as the proofs before the timing
+        p0, p1 = _curve_ends(out.path)
+    else:
+        smp = out.sample(np.array([0.0, out.duration]))
+        p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
+        p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
+    out = _reroute(p0, p1, out.robot, movers, margin, blocked, options, caches, request)
+    out.stats["moving"]["blocked_before_timing"] = False
+    return out
+
+
+def _curve_ends(curve: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return a curve's first and last points (m), each shape (2,)."""
+    ends = np.asarray(curve(curve.u_at_s(np.array([0.0, float(curve.length)]))), dtype=float)
+    return ends[0].copy(), ends[1].copy()
+
+
+def _reroute(
+    p0: np.ndarray,
+    p1: np.ndarray,
+    robot: Robot,
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    blocked: BlockedError,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+) -> PlanResult:
+    """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here."""
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
         inflated = np.asarray(caches.inflated.occupied)
-        smp = out.sample(np.array([0.0]))
-        ix, iy = (int(c) for c in caches.grid.world_to_cell((float(smp.x[0]), float(smp.y[0]))))
+        ix, iy = (int(c) for c in caches.grid.world_to_cell((float(p0[0]), float(p0[1]))))
         labels = caches.components
         return ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
 
     def plan_leg(
         grid: OccupancyGrid,
-        p0: np.ndarray | None,
-        p1: np.ndarray | None,
+        a: np.ndarray | None,
+        b: np.ndarray | None,
         heading: float | None,
+        goal_heading: float | None = None,
+        start_steer: float = 0.0,
     ) -> PlanResult:
         leg = request
-        if p0 is not None:
+        if a is not None:
             leg = dataclasses.replace(
-                leg, start=(float(p0[0]), float(p0[1])), start_heading=heading
+                leg,
+                start=(float(a[0]), float(a[1])),
+                start_heading=heading,
+                start_steer=start_steer,
             )
-        if p1 is not None:
+        if b is not None:
             leg = dataclasses.replace(
-                leg, goal=(float(p1[0]), float(p1[1])), goal_heading=None, goal_steer=None
+                leg, goal=(float(b[0]), float(b[1])), goal_heading=goal_heading, goal_steer=None
             )
         return run_query(options, caches.derived(grid), leg)
 
-    return reroute(out, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg)
+    return reroute(
+        p0, p1, robot, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg
+    )

@@ -9,7 +9,7 @@ two cannot disagree on a setting, its default or its validation.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -374,6 +374,13 @@ class PlanRequest:
     goal_steer : float or None
         A car's steering angle asked for at the goal (rad), turned to at rest after the
         last drive; ``None`` (default): whatever the last drive ends with.
+    check_curve : callable or None
+        ``check_curve(curve)``: called by a disc robot's stages
+        (:func:`~trajopt.planning._disc.plan_disc`, without a footprint) on the certified
+        curve (:class:`~trajopt.smoother.SmoothPath`) before it is timed; whatever it raises
+        ends the query. A plan among movers proves there that its path is blocked, before
+        paying for the timing (:func:`~trajopt.planning.plan_among_movers`). Default
+        ``None``: nothing is called. Not part of the request's equality.
     """
 
     start: Sequence[float] | State
@@ -386,6 +393,7 @@ class PlanRequest:
     start_alpha: float = 0.0
     start_steer: float = 0.0
     goal_steer: float | None = None
+    check_curve: Callable[[Any], None] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "start_heading", heading("start_heading", self.start_heading))

@@ -102,6 +102,50 @@ def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
     assert np.hypot(end.x[0] - goal[0], end.y[0] - goal[1]) < 1e-6
 
 
+def test_a_car_waits_at_a_safe_place_with_a_heading():
+    """A car (no turn in place) meets a forklift head-on in a corridor with a side room: no
+    route avoids it, so it pulls aside facing on, waits, and drives on; the two legs join in
+    position, heading and steering."""
+    grid = _grid((120, 240), [(0.5, 11.5, 1.4, 2.6), (4.5, 8.5, 2.6, 5.0)])
+    robot = trajopt.Robot(
+        drive="ackermann", min_turning_radius=0.6, radius=0.2, wheelbase=0.3, steer_rate_max=1.0
+    )
+    planner = trajopt.Planner(grid, robot)
+    start, goal = (1.0, 2.0), (11.0, 2.0)
+    forklift = trajopt.MovingObstacle.constant_velocity(
+        (13.0, 2.0), (-0.5, 0.0), radius=0.2, horizon=30.0, name="forklift"
+    )
+    out = planner.plan(
+        start, goal, start_heading=0.0, goal_heading=0.0, moving_obstacles=[forklift],
+        mover_margin=0.02,
+    )  # fmt: skip
+    assert out.stats["moving"]["route"] == "waited"
+    last = out.stats["moving"]["reroute"][-1]
+    assert last["result"] == "ok" and "heading" in last["what"]
+    _check(out, [forklift], grid, 0.02)
+    dt = 1e-3
+    smp = out.sample(np.append(np.arange(0.0, out.duration, dt), out.duration))
+    step = np.hypot(np.diff(smp.x), np.diff(smp.y))
+    assert np.max(step) <= robot.v_max * dt * (1 + 1e-6) + 1e-9  # no jump at the join
+    assert np.max(np.abs(np.diff(np.unwrap(smp.theta)))) < 0.01  # |omega| dt, no jump
+    assert np.max(np.abs(np.diff(smp.steer))) <= 1.0 * dt + 1e-9  # steer_rate_max dt
+    for k, (p, h) in ((0, (start, 0.0)), (-1, (goal, 0.0))):
+        assert math.dist((smp.x[k], smp.y[k]), p) < 1e-6
+        assert abs(math.remainder(smp.theta[k] - h, 2 * math.pi)) < 1e-6
+    # it stood still on the way, aside: out of the forklift's lane (y <= 2.2, plus the car's
+    # radius and the margin)
+    t = smp.t
+    rest = (smp.v == 0.0) & (t > 1.0) & (t < out.duration - 1.0)
+    assert rest.any() and np.all(smp.y[rest] > 2.0 + 0.2 + 0.2 + 0.02)
+
+
+def test_car_headings_face_on_then_along_the_way_in():
+    place, p0, p1 = np.array([0.0, 0.0]), np.array([-1.0, 0.0]), np.array([0.0, 2.0])
+    assert trajopt.moving.car_headings(place, p0, p1) == pytest.approx([math.pi / 2, 0.0])
+    # both agree (on the straight line from the start to the goal): one heading
+    assert trajopt.moving.car_headings(place, p0, np.array([3.0, 0.0])) == [0.0]
+
+
 @pytest.fixture(scope="module")
 def loop():
     """Two 1 m corridors (y = 1 and y = 4) joined at both ends, and a niche at x = 6."""
@@ -177,6 +221,87 @@ def test_a_mover_that_has_passed_needs_no_reroute(loop):
     out = planner.plan(start, goal, moving_obstacles=[cart])
     assert out.stats["moving"]["route"] == "retimed"
     assert np.array_equal(out.path.curve.c, base.path.curve.c)
+
+
+def _after_timing(planner, start, goal, movers, margin):
+    """The plan among movers with every proof on the timed static plan (no early proof)."""
+    from trajopt.planning import PlanRequest, plan_for_movers, run_query
+
+    request = PlanRequest(start, goal)
+    static = run_query(planner.options, planner.caches, request)
+    return plan_for_movers(static, tuple(movers), margin, planner.options, planner.caches, request)
+
+
+def _same_plan(a, b):
+    assert type(a) is type(b)
+    assert a.stats["moving"]["route"] == b.stats["moving"]["route"]
+    assert a.stats["moving"]["plan"] == b.stats["moving"]["plan"]
+    assert a.duration == b.duration
+    t = np.linspace(0.0, a.duration, 301)
+    sa, sb = a.sample(t), b.sample(t)
+    for f in ("x", "y", "theta", "v"):
+        assert np.array_equal(getattr(sa, f), getattr(sb, f)), f
+
+
+@pytest.mark.parametrize("kind", ["stops", "head-on", "passes"])
+def test_proofs_before_the_timing_give_the_plan_of_the_proofs_after_it(loop, kind):
+    """A blocked static curve is re-routed without its timing, to the same plan as before."""
+    grid, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    planner.plan(start, goal)  # the caches built, as for both plans below
+    movers = {
+        "stops": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 3.0], [(6.0, 2.0), (6.0, 1.0)], radius=0.25, name="cart"
+            )
+        ],
+        "head-on": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 20.0], [(11.0, 1.0), (1.0, 1.0)], radius=0.2, name="walker"
+            )
+        ],
+        "passes": [
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 6.0, 9.0], [(6.0, 2.0), (6.0, 1.0), (6.0, 2.0)], radius=0.25, name="cart"
+            )
+        ],
+    }[kind]
+    early = planner.plan(start, goal, moving_obstacles=movers, mover_margin=0.02)
+    late = _after_timing(planner, start, goal, movers, 0.02)
+    _same_plan(early, late)
+    if kind == "passes":
+        assert early.stats["moving"]["route"] == "retimed"
+        assert "blocked_before_timing" not in early.stats["moving"]
+    else:  # the quick proofs hold on the curve: its timing was skipped
+        assert early.stats["moving"]["route"] == "rerouted"
+        assert early.stats["moving"]["blocked_before_timing"] is True
+        assert late.stats["moving"]["blocked_before_timing"] is False
+        _check(early, movers, grid, 0.02)
+
+
+def test_check_curve_sees_the_curve_the_plan_is_timed_on(loop):
+    """``PlanRequest.check_curve``: called once, on the returned plan's path, before timing."""
+    from trajopt.planning import PlanRequest, run_query
+
+    _, planner = loop
+    seen = []
+    request = PlanRequest((1.0, 1.0), (11.0, 1.0), check_curve=seen.append)
+    out = run_query(planner.options, planner.caches, request)
+    assert len(seen) == 1 and seen[0] is out.path
+    assert request == PlanRequest((1.0, 1.0), (11.0, 1.0))  # not part of the equality
+
+    class Stop(Exception):
+        pass
+
+    def refuse(curve):
+        raise Stop
+
+    with pytest.raises(Stop):
+        run_query(
+            planner.options,
+            planner.caches,
+            PlanRequest((1.0, 1.0), (11.0, 1.0), check_curve=refuse),
+        )
 
 
 def test_derived_caches_equal_fresh_caches_and_leave_the_planner_alone(loop):

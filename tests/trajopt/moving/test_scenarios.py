@@ -52,6 +52,26 @@ def test_each_kind_is_certified_or_proven_blocked(scene, paper, kind):
     assert out.duration >= static.duration - 1e-9
 
 
+@pytest.mark.parametrize("kind", ["crossing", "head-on", "overtaking", "stopping"])
+def test_carts_of_each_kind_are_certified_or_proven_blocked(scene, paper, kind):
+    """Cart-shaped movers (convex rectangles turning with their motion): the plan passes the
+    independent check, written with its own point-to-polygon distance, or the refusal is
+    proven by the relaxation."""
+    planner, static = paper
+    movers = make_movers(static, kind, 2, seed=20 + KINDS.index(kind), shape="polygon")
+    assert len(movers) == 2 and all(m.vertices is not None for m in movers)
+    assert brute_min(static, movers, margin=MARGIN) < 0.0  # the static plan meets a cart
+    try:
+        out = planner.plan(
+            scene.start, scene.goal("A"), moving_obstacles=movers, mover_margin=MARGIN
+        )
+    except BlockedError:
+        assert path_blocked(static, movers, MARGIN, ds=0.02, dt=0.02)
+        return
+    chk = check_trajectory(out, movers, margin=MARGIN, grid=scene.grid)
+    assert chk.ok, chk
+
+
 def test_a_mover_stopping_on_the_path_is_proven_blocked_and_driven_round(scene, paper):
     planner, static = paper
     movers = make_movers(static, "stopping", 1, seed=1)

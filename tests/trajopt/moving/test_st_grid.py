@@ -5,7 +5,8 @@ grid time, written out here (node points from the path, the mover's track by np.
 radius from its fields); the grid's runs must forbid exactly those nodes, except within 1e-6 m
 of the limit (rounding). The runs' queries (a drive's blocked start times, a node's column)
 are checked against the dense grid, and the reachability sweep's early stop against a full
-sweep.
+sweep. Polygon movers (a point robot and a footprint robot) are checked the same way against
+distances from shapely.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from shapely.geometry import Point, Polygon
 
 from trajopt.geometry import CurveSegment, PolylineCurve
 from trajopt.moving import MovingObstacle, reachable, st_grid
@@ -77,6 +79,81 @@ def test_closed_form_runs_match_the_distances(sufficient):
     assert not np.any((g.blocked != ref) & ~near)
     for i in (0, 57, g.s.shape[0] - 1):
         assert np.array_equal(g.column(i), g.blocked[:, i])
+
+
+def _carts():
+    box = [(-0.4, -0.25), (0.4, -0.25), (0.4, 0.25), (-0.4, 0.25)]
+    tri = [(0.0, -0.3), (0.5, 0.2), (-0.2, 0.3)]
+    return [
+        # turning while it crosses the first leg, then standing on the second
+        MovingObstacle.from_waypoints(
+            [0.0, 3.0, 6.0],
+            [(1.5, -1.5), (1.8, 0.2), (4.2, 1.0)],
+            radius=0.05,
+            headings=[0.3, 1.6, 2.4],
+            vertices=box,
+            name="cart",
+        ),
+        MovingObstacle.from_waypoints(
+            [2.0, 9.0], [(6.0, 3.5), (3.0, 0.3)], radius=0.0, headings=[0.0, -2.0], vertices=tri
+        ),
+        MovingObstacle.constant_velocity((0.5, 2.0), (0.0, -0.3), radius=0.1, horizon=10.0),
+    ]
+
+
+@pytest.mark.parametrize(("sufficient", "body"), [(True, False), (False, False), (True, True)])
+def test_polygon_runs_match_shapely_distances(sufficient, body):
+    """Polygon movers (and a disc among them) against a point robot or a footprint robot: the
+    grid forbids exactly the nodes whose shapely distance at the grid time is below the limit."""
+    movers = _carts()
+    foot = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]]) if body else None
+    limit = 0.05 if body else LIMIT
+    stretch, dt = (1.5 if body else 1.0), 0.1
+    g = st_grid(
+        PATH,
+        PATH.length,
+        movers,
+        limit,
+        ds=0.05,
+        dt=dt,
+        horizon=12.0,
+        speed=V,
+        sufficient=sufficient,
+        body=foot,
+        stretch=stretch,
+    )
+    u = PATH.u_at_s(g.s)
+    pts = np.asarray(PATH(u))
+    heading = np.asarray(PATH.heading(u))
+    robots = []
+    for p, h in zip(pts, heading, strict=True):
+        if foot is None:
+            robots.append(Point(p))
+        else:
+            c, sn = np.cos(h), np.sin(h)
+            robots.append(Polygon(p + foot @ np.array([[c, sn], [-sn, c]])))
+    ref = np.zeros(g.blocked.shape, bool)
+    near = np.zeros_like(ref)
+    for m in movers:
+        if sufficient:
+            pad = 0.5 * (g.ds + dt * V) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
+        else:
+            pad = -0.5 * g.ds * stretch
+        for k, tk in enumerate(g.t):
+            x = np.interp(tk, m.times, m.positions[:, 0])
+            y = np.interp(tk, m.times, m.positions[:, 1])
+            h = np.interp(tk, m.times, m.headings)
+            if m.vertices is None:
+                shape = Point(x, y)
+            else:
+                c, sn = np.cos(h), np.sin(h)
+                shape = Polygon(np.array([x, y]) + m.vertices @ np.array([[c, sn], [-sn, c]]))
+            lim = limit + m.radius + m.growth * min(max(tk, 0.0), m.t_last) + pad
+            d = np.array([shape.distance(r) for r in robots])
+            ref[k] |= d < lim
+            near[k] |= np.abs(d - lim) < 1e-6
+    assert ref.any() and (~ref).any()
+    assert not np.any((g.blocked != ref) & ~near)
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
