@@ -1,4 +1,4 @@
-"""Tests of the pair filter of the closed-form windows (``near_pairs``) against brute force.
+"""Tests of trajopt.moving's pair filter of the closed-form windows (``near_pairs``) against brute force.
 
 A pair of a piece of a mover's track and a point that the filter leaves out must be farther
 than the piece's limit at every instant of the piece: checked on dense samples of the

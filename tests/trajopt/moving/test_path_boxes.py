@@ -1,4 +1,4 @@
-"""Tests of the certificate's filter of far intervals: the boxes of a path over arc ranges.
+"""Tests of trajopt.moving: the certificate's filter of far intervals: the boxes of a path over arc ranges.
 
 Every point of the path over an arc-length range, sampled densely (the path's own
 ``u_at_s``), must lie in the box :class:`PathBoxes` gives for that range; and a certificate
