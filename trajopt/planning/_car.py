@@ -222,7 +222,7 @@ def plan_car(
     # everything else in the map-local frame (module docstring, "Frame")
     origin = np.asarray(world.origin, dtype=float)
     local = bool(np.any(origin != 0.0))
-    grid = OccupancyGrid(world.occupied, world.resolution, (0.0, 0.0)) if local else world
+    grid = world.moved_to((0.0, 0.0)) if local else world  # its polygons moved with it
     p0, p1 = (p0w - origin, p1w - origin) if local else (p0w, p1w)
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
@@ -409,8 +409,17 @@ def _ends(
     if robot.footprint is not None:
         ends = dataclasses.replace(request, start=p0, start_heading=h0, goal=p1, goal_heading=h1)
         check_end_poses(robot.footprint, grid, ends)
-    check_endpoint(options, grid, "start", p0, robot.inscribed_radius)
-    check_endpoint(options, grid, "goal", p1, robot.inscribed_radius)
+    # a body checked against the map's polygons holds its inscribed disc clear of them:
+    # only the map's extent is checked (its cells may touch the disc)
+    exact = robot.footprint is not None and grid.polygons is not None
+    radius = 0.0 if exact else robot.inscribed_radius
+    for name, p in (("start", p0), ("goal", p1)):
+        if exact:
+            c = grid.world_to_cell(p)
+            if not grid.in_bounds(c):
+                check_endpoint(options, grid, name, p, radius)  # raises: off the map
+        else:
+            check_endpoint(options, grid, name, p, radius)
     return p0, p1, h0, h1
 
 

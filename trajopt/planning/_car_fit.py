@@ -65,6 +65,16 @@ PIECE_TURN_RAD = 0.6 * math.pi
 HALVING_DEPTH = 2
 #: Fewest steps (pose index differences) of a stretch that is halved.
 HALVING_MIN_POSES = 4
+#: Where the map knows its polygons, a segment is fitted and certified on a raster of them
+#: whose cells divide the map's and are at most this side (m) (:func:`fine_window`).
+FINE_CELL_M = 0.025
+#: Room (m) around the segment's poses and body in the window of :func:`fine_window`.
+FINE_PAD_M = 0.5
+#: A segment whose search poses hold the body more than this many cells off the map's
+#: occupied squares is fitted on them (:func:`bodies_clear_of_cells`), else on the finer
+#: raster of the polygons (:func:`fine_window`, about 16 times the cells: its fits cost 3-10
+#: times as long).
+CELL_FIT_CLEARANCE_CELLS = 0.25
 
 
 @dataclass(frozen=True, slots=True)
@@ -275,6 +285,10 @@ def fit_segment(
     robot = options.robot
     radius = robot.inscribed_radius
     pts = np.ascontiguousarray(poses[first : last + 1, :2])
+    if robot.footprint is not None and grid.polygons is not None:
+        seg = poses[first : last + 1]
+        if not bodies_clear_of_cells(robot.footprint, grid, seg):
+            grid = fine_window(grid, pts, robot.footprint.circumscribed_radius)
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
     kmax = 1.0 / robot.drive.min_turning_radius
@@ -331,6 +345,51 @@ def fit_segment(
         f"from ({pts[0, 0]:.6g}, {pts[0, 1]:.6g}) m to ({pts[-1, 0]:.6g}, {pts[-1, 1]:.6g}) "
         f"m: {'; '.join(errors)}",
         {"car_segment_failures": errors},
+    )
+
+
+def bodies_clear_of_cells(footprint: Footprint, grid: OccupancyGrid, poses: np.ndarray) -> bool:
+    """Whether the body at every pose ``(x, y, heading)`` (m, m, rad) is clear of the cells.
+
+    Clear of ``grid``'s occupied squares by more than :data:`CELL_FIT_CLEARANCE_CELLS`
+    cells: a segment whose search poses are has room for its certified curve on the map's
+    own cells (as on a map without polygons); one whose poses touch or near them (the
+    search cleared them against the polygons) is fitted in :func:`fine_window`.
+    """
+    from trajopt.robot import polygons_clearance
+
+    bodies = [footprint.at(float(x), float(y), float(h)) for x, y, h in poses]
+    cap = 2.0 * CELL_FIT_CLEARANCE_CELLS * grid.resolution
+    clr = polygons_clearance(bodies, grid, cap)
+    return bool(np.all(clr > CELL_FIT_CLEARANCE_CELLS * grid.resolution))
+
+
+def fine_window(grid: OccupancyGrid, pts: np.ndarray, reach: float) -> OccupancyGrid:
+    """Return a finer raster of ``grid``'s polygons around a segment's poses (m).
+
+    The map's polygons (:attr:`astar.OccupancyGrid.polygons`) rasterised conservatively
+    (:meth:`astar.OccupancyGrid.from_polygons`) in cells that divide ``grid``'s, of side at
+    most :data:`FINE_CELL_M`, over the poses' box grown by ``reach`` (the
+    body's circumscribed radius) plus :data:`FINE_PAD_M`, clipped to the map. The window's
+    outside counts as occupied (as a map's), so a curve and a body certified in it are
+    clear of the map's polygons and inside the map: the fits' certificate holds against the
+    polygons, with a cover that reaches at most a fine cell's diagonal beyond them (where
+    ``grid``'s cells reach up to its own diagonal).
+    """
+    k = max(1, math.ceil(grid.resolution / FINE_CELL_M - 1e-9))
+    res = grid.resolution / k
+    ox, oy = grid.origin
+    pad = reach + FINE_PAD_M
+    lo = np.maximum(pts.min(axis=0) - pad, (ox, oy))
+    hi = np.minimum(pts.max(axis=0) + pad, (ox + grid.width, oy + grid.height))
+    # the window's corner on the map's own cell lines: its fine cells nest in the map's
+    i0 = np.floor((lo - (ox, oy)) / grid.resolution)
+    i1 = np.ceil((hi - (ox, oy)) / grid.resolution)
+    i1 = np.minimum(i1, (grid.nx, grid.ny))
+    a = np.array([ox, oy]) + i0 * grid.resolution
+    b = np.array([ox, oy]) + i1 * grid.resolution
+    return OccupancyGrid.from_polygons(
+        grid.polygons, res, (float(a[0]), float(a[1]), float(b[0]), float(b[1]))
     )
 
 
