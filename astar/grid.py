@@ -95,7 +95,9 @@ class OccupancyGrid:
         object.__setattr__(self, "polygons", None)
         return self
 
-    def _keeping(self, other: OccupancyGrid, shift: tuple[float, float] = (0.0, 0.0)) -> OccupancyGrid:
+    def _keeping(
+        self, other: OccupancyGrid, shift: tuple[float, float] = (0.0, 0.0)
+    ) -> OccupancyGrid:
         """Return ``other`` with this grid's polygons moved by ``shift`` (m) (internal).
 
         Only for an ``other`` whose occupied squares cover every polygon so moved.

@@ -17,8 +17,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from astar import InvalidInputError, NoPathError
-from astar.hybrid import NoPosePathError, find_pose_path
 from astar.body_polygons import pack_polygons
+from astar.hybrid import NoPosePathError, find_pose_path
 from tests.astar.hybrid_checks import (
     REAR,
     SMALL,
