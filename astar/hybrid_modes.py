@@ -435,7 +435,7 @@ def _footprint_inputs(
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
-    poly = grid_polygons(collision.raw_grid)
+    poly = grid_polygons(collision)
     fdist = clearance_bound(occ)
     discs = footprint_discs(fp)
     for name, (x, y, th) in poses:
@@ -463,18 +463,12 @@ def _footprint_inputs(
     )
 
 
-def grid_polygons(raw_grid: object) -> PackedPolygons:
-    """Return the polygons of a raw map in cells (:func:`pack_polygons`), or none.
+def grid_polygons(collision: HybridCollision) -> PackedPolygons:
+    """Return the raw map's polygons in cells (:func:`pack_polygons`), or none.
 
-    An :class:`OccupancyGrid` with :attr:`~OccupancyGrid.polygons` gives them, moved to the
-    search's cell coordinates (cell ``(ix, iy)``'s centre at ``(ix, iy)``); a bool array or
-    a grid without polygons gives none.
+    :attr:`HybridCollision.raw_polygons` (set from an :class:`OccupancyGrid` ``raw_grid``
+    whose :attr:`~OccupancyGrid.polygons` are known), packed; none without them.
     """
     from astar.body_polygons import pack_polygons
 
-    rings = getattr(raw_grid, "polygons", None) if isinstance(raw_grid, OccupancyGrid) else None
-    if not rings:
-        return pack_polygons(None)
-    res = raw_grid.resolution
-    ox, oy = raw_grid.origin
-    return pack_polygons(rings, (ox + 0.5 * res, oy + 0.5 * res), res)
+    return pack_polygons(collision.raw_polygons)

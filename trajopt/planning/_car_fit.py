@@ -285,9 +285,13 @@ def fit_segment(
     robot = options.robot
     radius = robot.inscribed_radius
     pts = np.ascontiguousarray(poses[first : last + 1, :2])
+    cgrid = grid  # the corridor's grid
     if robot.footprint is not None and grid.polygons is not None:
-        seg = poses[first : last + 1]
-        if not bodies_clear_of_cells(robot.footprint, grid, seg):
+        if not bodies_clear_of_cells(robot.footprint, grid, poses[first : last + 1]):
+            # near the polygons: the corridor on the map's cells for a disc smaller by a
+            # cell's diagonal (every centre whose inscribed disc is clear of the polygons
+            # keeps it from the cells), the certificates on the fine raster of the polygons
+            radius = max(0.0, radius - math.sqrt(2.0) * grid.resolution)
             grid = fine_window(grid, pts, robot.footprint.circumscribed_radius)
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
@@ -306,11 +310,13 @@ def fit_segment(
         try:
             with timer.stage("corridor"):
                 if kind == "witness":
-                    corridor = witness_corridor(grid, radius, dense_polyline(pts, grid.resolution))
+                    corridor = witness_corridor(
+                        cgrid, radius, dense_polyline(pts, cgrid.resolution)
+                    )
                 elif kind == "reversed":
-                    corridor = build_polygon_corridor(grid, p_fit, radius)
+                    corridor = build_polygon_corridor(cgrid, p_fit, radius)
                 elif corridor is None:  # the two polygon fits share one corridor
-                    corridor = build_polygon_corridor(grid, pts, radius)
+                    corridor = build_polygon_corridor(cgrid, pts, radius)
             with timer.stage("smooth"):
                 smooth = smoother.fit(
                     p_fit,
