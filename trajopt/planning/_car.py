@@ -69,6 +69,7 @@ end speeds other than 0, missing end headings, and the chapter's ``inflation="pa
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -223,6 +224,7 @@ def plan_car(
     origin = np.asarray(world.origin, dtype=float)
     local = bool(np.any(origin != 0.0))
     grid = world.moved_to((0.0, 0.0)) if local else world  # its polygons moved with it
+    grid = search_cells(robot, grid)
     p0, p1 = (p0w - origin, p1w - origin) if local else (p0w, p1w)
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
@@ -260,7 +262,7 @@ def plan_car(
             dataclasses.replace(m, path=ShiftedCurve(m.path, origin), speed_limits=zones)
             for m in moves
         ]
-        search_grid = world.with_occupied(search_grid.occupied)
+        search_grid = OccupancyGrid(search_grid.occupied, search_grid.resolution, world.origin)
         poses = poses + np.array([origin[0], origin[1], 0.0])
     pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)
     stages = timer.finish()
@@ -300,6 +302,32 @@ def plan_car(
         "inflation": options.inflation,
     }
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+#: Turning radius of a car with a body, in cells of the grid it searches, below which
+#: :func:`search_cells` keeps the map's cells as they are.
+SEARCH_CELLS_PER_RADIUS = 30.0
+
+
+def search_cells(robot: Robot, grid: OccupancyGrid) -> OccupancyGrid:
+    """Return the grid a car with a body plans on: ``grid``, or its polygons' coarser cells.
+
+    Where ``grid`` knows the polygons it was rasterised from
+    (:attr:`astar.OccupancyGrid.polygons`) the body is tested exactly against them and the
+    cells are only a conservative pre-filter, so their size need not follow the map's: a
+    map finer than :data:`SEARCH_CELLS_PER_RADIUS` cells per turning radius is planned on
+    ``grid.coarsen(k)`` (cells ``k`` times larger, at most that fine; the polygons kept), so
+    that the search's states and primitives follow the car rather than the raster. A grid
+    without polygons, or a disc car, is returned as it is.
+    """
+    if robot.footprint is None or grid.polygons is None:
+        return grid
+    k = int(
+        math.floor(
+            robot.drive.min_turning_radius / SEARCH_CELLS_PER_RADIUS / grid.resolution + 1e-9
+        )
+    )
+    return grid.coarsen(k) if k > 1 else grid
 
 
 #: Smallest change of the steering angle (rad) a car steers at rest for: below it the
