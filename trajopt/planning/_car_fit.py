@@ -65,9 +65,11 @@ PIECE_TURN_RAD = 0.6 * math.pi
 HALVING_DEPTH = 2
 #: Fewest steps (pose index differences) of a stretch that is halved.
 HALVING_MIN_POSES = 4
-#: Where the map knows its polygons, a segment is fitted and certified on a raster of them
-#: whose cells divide the map's and are at most this side (m) (:func:`fine_window`).
-FINE_CELL_M = 0.025
+#: Where the map knows its polygons, a segment near them is certified on a raster of them
+#: whose cells divide the map's and are at most the turning radius over this (:func:`fine_window`:
+#: 2.5 cm for R = 3 m; on the parking suite's small car, R = 0.6 m, 2.5 cm cells left 6 of its
+#: segments without a certified curve, 5 mm cells none).
+FINE_CELLS_PER_RADIUS = 120.0
 #: Room (m) around the segment's poses and body in the window of :func:`fine_window`.
 FINE_PAD_M = 0.5
 #: A segment whose search poses hold the body more than this many cells off the map's
@@ -292,7 +294,8 @@ def fit_segment(
             # cell's diagonal (every centre whose inscribed disc is clear of the polygons
             # keeps it from the cells), the certificates on the fine raster of the polygons
             radius = max(0.0, radius - math.sqrt(2.0) * grid.resolution)
-            grid = fine_window(grid, pts, robot.footprint.circumscribed_radius)
+            cell = robot.drive.min_turning_radius / FINE_CELLS_PER_RADIUS
+            grid = fine_window(grid, pts, robot.footprint.circumscribed_radius, cell)
     turn = 0.0 if direction > 0 else math.pi
     h0, h1 = float(poses[first, 2] + turn), float(poses[last, 2] + turn)
     kmax = 1.0 / robot.drive.min_turning_radius
@@ -370,19 +373,19 @@ def bodies_clear_of_cells(footprint: Footprint, grid: OccupancyGrid, poses: np.n
     return bool(np.all(clr > CELL_FIT_CLEARANCE_CELLS * grid.resolution))
 
 
-def fine_window(grid: OccupancyGrid, pts: np.ndarray, reach: float) -> OccupancyGrid:
+def fine_window(grid: OccupancyGrid, pts: np.ndarray, reach: float, cell_m: float) -> OccupancyGrid:
     """Return a finer raster of ``grid``'s polygons around a segment's poses (m).
 
     The map's polygons (:attr:`astar.OccupancyGrid.polygons`) rasterised conservatively
     (:meth:`astar.OccupancyGrid.from_polygons`) in cells that divide ``grid``'s, of side at
-    most :data:`FINE_CELL_M`, over the poses' box grown by ``reach`` (the
+    most ``cell_m`` (m), over the poses' box grown by ``reach`` (the
     body's circumscribed radius) plus :data:`FINE_PAD_M`, clipped to the map. The window's
     outside counts as occupied (as a map's), so a curve and a body certified in it are
     clear of the map's polygons and inside the map: the fits' certificate holds against the
     polygons, with a cover that reaches at most a fine cell's diagonal beyond them (where
     ``grid``'s cells reach up to its own diagonal).
     """
-    k = max(1, math.ceil(grid.resolution / FINE_CELL_M - 1e-9))
+    k = max(1, math.ceil(grid.resolution / cell_m - 1e-9))
     res = grid.resolution / k
     ox, oy = grid.origin
     pad = reach + FINE_PAD_M
