@@ -436,7 +436,7 @@ def _ends(
     h0, h1 = float(h0), float(request.goal_heading)
     if robot.footprint is not None:
         ends = dataclasses.replace(request, start=p0, start_heading=h0, goal=p1, goal_heading=h1)
-        check_end_poses(robot.footprint, grid, ends)
+        check_end_poses(robot.footprint, grid, ends, polygons=True)
     # a body checked against the map's polygons holds its inscribed disc clear of them:
     # only the map's extent is checked (its cells may touch the disc)
     exact = robot.footprint is not None and grid.polygons is not None
