@@ -223,6 +223,8 @@ def search_and_fit(
                     if exc.reason == "disconnected":
                         stop = True
                         break
+                    if exc.reason == "exhausted":
+                        break  # every reachable state expanded: other costs reach no more
                 except astar.InvalidInputError as exc:
                     if robot.footprint is None:
                         raise
@@ -270,7 +272,9 @@ def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]
     default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (at most
     :data:`FOOTPRINT_DEFAULT_BUDGET_S`; the paths they find where they find one quickly:
     drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
-    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`.
+    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`. A search that
+    exhausts its states (every reachable state expanded) ends the variants of its try: the
+    costs change the order of the expansions, not the states reachable.
     """
     if robot.footprint is None:
         return (("", {}, SEARCH_BUDGET_S),)
