@@ -342,16 +342,22 @@ def parallel_scene(size: float, aisle: float = 4.5):
     return polys, (x0 - 0.3, -0.3, x1 + 0.3, top + 0.3), start, goal
 
 
-def test_full_size_car_backs_into_a_parallel_slot_of_1_3_car_lengths():
+@pytest.fixture(scope="module")
+def slot_1_3():
+    """The parallel slot of 1.3 car lengths (:func:`parallel_scene`) planned at 0.1 m."""
+    polys, bounds, start, goal = parallel_scene(1.3)
+    grid = astar.OccupancyGrid.from_polygons(polys, 0.1, bounds)
+    traj = trajopt.plan(
+        grid, start[:2], goal[:2], FULL.robot(), start_heading=start[2], goal_heading=goal[2]
+    )
+    return polys, bounds, start, goal, traj
+
+
+def test_full_size_car_backs_into_a_parallel_slot_of_1_3_car_lengths(slot_1_3):
     """Issue 45: a parallel slot 1.3 car lengths long entered backwards (the start behind
     the slot), at 0.1 m, planned on the grid from ``from_polygons`` and clear of the
     polygons by the exact check at 1 cm of corner travel."""
-    polys, bounds, start, goal = parallel_scene(1.3)
-    grid = astar.OccupancyGrid.from_polygons(polys, 0.1, bounds)
-    robot = FULL.robot()
-    traj = trajopt.plan(
-        grid, start[:2], goal[:2], robot, start_heading=start[2], goal_heading=goal[2]
-    )
+    polys, _, start, goal, traj = slot_1_3
     assert traj.stats["car"]["cusps"] >= 1 and traj.stats["car"]["reverse_length_m"] > 1.0
     t, poses = pc.trajectory_poses(traj, FULL.body())
     corners = pc.body_at(FULL.body(), poses)
@@ -393,3 +399,28 @@ def test_end_pose_clear_of_the_polygons_but_touching_a_cell_is_planned():
             start_heading=start[2],
             goal_heading=goal[2],
         )
+
+
+def test_polygons_move_with_a_far_away_origin(slot_1_3):
+    """The slot of 1.3 car lengths shifted by (4.5e9, -1.5e9) m: the map's polygons move into
+    the planner's local frame with its cells (``OccupancyGrid.moved_to``), and the plan is the
+    same trajectory, shifted, to 1e-6 m."""
+    polys, bounds, start, goal, near = slot_1_3
+    d = np.array([4.5e9, -1.5e9])
+    box = (bounds[0] + d[0], bounds[1] + d[1], bounds[2] + d[0], bounds[3] + d[1])
+    grid = astar.OccupancyGrid.from_polygons([p + d for p in polys], 0.1, box)
+    far = trajopt.plan(
+        grid,
+        np.asarray(start[:2]) + d,
+        np.asarray(goal[:2]) + d,
+        FULL.robot(),
+        start_heading=start[2],
+        goal_heading=goal[2],
+    )
+    assert far.duration == pytest.approx(near.duration, rel=1e-9)
+    t = np.linspace(0.0, near.duration, 400)
+    a, b = near.sample(t), far.sample(t)
+    np.testing.assert_allclose(
+        np.column_stack([b.x - d[0], b.y - d[1]]), np.column_stack([a.x, a.y]), atol=1e-6
+    )
+    np.testing.assert_allclose(b.theta, a.theta, atol=1e-6)
