@@ -67,9 +67,11 @@ HALVING_DEPTH = 2
 HALVING_MIN_POSES = 4
 #: Where the map knows its polygons, a segment near them is certified on a raster of them
 #: whose cells divide the map's and are at most the turning radius over this (:func:`fine_window`:
-#: 2.5 cm for R = 3 m; on the parking suite's small car, R = 0.6 m, 2.5 cm cells left 6 of its
-#: segments without a certified curve, 5 mm cells none).
-FINE_CELLS_PER_RADIUS = 120.0
+#: 1.25 cm for R = 3 m, 2.5 mm for R = 0.6 m). The search keeps the body only a few mm off
+#: the polygons, and a fine cell reaches up to its diagonal beyond them: on the parking suite
+#: R / 120 left the full-size car's slot of 1.23 car lengths 2-3 s of failed fits (0.3 s at
+#: R / 240) and the small car 6 segments without a certified curve at 2.5 cm cells.
+FINE_CELLS_PER_RADIUS = 240.0
 #: Room (m) around the segment's poses and body in the window of :func:`fine_window`.
 FINE_PAD_M = 0.5
 #: A segment whose search poses hold the body more than this many cells off the map's
