@@ -18,6 +18,8 @@ _EXPORTS: dict[str, str] = {
     # values and errors
     "OccupancyGrid": "astar.grid",
     "from_polygons": "astar.grid",
+    "bodies_distance": "astar.body_polygons",
+    "points_distance": "astar.body_polygons",
     "AstarError": "astar.errors",
     "InvalidInputError": "astar.errors",
     "MapFormatError": "astar.errors",
@@ -77,6 +79,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # pragma: no cover
+    from astar.body_polygons import bodies_distance, points_distance
     from astar.coarse_to_fine import (
         CoarseGrid,
         CoarsePath,

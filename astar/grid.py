@@ -12,7 +12,7 @@ Conventions (as ROS ``nav_msgs/OccupancyGrid`` and Nav2):
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -45,6 +45,18 @@ class OccupancyGrid:
     origin : tuple of float, optional
         World ``(x, y)`` in metres of the lower-left corner of cell ``(0, 0)``.
 
+    Attributes
+    ----------
+    polygons : tuple of ndarray or None
+        The polygon obstacles the grid was rasterised from (:meth:`from_polygons`), each
+        a read-only array ``(k, 2)`` of counter-clockwise vertices in world metres, or
+        ``None`` (a grid given as cells). Not a constructor parameter: set by
+        :meth:`from_polygons` and kept by the operations whose occupied squares still
+        cover every polygon (:meth:`split`, :meth:`coarsen`, :meth:`moved_to`); dropped by
+        :meth:`with_occupied` (new occupancy). Where they are known, the car planner tests
+        a body exactly against them (the cells a conservative pre-filter). Equality and
+        ``repr`` ignore them.
+
     Examples
     --------
     >>> import numpy as np
@@ -58,6 +70,7 @@ class OccupancyGrid:
     occupied: np.ndarray
     resolution: float
     origin: tuple[float, float] = (0.0, 0.0)
+    polygons: tuple[np.ndarray, ...] | None = field(default=None, init=False, compare=False)
 
     def __post_init__(self) -> None:
         occ = validation.bool_grid(self.occupied)
@@ -66,6 +79,7 @@ class OccupancyGrid:
         object.__setattr__(self, "occupied", occ)
         object.__setattr__(self, "resolution", res)
         object.__setattr__(self, "origin", (ox, oy))
+        object.__setattr__(self, "polygons", None)
 
     @classmethod
     def _construct_fast(
@@ -78,7 +92,29 @@ class OccupancyGrid:
         object.__setattr__(self, "occupied", occ)
         object.__setattr__(self, "resolution", float(resolution))
         object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
+        object.__setattr__(self, "polygons", None)
         return self
+
+    def _keeping(
+        self, other: OccupancyGrid, shift: tuple[float, float] = (0.0, 0.0)
+    ) -> OccupancyGrid:
+        """Return ``other`` with this grid's polygons moved by ``shift`` (m) (internal).
+
+        Only for an ``other`` whose occupied squares cover every polygon so moved.
+        """
+        if self.polygons is not None:
+            if shift != (0.0, 0.0):
+                d = np.asarray(shift, dtype=float)
+                rings = []
+                for v in self.polygons:
+                    w = v + d
+                    w.flags.writeable = False
+                    rings.append(w)
+                polys = tuple(rings)
+            else:
+                polys = self.polygons
+            object.__setattr__(other, "polygons", polys)
+        return other
 
     @classmethod
     def from_polygons(
@@ -127,8 +163,10 @@ class OccupancyGrid:
         >>> g.occupied.astype(int).tolist()
         [[1, 1], [1, 0]]
         """
-        occ, res, origin = rasterize_polygons(polygons, resolution, bounds)
-        return cls._construct_fast(occ, res, origin)
+        occ, res, origin, rings = rasterize_polygons(polygons, resolution, bounds)
+        out = cls._construct_fast(occ, res, origin)
+        object.__setattr__(out, "polygons", rings)
+        return out
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -164,8 +202,21 @@ class OccupancyGrid:
         return out
 
     def with_occupied(self, occupied: np.ndarray) -> OccupancyGrid:
-        """Return a grid with the same resolution and origin and new occupancy (validated)."""
+        """Return a grid with the same resolution and origin and new occupancy (validated).
+
+        The result has no :attr:`polygons` (its cells need not cover them).
+        """
         return OccupancyGrid(occupied, self.resolution, self.origin)
+
+    def moved_to(self, origin: tuple[float, float]) -> OccupancyGrid:
+        """Return the same cells with their lower-left corner at ``origin`` (m).
+
+        The map moved as a whole: :attr:`polygons`, when known, move with the cells (by
+        ``origin - self.origin``), so they stay covered.
+        """
+        o = validation.origin(origin)
+        out = OccupancyGrid._construct_fast(self.occupied, self.resolution, o)
+        return self._keeping(out, (o[0] - self.origin[0], o[1] - self.origin[1]))
 
     # ------------------------------------------------------- conversions
     def split(self, k: int) -> OccupancyGrid:
@@ -173,7 +224,8 @@ class OccupancyGrid:
 
         The occupied squares cover exactly the same area and the origin is kept, so a plan
         on the result can be compared with one on this grid (the planner's sizes follow
-        metres and the robot, not cells). ``k = 1`` returns ``self``.
+        metres and the robot, not cells). ``k = 1`` returns ``self``. :attr:`polygons` are
+        kept.
 
         Raises
         ------
@@ -184,7 +236,7 @@ class OccupancyGrid:
         if k == 1:
             return self
         occ = np.repeat(np.repeat(self.occupied, k, axis=0), k, axis=1)
-        return OccupancyGrid(occ, self.resolution / k, self.origin)
+        return self._keeping(OccupancyGrid(occ, self.resolution / k, self.origin))
 
     def coarsen(self, k: int) -> OccupancyGrid:
         """Return the map in cells ``k`` times larger, occupied wherever any of their cells was.
@@ -193,8 +245,8 @@ class OccupancyGrid:
         the result, so a path clear on the result is clear here. The last row and column of
         blocks, when ``nx`` or ``ny`` is not a multiple of ``k``, are filled up with
         occupied cells (the outside of the map). The origin is kept. ``k = 1`` returns
-        ``self``. The planner's memory grows with the cell count: this is the knob that
-        lowers it ``k * k`` times.
+        ``self``. :attr:`polygons` are kept (still covered). The planner's memory grows with
+        the cell count: this is the knob that lowers it ``k * k`` times.
 
         Raises
         ------
@@ -209,7 +261,7 @@ class OccupancyGrid:
         occ = np.ones((by * k, bx * k), dtype=bool)
         occ[:ny, :nx] = self.occupied
         blocks = occ.reshape(by, k, bx, k).any(axis=(1, 3))
-        return OccupancyGrid(blocks, self.resolution * k, self.origin)
+        return self._keeping(OccupancyGrid(blocks, self.resolution * k, self.origin))
 
     def world_to_cell(self, xy: np.ndarray | tuple[float, float]) -> np.ndarray:
         """Cells ``(ix, iy)`` containing world points.

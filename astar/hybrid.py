@@ -276,7 +276,10 @@ def find_pose_path(
         at an exact ``clearance`` (cells), or a ``footprint`` polygon (cells) with
         ``footprint_margin`` and ``footprint_slack``. ``raw_grid`` must have ``grid``'s
         shape. In the footprint mode the start and goal poses' footprints, grown by the
-        margin and the slack, must keep clear of the raw map and inside the grid.
+        margin and the slack, must keep clear of the raw map and inside the grid. A
+        ``raw_grid`` made by :meth:`~astar.OccupancyGrid.from_polygons` (its polygons known)
+        is tested against its polygons where its occupied squares do not clear the body:
+        the footprint then keeps the margin from the polygons, not from the squares.
 
     Other Parameters
     ----------------

@@ -51,6 +51,7 @@ import numba
 import numpy as np
 from numba import njit
 
+from astar.body_polygons import body_distance
 from astar.reeds_shepp import advance, car_word
 from astar.search_kernels import heap_pop, heap_push
 
@@ -222,6 +223,10 @@ class KernelCollision(NamedTuple):
         and the outside (:func:`footprint_discs_clear`; else 1 x 1).
     discs : ndarray of float64, shape (n, 3)
         Footprint mode: discs covering the footprint (``(0, 3)``: no quick test).
+    pedges, pstarts, pboxes : ndarray
+        Footprint mode: the raw map's polygons in cells
+        (:func:`astar.body_polygons.pack_polygons`; no edges: none known), tested exactly
+        where the occupied squares do not clear the body (:func:`_fp_clear`).
     """
 
     step: float
@@ -236,6 +241,9 @@ class KernelCollision(NamedTuple):
     fmin_slack: float
     fdist: np.ndarray
     discs: np.ndarray
+    pedges: np.ndarray
+    pstarts: np.ndarray
+    pboxes: np.ndarray
 
 
 @njit(cache=True)
@@ -714,17 +722,28 @@ def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - c
     return True
 
 
-@njit(cache=True, inline="always")
-def _fp_clear(occ, fsafe, fp, fdist, discs, x, y, th, grow, buf):  # pragma: no cover
-    """Return whether the footprint grown by ``grow`` is clear: quick test, else exact."""
-    return footprint_discs_clear(fdist, discs, x, y, th, grow) or (
-        footprint_hit(occ, fsafe, fp, x, y, th, grow, buf) == -1
-    )
+@njit(cache=True)
+def _fp_clear(occ, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  # pragma: no cover
+    """Return whether the footprint grown by ``grow`` is clear: quick test, else exact.
+
+    ``poly``: the map's polygons in cells (:func:`astar.body_polygons.pack_polygons`; none:
+    no edges). Where the cells (a conservative cover of the polygons) do not clear the body
+    inside the grid, its distance to the polygons decides (:func:`body_distance`).
+    """
+    if footprint_discs_clear(fdist, discs, x, y, th, grow):
+        return True
+    hit = footprint_hit(occ, fsafe, fp, x, y, th, grow, buf)
+    if hit == -1:
+        return True
+    if hit == -2 or poly[0].shape[0] == 0:
+        return False
+    # footprint_hit left the body's vertices at this pose in buf[:, :2]
+    return body_distance(poly[0], poly[1], poly[2], buf[:, :2], np.inf) > grow
 
 
 @njit(cache=True)
 def footprint_arc_clear(
-    occ, fsafe, fp, fdist, discs, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
+    occ, fsafe, fp, fdist, discs, poly, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
 ):  # pragma: no cover - compiled
     """Whether every pose of an arc keeps the footprint ``margin`` from the raw map.
 
@@ -742,7 +761,8 @@ def footprint_arc_clear(
     |kappa|) / 2`` is tested at the arc's middle first (one step covering the whole arc;
     only where ``fsafe``, made for a smaller growth, does not answer for the middle's cell);
     when it is clear, so is the arc. Each test tries :func:`footprint_discs_clear` (``fdist``,
-    ``discs``) first, :func:`footprint_hit` when it does not answer.
+    ``discs``) first, :func:`footprint_hit` when it does not answer, and the body's distance to
+    the map's polygons ``poly`` when the cells do not clear it (:func:`_fp_clear`).
     """
     ds_max = 2.0 * slack / (1.0 + rho * abs(kappa))
     m = max(1, int(math.ceil(abs(s) / ds_max)))
@@ -756,17 +776,17 @@ def footprint_arc_clear(
         ny, nx = occ.shape
         if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] == 0:
             sweep = 0.5 * abs(s) * (1.0 + rho * abs(kappa))
-            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sweep, buf):
+            if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sweep, buf):
                 return True
     grow = margin + slack
     half = 0.5 * s / m
     for j in range(m):
         mid = s * (j + 0.5) / m
         qx, qy, qth = advance(x, y, th, kappa, mid)
-        if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, grow, buf):
+        if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, grow, buf):
             continue
         if 0.5 * slack < min_slack or not _fp_clear(
-            occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf
+            occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf
         ):
             return False
         # halve the step (a stack of (middle, half length, slack)), down to min_slack
@@ -780,11 +800,11 @@ def footprint_arc_clear(
             top -= 1
             c, h, sl = stack[top, 0], stack[top, 1], stack[top, 2]
             qx, qy, qth = advance(x, y, th, kappa, c)
-            if _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin + sl, buf):
+            if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sl, buf):
                 continue
             if 0.5 * sl < min_slack or top + 2 > 64:
                 return False
-            if not _fp_clear(occ, fsafe, fp, fdist, discs, qx, qy, qth, margin, buf):
+            if not _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf):
                 return False
             stack[top, 0] = c - 0.5 * h
             stack[top + 1, 0] = c + 0.5 * h
@@ -801,6 +821,7 @@ def footprint_word_clear(
     fp,
     fdist,
     discs,
+    poly,
     rho,
     x,
     y,
@@ -829,6 +850,7 @@ def footprint_word_clear(
             fp,
             fdist,
             discs,
+            poly,
             rho,
             x,
             y,
@@ -1004,7 +1026,24 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         car_window,
     ) = costs
     max_expansions, deadline, polish = limits
-    step, safe, occ, exact_r, fp, fsafe, frho, fmargin, fslack, fmin_slack, fdist, discs = collision
+    (
+        step,
+        safe,
+        occ,
+        exact_r,
+        fp,
+        fsafe,
+        frho,
+        fmargin,
+        fslack,
+        fmin_slack,
+        fdist,
+        discs,
+        pedges,
+        pstarts,
+        pboxes,
+    ) = collision
+    poly = (pedges, pstarts, pboxes)
     ny, nx = free.shape
     nc = curvatures.shape[0]
     ndirs = 2 if reverse else 1
@@ -1155,6 +1194,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         fp,
                         fdist,
                         discs,
+                        poly,
                         frho,
                         ax,
                         ay,
@@ -1200,6 +1240,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 fp,
                 fdist,
                 discs,
+                poly,
                 frho,
                 ux,
                 uy,

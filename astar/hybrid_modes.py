@@ -22,6 +22,13 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
   :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
   construction), and tests the end poses' footprints; :func:`raw_occupied` reads the raw
   map of both modes, :func:`raw_occupancy` checks it against the grid.
+* Polygons: where ``raw_grid`` is an :class:`~astar.grid.OccupancyGrid` made by
+  :meth:`~astar.grid.OccupancyGrid.from_polygons` (its ``polygons`` known), the footprint
+  mode's test of a pose whose grown body meets an occupied square inside the grid is decided
+  by the body's exact distance to the polygons (:func:`grid_polygons`,
+  :func:`astar.body_polygons.body_distance`): the squares cover the polygons, so a body they
+  clear is clear, and the guarantee becomes "clear of the polygons by the margin". Without
+  polygons nothing changes.
 
 The compiled tests live in :mod:`astar.hybrid_kernel`, beside the search that calls them (so
 that numba's cache of the search is rebuilt whenever they change):
@@ -54,6 +61,7 @@ from astar.errors import InvalidInputError
 from astar.grid import OccupancyGrid
 
 if TYPE_CHECKING:  # pragma: no cover
+    from astar.body_polygons import PackedPolygons  # numba: imported when a search runs
     from astar.hybrid_kernel import KernelCollision  # numba: imported when a search runs
     from astar.hybrid_options import HybridCollision  # it imports this module
 
@@ -65,6 +73,7 @@ __all__ = [
     "footprint_polygon",
     "footprint_radii",
     "footprint_safe",
+    "grid_polygons",
     "kernel_collision",
     "raw_occupancy",
     "raw_occupied",
@@ -359,6 +368,7 @@ def kernel_collision(
         ``raw_grid`` does not have the grid's shape, or (footprint mode) an end pose's grown
         footprint meets an occupied square or leaves the grid.
     """
+    from astar.body_polygons import pack_polygons
     from astar.hybrid_kernel import KernelCollision
 
     dummy = np.zeros((1, 1), dtype=np.uint8)
@@ -368,7 +378,19 @@ def kernel_collision(
     if collision.clearance is None:
         no_discs = np.zeros((0, 3))
         return KernelCollision(
-            step, dummy, dummy, 0.0, no_fp, dummy, 0.0, 0.0, 0.0, 0.0, np.zeros((1, 1)), no_discs
+            step,
+            dummy,
+            dummy,
+            0.0,
+            no_fp,
+            dummy,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            np.zeros((1, 1)),
+            no_discs,
+            *pack_polygons(None),
         )
     r = collision.clearance
     occ = raw_occupancy(collision.raw_grid, free)
@@ -380,7 +402,19 @@ def kernel_collision(
     occ8 = np.ascontiguousarray(occ, dtype=np.uint8)
     no_discs = np.zeros((0, 3))
     return KernelCollision(
-        step, safe, occ8, r, no_fp, safe, 0.0, 0.0, 0.0, 0.0, np.zeros((1, 1)), no_discs
+        step,
+        safe,
+        occ8,
+        r,
+        no_fp,
+        safe,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        np.zeros((1, 1)),
+        no_discs,
+        *pack_polygons(None),
     )
 
 
@@ -391,6 +425,7 @@ def _footprint_inputs(
     poses: tuple[tuple[str, tuple[float, float, float]], ...],
 ) -> KernelCollision:
     """Build the footprint mode's kernel inputs and test the end poses' footprints."""
+    from astar.body_polygons import body_distance
     from astar.hybrid_kernel import KernelCollision, footprint_hit
 
     margin, slack = collision.footprint_margin, collision.footprint_slack
@@ -400,8 +435,15 @@ def _footprint_inputs(
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
+    poly = grid_polygons(collision)
+    fdist = clearance_bound(occ)
+    discs = footprint_discs(fp)
     for name, (x, y, th) in poses:
-        hit = int(footprint_hit(occ, safe, fp, x, y, th, margin + min_slack, buf))
+        grow = margin + min_slack
+        hit = int(footprint_hit(occ, safe, fp, x, y, th, grow, buf))
+        if hit >= 0 and len(poly[0]):  # the cells do not clear it: the polygons decide
+            if body_distance(*poly, np.ascontiguousarray(buf[:, :2]), np.inf) > grow:
+                hit = -1
         if hit != -1:
             where = (
                 "leaves the grid"
@@ -413,10 +455,20 @@ def _footprint_inputs(
                 f"{name} pose ({x:g}, {y:g}, {th:g}): its footprint grown by footprint_margin + "
                 f"the least sampling slack ({margin:g} + {min_slack:g} cells) {where}; it must keep "
                 "clear of every occupied square and inside the grid"
+                + (" (and of raw_grid's polygons)" if len(poly[0]) else "")
             )
     dummy = np.zeros((1, 1), dtype=np.uint8)
-    fdist = clearance_bound(occ)
-    discs = footprint_discs(fp)
     return KernelCollision(
-        step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack, fdist, discs
+        step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack, fdist, discs, *poly
     )
+
+
+def grid_polygons(collision: HybridCollision) -> PackedPolygons:
+    """Return the raw map's polygons in cells (:func:`pack_polygons`), or none.
+
+    :attr:`HybridCollision.raw_polygons` (set from an :class:`OccupancyGrid` ``raw_grid``
+    whose :attr:`~OccupancyGrid.polygons` are known), packed; none without them.
+    """
+    from astar.body_polygons import pack_polygons
+
+    return pack_polygons(collision.raw_polygons)

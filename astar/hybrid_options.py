@@ -289,7 +289,9 @@ class HybridCollision:
         The raw map (an ``OccupancyGrid``, or a bool array ``True`` on *occupied* cells, as
         ``OccupancyGrid.occupied``), the same shape as the search's ``grid`` (checked by
         :func:`astar.find_pose_path`). Stored as a read-only bool array of the occupied
-        cells (an ``OccupancyGrid``'s own, a copy of an array).
+        cells (an ``OccupancyGrid``'s own, a copy of an array); an ``OccupancyGrid``'s
+        :attr:`~astar.OccupancyGrid.polygons`, when known, are kept in
+        :attr:`raw_polygons`.
     clearance : float, optional
         Exact mode (with ``raw_grid``; finite, ``> 0``, cells): besides the cell checks on
         ``grid``, every chord between consecutive collision samples keeps Euclidean distance
@@ -363,8 +365,20 @@ class HybridCollision:
     footprint_margin: float = 0.0
     footprint_slack: float = DEFAULT_SLACK
     footprint_min_slack: float | None = None
+    #: The polygons ``raw_grid`` was rasterised from, in the search's cells (cell ``(ix,
+    #: iy)``'s centre at ``(ix, iy)``), or None: set from an ``OccupancyGrid`` ``raw_grid``
+    #: whose :attr:`~astar.OccupancyGrid.polygons` are known. In the footprint mode a pose
+    #: whose grown body meets an occupied square inside the grid is decided by its exact
+    #: distance to them (:mod:`astar.hybrid_modes`).
+    raw_polygons: tuple[np.ndarray, ...] | None = dataclasses.field(default=None, init=False)
 
     def __post_init__(self) -> None:
+        rings = None
+        if isinstance(self.raw_grid, OccupancyGrid) and self.raw_grid.polygons is not None:
+            g = self.raw_grid
+            shift = np.array([g.origin[0], g.origin[1]]) + 0.5 * g.resolution
+            rings = tuple((v - shift) / g.resolution for v in g.polygons)
+        object.__setattr__(self, "raw_polygons", rings)
         margin = validation.nonnegative_float("footprint_margin", self.footprint_margin, "cells")
         slack = validation.positive_float("footprint_slack", self.footprint_slack)
         min_slack = self.footprint_min_slack

@@ -274,7 +274,7 @@ def _mark_interior(occ: np.ndarray, v: np.ndarray, origin: tuple[float, float], 
 
 def rasterize_polygons(
     polygons: Sequence[object], resolution: object, bounds: object
-) -> tuple[np.ndarray, float, tuple[float, float]]:
+) -> tuple[np.ndarray, float, tuple[float, float], tuple[np.ndarray, ...]]:
     """Occupancy of the cells (closed squares) that the polygons meet, with its frame.
 
     Parameters
@@ -293,6 +293,8 @@ def rasterize_polygons(
     resolution : float
     origin : tuple of float
         ``(xmin, ymin)``.
+    rings : tuple of ndarray, shape (k, 2)
+        The checked polygons (:func:`check_polygon`: read-only, counter-clockwise).
 
     Raises
     ------
@@ -313,4 +315,4 @@ def rasterize_polygons(
     for v in rings:
         _mark_edges(occ, v, origin, res)
         _mark_interior(occ, v, origin, res)
-    return occ, res, origin
+    return occ, res, origin, tuple(rings)

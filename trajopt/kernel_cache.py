@@ -51,6 +51,7 @@ _log = logging.getLogger(__name__)
 
 #: Modules that define the compiled (numba) kernels of astar and trajopt.
 KERNEL_MODULES: tuple[str, ...] = (
+    "astar.body_polygons",
     "astar.coarse_to_fine",
     "astar.distance_transform",
     "astar.hybrid_kernel",

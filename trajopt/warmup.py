@@ -281,6 +281,9 @@ def _exercise_car() -> None:
         astar.find_pose_path(grid, start, goal, turning_radius=3.0, raw_grid=grid, footprint=body)
     except (astar.NoPathError, astar.InvalidInputError):  # compiled all the same
         pass
+    # the exact body-to-polygon distance (a car on a grid made from polygons)
+    square = np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])
+    astar.bodies_distance(np.asarray(body), np.array([[0.0, 0.0, 0.3]]), [square])
     astar.reeds_shepp_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
     astar.dubins_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
 

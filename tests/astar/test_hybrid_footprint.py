@@ -17,6 +17,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from astar import InvalidInputError, NoPathError
+from astar.body_polygons import pack_polygons
 from astar.hybrid import NoPosePathError, find_pose_path
 from tests.astar.hybrid_checks import (
     REAR,
@@ -322,6 +323,7 @@ def test_footprint_arc_clear_covers_the_whole_arc(slack, min_slack):
                 fp,
                 fdist,
                 discs,
+                pack_polygons(None),
                 rho,
                 x,
                 y,

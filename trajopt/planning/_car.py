@@ -51,6 +51,18 @@ necessary condition); each segment's corridor keeps the inscribed radius and its
 also pass the footprint certificate, with the body along the curve's tangent forwards and
 turned by ``pi`` backwards (:func:`~trajopt.planning._car_fit.body_along`).
 
+**Polygons.** On a grid that keeps the polygons it was rasterised from
+(:attr:`astar.OccupancyGrid.polygons`, from :meth:`astar.OccupancyGrid.from_polygons`), a car
+with a body is planned against the polygons, the cells only a conservative pre-filter: its
+end poses (:func:`~trajopt.planning._footprint_ladder.check_end_poses` with ``polygons``),
+the search's footprint tests (:attr:`astar.HybridCollision.raw_polygons`) and the band of
+its centre grid (:func:`~trajopt.planning._car_tries.polygon_band`), and the certificates
+of the segments near them (:func:`~trajopt.planning._car_fit.fine_window`); it searches
+cells of at least ``R /`` :data:`SEARCH_CELLS_PER_RADIUS` (:func:`search_cells`). The
+guarantee is then that the body is clear of the polygons at every instant (the fitted
+curves: of a finer conservative raster of them); on a grid without polygons, of the
+occupied cells, and such plans are the same as without this mode.
+
 **Frame.** Nothing in a plan depends on where the map's origin is: the ends are checked in
 the map's frame, then the search, the fits and the timing run in the map-local frame (the
 grid's origin subtracted, so coordinates are at most the map's size), and the result is
@@ -69,6 +81,7 @@ end speeds other than 0, missing end headings, and the chapter's ``inflation="pa
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -222,7 +235,8 @@ def plan_car(
     # everything else in the map-local frame (module docstring, "Frame")
     origin = np.asarray(world.origin, dtype=float)
     local = bool(np.any(origin != 0.0))
-    grid = OccupancyGrid(world.occupied, world.resolution, (0.0, 0.0)) if local else world
+    grid = world.moved_to((0.0, 0.0)) if local else world  # its polygons moved with it
+    grid = search_cells(robot, grid)
     p0, p1 = (p0w - origin, p1w - origin) if local else (p0w, p1w)
     res = grid.resolution
     start = _to_cells(grid, p0, h0)
@@ -260,7 +274,7 @@ def plan_car(
             dataclasses.replace(m, path=ShiftedCurve(m.path, origin), speed_limits=zones)
             for m in moves
         ]
-        search_grid = world.with_occupied(search_grid.occupied)
+        search_grid = OccupancyGrid(search_grid.occupied, search_grid.resolution, world.origin)
         poses = poses + np.array([origin[0], origin[1], 0.0])
     pieces, steered = with_steering(robot, moves, request.start_steer, request.goal_steer)
     stages = timer.finish()
@@ -300,6 +314,32 @@ def plan_car(
         "inflation": options.inflation,
     }
     return TrajectoryChain(tuple(pieces), robot, stats, steps)
+
+
+#: Turning radius of a car with a body, in cells of the grid it searches, below which
+#: :func:`search_cells` keeps the map's cells as they are.
+SEARCH_CELLS_PER_RADIUS = 30.0
+
+
+def search_cells(robot: Robot, grid: OccupancyGrid) -> OccupancyGrid:
+    """Return the grid a car with a body plans on: ``grid``, or its polygons' coarser cells.
+
+    Where ``grid`` knows the polygons it was rasterised from
+    (:attr:`astar.OccupancyGrid.polygons`) the body is tested exactly against them and the
+    cells are only a conservative pre-filter, so their size need not follow the map's: a
+    map finer than :data:`SEARCH_CELLS_PER_RADIUS` cells per turning radius is planned on
+    ``grid.coarsen(k)`` (cells ``k`` times larger, at most that fine; the polygons kept), so
+    that the search's states and primitives follow the car rather than the raster. A grid
+    without polygons, or a disc car, is returned as it is.
+    """
+    if robot.footprint is None or grid.polygons is None:
+        return grid
+    k = int(
+        math.floor(
+            robot.drive.min_turning_radius / SEARCH_CELLS_PER_RADIUS / grid.resolution + 1e-9
+        )
+    )
+    return grid.coarsen(k) if k > 1 else grid
 
 
 #: Smallest change of the steering angle (rad) a car steers at rest for: below it the
@@ -408,9 +448,18 @@ def _ends(
     h0, h1 = float(h0), float(request.goal_heading)
     if robot.footprint is not None:
         ends = dataclasses.replace(request, start=p0, start_heading=h0, goal=p1, goal_heading=h1)
-        check_end_poses(robot.footprint, grid, ends)
-    check_endpoint(options, grid, "start", p0, robot.inscribed_radius)
-    check_endpoint(options, grid, "goal", p1, robot.inscribed_radius)
+        check_end_poses(robot.footprint, grid, ends, polygons=True)
+    # a body checked against the map's polygons holds its inscribed disc clear of them:
+    # only the map's extent is checked (its cells may touch the disc)
+    exact = robot.footprint is not None and grid.polygons is not None
+    radius = 0.0 if exact else robot.inscribed_radius
+    for name, p in (("start", p0), ("goal", p1)):
+        if exact:
+            c = grid.world_to_cell(p)
+            if not grid.in_bounds(c):
+                check_endpoint(options, grid, name, p, radius)  # raises: off the map
+        else:
+            check_endpoint(options, grid, name, p, radius)
     return p0, p1, h0, h1
 
 

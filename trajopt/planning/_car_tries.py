@@ -223,6 +223,8 @@ def search_and_fit(
                     if exc.reason == "disconnected":
                         stop = True
                         break
+                    if exc.reason == "exhausted":
+                        break  # every reachable state expanded: other costs reach no more
                 except astar.InvalidInputError as exc:
                     if robot.footprint is None:
                         raise
@@ -270,7 +272,9 @@ def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]
     default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (at most
     :data:`FOOTPRINT_DEFAULT_BUDGET_S`; the paths they find where they find one quickly:
     drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
-    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`.
+    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`. A search that
+    exhausts its states (every reachable state expanded) ends the variants of its try: the
+    costs change the order of the expansions, not the states reachable.
     """
     if robot.footprint is None:
         return (("", {}, SEARCH_BUDGET_S),)
@@ -297,7 +301,10 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> O
     astar.OccupancyGrid
         ``grid`` with every cell within ``robot.radius`` plus :data:`SEARCH_MARGIN_CELLS`
         cells (without ``margin``: within ``robot.radius``) of an occupied square (or of the
-        outside) occupied.
+        outside) occupied. A car with a body: every cell whose centre is closer than the
+        inscribed radius minus half a cell's diagonal to an occupied square, or, where the
+        map knows its polygons (:attr:`astar.OccupancyGrid.polygons`), to a polygon
+        (:func:`polygon_band`), or to the outside.
     """
     r = robot.radius + (SEARCH_MARGIN_CELLS * grid.resolution if margin else 0.0)
     if robot.footprint is not None:
@@ -305,9 +312,46 @@ def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> O
         # anywhere in a cell keeps the inscribed radius, so its centre keeps that minus
         # half the cell's diagonal
         r = max(0.0, robot.inscribed_radius - 0.5 * math.sqrt(2.0) * grid.resolution)
-    return grid.with_occupied(
-        astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
+    occ = astar.inflate(grid, r, metric="square", outside_occupied=True).occupied
+    if robot.footprint is not None and grid.polygons is not None and r > 0.0:
+        occ = polygon_band(grid, occ, r)
+    return grid.with_occupied(occ)
+
+
+def polygon_band(grid: OccupancyGrid, blocked: np.ndarray, r: float) -> np.ndarray:
+    """Free the cells of ``blocked`` whose centre keeps ``r`` (m) from the map's polygons.
+
+    ``blocked``: the cells whose centre is closer than ``r`` to an occupied square or the
+    map's outside. Every occupied square lies within its diagonal of a polygon
+    (:meth:`astar.OccupancyGrid.from_polygons`), so a centre closer than ``r`` minus the
+    diagonal to a square is closer than ``r`` to a polygon: only the band between the two
+    is measured exactly against the polygons (:func:`astar.points_distance`) and against
+    the map's outside; a cell of it that keeps ``r`` from both is freed.
+    """
+    res = grid.resolution
+    inner = r - math.sqrt(2.0) * res
+    sure = (
+        astar.inflate(grid, inner, metric="square", outside_occupied=True).occupied
+        if inner > 0.0
+        else grid.occupied
     )
+    iy, ix = np.nonzero(blocked & ~sure)
+    if not len(ix):
+        return blocked
+    centres = grid.cell_to_world(np.column_stack([ix, iy]))
+    ox, oy = grid.origin
+    edge = np.minimum.reduce(
+        [
+            centres[:, 0] - ox,
+            ox + grid.width - centres[:, 0],
+            centres[:, 1] - oy,
+            oy + grid.height - centres[:, 1],
+        ]
+    )
+    keep = (astar.points_distance(centres, grid.polygons) >= r) & (edge >= r)
+    out = np.array(blocked, dtype=bool)
+    out[iy[keep], ix[keep]] = False
+    return out
 
 
 def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str, Any]:

@@ -205,11 +205,16 @@ def plan_with_footprint(
     raise SmoothingError("no footprint-certified trajectory: " + "; ".join(failures), stats)
 
 
-def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanRequest) -> None:
+def check_end_poses(
+    footprint: Footprint, raw: OccupancyGrid, request: PlanRequest, polygons: bool = False
+) -> None:
     """Raise when the footprint cannot stand at the start or the goal.
 
     With a heading (given, or a :class:`~trajopt.robot._state.State`'s ``theta``) the footprint at
-    that pose must be clear of the raw map; without one, at least one of
+    that pose must be clear of the raw map: of its occupied squares, or, with ``polygons``
+    (a planner that tests the body against them: the car's) where the map knows the polygons
+    it was rasterised from (:attr:`astar.OccupancyGrid.polygons`), of those polygons
+    (exactly, :func:`astar.bodies_distance`) and inside the map; without one, at least one of
     :data:`~trajopt.smoother._footprint_rounds.END_HEADINGS` sampled headings must be.
 
     Raises
@@ -238,6 +243,11 @@ def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanReque
             return
         if theta is not None and math.isfinite(float(theta)):
             clr = float(polygons_clearance([fp.at(*xy, float(theta))], raw, raw.resolution)[0])
+            exact = polygons and raw.polygons is not None
+            if clr <= 0.0 and exact and _inside_map(fp, raw, xy, float(theta)):
+                # the cells cover the polygons conservatively: the polygons decide
+                pose = np.array([[xy[0], xy[1], float(theta)]])
+                clr = float(astar.bodies_distance(fp.vertices, pose, raw.polygons)[0])
             if clr <= 0.0:
                 raise InvalidInputError(
                     f"{name} pose ({xy[0]:.4g}, {xy[1]:.4g}) m, heading {float(theta):.4g} rad: "
@@ -248,6 +258,20 @@ def check_end_poses(footprint: Footprint, raw: OccupancyGrid, request: PlanReque
                 f"{name} ({xy[0]:.4g}, {xy[1]:.4g}) m: the footprint meets an obstacle or the "
                 f"map edge at each of {END_HEADINGS} sampled headings; it cannot stand there"
             )
+
+
+def _inside_map(fp: Footprint, raw: OccupancyGrid, xy: np.ndarray, theta: float) -> bool:
+    """Whether the footprint at pose ``(xy, theta)`` lies inside the map's rectangle."""
+    c, s = math.cos(theta), math.sin(theta)
+    v = np.asarray(fp.vertices, dtype=float)
+    w = xy + v @ np.array([[c, s], [-s, c]])
+    ox, oy = raw.origin
+    return bool(
+        np.all(w[:, 0] > ox)
+        and np.all(w[:, 0] < ox + raw.width)
+        and np.all(w[:, 1] > oy)
+        and np.all(w[:, 1] < oy + raw.height)
+    )
 
 
 def _label(radius: float, checked: bool) -> str:

@@ -308,3 +308,119 @@ def test_full_size_car_fits_a_backwards_segment_in_halves():
     delta = geometric_steer(traj, t, FULL.wheelbase)
     rate = np.abs(np.diff(delta)) / np.diff(t)
     assert rate.max() <= robot.drive.steering.rate_max * (1.0 + 1e-6)
+
+
+# ------------------------------------------------------- the polygons inside the planner
+
+
+def parallel_scene(size: float, aisle: float = 4.5):
+    """A parallel slot ``size`` full-size car lengths long, the kerb 0.2 m below it.
+
+    Two parked cars each side (1 m apart), an aisle ``aisle`` m wide above, a U-shaped kerb
+    round the street and a wall on top; the start in the aisle behind the slot facing +x
+    (drive past, back in), the goal centred in the slot facing +x. The scene is moved by
+    (0.053, 0.047) m so that no polygon edge lies on a 0.1 m grid line: the conservative
+    cells reach up to a cell beyond the cars.
+    """
+    ln, wd = FULL.length, FULL.width
+    slot = size * ln
+    cy = 0.2 + 0.5 * wd  # the parked cars' centre line; the kerb's top at y = 0
+    cars = [
+        pc.rect(s * (0.5 * slot + 0.5 * ln + k * (ln + 1.0)), cy, ln, wd)
+        for s in (-1.0, 1.0)
+        for k in range(2)
+    ]
+    top = 0.2 + wd + aisle
+    x0, x1 = -0.5 * slot - 2 * ln - 3.0, 0.5 * slot + 2 * ln + 3.0
+    wall = np.array(
+        [(x0 - 0.2, top), (x1 + 0.2, top), (x1 + 0.2, top + 0.2), (x0 - 0.2, top + 0.2)]
+    )
+    d = np.array([0.053, 0.047])
+    polys = [p + d for p in (*cars, pc._u_kerb(x0, x1, 0.0, top, 0.2), wall)]
+    goal = (-0.5 * ln + FULL.rear_offset + d[0], cy + d[1], 0.0)
+    start = (-0.5 * slot - ln + d[0], cy + wd + 0.5 * aisle - 0.3 + d[1], 0.0)
+    return polys, (x0 - 0.3, -0.3, x1 + 0.3, top + 0.3), start, goal
+
+
+@pytest.fixture(scope="module")
+def slot_1_3():
+    """The parallel slot of 1.3 car lengths (:func:`parallel_scene`) planned at 0.1 m."""
+    polys, bounds, start, goal = parallel_scene(1.3)
+    grid = astar.OccupancyGrid.from_polygons(polys, 0.1, bounds)
+    traj = trajopt.plan(
+        grid, start[:2], goal[:2], FULL.robot(), start_heading=start[2], goal_heading=goal[2]
+    )
+    return polys, bounds, start, goal, traj
+
+
+def test_full_size_car_backs_into_a_parallel_slot_of_1_3_car_lengths(slot_1_3):
+    """Issue 45: a parallel slot 1.3 car lengths long entered backwards (the start behind
+    the slot), at 0.1 m, planned on the grid from ``from_polygons`` and clear of the
+    polygons by the exact check at 1 cm of corner travel."""
+    polys, _, start, goal, traj = slot_1_3
+    assert traj.stats["car"]["cusps"] >= 1 and traj.stats["car"]["reverse_length_m"] > 1.0
+    t, poses = pc.trajectory_poses(traj, FULL.body())
+    corners = pc.body_at(FULL.body(), poses)
+    assert np.hypot(*np.moveaxis(np.diff(corners, axis=0), -1, 0)).max() <= 0.01
+    np.testing.assert_allclose(poses[0], start, atol=1e-6)
+    np.testing.assert_allclose(poses[-1, :2], goal[:2], atol=1e-6)
+    assert abs(math.remainder(poses[-1, 2] - goal[2], 2 * math.pi)) < 1e-6
+    check = pc.check_poses(FULL.body(), poses, polys)
+    assert check.overlaps == 0 and check.min_clearance > 0.0
+    # the body ends in the slot, below the parked cars' tops
+    end = pc.body_at(FULL.body(), poses[-1:])[0]
+    assert end[:, 1].max() < polys[0][:, 1].max() + 1e-9
+
+
+def test_end_pose_clear_of_the_polygons_but_touching_a_cell_is_planned():
+    """The small car into a bay 1.15 car widths wide, nose first, on a 5 cm grid: its body
+    at the goal is 3.75 cm from each neighbour, closer than a cell, so it meets the
+    conservative cells; it is planned (not refused), and clear of the polygons at 1 cm of
+    corner travel. The same grid without its polygons refuses the goal."""
+    from trajopt.robot import polygons_clearance
+
+    polys, bounds, start, goal = bay_scene(1.15, "forwards")
+    grid = astar.OccupancyGrid.from_polygons(polys, 0.05, bounds)
+    robot = SMALL.robot()
+    assert polygons_clearance([robot.footprint.at(*goal)], grid, 0.05)[0] == 0.0
+    traj = trajopt.plan(
+        grid, start[:2], goal[:2], robot, start_heading=start[2], goal_heading=goal[2]
+    )
+    _, poses = pc.trajectory_poses(traj, SMALL.body())
+    np.testing.assert_allclose(poses[-1, :2], goal[:2], atol=1e-6)
+    check = pc.check_poses(SMALL.body(), poses, polys)
+    assert check.overlaps == 0 and check.min_clearance > 0.0
+    with pytest.raises(trajopt.InvalidInputError, match="goal pose"):
+        trajopt.plan(
+            grid.with_occupied(grid.occupied),
+            start[:2],
+            goal[:2],
+            robot,
+            start_heading=start[2],
+            goal_heading=goal[2],
+        )
+
+
+def test_polygons_move_with_a_far_away_origin(slot_1_3):
+    """The slot of 1.3 car lengths shifted by (4.5e9, -1.5e9) m: the map's polygons move into
+    the planner's local frame with its cells (``OccupancyGrid.moved_to``), and the plan is the
+    same trajectory, shifted, to 1e-6 m."""
+    polys, bounds, start, goal, near = slot_1_3
+    d = np.array([4.5e9, -1.5e9])
+    box = (bounds[0] + d[0], bounds[1] + d[1], bounds[2] + d[0], bounds[3] + d[1])
+    grid = astar.OccupancyGrid.from_polygons([p + d for p in polys], 0.1, box)
+    far = trajopt.plan(
+        grid,
+        np.asarray(start[:2]) + d,
+        np.asarray(goal[:2]) + d,
+        FULL.robot(),
+        start_heading=start[2],
+        goal_heading=goal[2],
+    )
+    assert far.duration == pytest.approx(near.duration, rel=1e-9)
+    t = np.linspace(0.0, near.duration, 400)
+    a, b = near.sample(t), far.sample(t)
+    np.testing.assert_allclose(
+        np.column_stack([b.x - d[0], b.y - d[1]]), np.column_stack([a.x, a.y]), atol=1e-6
+    )
+    np.testing.assert_allclose(b.theta, a.theta, atol=1e-6)
