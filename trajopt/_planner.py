@@ -81,6 +81,7 @@ from trajopt.planning import (
     Search,
     SearchMode,
     plan_among_movers,
+    plan_from_stop,
     run_query,
 )
 from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
@@ -502,6 +503,7 @@ class Planner:
                     heading: float,
                     steer: float,
                     seen: Sequence[MovingObstacle],
+                    along: Any = None,
                 ) -> PlanResult:  # a plan from the stop, as plan's with movers
                     if steps is None:
                         raise InvalidInputError("the re-plan has no steps: no goal to go on to")
@@ -513,8 +515,8 @@ class Planner:
                         start_steer=steer,
                         goal_steer=getattr(steps, "goal_steer", None),
                     )
-                    return plan_among_movers(
-                        tuple(seen), margin, self.options, self.caches, request
+                    return plan_from_stop(
+                        tuple(seen), margin, self.options, self.caches, request, along
                     )
 
                 ts = float(out.stats["splice_time_s"])

@@ -1,8 +1,10 @@
 """A quick proof that no re-timing along the path gets past the movers: :func:`no_way_past`.
 
-A re-timing keeps the path and changes only ``s(t)``: from rest at ``s = 0``, non-decreasing,
-with speed at most ``V`` (the robot's top speed, forwards or backwards) and ``s(t)`` at most
-the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from rest. This proof
+A re-timing keeps the path and changes only ``s(t)``: from ``s = 0`` at ``t = 0``,
+non-decreasing, with speed at most ``V`` (the robot's top speed, forwards or backwards) and
+``s(t)`` at most the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from the
+plan's start state (from rest; ``V t`` from a moving start, the rest of a trajectory being
+driven, which also holds every motion that brakes to a stop on the path and goes on from there). This proof
 drops everything else (the acceleration and the path's curvature caps between grid times,
 what lies between two nodes) and sweeps, node by node along the path, the times such an
 ``s(t)`` can be at each node of the *necessary* ``(s, t)`` grid (:func:`~trajopt.moving.st_grid`
@@ -16,7 +18,8 @@ none (a mover coming head-on leaves no way past). The grid's last time is after 
 last change, so its last row holds for ever, and the cost is that of the nodes and the
 movers' windows at them, not of the time horizon. When no mover ever comes to the start node
 and none stays on the path, the robot may wait at the start until every mover has left the
-path and then drive: the sweep is skipped (nothing to prove).
+path and then drive: the sweep is skipped (nothing to prove). A start node taken at ``t = 0``
+proves nothing either (a mover over the robot: the re-timing refuses that as bad input).
 
 The robot is its inscribed disc (inside a footprint, so a footprint is at least as close),
 and a plan of several pieces is its curves end to end (rests and turns in place add no
@@ -135,7 +138,8 @@ def no_way_past(
     Parameters
     ----------
     plan : PlanResult
-        A plan from rest (one curve, a chain, an omni translation).
+        A plan (one curve, a chain, an omni translation), from rest or moving (its
+        ``v_start``, m/s).
     movers : sequence of MovingObstacle
         The predictions (the plan's clock).
     margin : float
@@ -179,11 +183,11 @@ def no_way_past(
     )
     if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
         return None  # waiting at the start until every mover has left the path gets past
-    s_up = reach_bound(grid.t, v_top, a_max, j_max)
+    s_up = reach_bound(grid.t, v_top, a_max, j_max, abs(float(getattr(plan, "v_start", 0.0))))
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
     reach = reachable_times(grid, v_top, s_up)
-    if reach[-1]:
+    if not reach[0] or reach[-1]:
         return None
     i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0
     k = int(min(max((b for _, b in reach[i]), default=0.0) + 1, grid.t.shape[0] - 1))

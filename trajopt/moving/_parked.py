@@ -2,15 +2,18 @@
 
 A mover whose prediction ends standing still (its last waypoints equal) stays there for ever
 (:class:`~trajopt.moving.MovingObstacle`). If, from the time ``t_stop`` it stands, its shape is
-closer than the limit to some point ``C(s*)`` of the path, and no motion from rest under the
-robot's limits can be beyond ``s*`` by ``t_stop`` (``s* > reach(t_stop)``, the bound
-:func:`~trajopt.moving._st_grid.reach_bound` of ``s(t)``), then every re-timing of the path
+closer than the limit to some point ``C(s*)`` of the path, and no motion from the plan's start
+state under the robot's limits can be beyond ``s*`` by ``t_stop`` (``s* > reach(t_stop)``, the
+bound :func:`~trajopt.moving._st_grid.reach_bound` of ``s(t)``: from rest, or ``v_max t`` from
+a moving start, the rest of a trajectory being driven), then every re-timing of the path
 passes ``C(s*)`` (or stands there, at the goal) after ``t_stop``, closer than the limit: no
 re-timing avoids it. The robot is taken as its inscribed disc (inside a footprint, so a
 footprint is at least as close), the limit at ``t_stop`` (the radius only grows), and the
 distance is exact at the sampled points (one point suffices). A plan of several pieces is its
 curves end to end (rests and turns in place add no distance, so the reach bound holds for the
-arc length summed over the pieces).
+arc length summed over the pieces). A mover closer than the limit to the path's start at
+``t = 0`` proves nothing here (the robot is already over it: the re-timing refuses that as
+bad input).
 
 It decides in a few milliseconds what the ``(s, t)`` re-timing decides after its search fails;
 the planner tries it first and re-routes at once (:func:`~trajopt.moving.reroute`).
@@ -65,7 +68,8 @@ def parked_on_path(
     Parameters
     ----------
     plan : PlanResult
-        A plan from rest (one curve, a chain, an omni translation).
+        A plan (one curve, a chain, an omni translation), from rest or moving (its
+        ``v_start``, m/s).
     movers : sequence of MovingObstacle
         The predictions (the plan's clock).
     margin : float
@@ -83,9 +87,10 @@ def parked_on_path(
     robot = plan.robot
     back = getattr(robot.drive, "v_max_backwards", None)
     v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    v0 = abs(float(getattr(plan, "v_start", 0.0)))
     t_stops = [max(settle_time(m), 0.0) for m in movers]
     reaches = [
-        float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max)[0]) for t in t_stops
+        float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max, v0)[0]) for t in t_stops
     ]
     if min(reaches) >= sum(float(c.length) for c in curves):
         return None  # the robot may be past the whole path before any mover stands still
@@ -98,6 +103,8 @@ def parked_on_path(
         off += float(c.length)
     p = np.concatenate(pts)
     s_cum = np.concatenate(s_all)
+    if over_start(p[0], movers, float(robot.inscribed_radius) + margin):
+        return None
     for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
         if reach >= off:
             continue  # no point of the path lies beyond it
@@ -116,3 +123,13 @@ def parked_on_path(
                 t=t_stop,
             )
     return None
+
+
+def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float) -> bool:
+    """Whether a mover is closer than ``limit`` plus its radius (m) to ``start`` (m) at ``t = 0``."""
+    p = np.asarray(start, dtype=float).reshape(1, 2)
+    for m in movers:
+        d = float(point_polygon_distance(p, shape_at(m, np.array([0.0])))[0])
+        if d < limit + float(m.radius_at(0.0)):
+            return True
+    return False

@@ -14,7 +14,7 @@ from trajopt.planning._car import CarSteps, plan_car
 from trajopt.planning._car_tries import car_search_grid
 from trajopt.planning._ends import check_endpoint
 from trajopt.planning._feasibility import curvature_witness
-from trajopt.planning._moving import plan_among_movers, plan_for_movers
+from trajopt.planning._moving import plan_among_movers, plan_for_movers, plan_from_stop
 from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import (
     CorridorKind,
@@ -30,6 +30,7 @@ from trajopt.planning._runner import plan_free, plan_turning, run_query
 
 __all__ = [
     "plan_among_movers",
+    "plan_from_stop",
     "plan_for_movers",
     "CarSteps",
     "CorridorKind",

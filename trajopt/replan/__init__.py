@@ -7,10 +7,11 @@ result for them (:mod:`trajopt.replan._moving`).
 """
 
 from trajopt.replan._car import replan_car
-from trajopt.replan._moving import retime_replan
+from trajopt.replan._moving import Along, retime_replan
 from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, replan_moving
 
 __all__ = [
+    "Along",
     "BRAKE_AFTER_S",
     "replan_car",
     "replan_from",

@@ -53,6 +53,8 @@ from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    no_way_past,
+    parked_on_path,
     retime_chain,
     retime_for_movers,
     shift_clock,
@@ -111,13 +113,18 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
+    proof = blocked_along(out, movers, margin, ts, shifted)
     try:
+        if proof is not None:
+            raise proof
         timed, moving = _retimed(out, movers, margin, ts, shifted)
         moving["route"] = "retimed"
     except BlockedError as exc:
         if from_stop is None:
             raise
-        timed, moving = _stop_and_go_on(out, movers, margin, ts, shifted, from_stop, exc)
+        timed, moving = _stop_and_go_on(
+            out, movers, margin, ts, shifted, from_stop, exc, proved=proof is not None
+        )
     moving.update(
         time_s=time.perf_counter() - t0,
         clock_offset_s=float(ts),
@@ -158,6 +165,39 @@ def _retimed(
             )
         moving["certificate"] = cert.summary()
     return timed, moving
+
+
+def blocked_along(
+    out: PlanResult,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+) -> BlockedError | None:
+    """Return a proof that the path the robot follows is blocked from where it stops, or ``None``.
+
+    The quick proofs (:func:`trajopt.moving.parked_on_path`, then
+    :func:`trajopt.moving.no_way_past`) on what :func:`_retimed` re-times: one curve from the
+    moving state against ``shifted`` (their reach bound from a moving start, ``v_max t``, holds
+    every motion along the path, those that brake to a stop on it and go on from rest
+    included), or a chain's tail, a plan from rest after the head, against the movers seen
+    from the head's end. Either way nothing along that path from the stop gets past. Its time
+    is on the movers' clock; ``None`` when they find nothing (the re-timing decides).
+    """
+    if out.single_curve and out.direction == 1:
+        plan, t0, seen = out, ts, shifted
+    else:
+        head, tail = split_at_rest(out)
+        if not tail:
+            return None
+        t_head = sum(float(p.duration) - t_in for p, t_in in head)
+        plan = tail[0] if len(tail) == 1 else TrajectoryChain(tuple(tail), out.robot, {}, None)
+        t0 = ts + t_head
+        seen = [shift_clock(m, t0) for m in movers]
+    proof = parked_on_path(plan, seen, margin)
+    if proof is None:
+        proof = no_way_past(plan, seen, margin)
+    return None if proof is None else _on_movers_clock(proof, t0)
 
 
 def _on_movers_clock(exc: BlockedError, t0: float) -> BlockedError:
@@ -239,11 +279,29 @@ def _retime_tail(
     return chain, moving
 
 
-#: ``from_stop(position, heading, steer, movers)``: a plan from rest at ``position`` (m,
-#: shape (2,)) with ``heading`` (rad) and a car's ``steer`` (rad) to the re-plan's goal,
+#: ``from_stop(position, heading, steer, movers, along)``: a plan from rest at ``position``
+#: (m, shape (2,)) with ``heading`` (rad) and a car's ``steer`` (rad) to the re-plan's goal,
 #: re-timed for ``movers`` (seen from the stop), else re-routed around them, certified;
-#: raises ``TrajoptError`` otherwise.
-FromStop = Callable[[tuple[float, float], float, float, Sequence[MovingObstacle]], PlanResult]
+#: raises ``TrajoptError`` otherwise. ``along``: ``None``, or the path being followed from
+#: the stop (:class:`Along`), proved blocked: the re-route's candidates come first, the static
+#: plan from the stop last.
+FromStop = Callable[..., PlanResult]
+
+
+@dataclasses.dataclass(frozen=True)
+class Along:
+    """The path the robot follows, from where it stops, proved blocked for the movers.
+
+    Attributes
+    ----------
+    blocked : BlockedError
+        The proof (:func:`blocked_along`), its time on the clock seen from the stop (s).
+    points : ndarray, shape (n, 2)
+        Points (m) of that path from the stop to the goal, at most 5 cm apart.
+    """
+
+    blocked: BlockedError
+    points: np.ndarray
 
 
 def _stop_and_go_on(
@@ -254,16 +312,19 @@ def _stop_and_go_on(
     shifted: Sequence[MovingObstacle],
     from_stop: FromStop,
     blocked: BlockedError,
+    *,
+    proved: bool = False,
 ) -> tuple[PlanResult, dict[str, Any]]:
     """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
 
     One curve from the moving state is braked along its path
     (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
-    plans on for the movers seen from there (``ts`` plus the stop's time); the head and that
-    plan are certified whole against ``shifted``. ``BlockedError`` (the mover named, its time
-    on the movers' clock) when no stop applies, no plan from the stop works or the head meets
-    a mover.
+    plans on for the movers seen from there (``ts`` plus the stop's time), told the path
+    followed from the stop (:class:`Along`) when ``blocked`` is a proof on it (``proved``,
+    :func:`blocked_along`); the head and that plan are certified whole against ``shifted``.
+    ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies,
+    no plan from the stop works or the head meets a mover.
     """
     head: list[tuple[Any, float]] = []
     if getattr(out, "pieces", None) is not None:
@@ -271,6 +332,7 @@ def _stop_and_go_on(
         if not tail:
             raise blocked
         stop = tail[0].sample(np.array([0.0]))
+        ahead = tail
     elif out.single_curve and out.direction == 1:
         try:
             brake = brake_on_path(out, 0.0)
@@ -279,15 +341,26 @@ def _stop_and_go_on(
         if brake is not None:
             head.append((brake, 0.0))
         stop = (brake or out).sample(np.array([brake.duration if brake else 0.0]))
+        ahead = [out]
     else:
         raise blocked
     t_head = sum(float(p.duration) - t_in for p, t_in in head)
     seen = [shift_clock(m, ts + t_head) for m in movers]
     steer = getattr(stop, "steer", None)
     p_stop = (float(stop.x[0]), float(stop.y[0]))
+    along = None
+    if proved:
+        t_stop = max(blocked.t - ts - t_head, 0.0)  # on the clock seen from the stop
+        along = Along(
+            BlockedError(str(blocked), mover=blocked.mover, t=t_stop), _points(ahead, p_stop)
+        )
     try:
         rest = from_stop(
-            p_stop, float(stop.theta[0]), 0.0 if steer is None else float(steer[0]), seen
+            p_stop,
+            float(stop.theta[0]),
+            0.0 if steer is None else float(steer[0]),
+            seen,
+            along,
         )
     except TrajoptError as exc:
         mover, t = blocked.mover, blocked.t
@@ -331,3 +404,21 @@ def _stop_and_go_on(
         if key in done:
             moving[key] = done[key]
     return whole, moving
+
+
+def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
+    """Points (m, shape (n, 2)) of the pieces' curves end to end, at most 5 cm apart, from the stop on.
+
+    Turns in place add none; the points before the one nearest the stop (the part braked
+    over) are dropped.
+    """
+    pts = [np.asarray(p_stop, dtype=float).reshape(1, 2)]
+    for p in pieces:
+        if getattr(p, "pieces", None) is not None:
+            pts.append(_points(p.pieces, p_stop))
+        elif p.single_curve and float(p.length) > 0.0:
+            s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.05)) + 1)
+            pts.append(np.asarray(p.path(p.path.u_at_s(s)), dtype=float).reshape(-1, 2))
+    out = np.concatenate(pts)
+    near = int(np.argmin(np.hypot(out[1:, 0] - p_stop[0], out[1:, 1] - p_stop[1]))) + 1
+    return np.concatenate([out[:1], out[near:]])
