@@ -23,7 +23,7 @@ from trajopt.moving._certificate import MoverCertificate, certify_movers, check_
 from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._no_way_past import no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._parked import parked_on_path, settle_time
+from trajopt.moving._parked import over_start, parked_on_path, settle_time
 from trajopt.moving._reroute import car_headings, goal_taken, reroute
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
@@ -39,6 +39,7 @@ __all__ = [
     "goal_taken",
     "mark_swept",
     "no_way_past",
+    "over_start",
     "parked_on_path",
     "reachable",
     "reachable_times",

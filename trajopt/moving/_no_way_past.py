@@ -162,7 +162,8 @@ def no_way_past(
     if length <= 0.0:
         return None
     back = getattr(robot.drive, "v_max_backwards", None)
-    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    v0 = abs(float(getattr(plan, "v_start", 0.0)))
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
     a_max, j_max = float(robot.a_max), float(robot.j_max)
     t_last = max(max(float(m.t_last) for m in movers), 0.0)
     t_goal = length / v_top + v_top / a_max + a_max / j_max  # reach_bound passes L by then
@@ -183,7 +184,7 @@ def no_way_past(
     )
     if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
         return None  # waiting at the start until every mover has left the path gets past
-    s_up = reach_bound(grid.t, v_top, a_max, j_max, abs(float(getattr(plan, "v_start", 0.0))))
+    s_up = reach_bound(grid.t, v_top, a_max, j_max, v0)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
     reach = reachable_times(grid, v_top, s_up)

@@ -86,8 +86,8 @@ def parked_on_path(
         return None
     robot = plan.robot
     back = getattr(robot.drive, "v_max_backwards", None)
-    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
     v0 = abs(float(getattr(plan, "v_start", 0.0)))
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
     t_stops = [max(settle_time(m), 0.0) for m in movers]
     reaches = [
         float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max, v0)[0]) for t in t_stops

@@ -33,10 +33,10 @@ clear of it (no marked cell within the robot's radius of a point beyond the star
 goal's kept discs) are tried after the others, in the same order: their map leaves the blocked
 path open, so their plan likely takes it again (a mover's final place behind the robot, say).
 
-A detour's plan is first given the quick proofs (:func:`~trajopt.moving.parked_on_path`,
+Such a detour's plan is first given the quick proofs (:func:`~trajopt.moving.parked_on_path`,
 :func:`~trajopt.moving.no_way_past`), which refuse a blocked one in milliseconds, before the
-re-timing's search. A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
-(its reason kept). When none works, the original :class:`BlockedError` is raised again (it
+re-timing's search. A candidate whose map has no path, whose plan fails or whose re-timing is
+blocked is skipped (its reason and wall time kept). When none works, the original :class:`BlockedError` is raised again (it
 names the mover and the time) with the reasons appended. None is tried when a mover ends
 standing on the goal (its final shape closer than the robot's inscribed radius plus the margin
 to the goal point, for ever): every route ends there (:func:`goal_taken`).
@@ -166,7 +166,9 @@ def reroute(
 
     marked_maps: list[OccupancyGrid] = []
 
-    def detour(regions: list[tuple[MovingObstacle, float, float]]) -> Callable[[], Any]:
+    def detour(
+        regions: list[tuple[MovingObstacle, float, float]], prove: bool = False
+    ) -> Callable[[], Any]:
         def run() -> Any:
             marked = mark_swept(grid, regions, margin, keep)
             if marked is None:
@@ -175,9 +177,10 @@ def reroute(
                 raise BlockedError("the same map as a candidate tried before")
             marked_maps.append(marked)
             leg = plan_leg(marked, None, None, None)
-            proof = parked_on_path(leg, movers, margin) or no_way_past(leg, movers, margin)
-            if proof is not None:  # before the re-timing's search, which would end in it
-                raise proof
+            if prove:  # before the re-timing's search, which would end in it
+                proof = parked_on_path(leg, movers, margin) or no_way_past(leg, movers, margin)
+                if proof is not None:
+                    raise proof
             return retime_chain(leg, movers, margin=margin)
 
         return run
@@ -193,14 +196,14 @@ def reroute(
             spans.append((t_from, f" from t = {t_from:.3f} s"))
         for t0, when in spans:
             detours.append((f"around {who.name!r}{when}", [(who, t0, max(t_end, t0))]))
+    clear = [False] * len(detours)
     if path is not None:
         pts = _beyond(np.asarray(path, dtype=float).reshape(-1, 2), keep)
         clear = [_keeps_clear(grid, regions, margin + robot.radius, pts) for _, regions in detours]
-        detours = [d for d, c in zip(detours, clear, strict=True) if not c] + [
-            d for d, c in zip(detours, clear, strict=True) if c
-        ]
-    for what, regions in detours:
-        out = attempt(what, detour(regions), "rerouted")
+    order = [i for i, c in enumerate(clear) if not c] + [i for i, c in enumerate(clear) if c]
+    for i in order:
+        what, regions = detours[i]
+        out = attempt(what, detour(regions, prove=clear[i]), "rerouted")
         if out is not None:
             return out
     turns = robot.drive.turns_in_place and not robot.drive.signed_speed

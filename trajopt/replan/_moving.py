@@ -54,6 +54,7 @@ from trajopt.moving import (
     MovingObstacle,
     certify_movers,
     no_way_past,
+    over_start,
     parked_on_path,
     retime_chain,
     retime_for_movers,
@@ -182,7 +183,9 @@ def blocked_along(
     every motion along the path, those that brake to a stop on it and go on from rest
     included), or a chain's tail, a plan from rest after the head, against the movers seen
     from the head's end. Either way nothing along that path from the stop gets past. Its time
-    is on the movers' clock; ``None`` when they find nothing (the re-timing decides).
+    is on the movers' clock; ``None`` when they find nothing or a mover is within the robot's
+    circumscribed radius of the start at ``t = 0`` (the re-timing decides, or refuses that as
+    bad input).
     """
     if out.single_curve and out.direction == 1:
         plan, t0, seen = out, ts, shifted
@@ -194,6 +197,9 @@ def blocked_along(
         plan = tail[0] if len(tail) == 1 else TrajectoryChain(tuple(tail), out.robot, {}, None)
         t0 = ts + t_head
         seen = [shift_clock(m, t0) for m in movers]
+    start = plan.sample(np.array([0.0]))
+    if over_start((float(start.x[0]), float(start.y[0])), seen, float(out.robot.radius) + margin):
+        return None  # a mover over the robot (its circumscribed disc): the re-timing refuses it
     proof = parked_on_path(plan, seen, margin)
     if proof is None:
         proof = no_way_past(plan, seen, margin)
