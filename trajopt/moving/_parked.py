@@ -33,6 +33,10 @@ from trajopt.moving._st_grid import reach_bound
 
 #: Arc-length spacing (m) of the path points checked.
 PARKED_DS = 0.02
+#: Arc-length spacing (m) of the points that screen the movers first: a mover whose final
+#: shape's bounding disc (about its reference point) none of them comes within the limit plus
+#: half this of is nowhere within the limit of the path.
+SCREEN_DS = 0.25
 
 
 def settle_time(mover: MovingObstacle) -> float:
@@ -89,30 +93,30 @@ def parked_on_path(
     v0 = abs(float(getattr(plan, "v_start", 0.0)))
     v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
     t_stops = [max(settle_time(m), 0.0) for m in movers]
-    reaches = [
-        float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max, v0)[0]) for t in t_stops
-    ]
+    reaches = reach_bound(np.array(t_stops), v_top, robot.a_max, robot.j_max, v0).tolist()
     if min(reaches) >= sum(float(c.length) for c in curves):
         return None  # the robot may be past the whole path before any mover stands still
-    pts, s_all, off = [], [], 0.0
-    for c in curves:
-        n = max(2, int(np.ceil(c.length / PARKED_DS)) + 1)
-        s = np.linspace(0.0, c.length, n)
-        pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float))
-        s_all.append(s + off)
-        off += float(c.length)
-    p = np.concatenate(pts)
-    s_cum = np.concatenate(s_all)
-    if over_start(p[0], movers, float(robot.inscribed_radius) + margin):
-        return None
+    coarse, _, off = _path_points(curves, SCREEN_DS)
+    near = []  # the movers whose final shape's bounding disc comes near some coarse point
     for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
         if reach >= off:
             continue  # no point of the path lies beyond it
+        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
+        centre = m.position_at(np.array([t_stop])).reshape(2)
+        bound = float(np.max(np.hypot(*m.shape_vertices.T)))  # the shape within it of centre
+        d = np.hypot(*(coarse - centre).T) - bound
+        if np.any(d < limit + 0.5 * SCREEN_DS):  # a point between is nearer than ds/2 to one
+            near.append((m, t_stop, reach, limit))
+    if not near:
+        return None
+    p, s_cum, off = _path_points(curves, PARKED_DS)
+    for m, t_stop, reach, limit in near:
         shape = shape_at(m, np.array([t_stop]))
         d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
-        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
         hit = (d < limit) & (s_cum > reach)
         if hit.any():
+            if over_start(coarse[0], movers, float(robot.inscribed_radius) + margin):
+                return None
             i = int(np.argmax(hit))
             return BlockedError(
                 f"moving obstacle {m.name!r} stands on the path from t = {t_stop:.3f} s "
@@ -123,6 +127,21 @@ def parked_on_path(
                 t=t_stop,
             )
     return None
+
+
+def _path_points(curves: list[Any], ds: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Return points at most ``ds`` (m) apart along the curves end to end.
+
+    The points (m, shape (n, 2)), their arc lengths (m, shape (n,)) and the total length (m).
+    """
+    pts, s_all, off = [], [], 0.0
+    for c in curves:
+        n = max(2, int(np.ceil(c.length / ds)) + 1)
+        s = np.linspace(0.0, c.length, n)
+        pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float))
+        s_all.append(s + off)
+        off += float(c.length)
+    return np.concatenate(pts), np.concatenate(s_all), off
 
 
 def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float) -> bool:

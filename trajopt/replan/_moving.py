@@ -37,6 +37,18 @@ place: :func:`trajopt.moving.reroute`). The stop and that plan are certified who
 the shifted movers. ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
 ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
 plan from the stop works or the robot meets a mover while it stops.
+
+**A path proved blocked** (:func:`blocked_along`): the quick proofs on what is re-timed (one
+curve from the moving state, whose reach bound ``v_max t`` holds every motion along its path,
+a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
+from rest after the head) show that nothing along the path followed gets past the movers from
+the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
+parks on the rest: no search), :func:`trajopt.moving.no_way_past` after it fails. The proof
+is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
+which then tries the re-route's candidates at once and the static plan from the stop last:
+that plan is a new search from a point of the path followed, to the same goal on the same map,
+so it usually takes the path's rest again (blocked), but it may leave it (another grid path,
+smoothing or start heading), so it is tried rather than dropped.
 """
 
 from __future__ import annotations
@@ -114,7 +126,7 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
-    proof = blocked_along(out, movers, margin, ts, shifted)
+    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path,))
     try:
         if proof is not None:
             raise proof
@@ -123,8 +135,10 @@ def retime_replan(
     except BlockedError as exc:
         if from_stop is None:
             raise
+        if proof is None:  # is the path followed blocked from the stop on, too?
+            proof = blocked_along(out, movers, margin, ts, shifted, (no_way_past,))
         timed, moving = _stop_and_go_on(
-            out, movers, margin, ts, shifted, from_stop, exc, proved=proof is not None
+            out, movers, margin, ts, shifted, from_stop, exc, along=proof
         )
     moving.update(
         time_s=time.perf_counter() - t0,
@@ -174,10 +188,11 @@ def blocked_along(
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
+    proofs: Sequence[Callable[..., BlockedError | None]],
 ) -> BlockedError | None:
     """Return a proof that the path the robot follows is blocked from where it stops, or ``None``.
 
-    The quick proofs (:func:`trajopt.moving.parked_on_path`, then
+    The quick ``proofs`` (:func:`trajopt.moving.parked_on_path`,
     :func:`trajopt.moving.no_way_past`) on what :func:`_retimed` re-times: one curve from the
     moving state against ``shifted`` (their reach bound from a moving start, ``v_max t``, holds
     every motion along the path, those that brake to a stop on it and go on from rest
@@ -200,10 +215,11 @@ def blocked_along(
     start = plan.sample(np.array([0.0]))
     if over_start((float(start.x[0]), float(start.y[0])), seen, float(out.robot.radius) + margin):
         return None  # a mover over the robot (its circumscribed disc): the re-timing refuses it
-    proof = parked_on_path(plan, seen, margin)
-    if proof is None:
-        proof = no_way_past(plan, seen, margin)
-    return None if proof is None else _on_movers_clock(proof, t0)
+    for prove in proofs:
+        proof = prove(plan, seen, margin)
+        if proof is not None:
+            return _on_movers_clock(proof, t0)
+    return None
 
 
 def _on_movers_clock(exc: BlockedError, t0: float) -> BlockedError:
@@ -319,7 +335,7 @@ def _stop_and_go_on(
     from_stop: FromStop,
     blocked: BlockedError,
     *,
-    proved: bool = False,
+    along: BlockedError | None = None,
 ) -> tuple[PlanResult, dict[str, Any]]:
     """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
 
@@ -327,8 +343,8 @@ def _stop_and_go_on(
     (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
     plans on for the movers seen from there (``ts`` plus the stop's time), told the path
-    followed from the stop (:class:`Along`) when ``blocked`` is a proof on it (``proved``,
-    :func:`blocked_along`); the head and that plan are certified whole against ``shifted``.
+    followed from the stop (:class:`Along`) when ``along`` proves it blocked
+    (:func:`blocked_along`); the head and that plan are certified whole against ``shifted``.
     ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies,
     no plan from the stop works or the head meets a mover.
     """
@@ -354,19 +370,17 @@ def _stop_and_go_on(
     seen = [shift_clock(m, ts + t_head) for m in movers]
     steer = getattr(stop, "steer", None)
     p_stop = (float(stop.x[0]), float(stop.y[0]))
-    along = None
-    if proved:
-        t_stop = max(blocked.t - ts - t_head, 0.0)  # on the clock seen from the stop
-        along = Along(
-            BlockedError(str(blocked), mover=blocked.mover, t=t_stop), _points(ahead, p_stop)
-        )
+    told = None
+    if along is not None:
+        t_stop = max(along.t - ts - t_head, 0.0)  # on the clock seen from the stop
+        told = Along(BlockedError(str(along), mover=along.mover, t=t_stop), _points(ahead, p_stop))
     try:
         rest = from_stop(
             p_stop,
             float(stop.theta[0]),
             0.0 if steer is None else float(steer[0]),
             seen,
-            along,
+            told,
         )
     except TrajoptError as exc:
         mover, t = blocked.mover, blocked.t
