@@ -454,7 +454,9 @@ class Planner:
             (:func:`trajopt.moving.retime_chain`). When only the predictions changed, the
             kept rest keeps its path and only its timing changes. When no re-timing avoids
             the movers, the robot brakes to a stop and plans on from there as :meth:`plan`
-            does with movers (re-timed, else re-routed or a wait at a safe place). The
+            does with movers (re-timed, else re-routed or a wait at a safe place; when the
+            path followed is proved blocked, the re-route's candidates first and the static
+            plan from the stop last: :func:`trajopt.planning.plan_from_stop`). The
             result is certified whole; its ``t = 0`` is the splice ``ts = t + latency`` of
             that clock; ``stats["moving"]`` holds the re-timing (``plan``, ``certificate``,
             ``time_s``), ``route`` (``"retimed"`` or ``"stopped: <plan's route>"``),

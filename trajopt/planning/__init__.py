@@ -6,7 +6,8 @@ map's caches, the one query runner (:func:`run_query`) and the stages the drives
 a disc's or a footprint's plan (:func:`plan_free`), pose to pose with turns in place
 (:func:`plan_turning`), an omnidirectional base's (:func:`plan_omni`) and a car's
 (:func:`plan_car`); a plan among predicted movers, re-timed or re-routed
-(:func:`plan_among_movers`, :func:`plan_for_movers`).
+(:func:`plan_among_movers`, :func:`plan_for_movers`; from a re-plan's stop,
+:func:`plan_from_stop`).
 """
 
 from trajopt.planning._caches import PlannerCaches, change_reach
