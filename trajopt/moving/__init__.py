@@ -10,7 +10,7 @@
 * :func:`retime_chain`: any plan from rest on one clock (curves, turns in place, a car's
   drives between cusps and steering at rest, an omni orientation); :func:`shift_clock`;
 * :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it
-  (:func:`over_start`: a mover over the path's start, which the proofs leave to the re-timing);
+  (:func:`over_start`: whether a mover is over a point at ``t = 0``);
   :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers
   (:func:`reachable_times`: its sweep of the necessary grid, node by node);
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the

@@ -18,8 +18,7 @@ none (a mover coming head-on leaves no way past). The grid's last time is after 
 last change, so its last row holds for ever, and the cost is that of the nodes and the
 movers' windows at them, not of the time horizon. When no mover ever comes to the start node
 and none stays on the path, the robot may wait at the start until every mover has left the
-path and then drive: the sweep is skipped (nothing to prove). A start node taken at ``t = 0``
-proves nothing either (a mover over the robot: the re-timing refuses that as bad input).
+path and then drive: the sweep is skipped (nothing to prove).
 
 The robot is its inscribed disc (inside a footprint, so a footprint is at least as close),
 and a plan of several pieces is its curves end to end (rests and turns in place add no
@@ -188,7 +187,7 @@ def no_way_past(
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
     reach = reachable_times(grid, v_top, s_up)
-    if not reach[0] or reach[-1]:
+    if reach[-1]:
         return None
     i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0
     k = int(min(max((b for _, b in reach[i]), default=0.0) + 1, grid.t.shape[0] - 1))

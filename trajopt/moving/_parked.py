@@ -11,9 +11,7 @@ re-timing avoids it. The robot is taken as its inscribed disc (inside a footprin
 footprint is at least as close), the limit at ``t_stop`` (the radius only grows), and the
 distance is exact at the sampled points (one point suffices). A plan of several pieces is its
 curves end to end (rests and turns in place add no distance, so the reach bound holds for the
-arc length summed over the pieces). A mover closer than the limit to the path's start at
-``t = 0`` proves nothing here (the robot is already over it: the re-timing refuses that as
-bad input).
+arc length summed over the pieces).
 
 It decides in a few milliseconds what the ``(s, t)`` re-timing decides after its search fails;
 the planner tries it first and re-routes at once (:func:`~trajopt.moving.reroute`).
@@ -115,8 +113,6 @@ def parked_on_path(
         d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
         hit = (d < limit) & (s_cum > reach)
         if hit.any():
-            if over_start(coarse[0], movers, float(robot.inscribed_radius) + margin):
-                return None
             i = int(np.argmax(hit))
             return BlockedError(
                 f"moving obstacle {m.name!r} stands on the path from t = {t_stop:.3f} s "

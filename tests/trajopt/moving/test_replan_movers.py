@@ -494,3 +494,17 @@ def test_quick_proofs_from_a_moving_start_never_refuse_a_certified_re_timing(dri
         assert dense_min(timed, [mover])[0] >= -1e-6
         assert proof is None, proof
     assert found >= 5 and claimed >= 3, (found, claimed)  # both kinds met
+
+
+def test_a_mover_over_the_robot_at_the_splice_is_refused_not_proved(driven):
+    """A cart parked where the robot is at the splice: bad input (InvalidInputError), as the
+    re-timing says, not a proof that the path is blocked."""
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    at = traj.state_at(ts)
+    cart = trajopt.MovingObstacle.from_waypoints([0.0], [(at.x, at.y)], radius=0.2, name="cart")
+    assert trajopt.moving.parked_on_path(
+        planner.replan(traj, 1.0, latency=LATENCY), [trajopt.moving.shift_clock(cart, ts)]
+    )  # the proof alone would call it blocked
+    with pytest.raises(trajopt.errors.InvalidInputError, match="overlaps"):
+        planner.replan(traj, 1.0, latency=LATENCY, moving_obstacles=[cart])
