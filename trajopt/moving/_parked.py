@@ -33,7 +33,8 @@ from trajopt.moving._st_grid import reach_bound
 PARKED_DS = 0.02
 #: Arc-length spacing (m) of the points that screen the movers first: a mover whose final
 #: shape's bounding disc (about its reference point) none of them comes within the limit plus
-#: half this of is nowhere within the limit of the path.
+#: half this of is nowhere within the limit of the path; the fine points are evaluated only
+#: within this much arc of a screening point that one comes that close to.
 SCREEN_DS = 0.25
 
 
@@ -94,8 +95,9 @@ def parked_on_path(
     reaches = reach_bound(np.array(t_stops), v_top, robot.a_max, robot.j_max, v0).tolist()
     if min(reaches) >= sum(float(c.length) for c in curves):
         return None  # the robot may be past the whole path before any mover stands still
-    coarse, _, off = _path_points(curves, SCREEN_DS)
+    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
     near = []  # the movers whose final shape's bounding disc comes near some coarse point
+    close = np.zeros(s_coarse.shape[0], dtype=bool)
     for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
         if reach >= off:
             continue  # no point of the path lies beyond it
@@ -103,11 +105,14 @@ def parked_on_path(
         centre = m.position_at(np.array([t_stop])).reshape(2)
         bound = float(np.max(np.hypot(*m.shape_vertices.T)))  # the shape within it of centre
         d = np.hypot(*(coarse - centre).T) - bound
-        if np.any(d < limit + 0.5 * SCREEN_DS):  # a point between is nearer than ds/2 to one
+        hit = d < limit + 0.5 * SCREEN_DS  # a point between is nearer than ds/2 to one
+        if hit.any():
             near.append((m, t_stop, reach, limit))
+            close |= hit
     if not near:
         return None
-    p, s_cum, off = _path_points(curves, PARKED_DS)
+    # the fine points within SCREEN_DS of arc of a close coarse point: no other can be near
+    p, s_cum, off = _path_points(curves, PARKED_DS, s_coarse[close], SCREEN_DS)
     for m, t_stop, reach, limit in near:
         shape = shape_at(m, np.array([t_stop]))
         d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
@@ -125,18 +130,30 @@ def parked_on_path(
     return None
 
 
-def _path_points(curves: list[Any], ds: float) -> tuple[np.ndarray, np.ndarray, float]:
+def _path_points(
+    curves: list[Any], ds: float, around: np.ndarray | None = None, within: float = 0.0
+) -> tuple[np.ndarray, np.ndarray, float]:
     """Return points at most ``ds`` (m) apart along the curves end to end.
 
     The points (m, shape (n, 2)), their arc lengths (m, shape (n,)) and the total length (m).
+    Given ``around`` (arc lengths, m), only the points within ``within`` (m) of arc of one of
+    them (the same points as without it, the others left out).
     """
     pts, s_all, off = [], [], 0.0
     for c in curves:
         n = max(2, int(np.ceil(c.length / ds)) + 1)
         s = np.linspace(0.0, c.length, n)
-        pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float))
-        s_all.append(s + off)
+        if around is not None:
+            k = np.searchsorted(around, s + off)  # the nearest of around on either side
+            lo = np.abs(s + off - around[np.maximum(k - 1, 0)])
+            hi = np.abs(around[np.minimum(k, around.shape[0] - 1)] - (s + off))
+            s = s[np.minimum(lo, hi) <= within]
+        if s.shape[0]:
+            pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float).reshape(-1, 2))
+            s_all.append(s + off)
         off += float(c.length)
+    if not pts:
+        return np.zeros((0, 2)), np.zeros(0), off
     return np.concatenate(pts), np.concatenate(s_all), off
 
 
