@@ -319,7 +319,7 @@ class Along:
     blocked : BlockedError
         The proof (:func:`blocked_along`), its time on the clock seen from the stop (s).
     points : ndarray, shape (n, 2)
-        Points (m) of that path from the stop to the goal, at most 5 cm apart.
+        Points (m) of that path from the stop to the goal, at most 10 cm apart.
     """
 
     blocked: BlockedError
@@ -427,7 +427,7 @@ def _stop_and_go_on(
 
 
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
-    """Points (m, shape (n, 2)) of the pieces' curves end to end, at most 5 cm apart, from the stop on.
+    """Points (m, shape (n, 2)) of the pieces' curves end to end, at most 10 cm apart, from the stop on.
 
     Turns in place add none; the points before the one nearest the stop (the part braked
     over) are dropped.
@@ -437,7 +437,7 @@ def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
         if getattr(p, "pieces", None) is not None:
             pts.append(_points(p.pieces, p_stop))
         elif p.single_curve and float(p.length) > 0.0:
-            s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.05)) + 1)
+            s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.1)) + 1)
             pts.append(np.asarray(p.path(p.path.u_at_s(s)), dtype=float).reshape(-1, 2))
     out = np.concatenate(pts)
     near = int(np.argmin(np.hypot(out[1:, 0] - p_stop[0], out[1:, 1] - p_stop[1]))) + 1
