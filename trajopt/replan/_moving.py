@@ -427,9 +427,9 @@ def _stop_and_go_on(
 
 
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
-    """Points (m, shape (n, 2)) of the pieces' curves end to end, at most 10 cm apart, from the stop on.
+    """Return points of the pieces' curves end to end from the stop on, at most 10 cm apart.
 
-    Turns in place add none; the points before the one nearest the stop (the part braked
+    The points (m, shape (n, 2)) start with the stop; turns in place add none; the points before the one nearest the stop (the part braked
     over) are dropped.
     """
     pts = [np.asarray(p_stop, dtype=float).reshape(1, 2)]
