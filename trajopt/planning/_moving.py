@@ -19,6 +19,7 @@ from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
 from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
+    goal_taken,
     no_way_past,
     parked_on_path,
     reroute,
@@ -171,7 +172,8 @@ def plan_from_stop(
     included). The static plan from the stop is a new search on the same map to the same goal
     from a point of that path, so it takes the path's rest again unless the new grid path,
     its smoothing or the start heading leave it: it may differ, hence it is tried, after the
-    re-route's candidates have failed, re-timed only (no second re-route).
+    re-route's candidates have failed, re-timed only (no second re-route), unless a mover
+    stands on the goal for ever (:func:`trajopt.moving.goal_taken`), where every plan ends.
 
     Parameters
     ----------
@@ -206,6 +208,8 @@ def plan_from_stop(
             p0, p1, robot, movers, margin, along.blocked, options, caches, request, along.points
         )
     except BlockedError as exc:
+        if goal_taken(movers, p1, float(robot.inscribed_radius) + margin) is not None:
+            raise  # a mover stands on the goal for ever: the static plan ends there too
         try:
             static = run_query(options, caches, request)
             out = plan_for_movers(
