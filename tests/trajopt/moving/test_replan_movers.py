@@ -425,11 +425,15 @@ def test_the_static_plan_from_the_stop_is_still_tried_when_no_candidate_works(
     for name in ("x", "y", "theta", "v"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
     # and with nothing that works either, the reasons of both are given
-    blocker = trajopt.MovingObstacle.from_waypoints(
-        [0.0], [(11.0, 1.0)], radius=0.2, name="on-goal"
-    )
+    blocker = trajopt.MovingObstacle.from_waypoints([0.0], [(6.0, 1.0)], radius=0.2, name="c")
     with pytest.raises(BlockedError, match="the static plan from the stop"):
         where.plan_from_stop((blocker,), 0.0, planner.options, planner.caches, request, along)
+    # but a mover standing on the goal for ever ends every plan: no static plan is tried
+    on_goal = trajopt.MovingObstacle.from_waypoints([0.0], [(11.0, 1.0)], radius=0.2, name="g")
+    calls = _count_plans(monkeypatch)
+    with pytest.raises(BlockedError, match="no candidate") as info:
+        where.plan_from_stop((on_goal,), 0.0, planner.options, planner.caches, request, along)
+    assert "static plan" not in str(info.value) and not calls
 
 
 def test_parked_proof_from_a_moving_start_uses_its_speed():
