@@ -35,11 +35,28 @@ corridor, ``timing``), ``retime`` (its re-timing and certificate for the movers,
 ``stats["moving"]["time_s"]``) and ``other`` (the rest of ``reroute ms``: marking the map,
 the derived caches, candidates tried before).
 
+A second part (``--part replan``) times :meth:`trajopt.Planner.replan` with movers that block
+the rest of the path being driven. Each query is planned without movers (the plan driven),
+then re-planned ``REPLAN_AT`` s in (``latency=0``, the robot moving) with one mover on that
+plan's clock that blocks its rest: ``stop`` (the cart drives in from 1 m beside the middle of
+the rest and stops on it after 2 s) or ``head-on`` (the walker drives the plan's path backwards
+from the goal at 0.5 m/s from ``t = 0``). The re-plan brakes along the path and goes on from
+the stop (``stats["moving"]["route"]``: ``stopped: rerouted``, ...). It is timed against a
+plain plan (no movers, same warm planner, timed after one untimed call of the same query) from
+the pose where the result stops (``stats["moving"]["head_s"]``) to the goal with that heading:
+the re-route's target is 2x such a plan. Each re-plan and its plain plan are timed
+``--repeat`` times, alternating (the plain plan after one untimed call); ``ratio`` is the
+median re-plan's time over the median plain plan's, ``first med`` the first re-plan's alone
+(the later ones find the re-timing's tables of the kept rest warm). Every result is checked with the reference
+(``check_trajectory``: 1 ms samples, Lipschitz bounds, the static map) on the movers seen from
+the splice (shifted to the result's clock), and for continuity at the splice and at the stop.
+
 Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
 ``../shared/data``)::
 
     python benchmarks/bench_moving_reroute.py
     python benchmarks/bench_moving_reroute.py --queries 10 --seed 3
+    python benchmarks/bench_moving_reroute.py --part replan --queries 10
 """
 
 from __future__ import annotations
@@ -58,10 +75,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import astar  # noqa: E402
 import trajopt  # noqa: E402
-from tests.trajopt.moving.reference import dense_min  # noqa: E402
+from tests.trajopt.moving.reference import check_trajectory, dense_min  # noqa: E402
 from trajopt.errors import BlockedError, TrajoptError  # noqa: E402
 
 MAPS = ("turtlebot3_world", "smoothers_world", "depot")
+#: Time (s) into the plan driven at which it is re-planned with movers (``--part replan``).
+REPLAN_AT = 1.0
 
 
 def data_dir() -> Path:
@@ -171,11 +190,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--queries", type=int, default=6, help="queries per map")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--part", choices=("plan", "replan", "both"), default="both")
+    ap.add_argument(
+        "--repeat", type=int, default=3, help="timings of each re-plan and its plain plan"
+    )
     args = ap.parse_args()
     d = data_dir() / "ros"
     if not d.is_dir():
         print(f"shared data not found at {d} (set TRAJOPT_DATA)")
         return
+    if args.part in ("plan", "both"):
+        plan_part(d, args)
+    if args.part in ("replan", "both"):
+        replan_part(d, args)
+
+
+def plan_part(d: Path, args: argparse.Namespace) -> None:
+    """The first part: :meth:`trajopt.Planner.plan` with a mover that blocks its path."""
     rng = np.random.default_rng(args.seed)
     robot = trajopt.Robot()
     print(f"robot radius {robot.radius} m, v_max {robot.v_max} m/s; margin 0.02 m")
@@ -271,6 +302,168 @@ def main() -> None:
             f"all maps, {kind}: re-route / plain plan, median {statistics.median(r):.2f}x, "
             f"max {max(r):.2f}x over {len(r)} re-routes"
         )
+
+
+def rest_stop_mover(base, t_r):
+    """The cart: in from 1 m beside the middle of the rest after ``t_r`` (s), stops there at 2 s."""
+    smp = base.sample(np.array([0.5 * (t_r + base.duration)]))
+    p = np.array([smp.x[0], smp.y[0]])
+    n = np.array([-math.sin(smp.theta[0]), math.cos(smp.theta[0])])
+    return trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0], [p + 1.0 * n, p], radius=0.25, name="cart"
+    )
+
+
+def on_clock(movers, t0):
+    """The movers seen from ``t0`` (s) of their clock (as ``benchmarks/bench_moving.py``'s)."""
+    out = []
+    for m in movers:
+        times = m.times - t0
+        k = max(int(np.searchsorted(times, 0.0, side="right")) - 1, 0)
+        p0 = [np.interp(0.0, times, m.positions[:, i]) for i in (0, 1)]
+        h0 = np.interp(0.0, times, m.headings)
+        later = times[-1] > 0
+        t = np.r_[0.0, times[k + 1 :]] if later else np.zeros(1)
+        p = np.vstack([p0, m.positions[k + 1 :]]) if later else np.array([p0])
+        h = np.r_[h0, m.headings[k + 1 :]] if later else np.array([h0])
+        out.append(
+            trajopt.MovingObstacle.from_waypoints(
+                t, p, radius=m.radius + m.growth * max(t0, 0.0), growth=m.growth, headings=h,
+                vertices=m.vertices, name=m.name,
+            )
+        )  # fmt: skip
+    return out
+
+
+def jumps(a, ta: float, b, tb: float) -> float:
+    """Largest difference of position (m), heading (rad), speed and acceleration of two samples."""
+    sa, sb = a.sample(np.array([ta])), b.sample(np.array([tb]))
+    dh = abs(math.remainder(float(sa.theta[0] - sb.theta[0]), 2.0 * math.pi))
+    return max(
+        math.hypot(float(sa.x[0] - sb.x[0]), float(sa.y[0] - sb.y[0])),
+        dh,
+        abs(float(sa.v[0] - sb.v[0])),
+        abs(float(sa.a[0] - sb.a[0])),
+    )
+
+
+def replan_part(d: Path, args: argparse.Namespace) -> None:
+    """The second part: :meth:`trajopt.Planner.replan` with a mover that blocks the rest."""
+    rng = np.random.default_rng(args.seed)
+    robot = trajopt.Robot()
+    print()
+    print(
+        f"Planner.replan(plan, {REPLAN_AT} s, latency=0, moving_obstacles=[mover], "
+        "mover_margin=0.02) against a plain plan from the result's stop to the goal"
+    )
+    print(
+        f"{'map':18s} {'kind':8s} {'n':>3s} {'outcomes':30s} {'plain ms':>8s} {'replan ms':>9s} "
+        f"{'ratio med':>9s} {'p95':>6s} {'max':>6s} {'first med':>9s} {'check':>7s} "
+        f"{'worst slack':>11s} {'jump':>8s}"
+    )
+    all_ratios: dict[str, list[float]] = {}
+    all_first: dict[str, list[float]] = {}
+    failed = 0
+    for name in MAPS:
+        grid = astar.load_map(d / f"{name}.yaml")
+        planner = trajopt.Planner(grid, robot)
+        qs = queries(grid, robot, args.queries, rng)
+        kinds = (("stop", lambda b: rest_stop_mover(b, REPLAN_AT)), ("head-on", head_on_mover))
+        rows = {k: {"out": {}, "plain": [], "took": [], "ratio": [], "first": [], "bad": 0, "n": 0,
+                    "slack": math.inf, "jump": 0.0} for k, _ in kinds}  # fmt: skip
+        for p0, p1 in qs:
+            try:
+                planner.plan(p0, p1)
+                base = planner.plan(p0, p1)
+            except TrajoptError:
+                continue
+            if base.duration < REPLAN_AT + 3.0:
+                continue
+            for kind, make in kinds:
+                row = rows[kind]
+                mover = make(base)
+
+                def replan(mover=mover, base=base, planner=planner):
+                    return planner.replan(
+                        base, REPLAN_AT, latency=0.0, moving_obstacles=[mover], mover_margin=0.02
+                    )
+
+                t0 = time.perf_counter()
+                try:
+                    out = replan()
+                except TrajoptError as exc:
+                    what, out = type(exc).__name__, None
+                took = time.perf_counter() - t0
+                row["n"] += 1
+                if out is None:
+                    row["out"][what] = row["out"].get(what, 0) + 1
+                    continue
+                mv = out.stats["moving"]
+                what = mv["route"]
+                row["out"][what] = row["out"].get(what, 0) + 1
+                chk = check_trajectory(out, on_clock([mover], REPLAN_AT), margin=0.02, grid=grid)
+                row["slack"] = min(row["slack"], float(chk.mover_slack))
+                jump = jumps(base, REPLAN_AT, out, 0.0)
+                if "head_s" in mv:
+                    h = float(mv["head_s"])
+                    jump = max(jump, jumps(out, h - 1e-9, out, h + 1e-9))
+                row["jump"] = max(row["jump"], jump)
+                row["bad"] += int(not chk.ok)
+                failed += int(not chk.ok)
+                if not what.startswith("stopped"):
+                    continue
+                stop = out.sample(np.array([float(mv["head_s"])]))
+                q = ((float(stop.x[0]), float(stop.y[0])), p1)
+                heading = float(stop.theta[0])
+                try:
+                    planner.plan(*q, start_heading=heading)
+                except TrajoptError:
+                    continue
+                plains, tooks = [], [took]
+                for k in range(args.repeat):
+                    c0 = time.perf_counter()
+                    planner.plan(*q, start_heading=heading)
+                    plains.append(time.perf_counter() - c0)
+                    if k + 1 < args.repeat:
+                        c0 = time.perf_counter()
+                        replan()
+                        tooks.append(time.perf_counter() - c0)
+                plain = statistics.median(plains)
+                row["plain"].append(1e3 * plain)
+                row["took"].append(1e3 * statistics.median(tooks))
+                row["ratio"].append(statistics.median(tooks) / plain)
+                row["first"].append(took / plain)
+                all_ratios.setdefault(kind, []).append(statistics.median(tooks) / plain)
+                all_first.setdefault(kind, []).append(took / plain)
+        for kind, row in rows.items():
+            if not row["n"]:
+                continue
+            r = row["ratio"]
+            outs = ", ".join(f"{k} {v}" for k, v in sorted(row["out"].items()))
+            med = statistics.median
+            print(
+                f"{name:18s} {kind:8s} {row['n']:3d} {outs:30s} "
+                f"{(med(row['plain']) if r else math.nan):8.1f} "
+                f"{(med(row['took']) if r else math.nan):9.1f} "
+                f"{(med(r) if r else math.nan):9.2f} {(pct(r, 95) if r else math.nan):6.2f} "
+                f"{(max(r) if r else math.nan):6.2f} "
+                f"{(med(row['first']) if r else math.nan):9.2f} {row['bad']:3d} bad "
+                f"{row['slack']:11.4f} "
+                f"{row['jump']:8.1e}"
+            )
+    for kind, r in all_ratios.items():
+        print(
+            f"all maps, replan {kind}: re-route / plain plan from the stop, median "
+            f"{statistics.median(r):.2f}x, p95 {pct(r, 95):.2f}x, max {max(r):.2f}x over "
+            f"{len(r)} re-plans that stopped; the first call alone: median "
+            f"{statistics.median(all_first[kind]):.2f}x, p95 {pct(all_first[kind], 95):.2f}x"
+        )
+    print(f"results failing the independent check: {failed}")
+
+
+def pct(values, q: float) -> float:
+    """The ``q`` th percentile of ``values``."""
+    return float(np.percentile(np.asarray(values, dtype=float), q))
 
 
 if __name__ == "__main__":

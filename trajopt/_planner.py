@@ -81,6 +81,7 @@ from trajopt.planning import (
     Search,
     SearchMode,
     plan_among_movers,
+    plan_from_stop,
     run_query,
 )
 from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
@@ -453,7 +454,9 @@ class Planner:
             (:func:`trajopt.moving.retime_chain`). When only the predictions changed, the
             kept rest keeps its path and only its timing changes. When no re-timing avoids
             the movers, the robot brakes to a stop and plans on from there as :meth:`plan`
-            does with movers (re-timed, else re-routed or a wait at a safe place). The
+            does with movers (re-timed, else re-routed or a wait at a safe place; when the
+            path followed is proved blocked, the re-route's candidates first and the static
+            plan from the stop last: :func:`trajopt.planning.plan_from_stop`). The
             result is certified whole; its ``t = 0`` is the splice ``ts = t + latency`` of
             that clock; ``stats["moving"]`` holds the re-timing (``plan``, ``certificate``,
             ``time_s``), ``route`` (``"retimed"`` or ``"stopped: <plan's route>"``),
@@ -502,6 +505,7 @@ class Planner:
                     heading: float,
                     steer: float,
                     seen: Sequence[MovingObstacle],
+                    along: Any = None,
                 ) -> PlanResult:  # a plan from the stop, as plan's with movers
                     if steps is None:
                         raise InvalidInputError("the re-plan has no steps: no goal to go on to")
@@ -513,8 +517,8 @@ class Planner:
                         start_steer=steer,
                         goal_steer=getattr(steps, "goal_steer", None),
                     )
-                    return plan_among_movers(
-                        tuple(seen), margin, self.options, self.caches, request
+                    return plan_from_stop(
+                        tuple(seen), margin, self.options, self.caches, request, along
                     )
 
                 ts = float(out.stats["splice_time_s"])

@@ -9,7 +9,8 @@
 * :func:`retime_plan`: the same for a plan with turns in place at its ends;
 * :func:`retime_chain`: any plan from rest on one clock (curves, turns in place, a car's
   drives between cusps and steering at rest, an omni orientation); :func:`shift_clock`;
-* :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it;
+* :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it
+  (:func:`over_start`: whether a mover is over a point at ``t = 0``);
   :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers
   (:func:`reachable_times`: its sweep of the necessary grid, node by node);
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
@@ -23,7 +24,7 @@ from trajopt.moving._certificate import MoverCertificate, certify_movers, check_
 from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._no_way_past import no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._parked import parked_on_path, settle_time
+from trajopt.moving._parked import over_start, parked_on_path, settle_time
 from trajopt.moving._reroute import car_headings, goal_taken, reroute
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
@@ -39,6 +40,7 @@ __all__ = [
     "goal_taken",
     "mark_swept",
     "no_way_past",
+    "over_start",
     "parked_on_path",
     "reachable",
     "reachable_times",

@@ -1,8 +1,10 @@
 """A quick proof that no re-timing along the path gets past the movers: :func:`no_way_past`.
 
-A re-timing keeps the path and changes only ``s(t)``: from rest at ``s = 0``, non-decreasing,
-with speed at most ``V`` (the robot's top speed, forwards or backwards) and ``s(t)`` at most
-the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from rest. This proof
+A re-timing keeps the path and changes only ``s(t)``: from ``s = 0`` at ``t = 0``,
+non-decreasing, with speed at most ``V`` (the robot's top speed, forwards or backwards) and
+``s(t)`` at most the bound :func:`~trajopt.moving._st_grid.reach_bound` of a motion from the
+plan's start state (from rest; ``V t`` from a moving start, the rest of a trajectory being
+driven, which also holds every motion that brakes to a stop on the path and goes on from there). This proof
 drops everything else (the acceleration and the path's curvature caps between grid times,
 what lies between two nodes) and sweeps, node by node along the path, the times such an
 ``s(t)`` can be at each node of the *necessary* ``(s, t)`` grid (:func:`~trajopt.moving.st_grid`
@@ -135,7 +137,8 @@ def no_way_past(
     Parameters
     ----------
     plan : PlanResult
-        A plan from rest (one curve, a chain, an omni translation).
+        A plan (one curve, a chain, an omni translation), from rest or moving (its
+        ``v_start``, m/s).
     movers : sequence of MovingObstacle
         The predictions (the plan's clock).
     margin : float
@@ -158,7 +161,8 @@ def no_way_past(
     if length <= 0.0:
         return None
     back = getattr(robot.drive, "v_max_backwards", None)
-    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    v0 = abs(float(getattr(plan, "v_start", 0.0)))
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
     a_max, j_max = float(robot.a_max), float(robot.j_max)
     t_last = max(max(float(m.t_last) for m in movers), 0.0)
     t_goal = length / v_top + v_top / a_max + a_max / j_max  # reach_bound passes L by then
@@ -179,7 +183,7 @@ def no_way_past(
     )
     if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
         return None  # waiting at the start until every mover has left the path gets past
-    s_up = reach_bound(grid.t, v_top, a_max, j_max)
+    s_up = reach_bound(grid.t, v_top, a_max, j_max, v0)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
     reach = reachable_times(grid, v_top, s_up)

@@ -2,9 +2,10 @@
 
 A mover whose prediction ends standing still (its last waypoints equal) stays there for ever
 (:class:`~trajopt.moving.MovingObstacle`). If, from the time ``t_stop`` it stands, its shape is
-closer than the limit to some point ``C(s*)`` of the path, and no motion from rest under the
-robot's limits can be beyond ``s*`` by ``t_stop`` (``s* > reach(t_stop)``, the bound
-:func:`~trajopt.moving._st_grid.reach_bound` of ``s(t)``), then every re-timing of the path
+closer than the limit to some point ``C(s*)`` of the path, and no motion from the plan's start
+state under the robot's limits can be beyond ``s*`` by ``t_stop`` (``s* > reach(t_stop)``, the
+bound :func:`~trajopt.moving._st_grid.reach_bound` of ``s(t)``: from rest, or ``v_max t`` from
+a moving start, the rest of a trajectory being driven), then every re-timing of the path
 passes ``C(s*)`` (or stands there, at the goal) after ``t_stop``, closer than the limit: no
 re-timing avoids it. The robot is taken as its inscribed disc (inside a footprint, so a
 footprint is at least as close), the limit at ``t_stop`` (the radius only grows), and the
@@ -30,6 +31,11 @@ from trajopt.moving._st_grid import reach_bound
 
 #: Arc-length spacing (m) of the path points checked.
 PARKED_DS = 0.02
+#: Arc-length spacing (m) of the points that screen the movers first: a mover whose final
+#: shape's bounding disc (about its reference point) none of them comes within the limit plus
+#: half this of is nowhere within the limit of the path; the fine points are evaluated only
+#: within this much arc of a screening point that one comes that close to.
+SCREEN_DS = 0.25
 
 
 def settle_time(mover: MovingObstacle) -> float:
@@ -65,7 +71,8 @@ def parked_on_path(
     Parameters
     ----------
     plan : PlanResult
-        A plan from rest (one curve, a chain, an omni translation).
+        A plan (one curve, a chain, an omni translation), from rest or moving (its
+        ``v_start``, m/s).
     movers : sequence of MovingObstacle
         The predictions (the plan's clock).
     margin : float
@@ -82,28 +89,33 @@ def parked_on_path(
         return None
     robot = plan.robot
     back = getattr(robot.drive, "v_max_backwards", None)
-    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+    v0 = abs(float(getattr(plan, "v_start", 0.0)))
+    v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
     t_stops = [max(settle_time(m), 0.0) for m in movers]
-    reaches = [
-        float(reach_bound(np.array([t]), v_top, robot.a_max, robot.j_max)[0]) for t in t_stops
-    ]
+    reaches = reach_bound(np.array(t_stops), v_top, robot.a_max, robot.j_max, v0).tolist()
     if min(reaches) >= sum(float(c.length) for c in curves):
         return None  # the robot may be past the whole path before any mover stands still
-    pts, s_all, off = [], [], 0.0
-    for c in curves:
-        n = max(2, int(np.ceil(c.length / PARKED_DS)) + 1)
-        s = np.linspace(0.0, c.length, n)
-        pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float))
-        s_all.append(s + off)
-        off += float(c.length)
-    p = np.concatenate(pts)
-    s_cum = np.concatenate(s_all)
+    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
+    near = []  # the movers whose final shape's bounding disc comes near some coarse point
+    close = np.zeros(s_coarse.shape[0], dtype=bool)
     for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
         if reach >= off:
             continue  # no point of the path lies beyond it
+        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
+        centre = m.position_at(np.array([t_stop])).reshape(2)
+        bound = float(np.max(np.hypot(*m.shape_vertices.T)))  # the shape within it of centre
+        d = np.hypot(*(coarse - centre).T) - bound
+        hit = d < limit + 0.5 * SCREEN_DS  # a point between is nearer than ds/2 to one
+        if hit.any():
+            near.append((m, t_stop, reach, limit))
+            close |= hit
+    if not near:
+        return None
+    # the fine points within SCREEN_DS of arc of a close coarse point: no other can be near
+    p, s_cum, off = _path_points(curves, PARKED_DS, s_coarse[close], SCREEN_DS)
+    for m, t_stop, reach, limit in near:
         shape = shape_at(m, np.array([t_stop]))
         d = point_polygon_distance(p, np.broadcast_to(shape, (p.shape[0], *shape.shape[1:])))
-        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
         hit = (d < limit) & (s_cum > reach)
         if hit.any():
             i = int(np.argmax(hit))
@@ -116,3 +128,40 @@ def parked_on_path(
                 t=t_stop,
             )
     return None
+
+
+def _path_points(
+    curves: list[Any], ds: float, around: np.ndarray | None = None, within: float = 0.0
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Return points at most ``ds`` (m) apart along the curves end to end.
+
+    The points (m, shape (n, 2)), their arc lengths (m, shape (n,)) and the total length (m).
+    Given ``around`` (arc lengths, m), only the points within ``within`` (m) of arc of one of
+    them (the same points as without it, the others left out).
+    """
+    pts, s_all, off = [], [], 0.0
+    for c in curves:
+        n = max(2, int(np.ceil(c.length / ds)) + 1)
+        s = np.linspace(0.0, c.length, n)
+        if around is not None:
+            k = np.searchsorted(around, s + off)  # the nearest of around on either side
+            lo = np.abs(s + off - around[np.maximum(k - 1, 0)])
+            hi = np.abs(around[np.minimum(k, around.shape[0] - 1)] - (s + off))
+            s = s[np.minimum(lo, hi) <= within]
+        if s.shape[0]:
+            pts.append(np.asarray(c.path(c.path.u_at_s(s)), dtype=float).reshape(-1, 2))
+            s_all.append(s + off)
+        off += float(c.length)
+    if not pts:
+        return np.zeros((0, 2)), np.zeros(0), off
+    return np.concatenate(pts), np.concatenate(s_all), off
+
+
+def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float) -> bool:
+    """Whether a mover is closer than ``limit`` plus its radius (m) to ``start`` (m) at ``t = 0``."""
+    p = np.asarray(start, dtype=float).reshape(1, 2)
+    for m in movers:
+        d = float(point_polygon_distance(p, shape_at(m, np.array([0.0])))[0])
+        if d < limit + float(m.radius_at(0.0)):
+            return True
+    return False

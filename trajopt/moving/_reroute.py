@@ -28,8 +28,15 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    place, stands there with a heading (:func:`car_headings`: towards the goal, else along its
    way in); the second leg leaves with the first's end heading and last steering angle.
 
-A candidate whose map has no path, whose plan fails or whose re-timing is blocked is skipped
-(its reason kept). When none works, the original :class:`BlockedError` is raised again (it
+Given the blocked path's points (``path``), the detours of options 1 and 2 whose marks keep
+clear of it (no marked cell within the robot's radius of a point beyond the start's and the
+goal's kept discs) are tried after the others, in the same order: their map leaves the blocked
+path open, so their plan likely takes it again (a mover's final place behind the robot, say).
+
+Such a detour's plan is first given the quick proofs (:func:`~trajopt.moving.parked_on_path`,
+:func:`~trajopt.moving.no_way_past`), which refuse a blocked one in milliseconds, before the
+re-timing's search. A candidate whose map has no path, whose plan fails or whose re-timing is
+blocked is skipped (its reason and wall time kept). When none works, the original :class:`BlockedError` is raised again (it
 names the mover and the time) with the reasons appended. None is tried when a mover ends
 standing on the goal (its final shape closer than the robot's inscribed radius plus the margin
 to the goal point, for ever): every route ends there (:func:`goal_taken`).
@@ -49,7 +56,9 @@ from trajopt.errors import BlockedError, TrajoptError
 from trajopt.motion import TrajectoryChain
 from trajopt.moving._certificate import certify_movers, point_polygon_distance, shape_at
 from trajopt.moving._chain import retime_chain, shift_clock
+from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._parked import parked_on_path
 from trajopt.moving._swept import mark_swept, swept_mask
 
 #: Safe places tried (option 3).
@@ -77,6 +86,7 @@ def reroute(
     grid: OccupancyGrid,
     free: Callable[[], np.ndarray],
     plan_leg: PlanLeg,
+    path: np.ndarray | None = None,
 ) -> Any:
     """Return a certified plan by another route or a wait at a safe place (module docstring).
 
@@ -102,13 +112,17 @@ def reroute(
     plan_leg : callable
         ``plan_leg(grid, start, goal, start_heading, goal_heading, start_steer)``
         (:data:`PlanLeg`).
+    path : ndarray, shape (n, 2), optional
+        Points (m) of the blocked path from ``start`` to ``goal``: the detours whose marks keep
+        clear of it are tried after the others (module docstring).
 
     Returns
     -------
     PlanResult
         Certified; ``stats["moving"]["route"]`` is ``"rerouted"`` or ``"waited"``,
-        ``stats["moving"]["reroute"]`` lists the candidates tried (``what``, ``result``) and
-        the wall time.
+        ``stats["moving"]["reroute"]`` lists the candidates tried (``what``, ``result``,
+        ``time_s``, the wall time of each) and ``stats["moving"]["reroute_time_s"]`` the
+        wall time of all.
 
     Raises
     ------
@@ -132,12 +146,19 @@ def reroute(
         ) from blocked
 
     def attempt(what: str, run: Callable[[], Any], route: str) -> Any:
+        t0 = time.perf_counter()
         try:
             out = run()
         except TrajoptError as exc:
-            tried.append({"what": what, "result": f"{type(exc).__name__}: {exc}"})
+            tried.append(
+                {
+                    "what": what,
+                    "result": f"{type(exc).__name__}: {exc}",
+                    "time_s": time.perf_counter() - t0,
+                }
+            )
             return None
-        tried.append({"what": what, "result": "ok"})
+        tried.append({"what": what, "result": "ok", "time_s": time.perf_counter() - t0})
         stats = out.stats
         stats["moving"] = dict(stats["moving"], route=route, reroute=list(tried))
         stats["moving"]["reroute_time_s"] = time.perf_counter() - t_all
@@ -145,7 +166,9 @@ def reroute(
 
     marked_maps: list[OccupancyGrid] = []
 
-    def detour(regions: list[tuple[MovingObstacle, float, float]]) -> Callable[[], Any]:
+    def detour(
+        regions: list[tuple[MovingObstacle, float, float]], prove: bool = False
+    ) -> Callable[[], Any]:
         def run() -> Any:
             marked = mark_swept(grid, regions, margin, keep)
             if marked is None:
@@ -154,14 +177,16 @@ def reroute(
                 raise BlockedError("the same map as a candidate tried before")
             marked_maps.append(marked)
             leg = plan_leg(marked, None, None, None)
+            if prove:  # before the re-timing's search, which would end in it
+                proof = parked_on_path(leg, movers, margin) or no_way_past(leg, movers, margin)
+                if proof is not None:
+                    raise proof
             return retime_chain(leg, movers, margin=margin)
 
         return run
 
     finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
-    out = attempt("around every mover's final place", detour(finals), "rerouted")
-    if out is not None:
-        return out
+    detours = [("around every mover's final place", finals)]
     who = by_name.get(blocked.mover)
     if who is not None:
         t_end = max(who.t_last, 0.0)
@@ -170,11 +195,17 @@ def reroute(
         if t_from > 0.0:
             spans.append((t_from, f" from t = {t_from:.3f} s"))
         for t0, when in spans:
-            out = attempt(
-                f"around {who.name!r}{when}", detour([(who, t0, max(t_end, t0))]), "rerouted"
-            )
-            if out is not None:
-                return out
+            detours.append((f"around {who.name!r}{when}", [(who, t0, max(t_end, t0))]))
+    clear = [False] * len(detours)
+    if path is not None:
+        pts = _beyond(np.asarray(path, dtype=float).reshape(-1, 2), keep)
+        clear = [_keeps_clear(grid, regions, margin + robot.radius, pts) for _, regions in detours]
+    order = [i for i, c in enumerate(clear) if not c] + [i for i, c in enumerate(clear) if c]
+    for i in order:
+        what, regions = detours[i]
+        out = attempt(what, detour(regions, prove=clear[i]), "rerouted")
+        if out is not None:
+            return out
     turns = robot.drive.turns_in_place and not robot.drive.signed_speed
     if turns or not robot.drive.turns_in_place:  # a car stands at the place with a heading
         room = free()
@@ -198,6 +229,33 @@ def reroute(
         mover=blocked.mover,
         t=blocked.t,
     ) from blocked
+
+
+def _beyond(points: np.ndarray, keep: Sequence[tuple[np.ndarray, float]]) -> np.ndarray:
+    """Return the points (m, shape (k, 2)) outside every kept disc (centre m, radius m)."""
+    out = np.ones(points.shape[0], dtype=bool)
+    for p, r in keep:
+        out &= np.hypot(*(points - np.asarray(p, dtype=float)).T) > r
+    return points[out]
+
+
+def _keeps_clear(
+    grid: OccupancyGrid,
+    regions: Sequence[tuple[MovingObstacle, float, float]],
+    grow: float,
+    points: np.ndarray,
+) -> bool:
+    """Whether no swept region, grown by ``grow`` (m), covers the cell of any of ``points`` (m)."""
+    if points.shape[0] == 0:
+        return True
+    cells = np.asarray(grid.world_to_cell(points), dtype=np.int64).reshape(-1, 2)
+    ny, nx = grid.shape
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
+    cells = cells[inside]
+    for mover, t0, t1 in regions:
+        if swept_mask(grid, mover, t0, t1, grow)[cells[:, 1], cells[:, 0]].any():
+            return False
+    return True
 
 
 def goal_taken(
@@ -243,7 +301,11 @@ def safe_places(
     res = float(grid.resolution)
     pts = np.asarray(grid.origin, dtype=float) + (np.stack([ix, iy], axis=1) + 0.5) * res
     cost = np.hypot(*(pts - p0).T) + np.hypot(*(pts - p1).T)
-    order = np.argsort(cost, kind="stable")
+    if cost.shape[0] > 20000:  # the 20000 cheapest in order (ties by index), as a full sort
+        near = np.flatnonzero(cost <= np.partition(cost, 19999)[19999])
+        order = near[np.argsort(cost[near], kind="stable")]
+    else:
+        order = np.argsort(cost, kind="stable")
     out: list[np.ndarray] = []
     for i in order[:20000]:
         p = pts[i]

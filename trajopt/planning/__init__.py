@@ -6,7 +6,8 @@ map's caches, the one query runner (:func:`run_query`) and the stages the drives
 a disc's or a footprint's plan (:func:`plan_free`), pose to pose with turns in place
 (:func:`plan_turning`), an omnidirectional base's (:func:`plan_omni`) and a car's
 (:func:`plan_car`); a plan among predicted movers, re-timed or re-routed
-(:func:`plan_among_movers`, :func:`plan_for_movers`).
+(:func:`plan_among_movers`, :func:`plan_for_movers`; from a re-plan's stop,
+:func:`plan_from_stop`).
 """
 
 from trajopt.planning._caches import PlannerCaches, change_reach
@@ -14,7 +15,7 @@ from trajopt.planning._car import CarSteps, plan_car
 from trajopt.planning._car_tries import car_search_grid
 from trajopt.planning._ends import check_endpoint
 from trajopt.planning._feasibility import curvature_witness
-from trajopt.planning._moving import plan_among_movers, plan_for_movers
+from trajopt.planning._moving import plan_among_movers, plan_for_movers, plan_from_stop
 from trajopt.planning._omni import plan_omni
 from trajopt.planning._options import (
     CorridorKind,
@@ -30,6 +31,7 @@ from trajopt.planning._runner import plan_free, plan_turning, run_query
 
 __all__ = [
     "plan_among_movers",
+    "plan_from_stop",
     "plan_for_movers",
     "CarSteps",
     "CorridorKind",

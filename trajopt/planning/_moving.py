@@ -15,10 +15,11 @@ from typing import Any
 import numpy as np
 
 from astar.grid import OccupancyGrid
-from trajopt.errors import BlockedError, InvalidInputError
+from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
 from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
+    goal_taken,
     no_way_past,
     parked_on_path,
     reroute,
@@ -153,6 +154,78 @@ def plan_among_movers(
     )
 
 
+def plan_from_stop(
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    along: Any = None,
+) -> PlanResult:
+    """Plan on among movers from where a re-plan stopped (:meth:`trajopt.Planner.replan`).
+
+    Without ``along``, as :func:`plan_among_movers`. With it (the path the robot followed,
+    from the stop, proved blocked: :class:`trajopt.replan.Along`), the re-route's candidates
+    (:func:`trajopt.moving.reroute`) come first and the static plan from the stop last. Every
+    re-timing along the followed path from the stop is blocked (the proof holds every motion
+    along it from the splice state, a brake to this stop and any motion from rest after it
+    included). The static plan from the stop is a new search on the same map to the same goal
+    from a point of that path, so it takes the path's rest again unless the new grid path,
+    its smoothing or the start heading leave it: it may differ, hence it is tried, after the
+    re-route's candidates have failed, re-timed only (no second re-route), unless a mover
+    stands on the goal for ever (:func:`trajopt.moving.goal_taken`), where every plan ends.
+
+    Parameters
+    ----------
+    movers : tuple of MovingObstacle
+        The predictions seen from the stop.
+    margin : float
+        Extra distance to every mover (m).
+    options, caches, request
+        The planner's options and caches, and the query from the stop (at rest).
+    along : Along, optional
+        ``along.blocked``: the proof (its time on the clock seen from the stop);
+        ``along.points``: the followed path's points from the stop (m, shape (n, 2)).
+
+    Returns
+    -------
+    PlanResult
+        As :func:`plan_among_movers`.
+
+    Raises
+    ------
+    BlockedError
+        No candidate works and the static plan from the stop is blocked too (the proof's mover
+        and time, every reason appended).
+    """
+    if along is None:
+        return plan_among_movers(movers, margin, options, caches, request)
+    p0 = np.asarray(request.start, dtype=float).reshape(2)
+    p1 = np.asarray(request.goal, dtype=float).reshape(2)
+    robot = options.robot
+    try:
+        out = _reroute(
+            p0, p1, robot, movers, margin, along.blocked, options, caches, request, along.points
+        )
+    except BlockedError as exc:
+        if goal_taken(movers, p1, float(robot.inscribed_radius) + margin) is not None:
+            raise  # a mover stands on the goal for ever: the static plan ends there too
+        try:
+            static = run_query(options, caches, request)
+            out = plan_for_movers(
+                static, movers, margin, options, caches, request, reroute_blocked=False
+            )
+        except TrajoptError as last:
+            raise BlockedError(
+                f"{exc}; the static plan from the stop: {type(last).__name__}: {last}",
+                mover=exc.mover,
+                t=exc.t,
+            ) from exc
+        return out
+    out.stats["moving"]["blocked_before_timing"] = True
+    return out
+
+
 def plan_for_movers(
     out: PlanResult,
     movers: tuple[MovingObstacle, ...],
@@ -162,6 +235,7 @@ def plan_for_movers(
     request: PlanRequest,
     *,
     proved: bool = False,
+    reroute_blocked: bool = True,
 ) -> PlanResult:
     """Re-time a plan for movers, or re-route it; refuse what is not covered.
 
@@ -184,6 +258,8 @@ def plan_for_movers(
         The planner's options and caches, and the query (its legs are planned with them).
     proved : bool
         The quick proofs already ran on ``out``'s path and found nothing (skipped here).
+    reroute_blocked : bool
+        ``False``: a blocked plan raises its :class:`BlockedError` instead of re-routing.
     """
     if out.v_start != 0.0:
         raise InvalidInputError(
@@ -204,6 +280,8 @@ def plan_for_movers(
         else:
             kept.stats["moving"]["route"] = "retimed"
             return kept
+    if not reroute_blocked:
+        raise blocked
     if out.single_curve and _one_curve(out.robot, request):  # as the proofs before the timing
         p0, p1 = _curve_ends(out.path)
     else:
@@ -231,6 +309,7 @@ def _reroute(
     options: PlannerOptions,
     caches: PlannerCaches,
     request: PlanRequest,
+    path: np.ndarray | None = None,
 ) -> PlanResult:
     """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here."""
 
@@ -263,5 +342,14 @@ def _reroute(
         return run_query(options, caches.derived(grid), leg)
 
     return reroute(
-        p0, p1, robot, movers, margin, blocked, grid=caches.grid, free=free, plan_leg=plan_leg
+        p0,
+        p1,
+        robot,
+        movers,
+        margin,
+        blocked,
+        grid=caches.grid,
+        free=free,
+        plan_leg=plan_leg,
+        path=path,
     )

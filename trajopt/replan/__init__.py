@@ -3,14 +3,16 @@
 Internal: users call :meth:`trajopt.Planner.replan`. :func:`replan_from` checks the splice
 and asks the robot's drive to re-plan: :func:`replan_moving` for a base that turns in place,
 :func:`replan_car` for a car. With predicted movers, :func:`retime_replan` re-times the
-result for them (:mod:`trajopt.replan._moving`).
+result for them (:mod:`trajopt.replan._moving`), or stops and goes on from the stop (told
+the path followed when it is proved blocked: :class:`Along`).
 """
 
 from trajopt.replan._car import replan_car
-from trajopt.replan._moving import retime_replan
+from trajopt.replan._moving import Along, retime_replan
 from trajopt.replan._replan import BRAKE_AFTER_S, replan_from, replan_moving
 
 __all__ = [
+    "Along",
     "BRAKE_AFTER_S",
     "replan_car",
     "replan_from",

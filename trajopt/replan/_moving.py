@@ -37,6 +37,18 @@ place: :func:`trajopt.moving.reroute`). The stop and that plan are certified who
 the shifted movers. ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
 ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
 plan from the stop works or the robot meets a mover while it stops.
+
+**A path proved blocked** (:func:`blocked_along`): the quick proofs on what is re-timed (one
+curve from the moving state, whose reach bound ``v_max t`` holds every motion along its path,
+a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
+from rest after the head) show that nothing along the path followed gets past the movers from
+the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
+parks on the rest: no search), :func:`trajopt.moving.no_way_past` after it fails. The proof
+is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
+which then tries the re-route's candidates at once and the static plan from the stop last:
+that plan is a new search from a point of the path followed, to the same goal on the same map,
+so it usually takes the path's rest again (blocked), but it may leave it (another grid path,
+smoothing or start heading), so it is tried rather than dropped.
 """
 
 from __future__ import annotations
@@ -53,6 +65,9 @@ from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    no_way_past,
+    over_start,
+    parked_on_path,
     retime_chain,
     retime_for_movers,
     shift_clock,
@@ -111,13 +126,20 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
+    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path,))
     try:
+        if proof is not None:
+            raise proof
         timed, moving = _retimed(out, movers, margin, ts, shifted)
         moving["route"] = "retimed"
     except BlockedError as exc:
         if from_stop is None:
             raise
-        timed, moving = _stop_and_go_on(out, movers, margin, ts, shifted, from_stop, exc)
+        if proof is None:  # is the path followed blocked from the stop on, too?
+            proof = blocked_along(out, movers, margin, ts, shifted, (no_way_past,))
+        timed, moving = _stop_and_go_on(
+            out, movers, margin, ts, shifted, from_stop, exc, along=proof
+        )
     moving.update(
         time_s=time.perf_counter() - t0,
         clock_offset_s=float(ts),
@@ -158,6 +180,46 @@ def _retimed(
             )
         moving["certificate"] = cert.summary()
     return timed, moving
+
+
+def blocked_along(
+    out: PlanResult,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    ts: float,
+    shifted: Sequence[MovingObstacle],
+    proofs: Sequence[Callable[..., BlockedError | None]],
+) -> BlockedError | None:
+    """Return a proof that the path the robot follows is blocked from where it stops, or ``None``.
+
+    The quick ``proofs`` (:func:`trajopt.moving.parked_on_path`,
+    :func:`trajopt.moving.no_way_past`) on what :func:`_retimed` re-times: one curve from the
+    moving state against ``shifted`` (their reach bound from a moving start, ``v_max t``, holds
+    every motion along the path, those that brake to a stop on it and go on from rest
+    included), or a chain's tail, a plan from rest after the head, against the movers seen
+    from the head's end. Either way nothing along that path from the stop gets past. Its time
+    is on the movers' clock; ``None`` when they find nothing or a mover is within the robot's
+    circumscribed radius of the start at ``t = 0`` (the re-timing decides, or refuses that as
+    bad input).
+    """
+    if out.single_curve and out.direction == 1:
+        plan, t0, seen = out, ts, shifted
+    else:
+        head, tail = split_at_rest(out)
+        if not tail:
+            return None
+        t_head = sum(float(p.duration) - t_in for p, t_in in head)
+        plan = tail[0] if len(tail) == 1 else TrajectoryChain(tuple(tail), out.robot, {}, None)
+        t0 = ts + t_head
+        seen = [shift_clock(m, t0) for m in movers]
+    start = plan.sample(np.array([0.0]))
+    if over_start((float(start.x[0]), float(start.y[0])), seen, float(out.robot.radius) + margin):
+        return None  # a mover over the robot (its circumscribed disc): the re-timing refuses it
+    for prove in proofs:
+        proof = prove(plan, seen, margin)
+        if proof is not None:
+            return _on_movers_clock(proof, t0)
+    return None
 
 
 def _on_movers_clock(exc: BlockedError, t0: float) -> BlockedError:
@@ -239,11 +301,29 @@ def _retime_tail(
     return chain, moving
 
 
-#: ``from_stop(position, heading, steer, movers)``: a plan from rest at ``position`` (m,
-#: shape (2,)) with ``heading`` (rad) and a car's ``steer`` (rad) to the re-plan's goal,
+#: ``from_stop(position, heading, steer, movers, along)``: a plan from rest at ``position``
+#: (m, shape (2,)) with ``heading`` (rad) and a car's ``steer`` (rad) to the re-plan's goal,
 #: re-timed for ``movers`` (seen from the stop), else re-routed around them, certified;
-#: raises ``TrajoptError`` otherwise.
-FromStop = Callable[[tuple[float, float], float, float, Sequence[MovingObstacle]], PlanResult]
+#: raises ``TrajoptError`` otherwise. ``along``: ``None``, or the path being followed from
+#: the stop (:class:`Along`), proved blocked: the re-route's candidates come first, the static
+#: plan from the stop last.
+FromStop = Callable[..., PlanResult]
+
+
+@dataclasses.dataclass(frozen=True)
+class Along:
+    """The path the robot follows, from where it stops, proved blocked for the movers.
+
+    Attributes
+    ----------
+    blocked : BlockedError
+        The proof (:func:`blocked_along`), its time on the clock seen from the stop (s).
+    points : ndarray, shape (n, 2)
+        Points (m) of that path from the stop to the goal, at most 10 cm apart.
+    """
+
+    blocked: BlockedError
+    points: np.ndarray
 
 
 def _stop_and_go_on(
@@ -254,16 +334,19 @@ def _stop_and_go_on(
     shifted: Sequence[MovingObstacle],
     from_stop: FromStop,
     blocked: BlockedError,
+    *,
+    along: BlockedError | None = None,
 ) -> tuple[PlanResult, dict[str, Any]]:
     """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
 
     One curve from the moving state is braked along its path
     (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
-    plans on for the movers seen from there (``ts`` plus the stop's time); the head and that
-    plan are certified whole against ``shifted``. ``BlockedError`` (the mover named, its time
-    on the movers' clock) when no stop applies, no plan from the stop works or the head meets
-    a mover.
+    plans on for the movers seen from there (``ts`` plus the stop's time), told the path
+    followed from the stop (:class:`Along`) when ``along`` proves it blocked
+    (:func:`blocked_along`); the head and that plan are certified whole against ``shifted``.
+    ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies,
+    no plan from the stop works or the head meets a mover.
     """
     head: list[tuple[Any, float]] = []
     if getattr(out, "pieces", None) is not None:
@@ -271,6 +354,7 @@ def _stop_and_go_on(
         if not tail:
             raise blocked
         stop = tail[0].sample(np.array([0.0]))
+        ahead = tail
     elif out.single_curve and out.direction == 1:
         try:
             brake = brake_on_path(out, 0.0)
@@ -279,15 +363,24 @@ def _stop_and_go_on(
         if brake is not None:
             head.append((brake, 0.0))
         stop = (brake or out).sample(np.array([brake.duration if brake else 0.0]))
+        ahead = [out]
     else:
         raise blocked
     t_head = sum(float(p.duration) - t_in for p, t_in in head)
     seen = [shift_clock(m, ts + t_head) for m in movers]
     steer = getattr(stop, "steer", None)
     p_stop = (float(stop.x[0]), float(stop.y[0]))
+    told = None
+    if along is not None:
+        t_stop = max(along.t - ts - t_head, 0.0)  # on the clock seen from the stop
+        told = Along(BlockedError(str(along), mover=along.mover, t=t_stop), _points(ahead, p_stop))
     try:
         rest = from_stop(
-            p_stop, float(stop.theta[0]), 0.0 if steer is None else float(steer[0]), seen
+            p_stop,
+            float(stop.theta[0]),
+            0.0 if steer is None else float(steer[0]),
+            seen,
+            told,
         )
     except TrajoptError as exc:
         mover, t = blocked.mover, blocked.t
@@ -331,3 +424,21 @@ def _stop_and_go_on(
         if key in done:
             moving[key] = done[key]
     return whole, moving
+
+
+def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
+    """Return points of the pieces' curves end to end from the stop on, at most 10 cm apart.
+
+    The points (m, shape (n, 2)) start with the stop; turns in place add none; the points before the one nearest the stop (the part braked
+    over) are dropped.
+    """
+    pts = [np.asarray(p_stop, dtype=float).reshape(1, 2)]
+    for p in pieces:
+        if getattr(p, "pieces", None) is not None:
+            pts.append(_points(p.pieces, p_stop))
+        elif p.single_curve and float(p.length) > 0.0:
+            s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.1)) + 1)
+            pts.append(np.asarray(p.path(p.path.u_at_s(s)), dtype=float).reshape(-1, 2))
+    out = np.concatenate(pts)
+    near = int(np.argmin(np.hypot(out[1:, 0] - p_stop[0], out[1:, 1] - p_stop[1]))) + 1
+    return np.concatenate([out[:1], out[near:]])

@@ -5,7 +5,13 @@ keyword (an empty list is identical; the brake of a chain sampled against the re
 movers), and an independent slack computed here on the movers' own clock (the re-plan's
 samples at ``tau`` against each mover at ``ts + tau``, its radius from its fields) on 1 ms
 samples, plus reference.py's dense samples, brute force and ``check_trajectory`` (1 ms
-samples with the Lipschitz bound, the static map's clearance) on the shifted movers.
+samples with the Lipschitz bound, the static map's clearance) on the shifted movers. On a
+hand-built loop of two corridors, a re-plan whose kept rest is proved blocked stops and
+re-routes from the stop with the re-route's leg as its only plan (hand check: the cart stands
+on the rest before the robot, at most ``v_max`` from the splice, can be past it), and is
+continuous at the splice and at the stop; the static plan from the stop is still tried when
+no candidate works (its reference: the plan among the movers from the stop); the quick proofs
+from a moving start against a hand-derived reach and against certified re-timings.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ import numpy as np
 import pytest
 
 import trajopt
+import trajopt.planning
 from tests.trajopt.moving.reference import brute_min, check_trajectory, dense_min
 from tests.trajopt.replan.test_replan_car import forward_scene
 from trajopt.errors import BlockedError
@@ -270,3 +277,238 @@ def test_a_car_braked_and_planned_from_the_stop_is_re_timed():
     assert _slack_on_movers_clock(new, [mover], ts) >= -1e-6
     check = check_trajectory(new, shifted, grid=grid)
     assert check.ok and check.static_slack >= -1e-6
+
+
+RES = 0.05
+
+
+def _loop():
+    """Two 1 m corridors (y = 1 and y = 4) joined at both ends, a niche at x = 6 (5 cm cells)."""
+    from astar.grid import OccupancyGrid
+
+    occ = np.ones((100, 240), dtype=bool)
+    for x0, x1, y0, y1 in [
+        (0.5, 11.5, 0.5, 1.5),
+        (0.5, 11.5, 3.5, 4.5),
+        (0.5, 1.5, 0.5, 4.5),
+        (10.5, 11.5, 0.5, 4.5),
+        (5.5, 6.5, 1.5, 2.3),
+    ]:
+        occ[round(y0 / RES) : round(y1 / RES), round(x0 / RES) : round(x1 / RES)] = False
+    return OccupancyGrid(occ, RES, (0.0, 0.0))
+
+
+@pytest.fixture(scope="module")
+def loop_drive():
+    grid = _loop()
+    planner = trajopt.Planner(grid, trajopt.Robot())
+    traj = planner.plan((1.0, 1.0), (11.0, 1.0))
+    assert np.max(traj.sample(np.linspace(0, traj.duration, 200)).y) < 1.5  # the short way
+    return grid, planner, traj
+
+
+def _mover_planning():
+    """The module of :func:`trajopt.planning.plan_from_stop` (its names are patched here)."""
+    import sys
+
+    return sys.modules[trajopt.planning.plan_from_stop.__module__]
+
+
+def _count_plans(monkeypatch):
+    """Count the static plans the planner's mover code asks for (re-route legs included)."""
+    where = _mover_planning()
+    calls = []
+    real = where.run_query
+
+    def counted(*args, **kwargs):
+        calls.append(args[-1])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(where, "run_query", counted)
+    return calls
+
+
+def test_a_cart_parked_ahead_re_routes_from_the_stop_without_a_second_static_plan(
+    loop_drive, monkeypatch
+):
+    """The kept rest is proved blocked from the moving state; the stop follows that path, so the
+    re-route's first candidate is planned at once (one plan, not the static plan first)."""
+    grid, planner, traj = loop_drive
+    t, ts = 2.0, 2.0 + LATENCY
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 3.0], [(6.0, 2.0), (6.0, 1.0)], radius=0.25, name="cart"
+    )
+    # by hand: the cart stands on the rest (y = 1) from t = 3, and the robot, at most v_max
+    # from the splice on, is still short of it then: no timing along this path gets past
+    at = traj.state_at(ts)
+    rob = traj.robot
+    reach = at.x + rob.v_max * (3.0 - ts)
+    assert reach < 6.0 - 0.25 - rob.radius and abs(at.y - 1.0) < 0.05
+    calls = _count_plans(monkeypatch)
+    new = planner.replan(traj, t, latency=LATENCY, moving_obstacles=[cart])
+    moving = new.stats["moving"]
+    assert moving["route"] == "stopped: rerouted" and "'cart'" in moving["blocked"]
+    assert "stands on the path" in moving["blocked"]  # the quick proof, not a failed search
+    assert [c["what"] for c in moving["reroute"]] == ["around every mover's final place"]
+    assert len(calls) == 1  # the re-route's leg only: no static plan from the stop
+    _check_splice_and_stop(traj, new, ts, [cart], grid)
+
+
+def _check_splice_and_stop(traj, new, ts, movers, grid):
+    """Continuity at the splice and at the stop; the independent checks on the movers' clock."""
+    _splice_equal(traj, new, ts)
+    h = new.stats["moving"]["head_s"]
+    a, b = new.sample(np.array([h - 1e-9])), new.sample(np.array([h + 1e-9]))
+    assert math.hypot(a.x[0] - b.x[0], a.y[0] - b.y[0]) < 1e-6
+    assert abs(math.remainder(a.theta[0] - b.theta[0], 2 * math.pi)) < 1e-6
+    assert abs(a.v[0]) < 1e-6 and abs(b.v[0]) < 1e-6
+    assert abs(a.a[0]) < 1e-6 and abs(b.a[0]) < 1e-6
+    smp = new.sample(np.arange(0.0, new.duration, 1e-3))
+    rob = new.robot
+    assert np.max(np.abs(np.diff(smp.v))) < rob.a_max * 1e-3 * 1.01  # no jump in speed
+    assert np.max(np.abs(np.diff(smp.a))) < rob.j_max * 1e-3 * 1.01  # nor in acceleration
+    step = np.hypot(np.diff(smp.x), np.diff(smp.y))
+    assert np.max(step) <= rob.v_max * 1e-3 * 1.01  # nor in position
+    shifted = [trajopt.moving.shift_clock(m, ts) for m in movers]
+    assert new.stats["moving"]["certificate"]["ok"]
+    assert _slack_on_movers_clock(new, movers, ts) >= -1e-6
+    assert dense_min(new, shifted)[0] >= -1e-6
+    assert brute_min(new, shifted) >= -1e-6
+    check = check_trajectory(new, shifted, grid=grid)
+    assert check.ok and check.static_slack >= -1e-6
+
+
+def test_a_walker_head_on_re_routes_from_the_stop(loop_drive):
+    """A walker comes down the short corridor towards the robot (from t = 6 s) and stays at its
+    west end: the robot stops, waits in the niche while it passes, then drives on."""
+    grid, planner, traj = loop_drive
+    t, ts = 4.0, 4.0 + LATENCY
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [6.0, 26.0], [(11.0, 1.0), (1.0, 1.0)], radius=0.2, name="walker"
+    )
+    new = planner.replan(traj, t, latency=LATENCY, moving_obstacles=[walker], mover_margin=0.02)
+    moving = new.stats["moving"]
+    assert moving["route"] == "stopped: waited" and "'walker'" in moving["blocked"]
+    assert "no way past" in moving["blocked"]  # proved on the kept rest from the moving state
+    end = new.state_at(new.duration)
+    assert math.hypot(end.x - 11.0, end.y - 1.0) < 1e-9
+    _check_splice_and_stop(traj, new, ts, [walker], grid)
+
+
+def test_the_static_plan_from_the_stop_is_still_tried_when_no_candidate_works(
+    loop_drive, monkeypatch
+):
+    """The static plan from the stop is a new search: it may leave the followed path, so it is
+    tried last (re-timed) when every re-route candidate fails, and then equals the plan among
+    the movers from the stop that re-times it (the reference)."""
+    from trajopt.planning import PlanRequest
+    from trajopt.replan import Along
+
+    grid, planner, traj = loop_drive
+    where = _mover_planning()
+
+    def nothing(*args, **kwargs):
+        raise BlockedError("no candidate (test)", mover="x", t=0.0)
+
+    monkeypatch.setattr(where, "_reroute", nothing)
+    start, heading = (2.0, 1.0), 0.0
+    passer = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0], [(6.0, 2.0), (6.0, 2.2)], radius=0.2, name="passer"
+    )  # stays in the niche: a re-timing of the way along y = 1 passes it
+    along = Along(BlockedError("claimed (test)", mover="passer", t=0.0), np.zeros((1, 2)))
+    request = PlanRequest(start, (11.0, 1.0), start_heading=heading)
+    out = where.plan_from_stop((passer,), 0.0, planner.options, planner.caches, request, along)
+    ref = planner.plan(start, (11.0, 1.0), start_heading=heading, moving_obstacles=[passer])
+    assert out.stats["moving"]["route"] == "retimed" == ref.stats["moving"]["route"]
+    tt = np.linspace(0.0, ref.duration, 300)
+    a, b = out.sample(tt), ref.sample(tt)
+    for name in ("x", "y", "theta", "v"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    # and with nothing that works either, the reasons of both are given
+    blocker = trajopt.MovingObstacle.from_waypoints([0.0], [(6.0, 1.0)], radius=0.2, name="c")
+    with pytest.raises(BlockedError, match="the static plan from the stop"):
+        where.plan_from_stop((blocker,), 0.0, planner.options, planner.caches, request, along)
+    # but a mover standing on the goal for ever ends every plan: no static plan is tried
+    on_goal = trajopt.MovingObstacle.from_waypoints([0.0], [(11.0, 1.0)], radius=0.2, name="g")
+    calls = _count_plans(monkeypatch)
+    with pytest.raises(BlockedError, match="no candidate") as info:
+        where.plan_from_stop((on_goal,), 0.0, planner.options, planner.caches, request, along)
+    assert "static plan" not in str(info.value) and not calls
+
+
+def test_parked_proof_from_a_moving_start_uses_its_speed():
+    """Hand derivation: from rest the robot covers at most ``a_max t^2 / 2`` by ``t_stop``; from
+    a cruise at ``v0`` it can be ``v0 t_stop`` along. A cart that parks between the two (a limit
+    clear of both) may be passed from the cruise: no proof; from rest it is proved blocking."""
+    from astar.grid import OccupancyGrid
+
+    occ = np.ones((40, 400), dtype=bool)
+    occ[10:30, 10:390] = False
+    grid = OccupancyGrid(occ, RES, (0.0, 0.0))
+    planner = trajopt.Planner(grid, trajopt.Robot(a_max=0.1))
+    traj = planner.plan((1.0, 1.0), (19.0, 1.0))
+    rest = planner.replan(traj, 8.0, latency=0.0)  # cruising by then
+    rob = rest.robot
+    v0 = float(rest.v_start)
+    assert v0 > 0.45 and abs(rest.state_at(0.0).a) < 1e-9
+    t_stop = 4.0
+    from_rest = 0.5 * rob.a_max * (t_stop + 0.01) ** 2  # v <= a_max t from rest (1 ms sums)
+    limit = rob.inscribed_radius + 0.1  # the cart's radius
+    assert from_rest + limit + 0.1 < v0 * t_stop - limit - 0.1
+    s_park = v0 * t_stop - limit - 0.1  # the cruise is past it (by more than the limit) then
+    x0 = rest.state_at(0.0).x
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, t_stop], [(x0 + s_park, 1.8), (x0 + s_park, 1.0)], radius=0.1, name="cart"
+    )
+    assert trajopt.moving.parked_on_path(rest, [cart]) is None
+    # the same path from rest: its reach by t_stop is short of the cart by more than the limit
+    from_stop = planner.plan((x0, 1.0), (19.0, 1.0))
+    blocked = trajopt.moving.parked_on_path(from_stop, [cart])
+    assert blocked is not None and blocked.mover == "cart" and blocked.t == t_stop
+
+
+def test_quick_proofs_from_a_moving_start_never_refuse_a_certified_re_timing(driven):
+    """Soundness on seeded random movers about the kept rest (moving at the splice): when the
+    re-timing from the moving state finds a motion the certificate and 1 ms samples pass, the
+    proofs must not call the path blocked."""
+    planner, traj = driven
+    rest = planner.replan(traj, 1.0, latency=0.0)
+    assert rest.v_start > 0.0
+    rng = np.random.default_rng(7)
+    found = claimed = 0
+    for _ in range(30):
+        smp = rest.sample(np.array([rng.uniform(0.3, 0.9) * rest.duration]))
+        p = np.array([smp.x[0], smp.y[0]])
+        heading = rng.uniform(-math.pi, math.pi)
+        d = np.array([math.cos(heading), math.sin(heading)])
+        t_c, speed = rng.uniform(1.0, 8.0), rng.uniform(0.2, 0.6)
+        stop = rng.random() < 0.4  # some stop on the path
+        times = [t_c - 3.0, t_c] if stop else [t_c - 3.0, t_c + 3.0]
+        pts = [p - 3.0 * speed * d, p] if stop else [p - 3.0 * speed * d, p + 3.0 * speed * d]
+        mover = trajopt.MovingObstacle.from_waypoints(times, pts, radius=0.2, name="m")
+        proof = trajopt.moving.parked_on_path(rest, [mover]) or trajopt.moving.no_way_past(
+            rest, [mover]
+        )
+        claimed += proof is not None
+        try:
+            timed = trajopt.retime_for_movers(rest, [mover])
+        except (BlockedError, trajopt.errors.InvalidInputError):
+            continue
+        found += 1
+        assert dense_min(timed, [mover])[0] >= -1e-6
+        assert proof is None, proof
+    assert found >= 5 and claimed >= 3, (found, claimed)  # both kinds met
+
+
+def test_a_mover_over_the_robot_at_the_splice_is_refused_not_proved(driven):
+    """A cart parked where the robot is at the splice: bad input (InvalidInputError), as the
+    re-timing says, not a proof that the path is blocked."""
+    planner, traj = driven
+    ts = 1.0 + LATENCY
+    at = traj.state_at(ts)
+    cart = trajopt.MovingObstacle.from_waypoints([0.0], [(at.x, at.y)], radius=0.2, name="cart")
+    assert trajopt.moving.parked_on_path(
+        planner.replan(traj, 1.0, latency=LATENCY), [trajopt.moving.shift_clock(cart, ts)]
+    )  # the proof alone would call it blocked
+    with pytest.raises(trajopt.errors.InvalidInputError, match="overlaps"):
+        planner.replan(traj, 1.0, latency=LATENCY, moving_obstacles=[cart])

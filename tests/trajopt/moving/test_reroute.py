@@ -3,7 +3,7 @@
 Hand-built maps (5 cm cells): a corridor with a side bay (a head-on mover: the robot, differential or
 omni with its own orientation, must yield in the bay), a loop of two corridors (a cart stops on the short one: the robot goes
 round by the long one) and a plain corridor (a cart drives into it and stops: no way,
-BlockedError naming the cart). Every returned plan is checked by the independent references (1 ms samples, brute
+BlockedError naming the cart); the order of the candidates when the blocked path is given. Every returned plan is checked by the independent references (1 ms samples, brute
 force) and its samples against the map's occupied squares.
 """
 
@@ -100,6 +100,48 @@ def test_head_on_in_a_corridor_yields_in_the_bay(bay, drive, headings):
     assert smp.y[0] > 2.0 + 0.2 and 5.5 < smp.x[0] < 6.5
     end = out.sample(np.array([out.duration]))
     assert np.hypot(end.x[0] - goal[0], end.y[0] - goal[1]) < 1e-6
+
+
+def test_detours_that_keep_clear_of_the_blocked_path_go_last(bay):
+    """A forklift that ends far behind the start: its final place leaves the corridor open, so
+    with the blocked path given that detour is tried after those round the forklift's track;
+    without it the order is the module's (every plan fails here: only the order is read)."""
+    grid = bay
+    robot = trajopt.Robot()
+    forklift = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 15.0, 30.0], [(13.0, 2.0), (5.5, 2.0), (0.8, 1.8)], radius=0.2, name="forklift"
+    )
+    p0, p1 = np.array([3.0, 2.0]), np.array([11.0, 2.0])
+    path = np.stack([np.linspace(3.0, 11.0, 161), np.full(161, 2.0)], axis=1)
+    blocked = BlockedError("blocked (test)", mover="forklift", t=5.0)
+    asked = []
+
+    def plan_leg(marked, a, b, heading, goal_heading=None, start_steer=0.0):
+        asked.append(np.asarray(marked.occupied).sum())
+        raise trajopt.errors.NoPathError("no plan (test)")
+
+    def order(**kw):
+        with pytest.raises(BlockedError) as info:
+            trajopt.moving.reroute(
+                p0, p1, robot, [forklift], 0.02, blocked, grid=grid,
+                free=lambda: np.zeros(grid.shape, dtype=bool), plan_leg=plan_leg, **kw,
+            )  # fmt: skip
+        text = str(info.value)
+        names = ["around every mover's final place", "around 'forklift':", "from t = 5.000 s"]
+        return sorted(names, key=text.index)
+
+    assert order() == [
+        "around every mover's final place",
+        "around 'forklift':",
+        "from t = 5.000 s",
+    ]
+    # by hand: the final place (0.8, 1.8) is 2.2 m behind the start, the path runs east of it
+    assert math.dist((0.8, 1.8), p0) > robot.radius + 0.2 + 0.02 + robot.radius + 3 * RES
+    assert order(path=path) == [
+        "around 'forklift':",
+        "from t = 5.000 s",
+        "around every mover's final place",
+    ]
 
 
 def test_a_car_waits_at_a_safe_place_with_a_heading():
