@@ -152,6 +152,22 @@ def _exercise_timing() -> None:
     time_parameterize(curve, robot, v_start=0.05, v_end=0.05)
 
 
+def _exercise_moving() -> None:
+    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search)."""
+    from trajopt.geometry import PolylineCurve
+    from trajopt.moving import MovingObstacle, retime_for_movers
+    from trajopt.robot import Robot
+    from trajopt.timing import time_parameterize
+
+    robot = Robot(v_max=0.6, a_max=0.6, j_max=2.0)
+    line = time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [6.0, 0.0]])), robot)
+    movers = [
+        MovingObstacle.constant_velocity((4.5, -3.0), (0.0, 0.35), radius=0.3, horizon=24.0),
+        MovingObstacle.constant_velocity((0.0, -1.5), (0.0, 0.5), radius=0.3, horizon=24.0),
+    ]
+    retime_for_movers(line, movers)
+
+
 def _exercise_polygons() -> None:
     """Grow a polygon corridor along a polyline; intersect two of its polygons."""
     from trajopt.corridor import build_polygon_corridor
@@ -314,6 +330,7 @@ EXERCISES: dict[str, Exercise] = {
     "planners": Exercise(_exercise_planners, after=("plan", "astar", "fallback"), seconds=1.0),
     "compare": Exercise(_exercise_compare, after=("plan",), seconds=0.5),
     "car": Exercise(_exercise_car, seconds=8.0),
+    "moving": Exercise(_exercise_moving, after=("timing",), seconds=3.0),
 }
 
 #: What a default plan and :func:`trajopt.compare` need (with what they depend on): the

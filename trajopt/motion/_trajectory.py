@@ -532,6 +532,33 @@ class Trajectory(SampledExport):
             **extra,
         )
 
+    def pose(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Return ``(x, y, theta, s, v)`` at times ``t`` (s): the pose and motion only.
+
+        The same position (m), arc length (m) and speed (m/s, the body's: negative when
+        driving in reverse) as :meth:`sample`; the heading (rad, the body's) is the path's
+        tangent angle without :meth:`sample`'s continuous unwrapping (it differs from
+        ``sample(t).theta`` by a multiple of ``2 pi``). No curvature, rates or sample object:
+        a light evaluation for many times at once (the moving obstacles' certificate).
+
+        Parameters
+        ----------
+        t : ndarray, shape (n,)
+            Times (s); clipped to ``[0, duration]``.
+
+        Returns
+        -------
+        x, y, theta, s, v : ndarray, shape (n,)
+        """
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        s, v, _, _ = self.motion(tt)
+        u = self._u_at_s(s)
+        xy = np.asarray(self.path(u))
+        theta = np.asarray(self.path.heading(u), dtype=float)
+        if self.robot.drive.signed_speed and float(self.direction) < 0.0:
+            v, theta = -v, theta + self._reverse_shift()
+        return xy[..., 0], xy[..., 1], theta, s, v
+
     def _reverse_shift(self) -> float:
         """Return ``pi`` plus the multiple of ``2 pi`` that puts the body's start heading in ``[-pi, pi]``."""
         t0 = (

@@ -245,11 +245,9 @@ class _Curve:
         tr, off = self.traj, self.offset
         s0 = self.s_at(t0 - off)
         s1 = self.s_at(t1 - off)
-        smp = tr.sample(tm - off)
-        p = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
-        sm = np.asarray(smp.s, dtype=float)
+        x, y, th, sm, v = tr.pose(tm - off)
+        p = np.stack([x, y], axis=-1)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
-        th, v = np.asarray(smp.theta, dtype=float), np.asarray(smp.v, dtype=float)
         last = self.s_edges.shape[0] - 2
         i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
         i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)

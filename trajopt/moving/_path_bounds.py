@@ -117,14 +117,14 @@ class PathBoxes:
         pts = np.asarray(path(u), dtype=float)
         self.s = np.maximum.accumulate(np.asarray(path.s_at_u(u), dtype=float))
         self.pad = 0.5 * float(np.max(np.diff(self.s), initial=0.0)) + 1e-6
-        self.ranges = [RangeMax(v) for v in (-pts[:, 0], pts[:, 0], -pts[:, 1], pts[:, 1])]
+        self.ranges = RangeMax(np.stack([-pts[:, 0], pts[:, 0], -pts[:, 1], pts[:, 1]], axis=1))
 
     def box(self, s0: np.ndarray, s1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return ``(x_min, x_max, y_min, y_max)`` (m) of the path over ``[s0, s1]`` (m), elementwise."""
         last = self.s.shape[0] - 1
         i0 = np.clip(np.searchsorted(self.s, s0, side="right") - 1, 0, last)
         i1 = np.maximum(np.clip(np.searchsorted(self.s, s1, side="left"), 0, last), i0)
-        x0, x1, y0, y1 = (r(i0, i1) for r in self.ranges)
+        x0, x1, y0, y1 = self.ranges(i0, i1).T
         return -x0 - self.pad, x1 + self.pad, -y0 - self.pad, y1 + self.pad
 
 
@@ -151,21 +151,32 @@ def path_boxes_of(curve: Any) -> PathBoxes:
 
 
 class RangeMax:
-    """Maxima of ``values`` over index ranges in O(1) (a sparse table)."""
+    """Maxima of ``values`` over index ranges in O(1) (a sparse table).
+
+    ``values`` of shape (n,) or (n, c) (``c`` columns answered at once). Level ``j`` holds
+    the maxima of the windows of ``2^j`` values, padded with ``-inf`` to ``n`` rows, so that
+    a query is one gather from the (levels, n, ...) table.
+    """
 
     def __init__(self, values: np.ndarray) -> None:
-        self.levels = [np.asarray(values, dtype=float)]
-        while 2 ** len(self.levels) <= values.shape[0]:
-            prev, w = self.levels[-1], 2 ** (len(self.levels) - 1)
-            self.levels.append(np.maximum(prev[:-w], prev[w:]))
+        v = np.asarray(values, dtype=float)
+        n = v.shape[0]
+        levels = 1 + (int(math.floor(math.log2(n))) if n > 0 else 0)
+        self.table = np.full((levels, *v.shape), -np.inf)
+        self.table[0] = v
+        for j in range(1, levels):
+            w = 2 ** (j - 1)
+            prev = self.table[j - 1]
+            np.maximum(
+                prev[: n - 2 * w + 1], prev[w : n - w + 1], out=self.table[j, : n - 2 * w + 1]
+            )
 
     def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
-        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise."""
+        """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise.
+
+        Shape ``i0.shape`` (plus the columns of a 2-D ``values``).
+        """
         n = i1 - i0 + 1
         lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
-        out = np.empty(i0.shape)
-        for j in np.unique(lev):
-            sel = lev == j
-            arr = self.levels[int(j)]
-            out[sel] = np.maximum(arr[i0[sel]], arr[i1[sel] - 2 ** int(j) + 1])
-        return out
+        tb = self.table
+        return np.maximum(tb[lev, i0], tb[lev, i1 - (1 << lev) + 1])

@@ -20,7 +20,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from trajopt.moving._st_grid import NEVER_STEP, STGrid, visits
+from trajopt.moving._st_grid import NEVER_STEP, STGrid
+from trajopt.moving._st_kernels import (
+    arrive_kernel,
+    blocked_starts_kernel,
+    drive_nodes_kernel,
+)
 
 #: Evenly spaced stops tried besides the start, the goal and the fronts of the forbidden regions.
 N_EVEN_STOPS = 10
@@ -42,18 +47,33 @@ class Piece:
     memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     def nodes(self, grid: STGrid) -> np.ndarray:
-        """Return the grid node (index) of the drive at each grid step from its start, shape (m,)."""
+        """Return the grid node (index) of the drive at each grid step from its start, shape (m,).
+
+        The nearest node of :meth:`s_at` at the steps ``0, dt, ..., ceil(duration / dt) dt``
+        (compiled: :func:`._st_kernels.drive_nodes_kernel`); kept on the piece with
+        :meth:`visits`.
+        """
         key = (grid.dt, grid.ds, grid.s.shape[0])
         if key not in self.memo:
-            n = int(math.ceil(self.duration / grid.dt - 1e-9))
-            self.memo[key] = grid.index(self.s_at(np.arange(n + 1) * grid.dt))
+            idx, first, last = drive_nodes_kernel(
+                np.ascontiguousarray(self.rows, dtype=float),
+                float(self.duration),
+                float(self.s0),
+                float(self.s1),
+                float(grid.dt),
+                float(grid.ds),
+                key[2],
+                NEVER_STEP,
+            )
+            self.memo[key] = idx
+            self.memo[("visits", *key)] = (int(idx[0]), first, last)
         return self.memo[key]
 
     def visits(self, grid: STGrid) -> tuple[int, np.ndarray, np.ndarray]:
         """Return :func:`._st_grid.visits` of :meth:`nodes` (kept on the piece)."""
         key = ("visits", grid.dt, grid.ds, grid.s.shape[0])
         if key not in self.memo:
-            self.memo[key] = visits(self.nodes(grid))
+            self.nodes(grid)
         return self.memo[key]
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
@@ -68,57 +88,9 @@ class Piece:
 
 
 def fill_visits(pieces: Sequence[Piece], grid: STGrid) -> None:
-    """Compute :meth:`Piece.nodes` and :meth:`Piece.visits` of several drives at once (kept on each).
-
-    The drives' rows are put one after another on a clock that gives each drive its own
-    span (drive ``i`` at ``i T``, ``T`` a power of two above every duration), so that one
-    search finds the row of every grid step of every drive.
-    """
-    key = (grid.dt, grid.ds, grid.s.shape[0])
-    todo = [pc for pc in pieces if key not in pc.memo]
-    if not todo:
-        return
-    dt = grid.dt
-    dur = np.array([pc.duration for pc in todo])
-    steps = np.ceil(dur / dt - 1e-9).astype(np.int64) + 1
-    span = 2.0 ** math.ceil(math.log2(float(np.max(dur)) + 2.0))
-    rows = np.concatenate([pc.rows for pc in todo])
-    per = np.array([pc.rows.shape[0] for pc in todo])
-    first_row = np.cumsum(per) - per
-    who = np.repeat(np.arange(len(todo)), steps)
-    t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) * dt
-    tt = np.minimum(t, dur[who])
-    clock = np.repeat(np.arange(len(todo)), per) * span + rows[:, 0]
-    k = np.searchsorted(clock, who * span + tt, side="right") - 1
-    k = np.maximum(k, first_row[who])
-    tau = tt - rows[k, 0]
-    s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
-    s0 = np.array([pc.s0 for pc in todo])[who]
-    s1 = np.array([pc.s1 for pc in todo])[who]
-    s = np.where(tt >= dur[who], s1, np.minimum(np.maximum(s, s0), s1))
-    idx = grid.index(s)
-    # the visits of every drive at once (:func:`._st_grid.visits`): each drive's nodes are
-    # non-decreasing, so a node's first and last steps are where its run of steps starts
-    # and ends
-    ends = np.cumsum(steps)
-    starts = ends - steps
-    i0 = idx[starts]
-    size = idx[ends - 1] - i0 + 1
-    base = np.cumsum(size) - size
-    rel = idx - i0[who] + base[who]
-    j = np.arange(idx.shape[0]) - starts[who]
-    run_start = np.ones(idx.shape[0], dtype=bool)
-    run_start[1:] = (idx[1:] != idx[:-1]) | (who[1:] != who[:-1])
-    run_end = np.roll(run_start, -1)
-    run_end[-1] = True
-    first = np.full(int(size.sum()), NEVER_STEP)
-    last = np.full(int(size.sum()), -NEVER_STEP)
-    first[rel[run_start]] = j[run_start]
-    last[rel[run_end]] = j[run_end]
-    for i, pc in enumerate(todo):
-        pc.memo[key] = idx[starts[i] : ends[i]]
-        sl = slice(int(base[i]), int(base[i] + size[i]))
-        pc.memo[("visits", *key)] = (int(i0[i]), first[sl], last[sl])
+    """Compute :meth:`Piece.nodes` and :meth:`Piece.visits` of several drives (kept on each)."""
+    for pc in pieces:
+        pc.nodes(grid)
 
 
 def stop_points(grid: STGrid, extra: Sequence[float] = ()) -> list[float]:
@@ -257,22 +229,22 @@ def search(
     lt = least_times(sa[None, :] - sa[:, None], v_top, a_top, j_top)  # lt[w, v]: w -> v
     goal_col = grid.column(int(nodes[-1]))
     last_goal = int(np.max(np.flatnonzero(goal_col))) if goal_col.any() else -1
-    # arrivals[w][k]: the robot comes to rest at stop w at t_k; parent (stop, start index, piece)
-    arrivals = [np.zeros(kk, dtype=bool) for _ in range(w_n)]
-    parent_w = np.full((w_n, kk), -1, dtype=np.int64)
-    parent_k = np.full((w_n, kk), -1, dtype=np.int64)
-    parent_p = np.full((w_n, kk), -1, dtype=np.int64)
+    # arrivals[w, k]: the robot comes to rest at stop w at t_k; parent (stop, start index, piece)
+    arrivals = np.zeros((w_n, kk), dtype=bool)
+    parent = np.full((3, w_n, kk), -1, dtype=np.int64)  # (stop, start index, drive) of each
+    ptr, _, m_lo, m_hi = (np.asarray(x, dtype=np.int64) for x in grid.merged)
     pieces: list[Piece] = []
     start_col = grid.column(int(nodes[0]))
-    arrivals[0][0] = not start_col[0]
+    arrivals[0, 0] = not start_col[0]
     resting: list[tuple[np.ndarray, np.ndarray]] = []
     best: tuple[float, int, int, Piece] | None = None  # (arrival, from stop, start index, drive)
-    for w in range(w_n - 1):
+    goal = w_n - 1
+    for w in range(goal):
         col = start_col if w == 0 else grid.column(int(nodes[w]))
         rest, since = _rest_closure(arrivals[w], col)
         if w == 0 and moving:  # no rest: the launch leaves at t = 0
             rest = np.zeros(kk, dtype=bool)
-            rest[0] = arrivals[0][0]
+            rest[0] = arrivals[0, 0]
             since = np.zeros(kk, dtype=np.int64)
         resting.append((rest, since))
         if w == 0:
@@ -280,43 +252,62 @@ def search(
         if not rest.any():
             continue
         first = int(np.argmax(rest))
-        batch: list[tuple[int, Piece]] = []  # the drives to stops, tested together
-        for v in [w_n - 1, *range(w + 1, w_n - 1)]:  # the goal first: a bound for the rest
-            if moving and w == 0:  # from a speed: at least the distance at the top speed
-                lower = (stops[v] - stops[0]) / v_top + lt[v, w_n - 1]
-            else:
-                lower = first * dt + lt[w, v] + lt[v, w_n - 1]
-            # an arrival comes after the goal's last forbidden time, less a step
-            lower = max(lower, last_goal * dt)
-            if best is not None and lower >= best[0]:
-                continue
+        # a bound on the arrival through each later stop: a drive that cannot beat the best
+        # arrival is not timed; an arrival comes after the goal's last forbidden time, less
+        # a step
+        if moving and w == 0:  # from a speed: at least the distance at the top speed
+            lower = (sa[w + 1 :] - sa[0]) / v_top + lt[w + 1 :, goal]
+        else:
+            lower = first * dt + lt[w, w + 1 :] + lt[w + 1 :, goal]
+        lower = np.maximum(lower, last_goal * dt)
+        # the goal first: its arrival bounds the drives to the other stops
+        if best is None or lower[-1] < best[0]:
+            piece = launch(stops[goal]) if moving and w == 0 else drive(stops[w], stops[goal])
+            if piece is not None:
+                n = piece.nodes(grid).shape[0] - 1
+                i0, first_v, last_v = piece.visits(grid)
+                ok = ~blocked_starts_kernel(ptr, m_lo, m_hi, kk, i0, first_v, last_v) & rest
+                ok &= steps + n > last_goal
+                if ok.any():
+                    k = int(np.argmax(ok))
+                    t_arr = k * dt + piece.duration
+                    if best is None or t_arr < best[0]:
+                        best = (t_arr, w, k, piece)
+        cand = range(w + 1, goal)
+        if best is not None:
+            cand = (w + 1 + np.flatnonzero(lower[:-1] < best[0])).tolist()
+        vs: list[int] = []
+        batch: list[Piece] = []  # the drives to stops, tested together
+        for v in cand:
             piece = launch(stops[v]) if moving and w == 0 else drive(stops[w], stops[v])
-            if piece is None:
-                continue
-            if v < w_n - 1:
-                batch.append((v, piece))
-                continue
-            n = piece.nodes(grid).shape[0] - 1
-            ok = ~grid.blocked_starts_many([piece.visits(grid)])[0] & rest
-            ok &= steps + n > last_goal
-            if ok.any():
-                k = int(np.argmax(ok))
-                t_arr = k * dt + piece.duration
-                if best is None or t_arr < best[0]:
-                    best = (t_arr, w, k, piece)
-        fill_visits([pc for _, pc in batch], grid)
-        bad = grid.blocked_starts_many([pc.visits(grid) for _, pc in batch])
-        for (v, piece), bad_v in zip(batch, bad, strict=True):
-            n = piece.nodes(grid).shape[0] - 1
-            ok = ~bad_v & rest
-            ks = np.flatnonzero(ok[: max(0, kk - n)])
-            new = ks[~arrivals[v][ks + n]]
-            if new.size:
-                arrivals[v][new + n] = True
-                parent_w[v, new + n] = w
-                parent_k[v, new + n] = new
-                parent_p[v, new + n] = len(pieces)
-                pieces.append(piece)
+            if piece is not None:
+                vs.append(v)
+                batch.append(piece)
+        if not batch:
+            continue
+        fill_visits(batch, grid)
+        # the drive to stop v leaving at t_k arrives at t_(k + n) (the drives of one batch go
+        # to distinct stops): blocked starts and arrivals in one compiled pass
+        vis = [pc.visits(grid) for pc in batch]
+        size = np.array([x[1].shape[0] for x in vis], dtype=np.int64)
+        arrive_kernel(
+            ptr,
+            m_lo,
+            m_hi,
+            rest,
+            np.array([x[0] for x in vis], dtype=np.int64),
+            np.cumsum(size) - size,
+            size,
+            np.concatenate([x[1] for x in vis]),
+            np.concatenate([x[2] for x in vis]),
+            np.array([pc.nodes(grid).shape[0] - 1 for pc in batch], dtype=np.int64),
+            np.array(vs, dtype=np.int64),
+            w,
+            len(pieces),
+            arrivals,
+            parent,
+        )
+        pieces.extend(batch)
     if best is None:
         return None
     t_arr, w, k, piece = best
@@ -324,9 +315,9 @@ def search(
     while w > 0:
         k_arr = int(resting[w][1][k])
         w, k, piece = (
-            int(parent_w[w, k_arr]),
-            int(parent_k[w, k_arr]),
-            pieces[parent_p[w, k_arr]],
+            int(parent[0, w, k_arr]),
+            int(parent[1, w, k_arr]),
+            pieces[parent[2, w, k_arr]],
         )
         chain.append((k, piece))
     chain.reverse()

@@ -238,3 +238,23 @@ def test_invalid_construction():
         dataclasses.replace(traj, duration=0.1)
     with pytest.raises(InvalidInputError, match="duration"):
         dataclasses.replace(traj, duration=math.nan)
+
+
+@pytest.mark.parametrize("direction", [1, -1])
+def test_the_pose_is_the_sample_s_pose(direction):
+    # Trajectory.pose (the certificate's light evaluation) against sample at 2001 times: the
+    # same x, y, s and body speed, and a heading equal to sample's modulo 2 pi
+    path = Arc(2.0, 4.0)  # past the heading angle pi: the tangent angle wraps
+    tr = time_parameterize(path, PLAIN)
+    if direction < 0:
+        car = Robot(drive="ackermann", wheelbase=0.5, min_turning_radius=1.0)
+        tr = dataclasses.replace(tr, robot=car, direction=-1)
+    t = np.linspace(-0.5, tr.duration + 0.5, 2001)
+    x, y, theta, s, v = tr.pose(t)
+    smp = tr.sample(t)
+    for got, want in ((x, smp.x), (y, smp.y), (s, smp.s), (v, smp.v)):
+        assert np.array_equal(got, np.asarray(want))
+    turns = (np.asarray(smp.theta) - theta) / (2.0 * math.pi)
+    assert np.max(np.abs(turns - np.round(turns))) < 1e-12
+    if direction < 0:
+        assert np.all(v <= 0.0) and np.any(v < 0.0)

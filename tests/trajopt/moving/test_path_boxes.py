@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from tests.trajopt.moving.reference import brute_min, dense_min
 from trajopt.geometry import BSplineCurve, PolylineCurve, clamped_uniform_knots
 from trajopt.moving import MovingObstacle, certify_movers
-from trajopt.moving._path_bounds import PathBoxes
+from trajopt.moving._path_bounds import PathBoxes, RangeMax
 from trajopt.robot import Robot
 from trajopt.timing import time_parameterize
 
@@ -77,3 +77,15 @@ def test_the_certificate_with_far_movers_agrees_with_the_brute_force(seed):
         assert cert.slack <= lowest + 1e-9  # a lower bound of the true slack
     else:
         assert cert.verdict == "violated" and lowest < -0.5 * cert.tol
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 300), st.integers(1, 3), st.integers(0, 2**32 - 1))
+def test_range_maxima_are_the_maxima_of_the_ranges(n, cols, seed):
+    rng = np.random.default_rng(seed)
+    values = rng.normal(size=(n, cols)) if cols > 1 else rng.normal(size=n)
+    i0 = rng.integers(0, n, 200)
+    i1 = np.minimum(i0 + rng.integers(0, n, 200), n - 1)
+    got = RangeMax(values)(i0, i1)
+    want = np.array([values[a : b + 1].max(axis=0) for a, b in zip(i0, i1, strict=True)])
+    assert np.array_equal(got, want)

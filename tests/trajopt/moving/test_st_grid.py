@@ -20,6 +20,7 @@ from shapely.geometry import Point, Polygon
 from trajopt.geometry import CurveSegment, PolylineCurve
 from trajopt.moving import MovingObstacle, reachable, st_grid
 from trajopt.moving._st_grid import visits
+from trajopt.moving._st_kernels import arrive_kernel, blocked_starts_kernel
 from trajopt.moving._st_search import Piece, fill_visits
 from trajopt.robot import Robot
 from trajopt.timing import time_parameterize
@@ -196,6 +197,28 @@ def test_blocked_starts_against_the_dense_grid(first, steps):
     many = g.blocked_starts_many([visits(idx) for idx in others])
     for idx, row in zip(others, many, strict=True):
         assert np.array_equal(row, want(idx))
+    # the compiled kernels of the search: one drive's blocked starts, and a batch's arrivals
+    # (from a stop where the robot rests at the even steps) where those starts are free
+    ptr, _, m_lo, m_hi = (np.asarray(x, dtype=np.int64) for x in g.merged)
+    for idx in others:
+        assert np.array_equal(blocked_starts_kernel(ptr, m_lo, m_hi, kk, *visits(idx)), want(idx))
+    vis = [visits(idx) for idx in others]
+    size = np.array([x[1].shape[0] for x in vis], dtype=np.int64)
+    ns = np.array([len(idx) - 1 for idx in others], dtype=np.int64)
+    rest = np.arange(kk) % 2 == 0
+    arrivals = np.zeros((4, kk), bool)
+    parent = np.full((3, 4, kk), -1, dtype=np.int64)
+    args = [np.array([x[0] for x in vis], dtype=np.int64), np.cumsum(size) - size, size]
+    args += [np.concatenate([x[1] for x in vis]), np.concatenate([x[2] for x in vis])]
+    vs = np.array([1, 2, 3], dtype=np.int64)
+    arrive_kernel(ptr, m_lo, m_hi, rest, *args, ns, vs, 0, 5, arrivals, parent)
+    for j, idx in enumerate(others):
+        n, v = len(idx) - 1, vs[j]
+        ks = np.flatnonzero(rest & ~want(idx))
+        ks = ks[ks + n < kk]
+        assert np.array_equal(np.flatnonzero(arrivals[v]), ks + n)
+        assert np.all(parent[0, v, ks + n] == 0) and np.all(parent[2, v, ks + n] == 5 + j)
+        assert np.array_equal(parent[1, v, ks + n], ks)
 
 
 def _full_sweep(grid, speed):
