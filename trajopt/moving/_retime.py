@@ -55,6 +55,7 @@ from trajopt.moving._certificate import (
 )
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import geometry_key, kappa_max
+from trajopt.moving._shape_windows import ShapeWindows
 from trajopt.moving._st_grid import (
     STGrid,
     grid_nodes,
@@ -472,8 +473,7 @@ def _tightened(
         return sched[-1][0] + sched[-1][1].duration if sched else math.inf
 
     candidates: list[list[tuple[float, Piece]]] = []
-    disc = traj.robot.footprint is None and all(m.vertices is None for m in movers)
-    if disc:
+    if traj.robot.footprint is None:
         speed = max(float(traj.robot.v_max), abs(float(traj.v_start)))
         t_to = arrival(schedule) if schedule else float(grid.t[-1])
         limit = float(traj.robot.radius) + margin
@@ -546,7 +546,8 @@ def _fine_windows(
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)
 
-    return FineWindows(s, pts, movers, limit, band, where, float(tables.robot.v_max))
+    kind = FineWindows if all(m.vertices is None for m in movers) else ShapeWindows
+    return kind(s, pts, movers, limit, band, where, float(tables.robot.v_max))
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:
