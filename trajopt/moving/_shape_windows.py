@@ -34,8 +34,8 @@ NODE_STEP = 1e-2
 FINE_STEP = 5e-4
 #: Each window's ends are widened by this much (s), against rounding.
 EPS_W = 1e-9
-#: How far (s) before the launch it refines the refinement looks for an earlier one.
-REFINE_REACH = 0.06
+#: The launch steps (s) of the refinement's levels (:meth:`ShapeWindows._exact`).
+LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
 #: The refinement's spacing (s) of the motion's own points (:meth:`ShapeWindows._exact`).
 REFINE_TAU = 1e-3
 
@@ -107,6 +107,13 @@ class ShapeTracks:
         dist = np.min(np.hypot(qx - lam * e[..., 0], qy - lam * e[..., 1]), axis=1)
         inside = self.poly[j] & np.all(e[..., 0] * qy - e[..., 1] * qx >= 0.0, axis=1)
         return np.where(inside, 0.0, dist) - rad
+
+    def piece_at(self, mover: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Return the piece (row of :attr:`pieces`) of each ``mover`` at times ``t`` (s), ``t >= 0``."""
+        who = self.pieces[:, 0]
+        big = 2.0 * (float(np.max(self.pieces[:, 1], initial=0.0)) + float(np.max(t)) + 1.0)
+        key = who * big + self.pieces[:, 1]
+        return np.searchsorted(key, mover * big + t, side="right") - 1
 
     def windows(
         self,
@@ -241,31 +248,64 @@ class ShapeWindows(FineWindows):
         lo: float,
         hi: float,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Return launches (open intervals, s) that hold every one at which the motion meets the movers.
+        """Return open intervals (s) holding every launch in ``[lo, hi]`` at which the motion may meet the movers.
 
-        As :meth:`._tighten.FineWindows._exact`: during ``[a_j, b_j]`` (s from the launch)
-        against mover ``owner_j``, from the motion's own points every :data:`REFINE_TAU`
-        (s), for launches in ``[lo, hi]`` (s); each point's windows from
-        :meth:`ShapeTracks.windows` (step :data:`FINE_STEP`) in the mover times those
-        launches reach.
+        As :meth:`._tighten.FineWindows._exact` (during ``[a_j, b_j]``, s from the launch,
+        against mover ``owner_j``), found in the launch instead: the motion's own points
+        every :data:`REFINE_TAU` (s) give a lower bound ``G(L)`` of its clearance at launch
+        ``L`` (their distance to the shape at ``L + tau``, minus the radius and the limit,
+        minus ``(V + lip) REFINE_TAU / 2`` for the instants between them), and ``G`` changes
+        at most at ``lip`` (m/s) with ``L``, so ``G(L) > 0`` proves the launches within
+        ``G(L) / lip`` of ``L`` safe. ``G`` is evaluated on :data:`LAUNCH_STEPS` (s), each
+        level around the earliest launch the one before proved; everything not proved is
+        returned. The points that keep more than ``lip`` times the range at its middle are
+        left out (they are clear at every launch in it).
         """
-        # the launches before ``cut`` stay forbidden: the fine nodes' windows (which hold every
-        # launch before the one refined) come within a few steps of it
-        cut = max(lo, hi - REFINE_REACH)
-        lo = cut
         a, b, owner = merged_spans(a, b, owner)
         n = np.maximum(np.ceil((b - a) / REFINE_TAU).astype(np.int64), 1) + 1
         idx = np.repeat(np.arange(a.shape[0]), n)
         step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
         tau = np.minimum(a[idx] + step * REFINE_TAU, b[idx])
+        who = owner[idx]
         pts = self.where(s_of(tau))
-        pad = 0.5 * REFINE_TAU
-        band = (tau + lo - pad, tau + hi + pad)
-        _, pi, w_lo, w_hi = self.tracks.windows(
-            pts, self.limit + self.speed * pad, FINE_STEP, band, owner[idx]
-        )
-        w_lo, w_hi = w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
-        return np.append(w_lo, -np.inf), np.append(w_hi, cut)
+        tr = self.tracks
+        lip_m = np.zeros(len(self.movers))
+        np.maximum.at(lip_m, tr.pieces[:, 0].astype(np.int64), tr.lip)
+        lip = lip_m[who]
+        pad = 0.5 * REFINE_TAU * (self.speed + lip) + self.limit
+
+        def g(launch: np.ndarray, rows: np.ndarray) -> np.ndarray:
+            """Return the clearance bound (m), shape (len(launch), len(rows))."""
+            t = launch[:, None] + tau[None, rows]
+            seg = tr.piece_at(np.broadcast_to(who[rows], t.shape).ravel(), t.ravel())
+            p = np.broadcast_to(pts[rows], (*t.shape, 2)).reshape(-1, 2)
+            f = tr.clearance(seg, p, t.ravel()).reshape(t.shape)
+            return f - pad[rows]
+
+        mid = 0.5 * (lo + hi)
+        rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
+        lip_all = float(np.max(lip[rows], initial=0.0))
+        safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
+        left, right = lo, hi
+        for dl in LAUNCH_STEPS:
+            launch = np.arange(left, right + 0.5 * dl, dl)
+            bound = np.min(g(launch, rows), axis=1) if rows.size else np.full(launch.shape, np.inf)
+            reach = np.where(bound > 0.0, bound / max(lip_all, 1e-300), -np.inf)
+            ok = reach > 0.0
+            safe_lo.append(launch[ok] - reach[ok])
+            safe_hi.append(launch[ok] + reach[ok])
+            if not ok.any():
+                break
+            first = int(np.argmax(ok))
+            left, right = max(lo, float(launch[first]) - dl), float(launch[first])
+        # the complement in [lo, hi] of the proved launches
+        s_lo, s_hi = np.concatenate(safe_lo), np.concatenate(safe_hi)
+        order = np.argsort(s_lo)
+        s_lo, s_hi = s_lo[order], np.maximum.accumulate(s_hi[order]) if s_hi.size else s_hi
+        f_lo = np.concatenate([[lo - 1.0], s_hi])
+        f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
+        keep = f_hi > f_lo
+        return f_lo[keep], f_hi[keep]
 
 
 def _merged(
