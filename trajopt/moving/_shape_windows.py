@@ -15,7 +15,8 @@ proves safe: sufficient (every ``t`` with ``f(t) < 0`` is inside a window), and 
 (:func:`._disc_windows.inside_times`), an exact filter.
 
 :class:`ShapeWindows` puts these windows at the fine nodes of a path, for
-:func:`._tighten.tighten` (the robot a disc; movers of any shape).
+:func:`._tighten.tighten` (the robot a disc; movers of any shape); the launch that decides
+the wait at the start is refined from the motion's own points, in the launch itself.
 """
 
 from __future__ import annotations
@@ -30,13 +31,13 @@ from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces
 
 #: The least time step (s) of the fine nodes' windows.
 NODE_STEP = 1e-2
-#: The least time step (s) of the windows of a rest's point and of the refinement.
+#: The least time step (s) of the windows of a rest's point.
 FINE_STEP = 5e-4
 #: Each window's ends are widened by this much (s), against rounding.
 EPS_W = 1e-9
 #: The launch steps (s) of the refinement's levels (:meth:`ShapeWindows._exact`).
 LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
-#: The refinement's spacing (s) of the motion's own points (:meth:`ShapeWindows._exact`).
+#: The spacing (s) of the motion's own points in the refinement (:meth:`ShapeWindows._exact`).
 REFINE_TAU = 1e-3
 
 
@@ -198,9 +199,9 @@ class ShapeWindows(FineWindows):
     """The movers' violation windows at the fine nodes of a path, movers of any shape.
 
     :class:`._tighten.FineWindows` with the windows of :meth:`ShapeTracks.windows` (every
-    :data:`NODE_STEP` at the nodes, :data:`FINE_STEP` at a rest's point and in the
-    refinement, whose motion points are :data:`REFINE_TAU` apart) in place of the disc
-    movers' closed-form ones; parameters as there.
+    :data:`NODE_STEP` at the nodes, :data:`FINE_STEP` at a rest's point) in place of the disc
+    movers' closed-form ones, and the refinement of the wait at the start found in the
+    launch (:meth:`_exact`); parameters as there.
     """
 
     def __init__(
