@@ -12,7 +12,8 @@
    earliest arrival. From a moving start the first drive leaves at once from the start state
    (to the goal, or braking to rest at a stop);
 3. the rests are shortened (:mod:`._tighten`): each drive, with everything after it, is
-   launched as early as the movers' exact windows at fine nodes allow (the wait at the
+   launched as early as the movers' windows at fine nodes allow (exact for disc movers,
+   sampled with a Lipschitz pad for polygons, :mod:`._shape_windows`) (the wait at the
    start first, then the waits at stops), and from rest the path's one drive (the plan's
    own timing) is launched at the earliest time they allow, the earlier arrival of the two
    tried first;
@@ -55,6 +56,7 @@ from trajopt.moving._certificate import (
 )
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import geometry_key, kappa_max
+from trajopt.moving._shape_windows import ShapeWindows
 from trajopt.moving._st_grid import (
     STGrid,
     grid_nodes,
@@ -458,8 +460,9 @@ def _tightened(
     Tries, earliest arrival first: the schedule with every rest as short as the fine windows
     allow (:mod:`._tighten`), (from rest) the path's one drive launched at the earliest time
     they allow, and the schedule as it is; the first that :func:`certify_movers` accepts,
-    with its certificate and its plan in words. Other shapes than a disc robot and disc
-    movers: the wait at the start bisected over certificates. An empty ``schedule``: only
+    with its certificate and its plan in words. The fine windows of a disc robot are
+    closed-form for disc movers, sampled (:class:`._shape_windows.ShapeWindows`) when a
+    mover is a polygon; a footprint robot: the wait at the start bisected over certificates. An empty ``schedule``: only
     the one drive, at any launch up to the grid's horizon.
     """
     length = tables.length
@@ -472,8 +475,7 @@ def _tightened(
         return sched[-1][0] + sched[-1][1].duration if sched else math.inf
 
     candidates: list[list[tuple[float, Piece]]] = []
-    disc = traj.robot.footprint is None and all(m.vertices is None for m in movers)
-    if disc:
+    if traj.robot.footprint is None:
         speed = max(float(traj.robot.v_max), abs(float(traj.v_start)))
         t_to = arrival(schedule) if schedule else float(grid.t[-1])
         limit = float(traj.robot.radius) + margin
@@ -546,7 +548,8 @@ def _fine_windows(
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)
 
-    return FineWindows(s, pts, movers, limit, band, where, float(tables.robot.v_max))
+    kind = FineWindows if all(m.vertices is None for m in movers) else ShapeWindows
+    return kind(s, pts, movers, limit, band, where, float(tables.robot.v_max))
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:

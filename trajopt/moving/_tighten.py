@@ -19,9 +19,10 @@ range outside all of these intervals is the launch; for the wait at the start (t
 waiting witness of the benchmarks is measured by), the intervals that decide it are then
 computed again from the motion's own points on samples every :data:`REFINE_DT`
 (:meth:`FineWindows.earliest`); the waits at stops keep the fine nodes' answer (cheaper). The test is sufficient, and :func:`trajopt.certify_movers`
-decides on the result: the caller keeps the untightened schedule when it fails. Other
-shapes (a footprint robot, a polygon mover) bisect the wait at the start over certificates
-(:func:`bisect_start`).
+decides on the result: the caller keeps the untightened schedule when it fails. Polygon
+movers (with a disc robot) use the same machinery with sampled windows
+(:class:`._shape_windows.ShapeWindows`); a footprint robot bisects the wait at the start
+over certificates (:func:`bisect_start`).
 """
 
 from __future__ import annotations

@@ -1,0 +1,137 @@
+"""Tests of trajopt.moving's sampled windows for movers of any shape, against dense sampling.
+
+The windows must hold every instant a point is closer to a mover than the limit (checked on
+1 ms samples of the reference's own distance, :func:`tests.trajopt.moving.reference.slack_at`),
+and stay near such instants: every covered sample is within what the mover can close in two
+steps of the limit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.trajopt.moving.reference import mover_rate, slack_at
+from trajopt.geometry import PolylineCurve
+from trajopt.moving import MovingObstacle
+from trajopt.moving._shape_windows import NODE_STEP, ShapeTracks, ShapeWindows
+from trajopt.robot import Robot
+from trajopt.timing import time_parameterize
+
+CART = [(-0.45, -0.25), (0.45, -0.25), (0.45, 0.25), (-0.45, 0.25)]
+TRI = [(-0.3, -0.2), (0.4, 0.0), (-0.3, 0.2)]
+
+
+def _movers(rng):
+    out = []
+    for i, verts in enumerate((CART, TRI, None, CART)):
+        t = np.concatenate([[0.0], np.sort(rng.uniform(0.5, 7.0, 2))])
+        out.append(
+            MovingObstacle.from_waypoints(
+                t,
+                rng.uniform(-1.5, 1.5, (3, 2)),
+                radius=0.05 + 0.1 * (verts is None),
+                headings=rng.uniform(-3.0, 3.0, 3),
+                growth=0.03 * (i % 2),
+                vertices=verts,
+                name=f"m{i}",
+            )
+        )
+    return out
+
+
+def _covered(who, pi, lo, hi, j, i, t):
+    cov = np.zeros(t.shape, dtype=bool)
+    sel = (who == j) & (pi == i)
+    for a, b in zip(lo[sel], hi[sel], strict=True):
+        cov |= (t > a) & (t < b)
+    return cov
+
+
+@pytest.mark.parametrize("seed", [0])
+def test_windows_hold_every_violation_and_stay_near_them(seed):
+    rng = np.random.default_rng(seed)
+    movers = _movers(rng)
+    pts = rng.uniform(-1.8, 1.8, (24, 2))
+    limit = 0.25
+    who, pi, lo, hi = ShapeTracks(movers).windows(pts, limit, NODE_STEP)
+    t = np.arange(0.0, 10.0, 1e-3)  # the movers stand still after 7 s
+    hits = 0
+    for j, m in enumerate(movers):
+        rate = mover_rate(m)
+        for i in range(pts.shape[0]):
+            f = slack_at(np.repeat(pts[i : i + 1], t.size, 0), m, t, limit)
+            cov = _covered(who, pi, lo, hi, j, i, t)
+            assert not np.any((f < 0.0) & ~cov), (j, i)
+            assert np.all(f[cov] <= 2.0 * rate * NODE_STEP + 1e-9), (j, i)
+            hits += int(np.any(f < 0.0))
+    assert hits >= 6  # the case exercises the windows
+
+
+def test_band_and_owner_restrict_the_windows():
+    rng = np.random.default_rng(3)
+    movers = _movers(rng)
+    pts = rng.uniform(-1.5, 1.5, (30, 2))
+    tracks = ShapeTracks(movers)
+    band = (rng.uniform(0.0, 4.0, 30), rng.uniform(4.0, 8.0, 30))
+    owner = rng.integers(0, len(movers), 30)
+    who, pi, lo, hi = tracks.windows(pts, 0.2, 5e-4, band, owner)
+    assert np.all(who == owner[pi])
+    t = np.arange(0.0, 9.0, 1e-3)
+    for i in range(pts.shape[0]):
+        m = movers[owner[i]]
+        f = slack_at(np.repeat(pts[i : i + 1], t.size, 0), m, t, 0.2)
+        inside = (t >= band[0][i]) & (t <= band[1][i])
+        cov = _covered(who, pi, lo, hi, owner[i], i, t)
+        assert not np.any((f < 0.0) & inside & ~cov), i
+        assert np.all(f[cov] <= 2.0 * mover_rate(m) * 5e-4 + 1e-9), i
+
+
+def test_a_standing_shape_gives_one_lasting_window():
+    cart = MovingObstacle.from_waypoints([0.0], [(1.0, 0.0)], radius=0.0, vertices=CART)
+    who, pi, lo, hi = ShapeTracks([cart]).windows(np.array([[0.0, 0.0], [3.0, 0.0]]), 0.6, 0.01)
+    # the first point is 0.55 m from the cart's edge, the second 1.55 m
+    assert who.tolist() == [0] and pi.tolist() == [0]
+    assert lo[0] <= 0.0 and hi[0] > 1e300  # for ever
+
+
+def test_the_launches_left_by_the_refinement_are_clear():
+    # a straight 6 m drive; two turning carts cross it. Every launch in [lo, hi] outside the
+    # returned intervals must keep the limit on 1 ms samples of the motion (the reference's
+    # own distance), and some of them must be left
+    robot = Robot(v_max=0.6, a_max=0.6, j_max=2.0)
+    traj = time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [6.0, 0.0]])), robot)
+    carts = [
+        MovingObstacle.from_waypoints(
+            [0.0, 14.0],
+            [(x, -3.0), (x + 1.0, 4.0)],
+            radius=0.05,
+            headings=[1.2, 1.6],
+            vertices=CART,
+            name=f"cart{i}",
+        )
+        for i, x in enumerate((1.5, 3.5))
+    ]
+    limit = robot.radius
+    s = np.linspace(0.0, 6.0, 601)
+
+    def where(s_at):
+        return np.column_stack([s_at, np.zeros_like(s_at)])
+
+    fine = ShapeWindows(s, where(s), carts, limit, where=where, speed=robot.v_max)
+    dur = float(traj.duration)
+    a, b = np.array([0.0, 0.0]), np.array([dur, dur])
+    lo, hi = 3.75, 4.0  # the first clear launch is near 3.9 s
+    w_lo, w_hi = fine._exact(a, b, np.array([0, 1]), lambda t: traj.motion(t)[0], lo, hi)
+    tau = np.arange(0.0, dur, 2e-3)
+    p = where(traj.motion(tau)[0])
+    left, clear = [], []
+    for launch in np.arange(lo, hi, 1e-2):
+        gap = min(float(np.min(slack_at(p, m, tau + launch, limit))) for m in carts)
+        if gap >= 0.0:
+            clear.append(launch)
+        if not np.any((w_lo < launch) & (launch < w_hi)):
+            left.append(launch)
+            assert gap >= -1e-9, launch
+    # sufficient, and tight: the first launch left within 10 ms of the first clear one
+    assert left and clear and left[0] <= clear[0] + 0.01

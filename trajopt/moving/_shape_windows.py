@@ -1,0 +1,323 @@
+"""When points are within movers' limits, for any mover shape: sampled time windows with a Lipschitz pad.
+
+A mover's shape (a convex polygon rounded by its radius, or a disc) moves rigidly: on each
+piece of its track between waypoint times its reference point moves at a constant velocity
+``v``, its heading turns at a constant rate ``w`` and its radius grows at ``g``, so every
+point of the shape moves at most ``|v| + R |w|`` (``R`` the farthest vertex from the reference
+point) and the distance from a fixed point to the shape, minus the radius, changes at most at
+``lip = |v| + R |w| + g`` (m/s). With ``f(t)`` that distance minus the radius and the limit,
+``f(t_k) = f_k`` proves ``f > 0`` on ``(t_k - f_k / lip, t_k + f_k / lip)`` and ``f < 0`` on the
+same interval when ``f_k < 0``. :meth:`ShapeTracks.windows` steps through time by
+``max(|f_k| / lip, step)`` and reports as a violation window every stretch that no sample
+proves safe: sufficient (every ``t`` with ``f(t) < 0`` is inside a window), and tight to about
+``step`` at each end. Only the times at which the point is within the shape's bounding disc
+(radius ``R`` plus the rounding) plus the limit are sampled: those are closed-form
+(:func:`._disc_windows.inside_times`), an exact filter.
+
+:class:`ShapeWindows` puts these windows at the fine nodes of a path, for
+:func:`._tighten.tighten` (the robot a disc; movers of any shape); the launch that decides
+the wait at the start is refined from the motion's own points, in the launch itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from trajopt.moving._disc_windows import close_pairs, inside_times, mover_pieces, near_pairs
+from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
+
+#: The least time step (s) of the fine nodes' windows.
+NODE_STEP = 1e-2
+#: The least time step (s) of the windows of a rest's point.
+FINE_STEP = 5e-4
+#: Each window's ends are widened by this much (s), against rounding.
+EPS_W = 1e-9
+#: The launch steps (s) of the refinement's levels (:meth:`ShapeWindows._exact`).
+LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
+#: The spacing (s) of the motion's own points in the refinement (:meth:`ShapeWindows._exact`).
+REFINE_TAU = 1e-3
+
+
+class ShapeTracks:
+    """The movers' tracks as linear pieces with headings, for :meth:`windows` (module docstring).
+
+    Parameters
+    ----------
+    movers : sequence of MovingObstacle
+        Any shapes (a disc is a polygon of one vertex at its reference point).
+
+    Attributes
+    ----------
+    pieces : ndarray, shape (p, 9)
+        :func:`._disc_windows.mover_pieces` of the movers (limit 0): their reference points.
+    bound : ndarray, shape (p, 9)
+        The same with each mover's reach added to the radius: its bounding discs.
+    """
+
+    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
+        self.pieces = mover_pieces(movers, 0.0)
+        who = self.pieces[:, 0].astype(np.int64)
+        u, w = self.pieces[:, 1], self.pieces[:, 2]
+        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
+        m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
+        self.verts = np.zeros((len(movers), m_max, 2))
+        self.poly = np.zeros(len(movers), dtype=bool)
+        reach = np.zeros(len(movers))
+        for j, m in enumerate(movers):
+            v = m.shape_vertices
+            self.verts[j, : v.shape[0]] = v
+            self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
+            self.poly[j] = v.shape[0] >= 3
+            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
+            mine = who == j
+            uj, wj = u[mine], w[mine]
+            h_u = np.interp(uj, m.times, m.headings)
+            fin = np.isfinite(wj)
+            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                head0[mine] = h_u
+                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
+        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
+        self.head0, self.turn, self.reach = head0, turn, reach
+        self.bound = self.pieces.copy()
+        self.bound[:, 7] += reach[who]
+        speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
+        self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
+
+    def clearance(self, seg: np.ndarray, pts: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Return the distance (m) of ``pts`` (shape (n, 2)) to the shapes of pieces ``seg`` at ``t`` (s), minus their radius."""
+        row = self.pieces[seg]
+        tau = t - row[:, 1]
+        run = np.where(np.isfinite(row[:, 2]), tau, 0.0)
+        cx = row[:, 3] + row[:, 5] * run
+        cy = row[:, 4] + row[:, 6] * run
+        th = self.head0[seg] + self.turn[seg] * run
+        rad = row[:, 7] + row[:, 8] * tau
+        c, s = np.cos(th), np.sin(th)
+        dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+        # the point in the mover's frame, against its fixed polygon
+        px, py = c * dx + s * dy, -s * dx + c * dy
+        j = row[:, 0].astype(np.int64)
+        v, e = self.verts[j], self.edges[j]
+        qx, qy = px[:, None] - v[..., 0], py[:, None] - v[..., 1]
+        ee = np.maximum(e[..., 0] ** 2 + e[..., 1] ** 2, 1e-300)
+        lam = np.clip((qx * e[..., 0] + qy * e[..., 1]) / ee, 0.0, 1.0)
+        dist = np.min(np.hypot(qx - lam * e[..., 0], qy - lam * e[..., 1]), axis=1)
+        inside = self.poly[j] & np.all(e[..., 0] * qy - e[..., 1] * qx >= 0.0, axis=1)
+        return np.where(inside, 0.0, dist) - rad
+
+    def piece_at(self, mover: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Return the piece (row of :attr:`pieces`) of each ``mover`` at times ``t`` (s), ``t >= 0``."""
+        who = self.pieces[:, 0]
+        big = 2.0 * (float(np.max(self.pieces[:, 1], initial=0.0)) + float(np.max(t)) + 1.0)
+        key = who * big + self.pieces[:, 1]
+        return np.searchsorted(key, mover * big + t, side="right") - 1
+
+    def windows(
+        self,
+        pts: np.ndarray,
+        limit: float,
+        step: float,
+        band: tuple[np.ndarray, np.ndarray] | None = None,
+        owner: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Return windows (s) that hold every time a point is closer to a mover than ``limit``.
+
+        Sufficient, not exact (module docstring): open intervals ``(lo, hi)`` whose union holds
+        every ``t`` in the band at which a point's distance to a mover's shape is under
+        ``limit`` plus its radius, each end within about ``step`` (s) of the exact one.
+
+        Parameters
+        ----------
+        pts : ndarray, shape (n, 2)
+            Points (m).
+        limit : float
+            The distance to keep besides a mover's radius (m).
+        step : float
+            The least time step (s) between samples.
+        band : (ndarray, ndarray), optional
+            Per point, shape (n,) each: only the times (s) from ``band[0]`` to ``band[1]``
+            matter (``band[1]`` may be ``inf``); default all times from 0.
+        owner : ndarray of int, shape (n,), optional
+            Test point ``i`` against mover ``owner[i]`` only (then ``band`` is needed).
+
+        Returns
+        -------
+        mover, point : ndarray of int, shape (r,)
+        lo, hi : ndarray, shape (r,)
+            Open time intervals (s); ``hi = inf`` for one that lasts.
+        """
+        if owner is None:
+            seg, pi = near_pairs(pts, self.bound, limit, band)
+        else:
+            seg, pi = pieces_meeting(self.bound, owner, band[0], band[1])
+            keep = close_pairs(pts, self.bound, limit, seg, pi)
+            seg, pi = seg[keep], pi[keep]
+        r = self.bound[seg]
+        u, w = r[:, 1], r[:, 2]
+        t_lo, t_hi = inside_times(
+            pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
+        )
+        a = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
+        b = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
+        if band is not None:
+            a = np.maximum(a, band[0][pi])
+            b = np.minimum(b, band[1][pi])
+        keep = a < b
+        seg, pi, a, b = seg[keep], pi[keep], a[keep], b[keep]
+        lip = self.lip[seg]
+        out_i, out_lo, out_hi = [], [], []
+        t, cov = a.copy(), a.copy()  # next sample; everything before cov is settled
+        live = np.arange(a.shape[0])
+        while live.size:
+            tl = t[live]
+            f = self.clearance(seg[live], pts[pi[live]], tl) - limit
+            with np.errstate(divide="ignore", invalid="ignore"):  # a standing shape: lip 0
+                rho = np.where(lip[live] > 0.0, f / lip[live], np.where(f > 0.0, np.inf, -np.inf))
+            w_hi = np.minimum(tl - rho, b[live])
+            bad = w_hi > cov[live]
+            out_i.append(live[bad])
+            out_lo.append(cov[live][bad])
+            out_hi.append(w_hi[bad])
+            cov[live] = np.maximum(cov[live], tl + np.abs(rho))
+            last = tl >= b[live]
+            t[live] = np.minimum(tl + np.maximum(np.abs(rho), step), b[live])
+            live = live[~last & (cov[live] < b[live])]
+        idx = np.concatenate(out_i) if out_i else np.zeros(0, dtype=np.int64)
+        lo = np.concatenate(out_lo) if out_lo else np.zeros(0)
+        hi = np.concatenate(out_hi) if out_hi else np.zeros(0)
+        # one window per stretch: the touching ones of a pair merged, each end widened
+        lo, hi, idx = _merged(lo - EPS_W, hi + EPS_W, idx)
+        who = self.pieces[seg[idx], 0].astype(np.int64)
+        return who, pi[idx].astype(np.int64), lo, hi
+
+
+class ShapeWindows(FineWindows):
+    """The movers' violation windows at the fine nodes of a path, movers of any shape.
+
+    :class:`._tighten.FineWindows` with the windows of :meth:`ShapeTracks.windows` (every
+    :data:`NODE_STEP` at the nodes, :data:`FINE_STEP` at a rest's point) in place of the disc
+    movers' closed-form ones, and the refinement of the wait at the start found in the
+    launch (:meth:`_exact`); parameters as there.
+    """
+
+    def __init__(
+        self,
+        s: np.ndarray,
+        pts: np.ndarray,
+        movers: Sequence[MovingObstacle],
+        limit: float,
+        band: tuple[np.ndarray, np.ndarray] | None = None,
+        where: Callable[[np.ndarray], np.ndarray] | None = None,
+        speed: float = 0.0,
+    ) -> None:
+        self.s, self.h = s, float(s[1] - s[0])
+        self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
+        self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self.tracks = ShapeTracks(movers)
+        self.pieces = self.tracks.bound
+        if band is None:
+            band = (np.zeros(s.shape), np.full(s.shape, np.inf))
+        owner, node, lo, hi = self.tracks.windows(pts, limit + 0.5 * self.h, NODE_STEP, band)
+        order = np.argsort(node, kind="stable")
+        node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
+        counts = np.bincount(node, minlength=s.shape[0])
+        self.ptr = np.concatenate([[0], np.cumsum(counts)])
+
+    def point_windows(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Return the windows (s) of the path's point at ``s`` (m), the limit plus 0.1 mm (kept by ``s``)."""
+        if s not in self._points:
+            if self.where is None:
+                i = int(np.clip(np.rint(s / self.h), 0, self.s.shape[0] - 1))
+                run = slice(int(self.ptr[i]), int(self.ptr[i + 1]))
+                lo, hi = self.lo[run], self.hi[run]
+            else:
+                pt = self.where(np.array([s]))
+                _, _, lo, hi = self.tracks.windows(pt, self.limit + POINT_PAD, FINE_STEP)
+            self._points[s] = (lo, hi)
+        return self._points[s]
+
+    def _exact(
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        owner: np.ndarray,
+        s_of: Callable[[np.ndarray], np.ndarray],
+        lo: float,
+        hi: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Return open intervals (s) holding every launch in ``[lo, hi]`` at which the motion may meet the movers.
+
+        As :meth:`._tighten.FineWindows._exact` (during ``[a_j, b_j]``, s from the launch,
+        against mover ``owner_j``), found in the launch instead: the motion's own points
+        every :data:`REFINE_TAU` (s) give a lower bound ``G(L)`` of its clearance at launch
+        ``L`` (their distance to the shape at ``L + tau``, minus the radius and the limit,
+        minus ``(V + lip) REFINE_TAU / 2`` for the instants between them), and ``G`` changes
+        at most at ``lip`` (m/s) with ``L``, so ``G(L) > 0`` proves the launches within
+        ``G(L) / lip`` of ``L`` safe. ``G`` is evaluated on :data:`LAUNCH_STEPS` (s), each
+        level around the earliest launch the one before proved; everything not proved is
+        returned. The points that keep more than ``lip`` times the range at its middle are
+        left out (they are clear at every launch in it).
+        """
+        a, b, owner = merged_spans(a, b, owner)
+        n = np.maximum(np.ceil((b - a) / REFINE_TAU).astype(np.int64), 1) + 1
+        idx = np.repeat(np.arange(a.shape[0]), n)
+        step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        tau = np.minimum(a[idx] + step * REFINE_TAU, b[idx])
+        who = owner[idx]
+        pts = self.where(s_of(tau))
+        tr = self.tracks
+        lip_m = np.zeros(len(self.movers))
+        np.maximum.at(lip_m, tr.pieces[:, 0].astype(np.int64), tr.lip)
+        lip = lip_m[who]
+        pad = 0.5 * REFINE_TAU * (self.speed + lip) + self.limit
+
+        def g(launch: np.ndarray, rows: np.ndarray) -> np.ndarray:
+            """Return the clearance bound (m), shape (len(launch), len(rows))."""
+            t = launch[:, None] + tau[None, rows]
+            seg = tr.piece_at(np.broadcast_to(who[rows], t.shape).ravel(), t.ravel())
+            p = np.broadcast_to(pts[rows], (*t.shape, 2)).reshape(-1, 2)
+            f = tr.clearance(seg, p, t.ravel()).reshape(t.shape)
+            return f - pad[rows]
+
+        mid = 0.5 * (lo + hi)
+        rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
+        lip_all = float(np.max(lip[rows], initial=0.0))
+        safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
+        left, right = lo, hi
+        for dl in LAUNCH_STEPS:
+            launch = np.arange(left, right + 0.5 * dl, dl)
+            bound = np.min(g(launch, rows), axis=1) if rows.size else np.full(launch.shape, np.inf)
+            reach = np.where(bound > 0.0, bound / max(lip_all, 1e-300), -np.inf)
+            ok = reach > 0.0
+            safe_lo.append(launch[ok] - reach[ok])
+            safe_hi.append(launch[ok] + reach[ok])
+            if not ok.any():
+                break
+            first = int(np.argmax(ok))
+            left, right = max(lo, float(launch[first]) - dl), float(launch[first])
+        # the complement in [lo, hi] of the proved launches
+        s_lo, s_hi = np.concatenate(safe_lo), np.concatenate(safe_hi)
+        order = np.argsort(s_lo)
+        s_lo, s_hi = s_lo[order], np.maximum.accumulate(s_hi[order]) if s_hi.size else s_hi
+        f_lo = np.concatenate([[lo - 1.0], s_hi])
+        f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
+        keep = f_hi > f_lo
+        return f_lo[keep], f_hi[keep]
+
+
+def _merged(
+    lo: np.ndarray, hi: np.ndarray, key: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the windows ``(lo, hi)`` (s) of each ``key`` with the overlapping consecutive ones merged."""
+    if lo.size == 0:
+        return lo, hi, key
+    order = np.lexsort((lo, key))
+    lo, hi, key = lo[order], hi[order], key[order]
+    new = np.ones(lo.shape[0], dtype=bool)
+    new[1:] = (key[1:] != key[:-1]) | (lo[1:] > hi[:-1])
+    first = np.flatnonzero(new)
+    return lo[first], np.maximum.reduceat(hi, first), key[first]
