@@ -218,7 +218,7 @@ def sampled_clearance(grid, fp, curve, n=1500):
     outside = box(-1.0, -1.0, 5.0, 4.0).difference(box(0.0, 0.0, 4.0, 3.0))
     v = np.asarray(fp.vertices)
     best = math.inf
-    for (x, y), t in zip(xy, th):
+    for (x, y), t in zip(xy, th, strict=True):
         c, s = math.cos(t), math.sin(t)
         body = Polygon(
             np.column_stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]])
