@@ -23,7 +23,10 @@ could come up to half a cell's diagonal closer). A car with a body searches each
 with the default costs first, capped at :data:`FOOTPRINT_DEFAULT_EXPANSIONS`, then with
 :data:`FOOTPRINT_COSTS` (:func:`cost_variants`), and goes on to the second grid as soon as
 the first grid's first radius finds no path (there the sampling slack is refined near
-obstacles: :func:`exact_clearance`).
+obstacles: :func:`exact_clearance`). When every radius of the second grid exhausted its
+states, a car with a body searches it once more at :data:`TIGHT_FACTORS` with finer heading
+bins, shorter primitives and finer states near the end poses (:func:`tight_motion`,
+:func:`search_factors`): a bay entered nose first off a narrow aisle.
 The tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 """
 
@@ -425,8 +428,9 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
     the slack :data:`SEARCH_MARGIN_CELLS` (the first grid's margin: room for the smoother)
     or :data:`FOOTPRINT_SLACK_CELLS` refined down to :data:`FOOTPRINT_MIN_SLACK_CELLS`
     near obstacles (the second grid). The search's ``fine_radius`` (finer states near the
-    end poses when a small region is exhausted, instead of finer primitives everywhere) is
-    not used: on the parking suite at 0.1 m (half a body length, factor 3) it planned one
+    end poses when a small region is exhausted) is used only by the tight search
+    (:func:`tight_motion`), after the ordinary ones exhausted their states: as the first
+    search on the parking suite at 0.1 m (half a body length, factor 3) it planned one
     case more of 40 (a slot 1.23 car lengths long, 20 cusps) at 1.4x the median and 1.9x
     the p95 plan time.
 
