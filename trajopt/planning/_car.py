@@ -56,12 +56,13 @@ turned by ``pi`` backwards (:func:`~trajopt.planning._car_fit.body_along`).
 with a body is planned against the polygons, the cells only a conservative pre-filter: its
 end poses (:func:`~trajopt.planning._footprint_ladder.check_end_poses` with ``polygons``),
 the search's footprint tests (:attr:`astar.HybridCollision.raw_polygons`) and the band of
-its centre grid (:func:`~trajopt.planning._car_tries.polygon_band`), and the certificates
-of the segments near them (:func:`~trajopt.planning._car_fit.fine_window`); it searches
-cells of at least ``R /`` :data:`SEARCH_CELLS_PER_RADIUS` (:func:`search_cells`). The
-guarantee is then that the body is clear of the polygons at every instant (the fitted
-curves: of a finer conservative raster of them); on a grid without polygons, of the
-occupied cells, and such plans are the same as without this mode.
+its centre grid (:func:`~trajopt.planning._car_tries.polygon_band`), and the fits of the
+segments near them (the smoother on a finer raster of them,
+:func:`~trajopt.planning._car_fit.fine_window`, the footprint certificate exact against the
+polygons: :func:`trajopt.robot.certify_footprint`); it searches cells of at least ``R /``
+:data:`SEARCH_CELLS_PER_RADIUS` (:func:`search_cells`). The guarantee is then that the body
+is clear of the polygons at every instant; on a grid without polygons, of the occupied
+cells, and such plans are the same as without this mode.
 
 **Frame.** Nothing in a plan depends on where the map's origin is: the ends are checked in
 the map's frame, then the search, the fits and the timing run in the map-local frame (the

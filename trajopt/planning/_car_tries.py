@@ -23,7 +23,10 @@ could come up to half a cell's diagonal closer). A car with a body searches each
 with the default costs first, capped at :data:`FOOTPRINT_DEFAULT_EXPANSIONS`, then with
 :data:`FOOTPRINT_COSTS` (:func:`cost_variants`), and goes on to the second grid as soon as
 the first grid's first radius finds no path (there the sampling slack is refined near
-obstacles: :func:`exact_clearance`).
+obstacles: :func:`exact_clearance`). When every radius of the second grid exhausted its
+states, a car with a body searches it once more at :data:`TIGHT_FACTORS` with finer heading
+bins, shorter primitives and finer states near the end poses (:func:`tight_motion`,
+:func:`search_factors`): a bay entered nose first off a narrow aisle.
 The tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
 """
 
@@ -96,6 +99,19 @@ TIGHT_FACTOR = 1.05
 #: default 0.9 a curve cannot follow an arc of 1.02-1.05 ``R`` (held-out depot #5, forward
 #: only, a start facing a wall), with 0.99 it does.
 TIGHT_KAPPA_MARGIN = 0.99
+#: The tight search of a car with a body (:func:`tight_motion`), run on the radius grid at
+#: a turning radius whose searches exhausted their states: heading bins, the primitive's
+#: arc length and the radius round the end poses with finer states (both as fractions of
+#: the turning radius in cells) and their refinement (``astar.HybridMotion`` fields). A
+#: bay entered nose first off an aisle of 1.5 turning radii (the suite's
+#: perpendicular-forwards-0, 1.34 car widths) exhausts every state at 72 bins and 5 degree
+#: arcs, and with these finds a path of 15-18 cusps in about 1 s at 0.1 m.
+TIGHT_HEADING_BINS = 180
+TIGHT_FACTORS = (1.15, 1.05)
+TIGHT_PRIMITIVE_R = 1.0 / 15.0
+TIGHT_FINE_RADIUS_R = 1.0
+TIGHT_FINE_FACTOR = 2
+TIGHT_MIN_SLACK_CELLS = 0.05
 #: Time (s) after which no further try (search and fits) of a car's plan starts.
 CAR_BUDGET_S = 6.0
 #: Cap (s) on the Hybrid-A* search's time budget per try.
@@ -195,13 +211,21 @@ def search_and_fit(
             failures.append(InvalidInputError(blocked))
             continue
         largest = math.inf
-        for factor in SEARCH_RADIUS_FACTORS:
-            if factor > largest or time.perf_counter() > t_end:
+        exhausted: list[float] = []
+        for factor, tight in search_factors(robot, margin):
+            if time.perf_counter() > t_end or (
+                factor > largest if not tight else factor not in exhausted
+            ):
                 continue
             r_cells = factor * robot.drive.min_turning_radius / res
             path = None
             stop = False
-            for name, costs, cap in cost_variants(robot):
+            variants = (
+                ((TIGHT_NAME, tight_motion(robot.drive.min_turning_radius / res), SEARCH_BUDGET_S),)
+                if tight
+                else cost_variants(robot)
+            )
+            for name, costs, cap in variants:
                 if time.perf_counter() > t_end:
                     break
                 try:
@@ -213,8 +237,7 @@ def search_and_fit(
                             turning_radius=r_cells,
                             reverse=robot.drive.reverse,
                             time_budget=max(0.05, min(cap, t_end - time.perf_counter())),
-                            **exact_clearance(robot, grid, margin),
-                            **costs,
+                            **{**exact_clearance(robot, grid, margin), **costs},
                         )
                     break
                 except astar.NoPosePathError as exc:
@@ -239,6 +262,8 @@ def search_and_fit(
                 if robot.footprint is not None and margin:
                     break  # a body: the second grid (its slack refined near obstacles) next
                 largest = min(largest, factor)
+                if not tight and failures and getattr(failures[-1], "reason", "") == "exhausted":
+                    exhausted.append(factor)
                 continue
             poses = path.to_world(grid)
             try:
@@ -265,6 +290,20 @@ def search_and_fit(
     raise failure(robot, grid, start, goal, tries, failures)
 
 
+def search_factors(robot: Robot, margin: bool) -> list[tuple[float, bool]]:
+    """Return the tries of one search grid: ``(turning radius factor, tight)`` in order.
+
+    :data:`SEARCH_RADIUS_FACTORS`, then, for a car with a body on the radius grid, the tight
+    search (:func:`tight_motion`) at :data:`TIGHT_FACTORS`: each runs only when the
+    ordinary search at its factor exhausted its states (:func:`search_and_fit`), so a plan
+    the ordinary tries find is the same with or without the tight ones.
+    """
+    out = [(f, False) for f in SEARCH_RADIUS_FACTORS]
+    if robot.footprint is not None and not margin:
+        out += [(f, True) for f in TIGHT_FACTORS]
+    return out
+
+
 def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]:
     """Return the search costs a try runs with, in order: ``(name, costs, budget cap (s))``.
 
@@ -282,6 +321,32 @@ def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]
         ("", {"max_expansions": FOOTPRINT_DEFAULT_EXPANSIONS}, FOOTPRINT_DEFAULT_BUDGET_S),
         (", parking costs", FOOTPRINT_COSTS, SEARCH_BUDGET_S),
     )
+
+
+#: The name of the tight search in the tries (:func:`tight_motion`).
+TIGHT_NAME = ", tight (finer states and primitives near the ends)"
+
+
+def tight_motion(r_cells: float) -> dict[str, Any]:
+    """Return the search arguments of the tight try at turning radius ``r_cells`` (cells).
+
+    :data:`FOOTPRINT_COSTS` with :data:`TIGHT_HEADING_BINS` heading bins, primitives
+    :data:`TIGHT_PRIMITIVE_R` ``r_cells`` long, and, when a small region is exhausted,
+    states and primitives :data:`TIGHT_FINE_FACTOR` times finer within
+    :data:`TIGHT_FINE_RADIUS_R` ``r_cells`` of the end poses (``astar.HybridMotion``'s
+    ``fine_radius``). Run after a search of a car with a body on the radius grid exhausted
+    its states at that radius (:func:`search_and_fit`): the same search space sampled more
+    finely, where a manoeuvre of many short moves fits between the poses the coarse states
+    keep apart.
+    """
+    return {
+        **FOOTPRINT_COSTS,
+        "heading_bins": TIGHT_HEADING_BINS,
+        "primitive_length": TIGHT_PRIMITIVE_R * r_cells,
+        "fine_radius": TIGHT_FINE_RADIUS_R * r_cells,
+        "fine_factor": TIGHT_FINE_FACTOR,
+        "footprint_min_slack": TIGHT_MIN_SLACK_CELLS,
+    }
 
 
 def car_search_grid(robot: Robot, grid: OccupancyGrid, margin: bool = True) -> OccupancyGrid:
@@ -363,8 +428,9 @@ def exact_clearance(robot: Robot, grid: OccupancyGrid, margin: bool) -> dict[str
     the slack :data:`SEARCH_MARGIN_CELLS` (the first grid's margin: room for the smoother)
     or :data:`FOOTPRINT_SLACK_CELLS` refined down to :data:`FOOTPRINT_MIN_SLACK_CELLS`
     near obstacles (the second grid). The search's ``fine_radius`` (finer states near the
-    end poses when a small region is exhausted, instead of finer primitives everywhere) is
-    not used: on the parking suite at 0.1 m (half a body length, factor 3) it planned one
+    end poses when a small region is exhausted) is used only by the tight search
+    (:func:`tight_motion`), after the ordinary ones exhausted their states: as the first
+    search on the parking suite at 0.1 m (half a body length, factor 3) it planned one
     case more of 40 (a slot 1.23 car lengths long, 20 cusps) at 1.4x the median and 1.9x
     the p95 plan time.
 

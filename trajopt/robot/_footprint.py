@@ -248,7 +248,11 @@ def certify_footprint(
     distances) exceeds ``tol_m``; a piece that does not is split in two (de Casteljau), up
     to ``max_depth`` times, which tightens both bounds. The check is independent of the
     optimiser that produced the curve; margins are reported up to the circumscribed radius
-    plus two cells.
+    plus two cells. A map that knows the polygons its cells were rasterised from
+    (:attr:`astar.OccupancyGrid.polygons`: its occupied squares a conservative cover of
+    them) is checked against the polygons themselves instead of the squares (exact
+    distances of the convex bound to each polygon, convex or not, and to the map's
+    outside), the same bound, a tighter obstacle set.
 
     Parameters
     ----------
@@ -276,6 +280,26 @@ def certify_footprint(
     occ, res, ox, oy = grid_cells(raw_grid)
     origin = np.array([ox, oy])
     cap = footprint.circumscribed_radius / res + 2.0  # beyond it the exact value is moot
+    rho, phi = footprint.polar
+    bez = (pieces - origin) / res
+    polygons = getattr(raw_grid, "polygons", None)
+    if polygons is not None:  # the obstacles themselves, exactly (docstring)
+        from astar.body_polygons import pack_polygons
+
+        packed = pack_polygons(polygons, (ox, oy), res)
+        box = np.array([0.0, 0.0, raw_grid.width / res, raw_grid.height / res])
+        m_cells, heads = footprint_kernels.span_margins_polygons(
+            np.ascontiguousarray(bez),
+            rho / res,
+            phi,
+            MAX_ARC_RAD,
+            cap,
+            tol_m / res,
+            int(max_depth),
+            *packed,
+            box,
+        )
+        return _certificate(m_cells * res, heads, tol_m)
     allp = pieces.reshape(-1, 2) if len(pieces) else np.zeros((1, 2))
     reach = int(math.ceil(cap + footprint.circumscribed_radius / res)) + 2
     q = (allp - origin) / res
@@ -287,8 +311,6 @@ def certify_footprint(
         int(math.ceil(q[:, 1].max())) + reach,
     )
 
-    rho, phi = footprint.polar
-    bez = (pieces - origin) / res
     m_cells, heads = footprint_kernels.span_margins(
         np.ascontiguousarray(bez),
         rho / res,
@@ -299,7 +321,11 @@ def certify_footprint(
         int(max_depth),
         *idx.args,
     )
-    margins = m_cells * res
+    return _certificate(m_cells * res, heads, tol_m)
+
+
+def _certificate(margins: np.ndarray, heads: np.ndarray, tol_m: float) -> FootprintCertificate:
+    """Return the certificate of per-span ``margins`` (m) and heading intervals (rad)."""
     worst_span = int(np.argmin(margins)) if margins.size else 0
     return FootprintCertificate(
         ok=bool(np.all(margins > tol_m)),

@@ -5,6 +5,9 @@
 Bezier piece, the footprint swept over it (:func:`swept_hull`), the Minkowski sum with the
 piece's control points, its exact clearance from the obstacle index, and the halvings of a
 piece that is not clear. Units are whatever the caller passes (the certificate uses cells).
+:func:`span_margins_polygons` is the same check against obstacle polygons (exact
+convex-polygon-to-polygon distances, :func:`astar.body_polygons.body_distance`) and the
+outside of a rectangle, for maps that know the polygons their cells were rasterised from.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
+from astar.body_polygons import body_distance
 from trajopt.geometry import monotone_chain, poly_clearance, sort_xy
 from trajopt.kernel_cache import watch_compiles
 
@@ -168,6 +172,87 @@ def span_margins(
                 continue
             # de Casteljau at 1/2: left half to stack[top], right half to stack[top + 1]
             for r in range(p1):
+                work[r, 0] = cur[r, 0]
+                work[r, 1] = cur[r, 1]
+            for r in range(p1):
+                for c in range(2):
+                    stack[top, r, c] = work[0, c]
+                    stack[top + 1, p1 - 1 - r, c] = work[p1 - 1 - r, c]
+                for i in range(p1 - 1 - r):
+                    for c in range(2):
+                        work[i, c] = 0.5 * (work[i, c] + work[i + 1, c])
+            depth[top] = depth[top + 1] = d + 1
+            top += 2
+        margins[s] = worst
+    return margins, heads
+
+
+@njit(cache=True)
+def _piece_bound(bez, rho, phi, max_arc):  # pragma: no cover - compiled
+    """Return the convex bound (counter-clockwise) of the footprint over one Bezier piece."""
+    p1 = bez.shape[0]
+    lo, hi = cone(bez[1:] - bez[:-1])
+    sw = swept_hull(rho, phi, lo, hi, max_arc)
+    ns = sw.shape[0]
+    pts = np.empty((p1 * ns, 2))
+    for i in range(p1):
+        for j in range(ns):
+            pts[i * ns + j, 0] = bez[i, 0] + sw[j, 0]
+            pts[i * ns + j, 1] = bez[i, 1] + sw[j, 1]
+    return hull_of(pts, p1 * ns)
+
+
+@njit(cache=True)
+def _piece_margin_polygons(bez, rho, phi, max_arc, cap, edges, starts, boxes, box):
+    """Clearance of one piece's bound from the polygons and the outside of ``box``."""  # noqa: D401
+    poly = _piece_bound(bez, rho, phi, max_arc)
+    g = cap
+    for i in range(poly.shape[0]):  # the outside of the box: a vertex's room to each side
+        x = poly[i, 0]
+        y = poly[i, 1]
+        g = min(g, x - box[0], box[2] - x, y - box[1], box[3] - y)
+    if g <= 0.0:
+        return 0.0
+    return min(g, body_distance(edges, starts, boxes, poly, g))
+
+
+@njit(cache=True)
+def span_margins_polygons(
+    bez, rho, phi, max_arc, cap, tol, max_depth, edges, starts, boxes, box
+):  # pragma: no cover - compiled
+    """Return every piece's margin and heading interval against polygons.
+
+    As :func:`span_margins`, the obstacles being the polygons ``edges, starts, boxes``
+    (:func:`astar.body_polygons.pack_polygons`, in the units of ``bez``) and the outside of
+    ``box`` (``xmin, ymin, xmax, ymax``): a piece's margin is the exact distance of its
+    bound (the Minkowski sum of its control points' hull and the swept footprint, convex)
+    to the nearest polygon (0 when they meet, touching counts) or to the box's boundary (0
+    when a vertex of the bound leaves the box), capped at ``cap``.
+    """
+    m, p1 = bez.shape[0], bez.shape[1]
+    margins = np.empty(m)
+    heads = np.empty((m, 2))
+    stack = np.empty((max_depth + 2, p1, 2))
+    depth = np.empty(max_depth + 2, dtype=np.int64)
+    work = np.empty((p1, 2))
+    for s in range(m):
+        lo, hi = cone(bez[s, 1:] - bez[s, :-1])
+        heads[s, 0], heads[s, 1] = lo, hi
+        for r in range(p1):
+            stack[0, r, 0] = bez[s, r, 0]
+            stack[0, r, 1] = bez[s, r, 1]
+        depth[0] = 0
+        top = 1
+        worst = np.inf
+        while top > 0:
+            top -= 1
+            cur = stack[top].copy()
+            d = depth[top]
+            g = _piece_margin_polygons(cur, rho, phi, max_arc, cap, edges, starts, boxes, box)
+            if g > tol or d == max_depth:
+                worst = min(worst, g)
+                continue
+            for r in range(p1):  # de Casteljau at 1/2, as in span_margins
                 work[r, 0] = cur[r, 0]
                 work[r, 1] = cur[r, 1]
             for r in range(p1):

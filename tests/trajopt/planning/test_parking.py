@@ -424,3 +424,36 @@ def test_polygons_move_with_a_far_away_origin(slot_1_3):
         np.column_stack([b.x - d[0], b.y - d[1]]), np.column_stack([a.x, a.y]), atol=1e-6
     )
     np.testing.assert_allclose(b.theta, a.theta, atol=1e-6)
+
+
+def test_tight_search_runs_only_after_every_ordinary_search_exhausted():
+    """The bay of 1.20 car widths entered nose first off a 4.3 m aisle (suite case
+    perpendicular-forwards-1): every ordinary search exhausts its states, then the tight
+    searches (finer states and primitives near the ends) run and exhaust theirs too; a case
+    the ordinary tries plan never runs them."""
+    case = pc.make_case(FULL, "perpendicular", "forwards", 0, 1)
+    with pytest.raises(trajopt.NoPathError, match="exhausted") as err:
+        trajopt.plan(
+            case.grid(0.1),
+            case.start[:2],
+            case.goal[:2],
+            FULL.robot(),
+            start_heading=case.start[2],
+            goal_heading=case.goal[2],
+        )
+    tries = str(err.value).split("(tries: ")[-1]
+    ordinary = [t for t in tries.split("; ") if "radius grid," in t and "tight" not in t]
+    tight = [t for t in tries.split("; ") if "tight" in t]
+    assert len(ordinary) == 3 and all("exhausted" in t for t in ordinary)
+    assert len(tight) == 2 and all("exhausted" in t for t in tight)
+    assert tries.index(tight[0]) > tries.index(ordinary[-1])
+    easy = pc.make_case(FULL, "perpendicular", "backwards", 0, 1)
+    traj = trajopt.plan(
+        easy.grid(0.1),
+        easy.start[:2],
+        easy.goal[:2],
+        FULL.robot(),
+        start_heading=easy.start[2],
+        goal_heading=easy.goal[2],
+    )
+    assert not any("tight" in t for t in traj.stats["car"]["tries"])

@@ -190,3 +190,81 @@ def test_random_scenes_never_collide(seed):
         return
     smp = traj.sample(np.linspace(0.0, traj.duration, 1500))
     assert not footprint_collides(grid, robot.footprint, smp.x, smp.y, smp.theta)
+
+
+# ------------------------------------------------------------------ against polygons
+def polygon_scene(seed):
+    """A 4 x 3 m map of random convex and non-convex polygons, rasterised at 0.1 m."""
+    rng = np.random.default_rng(seed)
+    polys = []
+    for _ in range(6):
+        c = rng.uniform((0.3, 0.3), (3.7, 2.7))
+        k = int(rng.integers(3, 7))
+        ang = (np.arange(k) + rng.uniform(0.2, 0.8, k)) * (2 * np.pi / k)
+        r = rng.uniform(0.1, 0.45, k)  # a star: convex or not
+        polys.append(c + np.column_stack([r * np.cos(ang), r * np.sin(ang)]))
+    return astar.OccupancyGrid.from_polygons(polys, 0.1, (0.0, 0.0, 4.0, 3.0))
+
+
+def sampled_clearance(grid, fp, curve, n=1500):
+    """Least distance of the posed footprint to the polygons and the map's outside (shapely)."""
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import Polygon, box
+
+    u = np.linspace(*curve.domain, n)
+    xy, d = curve(u), curve(u, 1)
+    th = np.arctan2(d[:, 1], d[:, 0])
+    obst = shapely.union_all([Polygon(p) for p in grid.polygons])
+    outside = box(-1.0, -1.0, 5.0, 4.0).difference(box(0.0, 0.0, 4.0, 3.0))
+    v = np.asarray(fp.vertices)
+    best = math.inf
+    for (x, y), t in zip(xy, th, strict=True):
+        c, s = math.cos(t), math.sin(t)
+        body = Polygon(
+            np.column_stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]])
+        )
+        best = min(best, body.distance(obst), body.distance(outside))
+    return best
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_polygon_certificate_is_sound_against_dense_poses(seed):
+    """A map with polygons is certified against them: never a pass where a pose meets one."""
+    grid = polygon_scene(seed)
+    rng = np.random.default_rng(100 + seed)
+    fp = Footprint.rectangle(0.4, 0.2)
+    passed = failed = 0
+    for _ in range(10):
+        # a short random walk of control points: some curves pass, some graze or cross
+        turn = np.cumsum(rng.uniform(-0.5, 0.5, 6)) + rng.uniform(0.0, 2 * np.pi)
+        steps = 0.12 * np.column_stack([np.cos(turn), np.sin(turn)])
+        ctrl = rng.uniform((0.6, 0.6), (3.4, 2.4)) + np.cumsum(steps, axis=0)
+        curve = BSplineCurve(clamped_uniform_knots(6, 3, (0.0, 1.0)), ctrl, 3)
+        cert = certify_footprint(curve, fp, grid)
+        true = sampled_clearance(grid, fp, curve)
+        # every span's margin bounds the clearance of the poses sampled in it from below
+        assert cert.min_margin_m <= true + 1e-9
+        if cert.ok:
+            passed += 1
+            assert true > 0.0
+        else:
+            failed += 1
+    assert passed and failed  # both outcomes were exercised
+
+
+def test_polygon_certificate_passes_where_the_cells_do_not():
+    """A body 3 cm from a polygon on a 0.1 m raster: the cells close the way, the polygon does not."""
+    wall = np.array([[0.0, 1.0], [4.0, 1.0], [4.0, 1.3], [0.0, 1.3]])
+    grid = astar.OccupancyGrid.from_polygons([wall], 0.1, (0.0, 0.0, 4.0, 3.0))
+    fp = Footprint.rectangle(0.4, 0.2)
+    y = 1.3 + 0.1 + 0.03  # the body's side 3 cm above the wall
+    line = np.column_stack([np.linspace(0.5, 3.5, 6), np.full(6, y)])
+    curve = BSplineCurve(clamped_uniform_knots(6, 3, (0.0, 1.0)), line, 3)
+    cert = certify_footprint(curve, fp, grid)
+    assert cert.ok and cert.min_margin_m == pytest.approx(0.03, abs=1e-9)
+    cells = certify_footprint(curve, fp, astar.OccupancyGrid(grid.occupied, grid.resolution))
+    assert not cells.ok
+    low = line - [0.0, 0.05]  # 2 cm into the wall
+    bad = BSplineCurve(clamped_uniform_knots(6, 3, (0.0, 1.0)), low, 3)
+    assert not certify_footprint(bad, fp, grid).ok
+    assert sampled_clearance(grid, fp, bad, 200) == 0.0
