@@ -26,6 +26,7 @@ multiplied by that ``stretch``.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -360,7 +361,17 @@ def _shape_hits(
     least the reference points' distance minus both reaches, and a pair farther apart than
     ``lim + both reaches`` is clear. The k-d tree finds the other pairs; only they are
     measured (:func:`point_polygon_distance` or :func:`convex_distance`), in one batch.
+    From the first grid time at or after the mover's last prediction on, its shape stands
+    where it was last (and its radius stops growing): while ``lim`` stands still too, those
+    rows are the first one's, measured once.
     """
+    k_end = int(np.searchsorted(t, mover.t_last, side="left"))
+    if k_end < t.shape[0] - 1 and np.all(lim[k_end:] == lim[k_end]):
+        head = _shape_hits(pts, polys, mover, t[: k_end + 1], lim[: k_end + 1], tree)
+        hit = np.empty((t.shape[0], pts.shape[0]), dtype=bool)
+        hit[: k_end + 1] = head
+        hit[k_end + 1 :] = head[k_end]
+        return hit
     centre, _ = mover.pose_at(t)  # (K, 2)
     reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
     if polys is not None:
@@ -372,7 +383,7 @@ def _shape_hits(
     if counts.sum() == 0:
         return hit
     kk = np.repeat(np.arange(t.shape[0]), counts)
-    ii = np.fromiter((i for c in near for i in c), dtype=np.int64, count=int(counts.sum()))
+    ii = np.fromiter(itertools.chain.from_iterable(near), dtype=np.int64, count=int(counts.sum()))
     w = shape_at(mover, t[kk])  # (p, m, 2)
     d = point_polygon_distance(pts[ii], w) if polys is None else convex_distance(polys[ii], w)
     hit[kk, ii] = d < lim[kk]
@@ -387,12 +398,16 @@ def grid_nodes(length: float, ds: float) -> tuple[np.ndarray, float]:
 
 
 def _runs_of(hit: np.ndarray, j: int) -> tuple[np.ndarray, ...]:
-    """Return the runs ``(node, first, last, mover)`` of mover ``j``'s dense ``hit`` (K, n)."""
-    h = np.pad(hit.T, ((0, 0), (1, 1)))
+    """Return the runs ``(node, first, last, mover)`` of mover ``j``'s dense ``hit`` (K, n).
+
+    Only the nodes with a hit are scanned (in node order, as a scan of them all gives).
+    """
+    cols = np.flatnonzero(hit.any(axis=0))
+    h = np.pad(hit[:, cols].T, ((0, 0), (1, 1)))
     d = np.diff(h.astype(np.int8), axis=1)
     ci, k0 = np.nonzero(d == 1)
     _, k1 = np.nonzero(d == -1)
-    return ci, k0, k1 - 1, np.full(ci.shape[0], j)
+    return cols[ci], k0, k1 - 1, np.full(ci.shape[0], j)
 
 
 def _disc_runs(
