@@ -247,11 +247,20 @@ def _exercise_plan() -> None:
 
 
 def _exercise_footprint() -> None:
-    """Plan for a rectangular robot (the footprint certificate and its rounds)."""
-    from trajopt.robot import Robot
+    """Plan for a rectangular robot (the footprint certificate and its rounds, on cells and on polygons)."""
+    from trajopt.robot import Robot, certify_footprint
 
     r = _default_planner().robot.radius
-    _plan_like(Planner(_default_planner().grid, Robot.rectangle(2.2 * r, 1.4 * r)))
+    robot = Robot.rectangle(2.2 * r, 1.4 * r)
+    _plan_like(Planner(_default_planner().grid, robot))
+    # the certificate against the polygons of a map made from them
+    grid, start, goal = warm_up_map(Planner(_default_planner().grid, robot))
+    traj = Planner(grid, robot).plan(start, goal)
+    x0, y0 = grid.origin
+    square = [(x0, y0), (x0 + grid.resolution, y0), (x0 + grid.resolution, y0 + grid.resolution)]
+    bounds = (x0, y0, x0 + grid.width, y0 + grid.height)
+    polygons = OccupancyGrid.from_polygons([square], grid.resolution, bounds)
+    certify_footprint(traj.path, robot.footprint, polygons)
 
 
 def _exercise_planners() -> None:
