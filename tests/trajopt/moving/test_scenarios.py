@@ -40,6 +40,12 @@ def test_each_kind_is_certified_or_proven_blocked(scene, paper, kind):
     planner, static = paper
     movers = make_movers(static, kind, 2, seed=KINDS.index(kind) if kind in KINDS else 9)
     assert len(movers) == 2
+    _certified_or_proven_blocked(scene, planner, static, movers)
+
+
+def _certified_or_proven_blocked(scene, planner, static, movers):
+    """Plan SP -> A with ``movers``: the plan passes the independent check and is no faster
+    than the static one, or the refusal is proven by the relaxation along the static path."""
     try:
         out = planner.plan(
             scene.start, scene.goal("A"), moving_obstacles=movers, mover_margin=MARGIN
@@ -61,15 +67,7 @@ def test_carts_of_each_kind_are_certified_or_proven_blocked(scene, paper, kind):
     movers = make_movers(static, kind, 2, seed=20 + KINDS.index(kind), shape="polygon")
     assert len(movers) == 2 and all(m.vertices is not None for m in movers)
     assert brute_min(static, movers, margin=MARGIN) < 0.0  # the static plan meets a cart
-    try:
-        out = planner.plan(
-            scene.start, scene.goal("A"), moving_obstacles=movers, mover_margin=MARGIN
-        )
-    except BlockedError:
-        assert path_blocked(static, movers, MARGIN, ds=0.02, dt=0.02)
-        return
-    chk = check_trajectory(out, movers, margin=MARGIN, grid=scene.grid)
-    assert chk.ok, chk
+    _certified_or_proven_blocked(scene, planner, static, movers)
 
 
 def test_a_mover_stopping_on_the_path_is_proven_blocked_and_driven_round(scene, paper):
