@@ -120,6 +120,22 @@ def _piece_margin(bez, rho, phi, max_arc, cap, rects, meta, bstart, bids, stamp,
 
 
 @njit(cache=True)
+def _halve(cur, stack, top, work):  # pragma: no cover - compiled
+    """Split the Bezier piece ``cur`` at 1/2 (de Casteljau): left half to ``stack[top]``, right half to ``stack[top + 1]``."""
+    p1 = cur.shape[0]
+    for r in range(p1):  # element copies: no shape-mismatch error code
+        work[r, 0] = cur[r, 0]
+        work[r, 1] = cur[r, 1]
+    for r in range(p1):
+        for c in range(2):
+            stack[top, r, c] = work[0, c]
+            stack[top + 1, p1 - 1 - r, c] = work[p1 - 1 - r, c]
+        for i in range(p1 - 1 - r):
+            for c in range(2):
+                work[i, c] = 0.5 * (work[i, c] + work[i + 1, c])
+
+
+@njit(cache=True)
 def span_margins(
     bez, rho, phi, max_arc, cap, tol, max_depth, rects, meta, bstart, bids, stamp, buf
 ):  # pragma: no cover - compiled
@@ -170,17 +186,7 @@ def span_margins(
             if g > tol or d == max_depth:
                 worst = min(worst, g)
                 continue
-            # de Casteljau at 1/2: left half to stack[top], right half to stack[top + 1]
-            for r in range(p1):
-                work[r, 0] = cur[r, 0]
-                work[r, 1] = cur[r, 1]
-            for r in range(p1):
-                for c in range(2):
-                    stack[top, r, c] = work[0, c]
-                    stack[top + 1, p1 - 1 - r, c] = work[p1 - 1 - r, c]
-                for i in range(p1 - 1 - r):
-                    for c in range(2):
-                        work[i, c] = 0.5 * (work[i, c] + work[i + 1, c])
+            _halve(cur, stack, top, work)
             depth[top] = depth[top + 1] = d + 1
             top += 2
         margins[s] = worst
@@ -252,16 +258,7 @@ def span_margins_polygons(
             if g > tol or d == max_depth:
                 worst = min(worst, g)
                 continue
-            for r in range(p1):  # de Casteljau at 1/2, as in span_margins
-                work[r, 0] = cur[r, 0]
-                work[r, 1] = cur[r, 1]
-            for r in range(p1):
-                for c in range(2):
-                    stack[top, r, c] = work[0, c]
-                    stack[top + 1, p1 - 1 - r, c] = work[p1 - 1 - r, c]
-                for i in range(p1 - 1 - r):
-                    for c in range(2):
-                        work[i, c] = 0.5 * (work[i, c] + work[i + 1, c])
+            _halve(cur, stack, top, work)
             depth[top] = depth[top + 1] = d + 1
             top += 2
         margins[s] = worst
