@@ -104,8 +104,8 @@ def swept_hull(rho, phi, lo, hi, max_arc):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _piece_margin(bez, rho, phi, max_arc, cap, rects, meta, bstart, bids, stamp, buf):
-    """Clearance of one Bezier piece's bound (its control hull plus the swept footprint)."""  # noqa: D401
+def _piece_bound(bez, rho, phi, max_arc):  # pragma: no cover - compiled
+    """Return the convex bound (counter-clockwise) of the footprint over one Bezier piece."""
     p1 = bez.shape[0]
     lo, hi = cone(bez[1:] - bez[:-1])
     sw = swept_hull(rho, phi, lo, hi, max_arc)
@@ -115,7 +115,13 @@ def _piece_margin(bez, rho, phi, max_arc, cap, rects, meta, bstart, bids, stamp,
         for j in range(ns):
             pts[i * ns + j, 0] = bez[i, 0] + sw[j, 0]
             pts[i * ns + j, 1] = bez[i, 1] + sw[j, 1]
-    poly = hull_of(pts, p1 * ns)
+    return hull_of(pts, p1 * ns)
+
+
+@njit(cache=True)
+def _piece_margin(bez, rho, phi, max_arc, cap, rects, meta, bstart, bids, stamp, buf):
+    """Clearance of one Bezier piece's bound (its control hull plus the swept footprint)."""  # noqa: D401
+    poly = _piece_bound(bez, rho, phi, max_arc)
     return poly_clearance(poly, poly.shape[0], cap, rects, meta, bstart, bids, stamp, buf)
 
 
@@ -191,21 +197,6 @@ def span_margins(
             top += 2
         margins[s] = worst
     return margins, heads
-
-
-@njit(cache=True)
-def _piece_bound(bez, rho, phi, max_arc):  # pragma: no cover - compiled
-    """Return the convex bound (counter-clockwise) of the footprint over one Bezier piece."""
-    p1 = bez.shape[0]
-    lo, hi = cone(bez[1:] - bez[:-1])
-    sw = swept_hull(rho, phi, lo, hi, max_arc)
-    ns = sw.shape[0]
-    pts = np.empty((p1 * ns, 2))
-    for i in range(p1):
-        for j in range(ns):
-            pts[i * ns + j, 0] = bez[i, 0] + sw[j, 0]
-            pts[i * ns + j, 1] = bez[i, 1] + sw[j, 1]
-    return hull_of(pts, p1 * ns)
 
 
 @njit(cache=True)
