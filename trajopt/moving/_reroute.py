@@ -210,9 +210,7 @@ def reroute(
     if turns or not robot.drive.turns_in_place:  # a car stands at the place with a heading
         room = free()
         places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
-        places = [
-            p for p in places if _joined_at_last(grid, room, movers, robot.radius + margin, p, p1)
-        ]
+        places = _joined_at_last(grid, room, movers, robot.radius + margin, places, p1)
         for place in places:
             for heading in [None] if turns else car_headings(place, p0, p1):
                 at = "" if heading is None else f", heading {heading:.3f} rad"
@@ -289,30 +287,73 @@ def safe_places(
 
     Cell centres free in ``free`` whose cell keeps ``clearance`` (m) from every mover's
     swept region over ``[0, t_last]`` (:func:`swept_mask`), by the shortest detour
-    ``|p0 - p| + |p - p1|``, at least :data:`SAFE_PLACE_SPACING` apart.
+    ``|p0 - p| + |p - p1|`` (ties: the lower row, then the lower column), each the first in
+    that order at least :data:`SAFE_PLACE_SPACING` from those before it.
+
+    The points of detour at most ``c`` fill an ellipse with foci ``p0`` and ``p1``: the
+    places are chosen among the cells of detour at most ``c`` in that ellipse's bounding
+    box, for a growing ``c``, until all are found there (no cell outside, of a larger
+    detour, comes before them) or the box is the whole grid.
     """
-    unsafe = np.zeros(grid.shape, dtype=bool)
-    for m in movers:
-        unsafe |= swept_mask(grid, m, min(0.0, float(m.times[0])), t_last, clearance)
-    ok = free & ~unsafe
-    iy, ix = np.nonzero(ok)
-    if iy.size == 0:
-        return []
     res = float(grid.resolution)
-    pts = np.asarray(grid.origin, dtype=float) + (np.stack([ix, iy], axis=1) + 0.5) * res
-    cost = np.hypot(*(pts - p0).T) + np.hypot(*(pts - p1).T)
-    if cost.shape[0] > 20000:  # the 20000 cheapest in order (ties by index), as a full sort
-        near = np.flatnonzero(cost <= np.partition(cost, 19999)[19999])
-        order = near[np.argsort(cost[near], kind="stable")]
-    else:
-        order = np.argsort(cost, kind="stable")
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    mid = 0.5 * (p0 + p1)
+    f = 0.5 * math.hypot(*(p1 - p0))
+    cos, sin = ((p1 - p0) / (2.0 * f)).tolist() if f > 0.0 else (1.0, 0.0)
+    slack = 2.0 * SAFE_PLACE_SPACING
+    while True:
+        a = f + 0.5 * slack  # the ellipse's semi-axes
+        b = math.sqrt(a * a - f * f)
+        wx = math.hypot(a * cos, b * sin) + res
+        wy = math.hypot(a * sin, b * cos) + res
+        ix0 = max(0, int(math.floor((mid[0] - wx - ox) / res)))
+        ix1 = min(nx - 1, int(math.floor((mid[0] + wx - ox) / res)))
+        iy0 = max(0, int(math.floor((mid[1] - wy - oy) / res)))
+        iy1 = min(ny - 1, int(math.floor((mid[1] + wy - oy) / res)))
+        whole = ix0 == 0 and iy0 == 0 and ix1 == nx - 1 and iy1 == ny - 1
+        c = math.inf if whole else 2.0 * f + slack
+        places = _places_in(grid, free, movers, clearance, p0, p1, t_last, (ix0, ix1, iy0, iy1), c)
+        if whole or len(places) == N_SAFE_PLACES:
+            return places
+        slack *= 3.0
+
+
+def _places_in(
+    grid: OccupancyGrid,
+    free: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    clearance: float,
+    p0: np.ndarray,
+    p1: np.ndarray,
+    t_last: float,
+    box: tuple[int, int, int, int],
+    most: float,
+) -> list[np.ndarray]:
+    """Return :func:`safe_places`'s places (m) among the cells of ``box`` of detour <= ``most`` (m)."""
+    ix0, ix1, iy0, iy1 = box
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    x = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
+    y = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
+    cost = np.hypot(x[None, :] - p0[0], y[:, None] - p0[1]) + np.hypot(
+        x[None, :] - p1[0], y[:, None] - p1[1]
+    )
+    ok = free[iy0 : iy1 + 1, ix0 : ix1 + 1] & (cost <= most)
+    for m in movers:
+        if not ok.any():
+            return []
+        ok &= ~swept_mask(grid, m, min(0.0, float(m.times[0])), t_last, clearance, box)
+    cost = np.where(ok, cost, np.inf)
     out: list[np.ndarray] = []
-    for i in order[:20000]:
-        p = pts[i]
-        if all(math.hypot(*(p - q)) >= SAFE_PLACE_SPACING for q in out):
-            out.append(p)
-            if len(out) == N_SAFE_PLACES:
-                break
+    while len(out) < N_SAFE_PLACES:
+        k = int(np.argmin(cost))  # row-major: the first of equal detours is the lower row
+        iy, ix = divmod(k, cost.shape[1])
+        if not math.isfinite(float(cost[iy, ix])):
+            break
+        p = np.array([x[ix], y[iy]])
+        out.append(p)
+        cost[np.hypot(x[None, :] - p[0], y[:, None] - p[1]) < SAFE_PLACE_SPACING] = np.inf
     return out
 
 
@@ -321,15 +362,17 @@ def _joined_at_last(
     free: np.ndarray,
     movers: Sequence[MovingObstacle],
     clearance: float,
-    place: np.ndarray,
+    places: Sequence[np.ndarray],
     goal: np.ndarray,
-) -> bool:
-    """Whether ``place`` and ``goal`` are joined once every mover stands at its final place.
+) -> list[np.ndarray]:
+    """Return the ``places`` joined to ``goal`` once every mover stands at its final place.
 
     4-connected free cells of ``free`` less every mover's final shape grown by ``clearance``
     (the planner's search joins exactly the 4-connected free cells). A wait helps only where
     the way on stays open after the movers have passed.
     """
+    if not places:
+        return []
     from scipy import ndimage  # only a re-route pays its import
 
     open_ = np.array(free)
@@ -337,13 +380,14 @@ def _joined_at_last(
         t = max(m.t_last, 0.0)
         open_ &= ~swept_mask(grid, m, t, t, clearance)
     labels, _ = ndimage.label(open_)
-    cells = grid.world_to_cell(np.stack([place, goal]))
     ny, nx = grid.shape
-    if np.any(cells < 0) or np.any(cells[:, 0] >= nx) or np.any(cells[:, 1] >= ny):
-        return False
-    a = labels[cells[0, 1], cells[0, 0]]
-    b = labels[cells[1, 1], cells[1, 0]]
-    return bool(a > 0 and a == b)
+
+    def label(p: np.ndarray) -> int:
+        ix, iy = (int(v) for v in grid.world_to_cell(np.asarray(p, dtype=float).reshape(1, 2))[0])
+        return int(labels[iy, ix]) if 0 <= ix < nx and 0 <= iy < ny else 0
+
+    at_goal = label(goal)
+    return [p for p in places if at_goal > 0 and label(p) == at_goal]
 
 
 def car_headings(place: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> list[float]:

@@ -29,7 +29,12 @@ def track(mover: MovingObstacle, t0: float, t1: float) -> np.ndarray:
 
 
 def swept_mask(
-    grid: OccupancyGrid, mover: MovingObstacle, t0: float, t1: float, grow: float
+    grid: OccupancyGrid,
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    grow: float,
+    box: tuple[int, int, int, int] | None = None,
 ) -> np.ndarray:
     """Return the cells the mover's shape, grown by ``grow`` (m), covers at some ``t`` in ``[t0, t1]``.
 
@@ -43,15 +48,23 @@ def swept_mask(
         The time interval (s), ``t0 <= t1``.
     grow : float
         Distance added around the shape (m), >= 0.
+    box : (int, int, int, int), optional
+        ``(ix0, ix1, iy0, iy1)``: only the cells of this box of ``grid`` (bounds included,
+        inside the grid) are returned; ``None``: the whole grid.
 
     Returns
     -------
     ndarray of bool, shape (ny, nx)
-        ``mask[iy, ix]``: the cell's square meets the grown swept region.
+        ``mask[iy, ix]``: the cell's square meets the grown swept region (with ``box``, shape
+        ``(iy1 - iy0 + 1, ix1 - ix0 + 1)``, its cell ``(ix0, iy0)`` first).
     """
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
+    if box is not None:  # the box as a grid of its own: the same cell centres
+        bx0, bx1, by0, by1 = (int(v) for v in box)
+        ox, oy = ox + bx0 * res, oy + by0 * res
+        ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
     reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
     radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
     pts = track(mover, float(t0), float(t1))

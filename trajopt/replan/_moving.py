@@ -43,7 +43,10 @@ curve from the moving state, whose reach bound ``v_max t`` holds every motion al
 a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
 from rest after the head) show that nothing along the path followed gets past the movers from
 the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
-parks on the rest: no search), :func:`trajopt.moving.no_way_past` after it fails. The proof
+parks on the rest: no search), and so does :func:`trajopt.moving.no_way_past` when a mover
+drives along the path against it (:func:`trajopt.moving.meets_head_on`, a cheap screen: the
+re-timing's search would likely fail after it); otherwise ``no_way_past`` runs after the
+re-timing fails. The proof
 is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
 which then tries the re-route's candidates at once and the static plan from the stop last:
 that plan is a new search from a point of the path followed, to the same goal on the same map,
@@ -65,6 +68,7 @@ from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    meets_head_on,
     no_way_past,
     over_start,
     parked_on_path,
@@ -126,7 +130,13 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
-    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path,))
+    head_on: list[bool] = []
+
+    def head_on_proof(plan: Any, seen: Sequence[MovingObstacle], margin: float) -> Any:
+        head_on.append(meets_head_on(plan, seen, margin))
+        return no_way_past(plan, seen, margin) if head_on[-1] else None
+
+    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof
@@ -135,7 +145,7 @@ def retime_replan(
     except BlockedError as exc:
         if from_stop is None:
             raise
-        if proof is None:  # is the path followed blocked from the stop on, too?
+        if proof is None and not any(head_on):  # is the path followed blocked from the stop on?
             proof = blocked_along(out, movers, margin, ts, shifted, (no_way_past,))
         timed, moving = _stop_and_go_on(
             out, movers, margin, ts, shifted, from_stop, exc, along=proof

@@ -424,6 +424,40 @@ def test_swept_mask_is_the_cells_near_the_track(t0, t1):
     assert expect.sum() > 20
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_safe_places_are_the_cheapest_clear_cells_spaced_apart(seed):
+    """``safe_places`` against its definition written out over every cell: the free cells that
+    keep the clearance from every swept region, in order of detour (ties by row, then column),
+    each the first at least the spacing from those taken before it."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((80, 120), [(0.3, 5.7, 0.3, 3.7)])
+    free = ~np.asarray(grid.occupied)
+    free[rng.random(free.shape) < 0.3] = False
+    movers = [
+        trajopt.MovingObstacle.from_waypoints(
+            [0.0, 3.0, 6.0], rng.uniform((0.5, 0.5), (5.5, 3.5), (3, 2)), radius=0.2
+        )
+        for _ in range(2)
+    ]
+    p0, p1 = rng.uniform((0.5, 0.5), (5.5, 3.5), (2, 2))
+    got = trajopt.moving.safe_places(grid, free, movers, 0.3, p0, p1, 6.0)
+    unsafe = np.zeros(grid.shape, dtype=bool)
+    for m in movers:
+        unsafe |= trajopt.moving.swept_mask(grid, m, 0.0, 6.0, 0.3)
+    iy, ix = np.nonzero(free & ~unsafe)
+    pts = np.stack([ix, iy], axis=1) * RES + 0.5 * RES
+    cost = np.hypot(*(pts - p0).T) + np.hypot(*(pts - p1).T)
+    want = []
+    for i in np.argsort(cost, kind="stable"):
+        if all(math.dist(pts[i], q) >= trajopt.moving.SAFE_PLACE_SPACING for q in want):
+            want.append(pts[i])
+            if len(want) == trajopt.moving.N_SAFE_PLACES:
+                break
+    assert len(got) == len(want) == trajopt.moving.N_SAFE_PLACES
+    for g, w in zip(got, want, strict=True):
+        assert np.allclose(g, w, atol=1e-12)
+
+
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
 @given(
     st.lists(
