@@ -23,8 +23,9 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    straight-line detour ``|start - p| + |p - goal|``. The first leg is re-timed for the movers
    (standing at the safe place is safe whenever it arrives), the second leg, from the first's
    end heading (a turn in place), on the clock from the first's arrival
-   (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified whole (with an omni
-   orientation, by the two legs' certificates on their clocks). A car, which cannot turn in
+   (:func:`~trajopt.moving.shift_clock`); the two are one chain, certified by the two legs'
+   certificates on their clocks (the first's until the last prediction ends, the robot
+   standing at the safe place from its arrival; the second's from then on). A car, which cannot turn in
    place, stands there with a heading (:func:`car_headings`: towards the goal, else along its
    way in); the second leg leaves with the first's end heading and last steering angle.
 
@@ -54,7 +55,7 @@ import numpy as np
 from astar.grid import OccupancyGrid
 from trajopt.errors import BlockedError, TrajoptError
 from trajopt.motion import TrajectoryChain
-from trajopt.moving._certificate import certify_movers, point_polygon_distance, shape_at
+from trajopt.moving._certificate import point_polygon_distance, shape_at
 from trajopt.moving._chain import retime_chain, shift_clock
 from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
@@ -482,7 +483,7 @@ def _wait_at(
         starts = _starts(first) + _starts(second)
         stats = dict(second.stats)
         chain = TrajectoryChain(tuple(pieces), first.robot, stats, second.steps, tuple(starts))
-        summary = _certificate(chain, first, second, movers, margin, t1)
+        summary = _certificate(first, second, t1)
         stats["moving"] = {
             "plan": (
                 f"to ({place[0]:.2f}, {place[1]:.2f}) m: {first.stats['moving']['plan']}; "
@@ -496,30 +497,16 @@ def _wait_at(
     return run
 
 
-def _certificate(
-    chain: TrajectoryChain,
-    first: Any,
-    second: Any,
-    movers: Sequence[MovingObstacle],
-    margin: float,
-    t1: float,
-) -> dict[str, Any]:
-    """Return the certificate summary of both legs as one chain (raise when it fails).
+def _certificate(first: Any, second: Any, t1: float) -> dict[str, Any]:
+    """Return the certificate summary of both legs as one chain, from the legs' own.
 
-    A chain of curves and motions at rest is certified whole (:func:`certify_movers`). One
-    with an omni orientation (which the certificate does not take) is proved by its legs'
-    certificates: the first leg's until the last prediction ends with the robot standing at
-    the safe place, the second's on the clock from ``t1`` (s), its arrival there.
+    Each leg's re-timing certified it (:func:`~trajopt.moving.certify_movers`): the first against the movers
+    from ``t = 0`` until the last prediction ends, the robot standing at the safe place from
+    its arrival ``t1`` (s) on; the second on the clock from ``t1`` until the last prediction
+    ends, the robot standing at the goal from its arrival on. Together they cover the chain at
+    every instant (before ``t1`` the first leg, after it the second), so the chain is
+    certified without a third pass.
     """
-    if not any(p.own_orientation for p in chain.pieces):
-        cert = certify_movers(chain, movers, margin=margin)
-        if not cert.ok:
-            raise BlockedError(
-                f"the two legs meet {cert.mover!r} near t = {cert.witness_t:.3f} s",
-                mover=cert.mover,
-                t=cert.witness_t,
-            )
-        return cert.summary()
     a = first.stats["moving"]["certificate"]
     b = second.stats["moving"]["certificate"]
     if not (a["ok"] and b["ok"]):  # each leg's re-timing raises first; kept as a guard
