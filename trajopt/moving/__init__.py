@@ -18,7 +18,7 @@
   path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal;
   :func:`car_headings`: how a car stands at a safe place; :func:`safe_places`: where it
   waits); :func:`swept_mask`,
-  :func:`mark_swept`: a mover's swept region on a grid;
+  :func:`mark_swept`: a mover's swept region on a grid (:func:`swept_cells`: on given cells);
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.
 """
 
@@ -37,7 +37,7 @@ from trajopt.moving._reroute import (
 )
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
-from trajopt.moving._swept import mark_swept, swept_mask
+from trajopt.moving._swept import mark_swept, swept_cells, swept_mask
 
 __all__ = [
     "N_SAFE_PLACES",
@@ -64,6 +64,7 @@ __all__ = [
     "settle_time",
     "shift_clock",
     "st_grid",
+    "swept_cells",
     "swept_mask",
     "truncate",
 ]

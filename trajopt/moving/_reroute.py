@@ -60,7 +60,7 @@ from trajopt.moving._chain import retime_chain, shift_clock
 from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import parked_on_path
-from trajopt.moving._swept import mark_swept, swept_mask
+from trajopt.moving._swept import mark_swept, swept_cells, swept_mask
 
 #: Safe places tried (option 3).
 N_SAFE_PLACES = 2
@@ -304,7 +304,7 @@ def _keeps_clear(
     inside = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
     cells = cells[inside]
     for mover, t0, t1 in regions:
-        if swept_mask(grid, mover, t0, t1, grow)[cells[:, 1], cells[:, 0]].any():
+        if swept_cells(grid, mover, t0, t1, grow, cells).any():
             return False
     return True
 

@@ -422,6 +422,10 @@ def test_swept_mask_is_the_cells_near_the_track(t0, t1):
     differ = mask != expect
     assert np.all(np.abs(best[differ] - radius) < 1e-9)
     assert expect.sum() > 20
+    cells = np.stack([ix.ravel(), iy.ravel()], axis=1)
+    asked = trajopt.moving.swept_cells(grid, m, t0, t1, 0.05, cells)  # the same test, cell by cell
+    differ = asked != expect.ravel()
+    assert np.all(np.abs(best.ravel()[differ] - radius) < 1e-9)
 
 
 @pytest.mark.parametrize("seed", range(4))
