@@ -26,7 +26,7 @@ from trajopt.moving import (
     reroute,
     retime_chain,
 )
-from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._caches import PlannerCaches, change_reach
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query
 from trajopt.robot import Robot, State
@@ -414,16 +414,21 @@ def _shut_in(caches: PlannerCaches, grid: OccupancyGrid, p: np.ndarray, other: n
     (:meth:`PlannerCaches.inflated_window`): when ``p``'s part touches no side of the window
     but the map's own edges, it is the whole component, and ``other`` is reached only when
     its cell is in it. ``False`` when that does not settle it (the part reaches a side, or
-    ``p``'s cell is not free, which the plan refuses itself).
+    ``p``'s cell is not free, which the plan refuses itself) or when ``grid`` differs from
+    the planner's map nowhere that reaches the window (nothing to look at).
     """
-    from scipy import ndimage  # only a re-route pays its import
-
     ny, nx = grid.shape
     ix, iy = (int(v) for v in grid.world_to_cell(np.asarray(p, dtype=float)))
     if not (0 <= ix < nx and 0 <= iy < ny):
         return False
     k = SHUT_IN_CELLS
     x0, x1, y0, y1 = max(0, ix - k), min(nx - 1, ix + k), max(0, iy - k), min(ny - 1, iy + k)
+    r = change_reach(caches.options, grid.resolution)[0]  # what reaches the window's cells
+    near = (slice(max(0, y0 - r), y1 + r + 1), slice(max(0, x0 - r), x1 + r + 1))
+    if np.array_equal(grid.occupied[near], caches.grid.occupied[near]):
+        return False  # no mark near: the map the planner's own labels settle
+    from scipy import ndimage  # only a re-route near a mark pays its import
+
     free = ~caches.inflated_window(grid, (x0, x1, y0, y1))
     if not free[iy - y0, ix - x0]:
         return False
