@@ -336,12 +336,12 @@ def _reroute(
             np.asarray(request.goal if b is None else b, dtype=float).reshape(2),
         )
 
-    def shut_in(grid: OccupancyGrid, a: np.ndarray | None, b: np.ndarray | None) -> None:
+    def refuse_shut_in(grid: OccupancyGrid, a: np.ndarray | None, b: np.ndarray | None) -> None:
         if grid is caches.grid or id(grid) in made or not _disc_search(robot):
             return  # the plan's own check is as cheap, or the search is not the disc's
         p, q = ends(a, b)
         for name, here, there in (("start", p, q), ("goal", q, p)):
-            if _shut_in(caches, grid, here, there):
+            if shut_in(caches, grid, here, there):
                 raise NoPathError(
                     f"no path from start to goal on the marked map: the {name} "
                     f"({here[0]:.3f}, {here[1]:.3f}) m lies in a part of the inflated grid shut in "
@@ -349,7 +349,7 @@ def _reroute(
                 )
 
     def sketch(grid: OccupancyGrid) -> np.ndarray:
-        shut_in(grid, None, None)
+        refuse_shut_in(grid, None, None)
         return _grid_path(caches_of(grid), *ends(None, None))
 
     def plan_leg(
@@ -360,7 +360,7 @@ def _reroute(
         goal_heading: float | None = None,
         start_steer: float = 0.0,
     ) -> PlanResult:
-        shut_in(grid, a, b)
+        refuse_shut_in(grid, a, b)
         leg = request
         if a is not None:
             leg = dataclasses.replace(
@@ -390,7 +390,7 @@ def _reroute(
     )
 
 
-#: Half the side (cells) of the window round an end in which :func:`_shut_in` looks.
+#: Half the side (cells) of the window round an end in which :func:`shut_in` looks.
 SHUT_IN_CELLS = 24
 
 
@@ -405,7 +405,7 @@ def _disc_search(robot: Robot) -> bool:
     )
 
 
-def _shut_in(caches: PlannerCaches, grid: OccupancyGrid, p: np.ndarray, other: np.ndarray) -> bool:
+def shut_in(caches: PlannerCaches, grid: OccupancyGrid, p: np.ndarray, other: np.ndarray) -> bool:
     """Whether the search from ``p`` (m) on ``grid`` provably cannot reach ``other`` (m).
 
     The search reaches exactly the 4-connected free cells of the inflated grid joined to the
