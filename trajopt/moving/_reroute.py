@@ -36,7 +36,10 @@ path open, so their plan likely takes it again (a mover's final place behind the
 
 Such a detour's plan is first given the quick proofs (:func:`~trajopt.moving.parked_on_path`,
 :func:`~trajopt.moving.no_way_past`), which refuse a blocked one in milliseconds, before the
-re-timing's search. A candidate whose map has no path, whose plan fails or whose re-timing is
+re-timing's search. Given the caller's ``sketch`` (the search's grid path on a map, no
+corridor or smoothing), such a detour whose grid path stays within :data:`FOLLOWS_RADII` robot
+radii of the blocked path is tried after the waits instead: its plan would take that path
+again. A candidate whose map has no path, whose plan fails or whose re-timing is
 blocked is skipped (its reason and wall time kept). When none works, the original :class:`BlockedError` is raised again (it
 names the mover and the time) with the reasons appended. None is tried when a mover ends
 standing on the goal (its final shape closer than the robot's inscribed radius plus the margin

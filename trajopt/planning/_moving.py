@@ -312,7 +312,13 @@ def _reroute(
     request: PlanRequest,
     path: np.ndarray | None = None,
 ) -> PlanResult:
-    """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here."""
+    """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here.
+
+    Each marked map's caches are derived once (:meth:`PlannerCaches.derived`), shared by its
+    ``sketch`` (:func:`_grid_path`) and its plan. For a differential drive's disc, a leg whose
+    start or goal is shut in on the marked map (:func:`shut_in`) is refused with a
+    :class:`NoPathError` before the caches are derived.
+    """
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
         inflated = np.asarray(caches.inflated.occupied)
