@@ -26,7 +26,7 @@ from trajopt.moving import (
     reroute,
     retime_chain,
 )
-from trajopt.planning._caches import PlannerCaches, change_reach
+from trajopt.planning._caches import PlannerCaches, change_reach, component_labels
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query
 from trajopt.robot import Robot, State
@@ -433,12 +433,10 @@ def shut_in(caches: PlannerCaches, grid: OccupancyGrid, p: np.ndarray, other: np
     near = (slice(max(0, y0 - r), y1 + r + 1), slice(max(0, x0 - r), x1 + r + 1))
     if np.array_equal(grid.occupied[near], caches.grid.occupied[near]):
         return False  # no mark near: the map the planner's own labels settle
-    from scipy import ndimage  # only a re-route near a mark pays its import
-
     free = ~caches.inflated_window(grid, (x0, x1, y0, y1))
     if not free[iy - y0, ix - x0]:
         return False
-    labels, _ = ndimage.label(free)
+    labels = component_labels(~free)
     part = labels == labels[iy - y0, ix - x0]
     sides = (
         (x0 > 0 and part[:, 0].any())
