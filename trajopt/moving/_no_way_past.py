@@ -261,7 +261,7 @@ def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0
         p = m.position_at(t)
         v = np.diff(p, axis=0)
         close = np.hypot(*(p[1:] - p0).T) <= limit + reach + HEAD_ON_RUN
-        if not np.any(close & (v @ ahead < -0.5 * np.hypot(*v.T))):
+        if not np.any(close & (v[:, 0] * ahead[0] + v[:, 1] * ahead[1] < -0.5 * np.hypot(*v.T))):
             continue  # it comes near the start only across the heading or with it
         if pts is None:
             s = np.linspace(0.0, length, int(math.ceil(length / HEAD_ON_DS)) + 1)
