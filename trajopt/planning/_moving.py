@@ -315,9 +315,10 @@ def _reroute(
     """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here.
 
     Each marked map's caches are derived once (:meth:`PlannerCaches.derived`), shared by its
-    ``sketch`` (:func:`_grid_path`) and its plan. For a differential drive's disc, a leg whose
-    start or goal is shut in on the marked map (:func:`shut_in`) is refused with a
-    :class:`NoPathError` before the caches are derived.
+    ``sketch`` (:func:`_grid_path`) and its plan. Given the blocked ``path`` (a re-plan from
+    a stop on it, which stands in the blocking mover's swept region more often than not), a
+    differential drive's disc leg whose start or goal is shut in on the marked map
+    (:func:`shut_in`) is refused with a :class:`NoPathError` before the caches are derived.
     """
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
@@ -343,8 +344,9 @@ def _reroute(
         )
 
     def refuse_shut_in(grid: OccupancyGrid, a: np.ndarray | None, b: np.ndarray | None) -> None:
-        if grid is caches.grid or id(grid) in made or not _disc_search(robot):
-            return  # the plan's own check is as cheap, or the search is not the disc's
+        if path is None or grid is caches.grid or id(grid) in made or not _disc_search(robot):
+            return  # not from a stop on the blocked path; the plan's own check is as cheap; or
+            # the search is not the disc's
         p, q = ends(a, b)
         for name, here, there in (("start", p, q), ("goal", q, p)):
             if shut_in(caches, grid, here, there):
