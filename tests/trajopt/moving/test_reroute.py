@@ -428,6 +428,46 @@ def test_swept_mask_is_the_cells_near_the_track(t0, t1):
     assert np.all(np.abs(best.ravel()[differ] - radius) < 1e-9)
 
 
+def test_a_detour_whose_grid_path_follows_the_blocked_path_goes_after_the_waits(bay):
+    """With a ``sketch``, the detour round the forklift's final place (clear of the blocked
+    path) is drawn first: when its grid path follows the blocked path it is tried after the
+    waits at safe places; when it goes another way, before them (every plan fails here: only
+    the order is read)."""
+    grid = bay
+    robot = trajopt.Robot()
+    forklift = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 15.0, 30.0], [(13.0, 2.0), (5.5, 2.0), (0.8, 1.8)], radius=0.2, name="forklift"
+    )
+    p0, p1 = np.array([3.0, 2.0]), np.array([11.0, 2.0])
+    path = np.stack([np.linspace(3.0, 11.0, 161), np.full(161, 2.0)], axis=1)
+    blocked = BlockedError("blocked (test)", mover="forklift", t=5.0)
+    drawn = []
+
+    def plan_leg(marked, a, b, heading, goal_heading=None, start_steer=0.0):
+        raise trajopt.errors.NoPathError("no plan (test)")
+
+    def order(way):
+        def sketch(marked, a=None, b=None):
+            drawn.append(int(np.asarray(marked.occupied).sum()))
+            return way
+
+        with pytest.raises(BlockedError) as info:
+            trajopt.moving.reroute(
+                p0, p1, robot, [forklift], 0.02, blocked, grid=grid,
+                free=lambda: ~np.asarray(grid.occupied), plan_leg=plan_leg, path=path,
+                sketch=sketch,
+            )  # fmt: skip
+        text = str(info.value)
+        names = ["around every mover's final place", "wait at"]
+        assert all(n in text for n in names), text
+        return sorted(names, key=text.index)
+
+    assert order(path[::4]) == ["wait at", "around every mover's final place"]
+    assert drawn and drawn[0] > int(np.asarray(grid.occupied).sum())  # on the marked map
+    north = np.array([[3.0, 2.0], [6.0, 3.3], [11.0, 2.0]])  # 1.3 m off the path at the bay
+    assert order(north) == ["around every mover's final place", "wait at"]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_safe_places_are_the_cheapest_clear_cells_spaced_apart(seed):
     """``safe_places`` against its definition written out over every cell: the free cells that
