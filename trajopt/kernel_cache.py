@@ -55,6 +55,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "astar.coarse_to_fine",
     "astar.distance_transform",
     "astar.hybrid_kernel",
+    "astar.hybrid_shortcut",
     "astar.inflation",
     "astar.reeds_shepp",
     "astar.search_kernels",
