@@ -88,6 +88,7 @@ def shortcut_kernel(
         fmargin,
         fslack,
         fmin_slack,
+        onext,
         fdist,
         discs,
         pedges,
@@ -180,7 +181,7 @@ def shortcut_kernel(
                 )  # fmt: skip
                 if clear and footprint:
                     clear = footprint_word_clear(
-                        occ, fsafe, fp, fdist, discs, poly, frho, bp[i, 0], bp[i, 1], th0,
+                        occ, onext, fsafe, fp, fdist, discs, poly, frho, bp[i, 0], bp[i, 1], th0,
                         radius, kinds, lens, n, fmargin, fslack, fmin_slack, fbuf,
                     )  # fmt: skip
                 if clear:
