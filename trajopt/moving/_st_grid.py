@@ -17,7 +17,11 @@ form: on each piece of its track between waypoint times its centre ``c(t)`` and 
 linear in ``t``, so ``|C(s_i) - c(t)| - lim(t)`` is convex in ``t`` and its negative set is
 one interval, the roots of a quadratic; the node is forbidden exactly at the grid times inside
 it (widened by 1 ns on the sufficient grid, narrowed on the necessary one, against rounding).
-Other shapes (a polygon mover, a footprint robot) are evaluated at every node and grid time.
+A polygon mover against a disc robot: each pair of a piece of its track and a node is
+marched through the grid times (:mod:`._polygon_runs`): an exact test at a grid time decides
+every grid time within its clearance over the mover's speed bound, so the runs are those of
+the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding).
+A footprint robot is tested exactly at every node and grid time near a mover (:func:`_shape_hits`).
 
 A footprint robot is its convex polygon at each node, turned by the path's heading there; it
 moves at most ``(1 + R kappa_max)`` per metre of arc, so the robot's share of both pads is
@@ -36,6 +40,7 @@ from scipy.spatial import cKDTree
 from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._disc_windows import inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._polygon_runs import polygon_runs
 
 #: A run's end index standing for "until after the grid's last time" (the movers then stand).
 FOREVER = 1 << 40
@@ -318,6 +323,7 @@ def st_grid(
         stretch = 1.0
     runs: list[tuple[np.ndarray, ...]] = []
     discs: list[tuple[int, MovingObstacle, float]] = []
+    shapes: list[tuple[int, MovingObstacle, float]] = []
     tree: cKDTree | None = None
     for j, m in enumerate(movers):
         if sufficient:
@@ -327,15 +333,22 @@ def st_grid(
         if polys is None and m.vertices is None:
             discs.append((j, m, pad))
             continue
+        if polys is None:
+            shapes.append((j, m, pad))
+            continue
         if tree is None:
             tree = cKDTree(pts)
         lim = limit + m.radius_at(t) + pad
         runs.append(_runs_of(_shape_hits(pts, polys, m, t, lim, tree), j))
+    after = None
+    if leave is not None:
+        after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
     if discs:
-        after = None
-        if leave is not None:
-            after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
         runs.append(_disc_runs(pts, discs, limit, t, sufficient, after))
+    if shapes:
+        j_of, shape_movers, pads = zip(*shapes, strict=True)
+        lim0 = limit + np.asarray(pads, dtype=float)
+        runs.append(polygon_runs(pts, shape_movers, j_of, lim0, t, sufficient, after))
     if runs:
         col, lo, hi, owner = (np.concatenate(x) for x in zip(*runs, strict=True))
     else:

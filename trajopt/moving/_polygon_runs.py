@@ -1,0 +1,276 @@
+"""The forbidden runs of polygon movers against a disc robot on the ``(s, t)`` grid.
+
+A node ``s_i`` is forbidden at grid time ``t_k`` when the path's point there is closer to the
+mover's polygon at ``t_k`` than ``lim(t_k)`` (the robot radius, the margin, the mover's
+radius and the grid's pad, :func:`._st_grid.st_grid`). On each piece of a mover's track
+between waypoint times its reference point moves at a constant velocity ``v``, its heading
+turns at a constant rate ``w`` and its radius grows at ``g`` (:func:`polygon_pieces`), so
+every point of the polygon moves at most ``|v| + R |w|`` (``R`` its farthest vertex from the
+reference point) and ``f(t) = distance - lim(t)`` changes at most at ``lip = |v| + R |w| +
+g`` (m/s). One exact evaluation ``f(t_k)`` therefore decides every grid time within
+``|f(t_k)| / lip`` of ``t_k``: all have the sign of ``f(t_k)``. :func:`polygon_runs` marches
+each pair of a piece and a node through the piece's grid times this way
+(:func:`march_kernel`): where the point is far from the boundary it strides over many grid
+times, near it one at a time, and every grid time gets the answer of the exact test.
+
+The test is made conservative against rounding: ``lim`` is raised by :data:`EPS_LIM` on a
+sufficient grid (a node within 1 nm of the limit counts as forbidden) and lowered by it on a
+necessary one, and a stride keeps :data:`EPS_LIM` of ``|f|`` in hand. Only the pairs whose
+distance can come under the limit at all are marched (:func:`._disc_windows.near_pairs` with
+each piece's bounding disc: an exact filter).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numba import njit
+
+from trajopt.kernel_cache import watch_compiles
+from trajopt.moving._disc_windows import mover_pieces, near_pairs
+from trajopt.moving._obstacle import MovingObstacle
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
+
+#: The limit is raised (sufficient grid) or lowered (necessary grid) by this much (m).
+EPS_LIM = 1e-9
+
+
+class PolygonPieces:
+    """The movers' tracks as linear pieces with headings (module docstring).
+
+    Parameters
+    ----------
+    movers : sequence of MovingObstacle
+        Any shapes (a disc is a polygon of one vertex at its reference point).
+
+    Attributes
+    ----------
+    pieces : ndarray, shape (p, 9)
+        :func:`._disc_windows.mover_pieces` of the movers (limit 0): their reference points.
+    bound : ndarray, shape (p, 9)
+        The same with each mover's reach added to the radius: its bounding discs.
+    head0, turn : ndarray, shape (p,)
+        Heading (rad) at each piece's start and its turn rate (rad/s).
+    verts : ndarray, shape (movers, m, 2)
+        Each mover's polygon in its own frame (m), CCW, padded by repeating its first vertex.
+    edges : ndarray, shape (movers, m, 2)
+        ``verts`` rolled by one minus ``verts`` (zero for the padding).
+    poly : ndarray of bool, shape (movers,)
+        The mover is a polygon (3 vertices or more).
+    reach : ndarray, shape (movers,)
+        Farthest vertex from the reference point (m).
+    lip : ndarray, shape (p,)
+        ``|v| + R |w| + max(g, 0)`` (m/s) of each piece.
+    """
+
+    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
+        self.pieces = mover_pieces(movers, 0.0)
+        who = self.pieces[:, 0].astype(np.int64)
+        u, w = self.pieces[:, 1], self.pieces[:, 2]
+        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
+        m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
+        self.verts = np.zeros((len(movers), m_max, 2))
+        self.poly = np.zeros(len(movers), dtype=bool)
+        reach = np.zeros(len(movers))
+        for j, m in enumerate(movers):
+            v = m.shape_vertices
+            self.verts[j, : v.shape[0]] = v
+            self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
+            self.poly[j] = v.shape[0] >= 3
+            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
+            mine = who == j
+            uj, wj = u[mine], w[mine]
+            h_u = np.interp(uj, m.times, m.headings)
+            fin = np.isfinite(wj)
+            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                head0[mine] = h_u
+                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
+        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
+        self.head0, self.turn, self.reach = head0, turn, reach
+        self.bound = self.pieces.copy()
+        self.bound[:, 7] += reach[who]
+        speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
+        self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
+
+
+def polygon_runs(
+    pts: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    owners: Sequence[int],
+    lim0: np.ndarray,
+    t: np.ndarray,
+    sufficient: bool,
+    after: np.ndarray | None = None,
+) -> tuple[np.ndarray, ...]:
+    """Return the runs ``(node, first, last, mover)`` of polygon movers against points (module docstring).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        The path's points at the nodes (m).
+    movers : sequence of MovingObstacle
+        Polygon movers (a disc is accepted too: a polygon of one vertex).
+    owners : sequence of int
+        The grid's index of each mover (the runs' ``mover``).
+    lim0 : ndarray, shape (len(movers),)
+        Each mover's limit without its radius (m): the robot radius, the margin and the pad;
+        the mover's radius at ``t_k`` (growing) is added.
+    t : ndarray, shape (K,)
+        Grid times ``k dt`` (s).
+    sufficient : bool
+        Raise the limit by :data:`EPS_LIM` (else lower it).
+    after : ndarray, shape (n,), optional
+        Per node (s): the pieces of track that end before it are left out for that node
+        (their runs could not meet the robot).
+
+    Returns
+    -------
+    node, first, last, mover : ndarray of int, shape (r,)
+        A run per stretch of forbidden grid times of a node on one piece (first and last
+        time index inclusive; runs of consecutive pieces may touch or overlap).
+    """
+    tracks = PolygonPieces(movers)
+    j = tracks.pieces[:, 0].astype(np.int64)
+    eps = EPS_LIM if sufficient else -EPS_LIM
+    lim_add = np.asarray(lim0, dtype=float)[j] + eps
+    rows = tracks.bound.copy()
+    rows[:, 7] += lim_add
+    band = None if after is None else (after, np.full(after.shape, np.inf))
+    seg, pi = near_pairs(pts, rows, 0.0, band)
+    dt, kk = float(t[1] - t[0]), int(t.shape[0])
+    p = tracks.pieces
+    node, k0, k1, piece = march_kernel(
+        np.ascontiguousarray(pts, dtype=np.float64),
+        seg.astype(np.int64),
+        pi.astype(np.int64),
+        np.ascontiguousarray(p[:, 1:9]),
+        j,
+        tracks.head0,
+        tracks.turn,
+        tracks.lip,
+        lim_add,
+        tracks.verts,
+        tracks.edges,
+        tracks.poly,
+        dt,
+        kk,
+    )
+    owner = np.asarray(owners, dtype=np.int64)[j[piece]]
+    return node, k0, k1, owner
+
+
+@njit(cache=True)
+def _clearance(
+    px, py, row, head0, turn, lim_add, verts, edges, poly, j, tk
+):  # pragma: no cover - compiled
+    """Return the point's distance (m) to mover ``j``'s polygon at ``tk`` minus the limit."""
+    u, w = row[0], row[1]
+    tau = tk - u
+    run = tau if np.isfinite(w) else 0.0
+    cx = row[2] + row[4] * run
+    cy = row[3] + row[5] * run
+    th = head0 + turn * run
+    rad = row[6] + row[7] * tau
+    c, s = np.cos(th), np.sin(th)
+    dx, dy = px - cx, py - cy
+    qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
+    best = np.inf
+    inside = poly[j]
+    for e in range(verts.shape[1]):
+        qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
+        ex, ey = edges[j, e, 0], edges[j, e, 1]
+        ee = ex * ex + ey * ey
+        lam = 0.0
+        if ee > 0.0:
+            lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
+        rx, ry = qx - lam * ex, qy - lam * ey
+        best = min(best, np.sqrt(rx * rx + ry * ry))
+        if ex * qy - ey * qx < 0.0:
+            inside = False
+    d = 0.0 if inside else best
+    return d - rad - lim_add
+
+
+@njit(cache=True)
+def march_kernel(
+    pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, dt, kk
+):  # pragma: no cover - compiled
+    """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    seg, pi : ndarray of int64, shape (q,)
+        The piece and the point of each pair.
+    rows : ndarray, shape (p, 8)
+        Columns 1..8 of :func:`._disc_windows.mover_pieces`: ``u, w, x, y, vx, vy, r, g``.
+    who : ndarray of int64, shape (p,)
+        The mover of each piece (a row of ``verts``).
+    head0, turn, lip, lim_add : ndarray, shape (p,)
+        Heading (rad) at ``u``, turn rate (rad/s), Lipschitz bound (m/s), and the limit
+        besides the mover's radius (m) of each piece.
+    verts, edges : ndarray, shape (movers, m, 2)
+    poly : ndarray of bool, shape (movers,)
+        As :class:`PolygonPieces`.
+    dt : float
+        Grid step (s).
+    kk : int
+        Grid times.
+    """
+    cap = max(16, 2 * seg.shape[0])
+    out = np.empty((cap, 4), dtype=np.int64)
+    nr = 0
+    for q in range(seg.shape[0]):
+        p, i = seg[q], pi[q]
+        u, w = rows[p, 0], rows[p, 1]
+        ka = max(int(np.ceil(u / dt - 1e-9)), 0)
+        kb = kk - 1
+        if np.isfinite(w):
+            kb = min(int(np.floor(w / dt + 1e-9)), kk - 1)
+        j = who[p]
+        lp = lip[p]
+        px, py = pts[i, 0], pts[i, 1]
+        k = ka
+        start = -1  # first time index of the open run
+        while k <= kb:
+            f = _clearance(
+                px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
+            )
+            hit = f < 0.0
+            room = abs(f) - 1e-9  # in hand against rounding
+            more = 0
+            if lp <= 0.0:
+                if room > 0.0:
+                    more = kb - k
+            elif room > 0.0:
+                x = room / (lp * dt)
+                if x > kb - k + 1.0:
+                    more = kb - k
+                else:
+                    more = int(x)
+                    if more * lp * dt >= room:
+                        more -= 1
+                    more = max(more, 0)
+            if hit and start < 0:
+                start = k
+            elif not hit and start >= 0:
+                if nr == out.shape[0]:
+                    bigger = np.empty((2 * out.shape[0], 4), dtype=np.int64)
+                    bigger[:nr] = out[:nr]
+                    out = bigger
+                out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, start, k - 1, p
+                nr += 1
+                start = -1
+            k += more + 1
+        if start >= 0:
+            if nr == out.shape[0]:
+                bigger = np.empty((2 * out.shape[0], 4), dtype=np.int64)
+                bigger[:nr] = out[:nr]
+                out = bigger
+            out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, start, kb, p
+            nr += 1
+    return out[:nr, 0].copy(), out[:nr, 1].copy(), out[:nr, 2].copy(), out[:nr, 3].copy()
