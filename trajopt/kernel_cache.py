@@ -67,7 +67,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.robot._footprint_kernels",
     "trajopt.geometry._obstacle_index",
     "trajopt.moving._st_kernels",
-    "trajopt.moving._polygon_runs",
+    "trajopt.moving._polygon_march",
     "trajopt.corridor._polygons.path_kernels",
     "trajopt.corridor._polygons.region_kernels",
     "trajopt.smoother._cost_kernels",

@@ -166,7 +166,7 @@ def _exercise_moving() -> None:
         MovingObstacle.constant_velocity((0.0, -1.5), (0.0, 0.5), radius=0.3, horizon=24.0),
     ]
     retime_for_movers(line, movers)
-    # a cart crossing the drive: the polygon movers' grid (trajopt.moving._polygon_runs)
+    # a cart crossing the drive: the polygon movers' grid (trajopt.moving._polygon_march)
     box = [(-0.4, -0.25), (0.4, -0.25), (0.4, 0.25), (-0.4, 0.25)]
     cart = MovingObstacle.constant_velocity(
         (3.0, -3.0), (0.0, 0.4), radius=0.05, horizon=24.0, vertices=box

@@ -25,8 +25,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from trajopt.moving._disc_windows import close_pairs, inside_times, mover_pieces, near_pairs
+from trajopt.moving._disc_windows import close_pairs, inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._polygon_march import PolygonPieces, windows_kernel
 from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
 
 #: The least time step (s) of the fine nodes' windows.
@@ -41,51 +42,22 @@ LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
 REFINE_TAU = 1e-3
 
 
-class ShapeTracks:
+class ShapeTracks(PolygonPieces):
     """The movers' tracks as linear pieces with headings, for :meth:`windows` (module docstring).
+
+    :class:`._polygon_march.PolygonPieces` (its attributes) with the clearance of points and
+    the march of :meth:`windows`.
 
     Parameters
     ----------
     movers : sequence of MovingObstacle
         Any shapes (a disc is a polygon of one vertex at its reference point).
-
-    Attributes
-    ----------
-    pieces : ndarray, shape (p, 9)
-        :func:`._disc_windows.mover_pieces` of the movers (limit 0): their reference points.
-    bound : ndarray, shape (p, 9)
-        The same with each mover's reach added to the radius: its bounding discs.
     """
 
     def __init__(self, movers: Sequence[MovingObstacle]) -> None:
-        self.pieces = mover_pieces(movers, 0.0)
-        who = self.pieces[:, 0].astype(np.int64)
-        u, w = self.pieces[:, 1], self.pieces[:, 2]
-        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
-        m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
-        self.verts = np.zeros((len(movers), m_max, 2))
-        self.poly = np.zeros(len(movers), dtype=bool)
-        reach = np.zeros(len(movers))
-        for j, m in enumerate(movers):
-            v = m.shape_vertices
-            self.verts[j, : v.shape[0]] = v
-            self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
-            self.poly[j] = v.shape[0] >= 3
-            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
-            mine = who == j
-            uj, wj = u[mine], w[mine]
-            h_u = np.interp(uj, m.times, m.headings)
-            fin = np.isfinite(wj)
-            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                head0[mine] = h_u
-                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
-        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
-        self.head0, self.turn, self.reach = head0, turn, reach
-        self.bound = self.pieces.copy()
-        self.bound[:, 7] += reach[who]
-        speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
-        self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
+        super().__init__(movers)
+        self._rows = np.ascontiguousarray(self.pieces[:, 1:9])
+        self._who = self.pieces[:, 0].astype(np.int64)
 
     def clearance(self, seg: np.ndarray, pts: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Return the distance (m) of ``pts`` (shape (n, 2)) to the shapes of pieces ``seg`` at ``t`` (s), minus their radius."""
@@ -168,29 +140,24 @@ class ShapeTracks:
             b = np.minimum(b, band[1][pi])
         keep = a < b
         seg, pi, a, b = seg[keep], pi[keep], a[keep], b[keep]
-        lip = self.lip[seg]
-        out_i, out_lo, out_hi = [], [], []
-        t, cov = a.copy(), a.copy()  # next sample; everything before cov is settled
-        live = np.arange(a.shape[0])
-        while live.size:
-            tl = t[live]
-            f = self.clearance(seg[live], pts[pi[live]], tl) - limit
-            with np.errstate(divide="ignore", invalid="ignore"):  # a standing shape: lip 0
-                rho = np.where(lip[live] > 0.0, f / lip[live], np.where(f > 0.0, np.inf, -np.inf))
-            w_hi = np.minimum(tl - rho, b[live])
-            bad = w_hi > cov[live]
-            out_i.append(live[bad])
-            out_lo.append(cov[live][bad])
-            out_hi.append(w_hi[bad])
-            cov[live] = np.maximum(cov[live], tl + np.abs(rho))
-            last = tl >= b[live]
-            t[live] = np.minimum(tl + np.maximum(np.abs(rho), step), b[live])
-            live = live[~last & (cov[live] < b[live])]
-        idx = np.concatenate(out_i) if out_i else np.zeros(0, dtype=np.int64)
-        lo = np.concatenate(out_lo) if out_lo else np.zeros(0)
-        hi = np.concatenate(out_hi) if out_hi else np.zeros(0)
-        # one window per stretch: the touching ones of a pair merged, each end widened
-        lo, hi, idx = _merged(lo - EPS_W, hi + EPS_W, idx)
+        idx, lo, hi = windows_kernel(
+            np.ascontiguousarray(pts, dtype=np.float64),
+            seg.astype(np.int64),
+            pi.astype(np.int64),
+            a,
+            b,
+            self._rows,
+            self._who,
+            self.head0,
+            self.turn,
+            self.lip,
+            float(limit),
+            self.verts,
+            self.edges,
+            self.poly,
+            float(step),
+            EPS_W,
+        )
         who = self.pieces[seg[idx], 0].astype(np.int64)
         return who, pi[idx].astype(np.int64), lo, hi
 
@@ -307,17 +274,3 @@ class ShapeWindows(FineWindows):
         f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
         keep = f_hi > f_lo
         return f_lo[keep], f_hi[keep]
-
-
-def _merged(
-    lo: np.ndarray, hi: np.ndarray, key: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Return the windows ``(lo, hi)`` (s) of each ``key`` with the overlapping consecutive ones merged."""
-    if lo.size == 0:
-        return lo, hi, key
-    order = np.lexsort((lo, key))
-    lo, hi, key = lo[order], hi[order], key[order]
-    new = np.ones(lo.shape[0], dtype=bool)
-    new[1:] = (key[1:] != key[:-1]) | (lo[1:] > hi[:-1])
-    first = np.flatnonzero(new)
-    return lo[first], np.maximum.reduceat(hi, first), key[first]

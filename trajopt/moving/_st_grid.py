@@ -18,7 +18,7 @@ linear in ``t``, so ``|C(s_i) - c(t)| - lim(t)`` is convex in ``t`` and its nega
 one interval, the roots of a quadratic; the node is forbidden exactly at the grid times inside
 it (widened by 1 ns on the sufficient grid, narrowed on the necessary one, against rounding).
 A polygon mover against a disc robot: each pair of a piece of its track and a node is
-marched through the grid times (:mod:`._polygon_runs`): an exact test at a grid time decides
+marched through the grid times (:mod:`._polygon_march`): an exact test at a grid time decides
 every grid time within its clearance over the mover's speed bound, so the runs are those of
 the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding).
 A footprint robot is tested exactly at every node and grid time near a mover (:func:`_shape_hits`).
@@ -40,7 +40,7 @@ from scipy.spatial import cKDTree
 from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._disc_windows import inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._polygon_runs import polygon_runs
+from trajopt.moving._polygon_march import polygon_runs
 
 #: A run's end index standing for "until after the grid's last time" (the movers then stand).
 FOREVER = 1 << 40

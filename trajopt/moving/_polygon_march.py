@@ -187,7 +187,7 @@ def _clearance(
         if ee > 0.0:
             lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
         rx, ry = qx - lam * ex, qy - lam * ey
-        best = min(best, np.sqrt(rx * rx + ry * ry))
+        best = min(best, np.hypot(rx, ry))
         if ex * qy - ey * qx < 0.0:
             inside = False
     d = 0.0 if inside else best
@@ -274,3 +274,68 @@ def march_kernel(
             out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, start, kb, p
             nr += 1
     return out[:nr, 0].copy(), out[:nr, 1].copy(), out[:nr, 2].copy(), out[:nr, 3].copy()
+
+
+@njit(cache=True)
+def windows_kernel(
+    pts, seg, pi, a, b, rows, who, head0, turn, lip, limit, verts, edges, poly, step, eps
+):  # pragma: no cover - compiled
+    """Return the violation windows ``(pair, lo, hi)`` (s) of the pairs ``(seg[q], pi[q])`` during ``[a[q], b[q]]``.
+
+    The march of :meth:`._shape_windows.ShapeTracks.windows`: from ``t = a`` a sample
+    ``f = f(t)`` (the clearance minus ``limit``, m) proves ``f > 0`` or ``f < 0`` on
+    ``(t - |f| / lip, t + |f| / lip)``; every stretch from the first time not yet settled
+    to ``t - f / lip`` (capped at ``b``) is a window, and the next sample is
+    ``max(|f| / lip, step)`` later (capped at ``b``), until ``b`` is settled or sampled.
+    Each window is widened by ``eps`` (s) at both ends, and the consecutive ones of a pair
+    that then overlap are merged. Arguments as :func:`march_kernel`, besides ``a``, ``b``
+    (shape (q,), s; ``b`` may be ``inf``), ``limit`` (m) and ``step`` (s).
+
+    Returns
+    -------
+    pair : ndarray of int64, shape (r,)
+        Index into ``seg``/``pi``.
+    lo, hi : ndarray, shape (r,)
+        The windows (s), in order of pair and time.
+    """
+    cap = max(16, seg.shape[0])
+    pair = np.empty(cap, dtype=np.int64)
+    lo = np.empty(cap)
+    hi = np.empty(cap)
+    nr = 0
+    for q in range(seg.shape[0]):
+        p, i = seg[q], pi[q]
+        j = who[p]
+        lp = lip[p]
+        px, py = pts[i, 0], pts[i, 1]
+        bq = b[q]
+        t = a[q]
+        cov = a[q]
+        last_hi = -np.inf  # the widened end of the pair's last window
+        while True:
+            f = _clearance(px, py, rows[p], head0[p], turn[p], limit, verts, edges, poly, j, t)
+            if lp > 0.0:
+                rho = f / lp
+            elif f > 0.0:
+                rho = np.inf
+            else:
+                rho = -np.inf
+            w_hi = min(t - rho, bq)
+            if w_hi > cov:
+                w_lo, w_up = cov - eps, w_hi + eps
+                if nr > 0 and pair[nr - 1] == q and not (w_lo > last_hi):
+                    hi[nr - 1] = max(hi[nr - 1], w_up)
+                else:
+                    if nr == pair.shape[0]:
+                        pair = np.concatenate((pair, np.empty(nr, dtype=np.int64)))
+                        lo = np.concatenate((lo, np.empty(nr)))
+                        hi = np.concatenate((hi, np.empty(nr)))
+                    pair[nr], lo[nr], hi[nr] = q, w_lo, w_up
+                    nr += 1
+                last_hi = w_up
+            cov = max(cov, t + abs(rho))
+            done = t >= bq
+            t = min(t + max(abs(rho), step), bq)
+            if done or not (cov < bq):
+                break
+    return pair[:nr].copy(), lo[:nr].copy(), hi[:nr].copy()

@@ -16,7 +16,7 @@ import shapely
 from shapely.geometry import Polygon
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._polygon_runs import polygon_runs
+from trajopt.moving._polygon_march import polygon_runs
 
 
 def _random_movers(rng, n):
