@@ -1,23 +1,28 @@
-"""The forbidden runs of polygon movers against a disc robot on the ``(s, t)`` grid.
+"""Marching points against polygon movers' tracks: one exact test decides a stretch of time.
 
-A node ``s_i`` is forbidden at grid time ``t_k`` when the path's point there is closer to the
-mover's polygon at ``t_k`` than ``lim(t_k)`` (the robot radius, the margin, the mover's
-radius and the grid's pad, :func:`._st_grid.st_grid`). On each piece of a mover's track
-between waypoint times its reference point moves at a constant velocity ``v``, its heading
-turns at a constant rate ``w`` and its radius grows at ``g`` (:func:`polygon_pieces`), so
-every point of the polygon moves at most ``|v| + R |w|`` (``R`` its farthest vertex from the
-reference point) and ``f(t) = distance - lim(t)`` changes at most at ``lip = |v| + R |w| +
-g`` (m/s). One exact evaluation ``f(t_k)`` therefore decides every grid time within
-``|f(t_k)| / lip`` of ``t_k``: all have the sign of ``f(t_k)``. :func:`polygon_runs` marches
-each pair of a piece and a node through the piece's grid times this way
-(:func:`march_kernel`): where the point is far from the boundary it strides over many grid
-times, near it one at a time, and every grid time gets the answer of the exact test.
+On each piece of a mover's track between waypoint times its reference point moves at a
+constant velocity ``v``, its heading turns at a constant rate ``w`` and its radius grows at
+``g`` (:class:`PolygonPieces`), so every point of its polygon moves at most ``|v| + R |w|``
+(``R`` its farthest vertex from the reference point) and the distance ``f(t)`` from a fixed
+point to the shape, minus the radius and a limit, changes at most at ``lip = |v| + R |w| +
+g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves the sign of
+``f`` on ``(t - |f(t)| / lip, t + |f(t)| / lip)``. Two marches use it:
 
-The test is made conservative against rounding: ``lim`` is raised by :data:`EPS_LIM` on a
-sufficient grid (a node within 1 nm of the limit counts as forbidden) and lowered by it on a
-necessary one, and a stride keeps :data:`EPS_LIM` of ``|f|`` in hand. Only the pairs whose
-distance can come under the limit at all are marched (:func:`._disc_windows.near_pairs` with
-each piece's bounding disc: an exact filter).
+* :func:`polygon_runs` (:func:`march_kernel`): the ``(s, t)`` grid's forbidden runs of polygon
+  movers against a disc robot (:func:`._st_grid.st_grid`). A node ``s_i`` is forbidden at
+  grid time ``t_k`` when the path's point there is closer to the mover's shape at ``t_k``
+  than ``lim(t_k)`` (the robot radius, the margin, the mover's radius and the grid's pad).
+  Each pair of a piece and a node is marched through the piece's grid times: one exact test
+  decides every grid time within ``|f| / lip`` of it (all have its sign), so where the point
+  is far from the boundary the march strides over many grid times, near it it steps one at
+  a time, and every grid time gets the answer of the exact test. Against rounding the test
+  is conservative: ``lim`` is raised by :data:`EPS_LIM` on a sufficient grid (a node within
+  1 nm of the limit counts as forbidden) and lowered by it on a necessary one, and a stride
+  keeps 1 nm of ``|f|`` in hand. Only the pairs whose distance can come under the limit at
+  all are marched (:func:`._disc_windows.near_pairs` with each piece's bounding disc: an
+  exact filter).
+* :func:`windows_kernel`: the violation windows in continuous time of
+  :meth:`._shape_windows.ShapeTracks.windows` (sampled with a least step; sufficient).
 """
 
 from __future__ import annotations
@@ -38,7 +43,7 @@ EPS_LIM = 1e-9
 
 
 class PolygonPieces:
-    """The movers' tracks as linear pieces with headings (module docstring).
+    """The movers' tracks as linear pieces with headings, and their Lipschitz bounds (module docstring).
 
     Parameters
     ----------
