@@ -68,6 +68,10 @@ class PolygonPieces:
         Farthest vertex from the reference point (m).
     lip : ndarray, shape (p,)
         ``|v| + R |w| + max(g, 0)`` (m/s) of each piece.
+    rows : ndarray, shape (p, 8)
+        Columns 1..8 of ``pieces`` (the kernels' form).
+    who : ndarray of int64, shape (p,)
+        The mover of each piece.
     """
 
     def __init__(self, movers: Sequence[MovingObstacle]) -> None:
@@ -99,6 +103,8 @@ class PolygonPieces:
         self.bound[:, 7] += reach[who]
         speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
         self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
+        self.rows = np.ascontiguousarray(self.pieces[:, 1:9])
+        self.who = who
 
 
 def polygon_runs(
@@ -138,7 +144,7 @@ def polygon_runs(
         time index inclusive; runs of consecutive pieces may touch or overlap).
     """
     tracks = PolygonPieces(movers)
-    j = tracks.pieces[:, 0].astype(np.int64)
+    j = tracks.who
     eps = EPS_LIM if sufficient else -EPS_LIM
     lim_add = np.asarray(lim0, dtype=float)[j] + eps
     rows = tracks.bound.copy()
@@ -146,12 +152,11 @@ def polygon_runs(
     band = None if after is None else (after, np.full(after.shape, np.inf))
     seg, pi = near_pairs(pts, rows, 0.0, band)
     dt, kk = float(t[1] - t[0]), int(t.shape[0])
-    p = tracks.pieces
     node, k0, k1, piece = march_kernel(
         np.ascontiguousarray(pts, dtype=np.float64),
         seg.astype(np.int64),
         pi.astype(np.int64),
-        np.ascontiguousarray(p[:, 1:9]),
+        tracks.rows,
         j,
         tracks.head0,
         tracks.turn,
@@ -344,3 +349,47 @@ def windows_kernel(
             if done or not (cov < bq):
                 break
     return pair[:nr].copy(), lo[:nr].copy(), hi[:nr].copy()
+
+
+@njit(cache=True)
+def launch_bound_kernel(
+    launch, tau, mover, pts, pad, rows, first, head0, turn, verts, edges, poly
+):  # pragma: no cover - compiled
+    """Return the clearance (m) of points at times ``launch + tau`` less ``pad``, shape (L, q).
+
+    Point ``pts[r]`` (m) is measured against mover ``mover[r]`` at ``launch[l] + tau[r]``
+    (s, at least 0) on the piece of its track holding that time (the last piece starting at
+    or before it), minus the radius and ``pad[r]`` (m) (the bound ``G`` of
+    :meth:`._shape_windows.ShapeWindows._exact` before its minimum over the points).
+
+    Parameters
+    ----------
+    launch : ndarray, shape (L,)
+    tau, pad : ndarray, shape (q,)
+    mover : ndarray of int64, shape (q,)
+    pts : ndarray, shape (q, 2)
+    rows : ndarray, shape (p, 8)
+        As :func:`march_kernel` (the pieces in order of mover and time).
+    first : ndarray of int64, shape (movers + 1,)
+        The pieces of mover ``j`` are ``first[j]:first[j + 1]``.
+    head0, turn, verts, edges, poly
+        As :func:`march_kernel`.
+    """
+    out = np.empty((launch.shape[0], tau.shape[0]))
+    for r in range(tau.shape[0]):
+        j = mover[r]
+        a, b = first[j], first[j + 1]
+        for li in range(launch.shape[0]):
+            t = launch[li] + tau[r]
+            lo_i, hi_i = a, b - 1  # the last piece with u <= t (the first if none)
+            while lo_i < hi_i:
+                m = (lo_i + hi_i + 1) // 2
+                if rows[m, 0] <= t:
+                    lo_i = m
+                else:
+                    hi_i = m - 1
+            p = lo_i
+            out[li, r] = _clearance(
+                pts[r, 0], pts[r, 1], rows[p], head0[p], turn[p], pad[r], verts, edges, poly, j, t
+            )
+    return out

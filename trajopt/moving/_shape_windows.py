@@ -27,7 +27,7 @@ import numpy as np
 
 from trajopt.moving._disc_windows import close_pairs, inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._polygon_march import PolygonPieces, windows_kernel
+from trajopt.moving._polygon_march import PolygonPieces, launch_bound_kernel, windows_kernel
 from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
 
 #: The least time step (s) of the fine nodes' windows.
@@ -45,48 +45,13 @@ REFINE_TAU = 1e-3
 class ShapeTracks(PolygonPieces):
     """The movers' tracks as linear pieces with headings, for :meth:`windows` (module docstring).
 
-    :class:`._polygon_march.PolygonPieces` (its attributes) with the clearance of points and
-    the march of :meth:`windows`.
+    :class:`._polygon_march.PolygonPieces` (its attributes) with the march of :meth:`windows`.
 
     Parameters
     ----------
     movers : sequence of MovingObstacle
         Any shapes (a disc is a polygon of one vertex at its reference point).
     """
-
-    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
-        super().__init__(movers)
-        self._rows = np.ascontiguousarray(self.pieces[:, 1:9])
-        self._who = self.pieces[:, 0].astype(np.int64)
-
-    def clearance(self, seg: np.ndarray, pts: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Return the distance (m) of ``pts`` (shape (n, 2)) to the shapes of pieces ``seg`` at ``t`` (s), minus their radius."""
-        row = self.pieces[seg]
-        tau = t - row[:, 1]
-        run = np.where(np.isfinite(row[:, 2]), tau, 0.0)
-        cx = row[:, 3] + row[:, 5] * run
-        cy = row[:, 4] + row[:, 6] * run
-        th = self.head0[seg] + self.turn[seg] * run
-        rad = row[:, 7] + row[:, 8] * tau
-        c, s = np.cos(th), np.sin(th)
-        dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
-        # the point in the mover's frame, against its fixed polygon
-        px, py = c * dx + s * dy, -s * dx + c * dy
-        j = row[:, 0].astype(np.int64)
-        v, e = self.verts[j], self.edges[j]
-        qx, qy = px[:, None] - v[..., 0], py[:, None] - v[..., 1]
-        ee = np.maximum(e[..., 0] ** 2 + e[..., 1] ** 2, 1e-300)
-        lam = np.clip((qx * e[..., 0] + qy * e[..., 1]) / ee, 0.0, 1.0)
-        dist = np.min(np.hypot(qx - lam * e[..., 0], qy - lam * e[..., 1]), axis=1)
-        inside = self.poly[j] & np.all(e[..., 0] * qy - e[..., 1] * qx >= 0.0, axis=1)
-        return np.where(inside, 0.0, dist) - rad
-
-    def piece_at(self, mover: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Return the piece (row of :attr:`pieces`) of each ``mover`` at times ``t`` (s), ``t >= 0``."""
-        who = self.pieces[:, 0]
-        big = 2.0 * (float(np.max(self.pieces[:, 1], initial=0.0)) + float(np.max(t)) + 1.0)
-        key = who * big + self.pieces[:, 1]
-        return np.searchsorted(key, mover * big + t, side="right") - 1
 
     def windows(
         self,
@@ -146,8 +111,8 @@ class ShapeTracks(PolygonPieces):
             pi.astype(np.int64),
             a,
             b,
-            self._rows,
-            self._who,
+            self.rows,
+            self.who,
             self.head0,
             self.turn,
             self.lip,
@@ -242,13 +207,25 @@ class ShapeWindows(FineWindows):
         lip = lip_m[who]
         pad = 0.5 * REFINE_TAU * (self.speed + lip) + self.limit
 
+        pts = np.ascontiguousarray(pts, dtype=np.float64)
+        starts = np.searchsorted(tr.who, np.arange(len(self.movers) + 1))
+
         def g(launch: np.ndarray, rows: np.ndarray) -> np.ndarray:
             """Return the clearance bound (m), shape (len(launch), len(rows))."""
-            t = launch[:, None] + tau[None, rows]
-            seg = tr.piece_at(np.broadcast_to(who[rows], t.shape).ravel(), t.ravel())
-            p = np.broadcast_to(pts[rows], (*t.shape, 2)).reshape(-1, 2)
-            f = tr.clearance(seg, p, t.ravel()).reshape(t.shape)
-            return f - pad[rows]
+            return launch_bound_kernel(
+                np.ascontiguousarray(launch, dtype=np.float64),
+                tau[rows],
+                who[rows].astype(np.int64),
+                pts[rows],
+                pad[rows],
+                tr.rows,
+                starts,
+                tr.head0,
+                tr.turn,
+                tr.verts,
+                tr.edges,
+                tr.poly,
+            )
 
         mid = 0.5 * (lo + hi)
         rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
