@@ -16,7 +16,7 @@ import shapely
 from shapely.geometry import Polygon
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._polygon_march import polygon_runs
+from trajopt.moving._polygon_march import PolygonPieces, launch_bound_kernel, polygon_runs
 
 
 def _random_movers(rng, n):
@@ -118,3 +118,42 @@ def test_a_standing_mover_is_decided_by_one_test_and_lasts_to_the_last_time():
     # limits 0.35 m: the first and the last are inside, the middle one outside
     assert sorted(node.tolist()) == [0, 2]
     assert np.all(lo == 0) and np.all(hi == 49)
+
+
+def test_the_launch_bound_is_the_clearance_at_the_launch_plus_tau():
+    """Each point against its mover at ``launch + tau``: shapely's distance minus the
+    mover's radius (growing) minus the pad."""
+    rng = np.random.default_rng(3)
+    movers = _random_movers(rng, 3)
+    tracks = PolygonPieces(movers)
+    q = 40
+    pts = rng.uniform(-1.0, 4.0, (q, 2))
+    tau = rng.uniform(0.0, 2.0, q)
+    mover = rng.integers(0, 3, q)
+    pad = rng.uniform(0.0, 0.2, q)
+    launch = np.array([0.0, 0.7, 3.3, 9.0])
+    starts = np.searchsorted(tracks.who, np.arange(len(movers) + 1))
+    got = launch_bound_kernel(
+        launch,
+        tau,
+        mover,
+        pts,
+        pad,
+        tracks.rows,
+        starts,
+        tracks.head0,
+        tracks.turn,
+        tracks.verts,
+        tracks.edges,
+        tracks.poly,
+    )
+    for li, lt in enumerate(launch):
+        for r in range(q):
+            m, t = movers[mover[r]], lt + tau[r]
+            x = np.interp(t, m.times, m.positions[:, 0])
+            y = np.interp(t, m.times, m.positions[:, 1])
+            h = np.interp(t, m.times, m.headings)
+            c, sn = np.cos(h), np.sin(h)
+            shape = Polygon(np.array([x, y]) + m.vertices @ np.array([[c, sn], [-sn, c]]))
+            want = shapely.distance(shape, shapely.points(pts[r])) - m.radius_at(t) - pad[r]
+            assert got[li, r] == pytest.approx(want, abs=1e-9)
