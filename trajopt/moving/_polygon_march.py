@@ -40,6 +40,9 @@ watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 #: The limit is raised (sufficient grid) or lowered (necessary grid) by this much (m).
 EPS_LIM = 1e-9
+#: Added to the pair filter's reach with a footprint (m): rounding of the reaches never drops
+#: a pair the exact test hits.
+NEAR_PAD = 1e-9
 
 
 class PolygonPieces:
@@ -64,6 +67,8 @@ class PolygonPieces:
         ``verts`` rolled by one minus ``verts`` (zero for the padding).
     poly : ndarray of bool, shape (movers,)
         The mover is a polygon (3 vertices or more).
+    nv : ndarray of int64, shape (movers,)
+        Its number of vertices (the first ``nv[j]`` rows of ``verts[j]``).
     reach : ndarray, shape (movers,)
         Farthest vertex from the reference point (m).
     lip : ndarray, shape (p,)
@@ -83,6 +88,7 @@ class PolygonPieces:
         self.verts = np.zeros((len(movers), m_max, 2))
         self.poly = np.zeros(len(movers), dtype=bool)
         reach = np.zeros(len(movers))
+        self.nv = np.array([m.shape_vertices.shape[0] for m in movers], dtype=np.int64)
         for j, m in enumerate(movers):
             v = m.shape_vertices
             self.verts[j, : v.shape[0]] = v
@@ -115,8 +121,9 @@ def polygon_runs(
     t: np.ndarray,
     sufficient: bool,
     after: np.ndarray | None = None,
+    polys: np.ndarray | None = None,
 ) -> tuple[np.ndarray, ...]:
-    """Return the runs ``(node, first, last, mover)`` of polygon movers against points (module docstring).
+    """Return the runs ``(node, first, last, mover)`` of polygon movers against a disc or footprint robot (module docstring).
 
     Parameters
     ----------
@@ -127,8 +134,8 @@ def polygon_runs(
     owners : sequence of int
         The grid's index of each mover (the runs' ``mover``).
     lim0 : ndarray, shape (len(movers),)
-        Each mover's limit without its radius (m): the robot radius, the margin and the pad;
-        the mover's radius at ``t_k`` (growing) is added.
+        Each mover's limit without its radius (m): the robot radius (none with ``polys``),
+        the margin and the pad; the mover's radius at ``t_k`` (growing) is added.
     t : ndarray, shape (K,)
         Grid times ``k dt`` (s).
     sufficient : bool
@@ -136,6 +143,10 @@ def polygon_runs(
     after : ndarray, shape (n,), optional
         Per node (s): the pieces of track that end before it are left out for that node
         (their runs could not meet the robot).
+    polys : ndarray, shape (n, mb, 2), optional
+        A footprint robot: its convex CCW polygon at each node (m); the test is then the
+        signed distance of the two polygons (:func:`._certificate.convex_distance`) against
+        the limit, and a node's pairs are those within the footprint's reach of it.
 
     Returns
     -------
@@ -149,6 +160,12 @@ def polygon_runs(
     lim_add = np.asarray(lim0, dtype=float)[j] + eps
     rows = tracks.bound.copy()
     rows[:, 7] += lim_add
+    if polys is None:
+        body = np.zeros((0, 1, 2))
+    else:
+        body = np.ascontiguousarray(polys, dtype=np.float64)
+        rows[:, 7] += float(np.max(np.hypot(*(body - pts[:, None, :]).reshape(-1, 2).T)))
+        rows[:, 7] += NEAR_PAD
     band = None if after is None else (after, np.full(after.shape, np.inf))
     seg, pi = near_pairs(pts, rows, 0.0, band)
     dt, kk = float(t[1] - t[0]), int(t.shape[0])
@@ -165,6 +182,8 @@ def polygon_runs(
         tracks.verts,
         tracks.edges,
         tracks.poly,
+        tracks.nv,
+        body,
         dt,
         kk,
     )
@@ -205,8 +224,85 @@ def _clearance(
 
 
 @njit(cache=True)
+def _point_polygon(x, y, w, nw):  # pragma: no cover - compiled
+    """Return the distance (m) of the point ``(x, y)`` to the convex CCW polygon ``w[:nw]``; 0 inside."""
+    if nw == 1:
+        return np.hypot(x - w[0, 0], y - w[0, 1])
+    best = np.inf
+    inside = True
+    for e in range(nw):
+        ax, ay = w[e, 0], w[e, 1]
+        ex, ey = w[(e + 1) % nw, 0] - ax, w[(e + 1) % nw, 1] - ay
+        qx, qy = x - ax, y - ay
+        ee = max(ex * ex + ey * ey, 1e-300)
+        lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
+        best = min(best, np.hypot(qx - lam * ex, qy - lam * ey))
+        if ex * qy - ey * qx < 0.0:
+            inside = False
+    return 0.0 if inside else best
+
+
+@njit(cache=True)
+def _signed_distance(a, na, b, nb):  # pragma: no cover - compiled
+    """Return the signed distance (m) of the convex CCW polygons ``a[:na]`` and ``b[:nb]``.
+
+    :func:`._certificate.convex_distance` for one pair: separated, the least distance of a
+    vertex of one to the other; overlapping, minus the penetration depth along the edge
+    normals of both (a polygon of fewer than 3 vertices has none).
+    """
+    separated = False
+    depth = np.inf
+    for side in range(2):
+        p, n_p, q, n_q = (a, na, b, nb) if side == 0 else (b, nb, a, na)
+        if n_p < 3:
+            continue
+        for e in range(n_p):
+            ax, ay = p[e, 0], p[e, 1]
+            ex, ey = p[(e + 1) % n_p, 0] - ax, p[(e + 1) % n_p, 1] - ay
+            norm = max(np.hypot(ex, ey), 1e-300)
+            nx, ny = ey / norm, -ex / norm  # outward for CCW
+            lo_q, hi_q, lo_p = np.inf, -np.inf, np.inf
+            for v in range(n_q):
+                d = (q[v, 0] - ax) * nx + (q[v, 1] - ay) * ny
+                lo_q, hi_q = min(lo_q, d), max(hi_q, d)
+            for v in range(n_p):
+                lo_p = min(lo_p, (p[v, 0] - ax) * nx + (p[v, 1] - ay) * ny)
+            if lo_q > 0.0:
+                separated = True
+            depth = min(depth, min(-lo_q, hi_q - lo_p))
+    if separated or not np.isfinite(depth):
+        d = np.inf
+        for v in range(na):
+            d = min(d, _point_polygon(a[v, 0], a[v, 1], b, nb))
+        for v in range(nb):
+            d = min(d, _point_polygon(b[v, 0], b[v, 1], a, na))
+        return d
+    return -depth
+
+
+@njit(cache=True)
+def _footprint_clearance(
+    foot, row, head0, turn, lim_add, verts, nv, j, tk, shape
+):  # pragma: no cover - compiled
+    """Return the signed distance (m) of the polygon ``foot`` to mover ``j``'s polygon at ``tk`` minus the limit (``shape``: scratch)."""
+    u, w = row[0], row[1]
+    tau = tk - u
+    run = tau if np.isfinite(w) else 0.0
+    cx = row[2] + row[4] * run
+    cy = row[3] + row[5] * run
+    th = head0 + turn * run
+    rad = row[6] + row[7] * tau
+    c, s = np.cos(th), np.sin(th)
+    m = nv[j]
+    for v in range(m):
+        shape[v, 0] = cx + c * verts[j, v, 0] - s * verts[j, v, 1]
+        shape[v, 1] = cy + s * verts[j, v, 0] + c * verts[j, v, 1]
+    return _signed_distance(foot, foot.shape[0], shape, m) - rad - lim_add
+
+
+@njit(cache=True)
 def march_kernel(
-    pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, dt, kk
+    pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, nv, body, dt, kk
 ):  # pragma: no cover - compiled
     """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
 
@@ -224,8 +320,11 @@ def march_kernel(
         Heading (rad) at ``u``, turn rate (rad/s), Lipschitz bound (m/s), and the limit
         besides the mover's radius (m) of each piece.
     verts, edges : ndarray, shape (movers, m, 2)
-    poly : ndarray of bool, shape (movers,)
+    poly, nv : ndarray, shape (movers,)
         As :class:`PolygonPieces`.
+    body : ndarray, shape (n, mb, 2)
+        A footprint robot's polygon at each point (m, CCW); ``n = 0``: a disc robot (the
+        point itself, its radius in the limit).
     dt : float
         Grid step (s).
     kk : int
@@ -233,6 +332,8 @@ def march_kernel(
     """
     cap = max(16, 2 * seg.shape[0])
     out = np.empty((cap, 4), dtype=np.int64)
+    foot = body.shape[0] > 0
+    shape = np.empty((verts.shape[1], 2))  # a mover's polygon in the world
     nr = 0
     for q in range(seg.shape[0]):
         p, i = seg[q], pi[q]
@@ -247,9 +348,14 @@ def march_kernel(
         k = ka
         start = -1  # first time index of the open run
         while k <= kb:
-            f = _clearance(
-                px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
-            )
+            if foot:
+                f = _footprint_clearance(
+                    body[i], rows[p], head0[p], turn[p], lim_add[p], verts, nv, j, k * dt, shape
+                )
+            else:
+                f = _clearance(
+                    px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
+                )
             hit = f < 0.0
             room = abs(f) - 1e-9  # in hand against rounding
             more = 0

@@ -21,7 +21,8 @@ A polygon mover against a disc robot: each pair of a piece of its track and a no
 marched through the grid times (:mod:`._polygon_march`): an exact test at a grid time decides
 every grid time within its clearance over the mover's speed bound, so the runs are those of
 the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding).
-A footprint robot is tested exactly at every node and grid time near a mover (:func:`_shape_hits`).
+A footprint robot is marched the same way against every mover (discs too), with the signed
+distance of its polygon at the node and the mover's.
 
 A footprint robot is its convex polygon at each node, turned by the path's heading there; it
 moves at most ``(1 + R kappa_max)`` per metre of arc, so the robot's share of both pads is
@@ -30,14 +31,11 @@ multiplied by that ``stretch``.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._disc_windows import inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import polygon_runs
@@ -324,7 +322,6 @@ def st_grid(
     runs: list[tuple[np.ndarray, ...]] = []
     discs: list[tuple[int, MovingObstacle, float]] = []
     shapes: list[tuple[int, MovingObstacle, float]] = []
-    tree: cKDTree | None = None
     for j, m in enumerate(movers):
         if sufficient:
             pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
@@ -332,14 +329,8 @@ def st_grid(
             pad = -0.5 * ds * stretch
         if polys is None and m.vertices is None:
             discs.append((j, m, pad))
-            continue
-        if polys is None:
+        else:
             shapes.append((j, m, pad))
-            continue
-        if tree is None:
-            tree = cKDTree(pts)
-        lim = limit + m.radius_at(t) + pad
-        runs.append(_runs_of(_shape_hits(pts, polys, m, t, lim, tree), j))
     after = None
     if leave is not None:
         after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
@@ -348,7 +339,7 @@ def st_grid(
     if shapes:
         j_of, shape_movers, pads = zip(*shapes, strict=True)
         lim0 = limit + np.asarray(pads, dtype=float)
-        runs.append(polygon_runs(pts, shape_movers, j_of, lim0, t, sufficient, after))
+        runs.append(polygon_runs(pts, shape_movers, j_of, lim0, t, sufficient, after, polys))
     if runs:
         col, lo, hi, owner = (np.concatenate(x) for x in zip(*runs, strict=True))
     else:
@@ -357,70 +348,11 @@ def st_grid(
     return STGrid(s, t, ds, float(dt), col, lo, hi, owner)
 
 
-def _shape_hits(
-    pts: np.ndarray,
-    polys: np.ndarray | None,
-    mover: MovingObstacle,
-    t: np.ndarray,
-    lim: np.ndarray,
-    tree: cKDTree,
-) -> np.ndarray:
-    """Return whether each node is closer than ``lim[k]`` (m) to ``mover``'s shape at ``t[k]``, shape (K, n).
-
-    The robot is the point ``pts[i]`` (m, shape (n, 2)), or the convex polygon ``polys[i]``
-    (shape (n, mb, 2)) with a footprint; ``tree`` is the k-d tree of ``pts``. An exact filter
-    first: both shapes lie within their reaches (the farthest vertex from the reference
-    point) of the mover's reference point and of the node, so their (signed) distance is at
-    least the reference points' distance minus both reaches, and a pair farther apart than
-    ``lim + both reaches`` is clear. The k-d tree finds the other pairs; only they are
-    measured (:func:`point_polygon_distance` or :func:`convex_distance`), in one batch.
-    From the first grid time at or after the mover's last prediction on, its shape stands
-    where it was last (and its radius stops growing): while ``lim`` stands still too, those
-    rows are the first one's, measured once.
-    """
-    k_end = int(np.searchsorted(t, mover.t_last, side="left"))
-    if k_end < t.shape[0] - 1 and np.all(lim[k_end:] == lim[k_end]):
-        head = _shape_hits(pts, polys, mover, t[: k_end + 1], lim[: k_end + 1], tree)
-        hit = np.empty((t.shape[0], pts.shape[0]), dtype=bool)
-        hit[: k_end + 1] = head
-        hit[k_end + 1 :] = head[k_end]
-        return hit
-    centre, _ = mover.pose_at(t)  # (K, 2)
-    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
-    if polys is not None:
-        reach += float(np.max(np.hypot(*(polys - pts[:, None, :]).reshape(-1, 2).T)))
-    hit = np.zeros((t.shape[0], pts.shape[0]), dtype=bool)
-    # 1 nm above the bound: rounding of the reaches never drops a pair the exact test hits
-    near = tree.query_ball_point(centre, np.maximum(lim + reach + 1e-9, 0.0))
-    counts = np.fromiter((len(c) for c in near), dtype=np.int64, count=len(near))
-    if counts.sum() == 0:
-        return hit
-    kk = np.repeat(np.arange(t.shape[0]), counts)
-    ii = np.fromiter(itertools.chain.from_iterable(near), dtype=np.int64, count=int(counts.sum()))
-    w = shape_at(mover, t[kk])  # (p, m, 2)
-    d = point_polygon_distance(pts[ii], w) if polys is None else convex_distance(polys[ii], w)
-    hit[kk, ii] = d < lim[kk]
-    return hit
-
-
 def grid_nodes(length: float, ds: float) -> tuple[np.ndarray, float]:
     """Return the nodes (m), shape (n,), of a path of ``length`` (m) for a requested ``ds``, and the spacing used."""
     n = max(2, int(math.ceil(length / ds)) + 1)
     s = np.linspace(0.0, length, n)
     return s, float(s[1] - s[0])
-
-
-def _runs_of(hit: np.ndarray, j: int) -> tuple[np.ndarray, ...]:
-    """Return the runs ``(node, first, last, mover)`` of mover ``j``'s dense ``hit`` (K, n).
-
-    Only the nodes with a hit are scanned (in node order, as a scan of them all gives).
-    """
-    cols = np.flatnonzero(hit.any(axis=0))
-    h = np.pad(hit[:, cols].T, ((0, 0), (1, 1)))
-    d = np.diff(h.astype(np.int8), axis=1)
-    ci, k0 = np.nonzero(d == 1)
-    _, k1 = np.nonzero(d == -1)
-    return cols[ci], k0, k1 - 1, np.full(ci.shape[0], j)
 
 
 def _disc_runs(

@@ -16,7 +16,12 @@ import shapely
 from shapely.geometry import Polygon
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._polygon_march import PolygonPieces, launch_bound_kernel, polygon_runs
+from trajopt.moving._polygon_march import (
+    PolygonPieces,
+    _signed_distance,
+    launch_bound_kernel,
+    polygon_runs,
+)
 
 
 def _random_movers(rng, n):
@@ -157,3 +162,77 @@ def test_the_launch_bound_is_the_clearance_at_the_launch_plus_tau():
             shape = Polygon(np.array([x, y]) + m.vertices @ np.array([[c, sn], [-sn, c]]))
             want = shapely.distance(shape, shapely.points(pts[r])) - m.radius_at(t) - pad[r]
             assert got[li, r] == pytest.approx(want, abs=1e-9)
+
+
+def _foot_at(pts, heading, body):
+    c, sn = np.cos(heading)[:, None], np.sin(heading)[:, None]
+    return np.stack(
+        [
+            pts[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+            pts[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+        ],
+        axis=-1,
+    )
+
+
+@pytest.mark.parametrize("sufficient", [True, False])
+def test_a_footprint_is_marched_against_polygons_and_discs_as_shapely_measures(sufficient):
+    """A footprint robot (a rectangle turned along the points) against turning polygons and a
+    disc mover: forbidden exactly where shapely's polygon-to-polygon distance is under the
+    limit (the limits positive: an overlap counts as distance 0)."""
+    rng = np.random.default_rng(11)
+    movers = _random_movers(rng, 2) + [
+        MovingObstacle.from_waypoints([0.5, 5.0], [(0.0, 1.0), (4.0, 1.5)], radius=0.2)
+    ]
+    body = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+    pts = np.column_stack([np.linspace(-1.0, 4.5, 50), 1.0 + np.sin(np.linspace(0.0, 4.0, 50))])
+    heading = np.linspace(0.0, 2.0, 50)
+    polys = _foot_at(pts, heading, body)
+    lim0 = np.array([0.05, 0.1, 0.02])
+    t = np.arange(120) * 0.05
+    runs = polygon_runs(pts, movers, range(3), lim0, t, sufficient, None, polys)
+    got = _painted(runs, 3, t.shape[0], pts.shape[0])
+    feet = [Polygon(p) for p in polys]
+    hits = 0
+    for j, m in enumerate(movers):
+        ref = np.zeros((t.shape[0], pts.shape[0]), bool)
+        near = np.zeros_like(ref)
+        for k, tk in enumerate(t):
+            x = np.interp(tk, m.times, m.positions[:, 0])
+            y = np.interp(tk, m.times, m.positions[:, 1])
+            h = np.interp(tk, m.times, m.headings)
+            c, sn = np.cos(h), np.sin(h)
+            v = m.shape_vertices
+            if v.shape[0] == 1:
+                shape = shapely.points([x, y])
+            else:
+                shape = Polygon(np.array([x, y]) + v @ np.array([[c, sn], [-sn, c]]))
+            lim = lim0[j] + m.radius + m.growth * min(max(tk, 0.0), m.t_last)
+            d = shapely.distance(shape, feet)
+            ref[k] = d < lim
+            near[k] = np.abs(d - lim) < 1e-6
+        hits += int(ref.any())
+        assert not np.any((got[j] != ref) & ~near)
+    assert hits >= 2
+
+
+def test_the_signed_distance_of_overlapping_polygons_is_minus_their_penetration_depth():
+    """Against the Minkowski difference measured by shapely: the origin's distance to the
+    boundary of the hull of ``a_i - b_j`` (inside: minus it), for overlapping and separate pairs."""
+    rng = np.random.default_rng(2)
+    for _ in range(60):
+        a = shapely.convex_hull(shapely.multipoints(rng.uniform(-1.0, 1.0, (6, 2))))
+        b = shapely.convex_hull(
+            shapely.multipoints(rng.uniform(-1.0, 1.0, (5, 2)) + rng.uniform(-1.5, 1.5, 2))
+        )
+        pa = np.asarray(a.exterior.coords)[:-1]
+        pb = np.asarray(b.exterior.coords)[:-1]
+        pa, pb = pa[::-1].copy(), pb[::-1].copy()  # shapely's hulls are clockwise
+        diff = shapely.convex_hull(
+            shapely.multipoints((pa[:, None, :] - pb[None, :, :]).reshape(-1, 2))
+        )
+        origin = shapely.points([0.0, 0.0])
+        gap = shapely.distance(diff.exterior, origin)
+        want = -gap if diff.contains(origin) else gap
+        got = _signed_distance(pa, pa.shape[0], pb, pb.shape[0])
+        assert got == pytest.approx(want, abs=1e-9)
