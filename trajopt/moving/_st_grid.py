@@ -294,7 +294,7 @@ def st_grid(
         The path's points at the nodes (m), when the caller has them (:func:`grid_nodes`).
     leave : float, optional
         The robot leaves ``s = 0`` no earlier than this (s) and drives at most ``speed``: it
-        cannot be nearest to node ``s_i`` before ``leave + (s_i - ds/2) / speed``, and a disc
+        cannot be nearest to node ``s_i`` before ``leave + (s_i - ds/2) / speed``, and a
         mover's pieces of track that end a grid step before that are not solved for the
         node (their runs could not meet the robot). Default: all times.
 
