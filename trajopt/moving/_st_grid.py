@@ -37,6 +37,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from trajopt.moving._disc_windows import inside_times, near_pairs
+from trajopt.moving._grid_kernels import dense_kernel, sweep_kernel
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import polygon_runs
 
@@ -205,15 +206,14 @@ class STGrid:
 
     def _dense_grid(self) -> tuple[np.ndarray, np.ndarray]:
         if self._dense is None:
-            kk, n = self.t.shape[0], self.s.shape[0]
-            blocked = np.zeros((kk, n), dtype=bool)
-            who = np.full((kk, n), -1, dtype=np.int16)
-            col = np.repeat(np.arange(n), np.diff(self.ptr))
-            for r in np.argsort(self.owner, kind="stable")[::-1]:  # the first mover wins
-                a, b = self.lo[r], min(self.hi[r], kk - 1)
-                blocked[a : b + 1, col[r]] = True
-                who[a : b + 1, col[r]] = self.owner[r]
-            self._dense = (blocked, who)
+            self._dense = dense_kernel(
+                self.t.shape[0],
+                self.s.shape[0],
+                self.col.astype(np.int64),
+                self.lo.astype(np.int64),
+                self.hi.astype(np.int64),
+                self.owner.astype(np.int64),
+            )
         return self._dense
 
     @property
@@ -444,7 +444,8 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
 
     Once the grid's rows no longer change (after the last run starts or ends) and neither
     does the bound, a step that leaves the reachable nodes as they were is a fixed point:
-    the sweep stops there with the answer of the last time.
+    the sweep stops there with the answer of the last time. The sweep is a compiled loop
+    (:func:`._grid_kernels.sweep_kernel`).
 
     Returns
     -------
@@ -456,27 +457,13 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
         The furthest reachable node before that (the place where the robot is stopped).
     """
     fb = grid.blocked
-    kk, n = fb.shape
+    kk = fb.shape[0]
     ends = np.concatenate([grid.lo, np.where(grid.hi >= FOREVER, 0, grid.hi + 1), [0]])
     k_static = int(np.max(ends))
     if s_up is not None:
         k_static = max(k_static, int(np.searchsorted(s_up, grid.s[-1] + 0.5 * grid.ds)))
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
-    idx = np.arange(n)
-    reach = np.zeros(n, dtype=bool)
-    reach[0] = not fb[0, 0]
-    last_i = 0
-    if not reach[0]:
-        return False, 0, 0
-    for k in range(1, kk):
-        lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
-        nxt = ~fb[k] & (idx - lastr <= m)
-        if s_up is not None:
-            nxt &= grid.s <= s_up[k] + 0.5 * grid.ds
-        if not nxt.any():
-            return False, k, last_i
-        if k > k_static and np.array_equal(nxt, reach):
-            break
-        reach = nxt
-        last_i = int(np.max(np.flatnonzero(reach)))
-    return bool(reach[-1]), kk - 1, last_i
+    bounded = s_up is not None
+    up = np.asarray(s_up, dtype=float) if bounded else np.zeros(kk)
+    ok, k, i = sweep_kernel(fb, grid.s, up, bounded, 0.5 * grid.ds, m, k_static)
+    return bool(ok), int(k), int(i)
