@@ -67,6 +67,8 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.robot._footprint_kernels",
     "trajopt.geometry._obstacle_index",
     "trajopt.moving._st_kernels",
+    "trajopt.moving._polygon_march",
+    "trajopt.moving._grid_kernels",
     "trajopt.corridor._polygons.path_kernels",
     "trajopt.corridor._polygons.region_kernels",
     "trajopt.smoother._cost_kernels",
