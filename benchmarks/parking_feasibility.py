@@ -630,53 +630,16 @@ def _wrap_pose(pose) -> tuple[float, float, float]:
     return float(pose[0]), float(pose[1]), float(math.remainder(pose[2], 2 * math.pi))
 
 
-def feasibility_level(
-    body: np.ndarray,
-    polygons: Sequence[np.ndarray],
-    start,
-    goal,
-    region: tuple[float, float, float, float],
-    resolution: float,
-    theta_bins: int,
-    block: int = 8,
-) -> Verdict:
-    """One grid: the inner and outer fills (module docstring) at one resolution.
+def _fill(sc: _Scene, a, b, da: float, db: float, grid, shape, block: int, target=None) -> dict:
+    """One grid: classify its cells, then the inner fill and, if that fails, the outer fill.
 
-    Parameters
-    ----------
-    body : ndarray, shape (k, 2)
-        Convex body in the reference frame (m).
-    polygons : sequence of ndarray, shape (m_i, 2)
-        Obstacle polygons (m).
-    start, goal : tuple of float
-        ``(x, y, theta)`` (m, m, rad).
-    region : tuple of float
-        ``(xmin, ymin, xmax, ymax)`` (m) of the reference point; outside it, one more
-        component adjacent to the region's x and y faces.
-    resolution : float
-        Cell side in x and y (m); the region is widened to a whole number of cells.
-    theta_bins : int
-        Heading cells over ``[-pi, pi)``.
-    block : int, optional
-        Side (cells) of the blocks classified by recursive halving.
-
-    Returns
-    -------
-    Verdict
+    ``a``, ``b``: the end poses (wrapped), ``da``, ``db`` their signed distances (> 0);
+    ``grid`` = ``(x0, y0, -pi, h, h, h_theta)``; ``target``: optional bool mask of inner
+    cells already known to be connected to ``b`` (a finer grid's view of a coarser grid's
+    component), seeds of ``b`` too. Returns a dict: ``verdict``, ``inner``, ``lab``,
+    ``comp``, ``a_seeds``, ``b_seeds``, ``path`` (flat cells from an ``a`` seed to a ``b``
+    seed, or None), ``evaluations``.
     """
-    if not (resolution > 0 and math.isfinite(resolution)):
-        raise ValueError(f"resolution: must be a positive finite number of m, got {resolution!r}")
-    if theta_bins < 1:
-        raise ValueError(f"theta_bins: must be >= 1, got {theta_bins!r}")
-    t_start = time.perf_counter()
-    sc = _scene(body, polygons)
-    start, goal = _wrap_pose(start), _wrap_pose(goal)
-    x0, y0, x1, y1 = (float(v) for v in region)
-    nx = max(1, math.ceil((x1 - x0) / resolution - 1e-9))
-    ny = max(1, math.ceil((y1 - y0) / resolution - 1e-9))
-    nt = int(theta_bins)
-    grid = (x0, y0, -math.pi, resolution, resolution, 2 * math.pi / nt)
-    shape = (nx, ny, nt)
     inner = np.zeros(shape, dtype=np.uint8)
     may = np.zeros(shape, dtype=np.uint8)
     evals = _classify(
@@ -692,55 +655,57 @@ def feasibility_level(
         inner,
         may,
     )
-    ds, dg = signed_distance(sc.fp, np.array([start, goal]), polygons)
-    res = dict(resolution=resolution, theta_bins=nt, cells=nx * ny * nt, evaluations=evals)
-    if ds <= 0.0 or dg <= 0.0:  # an end pose outside the open C_free: no path at all
-        return Verdict("infeasible", seconds=time.perf_counter() - t_start, **res)
-    # the inner fill
+    out = dict(inner=inner, evaluations=int(evals), path=None)
     lab, comp = _labels(inner.astype(bool), full=False, sink=False)
-    s_seeds = _seeds(start, ds, grid, shape, inner, sc.r_far)
-    g_seeds = _seeds(goal, dg, grid, shape, inner, sc.r_far)
+    out.update(lab=lab, comp=comp)
+    a_seeds = np.array(_seeds(a, da, grid, shape, inner, sc.r_far), dtype=np.int64)
+    b_seeds = np.array(_seeds(b, db, grid, shape, inner, sc.r_far), dtype=np.int64)
+    if target is not None:
+        b_seeds = np.union1d(b_seeds, np.flatnonzero(target.ravel() & inner.ravel().astype(bool)))
+    out.update(a_seeds=a_seeds, b_seeds=b_seeds)
     flat = lab.ravel()
-    s_comp = {int(comp[flat[c]]) for c in s_seeds}
-    g_comp = {int(comp[flat[c]]) for c in g_seeds}
-    if s_comp & g_comp:
-        path = _bfs(inner, np.array(s_seeds, dtype=np.int64), np.array(g_seeds, dtype=np.int64))
-        return Verdict(
-            "feasible",
-            seconds=time.perf_counter() - t_start,
-            witness=_witness_poses(path, start, goal, grid, shape, sc.r_far),
-            **res,
-        )
+    if np.intersect1d(comp[flat[a_seeds]], comp[flat[b_seeds]]).size:
+        out["path"] = _bfs(inner, a_seeds, b_seeds)
+        out["verdict"] = "feasible"
+        return out
     # the outer fill
-    lab, comp = _labels(may.astype(bool), full=True, sink=True)
-    cs, cg = _cell_of(start, grid, shape), _cell_of(goal, grid, shape)
-    ks = comp[lab[cs]] if cs is not None else comp[-1]
-    kg = comp[lab[cg]] if cg is not None else comp[-1]
-    verdict = "infeasible" if ks != kg else "unknown"
-    return Verdict(verdict, seconds=time.perf_counter() - t_start, **res)
+    lab2, comp2 = _labels(may.astype(bool), full=True, sink=True)
+    ca, cb = _cell_of(a, grid, shape), _cell_of(b, grid, shape)
+    ka = comp2[lab2[ca]] if ca is not None else comp2[-1]
+    kb = comp2[lab2[cb]] if cb is not None else comp2[-1]
+    out["verdict"] = "infeasible" if ka != kb else "unknown"
+    return out
 
 
-def _witness_poses(path, start, goal, grid, shape, r_far) -> np.ndarray:
-    """Start, the clamped point of the first cell, cell centres, the last's clamped point, goal."""
+def _centres(path, grid, shape) -> np.ndarray:
     x0, y0, t0, hx, hy, ht = grid
     nx, ny, nt = shape
     i, j, k = path // (ny * nt), (path // nt) % ny, path % nt
-    centres = np.column_stack([x0 + (i + 0.5) * hx, y0 + (j + 0.5) * hy, t0 + (k + 0.5) * ht])
-    # headings unwrapped along the path (face-adjacent cells differ by one heading cell)
-    centres[:, 2] = np.unwrap(centres[:, 2])
+    return np.column_stack([x0 + (i + 0.5) * hx, y0 + (j + 0.5) * hy, t0 + (k + 0.5) * ht])
 
-    def clamp(pose, c):
-        lo = c - (0.5 * hx, 0.5 * hy, 0.5 * ht)
-        th = c[2] + math.remainder(pose[2] - c[2], 2 * math.pi)
-        return np.clip([pose[0], pose[1], th], lo, lo + (hx, hy, ht)), th
 
-    qs, ths = clamp(start, centres[0])
-    qg, thg = clamp(goal, centres[-1])
-    return np.vstack([[start[0], start[1], ths], qs, centres, qg, [goal[0], goal[1], thg]])
+def _clamped(pose, centre, grid) -> np.ndarray:
+    """The pose (heading turned next to the centre's) and its nearest point of the cell."""
+    _, _, _, hx, hy, ht = grid
+    th = centre[2] + math.remainder(pose[2] - centre[2], 2 * math.pi)
+    lo = centre - (0.5 * hx, 0.5 * hy, 0.5 * ht)
+    q = np.clip([pose[0], pose[1], th], lo, lo + (hx, hy, ht))
+    return np.array([[pose[0], pose[1], th], q])
+
+
+def _unwrap(poses: np.ndarray) -> np.ndarray:
+    out = poses.copy()
+    out[:, 2] = np.unwrap(out[:, 2])
+    return out
 
 
 def densify(poses: np.ndarray, body: np.ndarray, step: float = 0.01) -> np.ndarray:
-    """Straight-line interpolation of a pose path so that no body corner moves > ``step`` m."""
+    """Straight-line interpolation of a pose path so that no body point moves > ``step`` m.
+
+    Consecutive poses are joined by straight segments in ``(x, y, theta)`` (headings as
+    given: unwrap them first); a segment moves body points at most ``|dxy| + |dtheta|
+    r_far``.
+    """
     fp = np.asarray(body, dtype=float)
     r_far = float(np.max(np.hypot(fp[:, 0], fp[:, 1])))
     out = [poses[:1]]
@@ -752,6 +717,13 @@ def densify(poses: np.ndarray, body: np.ndarray, step: float = 0.01) -> np.ndarr
     return np.vstack(out)
 
 
+def _grid(region, h: float, nt: int):
+    x0, y0, x1, y1 = (float(v) for v in region)
+    nx = max(1, math.ceil((x1 - x0) / h - 1e-9))
+    ny = max(1, math.ceil((y1 - y0) / h - 1e-9))
+    return (x0, y0, -math.pi, h, h, 2 * math.pi / nt), (nx, ny, int(nt))
+
+
 def feasibility(
     body: np.ndarray,
     polygons: Sequence[np.ndarray],
@@ -760,58 +732,182 @@ def feasibility(
     region: tuple[float, float, float, float],
     resolution: float,
     theta_bins: int | None = None,
-    refine: int = 1,
+    refine: int = 2,
     check_witness: bool = True,
+    block: int = 8,
 ) -> Verdict:
     """Decide whether a path from ``start`` to ``goal`` exists (module docstring).
 
-    Tries ``resolution`` (and ``theta_bins``, by default :func:`theta_bins_for`), then
-    halves the cells (and doubles the heading cells) up to ``refine`` times while the answer
-    is unknown. A feasible answer's witness is checked by :func:`parking_cases.body_overlaps`
-    at poses whose corners move <= 1 cm apart when ``check_witness``.
+    Level 0: the inner and outer fills over ``region`` at ``resolution`` and ``theta_bins``
+    heading cells (default :func:`theta_bins_for`). While unknown, level ``k`` (up to
+    ``refine``) halves the cells again over a box round the *smaller* end's component of
+    the previous level (its cells' xy box, grown by ``r_far / 2**(k - 1)``, the body's
+    far-point radius; full headings), aligned to level 0's cells. There the level-0 inner
+    cells of the other end's component (each sub-cell of one is wholly free too) count as
+    the other end: reaching one proves the path (the union of two intersecting closed
+    cells in ``C_free`` is path-connected). The outer fill there treats everything outside
+    the box as one component, so a separated small end proves infeasibility as before.
+
+    A feasible answer carries a witness pose path (start, clamped point, cell centres,
+    ..., goal; consecutive poses joined by straight segments in ``(x, y, theta)`` stay in
+    ``C_free``), checked by :func:`parking_cases.body_overlaps` at poses whose body points
+    move <= 1 cm apart when ``check_witness``.
 
     Parameters
     ----------
-    body, polygons, start, goal, region
-        As :func:`feasibility_level`.
+    body : ndarray, shape (k, 2)
+        Convex body in the reference frame (m).
+    polygons : sequence of ndarray, shape (m_i, 2)
+        Obstacle polygons (m).
+    start, goal : tuple of float
+        ``(x, y, theta)`` (m, m, rad).
+    region : tuple of float
+        ``(xmin, ymin, xmax, ymax)`` (m) of the reference point (widened to whole cells);
+        outside it, one more component adjacent to the region's x and y faces.
     resolution : float
-        The first cell side (m).
+        Level 0's cell side (m).
     theta_bins : int, optional
-        The first grid's heading cells.
+        Level 0's heading cells over ``[-pi, pi)``.
     refine : int, optional
-        Refinements after the first grid (>= 0).
+        Refinement levels after level 0 (>= 0).
     check_witness : bool, optional
         Check a feasible answer's witness exactly.
+    block : int, optional
+        Side (cells) of the blocks classified by recursive halving.
 
     Returns
     -------
     Verdict
-        Of the last level tried; ``seconds`` over all levels.
+        Resolution and heading cells of the last level tried; ``seconds`` over all levels.
     """
+    if not (resolution > 0 and math.isfinite(resolution)):
+        raise ValueError(f"resolution: must be a positive finite number of m, got {resolution!r}")
     if refine < 0:
         raise ValueError(f"refine: must be >= 0, got {refine!r}")
-    nt = theta_bins or theta_bins_for(body, resolution)
+    nt0 = int(theta_bins or theta_bins_for(body, resolution))
+    if nt0 < 1:
+        raise ValueError(f"theta_bins: must be >= 1, got {theta_bins!r}")
+    t_start = time.perf_counter()
+    sc = _scene(body, polygons)
+    start, goal = _wrap_pose(start), _wrap_pose(goal)
+    ds, dg = signed_distance(sc.fp, np.array([start, goal]), polygons)
+    grid0, shape0 = _grid(region, resolution, nt0)
     levels = []
-    total = 0.0
-    for level in range(refine + 1):
-        h = resolution / 2**level
-        v = feasibility_level(body, polygons, start, goal, region, h, nt * 2**level)
-        total += v.seconds
-        levels.append((h, v.theta_bins, v.verdict, v.seconds))
-        if v.verdict != "unknown":
-            break
-    v.seconds = total
-    v.levels = levels
-    if v.witness is not None and check_witness:
-        dense = densify(v.witness, body, 0.01)
-        v.witness_clear = not bool(pc.body_overlaps(np.asarray(body), dense, polygons).any())
-    return v
+
+    def verdict(name, grid, shape, evals, witness=None):
+        v = Verdict(
+            name,
+            resolution=grid[3],
+            theta_bins=shape[2],
+            seconds=time.perf_counter() - t_start,
+            cells=int(np.prod(shape)),
+            evaluations=evals,
+            witness=witness,
+            levels=levels,
+        )
+        if witness is not None and check_witness:
+            dense = densify(witness, sc.fp, 0.01)
+            v.witness_clear = not bool(pc.body_overlaps(sc.fp, dense, polygons).any())
+        return v
+
+    if ds <= 0.0 or dg <= 0.0:  # an end pose outside the open C_free: no path at all
+        return verdict("infeasible", grid0, shape0, 0)
+    t0 = time.perf_counter()
+    L0 = _fill(sc, start, goal, ds, dg, grid0, shape0, block)
+    levels.append((resolution, nt0, L0["verdict"], time.perf_counter() - t0))
+    if L0["verdict"] != "unknown":
+        w = None
+        if L0["path"] is not None:
+            c = _centres(L0["path"], grid0, shape0)
+            w = _unwrap(
+                np.vstack([_clamped(start, c[0], grid0), c, _clamped(goal, c[-1], grid0)[::-1]])
+            )
+        return verdict(L0["verdict"], grid0, shape0, L0["evaluations"], w)
+    flat0 = L0["lab"].ravel()
+    comp0 = L0["comp"]
+    inner0 = L0["inner"].astype(bool)
+    comp_cells = np.where(inner0, comp0[L0["lab"]], -1)
+    sizes = np.bincount(comp_cells[inner0].ravel(), minlength=len(comp0))
+    ends = {
+        "start": (start, ds, set(comp0[flat0[L0["a_seeds"]]].tolist())),
+        "goal": (goal, dg, set(comp0[flat0[L0["b_seeds"]]].tolist())),
+    }
+    small = min(ends, key=lambda e: sum(int(sizes[k]) for k in ends[e][2]))
+    other = "goal" if small == "start" else "start"
+    a, da, _ = ends[small]
+    b, db, b_ids = ends[other]
+    target0 = np.isin(comp_cells, list(b_ids)) if b_ids else np.zeros_like(inner0)
+    # the small end's cells at the previous level, in world coordinates
+    prev_cells = np.argwhere(np.isin(comp_cells, list(ends[small][2])))
+    prev_grid = grid0
+    x0, y0, _, h0, _, _ = grid0
+    v_last = (grid0, shape0, L0["evaluations"])
+    for k in range(1, refine + 1):
+        f = 2**k
+        margin = sc.r_far / 2 ** (k - 1)
+        ph = prev_grid[3]
+        if len(prev_cells):
+            lo = prev_cells[:, :2].min(axis=0) * ph + (prev_grid[0], prev_grid[1])
+            hi = (prev_cells[:, :2].max(axis=0) + 1) * ph + (prev_grid[0], prev_grid[1])
+        else:
+            lo = hi = np.array(a[:2])
+        i_lo = max(0, math.floor((lo[0] - margin - x0) / h0))
+        j_lo = max(0, math.floor((lo[1] - margin - y0) / h0))
+        i_hi = min(shape0[0], math.ceil((hi[0] + margin - x0) / h0))
+        j_hi = min(shape0[1], math.ceil((hi[1] + margin - y0) / h0))
+        grid = (x0 + i_lo * h0, y0 + j_lo * h0, -math.pi, h0 / f, h0 / f, 2 * math.pi / (nt0 * f))
+        shape = ((i_hi - i_lo) * f, (j_hi - j_lo) * f, nt0 * f)
+        target = target0[i_lo:i_hi, j_lo:j_hi, :]
+        for ax in range(3):
+            target = np.repeat(target, f, axis=ax)
+        t0 = time.perf_counter()
+        Lk = _fill(sc, a, b, da, db, grid, shape, block, target=target)
+        del target
+        levels.append((grid[3], shape[2], Lk["verdict"], time.perf_counter() - t0))
+        v_last = (grid, shape, Lk["evaluations"])
+        if Lk["verdict"] == "infeasible":
+            return verdict("infeasible", *v_last)
+        if Lk["verdict"] == "feasible":
+            fine = _centres(Lk["path"], grid, shape)
+            # the last fine cell lies in a level-0 inner cell of the other end's component
+            last = Lk["path"][-1]
+            ny, nt = shape[1], shape[2]
+            ci = i_lo + (last // (ny * nt)) // f
+            cj = j_lo + ((last // nt) % ny) // f
+            ck = (last % nt) // f
+            c0 = (ci * shape0[1] + cj) * shape0[2] + ck
+            coarse = _centres(
+                _bfs(
+                    L0["inner"],
+                    np.array([c0], dtype=np.int64),
+                    L0["b_seeds" if small == "start" else "a_seeds"],
+                ),
+                grid0,
+                shape0,
+            )
+            if _cell_of(b, grid, shape) is not None and Lk["path"][-1] in set(
+                _seeds(b, db, grid, shape, Lk["inner"], sc.r_far)
+            ):
+                tail = [fine, _clamped(b, fine[-1], grid)[::-1]]
+            else:
+                tail = [fine, coarse, _clamped(b, coarse[-1], grid0)[::-1]]
+            w = _unwrap(np.vstack([_clamped(a, fine[0], grid), *tail]))
+            if small == "goal":
+                w = w[::-1]
+            return verdict("feasible", *v_last, witness=w)
+        lab, comp = Lk["lab"], Lk["comp"]
+        ids = np.unique(comp[lab.ravel()[Lk["a_seeds"]]])
+        innerk = Lk["inner"].astype(bool)
+        prev_cells = np.argwhere(innerk & np.isin(np.where(innerk, comp[lab], -1), ids))
+        prev_grid = grid
+        del Lk
+    return verdict("unknown", *v_last)
 
 
 def case_feasibility(
     case: pc.ParkingCase,
     resolution: float | None = None,
-    refine: int = 1,
+    refine: int = 2,
     theta_bins: int | None = None,
 ) -> Verdict:
     """:func:`feasibility` of a suite case over its map's bounds (0.1 m x the car's scale)."""
@@ -836,7 +932,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--resolution", type=float, default=None, help="cell side (m)")
     ap.add_argument("--theta-bins", type=int, default=None)
-    ap.add_argument("--refine", type=int, default=1, help="refinements while unknown")
+    ap.add_argument("--refine", type=int, default=2, help="refinements while unknown")
     ap.add_argument("--cases", type=str, default=None, help="indices or case ids, comma-separated")
     ap.add_argument("--json", type=Path, default=None, help="write the verdicts here")
     args = ap.parse_args(argv)
