@@ -956,6 +956,9 @@ def main(argv: list[str] | None = None) -> int:
         rows.append(
             dict(
                 case_id=case.case_id,
+                start=list(case.start),
+                goal=list(case.goal),
+                size=case.size,
                 verdict=v.verdict,
                 resolution=v.resolution,
                 theta_bins=v.theta_bins,
