@@ -56,11 +56,23 @@ may-meet cell on the region's x or y faces (so a region smaller than the map sta
 If the start's and the goal's cells are in different components, no path exists.
 
 Otherwise the answer is *unknown* at that resolution, and the grid is refined (cells halved
-in x, y and theta) up to ``refine`` times.
+in x, y and theta, up to ``refine`` times) over a box round the *smaller* end's component
+(:func:`feasibility`): there, the coarse inner cells of the other end's component count as
+the other end (a fine cell inside one of them intersects it, and two intersecting closed
+subsets of ``C_free`` that are each path-connected have a path-connected union), and the
+outer fill treats the outside of the box as one component, as above.
+
+Not decided here: anything about the car's own paths. A feasible verdict says that a
+collision-free *pose* path exists, hence (small-time local controllability) a car path of
+Reeds-Shepp arcs with cusps within any neighbourhood of it; it may need very many cusps
+where the free space is a thin tube.
 
 Run: ``python benchmarks/parking_feasibility.py [--car full|small] [--limit 40] [--seed 0]
-[--resolution 0.1] [--refine 1] [--cases 9,full-perpendicular-forwards-1] [--json out.json]``
-(``--resolution``: the cell side in m, 0.1 m times the car's scale by default).
+[--resolution 0.1] [--refine 2] [--cases 9,full-perpendicular-forwards-1] [--json out.json]``
+(``--resolution``: level 0's cell side in m, 0.1 m times the car's scale by default; the
+heading cells balance it, :func:`theta_bins_for`). The suite's verdicts for seed 0 are
+kept in ``benchmarks/parking_feasibility_full.json`` and ``..._small.json`` (read by
+``bench_parking.py --feasibility``).
 """
 
 from __future__ import annotations
@@ -275,7 +287,7 @@ def _signed(verts, starts, boxes, sign, convex, fp, x, y, th, cap, deep, bx, by,
     clear = cap
     hit = False
     pen = 0.0
-    sigma = max(deep, 1e-3)
+    sigma = max(deep, 1e-3) if deep < math.inf else 0.01  # sampling of non-convex polygons
     for j in range(boxes.shape[0]):
         gx = max(boxes[j, 0] - x1, x0 - boxes[j, 2], 0.0)
         gy = max(boxes[j, 1] - y1, y0 - boxes[j, 3], 0.0)
@@ -512,7 +524,8 @@ def signed_distance(
     ndarray, shape (n,)
         The distance (m) when the body meets no polygon (``inf`` with none); when it meets
         one (touching counts), ``-p`` with ``0 <= p`` a lower bound on the depth: no pose
-        moving every body point less than ``p`` from this one is free.
+        moving every body point less than ``p`` from this one is free (a non-convex
+        polygon's part of the bound samples the body's edges 1 cm apart).
     """
     sc = _scene(body, polygons)
     q = np.ascontiguousarray(np.asarray(poses, dtype=float).reshape(-1, 3))
