@@ -92,9 +92,11 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-import parking_cases as pc  # noqa: E402
+if __package__:  # imported as benchmarks.parking_feasibility (the tests): one parking_cases
+    from . import parking_cases as pc
+else:  # run as a script, or imported next to parking_cases (bench_parking.py)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import parking_cases as pc
 
 VERDICTS = ("feasible", "infeasible", "unknown")
 _TOL = 1e-9  # relative slack on the cell bound L: rounding never decides a cell
