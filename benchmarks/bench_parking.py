@@ -314,7 +314,8 @@ def feasibility_verdicts(cases: list[pc.ParkingCase], how: str) -> dict[str, str
     goal or size differ from the suite's by more than 1e-9, raises ``ValueError``.
     """
     if how == "compute":
-        import parking_feasibility as pfz
+        # the package's module: numba's cache of its kernels names benchmarks.parking_feasibility
+        from benchmarks import parking_feasibility as pfz
 
         out = {}
         for case in cases:

@@ -991,4 +991,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    # run the kernels as benchmarks.parking_feasibility whatever the entry point: numba's
+    # cache of a kernel calling another names the module it was compiled in
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from benchmarks import parking_feasibility as canonical
+
+    raise SystemExit(canonical.main())
