@@ -34,7 +34,15 @@ trajopt's failure reasons (error type and the first words of the message).
 
 Run: ``python benchmarks/bench_parking.py [--limit 40] [--resolution 0.1] [--car full|small]
 [--seed 0] [--ompl-time 1.5] [--ompl-planner bitstar|rrtstar] [--no-ompl] [--out rows.csv|rows.parquet]
-[--cases 3,17,full-parallel-forwards-1]`` (``--cases``: a subset of the suite to iterate on).
+[--cases 3,17,full-parallel-forwards-1] [--feasibility compute|FILE.json]`` (``--cases``: a
+subset of the suite to iterate on).
+
+``--feasibility``: each case's verdict of :mod:`parking_feasibility` (feasible, infeasible or
+unknown, from the connectivity of the car's free configuration space), either computed in
+the run (``compute``: 5-20 s a case) or read from a file its CLI wrote (``--json``; the
+suite's are ``benchmarks/parking_feasibility_full.json`` and ``..._small.json``, for seed 0;
+a file whose start, goal or size of a case differs from the suite's is refused). The report
+then ends with trajopt's planned rate over all cases and over the cases proven feasible.
 """
 
 from __future__ import annotations
@@ -298,6 +306,62 @@ def report(rows: list[dict], have_ompl: bool) -> str:
     return "\n".join(lines)
 
 
+def feasibility_verdicts(cases: list[pc.ParkingCase], how: str) -> dict[str, str]:
+    """Each case's feasibility verdict: computed (``how == "compute"``) or read from a JSON file.
+
+    The file is a list of rows with ``case_id``, ``verdict``, ``start``, ``goal`` and
+    ``size`` (``parking_feasibility.py --json``); a case missing from it, or whose start,
+    goal or size differ from the suite's by more than 1e-9, raises ``ValueError``.
+    """
+    if how == "compute":
+        # the package's module: numba's cache of its kernels names benchmarks.parking_feasibility
+        from benchmarks import parking_feasibility as pfz
+
+        out = {}
+        for case in cases:
+            v = pfz.case_feasibility(case)
+            print(
+                f"feasibility {case.case_id}: {v.verdict} ({v.resolution:.3f} m, {v.seconds:.0f} s)"
+            )
+            out[case.case_id] = v.verdict
+        return out
+    import json
+
+    rows = {r["case_id"]: r for r in json.loads(Path(how).read_text())}
+    out = {}
+    for case in cases:
+        r = rows.get(case.case_id)
+        if r is None:
+            raise ValueError(f"--feasibility {how}: no verdict for case {case.case_id!r}")
+        same = np.allclose(r["start"], case.start, atol=1e-9, rtol=0) and np.allclose(
+            r["goal"], case.goal, atol=1e-9, rtol=0
+        )
+        if not same or abs(r["size"] - case.size) > 1e-9:
+            raise ValueError(
+                f"--feasibility {how}: case {case.case_id!r} differs from the suite's "
+                "(start, goal or size): the file is stale, recompute it"
+            )
+        out[case.case_id] = r["verdict"]
+    return out
+
+
+def feasibility_lines(rows: list[dict]) -> list[str]:
+    """trajopt's planned rate over all cases and over the cases proven feasible."""
+    t = [r for r in rows if r["method"] == "trajopt"]
+    feas = [r for r in t if r["feasibility"] == "feasible"]
+    counts = {
+        k: sum(r["feasibility"] == k for r in t) for k in ("feasible", "infeasible", "unknown")
+    }
+    ok_all = sum(bool(r["ok"]) for r in t)
+    ok_feas = sum(bool(r["ok"]) for r in feas)
+    return [
+        "feasibility (parking_feasibility): " + ", ".join(f"{n} {k}" for k, n in counts.items()),
+        f"trajopt planned {ok_all}/{len(t)} of all cases ({100 * ok_all / max(len(t), 1):.1f}%), "
+        f"{ok_feas}/{len(feas)} of the cases proven feasible "
+        f"({100 * ok_feas / max(len(feas), 1):.1f}%)",
+    ]
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark (module docstring)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -315,6 +379,13 @@ def main(argv: list[str] | None = None) -> int:
         default=None,
         help="only these cases of the suite: comma-separated indices (0-based) or case ids",
     )
+    ap.add_argument(
+        "--feasibility",
+        type=str,
+        default=None,
+        help="'compute' or a JSON file of parking_feasibility.py --json: also report the "
+        "planned rate over the cases proven feasible",
+    )
     args = ap.parse_args(argv)
 
     import trajopt  # noqa: F401 - imported before timing
@@ -325,6 +396,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.cases:
         picks = [w.strip() for w in args.cases.split(",") if w.strip()]
         cases = [c for i, c in enumerate(cases) if str(i) in picks or c.case_id in picks]
+    verdicts = feasibility_verdicts(cases, args.feasibility) if args.feasibility else None
     have_ompl = not args.no_ompl
     if have_ompl:
         try:
@@ -361,6 +433,8 @@ def main(argv: list[str] | None = None) -> int:
             "cells": grid.nx * grid.ny,
             "grid_s": grid_s,
         }
+        if verdicts is not None:
+            base["feasibility"] = verdicts[case.case_id]
         r = run_trajopt(case, grid, robot)
         rows.append({**base, **r})
         msg = (
@@ -380,6 +454,8 @@ def main(argv: list[str] | None = None) -> int:
         print(msg, flush=True)
     print(f"total {time.perf_counter() - t_all:.0f} s\n")
     print(report(rows, have_ompl))
+    if verdicts is not None:
+        print("\n".join(feasibility_lines(rows)))
     if args.out is not None:
         import pandas as pd
 
