@@ -1,4 +1,4 @@
-"""Tests of the (s, t) grid's compiled loops against plain references written out here.
+"""Tests of trajopt.moving: the (s, t) grid's compiled loops against plain references here.
 
 Random runs (nodes, time ranges, movers; some reaching past the grid's last time) are painted
 run by run in Python (the least mover index winning a node), and the reachability sweep is
