@@ -234,31 +234,60 @@ def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
 
     Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
     last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
-    ``limit`` plus the radius is ``r + g (t - u)`` (m).
+    ``limit`` plus the radius is ``r + g (t - u)`` (m). A mover's knots are ``0``, its times
+    after 0 and ``t_end = max(t_last, 0) + 1``; its centre at the knots is its waypoint there,
+    at 0 its prediction (``numpy.interp``'s value: the first or last waypoint outside its
+    times), at ``t_end`` its last waypoint. All movers at once.
     """
-    out = []
-    for j, m in enumerate(movers):
-        tk = m.times
-        t_end = max(float(tk[-1]), 0.0) + 1.0
-        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
-        u, w = knots[:-1], knots[1:]
-        mid = 0.5 * (u + w)
-        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
-        inside = (mid > tk[0]) & (mid < tk[-1])
-        span = w - u
-        out.append(
-            np.column_stack(
-                [
-                    np.full(u.shape, float(j)),
-                    u,
-                    np.where(w >= t_end, np.inf, w),
-                    px[:-1],
-                    py[:-1],
-                    np.where(inside, np.diff(px) / span, 0.0),
-                    np.where(inside, np.diff(py) / span, 0.0),
-                    limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)),
-                    np.where(mid < m.t_last, m.growth, 0.0),
-                ]
-            )
-        )
-    return np.concatenate(out) if out else np.zeros((0, 9))
+    if len(movers) == 0:
+        return np.zeros((0, 9))
+    n_j = np.array([m.times.shape[0] for m in movers])
+    tk = np.concatenate([m.times for m in movers])
+    pos = np.concatenate([m.positions for m in movers])
+    j = np.arange(n_j.shape[0])
+    owner = np.repeat(j, n_j)
+    base = np.cumsum(n_j) - n_j  # each mover's first waypoint
+    last = base + n_j - 1
+    t_first, t_last = tk[base], tk[last]
+    t_end = np.maximum(t_last, 0.0) + 1.0
+    after = tk > 0.0  # the knots inside: a suffix of each mover's times
+    k = base + np.bincount(owner, weights=~after, minlength=j.shape[0]).astype(np.int64) - 1
+    # the centre at t = 0, as numpy.interp gives it (outside the times: the first or last
+    # waypoint; at a waypoint: it; else slope (t - t_k) + p_k)
+    p0 = np.where((t_first >= 0.0)[:, None], pos[base], pos[last])
+    between = (t_first < 0.0) & (t_last > 0.0)
+    if between.any():
+        kb = k[between]
+        slope = (pos[kb + 1] - pos[kb]) / (tk[kb + 1] - tk[kb])[:, None]
+        at = np.where((tk[kb] == 0.0)[:, None], pos[kb], slope * (0.0 - tk[kb])[:, None] + pos[kb])
+        p0[between] = at
+    cnt = 2 + np.bincount(owner, weights=after, minlength=j.shape[0]).astype(np.int64)
+    first = np.cumsum(cnt) - cnt
+    end = first + cnt - 1
+    knots, pk = np.empty(first[-1] + cnt[-1]), np.empty((first[-1] + cnt[-1], 2))
+    knots[first], pk[first] = 0.0, p0
+    knots[end], pk[end] = t_end, pos[last]
+    inner = np.flatnonzero(after)
+    slot = first[owner[inner]] + inner - k[owner[inner]]
+    knots[slot], pk[slot] = tk[inner], pos[inner]
+    row = np.delete(np.arange(knots.shape[0]), end)  # each knot but a mover's last
+    who = np.repeat(j, cnt - 1)
+    u, w = knots[row], knots[row + 1]
+    mid = 0.5 * (u + w)
+    inside = (mid > t_first[who]) & (mid < t_last[who])
+    vel = np.where(inside[:, None], (pk[row + 1] - pk[row]) / (w - u)[:, None], 0.0)
+    radius = np.array([m.radius for m in movers], dtype=float)
+    growth = np.array([m.growth for m in movers], dtype=float)
+    return np.column_stack(
+        [
+            who.astype(float),
+            u,
+            np.where(w >= t_end[who], np.inf, w),
+            pk[row, 0],
+            pk[row, 1],
+            vel[:, 0],
+            vel[:, 1],
+            limit + radius[who] + growth[who] * np.clip(u, 0.0, np.maximum(t_last, 0.0)[who]),
+            np.where(mid < t_last[who], growth[who], 0.0),
+        ]
+    )

@@ -170,8 +170,12 @@ class FineWindows:
         f_lo = self.lo[run] - b[which]
         f_hi = self.hi[run] - a[which]
         keep = f_hi > lo
-        f_lo, f_hi = f_lo[keep], f_hi[keep]
-        span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
+        # in order of f_lo once: every sweep below sorts these again with a few short
+        # intervals appended, which the stable sort (timsort) merges in linear time
+        order = np.flatnonzero(keep)
+        order = order[np.argsort(f_lo[order], kind="stable")]
+        f_lo, f_hi = f_lo[order], f_hi[order]
+        span_a, span_b, owner = a[which][order], b[which][order], self.owner[run][order]
         cur = _sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
         if s_of is None or self.where is None:
             return cur if cur <= hi else None

@@ -4,7 +4,9 @@ A pair of a piece of a mover's track and a point that the filter leaves out must
 than the piece's limit at every instant of the piece: checked on dense samples of the
 piece's centre and limit (written out here from the piece's row). The windows computed on
 the kept pairs must be exactly those computed on every pair. The merged spans of the
-tightening's refinement must cover exactly the union of the spans, per mover.
+tightening's refinement must cover exactly the union of the spans, per mover. The pieces of
+the tracks, built for all movers at once, must be exactly those written out mover by mover
+with ``numpy.interp`` (waypoints before, at and after ``t = 0``).
 """
 
 from __future__ import annotations
@@ -114,3 +116,57 @@ def test_merged_spans_are_the_union_of_each_owners_spans(spans):
         assert np.array_equal(got, want)
         # disjoint and in order: each merged span starts after the previous one ended
         assert np.all(ma[got_sel][1:] > mb[got_sel][:-1])
+
+
+def _pieces_one_by_one(movers, limit):
+    """The rows of :func:`mover_pieces` written out mover by mover (``numpy.interp``)."""
+    out = []
+    for j, m in enumerate(movers):
+        tk = m.times
+        t_end = max(float(tk[-1]), 0.0) + 1.0
+        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
+        u, w = knots[:-1], knots[1:]
+        mid = 0.5 * (u + w)
+        px = np.interp(knots, tk, m.positions[:, 0])
+        py = np.interp(knots, tk, m.positions[:, 1])
+        inside = (mid > tk[0]) & (mid < tk[-1])
+        span = w - u
+        out.append(
+            np.column_stack(
+                [
+                    np.full(u.shape, float(j)),
+                    u,
+                    np.where(w >= t_end, np.inf, w),
+                    px[:-1],
+                    py[:-1],
+                    np.where(inside, np.diff(px) / span, 0.0),
+                    np.where(inside, np.diff(py) / span, 0.0),
+                    limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)),
+                    np.where(mid < m.t_last, m.growth, 0.0),
+                ]
+            )
+        )
+    return np.concatenate(out)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), n_movers=st.integers(1, 6))
+def test_the_pieces_of_all_movers_at_once_equal_those_one_by_one(seed, n_movers):
+    rng = np.random.default_rng(seed)
+    movers = []
+    for j in range(n_movers):
+        k = int(rng.integers(1, 7))
+        times = np.cumsum(rng.uniform(0.05, 2.0, size=k)) + rng.choice([-4.0, -0.5, 0.0, 0.3])
+        if k > 1 and rng.random() < 0.3:  # a waypoint exactly at t = 0
+            times = times - times[rng.integers(k)]
+        movers.append(
+            MovingObstacle.from_waypoints(
+                times,
+                rng.uniform(-3.0, 3.0, size=(k, 2)),
+                radius=float(rng.uniform(0.0, 0.5)),
+                growth=float(rng.choice([0.0, rng.uniform(0.0, 0.2)])),
+                name=f"m{j}",
+            )
+        )
+    limit = float(rng.uniform(0.0, 0.3))
+    np.testing.assert_array_equal(mover_pieces(movers, limit), _pieces_one_by_one(movers, limit))
