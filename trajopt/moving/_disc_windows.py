@@ -229,49 +229,85 @@ def disc_windows(
     return who[seg[keep]], pi[keep].astype(np.int64), lo[keep], hi[keep]
 
 
+def track_knots(
+    movers: Sequence[MovingObstacle], a: float | np.ndarray, b: float | np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return every mover's knots on ``[a, b]`` and its centre there, all movers at once.
+
+    A mover's knots are ``a``, its waypoint times strictly between ``a`` and ``b``, and
+    ``b`` (``a < b``); its centre at them is what ``numpy.interp`` gives, bit for bit: a
+    waypoint at its time, the first or last waypoint outside the times, else
+    ``slope (t - t_k) + p_k`` on the waypoints' segment.
+
+    Parameters
+    ----------
+    movers : sequence of MovingObstacle
+        At least one.
+    a, b : float or ndarray, shape (movers,)
+        The range (s), one for all movers or one each.
+
+    Returns
+    -------
+    owner : ndarray of int, shape (k,)
+        The mover of each knot (movers in order, each one's knots in order of time).
+    knots : ndarray, shape (k,)
+        The knots (s).
+    centre : ndarray, shape (k, 2)
+        The centre (m) at each knot.
+    """
+    m = len(movers)
+    n_j = np.array([mv.times.shape[0] for mv in movers])
+    tk = np.concatenate([mv.times for mv in movers])
+    pos = np.concatenate([mv.positions for mv in movers])
+    j = np.arange(m)
+    own = np.repeat(j, n_j)
+    base = np.cumsum(n_j) - n_j  # each mover's first waypoint
+    last = base + n_j - 1
+    a = np.broadcast_to(np.asarray(a, dtype=float), (m,))
+    b = np.broadcast_to(np.asarray(b, dtype=float), (m,))
+
+    def centre_at(x: np.ndarray) -> np.ndarray:
+        k = base + np.bincount(own, weights=tk <= x[own], minlength=m).astype(np.int64) - 1
+        out = np.where((x < tk[base])[:, None], pos[base], pos[last])
+        between = (x >= tk[base]) & (x < tk[last])  # then base <= k < last
+        if between.any():
+            kb, xb = k[between], x[between]
+            slope = (pos[kb + 1] - pos[kb]) / (tk[kb + 1] - tk[kb])[:, None]
+            at = slope * (xb - tk[kb])[:, None] + pos[kb]
+            out[between] = np.where((tk[kb] == xb)[:, None], pos[kb], at)
+        return out
+
+    inner = (tk > a[own]) & (tk < b[own])
+    lead = base + np.bincount(own, weights=tk <= a[own], minlength=m).astype(np.int64)
+    cnt = 2 + np.bincount(own, weights=inner, minlength=m).astype(np.int64)
+    first = np.cumsum(cnt) - cnt
+    end = first + cnt - 1
+    total = int(first[-1] + cnt[-1])
+    knots, centre = np.empty(total), np.empty((total, 2))
+    knots[first], centre[first] = a, centre_at(a)
+    knots[end], centre[end] = b, centre_at(b)
+    idx = np.flatnonzero(inner)
+    slot = first[own[idx]] + 1 + idx - lead[own[idx]]
+    knots[slot], centre[slot] = tk[idx], pos[idx]
+    return np.repeat(j, cnt), knots, centre
+
+
 def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
     """Return the linear pieces of disc movers' tracks, shape (p, 9), for :func:`disc_windows`.
 
     Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
     last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
     ``limit`` plus the radius is ``r + g (t - u)`` (m). A mover's knots are ``0``, its times
-    after 0 and ``t_end = max(t_last, 0) + 1``; its centre at the knots is its waypoint there,
-    at 0 its prediction (``numpy.interp``'s value: the first or last waypoint outside its
-    times), at ``t_end`` its last waypoint. All movers at once.
+    after 0 and ``t_end = max(t_last, 0) + 1`` (:func:`track_knots`).
     """
     if len(movers) == 0:
         return np.zeros((0, 9))
-    n_j = np.array([m.times.shape[0] for m in movers])
-    tk = np.concatenate([m.times for m in movers])
-    pos = np.concatenate([m.positions for m in movers])
-    j = np.arange(n_j.shape[0])
-    owner = np.repeat(j, n_j)
-    base = np.cumsum(n_j) - n_j  # each mover's first waypoint
-    last = base + n_j - 1
-    t_first, t_last = tk[base], tk[last]
+    t_first = np.array([float(m.times[0]) for m in movers])
+    t_last = np.array([m.t_last for m in movers])
     t_end = np.maximum(t_last, 0.0) + 1.0
-    after = tk > 0.0  # the knots inside: a suffix of each mover's times
-    k = base + np.bincount(owner, weights=~after, minlength=j.shape[0]).astype(np.int64) - 1
-    # the centre at t = 0, as numpy.interp gives it (outside the times: the first or last
-    # waypoint; at a waypoint: it; else slope (t - t_k) + p_k)
-    p0 = np.where((t_first >= 0.0)[:, None], pos[base], pos[last])
-    between = (t_first < 0.0) & (t_last > 0.0)
-    if between.any():
-        kb = k[between]
-        slope = (pos[kb + 1] - pos[kb]) / (tk[kb + 1] - tk[kb])[:, None]
-        at = np.where((tk[kb] == 0.0)[:, None], pos[kb], slope * (0.0 - tk[kb])[:, None] + pos[kb])
-        p0[between] = at
-    cnt = 2 + np.bincount(owner, weights=after, minlength=j.shape[0]).astype(np.int64)
-    first = np.cumsum(cnt) - cnt
-    end = first + cnt - 1
-    knots, pk = np.empty(first[-1] + cnt[-1]), np.empty((first[-1] + cnt[-1], 2))
-    knots[first], pk[first] = 0.0, p0
-    knots[end], pk[end] = t_end, pos[last]
-    inner = np.flatnonzero(after)
-    slot = first[owner[inner]] + inner - k[owner[inner]]
-    knots[slot], pk[slot] = tk[inner], pos[inner]
-    row = np.delete(np.arange(knots.shape[0]), end)  # each knot but a mover's last
-    who = np.repeat(j, cnt - 1)
+    owner, knots, pk = track_knots(movers, 0.0, t_end)
+    row = np.flatnonzero(owner[1:] == owner[:-1])  # each knot but a mover's last
+    who = owner[row]
     u, w = knots[row], knots[row + 1]
     mid = 0.5 * (u + w)
     inside = (mid > t_first[who]) & (mid < t_last[who])

@@ -6,7 +6,8 @@ piece's centre and limit (written out here from the piece's row). The windows co
 the kept pairs must be exactly those computed on every pair. The merged spans of the
 tightening's refinement must cover exactly the union of the spans, per mover. The pieces of
 the tracks, built for all movers at once, must be exactly those written out mover by mover
-with ``numpy.interp`` (waypoints before, at and after ``t = 0``).
+with ``numpy.interp`` (waypoints before, at and after ``t = 0``), and so must the knots of
+any range and the centres there (:func:`track_knots`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._disc_windows import disc_windows, mover_pieces, near_pairs
+from trajopt.moving._disc_windows import disc_windows, mover_pieces, near_pairs, track_knots
 from trajopt.moving._tighten import merged_spans
 
 
@@ -149,10 +150,7 @@ def _pieces_one_by_one(movers, limit):
     return np.concatenate(out)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**31 - 1), n_movers=st.integers(1, 6))
-def test_the_pieces_of_all_movers_at_once_equal_those_one_by_one(seed, n_movers):
-    rng = np.random.default_rng(seed)
+def _tracks(rng, n_movers):
     movers = []
     for j in range(n_movers):
         k = int(rng.integers(1, 7))
@@ -168,5 +166,35 @@ def test_the_pieces_of_all_movers_at_once_equal_those_one_by_one(seed, n_movers)
                 name=f"m{j}",
             )
         )
+    return movers
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), n_movers=st.integers(1, 6))
+def test_the_pieces_of_all_movers_at_once_equal_those_one_by_one(seed, n_movers):
+    rng = np.random.default_rng(seed)
+    movers = _tracks(rng, n_movers)
     limit = float(rng.uniform(0.0, 0.3))
     np.testing.assert_array_equal(mover_pieces(movers, limit), _pieces_one_by_one(movers, limit))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), n_movers=st.integers(1, 6))
+def test_the_knots_of_a_range_equal_numpy_interp_mover_by_mover(seed, n_movers):
+    rng = np.random.default_rng(seed)
+    movers = _tracks(rng, n_movers)
+    times = np.concatenate([m.times for m in movers])
+    a = float(rng.choice([rng.uniform(-5.0, 8.0), rng.choice(times)]))  # at a waypoint, too
+    b = a + float(rng.choice([rng.uniform(0.0, 6.0), 0.0]))
+    if rng.random() < 0.3:  # one range per mover
+        a = a + rng.uniform(0.0, 1.0, size=n_movers)
+        b = a + rng.uniform(0.0, 4.0, size=n_movers)
+    owner, knots, centre = track_knots(movers, a, b)
+    aa, bb = np.broadcast_to(a, (n_movers,)), np.broadcast_to(b, (n_movers,))
+    for j, m in enumerate(movers):
+        tk = m.times
+        kn = np.concatenate([[aa[j]], tk[(tk > aa[j]) & (tk < bb[j])], [bb[j]]])
+        mine = owner == j
+        np.testing.assert_array_equal(knots[mine], kn)
+        for c in range(2):
+            np.testing.assert_array_equal(centre[mine, c], np.interp(kn, tk, m.positions[:, c]))
