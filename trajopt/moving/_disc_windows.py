@@ -17,7 +17,7 @@ import numpy as np
 from trajopt.moving._obstacle import MovingObstacle
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
-BOX = 8
+BOX = 16
 #: :func:`near_pairs` keeps the pairs within this much (m) of the limit (against rounding).
 NEAR_SLACK = 1e-6
 

@@ -170,10 +170,11 @@ class FineWindows:
         f_lo = self.lo[run] - b[which]
         f_hi = self.hi[run] - a[which]
         keep = f_hi > lo
-        # in order of f_lo once: every sweep below sorts these again with a few short
+        # in order of f_lo once (ties in any order: a sweep's answer is the least free
+        # launch, whatever the order): every sweep below sorts these again with a few short
         # intervals appended, which the stable sort (timsort) merges in linear time
         order = np.flatnonzero(keep)
-        order = order[np.argsort(f_lo[order], kind="stable")]
+        order = order[np.argsort(f_lo[order])]
         f_lo, f_hi = f_lo[order], f_hi[order]
         span_a, span_b, owner = a[which][order], b[which][order], self.owner[run][order]
         cur = _sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
