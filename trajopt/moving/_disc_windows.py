@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._st_kernels import disc_windows_kernel, inside_times_kernel
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
 BOX = 16
@@ -95,37 +96,17 @@ def inside_times(
     The point at ``D = (dx, dy)`` from the mover's centre at the piece's start, the centre
     moving at ``V = (vx, vy)`` (m/s), the limit ``rr + g tau`` (m): ``|D - V tau| < rr + g tau``
     on the open interval ``(t_lo, t_hi)`` (``t_lo > t_hi`` or infinite ends when empty or
-    unbounded; NaN where undefined). Broadcasts.
+    unbounded; NaN where undefined). Broadcasts. The roots of the quadratic
+    ``|D - V tau|^2 - (rr + g tau)^2`` as ``q / a`` and ``c / q`` with
+    ``q = -(b + sign(b) sqrt(b^2 - 4 a c)) / 2`` (no cancellation), the linear root where
+    ``|a| <= 1e-12``, and ``t_lo >= -rr / g`` where the limit grows (it must be positive);
+    compiled per pair (:func:`._st_kernels.inside_times_kernel`).
     """
     dx, dy, vx, vy, rr, g = np.broadcast_arrays(dx, dy, vx, vy, rr, g)
-    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
-    a = vx * vx + vy * vy - g * g
-    b = -2.0 * (dx * vx + dy * vy + rr * g)
-    c = dx * dx + dy * dy - rr * rr
-    big = np.inf
-    with np.errstate(divide="ignore", invalid="ignore"):
-        disc = b * b - 4.0 * a * c
-        two = disc > 0
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        # the roots q / a and c / q, q = -(b + sign(b) sq) / 2 (no cancellation)
-        q = -0.5 * (b + np.where(b > 0, sq, -sq))
-        r1, r2 = q / a, c / q
-        up = a > 0
-        t_lo = np.where(two, np.where(up, np.minimum(r1, r2), np.maximum(r1, r2)), 0.0)
-        t_lo[~two] = np.where(up, big, -big)[~two]
-        t_hi = np.where(up, np.where(two, np.maximum(r1, r2), -big), big)
-        flat = np.abs(a) <= 1e-12
-        if flat.any():
-            bf, cf = b[flat], c[flat]
-            lin = -cf / bf
-            t_lo[flat] = np.where(bf < 0, lin, -big)
-            t_hi[flat] = np.where(bf > 0, lin, np.where((bf == 0) & (cf >= 0), -big, big))
-        # the limit must be positive: rr + g tau > 0
-        grows = g > 0
-        if grows.any():
-            t_lo = np.where(grows, np.maximum(t_lo, -rr / g), t_lo)
-        t_lo = np.where(grows | (rr > 0), t_lo, big)
-    return t_lo, t_hi
+    shape = dx.shape
+    flat = [np.ascontiguousarray(x, dtype=float).reshape(-1) for x in (dx, dy, vx, vy, rr, g)]
+    t_lo, t_hi = inside_times_kernel(*flat)
+    return t_lo.reshape(shape), t_hi.reshape(shape)
 
 
 def close_pairs(
@@ -208,7 +189,8 @@ def disc_windows(
     mover, point : ndarray of int, shape (r,)
         The mover and the point of each window.
     lo, hi : ndarray, shape (r,)
-        The open time interval (s) of each window; ``hi = inf`` for one that lasts.
+        The open time interval (s) of each window; ``hi`` is the largest float for one that
+        lasts (``numpy.nan_to_num`` of an infinite end).
     """
     rows = movers if isinstance(movers, np.ndarray) else mover_pieces(movers, 0.0)
     who = rows[:, 0].astype(np.int64)
@@ -218,13 +200,14 @@ def disc_windows(
         seg, pi = near_pairs(pts, rows, limit)
     else:
         seg, pi = np.nonzero(near[who])
-    r = rows[seg]
-    u, w = r[:, 1], r[:, 2]
-    t_lo, t_hi = inside_times(
-        pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
+    # inside_times of each pair, clipped to its piece's span (compiled: the same floats)
+    lo, hi = disc_windows_kernel(
+        np.ascontiguousarray(pts, dtype=float),
+        np.ascontiguousarray(rows, dtype=float),
+        float(limit),
+        np.ascontiguousarray(seg, dtype=np.int64),
+        np.ascontiguousarray(pi, dtype=np.int64),
     )
-    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
-    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
     keep = lo < hi
     return who[seg[keep]], pi[keep].astype(np.int64), lo[keep], hi[keep]
 

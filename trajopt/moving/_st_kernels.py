@@ -1,4 +1,4 @@
-"""The compiled kernels of the ``(s, t)`` search: a drive's blocked starts and a stop's arrivals.
+"""The compiled kernels of the ``(s, t)`` search and of the disc movers' windows.
 
 A non-decreasing motion along the path (a drive) is at node ``i0 + i`` exactly at the steps
 ``first[i]..last[i]`` after its start (:func:`._st_grid.visits`); a forbidden run
@@ -10,6 +10,11 @@ robot rests at the stop at ``t_k``, the drive is not blocked there and its stop 
 arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme of
 :func:`._st_search.search`). Integer arithmetic only: the same answers as the numpy forms
 (:meth:`._st_grid.STGrid.blocked_starts_many`).
+
+:func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
+order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
+span with ``numpy.nan_to_num``'s replacements), so the same floats.
 """
 
 from __future__ import annotations
@@ -155,3 +160,124 @@ def drive_nodes_kernel(rows, duration, s0, s1, dt, ds, n_nodes, never):  # pragm
             first[q] = j
         last[q] = j
     return idx, first, last
+
+
+_BIG = np.finfo(np.float64).max
+
+
+@njit(cache=True)
+def _max_nan(x, y):  # pragma: no cover - compiled
+    """``numpy.maximum`` of two floats (NaN if either is)."""
+    if np.isnan(x) or np.isnan(y):
+        return np.nan
+    return x if x >= y else y
+
+
+@njit(cache=True)
+def _min_nan(x, y):  # pragma: no cover - compiled
+    """``numpy.minimum`` of two floats (NaN if either is)."""
+    if np.isnan(x) or np.isnan(y):
+        return np.nan
+    return x if x <= y else y
+
+
+@njit(cache=True)
+def _finite(x, nan):  # pragma: no cover - compiled
+    """``numpy.nan_to_num(x, nan=nan)`` of one float (infinities to the largest floats)."""
+    if np.isnan(x):
+        return nan
+    if x == np.inf:
+        return _BIG
+    if x == -np.inf:
+        return -_BIG
+    return x
+
+
+@njit(cache=True, error_model="numpy")
+def _inside(dx, dy, vx, vy, rr, g):  # pragma: no cover - compiled
+    """``(t_lo, t_hi)`` of one point and piece: :func:`._disc_windows.inside_times`, scalar."""
+    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
+    a = vx * vx + vy * vy - g * g
+    b = -2.0 * (dx * vx + dy * vy + rr * g)
+    c = dx * dx + dy * dy - rr * rr
+    disc = b * b - 4.0 * a * c
+    two = disc > 0
+    sq = np.sqrt(_max_nan(disc, 0.0))
+    q = -0.5 * (b + (sq if b > 0 else -sq))
+    r1 = q / a
+    r2 = c / q
+    up = a > 0
+    if two:
+        t_lo = _min_nan(r1, r2) if up else _max_nan(r1, r2)
+    else:
+        t_lo = np.inf if up else -np.inf
+    if up:
+        t_hi = _max_nan(r1, r2) if two else -np.inf
+    else:
+        t_hi = np.inf
+    if abs(a) <= 1e-12:
+        lin = -c / b
+        t_lo = lin if b < 0 else -np.inf
+        if b > 0:
+            t_hi = lin
+        elif b == 0 and c >= 0:
+            t_hi = -np.inf
+        else:
+            t_hi = np.inf
+    if g > 0:
+        t_lo = _max_nan(t_lo, -rr / g)
+    if not (g > 0 or rr > 0):
+        t_lo = np.inf
+    return t_lo, t_hi
+
+
+@njit(cache=True)
+def inside_times_kernel(dx, dy, vx, vy, rr, g):  # pragma: no cover - compiled
+    """Return ``(t_lo, t_hi)`` (s) of :func:`._disc_windows.inside_times`, 1-D arrays of one length."""
+    n = dx.shape[0]
+    t_lo = np.empty(n)
+    t_hi = np.empty(n)
+    for i in range(n):
+        t_lo[i], t_hi[i] = _inside(dx[i], dy[i], vx[i], vy[i], rr[i], g[i])
+    return t_lo, t_hi
+
+
+@njit(cache=True)
+def disc_windows_kernel(pts, rows, limit, seg, pi):  # pragma: no cover - compiled
+    """Return the open windows ``(lo, hi)`` (s) of the pairs ``(rows[seg[i]], pts[pi[i]])``.
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    rows : ndarray, shape (p, 9)
+        Pieces ``(mover, u, w, x, y, vx, vy, r, g)`` (:func:`._disc_windows.mover_pieces`).
+    limit : float
+        Added to every piece's ``r`` (m).
+    seg, pi : ndarray of int64, shape (q,)
+        The pairs.
+
+    Returns
+    -------
+    lo, hi : ndarray, shape (q,)
+        The window of each pair within its piece's span (``numpy.nan_to_num`` of its
+        :func:`._disc_windows.inside_times` from the piece's start, clipped to the span);
+        empty (``lo >= hi``) when none.
+    """
+    q = seg.shape[0]
+    lo = np.empty(q)
+    hi = np.empty(q)
+    for i in range(q):
+        k = seg[i]
+        u, w = rows[k, 1], rows[k, 2]
+        t_lo, t_hi = _inside(
+            pts[pi[i], 0] - rows[k, 3],
+            pts[pi[i], 1] - rows[k, 4],
+            rows[k, 5],
+            rows[k, 6],
+            rows[k, 7] + limit,
+            rows[k, 8],
+        )
+        lo[i] = _max_nan(u + _finite(t_lo, np.inf), u)
+        hi[i] = _min_nan(u + _finite(t_hi, -np.inf), w)
+    return lo, hi

@@ -7,7 +7,11 @@ the kept pairs must be exactly those computed on every pair. The merged spans of
 tightening's refinement must cover exactly the union of the spans, per mover. The pieces of
 the tracks, built for all movers at once, must be exactly those written out mover by mover
 with ``numpy.interp`` (waypoints before, at and after ``t = 0``), and so must the knots of
-any range and the centres there (:func:`track_knots`).
+any range and the centres there (:func:`track_knots`). The compiled closed form of the times a
+point is inside a mover's limit must give the floats of the same closed form written with
+numpy, degenerate cases (no relative motion, a limit growing as fast as the mover moves, a
+zero limit) included (the grid built on it is checked against the distances at every node and
+grid time in test_st_grid, the re-timings on it against 1 ms samples in test_retime).
 """
 
 from __future__ import annotations
@@ -17,7 +21,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from trajopt.moving import MovingObstacle
-from trajopt.moving._disc_windows import disc_windows, mover_pieces, near_pairs, track_knots
+from trajopt.moving._disc_windows import (
+    disc_windows,
+    inside_times,
+    mover_pieces,
+    near_pairs,
+    track_knots,
+)
 from trajopt.moving._tighten import merged_spans
 
 
@@ -198,3 +208,52 @@ def test_the_knots_of_a_range_equal_numpy_interp_mover_by_mover(seed, n_movers):
         np.testing.assert_array_equal(knots[mine], kn)
         for c in range(2):
             np.testing.assert_array_equal(centre[mine, c], np.interp(kn, tk, m.positions[:, c]))
+
+
+def _inside_numpy(dx, dy, vx, vy, rr, g):
+    """The closed form of ``inside_times`` written with numpy arrays (the reference)."""
+    dx, dy, vx, vy, rr, g = np.broadcast_arrays(dx, dy, vx, vy, rr, g)
+    a = vx * vx + vy * vy - g * g
+    b = -2.0 * (dx * vx + dy * vy + rr * g)
+    c = dx * dx + dy * dy - rr * rr
+    with np.errstate(divide="ignore", invalid="ignore"):
+        disc = b * b - 4.0 * a * c
+        two = disc > 0
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        q = -0.5 * (b + np.where(b > 0, sq, -sq))
+        r1, r2 = q / a, c / q
+        up = a > 0
+        t_lo = np.where(two, np.where(up, np.minimum(r1, r2), np.maximum(r1, r2)), 0.0)
+        t_lo = np.where(two, t_lo, np.where(up, np.inf, -np.inf))
+        t_hi = np.where(up, np.where(two, np.maximum(r1, r2), -np.inf), np.inf)
+        flat = np.abs(a) <= 1e-12
+        lin = -c / b
+        t_lo = np.where(flat, np.where(b < 0, lin, -np.inf), t_lo)
+        t_hi = np.where(
+            flat, np.where(b > 0, lin, np.where((b == 0) & (c >= 0), -np.inf, np.inf)), t_hi
+        )
+        t_lo = np.where(g > 0, np.maximum(t_lo, -rr / g), t_lo)
+        t_lo = np.where((g > 0) | (rr > 0), t_lo, np.inf)
+    return t_lo, t_hi
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1))
+def test_the_compiled_inside_times_equal_the_numpy_closed_form(seed):
+    rng = np.random.default_rng(seed)
+    n = 400
+
+    def some(lo, hi, *special):
+        x = rng.uniform(lo, hi, n)
+        pick = rng.random(n) < 0.25
+        return np.where(pick, rng.choice(np.array(special, dtype=float), n), x)
+
+    dx, dy = some(-3.0, 3.0, 0.0, 0.5), some(-3.0, 3.0, 0.0, -1.0)
+    vx, vy = some(-2.0, 2.0, 0.0, 1.0), some(-2.0, 2.0, 0.0, 0.3)
+    rr = some(0.0, 1.0, 0.0, 0.4)
+    g = np.where(rng.random(n) < 0.5, 0.0, rng.uniform(0.0, 2.0, n))
+    g = np.where(rng.random(n) < 0.15, np.hypot(vx, vy), g)  # a = 0: linear
+    got = inside_times(dx, dy, vx, vy, rr, g)
+    want = _inside_numpy(dx, dy, vx, vy, rr, g)
+    for x, y in zip(got, want, strict=True):
+        np.testing.assert_array_equal(x, y)
