@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_kernels import disc_windows_kernel, inside_times_kernel
+from trajopt.moving._st_kernels import close_kernel, disc_windows_kernel, inside_times_kernel
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
 BOX = 16
@@ -141,20 +141,20 @@ def _close(
     seg: np.ndarray,
     point: np.ndarray,
 ) -> np.ndarray:
-    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool)."""
-    ax, ay = a[:, 0], a[:, 1]
-    dx, dy = b[:, 0] - ax, b[:, 1] - ay
-    dd = dx * dx + dy * dy
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
-    qx = pts[:, 0][point] - ax[seg]
-    qy = pts[:, 1][point] - ay[seg]
-    sx, sy = dx[seg], dy[seg]
-    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
-    qx -= f * sx
-    qy -= f * sy
-    r = reach[seg]
-    return ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
+    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool).
+
+    The distance to the segment (the projection's parameter clipped to ``[0, 1]``) against
+    the reach; a NaN or infinite distance is kept. Compiled
+    (:func:`._st_kernels.close_kernel`).
+    """
+    return close_kernel(
+        np.ascontiguousarray(pts, dtype=float),
+        np.ascontiguousarray(a, dtype=float),
+        np.ascontiguousarray(b, dtype=float),
+        np.ascontiguousarray(reach, dtype=float),
+        np.ascontiguousarray(seg, dtype=np.int64),
+        np.ascontiguousarray(point, dtype=np.int64),
+    )
 
 
 def disc_windows(

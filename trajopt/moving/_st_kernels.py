@@ -11,7 +11,8 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 :func:`._st_search.search`). Integer arithmetic only: the same answers as the numpy forms
 (:meth:`._st_grid.STGrid.blocked_starts_many`).
 
-:func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+:func:`close_kernel` is the point-to-segment test of the pair filter
+(:func:`._disc_windows.near_pairs`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
 order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
 span with ``numpy.nan_to_num``'s replacements), so the same floats.
@@ -281,3 +282,31 @@ def disc_windows_kernel(pts, rows, limit, seg, pi):  # pragma: no cover - compil
         lo[i] = _max_nan(u + _finite(t_lo, np.inf), u)
         hi[i] = _min_nan(u + _finite(t_hi, -np.inf), w)
     return lo, hi
+
+
+@njit(cache=True)
+def close_kernel(pts, a, b, reach, seg, point):  # pragma: no cover - compiled
+    """Return whether ``pts[point[i]]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool).
+
+    The segments run from ``a[k]`` to ``b[k]`` (m, shape (p, 2)); the same operations as the
+    numpy form of :func:`._disc_windows.close_pairs` (the projection's parameter clipped to
+    ``[0, 1]``, a NaN or infinite distance kept).
+    """
+    q = seg.shape[0]
+    out = np.empty(q, dtype=np.bool_)
+    for i in range(q):
+        k = seg[i]
+        ax, ay = a[k, 0], a[k, 1]
+        sx, sy = b[k, 0] - ax, b[k, 1] - ay
+        dd = sx * sx + sy * sy
+        inv = 1.0 / dd if dd > 0.0 else 0.0
+        qx = pts[point[i], 0] - ax
+        qy = pts[point[i], 1] - ay
+        f = (qx * sx + qy * sy) * inv
+        if not np.isnan(f):
+            f = min(max(f, 0.0), 1.0)
+        qx -= f * sx
+        qy -= f * sy
+        r = reach[k]
+        out[i] = not (qx * qx + qy * qy >= r * r)
+    return out

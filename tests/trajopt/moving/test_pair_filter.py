@@ -11,7 +11,8 @@ any range and the centres there (:func:`track_knots`). The compiled closed form 
 point is inside a mover's limit must give the floats of the same closed form written with
 numpy, degenerate cases (no relative motion, a limit growing as fast as the mover moves, a
 zero limit) included (the grid built on it is checked against the distances at every node and
-grid time in test_st_grid, the re-timings on it against 1 ms samples in test_retime).
+grid time in test_st_grid, the re-timings on it against 1 ms samples in test_retime); so must
+the compiled point-to-segment test of the pair filter.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from hypothesis import strategies as st
 
 from trajopt.moving import MovingObstacle
 from trajopt.moving._disc_windows import (
+    close_pairs,
     disc_windows,
     inside_times,
     mover_pieces,
@@ -257,3 +259,31 @@ def test_the_compiled_inside_times_equal_the_numpy_closed_form(seed):
     want = _inside_numpy(dx, dy, vx, vy, rr, g)
     for x, y in zip(got, want, strict=True):
         np.testing.assert_array_equal(x, y)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), n_movers=st.integers(1, 5))
+def test_the_compiled_segment_test_equals_the_numpy_form(seed, n_movers):
+    rng = np.random.default_rng(seed)
+    pieces = mover_pieces(_tracks(rng, n_movers), 0.0)
+    pts = _points(rng, 200)
+    limit = float(rng.uniform(0.0, 0.3))
+    seg = rng.integers(0, pieces.shape[0], 3000)
+    point = rng.integers(0, pts.shape[0], 3000)
+    # the numpy form: each piece's swept segment, the reach its limit at most plus the slack
+    span = pieces[:, 2] - pieces[:, 1]
+    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
+    a = pieces[:, 3:5]
+    b = a + pieces[:, 5:7] * np.where(still, 0.0, span)[:, None]
+    with np.errstate(invalid="ignore"):
+        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
+    reach = pieces[:, 7] + limit + grow + 1e-6
+    d = b - a
+    dd = np.sum(d * d, axis=1)
+    with np.errstate(divide="ignore"):
+        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
+    q = pts[point] - a[seg]
+    f = np.clip(np.sum(q * d[seg], axis=1) * inv[seg], 0.0, 1.0)
+    q = q - f[:, None] * d[seg]
+    want = ~(q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] >= reach[seg] ** 2)
+    np.testing.assert_array_equal(close_pairs(pts, pieces, limit, seg, point), want)
