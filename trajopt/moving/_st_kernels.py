@@ -12,7 +12,8 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 (:meth:`._st_grid.STGrid.blocked_starts_many`).
 
 :func:`close_kernel` is the point-to-segment test of the pair filter
-(:func:`._disc_windows.near_pairs`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+(:func:`._disc_windows.near_pairs`), :func:`least_free_kernel` the sweep of the rests'
+shortening (:func:`._tighten.sweep`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
 order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
 span with ``numpy.nan_to_num``'s replacements), so the same floats.
@@ -310,3 +311,81 @@ def close_kernel(pts, a, b, reach, seg, point):  # pragma: no cover - compiled
         r = reach[k]
         out[i] = not (qx * qx + qy * qy >= r * r)
     return out
+
+
+#: A bucket of :func:`least_free_kernel` longer than this is sorted by numpy's sort, not by
+#: insertion.
+_INSERTION_MAX = 32
+
+
+@njit(cache=True)
+def least_free_kernel(f_lo, f_hi, lo, eps):  # pragma: no cover - compiled
+    """Return the least ``L >= lo`` inside none of the open intervals ``(f_lo, f_hi + eps)``.
+
+    Only the intervals with ``f_hi > lo`` count. The intervals in order of ``f_lo`` (a bucket
+    sort: buckets of equal width over the finite ``f_lo``, each bucket sorted), then the
+    walk of :func:`._tighten.sweep`'s numpy form: the first interval that starts at or
+    after ``max(lo, max(f_hi so far) + eps)`` leaves that launch free. NaN when an
+    ``f_lo`` is NaN (the caller then uses the numpy form).
+    """
+    n = f_lo.shape[0]
+    idx = np.empty(n, dtype=np.int64)
+    m = 0
+    mn, mx = np.inf, -np.inf
+    for i in range(n):
+        if f_hi[i] > lo:
+            x = f_lo[i]
+            if np.isnan(x):
+                return np.nan
+            idx[m] = i
+            m += 1
+            if np.isfinite(x):
+                mn = min(mn, x)
+                mx = max(mx, x)
+    if m == 0:
+        return lo
+    width = (mx - mn) / m if mx > mn else 1.0
+    if not width > 0.0:  # an underflow
+        width = 1.0
+    key = np.empty(m, dtype=np.int64)
+    count = np.zeros(m + 1, dtype=np.int64)
+    for k in range(m):
+        x = f_lo[idx[k]]
+        if x <= mn:
+            b = 0
+        elif x >= mx:
+            b = m - 1
+        else:
+            b = min(int((x - mn) / width), m - 1)
+        key[k] = b
+        count[b + 1] += 1
+    for b in range(m):
+        count[b + 1] += count[b]
+    order = np.empty(m, dtype=np.int64)
+    fill = count[:m].copy()
+    for k in range(m):
+        order[fill[key[k]]] = idx[k]
+        fill[key[k]] += 1
+    for b in range(m):
+        s0, s1 = count[b], count[b + 1]
+        if s1 - s0 > _INSERTION_MAX:
+            part = order[s0:s1].copy()
+            order[s0:s1] = part[np.argsort(f_lo[part])]
+        else:
+            for j in range(s0 + 1, s1):
+                v = order[j]
+                x = f_lo[v]
+                h = j - 1
+                while h >= s0 and f_lo[order[h]] > x:
+                    order[h + 1] = order[h]
+                    h -= 1
+                order[h + 1] = v
+    prev = lo
+    top = -np.inf
+    for k in range(m):
+        j = order[k]
+        if f_lo[j] >= prev:
+            return prev
+        top = max(top, f_hi[j])
+        prev = max(top + eps, lo)
+    return prev

@@ -12,7 +12,9 @@ point is inside a mover's limit must give the floats of the same closed form wri
 numpy, degenerate cases (no relative motion, a limit growing as fast as the mover moves, a
 zero limit) included (the grid built on it is checked against the distances at every node and
 grid time in test_st_grid, the re-timings on it against 1 ms samples in test_retime); so must
-the compiled point-to-segment test of the pair filter.
+the compiled point-to-segment test of the pair filter. The launch sweep of the rests'
+shortening (compiled, a bucket sort) must give the least launch inside none of the intervals,
+found by brute force over the candidate launches, and the numpy form's answer.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from trajopt.moving._disc_windows import (
     near_pairs,
     track_knots,
 )
-from trajopt.moving._tighten import merged_spans
+from trajopt.moving._tighten import EPS_L, merged_spans, sweep, sweep_numpy
 
 
 def _movers(rng, n):
@@ -287,3 +289,27 @@ def test_the_compiled_segment_test_equals_the_numpy_form(seed, n_movers):
     q = q - f[:, None] * d[seg]
     want = ~(q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] >= reach[seg] ** 2)
     np.testing.assert_array_equal(close_pairs(pts, pieces, limit, seg, point), want)
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(0, 120))
+def test_the_launch_sweep_is_the_least_free_launch(seed, n):
+    rng = np.random.default_rng(seed)
+    f_lo = rng.uniform(-2.0, 10.0, n)
+    if rng.random() < 0.5:
+        f_lo = np.round(f_lo, 1)  # ties
+    f_hi = f_lo + rng.exponential(0.4, n)
+    if n and rng.random() < 0.3:  # a rest at the goal: from -inf
+        f_lo[rng.integers(n)] = -np.inf
+    if n and rng.random() < 0.3:  # a window that lasts
+        f_hi[rng.integers(n)] = np.finfo(float).max
+    lo = float(rng.choice([0.0, rng.uniform(-1.0, 5.0)]))
+    got = sweep(f_lo, f_hi, lo)
+    # brute force: the least candidate (lo, or an interval's end plus EPS_L) that no interval
+    # ending after lo holds (open intervals, each extended by EPS_L)
+    keep = f_hi > lo
+    lo_k, end = f_lo[keep], f_hi[keep] + EPS_L
+    cands = np.sort(np.append(end[end >= lo], lo))
+    free = [c for c in cands if not np.any((lo_k < c) & (c < end))]
+    assert got == free[0]
+    assert got == sweep_numpy(f_lo, f_hi, lo)
