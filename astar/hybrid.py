@@ -538,6 +538,26 @@ def find_pose_path(
         backward,
         motion.fine_factor,
     )
+    if reverse:  # fewer cusps where a cheaper word is clear (the search's own costs and tests)
+        from astar.hybrid_shortcut import shorten_cusps
+
+        t3 = time.perf_counter()
+        short = shorten_cusps(
+            free,
+            arrays[3],
+            (gx, gy, gth),
+            radius,
+            (costs.reverse_penalty, costs.cusp_penalty * radius, 1.0 + costs.turn_penalty),
+            kcoll,
+            limits.sample_step,
+        )
+        stats["shortcut"] = {
+            "replaced": 0 if short is None else short[4],
+            "cusps_before": len(arrays[2]) - 1,
+        }
+        stats["shortcut_s"] = time.perf_counter() - t3
+        if short is not None:
+            arrays = short[:4]
     path = PosePath(*arrays, radius)
     stats["total_s"] = time.perf_counter() - t0
     object.__setattr__(path, "stats", stats)

@@ -218,6 +218,9 @@ class KernelCollision(NamedTuple):
     fmin_slack : float
         Cells: the least slack a failed sample test is refined to
         (:func:`footprint_arc_clear`; ``>= fslack``: no refinement).
+    onext : ndarray of int32, shape (ny, nx + 1)
+        Footprint mode: :func:`astar.hybrid_modes.edge_next` of ``occ`` (the next cell of
+        value 1 along each row; else 1 x 2).
     fdist : ndarray of float64, shape (ny, nx)
         Footprint mode: a lower bound of every point's distance to the occupied squares
         and the outside (:func:`footprint_discs_clear`; else 1 x 1).
@@ -239,6 +242,7 @@ class KernelCollision(NamedTuple):
     fmargin: float
     fslack: float
     fmin_slack: float
+    onext: np.ndarray
     fdist: np.ndarray
     discs: np.ndarray
     pedges: np.ndarray
@@ -577,7 +581,7 @@ def word_clear(
 
 # --------------------------------------------------------------------------- footprint mode
 @njit(cache=True)
-def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - compiled
+def footprint_hit(occ, onext, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - compiled
     """Test the footprint at pose ``(x, y, th)``, grown by ``grow`` cells, against the raw map.
 
     Parameters
@@ -590,6 +594,10 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
         and meets an occupied square meets one of value 1 (where it first enters the
         occupied squares, along a path in the body from that point), so the test stays
         exact. Plain 0/1 maps work as they are.
+    onext : ndarray of int32, shape (ny, nx + 1)
+        :func:`astar.hybrid_modes.edge_next` of ``occ``: along each row, the next cell of
+        value 1 at or after a column (``nx``: none), so that a row of the footprint's box is
+        read only at its cells of value 1 (the others are skipped all the same).
     fsafe : ndarray of uint8, shape (ny, nx)
         :func:`astar.hybrid_modes.footprint_safe` for a reach of at least ``rho + grow``
         (or zeros): a pose whose centre lies in a safe cell is clear without further test.
@@ -649,9 +657,11 @@ def footprint_hit(occ, fsafe, fp, x, y, th, grow, buf):  # pragma: no cover - co
     lo_y = max(0, int(math.ceil(miny - grow - 0.5)))
     hi_y = min(ny - 1, int(math.floor(maxy + grow + 0.5)))
     for iy in range(lo_y, hi_y + 1):
-        for ix in range(lo_x, hi_x + 1):
-            if occ[iy, ix] != 1:
-                continue  # free, or occupied with occupied neighbours only (see occ)
+        # the row's cells of value 1 only (free cells and those inside solid blocks: see occ)
+        nxt = onext[iy, lo_x]
+        while nxt <= hi_x:
+            ix = nxt
+            nxt = onext[iy, ix + 1]
             # separating axes x and y: the gaps between the polygon's box and the square
             gx = max(ix - 0.5 - maxx, minx - ix - 0.5, 0.0)
             gy = max(iy - 0.5 - maxy, miny - iy - 0.5, 0.0)
@@ -723,7 +733,7 @@ def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - c
 
 
 @njit(cache=True)
-def _fp_clear(occ, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  # pragma: no cover
+def _fp_clear(occ, onext, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  # pragma: no cover
     """Return whether the footprint grown by ``grow`` is clear: quick test, else exact.
 
     ``poly``: the map's polygons in cells (:func:`astar.body_polygons.pack_polygons`; none:
@@ -732,7 +742,7 @@ def _fp_clear(occ, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  # pragm
     """
     if footprint_discs_clear(fdist, discs, x, y, th, grow):
         return True
-    hit = footprint_hit(occ, fsafe, fp, x, y, th, grow, buf)
+    hit = footprint_hit(occ, onext, fsafe, fp, x, y, th, grow, buf)
     if hit == -1:
         return True
     if hit == -2 or poly[0].shape[0] == 0:
@@ -743,7 +753,23 @@ def _fp_clear(occ, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  # pragm
 
 @njit(cache=True)
 def footprint_arc_clear(
-    occ, fsafe, fp, fdist, discs, poly, rho, x, y, th, kappa, s, margin, slack, min_slack, buf
+    occ,
+    onext,
+    fsafe,
+    fp,
+    fdist,
+    discs,
+    poly,
+    rho,
+    x,
+    y,
+    th,
+    kappa,
+    s,
+    margin,
+    slack,
+    min_slack,
+    buf,
 ):  # pragma: no cover - compiled
     """Whether every pose of an arc keeps the footprint ``margin`` from the raw map.
 
@@ -776,17 +802,19 @@ def footprint_arc_clear(
         ny, nx = occ.shape
         if 0 <= cx < nx and 0 <= cy < ny and fsafe[cy, cx] == 0:
             sweep = 0.5 * abs(s) * (1.0 + rho * abs(kappa))
-            if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sweep, buf):
+            if _fp_clear(
+                occ, onext, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sweep, buf
+            ):
                 return True
     grow = margin + slack
     half = 0.5 * s / m
     for j in range(m):
         mid = s * (j + 0.5) / m
         qx, qy, qth = advance(x, y, th, kappa, mid)
-        if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, grow, buf):
+        if _fp_clear(occ, onext, fsafe, fp, fdist, discs, poly, qx, qy, qth, grow, buf):
             continue
         if 0.5 * slack < min_slack or not _fp_clear(
-            occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf
+            occ, onext, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf
         ):
             return False
         # halve the step (a stack of (middle, half length, slack)), down to min_slack
@@ -800,11 +828,11 @@ def footprint_arc_clear(
             top -= 1
             c, h, sl = stack[top, 0], stack[top, 1], stack[top, 2]
             qx, qy, qth = advance(x, y, th, kappa, c)
-            if _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sl, buf):
+            if _fp_clear(occ, onext, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin + sl, buf):
                 continue
             if 0.5 * sl < min_slack or top + 2 > 64:
                 return False
-            if not _fp_clear(occ, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf):
+            if not _fp_clear(occ, onext, fsafe, fp, fdist, discs, poly, qx, qy, qth, margin, buf):
                 return False
             stack[top, 0] = c - 0.5 * h
             stack[top + 1, 0] = c + 0.5 * h
@@ -817,6 +845,7 @@ def footprint_arc_clear(
 @njit(cache=True)
 def footprint_word_clear(
     occ,
+    onext,
     fsafe,
     fp,
     fdist,
@@ -846,6 +875,7 @@ def footprint_word_clear(
         kappa = kinds[i] / radius
         if not footprint_arc_clear(
             occ,
+            onext,
             fsafe,
             fp,
             fdist,
@@ -1037,6 +1067,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
         fmargin,
         fslack,
         fmin_slack,
+        onext,
         fdist,
         discs,
         pedges,
@@ -1190,6 +1221,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                     not footprint
                     or footprint_word_clear(
                         occ,
+                        onext,
                         fsafe,
                         fp,
                         fdist,
@@ -1236,6 +1268,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 continue
             if footprint and not footprint_arc_clear(
                 occ,
+                onext,
                 fsafe,
                 fp,
                 fdist,

@@ -17,6 +17,9 @@ given in the robot frame: ``x`` forwards along the heading, ``y`` to the left.
 * :func:`edge_occupancy` marks the occupied cells inside solid blocks (all 8 neighbours
   occupied or outside), which the footprint test skips, exactly (a body reaching one
   crosses the block's rim first).
+* :func:`edge_next` indexes, along each row, the next occupied cell that the footprint test
+  reads (value 1 of :func:`edge_occupancy`), so the test skips the free cells of the body's
+  box without reading them.
 * :func:`kernel_collision` builds the search kernel's collision record
   (:class:`~astar.hybrid_kernel.KernelCollision`) of a mode given as a
   :class:`~astar.hybrid_options.HybridCollision` (which validates its fields on
@@ -68,8 +71,9 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "DEFAULT_SLACK",
     "clearance_bound",
-    "footprint_discs",
+    "edge_next",
     "edge_occupancy",
+    "footprint_discs",
     "footprint_polygon",
     "footprint_radii",
     "footprint_safe",
@@ -298,6 +302,29 @@ def edge_occupancy(occ: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(out)
 
 
+def edge_next(occ: np.ndarray) -> np.ndarray:
+    """Along each row, the next cell of value 1 of an :func:`edge_occupancy` map.
+
+    Parameters
+    ----------
+    occ : ndarray of uint8, shape (ny, nx)
+        :func:`edge_occupancy` (or a plain 0/1 map).
+
+    Returns
+    -------
+    ndarray of int32, shape (ny, nx + 1)
+        ``out[iy, ix]``: the least ``j >= ix`` with ``occ[iy, j] == 1``, ``nx`` when there is
+        none (column ``nx`` is ``nx``): :func:`~astar.hybrid_kernel.footprint_hit` reads a row
+        of the footprint's box at those cells only, the ones it tests.
+    """
+    occ = np.asarray(occ)
+    ny, nx = occ.shape
+    cols = np.where(occ == 1, np.arange(nx, dtype=np.int32), np.int32(nx)).astype(np.int32)
+    out = np.full((ny, nx + 1), nx, dtype=np.int32)
+    out[:, :nx] = np.minimum.accumulate(cols[:, ::-1], axis=1)[:, ::-1]
+    return np.ascontiguousarray(out)
+
+
 def raw_occupied(raw_grid: object) -> np.ndarray:
     """Return the occupied cells of a raw map as a read-only bool array (ny, nx).
 
@@ -373,6 +400,7 @@ def kernel_collision(
 
     dummy = np.zeros((1, 1), dtype=np.uint8)
     no_fp = np.zeros((0, 4))
+    no_next = np.ones((1, 2), dtype=np.int32)
     if collision.footprint is not None:
         return _footprint_inputs(collision, free, step, poses)
     if collision.clearance is None:
@@ -388,6 +416,7 @@ def kernel_collision(
             0.0,
             0.0,
             0.0,
+            no_next,
             np.zeros((1, 1)),
             no_discs,
             *pack_polygons(None),
@@ -412,6 +441,7 @@ def kernel_collision(
         0.0,
         0.0,
         0.0,
+        no_next,
         np.zeros((1, 1)),
         no_discs,
         *pack_polygons(None),
@@ -432,6 +462,7 @@ def _footprint_inputs(
     min_slack = collision.footprint_min_slack
     fp = footprint_polygon(collision.footprint)
     occ = edge_occupancy(raw_occupancy(collision.raw_grid, free))
+    onext = edge_next(occ)
     _, rho = footprint_radii(fp)
     safe = footprint_safe(occ, rho + margin + slack)
     buf = np.empty((fp.shape[0], 5))
@@ -440,7 +471,7 @@ def _footprint_inputs(
     discs = footprint_discs(fp)
     for name, (x, y, th) in poses:
         grow = margin + min_slack
-        hit = int(footprint_hit(occ, safe, fp, x, y, th, grow, buf))
+        hit = int(footprint_hit(occ, onext, safe, fp, x, y, th, grow, buf))
         if hit >= 0 and len(poly[0]):  # the cells do not clear it: the polygons decide
             if body_distance(*poly, np.ascontiguousarray(buf[:, :2]), np.inf) > grow:
                 hit = -1
@@ -459,7 +490,7 @@ def _footprint_inputs(
             )
     dummy = np.zeros((1, 1), dtype=np.uint8)
     return KernelCollision(
-        step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack, fdist, discs, *poly
+        step, dummy, occ, 0.0, fp, safe, rho, margin, slack, min_slack, onext, fdist, discs, *poly
     )
 
 

@@ -31,6 +31,7 @@ default planner plans the query.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import sys
@@ -153,7 +154,8 @@ def _exercise_timing() -> None:
 
 
 def _exercise_moving() -> None:
-    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search)."""
+    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked)."""
+    from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve
     from trajopt.moving import MovingObstacle, retime_for_movers
     from trajopt.robot import Robot
@@ -166,6 +168,16 @@ def _exercise_moving() -> None:
         MovingObstacle.constant_velocity((0.0, -1.5), (0.0, 0.5), radius=0.3, horizon=24.0),
     ]
     retime_for_movers(line, movers)
+    # a cart crossing the drive: the polygon movers' grid (trajopt.moving._polygon_march)
+    box = [(-0.4, -0.25), (0.4, -0.25), (0.4, 0.25), (-0.4, 0.25)]
+    cart = MovingObstacle.constant_velocity(
+        (3.0, -3.0), (0.0, 0.4), radius=0.05, horizon=24.0, vertices=box
+    )
+    retime_for_movers(line, [cart])
+    # a cart parked on the drive: no re-timing gets past (the grid's sweep, trajopt.moving._grid_kernels)
+    parked = MovingObstacle.from_waypoints([0.0], [(3.0, 0.0)], radius=0.05, vertices=box)
+    with contextlib.suppress(BlockedError):
+        retime_for_movers(line, [parked])
 
 
 def _exercise_polygons() -> None:

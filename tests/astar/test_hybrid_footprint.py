@@ -199,10 +199,26 @@ def test_nose_to_the_wall():
         )
 
 
+def test_edge_next_against_a_row_scan():
+    """edge_next: along each row, the first column at or after ``ix`` holding a 1 (``nx``:
+    none), against a plain scan of the row; 2s (inside solid blocks) are skipped."""
+    from astar.hybrid_modes import edge_next
+
+    rng = np.random.default_rng(11)
+    occ = rng.choice(np.array([0, 1, 2], dtype=np.uint8), size=(9, 13), p=[0.6, 0.25, 0.15])
+    got = edge_next(occ)
+    ny, nx = occ.shape
+    assert got.shape == (ny, nx + 1) and got.dtype == np.int32
+    for iy in range(ny):
+        for ix in range(nx + 1):
+            want = next((j for j in range(ix, nx) if occ[iy, j] == 1), nx)
+            assert got[iy, ix] == want, (iy, ix)
+
+
 def test_footprint_hit_against_dense_samples():
     """footprint_hit against the brute-force distance of dense boundary and interior samples."""
     from astar.hybrid_kernel import footprint_hit
-    from astar.hybrid_modes import footprint_polygon
+    from astar.hybrid_modes import edge_next, footprint_polygon
 
     rng = np.random.default_rng(7)
     occ = rng.random((16, 18)) < 0.12
@@ -239,7 +255,10 @@ def test_footprint_hit_against_dense_samples():
         if not inside_hit and abs(d - grow) < 0.01:
             continue  # too close to tell by samples
         want = (not inside_hit) and d > grow
-        got = footprint_hit(occ8, nosafe, fp, x, y, th, grow, np.empty((len(fp), 5))) == -1
+        got = (
+            footprint_hit(occ8, edge_next(occ8), nosafe, fp, x, y, th, grow, np.empty((len(fp), 5)))
+            == -1
+        )
         assert got == want, (poly.tolist(), x, y, th, grow, d)
         seen[want] += 1
     assert min(seen.values()) > 20
@@ -249,7 +268,7 @@ def test_footprint_discs_clear_is_sound():
     """The discs' quick test never calls a pose clear that the exact test (footprint_hit)
     does not, on random maps, poses and growths; and it does answer in open space."""
     from astar.hybrid_kernel import footprint_discs_clear, footprint_hit
-    from astar.hybrid_modes import clearance_bound, footprint_discs, footprint_polygon
+    from astar.hybrid_modes import clearance_bound, edge_next, footprint_discs, footprint_polygon
 
     rng = np.random.default_rng(5)
     answered = 0
@@ -271,7 +290,9 @@ def test_footprint_discs_clear_is_sound():
                 if footprint_discs_clear(fdist, discs, x, y, th, grow):
                     answered += 1
                     buf = np.empty((len(fp), 5))
-                    assert footprint_hit(occ8, nosafe, fp, x, y, th, grow, buf) == -1
+                    assert (
+                        footprint_hit(occ8, edge_next(occ8), nosafe, fp, x, y, th, grow, buf) == -1
+                    )
     assert answered > 200
 
 
@@ -284,6 +305,7 @@ def test_footprint_arc_clear_covers_the_whole_arc(slack, min_slack):
     from astar.hybrid_kernel import footprint_arc_clear
     from astar.hybrid_modes import (
         clearance_bound,
+        edge_next,
         footprint_discs,
         footprint_polygon,
         footprint_radii,
@@ -319,6 +341,7 @@ def test_footprint_arc_clear_covers_the_whole_arc(slack, min_slack):
                 )
             got = footprint_arc_clear(
                 occ8,
+                edge_next(occ8),
                 safe,
                 fp,
                 fdist,

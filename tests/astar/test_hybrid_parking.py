@@ -251,7 +251,7 @@ def test_edge_occupancy_gives_the_same_footprint_test():
     """Solid blocks tested by their rim only (:func:`astar.hybrid_modes.edge_occupancy`):
     the same answer as the full map, at random poses, centres inside blocks included."""
     from astar.hybrid_kernel import footprint_hit
-    from astar.hybrid_modes import edge_occupancy, footprint_polygon
+    from astar.hybrid_modes import edge_next, edge_occupancy, footprint_polygon
 
     rng = np.random.default_rng(7)
     occ = np.zeros((40, 50), bool)
@@ -270,8 +270,8 @@ def test_edge_occupancy_gives_the_same_footprint_test():
         for _ in range(800):
             x, y = rng.uniform(-0.5, 49.5), rng.uniform(-0.5, 39.5)
             th, grow = rng.uniform(-np.pi, np.pi), float(rng.choice([0.0, 0.4]))
-            a = footprint_hit(full, nosafe, fp, x, y, th, grow, buf)
-            b = footprint_hit(edge, nosafe, fp, x, y, th, grow, buf)
+            a = footprint_hit(full, edge_next(full), nosafe, fp, x, y, th, grow, buf)
+            b = footprint_hit(edge, edge_next(edge), nosafe, fp, x, y, th, grow, buf)
             assert (a == -1) == (b == -1) and (a == -2) == (b == -2), (x, y, th, grow)
             seen[a == -1] += 1
     assert min(seen.values()) > 100

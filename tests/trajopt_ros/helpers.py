@@ -81,7 +81,7 @@ def wait_for(predicate, timeout: float = 10.0, what: str = "condition"):
         time.sleep(0.01)
 
 
-def call(client, request, timeout: float = 10.0):
+def call(client, request, timeout: float = 30.0):
     """Call a service and wait for the answer (woken by the answer itself, not by polling)."""
     done = threading.Event()
     fut = client.call_async(request)

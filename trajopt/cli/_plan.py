@@ -118,6 +118,21 @@ def add_parsers(sub: Any) -> None:
         "checked against the map) instead of an error",
     )
     p.add_argument(
+        "--movers",
+        metavar="FILE",
+        help="predicted moving obstacles (.json/.yaml movers file, times in seconds from the "
+        "plan's start; format: trajopt.moving.load_movers): the trajectory is certified "
+        "against them at every instant, re-timed or re-routed round them; .mcap output "
+        "shows them",
+    )
+    p.add_argument(
+        "--mover-margin",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="extra distance kept from every mover [m, >= 0] (default 0)",
+    )
+    p.add_argument(
         "--out", help="write the trajectory (.csv, .json, or .mcap for ROS 2 / Foxglove)"
     )
     p.add_argument("--dt", type=float, default=0.01, help="sample step of --out [s]")
@@ -169,6 +184,11 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     else:
         grid = load_map(args)
     robot = robot_from_args(args)
+    movers = None
+    if args.movers:
+        from trajopt.moving import load_movers
+
+        movers = load_movers(args.movers)
     speed_limits = None
     if args.speed_mask:
         from trajopt.timing import load_speed_mask
@@ -193,7 +213,12 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     )
     t0 = time.perf_counter()
     traj = planner.plan(
-        args.start, args.goal, start_heading=args.start_heading, goal_heading=args.goal_heading
+        args.start,
+        args.goal,
+        start_heading=args.start_heading,
+        goal_heading=args.goal_heading,
+        moving_obstacles=movers,
+        mover_margin=args.mover_margin,
     )
     wall = time.perf_counter() - t0
     # a pose plan's stage times are its chosen candidate's: the query took the wall time
@@ -206,6 +231,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     if traj.stats.get("corridor"):
         line += f", corridor {traj.stats['corridor']}"
     line += _turn_note(traj.stats)
+    if movers:
+        moving = traj.stats.get("moving", {})
+        line += f"; {len(movers)} movers, route {moving.get('route')}"
     if traj.stats.get("fallback"):
         reason = str(traj.stats.get("fallback_reason", "")).splitlines()[0][:120]
         line += (
@@ -220,7 +248,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         elif suffix == ".json":
             traj.to_json(args.out, dt=args.dt, frame_id=args.frame_id)
         else:
-            traj.to_mcap(args.out, dt=args.dt, frame_id=args.frame_id)
+            traj.to_mcap(args.out, dt=args.dt, frame_id=args.frame_id, movers=movers)
         print(f"wrote {args.out}")
     if args.plot:
         require_matplotlib()

@@ -17,11 +17,14 @@
   path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal;
   :func:`car_headings`: how a car stands at a safe place); :func:`swept_mask`,
   :func:`mark_swept`: a mover's swept region on a grid;
-* :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane.
+* :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane;
+* :func:`load_movers`, :func:`save_movers` (:func:`movers_from_data`,
+  :func:`movers_to_data`): predicted movers in a JSON or YAML file.
 """
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
 from trajopt.moving._chain import retime_chain, shift_clock, truncate
+from trajopt.moving._mover_file import load_movers, movers_from_data, movers_to_data, save_movers
 from trajopt.moving._no_way_past import no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import over_start, parked_on_path, settle_time
@@ -38,13 +41,17 @@ __all__ = [
     "certify_movers",
     "check_movers",
     "goal_taken",
+    "load_movers",
     "mark_swept",
+    "movers_from_data",
+    "movers_to_data",
     "no_way_past",
     "over_start",
     "parked_on_path",
     "reachable",
     "reachable_times",
     "reroute",
+    "save_movers",
     "retime_chain",
     "retime_for_movers",
     "retime_plan",

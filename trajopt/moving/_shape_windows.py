@@ -10,7 +10,7 @@ point) and the distance from a fixed point to the shape, minus the radius, chang
 same interval when ``f_k < 0``. :meth:`ShapeTracks.windows` steps through time by
 ``max(|f_k| / lip, step)`` and reports as a violation window every stretch that no sample
 proves safe: sufficient (every ``t`` with ``f(t) < 0`` is inside a window), and tight to about
-``step`` at each end. Only the times at which the point is within the shape's bounding disc
+``step`` at each end (the march is compiled: :func:`._polygon_march.windows_kernel`). Only the times at which the point is within the shape's bounding disc
 (radius ``R`` plus the rounding) plus the limit are sampled: those are closed-form
 (:func:`._disc_windows.inside_times`), an exact filter.
 
@@ -25,8 +25,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from trajopt.moving._disc_windows import close_pairs, inside_times, mover_pieces, near_pairs
+from trajopt.moving._disc_windows import close_pairs, inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._polygon_march import PolygonPieces, launch_bound_kernel, windows_kernel
 from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
 
 #: The least time step (s) of the fine nodes' windows.
@@ -41,80 +42,16 @@ LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
 REFINE_TAU = 1e-3
 
 
-class ShapeTracks:
+class ShapeTracks(PolygonPieces):
     """The movers' tracks as linear pieces with headings, for :meth:`windows` (module docstring).
+
+    :class:`._polygon_march.PolygonPieces` (its attributes) with the march of :meth:`windows`.
 
     Parameters
     ----------
     movers : sequence of MovingObstacle
         Any shapes (a disc is a polygon of one vertex at its reference point).
-
-    Attributes
-    ----------
-    pieces : ndarray, shape (p, 9)
-        :func:`._disc_windows.mover_pieces` of the movers (limit 0): their reference points.
-    bound : ndarray, shape (p, 9)
-        The same with each mover's reach added to the radius: its bounding discs.
     """
-
-    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
-        self.pieces = mover_pieces(movers, 0.0)
-        who = self.pieces[:, 0].astype(np.int64)
-        u, w = self.pieces[:, 1], self.pieces[:, 2]
-        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
-        m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
-        self.verts = np.zeros((len(movers), m_max, 2))
-        self.poly = np.zeros(len(movers), dtype=bool)
-        reach = np.zeros(len(movers))
-        for j, m in enumerate(movers):
-            v = m.shape_vertices
-            self.verts[j, : v.shape[0]] = v
-            self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
-            self.poly[j] = v.shape[0] >= 3
-            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
-            mine = who == j
-            uj, wj = u[mine], w[mine]
-            h_u = np.interp(uj, m.times, m.headings)
-            fin = np.isfinite(wj)
-            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                head0[mine] = h_u
-                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
-        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
-        self.head0, self.turn, self.reach = head0, turn, reach
-        self.bound = self.pieces.copy()
-        self.bound[:, 7] += reach[who]
-        speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
-        self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
-
-    def clearance(self, seg: np.ndarray, pts: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Return the distance (m) of ``pts`` (shape (n, 2)) to the shapes of pieces ``seg`` at ``t`` (s), minus their radius."""
-        row = self.pieces[seg]
-        tau = t - row[:, 1]
-        run = np.where(np.isfinite(row[:, 2]), tau, 0.0)
-        cx = row[:, 3] + row[:, 5] * run
-        cy = row[:, 4] + row[:, 6] * run
-        th = self.head0[seg] + self.turn[seg] * run
-        rad = row[:, 7] + row[:, 8] * tau
-        c, s = np.cos(th), np.sin(th)
-        dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
-        # the point in the mover's frame, against its fixed polygon
-        px, py = c * dx + s * dy, -s * dx + c * dy
-        j = row[:, 0].astype(np.int64)
-        v, e = self.verts[j], self.edges[j]
-        qx, qy = px[:, None] - v[..., 0], py[:, None] - v[..., 1]
-        ee = np.maximum(e[..., 0] ** 2 + e[..., 1] ** 2, 1e-300)
-        lam = np.clip((qx * e[..., 0] + qy * e[..., 1]) / ee, 0.0, 1.0)
-        dist = np.min(np.hypot(qx - lam * e[..., 0], qy - lam * e[..., 1]), axis=1)
-        inside = self.poly[j] & np.all(e[..., 0] * qy - e[..., 1] * qx >= 0.0, axis=1)
-        return np.where(inside, 0.0, dist) - rad
-
-    def piece_at(self, mover: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Return the piece (row of :attr:`pieces`) of each ``mover`` at times ``t`` (s), ``t >= 0``."""
-        who = self.pieces[:, 0]
-        big = 2.0 * (float(np.max(self.pieces[:, 1], initial=0.0)) + float(np.max(t)) + 1.0)
-        key = who * big + self.pieces[:, 1]
-        return np.searchsorted(key, mover * big + t, side="right") - 1
 
     def windows(
         self,
@@ -168,29 +105,24 @@ class ShapeTracks:
             b = np.minimum(b, band[1][pi])
         keep = a < b
         seg, pi, a, b = seg[keep], pi[keep], a[keep], b[keep]
-        lip = self.lip[seg]
-        out_i, out_lo, out_hi = [], [], []
-        t, cov = a.copy(), a.copy()  # next sample; everything before cov is settled
-        live = np.arange(a.shape[0])
-        while live.size:
-            tl = t[live]
-            f = self.clearance(seg[live], pts[pi[live]], tl) - limit
-            with np.errstate(divide="ignore", invalid="ignore"):  # a standing shape: lip 0
-                rho = np.where(lip[live] > 0.0, f / lip[live], np.where(f > 0.0, np.inf, -np.inf))
-            w_hi = np.minimum(tl - rho, b[live])
-            bad = w_hi > cov[live]
-            out_i.append(live[bad])
-            out_lo.append(cov[live][bad])
-            out_hi.append(w_hi[bad])
-            cov[live] = np.maximum(cov[live], tl + np.abs(rho))
-            last = tl >= b[live]
-            t[live] = np.minimum(tl + np.maximum(np.abs(rho), step), b[live])
-            live = live[~last & (cov[live] < b[live])]
-        idx = np.concatenate(out_i) if out_i else np.zeros(0, dtype=np.int64)
-        lo = np.concatenate(out_lo) if out_lo else np.zeros(0)
-        hi = np.concatenate(out_hi) if out_hi else np.zeros(0)
-        # one window per stretch: the touching ones of a pair merged, each end widened
-        lo, hi, idx = _merged(lo - EPS_W, hi + EPS_W, idx)
+        idx, lo, hi = windows_kernel(
+            np.ascontiguousarray(pts, dtype=np.float64),
+            seg.astype(np.int64),
+            pi.astype(np.int64),
+            a,
+            b,
+            self.rows,
+            self.who,
+            self.head0,
+            self.turn,
+            self.lip,
+            float(limit),
+            self.verts,
+            self.edges,
+            self.poly,
+            float(step),
+            EPS_W,
+        )
         who = self.pieces[seg[idx], 0].astype(np.int64)
         return who, pi[idx].astype(np.int64), lo, hi
 
@@ -275,13 +207,25 @@ class ShapeWindows(FineWindows):
         lip = lip_m[who]
         pad = 0.5 * REFINE_TAU * (self.speed + lip) + self.limit
 
+        pts = np.ascontiguousarray(pts, dtype=np.float64)
+        starts = np.searchsorted(tr.who, np.arange(len(self.movers) + 1))
+
         def g(launch: np.ndarray, rows: np.ndarray) -> np.ndarray:
             """Return the clearance bound (m), shape (len(launch), len(rows))."""
-            t = launch[:, None] + tau[None, rows]
-            seg = tr.piece_at(np.broadcast_to(who[rows], t.shape).ravel(), t.ravel())
-            p = np.broadcast_to(pts[rows], (*t.shape, 2)).reshape(-1, 2)
-            f = tr.clearance(seg, p, t.ravel()).reshape(t.shape)
-            return f - pad[rows]
+            return launch_bound_kernel(
+                np.ascontiguousarray(launch, dtype=np.float64),
+                tau[rows],
+                who[rows].astype(np.int64),
+                pts[rows],
+                pad[rows],
+                tr.rows,
+                starts,
+                tr.head0,
+                tr.turn,
+                tr.verts,
+                tr.edges,
+                tr.poly,
+            )
 
         mid = 0.5 * (lo + hi)
         rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
@@ -307,17 +251,3 @@ class ShapeWindows(FineWindows):
         f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
         keep = f_hi > f_lo
         return f_lo[keep], f_hi[keep]
-
-
-def _merged(
-    lo: np.ndarray, hi: np.ndarray, key: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Return the windows ``(lo, hi)`` (s) of each ``key`` with the overlapping consecutive ones merged."""
-    if lo.size == 0:
-        return lo, hi, key
-    order = np.lexsort((lo, key))
-    lo, hi, key = lo[order], hi[order], key[order]
-    new = np.ones(lo.shape[0], dtype=bool)
-    new[1:] = (key[1:] != key[:-1]) | (lo[1:] > hi[:-1])
-    first = np.flatnonzero(new)
-    return lo[first], np.maximum.reduceat(hi, first), key[first]

@@ -17,7 +17,12 @@ form: on each piece of its track between waypoint times its centre ``c(t)`` and 
 linear in ``t``, so ``|C(s_i) - c(t)| - lim(t)`` is convex in ``t`` and its negative set is
 one interval, the roots of a quadratic; the node is forbidden exactly at the grid times inside
 it (widened by 1 ns on the sufficient grid, narrowed on the necessary one, against rounding).
-Other shapes (a polygon mover, a footprint robot) are evaluated at every node and grid time.
+A polygon mover against a disc robot: each pair of a piece of its track and a node is
+marched through the grid times (:mod:`._polygon_march`): an exact test at a grid time decides
+every grid time within its clearance over the mover's speed bound, so the runs are those of
+the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding).
+A footprint robot is marched the same way against every mover (discs too), with the signed
+distance of its polygon at the node and the mover's.
 
 A footprint robot is its convex polygon at each node, turned by the path's heading there; it
 moves at most ``(1 + R kappa_max)`` per metre of arc, so the robot's share of both pads is
@@ -26,16 +31,15 @@ multiplied by that ``stretch``.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from trajopt.moving._certificate import convex_distance, point_polygon_distance, shape_at
 from trajopt.moving._disc_windows import inside_times, near_pairs
+from trajopt.moving._grid_kernels import dense_kernel, sweep_kernel
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._polygon_march import polygon_runs
 
 #: A run's end index standing for "until after the grid's last time" (the movers then stand).
 FOREVER = 1 << 40
@@ -202,15 +206,14 @@ class STGrid:
 
     def _dense_grid(self) -> tuple[np.ndarray, np.ndarray]:
         if self._dense is None:
-            kk, n = self.t.shape[0], self.s.shape[0]
-            blocked = np.zeros((kk, n), dtype=bool)
-            who = np.full((kk, n), -1, dtype=np.int16)
-            col = np.repeat(np.arange(n), np.diff(self.ptr))
-            for r in np.argsort(self.owner, kind="stable")[::-1]:  # the first mover wins
-                a, b = self.lo[r], min(self.hi[r], kk - 1)
-                blocked[a : b + 1, col[r]] = True
-                who[a : b + 1, col[r]] = self.owner[r]
-            self._dense = (blocked, who)
+            self._dense = dense_kernel(
+                self.t.shape[0],
+                self.s.shape[0],
+                self.col.astype(np.int64),
+                self.lo.astype(np.int64),
+                self.hi.astype(np.int64),
+                self.owner.astype(np.int64),
+            )
         return self._dense
 
     @property
@@ -291,7 +294,7 @@ def st_grid(
         The path's points at the nodes (m), when the caller has them (:func:`grid_nodes`).
     leave : float, optional
         The robot leaves ``s = 0`` no earlier than this (s) and drives at most ``speed``: it
-        cannot be nearest to node ``s_i`` before ``leave + (s_i - ds/2) / speed``, and a disc
+        cannot be nearest to node ``s_i`` before ``leave + (s_i - ds/2) / speed``, and a
         mover's pieces of track that end a grid step before that are not solved for the
         node (their runs could not meet the robot). Default: all times.
 
@@ -318,7 +321,7 @@ def st_grid(
         stretch = 1.0
     runs: list[tuple[np.ndarray, ...]] = []
     discs: list[tuple[int, MovingObstacle, float]] = []
-    tree: cKDTree | None = None
+    shapes: list[tuple[int, MovingObstacle, float]] = []
     for j, m in enumerate(movers):
         if sufficient:
             pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
@@ -326,16 +329,17 @@ def st_grid(
             pad = -0.5 * ds * stretch
         if polys is None and m.vertices is None:
             discs.append((j, m, pad))
-            continue
-        if tree is None:
-            tree = cKDTree(pts)
-        lim = limit + m.radius_at(t) + pad
-        runs.append(_runs_of(_shape_hits(pts, polys, m, t, lim, tree), j))
+        else:
+            shapes.append((j, m, pad))
+    after = None
+    if leave is not None:
+        after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
     if discs:
-        after = None
-        if leave is not None:
-            after = leave + np.maximum(s - 0.5 * ds, 0.0) / speed - dt
         runs.append(_disc_runs(pts, discs, limit, t, sufficient, after))
+    if shapes:
+        j_of, shape_movers, pads = zip(*shapes, strict=True)
+        lim0 = limit + np.asarray(pads, dtype=float)
+        runs.append(polygon_runs(pts, shape_movers, j_of, lim0, t, sufficient, after, polys))
     if runs:
         col, lo, hi, owner = (np.concatenate(x) for x in zip(*runs, strict=True))
     else:
@@ -344,70 +348,11 @@ def st_grid(
     return STGrid(s, t, ds, float(dt), col, lo, hi, owner)
 
 
-def _shape_hits(
-    pts: np.ndarray,
-    polys: np.ndarray | None,
-    mover: MovingObstacle,
-    t: np.ndarray,
-    lim: np.ndarray,
-    tree: cKDTree,
-) -> np.ndarray:
-    """Return whether each node is closer than ``lim[k]`` (m) to ``mover``'s shape at ``t[k]``, shape (K, n).
-
-    The robot is the point ``pts[i]`` (m, shape (n, 2)), or the convex polygon ``polys[i]``
-    (shape (n, mb, 2)) with a footprint; ``tree`` is the k-d tree of ``pts``. An exact filter
-    first: both shapes lie within their reaches (the farthest vertex from the reference
-    point) of the mover's reference point and of the node, so their (signed) distance is at
-    least the reference points' distance minus both reaches, and a pair farther apart than
-    ``lim + both reaches`` is clear. The k-d tree finds the other pairs; only they are
-    measured (:func:`point_polygon_distance` or :func:`convex_distance`), in one batch.
-    From the first grid time at or after the mover's last prediction on, its shape stands
-    where it was last (and its radius stops growing): while ``lim`` stands still too, those
-    rows are the first one's, measured once.
-    """
-    k_end = int(np.searchsorted(t, mover.t_last, side="left"))
-    if k_end < t.shape[0] - 1 and np.all(lim[k_end:] == lim[k_end]):
-        head = _shape_hits(pts, polys, mover, t[: k_end + 1], lim[: k_end + 1], tree)
-        hit = np.empty((t.shape[0], pts.shape[0]), dtype=bool)
-        hit[: k_end + 1] = head
-        hit[k_end + 1 :] = head[k_end]
-        return hit
-    centre, _ = mover.pose_at(t)  # (K, 2)
-    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
-    if polys is not None:
-        reach += float(np.max(np.hypot(*(polys - pts[:, None, :]).reshape(-1, 2).T)))
-    hit = np.zeros((t.shape[0], pts.shape[0]), dtype=bool)
-    # 1 nm above the bound: rounding of the reaches never drops a pair the exact test hits
-    near = tree.query_ball_point(centre, np.maximum(lim + reach + 1e-9, 0.0))
-    counts = np.fromiter((len(c) for c in near), dtype=np.int64, count=len(near))
-    if counts.sum() == 0:
-        return hit
-    kk = np.repeat(np.arange(t.shape[0]), counts)
-    ii = np.fromiter(itertools.chain.from_iterable(near), dtype=np.int64, count=int(counts.sum()))
-    w = shape_at(mover, t[kk])  # (p, m, 2)
-    d = point_polygon_distance(pts[ii], w) if polys is None else convex_distance(polys[ii], w)
-    hit[kk, ii] = d < lim[kk]
-    return hit
-
-
 def grid_nodes(length: float, ds: float) -> tuple[np.ndarray, float]:
     """Return the nodes (m), shape (n,), of a path of ``length`` (m) for a requested ``ds``, and the spacing used."""
     n = max(2, int(math.ceil(length / ds)) + 1)
     s = np.linspace(0.0, length, n)
     return s, float(s[1] - s[0])
-
-
-def _runs_of(hit: np.ndarray, j: int) -> tuple[np.ndarray, ...]:
-    """Return the runs ``(node, first, last, mover)`` of mover ``j``'s dense ``hit`` (K, n).
-
-    Only the nodes with a hit are scanned (in node order, as a scan of them all gives).
-    """
-    cols = np.flatnonzero(hit.any(axis=0))
-    h = np.pad(hit[:, cols].T, ((0, 0), (1, 1)))
-    d = np.diff(h.astype(np.int8), axis=1)
-    ci, k0 = np.nonzero(d == 1)
-    _, k1 = np.nonzero(d == -1)
-    return cols[ci], k0, k1 - 1, np.full(ci.shape[0], j)
 
 
 def _disc_runs(
@@ -499,7 +444,8 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
 
     Once the grid's rows no longer change (after the last run starts or ends) and neither
     does the bound, a step that leaves the reachable nodes as they were is a fixed point:
-    the sweep stops there with the answer of the last time.
+    the sweep stops there with the answer of the last time. The sweep is a compiled loop
+    (:func:`._grid_kernels.sweep_kernel`).
 
     Returns
     -------
@@ -511,27 +457,13 @@ def reachable(grid: STGrid, speed: float, s_up: np.ndarray | None = None) -> tup
         The furthest reachable node before that (the place where the robot is stopped).
     """
     fb = grid.blocked
-    kk, n = fb.shape
+    kk = fb.shape[0]
     ends = np.concatenate([grid.lo, np.where(grid.hi >= FOREVER, 0, grid.hi + 1), [0]])
     k_static = int(np.max(ends))
     if s_up is not None:
         k_static = max(k_static, int(np.searchsorted(s_up, grid.s[-1] + 0.5 * grid.ds)))
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
-    idx = np.arange(n)
-    reach = np.zeros(n, dtype=bool)
-    reach[0] = not fb[0, 0]
-    last_i = 0
-    if not reach[0]:
-        return False, 0, 0
-    for k in range(1, kk):
-        lastr = np.maximum.accumulate(np.where(reach, idx, -(10**9)))
-        nxt = ~fb[k] & (idx - lastr <= m)
-        if s_up is not None:
-            nxt &= grid.s <= s_up[k] + 0.5 * grid.ds
-        if not nxt.any():
-            return False, k, last_i
-        if k > k_static and np.array_equal(nxt, reach):
-            break
-        reach = nxt
-        last_i = int(np.max(np.flatnonzero(reach)))
-    return bool(reach[-1]), kk - 1, last_i
+    bounded = s_up is not None
+    up = np.asarray(s_up, dtype=float) if bounded else np.zeros(kk)
+    ok, k, i = sweep_kernel(fb, grid.s, up, bounded, 0.5 * grid.ds, m, k_static)
+    return bool(ok), int(k), int(i)

@@ -27,11 +27,17 @@ pytestmark = pytest.mark.filterwarnings("ignore:Animation was deleted without re
 BOX = [[-0.3, -0.15], [0.3, -0.15], [0.3, 0.15], [-0.3, 0.15]]
 
 
-@pytest.fixture(autouse=True)
+@pytest.fixture(autouse=True, scope="module")
 def _collect_animations():
-    """Collect each test's unrendered animations while their warning is filtered."""
+    """Collect the module's unrendered animations once, at its end, their warning filtered.
+
+    One collection for the module: a full ``gc.collect`` late in the suite walks a large
+    heap (a second or more each), so it is not run after every test.
+    """
     yield
-    gc.collect()
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Animation was deleted without rendering")
+        gc.collect()
 
 
 @pytest.fixture(scope="module")

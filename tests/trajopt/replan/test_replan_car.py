@@ -116,9 +116,11 @@ def _check_no_turn_in_place(out, robot=CAR):
     dt = 1e-3
     t = np.arange(0.0, out.duration, dt)
     smp = out.sample(t)
-    # sampled: the yaw rate is zero wherever the speed is (up to rounding)
+    # sampled: the yaw rate is zero wherever the speed is (up to rounding: |omega| = |v kappa|
+    # <= |v| / R)
     still = np.abs(smp.v) <= 1e-9
-    assert np.abs(smp.omega[still]).max(initial=0.0) <= 1e-9
+    bound = 1e-9 * max(1.0, 1.0 / robot.drive.min_turning_radius)
+    assert np.abs(smp.omega[still]).max(initial=0.0) <= bound
     # by finite differences: the heading turns by at most the distance moved over R
     moved = np.hypot(np.diff(smp.x), np.diff(smp.y))
     turned = _angle_diff(smp.theta[1:], smp.theta[:-1])

@@ -1,0 +1,501 @@
+"""Marching points against polygon movers' tracks: one exact test decides a stretch of time.
+
+On each piece of a mover's track between waypoint times its reference point moves at a
+constant velocity ``v``, its heading turns at a constant rate ``w`` and its radius grows at
+``g`` (:class:`PolygonPieces`), so every point of its polygon moves at most ``|v| + R |w|``
+(``R`` its farthest vertex from the reference point) and the distance ``f(t)`` from a fixed
+point to the shape, minus the radius and a limit, changes at most at ``lip = |v| + R |w| +
+g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves the sign of
+``f`` on ``(t - |f(t)| / lip, t + |f(t)| / lip)``. Two marches use it:
+
+* :func:`polygon_runs` (:func:`march_kernel`): the ``(s, t)`` grid's forbidden runs of polygon
+  movers against a disc robot (:func:`._st_grid.st_grid`). A node ``s_i`` is forbidden at
+  grid time ``t_k`` when the path's point there is closer to the mover's shape at ``t_k``
+  than ``lim(t_k)`` (the robot radius, the margin, the mover's radius and the grid's pad).
+  Each pair of a piece and a node is marched through the piece's grid times: one exact test
+  decides every grid time within ``|f| / lip`` of it (all have its sign), so where the point
+  is far from the boundary the march strides over many grid times, near it it steps one at
+  a time, and every grid time gets the answer of the exact test. Against rounding the test
+  is conservative: ``lim`` is raised by :data:`EPS_LIM` on a sufficient grid (a node within
+  1 nm of the limit counts as forbidden) and lowered by it on a necessary one, and a stride
+  keeps 1 nm of ``|f|`` in hand. Only the pairs whose distance can come under the limit at
+  all are marched (:func:`._disc_windows.near_pairs` with each piece's bounding disc: an
+  exact filter).
+* :func:`windows_kernel`: the violation windows in continuous time of
+  :meth:`._shape_windows.ShapeTracks.windows` (sampled with a least step; sufficient).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numba import njit
+
+from trajopt.kernel_cache import watch_compiles
+from trajopt.moving._disc_windows import mover_pieces, near_pairs
+from trajopt.moving._obstacle import MovingObstacle
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
+
+#: The limit is raised (sufficient grid) or lowered (necessary grid) by this much (m).
+EPS_LIM = 1e-9
+#: Added to the pair filter's reach with a footprint (m): rounding of the reaches never drops
+#: a pair the exact test hits.
+NEAR_PAD = 1e-9
+
+
+class PolygonPieces:
+    """The movers' tracks as linear pieces with headings, and their Lipschitz bounds (module docstring).
+
+    Parameters
+    ----------
+    movers : sequence of MovingObstacle
+        Any shapes (a disc is a polygon of one vertex at its reference point).
+
+    Attributes
+    ----------
+    pieces : ndarray, shape (p, 9)
+        :func:`._disc_windows.mover_pieces` of the movers (limit 0): their reference points.
+    bound : ndarray, shape (p, 9)
+        The same with each mover's reach added to the radius: its bounding discs.
+    head0, turn : ndarray, shape (p,)
+        Heading (rad) at each piece's start and its turn rate (rad/s).
+    verts : ndarray, shape (movers, m, 2)
+        Each mover's polygon in its own frame (m), CCW, padded by repeating its first vertex.
+    edges : ndarray, shape (movers, m, 2)
+        ``verts`` rolled by one minus ``verts`` (zero for the padding).
+    poly : ndarray of bool, shape (movers,)
+        The mover is a polygon (3 vertices or more).
+    nv : ndarray of int64, shape (movers,)
+        Its number of vertices (the first ``nv[j]`` rows of ``verts[j]``).
+    reach : ndarray, shape (movers,)
+        Farthest vertex from the reference point (m).
+    lip : ndarray, shape (p,)
+        ``|v| + R |w| + max(g, 0)`` (m/s) of each piece.
+    rows : ndarray, shape (p, 8)
+        Columns 1..8 of ``pieces`` (the kernels' form).
+    who : ndarray of int64, shape (p,)
+        The mover of each piece.
+    """
+
+    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
+        self.pieces = mover_pieces(movers, 0.0)
+        who = self.pieces[:, 0].astype(np.int64)
+        u, w = self.pieces[:, 1], self.pieces[:, 2]
+        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
+        m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
+        self.verts = np.zeros((len(movers), m_max, 2))
+        self.poly = np.zeros(len(movers), dtype=bool)
+        reach = np.zeros(len(movers))
+        self.nv = np.array([m.shape_vertices.shape[0] for m in movers], dtype=np.int64)
+        for j, m in enumerate(movers):
+            v = m.shape_vertices
+            self.verts[j, : v.shape[0]] = v
+            self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
+            self.poly[j] = v.shape[0] >= 3
+            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
+            mine = who == j
+            uj, wj = u[mine], w[mine]
+            h_u = np.interp(uj, m.times, m.headings)
+            fin = np.isfinite(wj)
+            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                head0[mine] = h_u
+                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
+        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
+        self.head0, self.turn, self.reach = head0, turn, reach
+        self.bound = self.pieces.copy()
+        self.bound[:, 7] += reach[who]
+        speed = np.hypot(self.pieces[:, 5], self.pieces[:, 6])
+        self.lip = speed + reach[who] * np.abs(turn) + np.maximum(self.pieces[:, 8], 0.0)
+        self.rows = np.ascontiguousarray(self.pieces[:, 1:9])
+        self.who = who
+
+
+def polygon_runs(
+    pts: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    owners: Sequence[int],
+    lim0: np.ndarray,
+    t: np.ndarray,
+    sufficient: bool,
+    after: np.ndarray | None = None,
+    polys: np.ndarray | None = None,
+) -> tuple[np.ndarray, ...]:
+    """Return the runs ``(node, first, last, mover)`` of polygon movers against a disc or footprint robot (module docstring).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        The path's points at the nodes (m).
+    movers : sequence of MovingObstacle
+        Polygon movers (a disc is accepted too: a polygon of one vertex).
+    owners : sequence of int
+        The grid's index of each mover (the runs' ``mover``).
+    lim0 : ndarray, shape (len(movers),)
+        Each mover's limit without its radius (m): the robot radius (none with ``polys``),
+        the margin and the pad; the mover's radius at ``t_k`` (growing) is added.
+    t : ndarray, shape (K,)
+        Grid times ``k dt`` (s).
+    sufficient : bool
+        Raise the limit by :data:`EPS_LIM` (else lower it).
+    after : ndarray, shape (n,), optional
+        Per node (s): the pieces of track that end before it are left out for that node
+        (their runs could not meet the robot).
+    polys : ndarray, shape (n, mb, 2), optional
+        A footprint robot: its convex CCW polygon at each node (m); the test is then the
+        signed distance of the two polygons (:func:`._certificate.convex_distance`) against
+        the limit, and a node's pairs are those within the footprint's reach of it.
+
+    Returns
+    -------
+    node, first, last, mover : ndarray of int, shape (r,)
+        A run per stretch of forbidden grid times of a node on one piece (first and last
+        time index inclusive; runs of consecutive pieces may touch or overlap).
+    """
+    tracks = PolygonPieces(movers)
+    j = tracks.who
+    eps = EPS_LIM if sufficient else -EPS_LIM
+    lim_add = np.asarray(lim0, dtype=float)[j] + eps
+    rows = tracks.bound.copy()
+    rows[:, 7] += lim_add
+    if polys is None:
+        body = np.zeros((0, 1, 2))
+    else:
+        body = np.ascontiguousarray(polys, dtype=np.float64)
+        rows[:, 7] += float(np.max(np.hypot(*(body - pts[:, None, :]).reshape(-1, 2).T)))
+        rows[:, 7] += NEAR_PAD
+    band = None if after is None else (after, np.full(after.shape, np.inf))
+    seg, pi = near_pairs(pts, rows, 0.0, band)
+    dt, kk = float(t[1] - t[0]), int(t.shape[0])
+    node, k0, k1, piece = march_kernel(
+        np.ascontiguousarray(pts, dtype=np.float64),
+        seg.astype(np.int64),
+        pi.astype(np.int64),
+        tracks.rows,
+        j,
+        tracks.head0,
+        tracks.turn,
+        tracks.lip,
+        lim_add,
+        tracks.verts,
+        tracks.edges,
+        tracks.poly,
+        tracks.nv,
+        body,
+        dt,
+        kk,
+    )
+    owner = np.asarray(owners, dtype=np.int64)[j[piece]]
+    return node, k0, k1, owner
+
+
+@njit(cache=True)
+def _clearance(
+    px, py, row, head0, turn, lim_add, verts, edges, poly, j, tk
+):  # pragma: no cover - compiled
+    """Return the point's distance (m) to mover ``j``'s polygon at ``tk`` minus the limit."""
+    u, w = row[0], row[1]
+    tau = tk - u
+    run = tau if np.isfinite(w) else 0.0
+    cx = row[2] + row[4] * run
+    cy = row[3] + row[5] * run
+    th = head0 + turn * run
+    rad = row[6] + row[7] * tau
+    c, s = np.cos(th), np.sin(th)
+    dx, dy = px - cx, py - cy
+    qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
+    best = np.inf
+    inside = poly[j]
+    for e in range(verts.shape[1]):
+        qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
+        ex, ey = edges[j, e, 0], edges[j, e, 1]
+        ee = ex * ex + ey * ey
+        lam = 0.0
+        if ee > 0.0:
+            lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
+        rx, ry = qx - lam * ex, qy - lam * ey
+        best = min(best, np.hypot(rx, ry))
+        if ex * qy - ey * qx < 0.0:
+            inside = False
+    d = 0.0 if inside else best
+    return d - rad - lim_add
+
+
+@njit(cache=True)
+def _point_polygon(x, y, w, nw):  # pragma: no cover - compiled
+    """Return the distance (m) of the point ``(x, y)`` to the convex CCW polygon ``w[:nw]``; 0 inside."""
+    if nw == 1:
+        return np.hypot(x - w[0, 0], y - w[0, 1])
+    best = np.inf
+    inside = True
+    for e in range(nw):
+        ax, ay = w[e, 0], w[e, 1]
+        ex, ey = w[(e + 1) % nw, 0] - ax, w[(e + 1) % nw, 1] - ay
+        qx, qy = x - ax, y - ay
+        ee = max(ex * ex + ey * ey, 1e-300)
+        lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
+        best = min(best, np.hypot(qx - lam * ex, qy - lam * ey))
+        if ex * qy - ey * qx < 0.0:
+            inside = False
+    return 0.0 if inside else best
+
+
+@njit(cache=True)
+def _signed_distance(a, na, b, nb):  # pragma: no cover - compiled
+    """Return the signed distance (m) of the convex CCW polygons ``a[:na]`` and ``b[:nb]``.
+
+    :func:`._certificate.convex_distance` for one pair: separated, the least distance of a
+    vertex of one to the other; overlapping, minus the penetration depth along the edge
+    normals of both (a polygon of fewer than 3 vertices has none).
+    """
+    separated = False
+    depth = np.inf
+    for side in range(2):
+        p, n_p, q, n_q = (a, na, b, nb) if side == 0 else (b, nb, a, na)
+        if n_p < 3:
+            continue
+        for e in range(n_p):
+            ax, ay = p[e, 0], p[e, 1]
+            ex, ey = p[(e + 1) % n_p, 0] - ax, p[(e + 1) % n_p, 1] - ay
+            norm = max(np.hypot(ex, ey), 1e-300)
+            nx, ny = ey / norm, -ex / norm  # outward for CCW
+            lo_q, hi_q, lo_p = np.inf, -np.inf, np.inf
+            for v in range(n_q):
+                d = (q[v, 0] - ax) * nx + (q[v, 1] - ay) * ny
+                lo_q, hi_q = min(lo_q, d), max(hi_q, d)
+            for v in range(n_p):
+                lo_p = min(lo_p, (p[v, 0] - ax) * nx + (p[v, 1] - ay) * ny)
+            if lo_q > 0.0:
+                separated = True
+            depth = min(depth, min(-lo_q, hi_q - lo_p))
+    if separated or not np.isfinite(depth):
+        d = np.inf
+        for v in range(na):
+            d = min(d, _point_polygon(a[v, 0], a[v, 1], b, nb))
+        for v in range(nb):
+            d = min(d, _point_polygon(b[v, 0], b[v, 1], a, na))
+        return d
+    return -depth
+
+
+@njit(cache=True)
+def _footprint_clearance(
+    foot, row, head0, turn, lim_add, verts, nv, j, tk, shape
+):  # pragma: no cover - compiled
+    """Return the signed distance (m) of the polygon ``foot`` to mover ``j``'s polygon at ``tk`` minus the limit (``shape``: scratch)."""
+    u, w = row[0], row[1]
+    tau = tk - u
+    run = tau if np.isfinite(w) else 0.0
+    cx = row[2] + row[4] * run
+    cy = row[3] + row[5] * run
+    th = head0 + turn * run
+    rad = row[6] + row[7] * tau
+    c, s = np.cos(th), np.sin(th)
+    m = nv[j]
+    for v in range(m):
+        shape[v, 0] = cx + c * verts[j, v, 0] - s * verts[j, v, 1]
+        shape[v, 1] = cy + s * verts[j, v, 0] + c * verts[j, v, 1]
+    return _signed_distance(foot, foot.shape[0], shape, m) - rad - lim_add
+
+
+@njit(cache=True)
+def march_kernel(
+    pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, nv, body, dt, kk
+):  # pragma: no cover - compiled
+    """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    seg, pi : ndarray of int64, shape (q,)
+        The piece and the point of each pair.
+    rows : ndarray, shape (p, 8)
+        Columns 1..8 of :func:`._disc_windows.mover_pieces`: ``u, w, x, y, vx, vy, r, g``.
+    who : ndarray of int64, shape (p,)
+        The mover of each piece (a row of ``verts``).
+    head0, turn, lip, lim_add : ndarray, shape (p,)
+        Heading (rad) at ``u``, turn rate (rad/s), Lipschitz bound (m/s), and the limit
+        besides the mover's radius (m) of each piece.
+    verts, edges : ndarray, shape (movers, m, 2)
+    poly, nv : ndarray, shape (movers,)
+        As :class:`PolygonPieces`.
+    body : ndarray, shape (n, mb, 2)
+        A footprint robot's polygon at each point (m, CCW); ``n = 0``: a disc robot (the
+        point itself, its radius in the limit).
+    dt : float
+        Grid step (s).
+    kk : int
+        Grid times.
+    """
+    cap = max(16, 2 * seg.shape[0])
+    out = np.empty((cap, 4), dtype=np.int64)
+    foot = body.shape[0] > 0
+    shape = np.empty((verts.shape[1], 2))  # a mover's polygon in the world
+    nr = 0
+    for q in range(seg.shape[0]):
+        p, i = seg[q], pi[q]
+        u, w = rows[p, 0], rows[p, 1]
+        ka = max(int(np.ceil(u / dt - 1e-9)), 0)
+        kb = kk - 1
+        if np.isfinite(w):
+            kb = min(int(np.floor(w / dt + 1e-9)), kk - 1)
+        j = who[p]
+        lp = lip[p]
+        px, py = pts[i, 0], pts[i, 1]
+        k = ka
+        start = -1  # first time index of the open run
+        while k <= kb:
+            if foot:
+                f = _footprint_clearance(
+                    body[i], rows[p], head0[p], turn[p], lim_add[p], verts, nv, j, k * dt, shape
+                )
+            else:
+                f = _clearance(
+                    px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
+                )
+            hit = f < 0.0
+            room = abs(f) - 1e-9  # in hand against rounding
+            more = 0
+            if lp <= 0.0:
+                if room > 0.0:
+                    more = kb - k
+            elif room > 0.0:
+                x = room / (lp * dt)
+                if x > kb - k + 1.0:
+                    more = kb - k
+                else:
+                    more = int(x)
+                    if more * lp * dt >= room:
+                        more -= 1
+                    more = max(more, 0)
+            if hit and start < 0:
+                start = k
+            elif not hit and start >= 0:
+                if nr == out.shape[0]:
+                    bigger = np.empty((2 * out.shape[0], 4), dtype=np.int64)
+                    bigger[:nr] = out[:nr]
+                    out = bigger
+                out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, start, k - 1, p
+                nr += 1
+                start = -1
+            k += more + 1
+        if start >= 0:
+            if nr == out.shape[0]:
+                bigger = np.empty((2 * out.shape[0], 4), dtype=np.int64)
+                bigger[:nr] = out[:nr]
+                out = bigger
+            out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, start, kb, p
+            nr += 1
+    return out[:nr, 0].copy(), out[:nr, 1].copy(), out[:nr, 2].copy(), out[:nr, 3].copy()
+
+
+@njit(cache=True)
+def windows_kernel(
+    pts, seg, pi, a, b, rows, who, head0, turn, lip, limit, verts, edges, poly, step, eps
+):  # pragma: no cover - compiled
+    """Return the violation windows ``(pair, lo, hi)`` (s) of the pairs ``(seg[q], pi[q])`` during ``[a[q], b[q]]``.
+
+    The march of :meth:`._shape_windows.ShapeTracks.windows`: from ``t = a`` a sample
+    ``f = f(t)`` (the clearance minus ``limit``, m) proves ``f > 0`` or ``f < 0`` on
+    ``(t - |f| / lip, t + |f| / lip)``; every stretch from the first time not yet settled
+    to ``t - f / lip`` (capped at ``b``) is a window, and the next sample is
+    ``max(|f| / lip, step)`` later (capped at ``b``), until ``b`` is settled or sampled.
+    Each window is widened by ``eps`` (s) at both ends, and the consecutive ones of a pair
+    that then overlap are merged. Arguments as :func:`march_kernel`, besides ``a``, ``b``
+    (shape (q,), s; ``b`` may be ``inf``), ``limit`` (m) and ``step`` (s).
+
+    Returns
+    -------
+    pair : ndarray of int64, shape (r,)
+        Index into ``seg``/``pi``.
+    lo, hi : ndarray, shape (r,)
+        The windows (s), in order of pair and time.
+    """
+    cap = max(16, seg.shape[0])
+    pair = np.empty(cap, dtype=np.int64)
+    lo = np.empty(cap)
+    hi = np.empty(cap)
+    nr = 0
+    for q in range(seg.shape[0]):
+        p, i = seg[q], pi[q]
+        j = who[p]
+        lp = lip[p]
+        px, py = pts[i, 0], pts[i, 1]
+        bq = b[q]
+        t = a[q]
+        cov = a[q]
+        last_hi = -np.inf  # the widened end of the pair's last window
+        while True:
+            f = _clearance(px, py, rows[p], head0[p], turn[p], limit, verts, edges, poly, j, t)
+            if lp > 0.0:
+                rho = f / lp
+            elif f > 0.0:
+                rho = np.inf
+            else:
+                rho = -np.inf
+            w_hi = min(t - rho, bq)
+            if w_hi > cov:
+                w_lo, w_up = cov - eps, w_hi + eps
+                if nr > 0 and pair[nr - 1] == q and not (w_lo > last_hi):
+                    hi[nr - 1] = max(hi[nr - 1], w_up)
+                else:
+                    if nr == pair.shape[0]:
+                        pair = np.concatenate((pair, np.empty(nr, dtype=np.int64)))
+                        lo = np.concatenate((lo, np.empty(nr)))
+                        hi = np.concatenate((hi, np.empty(nr)))
+                    pair[nr], lo[nr], hi[nr] = q, w_lo, w_up
+                    nr += 1
+                last_hi = w_up
+            cov = max(cov, t + abs(rho))
+            done = t >= bq
+            t = min(t + max(abs(rho), step), bq)
+            if done or not (cov < bq):
+                break
+    return pair[:nr].copy(), lo[:nr].copy(), hi[:nr].copy()
+
+
+@njit(cache=True)
+def launch_bound_kernel(
+    launch, tau, mover, pts, pad, rows, first, head0, turn, verts, edges, poly
+):  # pragma: no cover - compiled
+    """Return the clearance (m) of points at times ``launch + tau`` less ``pad``, shape (L, q).
+
+    Point ``pts[r]`` (m) is measured against mover ``mover[r]`` at ``launch[l] + tau[r]``
+    (s, at least 0) on the piece of its track holding that time (the last piece starting at
+    or before it), minus the radius and ``pad[r]`` (m) (the bound ``G`` of
+    :meth:`._shape_windows.ShapeWindows._exact` before its minimum over the points).
+
+    Parameters
+    ----------
+    launch : ndarray, shape (L,)
+    tau, pad : ndarray, shape (q,)
+    mover : ndarray of int64, shape (q,)
+    pts : ndarray, shape (q, 2)
+    rows : ndarray, shape (p, 8)
+        As :func:`march_kernel` (the pieces in order of mover and time).
+    first : ndarray of int64, shape (movers + 1,)
+        The pieces of mover ``j`` are ``first[j]:first[j + 1]``.
+    head0, turn, verts, edges, poly
+        As :func:`march_kernel`.
+    """
+    out = np.empty((launch.shape[0], tau.shape[0]))
+    for r in range(tau.shape[0]):
+        j = mover[r]
+        a, b = first[j], first[j + 1]
+        for li in range(launch.shape[0]):
+            t = launch[li] + tau[r]
+            lo_i, hi_i = a, b - 1  # the last piece with u <= t (the first if none)
+            while lo_i < hi_i:
+                m = (lo_i + hi_i + 1) // 2
+                if rows[m, 0] <= t:
+                    lo_i = m
+                else:
+                    hi_i = m - 1
+            p = lo_i
+            out[li, r] = _clearance(
+                pts[r, 0], pts[r, 1], rows[p], head0[p], turn[p], pad[r], verts, edges, poly, j, t
+            )
+    return out
