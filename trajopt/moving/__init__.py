@@ -12,11 +12,13 @@
 * :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it
   (:func:`over_start`: whether a mover is over a point at ``t = 0``);
   :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers
-  (:func:`reachable_times`: its sweep of the necessary grid, node by node);
+  (:func:`reachable_times`: its sweep of the necessary grid, node by node;
+  :func:`meets_head_on`: a cheap screen for when it is worth running first);
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
   path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal;
-  :func:`car_headings`: how a car stands at a safe place); :func:`swept_mask`,
-  :func:`mark_swept`: a mover's swept region on a grid;
+  :func:`car_headings`: how a car stands at a safe place; :func:`safe_places`: where it
+  waits); :func:`swept_mask`,
+  :func:`mark_swept`: a mover's swept region on a grid (:func:`swept_cells`: on given cells);
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane;
 * :func:`load_movers`, :func:`save_movers` (:func:`movers_from_data`,
   :func:`movers_to_data`): predicted movers in a JSON or YAML file.
@@ -25,15 +27,24 @@
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
 from trajopt.moving._chain import retime_chain, shift_clock, truncate
 from trajopt.moving._mover_file import load_movers, movers_from_data, movers_to_data, save_movers
-from trajopt.moving._no_way_past import no_way_past, reachable_times
+from trajopt.moving._no_way_past import meets_head_on, no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import over_start, parked_on_path, settle_time
-from trajopt.moving._reroute import car_headings, goal_taken, reroute
+from trajopt.moving._reroute import (
+    N_SAFE_PLACES,
+    SAFE_PLACE_SPACING,
+    car_headings,
+    goal_taken,
+    reroute,
+    safe_places,
+)
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
-from trajopt.moving._swept import mark_swept, swept_mask
+from trajopt.moving._swept import mark_swept, swept_cells, swept_mask
 
 __all__ = [
+    "N_SAFE_PLACES",
+    "SAFE_PLACE_SPACING",
     "MoverCertificate",
     "MovingObstacle",
     "STGrid",
@@ -43,6 +54,7 @@ __all__ = [
     "goal_taken",
     "load_movers",
     "mark_swept",
+    "meets_head_on",
     "movers_from_data",
     "movers_to_data",
     "no_way_past",
@@ -55,9 +67,11 @@ __all__ = [
     "retime_chain",
     "retime_for_movers",
     "retime_plan",
+    "safe_places",
     "settle_time",
     "shift_clock",
     "st_grid",
+    "swept_cells",
     "swept_mask",
     "truncate",
 ]

@@ -44,6 +44,13 @@ from trajopt.moving._st_grid import FOREVER, STGrid, grid_nodes, reach_bound, st
 PROOF_DS = 0.04
 #: Time step (s) of the necessary grid.
 PROOF_DT = 0.05
+#: Arc-length spacing (m) of the path points, and time step (s) of the mover samples, that
+#: :func:`meets_head_on` compares.
+HEAD_ON_DS = 0.25
+HEAD_ON_DT = 0.25
+#: Arc length (m) a mover must go back along the path, near it, for :func:`meets_head_on`,
+#: coming to within as much of the path's start.
+HEAD_ON_RUN = 0.5
 
 
 def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
@@ -202,3 +209,88 @@ def no_way_past(
         mover=movers[j].name,
         t=t,
     )
+
+
+def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0.0) -> bool:
+    """Whether a mover drives along the plan's path against it: a cheap screen for :func:`no_way_past`.
+
+    Each mover's reference point every :data:`HEAD_ON_DT` s over ``[0, t_last]`` is compared
+    with the path's points every :data:`HEAD_ON_DS` m: a sample is near the path when it is
+    within the robot's inscribed radius, the margin, the mover's circumscribed radius and
+    half the point spacing of a path point. The mover meets the path head-on when the arc
+    length of the nearest path point goes back by :data:`HEAD_ON_RUN` m or more from one
+    near sample to a later one that is within :data:`HEAD_ON_RUN` m of the path's start:
+    it comes along the path all the way to where the robot is (one that leaves the path
+    before, the robot may wait out at the start). Only movers that come within that of the
+    start, moving against the robot's heading there (within 60 degrees), are compared: the
+    screen costs little when none does. It decides nothing by itself: it tells the caller
+    that the proof, a few milliseconds, is worth running before a re-timing's search, whose
+    failure costs more.
+
+    Parameters
+    ----------
+    plan : PlanResult
+        A plan (one curve, a chain, an omni translation).
+    movers : sequence of MovingObstacle
+        The predictions (the plan's clock).
+    margin : float
+        Extra distance (m).
+
+    Returns
+    -------
+    bool
+    """
+    curves = path_curves(plan)
+    if not curves or not movers:
+        return False
+    length = float(sum(float(c.length) for c in curves))
+    if length < HEAD_ON_RUN:
+        return False
+    limit = float(plan.robot.inscribed_radius) + float(margin) + 0.5 * HEAD_ON_DS
+    at = plan.sample(np.zeros(1))
+    p0 = np.array([float(at.x[0]), float(at.y[0])])
+    ahead = np.array([math.cos(float(at.theta[0])), math.sin(float(at.theta[0]))])
+    gaps = _track_distances(movers, p0)
+    pts = s = None
+    for m, gap in zip(movers, gaps, strict=True):
+        reach = float(np.max(np.hypot(*m.shape_vertices.T))) + float(m.radius_at(m.t_last))
+        if gap > limit + reach + HEAD_ON_RUN:
+            continue  # it never comes near the path's start
+        t_end = max(float(m.t_last), 0.0)
+        t = np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end)
+        p = m.position_at(t)
+        v = np.diff(p, axis=0)
+        close = np.hypot(*(p[1:] - p0).T) <= limit + reach + HEAD_ON_RUN
+        if not np.any(close & (v[:, 0] * ahead[0] + v[:, 1] * ahead[1] < -0.5 * np.hypot(*v.T))):
+            continue  # it comes near the start only across the heading or with it
+        if pts is None:
+            s = np.linspace(0.0, length, int(math.ceil(length / HEAD_ON_DS)) + 1)
+            pts = _points(curves, s)
+        d = np.hypot(p[:, None, 0] - pts[None, :, 0], p[:, None, 1] - pts[None, :, 1])
+        nearest = np.argmin(d, axis=1)
+        near = d[np.arange(t.shape[0]), nearest] <= limit + reach
+        if np.count_nonzero(near) < 2:
+            continue
+        sn = s[nearest[near]]
+        back = np.maximum.accumulate(sn)[:-1] - sn[1:]
+        if np.any((back >= HEAD_ON_RUN) & (sn[1:] <= HEAD_ON_RUN)):
+            return True
+    return False
+
+
+def _track_distances(movers: Sequence[MovingObstacle], p: np.ndarray) -> np.ndarray:
+    """Distances (m) from ``p`` (m) to each mover's waypoint polyline (all its waypoints).
+
+    At most the distance to its track over ``[0, t_last]`` (a part of that polyline).
+    """
+    a = np.concatenate([m.positions[:-1] if len(m.positions) > 1 else m.positions for m in movers])
+    b = np.concatenate([m.positions[1:] if len(m.positions) > 1 else m.positions for m in movers])
+    owner = np.repeat(np.arange(len(movers)), [max(len(m.positions) - 1, 1) for m in movers])
+    d = b - a
+    dd = np.einsum("ij,ij->i", d, d)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.where(dd > 0.0, np.clip(((p - a) * d).sum(axis=1) / dd, 0.0, 1.0), 0.0)
+    dist = np.hypot(*(a + lam[:, None] * d - p).T)
+    out = np.full(len(movers), np.inf)
+    np.minimum.at(out, owner, dist)
+    return out

@@ -29,7 +29,12 @@ def track(mover: MovingObstacle, t0: float, t1: float) -> np.ndarray:
 
 
 def swept_mask(
-    grid: OccupancyGrid, mover: MovingObstacle, t0: float, t1: float, grow: float
+    grid: OccupancyGrid,
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    grow: float,
+    box: tuple[int, int, int, int] | None = None,
 ) -> np.ndarray:
     """Return the cells the mover's shape, grown by ``grow`` (m), covers at some ``t`` in ``[t0, t1]``.
 
@@ -43,21 +48,25 @@ def swept_mask(
         The time interval (s), ``t0 <= t1``.
     grow : float
         Distance added around the shape (m), >= 0.
+    box : (int, int, int, int), optional
+        ``(ix0, ix1, iy0, iy1)``: only the cells of this box of ``grid`` (bounds included,
+        inside the grid) are returned; ``None``: the whole grid.
 
     Returns
     -------
     ndarray of bool, shape (ny, nx)
-        ``mask[iy, ix]``: the cell's square meets the grown swept region.
+        ``mask[iy, ix]``: the cell's square meets the grown swept region (with ``box``, shape
+        ``(iy1 - iy0 + 1, ix1 - ix0 + 1)``, its cell ``(ix0, iy0)`` first).
     """
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
-    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
-    radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
-    pts = track(mover, float(t0), float(t1))
+    if box is not None:  # the box as a grid of its own: the same cell centres
+        bx0, bx1, by0, by1 = (int(v) for v in box)
+        ox, oy = ox + bx0 * res, oy + by0 * res
+        ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
+    a, b, radius = _capsules(mover, t0, t1, grow, res)
     mask = np.zeros((ny, nx), dtype=bool)
-    a = pts[:-1] if pts.shape[0] > 1 else pts
-    b = pts[1:] if pts.shape[0] > 1 else pts
     lo = np.minimum(a, b) - radius
     hi = np.maximum(a, b) + radius
     ix0 = np.maximum(0, np.floor((lo[:, 0] - ox) / res).astype(np.int64))
@@ -85,6 +94,51 @@ def swept_mask(
     hit = dist <= radius
     mask[iy[hit], ix[hit]] = True
     return mask
+
+
+def _capsules(
+    mover: MovingObstacle, t0: float, t1: float, grow: float, res: float
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Return the track's segment ends ``a``, ``b`` (m, shape (k, 2)) and the capsules' radius (m).
+
+    A cell's square meets the grown swept region when its centre is within the radius of a
+    segment ``[a_i, b_i]``.
+    """
+    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
+    radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
+    pts = track(mover, float(t0), float(t1))
+    a = pts[:-1] if pts.shape[0] > 1 else pts
+    b = pts[1:] if pts.shape[0] > 1 else pts
+    return a, b, radius
+
+
+def swept_cells(
+    grid: OccupancyGrid,
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    grow: float,
+    cells: np.ndarray,
+) -> np.ndarray:
+    """Return whether each of ``cells`` (``(ix, iy)``, shape (n, 2)) is in :func:`swept_mask`.
+
+    The same test on the given cells only (bool, shape (n,)): a cell far cheaper to ask
+    about than the whole grid's mask.
+    """
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    c = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    a, b, radius = _capsules(mover, t0, t1, grow, res)
+    px = (ox + (c[:, 0, None] + 0.5) * res) - a[None, :, 0]
+    py = (oy + (c[:, 1, None] + 0.5) * res) - a[None, :, 1]
+    d = b - a
+    dd = np.einsum("ij,ij->i", d, d)[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.where(
+            dd > 0.0, np.clip((px * d[None, :, 0] + py * d[None, :, 1]) / dd, 0.0, 1.0), 0.0
+        )
+    dist = np.hypot(px - lam * d[None, :, 0], py - lam * d[None, :, 1])
+    return np.any(dist <= radius, axis=1)
 
 
 def mark_swept(

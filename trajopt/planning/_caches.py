@@ -229,6 +229,17 @@ class PlannerCaches:
             out._discs = {r: d.derived(grid) for r, d in self._discs.items()}
             return out
 
+    def inflated_window(self, grid: OccupancyGrid, window: tuple[int, int, int, int]) -> np.ndarray:
+        """Return the inflated grid of ``grid`` (a map of the same frame) in ``window`` only.
+
+        The values :attr:`inflated` would hold for ``grid`` in the cell box ``window``
+        ``(x0, x1, y0, y1)`` (inclusive, inside the grid), computed from ``grid`` cut to the
+        box grown by :func:`change_reach` (as :meth:`update` patches it): bool, shape
+        ``(y1 - y0 + 1, x1 - x0 + 1)``, ``True`` where the robot centre may not go.
+        """
+        reach = change_reach(self.options, grid.resolution)[0]
+        return np.array(_window_values(grid, window, reach, self._inflate))
+
     def update(self, grid: OccupancyGrid) -> dict[str, Any]:
         """Replace the raw map, recomputing the caches only where the change reaches.
 
@@ -503,6 +514,12 @@ def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute)
     map's own edge), so they get exactly the values of a whole-map computation.
     """
     x0, x1, y0, y1 = window
+    target[y0 : y1 + 1, x0 : x1 + 1] = _window_values(grid, window, reach, compute)
+
+
+def _window_values(grid: OccupancyGrid, window, reach: int, compute) -> np.ndarray:
+    """Return ``compute``'s per-cell values of ``grid`` in ``window``, as :func:`_patch` sets them."""
+    x0, x1, y0, y1 = window
     cx0, cx1, cy0, cy1 = _grow(window, reach, grid.shape)
     res = grid.resolution
     ox, oy = grid.origin
@@ -510,4 +527,4 @@ def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute)
         grid.occupied[cy0 : cy1 + 1, cx0 : cx1 + 1], res, (ox + cx0 * res, oy + cy0 * res)
     )
     vals = compute(sub)
-    target[y0 : y1 + 1, x0 : x1 + 1] = vals[y0 - cy0 : y1 - cy0 + 1, x0 - cx0 : x1 - cx0 + 1]
+    return vals[y0 - cy0 : y1 - cy0 + 1, x0 - cx0 : x1 - cx0 + 1]

@@ -14,8 +14,9 @@ from typing import Any
 
 import numpy as np
 
+import astar
 from astar.grid import OccupancyGrid
-from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
+from trajopt.errors import BlockedError, InvalidInputError, NoPathError, TrajoptError
 from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
@@ -25,7 +26,7 @@ from trajopt.moving import (
     reroute,
     retime_chain,
 )
-from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._caches import PlannerCaches, change_reach, component_labels
 from trajopt.planning._options import PlannerOptions, PlanRequest
 from trajopt.planning._runner import run_query
 from trajopt.robot import Robot, State
@@ -311,13 +312,53 @@ def _reroute(
     request: PlanRequest,
     path: np.ndarray | None = None,
 ) -> PlanResult:
-    """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here."""
+    """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here.
+
+    Each marked map's caches are derived once (:meth:`PlannerCaches.derived`), shared by its
+    ``sketch`` (:func:`_grid_path`) and its plan. Given the blocked ``path`` (a re-plan from
+    a stop on it, which stands in the blocking mover's swept region more often than not), a
+    differential drive's disc leg whose start or goal is shut in on the marked map
+    (:func:`shut_in`) is refused with a :class:`NoPathError` before the caches are derived.
+    """
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
         inflated = np.asarray(caches.inflated.occupied)
         ix, iy = (int(c) for c in caches.grid.world_to_cell((float(p0[0]), float(p0[1]))))
         labels = caches.components
         return ~inflated & (labels == labels[iy, ix]) if labels[iy, ix] > 0 else ~inflated
+
+    made: dict[int, tuple[OccupancyGrid, PlannerCaches]] = {}
+
+    def caches_of(grid: OccupancyGrid) -> PlannerCaches:  # a marked map's, derived once
+        if grid is caches.grid:
+            return caches
+        if id(grid) not in made:
+            made[id(grid)] = (grid, caches.derived(grid))  # the grid kept: its id stays its own
+        return made[id(grid)][1]
+
+    def ends(a: np.ndarray | None, b: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        start = request.start.position if isinstance(request.start, State) else request.start
+        return (
+            np.asarray(start if a is None else a, dtype=float).reshape(2),
+            np.asarray(request.goal if b is None else b, dtype=float).reshape(2),
+        )
+
+    def refuse_shut_in(grid: OccupancyGrid, a: np.ndarray | None, b: np.ndarray | None) -> None:
+        if path is None or grid is caches.grid or id(grid) in made or not _disc_search(robot):
+            return  # not from a stop on the blocked path; the plan's own check is as cheap; or
+            # the search is not the disc's
+        p, q = ends(a, b)
+        for name, here, there in (("start", p, q), ("goal", q, p)):
+            if shut_in(caches, grid, here, there):
+                raise NoPathError(
+                    f"no path from start to goal on the marked map: the {name} "
+                    f"({here[0]:.3f}, {here[1]:.3f}) m lies in a part of the inflated grid shut in "
+                    f"within {SHUT_IN_CELLS} cells of it"
+                )
+
+    def sketch(grid: OccupancyGrid) -> np.ndarray:
+        refuse_shut_in(grid, None, None)
+        return _grid_path(caches_of(grid), *ends(None, None))
 
     def plan_leg(
         grid: OccupancyGrid,
@@ -327,6 +368,7 @@ def _reroute(
         goal_heading: float | None = None,
         start_steer: float = 0.0,
     ) -> PlanResult:
+        refuse_shut_in(grid, a, b)
         leg = request
         if a is not None:
             leg = dataclasses.replace(
@@ -339,7 +381,7 @@ def _reroute(
             leg = dataclasses.replace(
                 leg, goal=(float(b[0]), float(b[1])), goal_heading=goal_heading, goal_steer=None
             )
-        return run_query(options, caches.derived(grid), leg)
+        return run_query(options, caches_of(grid), leg)
 
     return reroute(
         p0,
@@ -352,4 +394,83 @@ def _reroute(
         free=free,
         plan_leg=plan_leg,
         path=path,
+        sketch=sketch if _disc_search(robot) else None,
     )
+
+
+#: Half the side (cells) of the window round an end in which :func:`shut_in` looks.
+SHUT_IN_CELLS = 24
+
+
+def _disc_search(robot: Robot) -> bool:
+    """Whether the robot's plans search its disc's inflated grid (a differential drive's disc)."""
+    drive = robot.drive
+    return (
+        robot.footprint is None
+        and drive.turns_in_place
+        and not drive.orients_body
+        and not drive.signed_speed
+    )
+
+
+def shut_in(caches: PlannerCaches, grid: OccupancyGrid, p: np.ndarray, other: np.ndarray) -> bool:
+    """Whether the search from ``p`` (m) on ``grid`` provably cannot reach ``other`` (m).
+
+    The search reaches exactly the 4-connected free cells of the inflated grid joined to the
+    start's (:func:`~trajopt.planning._caches.component_labels`). They are labelled in the
+    window of :data:`SHUT_IN_CELLS` cells round ``p``, its inflated cells exact
+    (:meth:`PlannerCaches.inflated_window`): when ``p``'s part touches no side of the window
+    but the map's own edges, it is the whole component, and ``other`` is reached only when
+    its cell is in it. ``False`` when that does not settle it (the part reaches a side, or
+    ``p``'s cell is not free, which the plan refuses itself) or when ``grid`` differs from
+    the planner's map nowhere that reaches the window (nothing to look at).
+    """
+    ny, nx = grid.shape
+    ix, iy = (int(v) for v in grid.world_to_cell(np.asarray(p, dtype=float)))
+    if not (0 <= ix < nx and 0 <= iy < ny):
+        return False
+    k = SHUT_IN_CELLS
+    x0, x1, y0, y1 = max(0, ix - k), min(nx - 1, ix + k), max(0, iy - k), min(ny - 1, iy + k)
+    r = change_reach(caches.options, grid.resolution)[0]  # what reaches the window's cells
+    near = (slice(max(0, y0 - r), y1 + r + 1), slice(max(0, x0 - r), x1 + r + 1))
+    if np.array_equal(grid.occupied[near], caches.grid.occupied[near]):
+        return False  # no mark near: the map the planner's own labels settle
+    free = ~caches.inflated_window(grid, (x0, x1, y0, y1))
+    if not free[iy - y0, ix - x0]:
+        return False
+    labels = component_labels(~free)
+    part = labels == labels[iy - y0, ix - x0]
+    sides = (
+        (x0 > 0 and part[:, 0].any())
+        or (x1 < nx - 1 and part[:, -1].any())
+        or (y0 > 0 and part[0, :].any())
+        or (y1 < ny - 1 and part[-1, :].any())
+    )
+    if sides:
+        return False
+    gx, gy = (int(v) for v in grid.world_to_cell(np.asarray(other, dtype=float)))
+    return not (x0 <= gx <= x1 and y0 <= gy <= y1 and part[gy - y0, gx - x0])
+
+
+def _grid_path(caches: PlannerCaches, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """Return the search's grid path (cell centres, m, shape (k, 2)) from ``p0`` to ``p1``.
+
+    The disc search of a plan on ``caches`` (exact, with its cost or landmarks), no
+    corridor or smoothing: :class:`NoPathError` when the ends are not joined.
+    """
+    grid = caches.grid
+    s, g = (tuple(int(v) for v in grid.world_to_cell(p)) for p in (p0, p1))
+    ny, nx = grid.shape
+    labels = caches.components
+    if not all(0 <= c[0] < nx and 0 <= c[1] < ny for c in (s, g)) or (
+        labels[s[1], s[0]] == 0 or labels[s[1], s[0]] != labels[g[1], g[0]]
+    ):
+        raise NoPathError(f"no path from start {p0.tolist()} m to goal {p1.tolist()} m")
+    lms = caches.landmarks
+    try:
+        path = astar.find_path(
+            caches.inflated, s, g, cost=caches.search_cost if lms is None else None, landmarks=lms
+        )
+    except astar.NoPathError as exc:
+        raise NoPathError(f"no path from start {p0.tolist()} m to goal {p1.tolist()} m") from exc
+    return np.asarray(grid.cell_to_world(path.cells), dtype=float).reshape(-1, 2)

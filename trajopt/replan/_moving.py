@@ -33,8 +33,10 @@ along its path (:func:`~trajopt.replan._brake.brake_on_path`); a chain keeps its
 ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
 from the stop, as :meth:`~trajopt._planner.Planner.plan` does with movers (the static plan
 re-timed, else re-routed around the blocking mover's swept region, or a wait at a safe
-place: :func:`trajopt.moving.reroute`). The stop and that plan are certified whole against
-the shifted movers. ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
+place: :func:`trajopt.moving.reroute`). The stop and that plan are certified as one chain
+against the shifted movers: the plan on by its own certificate (against the movers seen from
+the stop), the stop by one against the movers ended where it stops
+(:func:`trajopt.moving.truncate`). ``stats["moving"]["route"]`` is ``"retimed"`` or ``"stopped: <route>"``.
 ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
 plan from the stop works or the robot meets a mover while it stops.
 
@@ -43,7 +45,10 @@ curve from the moving state, whose reach bound ``v_max t`` holds every motion al
 a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
 from rest after the head) show that nothing along the path followed gets past the movers from
 the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
-parks on the rest: no search), :func:`trajopt.moving.no_way_past` after it fails. The proof
+parks on the rest: no search), and so does :func:`trajopt.moving.no_way_past` when a mover
+drives along the path against it (:func:`trajopt.moving.meets_head_on`, a cheap screen: the
+re-timing's search would likely fail after it); otherwise ``no_way_past`` runs after the
+re-timing fails. The proof
 is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
 which then tries the re-route's candidates at once and the static plan from the stop last:
 that plan is a new search from a point of the path followed, to the same goal on the same map,
@@ -65,12 +70,14 @@ from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    meets_head_on,
     no_way_past,
     over_start,
     parked_on_path,
     retime_chain,
     retime_for_movers,
     shift_clock,
+    truncate,
 )
 from trajopt.replan._brake import brake_on_path
 
@@ -126,7 +133,13 @@ def retime_replan(
             f"moving_obstacles need a goal at rest (the robot then stands there while the "
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
-    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path,))
+    head_on: list[bool] = []
+
+    def head_on_proof(plan: Any, seen: Sequence[MovingObstacle], margin: float) -> Any:
+        head_on.append(meets_head_on(plan, seen, margin))
+        return no_way_past(plan, seen, margin) if head_on[-1] else None
+
+    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof
@@ -135,7 +148,7 @@ def retime_replan(
     except BlockedError as exc:
         if from_stop is None:
             raise
-        if proof is None:  # is the path followed blocked from the stop on, too?
+        if proof is None and not any(head_on):  # is the path followed blocked from the stop on?
             proof = blocked_along(out, movers, margin, ts, shifted, (no_way_past,))
         timed, moving = _stop_and_go_on(
             out, movers, margin, ts, shifted, from_stop, exc, along=proof
@@ -344,7 +357,8 @@ def _stop_and_go_on(
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
     plans on for the movers seen from there (``ts`` plus the stop's time), told the path
     followed from the stop (:class:`Along`) when ``along`` proves it blocked
-    (:func:`blocked_along`); the head and that plan are certified whole against ``shifted``.
+    (:func:`blocked_along`); the head and that plan are certified as one chain against
+    ``shifted`` (:func:`_whole_certificate`).
     ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies,
     no plan from the stop works or the head meets a mover.
     """
@@ -404,7 +418,53 @@ def _stop_and_go_on(
         rest.steps,
         tuple([t for _, t in head] + starts),
     )
-    cert = certify_movers(whole, shifted, margin=margin)
+    done = rest.stats["moving"]
+    moving = {
+        "plan": f"stopped in {t_head:.3f} s, then: {done.get('plan')}",
+        "route": f"stopped: {done.get('route', 'retimed')}",
+        "blocked": str(blocked),
+        "head_s": t_head,
+        "certificate": _whole_certificate(whole, head, t_head, done, shifted, margin, blocked, ts),
+    }
+    for key in ("reroute", "reroute_time_s"):
+        if key in done:
+            moving[key] = done[key]
+    return whole, moving
+
+
+def _whole_certificate(
+    whole: TrajectoryChain,
+    head: list[tuple[Any, float]],
+    t_head: float,
+    done: dict[str, Any],
+    shifted: Sequence[MovingObstacle],
+    margin: float,
+    blocked: BlockedError,
+    ts: float,
+) -> dict[str, Any]:
+    """Return the certificate summary of the stop and the plan on from it, as one chain.
+
+    The plan from the stop was certified against the movers seen from the stop
+    (``done["certificate"]``: from ``t_head`` (s) on, the robot standing at the goal after
+    it arrives); the head is certified here against the movers ended at ``t_head``
+    (:func:`trajopt.moving.truncate`: equal to them until then), which covers it up to the
+    stop. Together they cover the whole at every instant. A plan on with no certificate of
+    its own is certified with the head, whole. ``BlockedError`` when the robot meets a mover.
+    """
+    rest = done.get("certificate")
+    own = rest is not None and bool(rest.get("ok"))
+    if not own:
+        cert = certify_movers(whole, shifted, margin=margin)
+    elif head:
+        pieces = tuple(p for p, _ in head)
+        played_head = (
+            pieces[0]
+            if len(head) == 1 and head[0][1] == 0.0
+            else TrajectoryChain(pieces, whole.robot, {}, None, tuple(t for _, t in head))
+        )
+        cert = certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
+    else:
+        return dict(rest)
     if not cert.ok:
         raise BlockedError(
             f"{blocked}; moving obstacle {cert.mover!r} meets the robot at "
@@ -412,18 +472,17 @@ def _stop_and_go_on(
             mover=cert.mover,
             t=cert.witness_t + ts,
         ) from blocked
-    done = rest.stats["moving"]
-    moving = {
-        "plan": f"stopped in {t_head:.3f} s, then: {done.get('plan')}",
-        "route": f"stopped: {done.get('route', 'retimed')}",
-        "blocked": str(blocked),
-        "head_s": t_head,
-        "certificate": cert.summary(),
+    out = cert.summary()
+    if not own:
+        return out
+    worst = out if out["slack_m"] <= rest["slack_m"] else rest
+    return {
+        "ok": True,
+        "slack_m": worst["slack_m"],
+        "mover": worst["mover"],
+        "horizon_s": max(out["horizon_s"], t_head + rest["horizon_s"]),
+        "intervals": out["intervals"] + rest["intervals"],
     }
-    for key in ("reroute", "reroute_time_s"):
-        if key in done:
-            moving[key] = done[key]
-    return whole, moving
 
 
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:

@@ -152,3 +152,21 @@ def test_the_node_sweep_equals_a_time_step_sweep(seed):
         for a, b in reach[j]:
             got[a : (kk + extra if b == np.inf else int(b) + 1)] = True
         assert np.array_equal(got, seen[:, j]), j
+
+
+@pytest.mark.parametrize("speed", [0.2, 0.5, 1.5])
+def test_the_head_on_screen_sees_a_walker_along_the_path_and_not_a_crossing(base, speed):
+    """``meets_head_on``: a walker that drives the path backwards is seen (whatever its speed);
+    one that drives it forwards (behind the robot) or crosses it once is not."""
+    assert trajopt.moving.meets_head_on(base, [_head_on(base, speed)], 0.02)
+    s = np.linspace(0.0, base.length, 60)
+    pts = np.asarray(base.path(base.path.u_at_s(s)))
+    follower = trajopt.MovingObstacle.from_waypoints(s / speed + 1.0, pts, radius=0.2)
+    assert not trajopt.moving.meets_head_on(base, [follower], 0.02)
+    smp = base.sample(np.array([0.5 * base.duration]))
+    p = np.array([smp.x[0], smp.y[0]])
+    n = np.array([-math.sin(smp.theta[0]), math.cos(smp.theta[0])])
+    crosser = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 8.0], [p - 2.0 * n, p + 2.0 * n], radius=0.2
+    )
+    assert not trajopt.moving.meets_head_on(base, [crosser], 0.02)

@@ -422,6 +422,84 @@ def test_swept_mask_is_the_cells_near_the_track(t0, t1):
     differ = mask != expect
     assert np.all(np.abs(best[differ] - radius) < 1e-9)
     assert expect.sum() > 20
+    cells = np.stack([ix.ravel(), iy.ravel()], axis=1)
+    asked = trajopt.moving.swept_cells(grid, m, t0, t1, 0.05, cells)  # the same test, cell by cell
+    differ = asked != expect.ravel()
+    assert np.all(np.abs(best.ravel()[differ] - radius) < 1e-9)
+
+
+def test_a_detour_whose_grid_path_follows_the_blocked_path_goes_after_the_waits(bay):
+    """With a ``sketch``, the detour round the forklift's final place (clear of the blocked
+    path) is drawn first: when its grid path follows the blocked path it is tried after the
+    waits at safe places; when it goes another way, before them (every plan fails here: only
+    the order is read)."""
+    grid = bay
+    robot = trajopt.Robot()
+    forklift = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 15.0, 30.0], [(13.0, 2.0), (5.5, 2.0), (0.8, 1.8)], radius=0.2, name="forklift"
+    )
+    p0, p1 = np.array([3.0, 2.0]), np.array([11.0, 2.0])
+    path = np.stack([np.linspace(3.0, 11.0, 161), np.full(161, 2.0)], axis=1)
+    blocked = BlockedError("blocked (test)", mover="forklift", t=5.0)
+    drawn = []
+
+    def plan_leg(marked, a, b, heading, goal_heading=None, start_steer=0.0):
+        raise trajopt.errors.NoPathError("no plan (test)")
+
+    def order(way):
+        def sketch(marked, a=None, b=None):
+            drawn.append(int(np.asarray(marked.occupied).sum()))
+            return way
+
+        with pytest.raises(BlockedError) as info:
+            trajopt.moving.reroute(
+                p0, p1, robot, [forklift], 0.02, blocked, grid=grid,
+                free=lambda: ~np.asarray(grid.occupied), plan_leg=plan_leg, path=path,
+                sketch=sketch,
+            )  # fmt: skip
+        text = str(info.value)
+        names = ["around every mover's final place", "wait at"]
+        assert all(n in text for n in names), text
+        return sorted(names, key=text.index)
+
+    assert order(path[::4]) == ["wait at", "around every mover's final place"]
+    assert drawn and drawn[0] > int(np.asarray(grid.occupied).sum())  # on the marked map
+    north = np.array([[3.0, 2.0], [6.0, 3.3], [11.0, 2.0]])  # 1.3 m off the path at the bay
+    assert order(north) == ["around every mover's final place", "wait at"]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_safe_places_are_the_cheapest_clear_cells_spaced_apart(seed):
+    """``safe_places`` against its definition written out over every cell: the free cells that
+    keep the clearance from every swept region, in order of detour (ties by row, then column),
+    each the first at least the spacing from those taken before it."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((80, 120), [(0.3, 5.7, 0.3, 3.7)])
+    free = ~np.asarray(grid.occupied)
+    free[rng.random(free.shape) < 0.3] = False
+    movers = [
+        trajopt.MovingObstacle.from_waypoints(
+            [0.0, 3.0, 6.0], rng.uniform((0.5, 0.5), (5.5, 3.5), (3, 2)), radius=0.2
+        )
+        for _ in range(2)
+    ]
+    p0, p1 = rng.uniform((0.5, 0.5), (5.5, 3.5), (2, 2))
+    got = trajopt.moving.safe_places(grid, free, movers, 0.3, p0, p1, 6.0)
+    unsafe = np.zeros(grid.shape, dtype=bool)
+    for m in movers:
+        unsafe |= trajopt.moving.swept_mask(grid, m, 0.0, 6.0, 0.3)
+    iy, ix = np.nonzero(free & ~unsafe)
+    pts = np.stack([ix, iy], axis=1) * RES + 0.5 * RES
+    cost = np.hypot(*(pts - p0).T) + np.hypot(*(pts - p1).T)
+    want = []
+    for i in np.argsort(cost, kind="stable"):
+        if all(math.dist(pts[i], q) >= trajopt.moving.SAFE_PLACE_SPACING for q in want):
+            want.append(pts[i])
+            if len(want) == trajopt.moving.N_SAFE_PLACES:
+                break
+    assert len(got) == len(want) == trajopt.moving.N_SAFE_PLACES
+    for g, w in zip(got, want, strict=True):
+        assert np.allclose(g, w, atol=1e-12)
 
 
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))

@@ -282,3 +282,38 @@ def test_update_labels_against_bfs():
             same = {(int(x), int(y)) for y, x in np.argwhere(out == out[iy, ix])}
             assert reach == same, seed
     assert local >= 10
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_an_end_shut_in_by_marks_is_one_no_search_leaves(seed):
+    """``shut_in`` (a re-route's refusal of a marked map) against fresh caches of the marked
+    map: whenever it says an end is shut in, the fresh labels put start and goal in different
+    components; a ring of marks round the start without a gap is seen, one with a wide gap
+    is not."""
+    from trajopt.planning._moving import shut_in
+
+    rng = np.random.default_rng(seed)
+    occ = random_grid(rng, 70, 90, 0.02)
+    grid = astar.OccupancyGrid(occ, 0.05, (0.0, 0.0))
+    planner = trajopt.Planner(grid, ROBOT)
+    caches = planner.caches
+    free = np.argwhere(~np.asarray(caches.inflated.occupied))
+    (sy, sx), (gy, gx) = free[rng.integers(len(free), size=2)]
+    start, goal = grid.cell_to_world(np.array([[sx, sy], [gx, gy]]))
+    iy, ix = np.mgrid[0:70, 0:90]
+    r = np.hypot(ix - sx, iy - sy)
+    for gap, inner in ((0.0, 6.0), (1.2, 6.0), (0.0, 9.0), (0.3, 7.0)):
+        ring = (r >= inner) & (r <= inner + 2.0)
+        if gap:  # no marks within the gap's angle
+            angle = np.abs(np.arctan2(iy - sy, ix - sx) - rng.uniform(-3, 3))
+            ring &= np.minimum(angle, 2 * np.pi - angle) > gap
+        marked = grid.with_occupied(occ | ring)
+        said = shut_in(caches, marked, start, goal)
+        labels = PlannerCaches(marked, None, planner.options).components
+        joined = labels[sy, sx] > 0 and labels[sy, sx] == labels[gy, gx]
+        if said:
+            assert not joined
+        if gap == 0.0 and labels[sy, sx] > 0 and r[gy, gx] > inner + 3.0:
+            assert said  # a full ring shuts the start in
+        if gap >= 1.2 and joined:
+            assert not said
