@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.moving._disc_windows import track_knots
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
 
@@ -437,19 +438,10 @@ def _certify_discs(
     holding it; the robot is evaluated once per distinct interval. Returns ``(verdict,
     slack, mover name, time, intervals)``.
     """
-    knots, owner, xs, ys, firsts, lasts = [], [], [], [], [], []
-    for j, m in enumerate(movers):
-        tk = m.times
-        kn = np.concatenate([[a], tk[(tk > a) & (tk < b)], [b]])  # sorted: times increase
-        knots.append(kn)
-        owner.append(np.full(kn.shape[0], j))
-        xs.append(np.interp(kn, tk, m.positions[:, 0]))
-        ys.append(np.interp(kn, tk, m.positions[:, 1]))
-        firsts.append(np.full(kn.shape[0], tk[0]))
-        lasts.append(np.full(kn.shape[0], tk[-1]))
-    kn, ow = np.concatenate(knots), np.concatenate(owner)
-    pos = np.stack([np.concatenate(xs), np.concatenate(ys)], axis=1)
-    first, last = np.concatenate(firsts), np.concatenate(lasts)
+    # each mover's knots: a, its times strictly inside, b; its centre there (numpy.interp's)
+    ow, kn, pos = track_knots(movers, a, b)
+    first = np.array([float(m.times[0]) for m in movers])[ow]
+    last = np.array([m.t_last for m in movers])[ow]
     # segments between consecutive knots of one mover: its centre is A + V t there
     seg = np.flatnonzero(ow[1:] == ow[:-1])
     u, w = kn[seg], kn[seg + 1]

@@ -15,9 +15,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._st_kernels import close_kernel, disc_windows_kernel, inside_times_kernel
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
-BOX = 8
+BOX = 16
 #: :func:`near_pairs` keeps the pairs within this much (m) of the limit (against rounding).
 NEAR_SLACK = 1e-6
 
@@ -95,37 +96,17 @@ def inside_times(
     The point at ``D = (dx, dy)`` from the mover's centre at the piece's start, the centre
     moving at ``V = (vx, vy)`` (m/s), the limit ``rr + g tau`` (m): ``|D - V tau| < rr + g tau``
     on the open interval ``(t_lo, t_hi)`` (``t_lo > t_hi`` or infinite ends when empty or
-    unbounded; NaN where undefined). Broadcasts.
+    unbounded; NaN where undefined). Broadcasts. The roots of the quadratic
+    ``|D - V tau|^2 - (rr + g tau)^2`` as ``q / a`` and ``c / q`` with
+    ``q = -(b + sign(b) sqrt(b^2 - 4 a c)) / 2`` (no cancellation), the linear root where
+    ``|a| <= 1e-12``, and ``t_lo >= -rr / g`` where the limit grows (it must be positive);
+    compiled per pair (:func:`._st_kernels.inside_times_kernel`).
     """
     dx, dy, vx, vy, rr, g = np.broadcast_arrays(dx, dy, vx, vy, rr, g)
-    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
-    a = vx * vx + vy * vy - g * g
-    b = -2.0 * (dx * vx + dy * vy + rr * g)
-    c = dx * dx + dy * dy - rr * rr
-    big = np.inf
-    with np.errstate(divide="ignore", invalid="ignore"):
-        disc = b * b - 4.0 * a * c
-        two = disc > 0
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        # the roots q / a and c / q, q = -(b + sign(b) sq) / 2 (no cancellation)
-        q = -0.5 * (b + np.where(b > 0, sq, -sq))
-        r1, r2 = q / a, c / q
-        up = a > 0
-        t_lo = np.where(two, np.where(up, np.minimum(r1, r2), np.maximum(r1, r2)), 0.0)
-        t_lo[~two] = np.where(up, big, -big)[~two]
-        t_hi = np.where(up, np.where(two, np.maximum(r1, r2), -big), big)
-        flat = np.abs(a) <= 1e-12
-        if flat.any():
-            bf, cf = b[flat], c[flat]
-            lin = -cf / bf
-            t_lo[flat] = np.where(bf < 0, lin, -big)
-            t_hi[flat] = np.where(bf > 0, lin, np.where((bf == 0) & (cf >= 0), -big, big))
-        # the limit must be positive: rr + g tau > 0
-        grows = g > 0
-        if grows.any():
-            t_lo = np.where(grows, np.maximum(t_lo, -rr / g), t_lo)
-        t_lo = np.where(grows | (rr > 0), t_lo, big)
-    return t_lo, t_hi
+    shape = dx.shape
+    flat = [np.ascontiguousarray(x, dtype=float).reshape(-1) for x in (dx, dy, vx, vy, rr, g)]
+    t_lo, t_hi = inside_times_kernel(*flat)
+    return t_lo.reshape(shape), t_hi.reshape(shape)
 
 
 def close_pairs(
@@ -160,20 +141,20 @@ def _close(
     seg: np.ndarray,
     point: np.ndarray,
 ) -> np.ndarray:
-    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool)."""
-    ax, ay = a[:, 0], a[:, 1]
-    dx, dy = b[:, 0] - ax, b[:, 1] - ay
-    dd = dx * dx + dy * dy
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = np.where(dd > 0.0, 1.0 / dd, 0.0)
-    qx = pts[:, 0][point] - ax[seg]
-    qy = pts[:, 1][point] - ay[seg]
-    sx, sy = dx[seg], dy[seg]
-    f = np.clip((qx * sx + qy * sy) * inv[seg], 0.0, 1.0)
-    qx -= f * sx
-    qy -= f * sy
-    r = reach[seg]
-    return ~(qx * qx + qy * qy >= r * r)  # NaN or infinite: kept
+    """Return whether point ``point[i]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool).
+
+    The distance to the segment (the projection's parameter clipped to ``[0, 1]``) against
+    the reach; a NaN or infinite distance is kept. Compiled
+    (:func:`._st_kernels.close_kernel`).
+    """
+    return close_kernel(
+        np.ascontiguousarray(pts, dtype=float),
+        np.ascontiguousarray(a, dtype=float),
+        np.ascontiguousarray(b, dtype=float),
+        np.ascontiguousarray(reach, dtype=float),
+        np.ascontiguousarray(seg, dtype=np.int64),
+        np.ascontiguousarray(point, dtype=np.int64),
+    )
 
 
 def disc_windows(
@@ -208,7 +189,8 @@ def disc_windows(
     mover, point : ndarray of int, shape (r,)
         The mover and the point of each window.
     lo, hi : ndarray, shape (r,)
-        The open time interval (s) of each window; ``hi = inf`` for one that lasts.
+        The open time interval (s) of each window; ``hi`` is the largest float for one that
+        lasts (``numpy.nan_to_num`` of an infinite end).
     """
     rows = movers if isinstance(movers, np.ndarray) else mover_pieces(movers, 0.0)
     who = rows[:, 0].astype(np.int64)
@@ -218,15 +200,79 @@ def disc_windows(
         seg, pi = near_pairs(pts, rows, limit)
     else:
         seg, pi = np.nonzero(near[who])
-    r = rows[seg]
-    u, w = r[:, 1], r[:, 2]
-    t_lo, t_hi = inside_times(
-        pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
+    # inside_times of each pair, clipped to its piece's span (compiled: the same floats)
+    lo, hi = disc_windows_kernel(
+        np.ascontiguousarray(pts, dtype=float),
+        np.ascontiguousarray(rows, dtype=float),
+        float(limit),
+        np.ascontiguousarray(seg, dtype=np.int64),
+        np.ascontiguousarray(pi, dtype=np.int64),
     )
-    lo = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
-    hi = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
     keep = lo < hi
     return who[seg[keep]], pi[keep].astype(np.int64), lo[keep], hi[keep]
+
+
+def track_knots(
+    movers: Sequence[MovingObstacle], a: float | np.ndarray, b: float | np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return every mover's knots on ``[a, b]`` and its centre there, all movers at once.
+
+    A mover's knots are ``a``, its waypoint times strictly between ``a`` and ``b``, and
+    ``b`` (``a < b``); its centre at them is what ``numpy.interp`` gives, bit for bit: a
+    waypoint at its time, the first or last waypoint outside the times, else
+    ``slope (t - t_k) + p_k`` on the waypoints' segment.
+
+    Parameters
+    ----------
+    movers : sequence of MovingObstacle
+        At least one.
+    a, b : float or ndarray, shape (movers,)
+        The range (s), one for all movers or one each.
+
+    Returns
+    -------
+    owner : ndarray of int, shape (k,)
+        The mover of each knot (movers in order, each one's knots in order of time).
+    knots : ndarray, shape (k,)
+        The knots (s).
+    centre : ndarray, shape (k, 2)
+        The centre (m) at each knot.
+    """
+    m = len(movers)
+    n_j = np.array([mv.times.shape[0] for mv in movers])
+    tk = np.concatenate([mv.times for mv in movers])
+    pos = np.concatenate([mv.positions for mv in movers])
+    j = np.arange(m)
+    own = np.repeat(j, n_j)
+    base = np.cumsum(n_j) - n_j  # each mover's first waypoint
+    last = base + n_j - 1
+    a = np.broadcast_to(np.asarray(a, dtype=float), (m,))
+    b = np.broadcast_to(np.asarray(b, dtype=float), (m,))
+
+    def centre_at(x: np.ndarray) -> np.ndarray:
+        k = base + np.bincount(own, weights=tk <= x[own], minlength=m).astype(np.int64) - 1
+        out = np.where((x < tk[base])[:, None], pos[base], pos[last])
+        between = (x >= tk[base]) & (x < tk[last])  # then base <= k < last
+        if between.any():
+            kb, xb = k[between], x[between]
+            slope = (pos[kb + 1] - pos[kb]) / (tk[kb + 1] - tk[kb])[:, None]
+            at = slope * (xb - tk[kb])[:, None] + pos[kb]
+            out[between] = np.where((tk[kb] == xb)[:, None], pos[kb], at)
+        return out
+
+    inner = (tk > a[own]) & (tk < b[own])
+    lead = base + np.bincount(own, weights=tk <= a[own], minlength=m).astype(np.int64)
+    cnt = 2 + np.bincount(own, weights=inner, minlength=m).astype(np.int64)
+    first = np.cumsum(cnt) - cnt
+    end = first + cnt - 1
+    total = int(first[-1] + cnt[-1])
+    knots, centre = np.empty(total), np.empty((total, 2))
+    knots[first], centre[first] = a, centre_at(a)
+    knots[end], centre[end] = b, centre_at(b)
+    idx = np.flatnonzero(inner)
+    slot = first[own[idx]] + 1 + idx - lead[own[idx]]
+    knots[slot], centre[slot] = tk[idx], pos[idx]
+    return np.repeat(j, cnt), knots, centre
 
 
 def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
@@ -234,31 +280,33 @@ def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
 
     Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
     last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
-    ``limit`` plus the radius is ``r + g (t - u)`` (m).
+    ``limit`` plus the radius is ``r + g (t - u)`` (m). A mover's knots are ``0``, its times
+    after 0 and ``t_end = max(t_last, 0) + 1`` (:func:`track_knots`).
     """
-    out = []
-    for j, m in enumerate(movers):
-        tk = m.times
-        t_end = max(float(tk[-1]), 0.0) + 1.0
-        knots = np.concatenate([[0.0], tk[(tk > 0.0) & (tk < t_end)], [t_end]])
-        u, w = knots[:-1], knots[1:]
-        mid = 0.5 * (u + w)
-        px, py = np.interp(knots, tk, m.positions[:, 0]), np.interp(knots, tk, m.positions[:, 1])
-        inside = (mid > tk[0]) & (mid < tk[-1])
-        span = w - u
-        out.append(
-            np.column_stack(
-                [
-                    np.full(u.shape, float(j)),
-                    u,
-                    np.where(w >= t_end, np.inf, w),
-                    px[:-1],
-                    py[:-1],
-                    np.where(inside, np.diff(px) / span, 0.0),
-                    np.where(inside, np.diff(py) / span, 0.0),
-                    limit + m.radius + m.growth * np.clip(u, 0.0, max(m.t_last, 0.0)),
-                    np.where(mid < m.t_last, m.growth, 0.0),
-                ]
-            )
-        )
-    return np.concatenate(out) if out else np.zeros((0, 9))
+    if len(movers) == 0:
+        return np.zeros((0, 9))
+    t_first = np.array([float(m.times[0]) for m in movers])
+    t_last = np.array([m.t_last for m in movers])
+    t_end = np.maximum(t_last, 0.0) + 1.0
+    owner, knots, pk = track_knots(movers, 0.0, t_end)
+    row = np.flatnonzero(owner[1:] == owner[:-1])  # each knot but a mover's last
+    who = owner[row]
+    u, w = knots[row], knots[row + 1]
+    mid = 0.5 * (u + w)
+    inside = (mid > t_first[who]) & (mid < t_last[who])
+    vel = np.where(inside[:, None], (pk[row + 1] - pk[row]) / (w - u)[:, None], 0.0)
+    radius = np.array([m.radius for m in movers], dtype=float)
+    growth = np.array([m.growth for m in movers], dtype=float)
+    return np.column_stack(
+        [
+            who.astype(float),
+            u,
+            np.where(w >= t_end[who], np.inf, w),
+            pk[row, 0],
+            pk[row, 1],
+            vel[:, 0],
+            vel[:, 1],
+            limit + radius[who] + growth[who] * np.clip(u, 0.0, np.maximum(t_last, 0.0)[who]),
+            np.where(mid < t_last[who], growth[who], 0.0),
+        ]
+    )

@@ -1,4 +1,4 @@
-"""The compiled kernels of the ``(s, t)`` search: a drive's blocked starts and a stop's arrivals.
+"""The compiled kernels of the ``(s, t)`` search and of the disc movers' windows.
 
 A non-decreasing motion along the path (a drive) is at node ``i0 + i`` exactly at the steps
 ``first[i]..last[i]`` after its start (:func:`._st_grid.visits`); a forbidden run
@@ -10,6 +10,13 @@ robot rests at the stop at ``t_k``, the drive is not blocked there and its stop 
 arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme of
 :func:`._st_search.search`). Integer arithmetic only: the same answers as the numpy forms
 (:meth:`._st_grid.STGrid.blocked_starts_many`).
+
+:func:`close_kernel` is the point-to-segment test of the pair filter
+(:func:`._disc_windows.near_pairs`), :func:`least_free_kernel` the sweep of the rests'
+shortening (:func:`._tighten.sweep`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
+order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
+span with ``numpy.nan_to_num``'s replacements), so the same floats.
 """
 
 from __future__ import annotations
@@ -155,3 +162,230 @@ def drive_nodes_kernel(rows, duration, s0, s1, dt, ds, n_nodes, never):  # pragm
             first[q] = j
         last[q] = j
     return idx, first, last
+
+
+_BIG = np.finfo(np.float64).max
+
+
+@njit(cache=True)
+def _max_nan(x, y):  # pragma: no cover - compiled
+    """``numpy.maximum`` of two floats (NaN if either is)."""
+    if np.isnan(x) or np.isnan(y):
+        return np.nan
+    return x if x >= y else y
+
+
+@njit(cache=True)
+def _min_nan(x, y):  # pragma: no cover - compiled
+    """``numpy.minimum`` of two floats (NaN if either is)."""
+    if np.isnan(x) or np.isnan(y):
+        return np.nan
+    return x if x <= y else y
+
+
+@njit(cache=True)
+def _finite(x, nan):  # pragma: no cover - compiled
+    """``numpy.nan_to_num(x, nan=nan)`` of one float (infinities to the largest floats)."""
+    if np.isnan(x):
+        return nan
+    if x == np.inf:
+        return _BIG
+    if x == -np.inf:
+        return -_BIG
+    return x
+
+
+@njit(cache=True, error_model="numpy")
+def _inside(dx, dy, vx, vy, rr, g):  # pragma: no cover - compiled
+    """``(t_lo, t_hi)`` of one point and piece: :func:`._disc_windows.inside_times`, scalar."""
+    # |D - V tau|^2 - (rr + g tau)^2 = a tau^2 + b tau + c < 0, with rr + g tau > 0
+    a = vx * vx + vy * vy - g * g
+    b = -2.0 * (dx * vx + dy * vy + rr * g)
+    c = dx * dx + dy * dy - rr * rr
+    disc = b * b - 4.0 * a * c
+    two = disc > 0
+    sq = np.sqrt(_max_nan(disc, 0.0))
+    q = -0.5 * (b + (sq if b > 0 else -sq))
+    r1 = q / a
+    r2 = c / q
+    up = a > 0
+    if two:
+        t_lo = _min_nan(r1, r2) if up else _max_nan(r1, r2)
+    else:
+        t_lo = np.inf if up else -np.inf
+    if up:
+        t_hi = _max_nan(r1, r2) if two else -np.inf
+    else:
+        t_hi = np.inf
+    if abs(a) <= 1e-12:
+        lin = -c / b
+        t_lo = lin if b < 0 else -np.inf
+        if b > 0:
+            t_hi = lin
+        elif b == 0 and c >= 0:
+            t_hi = -np.inf
+        else:
+            t_hi = np.inf
+    if g > 0:
+        t_lo = _max_nan(t_lo, -rr / g)
+    if not (g > 0 or rr > 0):
+        t_lo = np.inf
+    return t_lo, t_hi
+
+
+@njit(cache=True)
+def inside_times_kernel(dx, dy, vx, vy, rr, g):  # pragma: no cover - compiled
+    """Return ``(t_lo, t_hi)`` (s) of :func:`._disc_windows.inside_times`, 1-D arrays of one length."""
+    n = dx.shape[0]
+    t_lo = np.empty(n)
+    t_hi = np.empty(n)
+    for i in range(n):
+        t_lo[i], t_hi[i] = _inside(dx[i], dy[i], vx[i], vy[i], rr[i], g[i])
+    return t_lo, t_hi
+
+
+@njit(cache=True)
+def disc_windows_kernel(pts, rows, limit, seg, pi):  # pragma: no cover - compiled
+    """Return the open windows ``(lo, hi)`` (s) of the pairs ``(rows[seg[i]], pts[pi[i]])``.
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Points (m).
+    rows : ndarray, shape (p, 9)
+        Pieces ``(mover, u, w, x, y, vx, vy, r, g)`` (:func:`._disc_windows.mover_pieces`).
+    limit : float
+        Added to every piece's ``r`` (m).
+    seg, pi : ndarray of int64, shape (q,)
+        The pairs.
+
+    Returns
+    -------
+    lo, hi : ndarray, shape (q,)
+        The window of each pair within its piece's span (``numpy.nan_to_num`` of its
+        :func:`._disc_windows.inside_times` from the piece's start, clipped to the span);
+        empty (``lo >= hi``) when none.
+    """
+    q = seg.shape[0]
+    lo = np.empty(q)
+    hi = np.empty(q)
+    for i in range(q):
+        k = seg[i]
+        u, w = rows[k, 1], rows[k, 2]
+        t_lo, t_hi = _inside(
+            pts[pi[i], 0] - rows[k, 3],
+            pts[pi[i], 1] - rows[k, 4],
+            rows[k, 5],
+            rows[k, 6],
+            rows[k, 7] + limit,
+            rows[k, 8],
+        )
+        lo[i] = _max_nan(u + _finite(t_lo, np.inf), u)
+        hi[i] = _min_nan(u + _finite(t_hi, -np.inf), w)
+    return lo, hi
+
+
+@njit(cache=True)
+def close_kernel(pts, a, b, reach, seg, point):  # pragma: no cover - compiled
+    """Return whether ``pts[point[i]]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool).
+
+    The segments run from ``a[k]`` to ``b[k]`` (m, shape (p, 2)); the same operations as the
+    numpy form of :func:`._disc_windows.close_pairs` (the projection's parameter clipped to
+    ``[0, 1]``, a NaN or infinite distance kept).
+    """
+    q = seg.shape[0]
+    out = np.empty(q, dtype=np.bool_)
+    for i in range(q):
+        k = seg[i]
+        ax, ay = a[k, 0], a[k, 1]
+        sx, sy = b[k, 0] - ax, b[k, 1] - ay
+        dd = sx * sx + sy * sy
+        inv = 1.0 / dd if dd > 0.0 else 0.0
+        qx = pts[point[i], 0] - ax
+        qy = pts[point[i], 1] - ay
+        f = (qx * sx + qy * sy) * inv
+        if not np.isnan(f):
+            f = min(max(f, 0.0), 1.0)
+        qx -= f * sx
+        qy -= f * sy
+        r = reach[k]
+        out[i] = not (qx * qx + qy * qy >= r * r)
+    return out
+
+
+#: A bucket of :func:`least_free_kernel` longer than this is sorted by numpy's sort, not by
+#: insertion.
+_INSERTION_MAX = 32
+
+
+@njit(cache=True)
+def least_free_kernel(f_lo, f_hi, lo, eps):  # pragma: no cover - compiled
+    """Return the least ``L >= lo`` inside none of the open intervals ``(f_lo, f_hi + eps)``.
+
+    Only the intervals with ``f_hi > lo`` count. The intervals in order of ``f_lo`` (a bucket
+    sort: buckets of equal width over the finite ``f_lo``, each bucket sorted), then the
+    walk of :func:`._tighten.sweep`'s numpy form: the first interval that starts at or
+    after ``max(lo, max(f_hi so far) + eps)`` leaves that launch free. NaN when an
+    ``f_lo`` is NaN (the caller then uses the numpy form).
+    """
+    n = f_lo.shape[0]
+    idx = np.empty(n, dtype=np.int64)
+    m = 0
+    mn, mx = np.inf, -np.inf
+    for i in range(n):
+        if f_hi[i] > lo:
+            x = f_lo[i]
+            if np.isnan(x):
+                return np.nan
+            idx[m] = i
+            m += 1
+            if np.isfinite(x):
+                mn = min(mn, x)
+                mx = max(mx, x)
+    if m == 0:
+        return lo
+    width = (mx - mn) / m if mx > mn else 1.0
+    if not width > 0.0:  # an underflow
+        width = 1.0
+    key = np.empty(m, dtype=np.int64)
+    count = np.zeros(m + 1, dtype=np.int64)
+    for k in range(m):
+        x = f_lo[idx[k]]
+        if x <= mn:
+            b = 0
+        elif x >= mx:
+            b = m - 1
+        else:
+            b = min(int((x - mn) / width), m - 1)
+        key[k] = b
+        count[b + 1] += 1
+    for b in range(m):
+        count[b + 1] += count[b]
+    order = np.empty(m, dtype=np.int64)
+    fill = count[:m].copy()
+    for k in range(m):
+        order[fill[key[k]]] = idx[k]
+        fill[key[k]] += 1
+    for b in range(m):
+        s0, s1 = count[b], count[b + 1]
+        if s1 - s0 > _INSERTION_MAX:
+            part = order[s0:s1].copy()
+            order[s0:s1] = part[np.argsort(f_lo[part])]
+        else:
+            for j in range(s0 + 1, s1):
+                v = order[j]
+                x = f_lo[v]
+                h = j - 1
+                while h >= s0 and f_lo[order[h]] > x:
+                    order[h + 1] = order[h]
+                    h -= 1
+                order[h + 1] = v
+    prev = lo
+    top = -np.inf
+    for k in range(m):
+        j = order[k]
+        if f_lo[j] >= prev:
+            return prev
+        top = max(top, f_hi[j])
+        prev = max(top + eps, lo)
+    return prev

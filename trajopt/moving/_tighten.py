@@ -34,6 +34,7 @@ import numpy as np
 
 from trajopt.moving._disc_windows import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._st_kernels import least_free_kernel
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -172,7 +173,7 @@ class FineWindows:
         keep = f_hi > lo
         f_lo, f_hi = f_lo[keep], f_hi[keep]
         span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
-        cur = _sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
+        cur = sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
         if s_of is None or self.where is None:
             return cur if cur <= hi else None
         extra_lo, extra_hi = rest_lo, rest_hi
@@ -191,7 +192,7 @@ class FineWindows:
             f_lo, f_hi = f_lo[~bind], f_hi[~bind]
             span_a, span_b, owner = span_a[~bind], span_b[~bind], owner[~bind]
             extra_lo, extra_hi = np.append(extra_lo, x_lo), np.append(extra_hi, x_hi)
-            new = _sweep(np.append(f_lo, extra_lo), np.append(f_hi, extra_hi), lo)
+            new = sweep(np.append(f_lo, extra_lo), np.append(f_hi, extra_hi), lo)
             if new >= cur:
                 break
             cur = new
@@ -292,8 +293,25 @@ def pieces_meeting(
     return seg, item
 
 
-def _sweep(f_lo: np.ndarray, f_hi: np.ndarray, lo: float) -> float:
-    """Return the least ``L >= lo`` (s) inside none of the open intervals ``(f_lo, f_hi)``."""
+def sweep(f_lo: np.ndarray, f_hi: np.ndarray, lo: float) -> float:
+    """Return the least ``L >= lo`` (s) inside none of the open intervals ``(f_lo, f_hi)``.
+
+    The intervals ending after ``lo``, in order of start: the first one that starts at or
+    after everything before it (and ``lo``) has ended, plus :data:`EPS_L`, leaves that launch
+    free. Compiled with a bucket sort (:func:`._st_kernels.least_free_kernel`, linear in the
+    intervals); the numpy form (:func:`sweep_numpy`) where a start is NaN.
+    """
+    out = least_free_kernel(
+        np.ascontiguousarray(f_lo, dtype=float),
+        np.ascontiguousarray(f_hi, dtype=float),
+        float(lo),
+        EPS_L,
+    )
+    return float(out) if not math.isnan(out) else sweep_numpy(f_lo, f_hi, lo)
+
+
+def sweep_numpy(f_lo: np.ndarray, f_hi: np.ndarray, lo: float) -> float:
+    """:func:`sweep` with numpy: the intervals sorted by start, then the running end."""
     keep = f_hi > lo
     f_lo, f_hi = f_lo[keep], f_hi[keep]
     if f_lo.size == 0:
