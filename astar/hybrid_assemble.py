@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-__all__ = ["COLLISION_STEP", "assemble"]
+__all__ = ["COLLISION_STEP", "assemble", "join_pieces", "piece_poses"]
 
 #: Cells: the arc-length spacing of the kernel's collision samples (exact mode: the poses).
 COLLISION_STEP = 0.2
@@ -122,8 +122,6 @@ def assemble(
     drive = units if exact else [(p, None) for p in pieces]
     first = drive[0][0][:3] if drive else list(start)
     chunks = [np.array([first])]
-    dirs = [np.array([-1 if drive and drive[0][0][4] < 0 else 1], dtype=np.int8)]
-    ends = []
     for (px, py, pth, k, s), origin in drive:
         if exact:  # the kernel's samples (arc_clear), by its closed form
             m = max(1, math.ceil(abs(s) / COLLISION_STEP))
@@ -136,25 +134,70 @@ def assemble(
                 )
                 c[:, 2] += off
             chunks.append(c)
-            dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
-            ends.append(sum(len(ch) for ch in chunks) - 1)
-            continue
-        m = max(1, math.ceil(abs(s) / step - 1e-9))
-        q = s * np.arange(1, m + 1) / m
-        if k == 0.0:
-            c = np.column_stack([px + q * math.cos(pth), py + q * math.sin(pth), np.full(m, pth)])
         else:
-            th1 = pth + k * q
-            c = np.column_stack(
-                [
-                    px + (np.sin(th1) - math.sin(pth)) / k,
-                    py - (np.cos(th1) - math.cos(pth)) / k,
-                    th1,
-                ]
-            )
-        chunks.append(c)
-        dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
-        ends.append(sum(len(ch) for ch in chunks) - 1)
+            chunks.append(piece_poses(px, py, pth, k, s, step))
+    poses, directions, segments = join_pieces(chunks, [u[0][4] for u in drive], goal)
+    arr = np.array(pieces, dtype=np.float64).reshape(-1, 5)
+    return poses, directions, segments, arr
+
+
+def piece_poses(px: float, py: float, pth: float, k: float, s: float, step: float) -> np.ndarray:
+    """Return the poses along one piece after its start, at arc-length spacing ``<= step``.
+
+    Parameters
+    ----------
+    px, py, pth : float
+        The piece's start pose (cells, rad).
+    k, s : float
+        Its curvature (1/cells) and signed length (cells, negative backwards).
+    step : float
+        The largest spacing (cells).
+
+    Returns
+    -------
+    ndarray of float64, shape (m, 3)
+        ``m = max(1, ceil(|s| / step))`` equal steps, its end pose last (closed form).
+    """
+    m = max(1, math.ceil(abs(s) / step - 1e-9))
+    q = s * np.arange(1, m + 1) / m
+    if k == 0.0:
+        return np.column_stack([px + q * math.cos(pth), py + q * math.sin(pth), np.full(m, pth)])
+    th1 = pth + k * q
+    return np.column_stack(
+        [px + (np.sin(th1) - math.sin(pth)) / k, py - (np.cos(th1) - math.cos(pth)) / k, th1]
+    )
+
+
+def join_pieces(
+    chunks: list[np.ndarray], lengths: list[float], goal: tuple[float, float, float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the poses, directions and segments of a path sampled piece by piece.
+
+    Parameters
+    ----------
+    chunks : list of ndarray, shape (1, 3) then (m_i, 3)
+        The start pose, then each piece's poses after its start (:func:`piece_poses`).
+    lengths : list of float
+        Each piece's signed length (its sign: the direction of travel).
+    goal : tuple of float
+        The end pose; the last pose is set to it exactly (its heading unwrapped to the path's).
+
+    Returns
+    -------
+    poses, directions, segments
+        As :class:`astar.PosePath`'s fields.
+
+    Raises
+    ------
+    RuntimeError
+        The pieces do not end at ``goal`` (an internal error).
+    """
+    dirs = [np.array([-1 if lengths and lengths[0] < 0 else 1], dtype=np.int8)]
+    dirs += [
+        np.full(len(c), -1 if s < 0 else 1, dtype=np.int8)
+        for c, s in zip(chunks[1:], lengths, strict=True)
+    ]
+    ends = np.cumsum([len(c) for c in chunks])[1:] - 1
     poses = np.concatenate(chunks)
     directions = np.concatenate(dirs)
     # the end pose exactly (the word lands on it to rounding, ~1e-12 cells)
@@ -167,10 +210,9 @@ def assemble(
         )
     poses[-1] = (gx, gy, exact_th)
     cuts = [0]
-    for i in range(len(drive) - 1):
-        if (drive[i][0][4] < 0) != (drive[i + 1][0][4] < 0):
-            cuts.append(ends[i])
+    for i in range(len(lengths) - 1):
+        if (lengths[i] < 0) != (lengths[i + 1] < 0):
+            cuts.append(int(ends[i]))
     cuts.append(len(poses) - 1)
     segments = np.array([[a, b] for a, b in zip(cuts[:-1], cuts[1:], strict=True)], np.int64)
-    arr = np.array(pieces, dtype=np.float64).reshape(-1, 5)
-    return poses, directions, segments, arr
+    return poses, directions, segments

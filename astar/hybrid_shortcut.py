@@ -32,6 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
+from astar.hybrid_assemble import join_pieces, piece_poses
 from astar.hybrid_kernel import KernelCollision, footprint_word_clear, word_clear
 from astar.reeds_shepp import advance, car_word
 
@@ -77,25 +78,11 @@ def shortcut_kernel(
     tests : int
         Candidate words tested for collisions.
     """
-    (
-        step,
-        safe,
-        occ,
-        exact_r,
-        fp,
-        fsafe,
-        frho,
-        fmargin,
-        fslack,
-        fmin_slack,
-        onext,
-        fdist,
-        discs,
-        pedges,
-        pstarts,
-        pboxes,
-    ) = collision
-    poly = (pedges, pstarts, pboxes)
+    step, safe, occ, exact_r = collision.step, collision.safe, collision.occ, collision.exact_r
+    fp, fsafe, frho, onext = collision.fp, collision.fsafe, collision.frho, collision.onext
+    fmargin, fslack, fmin_slack = collision.fmargin, collision.fslack, collision.fmin_slack
+    fdist, discs = collision.fdist, collision.discs
+    poly = (collision.pedges, collision.pstarts, collision.pboxes)
     footprint = fp.shape[0] > 0
     fbuf = np.empty((max(fp.shape[0], 1), 5))
     m = pieces.shape[0]
@@ -251,41 +238,8 @@ def resample(pieces: np.ndarray, step: float, goal: tuple[float, float, float]) 
         else:
             merged.append(list(r))
     chunks = [np.array([merged[0][:3]])]
-    dirs = [np.array([-1 if merged[0][4] < 0 else 1], dtype=np.int8)]
-    ends = []
-    for px, py, pth, k, s in merged:
-        m = max(1, math.ceil(abs(s) / step - 1e-9))
-        q = s * np.arange(1, m + 1) / m
-        if k == 0.0:
-            c = np.column_stack([px + q * math.cos(pth), py + q * math.sin(pth), np.full(m, pth)])
-        else:
-            th1 = pth + k * q
-            c = np.column_stack(
-                [
-                    px + (np.sin(th1) - math.sin(pth)) / k,
-                    py - (np.cos(th1) - math.cos(pth)) / k,
-                    th1,
-                ]
-            )
-        chunks.append(c)
-        dirs.append(np.full(m, -1 if s < 0 else 1, dtype=np.int8))
-        ends.append(sum(len(ch) for ch in chunks) - 1)
-    poses = np.concatenate(chunks)
-    directions = np.concatenate(dirs)
-    gx, gy, gth = goal
-    end_th = poses[-1, 2]
-    exact_th = gth + 2.0 * math.pi * round((end_th - gth) / (2.0 * math.pi))
-    if math.hypot(poses[-1, 0] - gx, poses[-1, 1] - gy) > 1e-6 or abs(end_th - exact_th) > 1e-6:
-        raise RuntimeError(  # pragma: no cover - an internal error, not bad input
-            f"internal error: the shortened path ends at {poses[-1].tolist()}, not at {goal}"
-        )
-    poses[-1] = (gx, gy, exact_th)
-    cuts = [0]
-    for i in range(len(merged) - 1):
-        if (merged[i][4] < 0) != (merged[i + 1][4] < 0):
-            cuts.append(ends[i])
-    cuts.append(len(poses) - 1)
-    segments = np.array(list(zip(cuts[:-1], cuts[1:], strict=True)), np.int64).reshape(-1, 2)
+    chunks += [piece_poses(px, py, pth, k, s, step) for px, py, pth, k, s in merged]
+    poses, directions, segments = join_pieces(chunks, [p[4] for p in merged], goal)
     return poses, directions, segments, np.array(merged, dtype=np.float64).reshape(-1, 5)
 
 
