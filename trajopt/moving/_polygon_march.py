@@ -191,18 +191,25 @@ def polygon_runs(
     return node, k0, k1, owner
 
 
+@njit(cache=True, inline="always")
+def _mover_at(row, head0, turn, tk):  # pragma: no cover - compiled
+    """Return a track piece's reference point, heading and rounding at time ``tk``.
+
+    ``row``: the piece's ``(u, w, x, y, vx, vy, r, g)`` (:attr:`PolygonPieces.rows`: from
+    ``u`` to ``w``, ``w`` infinite when the mover stands after its last prediction);
+    ``head0``, ``turn``: its heading at ``u`` and its rate (rad, rad/s).
+    """
+    tau = tk - row[0]
+    run = tau if np.isfinite(row[1]) else 0.0
+    return row[2] + row[4] * run, row[3] + row[5] * run, head0 + turn * run, row[6] + row[7] * tau
+
+
 @njit(cache=True)
 def _clearance(
     px, py, row, head0, turn, lim_add, verts, edges, poly, j, tk
 ):  # pragma: no cover - compiled
     """Return the point's distance (m) to mover ``j``'s polygon at ``tk`` minus the limit."""
-    u, w = row[0], row[1]
-    tau = tk - u
-    run = tau if np.isfinite(w) else 0.0
-    cx = row[2] + row[4] * run
-    cy = row[3] + row[5] * run
-    th = head0 + turn * run
-    rad = row[6] + row[7] * tau
+    cx, cy, th, rad = _mover_at(row, head0, turn, tk)
     c, s = np.cos(th), np.sin(th)
     dx, dy = px - cx, py - cy
     qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
@@ -285,13 +292,7 @@ def _footprint_clearance(
     foot, row, head0, turn, lim_add, verts, nv, j, tk, shape
 ):  # pragma: no cover - compiled
     """Return the signed distance (m) of the polygon ``foot`` to mover ``j``'s polygon at ``tk`` minus the limit (``shape``: scratch)."""
-    u, w = row[0], row[1]
-    tau = tk - u
-    run = tau if np.isfinite(w) else 0.0
-    cx = row[2] + row[4] * run
-    cy = row[3] + row[5] * run
-    th = head0 + turn * run
-    rad = row[6] + row[7] * tau
+    cx, cy, th, rad = _mover_at(row, head0, turn, tk)
     c, s = np.cos(th), np.sin(th)
     m = nv[j]
     for v in range(m):
