@@ -66,10 +66,11 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
-from trajopt.motion import PlanResult, TrajectoryChain
+from trajopt.motion import PlanResult, Trajectory, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    joined_certificates,
     meets_head_on,
     no_way_past,
     over_start,
@@ -139,11 +140,16 @@ def retime_replan(
         head_on.append(meets_head_on(plan, seen, margin))
         return no_way_past(plan, seen, margin) if head_on[-1] else None
 
-    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
+    as_is = None  # one curve from the moving state: its certificate as it is comes first
+    if isinstance(out, Trajectory) and out.direction == 1:
+        as_is = certify_movers(out, shifted, margin=margin)
+    proof = None
+    if as_is is None or not as_is.ok:  # the proofs only for a path that must be re-timed
+        proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof
-        timed, moving = _retimed(out, movers, margin, ts, shifted)
+        timed, moving = _retimed(out, movers, margin, ts, shifted, as_is)
         moving["route"] = "retimed"
     except BlockedError as exc:
         if from_stop is None:
@@ -167,32 +173,87 @@ def _retimed(
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
+    as_is: Any = None,
 ) -> tuple[PlanResult, dict[str, Any]]:
-    """Re-time the result along its own path (module docstring); ``BlockedError`` if not."""
+    """Re-time the result along its own path (module docstring); ``BlockedError`` if not.
+
+    One proof of what is returned, at every instant until the last prediction ends: one
+    curve's certificate from :func:`trajopt.retime_for_movers` (``as_is``, the certificate
+    of the curve as it is when the caller has it, is not computed again); a chain's tail's
+    from :func:`trajopt.moving.retime_chain` (against the movers seen from the head's end)
+    with the head's own against the movers ended where it stops (:func:`_joined_head`); a
+    chain with no tail, its certificate whole.
+    """
     if out.single_curve and out.direction == 1:
         try:
-            timed = retime_for_movers(out, shifted, margin=margin)
+            timed = retime_for_movers(out, shifted, margin=margin, certificate=as_is)
         except BlockedError as exc:  # its time back on the movers' clock
             raise _on_movers_clock(exc, ts) from exc
-        moving = dict(timed.stats["moving"])
-    else:
-        head, tail = split_at_rest(out)
-        if tail:
-            timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
-        else:
-            timed, moving = out, {"plan": "as planned"}
-        cert = certify_movers(timed, shifted, margin=margin)
-        if not cert.ok:
-            raise BlockedError(
-                f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
-                f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
-                f"movers' clock ({'before it stops' if tail else 'it does not stop on the way'}"
-                ": only what follows a stop is re-timed)",
-                mover=cert.mover,
-                t=cert.witness_t + ts,
-            )
-        moving["certificate"] = cert.summary()
-    return timed, moving
+        return timed, dict(timed.stats["moving"])
+    head, tail = split_at_rest(out)
+    if tail:
+        timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
+        moving["certificate"] = _joined_head(
+            head, float(moving["head_s"]), moving.pop("tail_certificate"), out, shifted, margin
+        )
+        return timed, moving
+    cert = certify_movers(out, shifted, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
+            f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
+            "movers' clock (it does not stop on the way: only what follows a stop is re-timed)",
+            mover=cert.mover,
+            t=cert.witness_t + ts,
+        )
+    return out, {"plan": "as planned", "certificate": cert.summary()}
+
+
+def _joined_head(
+    head: list[tuple[Any, float]],
+    t_head: float,
+    rest: dict[str, Any],
+    out: PlanResult,
+    shifted: Sequence[MovingObstacle],
+    margin: float,
+) -> dict[str, Any]:
+    """Return the certificate summary of a head and the re-timed plan after it, as one.
+
+    ``rest`` is that plan's certificate summary, against the movers seen from the head's end
+    ``t_head`` (s): it covers every instant from there on. The head, when it plays for a
+    while, is certified here against ``shifted`` ended at ``t_head``
+    (:func:`trajopt.moving.truncate`: equal to them until then). ``BlockedError`` (its time
+    on the re-plan's clock) when the head meets a mover.
+    """
+    if t_head <= 0.0:
+        return dict(rest)
+    cert = _head_certificate(head, t_head, out.robot, shifted, margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
+            f"{out.stats.get('replan', '')}) at t = {cert.witness_t:.3f} s after the splice "
+            "(before it stops: only what follows a stop is re-timed)",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    return joined_certificates([(0.0, cert.summary()), (t_head, rest)])
+
+
+def _head_certificate(
+    head: list[tuple[Any, float]],
+    t_head: float,
+    robot: Any,
+    shifted: Sequence[MovingObstacle],
+    margin: float,
+) -> Any:
+    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``."""
+    pieces = tuple(p for p, _ in head)
+    played_head = (
+        pieces[0]
+        if len(head) == 1 and head[0][1] == 0.0
+        else TrajectoryChain(pieces, robot, {}, None, tuple(t for _, t in head))
+    )
+    return certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
 
 
 def blocked_along(
@@ -310,6 +371,7 @@ def _retime_tail(
     moving = {
         "plan": f"kept {t_head:.3f} s to a stop, then: {timed.stats['moving']['plan']}",
         "head_s": t_head,
+        "tail_certificate": timed.stats["moving"]["certificate"],
     }
     return chain, moving
 
@@ -456,13 +518,7 @@ def _whole_certificate(
     if not own:
         cert = certify_movers(whole, shifted, margin=margin)
     elif head:
-        pieces = tuple(p for p, _ in head)
-        played_head = (
-            pieces[0]
-            if len(head) == 1 and head[0][1] == 0.0
-            else TrajectoryChain(pieces, whole.robot, {}, None, tuple(t for _, t in head))
-        )
-        cert = certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
+        cert = _head_certificate(head, t_head, whole.robot, shifted, margin)
     else:
         return dict(rest)
     if not cert.ok:
@@ -472,17 +528,9 @@ def _whole_certificate(
             mover=cert.mover,
             t=cert.witness_t + ts,
         ) from blocked
-    out = cert.summary()
     if not own:
-        return out
-    worst = out if out["slack_m"] <= rest["slack_m"] else rest
-    return {
-        "ok": True,
-        "slack_m": worst["slack_m"],
-        "mover": worst["mover"],
-        "horizon_s": max(out["horizon_s"], t_head + rest["horizon_s"]),
-        "intervals": out["intervals"] + rest["intervals"],
-    }
+        return cert.summary()
+    return joined_certificates([(0.0, cert.summary()), (t_head, rest)])
 
 
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
