@@ -22,10 +22,15 @@ first starts a piece at rest (:func:`split_at_rest`): the head before it (a brak
 splice state, the end of a turn in place playing at the splice) is played as it is, since
 the robot is committed to it until it stops; the tail, a plan from rest, is re-timed by
 :func:`trajopt.moving.retime_chain` on the movers' clock seen from the head's end (turns in
-place, a car's drives between cusps, an omni orientation). Whatever is returned is certified
-whole (:func:`trajopt.certify_movers` against the shifted movers); a result with no piece
-from rest after its head (an omni base's own orientation from the moving state) is only
-certified.
+place, a car's drives between cusps, an omni orientation). Whatever is returned has one
+complete proof (:func:`trajopt.certify_movers` against the shifted movers, over its whole
+clock and the standing at the goal until the last prediction ends), made once: one curve's
+certificate as it is comes first (kept as planned when it passes: no other proof runs), and a
+re-timed curve's is the certificate :func:`trajopt.retime_for_movers` made of it; a chain's
+is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on) joined with
+the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
+none when the head plays for no time); a result with no piece from rest after its head (an
+omni base's own orientation from the moving state) is only certified, whole.
 
 **When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
 the robot stops, since it is moving at the splice. One curve from the moving state is braked
@@ -40,8 +45,8 @@ the stop), the stop by one against the movers ended where it stops
 ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
 plan from the stop works or the robot meets a mover while it stops.
 
-**A path proved blocked** (:func:`blocked_along`): the quick proofs on what is re-timed (one
-curve from the moving state, whose reach bound ``v_max t`` holds every motion along its path,
+**A path proved blocked** (:func:`blocked_along`): the quick proofs on what must be re-timed
+(one curve from the moving state that fails its certificate as it is, whose reach bound ``v_max t`` holds every motion along its path,
 a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
 from rest after the head) show that nothing along the path followed gets past the movers from
 the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
