@@ -46,19 +46,19 @@ the stop), the stop by one against the movers ended where it stops
 plan from the stop works or the robot meets a mover while it stops.
 
 **A path proved blocked** (:func:`blocked_along`): the quick proofs on what must be re-timed
-(one curve from the moving state that fails its certificate as it is, whose reach bound ``v_max t`` holds every motion along its path,
-a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
-from rest after the head) show that nothing along the path followed gets past the movers from
-the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
-parks on the rest: no search), and so does :func:`trajopt.moving.no_way_past` when a mover
-drives along the path against it (:func:`trajopt.moving.meets_head_on`, a cheap screen: the
-re-timing's search would likely fail after it); otherwise ``no_way_past`` runs after the
-re-timing fails. The proof
-is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
-which then tries the re-route's candidates at once and the static plan from the stop last:
-that plan is a new search from a point of the path followed, to the same goal on the same map,
-so it usually takes the path's rest again (blocked), but it may leave it (another grid path,
-smoothing or start heading), so it is tried rather than dropped.
+(one curve from the moving state that fails its certificate as it is, whose reach bound ``v_max
+t`` holds every motion along its path, a brake to a stop on it and any motion from rest after
+it included; a chain's tail, a plan from rest after the head) show that nothing along the path
+followed gets past the movers from the stop on. :func:`trajopt.moving.parked_on_path` runs
+before the re-timing (a mover that parks on the rest: no search), and so does
+:func:`trajopt.moving.no_way_past` when a mover drives along the path against it
+(:func:`trajopt.moving.meets_head_on`, a cheap screen: the re-timing's search would likely fail
+after it); otherwise ``no_way_past`` runs after the re-timing fails. The proof is handed to
+``from_stop`` (:class:`Along`: the proof and the path's points from the stop), which then tries
+the re-route's candidates at once and the static plan from the stop last: that plan is a new
+search from a point of the path followed, to the same goal on the same map, so it usually takes
+the path's rest again (blocked), but it may leave it (another grid path, smoothing or start
+heading), so it is tried rather than dropped.
 """
 
 from __future__ import annotations
