@@ -46,8 +46,8 @@ the stop), the stop by one against the movers ended where it stops
 plan from the stop works or the robot meets a mover while it stops.
 
 **A path proved blocked** (:func:`blocked_along`): the quick proofs on what must be re-timed
-(one curve from the moving state that fails its certificate as it is, whose reach bound ``v_max
-t`` holds every motion along its path, a brake to a stop on it and any motion from rest after
+(one curve from the moving state that fails its certificate as it is, whose reach bound
+``v_max t`` holds every motion along its path, a brake to a stop on it and any motion from rest after
 it included; a chain's tail, a plan from rest after the head) show that nothing along the path
 followed gets past the movers from the stop on. :func:`trajopt.moving.parked_on_path` runs
 before the re-timing (a mover that parks on the rest: no search), and so does
