@@ -9,6 +9,7 @@
 * :func:`retime_plan`: the same for a plan with turns in place at its ends;
 * :func:`retime_chain`: any plan from rest on one clock (curves, turns in place, a car's
   drives between cusps and steering at rest, an omni orientation); :func:`shift_clock`;
+  :func:`joined_certificates`: one certificate summary of parts certified one after another;
 * :func:`parked_on_path`: a quick proof that a mover parked on the path blocks it
   (:func:`over_start`: whether a mover is over a point at ``t = 0``);
   :func:`no_way_past`: a quick proof that no re-timing along the path gets past the movers
@@ -25,7 +26,7 @@
 """
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
-from trajopt.moving._chain import retime_chain, shift_clock, truncate
+from trajopt.moving._chain import joined_certificates, retime_chain, shift_clock, truncate
 from trajopt.moving._mover_file import load_movers, movers_from_data, movers_to_data, save_movers
 from trajopt.moving._no_way_past import meets_head_on, no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
@@ -52,6 +53,7 @@ __all__ = [
     "certify_movers",
     "check_movers",
     "goal_taken",
+    "joined_certificates",
     "load_movers",
     "mark_swept",
     "meets_head_on",

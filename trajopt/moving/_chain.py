@@ -16,9 +16,15 @@ omnidirectional or car-like robot (not the stop-and-turn fallback's polyline):
   (:func:`truncate`); the last curve with the robot standing at the goal until the last
   prediction ends. When a later curve is then blocked (leaving early led into a trap), the
   pieces are re-timed again with every curve standing at its end until the last prediction
-  ends. The pieces are re-timed one after another (greedy: safe, not complete);
-  the whole chain is then certified again (:func:`~trajopt.moving.certify_movers`). A chain
-  that passes the certificate as it is stays as it is;
+  ends. The pieces are re-timed one after another (greedy: safe, not complete). A chain
+  that passes its certificate (:func:`~trajopt.moving.certify_movers`) as it is stays as it
+  is; otherwise the proofs of the result are the curves' own certificates, which for a disc
+  robot cover every instant (a leg's until it ends, the next curve's from there, its rest at
+  the start and the motions at rest before it included, the last one's until the last
+  prediction ends), so the re-timed chain is not certified again; a footprint robot's is,
+  whole, since the body sweeps more while it turns in place than at rest. The chain's failed
+  certificate is its one curve's (after a rest as long as the motions at rest before it) for
+  a disc robot's chain of one curve, and is handed to that curve's re-timing;
 * an :class:`trajopt.OmniTrajectory` (an omni base's own orientation): its translation is
   re-timed as the robot's circumscribed disc (the body may face any way), and the orientation
   profile is built again on the re-timed translation (:func:`trajopt.timing.orient`, from the
@@ -37,7 +43,7 @@ import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError
 from trajopt.motion import Trajectory, TrajectoryChain
-from trajopt.moving._certificate import certify_movers
+from trajopt.moving._certificate import MoverCertificate, certify_movers
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._retime import retime_for_movers
 from trajopt.timing import orient
@@ -110,19 +116,26 @@ def flat_pieces(plan: Any) -> list[Any]:
 
 
 def _retime_curve(
-    curve: Trajectory, movers: Sequence[MovingObstacle], margin: float, not_before: float
+    curve: Trajectory,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    not_before: float,
+    as_is: MoverCertificate | None = None,
 ) -> Trajectory:
-    """Re-time one curve from rest to rest; a car's backwards drive under ``v_max_reverse``."""
+    """Re-time one curve from rest to rest; a car's backwards drive under ``v_max_reverse``.
+
+    ``as_is``: the certificate of the curve as it is after the rest ``not_before``, when the
+    caller has it (:func:`retime_for_movers`' ``certificate``).
+    """
     robot = curve.robot
     backwards = getattr(robot.drive, "v_max_backwards", None)
     limits = robot
     if curve.direction < 0 and backwards is not None and backwards(robot) != robot.v_max:
         limits = dataclasses.replace(robot, v_max=backwards(robot))
+    kw = {"margin": margin, "not_before": not_before, "certificate": as_is}
     if limits is robot:
-        return retime_for_movers(curve, movers, margin=margin, not_before=not_before)
-    out = retime_for_movers(
-        dataclasses.replace(curve, robot=limits), movers, margin=margin, not_before=not_before
-    )
+        return retime_for_movers(curve, movers, **kw)
+    out = retime_for_movers(dataclasses.replace(curve, robot=limits), movers, **kw)
     return dataclasses.replace(out, robot=robot)
 
 
@@ -173,8 +186,9 @@ def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float =
     Trajectory, TrajectoryChain or OmniTrajectory
         Of the plan's kind (a chain keeps its pieces in order), certified at every instant
         until the last prediction ends. ``stats["moving"]``: ``plan`` (each curve's re-timing
-        in words, ``"; "``-joined), ``certificate`` (:func:`certify_movers`' summary) and
-        ``time_s``.
+        in words, ``"; "``-joined_certificates), ``certificate`` (:func:`certify_movers`' summary: of
+        the plan as it is, or of the re-timed chain, a disc robot's as its curves'
+        certificates :func:`joined_certificates`) and ``time_s``.
 
     Raises
     ------
@@ -200,40 +214,81 @@ def retime_chain(plan: Any, movers: Sequence[MovingObstacle], *, margin: float =
             "time_s": time.perf_counter() - t_all,
         }
         return dataclasses.replace(plan, stats=stats)
+    # one curve after motions at rest, a disc robot: the chain's certificate is the curve's
+    # after a rest as long as they last (a disc stands still while it turns or steers)
+    one = sum(p.single_curve for p in pieces) == 1 and plan.robot.footprint is None
     try:
-        chain, labels = _in_order(plan, pieces, movers, margin, early=True)
-    except BlockedError:  # leaving early led into a trap: every leg stands at its end till the last
-        chain, labels = _in_order(plan, pieces, movers, margin, early=False)
-    cert = certify_movers(chain, movers, margin=margin)
-    if not cert.ok:
-        raise BlockedError(
-            f"moving obstacle {cert.mover!r} meets the robot near t = {cert.witness_t:.3f} s "
-            f"while it stands still in the re-timed chain ({cert.verdict})",
-            mover=cert.mover,
-            t=cert.witness_t,
+        chain, labels, certs = _in_order(
+            plan, pieces, movers, margin, early=True, as_is=cert if one else None
         )
+    except BlockedError:  # leaving early led into a trap: every leg stands at its end till the last
+        chain, labels, certs = _in_order(plan, pieces, movers, margin, early=False)
+    if plan.robot.footprint is None:  # the curves' certificates cover the disc at every instant
+        summary = joined_certificates(certs)
+    else:  # a footprint sweeps more while it turns in place than its rests: the whole chain
+        whole = certify_movers(chain, movers, margin=margin)
+        if not whole.ok:
+            raise BlockedError(
+                f"moving obstacle {whole.mover!r} meets the robot near "
+                f"t = {whole.witness_t:.3f} s while it stands still in the re-timed chain "
+                f"({whole.verdict})",
+                mover=whole.mover,
+                t=whole.witness_t,
+            )
+        summary = whole.summary()
     chain.stats["moving"] = {
         "plan": "; ".join(labels) if labels else "as planned",
-        "certificate": cert.summary(),
+        "certificate": summary,
         "time_s": time.perf_counter() - t_all,
     }
     return chain
 
 
+def joined_certificates(certs: Sequence[tuple[float, dict[str, Any]]]) -> dict[str, Any]:
+    """Return one certificate summary of parts certified on their own, one after another.
+
+    ``certs``: ``(t0, summary)`` pairs, each part's certificate summary
+    (:meth:`MoverCertificate.summary`) on a clock that starts at ``t0`` (s) of the whole. The
+    parts' certificates together must cover every instant of the whole (the caller's
+    argument); the result has the smallest slack and its mover, the latest end of a
+    certified range on the whole's clock and the intervals of all.
+    """
+    worst = min(certs, key=lambda c: c[1]["slack_m"])[1]
+    return {
+        "ok": all(bool(c["ok"]) for _, c in certs),
+        "slack_m": worst["slack_m"],
+        "mover": worst["mover"],
+        "horizon_s": max(t0 + float(c["horizon_s"]) for t0, c in certs),
+        "intervals": sum(int(c["intervals"]) for _, c in certs),
+    }
+
+
 def _in_order(
-    plan: Any, pieces: list[Any], movers: Sequence[MovingObstacle], margin: float, early: bool
-) -> tuple[TrajectoryChain, list[str]]:
+    plan: Any,
+    pieces: list[Any],
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    early: bool,
+    as_is: MoverCertificate | None = None,
+) -> tuple[TrajectoryChain, list[str], list[tuple[float, dict[str, Any]]]]:
     """Re-time the curves in order on one clock; ``early``: each leg clear only until it ends.
 
     With ``early`` a curve that another follows is re-timed by :func:`_retime_leg` (it may
     leave its start as soon as it is clear until its end); without, as the last one (standing
     at its end until the last prediction ends: it never arrives where a mover will still come,
-    which a later curve could not escape). Returns the chain and each curve's plan in words.
+    which a later curve could not escape). ``as_is``: the chain's failed certificate, handed
+    to the re-timing of its one curve as that curve's own (a disc robot's chain of one curve).
+    Returns the chain, each curve's plan in words and each curve's certificate summary with
+    the chain time where its clock starts. For a disc robot those certificates cover every
+    instant: a leg's until it ends (:func:`_retime_leg`), the next curve's from there (its
+    rest at the start, the motions at rest before it, included), the last curve's until the
+    last prediction ends, standing at the goal (the motions at rest after it included).
     """
     last = max(i for i, p in enumerate(pieces) if p.single_curve)
     out: list[Any] = []
     starts: list[float] = []
     labels: list[str] = []
+    certs: list[tuple[float, dict[str, Any]]] = []
     pending: list[Any] = []
     t_cur = lead = 0.0
     for i, piece in enumerate(pieces):
@@ -245,9 +300,10 @@ def _in_order(
         curve = (
             _retime_leg(piece, seen, margin, lead)
             if early and i != last
-            else _retime_curve(piece, seen, margin, lead)
+            else _retime_curve(piece, seen, margin, lead, as_is)
         )
         labels.append(str(curve.stats["moving"]["plan"]))
+        certs.append((t_cur, curve.stats["moving"]["certificate"]))
         out += pending
         starts += [0.0] * len(pending)
         out.append(curve)
@@ -257,7 +313,7 @@ def _in_order(
     out += pending
     starts += [0.0] * len(pending)
     chain = TrajectoryChain(tuple(out), plan.robot, dict(plan.stats), plan.steps, tuple(starts))
-    return chain, labels
+    return chain, labels, certs
 
 
 def _retime_omni(plan: Any, movers: Sequence[MovingObstacle], margin: float, t_all: float) -> Any:

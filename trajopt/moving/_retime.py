@@ -48,6 +48,7 @@ from trajopt.geometry import CurveSegment
 from trajopt.motion import Trajectory, TrajectoryChain
 from trajopt.moving._braking import braking_distance, state_at
 from trajopt.moving._certificate import (
+    MoverCertificate,
     ccw,
     certify_movers,
     check_movers,
@@ -296,6 +297,7 @@ def retime_for_movers(
     dt: float = 0.05,
     ds: float = 0.02,
     not_before: float = 0.0,
+    certificate: MoverCertificate | None = None,
 ) -> Trajectory:
     """Re-time ``traj`` along its path so that it keeps clear of the movers (module docstring).
 
@@ -315,6 +317,11 @@ def retime_for_movers(
     not_before : float
         The robot rests at the start until this time (s), >= 0 (a turn in place there):
         the result starts with a rest at least that long. Only for a start at rest.
+    certificate : MoverCertificate, optional
+        The certificate (:func:`certify_movers`) of ``traj`` as it is, after the rest
+        ``not_before``, against these movers and this margin, when the caller has it (a
+        caller that certified the same motion first): it decides whether ``traj`` is kept
+        as planned, and is not computed again.
 
     Returns
     -------
@@ -367,7 +374,7 @@ def retime_for_movers(
         whole = _piece_of(traj, 0.0, length)
         rows, duration = compose([(0.0, None, 0.0), (float(not_before), whole, 0.0)], length)
         traj = _timed(traj, rows, duration)
-    cert = certify_movers(traj, movers, margin=margin)
+    cert = certify_movers(traj, movers, margin=margin) if certificate is None else certificate
     if cert.ok:
         return _with_stats(traj, cert, "as planned", t_all)
     vmax = float(robot.v_max)

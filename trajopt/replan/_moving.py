@@ -22,10 +22,15 @@ first starts a piece at rest (:func:`split_at_rest`): the head before it (a brak
 splice state, the end of a turn in place playing at the splice) is played as it is, since
 the robot is committed to it until it stops; the tail, a plan from rest, is re-timed by
 :func:`trajopt.moving.retime_chain` on the movers' clock seen from the head's end (turns in
-place, a car's drives between cusps, an omni orientation). Whatever is returned is certified
-whole (:func:`trajopt.certify_movers` against the shifted movers); a result with no piece
-from rest after its head (an omni base's own orientation from the moving state) is only
-certified.
+place, a car's drives between cusps, an omni orientation). Whatever is returned has one
+complete proof (:func:`trajopt.certify_movers` against the shifted movers, over its whole
+clock and the standing at the goal until the last prediction ends), made once: one curve's
+certificate as it is comes first (kept as planned when it passes: no other proof runs), and a
+re-timed curve's is the certificate :func:`trajopt.retime_for_movers` made of it; a chain's
+is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on) joined with
+the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
+none when the head plays for no time); a result with no piece from rest after its head (an
+omni base's own orientation from the moving state) is only certified, whole.
 
 **When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
 the robot stops, since it is moving at the splice. One curve from the moving state is braked
@@ -40,20 +45,20 @@ the stop), the stop by one against the movers ended where it stops
 ``BlockedError`` (the mover named, its time on the movers' clock) when no stop applies, no
 plan from the stop works or the robot meets a mover while it stops.
 
-**A path proved blocked** (:func:`blocked_along`): the quick proofs on what is re-timed (one
-curve from the moving state, whose reach bound ``v_max t`` holds every motion along its path,
-a brake to a stop on it and any motion from rest after it included; a chain's tail, a plan
-from rest after the head) show that nothing along the path followed gets past the movers from
-the stop on. :func:`trajopt.moving.parked_on_path` runs before the re-timing (a mover that
-parks on the rest: no search), and so does :func:`trajopt.moving.no_way_past` when a mover
-drives along the path against it (:func:`trajopt.moving.meets_head_on`, a cheap screen: the
-re-timing's search would likely fail after it); otherwise ``no_way_past`` runs after the
-re-timing fails. The proof
-is handed to ``from_stop`` (:class:`Along`: the proof and the path's points from the stop),
-which then tries the re-route's candidates at once and the static plan from the stop last:
-that plan is a new search from a point of the path followed, to the same goal on the same map,
-so it usually takes the path's rest again (blocked), but it may leave it (another grid path,
-smoothing or start heading), so it is tried rather than dropped.
+**A path proved blocked** (:func:`blocked_along`): the quick proofs on what must be re-timed
+(one curve from the moving state that fails its certificate as it is, whose reach bound
+``v_max t`` holds every motion along its path, a brake to a stop on it and any motion from rest after
+it included; a chain's tail, a plan from rest after the head) show that nothing along the path
+followed gets past the movers from the stop on. :func:`trajopt.moving.parked_on_path` runs
+before the re-timing (a mover that parks on the rest: no search), and so does
+:func:`trajopt.moving.no_way_past` when a mover drives along the path against it
+(:func:`trajopt.moving.meets_head_on`, a cheap screen: the re-timing's search would likely fail
+after it); otherwise ``no_way_past`` runs after the re-timing fails. The proof is handed to
+``from_stop`` (:class:`Along`: the proof and the path's points from the stop), which then tries
+the re-route's candidates at once and the static plan from the stop last: that plan is a new
+search from a point of the path followed, to the same goal on the same map, so it usually takes
+the path's rest again (blocked), but it may leave it (another grid path, smoothing or start
+heading), so it is tried rather than dropped.
 """
 
 from __future__ import annotations
@@ -66,10 +71,11 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
-from trajopt.motion import PlanResult, TrajectoryChain
+from trajopt.motion import PlanResult, Trajectory, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
+    joined_certificates,
     meets_head_on,
     no_way_past,
     over_start,
@@ -139,11 +145,16 @@ def retime_replan(
         head_on.append(meets_head_on(plan, seen, margin))
         return no_way_past(plan, seen, margin) if head_on[-1] else None
 
-    proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
+    as_is = None  # one curve from the moving state: its certificate as it is comes first
+    if isinstance(out, Trajectory) and out.direction == 1:
+        as_is = certify_movers(out, shifted, margin=margin)
+    proof = None
+    if as_is is None or not as_is.ok:  # the proofs only for a path that must be re-timed
+        proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof
-        timed, moving = _retimed(out, movers, margin, ts, shifted)
+        timed, moving = _retimed(out, movers, margin, ts, shifted, as_is)
         moving["route"] = "retimed"
     except BlockedError as exc:
         if from_stop is None:
@@ -167,32 +178,87 @@ def _retimed(
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
+    as_is: Any = None,
 ) -> tuple[PlanResult, dict[str, Any]]:
-    """Re-time the result along its own path (module docstring); ``BlockedError`` if not."""
+    """Re-time the result along its own path (module docstring); ``BlockedError`` if not.
+
+    One proof of what is returned, at every instant until the last prediction ends: one
+    curve's certificate from :func:`trajopt.retime_for_movers` (``as_is``, the certificate
+    of the curve as it is when the caller has it, is not computed again); a chain's tail's
+    from :func:`trajopt.moving.retime_chain` (against the movers seen from the head's end)
+    with the head's own against the movers ended where it stops (:func:`_joined_head`); a
+    chain with no tail, its certificate whole.
+    """
     if out.single_curve and out.direction == 1:
         try:
-            timed = retime_for_movers(out, shifted, margin=margin)
+            timed = retime_for_movers(out, shifted, margin=margin, certificate=as_is)
         except BlockedError as exc:  # its time back on the movers' clock
             raise _on_movers_clock(exc, ts) from exc
-        moving = dict(timed.stats["moving"])
-    else:
-        head, tail = split_at_rest(out)
-        if tail:
-            timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
-        else:
-            timed, moving = out, {"plan": "as planned"}
-        cert = certify_movers(timed, shifted, margin=margin)
-        if not cert.ok:
-            raise BlockedError(
-                f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
-                f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
-                f"movers' clock ({'before it stops' if tail else 'it does not stop on the way'}"
-                ": only what follows a stop is re-timed)",
-                mover=cert.mover,
-                t=cert.witness_t + ts,
-            )
-        moving["certificate"] = cert.summary()
-    return timed, moving
+        return timed, dict(timed.stats["moving"])
+    head, tail = split_at_rest(out)
+    if tail:
+        timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
+        moving["certificate"] = _joined_head(
+            head, float(moving["head_s"]), moving.pop("tail_certificate"), out, shifted, margin
+        )
+        return timed, moving
+    cert = certify_movers(out, shifted, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
+            f"{out.stats.get('replan', '')}) at t = {cert.witness_t + ts:.3f} s of the "
+            "movers' clock (it does not stop on the way: only what follows a stop is re-timed)",
+            mover=cert.mover,
+            t=cert.witness_t + ts,
+        )
+    return out, {"plan": "as planned", "certificate": cert.summary()}
+
+
+def _joined_head(
+    head: list[tuple[Any, float]],
+    t_head: float,
+    rest: dict[str, Any],
+    out: PlanResult,
+    shifted: Sequence[MovingObstacle],
+    margin: float,
+) -> dict[str, Any]:
+    """Return the certificate summary of a head and the re-timed plan after it, as one.
+
+    ``rest`` is that plan's certificate summary, against the movers seen from the head's end
+    ``t_head`` (s): it covers every instant from there on. The head, when it plays for a
+    while, is certified here against ``shifted`` ended at ``t_head``
+    (:func:`trajopt.moving.truncate`: equal to them until then). ``BlockedError`` (its time
+    on the re-plan's clock) when the head meets a mover.
+    """
+    if t_head <= 0.0:
+        return dict(rest)
+    cert = _head_certificate(head, t_head, out.robot, shifted, margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-plan ({type(out).__name__}, "
+            f"{out.stats.get('replan', '')}) at t = {cert.witness_t:.3f} s after the splice "
+            "(before it stops: only what follows a stop is re-timed)",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    return joined_certificates([(0.0, cert.summary()), (t_head, rest)])
+
+
+def _head_certificate(
+    head: list[tuple[Any, float]],
+    t_head: float,
+    robot: Any,
+    shifted: Sequence[MovingObstacle],
+    margin: float,
+) -> Any:
+    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``."""
+    pieces = tuple(p for p, _ in head)
+    played_head = (
+        pieces[0]
+        if len(head) == 1 and head[0][1] == 0.0
+        else TrajectoryChain(pieces, robot, {}, None, tuple(t for _, t in head))
+    )
+    return certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
 
 
 def blocked_along(
@@ -310,6 +376,7 @@ def _retime_tail(
     moving = {
         "plan": f"kept {t_head:.3f} s to a stop, then: {timed.stats['moving']['plan']}",
         "head_s": t_head,
+        "tail_certificate": timed.stats["moving"]["certificate"],
     }
     return chain, moving
 
@@ -456,13 +523,7 @@ def _whole_certificate(
     if not own:
         cert = certify_movers(whole, shifted, margin=margin)
     elif head:
-        pieces = tuple(p for p, _ in head)
-        played_head = (
-            pieces[0]
-            if len(head) == 1 and head[0][1] == 0.0
-            else TrajectoryChain(pieces, whole.robot, {}, None, tuple(t for _, t in head))
-        )
-        cert = certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
+        cert = _head_certificate(head, t_head, whole.robot, shifted, margin)
     else:
         return dict(rest)
     if not cert.ok:
@@ -472,17 +533,9 @@ def _whole_certificate(
             mover=cert.mover,
             t=cert.witness_t + ts,
         ) from blocked
-    out = cert.summary()
     if not own:
-        return out
-    worst = out if out["slack_m"] <= rest["slack_m"] else rest
-    return {
-        "ok": True,
-        "slack_m": worst["slack_m"],
-        "mover": worst["mover"],
-        "horizon_s": max(out["horizon_s"], t_head + rest["horizon_s"]),
-        "intervals": out["intervals"] + rest["intervals"],
-    }
+        return cert.summary()
+    return joined_certificates([(0.0, cert.summary()), (t_head, rest)])
 
 
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:

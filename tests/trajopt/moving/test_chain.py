@@ -176,3 +176,40 @@ def test_shift_clock_is_the_same_prediction():
         for a, b in zip(sh.pose_at(tau), m.pose_at(tau + t0), strict=True):
             np.testing.assert_allclose(a, b, atol=1e-12)
         np.testing.assert_allclose(sh.radius_at(tau), m.radius_at(tau + t0), atol=1e-12)
+
+
+def test_a_disc_chain_of_two_curves_is_proved_by_its_curves(scene, driven):
+    """Two curves with turns in place between, a disc robot: re-timed, clear at every instant.
+
+    The re-timed chain's proof is its curves' certificates (no certificate of the whole); the
+    independent references (1 ms samples, brute force) and the whole chain's certificate
+    agree that it keeps clear, and the joined summary covers the chain until the last
+    prediction ends.
+    """
+    planner, _ = driven
+    a, b, c = scene.start, scene.goal("A"), scene.goal("B")
+    first = planner.plan(a, b, goal_heading=0.0)
+    second = planner.plan(b, c, start_heading=0.0)
+    pieces = tuple(q for p in (first, second) for q in getattr(p, "pieces", (p,)))
+    plan = trajopt.TrajectoryChain(pieces, first.robot, {}, None)
+    curves = [p for p in pieces if p.single_curve]
+    assert len(curves) == 2
+    # crossing the second curve's middle when it is there, the first curve's end before
+    t2 = float(plan.duration) - 0.5 * float(curves[-1].duration)
+    walker = _crossing_at(plan, t2, name="walker", radius=0.15)
+    assert dense_min(plan, [walker])[0] < 0.0  # the chain as planned would hit it
+    out = trajopt.moving.retime_chain(plan, [walker])
+    assert out.duration > plan.duration
+    _checked(out, [walker])
+    cert = out.stats["moving"]["certificate"]
+    assert cert["horizon_s"] >= max(float(out.duration), float(walker.t_last)) - 1e-9
+
+
+def test_joined_certificates_by_hand():
+    """The worst slack and its mover, the latest end on the whole's clock, all intervals."""
+    a = {"ok": True, "slack_m": 0.3, "mover": "a", "horizon_s": 4.0, "intervals": 10}
+    b = {"ok": True, "slack_m": 0.1, "mover": "b", "horizon_s": 2.5, "intervals": 7}
+    got = trajopt.moving.joined_certificates([(0.0, a), (3.0, b)])
+    assert got == {"ok": True, "slack_m": 0.1, "mover": "b", "horizon_s": 5.5, "intervals": 17}
+    bad = dict(b, ok=False)
+    assert not trajopt.moving.joined_certificates([(0.0, a), (3.0, bad)])["ok"]
