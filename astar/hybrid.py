@@ -269,8 +269,9 @@ def find_pose_path(
         (1.5). Default: ``HybridCosts()``.
     limits : HybridLimits, optional
         ``max_expansions`` (500 000), ``time_budget`` (2 s), ``sample_step`` (0.5 cells),
-        ``search_from`` (``"auto"``: from the start, then from the goal; see Notes).
-        Default: ``HybridLimits()``.
+        ``search_from`` (``"auto"``: from the start, then from the goal; see Notes),
+        ``retry_expansions`` (None: the finer search after a small region was exhausted
+        gets what is left of ``max_expansions``). Default: ``HybridLimits()``.
     collision : HybridCollision, optional
         What the path keeps clear of besides ``grid``: nothing (the default), the raw map
         at an exact ``clearance`` (cells), or a ``footprint`` polygon (cells) with
@@ -321,9 +322,9 @@ def find_pose_path(
     cheapest path (costs: length, backwards and arc weights, cusps). When the search exhausts
     a small region (at most 20 000 expansions: a pocket where no primitive fits, a dead end),
     it runs once more with primitives a third as long and three times as many heading bins,
-    within the remaining budgets (with ``fine_radius``: the same primitives and states, and
-    within ``fine_radius`` of the end poses finer states and shorter primitives besides,
-    :class:`~astar.HybridMotion`). The search may also grow from the goal
+    within the remaining budgets and ``retry_expansions`` (with ``fine_radius``: the same
+    primitives and states, and within ``fine_radius`` of the end poses finer states and
+    shorter primitives besides, :class:`~astar.HybridMotion`). The search may also grow from the goal
     (``search_from="goal"``): it drives its primitives back in time from the goal pose and
     shoots words from the start pose, and the path it returns is the same kind of path (from
     the start, each piece driven as the path drives it, checked the same way). With
@@ -460,10 +461,12 @@ def find_pose_path(
         status, n_exp = out[0], min(int(out[7]), exp_cap)  # the kernel counts the one refused
         expanded += n_exp
         shots += int(out[8])
-        if status == EXHAUSTED and n_exp <= _RETRY_BELOW and max_exp > expanded:
+        left = max_exp - expanded
+        if limits.retry_expansions is not None:
+            left = min(left, limits.retry_expansions)
+        if status == EXHAUSTED and n_exp <= _RETRY_BELOW and left > 0:
             # a small region was exhausted (a pocket where no primitive fits?): once more with
             # primitives a third as long and three times as many heading bins
-            left = max_exp - expanded
             if motion.fine_radius > 0.0:  # finer states and primitives near the ends only
                 out = search(backward, prim_len, nbins, left, t1 + budget, fine=True)
             else:
@@ -475,7 +478,7 @@ def find_pose_path(
         stats["searches"].append(
             {"from": "goal" if backward else "start", "status": int(status), "expanded": n_exp}
         )
-        if status in (FOUND, EXHAUSTED) or expanded >= max_exp:
+        if status in (FOUND, EXHAUSTED) or retried or expanded >= max_exp:
             break  # found, or no path at all: the other end's states are the same
     nodes = out[2]
     t2 = time.perf_counter()
@@ -520,6 +523,11 @@ def find_pose_path(
         else:
             reason = "max_expansions"
             why = f"the search reached max_expansions={max_exp}"
+            if retried and expanded < max_exp:
+                why = (
+                    f"the finer search after a small region was exhausted reached "
+                    f"retry_expansions={limits.retry_expansions}"
+                )
         raise NoPosePathError(
             f"no path from start pose ({sx:g}, {sy:g}, {sth:g}) to goal pose ({gx:g}, {gy:g}, "
             f"{gth:g}): {why}",

@@ -249,6 +249,12 @@ class HybridLimits:
         A search from the tight end lands its shots in the open: parking into a slot 1.3
         car lengths long takes a few thousand expansions from the slot, and does not finish
         within 2 s from the lane.
+    retry_expansions : int or None, optional
+        ``>= 0``: at most this many expansions for the finer search that runs after a
+        small region was exhausted (:func:`astar.find_pose_path`, Notes); 0: no such
+        search, the search reports ``"exhausted"``. None (default): what is left of
+        ``max_expansions``. A caller with further tries that do better on such places (a
+        grid whose sampling is refined near obstacles) skips or bounds it.
 
     Raises
     ------
@@ -260,6 +266,7 @@ class HybridLimits:
     time_budget: float = 2.0
     sample_step: float = 0.5
     search_from: str = "auto"
+    retry_expansions: int | None = None
 
     def __post_init__(self) -> None:
         max_exp = validation.int_at_least("max_expansions", self.max_expansions, 1)
@@ -273,6 +280,9 @@ class HybridLimits:
         object.__setattr__(self, "max_expansions", max_exp)
         object.__setattr__(self, "time_budget", budget)
         object.__setattr__(self, "sample_step", step)
+        if self.retry_expansions is not None:
+            retry = validation.int_at_least("retry_expansions", self.retry_expansions, 0)
+            object.__setattr__(self, "retry_expansions", retry)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -251,6 +251,31 @@ def test_pocket_where_no_primitive_fits_is_retried_finer():
     assert p.stats["retried"] and p.cusps >= 1
 
 
+def test_retry_expansions_bounds_the_finer_search():
+    """``retry_expansions`` caps the finer search after a small region was exhausted: 0
+    skips it (the pocket's coarse states are all expanded: ``"exhausted"``), a cap below
+    what it needs stops it there (``"max_expansions"``, the count within the cap), and a
+    cap above what it needs returns the same path as no cap."""
+    rows = [r for r in POCKET.strip().splitlines()][::-1]
+    free = np.array([[c != "#" for c in r] for r in rows])
+    sy = next(i for i, r in enumerate(rows) if "S" in r)
+    start, goal = ((float(rows[sy].index("S")), float(sy), 2.1211601392508337), (14.0, sy, 2.356))
+    ref = find_pose_path(free, start, goal, turning_radius=5.0)
+    with pytest.raises(NoPosePathError) as none:
+        find_pose_path(free, start, goal, turning_radius=5.0, retry_expansions=0)
+    assert none.value.reason == "exhausted" and not none.value.stats["retried"]
+    first = none.value.stats["expanded"]
+    assert 0 < first < ref.stats["expanded"]
+    with pytest.raises(NoPosePathError, match=r"reached retry_expansions=3\b") as capped:
+        find_pose_path(free, start, goal, turning_radius=5.0, retry_expansions=3)
+    assert capped.value.reason == "max_expansions" and capped.value.stats["retried"]
+    assert first < capped.value.stats["expanded"] <= first + 3
+    again = find_pose_path(
+        free, start, goal, turning_radius=5.0, retry_expansions=ref.stats["expanded"]
+    )
+    np.testing.assert_array_equal(again.poses, ref.poses)
+
+
 @st.composite
 def _queries(draw):
     ny = draw(st.integers(8, 18))

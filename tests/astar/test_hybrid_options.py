@@ -117,6 +117,8 @@ BAD = [
     (HybridLimits, "max_expansions", 1e6, "max_expansions must be an int, got 1000000.0"),
     (HybridLimits, "time_budget", 0, "time_budget must be finite and > 0, got 0.0"),
     (HybridLimits, "sample_step", -0.5, "sample_step must be finite and > 0, got -0.5"),
+    (HybridLimits, "retry_expansions", -1, "retry_expansions must be >= 0, got -1"),
+    (HybridLimits, "retry_expansions", 2.5, "retry_expansions must be an int, got 2.5"),
     (HybridCollision, "clearance", -1.0, "clearance must be finite and > 0, got -1.0"),
     (HybridCollision, "footprint", "square", "footprint must be an array of vertices"),
     (HybridCollision, "footprint", [[-1, -1], [1, 1]], "footprint must have shape (k, 2)"),
