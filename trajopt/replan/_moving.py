@@ -71,7 +71,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError, TrajoptError
-from trajopt.motion import PlanResult, Trajectory, TrajectoryChain
+from trajopt.motion import PlanResult, TrajectoryChain
 from trajopt.moving import (
     MovingObstacle,
     certify_movers,
@@ -146,7 +146,7 @@ def retime_replan(
         return no_way_past(plan, seen, margin) if head_on[-1] else None
 
     as_is = None  # one curve from the moving state: its certificate as it is comes first
-    if isinstance(out, Trajectory) and out.direction == 1:
+    if out.single_curve and out.direction == 1:
         as_is = certify_movers(out, shifted, margin=margin)
     proof = None
     if as_is is None or not as_is.ok:  # the proofs only for a path that must be re-timed
