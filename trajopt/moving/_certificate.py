@@ -50,6 +50,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.moving._disc_windows import track_knots
+from trajopt.moving._mover_segments import MoverSegments
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
 
@@ -180,21 +181,6 @@ def shape_at(mover: MovingObstacle, t: np.ndarray) -> np.ndarray:
     x = c[:, 0:1] + ch * v[None, :, 0] - sh * v[None, :, 1]
     y = c[:, 1:2] + sh * v[None, :, 0] + ch * v[None, :, 1]
     return np.stack([x, y], axis=-1)
-
-
-def _segment_rates(mover: MovingObstacle, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Return the velocity (m/s), shape (n, 2), and turn rate (rad/s), shape (n,), on the segment holding each ``t``."""
-    tk = mover.times
-    n = t.shape[0]
-    if tk.shape[0] < 2:
-        return np.zeros((n, 2)), np.zeros(n)
-    k = np.searchsorted(tk, t, side="right") - 1
-    inside = (k >= 0) & (k < tk.shape[0] - 1)
-    kk = np.clip(k, 0, tk.shape[0] - 2)
-    dt = tk[kk + 1] - tk[kk]
-    vel = (mover.positions[kk + 1] - mover.positions[kk]) / dt[:, None]
-    w = (mover.headings[kk + 1] - mover.headings[kk]) / dt
-    return np.where(inside[:, None], vel, 0.0), np.where(inside, w, 0.0)
 
 
 def _profile_bounds(traj: Any) -> tuple[float, float]:
@@ -398,9 +384,10 @@ def certify_movers(
             if verdict != "clear":
                 return MoverCertificate(False, verdict, slack, who, wt, horizon, tol, total)
             best = min(best, (slack, who, wt))
-        for mover in polygons if b > a else movers:
-            t0, t1 = _cover(a, b, mover.times)
-            verdict, slack, wt, count = _certify_one(model, mover, t0, t1, extra, tol, body)
+        ones = polygons if b > a else list(movers)
+        for mover, (verdict, slack, wt, count) in zip(
+            ones, _certify_each(model, ones, a, b, extra, tol, body), strict=False
+        ):
             total += count
             if verdict != "clear":
                 return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
@@ -433,7 +420,7 @@ def _certify_discs(
 ) -> tuple[str, float, str, float, int]:
     """Split the intervals of ``[a, b]`` for all disc movers at once (in :data:`SPLIT` parts).
 
-    The same bounds as :func:`_certify_one`, vectorised over the movers: each interval keeps
+    The same bounds as :func:`_certify_each`, in :data:`SPLIT` parts: each interval keeps
     its mover's index and the line ``A + V t`` its centre follows on the waypoint segment
     holding it; the robot is evaluated once per distinct interval. Returns ``(verdict,
     slack, mover name, time, intervals)``.
@@ -544,42 +531,78 @@ def _certify_discs(
     return "clear", proven, movers[proven_j].name if movers else "", proven_t, count
 
 
-def _certify_one(
+def _certify_each(
     model: Any,
-    mover: MovingObstacle,
-    t0: np.ndarray,
-    t1: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    a: float,
+    b: float,
     extra: float,
     tol: float,
-    body: np.ndarray | None = None,
-) -> tuple[str, float, float, int]:
-    """Bisect ``[t0, t1]`` intervals for one mover: ``(verdict, slack, time, intervals)``.
+    body: np.ndarray | None,
+) -> list[tuple[str, float, float, int]]:
+    """Bisect each mover's cover of ``[a, b]``: ``(verdict, slack, time, intervals)`` per mover.
 
+    Each mover's intervals are halved until decided (first order; second order for a disc
+    mover and a disc robot), in the order one mover at a time would take them (its own
+    intervals: the undecided ones' left halves, then their right halves), so that its
+    verdict, slack, time and count do not depend on the other movers. All movers advance
+    together: the robot is evaluated once per distinct interval of a level, the movers'
+    poses and rates are gathered from :class:`MoverSegments`. The movers after the first one
+    not clear are not certified (:func:`certify_movers` stops there): the list ends at it.
     ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
     a disc (whose radius is in ``extra``).
     """
-    disc = mover.vertices is None
-    reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
-    proven = math.inf
-    proven_t = 0.0
-    count = 0
+    nm = len(movers)
+    if nm == 0:
+        return []
+    covers = [_cover(a, b, m.times) for m in movers]
+    t0 = np.concatenate([c[0] for c in covers])
+    t1 = np.concatenate([c[1] for c in covers])
+    mj = np.repeat(np.arange(nm), [c[0].shape[0] for c in covers])
+    seg = MoverSegments(movers)
+    # an interval never straddles its mover's times: its midpoint is on the segment of its
+    # start, or on the next one when it falls on the next time (``searchsorted`` right)
+    g0 = seg.row(mj, t0)
+    reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
+    rad0 = np.array([m.radius for m in movers])
+    grow = np.array([m.growth for m in movers])
+    t_last = np.array([max(m.t_last, 0.0) for m in movers])
+    disc = np.array([m.vertices is None for m in movers])
+    sizes = np.array([m.shape_vertices.shape[0] for m in movers])
+    verts = [m.shape_vertices for m in movers]
+    reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
+    proven = np.full(nm, math.inf)
+    proven_t = np.zeros(nm)
+    counts = np.zeros(nm, dtype=np.int64)
+    result: list[tuple[str, float, float, int] | None] = [None] * nm
+    stop = nm  # the first mover not clear (those after it are not certified)
     while t0.size:
-        count += t0.size
-        if count > MAX_INTERVALS:
-            return "undecided", proven, proven_t, count
+        counts += np.bincount(mj, minlength=nm)
+        over = np.flatnonzero(counts[:stop] > MAX_INTERVALS)
+        if over.size:
+            j = int(over[0])
+            result[j] = ("undecided", float(proven[j]), float(proven_t[j]), int(counts[j]))
+            stop = j
+            keep = mj < stop
+            t0, t1, mj, g0 = t0[keep], t1[keep], mj[keep], g0[keep]
+            if not t0.size:
+                break
         tm = 0.5 * (t0 + t1)
         h = 0.5 * (t1 - t0)
-        p, rho_p, v_rob = model.at(t0, tm, t1)
-        vel, w = _segment_rates(mover, tm)
-        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach * np.abs(w)) * h
-        shape = shape_at(mover, tm)
-        dist_m = point_polygon_distance(p, shape)
-        lim_mid = extra + mover.radius_at(tm)
-        lim_hi = extra + mover.radius_at(t1)
-        lower = dist_m - rho_p - rho_m - lim_hi
-        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
-            reach_b = float(np.max(np.hypot(body[:, 0], body[:, 1])))
-            c, sn = np.cos(model.theta)[:, None], np.sin(model.theta)[:, None]
+        uniq, inv = np.unique(t0 + 1j * t1, return_inverse=True)
+        inv = inv.reshape(-1)
+        u0, u1 = uniq.real, uniq.imag
+        p, rho_p, v_rob = (x[inv] for x in model.at(u0, 0.5 * (u0 + u1), u1))
+        g = g0 + (tm >= seg.next[g0])
+        vel, w = seg.vel[g], seg.turn[g]
+        pose = seg.at(g, tm)
+        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach[mj] * np.abs(w)) * h
+        lim_mid = extra + (rad0[mj] + grow[mj] * np.clip(tm, 0.0, t_last[mj]))
+        lim_hi = extra + (rad0[mj] + grow[mj] * np.clip(t1, 0.0, t_last[mj]))
+        dist_m = np.empty(tm.shape[0])
+        if body is not None:
+            theta, turn = model.theta[inv], model.turn[inv]
+            c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
             poly = np.stack(
                 [
                     p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
@@ -587,26 +610,63 @@ def _certify_one(
                 ],
                 axis=-1,
             )
-            dist_m = convex_distance(poly, shape)
-            lower_poly = dist_m - rho_p - reach_b * model.turn - rho_m - lim_hi
+        dist_c = np.empty(tm.shape[0])
+        for size in np.unique(sizes[mj]):
+            sel = sizes[mj] == size
+            v = np.stack([verts[j] for j in mj[sel]])
+            ps = pose[sel]
+            ch, sh = np.cos(ps[:, 2])[:, None], np.sin(ps[:, 2])[:, None]
+            x = ps[:, 0:1] + ch * v[:, :, 0] - sh * v[:, :, 1]
+            y = ps[:, 1:2] + sh * v[:, :, 0] + ch * v[:, :, 1]
+            shape = np.stack([x, y], axis=-1)
+            dist_c[sel] = point_polygon_distance(p[sel], shape)
+            if body is not None:
+                dist_m[sel] = convex_distance(poly[sel], shape)
+        lower = dist_c - rho_p - rho_m - lim_hi
+        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
+            lower_poly = dist_m - rho_p - reach_b * turn - rho_m - lim_hi
             lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
-        elif disc:
-            # second order: min over |tau| <= h of |D + w tau|, minus the curvature term
-            d = p - mover.position_at(tm)
-            lower2 = second_order_lower(d, v_rob - vel, h, model.c2_local) - lim_hi
-            lower = np.fmax(lower, lower2)  # an unbounded curvature gives -inf or nan
+        else:
+            dist_m = dist_c
+            dm = disc[mj]
+            if np.any(dm):  # second order: min over |tau| <= h of |D + w tau|, less curvature
+                d = p[dm] - pose[dm, :2]
+                c2 = np.broadcast_to(model.c2_local, u0.shape)[inv][dm]
+                lower2 = second_order_lower(d, v_rob[dm] - vel[dm], h[dm], c2) - lim_hi[dm]
+                lower[dm] = np.fmax(lower[dm], lower2)
         slack_mid = dist_m - lim_mid
         bad = slack_mid < -0.5 * tol
         if np.any(bad):
-            i = int(np.argmin(np.where(bad, slack_mid, np.inf)))
-            return "violated", float(slack_mid[i]), float(tm[i]), count
+            # each mover's first smallest witness (its intervals are contiguous, in order)
+            order = np.lexsort((np.arange(bad.size), np.where(bad, slack_mid, np.inf), mj))
+            first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+            for i in first[bad[first]]:
+                j = int(mj[i])
+                if j < stop:
+                    result[j] = ("violated", float(slack_mid[i]), float(tm[i]), int(counts[j]))
+                    stop = j
         done = lower >= -tol
         if np.any(done):
-            i = int(np.argmin(np.where(done, lower, np.inf)))
-            if lower[i] < proven:
-                proven, proven_t = float(lower[i]), float(tm[i])
-        split = ~done
-        a, m, b = t0[split], tm[split], t1[split]
-        t0 = np.concatenate([a, m])
-        t1 = np.concatenate([m, b])
-    return "clear", proven, proven_t, count
+            order = np.lexsort((np.arange(done.size), np.where(done, lower, np.inf), mj))
+            first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+            i = first[done[first]]
+            j = mj[i]
+            better = lower[i] < proven[j]
+            proven[j[better]], proven_t[j[better]] = lower[i][better], tm[i][better]
+        split = ~done & (mj < stop)
+        a0, m0, b0, j0, gg = t0[split], tm[split], t1[split], mj[split], g0[split]
+        # each mover's left halves in order, then its right halves (as one mover alone)
+        order = np.argsort(np.concatenate([j0, j0]), kind="stable")
+        t0 = np.concatenate([a0, m0])[order]
+        t1 = np.concatenate([m0, b0])[order]
+        mj = np.concatenate([j0, j0])[order]
+        g0 = np.concatenate([gg, gg])[order]
+    out = []
+    for j in range(stop + 1 if stop < nm else nm):
+        res = result[j]
+        out.append(
+            res
+            if res is not None
+            else ("clear", float(proven[j]), float(proven_t[j]), int(counts[j]))
+        )
+    return out

@@ -151,3 +151,76 @@ def test_bad_arguments(line):
     with pytest.raises(InvalidInputError, match="Trajectory"):
         certify_movers("traj", [m])
     assert certify_movers(line, []).ok and math.isinf(certify_movers(line, []).slack)
+
+
+def test_mover_segments_are_numpy_interp_bit_for_bit():
+    """Poses and rates gathered for several movers equal numpy.interp and the waypoint slopes."""
+    from trajopt.moving._mover_segments import MoverSegments
+
+    rng = np.random.default_rng(3)
+    movers = [
+        MovingObstacle.from_waypoints(
+            np.cumsum(rng.uniform(0.1, 2.0, n)) - 1.0,
+            rng.normal(size=(n, 2)),
+            radius=0.1,
+            headings=rng.normal(size=n),
+            vertices=SQUARE if n % 2 else None,
+        )
+        for n in (1, 2, 3, 6)
+    ]
+    seg = MoverSegments(movers)
+    for j, m in enumerate(movers):
+        t = np.concatenate([m.times, rng.uniform(-2.0, 12.0, 200), [m.times[-1] + 1.0]])
+        g = seg.row(np.full(t.shape, j), t)
+        pose = seg.at(g, t)
+        c, h = m.pose_at(t)
+        assert np.array_equal(pose[:, :2], c) and np.array_equal(pose[:, 2], h)
+        k = np.searchsorted(m.times, t, side="right") - 1
+        inside = (k >= 0) & (k < m.times.shape[0] - 1)
+        kk = np.clip(k, 0, max(m.times.shape[0] - 2, 0))
+        if m.times.shape[0] >= 2:
+            dt = m.times[kk + 1] - m.times[kk]
+            vel = (m.positions[kk + 1] - m.positions[kk]) / dt[:, None]
+            assert np.array_equal(seg.vel[g], np.where(inside[:, None], vel, 0.0))
+        else:
+            assert not np.any(seg.vel[g]) and not np.any(seg.turn[g])
+
+
+def test_movers_together_as_each_alone():
+    """The verdict of several movers is the first failing one's alone, else the least slack.
+
+    The movers share their first and last times (the same horizon, so the same covers).
+    """
+    traj = time_parameterize(_curve([0.6, -0.5, 0.4], 4.0), ROBOT)
+    rng = np.random.default_rng(5)
+    for _ in range(6):
+        movers = []
+        for i in range(5):
+            t_a = float(rng.uniform(0.5, 8.0))
+            p = rng.uniform([-1.0, -2.0], [5.0, 2.0])
+            v = rng.uniform(-0.6, 0.6, 2)
+            movers.append(
+                MovingObstacle.from_waypoints(
+                    [0.0, t_a, 12.0],
+                    [p, p + t_a * v, p + t_a * v + (12.0 - t_a) * v[::-1]],
+                    radius=float(rng.uniform(0.0, 0.2)),
+                    headings=[0.0, 0.5, 1.0],
+                    vertices=SQUARE if i % 3 else None,
+                    name=f"m{i}",
+                )
+            )
+        polys = [m for m in movers if m.vertices is not None]
+        alone = [certify_movers(traj, [m]) for m in polys]
+        together = certify_movers(traj, polys)
+        failing = [c for c in alone if not c.ok]
+        if failing:
+            assert together.verdict == failing[0].verdict
+            assert (together.mover, together.slack, together.witness_t) == (
+                failing[0].mover,
+                failing[0].slack,
+                failing[0].witness_t,
+            )
+        else:
+            least = min(alone, key=lambda c: (c.slack, c.mover, c.witness_t))
+            assert together.ok and together.slack == least.slack
+            assert together.intervals == sum(c.intervals for c in alone)

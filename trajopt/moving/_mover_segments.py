@@ -1,0 +1,74 @@
+"""The waypoint segments of several movers in one table: their rates and poses, gathered.
+
+:class:`MoverSegments` lets the moving-obstacle certificate
+(:func:`trajopt.moving.certify_movers`) evaluate every mover's pose and rates on many time
+intervals with one gather instead of one ``numpy.interp`` per mover.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from trajopt.moving._obstacle import MovingObstacle
+
+
+class MoverSegments:
+    """The movers' waypoint segments, all movers at once: their rates and poses.
+
+    Mover ``j``'s segment ``k`` (``-1`` before its first time, ``len(times) - 1`` from its
+    last) is row ``base[j] + k + 1``: its start time, the next waypoint time (``inf`` after
+    the last), its velocity (m/s) and turn rate (rad/s) (zero outside the times) and its
+    start pose. A pose at ``t`` on segment ``k`` is what ``numpy.interp`` gives, bit for
+    bit: the waypoint at its time, the first (last) waypoint before (from) the times, else
+    ``slope (t - t_k) + p_k``.
+    """
+
+    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
+        n_j = np.array([m.times.shape[0] for m in movers], dtype=np.int64)
+        self.n = n_j
+        self.base = np.cumsum(n_j + 1) - (n_j + 1)
+        rows = int(np.sum(n_j + 1))
+        self.start = np.full(rows, -np.inf)
+        self.next = np.full(rows, np.inf)
+        self.vel = np.zeros((rows, 2))
+        self.turn = np.zeros(rows)
+        self.pose = np.zeros((rows, 3))  # x, y, heading at the start (or the held waypoint)
+        self.moves = np.zeros(rows, dtype=bool)  # interpolated: t_k <= t < t_{k+1}
+        for j, m in enumerate(movers):
+            tk, n, r = m.times, int(n_j[j]), int(self.base[j])
+            wp = np.column_stack([m.positions, m.headings])
+            self.start[r + 1 : r + n + 1] = tk
+            self.next[r : r + n] = tk
+            self.pose[r] = wp[0]
+            self.pose[r + 1 : r + n + 1] = wp
+            if n >= 2:
+                dt = tk[1:] - tk[:-1]
+                self.vel[r + 1 : r + n] = (m.positions[1:] - m.positions[:-1]) / dt[:, None]
+                self.turn[r + 1 : r + n] = (m.headings[1:] - m.headings[:-1]) / dt
+                self.moves[r + 1 : r + n] = True
+
+    def row(self, j: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Return the row of mover ``j``'s segment holding each ``t`` (s), shape (n,).
+
+        The segment ``k`` with ``t_k <= t < t_{k+1}`` (``searchsorted`` right, less one).
+        """
+        out = np.empty(t.shape[0], dtype=np.int64)
+        for jj in np.unique(j):
+            sel = j == jj
+            r = int(self.base[jj])
+            n = int(self.n[jj])
+            out[sel] = r + np.searchsorted(self.start[r + 1 : r + n + 1], t[sel], side="right")
+        return out
+
+    def at(self, g: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Return the pose ``(x, y, heading)`` (m, m, rad), shape (n, 3), at times ``t`` (s) on rows ``g``.
+
+        ``g`` (n,) must be the rows holding ``t`` (:meth:`row`).
+        """
+        p = self.pose[g]
+        slope = np.column_stack([self.vel[g], self.turn[g]])
+        run = self.moves[g] & (t != self.start[g])
+        off = np.where(run, t - np.where(run, self.start[g], 0.0), 0.0)
+        return np.where(run[:, None], slope * off[:, None] + p, p)
