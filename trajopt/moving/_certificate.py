@@ -52,7 +52,7 @@ from trajopt.errors import InvalidInputError
 from trajopt.moving._disc_windows import track_knots
 from trajopt.moving._mover_segments import MoverSegments
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
+from trajopt.moving._robot_windows import robot_windows
 
 #: Bisection budget (intervals evaluated per mover) before the certificate gives up undecided.
 MAX_INTERVALS = 400_000
@@ -183,128 +183,10 @@ def shape_at(mover: MovingObstacle, t: np.ndarray) -> np.ndarray:
     return np.stack([x, y], axis=-1)
 
 
-def _profile_bounds(traj: Any) -> tuple[float, float]:
-    """``(V, A)``: bounds of the speed (m/s) and |acceleration| (m/s^2) of ``s(t)`` over its phases."""
-    pt, pv, pa, pj = traj.phase_t, traj.phase_v, traj.phase_a, traj.phase_j
-    dur = np.append(np.diff(pt), traj.duration - pt[-1]).clip(0.0)
-    a_end = pa + pj * dur
-    v_end = pv + dur * (pa + 0.5 * pj * dur)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.where(pj != 0.0, -pa / pj, -1.0)
-    inner = (tau > 0.0) & (tau < dur)
-    v_peak = np.where(inner, pv + tau * (pa + 0.5 * pj * tau), 0.0)
-    vmax = float(np.max(np.abs(np.concatenate([pv, v_end, v_peak, [traj.v_end]]))))
-    amax = float(np.max(np.abs(np.concatenate([pa, a_end]))))
-    return vmax, amax
-
-
-class _Curve:
-    """The robot on one timed curve, played from global time ``offset`` on its own clock."""
-
-    def __init__(self, traj: Any, offset: float) -> None:
-        self.traj, self.offset = traj, float(offset)
-        self.vmax, self.amax = _profile_bounds(traj)
-        # the heading turns at most kappa per metre: bounds per arc-length interval
-        self.s_edges, k = kappa_table_of(traj.path)
-        self.kmax = RangeMax(k)
-        self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
-        self.length = float(traj.length)
-        self.phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
-
-    def s_at(self, t: np.ndarray) -> np.ndarray:
-        """Return the arc length (m) at the curve's own times ``t`` (s): ``traj.motion``'s ``s``."""
-        pt, ps, pv, pa, pj = self.phases
-        dur = self.traj.duration
-        tt = np.clip(t, 0.0, dur)
-        k = np.clip(np.searchsorted(pt, tt, side="right") - 1, 0, pt.shape[0] - 1)
-        tau = tt - pt[k]
-        s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
-        return np.where(tt >= dur, self.length, np.clip(s, 0.0, self.length))
-
-    def box(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Return ``(x_min, x_max, y_min, y_max)`` (m): a box holding the robot's reference point during ``[t0, t1]``."""
-        s0 = self.s_at(t0 - self.offset)
-        s1 = self.s_at(t1 - self.offset)
-        return path_boxes_of(self.traj.path).box(s0, s1)
-
-    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
-        tr, off = self.traj, self.offset
-        s0 = self.s_at(t0 - off)
-        s1 = self.s_at(t1 - off)
-        x, y, th, sm, v = tr.pose(tm - off)
-        p = np.stack([x, y], axis=-1)
-        rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
-        last = self.s_edges.shape[0] - 2
-        i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
-        i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)
-        kap = self.kmax(i0, np.maximum(i0, i1))  # |kappa| on the arc [s0, s1] (1/m)
-        self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
-        self.c2_local = kap * self.vmax**2 + self.amax
-        return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
-
-
-class _Still:
-    """The robot standing still, played from global time ``offset`` (a turn in place).
-
-    Its position is fixed; its heading is sampled but not bounded between samples (a
-    footprint counts by its circumscribed disc there).
-    """
-
-    c2 = 0.0
-    c2_local = 0.0
-
-    def __init__(self, piece: Any, offset: float) -> None:
-        self.piece, self.offset = piece, float(offset)
-        smp = piece.sample(np.array([0.0]))
-        self.point = np.array([smp.x[0], smp.y[0]], dtype=float)
-
-    def box(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Return ``(x_min, x_max, y_min, y_max)`` (m): the point where it stands, for each interval."""
-        x, y = (np.full(t0.shape, float(c)) for c in self.point)
-        return x, x, y, y
-
-    def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Return the position (m), shape (n, 2), a zero bound and a zero velocity."""
-        n = tm.shape[0]
-        self.theta = np.asarray(self.piece.sample(tm - self.offset).theta, dtype=float)
-        self.turn = np.full(n, math.pi)
-        return np.broadcast_to(self.point, (n, 2)), np.zeros(n), np.zeros((n, 2))
-
-
 def ccw(v: np.ndarray) -> np.ndarray:
     """Return the polygon ``v`` (m, 2) counter-clockwise."""
     area2 = float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
     return v if area2 > 0.0 else v[::-1].copy()
-
-
-def _windows(traj: Any) -> list[tuple[Any, float, float]]:
-    """Return ``(motion model, t0, t1)`` (s) covering the trajectory's time, in order."""
-    if getattr(traj, "single_curve", False):
-        for name in ("motion", "sample", "duration", "robot", "phase_t", "phase_v", "path"):
-            if not hasattr(traj, name):
-                raise InvalidInputError(f"trajectory must be a trajopt.Trajectory (no {name!r})")
-        return [(_Curve(traj, 0.0), 0.0, float(traj.duration))]
-    pieces = getattr(traj, "pieces", None)
-    if pieces is None or not hasattr(traj, "piece_times"):
-        raise InvalidInputError(
-            "trajectory must be a trajopt.Trajectory or a TrajectoryChain of curves and motions "
-            f"at rest, got {type(traj).__name__}"
-        )
-    out = []
-    times = np.asarray(traj.piece_times, dtype=float)
-    for i, pc in enumerate(pieces):
-        a, b = float(times[i]), float(times[i + 1])
-        if pc.single_curve:
-            out.append((_Curve(pc, a - float(traj.starts[i])), a, b))
-        elif pc.turning or pc.steering_at_rest:
-            out.append((_Still(pc, a - float(traj.starts[i])), a, b))
-        else:
-            raise InvalidInputError(
-                f"the certificate covers curves and motions at rest, got a {type(pc).__name__} "
-                f"(piece {i})"
-            )
-    return out
 
 
 def check_movers(movers: Sequence[MovingObstacle] | None) -> tuple[MovingObstacle, ...]:
@@ -363,7 +245,7 @@ def certify_movers(
         raise InvalidInputError(
             f"trajectory must be a trajopt.Trajectory or TrajectoryChain, got {type(traj).__name__}"
         )
-    windows = _windows(traj)
+    windows = robot_windows(traj)
     r_rob = float(traj.robot.radius if robot_radius is None else robot_radius)
     footprint = traj.robot.footprint if robot_radius is None else None
     body = None if footprint is None else ccw(np.asarray(footprint.vertices, dtype=float))
@@ -377,6 +259,7 @@ def certify_movers(
     polygons = [m for m in movers if m.vertices is not None]
     best = (math.inf, "", 0.0)
     total = 0
+    pending = []  # the polygon movers' bisections, their far intervals not yet evaluated
     for model, a, b in windows:
         if discs and b > a:
             verdict, slack, who, wt, count = _certify_discs(model, discs, a, b, extra, tol, body)
@@ -385,12 +268,16 @@ def certify_movers(
                 return MoverCertificate(False, verdict, slack, who, wt, horizon, tol, total)
             best = min(best, (slack, who, wt))
         ones = polygons if b > a else list(movers)
-        for mover, (verdict, slack, wt, count) in zip(
-            ones, _certify_each(model, ones, a, b, extra, tol, body), strict=False
-        ):
+        bisection = _Bisection(model, ones, a, b, extra, tol, body)
+        for mover, (verdict, slack, wt, count) in zip(ones, bisection.results, strict=False):
             total += count
             if verdict != "clear":
                 return MoverCertificate(False, verdict, slack, mover.name, wt, horizon, tol, total)
+        pending.append((ones, bisection))
+    # the far intervals whose bound may be the least slack (or equal to it), evaluated
+    below = min([best[0]] + [float(np.min(bs.proven, initial=math.inf)) for _, bs in pending])
+    for ones, bisection in pending:
+        for mover, (slack, wt) in zip(ones, bisection.resolve(below), strict=False):
             best = min(best, (slack, mover.name, wt))
     return MoverCertificate(True, "clear", best[0], best[1], best[2], horizon, tol, total)
 
@@ -558,16 +445,8 @@ def _certify_discs(
     return "clear", proven, movers[proven_j].name if movers else "", proven_t, count
 
 
-def _certify_each(
-    model: Any,
-    movers: Sequence[MovingObstacle],
-    a: float,
-    b: float,
-    extra: float,
-    tol: float,
-    body: np.ndarray | None,
-) -> list[tuple[str, float, float, int]]:
-    """Bisect each mover's cover of ``[a, b]``: ``(verdict, slack, time, intervals)`` per mover.
+class _Bisection:
+    """Bisect each mover's cover of ``[a, b]``: ``results``, ``(verdict, slack, time, intervals)`` per mover.
 
     Each mover's intervals are halved until decided (first order; second order for a disc
     mover and a disc robot), in the order one mover at a time would take them (its own
@@ -578,47 +457,150 @@ def _certify_each(
     not clear are not certified (:func:`certify_movers` stops there): the list ends at it.
     ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
     a disc (whose radius is in ``extra``).
+
+    Far first intervals are set aside unevaluated: the gap between the box of the robot's
+    positions (the motion model's ``box_rho``) and the box of the mover's reference point (its
+    positions at both ends: it moves on a line), less the mover's reach, the robot's
+    ``rho_P`` bound (its arc), the mover's ``rho_M``, the limit at the end, the footprint's
+    reach and 1e-6 m against rounding, is a lower bound ``cheap`` of the interval's first
+    bound. Where ``cheap >= 0`` the interval is accepted at the first level (no violation
+    there, no halves), so only its bound, the mover's slack if it is the least, is missing:
+    :meth:`resolve` evaluates it when ``cheap`` is not above a known slack. A clear mover's
+    ``results`` slack is that of the intervals evaluated until then.
     """
-    nm = len(movers)
-    if nm == 0:
-        return []
-    t0, t1, mj = _covers(a, b, movers)
-    seg = MoverSegments(movers)
-    # an interval never straddles its mover's times: its midpoint is on the segment of its
-    # start, or on the next one when it falls on the next time (``searchsorted`` right)
-    g0 = seg.row(mj, t0)
-    reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
-    rad0 = np.array([m.radius for m in movers])
-    grow = np.array([m.growth for m in movers])
-    t_last = np.array([max(m.t_last, 0.0) for m in movers])
-    disc = np.array([m.vertices is None for m in movers])
-    sizes = np.array([m.shape_vertices.shape[0] for m in movers])
-    verts = {  # each vertex count's table of the movers' vertices (other movers: zeros)
-        int(size): np.stack(
-            [
-                m.shape_vertices if m.shape_vertices.shape[0] == size else np.zeros((size, 2))
-                for m in movers
-            ]
-        )
-        for size in np.unique(sizes)
-    }
-    reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
-    proven = np.full(nm, math.inf)
-    proven_t = np.zeros(nm)
-    counts = np.zeros(nm, dtype=np.int64)
-    result: list[tuple[str, float, float, int] | None] = [None] * nm
-    stop = nm  # the first mover not clear (those after it are not certified)
-    while t0.size:
-        counts += np.bincount(mj, minlength=nm)
-        over = np.flatnonzero(counts[:stop] > MAX_INTERVALS)
-        if over.size:
-            j = int(over[0])
-            result[j] = ("undecided", float(proven[j]), float(proven_t[j]), int(counts[j]))
-            stop = j
-            keep = mj < stop
-            t0, t1, mj, g0 = t0[keep], t1[keep], mj[keep], g0[keep]
+
+    def __init__(
+        self,
+        model: Any,
+        movers: Sequence[MovingObstacle],
+        a: float,
+        b: float,
+        extra: float,
+        tol: float,
+        body: np.ndarray | None,
+    ) -> None:
+        nm = len(movers)
+        self.model, self.extra, self.body, self.nm = model, extra, body, nm
+        self.results: list[tuple[str, float, float, int]] = []
+        self.proven = np.zeros(0)
+        if nm == 0:
+            return
+        t0, t1, mj = _covers(a, b, movers)
+        self.seg = seg = MoverSegments(movers)
+        # an interval never straddles its mover's times: its midpoint is on the segment of its
+        # start, or on the next one when it falls on the next time (``searchsorted`` right)
+        g0 = seg.row(mj, t0)
+        self.reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
+        self.rad0 = np.array([m.radius for m in movers])
+        self.grow = np.array([m.growth for m in movers])
+        self.t_last = np.array([max(m.t_last, 0.0) for m in movers])
+        self.disc = np.array([m.vertices is None for m in movers])
+        self.sizes = np.array([m.shape_vertices.shape[0] for m in movers])
+        self.verts = {  # each vertex count's table of the movers' vertices (others: zeros)
+            int(size): np.stack(
+                [
+                    m.shape_vertices if m.shape_vertices.shape[0] == size else np.zeros((size, 2))
+                    for m in movers
+                ]
+            )
+            for size in np.unique(self.sizes)
+        }
+        self.reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
+        # each first interval's place in its mover's cover (ties go to the first)
+        pos = np.arange(mj.shape[0]) - np.searchsorted(mj, mj, side="left")
+        cheap = self._cheap(t0, t1, mj, g0)
+        far = cheap >= 0.0
+        self.far = (t0[far], t1[far], mj[far], g0[far], pos[far], cheap[far])
+        near = ~far
+        t0, t1, mj, g0, pos = t0[near], t1[near], mj[near], g0[near], pos[near]
+        proven = np.full(nm, math.inf)
+        proven_t = np.zeros(nm)
+        proven_key = np.full((nm, 2), np.iinfo(np.int64).max)  # (level, place) of the least
+        counts = np.bincount(self.far[2], minlength=nm).astype(np.int64)
+        result: list[tuple[str, float, float, int] | None] = [None] * nm
+        stop = nm  # the first mover not clear (those after it are not certified)
+        level = 0
+        while t0.size or level == 0:
+            counts += np.bincount(mj, minlength=nm)
+            over = np.flatnonzero(counts[:stop] > MAX_INTERVALS)
+            if over.size:
+                j = int(over[0])
+                result[j] = ("undecided", math.inf, 0.0, int(counts[j]))
+                stop = j
+                keep = mj < stop
+                t0, t1, mj, g0, pos = t0[keep], t1[keep], mj[keep], g0[keep], pos[keep]
             if not t0.size:
                 break
+            lower, slack_mid, tm = self._bounds(t0, t1, mj, g0)
+            bad = slack_mid < -0.5 * tol
+            if np.any(bad):
+                # each mover's first smallest witness (its intervals are contiguous, in order)
+                order = np.lexsort((np.arange(bad.size), np.where(bad, slack_mid, np.inf), mj))
+                first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+                for i in first[bad[first]]:
+                    j = int(mj[i])
+                    if j < stop:
+                        result[j] = ("violated", float(slack_mid[i]), float(tm[i]), int(counts[j]))
+                        stop = j
+            done = lower >= -tol
+            if np.any(done):
+                order = np.lexsort((np.arange(done.size), np.where(done, lower, np.inf), mj))
+                first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+                i = first[done[first]]
+                j = mj[i]
+                better = lower[i] < proven[j]
+                i, j = i[better], j[better]
+                proven[j], proven_t[j] = lower[i], tm[i]
+                proven_key[j, 0] = level
+                proven_key[j, 1] = pos[i] if level == 0 else 0
+            split = ~done & (mj < stop)
+            a0, m0, b0, j0, gg = t0[split], tm[split], t1[split], mj[split], g0[split]
+            # each mover's left halves in order, then its right halves (as one mover alone)
+            order = np.argsort(np.concatenate([j0, j0]), kind="stable")
+            t0 = np.concatenate([a0, m0])[order]
+            t1 = np.concatenate([m0, b0])[order]
+            mj = np.concatenate([j0, j0])[order]
+            g0 = np.concatenate([gg, gg])[order]
+            pos = np.zeros(t0.shape[0], dtype=np.int64)
+            level += 1
+        self.proven, self.proven_t, self.proven_key = proven, proven_t, proven_key
+        self.stop = stop
+        for j in range(stop + 1 if stop < nm else nm):
+            res = result[j]
+            if res is None:
+                res = ("clear", float(proven[j]), float(proven_t[j]), int(counts[j]))
+            elif res[0] == "undecided":  # its slack: the least bound so far, far ones too
+                self.resolve(float(proven[j]), only=j)
+                res = ("undecided", float(self.proven[j]), float(self.proven_t[j]), res[3])
+            self.results.append(res)
+
+    def _cheap(self, t0: np.ndarray, t1: np.ndarray, mj: np.ndarray, g0: np.ndarray) -> np.ndarray:
+        """Return a lower bound (m) of each first interval's bound (class docstring)."""
+        seg = self.seg
+        x0, x1, y0, y1, rho_up = self.model.box_rho(t0, t1)
+        c0, c1 = seg.at(g0, t0), seg.at(g0, t1)
+        gx = np.maximum(
+            np.maximum(np.minimum(c0[:, 0], c1[:, 0]) - x1, x0 - np.maximum(c0[:, 0], c1[:, 0])),
+            0.0,
+        )
+        gy = np.maximum(
+            np.maximum(np.minimum(c0[:, 1], c1[:, 1]) - y1, y0 - np.maximum(c0[:, 1], c1[:, 1])),
+            0.0,
+        )
+        tm = 0.5 * (t0 + t1)
+        g = g0 + (tm >= seg.next[g0])
+        vel, w = seg.vel[g], seg.turn[g]
+        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + self.reach[mj] * np.abs(w)) * (0.5 * (t1 - t0))
+        lim_hi = self.extra + (self.rad0[mj] + self.grow[mj] * np.clip(t1, 0.0, self.t_last[mj]))
+        gap = np.hypot(gx, gy) - self.reach[mj] - self.reach_b
+        return gap - rho_up - rho_m - lim_hi - 1e-6
+
+    def _bounds(
+        self, t0: np.ndarray, t1: np.ndarray, mj: np.ndarray, g0: np.ndarray
+    ) -> tuple[np.ndarray, ...]:
+        """Return each interval's lower bound of the slack, slack at the middle and middle."""
+        model, seg, body, extra = self.model, self.seg, self.body, self.extra
+        reach_b, sizes = self.reach_b, self.sizes
         tm = 0.5 * (t0 + t1)
         h = 0.5 * (t1 - t0)
         uniq, inv = np.unique(t0 + 1j * t1, return_inverse=True)
@@ -628,9 +610,10 @@ def _certify_each(
         g = g0 + (tm >= seg.next[g0])
         vel, w = seg.vel[g], seg.turn[g]
         pose = seg.at(g, tm)
-        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + reach[mj] * np.abs(w)) * h
-        lim_mid = extra + (rad0[mj] + grow[mj] * np.clip(tm, 0.0, t_last[mj]))
-        lim_hi = extra + (rad0[mj] + grow[mj] * np.clip(t1, 0.0, t_last[mj]))
+        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + self.reach[mj] * np.abs(w)) * h
+        t_last = self.t_last[mj]
+        lim_mid = extra + (self.rad0[mj] + self.grow[mj] * np.clip(tm, 0.0, t_last))
+        lim_hi = extra + (self.rad0[mj] + self.grow[mj] * np.clip(t1, 0.0, t_last))
         dist_m = np.empty(tm.shape[0])
         if body is not None:
             theta, turn = model.theta[inv], model.turn[inv]
@@ -645,7 +628,7 @@ def _certify_each(
         dist_c = np.empty(tm.shape[0])
         for size in np.unique(sizes[mj]):
             sel = sizes[mj] == size
-            v = verts[int(size)][mj[sel]]
+            v = self.verts[int(size)][mj[sel]]
             ps = pose[sel]
             ch, sh = np.cos(ps[:, 2])[:, None], np.sin(ps[:, 2])[:, None]
             x = ps[:, 0:1] + ch * v[:, :, 0] - sh * v[:, :, 1]
@@ -660,45 +643,36 @@ def _certify_each(
             lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
         else:
             dist_m = dist_c
-            dm = disc[mj]
+            dm = self.disc[mj]
             if np.any(dm):  # second order: min over |tau| <= h of |D + w tau|, less curvature
                 d = p[dm] - pose[dm, :2]
                 c2 = np.broadcast_to(model.c2_local, u0.shape)[inv][dm]
                 lower2 = second_order_lower(d, v_rob[dm] - vel[dm], h[dm], c2) - lim_hi[dm]
                 lower[dm] = np.fmax(lower[dm], lower2)
-        slack_mid = dist_m - lim_mid
-        bad = slack_mid < -0.5 * tol
-        if np.any(bad):
-            # each mover's first smallest witness (its intervals are contiguous, in order)
-            order = np.lexsort((np.arange(bad.size), np.where(bad, slack_mid, np.inf), mj))
+        return lower, dist_m - lim_mid, tm
+
+    def resolve(self, below: float, only: int | None = None) -> list[tuple[float, float]]:
+        """Evaluate the far intervals whose ``cheap`` is at most ``below``; return ``(slack, time)`` per mover.
+
+        A far interval not evaluated has a bound above ``below``: it is not a slack at most
+        ``below``. ``only``: that mover's far intervals alone.
+        """
+        if self.nm == 0:
+            return []
+        t0, t1, mj, g0, pos, cheap = self.far
+        pick = (cheap <= below) & (mj <= self.stop)
+        if only is not None:
+            pick &= mj == only
+        if np.any(pick):
+            t0, t1, mj, g0, pos = t0[pick], t1[pick], mj[pick], g0[pick], pos[pick]
+            self.far = tuple(x[~pick] for x in self.far)
+            lower, _, tm = self._bounds(t0, t1, mj, g0)
+            # each mover's least (first place on a tie), against its least so far
+            order = np.lexsort((pos, lower, mj))
             first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
-            for i in first[bad[first]]:
+            for i in first:
                 j = int(mj[i])
-                if j < stop:
-                    result[j] = ("violated", float(slack_mid[i]), float(tm[i]), int(counts[j]))
-                    stop = j
-        done = lower >= -tol
-        if np.any(done):
-            order = np.lexsort((np.arange(done.size), np.where(done, lower, np.inf), mj))
-            first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
-            i = first[done[first]]
-            j = mj[i]
-            better = lower[i] < proven[j]
-            proven[j[better]], proven_t[j[better]] = lower[i][better], tm[i][better]
-        split = ~done & (mj < stop)
-        a0, m0, b0, j0, gg = t0[split], tm[split], t1[split], mj[split], g0[split]
-        # each mover's left halves in order, then its right halves (as one mover alone)
-        order = np.argsort(np.concatenate([j0, j0]), kind="stable")
-        t0 = np.concatenate([a0, m0])[order]
-        t1 = np.concatenate([m0, b0])[order]
-        mj = np.concatenate([j0, j0])[order]
-        g0 = np.concatenate([gg, gg])[order]
-    out = []
-    for j in range(stop + 1 if stop < nm else nm):
-        res = result[j]
-        out.append(
-            res
-            if res is not None
-            else ("clear", float(proven[j]), float(proven_t[j]), int(counts[j]))
-        )
-    return out
+                if (lower[i], 0, pos[i]) < (self.proven[j], *self.proven_key[j]):
+                    self.proven[j], self.proven_t[j] = lower[i], tm[i]
+                    self.proven_key[j] = (0, pos[i])
+        return [(float(self.proven[j]), float(self.proven_t[j])) for j in range(self.nm)]

@@ -224,3 +224,36 @@ def test_movers_together_as_each_alone():
             least = min(alone, key=lambda c: (c.slack, c.mover, c.witness_t))
             assert together.ok and together.slack == least.slack
             assert together.intervals == sum(c.intervals for c in alone)
+
+
+def test_far_intervals_set_aside_change_nothing(monkeypatch):
+    """Setting far intervals aside gives the certificate of evaluating every interval."""
+    from trajopt.moving import _certificate
+
+    traj = time_parameterize(_curve([0.8, -0.6, 0.5], 5.0), ROBOT)
+    rng = np.random.default_rng(11)
+    cases = []
+    for _ in range(8):
+        movers = []
+        for i in range(4):
+            p = rng.uniform([-2.0, -3.0], [7.0, 3.0])
+            v = rng.uniform(-0.5, 0.5, 2)
+            t_a = float(rng.uniform(0.5, 9.0))
+            movers.append(
+                MovingObstacle.from_waypoints(
+                    [0.0, t_a, 12.0],
+                    [p, p + t_a * v, p + t_a * v + (12.0 - t_a) * v[::-1]],
+                    radius=float(rng.uniform(0.0, 0.2)),
+                    headings=[0.0, 0.7, 1.4],
+                    vertices=SQUARE,
+                    name=f"m{i}",
+                )
+            )
+        cases.append(movers)
+    fast = [certify_movers(traj, m) for m in cases]
+    monkeypatch.setattr(
+        _certificate._Bisection, "_cheap", lambda self, t0, *_: np.full(t0.shape, -np.inf)
+    )
+    every = [certify_movers(traj, m) for m in cases]
+    assert fast == every
+    assert {c.verdict for c in every} == {"clear", "violated"}
