@@ -36,7 +36,11 @@ one evaluation of the robot whatever its size, so fewer, wider levels), in halve
 polygon mover. The splitting ends: once the bound's loss is below ``tol / 2`` an interval is
 either accepted or a witness. Before that, a disc mover's interval whose box of the robot's
 positions (:class:`._path_bounds.PathBoxes`) is farther from the box of the mover's centre than the largest
-limit is accepted at once, the gap less the limit its bound.
+limit is accepted at once, the gap less the limit its bound. The polygon movers are bisected
+together, each as it would be alone (the same intervals, bounds and verdict), the robot
+evaluated once per distinct interval; a first interval whose box gap bounds its first bound
+from below by at least 0 is accepted without its evaluation, which is made only when that
+bound could be the least slack reported (so that the slack is the same as evaluating it).
 """
 
 from __future__ import annotations
