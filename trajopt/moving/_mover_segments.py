@@ -36,18 +36,20 @@ class MoverSegments:
         self.turn = np.zeros(rows)
         self.pose = np.zeros((rows, 3))  # x, y, heading at the start (or the held waypoint)
         self.moves = np.zeros(rows, dtype=bool)  # interpolated: t_k <= t < t_{k+1}
-        for j, m in enumerate(movers):
-            tk, n, r = m.times, int(n_j[j]), int(self.base[j])
-            wp = np.column_stack([m.positions, m.headings])
-            self.start[r + 1 : r + n + 1] = tk
-            self.next[r : r + n] = tk
-            self.pose[r] = wp[0]
-            self.pose[r + 1 : r + n + 1] = wp
-            if n >= 2:
-                dt = tk[1:] - tk[:-1]
-                self.vel[r + 1 : r + n] = (m.positions[1:] - m.positions[:-1]) / dt[:, None]
-                self.turn[r + 1 : r + n] = (m.headings[1:] - m.headings[:-1]) / dt
-                self.moves[r + 1 : r + n] = True
+        own = np.repeat(np.arange(n_j.shape[0]), n_j)
+        tk = np.concatenate([m.times for m in movers])
+        pos = np.concatenate([m.positions for m in movers])
+        wp = np.column_stack([pos, np.concatenate([m.headings for m in movers])])
+        rows_wp = self.base[own] + 1 + (np.arange(tk.shape[0]) - (np.cumsum(n_j) - n_j)[own])
+        self.start[rows_wp] = tk
+        self.next[rows_wp - 1] = tk
+        self.pose[rows_wp] = wp
+        self.pose[self.base] = wp[np.cumsum(n_j) - n_j]
+        pair = np.flatnonzero(own[1:] == own[:-1])  # consecutive waypoints of one mover
+        dt = tk[pair + 1] - tk[pair]
+        self.vel[rows_wp[pair]] = (pos[pair + 1] - pos[pair]) / dt[:, None]
+        self.turn[rows_wp[pair]] = (wp[pair + 1, 2] - wp[pair, 2]) / dt
+        self.moves[rows_wp[pair]] = True
 
     def row(self, j: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Return the row of mover ``j``'s segment holding each ``t`` (s), shape (n,).
