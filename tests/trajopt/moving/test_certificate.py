@@ -251,9 +251,15 @@ def test_far_intervals_set_aside_change_nothing(monkeypatch):
             )
         cases.append(movers)
     fast = [certify_movers(traj, m) for m in cases]
+    monkeypatch.setattr(_certificate, "MAX_INTERVALS", 30)  # some give up undecided
+    fast_short = [certify_movers(traj, m) for m in cases]
     monkeypatch.setattr(
         _certificate._Bisection, "_cheap", lambda self, t0, *_: np.full(t0.shape, -np.inf)
     )
+    every_short = [certify_movers(traj, m) for m in cases]
+    monkeypatch.setattr(_certificate, "MAX_INTERVALS", 400_000)
     every = [certify_movers(traj, m) for m in cases]
     assert fast == every
     assert {c.verdict for c in every} == {"clear", "violated"}
+    assert fast_short == every_short
+    assert "undecided" in {c.verdict for c in every_short}
