@@ -78,20 +78,29 @@ def kappa_table_of(curve: Any) -> tuple[np.ndarray, np.ndarray]:
     Found by the object, else by its geometry (:func:`geometry_key`, its domain and length):
     a re-plan's kept rest is a new curve object of the same geometry.
     """
-    for i, (c, _, tab) in enumerate(_KAPPA_TABLES):
+    return _kept(_KAPPA_TABLES, curve, kappa_table)
+
+
+def _kept(cache: list, curve: Any, build: Any) -> Any:
+    """Return ``build(curve)`` from ``cache`` (found by the object, else by its geometry).
+
+    ``cache`` holds ``(curve, key, value)`` with the last used last; a miss builds the value
+    and keeps the :data:`_KAPPA_KEPT` most recent.
+    """
+    for i, (c, _, value) in enumerate(cache):
         if c is curve:
-            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
-            return tab
+            cache.append(cache.pop(i))
+            return value
     dom = getattr(curve, "domain", None)
     key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
-    for i, (_, k, tab) in enumerate(_KAPPA_TABLES):
+    for i, (_, k, value) in enumerate(cache):
         if k == key:
-            _KAPPA_TABLES.append(_KAPPA_TABLES.pop(i))
-            return tab
-    tab = kappa_table(curve)
-    _KAPPA_TABLES.append((curve, key, tab))
-    del _KAPPA_TABLES[:-_KAPPA_KEPT]
-    return tab
+            cache.append(cache.pop(i))
+            return value
+    value = build(curve)
+    cache.append((curve, key, value))
+    del cache[:-_KAPPA_KEPT]
+    return value
 
 
 def kappa_max(curve: Any) -> float:
@@ -134,20 +143,7 @@ _BOXES: list[tuple[Any, tuple[Any, ...], PathBoxes]] = []
 
 def path_boxes_of(curve: Any) -> PathBoxes:
     """Return :class:`PathBoxes` of ``curve``, reused as :func:`kappa_table_of` reuses its tables."""
-    for i, (c, _, boxes) in enumerate(_BOXES):
-        if c is curve:
-            _BOXES.append(_BOXES.pop(i))
-            return boxes
-    dom = getattr(curve, "domain", None)
-    key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
-    for i, (_, k, boxes) in enumerate(_BOXES):
-        if k == key:
-            _BOXES.append(_BOXES.pop(i))
-            return boxes
-    boxes = PathBoxes(curve)
-    _BOXES.append((curve, key, boxes))
-    del _BOXES[:-_KAPPA_KEPT]
-    return boxes
+    return _kept(_BOXES, curve, PathBoxes)
 
 
 class RangeMax:
