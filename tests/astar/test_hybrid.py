@@ -220,6 +220,47 @@ def test_arc_bulge_between_samples_is_caught():
     assert not arc_clear(free, x, y, th, k, s, 0.2, off, off, 0.0)
 
 
+def test_free_box_and_arc_in_box_against_brute_force():
+    """free_box against a scan of the boxes round each cell; arc_in_box (the search's quick
+    test) only says True where every point of the arc, sampled 0.01 cells apart, lies in a
+    free cell (and, exact mode, a safe one) and arc_clear agrees."""
+    from astar.hybrid_kernel import arc_clear, arc_in_box, free_box
+    from astar.reeds_shepp import advance
+
+    rng = np.random.default_rng(5)
+    shown = 0
+    for trial in range(24):
+        ny, nx = rng.integers(8, 22, size=2)
+        free = (rng.random((ny, nx)) > rng.uniform(0.0, 0.08)).astype(np.uint8)
+        exact = trial % 2 == 1
+        safe = (free & (rng.random((ny, nx)) > 0.03)).astype(np.uint8) if exact else free
+        ring = np.zeros((ny, nx), np.uint8)
+        k_max = 4
+        ok = free & safe if exact else free
+        for iy in range(ny):
+            for ix in range(nx):
+                want = -1
+                for k in range(k_max + 1):
+                    y0, y1, x0, x1 = iy - k, iy + k + 1, ix - k, ix + k + 1
+                    if y0 < 0 or x0 < 0 or y1 > ny or x1 > nx or not ok[y0:y1, x0:x1].all():
+                        break
+                    want = k
+                assert free_box(free, safe, exact, ring, ix, iy, k_max) == want
+        for _ in range(80):
+            x, y = rng.uniform(-0.5, nx - 0.5), rng.uniform(-0.5, ny - 0.5)
+            th, kappa = rng.uniform(-np.pi, np.pi), rng.choice([-1 / 3, 0.0, 1 / 3])
+            s = rng.uniform(-3.5, 3.5)
+            if not arc_in_box(free, safe, exact, ring, x, y, s, k_max):
+                continue
+            shown += 1
+            for q in np.linspace(0.0, 1.0, int(abs(s) / 0.01) + 2):
+                px, py, _ = advance(x, y, th, kappa, s * q)
+                assert ok[int(math.floor(py + 0.5)), int(math.floor(px + 0.5))]
+            # exact mode: a safe cell keeps any clearance, so r only matters off the box
+            assert arc_clear(free, x, y, th, kappa, s, 0.2, safe, 1 - free, 1.0 if exact else 0.0)
+    assert shown > 50  # the quick test does answer
+
+
 POCKET = """
 ##############################
 ####################...#######
