@@ -18,7 +18,9 @@ keeps the cheapest pose that reached it, and a closed state is never reopened.
   arc, the chord moved by the sagitta towards the bulge too (:func:`arc_clear`). A
   primitive that stays inside the box of free cells round its start pose's cell (each
   cell's box measured once per search, :func:`free_box`) passes without that traversal
-  (:func:`arc_in_box`): in open space, most of them.
+  (:func:`arc_in_box`): in open space, most of them. A primitive is tested only when its
+  end state is open and not yet reached more cheaply (a closed state is never reopened,
+  so the order of the checks changes nothing but their cost).
   In the footprint mode (``fp`` not empty) every pose of the arc also keeps the robot's
   convex footprint, rotated by the heading, ``fmargin`` cells from the raw map's occupied
   squares and inside the grid (:func:`footprint_arc_clear`).
@@ -225,8 +227,8 @@ class KernelCollision(NamedTuple):
         Footprint mode: :func:`astar.hybrid_modes.edge_next` of ``occ`` (the next cell of
         value 1 along each row; else 1 x 2).
     fdist : ndarray of float64, shape (ny, nx)
-        Footprint mode: a lower bound of every point's distance to the occupied squares
-        and the outside (:func:`footprint_discs_clear`; else 1 x 1).
+        Footprint mode: a lower bound of each cell centre's distance to the occupied
+        squares and the outside (:func:`footprint_discs_clear`; else 1 x 1).
     discs : ndarray of float64, shape (n, 3)
         Footprint mode: discs covering the footprint (``(0, 3)``: no quick test).
     pedges, pstarts, pboxes : ndarray
@@ -764,11 +766,12 @@ def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - c
 
     ``discs`` (``(n, 3)``: centre in the robot frame and radius, cells) cover the footprint
     (:func:`astar.hybrid_modes.footprint_discs`); ``fdist`` is a lower bound of the
-    distance from any point of a cell to the occupied squares and the grid's outside
-    (:func:`astar.hybrid_modes.clearance_bound`). When every disc's centre, at pose
-    ``(x, y, th)``, lies in the grid with a bound above its radius plus ``grow``, the grown
-    discs, hence the grown footprint, keep clear: True. False means "not shown": test
-    exactly (:func:`footprint_hit`). No discs: False.
+    distance from a cell's centre to the occupied squares and the grid's outside
+    (:func:`astar.hybrid_modes.clearance_bound`), so a point ``p`` of cell ``c`` keeps
+    ``fdist[c] - |p - c|``. When every disc's centre, at pose ``(x, y, th)``, lies in the
+    grid with that bound above its radius plus ``grow``, the grown discs, hence the grown
+    footprint, keep clear: True. False means "not shown": test exactly
+    (:func:`footprint_hit`). No discs: False.
     """
     n = discs.shape[0]
     if n == 0:
@@ -783,7 +786,9 @@ def footprint_discs_clear(fdist, discs, x, y, th, grow):  # pragma: no cover - c
         iy = int(math.floor(py + 0.5))
         if ix < 0 or iy < 0 or ix >= nx or iy >= ny:
             return False
-        if fdist[iy, ix] <= discs[i, 2] + grow:
+        d = fdist[iy, ix] - discs[i, 2] - grow
+        # |p - c| <= sqrt(1/2): measured only where it decides
+        if d <= 0.7072 and d <= math.hypot(px - ix, py - iy):
             return False
     return True
 
@@ -1325,6 +1330,28 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
             # drives it the other way when it runs back from the goal
             d = 1.0 if di == 0 else -1.0
             s = -d * plen if backward else d * plen
+            cx, cy, cth = advance(ux, uy, uth, kappa, s)
+            if not (-0.5 <= cx < nx - 0.5 and -0.5 <= cy < ny - 0.5):
+                continue  # off the grid (arc_clear would refuse it)
+            cost = plen
+            if di == 1:
+                cost *= reverse_penalty
+            if kappa != 0.0:
+                cost *= 1.0 + turn_penalty
+            if pu >= 0:
+                if curvatures[(pu % (2 * nc)) >> 1] != kappa:
+                    cost *= 1.0 + steer_penalty
+                if (pu & 1) != di:
+                    cost += cusp_penalty
+            cg = ug + cost
+            ck = state_key(
+                cx, cy, cth, nx, nbins, _near_ends(cx, cy, sx, sy, gx, gy, fine_r), fine_f
+            )
+            sl = _slot(keys, ck)
+            if keys[sl] == ck:
+                v = vals[sl]
+                if closed[v] != 0 or cg >= pg[v]:
+                    continue  # before the collision tests: they cost the most
             if not arc_in_box(free, safe, exact, ring, ux, uy, s, k_box) and not arc_clear(
                 free, ux, uy, uth, kappa, s, step, safe, occ, exact_r
             ):
@@ -1349,26 +1376,6 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                 fbuf,
             ):
                 continue
-            cx, cy, cth = advance(ux, uy, uth, kappa, s)
-            cost = plen
-            if di == 1:
-                cost *= reverse_penalty
-            if kappa != 0.0:
-                cost *= 1.0 + turn_penalty
-            if pu >= 0:
-                if curvatures[(pu % (2 * nc)) >> 1] != kappa:
-                    cost *= 1.0 + steer_penalty
-                if (pu & 1) != di:
-                    cost += cusp_penalty
-            cg = ug + cost
-            ck = state_key(
-                cx, cy, cth, nx, nbins, _near_ends(cx, cy, sx, sy, gx, gy, fine_r), fine_f
-            )
-            sl = _slot(keys, ck)
-            if keys[sl] == ck:
-                v = vals[sl]
-                if closed[v] != 0 or cg >= pg[v]:
-                    continue
             if nn == px.shape[0]:
                 px = _grow_f(px)
                 py = _grow_f(py)

@@ -123,14 +123,14 @@ def footprint_discs(fp: np.ndarray) -> np.ndarray:
 
 
 def clearance_bound(occ: np.ndarray) -> np.ndarray:
-    """Return a lower bound of the distance from any point of each cell to the obstacles.
+    """Return a lower bound of the distance from each cell's centre to the obstacles.
 
     The obstacles are the occupied squares of ``occ`` and the outside of the grid (a ring of
     occupied cells round it). With ``E`` the Euclidean distance between the cell's centre
     and the nearest obstacle cell's centre (:func:`scipy.ndimage.distance_transform_edt`),
-    a point ``p`` of the cell is at least ``E - sqrt(2)`` from every obstacle square (half a
-    diagonal from ``p`` to its cell's centre, half a diagonal from a square's centre to its
-    points).
+    the centre is at least ``E - sqrt(2) / 2`` from every obstacle square (half a diagonal
+    from a square's centre to its points), and a point ``p`` of the cell at least that
+    minus its distance to the centre (:func:`astar.hybrid_kernel.footprint_discs_clear`).
 
     Parameters
     ----------
@@ -140,7 +140,7 @@ def clearance_bound(occ: np.ndarray) -> np.ndarray:
     Returns
     -------
     ndarray of float64, shape (ny, nx)
-        The bound (cells); ``<= 0`` on and next to obstacles.
+        The bound (cells); ``<= 0`` on obstacles.
     """
     from scipy.ndimage import distance_transform_edt
 
@@ -148,7 +148,7 @@ def clearance_bound(occ: np.ndarray) -> np.ndarray:
     pad = np.zeros((occ.shape[0] + 2, occ.shape[1] + 2), dtype=bool)  # the ring: occupied
     pad[1:-1, 1:-1] = ~occ  # True where free: the distances to the nearest False
     e = distance_transform_edt(pad)[1:-1, 1:-1]
-    return np.ascontiguousarray(e - math.sqrt(2.0) - 1e-9)
+    return np.ascontiguousarray(e - math.sqrt(0.5) - 1e-9)
 
 
 def footprint_polygon(value: object) -> np.ndarray:
