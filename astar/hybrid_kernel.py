@@ -808,8 +808,10 @@ def _fp_clear(occ, onext, fsafe, fp, fdist, discs, poly, x, y, th, grow, buf):  
         return True
     if hit == -2 or poly[0].shape[0] == 0:
         return False
-    # footprint_hit left the body's vertices at this pose in buf[:, :2]
-    return body_distance(poly[0], poly[1], poly[2], buf[:, :2], np.inf) > grow
+    # footprint_hit left the body's vertices at this pose in buf[:, :2]; only whether the
+    # distance exceeds grow matters, so polygons farther than a hair above it are skipped
+    cap = grow + 1e-9 * (1.0 + grow)
+    return body_distance(poly[0], poly[1], poly[2], buf[:, :2], cap) > grow
 
 
 @njit(cache=True)
@@ -1280,9 +1282,10 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         if (lens[i] < 0.0) != ((pu & 1) == 1):
                             c += cusp_penalty
                         break
+            # the footprint first: on the parking suite it refused most shots in about half
+            # the time the free cells' traversal took (both must pass)
             if (
                 ug + c < best
-                and word_clear(free, ax, ay, ath, radius, kinds, lens, n, step, safe, occ, exact_r)
                 and (
                     not footprint
                     or footprint_word_clear(
@@ -1307,6 +1310,7 @@ def hybrid_kernel(query, motion, costs, limits, collision):  # pragma: no cover 
                         fbuf,
                     )
                 )
+                and word_clear(free, ax, ay, ath, radius, kinds, lens, n, step, safe, occ, exact_r)
             ):
                 if status != FOUND:
                     # keep searching for a cheaper path, at most as long again
