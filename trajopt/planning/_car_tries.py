@@ -86,7 +86,8 @@ FOOTPRINT_MIN_SLACK_CELLS = 0.05
 FOOTPRINT_COSTS = {"cusp_penalty": 0.5, "reverse_penalty": 1.2, "heuristic_weight": 2.5}
 #: Caps on the search of a car with a body at the default costs, before
 #: :data:`FOOTPRINT_COSTS`: expansions (the cap that decides, so that the path does not
-#: depend on the machine's load; about 0.25 s) and seconds.
+#: depend on the machine's load; 0.05-0.08 s of CPU on the parking suite's slow cases at
+#: 0.1 m) and seconds.
 FOOTPRINT_DEFAULT_EXPANSIONS = 5000
 FOOTPRINT_DEFAULT_BUDGET_S = 0.5
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
