@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
     goal_taken,
+    meets_head_on,
     no_way_past,
     parked_on_path,
     reroute,
@@ -84,6 +86,18 @@ class _Polyline:
         return np.stack([x, y], axis=-1)
 
 
+@dataclass(frozen=True)
+class _GridCurve(_Curve):
+    """A grid path (:class:`_Polyline`) as the quick proofs and their screen read a plan."""
+
+    def sample(self, t: np.ndarray) -> SimpleNamespace:
+        """Return the start, at rest, facing along the first segment (``t`` not read; shape (1,))."""
+        p = self.path.points
+        d = p[min(1, p.shape[0] - 1)] - p[0]
+        theta = float(np.arctan2(d[1], d[0]))
+        return SimpleNamespace(x=p[:1, 0], y=p[:1, 1], theta=np.array([theta]))
+
+
 class _GridBlocked(Exception):
     """Raised through the stages by :class:`_GridScreen` when the grid path is found blocked."""
 
@@ -103,9 +117,9 @@ class _GridScreen:
         if line.length <= 0.0:
             return
         r = float(self.robot.radius)
-        plan = _Curve(line, self.robot)
+        plan = _GridCurve(line, self.robot)
         blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
-        if blocked is None:
+        if blocked is None and meets_head_on(plan, self.movers, self.margin):
             blocked = no_way_past(plan, self.movers, self.margin - HEAD_ON_SLACK_RADII * r)
         if blocked is not None:
             raise _GridBlocked(blocked)
