@@ -199,8 +199,10 @@ def plan_among_movers(
     Before that, they screen the search's grid path (``request.check_grid_path``,
     :class:`_GridScreen`), before the corridor and the fit: with the margin less
     :data:`SCREEN_SLACK_RADII` robot radii for a parked mover and
-    :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past, since the curve fitted
-    round the grid path strays from it (up to 0.28 m measured). A grid path they find
+    :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past (run only where
+    :func:`trajopt.moving.meets_head_on` finds a mover coming along the grid path against
+    the robot), since the curve fitted round the grid path strays from it (up to 0.28 m
+    measured). A grid path they find
     blocked is re-routed at once, the static plan neither fitted nor timed. The finding is on
     the grid path, not a proof on the curve: when no re-route works the query is planned
     again without the screen (its curve, proofs and re-timing decide, the re-route's
