@@ -629,3 +629,60 @@ def test_random_movers_on_the_loop_never_violate(loop, movers):
         return
     assert dense_min(out, obs, dt=2e-3, margin=0.02)[0] >= -1e-6
     assert _static_clearance(out, grid, dt=0.02) >= out.robot.radius - 1e-6
+
+
+@pytest.mark.parametrize("seed", [0, 4])  # seed 0 with waits, 4 with a BlockedError
+def test_the_grid_path_screen_changes_no_plan_on_random_movers(loop, monkeypatch, seed):
+    """The screen against the plan without it (the screen made a no-op), on random movers of
+    the loop: a cart that drives in and stops near the short corridor, a walker coming
+    along it head-on, a mover that crosses it and leaves. Each query gives the same outcome
+    and, where a plan is returned, the same plan (the screen decides only when the static
+    plan is fitted)."""
+    import trajopt.planning._moving as among
+
+    _, planner = loop
+    rng = np.random.default_rng(seed)
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    scenes = []
+    for _ in range(3):
+        x = float(rng.uniform(3.0, 9.0))
+        off = float(rng.choice([0.0, rng.uniform(0.3, 0.6)]))
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, float(rng.uniform(1.0, 4.0))], [(x, 2.0), (x, 1.0 + off)], radius=0.25,
+                name="cart",
+            )
+        )  # fmt: skip
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, float(rng.uniform(12.0, 24.0))], [(11.0, 1.0 + off), (1.0, 1.0 + off)],
+                radius=float(rng.uniform(0.1, 0.25)), name="walker",
+            )
+        )  # fmt: skip
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 4.0, 8.0], [(x, 2.2), (x, 1.0), (x, 0.2)], radius=0.2, name="crossing"
+            )
+        )
+
+    def outcome(mover):
+        try:
+            return planner.plan(start, goal, moving_obstacles=[mover], mover_margin=0.02)
+        except BlockedError as exc:
+            return exc
+
+    with_screen = [outcome(m) for m in scenes]
+    monkeypatch.setattr(among._GridScreen, "__call__", lambda self, points: None)
+    without = [outcome(m) for m in scenes]
+    monkeypatch.undo()
+    early = [
+        not isinstance(a, BlockedError) and a.stats["moving"].get("blocked_on_grid_path")
+        for a in with_screen
+    ]
+    assert any(early) and not all(early)  # the screen found some, not all
+    for a, b in zip(with_screen, without, strict=True):
+        if isinstance(b, BlockedError):
+            assert isinstance(a, BlockedError) and str(a) == str(b)
+            continue
+        _same_plan(a, b)  # certified: the tests above check such plans independently
+        assert a.stats["moving"]["certificate"]["ok"]
