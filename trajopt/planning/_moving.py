@@ -55,10 +55,10 @@ class _Curve:
 #: path than the limit parks within the limit of the curve.
 SCREEN_SLACK_RADII = 2.0
 #: The screen runs :func:`trajopt.moving.no_way_past` with the margin less this many robot
-#: radii: a mover that comes along the path against the robot is near the grid path and the
-#: curve alike (it blocks both over the corridor's stretch it sweeps); a larger slack lets
-#: a mover on the curve miss the grid path's corners (0.28 m off it) and the screen find
-#: nothing.
+#: radii: smaller than the parked screen's, since a mover driving the curve strays from the
+#: grid path at its corners (up to 0.28 m) and the sweep needs it near every node it holds;
+#: measured on ``benchmarks/bench_moving_reroute.py``'s 30 head-on queries, half a radius
+#: finds all 30, one radius 18.
 HEAD_ON_SLACK_RADII = 0.5
 
 
@@ -75,9 +75,11 @@ class _Polyline:
         self.length = float(self.s[-1])
 
     def u_at_s(self, s: np.ndarray) -> np.ndarray:
+        """Return the parameter (m) at arc lengths ``s`` (m): ``s`` clipped to the length."""
         return np.clip(np.asarray(s, dtype=float), 0.0, self.length)
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
+        """Return the points (m, shape (..., 2)) at parameters ``u`` (m)."""
         u = np.asarray(u, dtype=float)
         if self.points.shape[0] == 1:
             return np.broadcast_to(self.points[0], (*u.shape, 2)).copy()
@@ -202,9 +204,8 @@ def plan_among_movers(
     :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past (run only where
     :func:`trajopt.moving.meets_head_on` finds a mover coming along the grid path against
     the robot), since the curve fitted round the grid path strays from it (up to 0.28 m
-    measured). A grid path they find
-    blocked is re-routed at once, the static plan neither fitted nor timed. The finding is on
-    the grid path, not a proof on the curve: when no re-route works the query is planned
+    measured). A grid path they find blocked is re-routed at once, the static plan neither
+    fitted nor timed. The finding is on the grid path, not a proof on the curve: when no re-route works the query is planned
     again without the screen (its curve, proofs and re-timing decide, the re-route's
     candidates tried again if the curve is blocked too), so the screen never turns a plan into
     a :class:`BlockedError`; a mover that stands on the goal for ever
