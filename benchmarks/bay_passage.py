@@ -18,7 +18,7 @@ distance to the polygons), never against a grid:
   ``--cell`` m and ``--cell-deg`` degrees already holds one reached with no more cusps),
   driving arcs of curvature ``-1/(1.05 R)``, 0 and ``1/(1.05 R)`` forwards and backwards,
   5, 10, 25 and 50 cm long (scaled by the car) and as long as they stay clear (up to
-  ``--longest`` m), each arc tested at 1 cm steps with its body ``--margin`` m from the
+  ``--longest`` m; none shorter than ``--shortest`` m), each arc tested at 1 cm steps with its body ``--margin`` m from the
   polygons (between two steps every body point moves at most ``1 cm (1 + r_c / (1.05 R))
   / 2``, under the default margin, so the whole arc is clear). Its order: the rotation made
   from the goal's heading towards ``--turn`` (counter-clockwise: ``ccw``) weighted
@@ -28,10 +28,15 @@ distance to the polygons), never against a grid:
   :func:`parking_cases.check_poses` at poses no body corner moves more than 1 cm between.
   A path it finds proves that a car path with that many cusps exists; it does not bound
   how few cusps a path needs.
+* **What if the planner had it** (``--plan RESOLUTION``, :func:`plan_with_escape`):
+  ``trajopt.plan`` on the case with one of its searches answered by a real search from the
+  start to the escape's end joined to the escape driven backwards in time, so that the
+  planner's own fits, certificates and timing run on such a manoeuvre.
 
 Run: ``python benchmarks/bay_passage.py [--car full] [--case 9] [--turn ccw|cw]
-[--rotation-weight 300] [--max-expansions 400000] [--no-escape]`` (the escape search of
-case 9 at the defaults: 0.5-1.5 min on a 2-core machine).
+[--rotation-weight 300] [--shortest 0.05] [--max-expansions 400000] [--no-escape]
+[--plan 0.1]`` (the escape search of case 9 at the defaults: 0.5-1.5 min on a 2-core
+machine).
 """
 
 from __future__ import annotations
@@ -154,6 +159,7 @@ def _search(
     rot_w,
     turn,
     max_exp,
+    shortest,
 ):  # pragma: no cover - compiled
     buf = np.empty((fp.shape[0], 2))
     cap = 4 * max_exp + 16
@@ -187,7 +193,7 @@ def _search(
                 )
                 for j in range(moves.shape[0] + 1):
                     s = moves[j] if j < moves.shape[0] else far
-                    if s > far or s < 0.5 * step or (j < moves.shape[0] and s == far):
+                    if s > far or s < shortest or (j < moves.shape[0] and s == far):
                         continue
                     x, y, t = _advance(xs[i], ys[i], ts[i], k, d * s)
                     key = (
@@ -227,12 +233,15 @@ def escape(
     cell_deg: float = 0.25,
     longest: float = 0.6,
     max_expansions: int = 400_000,
+    shortest: float = 0.0,
 ) -> dict:
     """Search an escape from the goal pose (module docstring); lengths in m for the full car.
 
     Returns a dict: ``found``, ``expanded``, ``seconds``, and when found ``cusps``,
     ``segments``, ``pieces`` (arcs after merging equal neighbours), ``length_m``,
-    ``end`` (the pose with room) and ``check`` (:func:`parking_cases.check_poses` of the path).
+    ``end`` (the pose with room), ``arcs`` (``(pieces, 5)``: per arc its start pose, curvature
+    and signed length, m, rad, 1/m, from the goal outwards) and ``check``
+    (:func:`parking_cases.check_poses` of the path).
     """
     s = case.car.scale
     car = case.car
@@ -244,7 +253,7 @@ def escape(
     out = _search(
         edges, starts, boxes, fp, np.array(case.goal, dtype=float), kmax, moves, longest * s,
         STEP_M * s, margin * s, room * s, cell * s, math.radians(cell_deg), rot_w, turn,
-        max_expansions,
+        max_expansions, max(shortest, 0.5 * STEP_M) * s,
     )  # fmt: skip
     seconds = time.perf_counter() - t0
     last, expanded = int(out[0]), int(out[1])
@@ -280,6 +289,7 @@ def escape(
         pieces=len(merged),
         length_m=float(sum(abs(a[4]) for a in merged)),
         end=tuple(float(v) for v in (xs[last], ys[last], ts[last])),
+        arcs=np.array(merged, dtype=float).reshape(-1, 5),
         check=pc.check_poses(fp, poses, case.polygons, 0.01 * s),
     )
     return res
@@ -300,7 +310,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cell", type=float, default=0.015, help="m, scaled")
     ap.add_argument("--cell-deg", type=float, default=0.25)
     ap.add_argument("--max-expansions", type=int, default=400_000)
+    ap.add_argument("--shortest", type=float, default=0.0, help="shortest arc (m, scaled)")
     ap.add_argument("--no-escape", action="store_true")
+    ap.add_argument(
+        "--plan",
+        type=float,
+        default=None,
+        metavar="RESOLUTION",
+        help="also run trajopt.plan with the escape as its search's answer (plan_with_escape)",
+    )
     args = ap.parse_args(argv)
     car = pc.CARS[args.car]
     case = pc.make_cases(car, args.case + 1, args.seed)[args.case]
@@ -335,6 +353,7 @@ def main(argv: list[str] | None = None) -> int:
         cell_deg=args.cell_deg,
         longest=args.longest,
         max_expansions=args.max_expansions,
+        shortest=args.shortest,
     )
     if not res["found"]:
         print(f"escape: none within {res['expanded']} expansions ({res['seconds']:.1f} s)")
@@ -348,7 +367,95 @@ def main(argv: list[str] | None = None) -> int:
         f"of {chk.poses} poses, least clearance {chk.min_clearance:.4f} m, largest corner step "
         f"{chk.max_corner_step * 1e3:.1f} mm"
     )
+    if args.plan is not None:
+        out = plan_with_escape(case, res["arcs"], args.plan)
+        print(out)
     return 0
+
+
+def plan_with_escape(case: pc.ParkingCase, arcs: np.ndarray, resolution: float) -> str:
+    """What if the planner's search returned the escape: ``trajopt.plan`` fits and times it.
+
+    ``trajopt.plan`` runs on the case's grid at ``resolution`` (m) with its tries as they are,
+    but for one: its first search at ``1.05 R`` on the radius grid (``footprint_min_slack``
+    given, no ``fine_radius``) is answered by :func:`astar.find_pose_path` from the start
+    to the escape's end pose, with that try's own arguments, followed by the escape driven
+    backwards in time (each arc from its end, its length negated), as one
+    :class:`astar.PosePath` (:func:`astar.hybrid_shortcut.resample`). The plan's budget
+    (``_car_tries.CAR_BUDGET_S``) is lifted. Everything after the search is the planner's:
+    the fits of every segment, their certificates, the timing; the trajectory is then
+    checked by :func:`parking_cases.check_trajectory`. Returns a line of text.
+    """
+    import astar
+    import trajopt
+    import trajopt.planning._car_tries as tries
+    from astar.hybrid_shortcut import resample
+    from astar.reeds_shepp import advance
+
+    car = case.car
+    grid = case.grid(resolution)
+    ox, oy = grid.origin
+    back = []  # the escape driven backwards in time, in the search's cells (map-local)
+    for x, y, th, k, ln in arcs[::-1]:
+        ex, ey, eth = advance.py_func(x, y, th, k, ln)
+        back.append(
+            [
+                (ex - ox) / resolution - 0.5,
+                (ey - oy) / resolution - 0.5,
+                eth,
+                k * resolution,
+                -ln / resolution,
+            ]
+        )
+    back_arr = np.array(back)
+    search = astar.find_pose_path
+    used = {"connection": None}
+    r_tight = 1.05 * car.turning_radius / resolution
+
+    def answered(grid_, start, goal, **kw):
+        tight = kw.get("footprint_min_slack") is not None and "fine_radius" not in kw
+        if used["connection"] is None and tight and abs(kw["turning_radius"] - r_tight) < 1e-9:
+            first = search(grid_, start, tuple(back_arr[0, :3]), **kw)
+            used["connection"] = first.cusps
+            b = back_arr.copy()
+            b[:, 2] += 2.0 * math.pi * round((first.poses[-1, 2] - b[0, 2]) / (2.0 * math.pi))
+            end_th = float(advance.py_func(*b[-1])[2])
+            gth = goal[2] + 2.0 * math.pi * round((end_th - goal[2]) / (2.0 * math.pi))
+            arrays = resample(
+                np.vstack([np.asarray(first.pieces), b]), 0.5, (goal[0], goal[1], gth)
+            )
+            return astar.PosePath(*arrays, kw["turning_radius"], dict(first.stats))
+        return search(grid_, start, goal, **kw)
+
+    budget = tries.CAR_BUDGET_S
+    tries.astar.find_pose_path = answered
+    tries.CAR_BUDGET_S = math.inf
+    t0 = time.perf_counter()
+    try:
+        traj = trajopt.plan(
+            grid,
+            case.start[:2],
+            case.goal[:2],
+            car.robot(),
+            start_heading=case.start[2],
+            goal_heading=case.goal[2],
+        )
+    except trajopt.TrajoptError as exc:
+        return f"plan: {type(exc).__name__} after {time.perf_counter() - t0:.1f} s: {exc}"
+    finally:
+        tries.astar.find_pose_path = search
+        tries.CAR_BUDGET_S = budget
+    seconds = time.perf_counter() - t0
+    st = traj.stats
+    stages = ", ".join(f"{k} {v:.2f}" for k, v in st["stages_s"].items())
+    chk = pc.check_trajectory(traj, car.body(), case.polygons)
+    return (
+        f"plan ({resolution} m grid): {seconds:.1f} s, {st['car']['cusps']} cusps, "
+        f"{st['car']['segments']} fitted segments (the connection {used['connection']} cusps), "
+        f"stages s: {stages}; manoeuvre {float(traj.duration):.0f} s; exact check: "
+        f"{chk.overlaps} overlapping of {chk.poses} poses, least clearance "
+        f"{chk.min_clearance * 1e3:.1f} mm"
+    )
 
 
 if __name__ == "__main__":
