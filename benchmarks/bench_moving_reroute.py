@@ -18,18 +18,22 @@ The ratio is each query's time with the mover over its plain plan's; the issue's
 re-route within 2x a plain plan. ``reroute ms`` is the share after the re-timing along the
 static path was found blocked (``stats["moving"]["reroute_time_s"]``: marking the map,
 planning and re-timing the new route), and ``rr ratio`` its ratio to the plain plan; the
-rest is the static plan and the proof that it is blocked. ``proof ms`` is the quick proofs
-the planner runs on the static plan before re-routing (:func:`trajopt.moving.parked_on_path`,
-then :func:`trajopt.moving.no_way_past` when it finds nothing), timed here on the same static
-plan; ``raise ms`` (``trapped``) is the time from that proof to the :class:`BlockedError`:
+rest is the static plan (its search alone where the screen of its grid path finds it
+blocked) and the proof that it is blocked. ``proof ms`` is the quick proofs on the static
+plan (:func:`trajopt.moving.parked_on_path`, then :func:`trajopt.moving.no_way_past` when it
+finds nothing), timed here on the same static plan (the planner runs them on the grid path
+first, with a slack, and on the curve when they find nothing there); ``raise ms`` (``trapped``) is the time from that proof to the :class:`BlockedError`:
 the query's time less its plain plan's and the proof's (a difference of wall times, so
-noisy). ``cpu ms`` is the query's CPU time (``time.process_time``). The machine is shared:
+noisy; negative where the screen of the grid path skips the static plan's fit, the proof's
+time on the curve being that of a plan not made). ``cpu ms`` is the query's CPU time (``time.process_time``). The machine is shared:
 times are noisy.
 
 A second table splits the re-routes' wall time (medians, ms; ``x plain``: each part over the
 query's plain plan): ``static`` (the static plan and the proof that it is blocked: the
 query's time less ``reroute ms``; the timing is skipped where the proof holds on the curve,
-``stats["moving"]["blocked_before_timing"]``, counted in ``early``), ``leg`` (the
+``stats["moving"]["blocked_before_timing"]``, counted in ``early``; the static plan is not
+fitted either where the screen of its grid path finds it blocked,
+``stats["moving"]["blocked_on_grid_path"]``, counted in ``grid``), ``leg`` (the
 returned route's own plan, its ``stats["stages_s"]``: ``search``, ``smooth`` with the
 corridor, ``timing``), ``retime`` (its re-timing and certificate for the movers,
 ``stats["moving"]["time_s"]``) and ``other`` (the rest of ``reroute ms``: marking the map,
@@ -157,6 +161,7 @@ def split(out, took: float, plain: float) -> dict[str, float]:
     out_ms = {k: 1e3 * v for k, v in parts.items()}
     out_ms.update({f"x {k}": v / plain for k, v in parts.items() if k in PARTS_X})
     out_ms["early"] = float(bool(mv.get("blocked_before_timing")))
+    out_ms["grid"] = float(bool(mv.get("blocked_on_grid_path")))
     return out_ms
 
 
@@ -171,7 +176,7 @@ def print_split(split_rows) -> None:
     keys = ("static", "search", "smooth", "timing", "leg", "retime", "other")
     print()
     print(
-        f"{'re-routes: ms':18s} {'kind':8s} {'n':>3s} {'early':>5s} "
+        f"{'re-routes: ms':18s} {'kind':8s} {'n':>3s} {'early':>5s} {'grid':>4s} "
         + " ".join(f"{k:>7s}" for k in keys)
         + " "
         + " ".join(f"{'x ' + k:>8s}" for k in PARTS_X)
@@ -180,6 +185,7 @@ def print_split(split_rows) -> None:
         n = len(parts["leg"])
         print(
             f"{name:18s} {kind:8s} {n:3d} {int(sum(parts['early'])):5d} "
+            f"{int(sum(parts['grid'])):4d} "
             + " ".join(f"{statistics.median(parts[k]):7.1f}" for k in keys)
             + " "
             + " ".join(f"{statistics.median(parts['x ' + k]):8.2f}" for k in PARTS_X)

@@ -125,6 +125,9 @@ def plan_disc(
         q.path = grid_path
         if path_check is not None:
             q.path, q.inflated = path_check(caches, q)
+    if request.check_grid_path is not None and footprint is None and path_check is None:
+        pts = np.asarray(caches.grid.cell_to_world(q.path.cells), dtype=float).reshape(-1, 2)
+        request.check_grid_path(np.concatenate([q.start[None, :], pts[1:-1], q.goal[None, :]]))
     smooth = None
     try:
         smooth = _smooth(options, caches.grid, q)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
     goal_taken,
+    meets_head_on,
     no_way_past,
     parked_on_path,
     reroute,
@@ -44,6 +46,85 @@ class _Curve:
     @property
     def length(self) -> float:
         return float(self.path.length)
+
+
+#: The grid path screen (:class:`_GridScreen`) runs :func:`trajopt.moving.parked_on_path`
+#: with the margin less this many robot radii: the search's grid path strays from the
+#: certified curve fitted round it by up to 0.28 m (1.7 radii of 0.165 m; measured on 90
+#: random queries on the shared maps), so a mover that parks this much closer to the grid
+#: path than the limit parks within the limit of the curve.
+SCREEN_SLACK_RADII = 2.0
+#: The screen runs :func:`trajopt.moving.no_way_past` with the margin less this many robot
+#: radii: smaller than the parked screen's, since a mover driving the curve strays from the
+#: grid path at its corners (up to 0.28 m) and the sweep needs it near every node it holds;
+#: measured on ``benchmarks/bench_moving_reroute.py``'s 30 head-on queries, half a radius
+#: finds all 30, one radius 18.
+HEAD_ON_SLACK_RADII = 0.5
+
+
+class _Polyline:
+    """A polyline as the quick proofs read a curve: arc length is its parameter (m)."""
+
+    def __init__(self, points: np.ndarray):
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        keep = np.ones(pts.shape[0], dtype=bool)
+        keep[1:] = np.any(pts[1:] != pts[:-1], axis=1)  # no zero-length segment
+        self.points = pts[keep]
+        seg = np.hypot(*np.diff(self.points, axis=0).T)
+        self.s = np.concatenate([[0.0], np.cumsum(seg)])
+        self.length = float(self.s[-1])
+
+    def u_at_s(self, s: np.ndarray) -> np.ndarray:
+        """Return the parameter (m) at arc lengths ``s`` (m): ``s`` clipped to the length."""
+        return np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        """Return the points (m, shape (..., 2)) at parameters ``u`` (m)."""
+        u = np.asarray(u, dtype=float)
+        if self.points.shape[0] == 1:
+            return np.broadcast_to(self.points[0], (*u.shape, 2)).copy()
+        x = np.interp(u, self.s, self.points[:, 0])
+        y = np.interp(u, self.s, self.points[:, 1])
+        return np.stack([x, y], axis=-1)
+
+
+@dataclass(frozen=True)
+class _GridCurve(_Curve):
+    """A grid path (:class:`_Polyline`) as the quick proofs and their screen read a plan."""
+
+    def sample(self, t: np.ndarray) -> SimpleNamespace:
+        """Return the start, at rest, facing along the first segment (``t`` not read; shape (1,))."""
+        p = self.path.points
+        d = p[min(1, p.shape[0] - 1)] - p[0]
+        theta = float(np.arctan2(d[1], d[0]))
+        return SimpleNamespace(x=p[:1, 0], y=p[:1, 1], theta=np.array([theta]))
+
+
+class _GridBlocked(Exception):
+    """Raised through the stages by :class:`_GridScreen` when the grid path is found blocked."""
+
+    def __init__(self, blocked: BlockedError):
+        super().__init__(str(blocked))
+        self.blocked = blocked
+
+
+class _GridScreen:
+    """``request.check_grid_path`` of a plan among movers: the quick proofs on the grid path."""
+
+    def __init__(self, movers: tuple[MovingObstacle, ...], margin: float, robot: Robot):
+        self.movers, self.margin, self.robot = movers, margin, robot
+
+    def __call__(self, points: np.ndarray) -> None:
+        line = _Polyline(points)
+        if line.length <= 0.0:
+            return
+        r = float(self.robot.radius)
+        plan = _GridCurve(line, self.robot)
+        blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
+        if blocked is None and meets_head_on(plan, self.movers, self.margin):
+            blocked = no_way_past(plan, self.movers, self.margin - HEAD_ON_SLACK_RADII * r)
+        if blocked is not None:
+            raise _GridBlocked(blocked)
 
 
 class _PathBlocked(Exception):
@@ -117,6 +198,21 @@ def plan_among_movers(
     and a path they prove blocked is re-routed at once (:func:`trajopt.moving.reroute`)
     without timing it.
 
+    Before that, they screen the search's grid path (``request.check_grid_path``,
+    :class:`_GridScreen`), before the corridor and the fit: with the margin less
+    :data:`SCREEN_SLACK_RADII` robot radii for a parked mover and
+    :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past (run only where
+    :func:`trajopt.moving.meets_head_on` finds a mover coming along the grid path against
+    the robot), since the curve fitted round the grid path strays from it (up to 0.28 m
+    measured). A grid path they find blocked is re-routed at once, the static plan neither
+    fitted nor timed. The finding is on the grid path, not a proof on the curve: when no re-route works the query is planned
+    again without the screen (its curve, proofs and re-timing decide, the re-route's
+    candidates tried again if the curve is blocked too), so the screen never turns a plan into
+    a :class:`BlockedError`; a mover that stands on the goal for ever
+    (:func:`trajopt.moving.goal_taken`) ends every plan, and its error is raised at once. A
+    curve that a re-timing would have got past is re-routed where the screen is wrong: the
+    result is certified all the same (every candidate is), only not the static path.
+
     Parameters
     ----------
     movers : tuple of MovingObstacle
@@ -134,25 +230,62 @@ def plan_among_movers(
     -------
     PlanResult
         As :func:`plan_for_movers`; a re-route's ``stats["moving"]["blocked_before_timing"]``
-        tells whether the static plan was proved blocked before its timing.
+        tells whether the static plan was proved blocked before its timing, and
+        ``stats["moving"]["blocked_on_grid_path"]`` whether the screen of its grid path
+        found it (the static plan then neither fitted nor timed).
     """
     proof = None
-    asked = request
+    asked = screened = request
     if _one_curve(options.robot, request):
         proof = _CurveProof(movers, margin, options.robot)
         asked = dataclasses.replace(request, check_curve=proof)
+        screened = dataclasses.replace(
+            asked, check_grid_path=_GridScreen(movers, margin, options.robot)
+        )
     try:
-        out = run_query(options, caches, asked)
+        try:
+            out = run_query(options, caches, screened)
+        except _GridBlocked as found:
+            try:
+                return _reroute_early(found.blocked, movers, margin, options, caches, request)
+            except BlockedError:
+                p1 = np.asarray(request.goal, dtype=float).reshape(2)
+                limit = float(options.robot.inscribed_radius) + margin
+                if goal_taken(movers, p1, limit) is not None:
+                    raise  # every plan ends where a mover stands for ever
+            out = run_query(options, caches, asked)  # the curve and its own proofs decide
     except _PathBlocked as stop:
         p0, p1 = _curve_ends(stop.curve)
         out = _reroute(
             p0, p1, options.robot, movers, margin, stop.blocked, options, caches, request
         )
         out.stats["moving"]["blocked_before_timing"] = True
+        out.stats["moving"]["blocked_on_grid_path"] = False
         return out
     return plan_for_movers(
         out, movers, margin, options, caches, request, proved=proof is not None and proof.ran
     )
+
+
+def _reroute_early(
+    blocked: BlockedError,
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+) -> PlanResult:
+    """Re-route the query whose grid path the quick proofs found blocked (``blocked``).
+
+    :func:`trajopt.moving.reroute` from the query's ends, as for a blocked curve; raises its
+    :class:`BlockedError` when no candidate works.
+    """
+    p0 = np.asarray(request.start, dtype=float).reshape(2)
+    p1 = np.asarray(request.goal, dtype=float).reshape(2)
+    out = _reroute(p0, p1, options.robot, movers, margin, blocked, options, caches, request)
+    out.stats["moving"]["blocked_before_timing"] = True
+    out.stats["moving"]["blocked_on_grid_path"] = True
+    return out
 
 
 def plan_from_stop(

@@ -381,6 +381,14 @@ class PlanRequest:
         ends the query. A plan among movers proves there that its path is blocked, before
         paying for the timing (:func:`~trajopt.planning.plan_among_movers`). Default
         ``None``: nothing is called. Not part of the request's equality.
+    check_grid_path : callable or None
+        ``check_grid_path(points)``: called by the same stages on the search's grid path
+        (its cell centres from the start point to the goal point, m, shape (k, 2), the
+        exact ends in place of their cells' centres) before the corridor and the fit;
+        whatever it raises ends the query. A plan among movers screens there for a mover
+        that blocks the path, before paying for the fit
+        (:func:`~trajopt.planning.plan_among_movers`). Default ``None``. Not part of the
+        request's equality.
     """
 
     start: Sequence[float] | State
@@ -394,6 +402,7 @@ class PlanRequest:
     start_steer: float = 0.0
     goal_steer: float | None = None
     check_curve: Callable[[Any], None] | None = field(default=None, compare=False)
+    check_grid_path: Callable[[np.ndarray], None] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "start_heading", heading("start_heading", self.start_heading))

@@ -314,11 +314,104 @@ def test_proofs_before_the_timing_give_the_plan_of_the_proofs_after_it(loop, kin
     if kind == "passes":
         assert early.stats["moving"]["route"] == "retimed"
         assert "blocked_before_timing" not in early.stats["moving"]
-    else:  # the quick proofs hold on the curve: its timing was skipped
+    else:  # the screen of the grid path found it: neither fitted nor timed
         assert early.stats["moving"]["route"] == "rerouted"
         assert early.stats["moving"]["blocked_before_timing"] is True
+        assert early.stats["moving"]["blocked_on_grid_path"] is True
         assert late.stats["moving"]["blocked_before_timing"] is False
         _check(early, movers, grid, 0.02)
+
+
+def test_check_grid_path_sees_the_search_grid_path(loop):
+    """``PlanRequest.check_grid_path``: called once, before the fit, on the grid path's cell
+    centres with the exact ends in place of their cells'."""
+    from trajopt.planning import PlanRequest, run_query
+
+    grid, planner = loop
+    start, goal = (1.01, 0.98), (11.0, 1.02)
+    seen = []
+    request = PlanRequest(start, goal, check_grid_path=seen.append)
+    out = run_query(planner.options, planner.caches, request)
+    assert len(seen) == 1 and request == PlanRequest(start, goal)
+    cells = np.asarray(out.steps.grid_path.cells)
+    centres = (cells + 0.5) * RES  # origin (0, 0)
+    assert seen[0].shape == centres.shape
+    assert np.allclose(seen[0][1:-1], centres[1:-1], atol=1e-12)
+    assert np.array_equal(seen[0][0], start) and np.array_equal(seen[0][-1], goal)
+    order = []
+    request = PlanRequest(
+        start, goal, check_grid_path=lambda p: order.append("grid"), check_curve=order.append
+    )
+    run_query(planner.options, planner.caches, request)
+    assert order[0] == "grid" and len(order) == 2
+
+    class Stop(Exception):
+        pass
+
+    def refuse(points):
+        raise Stop
+
+    with pytest.raises(Stop):
+        run_query(planner.options, planner.caches, PlanRequest(start, goal, check_grid_path=refuse))
+
+
+def test_a_grid_path_screen_that_finds_no_re_route_plans_as_without_it(loop, monkeypatch):
+    """When no re-route from the screen's finding works, the query is planned as without the
+    screen: here the finding is made up (the cart passes; a re-timing waits for it), and the
+    re-route from it is refused, so the plan is the re-timed static plan all the same."""
+    import trajopt.planning._moving as among
+
+    grid, planner = loop
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 6.0, 9.0], [(6.0, 2.0), (6.0, 1.0), (6.0, 2.0)], radius=0.25, name="cart"
+    )
+    calls = []
+
+    def wrong(self, points):
+        calls.append(points.shape)
+        raise among._GridBlocked(BlockedError("made up", mover="cart", t=1.0))
+
+    def refused(blocked, *args):
+        calls.append("reroute")
+        raise BlockedError("no re-route", mover="cart", t=1.0)
+
+    monkeypatch.setattr(among._GridScreen, "__call__", wrong)
+    monkeypatch.setattr(among, "_reroute_early", refused)
+    out = planner.plan(start, goal, moving_obstacles=[cart], mover_margin=0.02)
+    assert calls[1] == "reroute" and len(calls) == 2  # the second query runs without the screen
+    monkeypatch.undo()
+    _same_plan(out, _after_timing(planner, start, goal, [cart], 0.02))
+    assert out.stats["moving"]["route"] == "retimed"
+    _check(out, [cart], grid, 0.02)
+
+
+def test_a_blocked_corridor_raises_as_without_the_screen(monkeypatch):
+    """The screen finds the only corridor blocked, no re-route works: the query is planned again
+    and raises the error the plan without the screen raises."""
+    import trajopt.planning._moving as among
+
+    found = []
+    early_reroute = among._reroute_early
+
+    def spy(blocked, *args):
+        found.append(blocked.mover)
+        return early_reroute(blocked, *args)
+
+    monkeypatch.setattr(among, "_reroute_early", spy)
+    grid = _grid((60, 240), [(0.5, 11.5, 1.0, 2.0)])
+    planner = trajopt.Planner(grid, trajopt.Robot())
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 4.0], [(9.0, 1.5), (6.0, 1.5)], radius=0.25, name="cart"
+    )
+    start, goal = (1.0, 1.5), (11.0, 1.5)
+    with pytest.raises(BlockedError) as early:
+        planner.plan(start, goal, moving_obstacles=[cart], mover_margin=0.02)
+    with pytest.raises(BlockedError) as late:
+        _after_timing(planner, start, goal, [cart], 0.02)
+    assert found == ["cart"]  # the screen found it
+    assert str(early.value) == str(late.value)
+    assert (early.value.mover, early.value.t) == (late.value.mover, late.value.t)
 
 
 def test_check_curve_sees_the_curve_the_plan_is_timed_on(loop):
@@ -536,3 +629,60 @@ def test_random_movers_on_the_loop_never_violate(loop, movers):
         return
     assert dense_min(out, obs, dt=2e-3, margin=0.02)[0] >= -1e-6
     assert _static_clearance(out, grid, dt=0.02) >= out.robot.radius - 1e-6
+
+
+@pytest.mark.parametrize("seed", [0, 4])  # seed 0 with waits, 4 with a BlockedError
+def test_the_grid_path_screen_changes_no_plan_on_random_movers(loop, monkeypatch, seed):
+    """The screen against the plan without it (the screen made a no-op), on random movers of
+    the loop: a cart that drives in and stops near the short corridor, a walker coming
+    along it head-on, a mover that crosses it and leaves. Each query gives the same outcome
+    and, where a plan is returned, the same plan (the screen decides only when the static
+    plan is fitted)."""
+    import trajopt.planning._moving as among
+
+    _, planner = loop
+    rng = np.random.default_rng(seed)
+    start, goal = (1.0, 1.0), (11.0, 1.0)
+    scenes = []
+    for _ in range(3):
+        x = float(rng.uniform(3.0, 9.0))
+        off = float(rng.choice([0.0, rng.uniform(0.3, 0.6)]))
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, float(rng.uniform(1.0, 4.0))], [(x, 2.0), (x, 1.0 + off)], radius=0.25,
+                name="cart",
+            )
+        )  # fmt: skip
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, float(rng.uniform(12.0, 24.0))], [(11.0, 1.0 + off), (1.0, 1.0 + off)],
+                radius=float(rng.uniform(0.1, 0.25)), name="walker",
+            )
+        )  # fmt: skip
+        scenes.append(
+            trajopt.MovingObstacle.from_waypoints(
+                [0.0, 4.0, 8.0], [(x, 2.2), (x, 1.0), (x, 0.2)], radius=0.2, name="crossing"
+            )
+        )
+
+    def outcome(mover):
+        try:
+            return planner.plan(start, goal, moving_obstacles=[mover], mover_margin=0.02)
+        except BlockedError as exc:
+            return exc
+
+    with_screen = [outcome(m) for m in scenes]
+    monkeypatch.setattr(among._GridScreen, "__call__", lambda self, points: None)
+    without = [outcome(m) for m in scenes]
+    monkeypatch.undo()
+    early = [
+        not isinstance(a, BlockedError) and a.stats["moving"].get("blocked_on_grid_path")
+        for a in with_screen
+    ]
+    assert any(early) and not all(early)  # the screen found some, not all
+    for a, b in zip(with_screen, without, strict=True):
+        if isinstance(b, BlockedError):
+            assert isinstance(a, BlockedError) and str(a) == str(b)
+            continue
+        _same_plan(a, b)  # certified: the tests above check such plans independently
+        assert a.stats["moving"]["certificate"]["ok"]
