@@ -170,14 +170,14 @@ def check_path(p: PosePath, free: np.ndarray, start, goal, radius: float) -> Non
         ds = s / m
         # the chord of each step: length 2 sin(k ds / 2) / k along the mid-step heading
         chord = ds if k == 0 else 2.0 * math.sin(0.5 * k * ds) / k
-        x, y, th = px, py, pth
-        for _ in range(m):
-            thm = th + 0.5 * k * ds
-            x += chord * math.cos(thm)
-            y += chord * math.sin(thm)
-            th += k * ds
-            pts.append((x, y))
-    pts = np.array(pts)
+        # the m steps added up one after another (cumsum is sequential), from the piece's start
+        ths = np.cumsum(np.concatenate([[pth], np.full(m, k * ds)]))
+        thm = ths[:-1] + 0.5 * k * ds
+        xs = np.cumsum(np.concatenate([[px], chord * np.cos(thm)]))[1:]
+        ys = np.cumsum(np.concatenate([[py], chord * np.sin(thm)]))[1:]
+        x, y, th = xs[-1], ys[-1], ths[-1]
+        pts.append(np.column_stack([xs, ys]))
+    pts = np.concatenate(pts)
     ix = np.floor(pts[:, 0] + 0.5).astype(int)
     iy = np.floor(pts[:, 1] + 0.5).astype(int)
     inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
