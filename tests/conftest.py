@@ -16,6 +16,12 @@
   background lane, when collection ends, and run while the other tests run
   (``tests/processes.py``; ``TRAJOPT_EARLY_PROCESSES=0`` starts them when their module's
   first test runs).
+* Bytecode is cached even where ``PYTHONDONTWRITEBYTECODE`` is set: pytest's rewritten test
+  modules (``tests/**/__pycache__``) and the packages' compiled sources (``__pycache__``
+  beside them, where numba's cache already lives; both ignored by git). Without it every
+  run rewrites the assertions of every test module and compiles every source again before
+  the first test (about 10 s of the collection on the shared 2-core machine), and every
+  fresh process a test starts compiles the sources again.
 * The notebooks execute in the background lane too, after the queued processes, from the
   moment their tests are collected on (when no ``-k``, ``-m`` other than the default,
   ``--deselect``, ``--lf`` or ``--sw`` can drop them later; else from the end of collection
@@ -40,6 +46,10 @@ from hypothesis import settings
 # without a format checker), so the test process does without it.
 if "rfc3987_syntax" not in sys.modules:
     sys.modules["rfc3987_syntax"] = None  # type: ignore[assignment]  # ImportError on import
+
+# The bytecode caches (module docstring): pytest reads this flag when it imports each test
+# module, after this file.
+sys.dont_write_bytecode = False
 
 settings.register_profile("deterministic", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)

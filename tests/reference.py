@@ -64,6 +64,7 @@ __all__ = [
     "sampled_rect_clearance",
     "scipy_distance_cells",
     "square_clearance",
+    "step_graph",
     "three_point_curvature",
     "turn_limits_by_hand",
     "v_limit_by_hand",
@@ -296,7 +297,7 @@ def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):
     The graph of a grid (and cost) is built once and reused for every start.
     """
     ny, nx = occ.shape
-    graph = _step_graph(occ, connectivity, corner_cutting, cost)
+    graph = step_graph(occ, connectivity, corner_cutting, cost)
     d = dijkstra(graph, indices=start[1] * nx + start[0])
     return d.reshape(ny, nx)
 
@@ -305,8 +306,9 @@ def dijkstra_costs(occ, start, connectivity, corner_cutting, cost=None):
 _GRAPHS: dict[tuple, csr_matrix] = {}
 
 
-def _step_graph(occ, connectivity, corner_cutting, cost) -> csr_matrix:
-    """The explicit graph of :func:`dijkstra_costs` (cached: tests ask many starts per grid)."""
+def step_graph(occ, connectivity, corner_cutting, cost=None) -> csr_matrix:
+    """The explicit graph of :func:`dijkstra_costs`: an edge of weight ``w`` from cell index
+    ``iy * nx + ix`` per legal move (cached: tests ask many starts per grid)."""
     occ = np.asarray(occ)
     key = (
         occ.shape,
@@ -320,20 +322,28 @@ def _step_graph(occ, connectivity, corner_cutting, cost) -> csr_matrix:
     if graph is not None:
         return graph
     ny, nx = occ.shape
+    # the moves of legal_step, each for every cell at once: the cells a = (ix, iy) whose
+    # move b = a + (dx, dy) stays in the map, as slices of the grid ("a" rows and columns,
+    # "b" rows and columns); tests/astar/test_search.py checks it is legal_step's
+    free = ~occ.astype(bool)
+    index = np.arange(ny * nx).reshape(ny, nx)
     rows, cols, w = [], [], []
     moves = [(1, 0), (-1, 0), (0, 1), (0, -1)]
     if connectivity == 8:
         moves += [(1, 1), (1, -1), (-1, 1), (-1, -1)]
-    for iy in range(ny):
-        for ix in range(nx):
-            for dx, dy in moves:
-                if legal_step(occ, (ix, iy), (ix + dx, iy + dy), connectivity, corner_cutting):
-                    step = SQRT2 if dx and dy else 1.0
-                    if cost is not None:
-                        step *= 1.0 + 0.5 * (cost[iy, ix] + cost[iy + dy, ix + dx])
-                    rows.append(iy * nx + ix)
-                    cols.append((iy + dy) * nx + ix + dx)
-                    w.append(step)
+    for dx, dy in moves:
+        ay, ax = slice(max(0, -dy), ny - max(0, dy)), slice(max(0, -dx), nx - max(0, dx))
+        by, bx = slice(max(0, dy), ny - max(0, -dy)), slice(max(0, dx), nx - max(0, -dx))
+        ok = free[ay, ax] & free[by, bx]
+        if dx and dy and not corner_cutting:  # both side cells free
+            ok &= free[ay, bx] & free[by, ax]
+        step = np.full(ok.shape, SQRT2 if dx and dy else 1.0)
+        if cost is not None:
+            step *= 1.0 + 0.5 * (cost[ay, ax] + cost[by, bx])
+        rows.append(index[ay, ax][ok])
+        cols.append(index[by, bx][ok])
+        w.append(step[ok])
+    rows, cols, w = np.concatenate(rows), np.concatenate(cols), np.concatenate(w)
     graph = csr_matrix((w, (rows, cols)), shape=(nx * ny, nx * ny))
     if len(_GRAPHS) >= 8:
         _GRAPHS.pop(next(iter(_GRAPHS)))

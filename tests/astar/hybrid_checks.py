@@ -115,23 +115,28 @@ def body_collisions(
     pad = np.ones((ny + 2, nx + 2), bool)
     pad[1:-1, 1:-1] = occ
     oy, ox = np.nonzero(occ)
-    bad = []
-    for i in near:
-        x, y, th = poses[i]
-        c, s = math.cos(th), math.sin(th)
-        rot = np.array([[c, -s], [s, c]])
-        b = boundary @ rot.T + (x, y)
-        pts = np.concatenate([b, interior @ rot.T + (x, y)])
-        jx = np.clip(np.floor(pts[:, 0] + 0.5).astype(int) + 1, 0, nx + 1)
-        jy = np.clip(np.floor(pts[:, 1] + 0.5).astype(int) + 1, 0, ny + 1)
-        hit = bool(pad[jy, jx].any())
-        if margin > 0.0 and not hit:
+    px, py = np.concatenate([boundary, interior]).T
+    flat = pad.ravel()
+    hit = np.zeros(len(near), bool)
+    # the near poses' bodies, a chunk of poses at a time as (poses, points) arrays; a point's
+    # square (ix, iy), clipped to the pad's ring outside the grid, is pad[iy + 1, ix + 1]
+    for j in range(0, len(near), 64):
+        x, y, th = poses[near[j : j + 64]].T
+        c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+        wx = c * px - s * py + x[:, None] + 0.5
+        wy = s * px + c * py + y[:, None] + 0.5
+        np.clip(np.floor(wx, out=wx), -1, nx, out=wx)
+        np.clip(np.floor(wy, out=wy), -1, ny, out=wy)
+        hit[j : j + 64] = flat[((wy + 1) * (nx + 2) + wx + 1).astype(np.intp)].any(axis=1)
+    if margin > 0.0:
+        for n in np.nonzero(~hit)[0]:
+            x, y, th = poses[near[n]]
+            c, s = math.cos(th), math.sin(th)
+            b = boundary @ np.array([[c, s], [-s, c]]) + (x, y)
             reach = rho + margin + 1.0
             k = (np.abs(ox - x) <= reach) & (np.abs(oy - y) <= reach)
-            hit = bool((square_distance(b, occ, (ox[k], oy[k])) <= margin - TOL).any())
-        if hit:
-            bad.append(i)
-    return np.array(bad, dtype=int)
+            hit[n] = bool((square_distance(b, occ, (ox[k], oy[k])) <= margin - TOL).any())
+    return near[hit].astype(int)
 
 
 def check_footprint_path(p, occ, poly, start, goal, margin=0.0):
@@ -165,14 +170,14 @@ def check_path(p: PosePath, free: np.ndarray, start, goal, radius: float) -> Non
         ds = s / m
         # the chord of each step: length 2 sin(k ds / 2) / k along the mid-step heading
         chord = ds if k == 0 else 2.0 * math.sin(0.5 * k * ds) / k
-        x, y, th = px, py, pth
-        for _ in range(m):
-            thm = th + 0.5 * k * ds
-            x += chord * math.cos(thm)
-            y += chord * math.sin(thm)
-            th += k * ds
-            pts.append((x, y))
-    pts = np.array(pts)
+        # the m steps added up one after another (cumsum is sequential), from the piece's start
+        ths = np.cumsum(np.concatenate([[pth], np.full(m, k * ds)]))
+        thm = ths[:-1] + 0.5 * k * ds
+        xs = np.cumsum(np.concatenate([[px], chord * np.cos(thm)]))[1:]
+        ys = np.cumsum(np.concatenate([[py], chord * np.sin(thm)]))[1:]
+        x, y, th = xs[-1], ys[-1], ths[-1]
+        pts.append(np.column_stack([xs, ys]))
+    pts = np.concatenate(pts)
     ix = np.floor(pts[:, 0] + 0.5).astype(int)
     iy = np.floor(pts[:, 1] + 0.5).astype(int)
     inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)

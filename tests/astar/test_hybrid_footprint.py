@@ -361,9 +361,10 @@ def test_footprint_arc_clear_covers_the_whole_arc(slack, min_slack):
             c, sn = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
             wx = poses[:, :1] + c * pts0[:, 0] - sn * pts0[:, 1]  # (poses, points)
             wy = poses[:, 1:2] + sn * pts0[:, 0] + c * pts0[:, 1]
-            jx = np.clip(np.floor(wx + 0.5).astype(int) + 1, 0, nx + 1)
-            jy = np.clip(np.floor(wy + 0.5).astype(int) + 1, 0, ny + 1)
-            hit = bool(pad[jy, jx].any())
+            # the square (ix, iy) of each point, clipped to the pad's ring outside the grid
+            jx = np.clip(np.floor(wx + 0.5), -1, nx) + 1
+            jy = np.clip(np.floor(wy + 0.5), -1, ny) + 1
+            hit = bool(pad.ravel()[(jy * (nx + 2) + jx).astype(np.intp)].any())
             if got:
                 assert not hit, (poly.tolist(), x, y, th, k, s)
                 seen["clear"] += 1

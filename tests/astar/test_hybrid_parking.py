@@ -85,22 +85,36 @@ def check_big_body(p, occ, poly, start, goal, spacing=0.05):
     cy = np.clip(np.floor(poses[:, 1] + 0.5).astype(int), 0, ny - 1)
     near_pose = dist[cy, cx] <= rho + 2.0
     oy, ox = np.nonzero(occ)
-    for x, y, th in poses[near_pose]:
-        c, s = math.cos(th), math.sin(th)
+    sel = poses[near_pose]
+    for j in range(0, len(sel), 64):  # 64 poses at a time, as (poses, points) arrays
+        x, y, th = sel[j : j + 64, :, None].transpose(1, 0, 2)
+        c, s = np.cos(th), np.sin(th)
         bx = x + c * boundary[:, 0] - s * boundary[:, 1]
         by = y + s * boundary[:, 0] + c * boundary[:, 1]
-        assert bx.min() >= -0.5 and bx.max() <= nx - 0.5, (x, y, th)
-        assert by.min() >= -0.5 and by.max() <= ny - 0.5, (x, y, th)
+        out = (
+            (bx.min(1) < -0.5)
+            | (bx.max(1) > nx - 0.5)
+            | (by.min(1) < -0.5)
+            | (by.max(1) > ny - 0.5)
+        )
+        assert not out.any(), sel[j + np.argmax(out)]
         # every square the point lies in (two or four on a shared side or corner)
+        hit = np.zeros(len(x), bool)
         for dx, dy in ((-1e-9, -1e-9), (-1e-9, 1e-9), (1e-9, -1e-9), (1e-9, 1e-9)):
             jx = np.clip(np.floor(bx + dx + 0.5).astype(int), 0, nx - 1)
             jy = np.clip(np.floor(by + dy + 0.5).astype(int), 0, ny - 1)
-            assert not occ[jy, jx].any(), (x, y, th)
-        near = (np.abs(ox - x) <= rho + 1) & (np.abs(oy - y) <= rho + 1)
+            hit |= occ[jy, jx].any(axis=1)
+        assert not hit.any(), sel[j + np.argmax(hit)]
+        # the occupied centres in reach of the chunk's poses (no farther centre lies inside)
+        near = (ox >= x.min() - rho - 1) & (ox <= x.max() + rho + 1)
+        near &= (oy >= y.min() - rho - 1) & (oy <= y.max() + rho + 1)
         qx, qy = ox[near] - x, oy[near] - y
         lx, ly = c * qx + s * qy, -s * qx + c * qy  # into the body frame
-        inside = np.all(np.outer(lx, normal[:, 0]) + np.outer(ly, normal[:, 1]) <= offset, axis=1)
-        assert not inside.any(), (x, y, th)
+        inside = np.ones(lx.shape, bool)
+        for (n0, n1), off in zip(normal, offset, strict=True):
+            inside &= lx * n0 + ly * n1 <= off
+        inside = inside.any(axis=1)
+        assert not inside.any(), sel[j + np.argmax(inside)]
     assert near_pose.sum() > 0
 
 

@@ -40,12 +40,13 @@ def _walk(kinds, lens, radius):
     for k, s in zip(kinds, lens, strict=True):
         m = max(1, int(abs(s) / 1e-4))
         ds = s / m
-        for _ in range(m):
-            # midpoint rule on the heading: exact for straight segments, O(ds^2) on arcs
-            thm = th + 0.5 * k / radius * ds
-            x += ds * math.cos(thm)
-            y += ds * math.sin(thm)
-            th += k / radius * ds
+        # the m steps' headings, added up one step after another (cumsum is sequential)
+        ths = np.cumsum(np.concatenate([[th], np.full(m, k / radius * ds)]))
+        # midpoint rule on the heading: exact for straight segments, O(ds^2) on arcs
+        thm = ths[:-1] + 0.5 * k / radius * ds
+        x = float(np.cumsum(np.concatenate([[x], ds * np.cos(thm)]))[-1])
+        y = float(np.cumsum(np.concatenate([[y], ds * np.sin(thm)]))[-1])
+        th = float(ths[-1])
     return x, y, th
 
 

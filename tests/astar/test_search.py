@@ -4,6 +4,7 @@ the Moving AI optimal lengths on the shared real maps.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -13,7 +14,7 @@ from hypothesis import strategies as st
 
 import astar
 from astar import GridPath, InvalidInputError, NoPathError, OccupancyGrid, find_path
-from tests.reference import check_path, dijkstra_costs
+from tests.reference import check_path, dijkstra_costs, legal_step, step_graph
 
 SQRT2 = math.sqrt(2.0)
 
@@ -56,6 +57,29 @@ def test_matches_dijkstra(prob, connectivity, corner_cutting, weighted):
     assert path.expanded >= 1
     # deterministic
     assert find_path(grid, start, goal, **kw) == path
+
+
+def test_reference_graph_is_the_step_rule():
+    """The reference's graph (built a whole move at a time, for speed) has exactly the edges
+    of ``legal_step`` (the documented move rules, one move at a time), with the step length
+    times ``1 + (cost_a + cost_b) / 2``, on random grids up to their edges."""
+    rng = np.random.default_rng(4)
+    moves = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1) if dx or dy]
+    for trial in range(24):
+        ny, nx = (int(v) for v in rng.integers(1, 9, size=2))
+        occ = rng.random((ny, nx)) < 0.35
+        cost = rng.random(occ.shape) * 3.0 if trial % 2 else None
+        for connectivity, corner_cutting in ((8, False), (8, True), (4, False), (4, True)):
+            want = {}
+            for iy, ix, (dx, dy) in itertools.product(range(ny), range(nx), moves):
+                if legal_step(occ, (ix, iy), (ix + dx, iy + dy), connectivity, corner_cutting):
+                    step = SQRT2 if dx and dy else 1.0
+                    if cost is not None:
+                        step *= 1.0 + 0.5 * (cost[iy, ix] + cost[iy + dy, ix + dx])
+                    want[(iy * nx + ix, (iy + dy) * nx + ix + dx)] = step
+            g = step_graph(occ, connectivity, corner_cutting, cost).tocoo()
+            got = {(int(r), int(c)): w for r, c, w in zip(g.row, g.col, g.data, strict=True)}
+            assert got == want, (occ.astype(int).tolist(), connectivity, corner_cutting)
 
 
 def test_open_grid_octile_length():

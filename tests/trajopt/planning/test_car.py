@@ -265,26 +265,35 @@ def _body_hits(grid, vertices, x, y, th, spacing=0.005):
     ox, oy = grid.origin
     res = grid.resolution
     reach = float(np.hypot(v[:, 0], v[:, 1]).max()) + res
+    x, y, th = (np.asarray(a, dtype=float) for a in (x, y, th))
+    cy, cx = np.nonzero(occ)
+    cx, cy = ox + (cx + 0.5) * res, oy + (cy + 0.5) * res  # the occupied cells' centres
+    pad = np.ones((ny + 2, nx + 2), dtype=bool)  # the grid in a ring of occupied cells
+    pad[1:-1, 1:-1] = occ
+    pad = pad.ravel()
     hits = np.zeros(len(x), dtype=bool)
-    for k in range(len(x)):
-        c, s_ = math.cos(th[k]), math.sin(th[k])
-        rot = np.array([[c, -s_], [s_, c]])
-        b = boundary @ rot.T + (x[k], y[k])
-        jx = np.floor((b[:, 0] - ox) / res).astype(int)
-        jy = np.floor((b[:, 1] - oy) / res).astype(int)
-        out = (jx < 0) | (jy < 0) | (jx >= nx) | (jy >= ny)
-        if out.any() or occ[jy, jx].any():
-            hits[k] = True
-            continue
-        # the occupied cells of the window round the body (no centre farther lies inside)
-        i0 = max(0, int((x[k] - reach - ox) / res))
-        i1 = min(nx, int((x[k] + reach - ox) / res) + 2)
-        j0 = max(0, int((y[k] - reach - oy) / res))
-        j1 = min(ny, int((y[k] + reach - oy) / res) + 2)
-        wy, wx = np.nonzero(occ[j0:j1, i0:i1])
-        near = np.column_stack([ox + (wx + i0 + 0.5) * res, oy + (wy + j0 + 0.5) * res])
-        local = (near - (x[k], y[k])) @ rot  # into the body frame
-        hits[k] = bool(np.any(np.all(local @ normal.T <= offset, axis=1)))
+    # a chunk of poses at a time, as (poses, points) arrays; a boundary point's cell (jx, jy),
+    # clipped to the ring outside the grid, is pad[jy + 1, jx + 1]
+    for k in range(0, len(x), 64):
+        xk, yk = x[k : k + 64, None], y[k : k + 64, None]
+        c, s_ = np.cos(th[k : k + 64, None]), np.sin(th[k : k + 64, None])
+        jx = np.floor((c * boundary[:, 0] - s_ * boundary[:, 1] + xk - ox) / res)
+        jy = np.floor((s_ * boundary[:, 0] + c * boundary[:, 1] + yk - oy) / res)
+        np.clip(jx, -1, nx, out=jx)
+        np.clip(jy, -1, ny, out=jy)
+        jy += 1
+        jy *= nx + 2
+        jy += jx + 1
+        hit = pad[jy.astype(np.intp)].any(axis=1)
+        # the occupied cells in reach of the chunk's box (no centre farther lies inside a body)
+        near = (cx >= xk.min() - reach) & (cx <= xk.max() + reach)
+        near &= (cy >= yk.min() - reach) & (cy <= yk.max() + reach)
+        dx, dy = cx[near] - xk, cy[near] - yk
+        lx, ly = dx * c + dy * s_, dx * -s_ + dy * c  # into the body frame
+        inside = np.ones(lx.shape, dtype=bool)
+        for (n0, n1), off in zip(normal, offset, strict=True):
+            inside &= lx * n0 + ly * n1 <= off
+        hits[k : k + 64] = hit | inside.any(axis=1)
     return hits
 
 

@@ -217,14 +217,12 @@ def sampled_clearance(grid, fp, curve, n=1500):
     obst = shapely.union_all([Polygon(p) for p in grid.polygons])
     outside = box(-1.0, -1.0, 5.0, 4.0).difference(box(0.0, 0.0, 4.0, 3.0))
     v = np.asarray(fp.vertices)
-    best = math.inf
-    for (x, y), t in zip(xy, th, strict=True):
-        c, s = math.cos(t), math.sin(t)
-        body = Polygon(
-            np.column_stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]])
-        )
-        best = min(best, body.distance(obst), body.distance(outside))
-    return best
+    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+    x, y = xy[:, :1], xy[:, 1:]
+    bodies = shapely.polygons(
+        np.stack([x + c * v[:, 0] - s * v[:, 1], y + s * v[:, 0] + c * v[:, 1]], axis=-1)
+    )  # the body at every pose, shape (n,)
+    return float(min(shapely.distance(bodies, obst).min(), shapely.distance(bodies, outside).min()))
 
 
 @pytest.mark.parametrize("seed", range(4))
