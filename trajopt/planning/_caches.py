@@ -444,6 +444,13 @@ def update_labels(
     Otherwise (a component may split or merge, or a new one appears) returns ``None``:
     label the whole grid again.
 
+    A change that frees no cell (a re-route's marks, :meth:`PlannerCaches.derived`) needs
+    the box labelled after the change only: cells joined after the change were joined before
+    (a path of free cells after is one before), so each local component lies in one old
+    component; when no two local components lie in the same old one, the partition is the
+    old one with the blocked cells removed (a path's stretch inside ``B`` joins two cells of
+    its edge, free after, of one old component, hence of one local component).
+
     Returns
     -------
     ndarray of int32 or None
@@ -452,8 +459,10 @@ def update_labels(
     """
     x0, x1, y0, y1 = _grow(window, max(1, margin), labels.shape)
     box = (slice(y0, y1 + 1), slice(x0, x1 + 1))
-    before = component_labels(old_occupied[box])
     after = component_labels(occupied[box])
+    if not np.any(old_occupied[box] > occupied[box]):  # no cell freed
+        return _blocked_only(labels, after, box)
+    before = component_labels(old_occupied[box])
     both = (before > 0) & (after > 0)  # free before and after
     a, b = after[both], before[both]
     n_after, n_before = int(after.max()), int(before.max())
@@ -466,6 +475,27 @@ def update_labels(
         return None
     lut = np.zeros(n_after + 1, dtype=np.int32)
     lut[a] = labels[box][both]  # one old label per local component (checked above)
+    out = np.array(labels)
+    out[box] = lut[after]
+    out.flags.writeable = False
+    return out
+
+
+def _blocked_only(
+    labels: np.ndarray, after: np.ndarray, box: tuple[slice, slice]
+) -> np.ndarray | None:
+    """:func:`update_labels` for a change that frees no cell, from the box's labels ``after`` it.
+
+    Each local component takes the old label of its cells (one per component, as no cell was
+    freed); ``None`` when two local components take the same one (the change may have cut
+    an old component in two).
+    """
+    free = after > 0
+    n_after = int(after.max())
+    lut = np.zeros(n_after + 1, dtype=np.int32)
+    lut[after[free]] = labels[box][free]
+    if np.unique(lut[1:]).size != n_after:
+        return None
     out = np.array(labels)
     out[box] = lut[after]
     out.flags.writeable = False
