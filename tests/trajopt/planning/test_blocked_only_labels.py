@@ -1,6 +1,7 @@
 """Tests of the component labels' update for a change that frees no cell (a re-route's marks).
 
-:func:`update_labels` labels only the box after such a change; its labels are checked against
+:func:`update_labels` labels only the box after such a change, and the derived caches patch the
+inflated grid and the clearance cost from the blocked cells alone; the labels are checked against
 a brute-force breadth-first search with the search's own move rules
 (``tests.reference.reachable_cells``), and the marked map's derived caches against caches
 built afresh for it.
@@ -9,6 +10,7 @@ built afresh for it.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import astar
 import trajopt
@@ -63,12 +65,15 @@ def test_a_cut_corridor_is_labelled_again():
     assert update_labels(component_labels(old), old, new, (9, 9, 2, 2), 1) is None
 
 
-def test_derived_caches_of_a_marked_map_equal_fresh_ones():
-    """Marks (cells blocked only) on a map: the derived caches equal caches built afresh."""
+@pytest.mark.parametrize("inflation", ["exact", "paper"])
+def test_derived_caches_of_a_marked_map_equal_fresh_ones(inflation):
+    """Marks (cells blocked only, some at the map's edge) on a map: the derived caches (the
+    inflated grid and the clearance cost from the marks alone with ``"exact"``) equal caches
+    built afresh."""
     rng = np.random.default_rng(5)
     occ = rng.random((60, 80)) < 0.03
     grid = astar.OccupancyGrid(occ, 0.05, (0.0, 0.0))
-    planner = trajopt.Planner(grid, trajopt.Robot(radius=0.12))
+    planner = trajopt.Planner(grid, trajopt.Robot(radius=0.12), inflation=inflation)
     caches = planner.caches
     assert caches.components is not None and caches.search_cost is not None  # built
     for k in range(6):
