@@ -97,6 +97,7 @@ def reroute(
     plan_leg: PlanLeg,
     path: np.ndarray | None = None,
     sketch: Callable[[OccupancyGrid], np.ndarray] | None = None,
+    label: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> Any:
     """Return a certified plan by another route or a wait at a safe place (module docstring).
 
@@ -130,6 +131,12 @@ def reroute(
         on a marked map, a :class:`TrajoptError` when there is none. With ``path``, a detour
         whose marks keep clear of the blocked path and whose sketch follows it is tried after
         the waits (module docstring).
+    label : callable, optional
+        ``label(occupied)``: the 4-connected components of the cells not occupied (bool,
+        shape (ny, nx)), an int array of that shape, 0 on occupied cells and one positive
+        label per component (the planner's own labelling); used to keep the safe places the
+        goal is joined to. ``None``: :func:`scipy.ndimage.label` of the free cells (the same
+        partition; its import costs a process's first wait about 0.1 s).
 
     Returns
     -------
@@ -247,7 +254,7 @@ def reroute(
     if turns or not robot.drive.turns_in_place:  # a car stands at the place with a heading
         room = free()
         places = safe_places(grid, room, movers, robot.radius + margin, p0, p1, t_last)
-        places = _joined_at_last(grid, room, movers, robot.radius + margin, places, p1)
+        places = _joined_at_last(grid, room, movers, robot.radius + margin, places, p1, label)
         for place in places:
             for heading in [None] if turns else car_headings(place, p0, p1):
                 at = "" if heading is None else f", heading {heading:.3f} rad"
@@ -420,22 +427,27 @@ def _joined_at_last(
     clearance: float,
     places: Sequence[np.ndarray],
     goal: np.ndarray,
+    label: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> list[np.ndarray]:
     """Return the ``places`` joined to ``goal`` once every mover stands at its final place.
 
     4-connected free cells of ``free`` less every mover's final shape grown by ``clearance``
-    (the planner's search joins exactly the 4-connected free cells). A wait helps only where
-    the way on stays open after the movers have passed.
+    (the planner's search joins exactly the 4-connected free cells), labelled by ``label``
+    (:func:`reroute`'s; ``None``: :func:`scipy.ndimage.label`). A wait helps only where the
+    way on stays open after the movers have passed.
     """
     if not places:
         return []
-    from scipy import ndimage  # only a re-route pays its import
-
     open_ = np.array(free)
     for m in movers:
         t = max(m.t_last, 0.0)
         open_ &= ~swept_mask(grid, m, t, t, clearance)
-    labels, _ = ndimage.label(open_)
+    if label is None:
+        from scipy import ndimage  # only a re-route without the planner's labelling pays it
+
+        labels, _ = ndimage.label(open_)
+    else:
+        labels = label(~open_)
     ny, nx = grid.shape
 
     def label(p: np.ndarray) -> int:

@@ -2,7 +2,8 @@
 
 The inflated grid, its connected components, the search cost and the ALT landmarks are
 computed on first use and kept; :meth:`PlannerCaches.update` recomputes the inflated grid
-and the clearance cost only where a map change reaches. The search landmarks, whose
+and the clearance cost only where a map change reaches (from the newly blocked cells alone
+when the change frees no cell, as a re-route's marks, :func:`_blocked_patch`). The search landmarks, whose
 distances span the whole map, are kept (:meth:`astar.Landmarks.rebase`: still exact lower
 bounds) when the change only adds obstacles, so that no inflated cell is freed and no cost
 falls; otherwise they are dropped and built again by the next search. The component labels
@@ -193,6 +194,25 @@ class PlannerCaches:
             )
         return cost
 
+    def _inflate_alone(self, grid: OccupancyGrid) -> np.ndarray:
+        """:meth:`_inflate` (``inflation="exact"``) of ``grid``'s cells alone, no outside wall."""
+        return astar.inflate(grid, self.options.robot.radius, metric="square").occupied
+
+    def _cost_alone(self, grid: OccupancyGrid) -> np.ndarray:
+        """:meth:`_clearance_cost` of ``grid``'s cells alone, no outside wall (no costmap)."""
+        cost = np.zeros(grid.shape)
+        if self.options.search in ("clearance", "costmap+clearance") and grid.occupied.any():
+            cost += astar.clearance_cost(
+                grid,
+                self.options.robot.radius,
+                falloff_cells=(
+                    FALLOFF_UNITS
+                    if self.cell_units
+                    else falloff_cells(self.options, grid.resolution)
+                ),
+            )
+        return cost
+
     def derived(self, grid: OccupancyGrid) -> PlannerCaches:
         """Return the caches of a changed map of the same frame, leaving these untouched.
 
@@ -291,17 +311,29 @@ class PlannerCaches:
             box = (int(ix.min()), int(ix.max()), int(iy.min()), int(iy.max()))
             r_cells, reach_cost = change_reach(self.options, grid.resolution)
             window = _grow(box, max(r_cells, reach_cost), grid.shape)
+            near = _grow(box, r_cells, grid.shape)  # where the inflated grid may change
+            # a change that only blocks cells (a re-route's marks), exact inflation: computed
+            # from the blocked cells alone and merged (_blocked_patch)
+            blocking = self.options.inflation == "exact" and bool(grid.occupied.flat[changed].all())
             if self._inflated is not None:
                 occ = np.array(self._inflated.occupied)
-                _patch(occ, grid, window, r_cells, self._inflate)
+                if blocking:
+                    part, vals = _blocked_patch(grid, old, box, r_cells, self._inflate_alone)
+                    occ[part] |= vals
+                else:
+                    _patch(occ, grid, near, r_cells, self._inflate)
                 if self._components is not None:
                     self._components = update_labels(
-                        self._components, self._inflated.occupied, occ, window, r_cells
+                        self._components, self._inflated.occupied, occ, near, r_cells
                     )
                 self._inflated = grid.with_occupied(occ)
             if self._cost is not None:
                 cost = np.array(self._cost)
-                _patch(cost, grid, window, reach_cost, self._clearance_cost)
+                if blocking:
+                    part, vals = _blocked_patch(grid, old, box, reach_cost, self._cost_alone)
+                    np.maximum(cost[part], vals, out=cost[part])
+                else:
+                    _patch(cost, grid, window, reach_cost, self._clearance_cost)
                 cost.flags.writeable = False  # shared with the landmarks
                 self._cost = cost
             if self._coarse is not None:  # built from both, so both were built
@@ -444,6 +476,13 @@ def update_labels(
     Otherwise (a component may split or merge, or a new one appears) returns ``None``:
     label the whole grid again.
 
+    A change that frees no cell (a re-route's marks, :meth:`PlannerCaches.derived`) needs
+    the box labelled after the change only: cells joined after the change were joined before
+    (a path of free cells after is one before), so each local component lies in one old
+    component; when no two local components lie in the same old one, the partition is the
+    old one with the blocked cells removed (a path's stretch inside ``B`` joins two cells of
+    its edge, free after, of one old component, hence of one local component).
+
     Returns
     -------
     ndarray of int32 or None
@@ -452,8 +491,10 @@ def update_labels(
     """
     x0, x1, y0, y1 = _grow(window, max(1, margin), labels.shape)
     box = (slice(y0, y1 + 1), slice(x0, x1 + 1))
-    before = component_labels(old_occupied[box])
     after = component_labels(occupied[box])
+    if not np.any(old_occupied[box] > occupied[box]):  # no cell freed
+        return _blocked_only(labels, after, box)
+    before = component_labels(old_occupied[box])
     both = (before > 0) & (after > 0)  # free before and after
     a, b = after[both], before[both]
     n_after, n_before = int(after.max()), int(before.max())
@@ -466,6 +507,27 @@ def update_labels(
         return None
     lut = np.zeros(n_after + 1, dtype=np.int32)
     lut[a] = labels[box][both]  # one old label per local component (checked above)
+    out = np.array(labels)
+    out[box] = lut[after]
+    out.flags.writeable = False
+    return out
+
+
+def _blocked_only(
+    labels: np.ndarray, after: np.ndarray, box: tuple[slice, slice]
+) -> np.ndarray | None:
+    """:func:`update_labels` for a change that frees no cell, from the box's labels ``after`` it.
+
+    Each local component takes the old label of its cells (one per component, as no cell was
+    freed); ``None`` when two local components take the same one (the change may have cut
+    an old component in two).
+    """
+    free = after > 0
+    n_after = int(after.max())
+    lut = np.zeros(n_after + 1, dtype=np.int32)
+    lut[after[free]] = labels[box][free]
+    if np.unique(lut[1:]).size != n_after:
+        return None
     out = np.array(labels)
     out[box] = lut[after]
     out.flags.writeable = False
@@ -515,6 +577,27 @@ def _patch(target: np.ndarray, grid: OccupancyGrid, window, reach: int, compute)
     """
     x0, x1, y0, y1 = window
     target[y0 : y1 + 1, x0 : x1 + 1] = _window_values(grid, window, reach, compute)
+
+
+def _blocked_patch(
+    grid: OccupancyGrid, old: OccupancyGrid, box, reach: int, compute
+) -> tuple[tuple[slice, slice], np.ndarray]:
+    """Return the cells and ``compute``'s values of the cells ``grid`` blocks that ``old`` did not.
+
+    For a change that only blocks cells, all inside the cell box ``box``: ``compute`` runs
+    on the map cut to ``box`` grown by ``reach`` with those cells alone occupied (no
+    outside wall), and returns the cut (``(rows, columns)`` slices) and its values. The
+    inflated grid is a union of discs round the occupied cells, so the new one is the old one
+    or this; the clearance cost is a non-increasing function of the distance to the nearest
+    occupied cell (:func:`astar.clearance_cost`), so the new one is the larger of the old
+    one and this, which is 0 farther than ``reach`` from these cells.
+    """
+    x0, x1, y0, y1 = _grow(box, reach, grid.shape)
+    part = (slice(y0, y1 + 1), slice(x0, x1 + 1))
+    res = grid.resolution
+    ox, oy = grid.origin
+    alone = np.asarray(grid.occupied[part]) & ~np.asarray(old.occupied[part])
+    return part, compute(OccupancyGrid(alone, res, (ox + x0 * res, oy + y0 * res)))
 
 
 def _window_values(grid: OccupancyGrid, window, reach: int, compute) -> np.ndarray:

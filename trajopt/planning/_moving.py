@@ -528,6 +528,7 @@ def _reroute(
         plan_leg=plan_leg,
         path=path,
         sketch=sketch if _disc_search(robot) else None,
+        label=component_labels,
     )
 
 
