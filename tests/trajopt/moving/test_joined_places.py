@@ -1,4 +1,5 @@
-"""Tests of the safe places a wait keeps: those joined to the goal once the movers stand still.
+"""Tests of trajopt.moving's safe places a wait keeps: those joined to the goal once the
+movers stand still.
 
 ``_joined_at_last`` labels the free cells less the movers' final shapes with the planner's
 labelling (``label=component_labels``, as :meth:`trajopt.Planner.plan` passes it) or with

@@ -1,4 +1,5 @@
-"""Tests of the component labels' update for a change that frees no cell (a re-route's marks).
+"""Tests of trajopt.planning's component labels' update for a change that frees no cell (a
+re-route's marks).
 
 :func:`update_labels` labels only the box after such a change, and the derived caches patch the
 inflated grid and the clearance cost from the blocked cells alone; the labels are checked against
