@@ -65,7 +65,7 @@ COVER_DT = 0.5
 #: Parts an undecided interval is split in (disc movers).
 SPLIT = 4
 #: Parts an undecided interval of a polygon mover is split in.
-POLYGON_SPLIT = 4
+POLYGON_SPLIT = 8
 
 
 @dataclass(frozen=True, slots=True)

@@ -113,6 +113,32 @@ class PolygonPieces:
         self.who = who
 
 
+#: The pieces of the last movers marched (:func:`pieces_of`), most recent last.
+_PIECES: list[tuple[tuple[MovingObstacle, ...], PolygonPieces]] = []
+_PIECES_KEPT = 4
+
+
+def pieces_of(movers: Sequence[MovingObstacle]) -> PolygonPieces:
+    """Return the :class:`PolygonPieces` of ``movers``, built or kept from a recent call.
+
+    Movers are immutable values: the same objects in the same order have the same pieces
+    (a re-timing's grids and its fine windows march the same movers). The last
+    :data:`_PIECES_KEPT` are kept, their arrays read-only.
+    """
+    key = tuple(movers)
+    for i, (kept, pieces) in enumerate(_PIECES):
+        if len(kept) == len(key) and all(a is b for a, b in zip(kept, key, strict=True)):
+            _PIECES.append(_PIECES.pop(i))
+            return pieces
+    pieces = PolygonPieces(key)
+    for value in vars(pieces).values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    _PIECES.append((key, pieces))
+    del _PIECES[:-_PIECES_KEPT]
+    return pieces
+
+
 def polygon_runs(
     pts: np.ndarray,
     movers: Sequence[MovingObstacle],
@@ -154,7 +180,7 @@ def polygon_runs(
         A run per stretch of forbidden grid times of a node on one piece (first and last
         time index inclusive; runs of consecutive pieces may touch or overlap).
     """
-    tracks = PolygonPieces(movers)
+    tracks = pieces_of(movers)
     j = tracks.who
     eps = EPS_LIM if sufficient else -EPS_LIM
     lim_add = np.asarray(lim0, dtype=float)[j] + eps
