@@ -239,7 +239,7 @@ def _clearance(
     c, s = np.cos(th), np.sin(th)
     dx, dy = px - cx, py - cy
     qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
-    best = np.inf
+    best2, bx, by = np.inf, 0.0, 0.0  # the nearest edge by squared distance, one hypot
     inside = poly[j]
     for e in range(verts.shape[1]):
         qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
@@ -249,10 +249,12 @@ def _clearance(
         if ee > 0.0:
             lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
         rx, ry = qx - lam * ex, qy - lam * ey
-        best = min(best, np.hypot(rx, ry))
+        r2 = rx * rx + ry * ry
+        if r2 < best2:
+            best2, bx, by = r2, rx, ry
         if ex * qy - ey * qx < 0.0:
             inside = False
-    d = 0.0 if inside else best
+    d = 0.0 if inside else np.hypot(bx, by)
     return d - rad - lim_add
 
 
