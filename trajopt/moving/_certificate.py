@@ -31,9 +31,9 @@ a motion at rest (a turn in place) as a robot standing still (``rho_P = 0``).
 
 An interval whose bound clears the limit (within ``tol``) is accepted; one whose midpoint
 is closer than the limit by more than ``tol / 2`` is a proven violation (a witness);
-otherwise it is split in :data:`SPLIT` equal parts (disc movers: a level of splitting costs
-one evaluation of the robot whatever its size, so fewer, wider levels), in halves for a
-polygon mover. The splitting ends: once the bound's loss is below ``tol / 2`` an interval is
+otherwise it is split in :data:`SPLIT` equal parts (disc movers; polygon movers in
+:data:`POLYGON_SPLIT`): a level of splitting costs one evaluation of the robot whatever its
+size, so fewer, wider levels. The splitting ends: once the bound's loss is below ``tol / 2`` an interval is
 either accepted or a witness. Before that, a disc mover's interval whose box of the robot's
 positions (:class:`._path_bounds.PathBoxes`) is farther from the box of the mover's centre than the largest
 limit is accepted at once, the gap less the limit its bound. The polygon movers are bisected
@@ -62,8 +62,10 @@ from trajopt.moving._robot_windows import robot_windows
 MAX_INTERVALS = 400_000
 #: Initial time step of the interval cover (s).
 COVER_DT = 0.5
-#: Parts an undecided interval is split in (disc movers; one mover's polygon: halves).
+#: Parts an undecided interval is split in (disc movers).
 SPLIT = 4
+#: Parts an undecided interval of a polygon mover is split in.
+POLYGON_SPLIT = 8
 
 
 @dataclass(frozen=True, slots=True)
@@ -452,9 +454,10 @@ def _certify_discs(
 class _Bisection:
     """Bisect each mover's cover of ``[a, b]``: ``results``, ``(verdict, slack, time, intervals)`` per mover.
 
-    Each mover's intervals are halved until decided (first order; second order for a disc
-    mover and a disc robot), in the order one mover at a time would take them (its own
-    intervals: the undecided ones' left halves, then their right halves), so that its
+    Each mover's intervals are split in :data:`POLYGON_SPLIT` equal parts until decided
+    (first order; second order for a disc mover and a disc robot), in the order one mover
+    at a time would take them (its own intervals: the undecided ones' first parts, then
+    their second parts, ...), so that its
     verdict, slack, time and count do not depend on the other movers. All movers advance
     together: the robot is evaluated once per distinct interval of a level, the movers'
     poses and rates are gathered from :class:`MoverSegments`. The movers after the first one
@@ -468,7 +471,7 @@ class _Bisection:
     ``rho_P`` bound (its arc), the mover's ``rho_M``, the limit at the end, the footprint's
     reach and 1e-6 m against rounding, is a lower bound ``cheap`` of the interval's first
     bound. Where ``cheap >= 0`` the interval is accepted at the first level (no violation
-    there, no halves), so only its bound, the mover's slack if it is the least, is missing:
+    there, no parts), so only its bound, the mover's slack if it is the least, is missing:
     :meth:`resolve` evaluates it when ``cheap`` is not above a known slack. A clear mover's
     ``results`` slack is that of the intervals evaluated until then.
     """
@@ -558,13 +561,16 @@ class _Bisection:
                 proven_key[j, 0] = level
                 proven_key[j, 1] = pos[i] if level == 0 else 0
             split = ~done & (mj < stop)
-            a0, m0, b0, j0, gg = t0[split], tm[split], t1[split], mj[split], g0[split]
-            # each mover's left halves in order, then its right halves (as one mover alone)
-            order = np.argsort(np.concatenate([j0, j0]), kind="stable")
-            t0 = np.concatenate([a0, m0])[order]
-            t1 = np.concatenate([m0, b0])[order]
-            mj = np.concatenate([j0, j0])[order]
-            g0 = np.concatenate([gg, gg])[order]
+            a0, b0, j0, gg = t0[split], t1[split], mj[split], g0[split]
+            # each mover's first parts in order, then its second parts, ... (as one mover
+            # alone); the parts meet at the same floats (a + width k / POLYGON_SPLIT)
+            n, width = POLYGON_SPLIT, b0 - a0
+            cuts = [a0] + [a0 + width * (k / n) for k in range(1, n)] + [b0]
+            order = np.argsort(np.tile(j0, n), kind="stable")
+            t0 = np.concatenate(cuts[:-1])[order]
+            t1 = np.concatenate(cuts[1:])[order]
+            mj = np.tile(j0, n)[order]
+            g0 = np.tile(gg, n)[order]
             pos = np.zeros(t0.shape[0], dtype=np.int64)
             level += 1
         self.proven, self.proven_t, self.proven_key = proven, proven_t, proven_key

@@ -35,6 +35,7 @@ omnidirectional or car-like robot (not the stop-and-turn fallback's polyline):
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -58,8 +59,15 @@ def shift_clock(mover: MovingObstacle, t0: float) -> MovingObstacle:
     """
     t_last = max(mover.t_last, 0.0)
     grown = mover.radius + mover.growth * min(max(float(t0), 0.0), t_last)
-    return MovingObstacle(
-        times=mover.times - float(t0),
+    times = mover.times - float(t0)
+    if (
+        math.isfinite(grown)
+        and bool(np.all(np.isfinite(times)))
+        and bool(np.all(np.diff(times) > 0.0))
+    ):
+        return _moved(mover, times, grown)
+    return MovingObstacle(  # validated: a rounding that breaks the times is refused by name
+        times=times,
         positions=mover.positions,
         headings=mover.headings,
         radius=grown,
@@ -67,6 +75,40 @@ def shift_clock(mover: MovingObstacle, t0: float) -> MovingObstacle:
         vertices=mover.vertices,
         name=mover.name,
     )
+
+
+def _moved(
+    mover: MovingObstacle,
+    times: np.ndarray,
+    radius: float,
+    positions: np.ndarray | None = None,
+    headings: np.ndarray | None = None,
+) -> MovingObstacle:
+    """Return ``mover`` with new waypoint times and radius (and track), its shape and name shared.
+
+    An internal constructor (as scipy's ``BSpline.construct_fast``): ``times`` (s, shape
+    (k,), strictly increasing and finite), ``radius`` (m, finite, >= 0), ``positions`` (m,
+    shape (k, 2), finite) and ``headings`` (rad, shape (k,), finite) are the caller's to
+    check (default: the mover's own); the shape, growth and name are the mover's, already
+    validated.
+    """
+    out = object.__new__(MovingObstacle)
+    fields = [times, mover.positions if positions is None else positions]
+    fields.append(mover.headings if headings is None else headings)
+    times, positions, headings = (np.array(x, dtype=float) for x in fields)
+    for x in (times, positions, headings):
+        x.setflags(write=False)
+    for name, value in (
+        ("times", times),
+        ("positions", positions),
+        ("headings", headings),
+        ("radius", float(radius)),
+        ("growth", mover.growth),
+        ("vertices", mover.vertices),
+        ("name", mover.name),
+    ):
+        object.__setattr__(out, name, value)
+    return out
 
 
 def truncate(mover: MovingObstacle, t_end: float) -> MovingObstacle:
@@ -80,10 +122,15 @@ def truncate(mover: MovingObstacle, t_end: float) -> MovingObstacle:
         return mover
     keep = mover.times < t_end
     c, h = mover.pose_at(np.array([t_end]))
+    times = np.append(mover.times[keep], t_end)
+    positions = np.concatenate([mover.positions[keep], c])
+    headings = np.append(mover.headings[keep], h)
+    if math.isfinite(t_end) and bool(np.all(np.isfinite(positions))):
+        return _moved(mover, times, mover.radius, positions, headings)
     return MovingObstacle(
-        times=np.append(mover.times[keep], t_end),
-        positions=np.concatenate([mover.positions[keep], c]),
-        headings=np.append(mover.headings[keep], h),
+        times=times,
+        positions=positions,
+        headings=headings,
         radius=mover.radius,
         growth=mover.growth,
         vertices=mover.vertices,

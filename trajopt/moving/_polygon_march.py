@@ -113,6 +113,32 @@ class PolygonPieces:
         self.who = who
 
 
+#: The pieces of the last movers marched (:func:`pieces_of`), most recent last.
+_PIECES: list[tuple[tuple[MovingObstacle, ...], PolygonPieces]] = []
+_PIECES_KEPT = 4
+
+
+def pieces_of(movers: Sequence[MovingObstacle]) -> PolygonPieces:
+    """Return the :class:`PolygonPieces` of ``movers``, built or kept from a recent call.
+
+    Movers are immutable values: the same objects in the same order have the same pieces
+    (a re-timing's grids and its fine windows march the same movers). The last
+    :data:`_PIECES_KEPT` are kept, their arrays read-only.
+    """
+    key = tuple(movers)
+    for i, (kept, pieces) in enumerate(_PIECES):
+        if len(kept) == len(key) and all(a is b for a, b in zip(kept, key, strict=True)):
+            _PIECES.append(_PIECES.pop(i))
+            return pieces
+    pieces = PolygonPieces(key)
+    for value in vars(pieces).values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    _PIECES.append((key, pieces))
+    del _PIECES[:-_PIECES_KEPT]
+    return pieces
+
+
 def polygon_runs(
     pts: np.ndarray,
     movers: Sequence[MovingObstacle],
@@ -154,7 +180,7 @@ def polygon_runs(
         A run per stretch of forbidden grid times of a node on one piece (first and last
         time index inclusive; runs of consecutive pieces may touch or overlap).
     """
-    tracks = PolygonPieces(movers)
+    tracks = pieces_of(movers)
     j = tracks.who
     eps = EPS_LIM if sufficient else -EPS_LIM
     lim_add = np.asarray(lim0, dtype=float)[j] + eps
@@ -213,7 +239,7 @@ def _clearance(
     c, s = np.cos(th), np.sin(th)
     dx, dy = px - cx, py - cy
     qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
-    best = np.inf
+    best2, bx, by = np.inf, 0.0, 0.0  # the nearest edge by squared distance, one hypot
     inside = poly[j]
     for e in range(verts.shape[1]):
         qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
@@ -223,10 +249,12 @@ def _clearance(
         if ee > 0.0:
             lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
         rx, ry = qx - lam * ex, qy - lam * ey
-        best = min(best, np.hypot(rx, ry))
+        r2 = rx * rx + ry * ry
+        if r2 < best2:
+            best2, bx, by = r2, rx, ry
         if ex * qy - ey * qx < 0.0:
             inside = False
-    d = 0.0 if inside else best
+    d = 0.0 if inside else np.hypot(bx, by)
     return d - rad - lim_add
 
 

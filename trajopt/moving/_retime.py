@@ -246,14 +246,14 @@ def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float
         theta = float(traj.sample(np.zeros(1)).theta[0])
         c, sn = math.cos(theta), math.sin(theta)
         robot = (p0 + v @ np.array([[c, sn], [-sn, c]]))[None]
-    disc = [m for m in movers if m.vertices is None]
-    if fp is None and disc:  # one vectorised test first: most movers are far
-        c = np.array([m.position_at(0.0) for m in disc])
-        r = np.array([float(m.radius_at(0.0)) for m in disc])
-        gap = np.hypot(c[:, 0] - p0[0, 0], c[:, 1] - p0[0, 1]) - r - traj.robot.radius - margin
-        if np.all(gap > 1e-9) and len(disc) == len(movers):
-            return
-    for m in movers:
+    # most movers are far: clear when their points' distance exceeds both reaches and the margin
+    reach_r = (
+        float(np.max(np.hypot(*(robot[0] - p0[0]).T))) if fp is not None else traj.robot.radius
+    )
+    c = np.array([m.position_at(0.0) for m in movers]).reshape(-1, 2)
+    reach_m = [m.radius_at(0.0) + np.max(np.hypot(*m.shape_vertices.T)) for m in movers]
+    gap = np.hypot(*(c - p0[0]).T) - np.array(reach_m, dtype=float) - reach_r - margin
+    for m in (m for m, g in zip(movers, gap, strict=True) if not g > 1e-9):
         d = float(convex_distance(robot, shape_at(m, np.zeros(1)))[0])
         need = margin + float(m.radius_at(0.0)) + (traj.robot.radius if fp is None else 0.0)
         if d < need:

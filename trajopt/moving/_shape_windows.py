@@ -27,7 +27,12 @@ import numpy as np
 
 from trajopt.moving._disc_windows import close_pairs, inside_times, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._polygon_march import PolygonPieces, launch_bound_kernel, windows_kernel
+from trajopt.moving._polygon_march import (
+    PolygonPieces,
+    launch_bound_kernel,
+    pieces_of,
+    windows_kernel,
+)
 from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
 
 #: The least time step (s) of the fine nodes' windows.
@@ -52,6 +57,13 @@ class ShapeTracks(PolygonPieces):
     movers : sequence of MovingObstacle
         Any shapes (a disc is a polygon of one vertex at its reference point).
     """
+
+    @classmethod
+    def of(cls, movers: Sequence[MovingObstacle]) -> ShapeTracks:
+        """Return the tracks of ``movers``, their pieces shared with a recent march (:func:`._polygon_march.pieces_of`)."""
+        out = cls.__new__(cls)
+        vars(out).update(vars(pieces_of(movers)))
+        return out
 
     def windows(
         self,
@@ -149,7 +161,7 @@ class ShapeWindows(FineWindows):
         self.s, self.h = s, float(s[1] - s[0])
         self.movers, self.limit, self.where, self.speed = list(movers), limit, where, speed
         self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-        self.tracks = ShapeTracks(movers)
+        self.tracks = ShapeTracks.of(movers)
         self.pieces = self.tracks.bound
         if band is None:
             band = (np.zeros(s.shape), np.full(s.shape, np.inf))
