@@ -179,9 +179,15 @@ class PlannerCaches:
             out = out | astar.avoidance_area(grid, o.w_cells, border=True).occupied
         return out
 
-    def _clearance_cost(self, grid: OccupancyGrid) -> np.ndarray:
+    def _clearance_cost(self, grid: OccupancyGrid, outside: bool = True) -> np.ndarray:
+        """Return the clearance cost of ``grid`` (zeros unless the search uses it).
+
+        ``outside=False``: of ``grid``'s cells alone, no outside wall (:meth:`_cost_alone`).
+        """
         cost = np.zeros(grid.shape)
-        if self.options.search in ("clearance", "costmap+clearance"):
+        if self.options.search in ("clearance", "costmap+clearance") and (
+            outside or grid.occupied.any()
+        ):
             cost += astar.clearance_cost(
                 grid,
                 self.options.robot.radius,
@@ -190,7 +196,7 @@ class PlannerCaches:
                     if self.cell_units
                     else falloff_cells(self.options, grid.resolution)
                 ),
-                outside_occupied=True,
+                outside_occupied=outside,
             )
         return cost
 
@@ -200,18 +206,7 @@ class PlannerCaches:
 
     def _cost_alone(self, grid: OccupancyGrid) -> np.ndarray:
         """:meth:`_clearance_cost` of ``grid``'s cells alone, no outside wall (no costmap)."""
-        cost = np.zeros(grid.shape)
-        if self.options.search in ("clearance", "costmap+clearance") and grid.occupied.any():
-            cost += astar.clearance_cost(
-                grid,
-                self.options.robot.radius,
-                falloff_cells=(
-                    FALLOFF_UNITS
-                    if self.cell_units
-                    else falloff_cells(self.options, grid.resolution)
-                ),
-            )
-        return cost
+        return self._clearance_cost(grid, outside=False)
 
     def derived(self, grid: OccupancyGrid) -> PlannerCaches:
         """Return the caches of a changed map of the same frame, leaving these untouched.
