@@ -59,7 +59,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -332,9 +332,13 @@ class Planner:
             movers' swept regions marked, or the robot waits at a safe place
             (:func:`trajopt.moving.reroute`). ``stats["moving"]``: ``route``
             (``"retimed"``, ``"rerouted"`` or ``"waited"``), ``plan`` in words, the
-            certificate and the wall times. Refused with
-            :class:`~trajopt.errors.InvalidInputError`: a moving start (``v_start > 0``)
-            and the stop-and-turn fallback's polyline.
+            certificate and the wall times. From a moving start (``v_start > 0``) the
+            static plan is re-timed as :meth:`replan` re-times its rest
+            (:func:`trajopt.replan.retime_replan`, the splice at ``t = 0``): its curve
+            from the moving state, else a brake along the path to a stop and a plan on from
+            there (``route`` ``"stopped: ..."``). Refused with
+            :class:`~trajopt.errors.InvalidInputError`: the stop-and-turn fallback's
+            polyline.
         mover_margin : float
             Extra distance to every mover (m), >= 0 (checked even without movers).
 
@@ -379,12 +383,44 @@ class Planner:
         )
         with self._lock:
             t0 = time.perf_counter()
-            if movers:
+            if movers and request.v_start != 0.0:  # moving: re-timed as a re-plan's rest
+                out = run_query(self.options, self.caches, request)
+                out = retime_replan(out, movers, margin, 0.0, self._from_stop(out.steps, margin))
+            elif movers:
                 out = plan_among_movers(movers, margin, self.options, self.caches, request)
             else:
                 out = run_query(self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
             return out
+
+    def _from_stop(self, steps: Any, margin: float) -> Callable[..., PlanResult]:
+        """Return the plan from a stop to ``steps``' goal that a blocked re-timing goes on by.
+
+        ``from_stop(position, heading, steer, movers, along=None)``
+        (:data:`trajopt.replan` ``FromStop``): a plan from rest at the stop, for the movers
+        seen from it, as :meth:`plan`'s with movers (:func:`trajopt.planning.plan_from_stop`).
+        """
+
+        def from_stop(
+            p: tuple[float, float],
+            heading: float,
+            steer: float,
+            seen: Sequence[MovingObstacle],
+            along: Any = None,
+        ) -> PlanResult:
+            if steps is None:
+                raise InvalidInputError("the plan has no steps: no goal to go on to")
+            request = PlanRequest(
+                p,
+                tuple(steps.goal),
+                start_heading=heading,
+                goal_heading=steps.goal_heading,
+                start_steer=steer,
+                goal_steer=getattr(steps, "goal_steer", None),
+            )
+            return plan_from_stop(tuple(seen), margin, self.options, self.caches, request, along)
+
+        return from_stop
 
     @property
     def latency_s(self) -> float:
@@ -498,31 +534,8 @@ class Planner:
                 brake_after_s=brake_after_s,
             )
             if movers:
-                steps = out.steps
-
-                def from_stop(
-                    p: tuple[float, float],
-                    heading: float,
-                    steer: float,
-                    seen: Sequence[MovingObstacle],
-                    along: Any = None,
-                ) -> PlanResult:  # a plan from the stop, as plan's with movers
-                    if steps is None:
-                        raise InvalidInputError("the re-plan has no steps: no goal to go on to")
-                    request = PlanRequest(
-                        p,
-                        tuple(steps.goal),
-                        start_heading=heading,
-                        goal_heading=steps.goal_heading,
-                        start_steer=steer,
-                        goal_steer=getattr(steps, "goal_steer", None),
-                    )
-                    return plan_from_stop(
-                        tuple(seen), margin, self.options, self.caches, request, along
-                    )
-
                 ts = float(out.stats["splice_time_s"])
-                out = retime_replan(out, movers, margin, ts, from_stop)
+                out = retime_replan(out, movers, margin, ts, self._from_stop(out.steps, margin))
             self._latencies.append(time.perf_counter() - t0)
             return out
 

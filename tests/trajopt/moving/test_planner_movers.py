@@ -2,7 +2,7 @@
 
 An empty list gives today's plan bit for bit; a mover crossing the planned path is let pass
 (the same path, re-timed, certified and checked on 1 ms samples and by brute force); what is
-not covered yet is refused with a typed error.
+not covered is refused with a typed error; a moving start is re-timed from its speed.
 """
 
 from __future__ import annotations
@@ -78,11 +78,41 @@ def test_a_mover_parked_on_the_path_blocks_it_and_is_driven_round(scene, planned
     assert dense_min(out, [parked])[0] >= -1e-6
 
 
+def _speed_from_positions(traj, dt=1e-3):
+    """Speed (m/s) between 1 ms samples, from the positions alone, shape (n - 1,)."""
+    t = np.arange(0.0, traj.duration, dt)
+    smp = traj.sample(t)
+    return np.hypot(np.diff(smp.x), np.diff(smp.y)) / dt
+
+
+@pytest.mark.parametrize("kind", ["crossing", "parked"])
+def test_a_moving_start_is_re_timed_from_its_speed(scene, kind):
+    """From v_start > 0: a crossing mover is let pass by braking on the path, a parked one
+    is driven round after a stop; both keep the start state and the speed limit."""
+    planner = trajopt.Planner(scene.grid, trajopt.Robot())
+    base = planner.plan(scene.start, scene.goal("A"), v_start=0.2)
+    mover = _crossing(base)
+    if kind == "parked":
+        smp = base.sample(np.array([0.5 * base.duration]))
+        mover = trajopt.MovingObstacle.from_waypoints(
+            [0.0], [(smp.x[0], smp.y[0])], radius=0.2, name="cart"
+        )
+    assert dense_min(base, [mover], margin=0.05)[0] < 0.0  # the static plan meets it
+    out = planner.plan(
+        scene.start, scene.goal("A"), v_start=0.2, moving_obstacles=[mover], mover_margin=0.05
+    )
+    route = out.stats["moving"]["route"]
+    assert route == "retimed" if kind == "crossing" else route.startswith("stopped: ")
+    s0 = out.sample(np.array([0.0]))
+    assert (s0.x[0], s0.y[0]) == pytest.approx(scene.start, abs=1e-9)
+    assert s0.v[0] == pytest.approx(0.2, abs=1e-9) and out.v_start == 0.2
+    assert dense_min(out, [mover], margin=0.05)[0] >= -1e-6
+    assert brute_min(out, [mover], margin=0.05) >= -1e-6
+    assert _speed_from_positions(out).max() <= trajopt.Robot().v_max * (1 + 1e-6)
+
+
 def test_queries_not_covered_are_refused(scene, planned):
     planner, base = planned
-    mover = _crossing(base)
-    with pytest.raises(InvalidInputError, match="moving_obstacles"):
-        planner.plan(scene.start, scene.goal("A"), v_start=0.2, moving_obstacles=[mover])
     with pytest.raises(InvalidInputError, match="MovingObstacle"):
         planner.plan(scene.start, scene.goal("A"), moving_obstacles=[(1.0, 2.0)])
 
