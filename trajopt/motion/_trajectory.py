@@ -454,32 +454,16 @@ class Trajectory(SampledExport):
     def _u_at_s(self, s: np.ndarray) -> np.ndarray:
         """Curve parameter at arc length ``s``.
 
-        The dense ``u_grid`` table, then Newton steps on ``path.s_at_u``, repeated (at most 6)
-        where a step moved ``u`` by more than 1e-9 of the domain (near a sharp curvature peak
-        the table's first guess can be 1e-5 of the domain off). Falls back to ``path.u_at_s``
-        without a table.
+        The dense ``u_grid`` table's guess refined by ``path.refine_u_at_s`` (Newton steps
+        on the quadrature; compiled for a B-spline). Falls back to ``path.u_at_s`` without
+        a table.
         """
         path = self.path
         if self.u_grid.shape[0] < 2:
             return np.asarray(path.u_at_s(s))
         u = np.array(np.interp(s, self.theta_grid_s, self.u_grid), dtype=float)
         ss = np.broadcast_to(np.asarray(s, dtype=float), u.shape)
-        lo, hi = path.domain
-        todo = np.ones(u.shape, dtype=bool)  # only points whose last step moved go on
-        for _ in range(6):
-            uu = u[todo]
-            sp = np.asarray(path.speed(uu))
-            err = np.asarray(path.s_at_u(uu)) - ss[todo]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                step = np.where(sp > 0, err / sp, 0.0)
-            u[todo] = np.clip(uu - step, lo, hi)
-            # Newton converges quadratically: after a step below 1e-9 of the domain the
-            # next would be ~1e-16 of it, so only larger steps are followed up
-            moving = np.abs(step) > 1e-9 * (hi - lo)
-            if not np.any(moving):
-                break
-            todo[todo] = moving
-        return u
+        return path.refine_u_at_s(ss.reshape(-1), u.reshape(-1)).reshape(u.shape)
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample | CarSample:
         """Evaluate the trajectory at times ``t`` (vectorised; a car's is a :class:`CarSample`).
