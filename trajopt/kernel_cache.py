@@ -66,6 +66,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.planning._feasibility",
     "trajopt.robot._footprint_kernels",
     "trajopt.geometry._obstacle_index",
+    "trajopt.motion._phase_motion",
     "trajopt.moving._st_kernels",
     "trajopt.moving._polygon_march",
     "trajopt.moving._grid_kernels",

@@ -22,6 +22,7 @@ import numpy as np
 from astar.files import atomic_write
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import ParametricCurve
+from trajopt.motion._phase_motion import phase_motion
 from trajopt.motion._samples import (
     SAMPLE_UNITS,
     CarSample,
@@ -431,25 +432,21 @@ class Trajectory(SampledExport):
         """Return the motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
 
         Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
-        ``(length, v_end, 0, 0)``.
+        ``(length, v_end, 0, 0)`` (compiled: :func:`~trajopt.motion._phase_motion.phase_motion`).
         """
-        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        k = np.searchsorted(self.phase_t, tt, side="right") - 1
-        k = np.clip(k, 0, self.phase_t.shape[0] - 1)
-        tau = tt - self.phase_t[k]
-        j = self.phase_j[k]
-        a0 = self.phase_a[k]
-        v0 = self.phase_v[k]
-        s = self.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
-        v = v0 + tau * (a0 + 0.5 * j * tau)
-        a = a0 + j * tau
-        end = tt >= self.duration
-        length = self.length
-        s = np.where(end, length, np.clip(s, 0.0, length))
-        v = np.where(end, self.v_end, np.where((v < 0.0) & (v > -1e-9), 0.0, v))
-        a = np.where(end, 0.0, a)
-        j = np.where(end, 0.0, j)
-        return s, v, a, j
+        tt = np.asarray(t, dtype=np.float64)
+        out = phase_motion(
+            self.phase_t,
+            self.phase_s,
+            self.phase_v,
+            self.phase_a,
+            self.phase_j,
+            self.duration,
+            self.length,
+            float(self.v_end),
+            np.ascontiguousarray(tt.reshape(-1)),
+        )
+        return tuple(x.reshape(tt.shape) for x in out)
 
     def _u_at_s(self, s: np.ndarray) -> np.ndarray:
         """Curve parameter at arc length ``s``.
