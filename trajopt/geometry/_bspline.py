@@ -319,7 +319,7 @@ def arc_newton(t1, c1, k1, nodes, s_nodes, s, u, lo, hi, gl_x, gl_w):  # pragma:
     """Refine the parameters ``u`` (in place) at arc lengths ``s`` by Newton steps on the quadrature.
 
     Each point: up to 6 steps ``u -= (s(u) - s) / |C'(u)|`` clipped to ``[lo, hi]``, stopping
-    after a step of at most ``1e-9 (hi - lo)``; ``s(u)`` is the arc-length table's node below
+    after a step of at most ``1e-9 (hi - lo)`` (NaN where ``s`` or the guess is NaN); ``s(u)`` is the arc-length table's node below
     ``u`` plus 5-point Gauss-Legendre quadrature of ``|C'|`` from it (as
     :meth:`ParametricCurve.s_at_u`). The same arithmetic as the vectorised
     :meth:`ParametricCurve.refine_u_at_s`; the quadrature's weighted sum is taken in the
@@ -351,6 +351,9 @@ def arc_newton(t1, c1, k1, nodes, s_nodes, s, u, lo, hi, gl_x, gl_w):  # pragma:
     last = nodes.shape[0] - 2
     for q in range(u.shape[0]):
         x = u[q]
+        if not (x == x and s[q] == s[q]):
+            u[q] = np.nan
+            continue
         for _ in range(6):
             sp = _speed_at(t1, c1, k1, x, d)
             uu = min(max(x, nodes[0]), nodes[-1])
