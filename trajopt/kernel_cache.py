@@ -69,6 +69,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.motion._phase_motion",
     "trajopt.moving._st_kernels",
     "trajopt.moving._polygon_march",
+    "trajopt.moving._polygon_distance",
     "trajopt.moving._grid_kernels",
     "trajopt.corridor._polygons.path_kernels",
     "trajopt.corridor._polygons.region_kernels",
