@@ -141,7 +141,7 @@ def _around_the_wall(planner: Planner, start, goal) -> np.ndarray:
 
 
 def _exercise_timing() -> None:
-    """Time a cubic B-spline (an S-bend) from rest and between moving states."""
+    """Time a cubic B-spline (an S-bend) from rest and between moving states; evaluate poses."""
     from trajopt.geometry import BSplineCurve, clamped_uniform_knots
     from trajopt.robot import Robot
     from trajopt.timing import time_parameterize
@@ -149,8 +149,9 @@ def _exercise_timing() -> None:
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 1.0], [3.0, 1.0], [4.0, 0.0], [5.0, 0.0]])
     curve = BSplineCurve(clamped_uniform_knots(len(pts), 3, (0.0, 6.0)), pts, 3)
     robot = Robot()
-    time_parameterize(curve, robot)
+    traj = time_parameterize(curve, robot)
     time_parameterize(curve, robot, v_start=0.05, v_end=0.05)
+    traj.pose(np.linspace(0.0, traj.duration, 5))  # the arc-length inversion (arc_newton)
 
 
 def _exercise_moving() -> None:

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._curve import ParametricCurve
+from trajopt.geometry._curve import GL_W, GL_X, ParametricCurve
 from trajopt.kernel_cache import watch_compiles
 
 
@@ -94,6 +98,31 @@ class BSplineCurve(ParametricCurve):
         t, c = self._derivative_coefficients(nu)  # float64, contiguous
         flat = np.ascontiguousarray(uu.reshape(-1))
         return de_boor(t, c, self.k - nu, flat).reshape(uu.shape + (2,))
+
+    def refine_u_at_s(self, s: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Refine first guesses ``u`` at arc lengths ``s`` (m): :meth:`ParametricCurve.refine_u_at_s`, compiled.
+
+        The same Newton steps, point by point in one compiled loop (:func:`arc_newton`).
+
+        Parameters
+        ----------
+        s : ndarray, shape (n,)
+            Arc lengths (m) from the start.
+        u : ndarray, shape (n,)
+            First guesses of the parameters.
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            The refined parameters, clipped to :attr:`domain` (a new array).
+        """
+        nodes, s_nodes, _ = self._arc_table()
+        t1, c1 = self._derivative_coefficients(1)
+        lo, hi = self.domain
+        out = np.array(u, dtype=np.float64)
+        ss = np.ascontiguousarray(np.broadcast_to(np.asarray(s, dtype=np.float64), out.shape))
+        arc_newton(t1, c1, self.k - 1, nodes, s_nodes, ss, out, lo, hi, GL_X, GL_W)
+        return out
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
         """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
@@ -251,6 +280,96 @@ def derivative_control_points(
 
 
 watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):  # pragma: no cover - compiled
+    """Return ``a * b + c`` rounded once (LLVM's ``llvm.fma.f64``)."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        d = ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [d], ir.FunctionType(d, [d, d, d]))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+@njit(cache=True)
+def _speed_at(t, c, k, x, d):  # pragma: no cover - compiled
+    """Return ``|C(x)|`` of the planar spline ``(t, c, k)`` (de Boor's algorithm as :func:`de_boor`; ``d``: scratch, shape (k + 1, 2))."""
+    n = c.shape[0]
+    x = min(max(x, t[k]), t[n])
+    j = np.searchsorted(t, x, side="right") - 1
+    j = min(max(j, k), n - 1)
+    for i in range(k + 1):
+        d[i, 0] = c[j - k + i, 0]
+        d[i, 1] = c[j - k + i, 1]
+    for r in range(1, k + 1):
+        for i in range(k, r - 1, -1):
+            left = t[j - k + i]
+            alpha = (x - left) / (t[j + 1 + i - r] - left)
+            d[i, 0] = (1.0 - alpha) * d[i - 1, 0] + alpha * d[i, 0]
+            d[i, 1] = (1.0 - alpha) * d[i - 1, 1] + alpha * d[i, 1]
+    return math.hypot(d[k, 0], d[k, 1])
+
+
+@njit(cache=True)
+def arc_newton(t1, c1, k1, nodes, s_nodes, s, u, lo, hi, gl_x, gl_w):  # pragma: no cover - compiled
+    """Refine the parameters ``u`` (in place) at arc lengths ``s`` by Newton steps on the quadrature.
+
+    Each point: up to 6 steps ``u -= (s(u) - s) / |C'(u)|`` clipped to ``[lo, hi]``, stopping
+    after a step of at most ``1e-9 (hi - lo)`` (NaN where ``s`` or the guess is NaN); ``s(u)`` is the arc-length table's node below
+    ``u`` plus 5-point Gauss-Legendre quadrature of ``|C'|`` from it (as
+    :meth:`ParametricCurve.s_at_u`). The same arithmetic as the vectorised
+    :meth:`ParametricCurve.refine_u_at_s`; the quadrature's weighted sum is taken in the
+    order numpy's matrix product takes it on OpenBLAS's AVX-512 kernel (bit-identical
+    there; elsewhere the two can differ in the last bit).
+
+    Parameters
+    ----------
+    t1 : ndarray, shape (m + k1 + 1,)
+        Knots of the curve's derivative ``C'``.
+    c1 : ndarray, shape (m, 2)
+        Its control points (m per unit of ``u``).
+    k1 : int
+        Its degree (the curve's minus one).
+    nodes, s_nodes : ndarray, shape (q,)
+        The arc-length table: parameters and arc lengths (m) at them.
+    s : ndarray, shape (n,)
+        Target arc lengths (m).
+    u : ndarray, shape (n,)
+        First guesses, overwritten by the refined parameters.
+    lo, hi : float
+        The domain.
+    gl_x, gl_w : ndarray, shape (5,)
+        Gauss-Legendre nodes on ``[-1, 1]`` and weights.
+    """
+    d = np.empty((k1 + 1, 2))
+    v = np.empty(5)
+    tol = 1e-9 * (hi - lo)
+    last = nodes.shape[0] - 2
+    for q in range(u.shape[0]):
+        x = u[q]
+        if not (x == x and s[q] == s[q]):
+            u[q] = np.nan
+            continue
+        for _ in range(6):
+            sp = _speed_at(t1, c1, k1, x, d)
+            uu = min(max(x, nodes[0]), nodes[-1])
+            i = min(max(np.searchsorted(nodes, uu, side="right") - 1, 0), last)
+            a = nodes[i]
+            half = 0.5 * (uu - a)
+            mid = 0.5 * (a + uu)
+            for g in range(5):
+                v[g] = _speed_at(t1, c1, k1, mid + half * gl_x[g], d)
+            acc = (v[0] * gl_w[0] + v[2] * gl_w[2]) + (v[1] * gl_w[1] + v[3] * gl_w[3])
+            err = (s_nodes[i] + half * _fma(v[4], gl_w[4], acc)) - s[q]
+            step = err / sp if sp > 0 else 0.0
+            x = min(max(x - step, lo), hi)
+            if not abs(step) > tol:
+                break
+        u[q] = x
 
 
 @njit(cache=True)

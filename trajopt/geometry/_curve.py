@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial.legendre import leggauss
 
-_GL_X, _GL_W = leggauss(5)
+GL_X, GL_W = leggauss(5)  # 5-point Gauss-Legendre nodes on [-1, 1], weights
 STILL_SPEED_RATIO = 1e-9  # |c'| below this fraction of the mean parametric speed counts as zero
 
 
@@ -190,8 +190,8 @@ class ParametricCurve(ABC):
 
     def _gl(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         half = 0.5 * (b - a)
-        q = (0.5 * (a + b))[:, None] + half[:, None] * _GL_X[None, :]
-        return half * (self.speed(q) @ _GL_W)
+        q = (0.5 * (a + b))[:, None] + half[:, None] * GL_X[None, :]
+        return half * (self.speed(q) @ GL_W)
 
     @property
     def length(self) -> float:
@@ -211,8 +211,8 @@ class ParametricCurve(ABC):
     def _partial_length(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         half = 0.5 * (b - a)
         mid = 0.5 * (a + b)
-        q = mid[..., None] + half[..., None] * _GL_X
-        return half * (self.speed(q) @ _GL_W)
+        q = mid[..., None] + half[..., None] * GL_X
+        return half * (self.speed(q) @ GL_W)
 
     def u_at_s(self, s: np.ndarray | float, *, exact: bool = True) -> np.ndarray:
         """Parameter at arc length ``s`` (m) from the start, vectorised.
@@ -244,6 +244,44 @@ class ParametricCurve(ABC):
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = np.where(df > 0, f / df, 0.0)
             u = np.clip(u - step, lo, hi)
+        return u
+
+    def refine_u_at_s(self, s: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Refine first guesses ``u`` of the parameters at arc lengths ``s`` (m) by Newton steps.
+
+        Newton steps on :meth:`s_at_u` (the quadrature), each point repeated (at most 6 steps)
+        while its last step moved it by more than 1e-9 of the domain: Newton converges
+        quadratically, so after a step below that the next would be ~1e-16 of the domain.
+        A good first guess (a dense table's) needs one or two steps; near a sharp curvature
+        peak a table's guess can be 1e-5 of the domain off and needs more.
+
+        Parameters
+        ----------
+        s : ndarray, shape (n,)
+            Arc lengths (m) from the start.
+        u : ndarray, shape (n,)
+            First guesses of the parameters (in the domain).
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            The refined parameters, clipped to :attr:`domain` (a new array).
+        """
+        u = np.array(u, dtype=float)
+        ss = np.broadcast_to(np.asarray(s, dtype=float), u.shape)
+        lo, hi = self.domain
+        todo = np.ones(u.shape, dtype=bool)  # only points whose last step moved go on
+        for _ in range(6):
+            uu = u[todo]
+            sp = np.asarray(self.speed(uu))
+            err = np.asarray(self.s_at_u(uu)) - ss[todo]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = np.where(sp > 0, err / sp, 0.0)
+            u[todo] = np.clip(uu - step, lo, hi)
+            moving = np.abs(step) > 1e-9 * (hi - lo)
+            if not np.any(moving):
+                break
+            todo[todo] = moving
         return u
 
     # ---------------------------------------------------------------- sampling

@@ -22,6 +22,7 @@ import numpy as np
 from astar.files import atomic_write
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import ParametricCurve
+from trajopt.motion._phase_motion import phase_motion
 from trajopt.motion._samples import (
     SAMPLE_UNITS,
     CarSample,
@@ -431,55 +432,35 @@ class Trajectory(SampledExport):
         """Return the motion along the path only: ``(s, v, a, jerk)`` at times ``t`` (s).
 
         Times are clipped to ``[0, duration]``; at and after ``duration`` the state is exactly
-        ``(length, v_end, 0, 0)``.
+        ``(length, v_end, 0, 0)`` (compiled: :func:`~trajopt.motion._phase_motion.phase_motion`).
         """
-        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        k = np.searchsorted(self.phase_t, tt, side="right") - 1
-        k = np.clip(k, 0, self.phase_t.shape[0] - 1)
-        tau = tt - self.phase_t[k]
-        j = self.phase_j[k]
-        a0 = self.phase_a[k]
-        v0 = self.phase_v[k]
-        s = self.phase_s[k] + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0))
-        v = v0 + tau * (a0 + 0.5 * j * tau)
-        a = a0 + j * tau
-        end = tt >= self.duration
-        length = self.length
-        s = np.where(end, length, np.clip(s, 0.0, length))
-        v = np.where(end, self.v_end, np.where((v < 0.0) & (v > -1e-9), 0.0, v))
-        a = np.where(end, 0.0, a)
-        j = np.where(end, 0.0, j)
-        return s, v, a, j
+        tt = np.asarray(t, dtype=np.float64)
+        out = phase_motion(
+            self.phase_t,
+            self.phase_s,
+            self.phase_v,
+            self.phase_a,
+            self.phase_j,
+            self.duration,
+            self.length,
+            float(self.v_end),
+            np.ascontiguousarray(tt.reshape(-1)),
+        )
+        return tuple(x.reshape(tt.shape) for x in out)
 
     def _u_at_s(self, s: np.ndarray) -> np.ndarray:
         """Curve parameter at arc length ``s``.
 
-        The dense ``u_grid`` table, then Newton steps on ``path.s_at_u``, repeated (at most 6)
-        where a step moved ``u`` by more than 1e-9 of the domain (near a sharp curvature peak
-        the table's first guess can be 1e-5 of the domain off). Falls back to ``path.u_at_s``
-        without a table.
+        The dense ``u_grid`` table's guess refined by ``path.refine_u_at_s`` (Newton steps
+        on the quadrature; compiled for a B-spline). Falls back to ``path.u_at_s`` without
+        a table.
         """
         path = self.path
         if self.u_grid.shape[0] < 2:
             return np.asarray(path.u_at_s(s))
         u = np.array(np.interp(s, self.theta_grid_s, self.u_grid), dtype=float)
         ss = np.broadcast_to(np.asarray(s, dtype=float), u.shape)
-        lo, hi = path.domain
-        todo = np.ones(u.shape, dtype=bool)  # only points whose last step moved go on
-        for _ in range(6):
-            uu = u[todo]
-            sp = np.asarray(path.speed(uu))
-            err = np.asarray(path.s_at_u(uu)) - ss[todo]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                step = np.where(sp > 0, err / sp, 0.0)
-            u[todo] = np.clip(uu - step, lo, hi)
-            # Newton converges quadratically: after a step below 1e-9 of the domain the
-            # next would be ~1e-16 of it, so only larger steps are followed up
-            moving = np.abs(step) > 1e-9 * (hi - lo)
-            if not np.any(moving):
-                break
-            todo[todo] = moving
-        return u
+        return path.refine_u_at_s(ss.reshape(-1), u.reshape(-1)).reshape(u.shape)
 
     def sample(self, t: np.ndarray | float) -> TrajectorySample | CarSample:
         """Evaluate the trajectory at times ``t`` (vectorised; a car's is a :class:`CarSample`).

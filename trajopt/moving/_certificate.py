@@ -56,6 +56,7 @@ from trajopt.errors import InvalidInputError
 from trajopt.moving._disc_windows import track_knots
 from trajopt.moving._mover_segments import MoverSegments
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._polygon_distance import point_polygon_kernel
 from trajopt.moving._robot_windows import robot_windows
 
 #: Bisection budget (intervals evaluated per mover) before the certificate gives up undecided.
@@ -132,21 +133,10 @@ def second_order_lower(d: np.ndarray, rel: np.ndarray, h: float, c2: np.ndarray)
 
 
 def point_polygon_distance(p: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Distance (m) from points ``p`` (n, 2) to convex CCW polygons ``w`` (n, m, 2); 0 inside."""
-    if w.shape[1] == 1:
-        d = p - w[:, 0]
-        return np.hypot(d[:, 0], d[:, 1])
-    a = w
-    b = np.roll(w, -1, axis=1)
-    e = b - a
-    q = p[:, None, :] - a
-    ee = np.maximum(np.sum(e * e, axis=2), 1e-300)
-    lam = np.clip(np.sum(q * e, axis=2) / ee, 0.0, 1.0)
-    r = q - lam[..., None] * e
-    dist = np.min(np.hypot(r[..., 0], r[..., 1]), axis=1)
-    cross = e[..., 0] * q[..., 1] - e[..., 1] * q[..., 0]
-    inside = np.all(cross >= 0.0, axis=1)
-    return np.where(inside, 0.0, dist)
+    """Distance (m) from points ``p`` (n, 2) to convex CCW polygons ``w`` (n, m, 2); 0 inside (compiled: :func:`~trajopt.moving._polygon_distance.point_polygon_kernel`)."""
+    return point_polygon_kernel(
+        np.ascontiguousarray(p, dtype=np.float64), np.ascontiguousarray(w, dtype=np.float64)
+    )
 
 
 def convex_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -53,6 +53,10 @@ class SmoothPath(ParametricCurve):
     def _arc_table(self):
         return self.curve._arc_table()
 
+    def refine_u_at_s(self, s: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Refine first guesses ``u`` at arc lengths ``s`` (m): the B-spline's (compiled)."""
+        return self.curve.refine_u_at_s(s, u)
+
     @property
     def control_points(self) -> np.ndarray:
         """Control points, shape (n, 2) (m, read-only)."""

@@ -263,3 +263,35 @@ def test_far_intervals_set_aside_change_nothing(monkeypatch):
     assert {c.verdict for c in every} == {"clear", "violated"}
     assert fast_short == every_short
     assert "undecided" in {c.verdict for c in every_short}
+
+
+@pytest.mark.parametrize("m", [1, 3, 4, 7])
+def test_point_polygon_distance_against_dense_edges_and_matplotlib(m):
+    # random convex CCW polygons (m vertices on circles) and points near them: the distance
+    # against the least over 2001 samples of every edge (within the sampling's half-step),
+    # 0 exactly inside (matplotlib's point-in-polygon, shrunk by 1e-9 m to avoid the edges)
+    from matplotlib.path import Path
+
+    from trajopt.moving._certificate import point_polygon_distance
+
+    rng = np.random.default_rng(m)
+    n = 60
+    ang = np.sort(rng.uniform(0.0, 2.0 * math.pi, (n, m)), axis=1)
+    rad = rng.uniform(0.2, 1.0, (n, 1))
+    w = np.stack([rad * np.cos(ang), rad * np.sin(ang)], axis=-1) + rng.normal(size=(n, 1, 2))
+    p = rng.normal(size=(n, 2))
+    got = point_polygon_distance(p, w)
+    lam = np.linspace(0.0, 1.0, 2001)
+    n_inside = 0
+    for i in range(n):
+        a, b = w[i], np.roll(w[i], -1, axis=0)
+        pts = (a[:, None, :] + lam[None, :, None] * (b - a)[:, None, :]).reshape(-1, 2)
+        ref = float(np.min(np.hypot(*(pts - p[i]).T)))
+        step = float(np.max(np.hypot(*(b - a).T))) / 2000.0
+        inside = m >= 3 and Path(w[i]).contains_point(p[i], radius=-1e-9)
+        n_inside += inside
+        if inside:
+            assert got[i] == 0.0
+        else:
+            assert ref - 0.5 * step - 1e-12 <= got[i] <= ref + 1e-12
+    assert m < 3 or 0 < n_inside < n
