@@ -176,6 +176,9 @@ class CarFound:
         The certified fits, in order.
     tries : list of str
         Every try made, this one last.
+    expansions : int
+        The expansions of every try's search, this one's included (at most the plan's cap:
+        :func:`expansion_caps`).
     """
 
     search_grid: OccupancyGrid
@@ -184,6 +187,7 @@ class CarFound:
     poses: np.ndarray
     segments: list[CarSegment]
     tries: list[str]
+    expansions: int
 
 
 def search_and_fit(
@@ -291,6 +295,13 @@ def search_and_fit(
                             **first_grid_limits(robot, margin),
                         )
                     spent += int(path.stats["expanded"])
+                    if any(sub["stop"] == "time_budget" for sub in path.stats["searches"]):
+                        # the first of two searches stopped by its share of the safety net
+                        raise safety_net_error(
+                            f"the search {label!r} ran into its wall-clock safety net "
+                            f"(a share of {SEARCH_SAFETY_S:g} s) before its expansion cap",
+                            tries,
+                        )
                     break
                 except astar.NoPosePathError as exc:
                     spent += int((exc.stats or {}).get("expanded", 0))
@@ -346,7 +357,7 @@ def search_and_fit(
                 failures.append(exc)
                 continue
             tries.append(f"{label}: planned")
-            return CarFound(search_grid, path, r_cells, poses, segments, tries)
+            return CarFound(search_grid, path, r_cells, poses, segments, tries, spent)
     raise failure(robot, grid, start, goal, tries, failures)
 
 
