@@ -140,7 +140,12 @@ def test_parallel_slot_1_3_lengths_is_parked_backwards_from_the_goal():
     # the slot is the tighter end: a probe from the start, then the search from the goal
     assert p.stats["search_from"] == "goal"
     probe, pull_out = p.stats["searches"]
-    assert probe == {"from": "start", "status": 2, "expanded": AUTO_PROBE}
+    assert probe == {
+        "from": "start",
+        "status": 2,
+        "stop": "max_expansions",
+        "expanded": AUTO_PROBE,
+    }
     assert pull_out["from"] == "goal" and pull_out["status"] == 1
     assert p.cusps >= 1 and p.reverse_length > 0.0
     check_big_body(p, occ, poly, start, goal)
@@ -165,7 +170,12 @@ def test_parallel_slot_from_the_start_is_the_old_search():
         _search(occ, poly, start, goal, time_budget=0.3, search_from="start")
     assert info.value.reason == "time_budget"
     assert info.value.stats["searches"] == [
-        {"from": "start", "status": 3, "expanded": info.value.stats["expanded"]}
+        {
+            "from": "start",
+            "status": 3,
+            "stop": "time_budget",
+            "expanded": info.value.stats["expanded"],
+        }
     ]
     p = _search(occ, poly, start, goal, time_budget=0.3, search_from="goal")
     check_big_body(p, occ, poly, start, goal)
