@@ -34,10 +34,14 @@ Each search stops after :data:`SEARCH_EXPANSIONS` expansions
 (:data:`FOOTPRINT_SEARCH_EXPANSIONS` for a car with a body, its default costs after
 :data:`FOOTPRINT_DEFAULT_EXPANSIONS`), and the searches of one plan share
 :data:`CAR_EXPANSIONS` (:data:`FOOTPRINT_CAR_EXPANSIONS`): no try starts once they are
-spent, and a try gets at most what is left. The wall-clock limits, :data:`SEARCH_SAFETY_S` per search and :data:`CAR_BUDGET_S`
-per plan, are only safety nets, far above what the searches take (module constants); when
-one fires, the plan stops with a :class:`~trajopt.errors.NoPathError` that says so (its
-answer would depend on the machine's load) instead of going on to the next try.
+spent, and a try gets at most what is left. The wall-clock limits, :data:`SEARCH_SAFETY_S`
+per search and :data:`CAR_BUDGET_S` per plan, are only safety nets, far above what the
+searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
+that says so (its answer would depend on the machine's load) instead of going on to the
+next try. The fits keep the smoother's own wall-clock budget (at most
+``trajopt.planning._car.SEGMENT_BUDGET_S``, 2 s, per fit; the smooth stage of a plan
+takes about 20 ms at the median on ``benchmarks/bench_car.py``'s queries), and a fit that
+runs out of it goes on to the next try: not yet a count.
 """
 
 from __future__ import annotations
@@ -382,9 +386,9 @@ def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], int], ...]:
     default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (the paths they find
     where they find one quickly: drives into a bay without reversing), then
     :data:`FOOTPRINT_COSTS` (named ``", parking costs"`` in the tries) for
-    :data:`FOOTPRINT_SEARCH_EXPANSIONS`. A search that exhausts its states (every reachable state
-    expanded) ends the variants of its try: the costs change the order of the expansions,
-    not the states reachable.
+    :data:`FOOTPRINT_SEARCH_EXPANSIONS`. A search that exhausts its states (every reachable
+    state expanded) ends the variants of its try: the costs change the order of the
+    expansions, not the states reachable.
     """
     search_cap = expansion_caps(robot)[0]
     if robot.footprint is None:
