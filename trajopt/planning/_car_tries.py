@@ -135,9 +135,9 @@ TIGHT_MIN_SLACK_CELLS = 0.05
 FIRST_GRID_RETRY_EXPANSIONS = 0
 #: Caps (expansions) that decide when a search of a car's plan gives up (module docstring):
 #: ``(per search, all the searches of one plan)``, for a disc and for a car with a body
-#: (:func:`expansion_caps`). They replace wall-clock budgets of 2 s per search and 6 s per
-#: plan, at what those allowed on a quiet machine: a disc's search expands a state in about
-#: 3.5 us (the search's default 500 000 came first), a body's in 10-14 us (footprint tests).
+#: (:func:`expansion_caps`). About what 2 s per search and 6 s per plan allow on a quiet
+#: machine: a disc's search expands a state in about 3.5 us, a body's in 10-14 us (its
+#: footprint tests).
 #: What the searches need: on the parking suite (full-size car at 0.1 and 0.05 m, small car
 #: at 0.05 m) the largest search that found a path expanded 51 225 states, the most one
 #: plan expanded in all 70 380; on the held-out road and room queries of
