@@ -311,7 +311,11 @@ def search_and_fit(
                     spent += int((exc.stats or {}).get("expanded", 0))
                     tries.append(f"{label}: no path ({exc.reason})")
                     failures.append(exc)
-                    if exc.reason == "time_budget":
+                    subs = (exc.stats or {}).get("searches", [])
+                    if exc.reason == "time_budget" or any(
+                        sub["stop"] == "time_budget" for sub in subs
+                    ):  # the clock stopped a search (the first of two: the second's answer
+                        # could differ from the one after the first's expansion share)
                         raise safety_net_error(
                             f"the search {label!r} ran into its wall-clock safety net of "
                             f"{SEARCH_SAFETY_S:g} s ({exc.stats.get('expanded', 0)} expansions)",
