@@ -51,6 +51,7 @@ _DIJKSTRA_SLACK_R = 20.0  # the 2-D distance field reaches 20 R + 50 cells beyon
 _RETRY_BELOW = 20_000  # an exhausted search this small is retried at a finer resolution
 _POLISH = 100  # expansions the search may go on after its first path, besides as many again
 _REASONS = ("disconnected", "exhausted", "max_expansions", "time_budget")
+_STOPS = ("exhausted", "found", "max_expansions", "time_budget")  # by the kernel's status code
 
 
 class NoPosePathError(NoPathError):
@@ -109,7 +110,9 @@ class PosePath:
         ``footprint`` (True), ``footprint_margin`` and ``footprint_slack`` (cells);
         ``search_from`` (``"start"`` or ``"goal"``: the search that returned) and
         ``searches`` (per search run: ``from``, ``status`` (the kernel's code: 1 found, 0
-        exhausted, 2 max_expansions, 3 time_budget) and ``expanded``).
+        exhausted, 2 max_expansions, 3 time_budget), ``stop`` (the same as a word:
+        ``"found"``, ``"exhausted"``, ``"max_expansions"`` or ``"time_budget"``; only
+        ``"time_budget"`` depends on the machine's speed) and ``expanded``).
 
     Attributes
     ----------
@@ -476,7 +479,12 @@ def find_pose_path(
             expanded += min(int(out[7]), left)
             shots += int(out[8])
         stats["searches"].append(
-            {"from": "goal" if backward else "start", "status": int(status), "expanded": n_exp}
+            {
+                "from": "goal" if backward else "start",
+                "status": int(status),
+                "stop": _STOPS[int(status)],
+                "expanded": n_exp,
+            }
         )
         if status in (FOUND, EXHAUSTED) or retried or expanded >= max_exp:
             break  # found, or no path at all: the other end's states are the same
@@ -519,7 +527,10 @@ def find_pose_path(
                 )
         elif status == TIME_BUDGET:
             reason = "time_budget"
-            why = f"the search ran out of its time_budget of {budget:g} s ({expanded} expansions)"
+            why = (
+                f"the search ran out of its time_budget of {budget:g} s ({expanded} expansions; "
+                "wall clock: where it stops depends on the machine's load)"
+            )
         else:
             reason = "max_expansions"
             why = f"the search reached max_expansions={max_exp}"

@@ -231,8 +231,11 @@ class HybridLimits:
     max_expansions : int, optional
         ``>= 1``: the search gives up after this many expansions.
     time_budget : float, optional
-        ``> 0``: seconds; the search (not the 2-D distance field before it) gives up after
-        this long (checked every 128 expansions).
+        ``> 0``: seconds of wall clock; the search (not the 2-D distance field before it)
+        gives up after this long (checked every 128 expansions). A search it stops depends on
+        the machine's speed and load; for answers that do not, let ``max_expansions`` decide
+        and set this far above the time those expansions take, as a safety net (the car
+        planner does: ``trajopt/planning/_car_tries.py``).
     sample_step : float, optional
         ``> 0``: largest arc length between returned poses, cells (ignored in the exact
         clearance mode, whose poses are the collision samples, at most 0.2 cells apart).

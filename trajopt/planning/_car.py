@@ -8,8 +8,9 @@ A car faces its direction of travel (or its reverse), turns no tighter than its
    (Hybrid-A* with Reeds-Shepp shots, or Dubins shots when ``robot.drive.reverse`` is False) from
    the start pose to the goal pose, on the raw map inflated by the robot radius plus a
    margin, with a turning radius a little above ``R``; gentler or tighter radii and the grid
-   inflated by the radius alone are the further tries, all within one budget;
-   ``stats["car"]["tries"]`` lists them.
+   inflated by the radius alone are the further tries, all within one budget of
+   expansions (wall-clock limits only as safety nets); ``stats["car"]["tries"]`` lists
+   them, ``stats["car"]["expansions"]`` counts their expansions.
 2. **Segments** (:mod:`trajopt.planning._car_fit`). The path is split at its cusps (where
    the direction of travel flips; the heading is continuous there, the tangent flips by
    ``pi``). Each segment is fitted as an ordinary curve in the direction of travel in a
@@ -308,6 +309,7 @@ def plan_car(
             "search_length_m": float(path.length * res),
             "search_turning_radius_m": radius_cells * res,
             "tries": tries,
+            "expansions": found.expansions,
             "corridors": [s.corridor_kind for s in segments],
             "steer_at_rest": steered,
             "search": dict(path.stats),

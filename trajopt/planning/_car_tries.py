@@ -27,7 +27,21 @@ obstacles: :func:`exact_clearance`). When every radius of the second grid exhaus
 states, a car with a body searches it once more at :data:`TIGHT_FACTORS` with finer heading
 bins, shorter primitives and finer states near the end poses (:func:`tight_motion`,
 :func:`search_factors`): a bay entered nose first off a narrow aisle.
-The tries share :data:`CAR_BUDGET_S`; ``stats["car"]["tries"]`` lists them.
+``stats["car"]["tries"]`` lists them.
+
+Budgets: expansion counts decide, so that the plan does not depend on the machine's load.
+Each search stops after :data:`SEARCH_EXPANSIONS` expansions
+(:data:`FOOTPRINT_SEARCH_EXPANSIONS` for a car with a body, its default costs after
+:data:`FOOTPRINT_DEFAULT_EXPANSIONS`), and the searches of one plan share
+:data:`CAR_EXPANSIONS` (:data:`FOOTPRINT_CAR_EXPANSIONS`): no try starts once they are
+spent, and a try gets at most what is left. The wall-clock limits, :data:`SEARCH_SAFETY_S`
+per search and :data:`CAR_BUDGET_S` per plan, are only safety nets, far above what the
+searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
+that says so (its answer would depend on the machine's load) instead of going on to the
+next try. The fits keep the smoother's own wall-clock budget (at most
+``trajopt.planning._car.SEGMENT_BUDGET_S``, 2 s, per fit; the smooth stage of a plan
+takes about 20 ms at the median on ``benchmarks/bench_car.py``'s queries), and a fit that
+runs out of it goes on to the next try: not yet a count.
 """
 
 from __future__ import annotations
@@ -84,12 +98,9 @@ FOOTPRINT_MIN_SLACK_CELLS = 0.05
 #: that ran the second grid's search out of 3 s, these planned 5 (0.3-2.6 s). Tried after
 #: the default costs (:func:`cost_variants`).
 FOOTPRINT_COSTS = {"cusp_penalty": 0.5, "reverse_penalty": 1.2, "heuristic_weight": 2.5}
-#: Caps on the search of a car with a body at the default costs, before
-#: :data:`FOOTPRINT_COSTS`: expansions (the cap that decides, so that the path does not
-#: depend on the machine's load; 0.05-0.08 s of CPU on the parking suite's slow cases at
-#: 0.1 m) and seconds.
+#: Cap (expansions) on the search of a car with a body at the default costs, before
+#: :data:`FOOTPRINT_COSTS` (0.05-0.08 s of CPU on the parking suite's slow cases at 0.1 m).
 FOOTPRINT_DEFAULT_EXPANSIONS = 5000
-FOOTPRINT_DEFAULT_BUDGET_S = 0.5
 #: Turning radii of the search, as multiples of ``min_turning_radius``, tried in order
 #: (module docstring: a factor above one that failed to search is skipped afterwards).
 SEARCH_RADIUS_FACTORS = (1.15, 1.5, 1.05, 1.0)
@@ -122,10 +133,29 @@ TIGHT_MIN_SLACK_CELLS = 0.05
 #: expansions and cusps (the suite's full-parallel-forwards-3 at 0.1 m: 68 000 expansions
 #: and 12 cusps on the first grid against about 20 000 and 9 on the second).
 FIRST_GRID_RETRY_EXPANSIONS = 0
-#: Time (s) after which no further try (search and fits) of a car's plan starts.
-CAR_BUDGET_S = 6.0
-#: Cap (s) on the Hybrid-A* search's time budget per try.
-SEARCH_BUDGET_S = 2.0
+#: Caps (expansions) that decide when a search of a car's plan gives up (module docstring):
+#: ``(per search, all the searches of one plan)``, for a disc and for a car with a body
+#: (:func:`expansion_caps`). About what 2 s per search and 6 s per plan allow on a quiet
+#: machine: a disc's search expands a state in about 3.5 us, a body's in 10-14 us (its
+#: footprint tests).
+#: What the searches need: on the parking suite (full-size car at 0.1 and 0.05 m, small car
+#: at 0.05 m) the largest search that found a path expanded 51 225 states, the most one
+#: plan expanded in all 70 380; on the held-out road and room queries of
+#: ``benchmarks/bench_car.py`` (5 a map) a disc's largest search expanded 105 711 (its
+#: states exhausted), the largest that found a path 31 238.
+SEARCH_EXPANSIONS = 500_000
+CAR_EXPANSIONS = 1_500_000
+FOOTPRINT_SEARCH_EXPANSIONS = 150_000
+FOOTPRINT_CAR_EXPANSIONS = 450_000
+#: Safety net (s, wall clock) on one search (``time_budget`` of
+#: :func:`astar.find_pose_path`): about 15 times what a search that reaches its expansion
+#: cap takes on a quiet machine (1.7-2.1 s); the searches of the parking suite take at most
+#: 0.6 s. When it fires, the plan stops with a :class:`~trajopt.errors.NoPathError` saying so.
+SEARCH_SAFETY_S = 30.0
+#: Safety net (s, wall clock) on a car's plan: a try due to start after it raises
+#: :class:`~trajopt.errors.NoPathError` saying so instead. About 10 times what the tries
+#: take when they spend every expansion on a quiet machine (about 6 s).
+CAR_BUDGET_S = 60.0
 #: Slack (m) of the search's exact clearance on the radius grid: a quarter of the corridor's
 #: tolerance (``trajopt.corridor`` accepts points ``1e-9`` m closer than the radius), so that
 #: an end point exactly at the radius from a wall (a cell centre) may leave it.
@@ -150,6 +180,9 @@ class CarFound:
         The certified fits, in order.
     tries : list of str
         Every try made, this one last.
+    expansions : int
+        The expansions of every try's search, this one's included (at most the plan's cap:
+        :func:`expansion_caps`).
     """
 
     search_grid: OccupancyGrid
@@ -158,6 +191,7 @@ class CarFound:
     poses: np.ndarray
     segments: list[CarSegment]
     tries: list[str]
+    expansions: int
 
 
 def search_and_fit(
@@ -208,6 +242,8 @@ def search_and_fit(
     sm = smoother
     sm_tight = dataclasses.replace(sm, kappa_margin=max(sm.kappa_margin, TIGHT_KAPPA_MARGIN))
     t_end = time.perf_counter() + CAR_BUDGET_S
+    search_cap, car_cap = expansion_caps(robot)
+    spent = 0  # expansions of the searches so far
     tries: list[str] = []
     failures: list[Exception] = []
     for margin in (True, False):
@@ -223,21 +259,32 @@ def search_and_fit(
         largest = math.inf
         exhausted: list[float] = []
         for factor, tight in search_factors(robot, margin):
-            if time.perf_counter() > t_end or (
-                factor > largest if not tight else factor not in exhausted
-            ):
+            if spent >= car_cap or (factor > largest if not tight else factor not in exhausted):
                 continue
             r_cells = factor * robot.drive.min_turning_radius / res
             path = None
             stop = False
             variants = (
-                ((TIGHT_NAME, tight_motion(robot.drive.min_turning_radius / res), SEARCH_BUDGET_S),)
+                (
+                    (
+                        TIGHT_NAME,
+                        tight_motion(robot.drive.min_turning_radius / res),
+                        search_cap,
+                    ),
+                )
                 if tight
                 else cost_variants(robot)
             )
             for name, costs, cap in variants:
-                if time.perf_counter() > t_end:
+                if spent >= car_cap:
                     break
+                label = f"{grid_name(margin)}, {factor:g} R{name}"
+                if time.perf_counter() > t_end:
+                    raise safety_net_error(
+                        f"the plan's wall-clock safety net of {CAR_BUDGET_S:g} s fired before "
+                        f"the try {label!r} ({spent} of {car_cap} expansions spent)",
+                        tries,
+                    )
                 try:
                     with timer.stage("search"):
                         path = astar.find_pose_path(
@@ -246,14 +293,35 @@ def search_and_fit(
                             goal,
                             turning_radius=r_cells,
                             reverse=robot.drive.reverse,
-                            time_budget=max(0.05, min(cap, t_end - time.perf_counter())),
+                            max_expansions=min(cap, car_cap - spent),
+                            time_budget=SEARCH_SAFETY_S,
                             **{**exact_clearance(robot, grid, margin), **costs},
                             **first_grid_limits(robot, margin),
                         )
+                    spent += int(path.stats["expanded"])
+                    if any(sub["stop"] == "time_budget" for sub in path.stats["searches"]):
+                        # the first of two searches stopped by its share of the safety net
+                        raise safety_net_error(
+                            f"the search {label!r} ran into its wall-clock safety net "
+                            f"(a share of {SEARCH_SAFETY_S:g} s) before its expansion cap",
+                            tries,
+                        )
                     break
                 except astar.NoPosePathError as exc:
-                    tries.append(f"{grid_name(margin)}, {factor:g} R{name}: no path ({exc.reason})")
+                    spent += int((exc.stats or {}).get("expanded", 0))
+                    tries.append(f"{label}: no path ({exc.reason})")
                     failures.append(exc)
+                    subs = (exc.stats or {}).get("searches", [])
+                    if exc.reason == "time_budget" or any(
+                        sub["stop"] == "time_budget" for sub in subs
+                    ):  # the clock stopped a search (the first of two: the second's answer
+                        # could differ from the one after the first's expansion share)
+                        raise safety_net_error(
+                            f"the search {label!r} ran into its wall-clock safety net of "
+                            f"{SEARCH_SAFETY_S:g} s ({exc.stats.get('expanded', 0)} expansions)",
+                            tries,
+                            exc,
+                        ) from exc
                     if exc.reason == "disconnected":
                         stop = True
                         break
@@ -293,11 +361,11 @@ def search_and_fit(
                         )
                     )
             except SmoothingError as exc:
-                tries.append(f"{grid_name(margin)}, {factor:g} R{name}: a segment has no fit")
+                tries.append(f"{label}: a segment has no fit")
                 failures.append(exc)
                 continue
-            tries.append(f"{grid_name(margin)}, {factor:g} R{name}: planned")
-            return CarFound(search_grid, path, r_cells, poses, segments, tries)
+            tries.append(f"{label}: planned")
+            return CarFound(search_grid, path, r_cells, poses, segments, tries, spent)
     raise failure(robot, grid, start, goal, tries, failures)
 
 
@@ -315,23 +383,36 @@ def search_factors(robot: Robot, margin: bool) -> list[tuple[float, bool]]:
     return out
 
 
-def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], float], ...]:
-    """Return the search costs a try runs with, in order: ``(name, costs, budget cap (s))``.
+def cost_variants(robot: Robot) -> tuple[tuple[str, dict[str, Any], int], ...]:
+    """Return the search costs a try runs with, in order: ``(name, costs, expansion cap)``.
 
-    A disc: the search's default costs, :data:`SEARCH_BUDGET_S`. A car with a body: the
-    default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (at most
-    :data:`FOOTPRINT_DEFAULT_BUDGET_S`; the paths they find where they find one quickly:
-    drives into a bay without reversing), then :data:`FOOTPRINT_COSTS`
-    (named ``", parking costs"`` in the tries) for :data:`SEARCH_BUDGET_S`. A search that
-    exhausts its states (every reachable state expanded) ends the variants of its try: the
-    costs change the order of the expansions, not the states reachable.
+    A disc: the search's default costs, :data:`SEARCH_EXPANSIONS`. A car with a body: the
+    default costs for :data:`FOOTPRINT_DEFAULT_EXPANSIONS` expansions (the paths they find
+    where they find one quickly: drives into a bay without reversing), then
+    :data:`FOOTPRINT_COSTS` (named ``", parking costs"`` in the tries) for
+    :data:`FOOTPRINT_SEARCH_EXPANSIONS`. A search that exhausts its states (every reachable
+    state expanded) ends the variants of its try: the costs change the order of the
+    expansions, not the states reachable.
+    """
+    search_cap = expansion_caps(robot)[0]
+    if robot.footprint is None:
+        return (("", {}, search_cap),)
+    return (
+        ("", {}, FOOTPRINT_DEFAULT_EXPANSIONS),
+        (", parking costs", FOOTPRINT_COSTS, search_cap),
+    )
+
+
+def expansion_caps(robot: Robot) -> tuple[int, int]:
+    """Return the expansion caps of a car's plan: ``(per search, per plan)``.
+
+    :data:`SEARCH_EXPANSIONS` and :data:`CAR_EXPANSIONS` for a disc,
+    :data:`FOOTPRINT_SEARCH_EXPANSIONS` and :data:`FOOTPRINT_CAR_EXPANSIONS` for a car with
+    a body (its expansions test the footprint, about 3-4 times slower).
     """
     if robot.footprint is None:
-        return (("", {}, SEARCH_BUDGET_S),)
-    return (
-        ("", {"max_expansions": FOOTPRINT_DEFAULT_EXPANSIONS}, FOOTPRINT_DEFAULT_BUDGET_S),
-        (", parking costs", FOOTPRINT_COSTS, SEARCH_BUDGET_S),
-    )
+        return SEARCH_EXPANSIONS, CAR_EXPANSIONS
+    return FOOTPRINT_SEARCH_EXPANSIONS, FOOTPRINT_CAR_EXPANSIONS
 
 
 #: The name of the tight search in the tries (:func:`tight_motion`).
@@ -533,6 +614,22 @@ def failure(
         err.__cause__ = last
         return err
     return failures[-1]
+
+
+def safety_net_error(why: str, tries: list[str], cause: Exception | None = None) -> NoPathError:
+    """Return the error of a car's plan stopped by a wall-clock safety net (module docstring).
+
+    The expansion caps decide a plan; a safety net fires only when the machine is far slower
+    or busier than the constants assume, and the plan stops there rather than go on to a try
+    that a quiet machine would not have reached.
+    """
+    err = NoPathError(
+        f"no car plan: {why}. The wall-clock limits are safety nets far above normal search "
+        "times (the expansion caps decide the plan); on this machine's load the answer would "
+        f"depend on timing, so the plan stops (tries: {'; '.join(tries) or 'none'})"
+    )
+    err.__cause__ = cause
+    return err
 
 
 def pose_m(c: ArrayLike, grid: OccupancyGrid) -> str:
