@@ -191,7 +191,7 @@ def reroute(
 
     def mark(i: int) -> OccupancyGrid | None:  # candidate i's map, marked once
         if i not in marks:
-            marks[i] = mark_swept(grid, detours[i][1], margin, keep)
+            marks[i] = mark_swept(grid, detours[i][1], margin, keep, reaches.get(i))
         return marks[i]
 
     def detour(i: int, prove: bool = False) -> Callable[[], Any]:
@@ -213,11 +213,17 @@ def reroute(
 
     finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
     detours = [("around every mover's final place", finals)]
+    reaches: dict[int, tuple[np.ndarray, float, float]] = {}  # detours marked where reached
     who = by_name.get(blocked.mover)
     if who is not None:
         t_end = max(who.t_last, 0.0)
         t_from = min(max(blocked.t, 0.0), t_end)
-        spans = [(min(0.0, float(who.times[0])), "")]
+        t_all_of = min(0.0, float(who.times[0]))
+        reaches[len(detours)] = (p0, float(robot.v_max), float(robot.radius))
+        detours.append(
+            (f"around {who.name!r} where the robot could meet it", [(who, t_all_of, t_end)])
+        )
+        spans = [(t_all_of, "")]
         if t_from > 0.0:
             spans.append((t_from, f" from t = {t_from:.3f} s"))
         for t0, when in spans:

@@ -66,6 +66,104 @@ def swept_mask(
         ox, oy = ox + bx0 * res, oy + by0 * res
         ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
     a, b, radius = _capsules(mover, t0, t1, grow, res)
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius)
+
+
+#: The pieces of a mover's track :func:`reached_swept_mask` tests one by one are at most
+#: this many seconds long (each marks where the mover is during it only if a robot could be
+#: there by its end).
+REACH_PIECE_S = 0.25
+
+
+def reached_swept_mask(
+    grid: OccupancyGrid,
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    grow: float,
+    origin: np.ndarray,
+    speed: float,
+    slack: float,
+) -> np.ndarray:
+    """Return the cells the mover covers in ``[t0, t1]`` at a time a robot could be near them.
+
+    :func:`swept_mask` less what the mover covers only before a robot could come. A robot that leaves ``origin`` (m) at ``t = 0`` and drives at most ``speed`` (m/s) is
+    nowhere farther than ``speed * t`` from it at time ``t``. A cell is marked when the
+    mover's shape, grown by ``grow`` (m), meets its square at some time ``t`` in ``[t0, t1]``
+    (s; when ``t1`` is the prediction's last time or later, at any time from ``t0`` on: the
+    mover stands at its last place for ever) with
+    ``speed * t >= |c - origin| - slack`` for a point ``c`` of the cell: the cells the mover
+    covers only before any robot centre within ``slack`` (m) of them could have got there
+    are left free. With ``slack`` the robot's radius (the distance the planner inflates the
+    marked map by), a plan on the marked map keeps the robot off the mover at every time
+    the robot could be there at all: a robot centre ``y`` meets the grown shape at ``z``
+    only where ``|y - z| <= slack``, so it comes there no sooner than
+    ``(|z - origin| - slack) / speed``.
+
+    The track is cut into pieces of at most :data:`REACH_PIECE_S` seconds (and at its
+    waypoints); a piece marks the cells its capsule (:func:`swept_mask`) covers that a robot
+    could reach by the piece's end, the last place (for ever) every cell it covers.
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        The map whose cells are marked (its shape, resolution and origin).
+    mover : MovingObstacle
+        The prediction.
+    t0, t1 : float
+        The time interval (s), ``t0 <= t1``.
+    grow : float
+        Distance added around the shape (m), >= 0.
+    origin : ndarray, shape (2,)
+        Where the robot is at ``t = 0`` (m).
+    speed : float
+        The robot's largest speed (m/s), > 0.
+    slack : float
+        Distance (m), >= 0: as above.
+
+    Returns
+    -------
+    ndarray of bool, shape (ny, nx)
+        ``mask[iy, ix]``: the cell may hold the grown mover when a robot could be near it;
+        a subset of :func:`swept_mask` over ``[t0, t1]``.
+    """
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    t0, t1 = float(t0), float(t1)
+    inner = [t for t in mover.times.tolist() if t0 < t < t1]
+    knots = [t0, *inner, t1] if t1 > t0 else [t0]
+    times = [t0]
+    for lo, hi in zip(knots[:-1], knots[1:], strict=True):
+        k = max(1, math.ceil((hi - lo) / REACH_PIECE_S))
+        times += np.linspace(lo, hi, k + 1)[1:].tolist()
+    times_arr = np.asarray(times, dtype=float)
+    pts = mover.position_at(times_arr)
+    a = np.vstack([pts[:-1], pts[-1:]])  # each piece, then the last place for ever
+    b = np.vstack([pts[1:], pts[-1:]])
+    last = math.inf if t1 >= mover.t_last else t1
+    late = np.append(times_arr[1:], last)  # when each piece ends
+    radius = _capsules(mover, t0, t1, grow, res)[2]
+    reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, late, reach)
+
+
+def _capsule_mask(
+    frame: tuple[float, float, float, int, int],
+    a: np.ndarray,
+    b: np.ndarray,
+    radius: float,
+    late: np.ndarray | None = None,
+    reach: tuple[np.ndarray, float, float] | None = None,
+) -> np.ndarray:
+    """Return the cells whose centre is within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
+
+    ``frame``: ``(ox, oy, res, nx, ny)``, the cells' origin (m), size (m) and count. With
+    ``late`` (s, shape (k,)) and ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a
+    segment marks only the cells with ``|centre - origin| - slack - res / sqrt(2) <= speed *
+    late_i`` (:func:`reached_swept_mask`).
+    """
+    ox, oy, res, nx, ny = frame
     mask = np.zeros((ny, nx), dtype=bool)
     lo = np.minimum(a, b) - radius
     hi = np.maximum(a, b) + radius
@@ -82,8 +180,10 @@ def swept_mask(
     k = np.arange(seg.shape[0]) - np.repeat(np.cumsum(count) - count, count)
     ix = ix0[seg] + k % w[seg]
     iy = iy0[seg] + k // w[seg]
-    px = (ox + (ix + 0.5) * res) - a[seg, 0]
-    py = (oy + (iy + 0.5) * res) - a[seg, 1]
+    cx = ox + (ix + 0.5) * res
+    cy = oy + (iy + 0.5) * res
+    px = cx - a[seg, 0]
+    py = cy - a[seg, 1]
     d = b - a
     dd = np.einsum("ij,ij->i", d, d)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -92,6 +192,10 @@ def swept_mask(
         )
     dist = np.hypot(px - lam * d[seg, 0], py - lam * d[seg, 1])
     hit = dist <= radius
+    if late is not None and reach is not None:
+        origin, speed, slack = reach
+        far = np.hypot(cx - origin[0], cy - origin[1]) - slack - res * math.sqrt(0.5)
+        hit &= far <= speed * late[seg]
     mask[iy[hit], ix[hit]] = True
     return mask
 
@@ -146,6 +250,7 @@ def mark_swept(
     regions: Sequence[tuple[MovingObstacle, float, float]],
     grow: float,
     keep: Sequence[tuple[np.ndarray, float]] = (),
+    reach: tuple[np.ndarray, float, float] | None = None,
 ) -> OccupancyGrid | None:
     """Return ``grid`` with the swept regions marked occupied, or ``None`` when none adds a cell.
 
@@ -160,6 +265,10 @@ def mark_swept(
     keep : sequence of (ndarray, float)
         Points (m, shape (2,)) and radii (m) whose cells stay as in ``grid`` (the robot's
         start and goal, which a plan must be able to stand on).
+    reach : (ndarray, float, float), optional
+        ``(origin, speed, slack)`` (m, m/s, m): each region marked only where a robot from
+        ``origin`` could be near the mover (:func:`reached_swept_mask`); ``None``: the
+        whole swept regions (:func:`swept_mask`).
 
     Returns
     -------
@@ -168,7 +277,10 @@ def mark_swept(
     """
     add = np.zeros(grid.shape, dtype=bool)
     for mover, t0, t1 in regions:
-        add |= swept_mask(grid, mover, t0, t1, grow)
+        if reach is None:
+            add |= swept_mask(grid, mover, t0, t1, grow)
+        else:
+            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach)
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
