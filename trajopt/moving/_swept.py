@@ -19,6 +19,7 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._swept_kernel import capsule_kernel
 
 
 def track(mover: MovingObstacle, t0: float, t1: float) -> np.ndarray:
@@ -69,12 +70,6 @@ def swept_mask(
     return _capsule_mask((ox, oy, res, nx, ny), a, b, radius)
 
 
-#: The pieces of a mover's track :func:`reached_swept_mask` tests one by one are at most
-#: this many seconds long (each marks where the mover is during it only if a robot could be
-#: there by its end).
-REACH_PIECE_S = 0.25
-
-
 def reached_swept_mask(
     grid: OccupancyGrid,
     mover: MovingObstacle,
@@ -100,9 +95,11 @@ def reached_swept_mask(
     only where ``|y - z| <= slack``, so it comes there no sooner than
     ``(|z - origin| - slack) / speed``.
 
-    The track is cut into pieces of at most :data:`REACH_PIECE_S` seconds (and at its
-    waypoints); a piece marks the cells its capsule (:func:`swept_mask`) covers that a robot
-    could reach by the piece's end, the last place (for ever) every cell it covers.
+    Over a waypoint segment of the track, the mover's bounding disc (:func:`swept_mask`)
+    covers a cell's centre while its reference point is within the disc's radius of it: an
+    interval of the segment whose end gives the last time of that segment the cell is
+    covered, exactly; the cell is marked when that time, on some segment, is late enough
+    (after the track, the last place covers its cells for ever).
 
     Parameters
     ----------
@@ -131,21 +128,16 @@ def reached_swept_mask(
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
     t0, t1 = float(t0), float(t1)
-    inner = [t for t in mover.times.tolist() if t0 < t < t1]
-    knots = [t0, *inner, t1] if t1 > t0 else [t0]
-    times = [t0]
-    for lo, hi in zip(knots[:-1], knots[1:], strict=True):
-        k = max(1, math.ceil((hi - lo) / REACH_PIECE_S))
-        times += np.linspace(lo, hi, k + 1)[1:].tolist()
-    times_arr = np.asarray(times, dtype=float)
-    pts = mover.position_at(times_arr)
-    a = np.vstack([pts[:-1], pts[-1:]])  # each piece, then the last place for ever
+    times = mover.times
+    knots = np.concatenate([[t0], times[(times > t0) & (times < t1)], [t1] if t1 > t0 else []])
+    pts = mover.position_at(knots)
+    a = np.vstack([pts[:-1], pts[-1:]])  # each segment, then the last place for ever
     b = np.vstack([pts[1:], pts[-1:]])
     last = math.inf if t1 >= mover.t_last else t1
-    late = np.append(times_arr[1:], last)  # when each piece ends
+    spans = (np.append(knots[:-1], knots[-1]), np.append(knots[1:], last))
     radius = _capsules(mover, t0, t1, grow, res)[2]
     reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
-    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, late, reach)
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach)
 
 
 def _capsule_mask(
@@ -153,51 +145,34 @@ def _capsule_mask(
     a: np.ndarray,
     b: np.ndarray,
     radius: float,
-    late: np.ndarray | None = None,
+    spans: tuple[np.ndarray, np.ndarray] | None = None,
     reach: tuple[np.ndarray, float, float] | None = None,
 ) -> np.ndarray:
     """Return the cells whose centre is within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
 
     ``frame``: ``(ox, oy, res, nx, ny)``, the cells' origin (m), size (m) and count. With
-    ``late`` (s, shape (k,)) and ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a
-    segment marks only the cells with ``|centre - origin| - slack - res / sqrt(2) <= speed *
-    late_i`` (:func:`reached_swept_mask`).
+    ``spans`` (``(t_a, t_b)``, s, each shape (k,): the times a point moving linearly is at
+    ``a_i`` and ``b_i``; ``t_b`` infinite for a point standing at ``a_i = b_i`` for ever) and
+    ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a segment marks only the cells with
+    ``|centre - origin| - slack - res / sqrt(2) <= speed * t``, ``t`` the last time in
+    ``[t_a, t_b]`` the point is within ``radius`` of the centre (:func:`reached_swept_mask`).
     """
     ox, oy, res, nx, ny = frame
-    mask = np.zeros((ny, nx), dtype=bool)
-    lo = np.minimum(a, b) - radius
-    hi = np.maximum(a, b) + radius
-    ix0 = np.maximum(0, np.floor((lo[:, 0] - ox) / res).astype(np.int64))
-    ix1 = np.minimum(nx - 1, np.floor((hi[:, 0] - ox) / res).astype(np.int64))
-    iy0 = np.maximum(0, np.floor((lo[:, 1] - oy) / res).astype(np.int64))
-    iy1 = np.minimum(ny - 1, np.floor((hi[:, 1] - oy) / res).astype(np.int64))
-    w = np.maximum(ix1 - ix0 + 1, 0)
-    h = np.maximum(iy1 - iy0 + 1, 0)
-    count = w * h  # the cells of each segment's box, all segments at once
-    if not count.any():
-        return mask
-    seg = np.repeat(np.arange(count.shape[0]), count)
-    k = np.arange(seg.shape[0]) - np.repeat(np.cumsum(count) - count, count)
-    ix = ix0[seg] + k % w[seg]
-    iy = iy0[seg] + k // w[seg]
-    cx = ox + (ix + 0.5) * res
-    cy = oy + (iy + 0.5) * res
-    px = cx - a[seg, 0]
-    py = cy - a[seg, 1]
-    d = b - a
-    dd = np.einsum("ij,ij->i", d, d)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lam = np.where(
-            dd[seg] > 0.0, np.clip((px * d[seg, 0] + py * d[seg, 1]) / dd[seg], 0.0, 1.0), 0.0
-        )
-    dist = np.hypot(px - lam * d[seg, 0], py - lam * d[seg, 1])
-    hit = dist <= radius
-    if late is not None and reach is not None:
-        origin, speed, slack = reach
-        far = np.hypot(cx - origin[0], cy - origin[1]) - slack - res * math.sqrt(0.5)
-        hit &= far <= speed * late[seg]
-    mask[iy[hit], ix[hit]] = True
-    return mask
+    a = np.ascontiguousarray(a, dtype=np.float64).reshape(-1, 2)
+    b = np.ascontiguousarray(b, dtype=np.float64).reshape(-1, 2)
+    timed = spans is not None and reach is not None
+    if timed:
+        ta = np.ascontiguousarray(spans[0], dtype=np.float64)
+        tb = np.ascontiguousarray(spans[1], dtype=np.float64)
+        origin = np.ascontiguousarray(reach[0], dtype=np.float64).reshape(2)
+        speed, slack = float(reach[1]), float(reach[2])
+    else:
+        ta = tb = np.zeros(a.shape[0])
+        origin, speed, slack = np.zeros(2), 0.0, 0.0
+    return capsule_kernel(
+        float(ox), float(oy), float(res), int(nx), int(ny), a, b, float(radius), ta, tb, origin,
+        speed, slack, timed,
+    )  # fmt: skip
 
 
 def _capsules(

@@ -686,3 +686,86 @@ def test_the_grid_path_screen_changes_no_plan_on_random_movers(loop, monkeypatch
             continue
         _same_plan(a, b)  # certified: the tests above check such plans independently
         assert a.stats["moving"]["certificate"]["ok"]
+
+
+def test_reached_swept_mask_on_a_head_on_walker_by_hand():
+    """A walker from x = 10 m to x = 0 along y = 1 at 0.5 m/s, a robot from (0, 1) at 0.5 m/s:
+    the walker's disc (radius ``R`` with the grow and half a cell's diagonal) last covers the
+    centre at x when it is at ``x - R``, at ``t = (10 - x + R) / 0.5``; the robot can be within
+    ``slack`` of the cell by ``(x - slack - h) / 0.5`` (``h`` half a cell's diagonal): the cells
+    on the line are marked from the start up to ``x = (10 + R + slack + h) / 2`` and, past the
+    walker's end, all those its last place covers; none beyond."""
+    grid = _grid((40, 240), [])
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 20.0], [(10.0, 1.0), (0.0, 1.0)], radius=0.2, name="walker"
+    )
+    grow, slack = 0.03, 0.165
+    h = RES * math.sqrt(0.5)
+    big_r = 0.2 + grow + h
+    mask = trajopt.moving.reached_swept_mask(
+        grid, walker, 0.0, walker.t_last, grow, np.array([0.0, 1.0]), 0.5, slack
+    )
+    whole = trajopt.moving.swept_mask(grid, walker, 0.0, walker.t_last, grow)
+    assert not np.any(mask & ~whole)  # a part of the whole swept region
+    row = round((1.0 - 0.5 * RES) / RES)  # cell centres at y = 0.975 m: 0.025 m off the track
+    x = (np.arange(grid.shape[1]) + 0.5) * RES
+    off = 1.0 - (row + 0.5) * RES
+    reach_r = math.sqrt(big_r**2 - off**2)  # the walker covers the centre within this along x
+    edge = (10.0 + reach_r + slack + h) / 2.0
+    expect = (x <= edge) & (x <= 10.0 + reach_r)
+    away = np.abs(x - edge) > 1e-9
+    assert np.array_equal(mask[row][away], expect[away])
+    assert mask[row][x < 1.0].all() and not mask[row][x > edge + RES].any()
+    # a walker standing at x = 9 m for ever (after t = 2 s): marked where it stands, whenever
+    stands = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0], [(10.0, 1.0), (9.0, 1.0)], radius=0.2, name="stands"
+    )
+    mask = trajopt.moving.reached_swept_mask(
+        grid, stands, 0.0, stands.t_last, grow, np.array([0.0, 1.0]), 0.5, slack
+    )
+    near9 = np.abs(x - 9.0) < reach_r - 1e-9
+    assert mask[row][near9].all() and not mask[row][x > 9.0 + reach_r + 1e-9].any()
+    # over [0, 1] s only (not to its end): the walker is at x >= 9.5, out of the robot's reach
+    assert not trajopt.moving.reached_swept_mask(
+        grid, stands, 0.0, 1.0, grow, np.array([0.0, 1.0]), 0.5, slack
+    ).any()
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000))
+def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
+    """Brute force over 4 ms samples of random tracks (a stop on the way, growth, a polygon):
+    every cell the mover's bounding disc covers at a time ``t`` with ``speed t >= |c - o| -
+    slack - h`` is marked; every marked cell is covered at such a time, within the samples'
+    spacing (a mover moves at most ``v dt`` between two)."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((50, 70), [])
+    times = np.cumsum(rng.uniform(0.3, 1.5, 5)) - 0.5
+    pos = rng.uniform([0.0, 0.0], [3.5, 2.5], (5, 2))
+    pos[2] = pos[1]  # a stop on the way
+    mover = trajopt.MovingObstacle.from_waypoints(
+        times, pos, radius=0.05, growth=0.02, headings=rng.uniform(-3, 3, 5),
+        vertices=[(-0.2, -0.1), (0.2, -0.1), (0.2, 0.1), (-0.2, 0.1)], name="cart",
+    )  # fmt: skip
+    origin, speed, slack, grow = rng.uniform([0.0, 0.0], [3.5, 2.5]), 0.5, 0.15, 0.02
+    t0, t1 = (float(times[0]), float(times[-1]) + 1.0) if seed % 2 else (0.4, float(times[3]))
+    mask = trajopt.moving.reached_swept_mask(grid, mover, t0, t1, grow, origin, speed, slack)
+    h = RES * math.sqrt(0.5)
+    big_r = 0.0 + np.hypot(0.2, 0.1) + float(mover.radius_at(t1)) + grow + h
+    dt = 0.004
+    t_end = min(t1, mover.t_last)
+    t = np.append(np.arange(t0, t_end, dt), t_end)
+    p = mover.position_at(t)
+    iy, ix = np.mgrid[0:50, 0:70]
+    c = (np.stack([ix, iy], -1).reshape(-1, 2) + 0.5) * RES
+    far = np.hypot(*(c - origin).T) - slack - h
+    d = np.hypot(c[:, None, 0] - p[None, :, 0], c[:, None, 1] - p[None, :, 1])
+    seen = np.any((d <= big_r) & (speed * t[None, :] >= far[:, None]), axis=1)
+    v = float(mover.speed_max())
+    near = np.any((d <= big_r + v * dt) & (speed * (t[None, :] + dt) >= far[:, None]), axis=1)
+    if t1 >= mover.t_last:  # it stands at its last place for ever: any time is late enough
+        seen |= d[:, -1] <= big_r
+        near |= d[:, -1] <= big_r + 1e-9
+    flat = mask.ravel()
+    assert np.all(flat[seen])  # every sampled meeting is marked
+    assert not np.any(flat & ~near)  # and nothing that no sample comes close to
