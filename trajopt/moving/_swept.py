@@ -79,27 +79,33 @@ def reached_swept_mask(
     origin: np.ndarray,
     speed: float,
     slack: float,
+    late: tuple[float, float] = (0.0, 0.0),
 ) -> np.ndarray:
     """Return the cells the mover covers in ``[t0, t1]`` at a time a robot could be near them.
 
-    :func:`swept_mask` less what the mover covers only before a robot could come. A robot that leaves ``origin`` (m) at ``t = 0`` and drives at most ``speed`` (m/s) is
-    nowhere farther than ``speed * t`` from it at time ``t``. A cell is marked when the
-    mover's shape, grown by ``grow`` (m), meets its square at some time ``t`` in ``[t0, t1]``
-    (s; when ``t1`` is the prediction's last time or later, at any time from ``t0`` on: the
-    mover stands at its last place for ever) with
-    ``speed * t >= |c - origin| - slack`` for a point ``c`` of the cell: the cells the mover
-    covers only before any robot centre within ``slack`` (m) of them could have got there
-    are left free. With ``slack`` the robot's radius (the distance the planner inflates the
-    marked map by), a plan on the marked map keeps the robot off the mover at every time
-    the robot could be there at all: a robot centre ``y`` meets the grown shape at ``z``
-    only where ``|y - z| <= slack``, so it comes there no sooner than
-    ``(|z - origin| - slack) / speed``.
+    :func:`swept_mask` less what the mover covers only before a robot could come. A robot
+    that leaves ``origin`` (m) at ``t = 0`` and drives at most ``speed`` (m/s) is nowhere
+    farther than ``speed * t`` from it at time ``t``. A cell is marked when the mover's
+    shape, grown by ``grow`` (m), meets its square at some time ``t`` in ``[t0, t1]`` (s;
+    when ``t1`` is the prediction's last time or later, at any time from ``t0`` on: the mover
+    stands at its last place for ever) with ``speed * t >= |c - origin| - slack`` for a point
+    ``c`` of the cell: the cells the mover covers only before any robot centre within
+    ``slack`` (m) of them could have got there are left free. With ``slack`` the robot's
+    radius (the distance the planner inflates the marked map by), a plan on the marked map
+    keeps the robot off the mover at every time the robot could be there at all: a robot
+    centre ``y`` meets the grown shape at ``z`` only where ``|y - z| <= slack``, so it comes
+    there no sooner than ``(|z - origin| - slack) / speed``.
+
+    With ``late = (factor, extra)``, ``factor > 0``, a cell is also left free when the mover
+    first covers it (on each segment that covers it) only after ``factor * (|c - origin| +
+    slack) / speed + extra`` (s): a guess that the robot has passed it by then, not a bound
+    (a plan on that map is to be re-timed and certified).
 
     Over a waypoint segment of the track, the mover's bounding disc (:func:`swept_mask`)
     covers a cell's centre while its reference point is within the disc's radius of it: an
-    interval of the segment whose end gives the last time of that segment the cell is
-    covered, exactly; the cell is marked when that time, on some segment, is late enough
-    (after the track, the last place covers its cells for ever).
+    interval of the segment whose ends give the first and last times of that segment the
+    cell is covered, exactly; the cell is marked when that interval meets the times above on
+    some segment (after the track, the last place covers its cells for ever).
 
     Parameters
     ----------
@@ -117,6 +123,8 @@ def reached_swept_mask(
         The robot's largest speed (m/s), > 0.
     slack : float
         Distance (m), >= 0: as above.
+    late : (float, float)
+        ``(factor, extra)`` (1, s) as above; ``factor <= 0``: no such rule.
 
     Returns
     -------
@@ -137,7 +145,7 @@ def reached_swept_mask(
     spans = (np.append(knots[:-1], knots[-1]), np.append(knots[1:], last))
     radius = _capsules(mover, t0, t1, grow, res)[2]
     reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
-    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach)
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach, late)
 
 
 def _capsule_mask(
@@ -147,6 +155,7 @@ def _capsule_mask(
     radius: float,
     spans: tuple[np.ndarray, np.ndarray] | None = None,
     reach: tuple[np.ndarray, float, float] | None = None,
+    late: tuple[float, float] = (0.0, 0.0),
 ) -> np.ndarray:
     """Return the cells whose centre is within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
 
@@ -155,7 +164,9 @@ def _capsule_mask(
     ``a_i`` and ``b_i``; ``t_b`` infinite for a point standing at ``a_i = b_i`` for ever) and
     ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a segment marks only the cells with
     ``|centre - origin| - slack - res / sqrt(2) <= speed * t``, ``t`` the last time in
-    ``[t_a, t_b]`` the point is within ``radius`` of the centre (:func:`reached_swept_mask`).
+    ``[t_a, t_b]`` the point is within ``radius`` of the centre, and with ``late``
+    (``(factor, extra)``, ``factor > 0``) whose first such time is at most ``factor *
+    (|centre - origin| + slack + res / sqrt(2)) / speed + extra`` (:func:`reached_swept_mask`).
     """
     ox, oy, res, nx, ny = frame
     a = np.ascontiguousarray(a, dtype=np.float64).reshape(-1, 2)
@@ -171,7 +182,7 @@ def _capsule_mask(
         origin, speed, slack = np.zeros(2), 0.0, 0.0
     return capsule_kernel(
         float(ox), float(oy), float(res), int(nx), int(ny), a, b, float(radius), ta, tb, origin,
-        speed, slack, timed,
+        speed, slack, timed, late[0], late[1],
     )  # fmt: skip
 
 
@@ -226,6 +237,7 @@ def mark_swept(
     grow: float,
     keep: Sequence[tuple[np.ndarray, float]] = (),
     reach: tuple[np.ndarray, float, float] | None = None,
+    late: tuple[float, float] = (0.0, 0.0),
 ) -> OccupancyGrid | None:
     """Return ``grid`` with the swept regions marked occupied, or ``None`` when none adds a cell.
 
@@ -244,6 +256,8 @@ def mark_swept(
         ``(origin, speed, slack)`` (m, m/s, m): each region marked only where a robot from
         ``origin`` could be near the mover (:func:`reached_swept_mask`); ``None``: the
         whole swept regions (:func:`swept_mask`).
+    late : (float, float)
+        With ``reach``: :func:`reached_swept_mask`'s ``late``.
 
     Returns
     -------
@@ -255,7 +269,7 @@ def mark_swept(
         if reach is None:
             add |= swept_mask(grid, mover, t0, t1, grow)
         else:
-            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach)
+            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late)
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape

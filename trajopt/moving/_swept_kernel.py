@@ -20,7 +20,7 @@ watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 @njit(cache=True)
 def capsule_kernel(
-    ox, oy, res, nx, ny, a, b, radius, ta, tb, origin, speed, slack, timed
+    ox, oy, res, nx, ny, a, b, radius, ta, tb, origin, speed, slack, timed, late_factor, late_s
 ):  # pragma: no cover - compiled
     """Return the cells (bool, shape (ny, nx)) whose centre is within ``radius`` of a segment.
 
@@ -45,6 +45,9 @@ def capsule_kernel(
     timed : bool
         Mark a hit cell only when ``|centre - origin| - slack - res / sqrt(2) <= speed * t``,
         ``t`` the last time in ``[ta_i, tb_i]`` the point is within ``radius`` of the centre.
+    late_factor, late_s : float
+        With ``timed`` and ``late_factor > 0``: also only when the first such time is at most
+        ``late_factor (|centre - origin| + slack + res / sqrt(2)) / speed + late_s`` (s).
 
     Returns
     -------
@@ -83,8 +86,17 @@ def capsule_kernel(
                             off = (px * dy - py * dx) ** 2 / dd
                             mu = min(1.0, along + math.sqrt(max(radius * radius - off, 0.0) / dd))
                         last = ta[i] + mu * (tb[i] - ta[i])
-                    far = math.hypot(cx - origin[0], cy - origin[1]) - slack - half_diag
-                    if far > speed * last:
+                    dist = math.hypot(cx - origin[0], cy - origin[1])
+                    if dist - slack - half_diag > speed * last:
                         continue
+                    if late_factor > 0.0:
+                        nu = 0.0
+                        if dd > 0.0:
+                            along = (px * dx + py * dy) / dd
+                            off = (px * dy - py * dx) ** 2 / dd
+                            nu = max(0.0, along - math.sqrt(max(radius * radius - off, 0.0) / dd))
+                        first = ta[i] + nu * (tb[i] - ta[i]) if not math.isinf(tb[i]) else ta[i]
+                        if first > late_factor * (dist + slack + half_diag) / speed + late_s:
+                            continue
                 mask[iy, ix] = True
     return mask

@@ -716,6 +716,16 @@ def test_reached_swept_mask_on_a_head_on_walker_by_hand():
     away = np.abs(x - edge) > 1e-9
     assert np.array_equal(mask[row][away], expect[away])
     assert mask[row][x < 1.0].all() and not mask[row][x > edge + RES].any()
+    # and with the late rule (1.5, 2 s): also free where it first covers the centre (at
+    # (10 - x - r) / 0.5) after 1.5 (x + slack + h) / 0.5 + 2: before x = (18 - 2 r - 3 (slack +
+    # h)) / 5
+    late = trajopt.moving.reached_swept_mask(
+        grid, walker, 0.0, walker.t_last, grow, np.array([0.0, 1.0]), 0.5, slack, (1.5, 2.0)
+    )
+    lower = (18.0 - 2.0 * reach_r - 3.0 * (slack + h)) / 5.0
+    away &= np.abs(x - lower) > 1e-9
+    assert np.array_equal(late[row][away], (expect & (x >= lower))[away])
+    assert late[row][(x > lower + RES) & (x < edge - RES)].all() and not late[row][x < 2.5].any()
     # a walker standing at x = 9 m for ever (after t = 2 s): marked where it stands, whenever
     stands = trajopt.MovingObstacle.from_waypoints(
         [0.0, 2.0], [(10.0, 1.0), (9.0, 1.0)], radius=0.2, name="stands"
@@ -737,7 +747,8 @@ def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
     """Brute force over 4 ms samples of random tracks (a stop on the way, growth, a polygon):
     every cell the mover's bounding disc covers at a time ``t`` with ``speed t >= |c - o| -
     slack - h`` is marked; every marked cell is covered at such a time, within the samples'
-    spacing (a mover moves at most ``v dt`` between two)."""
+    spacing (a mover moves at most ``v dt`` between two); with the late rule, only at times
+    up to its guess of when the robot has passed."""
     rng = np.random.default_rng(seed)
     grid = _grid((50, 70), [])
     times = np.cumsum(rng.uniform(0.3, 1.5, 5)) - 0.5
@@ -749,7 +760,8 @@ def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
     )  # fmt: skip
     origin, speed, slack, grow = rng.uniform([0.0, 0.0], [3.5, 2.5]), 0.5, 0.15, 0.02
     t0, t1 = (float(times[0]), float(times[-1]) + 1.0) if seed % 2 else (0.4, float(times[3]))
-    mask = trajopt.moving.reached_swept_mask(grid, mover, t0, t1, grow, origin, speed, slack)
+    late = (1.5, 2.0) if seed % 4 >= 2 else (0.0, 0.0)
+    mask = trajopt.moving.reached_swept_mask(grid, mover, t0, t1, grow, origin, speed, slack, late)
     h = RES * math.sqrt(0.5)
     big_r = 0.0 + np.hypot(0.2, 0.1) + float(mover.radius_at(t1)) + grow + h
     dt = 0.004
@@ -760,12 +772,22 @@ def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
     c = (np.stack([ix, iy], -1).reshape(-1, 2) + 0.5) * RES
     far = np.hypot(*(c - origin).T) - slack - h
     d = np.hypot(c[:, None, 0] - p[None, :, 0], c[:, None, 1] - p[None, :, 1])
-    seen = np.any((d <= big_r) & (speed * t[None, :] >= far[:, None]), axis=1)
+    ub = np.full(c.shape[0], np.inf)
+    if late[0] > 0.0:  # the guess of when the robot has passed: first covered later, free
+        ub = late[0] * (np.hypot(*(c - origin).T) + slack + h) / speed + late[1]
+    seen = np.any(
+        (d <= big_r) & (speed * t[None, :] >= far[:, None]) & (t[None, :] <= ub[:, None]), axis=1
+    )
     v = float(mover.speed_max())
-    near = np.any((d <= big_r + v * dt) & (speed * (t[None, :] + dt) >= far[:, None]), axis=1)
+    near = np.any(
+        (d <= big_r + v * dt)
+        & (speed * (t[None, :] + dt) >= far[:, None])
+        & (t[None, :] - dt <= ub[:, None]),
+        axis=1,
+    )
     if t1 >= mover.t_last:  # it stands at its last place for ever: any time is late enough
-        seen |= d[:, -1] <= big_r
-        near |= d[:, -1] <= big_r + 1e-9
+        seen |= (d[:, -1] <= big_r) & (ub >= t_end)
+        near |= (d[:, -1] <= big_r + 1e-9) & (ub >= t_end - 1e-9)
     flat = mask.ravel()
     assert np.all(flat[seen])  # every sampled meeting is marked
     assert not np.any(flat & ~near)  # and nothing that no sample comes close to
