@@ -121,9 +121,11 @@ class _GridScreen:
             return
         r = float(self.robot.radius)
         plan = _GridCurve(line, self.robot)
-        blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
-        if blocked is None and meets_head_on(plan, self.movers, self.margin):
+        blocked = None
+        if meets_head_on(plan, self.movers, self.margin):  # cheap where none comes head-on
             blocked = no_way_past(plan, self.movers, self.margin - HEAD_ON_SLACK_RADII * r)
+        if blocked is None:
+            blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
         if blocked is not None:
             raise _GridBlocked(blocked, line.length)
 
@@ -204,7 +206,8 @@ def plan_among_movers(
     :data:`SCREEN_SLACK_RADII` robot radii for a parked mover and
     :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past (run only where
     :func:`trajopt.moving.meets_head_on` finds a mover coming along the grid path against
-    the robot), since the curve fitted round the grid path strays from it (up to 0.28 m
+    the robot; this one first, as ``meets_head_on`` costs little where no mover comes
+    head-on), since the curve fitted round the grid path strays from it (up to 0.28 m
     measured). A grid path they find blocked is re-routed at once, the static plan neither
     fitted nor timed. The finding is on the grid path, not a proof on the curve: when no re-route works the query is planned
     again without the screen (its curve, proofs and re-timing decide, the re-route's
