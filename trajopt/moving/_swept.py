@@ -264,13 +264,15 @@ def mark_swept(
     astar.OccupancyGrid or None
         The marked map (same shape, resolution and origin).
     """
+    res = float(grid.resolution)
+    if _all_kept(regions, grow, res, keep):
+        return None  # every capsule inside a kept disc: no cell to add
     add = np.zeros(grid.shape, dtype=bool)
     for mover, t0, t1 in regions:
         if reach is None:
             add |= swept_mask(grid, mover, t0, t1, grow)
         else:
             add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late)
-    res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
     for p, r in keep:
@@ -289,3 +291,27 @@ def mark_swept(
     if not new.any():
         return None
     return grid.with_occupied(occ | new)
+
+
+def _all_kept(
+    regions: Sequence[tuple[MovingObstacle, float, float]],
+    grow: float,
+    res: float,
+    keep: Sequence[tuple[np.ndarray, float]],
+) -> bool:
+    """Whether every capsule of the regions lies in one kept disc (its cells all stay free).
+
+    A marked cell's centre is within the capsule's radius of its segment; a segment whose
+    ends are within a kept disc's radius less the capsule's of its centre keeps every such
+    centre in the disc (a disc is convex), whose cells :func:`mark_swept` leaves as they are.
+    """
+    if not keep:
+        return False
+    for mover, t0, t1 in regions:
+        a, b, radius = _capsules(mover, t0, t1, grow, res)
+        ends = np.vstack([a, b])
+        if not any(
+            np.all(np.hypot(*(ends - np.asarray(p, dtype=float)).T) <= r - radius) for p, r in keep
+        ):
+            return False
+    return True

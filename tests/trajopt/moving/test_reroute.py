@@ -823,3 +823,28 @@ def test_a_walker_head_on_in_a_room_is_passed_with_a_side_step():
     k = int(np.argmin(gap))  # they pass: the robot beside the walker's line
     assert abs(smp.y[k] - 2.0) >= 0.165 + 0.2 + 0.02 - 1e-6 and 5.0 < smp.x[k] < 7.0
     assert np.max(np.abs(smp.y - 2.0)) < 1.0  # a side step, not a way round
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_mark_swept_adds_no_cell_exactly_when_the_kept_discs_hold_the_region(seed):
+    """``mark_swept`` answers ``None`` (no cell added) exactly when the swept region's cells,
+    less those whose centre is in a kept disc, are all occupied already (brute force over
+    the cells with :func:`swept_mask`); its shortcut for regions inside a kept disc agrees."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((60, 80), [(0.0, 4.0, 0.0, 3.0)])
+    p = rng.uniform([1.0, 1.0], [3.0, 2.0])
+    r = float(rng.uniform(0.3, 0.6))
+    end = p + rng.uniform(-0.25, 0.25, 2)  # stands near the kept point
+    mover = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 1.0], [p + rng.uniform(-0.3, 0.3, 2), end], radius=0.1, name="m"
+    )
+    for t0, t1 in ((1.0, 1.0), (0.0, 1.0)):
+        got = trajopt.moving.mark_swept(grid, [(mover, t0, t1)], 0.02, [(p, r)])
+        add = trajopt.moving.swept_mask(grid, mover, t0, t1, 0.02)
+        iy, ix = np.mgrid[0:60, 0:80]
+        c = (np.stack([ix, iy], -1) + 0.5) * RES
+        add &= np.hypot(c[..., 0] - p[0], c[..., 1] - p[1]) > r
+        add &= ~np.asarray(grid.occupied)
+        assert (got is None) == (not add.any())
+        if got is not None:
+            assert np.array_equal(np.asarray(got.occupied), np.asarray(grid.occupied) | add)
