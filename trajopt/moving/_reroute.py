@@ -14,7 +14,8 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    issue), usually the smallest detour;
 2. ``"rerouted"``: the same query with the blocking mover's swept region marked where the
    robot may meet it (:func:`~trajopt.moving.reached_swept_mask`): the cells it covers only
-   before a robot from the start at ``v_max`` could come near them are left free (it has
+   before a robot from the start at its top speed (forwards or backwards) could come near
+   them are left free (it has
    passed by then), and so are those it first covers only after
    :data:`LATE_FACTOR` times that earliest time plus :data:`LATE_S` (the robot has
    likely passed them by then; the re-timing decides): a way round where they would meet, often
@@ -261,7 +262,9 @@ def reroute(
         t_end = max(who.t_last, 0.0)
         t_from = min(max(blocked.t, 0.0), t_end)
         t_all_of = min(0.0, float(who.times[0]))
-        reach = (p0, float(robot.v_max), float(robot.radius))
+        back = getattr(robot.drive, "v_max_backwards", None)  # a car may reverse faster
+        top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+        reach = (p0, top, float(robot.radius))
         reaches[len(detours)] = (reach, (LATE_FACTOR, LATE_S))
         detours.append(
             (f"around {who.name!r} where the robot may meet it", [(who, t_all_of, t_end)])
