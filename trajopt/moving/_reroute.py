@@ -15,14 +15,13 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 2. ``"rerouted"``: the same query with the blocking mover's swept region marked where the
    robot may meet it (:func:`~trajopt.moving.reached_swept_mask`): the cells it covers only
    before a robot from the start at its top speed (forwards or backwards) could come near
-   them are left free (it has
-   passed by then), and so are those it first covers only after
-   :data:`LATE_FACTOR` times that earliest time plus :data:`LATE_S` (the robot has
-   likely passed them by then; the re-timing decides): a way round where they would meet, often
-   the static path but for a side step (a mover coming head-on); then with the cells it covers
-   at any time a robot could be near them marked (the first rule alone: a way that meets it
-   nowhere it could still be, after it has passed); then its whole swept region: a way
-   that never meets it, so its re-timing is mostly the certificate alone; then its region
+   them are left free (it has passed by then), and so are those it first covers only after
+   :data:`LATE_FACTOR` times that earliest time plus :data:`LATE_S` (the robot has likely
+   passed them by then; the re-timing decides): a way round where they would meet, often
+   the static path but for a side step (a mover coming head-on); then with the cells it
+   covers at any time a robot could be near them marked (the first rule alone: a way that
+   meets it nowhere it could still be, after it has passed); then its whole swept region: a
+   way that never meets it, so its re-timing is mostly the certificate alone; then its region
    over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
    stops, or round the rest of its track;
 3. ``"waited"``: drive to a **safe place**, wait there until the way is clear, drive to the
