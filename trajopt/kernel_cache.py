@@ -71,6 +71,8 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.moving._polygon_march",
     "trajopt.moving._polygon_distance",
     "trajopt.moving._grid_kernels",
+    "trajopt.moving._swept_kernel",
+    "trajopt.moving._reach_kernel",
     "trajopt.corridor._polygons.path_kernels",
     "trajopt.corridor._polygons.region_kernels",
     "trajopt.smoother._cost_kernels",

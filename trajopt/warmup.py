@@ -155,10 +155,16 @@ def _exercise_timing() -> None:
 
 
 def _exercise_moving() -> None:
-    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked)."""
+    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked, and proved so); mark a swept region."""
     from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve
-    from trajopt.moving import MovingObstacle, retime_for_movers
+    from trajopt.moving import (
+        MovingObstacle,
+        no_way_past,
+        reached_swept_mask,
+        retime_for_movers,
+        swept_mask,
+    )
     from trajopt.robot import Robot
     from trajopt.timing import time_parameterize
 
@@ -179,6 +185,13 @@ def _exercise_moving() -> None:
     parked = MovingObstacle.from_waypoints([0.0], [(3.0, 0.0)], radius=0.05, vertices=box)
     with contextlib.suppress(BlockedError):
         retime_for_movers(line, [parked])
+    # the quick proof that no re-timing gets past (its sweep, trajopt.moving._reach_kernel)
+    no_way_past(line, [parked])
+    # a mover's swept region on a grid, and where a robot could meet it (a re-route's marks,
+    # trajopt.moving._swept_kernel)
+    room = OccupancyGrid(np.zeros((40, 60), dtype=bool), 0.1, (0.0, -2.0))
+    swept_mask(room, movers[0], 0.0, 4.0, 0.1)
+    reached_swept_mask(room, movers[0], 0.0, 24.0, 0.1, np.zeros(2), 0.6, 0.2)
 
 
 def _exercise_polygons() -> None:

@@ -19,7 +19,8 @@
   path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal;
   :func:`car_headings`: how a car stands at a safe place; :func:`safe_places`: where it
   waits); :func:`swept_mask`,
-  :func:`mark_swept`: a mover's swept region on a grid (:func:`swept_cells`: on given cells);
+  :func:`mark_swept`: a mover's swept region on a grid (:func:`swept_cells`: on given cells;
+  :func:`reached_swept_mask`: only where a robot could meet the mover);
 * :func:`st_grid`, :class:`STGrid`: the movers' forbidden regions of the ``(s, t)`` plane;
 * :func:`load_movers`, :func:`save_movers` (:func:`movers_from_data`,
   :func:`movers_to_data`): predicted movers in a JSON or YAML file.
@@ -41,7 +42,7 @@ from trajopt.moving._reroute import (
 )
 from trajopt.moving._retime import retime_for_movers, retime_plan
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
-from trajopt.moving._swept import mark_swept, swept_cells, swept_mask
+from trajopt.moving._swept import mark_swept, reached_swept_mask, swept_cells, swept_mask
 
 __all__ = [
     "N_SAFE_PLACES",
@@ -64,6 +65,7 @@ __all__ = [
     "parked_on_path",
     "reachable",
     "reachable_times",
+    "reached_swept_mask",
     "reroute",
     "save_movers",
     "retime_chain",

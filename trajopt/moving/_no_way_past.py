@@ -38,6 +38,7 @@ import numpy as np
 from trajopt.errors import BlockedError
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import path_curves
+from trajopt.moving._reach_kernel import reach_kernel
 from trajopt.moving._st_grid import FOREVER, STGrid, grid_nodes, reach_bound, st_grid
 
 #: Arc-length spacing (m) of the necessary grid's nodes.
@@ -68,19 +69,6 @@ def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _free(runs: list[tuple[int, int]], k_from: int) -> list[tuple[int, float]]:
-    """Return a node's free time-index intervals ``[a, b]`` (``b`` may be inf) from ``k_from`` on."""
-    out, at = [], k_from
-    for lo, hi in sorted(runs):
-        if lo > at:
-            out.append((at, lo - 1))
-        at = max(at, hi + 1)
-        if at >= FOREVER:
-            return out
-    out.append((at, math.inf))
-    return out
-
-
 def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[tuple[int, float]]]:
     """Return, for each node, the time-index intervals a relaxed ``s(t)`` can be there (module docstring).
 
@@ -108,27 +96,30 @@ def reachable_times(grid: STGrid, speed: float, s_up: np.ndarray) -> list[list[t
         ``reach[j]``: the intervals ``[a, b]`` of time indices (``b`` inf: for ever); empty
         when the node is never reachable.
     """
+    rptr, ra, rb = _reach_arrays(grid, speed, s_up)
+    a = ra.astype(np.int64).tolist()
+    b = [math.inf if math.isinf(v) else int(v) for v in rb.tolist()]
+    pairs = list(zip(a, b, strict=True))
+    bounds = rptr.tolist()
+    return [pairs[bounds[j] : bounds[j + 1]] for j in range(len(bounds) - 1)]
+
+
+def _reach_arrays(
+    grid: STGrid, speed: float, s_up: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`reachable_times` as flat arrays (:func:`._reach_kernel.reach_kernel`'s)."""
     n = grid.s.shape[0]
     m = int(math.ceil(speed * grid.dt / grid.ds)) + 1
-    k_cap = np.searchsorted(s_up + 0.5 * grid.ds, grid.s, side="left").tolist()
-    ptr = grid.ptr.tolist()
-    runs = list(zip(grid.lo.tolist(), grid.hi.tolist(), strict=True))
-    reach: list[list[tuple[int, float]]] = []
-    first = _free(runs[ptr[0] : ptr[1]], 0)
-    reach.append([first[0]] if first and first[0][0] == 0 else [])
-    for j in range(1, n):
-        if j >= m and not any(reach[j - m : j]):  # no way into j, nor into any node after it
-            reach += [[] for _ in range(n - j)]
-            break
-        came = [(a + 1, b + 1) for i in range(max(0, j - m), j) for a, b in reach[i]]
-        got = []
-        if came:
-            for a, b in _free(runs[ptr[j] : ptr[j + 1]], k_cap[j]):
-                e = min((max(a, p) for p, q in came if p <= b and q >= a), default=None)
-                if e is not None:
-                    got.append((e, b))
-        reach.append(got)
-    return reach
+    k_cap = np.searchsorted(s_up + 0.5 * grid.ds, grid.s, side="left").astype(np.int64)
+    return reach_kernel(
+        n,
+        m,
+        k_cap,
+        np.ascontiguousarray(grid.ptr, dtype=np.int64),
+        np.ascontiguousarray(grid.lo, dtype=np.int64),
+        np.ascontiguousarray(grid.hi, dtype=np.int64),
+        FOREVER,
+    )
 
 
 def no_way_past(
@@ -193,11 +184,13 @@ def no_way_past(
     s_up = reach_bound(grid.t, v_top, a_max, j_max, v0)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
-    reach = reachable_times(grid, v_top, s_up)
-    if reach[-1]:
+    rptr, _, rb = _reach_arrays(grid, v_top, s_up)
+    if rptr[-1] > rptr[-2]:
         return None
-    i = max(j for j, r in enumerate(reach) if r) if any(reach) else 0
-    k = int(min(max((b for _, b in reach[i]), default=0.0) + 1, grid.t.shape[0] - 1))
+    held = np.flatnonzero(np.diff(rptr) > 0)  # the nodes with a reachable time
+    i = int(held[-1]) if held.size else 0
+    last = float(np.max(rb[rptr[i] : rptr[i + 1]])) if held.size else 0.0
+    k = int(min(last + 1, grid.t.shape[0] - 1))
     a, b = int(grid.ptr[i]), int(grid.ptr[-1])
     live = (grid.lo[a:b] <= k) & (grid.hi[a:b] >= k)  # runs at or after the robot's place then
     j = int(grid.owner[a:b][live][0]) if live.any() else int(grid.owner[0])

@@ -12,8 +12,16 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    the robot's radius as any obstacle): a route that no mover stays on; its re-timing waits
    at the start, or on the way, while a mover still passes (the waiting witness of the
    issue), usually the smallest detour;
-2. ``"rerouted"``: the same query with the blocking mover's whole swept region marked: a way
-   that never meets it, so its re-timing is mostly the certificate alone; then with its region
+2. ``"rerouted"``: the same query with the blocking mover's swept region marked where the
+   robot may meet it (:func:`~trajopt.moving.reached_swept_mask`): the cells it covers only
+   before a robot from the start at its top speed (forwards or backwards) could come near
+   them are left free (it has passed by then), and so are those it first covers only after
+   :data:`LATE_FACTOR` times that earliest time plus :data:`LATE_S` (the robot has likely
+   passed them by then; the re-timing decides): a way round where they would meet, often
+   the static path but for a side step (a mover coming head-on); then with the cells it
+   covers at any time a robot could be near them marked (the first rule alone: a way that
+   meets it nowhere it could still be, after it has passed); then its whole swept region: a
+   way that never meets it, so its re-timing is mostly the certificate alone; then its region
    over ``[t, t_last]`` only (``t`` the time from which it blocks): a way round where it
    stops, or round the rest of its track;
 3. ``"waited"``: drive to a **safe place**, wait there until the way is clear, drive to the
@@ -28,6 +36,12 @@ for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
    standing at the safe place from its arrival; the second's from then on). A car, which cannot turn in
    place, stands there with a heading (:func:`car_headings`: towards the goal, else along its
    way in); the second leg leaves with the first's end heading and last steering angle.
+
+A detour round where the robot may (or could) meet the blocking mover whose path is longer
+than :data:`LONG_WAY_FACTOR` times the blocked path's plus :data:`LONG_WAY_M` (going back
+round a loop, say) is kept aside, the detours after it not tried: the waits of option 3 are,
+and the earlier arrival of the kept detour and the first wait that works is returned (the
+kept detour when none works).
 
 Given the blocked path's points (``path``), the detours of options 1 and 2 whose marks keep
 clear of it (no marked cell within the robot's radius of a point beyond the start's and the
@@ -62,9 +76,25 @@ from trajopt.moving._certificate import point_polygon_distance, shape_at
 from trajopt.moving._chain import retime_chain, shift_clock
 from trajopt.moving._no_way_past import no_way_past
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._parked import parked_on_path
+from trajopt.moving._parked import parked_on_path, path_curves
 from trajopt.moving._swept import mark_swept, swept_cells, swept_mask
 
+#: The first detour round the blocking mover (option 2) leaves free the cells it first covers
+#: after this many times the earliest time a robot could be near them, plus
+#: :data:`LATE_S` (s): measured on ``benchmarks/bench_moving_reroute.py``'s 30 head-on
+#: queries, (1.25, 1 s), (1.5, 2 s) and (2, 3 s) all give a certified route on the first
+#: try, arriving 1.04x the static plan's time (median).
+LATE_FACTOR = 1.5
+#: See :data:`LATE_FACTOR` (s).
+LATE_S = 2.0
+#: A detour round where the robot may meet the blocking mover whose path is longer than
+#: this many times the blocked path's, plus :data:`LONG_WAY_M` (m), is kept aside while the
+#: waits are tried (the earlier arrival of it and the first wait that works is returned):
+#: the detours of ``benchmarks/bench_moving_reroute.py``'s head-on queries are at most 1.7x
+#: the static path; going back round a loop instead of waiting in a niche is 2.5x.
+LONG_WAY_FACTOR = 1.5
+#: See :data:`LONG_WAY_FACTOR` (m).
+LONG_WAY_M = 2.0
 #: Safe places tried (option 3).
 N_SAFE_PLACES = 2
 #: Smallest distance (m) between two safe places tried.
@@ -98,6 +128,7 @@ def reroute(
     path: np.ndarray | None = None,
     sketch: Callable[[OccupancyGrid], np.ndarray] | None = None,
     label: Callable[[np.ndarray], np.ndarray] | None = None,
+    length: float | None = None,
 ) -> Any:
     """Return a certified plan by another route or a wait at a safe place (module docstring).
 
@@ -137,6 +168,11 @@ def reroute(
         label per component (the planner's own labelling); used to keep the safe places the
         goal is joined to. ``None``: :func:`scipy.ndimage.label` of the free cells (the same
         partition; its import costs a process's first wait about 0.1 s).
+    length : float, optional
+        The blocked path's length (m); ``None``: that of ``path``'s polyline, at least
+        ``|goal - start|``. A detour round where the robot may meet the mover longer than
+        :data:`LONG_WAY_FACTOR` times it plus :data:`LONG_WAY_M` is kept aside while the
+        waits are tried (module docstring).
 
     Returns
     -------
@@ -167,6 +203,11 @@ def reroute(
             t=blocked.t,
         ) from blocked
 
+    def finish(out: Any) -> Any:  # a kept detour returned after the waits: every try listed
+        out.stats["moving"] = dict(out.stats["moving"], reroute=list(tried))
+        out.stats["moving"]["reroute_time_s"] = time.perf_counter() - t_all
+        return out
+
     def attempt(what: str, run: Callable[[], Any], route: str) -> Any:
         t0 = time.perf_counter()
         try:
@@ -191,7 +232,7 @@ def reroute(
 
     def mark(i: int) -> OccupancyGrid | None:  # candidate i's map, marked once
         if i not in marks:
-            marks[i] = mark_swept(grid, detours[i][1], margin, keep)
+            marks[i] = mark_swept(grid, detours[i][1], margin, keep, *reaches.get(i, (None,)))
         return marks[i]
 
     def detour(i: int, prove: bool = False) -> Callable[[], Any]:
@@ -213,11 +254,25 @@ def reroute(
 
     finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
     detours = [("around every mover's final place", finals)]
+    # detours marked where the robot may meet the mover: (origin, speed, slack), late rule
+    reaches: dict[int, tuple[tuple[np.ndarray, float, float], tuple[float, float]]] = {}
     who = by_name.get(blocked.mover)
     if who is not None:
         t_end = max(who.t_last, 0.0)
         t_from = min(max(blocked.t, 0.0), t_end)
-        spans = [(min(0.0, float(who.times[0])), "")]
+        t_all_of = min(0.0, float(who.times[0]))
+        back = getattr(robot.drive, "v_max_backwards", None)  # a car may reverse faster
+        top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0)
+        reach = (p0, top, float(robot.radius))
+        reaches[len(detours)] = (reach, (LATE_FACTOR, LATE_S))
+        detours.append(
+            (f"around {who.name!r} where the robot may meet it", [(who, t_all_of, t_end)])
+        )
+        reaches[len(detours)] = (reach, (0.0, 0.0))
+        detours.append(
+            (f"around {who.name!r} where the robot could meet it", [(who, t_all_of, t_end)])
+        )
+        spans = [(t_all_of, "")]
         if t_from > 0.0:
             spans.append((t_from, f" from t = {t_from:.3f} s"))
         for t0, when in spans:
@@ -229,6 +284,12 @@ def reroute(
         clear = [_keeps_clear(grid, regions, margin + robot.radius, pts) for _, regions in detours]
     order = [i for i, c in enumerate(clear) if not c] + [i for i, c in enumerate(clear) if c]
     late: list[int] = []  # detours whose sketch follows the blocked path: after the waits
+    kept = None  # a detour round where the robot may meet the mover, too long to take at once
+    if length is None:
+        along = np.zeros((0, 2)) if path is None else np.asarray(path, dtype=float).reshape(-1, 2)
+        length = float(np.sum(np.hypot(*np.diff(along, axis=0).T))) if along.shape[0] > 1 else 0.0
+        length = max(length, math.hypot(*(p1 - p0)))
+    long_way = LONG_WAY_FACTOR * float(length) + LONG_WAY_M
     for i in order:
         what, regions = detours[i]
         if clear[i] and sketch is not None and pts.shape[0] and mark(i) is not None:
@@ -248,6 +309,12 @@ def reroute(
                 late.append(i)
                 continue
         out = attempt(what, detour(i, prove=clear[i]), "rerouted")
+        if out is not None and i in reaches and _path_length(out) > long_way:
+            kept = out  # a long way round: a wait may arrive sooner
+            tried[-1]["result"] = (
+                f"ok, kept: {_path_length(out):.2f} m, longer than {long_way:.2f} m"
+            )
+            break
         if out is not None:
             return out
     turns = robot.drive.turns_in_place and not robot.drive.signed_speed
@@ -263,8 +330,12 @@ def reroute(
                     _wait_at(place, heading, movers, margin, grid, plan_leg),
                     "waited",
                 )
+                if out is not None and kept is not None and kept.duration < out.duration:
+                    return finish(kept)
                 if out is not None:
                     return out
+    if kept is not None:
+        return finish(kept)
     for i in late:
         out = attempt(detours[i][0], detour(i, prove=True), "rerouted")
         if out is not None:
@@ -275,6 +346,11 @@ def reroute(
         mover=blocked.mover,
         t=blocked.t,
     ) from blocked
+
+
+def _path_length(plan: Any) -> float:
+    """Return a plan's path length (m): its curves end to end."""
+    return float(sum(float(c.length) for c in path_curves(plan)))
 
 
 def _beyond(points: np.ndarray, keep: Sequence[tuple[np.ndarray, float]]) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 
 from astar.grid import OccupancyGrid
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._swept_kernel import capsule_kernel
 
 
 def track(mover: MovingObstacle, t0: float, t1: float) -> np.ndarray:
@@ -66,34 +67,123 @@ def swept_mask(
         ox, oy = ox + bx0 * res, oy + by0 * res
         ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
     a, b, radius = _capsules(mover, t0, t1, grow, res)
-    mask = np.zeros((ny, nx), dtype=bool)
-    lo = np.minimum(a, b) - radius
-    hi = np.maximum(a, b) + radius
-    ix0 = np.maximum(0, np.floor((lo[:, 0] - ox) / res).astype(np.int64))
-    ix1 = np.minimum(nx - 1, np.floor((hi[:, 0] - ox) / res).astype(np.int64))
-    iy0 = np.maximum(0, np.floor((lo[:, 1] - oy) / res).astype(np.int64))
-    iy1 = np.minimum(ny - 1, np.floor((hi[:, 1] - oy) / res).astype(np.int64))
-    w = np.maximum(ix1 - ix0 + 1, 0)
-    h = np.maximum(iy1 - iy0 + 1, 0)
-    count = w * h  # the cells of each segment's box, all segments at once
-    if not count.any():
-        return mask
-    seg = np.repeat(np.arange(count.shape[0]), count)
-    k = np.arange(seg.shape[0]) - np.repeat(np.cumsum(count) - count, count)
-    ix = ix0[seg] + k % w[seg]
-    iy = iy0[seg] + k // w[seg]
-    px = (ox + (ix + 0.5) * res) - a[seg, 0]
-    py = (oy + (iy + 0.5) * res) - a[seg, 1]
-    d = b - a
-    dd = np.einsum("ij,ij->i", d, d)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lam = np.where(
-            dd[seg] > 0.0, np.clip((px * d[seg, 0] + py * d[seg, 1]) / dd[seg], 0.0, 1.0), 0.0
-        )
-    dist = np.hypot(px - lam * d[seg, 0], py - lam * d[seg, 1])
-    hit = dist <= radius
-    mask[iy[hit], ix[hit]] = True
-    return mask
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius)
+
+
+def reached_swept_mask(
+    grid: OccupancyGrid,
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    grow: float,
+    origin: np.ndarray,
+    speed: float,
+    slack: float,
+    late: tuple[float, float] = (0.0, 0.0),
+) -> np.ndarray:
+    """Return the cells the mover covers in ``[t0, t1]`` at a time a robot could be near them.
+
+    :func:`swept_mask` less what the mover covers only before a robot could come. A robot
+    that leaves ``origin`` (m) at ``t = 0`` and drives at most ``speed`` (m/s) is nowhere
+    farther than ``speed * t`` from it at time ``t``. A cell is marked when the mover's
+    shape, grown by ``grow`` (m), meets its square at some time ``t`` in ``[t0, t1]`` (s;
+    when ``t1`` is the prediction's last time or later, at any time from ``t0`` on: the mover
+    stands at its last place for ever) with ``speed * t >= |c - origin| - slack`` for a point
+    ``c`` of the cell: the cells the mover covers only before any robot centre within
+    ``slack`` (m) of them could have got there are left free. With ``slack`` the robot's
+    radius (the distance the planner inflates the marked map by), a plan on the marked map
+    keeps the robot off the mover at every time the robot could be there at all: a robot
+    centre ``y`` meets the grown shape at ``z`` only where ``|y - z| <= slack``, so it comes
+    there no sooner than ``(|z - origin| - slack) / speed``.
+
+    With ``late = (factor, extra)``, ``factor > 0``, a cell is also left free when the mover
+    first covers it (on each segment that covers it) only after ``factor * (|c - origin| +
+    slack) / speed + extra`` (s): a guess that the robot has passed it by then, not a bound
+    (a plan on that map is to be re-timed and certified).
+
+    Over a waypoint segment of the track, the mover's bounding disc (:func:`swept_mask`)
+    covers a cell's centre while its reference point is within the disc's radius of it: an
+    interval of the segment whose ends give the first and last times of that segment the
+    cell is covered, exactly; the cell is marked when that interval meets the times above on
+    some segment (after the track, the last place covers its cells for ever).
+
+    Parameters
+    ----------
+    grid : astar.OccupancyGrid
+        The map whose cells are marked (its shape, resolution and origin).
+    mover : MovingObstacle
+        The prediction.
+    t0, t1 : float
+        The time interval (s), ``t0 <= t1``.
+    grow : float
+        Distance added around the shape (m), >= 0.
+    origin : ndarray, shape (2,)
+        Where the robot is at ``t = 0`` (m).
+    speed : float
+        The robot's largest speed (m/s), > 0.
+    slack : float
+        Distance (m), >= 0: as above.
+    late : (float, float)
+        ``(factor, extra)`` (1, s) as above; ``factor <= 0``: no such rule.
+
+    Returns
+    -------
+    ndarray of bool, shape (ny, nx)
+        ``mask[iy, ix]``: the cell may hold the grown mover when a robot could be near it;
+        a subset of :func:`swept_mask` over ``[t0, t1]``.
+    """
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    t0, t1 = float(t0), float(t1)
+    times = mover.times
+    knots = np.concatenate([[t0], times[(times > t0) & (times < t1)], [t1] if t1 > t0 else []])
+    pts = mover.position_at(knots)
+    a = np.vstack([pts[:-1], pts[-1:]])  # each segment, then the last place for ever
+    b = np.vstack([pts[1:], pts[-1:]])
+    last = math.inf if t1 >= mover.t_last else t1
+    spans = (np.append(knots[:-1], knots[-1]), np.append(knots[1:], last))
+    radius = _capsules(mover, t0, t1, grow, res)[2]
+    reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
+    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach, late)
+
+
+def _capsule_mask(
+    frame: tuple[float, float, float, int, int],
+    a: np.ndarray,
+    b: np.ndarray,
+    radius: float,
+    spans: tuple[np.ndarray, np.ndarray] | None = None,
+    reach: tuple[np.ndarray, float, float] | None = None,
+    late: tuple[float, float] = (0.0, 0.0),
+) -> np.ndarray:
+    """Return the cells whose centre is within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
+
+    ``frame``: ``(ox, oy, res, nx, ny)``, the cells' origin (m), size (m) and count. With
+    ``spans`` (``(t_a, t_b)``, s, each shape (k,): the times a point moving linearly is at
+    ``a_i`` and ``b_i``; ``t_b`` infinite for a point standing at ``a_i = b_i`` for ever) and
+    ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a segment marks only the cells with
+    ``|centre - origin| - slack - res / sqrt(2) <= speed * t``, ``t`` the last time in
+    ``[t_a, t_b]`` the point is within ``radius`` of the centre, and with ``late``
+    (``(factor, extra)``, ``factor > 0``) whose first such time is at most ``factor *
+    (|centre - origin| + slack + res / sqrt(2)) / speed + extra`` (:func:`reached_swept_mask`).
+    """
+    ox, oy, res, nx, ny = frame
+    a = np.ascontiguousarray(a, dtype=np.float64).reshape(-1, 2)
+    b = np.ascontiguousarray(b, dtype=np.float64).reshape(-1, 2)
+    timed = spans is not None and reach is not None
+    if timed:
+        ta = np.ascontiguousarray(spans[0], dtype=np.float64)
+        tb = np.ascontiguousarray(spans[1], dtype=np.float64)
+        origin = np.ascontiguousarray(reach[0], dtype=np.float64).reshape(2)
+        speed, slack = float(reach[1]), float(reach[2])
+    else:
+        ta = tb = np.zeros(a.shape[0])
+        origin, speed, slack = np.zeros(2), 0.0, 0.0
+    return capsule_kernel(
+        float(ox), float(oy), float(res), int(nx), int(ny), a, b, float(radius), ta, tb, origin,
+        speed, slack, timed, late[0], late[1],
+    )  # fmt: skip
 
 
 def _capsules(
@@ -146,6 +236,8 @@ def mark_swept(
     regions: Sequence[tuple[MovingObstacle, float, float]],
     grow: float,
     keep: Sequence[tuple[np.ndarray, float]] = (),
+    reach: tuple[np.ndarray, float, float] | None = None,
+    late: tuple[float, float] = (0.0, 0.0),
 ) -> OccupancyGrid | None:
     """Return ``grid`` with the swept regions marked occupied, or ``None`` when none adds a cell.
 
@@ -160,16 +252,27 @@ def mark_swept(
     keep : sequence of (ndarray, float)
         Points (m, shape (2,)) and radii (m) whose cells stay as in ``grid`` (the robot's
         start and goal, which a plan must be able to stand on).
+    reach : (ndarray, float, float), optional
+        ``(origin, speed, slack)`` (m, m/s, m): each region marked only where a robot from
+        ``origin`` could be near the mover (:func:`reached_swept_mask`); ``None``: the
+        whole swept regions (:func:`swept_mask`).
+    late : (float, float)
+        With ``reach``: :func:`reached_swept_mask`'s ``late``.
 
     Returns
     -------
     astar.OccupancyGrid or None
         The marked map (same shape, resolution and origin).
     """
+    res = float(grid.resolution)
+    if _all_kept(regions, grow, res, keep):
+        return None  # every capsule inside a kept disc: no cell to add
     add = np.zeros(grid.shape, dtype=bool)
     for mover, t0, t1 in regions:
-        add |= swept_mask(grid, mover, t0, t1, grow)
-    res = float(grid.resolution)
+        if reach is None:
+            add |= swept_mask(grid, mover, t0, t1, grow)
+        else:
+            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
     for p, r in keep:
@@ -188,3 +291,27 @@ def mark_swept(
     if not new.any():
         return None
     return grid.with_occupied(occ | new)
+
+
+def _all_kept(
+    regions: Sequence[tuple[MovingObstacle, float, float]],
+    grow: float,
+    res: float,
+    keep: Sequence[tuple[np.ndarray, float]],
+) -> bool:
+    """Whether every capsule of the regions lies in one kept disc (its cells all stay free).
+
+    A marked cell's centre is within the capsule's radius of its segment; a segment whose
+    ends are within a kept disc's radius less the capsule's of its centre keeps every such
+    centre in the disc (a disc is convex), whose cells :func:`mark_swept` leaves as they are.
+    """
+    if not keep:
+        return False
+    for mover, t0, t1 in regions:
+        a, b, radius = _capsules(mover, t0, t1, grow, res)
+        ends = np.vstack([a, b])
+        if not any(
+            np.all(np.hypot(*(ends - np.asarray(p, dtype=float)).T) <= r - radius) for p, r in keep
+        ):
+            return False
+    return True

@@ -103,9 +103,10 @@ class _GridCurve(_Curve):
 class _GridBlocked(Exception):
     """Raised through the stages by :class:`_GridScreen` when the grid path is found blocked."""
 
-    def __init__(self, blocked: BlockedError):
+    def __init__(self, blocked: BlockedError, length: float):
         super().__init__(str(blocked))
         self.blocked = blocked
+        self.length = length  # the grid path's (m)
 
 
 class _GridScreen:
@@ -120,11 +121,13 @@ class _GridScreen:
             return
         r = float(self.robot.radius)
         plan = _GridCurve(line, self.robot)
-        blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
-        if blocked is None and meets_head_on(plan, self.movers, self.margin):
+        blocked = None
+        if meets_head_on(plan, self.movers, self.margin):  # cheap where none comes head-on
             blocked = no_way_past(plan, self.movers, self.margin - HEAD_ON_SLACK_RADII * r)
+        if blocked is None:
+            blocked = parked_on_path(plan, self.movers, self.margin - SCREEN_SLACK_RADII * r)
         if blocked is not None:
-            raise _GridBlocked(blocked)
+            raise _GridBlocked(blocked, line.length)
 
 
 class _PathBlocked(Exception):
@@ -203,7 +206,8 @@ def plan_among_movers(
     :data:`SCREEN_SLACK_RADII` robot radii for a parked mover and
     :data:`HEAD_ON_SLACK_RADII` for one that leaves no way past (run only where
     :func:`trajopt.moving.meets_head_on` finds a mover coming along the grid path against
-    the robot), since the curve fitted round the grid path strays from it (up to 0.28 m
+    the robot; this one first, as ``meets_head_on`` costs little where no mover comes
+    head-on), since the curve fitted round the grid path strays from it (up to 0.28 m
     measured). A grid path they find blocked is re-routed at once, the static plan neither
     fitted nor timed. The finding is on the grid path, not a proof on the curve: when no re-route works the query is planned
     again without the screen (its curve, proofs and re-timing decide, the re-route's
@@ -247,7 +251,9 @@ def plan_among_movers(
             out = run_query(options, caches, screened)
         except _GridBlocked as found:
             try:
-                return _reroute_early(found.blocked, movers, margin, options, caches, request)
+                return _reroute_early(
+                    found.blocked, movers, margin, options, caches, request, found.length
+                )
             except BlockedError:
                 p1 = np.asarray(request.goal, dtype=float).reshape(2)
                 limit = float(options.robot.inscribed_radius) + margin
@@ -257,8 +263,9 @@ def plan_among_movers(
     except _PathBlocked as stop:
         p0, p1 = _curve_ends(stop.curve)
         out = _reroute(
-            p0, p1, options.robot, movers, margin, stop.blocked, options, caches, request
-        )
+            p0, p1, options.robot, movers, margin, stop.blocked, options, caches, request,
+            length=float(stop.curve.length),
+        )  # fmt: skip
         out.stats["moving"]["blocked_before_timing"] = True
         out.stats["moving"]["blocked_on_grid_path"] = False
         return out
@@ -274,15 +281,19 @@ def _reroute_early(
     options: PlannerOptions,
     caches: PlannerCaches,
     request: PlanRequest,
+    length: float,
 ) -> PlanResult:
     """Re-route the query whose grid path the quick proofs found blocked (``blocked``).
 
-    :func:`trajopt.moving.reroute` from the query's ends, as for a blocked curve; raises its
-    :class:`BlockedError` when no candidate works.
+    :func:`trajopt.moving.reroute` from the query's ends, as for a blocked curve (the grid
+    path's ``length``, m, as the blocked path's); raises its :class:`BlockedError` when no
+    candidate works.
     """
     p0 = np.asarray(request.start, dtype=float).reshape(2)
     p1 = np.asarray(request.goal, dtype=float).reshape(2)
-    out = _reroute(p0, p1, options.robot, movers, margin, blocked, options, caches, request)
+    out = _reroute(
+        p0, p1, options.robot, movers, margin, blocked, options, caches, request, length=length
+    )
     out.stats["moving"]["blocked_before_timing"] = True
     out.stats["moving"]["blocked_on_grid_path"] = True
     return out
@@ -422,7 +433,10 @@ def plan_for_movers(
         smp = out.sample(np.array([0.0, out.duration]))
         p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
         p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
-    out = _reroute(p0, p1, out.robot, movers, margin, blocked, options, caches, request)
+    out = _reroute(
+        p0, p1, out.robot, movers, margin, blocked, options, caches, request,
+        length=float(out.length),
+    )  # fmt: skip
     out.stats["moving"]["blocked_before_timing"] = False
     return out
 
@@ -444,8 +458,11 @@ def _reroute(
     caches: PlannerCaches,
     request: PlanRequest,
     path: np.ndarray | None = None,
+    length: float | None = None,
 ) -> PlanResult:
     """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here.
+
+    ``length``: the blocked path's (m; :func:`trajopt.moving.reroute`'s).
 
     Each marked map's caches are derived once (:meth:`PlannerCaches.derived`), shared by its
     ``sketch`` (:func:`_grid_path`) and its plan. Given the blocked ``path`` (a re-plan from
@@ -529,6 +546,7 @@ def _reroute(
         path=path,
         sketch=sketch if _disc_search(robot) else None,
         label=component_labels,
+        length=length,
     )
 
 

@@ -380,7 +380,9 @@ def _check_splice_and_stop(traj, new, ts, movers, grid):
 
 def test_a_walker_head_on_re_routes_from_the_stop(loop_drive):
     """A walker comes down the short corridor towards the robot (from t = 6 s) and stays at its
-    west end: the robot stops, waits in the niche while it passes, then drives on."""
+    west end: the robot stops, waits in the niche while it passes, then drives on. The way
+    back round the long corridor (the detour round where it may meet the walker) is kept
+    aside as too long, and the wait arrives sooner."""
     grid, planner, traj = loop_drive
     t, ts = 4.0, 4.0 + LATENCY
     walker = trajopt.MovingObstacle.from_waypoints(
@@ -390,6 +392,8 @@ def test_a_walker_head_on_re_routes_from_the_stop(loop_drive):
     moving = new.stats["moving"]
     assert moving["route"] == "stopped: waited" and "'walker'" in moving["blocked"]
     assert "no way past" in moving["blocked"]  # proved on the kept rest from the moving state
+    first = moving["reroute"][0]
+    assert "may meet" in first["what"] and first["result"].startswith("ok, kept")
     end = new.state_at(new.duration)
     assert math.hypot(end.x - 11.0, end.y - 1.0) < 1e-9
     _check_splice_and_stop(traj, new, ts, [walker], grid)

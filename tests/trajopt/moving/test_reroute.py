@@ -145,9 +145,10 @@ def test_detours_that_keep_clear_of_the_blocked_path_go_last(bay):
 
 
 def test_a_car_waits_at_a_safe_place_with_a_heading():
-    """A car (no turn in place) meets a forklift head-on in a corridor with a side room: no
-    route avoids it, so it pulls aside facing on, waits, and drives on; the two legs join in
-    position, heading and steering."""
+    """A car (no turn in place) meets a forklift head-on in a corridor with a side room: it
+    swerves into the room where they meet (the detour round where it may meet the forklift)
+    or pulls aside facing on, waits, and drives on (the two legs join in position, heading
+    and steering); either way it is out of the forklift's lane when they pass."""
     grid = _grid((120, 240), [(0.5, 11.5, 1.4, 2.6), (4.5, 8.5, 2.6, 5.0)])
     robot = trajopt.Robot(
         drive="ackermann", min_turning_radius=0.6, radius=0.2, wheelbase=0.3, steer_rate_max=1.0
@@ -161,9 +162,10 @@ def test_a_car_waits_at_a_safe_place_with_a_heading():
         start, goal, start_heading=0.0, goal_heading=0.0, moving_obstacles=[forklift],
         mover_margin=0.02,
     )  # fmt: skip
-    assert out.stats["moving"]["route"] == "waited"
+    route = out.stats["moving"]["route"]
+    assert route in ("rerouted", "waited")
     last = out.stats["moving"]["reroute"][-1]
-    assert last["result"] == "ok" and "heading" in last["what"]
+    assert last["result"] == "ok" and ("heading" in last["what"]) == (route == "waited")
     _check(out, [forklift], grid, 0.02)
     dt = 1e-3
     smp = out.sample(np.append(np.arange(0.0, out.duration, dt), out.duration))
@@ -174,11 +176,15 @@ def test_a_car_waits_at_a_safe_place_with_a_heading():
     for k, (p, h) in ((0, (start, 0.0)), (-1, (goal, 0.0))):
         assert math.dist((smp.x[k], smp.y[k]), p) < 1e-6
         assert abs(math.remainder(smp.theta[k] - h, 2 * math.pi)) < 1e-6
-    # it stood still on the way, aside: out of the forklift's lane (y <= 2.2, plus the car's
-    # radius and the margin)
+    # when they pass (the forklift at the car's x) the car is out of the forklift's lane
+    # (y <= 2.2, plus the car's radius and the margin)
     t = smp.t
-    rest = (smp.v == 0.0) & (t > 1.0) & (t < out.duration - 1.0)
-    assert rest.any() and np.all(smp.y[rest] > 2.0 + 0.2 + 0.2 + 0.02)
+    fx = forklift.position_at(t)[:, 0]
+    k = int(np.argmin(np.abs(fx - smp.x)))
+    assert smp.y[k] > 2.0 + 0.2 + 0.2 + 0.02
+    if route == "waited":  # it stood still on the way, aside
+        rest = (smp.v == 0.0) & (t > 1.0) & (t < out.duration - 1.0)
+        assert rest.any() and np.all(smp.y[rest] > 2.0 + 0.2 + 0.2 + 0.02)
 
 
 def test_car_headings_face_on_then_along_the_way_in():
@@ -370,7 +376,7 @@ def test_a_grid_path_screen_that_finds_no_re_route_plans_as_without_it(loop, mon
 
     def wrong(self, points):
         calls.append(points.shape)
-        raise among._GridBlocked(BlockedError("made up", mover="cart", t=1.0))
+        raise among._GridBlocked(BlockedError("made up", mover="cart", t=1.0), 10.0)
 
     def refused(blocked, *args):
         calls.append("reroute")
@@ -686,3 +692,159 @@ def test_the_grid_path_screen_changes_no_plan_on_random_movers(loop, monkeypatch
             continue
         _same_plan(a, b)  # certified: the tests above check such plans independently
         assert a.stats["moving"]["certificate"]["ok"]
+
+
+def test_reached_swept_mask_on_a_head_on_walker_by_hand():
+    """A walker from x = 10 m to x = 0 along y = 1 at 0.5 m/s, a robot from (0, 1) at 0.5 m/s:
+    the walker's disc (radius ``R`` with the grow and half a cell's diagonal) last covers the
+    centre at x when it is at ``x - R``, at ``t = (10 - x + R) / 0.5``; the robot can be within
+    ``slack`` of the cell by ``(x - slack - h) / 0.5`` (``h`` half a cell's diagonal): the cells
+    on the line are marked from the start up to ``x = (10 + R + slack + h) / 2`` and, past the
+    walker's end, all those its last place covers; none beyond."""
+    grid = _grid((40, 240), [])
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 20.0], [(10.0, 1.0), (0.0, 1.0)], radius=0.2, name="walker"
+    )
+    grow, slack = 0.03, 0.165
+    h = RES * math.sqrt(0.5)
+    big_r = 0.2 + grow + h
+    mask = trajopt.moving.reached_swept_mask(
+        grid, walker, 0.0, walker.t_last, grow, np.array([0.0, 1.0]), 0.5, slack
+    )
+    whole = trajopt.moving.swept_mask(grid, walker, 0.0, walker.t_last, grow)
+    assert not np.any(mask & ~whole)  # a part of the whole swept region
+    row = round((1.0 - 0.5 * RES) / RES)  # cell centres at y = 0.975 m: 0.025 m off the track
+    x = (np.arange(grid.shape[1]) + 0.5) * RES
+    off = 1.0 - (row + 0.5) * RES
+    reach_r = math.sqrt(big_r**2 - off**2)  # the walker covers the centre within this along x
+    edge = (10.0 + reach_r + slack + h) / 2.0
+    expect = (x <= edge) & (x <= 10.0 + reach_r)
+    away = np.abs(x - edge) > 1e-9
+    assert np.array_equal(mask[row][away], expect[away])
+    assert mask[row][x < 1.0].all() and not mask[row][x > edge + RES].any()
+    # and with the late rule (1.5, 2 s): also free where it first covers the centre (at
+    # (10 - x - r) / 0.5) after 1.5 (x + slack + h) / 0.5 + 2: before x = (18 - 2 r - 3 (slack +
+    # h)) / 5
+    late = trajopt.moving.reached_swept_mask(
+        grid, walker, 0.0, walker.t_last, grow, np.array([0.0, 1.0]), 0.5, slack, (1.5, 2.0)
+    )
+    lower = (18.0 - 2.0 * reach_r - 3.0 * (slack + h)) / 5.0
+    away &= np.abs(x - lower) > 1e-9
+    assert np.array_equal(late[row][away], (expect & (x >= lower))[away])
+    assert late[row][(x > lower + RES) & (x < edge - RES)].all() and not late[row][x < 2.5].any()
+    # a walker standing at x = 9 m for ever (after t = 2 s): marked where it stands, whenever
+    stands = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0], [(10.0, 1.0), (9.0, 1.0)], radius=0.2, name="stands"
+    )
+    mask = trajopt.moving.reached_swept_mask(
+        grid, stands, 0.0, stands.t_last, grow, np.array([0.0, 1.0]), 0.5, slack
+    )
+    near9 = np.abs(x - 9.0) < reach_r - 1e-9
+    assert mask[row][near9].all() and not mask[row][x > 9.0 + reach_r + 1e-9].any()
+    # over [0, 1] s only (not to its end): the walker is at x >= 9.5, out of the robot's reach
+    assert not trajopt.moving.reached_swept_mask(
+        grid, stands, 0.0, 1.0, grow, np.array([0.0, 1.0]), 0.5, slack
+    ).any()
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000))
+def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
+    """Brute force over 4 ms samples of random tracks (a stop on the way, growth, a polygon):
+    every cell the mover's bounding disc covers at a time ``t`` with ``speed t >= |c - o| -
+    slack - h`` is marked; every marked cell is covered at such a time, within the samples'
+    spacing (a mover moves at most ``v dt`` between two); with the late rule, only at times
+    up to its guess of when the robot has passed."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((50, 70), [])
+    times = np.cumsum(rng.uniform(0.3, 1.5, 5)) - 0.5
+    pos = rng.uniform([0.0, 0.0], [3.5, 2.5], (5, 2))
+    pos[2] = pos[1]  # a stop on the way
+    mover = trajopt.MovingObstacle.from_waypoints(
+        times, pos, radius=0.05, growth=0.02, headings=rng.uniform(-3, 3, 5),
+        vertices=[(-0.2, -0.1), (0.2, -0.1), (0.2, 0.1), (-0.2, 0.1)], name="cart",
+    )  # fmt: skip
+    origin, speed, slack, grow = rng.uniform([0.0, 0.0], [3.5, 2.5]), 0.5, 0.15, 0.02
+    t0, t1 = (float(times[0]), float(times[-1]) + 1.0) if seed % 2 else (0.4, float(times[3]))
+    late = (1.5, 2.0) if seed % 4 >= 2 else (0.0, 0.0)
+    mask = trajopt.moving.reached_swept_mask(grid, mover, t0, t1, grow, origin, speed, slack, late)
+    h = RES * math.sqrt(0.5)
+    big_r = 0.0 + np.hypot(0.2, 0.1) + float(mover.radius_at(t1)) + grow + h
+    dt = 0.004
+    t_end = min(t1, mover.t_last)
+    t = np.append(np.arange(t0, t_end, dt), t_end)
+    p = mover.position_at(t)
+    iy, ix = np.mgrid[0:50, 0:70]
+    c = (np.stack([ix, iy], -1).reshape(-1, 2) + 0.5) * RES
+    far = np.hypot(*(c - origin).T) - slack - h
+    d = np.hypot(c[:, None, 0] - p[None, :, 0], c[:, None, 1] - p[None, :, 1])
+    ub = np.full(c.shape[0], np.inf)
+    if late[0] > 0.0:  # the guess of when the robot has passed: first covered later, free
+        ub = late[0] * (np.hypot(*(c - origin).T) + slack + h) / speed + late[1]
+    seen = np.any(
+        (d <= big_r) & (speed * t[None, :] >= far[:, None]) & (t[None, :] <= ub[:, None]), axis=1
+    )
+    v = float(mover.speed_max())
+    near = np.any(
+        (d <= big_r + v * dt)
+        & (speed * (t[None, :] + dt) >= far[:, None])
+        & (t[None, :] - dt <= ub[:, None]),
+        axis=1,
+    )
+    if t1 >= mover.t_last:  # it stands at its last place for ever: any time is late enough
+        seen |= (d[:, -1] <= big_r) & (ub >= t_end)
+        near |= (d[:, -1] <= big_r + 1e-9) & (ub >= t_end - 1e-9)
+    flat = mask.ravel()
+    assert np.all(flat[seen])  # every sampled meeting is marked
+    assert not np.any(flat & ~near)  # and nothing that no sample comes close to
+
+
+def test_a_walker_head_on_in_a_room_is_passed_with_a_side_step():
+    """A walker drives the straight way between the robot's ends backwards at the robot's top
+    speed: the detour round where the robot may meet it keeps the straight way but for a side
+    step where they meet (at x = 6 m by hand: both at 0.5 m/s from 10 m apart), so the robot
+    arrives within 5 % of the static plan's time (a way round its whole track is longer)."""
+    grid = _grid((80, 240), [(0.5, 11.5, 0.5, 3.5)])
+    planner = trajopt.Planner(grid, trajopt.Robot())
+    start, goal = (1.0, 2.0), (11.0, 2.0)
+    base = planner.plan(start, goal)
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 20.0], [goal, start], radius=0.2, name="walker"
+    )
+    out = planner.plan(start, goal, moving_obstacles=[walker], mover_margin=0.02)
+    mv = out.stats["moving"]
+    assert mv["route"] == "rerouted"
+    assert mv["reroute"][-1]["what"] == "around 'walker' where the robot may meet it"
+    _check(out, [walker], grid, 0.02)
+    assert out.length <= 1.05 * base.length and out.duration <= 1.05 * base.duration
+    t = np.linspace(0.0, out.duration, 2001)
+    smp = out.sample(t)
+    gap = np.abs(walker.position_at(t)[:, 0] - smp.x)
+    k = int(np.argmin(gap))  # they pass: the robot beside the walker's line
+    assert abs(smp.y[k] - 2.0) >= 0.165 + 0.2 + 0.02 - 1e-6 and 5.0 < smp.x[k] < 7.0
+    assert np.max(np.abs(smp.y - 2.0)) < 1.0  # a side step, not a way round
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_mark_swept_adds_no_cell_exactly_when_the_kept_discs_hold_the_region(seed):
+    """``mark_swept`` answers ``None`` (no cell added) exactly when the swept region's cells,
+    less those whose centre is in a kept disc, are all occupied already (brute force over
+    the cells with :func:`swept_mask`); its shortcut for regions inside a kept disc agrees."""
+    rng = np.random.default_rng(seed)
+    grid = _grid((60, 80), [(0.0, 4.0, 0.0, 3.0)])
+    p = rng.uniform([1.0, 1.0], [3.0, 2.0])
+    r = float(rng.uniform(0.3, 0.6))
+    end = p + rng.uniform(-0.25, 0.25, 2)  # stands near the kept point
+    mover = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 1.0], [p + rng.uniform(-0.3, 0.3, 2), end], radius=0.1, name="m"
+    )
+    for t0, t1 in ((1.0, 1.0), (0.0, 1.0)):
+        got = trajopt.moving.mark_swept(grid, [(mover, t0, t1)], 0.02, [(p, r)])
+        add = trajopt.moving.swept_mask(grid, mover, t0, t1, 0.02)
+        iy, ix = np.mgrid[0:60, 0:80]
+        c = (np.stack([ix, iy], -1) + 0.5) * RES
+        add &= np.hypot(c[..., 0] - p[0], c[..., 1] - p[1]) > r
+        add &= ~np.asarray(grid.occupied)
+        assert (got is None) == (not add.any())
+        if got is not None:
+            assert np.array_equal(np.asarray(got.occupied), np.asarray(grid.occupied) | add)

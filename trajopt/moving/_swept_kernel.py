@@ -1,0 +1,102 @@
+"""The compiled loop that marks a mover's swept region on a grid: :func:`capsule_kernel`.
+
+:func:`trajopt.moving.swept_mask` and :func:`trajopt.moving.reached_swept_mask` mark the
+cells whose centre is within a radius of a segment of the mover's track (its capsules); this
+kernel visits each segment's bounding box of cells once, with the same arithmetic as the
+array form it replaced (the projection clipped to the segment, ``hypot`` of the offset).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from trajopt.kernel_cache import watch_compiles
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
+
+
+@njit(cache=True)
+def capsule_kernel(
+    ox, oy, res, nx, ny, a, b, radius, ta, tb, origin, speed, slack, timed, late_factor, late_s
+):  # pragma: no cover - compiled
+    """Return the cells (bool, shape (ny, nx)) whose centre is within ``radius`` of a segment.
+
+    Parameters
+    ----------
+    ox, oy, res : float
+        The cells' origin (m) and size (m): cell ``(ix, iy)`` has its centre at
+        ``(ox + (ix + 0.5) res, oy + (iy + 0.5) res)``.
+    nx, ny : int
+        The cell counts.
+    a, b : ndarray, shape (k, 2)
+        The segments' ends (m).
+    radius : float
+        The capsules' radius (m).
+    ta, tb : ndarray, shape (k,)
+        With ``timed``: the times (s) a point moving linearly along segment ``i`` is at
+        ``a_i`` and at ``b_i`` (``tb`` inf: it stands at ``a_i = b_i`` for ever).
+    origin : ndarray, shape (2,)
+        With ``timed``: where the robot starts (m).
+    speed, slack : float
+        With ``timed``: the robot's top speed (m/s) and a distance (m).
+    timed : bool
+        Mark a hit cell only when ``|centre - origin| - slack - res / sqrt(2) <= speed * t``,
+        ``t`` the last time in ``[ta_i, tb_i]`` the point is within ``radius`` of the centre.
+    late_factor, late_s : float
+        With ``timed`` and ``late_factor > 0``: also only when the first such time is at most
+        ``late_factor (|centre - origin| + slack + res / sqrt(2)) / speed + late_s`` (s).
+
+    Returns
+    -------
+    ndarray of bool, shape (ny, nx)
+    """
+    mask = np.zeros((ny, nx), dtype=np.bool_)
+    half_diag = res * math.sqrt(0.5)
+    for i in range(a.shape[0]):
+        ax, ay, bx, by = a[i, 0], a[i, 1], b[i, 0], b[i, 1]
+        ix0 = max(0, int(math.floor((min(ax, bx) - radius - ox) / res)))
+        ix1 = min(nx - 1, int(math.floor((max(ax, bx) + radius - ox) / res)))
+        iy0 = max(0, int(math.floor((min(ay, by) - radius - oy) / res)))
+        iy1 = min(ny - 1, int(math.floor((max(ay, by) + radius - oy) / res)))
+        dx, dy = bx - ax, by - ay
+        dd = dx * dx + dy * dy
+        for iy in range(iy0, iy1 + 1):
+            cy = oy + (iy + 0.5) * res
+            py = cy - ay
+            for ix in range(ix0, ix1 + 1):
+                if mask[iy, ix]:  # marked by an earlier segment
+                    continue
+                cx = ox + (ix + 0.5) * res
+                px = cx - ax
+                lam = 0.0
+                if dd > 0.0:
+                    lam = min(max((px * dx + py * dy) / dd, 0.0), 1.0)
+                if math.hypot(px - lam * dx, py - lam * dy) > radius:
+                    continue
+                if timed:
+                    if math.isinf(tb[i]):
+                        last = math.inf
+                    else:
+                        mu = 1.0
+                        if dd > 0.0:
+                            along = (px * dx + py * dy) / dd
+                            off = (px * dy - py * dx) ** 2 / dd
+                            mu = min(1.0, along + math.sqrt(max(radius * radius - off, 0.0) / dd))
+                        last = ta[i] + mu * (tb[i] - ta[i])
+                    dist = math.hypot(cx - origin[0], cy - origin[1])
+                    if dist - slack - half_diag > speed * last:
+                        continue
+                    if late_factor > 0.0:
+                        nu = 0.0
+                        if dd > 0.0:
+                            along = (px * dx + py * dy) / dd
+                            off = (px * dy - py * dx) ** 2 / dd
+                            nu = max(0.0, along - math.sqrt(max(radius * radius - off, 0.0) / dd))
+                        first = ta[i] + nu * (tb[i] - ta[i]) if not math.isinf(tb[i]) else ta[i]
+                        if first > late_factor * (dist + slack + half_diag) / speed + late_s:
+                            continue
+                mask[iy, ix] = True
+    return mask
