@@ -309,6 +309,54 @@ BENCHES: tuple[Bench, ...] = (
         ("--rounds", "3"),
     ),
     Bench(
+        "hybrid",
+        "Car-like robots: Hybrid-A* over (x, y, heading) vs OMPL Reeds-Shepp/Dubins",
+        "bench_hybrid.py",
+        "`astar.find_pose_path` (Hybrid-A*, Reeds-Shepp shots; forward only: Dubins) on the "
+        "shared suite `shared-full`, seeded random start and goal headings, R = 2 x the robot "
+        "radius, on the map inflated by the radius, against OMPL's `RRTstar` in "
+        "`ReedsSheppStateSpace(R)` / `DubinsStateSpace(R)` on the same inflated grid (its "
+        "first solution or its time limit, then `simplifySolution`). Every Hybrid-A* path is "
+        "re-integrated independently (exact chords every 0.05 cells) against the inflated "
+        "grid; the 2-D heuristic (a Dijkstra over the free grid) is reported apart from the "
+        "search.",
+        ("--limit", "4"),
+        ("--limit", "10", "--ompl-time", "2.0"),
+    ),
+    Bench(
+        "car",
+        "Car-like robots end to end",
+        "bench_car.py",
+        "`trajopt.plan` for a car-like disc robot (`Ackermann`, R = 2 x radius, with and "
+        "without reversing: search, split at cusps, certified B-spline per segment with "
+        "curvature <= 1/R, rest-to-rest timing) as the `trajopt.bench` methods "
+        "`trajopt-ackermann` / `trajopt-ackermann-forward`, against `ompl-reedsshepp` / "
+        "`ompl-dubins` (OMPL's `RRTstar`, first exact solution or 2 s, then "
+        "`simplifySolution`) on `shared-full` with seeded random end headings. All methods "
+        "are judged by the same independent checks (`trajopt/analysis/bench/_car.py`: "
+        "clearance on dense samples against the raw map, curvature by circles through three "
+        "points against 1/R, speed at every join, heading against the direction of travel, "
+        "the end headings); OMPL's path is not timed, so it is compared by length, cusps and "
+        "reverse length, and its time is the time to its first solution.",
+        ("--limit", "3", "--workers", "1"),
+        ("--limit", "10", "--workers", "2"),
+    ),
+    Bench(
+        "ros",
+        "ROS 2 node: round trips, map updates, start-up, soak",
+        "bench_ros.py",
+        "The `trajopt_ros` node in its own process and the benchmark's client node in "
+        "another, over Fast DDS on localhost (LOCALHOST discovery, a domain id of its own, a "
+        "temporary log folder), on a 400 x 400 map of 0.05 m cells: the start-up to "
+        "`get_plan` found, a map's publication to the planner ready, the node's share of a "
+        "`get_plan` round trip (the round trip less the library's plan time the node logged "
+        "and this client's deserialisation), a map update to the re-planned `/plan`, and a "
+        "soak of requests (every third one bad) with the node's memory before and after. "
+        "Needs the `ros2` extra; the script's docstring defines each number.",
+        ("--requests", "150", "--repeats", "20"),
+        ("--requests", "1000", "--repeats", "60"),
+    ),
+    Bench(
         "moving",
         "Moving obstacles",
         "bench_moving.py",
