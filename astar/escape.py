@@ -65,7 +65,7 @@ ESCAPE_REASONS = ("exhausted", "max_expansions", "time_budget")
 #: Defaults of :func:`find_escape` as fractions of the turning radius (for the full-size car
 #: of the parking benchmarks, R = 3 m: margin 1.2 cm, room 0.35 m, cells 1.5 cm, moves 5,
 #: 10, 25, 50 cm, the longest 60 cm, the limit of a move to 1.5 mm).
-MARGIN_R = 0.006 / 3.0
+MARGIN_R = 0.012 / 3.0
 ROOM_R = 0.35 / 3.0
 CELL_R = 0.005
 MOVES_R = (0.05 / 3.0, 0.1 / 3.0, 0.25 / 3.0, 0.5 / 3.0)
