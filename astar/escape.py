@@ -206,11 +206,16 @@ def escape_kernel(
     cell,
     cell_th,
     rot_w,
-    turn,
+    turns,
     max_exp,
     deadline,
 ):  # pragma: no cover - compiled
-    """Best-first search of an escape (module docstring); lengths in the polygons' units.
+    """Best-first searches of an escape, one per turn, in turn (module docstring).
+
+    ``turns`` ``(t,)``: the sign of the rotation each search rewards (+1 counter-clockwise,
+    -1 clockwise); the searches keep their own poses and cells and expand one pose each in
+    turn (a search whose poses are spent is skipped), ``max_exp`` expansions in all.
+    Lengths in the polygons' units.
 
     Returns
     -------
@@ -218,9 +223,11 @@ def escape_kernel(
         ``(status, last, expanded, created, xs, ys, ts, parent, kap, lens)``: status 1 found
         (``last`` the pose with room), 0 exhausted, 2 ``max_expansions``, 3 past ``deadline``
         (``perf_counter`` seconds); per pose created its ``(x, y, heading)``, its parent (-1
-        for the first), the curvature and signed length of the arc that reached it.
+        for the first of each search), the curvature and signed length of the arc that reached
+        it.
     """
     buf = np.empty((fp.shape[0], 2))
+    nt = turns.shape[0]
     cap = 4 * max_exp + 1024
     xs = np.empty(cap)
     ys = np.empty(cap)
@@ -228,24 +235,38 @@ def escape_kernel(
     cusps = np.zeros(cap, np.int64)
     parent = np.full(cap, -1, np.int64)
     dirs = np.zeros(cap, np.int8)
+    side = np.zeros(cap, np.int64)
     kap = np.zeros(cap)
     lens = np.zeros(cap)
-    xs[0], ys[0], ts[0] = pose[0], pose[1], pose[2]
-    n = 1
     best = Dict.empty(types.int64, types.int64)
-    heap = [(0.0, 0)]
+    heaps = []
+    for h in range(nt):
+        xs[h], ys[h], ts[h] = pose[0], pose[1], pose[2]
+        side[h] = h
+        heaps.append([(0.0, h)])
+    n = nt
     done = np.zeros(cap, np.bool_)
     expanded = 0
     status = 0
     last = -1
-    while len(heap) > 0:
+    turn_no = 0
+    while True:
+        h = -1
+        for q in range(nt):  # the next search in turn with poses left
+            cand = (turn_no + q) % nt
+            if len(heaps[cand]) > 0:
+                h = cand
+                break
+        if h < 0:
+            break
+        turn_no = h + 1
         if expanded >= max_exp:
             status = 2
             break
         if (expanded & 255) == 0 and clock() > deadline:
             status = 3
             break
-        _, i = heapq.heappop(heap)
+        _, i = heapq.heappop(heaps[h])
         if done[i]:
             continue
         done[i] = True
@@ -267,18 +288,17 @@ def escape_kernel(
                         continue
                     x, y, t = advance(xs[i], ys[i], ts[i], k, d * s)
                     key = (
-                        np.int64(round(x / cell)) * 1000003 + np.int64(round(y / cell))
-                    ) * 1000003 + np.int64(round(t / cell_th))
+                        (np.int64(round(x / cell)) * 1000003 + np.int64(round(y / cell))) * 1000003
+                        + np.int64(round(t / cell_th))
+                    ) * nt + h
                     c = cusps[i] + (1 if dirs[i] != 0 and dirs[i] != d else 0)
                     if n >= cap or (key in best and best[key] <= c):
                         continue
                     best[key] = c
                     xs[n], ys[n], ts[n] = x, y, t
                     cusps[n], parent[n], dirs[n], kap[n], lens[n] = c, i, d, k, d * s
-                    heapq.heappush(
-                        heap,
-                        (c - rot_w * (abs(t - pose[2]) if turn == 0 else turn * (t - pose[2])), n),
-                    )
+                    side[n] = h
+                    heapq.heappush(heaps[h], (c - rot_w * turns[h] * (t - pose[2]), n))
                     n += 1
     return status, last, expanded, n, xs[:n], ys[:n], ts[:n], parent[:n], kap[:n], lens[:n]
 
@@ -297,7 +317,7 @@ def find_escape(
     longest: float | None = None,
     tol: float | None = None,
     rotation_weight: float = ROTATION_WEIGHT,
-    turn: float = 1.0,
+    turns: Sequence[float] = (1.0, -1.0),
     max_expansions: int = 200_000,
     time_budget: float = math.inf,
 ) -> Escape:
@@ -322,6 +342,10 @@ def find_escape(
         The heading cell (rad).
     rotation_weight : float, optional
         Cusps per radian turned in the search's order.
+    turns : sequence of float, optional
+        The searches run in turn, one per sign: +1 rewards turning counter-clockwise, -1
+        clockwise (the default both: which way out of a bay needs fewer expansions depends on
+        centimetres of its geometry).
     max_expansions : int, optional
         Poses expanded before the search gives up.
     time_budget : float, optional
@@ -356,6 +380,9 @@ def find_escape(
         raise InvalidInputError(f"max_expansions must be >= 1, got {max_expansions}")
     if not (time_budget > 0.0):
         raise InvalidInputError(f"time_budget must be > 0 s, got {time_budget}")
+    tw = np.array(list(turns), dtype=float).reshape(-1)
+    if len(tw) < 1 or not np.all(np.isin(tw, (1.0, -1.0))):
+        raise InvalidInputError(f"turns must be signs +1 or -1 (at least one), got {tw.tolist()}")
     p = tuple(float(v) for v in pose)
     if len(p) != 3 or not all(math.isfinite(v) for v in p):
         raise InvalidInputError(f"pose must be 3 finite numbers (x, y, heading), got {pose}")
@@ -379,7 +406,7 @@ def find_escape(
     deadline = t0 + time_budget if math.isfinite(time_budget) else 1e300
     out = escape_kernel(
         edges, starts, boxes, fp, rho, local, 1.0 / r, mv, longest, margin, tol, room, cell,
-        heading_cell, float(rotation_weight), float(turn), int(max_expansions), deadline,
+        heading_cell, float(rotation_weight), tw, int(max_expansions), deadline,
     )  # fmt: skip
     seconds = time.perf_counter() - t0
     status, last, expanded, created = (int(v) for v in out[:4])
