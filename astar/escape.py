@@ -63,18 +63,18 @@ __all__ = [
 #: the wall-clock safety net (by the kernel's status code 0, 2, 3).
 ESCAPE_REASONS = ("exhausted", "max_expansions", "time_budget")
 #: Defaults of :func:`find_escape` as fractions of the turning radius (for the full-size car
-#: of the parking benchmarks, R = 3 m: margin 1.2 cm, room 0.35 m, cells 1.5 cm, moves 5,
+#: of the parking benchmarks, R = 3 m: margin 1.2 cm, room 0.35 m, cells 1.8 cm, moves 5,
 #: 10, 25, 50 cm, the longest 60 cm, the limit of a move to 1.5 mm).
 MARGIN_R = 0.012 / 3.0
 ROOM_R = 0.35 / 3.0
-CELL_R = 0.005
+CELL_R = 0.006
 MOVES_R = (0.05 / 3.0, 0.1 / 3.0, 0.25 / 3.0, 0.5 / 3.0)
 LONGEST_R = 0.2
 TOL_R = 0.0005
 #: Default order weight: cusps per radian turned.
 ROTATION_WEIGHT = 300.0
-#: Default heading cell (rad): 0.25 degrees.
-HEADING_CELL = math.radians(0.25)
+#: Default heading cell (rad): 0.3 degrees.
+HEADING_CELL = math.radians(0.3)
 
 
 class NoEscapeError(NoPathError):
@@ -168,20 +168,26 @@ def pose_clearance(edges, starts, boxes, fp, x, y, th, cap, buf):  # pragma: no 
 
 @njit(cache=True)
 def arc_reach(
-    edges, starts, boxes, fp, rho, x, y, th, k, d, longest, margin, tol, buf
+    edges, starts, boxes, fp, rho, x, y, th, k, d, longest, margin, tol, c0, buf
 ):  # pragma: no cover - compiled
     """Return the longest length ``<= longest`` of an arc whose every pose keeps ``margin``.
 
     The arc leaves ``(x, y, th)`` at curvature ``k`` in direction ``d`` (+1 forwards, -1
-    backwards). Steps of ``(c - margin) / (1 + rho |k|)``, ``c`` the clearance where the step
-    starts (module docstring): every pose up to the returned length keeps ``margin``; the arc
-    goes on past it by less than ``tol`` before a pose keeps less (or it is ``longest``).
+    backwards); ``c0``: a lower bound of the body's clearance there (negative: unknown).
+    Steps of ``(c - margin) / (1 + rho |k|)``, ``c`` the clearance where the step starts
+    (module docstring): every pose up to the returned length keeps ``margin``; the arc goes
+    on past it by less than ``tol`` before a pose keeps less (or it is ``longest``).
     """
     v = 1.0 + rho * abs(k)
     s = 0.0
     while s < longest:
-        px, py, pt = advance(x, y, th, k, d * s)
-        c = pose_clearance(edges, starts, boxes, fp, px, py, pt, margin + v * (longest - s), buf)
+        if s == 0.0 and c0 >= 0.0:
+            c = c0
+        else:
+            px, py, pt = advance(x, y, th, k, d * s)
+            c = pose_clearance(
+                edges, starts, boxes, fp, px, py, pt, margin + v * (longest - s), buf
+            )
         free = (c - margin) / v
         if free < tol:
             return s
@@ -271,7 +277,10 @@ def escape_kernel(
             continue
         done[i] = True
         expanded += 1
-        if pose_clearance(edges, starts, boxes, fp, xs[i], ys[i], ts[i], room + 1.0, buf) >= room:
+        c0 = pose_clearance(
+            edges, starts, boxes, fp, xs[i], ys[i], ts[i], room + 2.0 * longest + 1.0, buf
+        )
+        if c0 >= room:
             status = 1
             last = i
             break
@@ -280,7 +289,7 @@ def escape_kernel(
                 k = kk * kmax
                 far = arc_reach(
                     edges, starts, boxes, fp, rho, xs[i], ys[i], ts[i], k, d, longest, margin,
-                    tol, buf,
+                    tol, c0, buf,
                 )  # fmt: skip
                 for j in range(moves.shape[0] + 1):
                     s = moves[j] if j < moves.shape[0] else far
