@@ -27,6 +27,8 @@ obstacles: :func:`exact_clearance`). When every radius of the second grid exhaus
 states, a car with a body searches it once more at :data:`TIGHT_FACTORS` with finer heading
 bins, shorter primitives and finer states near the end poses (:func:`tight_motion`,
 :func:`search_factors`): a bay entered nose first off a narrow aisle.
+When every try failed and expansions are left, the caller's last try runs
+(``last_try``: the escape out of a tight end pose, :mod:`trajopt.planning._car_escape`).
 ``stats["car"]["tries"]`` lists them.
 
 Budgets: expansion counts decide, so that the plan does not depend on the machine's load.
@@ -34,9 +36,9 @@ Each search stops after :data:`SEARCH_EXPANSIONS` expansions
 (:data:`FOOTPRINT_SEARCH_EXPANSIONS` for a car with a body, its default costs after
 :data:`FOOTPRINT_DEFAULT_EXPANSIONS`), and the searches of one plan share
 :data:`CAR_EXPANSIONS` (:data:`FOOTPRINT_CAR_EXPANSIONS`): no try starts once they are
-spent, and a try gets at most what is left. The wall-clock limits, :data:`SEARCH_SAFETY_S`
-per search and :data:`CAR_BUDGET_S` per plan, are only safety nets, far above what the
-searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
+spent, and a try gets at most what is left (the last try included). The wall-clock
+limits, :data:`SEARCH_SAFETY_S` per search and :data:`CAR_BUDGET_S` per plan, are only
+safety nets, far above what the searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
 that says so (its answer would depend on the machine's load) instead of going on to the
 next try. The fits keep the smoother's own wall-clock budget (at most
 ``trajopt.planning._car.SEGMENT_BUDGET_S``, 2 s, per fit; the smooth stage of a plan
@@ -49,7 +51,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -201,6 +203,7 @@ def search_and_fit(
     points: tuple[np.ndarray, np.ndarray],
     smoother: Smoother,
     timer: StageTimer,
+    last_try: Callable[..., CarFound | None] | None = None,
 ) -> CarFound:
     """Run the tries of a car's plan until one searches and fits (module docstring).
 
@@ -219,6 +222,11 @@ def search_and_fit(
         is raised to :data:`TIGHT_KAPPA_MARGIN` for the tight search radii.
     timer : StageTimer
         Receives the ``inflate``, ``search``, ``corridor`` and ``smooth`` stages.
+    last_try : callable, optional
+        Run when every try failed and expansions are left, as ``last_try(options, grid,
+        cells, tight smoother, timer, tries, failures, expansions left)``: a
+        :class:`CarFound` or None (the escape try,
+        :func:`trajopt.planning._car_escape.escape_and_fit`).
 
     Returns
     -------
@@ -366,14 +374,14 @@ def search_and_fit(
                 continue
             tries.append(f"{label}: planned")
             return CarFound(search_grid, path, r_cells, poses, segments, tries, spent)
-    if escape_applies(robot, grid):
+    if last_try is not None and spent < car_cap:
         if time.perf_counter() > t_end:
             raise safety_net_error(
                 f"the plan's wall-clock safety net of {CAR_BUDGET_S:g} s fired before the "
-                f"escape try ({spent} of {car_cap} expansions spent)",
+                f"last try ({spent} of {car_cap} expansions spent)",
                 tries,
             )
-        found = escape_and_fit(options, grid, cells, sm_tight, timer, tries, failures)
+        found = last_try(options, grid, cells, sm_tight, timer, tries, failures, car_cap - spent)
         if found is not None:
             return dataclasses.replace(found, expansions=found.expansions + spent)
     raise failure(robot, grid, start, goal, tries, failures)
@@ -607,8 +615,8 @@ def failure(
         last = failures[-1]
         err = NoPathError(
             f"no path of a car-like robot (turning radius {robot.drive.min_turning_radius} m) "
-            f"from pose {pose_m(start, grid)} to pose {pose_m(goal, grid)}: every search "
-            f"exhausted or ran out, and the escape out of the tight end pose found nothing "
+            f"from pose {pose_m(start, grid)} to pose {pose_m(goal, grid)}: no search found a "
+            f"path, and the escape out of the tight end pose found nothing "
             f"({last.reason}, {last.expanded} expansions): {last} (tries: {'; '.join(tries)})"
         )
         err.__cause__ = last
@@ -657,200 +665,3 @@ def pose_m(c: ArrayLike, grid: OccupancyGrid) -> str:
     x = grid.origin[0] + (c[0] + 0.5) * grid.resolution
     y = grid.origin[1] + (c[1] + 0.5) * grid.resolution
     return f"({x:.6g} m, {y:.6g} m, {c[2]:.6g} rad)"
-
-
-# --------------------------------------------------------------------------- the last try
-#: The escape try (:func:`escape_and_fit`): its arcs' radius as a multiple of ``R`` (fitted
-#: with :data:`TIGHT_KAPPA_MARGIN`: a segment at exactly ``1/R`` has no other curve), the
-#: expansions of each end's escape search (:func:`astar.find_escape`) and of the search that
-#: joins the escapes (its own caps: the plan's may be spent by the tries before it).
-ESCAPE_FACTOR = 1.05
-ESCAPE_EXPANSIONS = 300_000
-ESCAPE_JOIN_EXPANSIONS = FOOTPRINT_SEARCH_EXPANSIONS
-#: An end pose is tight (escaped from) when its body keeps less than this many escape
-#: radii from the polygons; the escape ends at a pose that keeps as much (0.37 m for the
-#: full-size car of the parking benchmarks, R = 3 m).
-ESCAPE_ROOM_R = 0.35 / 3.0
-#: The poses' spacing (cells) of the joined path (the search's own sample step).
-ESCAPE_STEP_CELLS = 0.5
-
-
-def escape_applies(robot: Robot, grid: OccupancyGrid) -> bool:
-    """Return whether the escape try may run: a car with a body that reverses, on polygons.
-
-    The escape tests the body exactly against the map's polygons
-    (:attr:`astar.OccupancyGrid.polygons`); without them, or for a car that only drives
-    forwards (the escape backs and fills), it is not tried.
-    """
-    return (
-        robot.footprint is not None
-        and robot.drive.reverse
-        and grid.polygons is not None
-        and len(grid.polygons) > 0
-    )
-
-
-def escape_and_fit(
-    options: PlannerOptions,
-    grid: OccupancyGrid,
-    cells: tuple[tuple[float, float, float], tuple[float, float, float]],
-    smoother: Smoother,
-    timer: StageTimer,
-    tries: list[str],
-    failures: list[Exception],
-) -> CarFound | None:
-    """Run the last try of a car's plan: escapes out of tight end poses joined by a search.
-
-    Run after every other try failed (:func:`search_and_fit`). An end pose is tight when its
-    body keeps less than :data:`ESCAPE_ROOM_R` times the escape's radius
-    from the map's polygons; from each tight end, :func:`astar.find_escape` (arcs at
-    :data:`ESCAPE_FACTOR` ``R``, at most :data:`ESCAPE_EXPANSIONS`) searches a way out to a
-    pose with room: from the start forwards in time, from the goal backwards
-    (:func:`astar.reversed_pieces`). :func:`astar.find_pose_path` joins the two poses with
-    room on the radius grid as the tight try searches it (:func:`exact_clearance`,
-    :data:`FOOTPRINT_COSTS`, at most :data:`ESCAPE_JOIN_EXPANSIONS`), and every segment of
-    the whole path is fitted with ``smoother`` (its ``kappa_margin`` raised to
-    :data:`TIGHT_KAPPA_MARGIN`) as the other tries' are.
-
-    Parameters
-    ----------
-    options, grid, cells, timer
-        As :func:`search_and_fit`.
-    smoother : Smoother
-        The tight fits' smoother.
-    tries, failures : list
-        The tries so far and their failures; this try's are appended.
-
-    Returns
-    -------
-    CarFound or None
-        None when no end is tight or a step failed (its failure appended).
-
-    Raises
-    ------
-    NoPathError
-        A search ran into its wall-clock safety net (:func:`safety_net_error`).
-    """
-    robot = options.robot
-    res = grid.resolution
-    ox, oy = grid.origin
-    r_m = ESCAPE_FACTOR * robot.drive.min_turning_radius
-    r_cells = r_m / res
-    room = ESCAPE_ROOM_R * r_m
-    body = np.asarray(robot.footprint.vertices, dtype=float)
-    world = [(ox + (c[0] + 0.5) * res, oy + (c[1] + 0.5) * res, float(c[2])) for c in cells]
-    clear = astar.bodies_distance(body, np.array(world), grid.polygons, room + 1.0)
-    if np.all(clear >= room):
-        return None  # no tight end: the tries before searched what this one would
-    ends = list(cells)
-    runs: list[np.ndarray] = [np.zeros((0, 5)), np.zeros((0, 5))]
-    spent = 0
-    for e, name in ((0, "start"), (1, "goal")):
-        if clear[e] >= room:
-            continue
-        label = f"escape from the {name}"
-        try:
-            with timer.stage("search"):
-                esc = astar.find_escape(
-                    body,
-                    world[e],
-                    grid.polygons,
-                    r_m,
-                    room=room,
-                    max_expansions=ESCAPE_EXPANSIONS,
-                    time_budget=SEARCH_SAFETY_S,
-                )
-        except astar.NoEscapeError as exc:
-            tries.append(f"{label}: none ({exc.reason}, {exc.expanded} expansions)")
-            failures.append(exc)
-            if exc.reason == "time_budget":
-                raise safety_net_error(
-                    f"the {label} ran into its wall-clock safety net of {SEARCH_SAFETY_S:g} s "
-                    f"({exc.expanded} expansions)",
-                    tries,
-                    exc,
-                ) from exc
-            return None
-        except astar.InvalidInputError as exc:  # the body at the end pose keeps no margin
-            tries.append(f"{label}: {exc}")
-            failures.append(InvalidInputError(str(exc)))
-            return None
-        spent += esc.expanded
-        tries.append(f"{label}: {esc.cusps} cusps, {esc.expanded} expansions")
-        run = esc.pieces if e == 0 else astar.reversed_pieces(esc.pieces)
-        run = np.column_stack(
-            [
-                (run[:, 0] - ox) / res - 0.5,
-                (run[:, 1] - oy) / res - 0.5,
-                run[:, 2],
-                run[:, 3] * res,
-                run[:, 4] / res,
-            ]
-        )
-        runs[e] = run
-        ends[e] = ((esc.end[0] - ox) / res - 0.5, (esc.end[1] - oy) / res - 0.5, esc.end[2])
-    with timer.stage("inflate"):
-        search_grid = car_search_grid(robot, grid, margin=False)
-    label = f"{grid_name(False)}, {ESCAPE_FACTOR:g} R, joining the escapes"
-    try:
-        with timer.stage("search"):
-            join = astar.find_pose_path(
-                search_grid,
-                tuple(ends[0]),
-                tuple(ends[1]),
-                turning_radius=r_cells,
-                reverse=True,
-                max_expansions=ESCAPE_JOIN_EXPANSIONS,
-                time_budget=SEARCH_SAFETY_S,
-                **{**exact_clearance(robot, grid, False), **FOOTPRINT_COSTS},
-            )
-    except astar.NoPosePathError as exc:
-        tries.append(f"{label}: no path ({exc.reason})")
-        failures.append(exc)
-        if exc.reason == "time_budget" or any(
-            sub["stop"] == "time_budget" for sub in (exc.stats or {}).get("searches", [])
-        ):
-            raise safety_net_error(
-                f"the search {label!r} ran into its wall-clock safety net of {SEARCH_SAFETY_S:g} s",
-                tries,
-                exc,
-            ) from exc
-        return None
-    except astar.InvalidInputError as exc:
-        tries.append(f"{label}: {exc}")
-        failures.append(InvalidInputError(str(exc)))
-        return None
-    spent += int(join.stats["expanded"])
-    if any(sub["stop"] == "time_budget" for sub in join.stats["searches"]):
-        raise safety_net_error(
-            f"the search {label!r} ran into its wall-clock safety net (a share of "
-            f"{SEARCH_SAFETY_S:g} s) before its expansion cap",
-            tries,
-        )
-    arrays = astar.join_escape(
-        [runs[0], np.asarray(join.pieces), runs[1]], cells[1], ESCAPE_STEP_CELLS
-    )
-    stats = {**join.stats, "escape_expanded": spent - int(join.stats["expanded"])}
-    path = astar.PosePath(*arrays, r_cells, stats)
-    poses = path.to_world(grid)
-    try:
-        segments = []
-        for a, b in np.asarray(path.segments):
-            segments.extend(
-                fit_run(
-                    options,
-                    grid,
-                    smoother,
-                    poses,
-                    (int(a), int(b)),
-                    int(path.directions[b]),
-                    start_curvature(path, int(a), res),
-                    timer,
-                )
-            )
-    except SmoothingError as exc:
-        tries.append(f"{label}: a segment has no fit")
-        failures.append(exc)
-        return None
-    tries.append(f"{label}: planned")
-    return CarFound(search_grid, path, r_cells, poses, segments, tries, spent)
