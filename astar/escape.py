@@ -208,6 +208,7 @@ def escape_kernel(
     longest,
     margin,
     tol,
+    shortest,
     room,
     cell,
     cell_th,
@@ -295,6 +296,8 @@ def escape_kernel(
                     s = moves[j] if j < moves.shape[0] else far
                     if s > far or s < tol or (j < moves.shape[0] and s == far):
                         continue
+                    if s < shortest and dirs[i] != 0 and dirs[i] != d:
+                        continue  # a segment between cusps is at least ``shortest`` long
                     x, y, t = advance(xs[i], ys[i], ts[i], k, d * s)
                     key = (
                         (np.int64(round(x / cell)) * 1000003 + np.int64(round(y / cell))) * 1000003
@@ -325,6 +328,7 @@ def find_escape(
     moves: Sequence[float] | None = None,
     longest: float | None = None,
     tol: float | None = None,
+    shortest: float | None = None,
     rotation_weight: float = ROTATION_WEIGHT,
     turns: Sequence[float] = (1.0, -1.0),
     max_expansions: int = 200_000,
@@ -347,6 +351,10 @@ def find_escape(
         cell, the fixed move lengths, the longest move and the tolerance of a move's limit
         (m); by default :data:`MARGIN_R`, :data:`ROOM_R`, :data:`CELL_R`, :data:`MOVES_R`,
         :data:`LONGEST_R` and :data:`TOL_R` times ``turning_radius``.
+    shortest : float, optional
+        No move that changes the direction of travel is shorter (m; default ``tol``), so no
+        stretch between cusps is: a curve fitted to a fraction of a map cell between two
+        cusps is ill-posed.
     heading_cell : float, optional
         The heading cell (rad).
     rotation_weight : float, optional
@@ -379,6 +387,7 @@ def find_escape(
     cell = _positive("cell", CELL_R * r if cell is None else cell)
     longest = _positive("longest", LONGEST_R * r if longest is None else longest)
     tol = _positive("tol", TOL_R * r if tol is None else tol)
+    shortest = _positive("shortest", tol if shortest is None else shortest)
     heading_cell = _positive("heading_cell", heading_cell)
     if not (math.isfinite(rotation_weight) and rotation_weight >= 0.0):
         raise InvalidInputError(f"rotation_weight must be finite and >= 0, got {rotation_weight}")
@@ -414,8 +423,8 @@ def find_escape(
     t0 = time.perf_counter()
     deadline = t0 + time_budget if math.isfinite(time_budget) else 1e300
     out = escape_kernel(
-        edges, starts, boxes, fp, rho, local, 1.0 / r, mv, longest, margin, tol, room, cell,
-        heading_cell, float(rotation_weight), tw, int(max_expansions), deadline,
+        edges, starts, boxes, fp, rho, local, 1.0 / r, mv, longest, margin, tol, shortest,
+        room, cell, heading_cell, float(rotation_weight), tw, int(max_expansions), deadline,
     )  # fmt: skip
     seconds = time.perf_counter() - t0
     status, last, expanded, created = (int(v) for v in out[:4])

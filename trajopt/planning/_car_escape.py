@@ -49,6 +49,9 @@ ESCAPE_JOIN_EXPANSIONS = FOOTPRINT_SEARCH_EXPANSIONS
 #: radii from the polygons; the escape ends at a pose that keeps as much (0.37 m for the
 #: full-size car of the parking benchmarks, R = 3 m).
 ESCAPE_ROOM_R = 0.35 / 3.0
+#: The escape's shortest move (cells of the map): the fits of the small car's moves of
+#: 1 cm between cusps on 5 cm cells (0.2 cells) ran their QP solver out of iterations.
+ESCAPE_SHORTEST_CELLS = 0.3
 #: The poses' spacing (cells) of the joined path (the search's own sample step).
 ESCAPE_STEP_CELLS = 0.5
 
@@ -80,15 +83,19 @@ def escape_and_fit(
 ) -> CarFound | None:
     """Run the last try of a car's plan: escapes out of tight end poses joined by a search.
 
-    Run after every other try failed (:func:`~trajopt.planning._car_tries.search_and_fit`). An end pose is tight when its
-    body keeps less than :data:`ESCAPE_ROOM_R` times the escape's radius
-    from the map's polygons; from each tight end, :func:`astar.find_escape` (arcs at
-    :data:`ESCAPE_FACTOR` ``R``, at most :data:`ESCAPE_EXPANSIONS`) searches a way out to a
-    pose with room: from the start forwards in time, from the goal backwards
-    (:func:`astar.reversed_pieces`). :func:`astar.find_pose_path` joins the two poses with
-    room on the radius grid as the tight try searches it (:func:`~trajopt.planning._car_tries.exact_clearance`,
-    :data:`~trajopt.planning._car_tries.FOOTPRINT_COSTS`, at most :data:`ESCAPE_JOIN_EXPANSIONS`), and every segment of
-    the whole path is fitted with ``smoother`` (its ``kappa_margin`` raised to
+    Run after every other try failed (:func:`~trajopt.planning._car_tries.search_and_fit`).
+    An end pose is tight when its body keeps less than :data:`ESCAPE_ROOM_R` times the
+    escape's radius from the map's polygons; from each tight end, :func:`astar.find_escape`
+    (arcs at :data:`ESCAPE_FACTOR` ``R``, at most :data:`ESCAPE_EXPANSIONS`, both turning
+    senses in turn) searches a way out to a pose with room: from the start forwards in
+    time, from the goal backwards (:func:`astar.reversed_pieces`).
+    :func:`astar.find_pose_path` joins the two poses with room on the radius grid as the
+    tight try searches it (:func:`~trajopt.planning._car_tries.exact_clearance`,
+    :data:`~trajopt.planning._car_tries.FOOTPRINT_COSTS`, at most
+    :data:`ESCAPE_JOIN_EXPANSIONS`); where it finds no path (an escape that left the car
+    turned the wrong way in a narrow aisle), the escapes run once more, each turning the
+    car the other way only, and the search again. Every segment of the whole path is fitted
+    with ``smoother`` (its ``kappa_margin`` raised to
     :data:`~trajopt.planning._car_tries.TIGHT_KAPPA_MARGIN`) as the other tries' are.
 
     Parameters
@@ -100,8 +107,8 @@ def escape_and_fit(
     tries, failures : list
         The tries so far and their failures; this try's are appended.
     left : int
-        The plan's expansions left (:func:`~trajopt.planning._car_tries.expansion_caps`): the searches of this try share
-        them, each capped as well by its own cap.
+        The plan's expansions left (:func:`~trajopt.planning._car_tries.expansion_caps`):
+        the searches of this try share them, each capped as well by its own cap.
 
     Returns
     -------
@@ -111,7 +118,8 @@ def escape_and_fit(
     Raises
     ------
     NoPathError
-        A search ran into its wall-clock safety net (:func:`~trajopt.planning._car_tries.safety_net_error`).
+        A search ran into its wall-clock safety net
+        (:func:`~trajopt.planning._car_tries.safety_net_error`).
     """
     robot = options.robot
     res = grid.resolution
@@ -124,90 +132,103 @@ def escape_and_fit(
     clear = astar.bodies_distance(body, np.array(world), grid.polygons, room + 1.0)
     if np.all(clear >= room):
         return None  # no tight end: the tries before searched what this one would
-    ends = list(cells)
-    runs: list[np.ndarray] = [np.zeros((0, 5)), np.zeros((0, 5))]
     spent = 0
-    for e, name in ((0, "start"), (1, "goal")):
-        if clear[e] >= room:
-            continue
+    senses: list[tuple[float, ...]] = [(1.0, -1.0), (1.0, -1.0)]
+    with timer.stage("inflate"):
+        search_grid = car_search_grid(robot, grid, margin=False)
+    for attempt in range(2):
+        ends = list(cells)
+        runs: list[np.ndarray] = [np.zeros((0, 5)), np.zeros((0, 5))]
+        turned = [1.0, 1.0]  # the sense each escape turned the car
+        for e, name in ((0, "start"), (1, "goal")):
+            if clear[e] >= room:
+                continue
+            label = f"escape from the {name}" + (" turning the other way" if attempt else "")
+            if spent >= left:
+                tries.append(f"{label}: not tried (the plan's expansions spent)")
+                return None
+            try:
+                with timer.stage("search"):
+                    esc = astar.find_escape(
+                        body,
+                        world[e],
+                        grid.polygons,
+                        r_m,
+                        room=room,
+                        shortest=ESCAPE_SHORTEST_CELLS * res,
+                        turns=senses[e],
+                        max_expansions=min(ESCAPE_EXPANSIONS, left - spent),
+                        time_budget=SEARCH_SAFETY_S,
+                    )
+            except astar.NoEscapeError as exc:
+                tries.append(f"{label}: none ({exc.reason}, {exc.expanded} expansions)")
+                failures.append(exc)
+                if exc.reason == "time_budget":
+                    raise safety_net_error(
+                        f"the {label} ran into its wall-clock safety net of "
+                        f"{SEARCH_SAFETY_S:g} s ({exc.expanded} expansions)",
+                        tries,
+                        exc,
+                    ) from exc
+                return None
+            except astar.InvalidInputError as exc:  # the body at the end pose keeps no margin
+                tries.append(f"{label}: {exc}")
+                failures.append(InvalidInputError(str(exc)))
+                return None
+            spent += esc.expanded
+            turned[e] = 1.0 if esc.end[2] >= world[e][2] else -1.0
+            tries.append(f"{label}: {esc.cusps} cusps, {esc.expanded} expansions")
+            run = esc.pieces if e == 0 else astar.reversed_pieces(esc.pieces)
+            runs[e] = np.column_stack(
+                [
+                    (run[:, 0] - ox) / res - 0.5,
+                    (run[:, 1] - oy) / res - 0.5,
+                    run[:, 2],
+                    run[:, 3] * res,
+                    run[:, 4] / res,
+                ]
+            )
+            ends[e] = ((esc.end[0] - ox) / res - 0.5, (esc.end[1] - oy) / res - 0.5, esc.end[2])
+        label = f"{grid_name(False)}, {ESCAPE_FACTOR:g} R, joining the escapes"
         if spent >= left:
-            tries.append(f"escape from the {name}: not tried (the plan's expansions spent)")
+            tries.append(f"{label}: not tried (the plan's expansions spent)")
             return None
-        label = f"escape from the {name}"
         try:
             with timer.stage("search"):
-                esc = astar.find_escape(
-                    body,
-                    world[e],
-                    grid.polygons,
-                    r_m,
-                    room=room,
-                    max_expansions=min(ESCAPE_EXPANSIONS, left - spent),
+                join = astar.find_pose_path(
+                    search_grid,
+                    tuple(ends[0]),
+                    tuple(ends[1]),
+                    turning_radius=r_cells,
+                    reverse=True,
+                    max_expansions=min(ESCAPE_JOIN_EXPANSIONS, left - spent),
                     time_budget=SEARCH_SAFETY_S,
+                    **{**exact_clearance(robot, grid, False), **FOOTPRINT_COSTS},
                 )
-        except astar.NoEscapeError as exc:
-            tries.append(f"{label}: none ({exc.reason}, {exc.expanded} expansions)")
+        except astar.NoPosePathError as exc:
+            spent += int((exc.stats or {}).get("expanded", 0))
+            tries.append(f"{label}: no path ({exc.reason})")
             failures.append(exc)
-            if exc.reason == "time_budget":
+            if exc.reason == "time_budget" or any(
+                sub["stop"] == "time_budget" for sub in (exc.stats or {}).get("searches", [])
+            ):
                 raise safety_net_error(
-                    f"the {label} ran into its wall-clock safety net of {SEARCH_SAFETY_S:g} s "
-                    f"({exc.expanded} expansions)",
+                    f"the search {label!r} ran into its wall-clock safety net of "
+                    f"{SEARCH_SAFETY_S:g} s",
                     tries,
                     exc,
                 ) from exc
+            if attempt == 0 and exc.reason in ("exhausted", "disconnected"):
+                # an escape's end the search cannot reach (a car turned the wrong way in a
+                # narrow aisle): once more, each escape turning the other way
+                senses = [(-turned[0],), (-turned[1],)]
+                continue
             return None
-        except astar.InvalidInputError as exc:  # the body at the end pose keeps no margin
+        except astar.InvalidInputError as exc:
             tries.append(f"{label}: {exc}")
             failures.append(InvalidInputError(str(exc)))
             return None
-        spent += esc.expanded
-        tries.append(f"{label}: {esc.cusps} cusps, {esc.expanded} expansions")
-        run = esc.pieces if e == 0 else astar.reversed_pieces(esc.pieces)
-        run = np.column_stack(
-            [
-                (run[:, 0] - ox) / res - 0.5,
-                (run[:, 1] - oy) / res - 0.5,
-                run[:, 2],
-                run[:, 3] * res,
-                run[:, 4] / res,
-            ]
-        )
-        runs[e] = run
-        ends[e] = ((esc.end[0] - ox) / res - 0.5, (esc.end[1] - oy) / res - 0.5, esc.end[2])
-    label = f"{grid_name(False)}, {ESCAPE_FACTOR:g} R, joining the escapes"
-    if spent >= left:
-        tries.append(f"{label}: not tried (the plan's expansions spent)")
-        return None
-    with timer.stage("inflate"):
-        search_grid = car_search_grid(robot, grid, margin=False)
-    try:
-        with timer.stage("search"):
-            join = astar.find_pose_path(
-                search_grid,
-                tuple(ends[0]),
-                tuple(ends[1]),
-                turning_radius=r_cells,
-                reverse=True,
-                max_expansions=min(ESCAPE_JOIN_EXPANSIONS, left - spent),
-                time_budget=SEARCH_SAFETY_S,
-                **{**exact_clearance(robot, grid, False), **FOOTPRINT_COSTS},
-            )
-    except astar.NoPosePathError as exc:
-        tries.append(f"{label}: no path ({exc.reason})")
-        failures.append(exc)
-        if exc.reason == "time_budget" or any(
-            sub["stop"] == "time_budget" for sub in (exc.stats or {}).get("searches", [])
-        ):
-            raise safety_net_error(
-                f"the search {label!r} ran into its wall-clock safety net of {SEARCH_SAFETY_S:g} s",
-                tries,
-                exc,
-            ) from exc
-        return None
-    except astar.InvalidInputError as exc:
-        tries.append(f"{label}: {exc}")
-        failures.append(InvalidInputError(str(exc)))
-        return None
+        break
     spent += int(join.stats["expanded"])
     if any(sub["stop"] == "time_budget" for sub in join.stats["searches"]):
         raise safety_net_error(
