@@ -185,8 +185,10 @@ def arc_reach(
             c = c0
         else:
             px, py, pt = advance(x, y, th, k, d * s)
+            # capped at one step of at most a quarter of the longest move: polygons farther
+            # than that from the body are skipped by their boxes
             c = pose_clearance(
-                edges, starts, boxes, fp, px, py, pt, margin + v * (longest - s), buf
+                edges, starts, boxes, fp, px, py, pt, margin + v * 0.25 * longest, buf
             )
         free = (c - margin) / v
         if free < tol:
@@ -278,9 +280,7 @@ def escape_kernel(
             continue
         done[i] = True
         expanded += 1
-        c0 = pose_clearance(
-            edges, starts, boxes, fp, xs[i], ys[i], ts[i], room + 2.0 * longest + 1.0, buf
-        )
+        c0 = pose_clearance(edges, starts, boxes, fp, xs[i], ys[i], ts[i], room, buf)
         if c0 >= room:
             status = 1
             last = i
