@@ -17,6 +17,8 @@ the wall-clock safety nets stop the plan as for the other tries.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 import astar
@@ -133,17 +135,24 @@ def escape_and_fit(
     if np.all(clear >= room):
         return None  # no tight end: the tries before searched what this one would
     spent = 0
-    senses: list[tuple[float, ...]] = [(1.0, -1.0), (1.0, -1.0)]
+    # first turn each end's car towards the other end's heading (out of a bay entered nose
+    # first, backwards in time, the car turns back to the heading it came with)
+    toward = [
+        1.0 if math.remainder(world[1 - e][2] - world[e][2], 2.0 * math.pi) >= 0.0 else -1.0
+        for e in (0, 1)
+    ]
+    senses: list[tuple[float, ...]] = [(toward[0],), (toward[1],)]
     with timer.stage("inflate"):
         search_grid = car_search_grid(robot, grid, margin=False)
     for attempt in range(2):
         ends = list(cells)
         runs: list[np.ndarray] = [np.zeros((0, 5)), np.zeros((0, 5))]
-        turned = [1.0, 1.0]  # the sense each escape turned the car
+        esc_failed = True  # until every tight end's escape is found
         for e, name in ((0, "start"), (1, "goal")):
             if clear[e] >= room:
                 continue
-            label = f"escape from the {name}" + (" turning the other way" if attempt else "")
+            way = ("counter-clockwise", "clockwise")[int(senses[e][0] < 0.0)]
+            label = f"escape from the {name} turning {way}"
             if spent >= left:
                 tries.append(f"{label}: not tried (the plan's expansions spent)")
                 return None
@@ -161,6 +170,7 @@ def escape_and_fit(
                         time_budget=SEARCH_SAFETY_S,
                     )
             except astar.NoEscapeError as exc:
+                spent += exc.expanded
                 tries.append(f"{label}: none ({exc.reason}, {exc.expanded} expansions)")
                 failures.append(exc)
                 if exc.reason == "time_budget":
@@ -170,13 +180,12 @@ def escape_and_fit(
                         tries,
                         exc,
                     ) from exc
-                return None
+                break
             except astar.InvalidInputError as exc:  # the body at the end pose keeps no margin
                 tries.append(f"{label}: {exc}")
                 failures.append(InvalidInputError(str(exc)))
                 return None
             spent += esc.expanded
-            turned[e] = 1.0 if esc.end[2] >= world[e][2] else -1.0
             tries.append(f"{label}: {esc.cusps} cusps, {esc.expanded} expansions")
             run = esc.pieces if e == 0 else astar.reversed_pieces(esc.pieces)
             runs[e] = np.column_stack(
@@ -189,6 +198,13 @@ def escape_and_fit(
                 ]
             )
             ends[e] = ((esc.end[0] - ox) / res - 0.5, (esc.end[1] - oy) / res - 0.5, esc.end[2])
+        else:
+            esc_failed = False
+        if esc_failed:
+            if attempt == 0:
+                senses = [(-toward[0],), (-toward[1],)]
+                continue
+            return None
         label = f"{grid_name(False)}, {ESCAPE_FACTOR:g} R, joining the escapes"
         if spent >= left:
             tries.append(f"{label}: not tried (the plan's expansions spent)")
@@ -221,7 +237,7 @@ def escape_and_fit(
             if attempt == 0 and exc.reason in ("exhausted", "disconnected"):
                 # an escape's end the search cannot reach (a car turned the wrong way in a
                 # narrow aisle): once more, each escape turning the other way
-                senses = [(-turned[0],), (-turned[1],)]
+                senses = [(-toward[0],), (-toward[1],)]
                 continue
             return None
         except astar.InvalidInputError as exc:
