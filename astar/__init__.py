@@ -57,6 +57,11 @@ _EXPORTS: dict[str, str] = {
     "HybridCosts": "astar.hybrid_options",
     "HybridLimits": "astar.hybrid_options",
     "HybridCollision": "astar.hybrid_options",
+    "Escape": "astar.escape",
+    "NoEscapeError": "astar.escape",
+    "find_escape": "astar.escape",
+    "join_escape": "astar.escape",
+    "reversed_pieces": "astar.escape",
     "CarPath": "astar.reeds_shepp",
     "reeds_shepp_path": "astar.reeds_shepp",
     "dubins_path": "astar.reeds_shepp",
@@ -88,6 +93,13 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from astar.costmap import Costmap, from_costmap, load_costmap
     from astar.errors import AstarError, InvalidInputError, MapFormatError, NoPathError
+    from astar.escape import (
+        Escape,
+        NoEscapeError,
+        find_escape,
+        join_escape,
+        reversed_pieces,
+    )
     from astar.grid import OccupancyGrid, from_polygons
     from astar.hybrid import NoPosePathError, PosePath, find_pose_path
     from astar.hybrid_options import HybridCollision, HybridCosts, HybridLimits, HybridMotion

@@ -312,7 +312,18 @@ def rasterize_polygons(
     ny, nx = grid_shape(box, res)
     occ = np.zeros((ny, nx), dtype=bool)
     origin = (box[0], box[1])
+    # a polygon whose box lies a cell or more outside the grid marks nothing (a window of a
+    # larger map: the fits' fine rasters)
+    x_hi, y_hi = box[0] + (nx + 1) * res, box[1] + (ny + 1) * res
+    x_lo, y_lo = box[0] - res, box[1] - res
     for v in rings:
+        if (
+            v[:, 0].min() > x_hi
+            or v[:, 0].max() < x_lo
+            or v[:, 1].min() > y_hi
+            or v[:, 1].max() < y_lo
+        ):
+            continue
         _mark_edges(occ, v, origin, res)
         _mark_interior(occ, v, origin, res)
     return occ, res, origin, tuple(rings)

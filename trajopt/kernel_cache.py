@@ -54,6 +54,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "astar.body_polygons",
     "astar.coarse_to_fine",
     "astar.distance_transform",
+    "astar.escape",
     "astar.hybrid_kernel",
     "astar.hybrid_shortcut",
     "astar.inflation",

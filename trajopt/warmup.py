@@ -335,6 +335,10 @@ def _exercise_car() -> None:
     # the exact body-to-polygon distance (a car on a grid made from polygons)
     square = np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])
     astar.bodies_distance(np.asarray(body), np.array([[0.0, 0.0, 0.3]]), [square])
+    # the escape out of a tight pose (the car's last try): a body between two walls
+    wall = np.array([[-1.0, 0.4], [2.0, 0.4], [2.0, 0.6], [-1.0, 0.6]])
+    walls = [wall, wall * np.array([1.0, -1.0])]
+    astar.find_escape(np.asarray(body), (0.0, 0.0, 0.0), walls, 3.0, room=0.2)
     astar.reeds_shepp_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
     astar.dubins_path((0.0, 0.0, 0.0), (1.0, 2.0, 1.0), 1.0).sample(0.5)
 

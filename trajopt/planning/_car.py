@@ -94,6 +94,7 @@ from trajopt.errors import InvalidInputError, TrajoptError
 from trajopt.geometry import ShiftedCurve, concatenate
 from trajopt.motion import Trajectory, TrajectoryChain, steer_in_place
 from trajopt.planning._caches import PlannerCaches
+from trajopt.planning._car_escape import escape_and_fit, escape_applies
 from trajopt.planning._car_fit import CarSegment
 from trajopt.planning._car_tries import search_and_fit
 from trajopt.planning._ends import check_endpoint
@@ -251,7 +252,8 @@ def plan_car(
         time_budget_s=min(sm.time_budget_s, SEGMENT_BUDGET_S),
     )
     try:
-        found = search_and_fit(options, grid, (start, goal), (p0w, p1w), sm, timer)
+        last_try = escape_and_fit if escape_applies(robot, grid) else None
+        found = search_and_fit(options, grid, (start, goal), (p0w, p1w), sm, timer, last_try)
     except TrajoptError as exc:
         if local and exc.args:
             exc.args = (

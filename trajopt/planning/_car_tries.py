@@ -27,6 +27,8 @@ obstacles: :func:`exact_clearance`). When every radius of the second grid exhaus
 states, a car with a body searches it once more at :data:`TIGHT_FACTORS` with finer heading
 bins, shorter primitives and finer states near the end poses (:func:`tight_motion`,
 :func:`search_factors`): a bay entered nose first off a narrow aisle.
+When every try failed and expansions are left, the caller's last try runs
+(``last_try``: the escape out of a tight end pose, :mod:`trajopt.planning._car_escape`).
 ``stats["car"]["tries"]`` lists them.
 
 Budgets: expansion counts decide, so that the plan does not depend on the machine's load.
@@ -34,9 +36,9 @@ Each search stops after :data:`SEARCH_EXPANSIONS` expansions
 (:data:`FOOTPRINT_SEARCH_EXPANSIONS` for a car with a body, its default costs after
 :data:`FOOTPRINT_DEFAULT_EXPANSIONS`), and the searches of one plan share
 :data:`CAR_EXPANSIONS` (:data:`FOOTPRINT_CAR_EXPANSIONS`): no try starts once they are
-spent, and a try gets at most what is left. The wall-clock limits, :data:`SEARCH_SAFETY_S`
-per search and :data:`CAR_BUDGET_S` per plan, are only safety nets, far above what the
-searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
+spent, and a try gets at most what is left (the last try included). The wall-clock
+limits, :data:`SEARCH_SAFETY_S` per search and :data:`CAR_BUDGET_S` per plan, are only
+safety nets, far above what the searches take; when one fires, the plan stops with a :class:`~trajopt.errors.NoPathError`
 that says so (its answer would depend on the machine's load) instead of going on to the
 next try. The fits keep the smoother's own wall-clock budget (at most
 ``trajopt.planning._car.SEGMENT_BUDGET_S``, 2 s, per fit; the smooth stage of a plan
@@ -49,7 +51,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -201,6 +203,7 @@ def search_and_fit(
     points: tuple[np.ndarray, np.ndarray],
     smoother: Smoother,
     timer: StageTimer,
+    last_try: Callable[..., CarFound | None] | None = None,
 ) -> CarFound:
     """Run the tries of a car's plan until one searches and fits (module docstring).
 
@@ -219,6 +222,11 @@ def search_and_fit(
         is raised to :data:`TIGHT_KAPPA_MARGIN` for the tight search radii.
     timer : StageTimer
         Receives the ``inflate``, ``search``, ``corridor`` and ``smooth`` stages.
+    last_try : callable, optional
+        Run when every try failed and expansions are left, as ``last_try(options, grid,
+        cells, tight smoother, timer, tries, failures, expansions left)``: a
+        :class:`CarFound` or None (the escape try,
+        :func:`trajopt.planning._car_escape.escape_and_fit`).
 
     Returns
     -------
@@ -366,6 +374,16 @@ def search_and_fit(
                 continue
             tries.append(f"{label}: planned")
             return CarFound(search_grid, path, r_cells, poses, segments, tries, spent)
+    if last_try is not None and spent < car_cap:
+        if time.perf_counter() > t_end:
+            raise safety_net_error(
+                f"the plan's wall-clock safety net of {CAR_BUDGET_S:g} s fired before the "
+                f"last try ({spent} of {car_cap} expansions spent)",
+                tries,
+            )
+        found = last_try(options, grid, cells, sm_tight, timer, tries, failures, car_cap - spent)
+        if found is not None:
+            return dataclasses.replace(found, expansions=found.expansions + spent)
     raise failure(robot, grid, start, goal, tries, failures)
 
 
@@ -593,6 +611,16 @@ def failure(
     failures: list[Exception],
 ) -> Exception:
     """Return the error of a car's plan that no try completed (module docstring)."""
+    if failures and isinstance(failures[-1], astar.NoEscapeError):
+        last = failures[-1]
+        err = NoPathError(
+            f"no path of a car-like robot (turning radius {robot.drive.min_turning_radius} m) "
+            f"from pose {pose_m(start, grid)} to pose {pose_m(goal, grid)}: no search found a "
+            f"path, and the escape out of the tight end pose found nothing "
+            f"({last.reason}, {last.expanded} expansions): {last} (tries: {'; '.join(tries)})"
+        )
+        err.__cause__ = last
+        return err
     fits = [f for f in failures if isinstance(f, SmoothingError)]
     searches = [f for f in failures if isinstance(f, astar.NoPosePathError)]
     summary = "; ".join(tries)

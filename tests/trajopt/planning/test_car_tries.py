@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import astar
 import trajopt
 import trajopt.planning._car_tries as car_tries
 from benchmarks import parking_cases as pc
@@ -115,3 +116,35 @@ def test_expansion_caps_by_kind_of_robot():
     )
     for search, plan in (car_tries.expansion_caps(disc), car_tries.expansion_caps(FULL.robot())):
         assert car_tries.FOOTPRINT_DEFAULT_EXPANSIONS < search < plan
+
+
+def boxed_goal_grid(play: float):
+    """A goal pose whose body keeps ``play`` (m) from four walls round it (the small car)."""
+    b = pc.CARS["small"].body()
+    gx, gy = 3.0, 2.0
+    xl, xh, yl, yh = gx + b[:, 0].min(), gx + b[:, 0].max(), gy + b[:, 1].min(), gy + b[:, 1].max()
+
+    def box(x0, y0, x1, y1):
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+
+    walls = [
+        box(xl - 0.1, yh + play, xh + 0.1, yh + play + 0.1),
+        box(xl - 0.1, yl - play - 0.1, xh + 0.1, yl - play),
+        box(xh + play, yl - 0.1, xh + play + 0.1, yh + 0.1),
+        box(xl - play - 0.1, yl - 0.1, xl - play, yh + 0.1),
+    ]
+    return astar.OccupancyGrid.from_polygons(walls, 0.05, (0.0, 0.0, 6.0, 4.0)), (gx, gy)
+
+
+def test_a_boxed_in_goal_ends_in_the_escapes_typed_error():
+    # every search fails, the escape (the last try) runs from the goal and finds nothing
+    grid, goal = boxed_goal_grid(0.01)
+    with pytest.raises(trajopt.NoPathError, match=r"escape .* found nothing \(exhausted, \d+ exp"):
+        trajopt.plan(
+            grid, (1.0, 0.7), goal, pc.CARS["small"].robot(), start_heading=0.0, goal_heading=0.0
+        )
+
+
+def test_the_escape_try_runs_only_after_every_other_try_failed(default_plan):
+    tries = default_plan.stats["car"]["tries"]
+    assert not any("escape" in t for t in tries)
