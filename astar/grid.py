@@ -18,7 +18,7 @@ import numpy as np
 
 from astar import validation
 from astar.errors import InvalidInputError
-from astar.polygons import rasterize_polygons
+from astar.polygons import check_bounds, rasterize_polygons, rasterize_rings
 
 __all__ = ["OccupancyGrid", "check_grid", "from_polygons"]
 
@@ -165,6 +165,42 @@ class OccupancyGrid:
         """
         occ, res, origin, rings = rasterize_polygons(polygons, resolution, bounds)
         out = cls._construct_fast(occ, res, origin)
+        object.__setattr__(out, "polygons", rings)
+        return out
+
+    def polygon_window(self, resolution: float, bounds: Sequence[float]) -> OccupancyGrid:
+        """Rasterise this grid's own polygons at ``resolution`` over ``bounds``.
+
+        The same cells as ``OccupancyGrid.from_polygons(self.polygons, resolution,
+        bounds)``, without checking the polygons again (they were checked when this grid
+        was made from them): a finer window round a stretch of a path, made once per fit.
+
+        Parameters
+        ----------
+        resolution : float
+            Cell side in metres (> 0, finite).
+        bounds : sequence of float
+            ``(xmin, ymin, xmax, ymax)`` in metres, as in :meth:`from_polygons`.
+
+        Returns
+        -------
+        OccupancyGrid
+            Keeps the same polygons.
+
+        Raises
+        ------
+        InvalidInputError
+            This grid was not made from polygons (``polygons`` is None); ``resolution`` or
+            ``bounds`` as in :meth:`from_polygons`.
+        """
+        if self.polygons is None:
+            raise InvalidInputError(
+                "polygon_window needs a grid made from polygons (OccupancyGrid.from_polygons); "
+                "this grid's polygons are None"
+            )
+        res = validation.positive_float("resolution", resolution)
+        occ, res, origin, rings = rasterize_rings(self.polygons, res, check_bounds(bounds))
+        out = type(self)._construct_fast(occ, res, origin)
         object.__setattr__(out, "polygons", rings)
         return out
 

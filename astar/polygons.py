@@ -14,6 +14,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from numba import njit
 
 from astar.errors import InvalidInputError
 from astar.validation import positive_float, short_repr
@@ -206,38 +207,68 @@ def grid_shape(bounds: tuple[float, float, float, float], resolution: float) -> 
     return ny, nx
 
 
+@njit(cache=True, nogil=True)
+def _edges_kernel(
+    occ: np.ndarray, g: np.ndarray, eps: float
+) -> None:  # pragma: no cover - compiled
+    """Mark the cells whose closed square meets an edge of the ring ``g`` (in cells)."""
+    ny, nx = occ.shape
+    k = g.shape[0]
+    for i in range(k):
+        j = i + 1 if i + 1 < k else 0
+        x0, y0, x1, y1 = g[i, 0], g[i, 1], g[j, 0], g[j, 1]
+        lo, hi = min(x0, x1), max(x0, x1)
+        c0 = max(0, math.ceil(lo - eps) - 1)
+        c1 = min(nx - 1, math.floor(hi + eps))
+        for c in range(c0, c1 + 1):
+            if x1 == x0:
+                ylo, yhi = min(y0, y1), max(y0, y1)
+            else:
+                xa = min(max(float(c), lo), hi)
+                xb = min(max(c + 1.0, lo), hi)
+                t = (y1 - y0) / (x1 - x0)
+                ya, yb = y0 + (xa - x0) * t, y0 + (xb - x0) * t
+                ylo, yhi = min(ya, yb), max(ya, yb)
+            r0 = max(0, math.ceil(ylo - eps) - 1)
+            r1 = min(ny - 1, math.floor(yhi + eps))
+            for r in range(r0, r1 + 1):
+                occ[r, c] = True
+
+
+@njit(cache=True, nogil=True)
+def _interior_kernel(occ: np.ndarray, g: np.ndarray) -> None:  # pragma: no cover - compiled
+    """Mark the cells whose centre lies inside the ring ``g`` (in cells; even-odd rows)."""
+    ny, nx = occ.shape
+    k = g.shape[0]
+    r0 = max(0, math.floor(g[:, 1].min() - 0.5))
+    r1 = min(ny - 1, math.ceil(g[:, 1].max() - 0.5))
+    xs = np.empty(k)
+    for r in range(r0, r1 + 1):
+        y = r + 0.5  # the centres' y, in cells
+        m = 0
+        for i in range(k):
+            j = i + 1 if i + 1 < k else 0
+            ya, yb = g[i, 1], g[j, 1]
+            if (ya <= y) != (yb <= y):  # half-open: a vertex on the line counts once
+                xs[m] = g[i, 0] + (y - ya) * (g[j, 0] - g[i, 0]) / (yb - ya)
+                m += 1
+        row = np.sort(xs[:m])
+        for p in range(0, m - 1, 2):
+            # centres c + 0.5 in [row[p], row[p + 1]]
+            c0 = max(0, math.ceil(row[p] - 0.5))
+            c1 = min(nx - 1, math.floor(row[p + 1] - 0.5))
+            for c in range(c0, c1 + 1):
+                occ[r, c] = True
+
+
 def _mark_edges(occ: np.ndarray, v: np.ndarray, origin: tuple[float, float], res: float) -> None:
     """Mark the cells whose closed square meets an edge of the ring ``v`` (exact, clipped).
 
     Column by column: the part of the edge over the column's closed x-range spans a
-    y-interval; the closed squares of that column meeting the interval are marked.
+    y-interval; the closed squares of that column meeting the interval are marked (compiled:
+    a window of a parking map holds tens of polygons and is rasterised once per fit).
     """
-    ny, nx = occ.shape
-    ox, oy = origin
-    eps = TOUCH_CELLS
-    g = (v - (ox, oy)) / res  # in cells
-    a, b = g, np.roll(g, -1, axis=0)
-    for (x0, y0), (x1, y1) in zip(a, b, strict=True):
-        lo, hi = min(x0, x1), max(x0, x1)
-        c0 = max(0, math.ceil(lo - eps) - 1)
-        c1 = min(nx - 1, math.floor(hi + eps))
-        if c1 < c0:
-            continue
-        cols = np.arange(c0, c1 + 1)
-        if x1 == x0:
-            ylo = np.full(len(cols), min(y0, y1))
-            yhi = np.full(len(cols), max(y0, y1))
-        else:
-            xa = np.clip(cols.astype(float), lo, hi)
-            xb = np.clip(cols + 1.0, lo, hi)
-            t = (y1 - y0) / (x1 - x0)
-            ya, yb = y0 + (xa - x0) * t, y0 + (xb - x0) * t
-            ylo, yhi = np.minimum(ya, yb), np.maximum(ya, yb)
-        r0 = np.maximum(0, np.ceil(ylo - eps).astype(np.int64) - 1)
-        r1 = np.minimum(ny - 1, np.floor(yhi + eps).astype(np.int64))
-        for c, lo_r, hi_r in zip(cols, r0, r1, strict=True):
-            if hi_r >= lo_r:
-                occ[lo_r : hi_r + 1, c] = True
+    _edges_kernel(occ, (v - origin) / res, TOUCH_CELLS)
 
 
 def _mark_interior(occ: np.ndarray, v: np.ndarray, origin: tuple[float, float], res: float) -> None:
@@ -246,30 +277,7 @@ def _mark_interior(occ: np.ndarray, v: np.ndarray, origin: tuple[float, float], 
     A cell that no edge meets lies wholly inside or wholly outside the polygon, so its
     centre decides; a cell some edge meets is already marked.
     """
-    ny, nx = occ.shape
-    ox, oy = origin
-    g = (v - (ox, oy)) / res
-    a, b = g, np.roll(g, -1, axis=0)
-    r0 = max(0, math.floor(g[:, 1].min() - 0.5))
-    r1 = min(ny - 1, math.ceil(g[:, 1].max() - 0.5))
-    if r1 < r0:
-        return
-    rows = np.arange(r0, r1 + 1) + 0.5  # the centres' y, in cells
-    ya, yb = a[:, 1][None, :], b[:, 1][None, :]
-    y = rows[:, None]
-    crosses = (ya <= y) != (yb <= y)  # half-open: a vertex on the line counts once
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xs = a[:, 0][None, :] + (y - ya) * (b[:, 0] - a[:, 0])[None, :] / (yb - ya)
-    xs = np.where(crosses, xs, np.inf)
-    xs.sort(axis=1)
-    for r, row in zip(range(r0, r1 + 1), xs, strict=True):
-        row = row[np.isfinite(row)]
-        for xl, xr in zip(row[0::2], row[1::2], strict=True):
-            # centres ix + 0.5 in [xl, xr]
-            c0 = max(0, math.ceil(xl - 0.5))
-            c1 = min(nx - 1, math.floor(xr - 0.5))
-            if c1 >= c0:
-                occ[r, c0 : c1 + 1] = True
+    _interior_kernel(occ, (v - origin) / res)
 
 
 def rasterize_polygons(
@@ -308,10 +316,25 @@ def rasterize_polygons(
         raise InvalidInputError(
             f"polygons must be a sequence of (k, 2) vertex arrays in m, got {short_repr(polygons)}"
         )
-    rings = [check_polygon(i, p) for i, p in enumerate(polygons)]
+    rings = tuple(check_polygon(i, p) for i, p in enumerate(polygons))
+    return rasterize_rings(rings, res, box)
+
+
+def rasterize_rings(
+    rings: tuple[np.ndarray, ...], resolution: float, bounds: tuple[float, float, float, float]
+) -> tuple[np.ndarray, float, tuple[float, float], tuple[np.ndarray, ...]]:
+    """Rasterise rings :func:`check_polygon` has already checked (no checks repeated).
+
+    For a finer raster of a map's own polygons over a window
+    (:meth:`astar.OccupancyGrid.polygon_window`): the rings come from :func:`check_polygon`,
+    ``resolution`` is a positive finite float and ``bounds`` a box of
+    :func:`check_bounds`; anything else is the caller's error.
+    """
+    res = float(resolution)
+    box = bounds
     ny, nx = grid_shape(box, res)
     occ = np.zeros((ny, nx), dtype=bool)
-    origin = (box[0], box[1])
+    origin = np.array([box[0], box[1]])
     # a polygon whose box lies a cell or more outside the grid marks nothing (a window of a
     # larger map: the fits' fine rasters)
     x_hi, y_hi = box[0] + (nx + 1) * res, box[1] + (ny + 1) * res
@@ -326,4 +349,4 @@ def rasterize_polygons(
             continue
         _mark_edges(occ, v, origin, res)
         _mark_interior(occ, v, origin, res)
-    return occ, res, origin, tuple(rings)
+    return occ, res, (box[0], box[1]), rings

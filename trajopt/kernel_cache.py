@@ -58,6 +58,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "astar.hybrid_kernel",
     "astar.hybrid_shortcut",
     "astar.inflation",
+    "astar.polygons",
     "astar.reeds_shepp",
     "astar.search_kernels",
     "astar.weighted_kernel",

@@ -272,3 +272,38 @@ def test_bad_resolution_refused(res):
 def test_an_empty_list_is_an_empty_map():
     g = astar.OccupancyGrid.from_polygons([], 0.5, BOUNDS)
     assert g.shape == (4, 4) and not g.occupied.any()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_polygon_window_matches_shapely_on_its_cells(seed):
+    """A finer window of a map's own polygons is the conservative raster of that window."""
+    rng = np.random.default_rng(100 + seed)
+    polys = [
+        star(rng, rng.uniform(0.3, 1.7, 2), 0.05, 0.6, int(rng.integers(3, 12))) for _ in range(4)
+    ]
+    grid = astar.OccupancyGrid.from_polygons(polys, 0.1, (-0.1, -0.2, 2.1, 2.05))
+    lo = rng.uniform(-0.1, 1.0, 2)
+    bounds = (float(lo[0]), float(lo[1]), float(lo[0] + 0.9), float(lo[1] + 0.7))
+    res = [0.025, 0.0125, 0.05, 0.02][seed]
+    window = grid.polygon_window(res, bounds)
+    assert window.polygons is grid.polygons
+    assert window.origin == (bounds[0], bounds[1]) and window.resolution == res
+    ref, dist = shapely_reference(polys, res, bounds, window.shape)
+    assert not (ref & ~window.occupied).any()  # conservative
+    extra = window.occupied & ~ref
+    assert np.all(dist[extra] <= 1e-8 * res)  # extra cells only where touching up to rounding
+    again = astar.OccupancyGrid.from_polygons(polys, res, bounds)
+    np.testing.assert_array_equal(window.occupied, again.occupied)
+
+
+def test_a_polygon_window_needs_a_grid_made_from_polygons():
+    grid = astar.OccupancyGrid(np.zeros((4, 4), dtype=bool), 0.1)
+    with pytest.raises(InvalidInputError, match="polygons are None"):
+        grid.polygon_window(0.05, (0.0, 0.0, 0.2, 0.2))
+    made = astar.OccupancyGrid.from_polygons(
+        [[(0.1, 0.1), (0.3, 0.1), (0.2, 0.3)]], 0.1, (0, 0, 1, 1)
+    )
+    with pytest.raises(InvalidInputError, match="resolution"):
+        made.polygon_window(-0.05, (0.0, 0.0, 0.2, 0.2))
+    with pytest.raises(InvalidInputError, match="bounds"):
+        made.polygon_window(0.05, (0.0, 0.0, -0.2, 0.2))

@@ -380,7 +380,7 @@ def fine_window(grid: OccupancyGrid, pts: np.ndarray, reach: float, cell_m: floa
     """Return a finer raster of ``grid``'s polygons around a segment's poses (m).
 
     The map's polygons (:attr:`astar.OccupancyGrid.polygons`) rasterised conservatively
-    (:meth:`astar.OccupancyGrid.from_polygons`) in cells that divide ``grid``'s, of side at
+    (:meth:`astar.OccupancyGrid.polygon_window`) in cells that divide ``grid``'s, of side at
     most ``cell_m`` (m), over the poses' box grown by ``reach`` (the
     body's circumscribed radius) plus :data:`FINE_PAD_M`, clipped to the map. The window's
     outside counts as occupied (as a map's), so a curve and a body certified in it are
@@ -400,9 +400,7 @@ def fine_window(grid: OccupancyGrid, pts: np.ndarray, reach: float, cell_m: floa
     i1 = np.minimum(i1, (grid.nx, grid.ny))
     a = np.array([ox, oy]) + i0 * grid.resolution
     b = np.array([ox, oy]) + i1 * grid.resolution
-    return OccupancyGrid.from_polygons(
-        grid.polygons, res, (float(a[0]), float(a[1]), float(b[0]), float(b[1]))
-    )
+    return grid.polygon_window(res, (float(a[0]), float(a[1]), float(b[0]), float(b[1])))
 
 
 def body_along(footprint: Footprint | None, direction: int, turned: bool) -> Footprint | None:
