@@ -245,10 +245,16 @@ def _clearance(
         qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
         ex, ey = edges[j, e, 0], edges[j, e, 1]
         ee = ex * ex + ey * ey
-        lam = 0.0
-        if ee > 0.0:
-            lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
-        rx, ry = qx - lam * ex, qy - lam * ey
+        dot = qx * ex + qy * ey
+        # the nearest point of the edge: its start, its end or between (the division only
+        # there; the same floats as clipping ``dot / ee`` to [0, 1])
+        if dot <= 0.0 or ee <= 0.0:
+            rx, ry = qx, qy
+        elif dot >= ee:
+            rx, ry = qx - ex, qy - ey
+        else:
+            lam = dot / ee
+            rx, ry = qx - lam * ex, qy - lam * ey
         r2 = rx * rx + ry * ry
         if r2 < best2:
             best2, bx, by = r2, rx, ry
