@@ -30,6 +30,7 @@ from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import (
     PolygonPieces,
     launch_bound_kernel,
+    launch_min_kernel,
     pieces_of,
     windows_kernel,
 )
@@ -242,11 +243,25 @@ class ShapeWindows(FineWindows):
         mid = 0.5 * (lo + hi)
         rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
         lip_all = float(np.max(lip[rows], initial=0.0))
+        # the least bound over the points at each launch (compiled, the same minimum as
+        # ``g``'s rows' with fewer tests: :func:`._polygon_march.launch_min_kernel`)
+        near = (tau[rows], who[rows].astype(np.int64), pts[rows], pad[rows])
         safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
         left, right = lo, hi
         for dl in LAUNCH_STEPS:
             launch = np.arange(left, right + 0.5 * dl, dl)
-            bound = np.min(g(launch, rows), axis=1) if rows.size else np.full(launch.shape, np.inf)
+            bound = launch_min_kernel(
+                np.ascontiguousarray(launch, dtype=np.float64),
+                *near,
+                tr.rows,
+                starts,
+                tr.head0,
+                tr.turn,
+                tr.lip,
+                tr.verts,
+                tr.edges,
+                tr.poly,
+            )
             reach = np.where(bound > 0.0, bound / max(lip_all, 1e-300), -np.inf)
             ok = reach > 0.0
             safe_lo.append(launch[ok] - reach[ok])
