@@ -54,7 +54,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.moving._disc_windows import track_knots
-from trajopt.moving._mover_segments import MoverSegments
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_distance import point_polygon_kernel
 from trajopt.moving._robot_windows import robot_windows
@@ -441,60 +441,6 @@ def _certify_discs(
     return "clear", proven, movers[proven_j].name if movers else "", proven_t, count
 
 
-class _MoverTable:
-    """What a bisection reads of its movers, all movers at once (:func:`_mover_table`).
-
-    ``seg`` (:class:`MoverSegments`); per mover, shape (movers,): ``reach`` (its farthest
-    vertex, m), ``rad0`` (radius, m), ``grow`` (growth, m/s), ``t_last`` (its last time, at
-    least 0, s), ``disc`` (no vertices), ``sizes`` (vertex count); ``verts``: each vertex
-    count's table of the movers' vertices, shape (movers, count, 2) (zeros for the others).
-    """
-
-    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
-        self.seg = MoverSegments(movers)
-        self.reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
-        self.rad0 = np.array([m.radius for m in movers])
-        self.grow = np.array([m.growth for m in movers])
-        self.t_last = np.array([max(m.t_last, 0.0) for m in movers])
-        self.disc = np.array([m.vertices is None for m in movers])
-        self.sizes = np.array([m.shape_vertices.shape[0] for m in movers])
-        self.verts = {
-            int(size): np.stack(
-                [
-                    m.shape_vertices if m.shape_vertices.shape[0] == size else np.zeros((size, 2))
-                    for m in movers
-                ]
-            )
-            for size in np.unique(self.sizes)
-        }
-        for value in (*vars(self.seg).values(), *vars(self).values(), *self.verts.values()):
-            if isinstance(value, np.ndarray):
-                value.setflags(write=False)
-
-
-#: The tables of the last movers certified (:func:`_mover_table`), most recent last.
-_TABLES: list[tuple[tuple[MovingObstacle, ...], _MoverTable]] = []
-_TABLES_KEPT = 4
-
-
-def _mover_table(movers: Sequence[MovingObstacle]) -> _MoverTable:
-    """Return the :class:`_MoverTable` of ``movers``, built or kept from a recent certificate.
-
-    Movers are immutable values: the same objects in the same order have the same table (a
-    re-timing certifies its candidates against the same movers). The last
-    :data:`_TABLES_KEPT` are kept, their arrays read-only.
-    """
-    key = tuple(movers)
-    for i, (kept, table) in enumerate(_TABLES):
-        if len(kept) == len(key) and all(a is b for a, b in zip(kept, key, strict=True)):
-            _TABLES.append(_TABLES.pop(i))
-            return table
-    table = _MoverTable(key)
-    _TABLES.append((key, table))
-    del _TABLES[:-_TABLES_KEPT]
-    return table
-
-
 class _Bisection:
     """Bisect each mover's cover of ``[a, b]``: ``results``, ``(verdict, slack, time, intervals)`` per mover.
 
@@ -504,7 +450,7 @@ class _Bisection:
     their second parts, ...), so that its
     verdict, slack, time and count do not depend on the other movers. All movers advance
     together: the robot is evaluated once per distinct interval of a level, the movers'
-    poses and rates are gathered from :class:`MoverSegments`. The movers after the first one
+    poses and rates are gathered from :class:`._mover_segments.MoverSegments`. The movers after the first one
     not clear are not certified (:func:`certify_movers` stops there): the list ends at it.
     ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
     a disc (whose radius is in ``extra``).
@@ -537,7 +483,7 @@ class _Bisection:
         if nm == 0:
             return
         t0, t1, mj = _covers(a, b, movers)
-        table = _mover_table(movers)
+        table = mover_table(movers)
         self.seg = seg = table.seg
         # an interval never straddles its mover's times: its midpoint is on the segment of its
         # start, or on the next one when it falls on the next time (``searchsorted`` right)
