@@ -236,7 +236,16 @@ def _clearance(
 ):  # pragma: no cover - compiled
     """Return the point's distance (m) to mover ``j``'s polygon at ``tk`` minus the limit."""
     cx, cy, th, rad = _mover_at(row, head0, turn, tk)
-    c, s = np.cos(th), np.sin(th)
+    return _clearance_to(
+        px, py, cx, cy, np.cos(th), np.sin(th), rad, lim_add, verts, edges, poly, j
+    )
+
+
+@njit(cache=True, inline="always")
+def _clearance_to(
+    px, py, cx, cy, c, s, rad, lim_add, verts, edges, poly, j
+):  # pragma: no cover - compiled
+    """:func:`_clearance` of mover ``j`` placed at ``(cx, cy)``, turned by ``(cos, sin) = (c, s)``, rounded by ``rad``."""
     dx, dy = px - cx, py - cy
     qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
     best2, bx, by = np.inf, 0.0, 0.0  # the nearest edge by squared distance, one hypot
@@ -369,6 +378,18 @@ def march_kernel(
     out = np.empty((cap, 4), dtype=np.int64)
     foot = body.shape[0] > 0
     shape = np.empty((verts.shape[1], 2))  # a mover's polygon in the world
+    # each piece's state at its grid times (place, turn, rounding), made once when first
+    # tested: every node paired with the piece tests the same grid times
+    n_p = rows.shape[0]
+    base = np.zeros(n_p + 1, dtype=np.int64)
+    for p in range(n_p):
+        ka = max(int(np.ceil(rows[p, 0] / dt - 1e-9)), 0)
+        kb = kk - 1
+        if np.isfinite(rows[p, 1]):
+            kb = min(int(np.floor(rows[p, 1] / dt + 1e-9)), kk - 1)
+        base[p + 1] = base[p] + max(kb - ka + 1, 0)
+    state = np.empty((base[n_p], 5))
+    made = np.zeros(base[n_p], dtype=np.bool_)
     nr = 0
     for q in range(seg.shape[0]):
         p, i = seg[q], pi[q]
@@ -388,8 +409,15 @@ def march_kernel(
                     body[i], rows[p], head0[p], turn[p], lim_add[p], verts, nv, j, k * dt, shape
                 )
             else:
-                f = _clearance(
-                    px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
+                x = base[p] + k - ka
+                if not made[x]:
+                    cx, cy, th, rad = _mover_at(rows[p], head0[p], turn[p], k * dt)
+                    state[x, 0], state[x, 1], state[x, 2] = cx, cy, np.cos(th)
+                    state[x, 3], state[x, 4] = np.sin(th), rad
+                    made[x] = True
+                st = state[x]
+                f = _clearance_to(
+                    px, py, st[0], st[1], st[2], st[3], st[4], lim_add[p], verts, edges, poly, j
                 )
             hit = f < 0.0
             room = abs(f) - 1e-9  # in hand against rounding
