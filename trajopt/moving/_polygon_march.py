@@ -20,9 +20,15 @@ g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves t
   1 nm of the limit counts as forbidden) and lowered by it on a necessary one, and a stride
   keeps 1 nm of ``|f|`` in hand. Only the pairs whose distance can come under the limit at
   all are marched (:func:`._disc_windows.near_pairs` with each piece's bounding disc: an
-  exact filter).
+  exact filter). The tests fall on grid times, so (a disc robot) each piece's place, turn
+  and rounding at a grid time is made once for all the nodes that test it.
 * :func:`windows_kernel`: the violation windows in continuous time of
   :meth:`._shape_windows.ShapeTracks.windows` (sampled with a least step; sufficient).
+
+:func:`launch_bound_kernel` gives the clearance of points at times after a launch (the
+refinement of :meth:`._shape_windows.ShapeWindows._exact`), and :func:`launch_min_kernel`
+its least value over the points per launch, skipping the points that the same Lipschitz
+bound shows cannot hold it.
 """
 
 from __future__ import annotations
@@ -349,6 +355,10 @@ def march_kernel(
     pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, nv, body, dt, kk
 ):  # pragma: no cover - compiled
     """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
+
+    Against a disc robot, each piece's state at a grid time (its place, the cosine and sine
+    of its heading, its rounding) is kept in a table when first made, for the other nodes
+    that test that time.
 
     Parameters
     ----------
