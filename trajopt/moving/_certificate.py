@@ -54,7 +54,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.moving._disc_windows import track_knots
-from trajopt.moving._mover_segments import MoverSegments
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_distance import point_polygon_kernel
 from trajopt.moving._robot_windows import robot_windows
@@ -450,7 +450,7 @@ class _Bisection:
     their second parts, ...), so that its
     verdict, slack, time and count do not depend on the other movers. All movers advance
     together: the robot is evaluated once per distinct interval of a level, the movers'
-    poses and rates are gathered from :class:`MoverSegments`. The movers after the first one
+    poses and rates are gathered from :class:`._mover_segments.MoverSegments`. The movers after the first one
     not clear are not certified (:func:`certify_movers` stops there): the list ends at it.
     ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
     a disc (whose radius is in ``extra``).
@@ -483,25 +483,14 @@ class _Bisection:
         if nm == 0:
             return
         t0, t1, mj = _covers(a, b, movers)
-        self.seg = seg = MoverSegments(movers)
+        table = mover_table(movers)
+        self.seg = seg = table.seg
         # an interval never straddles its mover's times: its midpoint is on the segment of its
         # start, or on the next one when it falls on the next time (``searchsorted`` right)
         g0 = seg.row(mj, t0)
-        self.reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
-        self.rad0 = np.array([m.radius for m in movers])
-        self.grow = np.array([m.growth for m in movers])
-        self.t_last = np.array([max(m.t_last, 0.0) for m in movers])
-        self.disc = np.array([m.vertices is None for m in movers])
-        self.sizes = np.array([m.shape_vertices.shape[0] for m in movers])
-        self.verts = {  # each vertex count's table of the movers' vertices (others: zeros)
-            int(size): np.stack(
-                [
-                    m.shape_vertices if m.shape_vertices.shape[0] == size else np.zeros((size, 2))
-                    for m in movers
-                ]
-            )
-            for size in np.unique(self.sizes)
-        }
+        self.reach, self.rad0, self.grow = table.reach, table.rad0, table.grow
+        self.t_last, self.disc, self.sizes = table.t_last, table.disc, table.sizes
+        self.verts = table.verts
         self.reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
         # each first interval's place in its mover's cover (ties go to the first)
         pos = np.arange(mj.shape[0]) - np.searchsorted(mj, mj, side="left")

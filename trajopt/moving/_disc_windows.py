@@ -15,7 +15,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_kernels import close_kernel, disc_windows_kernel, inside_times_kernel
+from trajopt.moving._st_kernels import (
+    close_kernel,
+    disc_windows_kernel,
+    inside_times_kernel,
+    near_pairs_kernel,
+)
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
 BOX = 16
@@ -38,7 +43,8 @@ def near_pairs(
     window there: every pair left out is at least ``R + NEAR_SLACK`` apart (an exact filter,
     checked by brute force in the tests). First the points are boxed in runs of
     :data:`BOX` (consecutive path points are near each other) and each piece's segment box,
-    grown by ``R``, against those boxes; then each remaining pair's point-to-segment distance.
+    grown by ``R``, against those boxes; then each remaining pair's point-to-segment distance
+    (compiled: :func:`._st_kernels.near_pairs_kernel`).
 
     Parameters
     ----------
@@ -61,31 +67,20 @@ def near_pairs(
     if n == 0 or p == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     a, b, reach = _swept(pieces, limit)
-    starts = np.arange(0, n, BOX)
-    lo = np.minimum.reduceat(pts, starts, axis=0)
-    hi = np.maximum.reduceat(pts, starts, axis=0)
-    p_lo = np.minimum(a, b) - reach[:, None]
-    p_hi = np.maximum(a, b) + reach[:, None]
-    hit = (
-        (p_lo[:, None, 0] <= hi[None, :, 0])
-        & (p_hi[:, None, 0] >= lo[None, :, 0])
-        & (p_lo[:, None, 1] <= hi[None, :, 1])
-        & (p_hi[:, None, 1] >= lo[None, :, 1])
+    none = np.zeros(n)
+    b_lo, b_hi = (none, none) if band is None else band
+    return near_pairs_kernel(
+        np.ascontiguousarray(pts, dtype=np.float64),
+        np.ascontiguousarray(a, dtype=np.float64),
+        np.ascontiguousarray(b, dtype=np.float64),
+        np.ascontiguousarray(reach, dtype=np.float64),
+        np.ascontiguousarray(pieces[:, 1], dtype=np.float64),
+        np.ascontiguousarray(pieces[:, 2], dtype=np.float64),
+        np.ascontiguousarray(b_lo, dtype=np.float64),
+        np.ascontiguousarray(b_hi, dtype=np.float64),
+        band is not None,
+        BOX,
     )
-    if band is not None:
-        b_lo = np.minimum.reduceat(band[0], starts)
-        b_hi = np.maximum.reduceat(band[1], starts)
-        hit &= (pieces[:, 1, None] <= b_hi[None, :]) & (pieces[:, 2, None] >= b_lo[None, :])
-    seg, box = np.nonzero(hit)
-    first = starts[box]
-    cnt = np.minimum(first + BOX, n) - first
-    total = int(cnt.sum())
-    seg = np.repeat(seg, cnt)
-    point = np.repeat(first - np.cumsum(cnt) + cnt, cnt) + np.arange(total)
-    keep = _close(pts, a, b, reach, seg, point)
-    if band is not None:
-        keep &= (pieces[seg, 1] <= band[1][point]) & (pieces[seg, 2] >= band[0][point])
-    return seg[keep], point[keep]
 
 
 def inside_times(

@@ -2,7 +2,8 @@
 
 :class:`MoverSegments` lets the moving-obstacle certificate
 (:func:`trajopt.moving.certify_movers`) evaluate every mover's pose and rates on many time
-intervals with one gather instead of one ``numpy.interp`` per mover.
+intervals with one gather instead of one ``numpy.interp`` per mover; :func:`mover_table`
+keeps it, with the movers' sizes and shapes, for the last movers certified.
 """
 
 from __future__ import annotations
@@ -74,3 +75,57 @@ class MoverSegments:
         run = self.moves[g] & (t != self.start[g])
         off = np.where(run, t - np.where(run, self.start[g], 0.0), 0.0)
         return np.where(run[:, None], slope * off[:, None] + p, p)
+
+
+class MoverTable:
+    """What the certificate's bisection reads of its movers, all movers at once (:func:`mover_table`).
+
+    ``seg`` (:class:`MoverSegments`); per mover, shape (movers,): ``reach`` (its farthest
+    vertex, m), ``rad0`` (radius, m), ``grow`` (growth, m/s), ``t_last`` (its last time, at
+    least 0, s), ``disc`` (no vertices), ``sizes`` (vertex count); ``verts``: each vertex
+    count's table of the movers' vertices, shape (movers, count, 2) (zeros for the others).
+    """
+
+    def __init__(self, movers: Sequence[MovingObstacle]) -> None:
+        self.seg = MoverSegments(movers)
+        self.reach = np.array([float(np.max(np.hypot(*m.shape_vertices.T))) for m in movers])
+        self.rad0 = np.array([m.radius for m in movers])
+        self.grow = np.array([m.growth for m in movers])
+        self.t_last = np.array([max(m.t_last, 0.0) for m in movers])
+        self.disc = np.array([m.vertices is None for m in movers])
+        self.sizes = np.array([m.shape_vertices.shape[0] for m in movers])
+        self.verts = {
+            int(size): np.stack(
+                [
+                    m.shape_vertices if m.shape_vertices.shape[0] == size else np.zeros((size, 2))
+                    for m in movers
+                ]
+            )
+            for size in np.unique(self.sizes)
+        }
+        for value in (*vars(self.seg).values(), *vars(self).values(), *self.verts.values()):
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
+
+
+#: The tables of the last movers certified (:func:`mover_table`), most recent last.
+_TABLES: list[tuple[tuple[MovingObstacle, ...], MoverTable]] = []
+_TABLES_KEPT = 4
+
+
+def mover_table(movers: Sequence[MovingObstacle]) -> MoverTable:
+    """Return the :class:`MoverTable` of ``movers``, built or kept from a recent certificate.
+
+    Movers are immutable values: the same objects in the same order have the same table (a
+    re-timing certifies its candidates against the same movers). The last
+    :data:`_TABLES_KEPT` are kept, their arrays read-only.
+    """
+    key = tuple(movers)
+    for i, (kept, table) in enumerate(_TABLES):
+        if len(kept) == len(key) and all(a is b for a, b in zip(kept, key, strict=True)):
+            _TABLES.append(_TABLES.pop(i))
+            return table
+    table = MoverTable(key)
+    _TABLES.append((key, table))
+    del _TABLES[:-_TABLES_KEPT]
+    return table

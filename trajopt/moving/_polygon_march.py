@@ -20,9 +20,15 @@ g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves t
   1 nm of the limit counts as forbidden) and lowered by it on a necessary one, and a stride
   keeps 1 nm of ``|f|`` in hand. Only the pairs whose distance can come under the limit at
   all are marched (:func:`._disc_windows.near_pairs` with each piece's bounding disc: an
-  exact filter).
+  exact filter). The tests fall on grid times, so (a disc robot) each piece's place, turn
+  and rounding at a grid time is made once for all the nodes that test it.
 * :func:`windows_kernel`: the violation windows in continuous time of
   :meth:`._shape_windows.ShapeTracks.windows` (sampled with a least step; sufficient).
+
+:func:`launch_bound_kernel` gives the clearance of points at times after a launch (the
+refinement of :meth:`._shape_windows.ShapeWindows._exact`), and :func:`launch_min_kernel`
+its least value over the points per launch, skipping the points that the same Lipschitz
+bound shows cannot hold it.
 """
 
 from __future__ import annotations
@@ -236,7 +242,16 @@ def _clearance(
 ):  # pragma: no cover - compiled
     """Return the point's distance (m) to mover ``j``'s polygon at ``tk`` minus the limit."""
     cx, cy, th, rad = _mover_at(row, head0, turn, tk)
-    c, s = np.cos(th), np.sin(th)
+    return _clearance_to(
+        px, py, cx, cy, np.cos(th), np.sin(th), rad, lim_add, verts, edges, poly, j
+    )
+
+
+@njit(cache=True, inline="always")
+def _clearance_to(
+    px, py, cx, cy, c, s, rad, lim_add, verts, edges, poly, j
+):  # pragma: no cover - compiled
+    """:func:`_clearance` of mover ``j`` placed at ``(cx, cy)``, turned by ``(cos, sin) = (c, s)``, rounded by ``rad``."""
     dx, dy = px - cx, py - cy
     qx0, qy0 = c * dx + s * dy, -s * dx + c * dy  # in the mover's frame
     best2, bx, by = np.inf, 0.0, 0.0  # the nearest edge by squared distance, one hypot
@@ -245,10 +260,16 @@ def _clearance(
         qx, qy = qx0 - verts[j, e, 0], qy0 - verts[j, e, 1]
         ex, ey = edges[j, e, 0], edges[j, e, 1]
         ee = ex * ex + ey * ey
-        lam = 0.0
-        if ee > 0.0:
-            lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
-        rx, ry = qx - lam * ex, qy - lam * ey
+        dot = qx * ex + qy * ey
+        # the nearest point of the edge: its start, its end or between (the division only
+        # there; the same floats as clipping ``dot / ee`` to [0, 1])
+        if dot <= 0.0 or ee <= 0.0:
+            rx, ry = qx, qy
+        elif dot >= ee:
+            rx, ry = qx - ex, qy - ey
+        else:
+            lam = dot / ee
+            rx, ry = qx - lam * ex, qy - lam * ey
         r2 = rx * rx + ry * ry
         if r2 < best2:
             best2, bx, by = r2, rx, ry
@@ -335,6 +356,10 @@ def march_kernel(
 ):  # pragma: no cover - compiled
     """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
 
+    Against a disc robot, each piece's state at a grid time (its place, the cosine and sine
+    of its heading, its rounding) is kept in a table when first made, for the other nodes
+    that test that time.
+
     Parameters
     ----------
     pts : ndarray, shape (n, 2)
@@ -363,6 +388,18 @@ def march_kernel(
     out = np.empty((cap, 4), dtype=np.int64)
     foot = body.shape[0] > 0
     shape = np.empty((verts.shape[1], 2))  # a mover's polygon in the world
+    # each piece's state at its grid times (place, turn, rounding), made once when first
+    # tested: every node paired with the piece tests the same grid times
+    n_p = rows.shape[0]
+    base = np.zeros(n_p + 1, dtype=np.int64)
+    for p in range(n_p):
+        ka = max(int(np.ceil(rows[p, 0] / dt - 1e-9)), 0)
+        kb = kk - 1
+        if np.isfinite(rows[p, 1]):
+            kb = min(int(np.floor(rows[p, 1] / dt + 1e-9)), kk - 1)
+        base[p + 1] = base[p] + max(kb - ka + 1, 0)
+    state = np.empty((base[n_p], 5))
+    made = np.zeros(base[n_p], dtype=np.bool_)
     nr = 0
     for q in range(seg.shape[0]):
         p, i = seg[q], pi[q]
@@ -382,8 +419,15 @@ def march_kernel(
                     body[i], rows[p], head0[p], turn[p], lim_add[p], verts, nv, j, k * dt, shape
                 )
             else:
-                f = _clearance(
-                    px, py, rows[p], head0[p], turn[p], lim_add[p], verts, edges, poly, j, k * dt
+                x = base[p] + k - ka
+                if not made[x]:
+                    cx, cy, th, rad = _mover_at(rows[p], head0[p], turn[p], k * dt)
+                    state[x, 0], state[x, 1], state[x, 2] = cx, cy, np.cos(th)
+                    state[x, 3], state[x, 4] = np.sin(th), rad
+                    made[x] = True
+                st = state[x]
+                f = _clearance_to(
+                    px, py, st[0], st[1], st[2], st[3], st[4], lim_add[p], verts, edges, poly, j
                 )
             hit = f < 0.0
             room = abs(f) - 1e-9  # in hand against rounding
@@ -527,4 +571,69 @@ def launch_bound_kernel(
             out[li, r] = _clearance(
                 pts[r, 0], pts[r, 1], rows[p], head0[p], turn[p], pad[r], verts, edges, poly, j, t
             )
+    return out
+
+
+@njit(cache=True)
+def launch_min_kernel(
+    launch, tau, mover, pts, pad, rows, first, head0, turn, lip, verts, edges, poly
+):  # pragma: no cover - compiled
+    """Return the least clearance (m) over the points at each launch: :func:`launch_bound_kernel`'s row minima.
+
+    The same minimum, bit for bit, with fewer tests: a point's clearance changes at most at
+    the ``lip`` (m/s) of the pieces of its mover's track between two times, so a value tested
+    at one launch bounds it from below at another; a point whose bound is above the least
+    value found so far at this launch (by more than 1e-9 m, against rounding) cannot hold the
+    minimum and is not tested. Each launch first tests the point that held the minimum at
+    the one before. Arguments as :func:`launch_bound_kernel`, besides ``lip``, shape (p,):
+    each piece's bound (:attr:`PolygonPieces.lip`).
+
+    Returns
+    -------
+    ndarray, shape (L,)
+        ``inf`` where there are no points.
+    """
+    nl, q = launch.shape[0], tau.shape[0]
+    out = np.full(nl, np.inf)
+    if q == 0:
+        return out
+    val = np.empty(q)  # each point's last tested clearance ...
+    at = np.full(q, np.nan)  # ... the launch it was tested at (NaN: never) ...
+    held = np.zeros(q, dtype=np.int64)  # ... and the piece holding its time then
+    arg = 0
+    arg_now = 0
+    for li in range(nl):
+        best = np.inf
+        for x in range(q + 1):
+            r = arg if x == 0 else x - 1
+            if x > 0 and r == arg:
+                continue
+            j = mover[r]
+            t = launch[li] + tau[r]
+            lo_i, hi_i = (
+                first[j],
+                first[j + 1] - 1,
+            )  # the last piece with u <= t (the first if none)
+            while lo_i < hi_i:
+                m = (lo_i + hi_i + 1) // 2
+                if rows[m, 0] <= t:
+                    lo_i = m
+                else:
+                    hi_i = m - 1
+            p = lo_i
+            if not np.isnan(at[r]):
+                rate = 0.0  # the largest lip of the pieces between the two times
+                for pp in range(min(p, held[r]), max(p, held[r]) + 1):
+                    rate = max(rate, lip[pp])
+                if val[r] - rate * abs(launch[li] - at[r]) > best + 1e-9:
+                    continue
+            g = _clearance(
+                pts[r, 0], pts[r, 1], rows[p], head0[p], turn[p], pad[r], verts, edges, poly, j, t
+            )
+            val[r], at[r], held[r] = g, launch[li], p
+            if g < best:
+                best, arg_now = g, r
+        if best < np.inf:
+            arg = arg_now
+        out[li] = best
     return out

@@ -25,14 +25,16 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from trajopt.moving._disc_windows import close_pairs, inside_times, near_pairs
+from trajopt.moving._disc_windows import close_pairs, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import (
     PolygonPieces,
     launch_bound_kernel,
+    launch_min_kernel,
     pieces_of,
     windows_kernel,
 )
+from trajopt.moving._st_kernels import disc_windows_kernel
 from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
 
 #: The least time step (s) of the fine nodes' windows.
@@ -105,22 +107,20 @@ class ShapeTracks(PolygonPieces):
             seg, pi = pieces_meeting(self.bound, owner, band[0], band[1])
             keep = close_pairs(pts, self.bound, limit, seg, pi)
             seg, pi = seg[keep], pi[keep]
-        r = self.bound[seg]
-        u, w = r[:, 1], r[:, 2]
-        t_lo, t_hi = inside_times(
-            pts[pi, 0] - r[:, 3], pts[pi, 1] - r[:, 4], r[:, 5], r[:, 6], r[:, 7] + limit, r[:, 8]
-        )
-        a = np.maximum(u + np.nan_to_num(t_lo, nan=np.inf), u)
-        b = np.minimum(u + np.nan_to_num(t_hi, nan=-np.inf), w)
+        pts = np.ascontiguousarray(pts, dtype=np.float64)
+        seg, pi = seg.astype(np.int64), pi.astype(np.int64)
+        # the times inside the bounding disc, within the piece's span (compiled: the floats
+        # of inside_times, then numpy.nan_to_num and the clip)
+        a, b = disc_windows_kernel(pts, self.bound, float(limit), seg, pi)
         if band is not None:
             a = np.maximum(a, band[0][pi])
             b = np.minimum(b, band[1][pi])
         keep = a < b
         seg, pi, a, b = seg[keep], pi[keep], a[keep], b[keep]
         idx, lo, hi = windows_kernel(
-            np.ascontiguousarray(pts, dtype=np.float64),
-            seg.astype(np.int64),
-            pi.astype(np.int64),
+            pts,
+            seg,
+            pi,
             a,
             b,
             self.rows,
@@ -242,11 +242,25 @@ class ShapeWindows(FineWindows):
         mid = 0.5 * (lo + hi)
         rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
         lip_all = float(np.max(lip[rows], initial=0.0))
+        # the least bound over the points at each launch (compiled, the same minimum as
+        # ``g``'s rows' with fewer tests: :func:`._polygon_march.launch_min_kernel`)
+        near = (tau[rows], who[rows].astype(np.int64), pts[rows], pad[rows])
         safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
         left, right = lo, hi
         for dl in LAUNCH_STEPS:
             launch = np.arange(left, right + 0.5 * dl, dl)
-            bound = np.min(g(launch, rows), axis=1) if rows.size else np.full(launch.shape, np.inf)
+            bound = launch_min_kernel(
+                np.ascontiguousarray(launch, dtype=np.float64),
+                *near,
+                tr.rows,
+                starts,
+                tr.head0,
+                tr.turn,
+                tr.lip,
+                tr.verts,
+                tr.edges,
+                tr.poly,
+            )
             reach = np.where(bound > 0.0, bound / max(lip_all, 1e-300), -np.inf)
             ok = reach > 0.0
             safe_lo.append(launch[ok] - reach[ok])

@@ -12,7 +12,7 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 (:meth:`._st_grid.STGrid.blocked_starts_many`).
 
 :func:`close_kernel` is the point-to-segment test of the pair filter
-(:func:`._disc_windows.near_pairs`), :func:`least_free_kernel` the sweep of the rests'
+(:func:`._disc_windows.near_pairs`), :func:`near_pairs_kernel` that filter whole, :func:`least_free_kernel` the sweep of the rests'
 shortening (:func:`._tighten.sweep`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
 order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
@@ -285,6 +285,24 @@ def disc_windows_kernel(pts, rows, limit, seg, pi):  # pragma: no cover - compil
     return lo, hi
 
 
+@njit(cache=True, inline="always")
+def _close_one(pts, a, b, reach, k, i):  # pragma: no cover - compiled
+    """Whether point ``pts[i]`` is within ``reach[k]`` of segment ``k`` (:func:`close_kernel`, one pair)."""
+    ax, ay = a[k, 0], a[k, 1]
+    sx, sy = b[k, 0] - ax, b[k, 1] - ay
+    dd = sx * sx + sy * sy
+    inv = 1.0 / dd if dd > 0.0 else 0.0
+    qx = pts[i, 0] - ax
+    qy = pts[i, 1] - ay
+    f = (qx * sx + qy * sy) * inv
+    if not np.isnan(f):
+        f = min(max(f, 0.0), 1.0)
+    qx -= f * sx
+    qy -= f * sy
+    r = reach[k]
+    return not (qx * qx + qy * qy >= r * r)
+
+
 @njit(cache=True)
 def close_kernel(pts, a, b, reach, seg, point):  # pragma: no cover - compiled
     """Return whether ``pts[point[i]]`` is within ``reach[seg[i]]`` of segment ``seg[i]`` (bool).
@@ -296,21 +314,67 @@ def close_kernel(pts, a, b, reach, seg, point):  # pragma: no cover - compiled
     q = seg.shape[0]
     out = np.empty(q, dtype=np.bool_)
     for i in range(q):
-        k = seg[i]
-        ax, ay = a[k, 0], a[k, 1]
-        sx, sy = b[k, 0] - ax, b[k, 1] - ay
-        dd = sx * sx + sy * sy
-        inv = 1.0 / dd if dd > 0.0 else 0.0
-        qx = pts[point[i], 0] - ax
-        qy = pts[point[i], 1] - ay
-        f = (qx * sx + qy * sy) * inv
-        if not np.isnan(f):
-            f = min(max(f, 0.0), 1.0)
-        qx -= f * sx
-        qy -= f * sy
-        r = reach[k]
-        out[i] = not (qx * qx + qy * qy >= r * r)
+        out[i] = _close_one(pts, a, b, reach, seg[i], point[i])
     return out
+
+
+@njit(cache=True)
+def near_pairs_kernel(pts, a, b, reach, u, w, band_lo, band_hi, banded, box):  # pragma: no cover
+    """Return ``(piece, point)``, the pairs of :func:`._disc_windows.near_pairs` (its docstring).
+
+    The points boxed in runs of ``box``; each piece's segment box (``a`` to ``b``, shape
+    (p, 2), grown by ``reach``) against them, and against the runs' time bands when
+    ``banded`` (a piece's span ``[u, w]`` against the least ``band_lo`` and the largest
+    ``band_hi`` of the run); then each pair's point-to-segment test (:func:`close_kernel`)
+    and its own band. The same comparisons as the numpy form (NaN-propagating minima and
+    maxima), the pairs in its order: by piece, then point.
+    """
+    n, p = pts.shape[0], a.shape[0]
+    nb = (n + box - 1) // box
+    lo = np.empty((nb, 2))
+    hi = np.empty((nb, 2))
+    b_lo = np.empty(nb)
+    b_hi = np.empty(nb)
+    for k in range(nb):
+        s0, s1 = k * box, min(k * box + box, n)
+        lo[k, 0], lo[k, 1] = pts[s0, 0], pts[s0, 1]
+        hi[k, 0], hi[k, 1] = pts[s0, 0], pts[s0, 1]
+        b_lo[k], b_hi[k] = band_lo[s0], band_hi[s0]
+        for i in range(s0 + 1, s1):
+            for c in range(2):
+                lo[k, c] = _min_nan(lo[k, c], pts[i, c])
+                hi[k, c] = _max_nan(hi[k, c], pts[i, c])
+            b_lo[k] = _min_nan(b_lo[k], band_lo[i])
+            b_hi[k] = _max_nan(b_hi[k], band_hi[i])
+    cap = 64
+    seg = np.empty(cap, dtype=np.int64)
+    point = np.empty(cap, dtype=np.int64)
+    m = 0
+    for j in range(p):
+        r = reach[j]
+        lo_x = _min_nan(a[j, 0], b[j, 0]) - r
+        lo_y = _min_nan(a[j, 1], b[j, 1]) - r
+        hi_x = _max_nan(a[j, 0], b[j, 0]) + r
+        hi_y = _max_nan(a[j, 1], b[j, 1]) + r
+        for k in range(nb):
+            if not (lo_x <= hi[k, 0] and hi_x >= lo[k, 0] and lo_y <= hi[k, 1]):
+                continue
+            if not hi_y >= lo[k, 1]:
+                continue
+            if banded and not (u[j] <= b_hi[k] and w[j] >= b_lo[k]):
+                continue
+            for i in range(k * box, min(k * box + box, n)):
+                if not _close_one(pts, a, b, reach, j, i):
+                    continue
+                if banded and not (u[j] <= band_hi[i] and w[j] >= band_lo[i]):
+                    continue
+                if m == cap:
+                    cap *= 2
+                    seg = np.concatenate((seg, np.empty(cap - m, dtype=np.int64)))
+                    point = np.concatenate((point, np.empty(cap - m, dtype=np.int64)))
+                seg[m], point[m] = j, i
+                m += 1
+    return seg[:m].copy(), point[:m].copy()
 
 
 #: A bucket of :func:`least_free_kernel` longer than this is sorted by numpy's sort, not by

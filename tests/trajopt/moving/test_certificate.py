@@ -186,6 +186,50 @@ def test_mover_segments_are_numpy_interp_bit_for_bit():
             assert not np.any(seg.vel[g]) and not np.any(seg.turn[g])
 
 
+def test_mover_table_is_kept_for_the_same_movers_only():
+    """The same mover objects in the same order get the kept table (read-only, its fields
+    each mover's own); other objects or another order get a new one; and a certificate
+    against the kept table is the one against a fresh copy of the movers."""
+    from trajopt.moving._mover_segments import mover_table
+
+    rng = np.random.default_rng(4)
+    movers = [
+        MovingObstacle.from_waypoints(
+            [0.0, 2.0 + i],
+            rng.normal(size=(2, 2)),
+            radius=0.1 * i,
+            growth=0.01 * i,
+            headings=[0.0, 0.5],
+            vertices=SQUARE if i % 2 else None,
+        )
+        for i in range(4)
+    ]
+    table = mover_table(movers)
+    assert mover_table(tuple(movers)) is table
+    assert mover_table(movers[::-1]) is not table
+    copies = [
+        MovingObstacle.from_waypoints(
+            m.times,
+            m.positions,
+            radius=m.radius,
+            growth=m.growth,
+            headings=m.headings,
+            vertices=m.vertices,
+        )
+        for m in movers
+    ]
+    assert mover_table(copies) is not table
+    assert not table.reach.flags.writeable and not table.seg.vel.flags.writeable
+    for j, m in enumerate(movers):
+        assert table.reach[j] == np.max(np.hypot(*m.shape_vertices.T))
+        assert table.rad0[j] == m.radius and table.grow[j] == m.growth
+        assert table.sizes[j] == m.shape_vertices.shape[0]
+        assert np.array_equal(table.verts[int(table.sizes[j])][j], m.shape_vertices)
+    traj = time_parameterize(_curve([0.6, -0.5, 0.4], 4.0), ROBOT)
+    kept, fresh = certify_movers(traj, movers), certify_movers(traj, copies)
+    assert kept == fresh
+
+
 def test_movers_together_as_each_alone():
     """The verdict of several movers is the first failing one's alone, else the least slack.
 

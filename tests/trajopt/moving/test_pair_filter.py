@@ -12,7 +12,8 @@ point is inside a mover's limit must give the floats of the same closed form wri
 numpy, degenerate cases (no relative motion, a limit growing as fast as the mover moves, a
 zero limit) included (the grid built on it is checked against the distances at every node and
 grid time in test_st_grid, the re-timings on it against 1 ms samples in test_retime); so must
-the compiled point-to-segment test of the pair filter. The launch sweep of the rests'
+the compiled point-to-segment test of the pair filter, and the compiled filter whole the
+numpy form's pairs, in its order. The launch sweep of the rests'
 shortening (compiled, a bucket sort) must give the least launch inside none of the intervals,
 found by brute force over the candidate launches, and the numpy form's answer.
 """
@@ -289,6 +290,62 @@ def test_the_compiled_segment_test_equals_the_numpy_form(seed, n_movers):
     q = q - f[:, None] * d[seg]
     want = ~(q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] >= reach[seg] ** 2)
     np.testing.assert_array_equal(close_pairs(pts, pieces, limit, seg, point), want)
+
+
+def _near_pairs_numpy(pts, pieces, limit, band=None):
+    """The pair filter in numpy (the form the compiled one replaced): boxes of 16 points,
+    each piece's grown segment box against them (and the boxes' time bands), then each
+    pair's point-to-segment test and its own band."""
+    n = pts.shape[0]
+    span = pieces[:, 2] - pieces[:, 1]
+    still = (pieces[:, 5] == 0.0) & (pieces[:, 6] == 0.0)
+    a = pieces[:, 3:5]
+    b = a + pieces[:, 5:7] * np.where(still, 0.0, span)[:, None]
+    with np.errstate(invalid="ignore"):
+        grow = np.where(pieces[:, 8] > 0.0, pieces[:, 8] * span, 0.0)
+    reach = pieces[:, 7] + limit + grow + 1e-6
+    starts = np.arange(0, n, 16)
+    lo = np.minimum.reduceat(pts, starts, axis=0)
+    hi = np.maximum.reduceat(pts, starts, axis=0)
+    p_lo = np.minimum(a, b) - reach[:, None]
+    p_hi = np.maximum(a, b) + reach[:, None]
+    hit = (
+        (p_lo[:, None, 0] <= hi[None, :, 0])
+        & (p_hi[:, None, 0] >= lo[None, :, 0])
+        & (p_lo[:, None, 1] <= hi[None, :, 1])
+        & (p_hi[:, None, 1] >= lo[None, :, 1])
+    )
+    if band is not None:
+        b_lo = np.minimum.reduceat(band[0], starts)
+        b_hi = np.maximum.reduceat(band[1], starts)
+        hit &= (pieces[:, 1, None] <= b_hi[None, :]) & (pieces[:, 2, None] >= b_lo[None, :])
+    seg, box = np.nonzero(hit)
+    first = starts[box]
+    cnt = np.minimum(first + 16, n) - first
+    seg = np.repeat(seg, cnt)
+    point = np.repeat(first - np.cumsum(cnt) + cnt, cnt) + np.arange(int(cnt.sum()))
+    keep = close_pairs(pts, pieces, limit, seg, point)
+    if band is not None:
+        keep &= (pieces[seg, 1] <= band[1][point]) & (pieces[seg, 2] >= band[0][point])
+    return seg[keep], point[keep]
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**31 - 1), st.integers(1, 6), st.integers(1, 150))
+def test_the_compiled_pair_filter_equals_the_numpy_form(seed, n_movers, n_points):
+    """The same pairs in the same order, with and without time bands (some infinite), on
+    tracks whose last pieces stand for ever."""
+    rng = np.random.default_rng(seed)
+    pieces = mover_pieces(_movers(rng, n_movers), float(rng.uniform(0.0, 0.3)))
+    pts = _points(rng, n_points)
+    limit = float(rng.uniform(0.0, 0.4))
+    b_lo = rng.uniform(-1.0, 10.0, n_points)
+    b_hi = np.where(rng.random(n_points) < 0.3, np.inf, b_lo + rng.uniform(0.0, 5.0, n_points))
+    for band in (None, (b_lo, b_hi)):
+        got = near_pairs(pts, pieces, limit, band)
+        want = _near_pairs_numpy(pts, pieces, limit, band)
+        for x, y in zip(got, want, strict=True):
+            np.testing.assert_array_equal(x, y)
 
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])

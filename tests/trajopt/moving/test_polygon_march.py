@@ -20,6 +20,7 @@ from trajopt.moving._polygon_march import (
     PolygonPieces,
     _signed_distance,
     launch_bound_kernel,
+    launch_min_kernel,
     polygon_runs,
 )
 
@@ -162,6 +163,39 @@ def test_the_launch_bound_is_the_clearance_at_the_launch_plus_tau():
             shape = Polygon(np.array([x, y]) + m.vertices @ np.array([[c, sn], [-sn, c]]))
             want = shapely.distance(shape, shapely.points(pts[r])) - m.radius_at(t) - pad[r]
             assert got[li, r] == pytest.approx(want, abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_least_launch_bound_is_the_minimum_over_the_points(seed):
+    """The pruned minimum per launch equals, bit for bit, the minimum over the points of the
+    full table (:func:`launch_bound_kernel`, itself checked against shapely above): on
+    launches a step apart (the refinement's grids) and jumping back and forth, with points
+    along a drive (many nearly as close as the least) and scattered ones."""
+    rng = np.random.default_rng(seed)
+    movers = _random_movers(rng, 4)
+    tracks = PolygonPieces(movers)
+    q = 120
+    along = np.column_stack([np.linspace(-1.0, 4.0, q // 2), np.full(q // 2, 1.5)])
+    pts = np.vstack([along, rng.uniform(-1.0, 4.0, (q - q // 2, 2))])
+    tau = np.concatenate([np.linspace(0.0, 2.0, q // 2), rng.uniform(0.0, 3.0, q - q // 2)])
+    mover = rng.integers(0, 4, q)
+    pad = rng.uniform(0.0, 0.2, q)
+    starts = np.searchsorted(tracks.who, np.arange(len(movers) + 1))
+    for launch in (
+        np.arange(0.0, 4.0, 1e-2),
+        np.arange(1.3, 1.5, 1e-3),
+        rng.uniform(-0.5, 8.0, 50),
+        np.zeros(0),
+    ):
+        args = (tracks.rows, starts, tracks.head0, tracks.turn)
+        shape = (tracks.verts, tracks.edges, tracks.poly)
+        want = launch_bound_kernel(launch, tau, mover, pts, pad, *args, *shape)
+        got = launch_min_kernel(launch, tau, mover, pts, pad, *args, tracks.lip, *shape)
+        assert np.array_equal(got, np.min(want, axis=1, initial=np.inf))
+    none = launch_min_kernel(
+        np.arange(3.0), tau[:0], mover[:0], pts[:0], pad[:0], *args, tracks.lip, *shape
+    )
+    assert np.all(none == np.inf)
 
 
 def _foot_at(pts, heading, body):
