@@ -25,9 +25,7 @@ the robot is committed to it until it stops; the tail, a plan from rest, is re-t
 place, a car's drives between cusps, an omni orientation). Whatever is returned has one
 complete proof (:func:`trajopt.certify_movers` against the shifted movers, over its whole
 clock and the standing at the goal until the last prediction ends), made once: one curve's
-certificate as it is comes first (kept as planned when it passes: no other proof runs; unless
-a mover comes head-on along it, :func:`trajopt.moving.meets_head_on`, where the quick proofs of
-a blocked path below run first and the certificate only when they find nothing), and a
+certificate as it is comes first (kept as planned when it passes: no other proof runs), and a
 re-timed curve's is the certificate :func:`trajopt.retime_for_movers` made of it; a chain's
 is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on) joined with
 the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
@@ -142,29 +140,17 @@ def retime_replan(
             f"predictions last), got v_end={out.v_end!r} m/s"
         )
     head_on: list[bool] = []
-    screened: dict[int, bool] = {}  # meets_head_on of each plan, once
-
-    def comes_head_on(plan: Any, seen: Sequence[MovingObstacle], margin: float) -> bool:
-        if id(plan) not in screened:
-            screened[id(plan)] = meets_head_on(plan, seen, margin)
-        return screened[id(plan)]
 
     def head_on_proof(plan: Any, seen: Sequence[MovingObstacle], margin: float) -> Any:
-        head_on.append(comes_head_on(plan, seen, margin))
+        head_on.append(meets_head_on(plan, seen, margin))
         return no_way_past(plan, seen, margin) if head_on[-1] else None
 
-    proofs = (parked_on_path, head_on_proof)
-    as_is = None  # one curve from the moving state: its certificate as it is comes first,
-    proof = None  # unless a mover comes head-on along it (the proofs first: likely blocked)
-    proved = False
+    as_is = None  # one curve from the moving state: its certificate as it is comes first
     if out.single_curve and out.direction == 1:
-        if comes_head_on(out, shifted, margin):
-            proof = blocked_along(out, movers, margin, ts, shifted, proofs)
-            proved = True
-        if proof is None:
-            as_is = certify_movers(out, shifted, margin=margin)
-    if not proved and (as_is is None or not as_is.ok):  # only a path that must be re-timed
-        proof = blocked_along(out, movers, margin, ts, shifted, proofs)
+        as_is = certify_movers(out, shifted, margin=margin)
+    proof = None
+    if as_is is None or not as_is.ok:  # the proofs only for a path that must be re-timed
+        proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof

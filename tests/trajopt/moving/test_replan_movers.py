@@ -399,39 +399,6 @@ def test_a_walker_head_on_re_routes_from_the_stop(loop_drive):
     _check_splice_and_stop(traj, new, ts, [walker], grid)
 
 
-def test_a_walker_head_on_is_proved_before_the_rest_is_certified(loop_drive, monkeypatch):
-    """The walker comes head-on along the kept rest: the quick proofs run first and hold, so
-    the rest's certificate as it is is never made (only the legs' and the stop's are), and
-    the result is that of the test above (the same proof, route and end)."""
-    from trajopt.replan import _moving
-
-    grid, planner, traj = loop_drive
-    t, ts = 4.0, 4.0 + LATENCY
-    walker = trajopt.MovingObstacle.from_waypoints(
-        [6.0, 26.0], [(11.0, 1.0), (1.0, 1.0)], radius=0.2, name="walker"
-    )
-    certified: list[object] = []
-    real = _moving.certify_movers
-
-    def counted(plan, movers, **kw):
-        certified.append(plan)
-        return real(plan, movers, **kw)
-
-    monkeypatch.setattr(_moving, "certify_movers", counted)
-    new = planner.replan(traj, t, latency=LATENCY, moving_obstacles=[walker], mover_margin=0.02)
-    moving = new.stats["moving"]
-    assert moving["route"] == "stopped: waited" and "no way past" in moving["blocked"]
-
-    def to_goal_moving(p) -> bool:  # the kept rest: from the moving state to the goal
-        end = p.state_at(p.duration)
-        return p.single_curve and p.v_start > 0.0 and math.hypot(end.x - 11.0, end.y - 1.0) < 1e-6
-
-    assert certified and not any(to_goal_moving(p) for p in certified)
-    shifted = [trajopt.moving.shift_clock(walker, ts)]
-    check = check_trajectory(new, shifted, grid=grid)
-    assert check.ok and check.mover_slack >= -1e-6
-
-
 def test_the_static_plan_from_the_stop_is_still_tried_when_no_candidate_works(
     loop_drive, monkeypatch
 ):
