@@ -66,6 +66,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.geometry._clearance",
     "trajopt.geometry._convex_hull",
     "trajopt.planning._feasibility",
+    "trajopt.planning._label_kernel",
     "trajopt.robot._footprint_kernels",
     "trajopt.geometry._obstacle_index",
     "trajopt.motion._phase_motion",

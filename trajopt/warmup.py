@@ -267,7 +267,10 @@ def _exercise_fallback() -> None:
 
 
 def _exercise_plan() -> None:
-    """Plan with the defaults: clearance cost, search, polygon corridor, smoother, timing."""
+    """Plan with the defaults: clearance cost, search, polygon corridor, smoother, timing.
+
+    Its check that the ends are joined labels the components (trajopt.planning._label_kernel).
+    """
     planner, start, goal = _default_query()
     planner.plan(start, goal)
 

@@ -52,6 +52,10 @@ HEAD_ON_DT = 0.25
 #: Arc length (m) a mover must go back along the path, near it, for :func:`meets_head_on`,
 #: coming to within as much of the path's start.
 HEAD_ON_RUN = 0.5
+#: The reach bounds from rest kept (:func:`_grid_reach_bound`), one per ``(dt, speed,
+#: a_max, j_max)``.
+_REACH_KEPT = 8
+_REACH: dict[tuple[float, float, float, float], np.ndarray] = {}
 
 
 def _points(curves: list[Any], s: np.ndarray) -> np.ndarray:
@@ -181,7 +185,10 @@ def no_way_past(
     )
     if grid.ptr[1] == 0 and not np.any(grid.hi >= FOREVER):
         return None  # waiting at the start until every mover has left the path gets past
-    s_up = reach_bound(grid.t, v_top, a_max, j_max, v0)
+    if v0 > 0.0:
+        s_up = reach_bound(grid.t, v_top, a_max, j_max, v0)
+    else:
+        s_up = _grid_reach_bound(grid.t.shape[0], grid.dt, v_top, a_max, j_max)
     if s_up[-1] + 0.5 * grid.ds < length:  # the grid must outlast the bound's reaching the goal
         return None
     rptr, _, rb = _reach_arrays(grid, v_top, s_up)
@@ -202,6 +209,27 @@ def no_way_past(
         mover=movers[j].name,
         t=t,
     )
+
+
+def _grid_reach_bound(kk: int, dt: float, speed: float, a_max: float, j_max: float) -> np.ndarray:
+    """Return :func:`~trajopt.moving._st_grid.reach_bound` from rest at ``np.arange(kk) * dt`` (s).
+
+    The same values (m, shape (kk,), read-only), kept per ``(dt, speed, a_max, j_max)``
+    (the last :data:`_REACH_KEPT`): the bound's 1 ms sums run from ``t = 0``, so the bound
+    at the first ``kk`` grid times is the first ``kk`` values of a longer grid's, which is
+    computed once (at least twice as long as the one it replaces) instead of once per proof.
+    """
+    key = (float(dt), float(speed), float(a_max), float(j_max))
+    kept = _REACH.get(key)
+    if kept is None or kept.shape[0] < kk:
+        n = max(kk, 0 if kept is None else 2 * kept.shape[0])
+        kept = reach_bound(np.arange(n) * dt, speed, a_max, j_max)
+        kept.setflags(write=False)
+        _REACH.pop(key, None)
+        while len(_REACH) >= _REACH_KEPT:
+            _REACH.pop(next(iter(_REACH)))
+        _REACH[key] = kept
+    return kept[:kk]
 
 
 def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0.0) -> bool:

@@ -281,7 +281,12 @@ def reroute(
     pts = np.zeros((0, 2))
     if path is not None:
         pts = _beyond(np.asarray(path, dtype=float).reshape(-1, 2), keep)
-        clear = [_keeps_clear(grid, regions, margin + robot.radius, pts) for _, regions in detours]
+        seen: dict[tuple[tuple[int, float, float], ...], bool] = {}  # the same regions once
+        for i, (_, regions) in enumerate(detours):
+            key = tuple((id(m), t0, t1) for m, t0, t1 in regions)
+            if key not in seen:
+                seen[key] = _keeps_clear(grid, regions, margin + robot.radius, pts)
+            clear[i] = seen[key]
     order = [i for i, c in enumerate(clear) if not c] + [i for i, c in enumerate(clear) if c]
     late: list[int] = []  # detours whose sketch follows the blocked path: after the waits
     kept = None  # a detour round where the robot may meet the mover, too long to take at once

@@ -170,3 +170,24 @@ def test_the_head_on_screen_sees_a_walker_along_the_path_and_not_a_crossing(base
         [0.0, 8.0], [p - 2.0 * n, p + 2.0 * n], radius=0.2
     )
     assert not trajopt.moving.meets_head_on(base, [crosser], 0.02)
+
+
+def test_kept_reach_bound_equals_a_fresh_one():
+    """The proof's kept reach bound: bit for bit the bound of the grid's own times, any order."""
+    from trajopt.moving._no_way_past import _grid_reach_bound
+    from trajopt.moving._st_grid import reach_bound
+
+    for kk in [3, 400, 17, 1200, 2, 401, 5000, 999]:
+        for dt, v, a, j in ((0.05, 0.5, 1.0, 5.0), (0.1, 0.7, 0.4, 2.0)):
+            got = _grid_reach_bound(kk, dt, v, a, j)
+            t = np.arange(kk) * dt
+            assert got.shape == (kk,) and not got.flags.writeable
+            np.testing.assert_array_equal(got, reach_bound(t, v, a, j))
+    # against the limits by hand: at least the left sums of v(t) = min(v_max, a(t) integrated)
+    t = np.arange(300) * 0.05
+    got = _grid_reach_bound(300, 0.05, 0.5, 1.0, 5.0)
+    t1 = 0.2  # a_max / j_max
+    v = np.minimum(0.5, np.where(t <= t1, 2.5 * t * t, 0.1 + (t - t1)))
+    assert np.all(np.diff(got) >= 0.0)
+    assert np.all(got + 1e-12 >= np.concatenate([[0.0], np.cumsum(v[:-1] * 0.05)]))
+    assert np.all(got <= 0.5 * t + 1e-3)  # never beyond top speed (plus a 1 ms step)

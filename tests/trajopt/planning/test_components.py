@@ -20,13 +20,7 @@ import trajopt
 from tests.reference import reachable_cells
 from trajopt.errors import NoPathError
 from trajopt.planning import _disc
-from trajopt.planning._caches import (
-    MERGE_ROUNDS,
-    PlannerCaches,
-    _merged_runs,
-    component_labels,
-    update_labels,
-)
+from trajopt.planning._caches import PlannerCaches, component_labels, update_labels
 
 ROBOT = trajopt.Robot(radius=0.12)
 
@@ -75,32 +69,6 @@ def test_labels_equal_scipy_ndimage_label(seed):
         np.testing.assert_array_equal(component_labels(occ), ref)
     assert np.all(component_labels(np.ones((5, 7), bool)) == 0)
     assert np.all(component_labels(np.zeros((5, 7), bool)) == 1)
-
-
-@pytest.mark.parametrize("seed", range(6))
-def test_merged_runs_equal_scipy_connected_components(seed):
-    """The quick labelling of a graph: scipy's labels, or ``None`` (never other labels)."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    rng = np.random.default_rng(300 + seed)
-    settled = 0
-    for _ in range(30):
-        n = int(rng.integers(1, 60))
-        m = int(rng.integers(0, 2 * n))
-        a, b = rng.integers(0, n, size=(2, m))
-        graph = csr_matrix((np.ones(m), (a, b)), shape=(n, n))
-        _, ref = connected_components(graph, directed=False)
-        got = _merged_runs(n, a, b)
-        if got is not None:
-            settled += 1
-            np.testing.assert_array_equal(got, ref)
-    assert settled > 0
-    # a chain whose hooks each move one step: more rounds than allowed, so None
-    n = 2 ** (MERGE_ROUNDS + 2)
-    order = rng.permutation(n)
-    chain = _merged_runs(n, order[:-1], order[1:])
-    assert chain is None or np.all(chain == 0)
 
 
 @pytest.mark.parametrize("seed", range(4))
