@@ -479,9 +479,16 @@ def machine() -> str:
     )
 
 
-def run_one(bench: Bench, args: tuple[str, ...]) -> tuple[str, float, int]:
-    """Run one benchmark command; returns (its output, wall time in s, exit code)."""
+def run_one(bench: Bench, args: tuple[str, ...]) -> tuple[str, float, int, str]:
+    """Run one benchmark command.
+
+    Returns its output, its wall time (s), its exit code and when it started (UTC, with the
+    machine's load average then).
+    """
     cmd = [sys.executable, str(ROOT / "benchmarks" / bench.script), *args]
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    started = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    started += f", load average {load:.2f}"
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - t0
@@ -489,16 +496,16 @@ def run_one(bench: Bench, args: tuple[str, ...]) -> tuple[str, float, int]:
     if proc.returncode != 0:
         tail = "\n".join(proc.stderr.rstrip().splitlines()[-15:])
         out = f"{out}\n\n[exit code {proc.returncode}]\n{tail}".strip()
-    return out, wall, proc.returncode
+    return out, wall, proc.returncode, started
 
 
-def section(bench: Bench, results: list[tuple[tuple[str, ...], str, float, int]]) -> str:
+def section(bench: Bench, results: list[tuple[tuple[str, ...], str, float, int, str]]) -> str:
     """The markdown section of one benchmark: its text, then each run's command and output."""
     body = []
-    for args, out, wall, code in results:
+    for args, out, wall, code, started in results:
         cmd = " ".join(["python", f"benchmarks/{bench.script}", *args])
         status = "" if code == 0 else f" **(failed, exit code {code})**"
-        body.append(f"`{cmd}`: {wall:.0f} s{status}\n\n```text\n{out}\n```\n")
+        body.append(f"`{cmd}`: {wall:.0f} s{status} (run {started})\n\n```text\n{out}\n```\n")
     return f"## {bench.title}\n\n{bench.what}\n\n" + "\n".join(body)
 
 
@@ -560,10 +567,10 @@ def main(argv: list[str] | None = None) -> int:
         results = []
         for run_args in bench.runs(args.full):
             print(f"running {bench.name} {' '.join(run_args)} ...", flush=True)
-            out, wall, code = run_one(bench, run_args)
+            out, wall, code, started = run_one(bench, run_args)
             failed += code != 0
             print(f"  {wall:.0f} s, exit code {code}", flush=True)
-            results.append((run_args, out, wall, code))
+            results.append((run_args, out, wall, code, started))
         parts.append(section(bench, results))
     if args.only is not None and args.out.is_file():
         parts = _merge(args.out.read_text(), parts)
