@@ -296,7 +296,8 @@ def _exercise_planners() -> None:
     """Plan with the other planner kinds, on a costmap too, and re-plan.
 
     Boxes, the chapter's inflation, shortest paths, a curvature bound, ALT landmarks; a
-    re-plan that keeps the corridor and one that does not.
+    re-plan that keeps the corridor, one that does not and one that brakes (its plan from
+    the moving state out of time).
     """
     from trajopt.robot import Robot
     from trajopt.smoother import Smoother
@@ -317,6 +318,9 @@ def _exercise_planners() -> None:
     traj = planner.plan(start, goal)
     planner.replan(traj, 0.3 * traj.duration, latency=0.0)
     planner.replan(traj, 0.3 * traj.duration, latency=0.0, reuse=False)
+    # a plan from the moving state out of time: brake, turn and go (trajopt.timing._greedy's
+    # braking kernels, first reached by a re-plan with movers that braked)
+    planner.replan(traj, 0.3 * traj.duration, latency=0.0, reuse=False, brake_after_s=1e-6)
 
 
 def _exercise_car() -> None:
