@@ -58,18 +58,13 @@ from trajopt.moving._certificate import (
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import geometry_key, kappa_max
 from trajopt.moving._shape_windows import ShapeWindows
-from trajopt.moving._st_grid import (
-    STGrid,
-    grid_nodes,
-    reach_bound,
-    reachable,
-    st_grid,
-)
+from trajopt.moving._st_grid import STGrid, grid_nodes, reach_bound, reachable, st_grid
 from trajopt.moving._st_search import Piece, compose, describe, parts_of, search
 from trajopt.moving._tighten import (
     FINE_DS,
     FineWindows,
     bisect_start,
+    pass_band,
     tail_occupancy,
     tail_s,
     tighten,
@@ -486,14 +481,17 @@ def _tightened(
         speed = max(float(traj.robot.v_max), abs(float(traj.v_start)))
         t_to = arrival(schedule) if schedule else float(grid.t[-1])
         limit = float(traj.robot.radius) + margin
-        fine = _fine_windows(tables, grid, movers, limit, (not_before, t_to, speed))
-        if schedule:
-            candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
         whole = None if moving else tables.drive(0.0, length)
         if len(schedule) == 1 and schedule[0][1] is whole:
             whole = None  # the tightened schedule is this drive at its earliest launch
+        latest = [schedule] if schedule else []  # the motions' latest launches
         if whole is not None:
             t_max = min(arrival(schedule), float(grid.t[-1])) - whole.duration
+            latest.append([(t_max, whole)])
+        fine = _fine_windows(tables, grid, movers, limit, (not_before, t_to, speed), latest)
+        if schedule:
+            candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
+        if whole is not None:
             one = [(0.0, whole)]
             drives, rests = tail_occupancy(fine, one, 0)
             launch = fine.earliest(drives, not_before, t_max, tail_s(one, 0), rests)
@@ -528,6 +526,7 @@ def _fine_windows(
     movers: Sequence[MovingObstacle],
     limit: float,
     span: tuple[float, float, float],
+    latest: Sequence[list[tuple[float, Piece]]] = (),
 ) -> FineWindows:
     """Return the movers' windows at the path's fine nodes (spacing at most ``dt`` times the speed).
 
@@ -536,7 +535,8 @@ def _fine_windows(
     motions asked about can be near the node: ``span = (t_from, t_to, V)``, the robot leaves
     the start no earlier than ``t_from`` (s), arrives at the goal no later than ``t_to`` (s)
     and drives at most ``V`` (m/s), so it is within ``h/2`` of ``s_i`` only between
-    ``t_from + (s_i - h/2) / V`` and ``t_to - (L - s_i - h/2) / V``; the band is widened by
+    ``t_from + (s_i - h/2) / V`` and ``t_to - (L - s_i - h/2) / V``, cut to
+    :func:`._tighten.pass_band` of ``latest`` (the schedules at their latest launches); widened by
     :data:`BAND_PAD` (the drives' samples reach a step beyond) and ``V`` by 1 %. A window
     left out by a wrong bound would only make a launch too early, which the certificate
     refuses (the caller then keeps the untightened schedule).
@@ -547,10 +547,10 @@ def _fine_windows(
     tb = tables.table
     t_from, t_to, speed = span
     v = 1.01 * speed
-    band = (
-        t_from + np.maximum(s - 0.5 * h, 0.0) / v - BAND_PAD,
-        t_to - np.maximum(tables.length - s - 0.5 * h, 0.0) / v + BAND_PAD,
-    )
+    p_lo, p_hi = pass_band(s, h, latest, t_from)
+    lo = np.maximum(t_from + np.maximum(s - 0.5 * h, 0.0) / v, p_lo)
+    hi = np.minimum(t_to - np.maximum(tables.length - s - 0.5 * h, 0.0) / v, p_hi)
+    band = (lo - BAND_PAD, hi + BAND_PAD)
 
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)

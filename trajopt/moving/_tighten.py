@@ -53,6 +53,8 @@ REFINE_SPAN = 0.25
 POINT_PAD = 1e-4
 #: Bisection steps of :func:`bisect_start`.
 BISECT_STEPS = 5
+#: Time step (s) of the samples of the motions that bound the fine windows' band (:func:`pass_band`).
+BAND_DT = 0.01
 
 #: A schedule: ``(launch time (s), drive)`` in order; the robot rests between the drives
 #: (and at the start before the first, at the goal after the last).
@@ -340,6 +342,45 @@ def tail_s(schedule: Schedule, k: int) -> Callable[[np.ndarray], np.ndarray]:
         return out
 
     return s_of
+
+
+def pass_band(
+    s: np.ndarray, h: float, latest: Sequence[Schedule], t_from: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return when (s) the schedules can be within ``h/2`` of the nodes ``s`` (m), launched earlier.
+
+    Each schedule of ``latest`` (drives moving forward, launched at the latest) may have
+    its launches moved earlier but not before ``t_from`` (s) nor into each other: the robot
+    leaves the band ``[s_i - h/2, s_i + h/2]`` no later than the schedule as it is does (the
+    first of its samples every :data:`BAND_DT` at or past ``s_i + h/2``; at its arrival for
+    the nodes that reach the goal's), and enters it no earlier than its drives back to back
+    from ``min(t_from, first launch)`` do (the last of their samples before ``s_i - h/2``).
+    Returns ``(lo, hi)``, shape (n,) each: the least of the entries, the greatest of the exits
+    (no schedules: all times).
+    """
+    if not latest:
+        return np.full(s.shape, -np.inf), np.full(s.shape, np.inf)
+    lo = np.full(s.shape, np.inf)
+    hi = np.full(s.shape, -np.inf)
+    for sched in latest:
+        t0 = sched[0][0]
+        end = sched[-1][0] + sched[-1][1].duration
+        tau = np.append(np.arange(0.0, end - t0, BAND_DT), end - t0)
+        s_t = np.maximum.accumulate(tail_s(sched, 0)(tau))
+        k = np.searchsorted(s_t, s + 0.5 * h, side="left")
+        hi = np.maximum(
+            hi, np.where(k < tau.shape[0], t0 + tau[np.minimum(k, tau.shape[0] - 1)], end)
+        )
+        start = min(t_from, t0)
+        packed, t = [], start
+        for _, pc in sched:
+            packed.append((t, pc))
+            t += pc.duration
+        tau = np.append(np.arange(0.0, t - start, BAND_DT), t - start)
+        s_t = np.maximum.accumulate(tail_s(packed, 0)(tau))
+        k = np.searchsorted(s_t, s - 0.5 * h, side="left") - 1
+        lo = np.minimum(lo, np.where(k >= 0, start + tau[np.maximum(k, 0)], start))
+    return lo, hi
 
 
 def tail_occupancy(

@@ -306,3 +306,43 @@ def test_polygon_movers_never_later_than_a_brute_force_wait_at_the_start(line6, 
     assert check_trajectory(out, movers).ok
     if witness is not None:
         assert out.duration <= witness + 1e-9
+
+
+def test_the_fine_windows_band_holds_every_earlier_launch(line6):
+    """The band of :func:`pass_band` holds the robot near each node for any earlier launches.
+
+    A schedule of three drives with rests; random launches moved earlier (never before
+    ``t_from``, never into the drive before): every 0.1 ms sample of the motion within
+    ``h/2`` of a node lies in the node's band (brute force on the motion's own samples).
+    """
+    from trajopt.moving._retime import _tables
+    from trajopt.moving._tighten import pass_band
+
+    tables = _tables(line6)
+    cuts = [0.0, 1.5, 3.5, 6.0]
+    drives = [tables.drive(a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+    schedule, t = [], 2.0
+    for pc in drives:
+        schedule.append((t, pc))
+        t += pc.duration + 1.5
+    t_from, h = 0.5, 0.01
+    s = np.linspace(0.0, 6.0, 601)
+    lo, hi = pass_band(s, h, [schedule], t_from)
+    rng = np.random.default_rng(3)
+    for trial in range(20):
+        launches, prev_end = [], t_from
+        for t_k, pc in schedule:  # the first trial: the schedule as it is
+            launch = rng.uniform(prev_end, t_k) if trial else t_k
+            launches.append(launch)
+            prev_end = launch + pc.duration
+        tau = np.arange(t_from, prev_end + 0.5, 1e-4)
+        pos = np.zeros(tau.shape)
+        for launch, (_, pc) in zip(launches, schedule, strict=True):
+            pos = np.where(tau >= launch, pc.s_at(tau - launch), pos)
+        assert np.all(np.diff(pos) >= 0.0)
+        # the samples near node i: from the first at s_i - h/2 to the last at s_i + h/2
+        first = np.searchsorted(pos, s - 0.5 * h, side="left")
+        last = np.searchsorted(pos, s + 0.5 * h, side="right") - 1
+        assert np.all(tau[first] >= lo - 1e-12)
+        inside = s + 0.5 * h < 6.0  # the nodes the robot leaves (at the goal: the rests' test)
+        assert np.all(tau[last][inside] <= hi[inside] + 1e-12)
