@@ -350,36 +350,38 @@ def pass_band(
     """Return when (s) the schedules can be within ``h/2`` of the nodes ``s`` (m), launched earlier.
 
     Each schedule of ``latest`` (drives moving forward, launched at the latest) may have
-    its launches moved earlier but not before ``t_from`` (s) nor into each other: the robot
-    leaves the band ``[s_i - h/2, s_i + h/2]`` no later than the schedule as it is does (the
-    first of its samples every :data:`BAND_DT` at or past ``s_i + h/2``; at its arrival for
-    the nodes that reach the goal's), and enters it no earlier than its drives back to back
-    from ``min(t_from, first launch)`` do (the last of their samples before ``s_i - h/2``).
-    Returns ``(lo, hi)``, shape (n,) each: the least of the entries, the greatest of the exits
-    (no schedules: all times).
+    its launches moved earlier but not before ``t_from`` (s) nor into each other. Each drive
+    is sampled every :data:`BAND_DT` from its launch to its end (rests need none: the robot
+    stands at a drive's end until the next launch). The robot leaves the band
+    ``[s_i - h/2, s_i + h/2]`` no later than the schedule as it is does (its first sample at
+    or past ``s_i + h/2``; at its arrival for the nodes that reach the goal's), and enters it
+    no earlier than the drives back to back from ``min(t_from, first launch)`` do (their last
+    sample before ``s_i - h/2``). Returns ``(lo, hi)``, shape (n,) each: the least of the
+    entries, the greatest of the exits (no schedules: all times).
     """
     if not latest:
         return np.full(s.shape, -np.inf), np.full(s.shape, np.inf)
     lo = np.full(s.shape, np.inf)
     hi = np.full(s.shape, -np.inf)
     for sched in latest:
-        t0 = sched[0][0]
-        end = sched[-1][0] + sched[-1][1].duration
-        tau = np.append(np.arange(0.0, end - t0, BAND_DT), end - t0)
-        s_t = np.maximum.accumulate(tail_s(sched, 0)(tau))
-        k = np.searchsorted(s_t, s + 0.5 * h, side="left")
-        hi = np.maximum(
-            hi, np.where(k < tau.shape[0], t0 + tau[np.minimum(k, tau.shape[0] - 1)], end)
-        )
-        start = min(t_from, t0)
-        packed, t = [], start
-        for _, pc in sched:
-            packed.append((t, pc))
+        taus, s_t, at, packed = [], [], [], []
+        t = min(t_from, sched[0][0])
+        for launch, pc in sched:
+            tau = np.append(np.arange(0.0, pc.duration, BAND_DT), pc.duration)
+            taus.append(tau)
+            s_t.append(pc.s_at(tau))
+            at.append(np.full(tau.shape, launch))
+            packed.append(np.full(tau.shape, t))
             t += pc.duration
-        tau = np.append(np.arange(0.0, t - start, BAND_DT), t - start)
-        s_t = np.maximum.accumulate(tail_s(packed, 0)(tau))
-        k = np.searchsorted(s_t, s - 0.5 * h, side="left") - 1
-        lo = np.minimum(lo, np.where(k >= 0, start + tau[np.maximum(k, 0)], start))
+        tau, s_all = np.concatenate(taus), np.maximum.accumulate(np.concatenate(s_t))
+        n = tau.shape[0]
+        k = np.searchsorted(s_all, s + 0.5 * h, side="left")
+        end = sched[-1][0] + sched[-1][1].duration
+        late = (np.concatenate(at) + tau)[np.minimum(k, n - 1)]
+        hi = np.maximum(hi, np.where(k < n, late, end))
+        k = np.searchsorted(s_all, s - 0.5 * h, side="left") - 1
+        early = (np.concatenate(packed) + tau)[np.maximum(k, 0)]
+        lo = np.minimum(lo, np.where(k >= 0, early, min(t_from, sched[0][0])))
     return lo, hi
 
 
