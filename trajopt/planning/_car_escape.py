@@ -24,7 +24,7 @@ import numpy as np
 import astar
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, SmoothingError
-from trajopt.planning._car_fit import fit_run, start_curvature
+from trajopt.planning._car_fit import fit_path
 from trajopt.planning._car_tries import (
     FOOTPRINT_COSTS,
     FOOTPRINT_SEARCH_EXPANSIONS,
@@ -259,20 +259,7 @@ def escape_and_fit(
     path = astar.PosePath(*arrays, r_cells, stats)
     poses = path.to_world(grid)
     try:
-        segments = []
-        for a, b in np.asarray(path.segments):
-            segments.extend(
-                fit_run(
-                    options,
-                    grid,
-                    smoother,
-                    poses,
-                    (int(a), int(b)),
-                    int(path.directions[b]),
-                    start_curvature(path, int(a), res),
-                    timer,
-                )
-            )
+        segments = fit_path(options, grid, smoother, path, poses, res, timer)
     except SmoothingError as exc:
         tries.append(f"{label}: a segment has no fit")
         failures.append(exc)

@@ -172,6 +172,38 @@ def end_curvature(path: SmoothPath) -> float:
     return float(np.asarray(path.curvature(np.array([path.domain[1]])), dtype=float)[-1])
 
 
+def fit_path(
+    options: PlannerOptions,
+    grid: OccupancyGrid,
+    smoother: Smoother,
+    path: PosePath,
+    poses: np.ndarray,
+    res: float,
+    timer: StageTimer,
+) -> list[CarSegment]:
+    """Fit every stretch between cusps of a search's ``path``, in order (:func:`fit_run`).
+
+    ``poses``: the path's poses in world metres, shape ``(n, 3)``; ``res``: the search
+    grid's cell side (m). Raises :class:`~trajopt.errors.SmoothingError` from the first
+    stretch that gets no certified curve.
+    """
+    segments: list[CarSegment] = []
+    for a, b in np.asarray(path.segments):
+        segments.extend(
+            fit_run(
+                options,
+                grid,
+                smoother,
+                poses,
+                (int(a), int(b)),
+                int(path.directions[b]),
+                start_curvature(path, int(a), res),
+                timer,
+            )
+        )
+    return segments
+
+
 def fit_run(
     options: PlannerOptions,
     grid: OccupancyGrid,

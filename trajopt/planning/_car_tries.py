@@ -61,7 +61,7 @@ from numpy.typing import ArrayLike
 import astar
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError, NoPathError, SmoothingError
-from trajopt.planning._car_fit import CarSegment, fit_run, start_curvature
+from trajopt.planning._car_fit import CarSegment, fit_path
 from trajopt.planning._options import PlannerOptions
 from trajopt.planning._query import StageTimer
 from trajopt.robot import Robot
@@ -354,20 +354,15 @@ def search_and_fit(
                 continue
             poses = path.to_world(grid)
             try:
-                segments = []
-                for a, b in np.asarray(path.segments):
-                    segments.extend(
-                        fit_run(
-                            options,
-                            grid,
-                            sm if factor > TIGHT_FACTOR else sm_tight,
-                            poses,
-                            (int(a), int(b)),
-                            int(path.directions[b]),
-                            start_curvature(path, int(a), res),
-                            timer,
-                        )
-                    )
+                segments = fit_path(
+                    options,
+                    grid,
+                    sm if factor > TIGHT_FACTOR else sm_tight,
+                    path,
+                    poses,
+                    res,
+                    timer,
+                )
             except SmoothingError as exc:
                 tries.append(f"{label}: a segment has no fit")
                 failures.append(exc)
