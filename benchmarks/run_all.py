@@ -10,7 +10,7 @@ page always states one run of the present code.
 Run from the repository root (the benchmarks on real maps need the shared data,
 ``$TRAJOPT_DATA`` or ``../shared/data``)::
 
-    python benchmarks/run_all.py --quick            # about 10-20 min on 2 cores
+    python benchmarks/run_all.py --quick            # about 15-25 min on 2 cores
     python benchmarks/run_all.py --full             # the settings quoted in the scripts
     python benchmarks/run_all.py --quick --only inflate astar --out /tmp/b.md
 """
