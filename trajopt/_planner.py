@@ -84,7 +84,7 @@ from trajopt.planning import (
     plan_from_stop,
     run_query,
 )
-from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
+from trajopt.replan import BRAKE_AFTER_S, record_marked, replan_from, retime_replan
 from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
@@ -388,6 +388,7 @@ class Planner:
                 out = retime_replan(out, movers, margin, 0.0, self._from_stop(out.steps, margin))
             elif movers:
                 out = plan_among_movers(movers, margin, self.options, self.caches, request)
+                out = record_marked(out, self.caches.grid, self.caches.inflated)
             else:
                 out = run_query(self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
@@ -418,7 +419,8 @@ class Planner:
                 start_steer=steer,
                 goal_steer=getattr(steps, "goal_steer", None),
             )
-            return plan_from_stop(tuple(seen), margin, self.options, self.caches, request, along)
+            out = plan_from_stop(tuple(seen), margin, self.options, self.caches, request, along)
+            return record_marked(out, self.caches.grid, self.caches.inflated)
 
         return from_stop
 
