@@ -29,8 +29,10 @@ certificate as it is comes first (kept as planned when it passes: no other proof
 re-timed curve's is the certificate :func:`trajopt.retime_for_movers` made of it; a chain's
 is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on) joined with
 the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
-none when the head plays for no time); a result with no piece from rest after its head (an
-omni base's own orientation from the moving state) is only certified, whole.
+none when the head plays for no time). An omni base's own orientation from the moving state
+has its translation certified as it is, else re-timed, as the circumscribed disc, its
+orientation profile kept as it is in time (:func:`_retimed_omni`); it is not braked
+when blocked (``BlockedError``).
 
 **When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
 the robot stops, since it is moving at the splice. One curve from the moving state is braked
@@ -195,6 +197,8 @@ def _retimed(
         except BlockedError as exc:  # its time back on the movers' clock
             raise _on_movers_clock(exc, ts) from exc
         return timed, dict(timed.stats["moving"])
+    if getattr(out, "translation", None) is not None and getattr(out, "pieces", None) is None:
+        return _retimed_omni(out, margin, ts, shifted)
     head, tail = split_at_rest(out)
     if tail:
         timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
@@ -212,6 +216,41 @@ def _retimed(
             t=cert.witness_t + ts,
         )
     return out, {"plan": "as planned", "certificate": cert.summary()}
+
+
+def _retimed_omni(
+    out: Any, margin: float, ts: float, shifted: Sequence[MovingObstacle]
+) -> tuple[PlanResult, dict[str, Any]]:
+    """Re-time an omni base's own orientation from the moving state along its path.
+
+    The translation (from the splice state) is certified as it is, else re-timed
+    (:func:`trajopt.retime_for_movers`), as the robot's circumscribed disc (the body may
+    face any way); the orientation profile is kept as it is in time (its angle, rate and
+    acceleration at the splice, its yaw limits: it does not depend on the translation's
+    timing, and a translation that ends at rest may end before or after it).
+    ``BlockedError`` (its time on the movers' clock) when no re-timing avoids the movers.
+    """
+    tr = out.translation
+    radius = float(out.robot.radius)
+    disc = dataclasses.replace(tr.robot, footprint=None) if tr.robot.footprint else tr.robot
+    as_is = certify_movers(tr, shifted, margin=margin, robot_radius=radius)
+    if as_is.ok:
+        return out, {"plan": "as planned", "certificate": as_is.summary()}
+    try:
+        moved = retime_for_movers(dataclasses.replace(tr, robot=disc), shifted, margin=margin)
+    except BlockedError as exc:
+        raise _on_movers_clock(exc, ts) from exc
+    moved = dataclasses.replace(moved, robot=tr.robot, steps=tr.steps)
+    cert = certify_movers(moved, shifted, margin=margin, robot_radius=radius)
+    if not cert.ok:  # the re-timing certified the same disc; only a numerical slip lands here
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-timed omni translation at "
+            f"t = {cert.witness_t + ts:.3f} s of the movers' clock ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t + ts,
+        )
+    timed = dataclasses.replace(out, translation=moved)
+    return timed, {"plan": str(moved.stats["moving"]["plan"]), "certificate": cert.summary()}
 
 
 def _joined_head(
@@ -541,16 +580,20 @@ def _whole_certificate(
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
     """Return points of the pieces' curves end to end from the stop on, at most 10 cm apart.
 
-    The points (m, shape (n, 2)) start with the stop; turns in place add none; the points before the one nearest the stop (the part braked
-    over) are dropped.
+    The points (m, shape (n, 2)) start with the stop; turns in place add none, an omni base's
+    own orientation its translation's curve; the points before the one nearest the stop (the
+    part braked over) are dropped.
     """
     pts = [np.asarray(p_stop, dtype=float).reshape(1, 2)]
-    for p in pieces:
+    for piece in pieces:
+        p = getattr(piece, "translation", piece)  # an omni base's own orientation: its curve
         if getattr(p, "pieces", None) is not None:
             pts.append(_points(p.pieces, p_stop))
         elif p.single_curve and float(p.length) > 0.0:
             s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.1)) + 1)
             pts.append(np.asarray(p.path(p.path.u_at_s(s)), dtype=float).reshape(-1, 2))
     out = np.concatenate(pts)
+    if out.shape[0] == 1:  # no curve ahead: the stop alone
+        return out
     near = int(np.argmin(np.hypot(out[1:, 0] - p_stop[0], out[1:, 1] - p_stop[1]))) + 1
     return np.concatenate([out[:1], out[near:]])
