@@ -31,13 +31,14 @@ is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on)
 the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
 none when the head plays for no time). An omni base's own orientation from the moving state
 has its translation certified as it is, else re-timed, as the circumscribed disc, its
-orientation profile kept as it is in time (:func:`_retimed_omni`); it is not braked
-when blocked (``BlockedError``).
+orientation profile kept as it is in time (:func:`_retimed_omni`); when blocked, its
+translation brakes along its path with the yaw rate stopped beside it
+(:func:`trajopt.timing.stop_orientation`), certified as its translation's disc.
 
 **When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
 the robot stops, since it is moving at the splice. One curve from the moving state is braked
-along its path (:func:`~trajopt.replan._brake.brake_on_path`); a chain keeps its head, which
-ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
+along its path (:func:`~trajopt.replan._brake.brake_on_path`; an omni base's own orientation
+has its yaw rate stopped beside the brake); a chain keeps its head, which ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
 from the stop, as :meth:`~trajopt._planner.Planner.plan` does with movers (the static plan
 re-timed, else re-routed around the blocking mover's swept region, or a wait at a safe
 place: :func:`trajopt.moving.reroute`). The stop and that plan are certified as one chain
@@ -88,6 +89,7 @@ from trajopt.moving import (
     truncate,
 )
 from trajopt.replan._brake import brake_on_path
+from trajopt.timing import stop_orientation
 
 
 def retime_replan(
@@ -290,14 +292,37 @@ def _head_certificate(
     shifted: Sequence[MovingObstacle],
     margin: float,
 ) -> Any:
-    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``."""
-    pieces = tuple(p for p, _ in head)
+    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``.
+
+    An omni base's piece with its own orientation (its brake, the yaw rate stopped beside
+    it) is certified as its translation, the circumscribed disc (the body may face any way):
+    where its orientation outlasts the translation the base stands still, which the
+    translation's certificate covers when the piece ends the head (the robot stands at its
+    end until the movers, ended at ``t_head``, last), or when the two end together.
+    """
+    last = len(head) - 1
+    disc = False
+    pieces = []
+    for i, (p, t_in) in enumerate(head):
+        tr = getattr(p, "translation", None)
+        if (
+            tr is not None
+            and t_in < float(tr.duration)
+            and (i == last or float(p.duration) - float(tr.duration) <= 1e-12)
+        ):
+            p, disc = tr, True
+        pieces.append(p)
     played_head = (
         pieces[0]
         if len(head) == 1 and head[0][1] == 0.0
-        else TrajectoryChain(pieces, robot, {}, None, tuple(t for _, t in head))
+        else TrajectoryChain(tuple(pieces), robot, {}, None, tuple(t for _, t in head))
     )
-    return certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
+    return certify_movers(
+        played_head,
+        [truncate(m, t_head) for m in shifted],
+        margin=margin,
+        robot_radius=float(robot.radius) if disc else None,
+    )
 
 
 def blocked_along(
@@ -459,7 +484,8 @@ def _stop_and_go_on(
     """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
 
     One curve from the moving state is braked along its path
-    (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
+    (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited; an omni
+    base's own orientation with its yaw rate stopped beside it, :func:`_omni_stop`); a chain
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
     plans on for the movers seen from there (``ts`` plus the stop's time), told the path
     followed from the stop (:class:`Along`) when ``along`` proves it blocked
@@ -483,6 +509,12 @@ def _stop_and_go_on(
         if brake is not None:
             head.append((brake, 0.0))
         stop = (brake or out).sample(np.array([brake.duration if brake else 0.0]))
+        ahead = [out]
+    elif getattr(out, "translation", None) is not None:  # an omni base's own orientation
+        stopped = _omni_stop(out, blocked)
+        if stopped is not None:
+            head.append((stopped, 0.0))
+        stop = (stopped or out).sample(np.array([stopped.duration if stopped else 0.0]))
         ahead = [out]
     else:
         raise blocked
@@ -536,6 +568,32 @@ def _stop_and_go_on(
         if key in done:
             moving[key] = done[key]
     return whole, moving
+
+
+def _omni_stop(out: Any, blocked: BlockedError) -> Any:
+    """Return an omni base's stop from the splice: its brake with the yaw rate stopped beside it.
+
+    The translation brakes along its path (:func:`~trajopt.replan._brake.brake_on_path`) and
+    the orientation goes on from its angle, rate and acceleration at the splice to rest
+    (:func:`trajopt.timing.stop_orientation`): an :class:`~trajopt.motion.OmniTrajectory`,
+    or ``None`` when the base is at rest and not turning at the splice. ``blocked`` is raised
+    when there is no such stop (no stop on the path, a body turning while the base stands).
+    """
+    start = out.orientation_at(0.0)
+    try:
+        brake = brake_on_path(out.translation, 0.0)
+    except TrajoptError as exc:  # no stop on the path: nowhere to plan on from
+        raise blocked from exc
+    if brake is None:
+        if start.omega != 0.0 or start.alpha != 0.0:
+            raise blocked
+        return None
+    try:
+        return stop_orientation(
+            brake, out.robot, start.theta, omega_start=start.omega, alpha_start=start.alpha
+        )
+    except TrajoptError as exc:
+        raise blocked from exc
 
 
 def _whole_certificate(
