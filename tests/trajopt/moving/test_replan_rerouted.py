@@ -212,4 +212,10 @@ def test_predictions_that_block_the_kept_detour_stop_and_go_the_short_way(rerout
     assert "'cart'" in moving["blocked"]
     tail = out.sample(np.linspace(moving["head_s"], out.duration, 400))
     assert np.max(tail.y) < 3.0  # the short way from the stop, not the blocked detour
+    # that chain re-planned while it brakes, the same predictions on its clock: its rest is
+    # kept (planned on the static map, or marked from it), re-timed from the stop on
+    seen = [_on_clock(m, ts) for m in movers]
+    again = planner.replan(out, 0.5, latency=LATENCY, moving_obstacles=seen, mover_margin=MARGIN)
+    assert again.stats["moving"]["replan"] == "kept"
+    _check(out, again, 0.5 + LATENCY, seen, grid)
     _check(first, out, ts, movers, grid)
