@@ -330,7 +330,9 @@ class Planner:
             certified at every instant until the last prediction ends. When no re-timing
             along the path avoids a mover, another route is planned on the map with the
             movers' swept regions marked, or the robot waits at a safe place
-            (:func:`trajopt.moving.reroute`). ``stats["moving"]``: ``route``
+            (:func:`trajopt.moving.reroute`; the steps of a plan made on a marked map
+            record the planner's map: :class:`trajopt.replan.MarkedSteps`, which a re-plan
+            keeps by). ``stats["moving"]``: ``route``
             (``"retimed"``, ``"rerouted"`` or ``"waited"``), ``plan`` in words, the
             certificate and the wall times. From a moving start (``v_start > 0``) the
             static plan is re-timed as :meth:`replan` re-times its rest
@@ -490,7 +492,9 @@ class Planner:
             (:func:`trajopt.replan.retime_replan`): one curve from the splice state; a
             chain after its part that ends in a stop (the brake), on one clock
             (:func:`trajopt.moving.retime_chain`). When only the predictions changed, the
-            kept rest keeps its path and only its timing changes. When no re-timing avoids
+            kept rest keeps its path and only its timing changes, a re-routed plan's too
+            (kept by the static map its movers' marks were drawn on,
+            :class:`trajopt.replan.MarkedSteps`). When no re-timing avoids
             the movers, the robot brakes to a stop and plans on from there as :meth:`plan`
             does with movers (re-timed, else re-routed or a wait at a safe place; when the
             path followed is proved blocked, the re-route's candidates first and the static
