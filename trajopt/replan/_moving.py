@@ -229,20 +229,29 @@ def _retimed_omni(
     (:func:`trajopt.retime_for_movers`), as the robot's circumscribed disc (the body may
     face any way); the orientation profile is kept as it is in time (its angle, rate and
     acceleration at the splice, its yaw limits: it does not depend on the translation's
-    timing, and a translation that ends at rest may end before or after it).
+    timing, and a translation that ends at rest may end before or after it). A base with a
+    footprint is only certified as it is: its clearance from the static map holds for the
+    planned pairs of position and orientation, which a re-timing would change.
     ``BlockedError`` (its time on the movers' clock) when no re-timing avoids the movers.
     """
     tr = out.translation
     radius = float(out.robot.radius)
-    disc = dataclasses.replace(tr.robot, footprint=None) if tr.robot.footprint else tr.robot
     as_is = certify_movers(tr, shifted, margin=margin, robot_radius=radius)
     if as_is.ok:
         return out, {"plan": "as planned", "certificate": as_is.summary()}
+    if out.robot.footprint is not None:
+        raise BlockedError(
+            f"moving obstacle {as_is.mover!r} meets the re-plan (an omni base with a "
+            f"footprint, from the moving state: not re-timed) at "
+            f"t = {as_is.witness_t + ts:.3f} s of the movers' clock",
+            mover=as_is.mover,
+            t=as_is.witness_t + ts,
+        )
     try:
-        moved = retime_for_movers(dataclasses.replace(tr, robot=disc), shifted, margin=margin)
+        moved = retime_for_movers(tr, shifted, margin=margin)
     except BlockedError as exc:
         raise _on_movers_clock(exc, ts) from exc
-    moved = dataclasses.replace(moved, robot=tr.robot, steps=tr.steps)
+    moved = dataclasses.replace(moved, steps=tr.steps)
     cert = certify_movers(moved, shifted, margin=margin, robot_radius=radius)
     if not cert.ok:  # the re-timing certified the same disc; only a numerical slip lands here
         raise BlockedError(
@@ -577,8 +586,12 @@ def _omni_stop(out: Any, blocked: BlockedError) -> Any:
     the orientation goes on from its angle, rate and acceleration at the splice to rest
     (:func:`trajopt.timing.stop_orientation`): an :class:`~trajopt.motion.OmniTrajectory`,
     or ``None`` when the base is at rest and not turning at the splice. ``blocked`` is raised
-    when there is no such stop (no stop on the path, a body turning while the base stands).
+    when there is no such stop (no stop on the path, a body turning while the base stands, a
+    base with a footprint: its clearance from the static map holds for the planned pairs of
+    position and orientation only).
     """
+    if out.robot.footprint is not None:
+        raise blocked
     start = out.orientation_at(0.0)
     try:
         brake = brake_on_path(out.translation, 0.0)
