@@ -84,7 +84,7 @@ from trajopt.planning import (
     plan_from_stop,
     run_query,
 )
-from trajopt.replan import BRAKE_AFTER_S, replan_from, retime_replan
+from trajopt.replan import BRAKE_AFTER_S, record_marked, replan_from, retime_replan
 from trajopt.robot import Robot, State
 from trajopt.smoother import Smoother
 from trajopt.timing import SpeedLimits
@@ -330,7 +330,9 @@ class Planner:
             certified at every instant until the last prediction ends. When no re-timing
             along the path avoids a mover, another route is planned on the map with the
             movers' swept regions marked, or the robot waits at a safe place
-            (:func:`trajopt.moving.reroute`). ``stats["moving"]``: ``route``
+            (:func:`trajopt.moving.reroute`; the steps of a plan made on a marked map
+            record the planner's map: :class:`trajopt.replan.MarkedSteps`, which a re-plan
+            keeps by). ``stats["moving"]``: ``route``
             (``"retimed"``, ``"rerouted"`` or ``"waited"``), ``plan`` in words, the
             certificate and the wall times. From a moving start (``v_start > 0``) the
             static plan is re-timed as :meth:`replan` re-times its rest
@@ -388,6 +390,7 @@ class Planner:
                 out = retime_replan(out, movers, margin, 0.0, self._from_stop(out.steps, margin))
             elif movers:
                 out = plan_among_movers(movers, margin, self.options, self.caches, request)
+                out = record_marked(out, self.caches.grid, self.caches.inflated)
             else:
                 out = run_query(self.options, self.caches, request)
             self._latencies.append(time.perf_counter() - t0)
@@ -418,7 +421,8 @@ class Planner:
                 start_steer=steer,
                 goal_steer=getattr(steps, "goal_steer", None),
             )
-            return plan_from_stop(tuple(seen), margin, self.options, self.caches, request, along)
+            out = plan_from_stop(tuple(seen), margin, self.options, self.caches, request, along)
+            return record_marked(out, self.caches.grid, self.caches.inflated)
 
         return from_stop
 
@@ -488,7 +492,9 @@ class Planner:
             (:func:`trajopt.replan.retime_replan`): one curve from the splice state; a
             chain after its part that ends in a stop (the brake), on one clock
             (:func:`trajopt.moving.retime_chain`). When only the predictions changed, the
-            kept rest keeps its path and only its timing changes. When no re-timing avoids
+            kept rest keeps its path and only its timing changes, a re-routed plan's too
+            (kept by the static map its movers' marks were drawn on,
+            :class:`trajopt.replan.MarkedSteps`). When no re-timing avoids
             the movers, the robot brakes to a stop and plans on from there as :meth:`plan`
             does with movers (re-timed, else re-routed or a wait at a safe place; when the
             path followed is proved blocked, the re-route's candidates first and the static

@@ -5,9 +5,19 @@ and the node stays unconfigured; the parameter set right, ``configure`` and ``ac
 bring up ``get_plan`` (a plan on a published map, checked by brute-force clearance);
 ``deactivate`` takes it off the graph, ``cleanup`` returns to unconfigured, SIGINT ends the
 process cleanly. The states are read with ``~/get_state``; no fixed sleeps.
+
+A service drops its answer to a client whose reply reader it has not matched yet (Fast DDS
+waits about 100 ms for that match, then rclpy warns "failed to send response (timeout):
+client will not receive response"), and ``wait_for_service`` returns as soon as the *client*
+sees the server, so under heavy load the first call of a client may get no answer at all.
+Each client's first call is therefore one that changes nothing, repeated until it is answered
+(:func:`_answered`); ``change_state`` is primed with a transition label the node does not
+know (refused, no transition); only then does a call that changes the node go out once.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 import pytest
@@ -18,6 +28,17 @@ from tests.trajopt_ros import helpers as h  # noqa: E402
 from tests.trajopt_ros.conftest import NodeProcess  # noqa: E402
 
 NS, NAME = "/managed", "trajopt_managed"
+
+
+def _answered(client, request, what: str, timeout: float = 60.0, attempt: float = 5.0):
+    """The answer to a request that changes nothing, sent again until one comes (module docstring)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            return h.call(client, request, attempt)
+        except TimeoutError:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"{what}: no answer within {timeout} s") from None
 
 
 def test_managed_node_lifecycle(ros_env, interfaces, client):
@@ -46,14 +67,18 @@ def test_managed_node_lifecycle(ros_env, interfaces, client):
     put = client.create_client(SetParameters, f"{base}/set_parameters")
     for srv in (change, get, put):
         assert srv.wait_for_service(timeout_sec=30.0), node.output()
+    unknown = ChangeState.Request()
+    unknown.transition.label = "no_such_transition"  # refused: no transition, no side effect
+    assert not _answered(change, unknown, "change_state primed").success, node.output()
+    assert not _answered(put, SetParameters.Request(), "set_parameters primed").results
 
     def state() -> int:
-        return h.call(get, GetState.Request()).current_state.id
+        return _answered(get, GetState.Request(), "get_state").current_state.id
 
     def step(transition: int) -> bool:
         req = ChangeState.Request()
         req.transition.id = transition
-        return h.call(change, req, 60.0).success
+        return h.call(change, req, 120.0).success  # configure warms the library up
 
     assert state() == State.PRIMARY_STATE_UNCONFIGURED
     # a bad parameter: configure fails with its reason, the node stays unconfigured
@@ -80,8 +105,8 @@ def test_managed_node_lifecycle(ros_env, interfaces, client):
     client.create_publisher(OccupancyGrid, f"{NS}/map", qos).publish(h.grid_msg(values))
     req = GetPlan.Request(start=h.pose(1.0, 1.0), goal=h.pose(5.0, 1.0))
     path = h.wait_for(
-        lambda: (p := h.call(get_plan, req).plan) and len(p.poses) > 0 and p,
-        20.0,
+        lambda: (p := _answered(get_plan, req, "get_plan").plan) and len(p.poses) > 0 and p,
+        30.0,
         "a plan from the activated node",
     )
     xy = h.path_xy(path)
@@ -91,7 +116,7 @@ def test_managed_node_lifecycle(ros_env, interfaces, client):
     assert step(Transition.TRANSITION_DEACTIVATE), node.output()
     assert state() == State.PRIMARY_STATE_INACTIVE
     # no server behind get_plan any more (the graph still lists it: this client uses it)
-    h.wait_for(lambda: not get_plan.service_is_ready(), 15.0, "get_plan gone after deactivate")
+    h.wait_for(lambda: not get_plan.service_is_ready(), 30.0, "get_plan gone after deactivate")
     assert step(Transition.TRANSITION_CLEANUP), node.output()
     assert state() == State.PRIMARY_STATE_UNCONFIGURED
     code, _ = node.stop()

@@ -12,13 +12,22 @@ searched, fitted or timed again: the curve is cut at the splice
 the splice on are kept as they are, shifted in time and arc length, and the cut curve is
 certified again against the corridor and the current map.
 
+A plan re-routed around predicted movers was made on the map with their swept regions
+marked (:mod:`trajopt.replan._marked`): "the map it was made on" is then the static map the
+marks were drawn on (:func:`~trajopt.replan._marked.planned_on`), so that a re-plan with new
+predictions keeps the rest of the detour when the static map has not changed where it
+matters (the same rules); the re-plan's re-timing (:mod:`trajopt.replan._moving`) then
+holds it to the new predictions. Its corridor, made on the marked map, is free on the
+static map too, and the cut curve is certified against the current (static) map.
+
 An omnidirectional base's :class:`~trajopt.motion.OmniTrajectory` is kept the same way
 (:func:`keep_omni`): its translation's rest by :func:`keep_rest`, and beside it the rest of
 its orientation profile, cut at the splice (:meth:`~trajopt.motion.OmniTrajectory.after`),
 when the goal heading is the orientation it ends at.
 
 When the rest cannot be kept because new obstacles came near it, :func:`remaining_grid_path`
-may still hand the re-plan the rest of the old grid path, so that it skips the search.
+may still hand the re-plan the rest of the old grid path, so that it skips the search (not
+a re-routed plan's: its grid path was least-cost on the marked map only).
 """
 
 from __future__ import annotations
@@ -34,6 +43,7 @@ from astar.search import GridPath
 from trajopt.corridor import Box, ConvexPolygon, PolygonCorridor
 from trajopt.motion import OmniTrajectory, PlanResult, Trajectory, TrajectoryChain
 from trajopt.planning import PlannerCaches, PlannerOptions, PlanSteps, change_reach
+from trajopt.replan._marked import MarkedSteps, planned_on
 from trajopt.replan._omni import turn_piece
 from trajopt.smoother import SmoothPath, certify
 from trajopt.validation import point
@@ -122,13 +132,15 @@ def keep_rest(
     out = trajectory_after(trajectory, ts, path, u0)
     elapsed = time.perf_counter() - t0
     stages = {"keep": elapsed, "total": elapsed}
+    maps = {"raw_grid": caches.grid, "inflated_grid": caches.inflated}
+    if isinstance(steps, MarkedSteps):  # made on the marked map: the static map is the new
+        maps = {"static_grid": caches.grid, "static_inflated": caches.inflated}
     new_steps = dataclasses.replace(
         steps,
-        raw_grid=caches.grid,
-        inflated_grid=caches.inflated,
         smooth_path=path,
         start=(float(start[0]), float(start[1])),
         stages_s=stages,
+        **maps,
     )
     stats = dict(out.stats)
     stats["stages_s"] = stages
@@ -185,7 +197,7 @@ def keep_omni(
         return None, "new goal heading"
     translation = trajectory.translation
     if ts >= translation.duration:  # standing at the path's end: the turn goes on
-        if caches.grid is not steps.raw_grid:
+        if caches.grid is not planned_on(steps)[0]:
             return None, "the map changed"
         rows, t_rot = trajectory.orientation_after(ts)
         if t_rot <= 0.0:
@@ -245,15 +257,20 @@ def _map_change(
     steps: PlanSteps,
     regions: list[ConvexPolygon] | list[Box],
 ) -> str:
-    """Return why the map change breaks the rest of the old curve ('' when it does not)."""
-    old, new = steps.raw_grid, caches.grid
+    """Return why the map change breaks the rest of the old curve ('' when it does not).
+
+    The old map is the static map the plan was made on (:func:`planned_on`: for a plan
+    re-routed on a map with movers' regions marked, the map the marks were drawn on).
+    """
+    old, old_inflated = planned_on(steps)
+    new = caches.grid
     if old is new:
         return ""
     if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
         return "map of another shape"
     # a cell the search could not enter before and can now may open a better route; a raw
     # cell freed inside what stays inflated adds nothing to the search's graph
-    if np.any(steps.inflated_grid.occupied & ~caches.inflated.occupied):
+    if np.any(old_inflated.occupied & ~caches.inflated.occupied):
         return "cells freed"
     iy, ix = np.divmod(np.flatnonzero(new.occupied & ~old.occupied), new.nx)
     if ix.size == 0:
@@ -286,7 +303,9 @@ def remaining_grid_path(
     no raw cell changed within the search cost's reach of it
     (:func:`~trajopt.planning._caches.change_reach`). Then the costs along the old part are the
     old ones and no other path got cheaper, so that part is still a least-cost path from its
-    first cell to the goal; only the short join is not searched.
+    first cell to the goal; only the short join is not searched. ``None`` for a re-routed
+    plan's steps (:class:`~trajopt.replan._marked.MarkedSteps`): its grid path was a
+    least-cost path on the marked map, not on the static one.
 
     Parameters
     ----------
@@ -304,6 +323,8 @@ def remaining_grid_path(
     astar.GridPath or None
         ``expanded`` 0, ``length`` and ``cost`` recomputed on the current search cost.
     """
+    if isinstance(steps, MarkedSteps):
+        return None  # its grid path was found on a marked map: no least-cost path here
     old, new = steps.raw_grid, caches.grid
     if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
         return None

@@ -29,13 +29,16 @@ certificate as it is comes first (kept as planned when it passes: no other proof
 re-timed curve's is the certificate :func:`trajopt.retime_for_movers` made of it; a chain's
 is its tail's from :func:`~trajopt.moving.retime_chain` (from the head's end on) joined with
 the head's against the movers ended where the head stops (:func:`trajopt.moving.truncate`;
-none when the head plays for no time); a result with no piece from rest after its head (an
-omni base's own orientation from the moving state) is only certified, whole.
+none when the head plays for no time). An omni base's own orientation from the moving state
+has its translation certified as it is, else re-timed, as the circumscribed disc, its
+orientation profile kept as it is in time (:func:`_retimed_omni`); when blocked, its
+translation brakes along its path with the yaw rate stopped beside it
+(:func:`trajopt.timing.stop_orientation`), certified as its translation's disc.
 
 **When the re-timing is blocked** (``BlockedError``, and the caller gives ``from_stop``):
 the robot stops, since it is moving at the splice. One curve from the moving state is braked
-along its path (:func:`~trajopt.replan._brake.brake_on_path`); a chain keeps its head, which
-ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
+along its path (:func:`~trajopt.replan._brake.brake_on_path`; an omni base's own orientation
+has its yaw rate stopped beside the brake); a chain keeps its head, which ends at rest. From the stopped pose ``from_stop`` plans on to the goal for the movers seen
 from the stop, as :meth:`~trajopt._planner.Planner.plan` does with movers (the static plan
 re-timed, else re-routed around the blocking mover's swept region, or a wait at a safe
 place: :func:`trajopt.moving.reroute`). The stop and that plan are certified as one chain
@@ -86,6 +89,7 @@ from trajopt.moving import (
     truncate,
 )
 from trajopt.replan._brake import brake_on_path
+from trajopt.timing import stop_orientation
 
 
 def retime_replan(
@@ -195,6 +199,8 @@ def _retimed(
         except BlockedError as exc:  # its time back on the movers' clock
             raise _on_movers_clock(exc, ts) from exc
         return timed, dict(timed.stats["moving"])
+    if getattr(out, "translation", None) is not None and getattr(out, "pieces", None) is None:
+        return _retimed_omni(out, margin, ts, shifted)
     head, tail = split_at_rest(out)
     if tail:
         timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
@@ -212,6 +218,50 @@ def _retimed(
             t=cert.witness_t + ts,
         )
     return out, {"plan": "as planned", "certificate": cert.summary()}
+
+
+def _retimed_omni(
+    out: Any, margin: float, ts: float, shifted: Sequence[MovingObstacle]
+) -> tuple[PlanResult, dict[str, Any]]:
+    """Re-time an omni base's own orientation from the moving state along its path.
+
+    The translation (from the splice state) is certified as it is, else re-timed
+    (:func:`trajopt.retime_for_movers`), as the robot's circumscribed disc (the body may
+    face any way); the orientation profile is kept as it is in time (its angle, rate and
+    acceleration at the splice, its yaw limits: it does not depend on the translation's
+    timing, and a translation that ends at rest may end before or after it). A base with a
+    footprint is only certified as it is: its clearance from the static map holds for the
+    planned pairs of position and orientation, which a re-timing would change.
+    ``BlockedError`` (its time on the movers' clock) when no re-timing avoids the movers.
+    """
+    tr = out.translation
+    radius = float(out.robot.radius)
+    as_is = certify_movers(tr, shifted, margin=margin, robot_radius=radius)
+    if as_is.ok:
+        return out, {"plan": "as planned", "certificate": as_is.summary()}
+    if out.robot.footprint is not None:
+        raise BlockedError(
+            f"moving obstacle {as_is.mover!r} meets the re-plan (an omni base with a "
+            f"footprint, from the moving state: not re-timed) at "
+            f"t = {as_is.witness_t + ts:.3f} s of the movers' clock",
+            mover=as_is.mover,
+            t=as_is.witness_t + ts,
+        )
+    try:
+        moved = retime_for_movers(tr, shifted, margin=margin)
+    except BlockedError as exc:
+        raise _on_movers_clock(exc, ts) from exc
+    moved = dataclasses.replace(moved, steps=tr.steps)
+    cert = certify_movers(moved, shifted, margin=margin, robot_radius=radius)
+    if not cert.ok:  # the re-timing certified the same disc; only a numerical slip lands here
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the re-timed omni translation at "
+            f"t = {cert.witness_t + ts:.3f} s of the movers' clock ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t + ts,
+        )
+    timed = dataclasses.replace(out, translation=moved)
+    return timed, {"plan": str(moved.stats["moving"]["plan"]), "certificate": cert.summary()}
 
 
 def _joined_head(
@@ -251,14 +301,37 @@ def _head_certificate(
     shifted: Sequence[MovingObstacle],
     margin: float,
 ) -> Any:
-    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``."""
-    pieces = tuple(p for p, _ in head)
+    """Return the certificate of the head played as it is against ``shifted`` ended at ``t_head``.
+
+    An omni base's piece with its own orientation (its brake, the yaw rate stopped beside
+    it) is certified as its translation, the circumscribed disc (the body may face any way):
+    where its orientation outlasts the translation the base stands still, which the
+    translation's certificate covers when the piece ends the head (the robot stands at its
+    end until the movers, ended at ``t_head``, last), or when the two end together.
+    """
+    last = len(head) - 1
+    disc = False
+    pieces = []
+    for i, (p, t_in) in enumerate(head):
+        tr = getattr(p, "translation", None)
+        if (
+            tr is not None
+            and t_in < float(tr.duration)
+            and (i == last or float(p.duration) - float(tr.duration) <= 1e-12)
+        ):
+            p, disc = tr, True
+        pieces.append(p)
     played_head = (
         pieces[0]
         if len(head) == 1 and head[0][1] == 0.0
-        else TrajectoryChain(pieces, robot, {}, None, tuple(t for _, t in head))
+        else TrajectoryChain(tuple(pieces), robot, {}, None, tuple(t for _, t in head))
     )
-    return certify_movers(played_head, [truncate(m, t_head) for m in shifted], margin=margin)
+    return certify_movers(
+        played_head,
+        [truncate(m, t_head) for m in shifted],
+        margin=margin,
+        robot_radius=float(robot.radius) if disc else None,
+    )
 
 
 def blocked_along(
@@ -420,7 +493,8 @@ def _stop_and_go_on(
     """Brake to a stop (or keep the head that ends in one) and plan on from the stop.
 
     One curve from the moving state is braked along its path
-    (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited); a chain
+    (:func:`~trajopt.replan._brake.brake_on_path`, time-optimal and jerk-limited; an omni
+    base's own orientation with its yaw rate stopped beside it, :func:`_omni_stop`); a chain
     keeps its head (:func:`split_at_rest`), which ends at rest. From the stop ``from_stop``
     plans on for the movers seen from there (``ts`` plus the stop's time), told the path
     followed from the stop (:class:`Along`) when ``along`` proves it blocked
@@ -444,6 +518,12 @@ def _stop_and_go_on(
         if brake is not None:
             head.append((brake, 0.0))
         stop = (brake or out).sample(np.array([brake.duration if brake else 0.0]))
+        ahead = [out]
+    elif getattr(out, "translation", None) is not None:  # an omni base's own orientation
+        stopped = _omni_stop(out, blocked)
+        if stopped is not None:
+            head.append((stopped, 0.0))
+        stop = (stopped or out).sample(np.array([stopped.duration if stopped else 0.0]))
         ahead = [out]
     else:
         raise blocked
@@ -499,6 +579,36 @@ def _stop_and_go_on(
     return whole, moving
 
 
+def _omni_stop(out: Any, blocked: BlockedError) -> Any:
+    """Return an omni base's stop from the splice: its brake with the yaw rate stopped beside it.
+
+    The translation brakes along its path (:func:`~trajopt.replan._brake.brake_on_path`) and
+    the orientation goes on from its angle, rate and acceleration at the splice to rest
+    (:func:`trajopt.timing.stop_orientation`): an :class:`~trajopt.motion.OmniTrajectory`,
+    or ``None`` when the base is at rest and not turning at the splice. ``blocked`` is raised
+    when there is no such stop (no stop on the path, a body turning while the base stands, a
+    base with a footprint: its clearance from the static map holds for the planned pairs of
+    position and orientation only).
+    """
+    if out.robot.footprint is not None:
+        raise blocked
+    start = out.orientation_at(0.0)
+    try:
+        brake = brake_on_path(out.translation, 0.0)
+    except TrajoptError as exc:  # no stop on the path: nowhere to plan on from
+        raise blocked from exc
+    if brake is None:
+        if start.omega != 0.0 or start.alpha != 0.0:
+            raise blocked
+        return None
+    try:
+        return stop_orientation(
+            brake, out.robot, start.theta, omega_start=start.omega, alpha_start=start.alpha
+        )
+    except TrajoptError as exc:
+        raise blocked from exc
+
+
 def _whole_certificate(
     whole: TrajectoryChain,
     head: list[tuple[Any, float]],
@@ -541,16 +651,20 @@ def _whole_certificate(
 def _points(pieces: Sequence[Any], p_stop: tuple[float, float]) -> np.ndarray:
     """Return points of the pieces' curves end to end from the stop on, at most 10 cm apart.
 
-    The points (m, shape (n, 2)) start with the stop; turns in place add none; the points before the one nearest the stop (the part braked
-    over) are dropped.
+    The points (m, shape (n, 2)) start with the stop; turns in place add none, an omni base's
+    own orientation its translation's curve; the points before the one nearest the stop (the
+    part braked over) are dropped.
     """
     pts = [np.asarray(p_stop, dtype=float).reshape(1, 2)]
-    for p in pieces:
+    for piece in pieces:
+        p = getattr(piece, "translation", piece)  # an omni base's own orientation: its curve
         if getattr(p, "pieces", None) is not None:
             pts.append(_points(p.pieces, p_stop))
         elif p.single_curve and float(p.length) > 0.0:
             s = np.linspace(0.0, float(p.length), int(np.ceil(float(p.length) / 0.1)) + 1)
             pts.append(np.asarray(p.path(p.path.u_at_s(s)), dtype=float).reshape(-1, 2))
     out = np.concatenate(pts)
+    if out.shape[0] == 1:  # no curve ahead: the stop alone
+        return out
     near = int(np.argmin(np.hypot(out[1:, 0] - p_stop[0], out[1:, 1] - p_stop[1]))) + 1
     return np.concatenate([out[:1], out[near:]])

@@ -60,6 +60,7 @@ from trajopt.replan._keep import (
     remaining_grid_path,
     target_change,
 )
+from trajopt.replan._marked import planned_on
 from trajopt.replan._omni import course_orientation
 from trajopt.validation import nonnegative, number, point
 
@@ -184,7 +185,7 @@ def _keep_chain(
 ) -> tuple[TrajectoryChain | None, str]:
     """Return the rest of a brake-turn-go chain from ``ts`` if nothing it relies on changed."""
     steps = chain.steps
-    if steps is None or grid is not steps.raw_grid:
+    if steps is None or grid is not planned_on(steps)[0]:  # a re-route's: its static map
         return None, "the map changed"
     why = target_change(chain, goal, goal_heading, v_end)  # a chain has no path: no heading
     return (None, why) if why else (chain.after(ts), "kept")
