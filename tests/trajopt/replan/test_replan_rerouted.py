@@ -1,4 +1,4 @@
-"""Tests of re-planning a first plan that was re-routed around a mover, with new predictions.
+"""Tests of trajopt.replan: re-planning a first plan that was re-routed around a mover, with new predictions.
 
 The scene: two 1 m corridors (y = 1 and y = 4) joined at both ends; a cart that parks on the
 short corridor at (6, 1) from t = 3 s makes the first plan from (1, 1) to (11, 1) take the
