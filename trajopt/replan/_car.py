@@ -63,6 +63,7 @@ from trajopt.planning import (
 )
 from trajopt.replan._brake import brake_on_path, check_new_obstacles
 from trajopt.replan._keep import target_change
+from trajopt.replan._marked import MarkedCarSteps, planned_on
 from trajopt.validation import point
 
 
@@ -253,13 +254,22 @@ def _keep(
     why = target_change(chain, goal, goal_heading, 0.0)
     if why:
         return None, why
-    old, new = steps.raw_grid, caches.grid
+    # a plan re-routed round movers was made on a map with their regions marked: the marks
+    # stood for the old predictions, which the re-plan's re-timing replaces; the static map
+    # they were drawn on is what the rest relies on
+    old, _ = planned_on(steps)
+    new = caches.grid
     rest = chain.after(ts)
     if old is not new:
         if (old.shape, old.resolution, old.origin) != (new.shape, new.resolution, new.origin):
             return None, "map of another shape"
         search_grid = car_search_grid(options.robot, new)
-        if np.any(np.asarray(steps.inflated_grid.occupied) & ~np.asarray(search_grid.occupied)):
+        old_search = (
+            car_search_grid(options.robot, old)
+            if isinstance(steps, MarkedCarSteps)
+            else steps.inflated_grid
+        )
+        if np.any(np.asarray(old_search.occupied) & ~np.asarray(search_grid.occupied)):
             return None, "cells freed"
         fresh = np.asarray(new.occupied) & ~np.asarray(old.occupied)
         if fresh.any():
@@ -270,6 +280,8 @@ def _keep(
                 if not _clear(options.robot.radius, grid, piece, t_from):
                     return None, "cells blocked near the rest of the path"
         steps = dataclasses.replace(steps, raw_grid=new, inflated_grid=search_grid)
+        if isinstance(steps, MarkedCarSteps):
+            steps = dataclasses.replace(steps, static_grid=new)
     stats = dict(rest.stats, replan="kept")
     return dataclasses.replace(rest, stats=stats, steps=steps), "kept"
 

@@ -17,7 +17,7 @@ import dataclasses
 from typing import Any
 
 from astar.grid import OccupancyGrid
-from trajopt.planning import PlanSteps
+from trajopt.planning import CarSteps, PlanSteps
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -39,14 +39,36 @@ class MarkedSteps(PlanSteps):
     static_inflated: OccupancyGrid | None = None
 
 
+@dataclasses.dataclass(frozen=True, slots=True)
+class MarkedCarSteps(CarSteps):
+    """The steps of a car's plan made on a map with movers' swept regions marked.
+
+    :class:`~trajopt.planning.CarSteps` (``raw_grid`` the marked map, ``inflated_grid`` the
+    car's search grid of it), and the static map the marks were drawn on. The car's search
+    grid of the static map is not kept: a re-plan derives it
+    (:func:`~trajopt.planning.car_search_grid`) only when its map differs from this one.
+
+    Attributes
+    ----------
+    static_grid : astar.OccupancyGrid
+        The planner's map the marks were added to (same shape, resolution and origin).
+    """
+
+    static_grid: OccupancyGrid | None = None
+
+
 def planned_on(steps: Any) -> tuple[Any, Any]:
     """Return the static map a plan's steps were made on, and its inflated grid.
 
-    A :class:`MarkedSteps`' ``static_grid`` and ``static_inflated``; otherwise the steps'
-    ``raw_grid`` and ``inflated_grid`` (``None`` where the steps have none).
+    A :class:`MarkedSteps`' ``static_grid`` and ``static_inflated``; a
+    :class:`MarkedCarSteps`' ``static_grid`` and ``None`` (its search grid is derived where
+    needed); otherwise the steps' ``raw_grid`` and ``inflated_grid`` (``None`` where the
+    steps have none).
     """
     if isinstance(steps, MarkedSteps):
         return steps.static_grid, steps.static_inflated
+    if isinstance(steps, MarkedCarSteps):
+        return steps.static_grid, None
     return getattr(steps, "raw_grid", None), getattr(steps, "inflated_grid", None)
 
 
@@ -57,8 +79,9 @@ def record_marked(out: Any, grid: OccupancyGrid, inflated: OccupancyGrid) -> Any
     ``grid`` (inflated: ``inflated``): every :class:`~trajopt.planning.PlanSteps` in it (its
     own, its pieces', an omni base's translation's) whose ``raw_grid`` is not ``grid`` was
     then made on a map derived from ``grid`` with movers' regions marked, and becomes a
-    :class:`MarkedSteps` naming ``grid``. Steps already marked, a car's steps and pieces
-    without steps are left as they are; ``out`` itself when nothing changes.
+    :class:`MarkedSteps` naming ``grid``; a car's :class:`~trajopt.planning.CarSteps` so
+    made becomes a :class:`MarkedCarSteps`. Steps already marked and pieces without steps
+    are left as they are; ``out`` itself when nothing changes.
 
     Parameters
     ----------
@@ -78,6 +101,13 @@ def record_marked(out: Any, grid: OccupancyGrid, inflated: OccupancyGrid) -> Any
     ):
         fields = {f.name: getattr(steps, f.name) for f in dataclasses.fields(PlanSteps)}
         changes["steps"] = MarkedSteps(**fields, static_grid=grid, static_inflated=inflated)
+    elif (
+        type(steps) is CarSteps
+        and steps.raw_grid is not grid
+        and steps.raw_grid.occupied.shape == grid.occupied.shape
+    ):
+        fields = {f.name: getattr(steps, f.name) for f in dataclasses.fields(CarSteps)}
+        changes["steps"] = MarkedCarSteps(**fields, static_grid=grid)
     pieces = getattr(out, "pieces", None)
     if pieces is not None:
         new = tuple(record_marked(p, grid, inflated) for p in pieces)

@@ -219,3 +219,83 @@ def test_predictions_that_block_the_kept_detour_stop_and_go_the_short_way(rerout
     assert again.stats["moving"]["replan"] == "kept"
     _check(out, again, 0.5 + LATENCY, seen, grid)
     _check(first, out, ts, movers, grid)
+
+
+@pytest.fixture(scope="module")
+def car_rerouted():
+    """A car on the loop and its first plan, re-routed the long way round the cart."""
+    grid = OccupancyGrid(_loop_grid(), RES, (0.0, 0.0))
+    robot = trajopt.Robot(
+        drive="ackermann", min_turning_radius=0.6, radius=0.2, wheelbase=0.3, steer_rate_max=1.0
+    )
+    planner = trajopt.Planner(grid, robot)
+    first = planner.plan(
+        START, GOAL, start_heading=0.0, goal_heading=0.0, moving_obstacles=[_cart()],
+        mover_margin=MARGIN,
+    )  # fmt: skip
+    assert first.stats["moving"]["route"] == "rerouted"
+    assert np.max(first.sample(np.linspace(0.0, first.duration, 400)).y) > 3.5  # the long way
+    return grid, planner, first
+
+
+def _car_continuity(first, out, ts):
+    """Pose, speed, acceleration and steering of ``out`` at 0 are ``first``'s at ``ts``."""
+    a, b = first.sample(np.array([ts])), out.sample(np.array([0.0]))
+    assert math.hypot(a.x[0] - b.x[0], a.y[0] - b.y[0]) < 1e-9
+    assert abs(math.remainder(a.theta[0] - b.theta[0], 2 * math.pi)) < 1e-9
+    assert abs(a.v[0] - b.v[0]) < 1e-9 and abs(a.a[0] - b.a[0]) < 1e-9
+    assert abs(a.steer[0] - b.steer[0]) < 1e-9
+
+
+def _on_chain(first, out):
+    """Largest distance (m) from ``out``'s positions to ``first``'s (1 mm samples of its path)."""
+    ref = first.sample(np.linspace(0.0, first.duration, int(first.length / 1e-3) + 1))
+    pts = out.sample(np.linspace(0.0, out.duration, 300))
+    return max(
+        float(np.min(np.hypot(ref.x - x, ref.y - y))) for x, y in zip(pts.x, pts.y, strict=True)
+    )
+
+
+def test_a_car_keeps_its_re_routed_rest_with_shifted_predictions(car_rerouted):
+    """The car's marked steps name the static map; shifted predictions keep the detour."""
+    grid, planner, first = car_rerouted
+    assert isinstance(first.steps, trajopt.replan.MarkedCarSteps)
+    assert first.steps.static_grid is planner.grid
+    assert np.all(first.steps.raw_grid.occupied >= grid.occupied)
+    assert np.any(first.steps.raw_grid.occupied & ~grid.occupied)
+    t = 2.0
+    ts = t + LATENCY
+    movers = [_cart(x=6.05, t_park=3.3)]
+    out = planner.replan(first, t, latency=LATENCY, moving_obstacles=movers, mover_margin=MARGIN)
+    assert out.stats["replan"] == "kept"
+    assert out.stats["moving"]["route"] == "retimed"
+    assert _on_chain(first, out) < 2e-3  # the detour's geometry, not a new path
+    _car_continuity(first, out, ts)
+    seen = [_on_clock(m, ts) for m in movers]
+    assert out.stats["moving"]["certificate"]["ok"]
+    assert check_trajectory(out, seen, margin=MARGIN, grid=grid).ok
+    assert brute_min(out, seen, margin=MARGIN) >= -1e-6
+
+
+def test_a_car_does_not_keep_its_re_routed_rest_when_the_static_map_changed(car_rerouted):
+    """The cell holding the point 0.1 m beside the detour's path occupied (closer than the
+    car's radius): planned anew, certified against the changed map."""
+    grid, planner, first = car_rerouted
+    smp = first.sample(np.linspace(0.0, first.duration, 4000))
+    k = int(np.argmin(np.hypot(smp.x - 6.0, smp.y - 4.0)))  # where the detour passes x = 6
+    assert abs(smp.x[k] - 6.0) < 0.05 and smp.y[k] > 3.5
+    occ = _loop_grid()
+    occ[int((smp.y[k] + 0.1) / RES), int(smp.x[k] / RES)] = True
+    changed = OccupancyGrid(occ, RES, (0.0, 0.0))
+    movers = [_cart(t_park=3.2)]
+    try:
+        out = planner.replan(
+            first, 2.0, grid=changed, latency=LATENCY, moving_obstacles=movers,
+            mover_margin=MARGIN,
+        )  # fmt: skip
+    finally:
+        planner.update_map(grid)
+    assert out.stats["replan"].startswith(("braked: ", "planned: "))
+    assert out.stats["moving"]["certificate"]["ok"]
+    seen = [_on_clock(m, 2.0 + LATENCY) for m in movers]
+    assert check_trajectory(out, seen, margin=MARGIN, grid=changed).ok
