@@ -465,9 +465,68 @@ def march_kernel(
     return out[:nr, 0].copy(), out[:nr, 1].copy(), out[:nr, 2].copy(), out[:nr, 3].copy()
 
 
+@njit(cache=True, inline="always")
+def _linear_span(alpha, beta, lo, hi):  # pragma: no cover - compiled
+    """Return ``[lo, hi]`` cut to the ``tau`` with ``alpha + beta tau <= 0``."""
+    if beta > 0.0:
+        return lo, min(hi, -alpha / beta)
+    if beta < 0.0:
+        return max(lo, -alpha / beta), hi
+    if alpha > 0.0:
+        return np.inf, -np.inf
+    return lo, hi
+
+
+@njit(cache=True)
+def _frozen_window(qx, qy, dx, dy, lim, verts, edges, poly, j):  # pragma: no cover - compiled
+    """Return ``(lo, hi)``: the ``tau`` at which the point ``q + d tau`` is within ``lim`` of polygon ``j``.
+
+    In the mover's frame (its heading fixed): ``q`` (m) the point at ``tau = 0``, ``d`` its
+    velocity (m/s). The points within ``lim`` of a convex polygon are the polygon, the
+    rectangles of depth ``lim`` on its edges (outward) and the discs of radius ``lim`` at its
+    vertices, a convex set: a line meets it in one interval, the hull of the intervals in
+    which it meets the parts (each a quadratic or linear inequality). ``lo > hi`` when empty.
+    """
+    lo, hi = np.inf, -np.inf
+    dd = dx * dx + dy * dy
+    inside_lo, inside_hi = -np.inf, np.inf
+    for e in range(verts.shape[1]):
+        wx, wy = qx - verts[j, e, 0], qy - verts[j, e, 1]
+        # the disc at the vertex: |w + d tau|^2 < lim^2
+        c0 = wx * wx + wy * wy - lim * lim
+        if dd > 0.0:
+            bb = 2.0 * (wx * dx + wy * dy)
+            disc = bb * bb - 4.0 * dd * c0
+            if disc > 0.0:
+                sq = np.sqrt(disc)
+                qq = -0.5 * (bb + sq) if bb >= 0.0 else -0.5 * (bb - sq)
+                r1, r2 = qq / dd, c0 / qq
+                lo, hi = min(lo, min(r1, r2)), max(hi, max(r1, r2))
+        elif c0 < 0.0:
+            lo, hi = -np.inf, np.inf
+        ex, ey = edges[j, e, 0], edges[j, e, 1]
+        ee = ex * ex + ey * ey
+        if ee <= 0.0:
+            continue
+        # the edge's rectangle: 0 <= w.e <= |e|^2, 0 <= n.w <= lim |e| (n = (ey, -ex), outward)
+        along0, along1 = wx * ex + wy * ey, dx * ex + dy * ey
+        out0, out1 = ey * wx - ex * wy, ey * dx - ex * dy
+        a0, a1 = _linear_span(-along0, -along1, -np.inf, np.inf)
+        a0, a1 = _linear_span(along0 - ee, along1, a0, a1)
+        a0, a1 = _linear_span(-out0, -out1, a0, a1)
+        a0, a1 = _linear_span(out0 - lim * np.sqrt(ee), out1, a0, a1)
+        if a0 <= a1:
+            lo, hi = min(lo, a0), max(hi, a1)
+        if poly[j]:  # the polygon itself: inside every edge's line
+            inside_lo, inside_hi = _linear_span(out0, out1, inside_lo, inside_hi)
+    if poly[j] and inside_lo <= inside_hi:
+        lo, hi = min(lo, inside_lo), max(hi, inside_hi)
+    return lo, hi
+
+
 @njit(cache=True)
 def windows_kernel(
-    pts, seg, pi, a, b, rows, who, head0, turn, lip, limit, verts, edges, poly, step, eps
+    pts, seg, pi, a, b, rows, who, head0, turn, lip, reach, limit, verts, edges, poly, step, eps
 ):  # pragma: no cover - compiled
     """Return the violation windows ``(pair, lo, hi)`` (s) of the pairs ``(seg[q], pi[q])`` during ``[a[q], b[q]]``.
 
@@ -478,7 +537,15 @@ def windows_kernel(
     ``max(|f| / lip, step)`` later (capped at ``b``), until ``b`` is settled or sampled.
     Each window is widened by ``eps`` (s) at both ends, and the consecutive ones of a pair
     that then overlap are merged. Arguments as :func:`march_kernel`, besides ``a``, ``b``
-    (shape (q,), s; ``b`` may be ``inf``), ``limit`` (m) and ``step`` (s).
+    (shape (q,), s; ``b`` may be ``inf``), ``reach`` (shape (p,), m: the farthest vertex of
+    each piece's mover), ``limit`` (m) and ``step`` (s).
+
+    A pair whose piece does not grow and turns by little during ``[a, b]`` is not marched:
+    its shape turned to the heading at the middle of ``[a, b]`` is within ``pad = reach
+    |turn| (b - a) / 2`` (m) of the true one at every instant, so the times its point is
+    within ``limit + radius + pad`` (+ :data:`EPS_LIM`) of that shape, one interval in closed
+    form (:func:`_frozen_window`), hold the true window; used when ``2 pad <= lip step``
+    (as tight as the march's windows, which are within ``2 lip step`` of the limit).
 
     Returns
     -------
@@ -499,6 +566,30 @@ def windows_kernel(
         px, py = pts[i, 0], pts[i, 1]
         bq = b[q]
         t = a[q]
+        row = rows[p]
+        if row[7] == 0.0:
+            fin = np.isfinite(row[1])
+            span = bq - t if fin else 0.0
+            pad = reach[p] * abs(turn[p]) * 0.5 * span if fin else 0.0
+            if 2.0 * pad <= lp * step or pad == 0.0:
+                tm = 0.5 * (t + bq) if fin else row[0]
+                th = head0[p] + turn[p] * (tm - row[0])
+                c, sn = np.cos(th), np.sin(th)
+                vx, vy = (row[4], row[5]) if fin else (0.0, 0.0)
+                ox, oy = px - row[2] + vx * row[0], py - row[3] + vy * row[0]  # p - c(0)
+                qx, qy = c * ox + sn * oy, -sn * ox + c * oy
+                dx, dy = -(c * vx + sn * vy), sn * vx - c * vy
+                lim = limit + row[6] + pad + EPS_LIM
+                w_lo, w_hi = _frozen_window(qx, qy, dx, dy, lim, verts, edges, poly, j)
+                w_lo, w_hi = max(w_lo, t), min(w_hi, bq)
+                if w_lo < w_hi:
+                    if nr == pair.shape[0]:
+                        pair = np.concatenate((pair, np.empty(nr, dtype=np.int64)))
+                        lo = np.concatenate((lo, np.empty(nr)))
+                        hi = np.concatenate((hi, np.empty(nr)))
+                    pair[nr], lo[nr], hi[nr] = q, w_lo - eps, w_hi + eps
+                    nr += 1
+                continue
         cov = a[q]
         last_hi = -np.inf  # the widened end of the pair's last window
         while True:

@@ -10,7 +10,10 @@ point) and the distance from a fixed point to the shape, minus the radius, chang
 same interval when ``f_k < 0``. :meth:`ShapeTracks.windows` steps through time by
 ``max(|f_k| / lip, step)`` and reports as a violation window every stretch that no sample
 proves safe: sufficient (every ``t`` with ``f(t) < 0`` is inside a window), and tight to about
-``step`` at each end (the march is compiled: :func:`._polygon_march.windows_kernel`). Only the times at which the point is within the shape's bounding disc
+``step`` at each end (the march is compiled: :func:`._polygon_march.windows_kernel`). A
+piece that does not grow and turns by little (its shape turned to one heading within
+``lip step / 2`` of the true one) is not marched: its window is one interval in closed form,
+with that turn as a pad. Only the times at which the point is within the shape's bounding disc
 (radius ``R`` plus the rounding) plus the limit are sampled: those are closed-form
 (:func:`._disc_windows.inside_times`), an exact filter.
 
@@ -128,6 +131,7 @@ class ShapeTracks(PolygonPieces):
             self.head0,
             self.turn,
             self.lip,
+            self.reach[self.who],
             float(limit),
             self.verts,
             self.edges,

@@ -68,6 +68,46 @@ def test_windows_hold_every_violation_and_stay_near_them(seed):
     assert hits >= 6  # the case exercises the windows
 
 
+def test_translating_shapes_get_exact_windows_and_slow_turns_near_ones():
+    # carts that only translate (constant headings), one that turns slowly, a disc, and one
+    # that stands after its last waypoint: the windows (closed form, no march) must hold
+    # every violation of 0.2 ms samples and cover only samples within the turn's pad
+    rng = np.random.default_rng(7)
+    movers = []
+    for i, (verts, turn) in enumerate(((CART, 0.0), (TRI, 0.0), (CART, 0.02), (None, 0.0))):
+        t = np.array([0.0, 2.0, 4.5])
+        h0 = rng.uniform(-3.0, 3.0)
+        movers.append(
+            MovingObstacle.from_waypoints(
+                t,
+                rng.uniform(-1.5, 1.5, (3, 2)),
+                radius=0.05,
+                headings=h0 + turn * t,
+                vertices=verts,
+                name=f"m{i}",
+            )
+        )
+    pts = rng.uniform(-1.8, 1.8, (40, 2))
+    limit = 0.3
+    who, pi, lo, hi = ShapeTracks(movers).windows(pts, limit, NODE_STEP)
+    t = np.arange(0.0, 6.0, 2e-4)
+    hits = 0
+    for j, m in enumerate(movers):
+        # the pad of a turning piece: its reach, its turn rate and half the piece's 2.5 s
+        reach = 0.0 if m.vertices is None else float(np.max(np.hypot(*np.asarray(CART).T)))
+        pad = reach * 0.02 * 1.25 if j == 2 else 0.0
+        rate = mover_rate(m)
+        for i in range(pts.shape[0]):
+            f = slack_at(np.repeat(pts[i : i + 1], t.size, 0), m, t, limit)
+            cov = _covered(who, pi, lo, hi, j, i, t)
+            assert not np.any((f < 0.0) & ~cov), (j, i)
+            assert np.all(f[cov] <= 2.0 * pad + rate * 2e-4 + 1e-8), (j, i, float(f[cov].max()))
+            hits += int(np.any(f < 0.0))
+    assert hits >= 10
+    # and after the last waypoint a standing shape: one window to the end of time or none
+    assert np.all((hi < 4.5 + 1e-6) | (hi > 1e300))
+
+
 def test_band_and_owner_restrict_the_windows():
     rng = np.random.default_rng(3)
     movers = _movers(rng)
