@@ -21,7 +21,10 @@ g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves t
   keeps 1 nm of ``|f|`` in hand. Only the pairs whose distance can come under the limit at
   all are marched (:func:`._disc_windows.near_pairs` with each piece's bounding disc: an
   exact filter). The tests fall on grid times, so (a disc robot) each piece's place, turn
-  and rounding at a grid time is made once for all the nodes that test it.
+  and rounding at a grid time is made once for all the nodes that test it. A disc robot's
+  pair whose piece does not grow and turns the shape by at most :data:`FROZEN_PAD` is not
+  marched: the shape turned to one heading moves on a line, and the times a point is within
+  a limit of it are one interval in closed form (:func:`_frozen_window`), the turn a pad.
 * :func:`windows_kernel`: the violation windows in continuous time of
   :meth:`._shape_windows.ShapeTracks.windows` (sampled with a least step; sufficient).
 
@@ -49,6 +52,9 @@ EPS_LIM = 1e-9
 #: Added to the pair filter's reach with a footprint (m): rounding of the reaches never drops
 #: a pair the exact test hits.
 NEAR_PAD = 1e-9
+#: The most a piece of track may turn its shape (m, at its farthest vertex, about the middle
+#: of its grid times) to be solved in closed form on the grid (:func:`march_kernel`).
+FROZEN_PAD = 1e-3
 
 
 class PolygonPieces:
@@ -218,6 +224,8 @@ def polygon_runs(
         body,
         dt,
         kk,
+        tracks.reach[j],
+        1.0 if sufficient else -1.0,
     )
     owner = np.asarray(owners, dtype=np.int64)[j[piece]]
     return node, k0, k1, owner
@@ -352,13 +360,38 @@ def _footprint_clearance(
 
 @njit(cache=True)
 def march_kernel(
-    pts, seg, pi, rows, who, head0, turn, lip, lim_add, verts, edges, poly, nv, body, dt, kk
+    pts,
+    seg,
+    pi,
+    rows,
+    who,
+    head0,
+    turn,
+    lip,
+    lim_add,
+    verts,
+    edges,
+    poly,
+    nv,
+    body,
+    dt,
+    kk,
+    reach,
+    widen,
 ):  # pragma: no cover - compiled
     """Return the runs ``(node, first, last, piece)`` of the pairs ``(seg[q], pi[q])`` (module docstring).
 
     Against a disc robot, each piece's state at a grid time (its place, the cosine and sine
     of its heading, its rounding) is kept in a table when first made, for the other nodes
-    that test that time.
+    that test that time. A disc robot's pair whose piece does not grow and turns the shape
+    by at most ``pad = reach |turn| (span of its grid times) / 2 <= FROZEN_PAD`` (m) is not
+    marched: the shape turned to the heading at the middle is within ``pad`` of the true one
+    at those grid times, so the grid times at which the node is within the limit plus
+    ``widen pad`` of it (``widen`` = 1 on a sufficient grid: every time the exact test
+    forbids, and a few more; -1 on a necessary one: only times it forbids), one interval in
+    closed form (:func:`_frozen_window`), are its run (its ends included on a sufficient
+    grid, left out on a necessary one). ``reach``: shape (p,), the farthest vertex of each
+    piece's mover (m).
 
     Parameters
     ----------
@@ -411,6 +444,33 @@ def march_kernel(
         j = who[p]
         lp = lip[p]
         px, py = pts[i, 0], pts[i, 1]
+        row = rows[p]
+        fin = np.isfinite(w)
+        pad = reach[p] * abs(turn[p]) * 0.5 * (kb - ka) * dt if fin else 0.0
+        if not foot and row[7] == 0.0 and pad <= FROZEN_PAD:
+            tm = 0.5 * (ka + kb) * dt if fin else u
+            th = head0[p] + turn[p] * (tm - u)
+            c, sn = np.cos(th), np.sin(th)
+            vx, vy = (row[4], row[5]) if fin else (0.0, 0.0)
+            ox, oy = px - row[2] + vx * u, py - row[3] + vy * u  # p - c(0)
+            qx, qy = c * ox + sn * oy, -sn * ox + c * oy
+            dx, dy = -(c * vx + sn * vy), sn * vx - c * vy
+            lim = lim_add[p] + row[6] + widen * pad
+            if lim > 0.0:
+                w_lo, w_hi = _frozen_window(qx, qy, dx, dy, lim, verts, edges, poly, j)
+                if widen > 0.0:  # the ends count (a time on them is forbidden)
+                    f0, f1 = np.ceil(w_lo / dt), np.floor(w_hi / dt)
+                else:  # only the times strictly inside
+                    f0, f1 = np.floor(w_lo / dt) + 1.0, np.ceil(w_hi / dt) - 1.0
+                if f0 <= f1 and f0 <= kb and f1 >= ka:  # (empty: w_lo > w_hi, or NaN)
+                    k0, k1 = int(max(f0, ka)), int(min(f1, kb))
+                    if nr == out.shape[0]:
+                        bigger = np.empty((2 * out.shape[0], 4), dtype=np.int64)
+                        bigger[:nr] = out[:nr]
+                        out = bigger
+                    out[nr, 0], out[nr, 1], out[nr, 2], out[nr, 3] = i, k0, k1, p
+                    nr += 1
+            continue
         k = ka
         start = -1  # first time index of the open run
         while k <= kb:

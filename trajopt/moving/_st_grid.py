@@ -20,7 +20,10 @@ it (widened by 1 ns on the sufficient grid, narrowed on the necessary one, again
 A polygon mover against a disc robot: each pair of a piece of its track and a node is
 marched through the grid times (:mod:`._polygon_march`): an exact test at a grid time decides
 every grid time within its clearance over the mover's speed bound, so the runs are those of
-the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding).
+the exact test at every grid time (the limit moved by 1 nm the safe way, against rounding);
+a piece that does not grow and turns the shape by at most
+:data:`._polygon_march.FROZEN_PAD` is solved in closed form instead, its turn a pad moved
+the safe way (a sufficient grid forbids a few more grid times, a necessary one a few fewer).
 A footprint robot is marched the same way against every mover (discs too), with the signed
 distance of its polygon at the node and the mover's.
 

@@ -17,6 +17,7 @@ from shapely.geometry import Polygon
 
 from trajopt.moving import MovingObstacle
 from trajopt.moving._polygon_march import (
+    FROZEN_PAD,
     PolygonPieces,
     _signed_distance,
     launch_bound_kernel,
@@ -94,6 +95,55 @@ def test_the_march_forbids_exactly_the_points_the_exact_test_does(seed, sufficie
     for j in range(len(movers)):
         assert not np.any((got[j] != ref[j]) & ~near[j])
     assert any(r.any() for r in ref) and any((~r).any() for r in ref)
+
+
+@pytest.mark.parametrize("sufficient", [True, False])
+def test_translating_and_slowly_turning_movers_solved_in_closed_form(sufficient):
+    """Pieces that only translate: exactly the exact test's grid times; a slow turn (within
+    ``FROZEN_PAD``): more of them on a sufficient grid, fewer on a necessary one, only within
+    the turn's pad of the limit; a faster one marched (exact)."""
+    rng = np.random.default_rng(11)
+    movers, pads = [], []
+    for i, turn in enumerate((0.0, 0.0, 0.0015, 0.02)):
+        times = np.array([0.0, 1.5, 3.0, 5.5])
+        verts = [(-0.45, -0.25), (0.45, -0.25), (0.45, 0.25), (-0.45, 0.25)]
+        if i == 1:
+            verts = [(0.0, -0.3), (0.5, 0.2), (-0.2, 0.3)]
+        heads = rng.uniform(-3.0, 3.0) + turn * times
+        movers.append(
+            MovingObstacle.from_waypoints(
+                times, rng.uniform(-1.0, 4.0, (4, 2)), radius=0.05, headings=heads, vertices=verts
+            )
+        )
+        reach = float(np.max(np.hypot(*np.array(verts).T)))
+        pads.append(min(reach * turn * 2.5 / 2, FROZEN_PAD))  # the longest piece: 2.5 s
+    assert 0.0 < pads[2] < FROZEN_PAD and reach * 0.02 * 2.5 / 2 > 10 * FROZEN_PAD
+    pts = np.column_stack([np.linspace(-1.0, 4.5, 24), 1.0 + np.sin(np.linspace(0.0, 4.0, 24))])
+    lim0 = np.full(len(movers), 0.3)
+    t = np.arange(2400) * 0.0025  # fine: the pad moves some grid times
+    got = _painted(
+        polygon_runs(pts, movers, range(len(movers)), lim0, t, sufficient),
+        len(movers),
+        t.shape[0],
+        pts.shape[0],
+    )
+    for j, m in enumerate(movers):
+        # the reference again, with the limit moved by twice the pad the safe way (the
+        # turned shape is within the pad of the true one, and the limit moved by it)
+        for sign in (0.0, 2.0):
+            l0 = [0.3 + sign * pads[j] * (1.0 if sufficient else -1.0)]
+            ref, near = _dense(pts, [m], l0, t)
+            if sign == 0.0:
+                inner = ref[0]
+            else:
+                outer = ref[0]
+        if sufficient:
+            assert not np.any(inner & ~got[j] & ~near[0])  # every forbidden time, and ...
+            assert not np.any(got[j] & ~outer & ~near[0])  # ... none farther than the pad
+        else:
+            assert not np.any(got[j] & ~inner & ~near[0])
+            assert not np.any(outer & ~got[j] & ~near[0])
+        assert inner.any()
 
 
 def test_the_runs_carry_the_grids_mover_index_and_leave_out_pieces_before_after():
