@@ -85,7 +85,9 @@ def _kept(cache: list, curve: Any, build: Any) -> Any:
     """Return ``build(curve)`` from ``cache`` (found by the object, else by its geometry).
 
     ``cache`` holds ``(curve, key, value)`` with the last used last; a miss builds the value
-    and keeps the :data:`_KAPPA_KEPT` most recent.
+    and keeps the :data:`_KAPPA_KEPT` most recent. A hit by geometry keeps ``curve`` as the
+    entry's object (the next look-up of the same object is found by identity, without its
+    key: a re-plan's curve is looked up several times).
     """
     for i, (c, _, value) in enumerate(cache):
         if c is curve:
@@ -95,7 +97,8 @@ def _kept(cache: list, curve: Any, build: Any) -> Any:
     key = (geometry_key(curve), None if dom is None else tuple(map(float, dom)), curve.length)
     for i, (_, k, value) in enumerate(cache):
         if k == key:
-            cache.append(cache.pop(i))
+            cache.pop(i)
+            cache.append((curve, k, value))
             return value
     value = build(curve)
     cache.append((curve, key, value))

@@ -81,6 +81,7 @@ def _piece_of(tr: Any, s0: float, s1: float) -> Piece:
 #: the cap table's value plus ruckig's velocity margin (1e-9 m/s), and a motion that starts in
 #: such a state must pass.
 CAP_TOLERANCE = 1e-7
+_LOW = np.array([1.0, 1.0, 1.0 - CAP_TOLERANCE, 1.0 - CAP_TOLERANCE, 1.0 - CAP_TOLERANCE, 1.0])
 
 
 def _under_caps(table: Any, rows: np.ndarray) -> bool:
@@ -90,9 +91,7 @@ def _under_caps(table: Any, rows: np.ndarray) -> bool:
     ``1 - CAP_TOLERANCE`` (speed, acceleration and jerk of every row; its arc lengths move by
     at most that fraction of the distance).
     """
-    low = np.array(rows, dtype=float)
-    low[:, 2:5] *= 1.0 - CAP_TOLERANCE
-    return bool(table.rows_ok(low))
+    return bool(table.rows_ok(np.array(rows, dtype=float) * _LOW))
 
 
 def _piece_of_rows(rows: np.ndarray | None, s1: float) -> Piece | None:
@@ -187,7 +186,6 @@ class _PathTables:
 
 #: How much (s) the fine windows' time band is widened (:func:`_fine_windows`).
 BAND_PAD = 0.05
-
 #: Timings of a moving start whose launches a path's tables keep.
 _LAUNCHES_KEPT = 4
 
@@ -207,8 +205,12 @@ def _tables(traj: Trajectory) -> _PathTables:
             return tb
     tb = _PathTables(traj.path, traj.robot, float(traj.length), zones)
     tb.key = key
-    if traj.v_start == 0.0 and traj.phase_a[0] == 0.0:  # the plan itself: the drive (0, L)
-        tb.drives[(0.0, tb.length)] = _piece_of(traj, 0.0, tb.length)
+    rests = (traj.phase_v == 0.0) & (traj.phase_a == 0.0) & (traj.phase_j == 0.0)
+    if traj.v_start == 0.0 and traj.phase_a[0] == 0.0:  # the drive (0, L): the plan's own
+        # timing (a re-timing's, with rests on the way: the path timed from rest again)
+        whole = tb.segment(0.0, tb.length) if rests.any() else _piece_of(traj, 0.0, tb.length)
+        if whole is not None:
+            tb.drives[(0.0, tb.length)] = whole
     _TABLES.append(tb)
     del _TABLES[:-_TABLES_KEPT]
     return tb
@@ -582,10 +584,8 @@ def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece
     rows = tables.rk.solve((s, v, a), (s1, 0.0, 0.0), max(v, 1e-9))
     if rows is None or not _under_caps(tables.table, rows):
         return None
-    keep = traj.phase_t < lo
-    head = np.column_stack([traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j])[
-        keep
-    ]
+    phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
+    head = np.column_stack(phases)[traj.phase_t < lo]
     tail = rows[:, :5].copy()
     tail[:, 0] += lo
     duration = float(lo + rows[-1, 0] + rows[-1, 5])

@@ -260,6 +260,32 @@ def test_a_path_of_the_same_geometry_re_times_as_when_cold():
     assert dense_min(warm, [m])[0] >= -1e-6
 
 
+def test_a_re_timed_trajectory_re_timed_again_cold_as_when_its_plan_came_first():
+    # a re-plan hands over a re-timing (with rests) to re-time for new predictions: its own
+    # timing is not the path's one drive, so a cold re-timing of it gives what a re-timing
+    # whose tables the plan made first gives
+    from trajopt.geometry import BSplineCurve
+    from trajopt.moving import _retime
+
+    t = np.array([0.0, 0.0, 0.0, 0.0, 2.0, 4.0, 6.0, 6.0, 6.0, 6.0])
+    c = np.array([[0.0, 0.0], [1.0, 0.2], [2.5, -0.2], [3.5, 0.3], [5.0, 0.0], [6.0, 0.1]])
+    m = MovingObstacle.constant_velocity(
+        (3.0, -2.0), (0.0, 0.35), radius=0.3, horizon=25.0, name="walker"
+    )
+    plan = time_parameterize(BSplineCurve(t, c, 3), ROBOT)
+    timed = retime_for_movers(plan, [m])
+    assert "wait" in timed.stats["moving"]["plan"]
+    later = MovingObstacle.constant_velocity(
+        (3.0, -2.4), (0.0, 0.35), radius=0.3, horizon=25.0, name="walker"
+    )
+    warm = retime_for_movers(timed, [later])
+    _retime._TABLES.clear()
+    cold = retime_for_movers(timed, [later])
+    assert cold.duration == warm.duration and certify_movers(cold, [later]).ok
+    for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
+        assert np.array_equal(getattr(warm, name), getattr(cold, name))
+
+
 CART = [(-0.45, -0.25), (0.45, -0.25), (0.45, 0.25), (-0.45, 0.25)]
 
 
