@@ -27,7 +27,13 @@
 """
 
 from trajopt.moving._certificate import MoverCertificate, certify_movers, check_movers
-from trajopt.moving._chain import joined_certificates, retime_chain, shift_clock, truncate
+from trajopt.moving._chain import (
+    joined_certificates,
+    retime_chain,
+    retime_plan,
+    shift_clock,
+    truncate,
+)
 from trajopt.moving._mover_file import load_movers, movers_from_data, movers_to_data, save_movers
 from trajopt.moving._no_way_past import meets_head_on, no_way_past, reachable_times
 from trajopt.moving._obstacle import MovingObstacle
@@ -40,7 +46,7 @@ from trajopt.moving._reroute import (
     reroute,
     safe_places,
 )
-from trajopt.moving._retime import retime_for_movers, retime_plan
+from trajopt.moving._retime import retime_for_movers
 from trajopt.moving._st_grid import STGrid, reachable, st_grid
 from trajopt.moving._swept import mark_swept, reached_swept_mask, swept_cells, swept_mask
 

@@ -30,6 +30,10 @@ omnidirectional or car-like robot (not the stop-and-turn fallback's polyline):
   profile is built again on the re-timed translation (:func:`trajopt.timing.orient`, from the
   same start orientation to the same end orientation, within the yaw limits): the body turns
   while the base drives or rests, the turn never outlasting what it would alone.
+
+:func:`retime_plan` is the narrower form for a plan of one curve with turns in place at its
+ends (a differential drive's pose-to-pose plan): the curve re-timed with a rest as long as
+the turns before it, the whole chain certified.
 """
 
 from __future__ import annotations
@@ -386,3 +390,77 @@ def _retime_omni(plan: Any, movers: Sequence[MovingObstacle], margin: float, t_a
         "time_s": time.perf_counter() - t_all,
     }
     return dataclasses.replace(out, stats=stats, steps=plan.steps)
+
+
+def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 0.0) -> Any:
+    """Re-time a plan for movers: one curve, or turns in place, one curve, turns in place.
+
+    A :class:`trajopt.Trajectory` goes to :func:`retime_for_movers`. A
+    :class:`trajopt.TrajectoryChain` of turns in place at the start, one curve and turns in
+    place at the goal (a differential drive's pose-to-pose plan) keeps its turns: the robot
+    stands at the start while it turns (``not_before`` = their duration), and at the goal
+    while it turns there (the certificate covers standing at the goal). The result's pieces
+    are the old turns and the re-timed curve, on one clock with the movers'.
+
+    Parameters
+    ----------
+    plan : Trajectory or TrajectoryChain
+        A disc robot's plan from rest to rest.
+    movers : sequence of MovingObstacle
+        The predictions (seconds from the plan's ``t = 0``).
+    margin : float
+        Extra distance to every mover (m), >= 0.
+
+    Returns
+    -------
+    Trajectory or TrajectoryChain
+        Of the plan's kind, certified (:func:`certify_movers`); ``stats["moving"]`` as in
+        :func:`retime_for_movers`.
+
+    Raises
+    ------
+    BlockedError
+        As :func:`retime_for_movers`; or a footprint turning in place meets a mover (the
+        whole chain is certified).
+    InvalidInputError
+        Any other plan (a chain of several curves, a car's steering, an omni orientation).
+    """
+    if plan.single_curve:
+        return retime_for_movers(plan, movers, margin=margin)
+    pieces = tuple(getattr(plan, "pieces", ()))
+    curves = [i for i, p in enumerate(pieces) if p.single_curve]
+    if len(curves) != 1 or not all(p.turning for p in pieces if not p.single_curve):
+        raise InvalidInputError(
+            "moving obstacles are covered for one curve with turns in place at its ends, got "
+            f"{type(plan).__name__} of {[type(p).__name__ for p in pieces]}"
+        )
+    if any(plan.starts):
+        raise InvalidInputError(
+            "moving obstacles: a chain that starts inside a piece is not covered"
+        )
+    i = curves[0]
+    lead = float(sum(p.duration for p in pieces[:i]))
+    curve = retime_for_movers(pieces[i], movers, margin=margin, not_before=lead)
+    starts = [0.0] * len(pieces)
+    starts[i] = lead
+    stats = dict(plan.stats)
+    stats["moving"] = dict(curve.stats["moving"])
+    out = TrajectoryChain(
+        pieces=(*pieces[:i], curve, *pieces[i + 1 :]),
+        robot=plan.robot,
+        stats=stats,
+        steps=plan.steps,
+        starts=tuple(starts),
+    )
+    # the chain's own certificate: a footprint sweeps more while it turns in place than the
+    # curve's rests at its end headings
+    cert = certify_movers(out, movers, margin=margin)
+    if not cert.ok:
+        raise BlockedError(
+            f"moving obstacle {cert.mover!r} meets the robot turning in place near "
+            f"t = {cert.witness_t:.3f} s ({cert.verdict})",
+            mover=cert.mover,
+            t=cert.witness_t,
+        )
+    stats["moving"]["certificate"] = cert.summary()
+    return out

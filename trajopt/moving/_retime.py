@@ -45,7 +45,7 @@ import numpy as np
 
 from trajopt.errors import BlockedError, InvalidInputError, TimingError
 from trajopt.geometry import CurveSegment
-from trajopt.motion import Trajectory, TrajectoryChain
+from trajopt.motion import Trajectory
 from trajopt.moving._braking import braking_distance, state_at
 from trajopt.moving._certificate import (
     MoverCertificate,
@@ -57,11 +57,12 @@ from trajopt.moving._certificate import (
 )
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import geometry_key, kappa_max
-from trajopt.moving._shape_windows import ShapeWindows
+from trajopt.moving._shape_windows import ShapeWindows, launch_floor
 from trajopt.moving._st_grid import STGrid, grid_nodes, reach_bound, reachable, st_grid
 from trajopt.moving._st_search import Piece, compose, describe, parts_of, search
 from trajopt.moving._tighten import (
     FINE_DS,
+    REFINE_SPAN,
     FineWindows,
     bisect_start,
     pass_band,
@@ -490,13 +491,16 @@ def _tightened(
         if whole is not None:
             t_max = min(arrival(schedule), float(grid.t[-1])) - whole.duration
             latest.append([(t_max, whole)])
-        fine = _fine_windows(tables, grid, movers, limit, (not_before, t_to, speed), latest)
+        firsts = [schedule] if schedule and not moving else []
+        firsts += [[(0.0, whole)]] if whole is not None else []
+        span = (not_before, t_to, speed)
+        fine, t_from = _fine_windows(tables, grid, movers, limit, span, latest, firsts)
         if schedule:
-            candidates.append(tighten(fine, schedule, math.inf if moving else not_before))
+            candidates.append(tighten(fine, schedule, math.inf if moving else t_from))
         if whole is not None:
             one = [(0.0, whole)]
             drives, rests = tail_occupancy(fine, one, 0)
-            launch = fine.earliest(drives, not_before, t_max, tail_s(one, 0), rests)
+            launch = fine.earliest(drives, t_from, t_max, tail_s(one, 0), rests)
             if launch is not None:
                 candidates.append([(launch, whole)])
     elif schedule and not moving and schedule[0][0] > not_before:
@@ -529,7 +533,8 @@ def _fine_windows(
     limit: float,
     span: tuple[float, float, float],
     latest: Sequence[list[tuple[float, Piece]]] = (),
-) -> FineWindows:
+    firsts: Sequence[list[tuple[float, Piece]]] = (),
+) -> tuple[FineWindows, float]:
     """Return the movers' windows at the path's fine nodes (spacing at most ``dt`` times the speed).
 
     Only the pairs of a piece of a track and a fine node that can come within the limit are
@@ -542,6 +547,12 @@ def _fine_windows(
     launches (discs' closed-form windows save less than the cut's ~0.2 ms). Widened by
     :data:`BAND_PAD` (the drives' samples reach a step beyond) and ``V`` by 1 %. A window left
     out by a wrong bound would only make a launch too early, which the certificate refuses.
+    With polygon movers and ``firsts`` (the schedules from the start whose first launches
+    are asked about, each launched as a block), the band is then cut again from a later
+    ``t_from``: the least launch :func:`._shape_windows.launch_floor` allows them, less
+    :data:`BAND_PAD` and two :data:`._tighten.REFINE_SPAN` (the refinement of a launch moves it earlier by at most
+    that much). Returns the windows and that ``t_from`` (s), the earliest launch to ask them
+    about.
     """
     h = min(FINE_DS, grid.dt * float(tables.robot.v_max))
     s, h = grid_nodes(tables.length, h)
@@ -550,15 +561,24 @@ def _fine_windows(
     t_from, t_to, speed = span
     v = 1.01 * speed
     kind = FineWindows if all(m.vertices is None for m in movers) else ShapeWindows
-    p_lo, p_hi = pass_band(s, h, latest if kind is ShapeWindows else (), t_from)
-    lo = np.maximum(t_from + np.maximum(s - 0.5 * h, 0.0) / v, p_lo)
-    hi = np.minimum(t_to - np.maximum(tables.length - s - 0.5 * h, 0.0) / v, p_hi)
-    band = (lo - BAND_PAD, hi + BAND_PAD)
+    hi = np.minimum(t_to - np.maximum(tables.length - s - 0.5 * h, 0.0) / v, np.inf)
+
+    def band_from(t0: float) -> tuple[np.ndarray, np.ndarray]:
+        p_lo, p_hi = pass_band(s, h, latest if kind is ShapeWindows else (), t0)
+        lo = np.maximum(t0 + np.maximum(s - 0.5 * h, 0.0) / v, p_lo)
+        return lo - BAND_PAD, np.minimum(hi, p_hi) + BAND_PAD
+
+    band = band_from(t_from)
+    if kind is ShapeWindows and firsts:
+        floor = launch_floor(s, pts, movers, limit, band, firsts, t_from)
+        if floor - 2.0 * REFINE_SPAN - BAND_PAD > t_from:
+            t_from = floor - 2.0 * REFINE_SPAN - BAND_PAD
+            band = band_from(t_from)
 
     def where(s_at: np.ndarray) -> np.ndarray:
         return np.asarray(tables.path(np.interp(s_at, tb.s_nodes, tb.u_nodes)), dtype=float)
 
-    return kind(s, pts, movers, limit, band, where, float(tables.robot.v_max))
+    return kind(s, pts, movers, limit, band, where, float(tables.robot.v_max)), t_from
 
 
 def _follow_then_stop(traj: Trajectory, tables: _PathTables, s1: float) -> Piece | None:
@@ -613,80 +633,6 @@ def _timed(traj: Trajectory, rows: np.ndarray, duration: float) -> Trajectory:
         direction=traj.direction,
         speed_limits=traj.speed_limits,
     )
-
-
-def retime_plan(plan: Any, movers: Sequence[MovingObstacle], *, margin: float = 0.0) -> Any:
-    """Re-time a plan for movers: one curve, or turns in place, one curve, turns in place.
-
-    A :class:`trajopt.Trajectory` goes to :func:`retime_for_movers`. A
-    :class:`trajopt.TrajectoryChain` of turns in place at the start, one curve and turns in
-    place at the goal (a differential drive's pose-to-pose plan) keeps its turns: the robot
-    stands at the start while it turns (``not_before`` = their duration), and at the goal
-    while it turns there (the certificate covers standing at the goal). The result's pieces
-    are the old turns and the re-timed curve, on one clock with the movers'.
-
-    Parameters
-    ----------
-    plan : Trajectory or TrajectoryChain
-        A disc robot's plan from rest to rest.
-    movers : sequence of MovingObstacle
-        The predictions (seconds from the plan's ``t = 0``).
-    margin : float
-        Extra distance to every mover (m), >= 0.
-
-    Returns
-    -------
-    Trajectory or TrajectoryChain
-        Of the plan's kind, certified (:func:`certify_movers`); ``stats["moving"]`` as in
-        :func:`retime_for_movers`.
-
-    Raises
-    ------
-    BlockedError
-        As :func:`retime_for_movers`; or a footprint turning in place meets a mover (the
-        whole chain is certified).
-    InvalidInputError
-        Any other plan (a chain of several curves, a car's steering, an omni orientation).
-    """
-    if plan.single_curve:
-        return retime_for_movers(plan, movers, margin=margin)
-    pieces = tuple(getattr(plan, "pieces", ()))
-    curves = [i for i, p in enumerate(pieces) if p.single_curve]
-    if len(curves) != 1 or not all(p.turning for p in pieces if not p.single_curve):
-        raise InvalidInputError(
-            "moving obstacles are covered for one curve with turns in place at its ends, got "
-            f"{type(plan).__name__} of {[type(p).__name__ for p in pieces]}"
-        )
-    if any(plan.starts):
-        raise InvalidInputError(
-            "moving obstacles: a chain that starts inside a piece is not covered"
-        )
-    i = curves[0]
-    lead = float(sum(p.duration for p in pieces[:i]))
-    curve = retime_for_movers(pieces[i], movers, margin=margin, not_before=lead)
-    starts = [0.0] * len(pieces)
-    starts[i] = lead
-    stats = dict(plan.stats)
-    stats["moving"] = dict(curve.stats["moving"])
-    out = TrajectoryChain(
-        pieces=(*pieces[:i], curve, *pieces[i + 1 :]),
-        robot=plan.robot,
-        stats=stats,
-        steps=plan.steps,
-        starts=tuple(starts),
-    )
-    # the chain's own certificate: a footprint sweeps more while it turns in place than the
-    # curve's rests at its end headings
-    cert = certify_movers(out, movers, margin=margin)
-    if not cert.ok:
-        raise BlockedError(
-            f"moving obstacle {cert.mover!r} meets the robot turning in place near "
-            f"t = {cert.witness_t:.3f} s ({cert.verdict})",
-            mover=cert.mover,
-            t=cert.witness_t,
-        )
-    stats["moving"]["certificate"] = cert.summary()
-    return out
 
 
 def _with_stats(traj: Trajectory, cert: Any, label: str, t_all: float) -> Trajectory:

@@ -38,7 +38,16 @@ from trajopt.moving._polygon_march import (
     windows_kernel,
 )
 from trajopt.moving._st_kernels import disc_windows_kernel
-from trajopt.moving._tighten import POINT_PAD, FineWindows, merged_spans, pieces_meeting
+from trajopt.moving._st_search import Piece
+from trajopt.moving._tighten import (
+    POINT_PAD,
+    FineWindows,
+    blocked_launches,
+    merged_spans,
+    near_times,
+    pieces_meeting,
+    sweep,
+)
 
 #: The least time step (s) of the fine nodes' windows.
 NODE_STEP = 1e-2
@@ -50,6 +59,8 @@ EPS_W = 1e-9
 LAUNCH_STEPS = (1e-2, 1e-3, 1e-4)
 #: The spacing (s) of the motion's own points in the refinement (:meth:`ShapeWindows._exact`).
 REFINE_TAU = 1e-3
+#: Every how many fine nodes :func:`launch_floor` tests.
+FLOOR_EVERY = 8
 
 
 class ShapeTracks(PolygonPieces):
@@ -281,3 +292,62 @@ class ShapeWindows(FineWindows):
         f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
         keep = f_hi > f_lo
         return f_lo[keep], f_hi[keep]
+
+
+def launch_floor(
+    s: np.ndarray,
+    pts: np.ndarray,
+    movers: Sequence[MovingObstacle],
+    limit: float,
+    band: tuple[np.ndarray, np.ndarray],
+    schedules: Sequence[Sequence[tuple[float, Piece]]],
+    lo: float,
+) -> float:
+    """Return the least launch (s) at or after ``lo`` that any of ``schedules`` may take: a floor.
+
+    The windows of :class:`ShapeWindows` at every :data:`FLOOR_EVERY`-th fine node only
+    (the same limit ``limit + h/2``, step and ``band``), and a schedule's drives' times near
+    those nodes (:func:`._tighten.near_times`), the schedule launched as a block (its
+    drives' launches moved together): a launch the windows at every node allow is allowed
+    by these, so the least launch from ``lo`` these allow (:func:`._tighten.sweep`) is no
+    later than the least the fine windows allow the schedule; the least over the schedules.
+
+    Parameters
+    ----------
+    s, pts : ndarray, shape (n,), (n, 2)
+        The fine nodes (m) and the path's points there (m).
+    movers : sequence of MovingObstacle
+    limit : float
+        Robot radius plus margin (m).
+    band : (ndarray, ndarray)
+        Per fine node, shape (n,) each: the times (s) its windows are made for.
+    schedules : sequence of list of (float, Piece)
+        Launch times (s) and drives, each schedule from the start.
+    lo : float
+        The earliest launch (s).
+    """
+    h = float(s[1] - s[0])
+    sub = np.arange(0, s.shape[0], FLOOR_EVERY)
+    tracks = ShapeTracks.of(movers)
+    _, node, w_lo, w_hi = tracks.windows(
+        pts[sub], limit + 0.5 * h, NODE_STEP, (band[0][sub], band[1][sub])
+    )
+    order = np.argsort(node, kind="stable")
+    node, w_lo, w_hi = node[order], w_lo[order], w_hi[order]
+    ptr = np.concatenate([[0], np.cumsum(np.bincount(node, minlength=sub.shape[0]))])
+    floor = np.inf
+    for sched in schedules:
+        f_lo, f_hi = [np.zeros(0)], [np.zeros(0)]
+        for t_j, pc in sched:
+            idx, a, b = near_times(pc, s, h)
+            mine = idx % FLOOR_EVERY == 0
+            off = t_j - sched[0][0]
+            x_lo, x_hi, _, _ = blocked_launches(
+                idx[mine] // FLOOR_EVERY, a[mine] + off, b[mine] + off, ptr, w_lo, w_hi
+            )
+            f_lo.append(x_lo)
+            f_hi.append(x_hi)
+        x_lo, x_hi = np.concatenate(f_lo), np.concatenate(f_hi)
+        keep = x_hi > lo
+        floor = min(floor, sweep(x_lo[keep], x_hi[keep], lo))
+    return float(floor)

@@ -106,32 +106,13 @@ class FineWindows:
         counts = np.bincount(node, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
 
-    def node_range(self, s0: float, s1: float, every: bool = False) -> np.ndarray:
-        """Return the fine nodes within ``h/2`` of ``[s0, s1]`` (m) that have windows (or all)."""
-        h = self.h
-        i0 = max(int(math.floor((s0 - 0.5 * h) / h + 1e-9)), 0)
-        i1 = min(int(math.ceil((s1 + 0.5 * h) / h - 1e-9)), self.s.shape[0] - 1)
-        idx = np.arange(i0, i1 + 1)
-        idx = idx[np.abs(np.clip(self.s[idx], s0, s1) - self.s[idx]) <= 0.5 * h + 1e-12]
-        return idx if every else idx[self.ptr[idx + 1] > self.ptr[idx]]
-
     def drive_occupancy(self, piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Return ``(node, a, b)``: the drive is within ``h/2`` of node ``s_i`` only in ``[a, b]`` (s).
 
         From samples every :data:`SAMPLE_DT` of ``s(t)`` (non-decreasing): from the last
         sample before it comes within ``h/2`` to the first after it leaves. Kept on the piece.
         """
-        key = ("fine", self.h, self.s.shape[0])
-        if key not in piece.memo:
-            idx = self.node_range(piece.s0, piece.s1, every=True)
-            n = int(math.ceil(piece.duration / SAMPLE_DT))
-            t = np.append(np.arange(n) * SAMPLE_DT, piece.duration)
-            s = piece.s_at(t)
-            h = 0.5 * self.h
-            enter = np.clip(np.searchsorted(s, self.s[idx] - h, side="left") - 1, 0, t.size - 1)
-            leave = np.clip(np.searchsorted(s, self.s[idx] + h, side="right"), 0, t.size - 1)
-            piece.memo[key] = (idx, t[enter], t[leave])
-        idx, a, b = piece.memo[key]
+        idx, a, b = near_times(piece, self.s, self.h)
         has = self.ptr[idx + 1] > self.ptr[idx]
         return idx[has], a[has], b[has]
 
@@ -165,13 +146,7 @@ class FineWindows:
         node = np.concatenate([o[0] for o in occupancy])
         a = np.concatenate([o[1] for o in occupancy])
         b = np.concatenate([o[2] for o in occupancy])
-        counts = self.ptr[node + 1] - self.ptr[node]
-        total = int(counts.sum())
-        which = np.repeat(np.arange(node.shape[0]), counts)
-        first = np.repeat(self.ptr[node], counts)
-        run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-        f_lo = self.lo[run] - b[which]
-        f_hi = self.hi[run] - a[which]
+        f_lo, f_hi, which, run = blocked_launches(node, a, b, self.ptr, self.lo, self.hi)
         keep = f_hi > lo
         f_lo, f_hi = f_lo[keep], f_hi[keep]
         span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
@@ -247,6 +222,50 @@ class FineWindows:
         pairs = (seg[near], item[near])
         _, pi, w_lo, w_hi = disc_windows(pts, self.pieces, self.speed * pad, pairs=pairs)
         return w_lo - tau[pi] - pad, w_hi - tau[pi] + pad
+
+
+def near_times(piece: Piece, s: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return ``(node, a, b)``: the drive is within ``h/2`` of node ``s[node]`` (m) only in ``[a, b]`` (s).
+
+    Every node within ``h/2`` of the drive's span (nodes ``s``, spacing ``h``, from 0), from
+    samples every :data:`SAMPLE_DT` of ``s(t)`` (non-decreasing): from the last sample before
+    it comes within ``h/2`` to the first after it leaves. Kept on the piece.
+    """
+    key = ("fine", h, s.shape[0])
+    if key not in piece.memo:
+        i0 = max(int(math.floor((piece.s0 - 0.5 * h) / h + 1e-9)), 0)
+        i1 = min(int(math.ceil((piece.s1 + 0.5 * h) / h - 1e-9)), s.shape[0] - 1)
+        idx = np.arange(i0, i1 + 1)
+        idx = idx[np.abs(np.clip(s[idx], piece.s0, piece.s1) - s[idx]) <= 0.5 * h + 1e-12]
+        n = int(math.ceil(piece.duration / SAMPLE_DT))
+        t = np.append(np.arange(n) * SAMPLE_DT, piece.duration)
+        at = piece.s_at(t)
+        enter = np.clip(np.searchsorted(at, s[idx] - 0.5 * h, side="left") - 1, 0, t.size - 1)
+        leave = np.clip(np.searchsorted(at, s[idx] + 0.5 * h, side="right"), 0, t.size - 1)
+        piece.memo[key] = (idx, t[enter], t[leave])
+    return piece.memo[key]
+
+
+def blocked_launches(
+    node: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    ptr: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Return the launches ``(lo_w - b, hi_w - a)`` (s) at which a motion meets a node's window.
+
+    The motion is near node ``node[j]`` during ``[L + a[j], L + b[j]]``; the windows of node
+    ``i`` are ``(lo, hi)[ptr[i]:ptr[i + 1]]``. Also returns, per interval, its ``j`` and its
+    window's index.
+    """
+    counts = ptr[node + 1] - ptr[node]
+    total = int(counts.sum())
+    which = np.repeat(np.arange(node.shape[0]), counts)
+    first = np.repeat(ptr[node], counts)
+    run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    return lo[run] - b[which], hi[run] - a[which], which, run
 
 
 def merged_spans(
