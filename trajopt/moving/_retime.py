@@ -550,9 +550,9 @@ def _fine_windows(
     With polygon movers and ``firsts`` (the schedules from the start whose first launches
     are asked about, each launched as a block), the band is then cut again from a later
     ``t_from``: the least launch :func:`._shape_windows.launch_floor` allows them, less
-    :data:`BAND_PAD` and two :data:`._tighten.REFINE_SPAN` (the refinement of a launch moves it earlier by at most
-    that much). Returns the windows and that ``t_from`` (s), the earliest launch to ask them
-    about.
+    :data:`BAND_PAD` and two :data:`._tighten.REFINE_SPAN` (the refinement of a launch moves
+    it earlier by at most that much), never past a latest first launch. Returns the windows
+    and that ``t_from`` (s), the earliest launch to ask them about.
     """
     h = min(FINE_DS, grid.dt * float(tables.robot.v_max))
     s, h = grid_nodes(tables.length, h)
@@ -571,8 +571,10 @@ def _fine_windows(
     band = band_from(t_from)
     if kind is ShapeWindows and firsts:
         floor = launch_floor(s, pts, movers, limit, band, firsts, t_from)
-        if floor - 2.0 * REFINE_SPAN - BAND_PAD > t_from:
-            t_from = floor - 2.0 * REFINE_SPAN - BAND_PAD
+        # never past a latest launch (the launches asked about start no later)
+        floor = min(floor - 2.0 * REFINE_SPAN - BAND_PAD, *(x[0][0] for x in latest))
+        if floor > t_from:
+            t_from = floor
             band = band_from(t_from)
 
     def where(s_at: np.ndarray) -> np.ndarray:
