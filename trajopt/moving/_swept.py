@@ -6,8 +6,9 @@ inflates the marked map by the robot's radius as it inflates any map). The shape
 its circumscribed disc (its reference point's farthest vertex plus its rounding, the rounding
 taken at ``t1``, where it is largest); the reference point moves linearly between waypoints,
 so over a waypoint segment the discs sweep a capsule. A cell is marked when its square meets
-the grown capsule (its centre within the capsule's radius plus half the cell's diagonal): the
-marked cells cover the swept region, never less.
+the grown capsule (the exact distance from the capsule's segment to the square, at most its
+radius): the marked cells cover the swept region, never less, and no cell the capsule misses
+(a route round the marks keeps as close to the mover as the grid allows).
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def swept_mask(
         bx0, bx1, by0, by1 = (int(v) for v in box)
         ox, oy = ox + bx0 * res, oy + by0 * res
         ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
-    a, b, radius = _capsules(mover, t0, t1, grow, res)
+    a, b, radius = _capsules(mover, t0, t1, grow)
     return _capsule_mask((ox, oy, res, nx, ny), a, b, radius)
 
 
@@ -143,7 +144,7 @@ def reached_swept_mask(
     b = np.vstack([pts[1:], pts[-1:]])
     last = math.inf if t1 >= mover.t_last else t1
     spans = (np.append(knots[:-1], knots[-1]), np.append(knots[1:], last))
-    radius = _capsules(mover, t0, t1, grow, res)[2]
+    radius = _capsules(mover, t0, t1, grow)[2]
     reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
     return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach, late)
 
@@ -157,14 +158,15 @@ def _capsule_mask(
     reach: tuple[np.ndarray, float, float] | None = None,
     late: tuple[float, float] = (0.0, 0.0),
 ) -> np.ndarray:
-    """Return the cells whose centre is within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
+    """Return the cells whose square comes within ``radius`` (m) of a segment ``[a_i, b_i]`` (m).
 
     ``frame``: ``(ox, oy, res, nx, ny)``, the cells' origin (m), size (m) and count. With
     ``spans`` (``(t_a, t_b)``, s, each shape (k,): the times a point moving linearly is at
     ``a_i`` and ``b_i``; ``t_b`` infinite for a point standing at ``a_i = b_i`` for ever) and
     ``reach`` (``origin`` m, ``speed`` m/s, ``slack`` m), a segment marks only the cells with
     ``|centre - origin| - slack - res / sqrt(2) <= speed * t``, ``t`` the last time in
-    ``[t_a, t_b]`` the point is within ``radius`` of the centre, and with ``late``
+    ``[t_a, t_b]`` the point is within ``radius + res / sqrt(2)`` of the centre (no earlier
+    than the last time it is within ``radius`` of the square), and with ``late``
     (``(factor, extra)``, ``factor > 0``) whose first such time is at most ``factor *
     (|centre - origin| + slack + res / sqrt(2)) / speed + extra`` (:func:`reached_swept_mask`).
     """
@@ -187,15 +189,15 @@ def _capsule_mask(
 
 
 def _capsules(
-    mover: MovingObstacle, t0: float, t1: float, grow: float, res: float
+    mover: MovingObstacle, t0: float, t1: float, grow: float
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """Return the track's segment ends ``a``, ``b`` (m, shape (k, 2)) and the capsules' radius (m).
 
-    A cell's square meets the grown swept region when its centre is within the radius of a
-    segment ``[a_i, b_i]``.
+    A cell's square meets the grown swept region when it comes within the radius of a
+    segment ``[a_i, b_i]`` (its centre within the radius plus half the cell's diagonal).
     """
     reach = float(np.max(np.hypot(*mover.shape_vertices.T)))
-    radius = reach + float(mover.radius_at(t1)) + float(grow) + res * math.sqrt(0.5)
+    radius = reach + float(mover.radius_at(t1)) + float(grow)
     pts = track(mover, float(t0), float(t1))
     a = pts[:-1] if pts.shape[0] > 1 else pts
     b = pts[1:] if pts.shape[0] > 1 else pts
@@ -218,17 +220,59 @@ def swept_cells(
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     c = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    a, b, radius = _capsules(mover, t0, t1, grow, res)
-    px = (ox + (c[:, 0, None] + 0.5) * res) - a[None, :, 0]
-    py = (oy + (c[:, 1, None] + 0.5) * res) - a[None, :, 1]
+    a, b, radius = _capsules(mover, t0, t1, grow)
+    centres = np.stack([ox + (c[:, 0] + 0.5) * res, oy + (c[:, 1] + 0.5) * res], axis=-1)
+    return np.any(square_segment_distances(centres, 0.5 * res, a, b) <= radius, axis=1)
+
+
+def _point_segment_distances(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Return the distances (m) from points ``p`` (shape (..., 2)) to segments ``[a, b]`` (same)."""
     d = b - a
-    dd = np.einsum("ij,ij->i", d, d)[None, :]
+    dd = np.sum(d * d, axis=-1)
+    w = p - a
     with np.errstate(divide="ignore", invalid="ignore"):
-        lam = np.where(
-            dd > 0.0, np.clip((px * d[None, :, 0] + py * d[None, :, 1]) / dd, 0.0, 1.0), 0.0
+        lam = np.where(dd > 0.0, np.clip(np.sum(w * d, axis=-1) / dd, 0.0, 1.0), 0.0)
+    return np.hypot(*(w - lam[..., None] * d).transpose(-1, *range(w.ndim - 1)))
+
+
+def square_segment_distances(
+    centres: np.ndarray, h: float, a: np.ndarray, b: np.ndarray
+) -> np.ndarray:
+    """Return the distances (m) from segments to axis-aligned squares, shape (n, k).
+
+    ``centres`` (m, shape (n, 2)): the squares' centres, ``h`` (m) their half side; ``a``,
+    ``b`` (m, shape (k, 2)): the segments' ends. 0 where they meet (the segment clipped to
+    the square's two slabs is not empty); else the nearer of the segment's ends to the square
+    and the square's corners to the segment (two disjoint convex sets are closest at a vertex
+    of one of them). The array form of :func:`~trajopt.moving._swept_kernel.square_segment_distance`.
+    """
+    p = np.asarray(a, dtype=float)[None, :, :] - np.asarray(centres, dtype=float)[:, None, :]
+    q = np.asarray(b, dtype=float)[None, :, :] - np.asarray(centres, dtype=float)[:, None, :]
+    d = q - p
+    lo = np.zeros(p.shape[:2])
+    hi = np.ones(p.shape[:2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for k in (0, 1):
+            flat = d[..., k] == 0.0
+            t1 = (-h - p[..., k]) / d[..., k]
+            t2 = (h - p[..., k]) / d[..., k]
+            lo = np.where(flat, lo, np.maximum(lo, np.minimum(t1, t2)))
+            hi = np.where(
+                flat, np.where(np.abs(p[..., k]) > h, -1.0, hi), np.minimum(hi, np.maximum(t1, t2))
+            )
+    meet = lo <= hi
+
+    def to_square(x: np.ndarray) -> np.ndarray:
+        return np.hypot(
+            np.maximum(np.abs(x[..., 0]) - h, 0.0), np.maximum(np.abs(x[..., 1]) - h, 0.0)
         )
-    dist = np.hypot(px - lam * d[None, :, 0], py - lam * d[None, :, 1])
-    return np.any(dist <= radius, axis=1)
+
+    best = np.minimum(to_square(p), to_square(q))
+    for sx in (-h, h):
+        for sy in (-h, h):
+            corner = np.broadcast_to(np.array([sx, sy]), p.shape)
+            best = np.minimum(best, _point_segment_distances(corner, p, q))
+    return np.where(meet, 0.0, best)
 
 
 def mark_swept(
@@ -301,14 +345,15 @@ def _all_kept(
 ) -> bool:
     """Whether every capsule of the regions lies in one kept disc (its cells all stay free).
 
-    A marked cell's centre is within the capsule's radius of its segment; a segment whose
-    ends are within a kept disc's radius less the capsule's of its centre keeps every such
+    A marked cell's centre is within the capsule's radius plus half the cell's diagonal of its
+    segment; a segment whose ends are within a kept disc's radius less that of its centre keeps every such
     centre in the disc (a disc is convex), whose cells :func:`mark_swept` leaves as they are.
     """
     if not keep:
         return False
     for mover, t0, t1 in regions:
-        a, b, radius = _capsules(mover, t0, t1, grow, res)
+        a, b, radius = _capsules(mover, t0, t1, grow)
+        radius += res * math.sqrt(0.5)
         ends = np.vstack([a, b])
         if not any(
             np.all(np.hypot(*(ends - np.asarray(p, dtype=float)).T) <= r - radius) for p, r in keep
