@@ -21,6 +21,8 @@ import trajopt.moving
 from astar.grid import OccupancyGrid
 from tests.trajopt.moving.reference import brute_min, dense_min
 from trajopt.errors import BlockedError
+from trajopt.moving._swept import square_segment_distances
+from trajopt.moving._swept_kernel import square_segment_distance
 
 RES = 0.05
 
@@ -496,35 +498,68 @@ def test_swept_mask_covers_the_shape_at_dense_times():
     assert not mask[0:4, 70:80].any()  # far from the track
 
 
+def _square_distance(c, h, pts):
+    """Distances (m) from points ``pts`` (shape (k, 2)) to the squares of centres ``c`` (shape
+    (..., 2)) and half side ``h``: the nearest over the points, written out here."""
+    best = np.full(c.shape[:-1], np.inf)
+    for p in pts:
+        dx = np.maximum(np.abs(c[..., 0] - p[0]) - h, 0.0)
+        dy = np.maximum(np.abs(c[..., 1] - p[1]) - h, 0.0)
+        best = np.minimum(best, np.hypot(dx, dy))
+    return best
+
+
+def _dense_track(pts, step):
+    """The polyline through ``pts`` sampled every ``step`` (m) or closer, ends included."""
+    out = [pts[:1]]
+    for a, b in zip(pts[:-1], pts[1:], strict=True):
+        n = max(1, int(np.ceil(np.hypot(*(b - a)) / step)))
+        out.append(a + np.linspace(0.0, 1.0, n + 1)[1:, None] * (b - a))
+    return np.vstack(out)
+
+
 @pytest.mark.parametrize("t0, t1", [(0.0, 4.0), (1.3, 1.3), (2.2, 9.0)])
-def test_swept_mask_is_the_cells_near_the_track(t0, t1):
-    """The marked cells are those whose centre is within the grown radius plus half a cell's
-    diagonal of the track polyline (brute force over every cell, partly off the map)."""
+def test_swept_mask_is_the_cells_whose_square_comes_near_the_track(t0, t1):
+    """The marked cells are those whose square comes within the grown radius of the track
+    polyline (brute force over every cell, partly off the map, the track sampled every
+    0.5 mm: equal but for cells within that sampling of the boundary)."""
     grid = _grid((50, 70), [])
     m = trajopt.MovingObstacle.from_waypoints(
         [0.0, 1.0, 2.5, 4.0], [(-0.3, 0.4), (1.2, 1.9), (3.1, 1.0), (3.1, 2.6)], radius=0.15
     )
     mask = trajopt.moving.swept_mask(grid, m, t0, t1, 0.05)
     res = float(grid.resolution)
-    radius = 0.15 + 0.05 + res * np.sqrt(0.5)
+    radius = 0.15 + 0.05
     iy, ix = np.mgrid[0:50, 0:70]
     c = np.asarray(grid.origin) + (np.stack([ix, iy], -1) + 0.5) * res  # (50, 70, 2)
     ts = np.concatenate([[t0], m.times[(m.times > t0) & (m.times < t1)], [t1]])
-    pts = m.position_at(ts)
-    best = np.full((50, 70), np.inf)
-    for a, b in zip(pts[:-1], pts[1:], strict=True):
-        d = b - a
-        lam = np.clip(((c - a) @ d) / max(float(d @ d), 1e-300), 0.0, 1.0)
-        best = np.minimum(best, np.hypot(*(c - a - lam[..., None] * d).transpose(2, 0, 1)))
+    step = 5e-4
+    best = _square_distance(c, 0.5 * res, _dense_track(m.position_at(ts), step))
     expect = best <= radius
-    # equal but for cells within rounding of the boundary
     differ = mask != expect
-    assert np.all(np.abs(best[differ] - radius) < 1e-9)
+    assert np.all(np.abs(best[differ] - radius) <= 0.5 * step + 1e-9)
     assert expect.sum() > 20
     cells = np.stack([ix.ravel(), iy.ravel()], axis=1)
     asked = trajopt.moving.swept_cells(grid, m, t0, t1, 0.05, cells)  # the same test, cell by cell
-    differ = asked != expect.ravel()
-    assert np.all(np.abs(best.ravel()[differ] - radius) < 1e-9)
+    assert np.array_equal(asked, mask.ravel())
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seg=st.lists(st.floats(-0.3, 0.3), min_size=4, max_size=4),
+    h=st.floats(0.005, 0.1),
+)
+def test_square_segment_distance_against_dense_samples(seg, h):
+    """The segment-to-square distance (compiled and array forms) is the smallest distance of
+    the segment's dense samples to the square (0 when one is inside), within the sampling."""
+    a, b = np.array(seg[:2]), np.array(seg[2:])
+    c = np.array([[0.0, 0.0], [0.03, -0.05], [-0.2, 0.1]])
+    step = 1e-4
+    want = _square_distance(c, h, _dense_track(np.stack([a, b]), step))
+    got = square_segment_distances(c, h, a[None], b[None])[:, 0]
+    one = [square_segment_distance(*ci, h, *a, *b) for ci in c]
+    assert np.all(got <= want + 1e-12) and np.all(got >= want - 0.5 * step - 1e-12)
+    assert np.allclose(one, got, rtol=0.0, atol=1e-12)
 
 
 def test_a_detour_whose_grid_path_follows_the_blocked_path_goes_after_the_waits(bay):
@@ -751,10 +786,11 @@ def test_reached_swept_mask_on_a_head_on_walker_by_hand():
 @given(seed=st.integers(0, 10_000))
 def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
     """Brute force over 4 ms samples of random tracks (a stop on the way, growth, a polygon):
-    every cell the mover's bounding disc covers at a time ``t`` with ``speed t >= |c - o| -
-    slack - h`` is marked; every marked cell is covered at such a time, within the samples'
-    spacing (a mover moves at most ``v dt`` between two); with the late rule, only at times
-    up to its guess of when the robot has passed."""
+    every cell whose square the mover's bounding disc meets at a time ``t`` with ``speed t >=
+    |c - o| - slack - h`` is marked; every marked cell's centre is within the disc's radius
+    plus ``h`` at such a time, within the samples' spacing (a mover moves at most ``v dt``
+    between two); with the late rule, only at times up to its guess of when the robot has
+    passed."""
     rng = np.random.default_rng(seed)
     grid = _grid((50, 70), [])
     times = np.cumsum(rng.uniform(0.3, 1.5, 5)) - 0.5
@@ -781,9 +817,10 @@ def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
     ub = np.full(c.shape[0], np.inf)
     if late[0] > 0.0:  # the guess of when the robot has passed: first covered later, free
         ub = late[0] * (np.hypot(*(c - origin).T) + slack + h) / speed + late[1]
-    seen = np.any(
-        (d <= big_r) & (speed * t[None, :] >= far[:, None]) & (t[None, :] <= ub[:, None]), axis=1
-    )
+    dx = np.maximum(np.abs(c[:, None, 0] - p[None, :, 0]) - 0.5 * RES, 0.0)
+    dy = np.maximum(np.abs(c[:, None, 1] - p[None, :, 1]) - 0.5 * RES, 0.0)
+    hit = np.hypot(dx, dy) <= big_r - h  # the disc meets the cell's square
+    seen = np.any(hit & (speed * t[None, :] >= far[:, None]) & (t[None, :] <= ub[:, None]), axis=1)
     v = float(mover.speed_max())
     near = np.any(
         (d <= big_r + v * dt)
@@ -792,7 +829,7 @@ def test_reached_swept_mask_holds_every_meeting_at_dense_times(seed):
         axis=1,
     )
     if t1 >= mover.t_last:  # it stands at its last place for ever: any time is late enough
-        seen |= (d[:, -1] <= big_r) & (ub >= t_end)
+        seen |= hit[:, -1] & (ub >= t_end)
         near |= (d[:, -1] <= big_r + 1e-9) & (ub >= t_end - 1e-9)
     flat = mask.ravel()
     assert np.all(flat[seen])  # every sampled meeting is marked
