@@ -19,7 +19,13 @@ from hypothesis import strategies as st
 import trajopt
 import trajopt.moving
 from astar.grid import OccupancyGrid
-from tests.trajopt.moving.reference import brute_min, dense_min
+from tests.trajopt.moving.reference import (
+    brute_min,
+    check_motion,
+    check_trajectory,
+    dense_min,
+    positions,
+)
 from trajopt.errors import BlockedError
 from trajopt.moving._swept import square_segment_distances
 from trajopt.moving._swept_kernel import square_segment_distance
@@ -885,3 +891,63 @@ def test_mark_swept_adds_no_cell_exactly_when_the_kept_discs_hold_the_region(see
         assert (got is None) == (not add.any())
         if got is not None:
             assert np.array_equal(np.asarray(got.occupied), np.asarray(grid.occupied) | add)
+
+
+def _with_final_discs(grid, movers, margin, slack=0.0):
+    """``grid`` with every cell marked whose square comes within a mover's final disc (its
+    last place, radius plus growth until then, farthest vertex and ``margin``) plus
+    ``slack`` (m) of its centre: the waiting witness's map (``slack`` 0), written here."""
+    occ = np.array(grid.occupied)
+    iy, ix = np.mgrid[0 : occ.shape[0], 0 : occ.shape[1]]
+    c = np.asarray(grid.origin) + (np.stack([ix, iy], -1) + 0.5) * grid.resolution
+    for m in movers:
+        reach = 0.0 if m.vertices is None else float(np.max(np.hypot(*np.asarray(m.vertices).T)))
+        r = m.radius + m.growth * max(float(m.times[-1]), 0.0) + reach + margin
+        occ |= _square_distance(c, 0.5 * grid.resolution, m.positions[-1:]) <= r + slack
+    return OccupancyGrid(occ, grid.resolution, grid.origin)
+
+
+def _waiting_witness(grid, robot, start, goal, movers, margin):
+    """The earliest arrival (s) of: rest at the start for a multiple of 10 ms, then drive the
+    plan round the movers' final discs (:func:`_with_final_discs`), as the reference
+    (:func:`~tests.trajopt.moving.reference.check_motion`) proves clear; and that plan."""
+    traj = trajopt.Planner(_with_final_discs(grid, movers, margin), robot).plan(start, goal)
+    for j in range(2000):
+        wait = 0.01 * j
+
+        def where(t, wait=wait):
+            return positions(traj, np.clip(np.asarray(t) - wait, 0.0, None))
+
+        chk = check_motion(
+            where, wait + traj.duration, movers, radius=robot.radius,
+            speed=robot.v_max + robot.a_max * 1e-3, margin=margin, grid=grid,
+        )  # fmt: skip
+        if chk.ok:
+            return wait + float(traj.duration), traj
+    raise AssertionError("no wait found")
+
+
+@pytest.mark.parametrize("drive", ["differential", "omni"])
+def test_a_cart_stopping_on_the_path_is_passed_no_later_than_the_waiting_witness(drive):
+    """A cart drives in from the side and stops on the straight way of a room: the re-route
+    arrives no later than the waiting witness (rest at the start while needed, then the plan
+    round the cart's final disc; found here with the reference), and passes the reference
+    check. The map of that witness is the one round the cart's final place: a marking of
+    every cell whose centre is within the disc's radius plus half a cell's diagonal (the
+    marking before this one) gives a route that arrives strictly later than the witness."""
+    grid = _grid((80, 180), [(0.5, 8.5, 0.5, 3.5)])
+    robot = trajopt.Robot(radius=0.2, drive=drive)
+    start, goal, margin = (1.0, 2.0), (8.0, 2.0), 0.05
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 2.0], [(4.0, 3.2), (4.0, 2.0)], radius=0.27, name="cart"
+    )
+    out = trajopt.Planner(grid, robot).plan(
+        start, goal, moving_obstacles=[cart], mover_margin=margin
+    )
+    assert out.stats["moving"]["route"] == "rerouted"
+    chk = check_trajectory(out, [cart], margin=margin, grid=grid)
+    assert chk.ok
+    witness, _ = _waiting_witness(grid, robot, start, goal, [cart], margin)
+    assert out.duration <= witness + 1e-6
+    wider = _with_final_discs(grid, [cart], margin, slack=0.5 * RES * math.sqrt(2.0))
+    assert trajopt.Planner(wider, robot).plan(start, goal).duration > witness + 1e-3
