@@ -20,7 +20,7 @@ from trajopt.kernel_cache import watch_compiles
 watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def square_segment_distance(cx, cy, h, ax, ay, bx, by):  # pragma: no cover - compiled
     """Return the distance (m) from the segment ``[a, b]`` (m) to the square of centre ``c``.
 
