@@ -60,6 +60,14 @@ def swept_mask(
         ``mask[iy, ix]``: the cell's square meets the grown swept region (with ``box``, shape
         ``(iy1 - iy0 + 1, ix1 - ix0 + 1)``, its cell ``(ix0, iy0)`` first).
     """
+    a, b, radius = _capsules(mover, t0, t1, grow)
+    return _capsule_mask(_frame(grid, box), a, b, radius)
+
+
+def _frame(
+    grid: OccupancyGrid, box: tuple[int, int, int, int] | None
+) -> tuple[float, float, float, int, int]:
+    """Return ``(ox, oy, res, nx, ny)`` of ``grid``, or of its cell ``box`` as a grid of its own."""
     res = float(grid.resolution)
     ox, oy = (float(v) for v in grid.origin)
     ny, nx = grid.shape
@@ -67,8 +75,7 @@ def swept_mask(
         bx0, bx1, by0, by1 = (int(v) for v in box)
         ox, oy = ox + bx0 * res, oy + by0 * res
         ny, nx = by1 - by0 + 1, bx1 - bx0 + 1
-    a, b, radius = _capsules(mover, t0, t1, grow)
-    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius)
+    return ox, oy, res, nx, ny
 
 
 def reached_swept_mask(
@@ -81,6 +88,7 @@ def reached_swept_mask(
     speed: float,
     slack: float,
     late: tuple[float, float] = (0.0, 0.0),
+    box: tuple[int, int, int, int] | None = None,
 ) -> np.ndarray:
     """Return the cells the mover covers in ``[t0, t1]`` at a time a robot could be near them.
 
@@ -126,16 +134,16 @@ def reached_swept_mask(
         Distance (m), >= 0: as above.
     late : (float, float)
         ``(factor, extra)`` (1, s) as above; ``factor <= 0``: no such rule.
+    box : (int, int, int, int), optional
+        As :func:`swept_mask`'s: only the cells of this box of ``grid``.
 
     Returns
     -------
     ndarray of bool, shape (ny, nx)
         ``mask[iy, ix]``: the cell may hold the grown mover when a robot could be near it;
-        a subset of :func:`swept_mask` over ``[t0, t1]``.
+        a subset of :func:`swept_mask` over ``[t0, t1]`` (with ``box``, of the box's shape).
     """
-    res = float(grid.resolution)
-    ox, oy = (float(v) for v in grid.origin)
-    ny, nx = grid.shape
+    ox, oy, res, nx, ny = _frame(grid, box)
     t0, t1 = float(t0), float(t1)
     times = mover.times
     knots = np.concatenate([[t0], times[(times > t0) & (times < t1)], [t1] if t1 > t0 else []])
@@ -309,50 +317,83 @@ def mark_swept(
         The marked map (same shape, resolution and origin).
     """
     res = float(grid.resolution)
-    if _all_kept(regions, grow, res, keep):
+    caps = [_capsules(mover, t0, t1, grow) for mover, t0, t1 in regions]
+    if _all_kept(caps, res, keep):
         return None  # every capsule inside a kept disc: no cell to add
-    add = np.zeros(grid.shape, dtype=bool)
-    for mover, t0, t1 in regions:
+    box = _cells_of(grid, caps)
+    if box is None:
+        return None  # every capsule off the map
+    bx0, bx1, by0, by1 = box
+    add = np.zeros((by1 - by0 + 1, bx1 - bx0 + 1), dtype=bool)
+    for (mover, t0, t1), (a, b, radius) in zip(regions, caps, strict=True):
         if reach is None:
-            add |= swept_mask(grid, mover, t0, t1, grow)
+            add |= _capsule_mask(_frame(grid, box), a, b, radius)
         else:
-            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late)
+            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late, box=box)
     ox, oy = (float(v) for v in grid.origin)
-    ny, nx = grid.shape
     for p, r in keep:
-        ix0 = max(0, int(math.floor((float(p[0]) - r - ox) / res)))
-        ix1 = min(nx - 1, int(math.floor((float(p[0]) + r - ox) / res)))
-        iy0 = max(0, int(math.floor((float(p[1]) - r - oy) / res)))
-        iy1 = min(ny - 1, int(math.floor((float(p[1]) + r - oy) / res)))
+        ix0 = max(bx0, int(math.floor((float(p[0]) - r - ox) / res)))
+        ix1 = min(bx1, int(math.floor((float(p[0]) + r - ox) / res)))
+        iy0 = max(by0, int(math.floor((float(p[1]) - r - oy) / res)))
+        iy1 = min(by1, int(math.floor((float(p[1]) + r - oy) / res)))
         if ix0 > ix1 or iy0 > iy1:
             continue
         cx = ox + (np.arange(ix0, ix1 + 1) + 0.5) * res
         cy = oy + (np.arange(iy0, iy1 + 1) + 0.5) * res
         near = np.hypot(cx[None, :] - float(p[0]), cy[:, None] - float(p[1])) <= r
-        add[iy0 : iy1 + 1, ix0 : ix1 + 1] &= ~near
+        add[iy0 - by0 : iy1 - by0 + 1, ix0 - bx0 : ix1 - bx0 + 1] &= ~near
     occ = np.asarray(grid.occupied)
-    new = add & ~occ
+    part = (slice(by0, by1 + 1), slice(bx0, bx1 + 1))
+    new = add & ~occ[part]
     if not new.any():
         return None
-    return grid.with_occupied(occ | new)
+    out = np.array(occ)
+    out[part] |= new
+    return grid.with_occupied(out)
+
+
+def _cells_of(
+    grid: OccupancyGrid, caps: Sequence[tuple[np.ndarray, np.ndarray, float]]
+) -> tuple[int, int, int, int] | None:
+    """Return the cell box ``(ix0, ix1, iy0, iy1)`` of every cell the capsules can mark.
+
+    The capsules are :func:`_capsules`' ends and radius; the box is cut to the grid, ``None``
+    when nothing of it is left.
+    """
+    res = float(grid.resolution)
+    ox, oy = (float(v) for v in grid.origin)
+    ny, nx = grid.shape
+    half_diag = res * math.sqrt(0.5)
+    lo = np.min(
+        [np.minimum(a.min(axis=0), b.min(axis=0)) - r - half_diag for a, b, r in caps], axis=0
+    )
+    hi = np.max(
+        [np.maximum(a.max(axis=0), b.max(axis=0)) + r + half_diag for a, b, r in caps], axis=0
+    )
+    ix0 = max(0, int(math.floor((float(lo[0]) - ox) / res)))
+    ix1 = min(nx - 1, int(math.floor((float(hi[0]) - ox) / res)))
+    iy0 = max(0, int(math.floor((float(lo[1]) - oy) / res)))
+    iy1 = min(ny - 1, int(math.floor((float(hi[1]) - oy) / res)))
+    if ix0 > ix1 or iy0 > iy1:
+        return None
+    return ix0, ix1, iy0, iy1
 
 
 def _all_kept(
-    regions: Sequence[tuple[MovingObstacle, float, float]],
-    grow: float,
+    caps: Sequence[tuple[np.ndarray, np.ndarray, float]],
     res: float,
     keep: Sequence[tuple[np.ndarray, float]],
 ) -> bool:
     """Whether every capsule of the regions lies in one kept disc (its cells all stay free).
 
-    A marked cell's centre is within the capsule's radius plus half the cell's diagonal of its
-    segment; a segment whose ends are within a kept disc's radius less that of its centre keeps every such
-    centre in the disc (a disc is convex), whose cells :func:`mark_swept` leaves as they are.
+    ``caps``: :func:`_capsules`' ends and radius of each region. A marked cell's centre is
+    within the capsule's radius plus half the cell's diagonal of its segment; a segment whose
+    ends are within a kept disc's radius less that of its centre keeps every such centre in
+    the disc (a disc is convex), whose cells :func:`mark_swept` leaves as they are.
     """
     if not keep:
         return False
-    for mover, t0, t1 in regions:
-        a, b, radius = _capsules(mover, t0, t1, grow)
+    for a, b, radius in caps:
         radius += res * math.sqrt(0.5)
         ends = np.vstack([a, b])
         if not any(

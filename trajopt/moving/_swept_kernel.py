@@ -101,6 +101,7 @@ def capsule_kernel(
     mask = np.zeros((ny, nx), dtype=np.bool_)
     half_diag = res * math.sqrt(0.5)
     outer = radius + half_diag  # no centre farther than this has its square within radius
+    r2, outer2 = radius * radius, outer * outer
     for i in range(a.shape[0]):
         ax, ay, bx, by = a[i, 0], a[i, 1], b[i, 0], b[i, 1]
         ix0 = max(0, int(math.floor((min(ax, bx) - outer - ox) / res)))
@@ -109,6 +110,8 @@ def capsule_kernel(
         iy1 = min(ny - 1, int(math.floor((max(ay, by) + outer - oy) / res)))
         dx, dy = bx - ax, by - ay
         dd = dx * dx + dy * dy
+        inv = 1.0 / dd if dd > 0.0 else 0.0
+        forever = math.isinf(tb[i])
         for iy in range(iy0, iy1 + 1):
             cy = oy + (iy + 0.5) * res
             py = cy - ay
@@ -117,37 +120,33 @@ def capsule_kernel(
                     continue
                 cx = ox + (ix + 0.5) * res
                 px = cx - ax
-                lam = 0.0
-                if dd > 0.0:
-                    lam = min(max((px * dx + py * dy) / dd, 0.0), 1.0)
-                dc = math.hypot(px - lam * dx, py - lam * dy)
-                if dc > outer:
+                along = (px * dx + py * dy) * inv
+                lam = min(max(along, 0.0), 1.0)
+                ex, ey = px - lam * dx, py - lam * dy
+                dc2 = ex * ex + ey * ey
+                if dc2 > outer2:
                     continue
-                if dc > radius and (
-                    square_segment_distance(cx, cy, 0.5 * res, ax, ay, bx, by) > radius
-                ):
-                    continue
-                if timed:
-                    if math.isinf(tb[i]):
-                        last = math.inf
-                    else:
-                        mu = 1.0
-                        if dd > 0.0:
-                            along = (px * dx + py * dy) / dd
-                            off = (px * dy - py * dx) ** 2 / dd
-                            mu = min(1.0, along + math.sqrt(max(outer * outer - off, 0.0) / dd))
+                if timed:  # the times the point is within outer of the centre: cheap first
+                    root = 0.0
+                    if dd > 0.0:
+                        off = (px * dy - py * dx) ** 2 * inv
+                        root = math.sqrt(max(outer2 - off, 0.0) * inv)
+                    last = math.inf
+                    if not forever:
+                        mu = min(1.0, along + root) if dd > 0.0 else 1.0
                         last = ta[i] + mu * (tb[i] - ta[i])
                     dist = math.hypot(cx - origin[0], cy - origin[1])
                     if dist - slack - half_diag > speed * last:
                         continue
                     if late_factor > 0.0:
-                        nu = 0.0
-                        if dd > 0.0:
-                            along = (px * dx + py * dy) / dd
-                            off = (px * dy - py * dx) ** 2 / dd
-                            nu = max(0.0, along - math.sqrt(max(outer * outer - off, 0.0) / dd))
-                        first = ta[i] + nu * (tb[i] - ta[i]) if not math.isinf(tb[i]) else ta[i]
+                        first = ta[i]
+                        if not forever and dd > 0.0:
+                            first = ta[i] + max(0.0, along - root) * (tb[i] - ta[i])
                         if first > late_factor * (dist + slack + half_diag) / speed + late_s:
                             continue
+                if dc2 > r2 and (
+                    square_segment_distance(cx, cy, 0.5 * res, ax, ay, bx, by) > radius
+                ):
+                    continue
                 mask[iy, ix] = True
     return mask
