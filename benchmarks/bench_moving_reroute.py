@@ -26,7 +26,10 @@ first, with a slack, and on the curve when they find nothing there); ``raise ms`
 the query's time less its plain plan's and the proof's (a difference of wall times, so
 noisy; negative where the screen of the grid path skips the static plan's fit, the proof's
 time on the curve being that of a plan not made). ``cpu ms`` is the query's CPU time (``time.process_time``). The machine is shared:
-times are noisy.
+times are noisy. The kernels are loaded before the timed parts (``trajopt.warm_up()``): the
+plain plans are timed after an untimed call of the same query, and without it the first
+queries with movers (on the first map) would load the moving-obstacle kernels from numba's
+disk cache inside their timed call.
 
 A second table splits the re-routes' wall time (medians, ms; ``x plain``: each part over the
 query's plain plan): ``static`` (the static plan and the proof that it is blocked: the
@@ -205,6 +208,7 @@ def main() -> None:
     if not d.is_dir():
         print(f"shared data not found at {d} (set TRAJOPT_DATA)")
         return
+    trajopt.warm_up()  # every kernel loaded: none loads inside a timed call
     if args.part in ("plan", "both"):
         plan_part(d, args)
     if args.part in ("replan", "both"):

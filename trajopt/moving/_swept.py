@@ -222,65 +222,18 @@ def swept_cells(
 ) -> np.ndarray:
     """Return whether each of ``cells`` (``(ix, iy)``, shape (n, 2)) is in :func:`swept_mask`.
 
-    The same test on the given cells only (bool, shape (n,)): a cell far cheaper to ask
-    about than the whole grid's mask.
+    The same test on the given cells only (bool, shape (n,)): the compiled loop runs on the
+    cells' bounding box as a grid of its own (the same cell centres), where it visits only
+    the capsules' own boxes, far cheaper than the whole grid's mask.
     """
-    res = float(grid.resolution)
-    ox, oy = (float(v) for v in grid.origin)
     c = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    if c.shape[0] == 0:
+        return np.zeros(0, dtype=bool)
+    x0, y0 = (int(v) for v in c.min(axis=0))
+    x1, y1 = (int(v) for v in c.max(axis=0))
     a, b, radius = _capsules(mover, t0, t1, grow)
-    centres = np.stack([ox + (c[:, 0] + 0.5) * res, oy + (c[:, 1] + 0.5) * res], axis=-1)
-    return np.any(square_segment_distances(centres, 0.5 * res, a, b) <= radius, axis=1)
-
-
-def _point_segment_distances(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Return the distances (m) from points ``p`` (shape (..., 2)) to segments ``[a, b]`` (same)."""
-    d = b - a
-    dd = np.sum(d * d, axis=-1)
-    w = p - a
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lam = np.where(dd > 0.0, np.clip(np.sum(w * d, axis=-1) / dd, 0.0, 1.0), 0.0)
-    return np.hypot(*(w - lam[..., None] * d).transpose(-1, *range(w.ndim - 1)))
-
-
-def square_segment_distances(
-    centres: np.ndarray, h: float, a: np.ndarray, b: np.ndarray
-) -> np.ndarray:
-    """Return the distances (m) from segments to axis-aligned squares, shape (n, k).
-
-    ``centres`` (m, shape (n, 2)): the squares' centres, ``h`` (m) their half side; ``a``,
-    ``b`` (m, shape (k, 2)): the segments' ends. 0 where they meet (the segment clipped to
-    the square's two slabs is not empty); else the nearer of the segment's ends to the square
-    and the square's corners to the segment (two disjoint convex sets are closest at a vertex
-    of one of them). The array form of :func:`~trajopt.moving._swept_kernel.square_segment_distance`.
-    """
-    p = np.asarray(a, dtype=float)[None, :, :] - np.asarray(centres, dtype=float)[:, None, :]
-    q = np.asarray(b, dtype=float)[None, :, :] - np.asarray(centres, dtype=float)[:, None, :]
-    d = q - p
-    lo = np.zeros(p.shape[:2])
-    hi = np.ones(p.shape[:2])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for k in (0, 1):
-            flat = d[..., k] == 0.0
-            t1 = (-h - p[..., k]) / d[..., k]
-            t2 = (h - p[..., k]) / d[..., k]
-            lo = np.where(flat, lo, np.maximum(lo, np.minimum(t1, t2)))
-            hi = np.where(
-                flat, np.where(np.abs(p[..., k]) > h, -1.0, hi), np.minimum(hi, np.maximum(t1, t2))
-            )
-    meet = lo <= hi
-
-    def to_square(x: np.ndarray) -> np.ndarray:
-        return np.hypot(
-            np.maximum(np.abs(x[..., 0]) - h, 0.0), np.maximum(np.abs(x[..., 1]) - h, 0.0)
-        )
-
-    best = np.minimum(to_square(p), to_square(q))
-    for sx in (-h, h):
-        for sy in (-h, h):
-            corner = np.broadcast_to(np.array([sx, sy]), p.shape)
-            best = np.minimum(best, _point_segment_distances(corner, p, q))
-    return np.where(meet, 0.0, best)
+    mask = _capsule_mask(_frame(grid, (x0, x1, y0, y1)), a, b, radius)
+    return mask[c[:, 1] - y0, c[:, 0] - x0]
 
 
 def mark_swept(

@@ -27,7 +27,6 @@ from tests.trajopt.moving.reference import (
     positions,
 )
 from trajopt.errors import BlockedError
-from trajopt.moving._swept import square_segment_distances
 from trajopt.moving._swept_kernel import square_segment_distance
 
 RES = 0.05
@@ -556,16 +555,14 @@ def test_swept_mask_is_the_cells_whose_square_comes_near_the_track(t0, t1):
     h=st.floats(0.005, 0.1),
 )
 def test_square_segment_distance_against_dense_samples(seg, h):
-    """The segment-to-square distance (compiled and array forms) is the smallest distance of
-    the segment's dense samples to the square (0 when one is inside), within the sampling."""
+    """The segment-to-square distance (compiled) is the smallest distance of the segment's
+    dense samples to the square (0 when one is inside), within the sampling."""
     a, b = np.array(seg[:2]), np.array(seg[2:])
     c = np.array([[0.0, 0.0], [0.03, -0.05], [-0.2, 0.1]])
     step = 1e-4
     want = _square_distance(c, h, _dense_track(np.stack([a, b]), step))
-    got = square_segment_distances(c, h, a[None], b[None])[:, 0]
-    one = [square_segment_distance(*ci, h, *a, *b) for ci in c]
+    got = np.array([square_segment_distance(*ci, h, *a, *b) for ci in c])
     assert np.all(got <= want + 1e-12) and np.all(got >= want - 0.5 * step - 1e-12)
-    assert np.allclose(one, got, rtol=0.0, atol=1e-12)
 
 
 def test_a_detour_whose_grid_path_follows_the_blocked_path_goes_after_the_waits(bay):
