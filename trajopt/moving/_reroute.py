@@ -8,10 +8,11 @@ head-on along a corridor (Fraichard's incompleteness of the path-speed split). W
 for **all** the movers and certified (:func:`~trajopt.moving.certify_movers`):
 
 1. ``"rerouted"``: the same query on the map with every mover's final place marked (where
-   each stands after its prediction ends; grown by the margin, and the planner inflates it by
+   each stands after its prediction ends; the cells whose square meets its bounding disc
+   grown by the margin, :func:`~trajopt.moving.mark_swept`, and the planner inflates them by
    the robot's radius as any obstacle): a route that no mover stays on; its re-timing waits
    at the start, or on the way, while a mover still passes (the waiting witness of the
-   issue), usually the smallest detour;
+   issue, whose route is planned on the same marks), usually the smallest detour;
 2. ``"rerouted"``: the same query with the blocking mover's swept region marked where the
    robot may meet it (:func:`~trajopt.moving.reached_swept_mask`): the cells it covers only
    before a robot from the start at its top speed (forwards or backwards) could come near
