@@ -16,7 +16,9 @@
   (:func:`reachable_times`: its sweep of the necessary grid, node by node;
   :func:`meets_head_on`: a cheap screen for when it is worth running first);
 * :func:`reroute`: another route, or a wait at a safe place, when no re-timing along the
-  path avoids the movers (:func:`goal_taken`: none when a mover ends standing on the goal;
+  path avoids the movers (:func:`around_final_places`: its first route, also tried when the
+  re-timing waits and a mover ends beside the path; :func:`goal_taken`: none when a mover
+  ends standing on the goal;
   :func:`car_headings`: how a car stands at a safe place; :func:`safe_places`: where it
   waits); :func:`swept_mask`,
   :func:`mark_swept`: a mover's swept region on a grid (:func:`swept_cells`: on given cells;
@@ -41,6 +43,7 @@ from trajopt.moving._parked import over_start, parked_on_path, settle_time
 from trajopt.moving._reroute import (
     N_SAFE_PLACES,
     SAFE_PLACE_SPACING,
+    around_final_places,
     car_headings,
     goal_taken,
     reroute,
@@ -56,6 +59,7 @@ __all__ = [
     "MoverCertificate",
     "MovingObstacle",
     "STGrid",
+    "around_final_places",
     "car_headings",
     "certify_movers",
     "check_movers",

@@ -354,6 +354,71 @@ def reroute(
     ) from blocked
 
 
+def around_final_places(
+    start: np.ndarray,
+    goal: np.ndarray,
+    robot: Any,
+    movers: Sequence[MovingObstacle],
+    margin: float,
+    retimed: Any,
+    *,
+    grid: OccupancyGrid,
+    plan_leg: PlanLeg,
+    path: np.ndarray,
+) -> Any:
+    """Return the earlier of ``retimed`` and the route round the movers' final places.
+
+    ``retimed``: the static plan re-timed for the movers (certified), whose path ``path``
+    (points, m, shape (n, 2)) is the static plan's. When it waits (it arrives later than the
+    path's own drive, ``stats["moving"]["plan"]`` not ``"as planned"``) and a mover's final
+    place, grown by the margin and the robot's radius, covers a point of the path beyond the
+    kept discs at its ends, the first candidate of :func:`reroute` is planned too (the same
+    query on the map with every mover's final place marked), re-timed for all the movers and
+    certified: the waiting witness's construction (rest at the start while a mover passes,
+    then the route round the final places) is among its re-timings, and a wait on the static
+    path may last longer than one on that route (a mover that ends beside the path holds the
+    static path's timing back). The earlier arrival is returned; the route's with
+    ``stats["moving"]["route"] == "rerouted"``. Either way ``stats["moving"]["final_places"]``
+    tells what was tried (``what``, ``result``, ``time_s``); a failed candidate (no path, a
+    blocked re-timing) leaves ``retimed``.
+    """
+    t0 = time.perf_counter()
+    mv = retimed.stats["moving"]
+    if mv.get("plan") == "as planned" or not movers:
+        return retimed
+    p0 = np.asarray(start, dtype=float).reshape(2)
+    p1 = np.asarray(goal, dtype=float).reshape(2)
+    keep = [(p0, robot.radius + 2.0 * grid.resolution), (p1, robot.radius + 2.0 * grid.resolution)]
+    finals = [(m, max(m.t_last, 0.0), max(m.t_last, 0.0)) for m in movers]
+    pts = _beyond(np.asarray(path, dtype=float).reshape(-1, 2), keep)
+    if _keeps_clear(grid, finals, margin + robot.radius, pts):
+        return retimed  # the marks would leave the static path as it is
+    what = "around every mover's final place"
+    try:
+        marked = mark_swept(grid, finals, margin, keep)
+        if marked is None:
+            raise BlockedError("the marked region adds no cell to the map")
+        out = retime_chain(plan_leg(marked, None, None, None), movers, margin=margin)
+    except TrajoptError as exc:
+        result, out = f"{type(exc).__name__}: {exc}", None
+    else:
+        result = f"ok, arrives at {float(out.duration):.3f} s"
+    took = time.perf_counter() - t0
+    tried = {"what": what, "result": result, "time_s": took}
+    if out is not None and float(out.duration) < float(retimed.duration):
+        out.stats["moving"] = dict(
+            out.stats["moving"],
+            route="rerouted",
+            final_places=tried,
+            reroute=[tried],
+            reroute_time_s=took,
+            blocked_before_timing=False,
+        )
+        return out
+    retimed.stats["moving"] = dict(mv, final_places=tried)
+    return retimed
+
+
 def _path_length(plan: Any) -> float:
     """Return a plan's path length (m): its curves end to end."""
     return float(sum(float(c.length) for c in path_curves(plan)))

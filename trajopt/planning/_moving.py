@@ -9,6 +9,7 @@ same options on caches derived from the planner's. :meth:`trajopt.Planner.plan` 
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
@@ -21,6 +22,7 @@ from trajopt.errors import BlockedError, InvalidInputError, NoPathError, Trajopt
 from trajopt.motion import PlanResult
 from trajopt.moving import (
     MovingObstacle,
+    around_final_places,
     goal_taken,
     meets_head_on,
     no_way_past,
@@ -389,7 +391,10 @@ def plan_for_movers(
     re-timing provably gets past the movers (:func:`trajopt.moving.no_way_past`); when
     it is blocked, :func:`trajopt.moving.reroute` plans other routes on the map with the movers'
     swept regions marked (each leg planned by :func:`~trajopt.planning.run_query` with the
-    planner's options, on caches derived from the planner's for the marked map).
+    planner's options, on caches derived from the planner's for the marked map). A re-timing
+    that waits while a mover ends beside the path is compared with the route round the
+    movers' final places, the earlier arrival kept (:func:`trajopt.moving.around_final_places`:
+    the waiting witness's route, on which a shorter wait may do).
 
     Parameters
     ----------
@@ -404,7 +409,8 @@ def plan_for_movers(
     proved : bool
         The quick proofs already ran on ``out``'s path and found nothing (skipped here).
     reroute_blocked : bool
-        ``False``: a blocked plan raises its :class:`BlockedError` instead of re-routing.
+        ``False``: a blocked plan raises its :class:`BlockedError` instead of re-routing, and
+        a re-timed one is returned as it is (no route round the final places either).
     """
     if out.v_start != 0.0:
         raise InvalidInputError(
@@ -424,21 +430,57 @@ def plan_for_movers(
             blocked = exc
         else:
             kept.stats["moving"]["route"] = "retimed"
-            return kept
+            if not reroute_blocked:
+                return kept
+            return _earlier_round_final_places(kept, out, movers, margin, options, caches, request)
     if not reroute_blocked:
         raise blocked
-    if out.single_curve and _one_curve(out.robot, request):  # as the proofs before the timing
-        p0, p1 = _curve_ends(out.path)
-    else:
-        smp = out.sample(np.array([0.0, out.duration]))
-        p0 = np.array([smp.x[0], smp.y[0]], dtype=float)
-        p1 = np.array([smp.x[1], smp.y[1]], dtype=float)
+    p0, p1 = _plan_ends(out, request)
     out = _reroute(
         p0, p1, out.robot, movers, margin, blocked, options, caches, request,
         length=float(out.length),
     )  # fmt: skip
     out.stats["moving"]["blocked_before_timing"] = False
     return out
+
+
+def _plan_ends(out: PlanResult, request: PlanRequest) -> tuple[np.ndarray, np.ndarray]:
+    """Return a static plan's first and last points (m), each shape (2,), as a re-route reads them."""
+    if out.single_curve and _one_curve(out.robot, request):  # as the proofs before the timing
+        return _curve_ends(out.path)
+    smp = out.sample(np.array([0.0, out.duration]))
+    return (
+        np.array([smp.x[0], smp.y[0]], dtype=float),
+        np.array([smp.x[1], smp.y[1]], dtype=float),
+    )
+
+
+def _earlier_round_final_places(
+    kept: PlanResult,
+    out: PlanResult,
+    movers: tuple[MovingObstacle, ...],
+    margin: float,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+) -> PlanResult:
+    """Return the earlier of the re-timed static plan ``kept`` and the route round the final places.
+
+    :func:`trajopt.moving.around_final_places` on the static plan ``out``'s path (its centre
+    sampled at least every half cell), the route's leg planned as a re-route's
+    (:func:`_leg_planner`): tried only when ``kept`` waits and a mover ends beside the path.
+    """
+    if kept.stats["moving"].get("plan") == "as planned":
+        return kept
+    grid = caches.grid
+    n = int(math.ceil(float(out.length) / (0.5 * float(grid.resolution)))) + 2
+    smp = out.sample(np.linspace(0.0, float(out.duration), n))
+    path = np.stack([np.asarray(smp.x, dtype=float), np.asarray(smp.y, dtype=float)], axis=-1)
+    p0, p1 = _plan_ends(out, request)
+    plan_leg = _leg_planner(p0, out.robot, options, caches, request)[1]
+    return around_final_places(
+        p0, p1, out.robot, movers, margin, kept, grid=grid, plan_leg=plan_leg, path=path
+    )
 
 
 def _curve_ends(curve: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -462,13 +504,47 @@ def _reroute(
 ) -> PlanResult:
     """Re-route a blocked query (:func:`trajopt.moving.reroute`), its legs planned here.
 
-    ``length``: the blocked path's (m; :func:`trajopt.moving.reroute`'s).
+    ``length``: the blocked path's (m; :func:`trajopt.moving.reroute`'s). The legs, the
+    sketches and the free cells come from :func:`_leg_planner`.
+    """
+    free, plan_leg, sketch = _leg_planner(p0, robot, options, caches, request, path)
+    return reroute(
+        p0,
+        p1,
+        robot,
+        movers,
+        margin,
+        blocked,
+        grid=caches.grid,
+        free=free,
+        plan_leg=plan_leg,
+        path=path,
+        sketch=sketch if _disc_search(robot) else None,
+        label=component_labels,
+        length=length,
+    )
+
+
+def _leg_planner(
+    p0: np.ndarray,
+    robot: Robot,
+    options: PlannerOptions,
+    caches: PlannerCaches,
+    request: PlanRequest,
+    path: np.ndarray | None = None,
+) -> tuple[Any, Any, Any]:
+    """Return ``(free, plan_leg, sketch)`` of a re-route of ``request`` from ``p0`` (m).
+
+    ``free()``: where the centre may stand on the static map, in the start's part
+    (:func:`trajopt.moving.reroute`'s ``free``); ``plan_leg``: its ``plan_leg``, each leg
+    planned by :func:`~trajopt.planning.run_query` with the planner's options; ``sketch``:
+    the search's grid path on a marked map (:func:`_grid_path`).
 
     Each marked map's caches are derived once (:meth:`PlannerCaches.derived`), shared by its
-    ``sketch`` (:func:`_grid_path`) and its plan. Given the blocked ``path`` (a re-plan from
-    a stop on it, which stands in the blocking mover's swept region more often than not), a
-    differential drive's disc leg whose start or goal is shut in on the marked map
-    (:func:`shut_in`) is refused with a :class:`NoPathError` before the caches are derived.
+    ``sketch`` and its plan. Given the blocked ``path`` (a re-plan from a stop on it, which
+    stands in the blocking mover's swept region more often than not), a differential drive's
+    disc leg whose start or goal is shut in on the marked map (:func:`shut_in`) is refused
+    with a :class:`NoPathError` before the caches are derived.
     """
 
     def free() -> np.ndarray:  # where the centre may stand, in the start's part of the map
@@ -533,21 +609,7 @@ def _reroute(
             )
         return run_query(options, caches_of(grid), leg)
 
-    return reroute(
-        p0,
-        p1,
-        robot,
-        movers,
-        margin,
-        blocked,
-        grid=caches.grid,
-        free=free,
-        plan_leg=plan_leg,
-        path=path,
-        sketch=sketch if _disc_search(robot) else None,
-        label=component_labels,
-        length=length,
-    )
+    return free, plan_leg, sketch
 
 
 #: Half the side (cells) of the window round an end in which :func:`shut_in` looks.

@@ -25,6 +25,7 @@ from tests.trajopt.moving.reference import (
     check_trajectory,
     dense_min,
     positions,
+    slack_at,
 )
 from trajopt.errors import BlockedError
 from trajopt.moving._swept_kernel import square_segment_distance
@@ -904,13 +905,39 @@ def _with_final_discs(grid, movers, margin, slack=0.0):
     return OccupancyGrid(occ, grid.resolution, grid.origin)
 
 
-def _waiting_witness(grid, robot, start, goal, movers, margin):
+def _waiting_witness(grid, robot, start, goal, movers, margin, static=None):
     """The earliest arrival (s) of: rest at the start for a multiple of 10 ms, then drive the
     plan round the movers' final discs (:func:`_with_final_discs`), as the reference
-    (:func:`~tests.trajopt.moving.reference.check_motion`) proves clear; and that plan."""
-    traj = trajopt.Planner(_with_final_discs(grid, movers, margin), robot).plan(start, goal)
+    (:func:`~tests.trajopt.moving.reference.check_motion`) proves clear; and that plan.
+    Given the ``static`` plan, it is driven instead when its centre, sampled every 5 ms, keeps
+    the robot's radius plus half the samples' spacing from every final disc."""
+    traj = static
+    if static is not None:
+        t = np.append(np.arange(0.0, static.duration, 5e-3), static.duration)
+        p = positions(static, t)
+        gap = float(np.max(np.hypot(*np.diff(p, axis=0).T)))
+        for m in movers:
+            reach = 0.0 if m.vertices is None else float(np.max(np.hypot(*m.vertices.T)))
+            r = m.radius + m.growth * max(float(m.times[-1]), 0.0) + reach + margin
+            d = np.hypot(*(p - m.positions[-1]).T)
+            if np.min(d) - robot.radius - r < 0.5 * gap + 1e-6:
+                traj = None  # the static path passes too close to a final disc
+    if traj is None:
+        traj = trajopt.Planner(_with_final_discs(grid, movers, margin), robot).plan(start, goal)
+    h = 0.01
+    tk = np.append(np.arange(0.0, traj.duration, h), traj.duration)
+    p = positions(traj, tk)
+    t_end = tk[-1] + max(float(m.times[-1]) for m in movers) + 1.0
     for j in range(2000):
-        wait = 0.01 * j
+        wait = h * j
+        # a quick necessary screen on the samples (a Lipschitz pad), then the reference
+        ahead = np.arange(tk[-1] + wait, t_end, h)
+        if not all(
+            np.all(slack_at(p, m, tk + wait, robot.radius + margin) >= -1e-6)
+            and np.all(slack_at(p[-1:], m, ahead, robot.radius + margin) >= -1e-6)
+            for m in movers
+        ):
+            continue
 
         def where(t, wait=wait):
             return positions(traj, np.clip(np.asarray(t) - wait, 0.0, None))
@@ -948,3 +975,34 @@ def test_a_cart_stopping_on_the_path_is_passed_no_later_than_the_waiting_witness
     assert out.duration <= witness + 1e-6
     wider = _with_final_discs(grid, [cart], margin, slack=0.5 * RES * math.sqrt(2.0))
     assert trajopt.Planner(wider, robot).plan(start, goal).duration > witness + 1e-3
+
+
+@pytest.mark.parametrize(
+    ("x", "side", "off", "t0", "t1"), [(4.48, 1, 0.84, 4.08, 8.15), (5.18, -1, 0.82, 6.72, 9.78)]
+)
+def test_a_cart_ending_beside_the_path_is_passed_no_later_than_the_waiting_witness(
+    x, side, off, t0, t1
+):
+    """A cart (1 x 0.5 m) crosses the straight way of a room and stops beside it, clear of
+    the path but within its bounding disc's reach: the re-timing along the static path waits
+    for it and arrives later than the waiting witness (rest at the start, then the route round
+    the cart's final disc), so the route round the final places is tried too and the earlier
+    arrival kept: no later than the witness, certified and passing the reference check."""
+    grid = _grid((80, 180), [(0.5, 8.5, 0.5, 3.5)])
+    robot = trajopt.Robot(radius=0.2)
+    planner = trajopt.Planner(grid, robot)
+    start, goal, margin = (1.0, 2.0), (8.0, 2.0), 0.05
+    box = [(-0.5, -0.25), (0.5, -0.25), (0.5, 0.25), (-0.5, 0.25)]
+    cart = trajopt.MovingObstacle.from_waypoints(
+        [t0, t1], [(x, 2.0 - 1.5 * side), (x, 2.0 + off * side)], radius=0.05,
+        vertices=box, headings=[0.5 * math.pi, 0.5 * math.pi], name="cart",
+    )  # fmt: skip
+    static = planner.plan(start, goal)
+    witness, _ = _waiting_witness(grid, robot, start, goal, [cart], margin, static)
+    along = trajopt.moving.retime_chain(static, [cart], margin=margin)
+    assert along.duration > witness + 1e-3  # the static path's re-timing alone: later
+    out = planner.plan(start, goal, moving_obstacles=[cart], mover_margin=margin)
+    mv = out.stats["moving"]
+    assert mv["route"] == "rerouted" and mv["final_places"]["result"].startswith("ok")
+    assert out.duration <= witness + 1e-6
+    assert check_trajectory(out, [cart], margin=margin, grid=grid).ok
