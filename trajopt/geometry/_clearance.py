@@ -407,18 +407,22 @@ def per_map(cache: dict, occ: np.ndarray, build: Any) -> Any:
     """Return ``build()`` for the occupancy array ``occ``, kept in ``cache`` by its identity.
 
     Kept only for a read-only ``occ`` (an :class:`astar.OccupancyGrid`'s is), so that it
-    cannot change under the cache; the last 4 arrays are kept, each held by the cache so
-    that its identity is not reused.
+    cannot change under the cache; the 4 arrays used last are kept (a hit counts as a use,
+    so a planner's own map stays while maps derived from it for one query come and go),
+    each held by the cache so that its identity is not reused.
     """
-    hit = cache.get(id(occ))
+    key = id(occ)
+    hit = cache.get(key)
     if hit is not None and hit[0] is occ:
+        cache.pop(key, None)  # the most recently used last: evicted last
+        cache[key] = hit
         return hit[1]
     value = build()
     if occ.flags.writeable:
         return value
     if len(cache) >= 4:
         cache.pop(next(iter(cache)))
-    cache[id(occ)] = (occ, value)
+    cache[key] = (occ, value)
     return value
 
 

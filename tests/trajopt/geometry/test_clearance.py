@@ -9,7 +9,7 @@ import pytest
 
 import astar
 from tests.reference import square_clearance
-from trajopt.geometry._clearance import min_points_clearance
+from trajopt.geometry._clearance import min_points_clearance, per_map
 
 
 @pytest.mark.parametrize("seed", range(40))
@@ -39,3 +39,38 @@ def test_min_points_clearance_skips_nothing_it_needs_in_any_order() -> None:
     assert min_points_clearance(pts, grid, 0.35) == pytest.approx(want, abs=1e-12)
     assert min_points_clearance(np.zeros((0, 2)), grid, 0.35) == 0.35
     assert math.isfinite(min_points_clearance(pts[:1], grid, 0.35))
+
+
+def test_per_map_keeps_the_maps_used_last():
+    """The cache keeps the 4 arrays used last: a map used between others is never rebuilt.
+
+    Reference: a count of the builds per array, by hand: one per array while it stays among
+    the last 4 used, one more after it fell out.
+    """
+    cache: dict = {}
+    builds: dict[int, int] = {}
+
+    def use(k, arr):
+        def build():
+            builds[k] = builds.get(k, 0) + 1
+            return k
+
+        assert per_map(cache, arr, build) == k
+
+    arrays = []
+    for _ in range(8):
+        a = np.zeros((2, 2), dtype=bool)
+        a.flags.writeable = False
+        arrays.append(a)
+    own = arrays[0]
+    for k in range(1, 8):  # the planner's own map used between maps derived for one query
+        use(0, own)
+        use(k, arrays[k])
+    assert builds[0] == 1 and all(builds[k] == 1 for k in range(1, 8))
+    assert len(cache) == 4
+    use(1, arrays[1])  # fell out long ago: built again
+    assert builds[1] == 2
+    writable = np.zeros((2, 2), dtype=bool)  # never kept: it could change under the cache
+    use(9, writable)
+    use(9, writable)
+    assert builds[9] == 2 and all(v[0] is not writable for v in cache.values())
