@@ -388,10 +388,12 @@ BENCHES: tuple[Bench, ...] = (
         "The re-time part of the previous section with cart-shaped movers (convex rectangles "
         'heading along their motion, `make_movers(..., shape="polygon")`), whose windows '
         "and certificates take the exact polygon distances: the same targets (<= 10 ms "
-        "median, <= 25 ms p99 for a re-plan that keeps its path); `--full` runs the "
-        "scenario table with carts first.",
+        "median, <= 25 ms p99 for a re-plan that keeps its path); then the scenario table "
+        "with carts (4 per kind and map; `--full` runs one with 10 first), the same checks "
+        "and witnesses.",
         ("--shape", "polygon", "--per-kind", "0", "--retime", "15"),
         ("--shape", "polygon"),
+        more=(("--shape", "polygon", "--retime", "0", "--per-kind", "4"),),
     ),
     Bench(
         "reroute",
