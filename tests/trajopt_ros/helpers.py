@@ -89,3 +89,21 @@ def call(client, request, timeout: float = 30.0):
     if not done.wait(timeout):
         raise TimeoutError(f"service answer not met within {timeout} s")
     return fut.result()
+
+
+def answered(client, request, what: str, timeout: float = 60.0, attempt: float = 5.0):
+    """The answer to a request that changes nothing, sent again until one comes.
+
+    A service drops its answer to a client whose reply reader it has not matched yet (Fast
+    DDS waits about 100 ms for that match), and ``wait_for_service`` returns as soon as the
+    *client* sees the server, so under heavy load a client's first call may get no answer at
+    all: its first call is one that changes nothing, repeated every ``attempt`` seconds until
+    answered (``timeout`` seconds in all).
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            return call(client, request, attempt)
+        except TimeoutError:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"{what}: no answer within {timeout} s") from None

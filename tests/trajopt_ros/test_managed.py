@@ -11,13 +11,11 @@ waits about 100 ms for that match, then rclpy warns "failed to send response (ti
 client will not receive response"), and ``wait_for_service`` returns as soon as the *client*
 sees the server, so under heavy load the first call of a client may get no answer at all.
 Each client's first call is therefore one that changes nothing, repeated until it is answered
-(:func:`_answered`); ``change_state`` is primed with a transition label the node does not
+(:func:`tests.trajopt_ros.helpers.answered`); ``change_state`` is primed with a transition label the node does not
 know (refused, no transition); only then does a call that changes the node go out once.
 """
 
 from __future__ import annotations
-
-import time
 
 import numpy as np
 import pytest
@@ -28,17 +26,6 @@ from tests.trajopt_ros import helpers as h  # noqa: E402
 from tests.trajopt_ros.conftest import NodeProcess  # noqa: E402
 
 NS, NAME = "/managed", "trajopt_managed"
-
-
-def _answered(client, request, what: str, timeout: float = 60.0, attempt: float = 5.0):
-    """The answer to a request that changes nothing, sent again until one comes (module docstring)."""
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            return h.call(client, request, attempt)
-        except TimeoutError:
-            if time.monotonic() > deadline:
-                raise TimeoutError(f"{what}: no answer within {timeout} s") from None
 
 
 def test_managed_node_lifecycle(ros_env, interfaces, client):
@@ -69,11 +56,11 @@ def test_managed_node_lifecycle(ros_env, interfaces, client):
         assert srv.wait_for_service(timeout_sec=30.0), node.output()
     unknown = ChangeState.Request()
     unknown.transition.label = "no_such_transition"  # refused: no transition, no side effect
-    assert not _answered(change, unknown, "change_state primed").success, node.output()
-    assert not _answered(put, SetParameters.Request(), "set_parameters primed").results
+    assert not h.answered(change, unknown, "change_state primed").success, node.output()
+    assert not h.answered(put, SetParameters.Request(), "set_parameters primed").results
 
     def state() -> int:
-        return _answered(get, GetState.Request(), "get_state").current_state.id
+        return h.answered(get, GetState.Request(), "get_state").current_state.id
 
     def step(transition: int) -> bool:
         req = ChangeState.Request()
@@ -105,7 +92,7 @@ def test_managed_node_lifecycle(ros_env, interfaces, client):
     client.create_publisher(OccupancyGrid, f"{NS}/map", qos).publish(h.grid_msg(values))
     req = GetPlan.Request(start=h.pose(1.0, 1.0), goal=h.pose(5.0, 1.0))
     path = h.wait_for(
-        lambda: (p := _answered(get_plan, req, "get_plan").plan) and len(p.poses) > 0 and p,
+        lambda: (p := h.answered(get_plan, req, "get_plan").plan) and len(p.poses) > 0 and p,
         30.0,
         "a plan from the activated node",
     )
