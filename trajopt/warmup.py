@@ -160,12 +160,13 @@ def _exercise_moving() -> None:
     from trajopt.geometry import PolylineCurve
     from trajopt.moving import (
         MovingObstacle,
+        certify_movers,
         no_way_past,
         reached_swept_mask,
         retime_for_movers,
         swept_mask,
     )
-    from trajopt.robot import Robot
+    from trajopt.robot import Footprint, Robot
     from trajopt.timing import time_parameterize
 
     robot = Robot(v_max=0.6, a_max=0.6, j_max=2.0)
@@ -181,6 +182,11 @@ def _exercise_moving() -> None:
         (3.0, -3.0), (0.0, 0.4), radius=0.05, horizon=24.0, vertices=box
     )
     retime_for_movers(line, [cart])
+    # a robot with a footprint against it: the footprint's bounds (point to polygon,
+    # trajopt.moving._polygon_distance; a disc robot's are trajopt.moving._bisection_bounds)
+    body = Footprint(vertices=[(-0.3, -0.2), (0.3, -0.2), (0.3, 0.2), (-0.3, 0.2)])
+    boxed = Robot(v_max=0.6, a_max=0.6, j_max=2.0, footprint=body)
+    certify_movers(time_parameterize(line.path, boxed), [cart])
     # a cart parked on the drive: no re-timing gets past (the grid's sweep, trajopt.moving._grid_kernels)
     parked = MovingObstacle.from_waypoints([0.0], [(3.0, 0.0)], radius=0.05, vertices=box)
     with contextlib.suppress(BlockedError):

@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.moving._bisection_bounds import disc_robot_bounds_kernel
 from trajopt.moving._disc_windows import track_knots
 from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
@@ -450,7 +451,9 @@ class _Bisection:
     their second parts, ...), so that its
     verdict, slack, time and count do not depend on the other movers. All movers advance
     together: the robot is evaluated once per distinct interval of a level, the movers'
-    poses and rates are gathered from :class:`._mover_segments.MoverSegments`. The movers after the first one
+    poses and rates are gathered from :class:`._mover_segments.MoverSegments`; a disc robot's
+    bounds are compiled (:func:`._bisection_bounds.disc_robot_bounds_kernel`), a footprint's
+    are arrays. The movers after the first one
     not clear are not certified (:func:`certify_movers` stops there): the list ends at it.
     ``body``: the robot's convex footprint (robot frame, CCW, shape (m, 2)), or ``None`` for
     a disc (whose radius is in ``extra``).
@@ -490,7 +493,7 @@ class _Bisection:
         g0 = seg.row(mj, t0)
         self.reach, self.rad0, self.grow = table.reach, table.rad0, table.grow
         self.t_last, self.disc, self.sizes = table.t_last, table.disc, table.sizes
-        self.verts = table.verts
+        self.verts, self.columns, self.padded = table.verts, table.columns, table.padded
         self.reach_b = 0.0 if body is None else float(np.max(np.hypot(body[:, 0], body[:, 1])))
         # each first interval's place in its mover's cover (ties go to the first)
         pos = np.arange(mj.shape[0]) - np.searchsorted(mj, mj, side="left")
@@ -597,23 +600,36 @@ class _Bisection:
         u0, u1 = uniq.real, uniq.imag
         p, rho_p, v_rob = (x[inv] for x in model.at(u0, 0.5 * (u0 + u1), u1))
         g = g0 + (tm >= seg.next[g0])
-        vel, w = seg.vel[g], seg.turn[g]
         pose = seg.at(g, tm)
-        rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + self.reach[mj] * np.abs(w)) * h
+        if body is None:  # compiled (a disc robot: no footprint, second order for disc movers)
+            c2 = np.broadcast_to(model.c2_local, u0.shape)[inv]
+            lower, slack_mid = disc_robot_bounds_kernel(
+                *(np.ascontiguousarray(x) for x in (t1, tm, h, mj, g, p, rho_p, v_rob, c2, pose)),
+                np.cos(pose[:, 2]),
+                np.sin(pose[:, 2]),
+                seg.vel,
+                seg.turn,
+                self.columns,
+                self.padded,
+                float(extra),
+            )
+            return lower, slack_mid, tm
+        # the footprint: exact at tm, its vertices move rho_P + R turn
+        w = seg.turn[g]
+        rho_m = (np.hypot(seg.vel[g, 0], seg.vel[g, 1]) + self.reach[mj] * np.abs(w)) * h
         t_last = self.t_last[mj]
         lim_mid = extra + (self.rad0[mj] + self.grow[mj] * np.clip(tm, 0.0, t_last))
         lim_hi = extra + (self.rad0[mj] + self.grow[mj] * np.clip(t1, 0.0, t_last))
         dist_m = np.empty(tm.shape[0])
-        if body is not None:
-            theta, turn = model.theta[inv], model.turn[inv]
-            c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
-            poly = np.stack(
-                [
-                    p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
-                    p[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
-                ],
-                axis=-1,
-            )
+        theta, turn = model.theta[inv], model.turn[inv]
+        c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
+        poly = np.stack(
+            [
+                p[:, 0:1] + c * body[None, :, 0] - sn * body[None, :, 1],
+                p[:, 1:2] + sn * body[None, :, 0] + c * body[None, :, 1],
+            ],
+            axis=-1,
+        )
         dist_c = np.empty(tm.shape[0])
         for size in np.unique(sizes[mj]):
             sel = sizes[mj] == size
@@ -624,20 +640,10 @@ class _Bisection:
             y = ps[:, 1:2] + sh * v[:, :, 0] + ch * v[:, :, 1]
             shape = np.stack([x, y], axis=-1)
             dist_c[sel] = point_polygon_distance(p[sel], shape)
-            if body is not None:
-                dist_m[sel] = convex_distance(poly[sel], shape)
+            dist_m[sel] = convex_distance(poly[sel], shape)
         lower = dist_c - rho_p - rho_m - lim_hi
-        if body is not None:  # the footprint: exact at tm, its vertices move rho_P + R turn
-            lower_poly = dist_m - rho_p - reach_b * turn - rho_m - lim_hi
-            lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
-        else:
-            dist_m = dist_c
-            dm = self.disc[mj]
-            if np.any(dm):  # second order: min over |tau| <= h of |D + w tau|, less curvature
-                d = p[dm] - pose[dm, :2]
-                c2 = np.broadcast_to(model.c2_local, u0.shape)[inv][dm]
-                lower2 = second_order_lower(d, v_rob[dm] - vel[dm], h[dm], c2) - lim_hi[dm]
-                lower[dm] = np.fmax(lower[dm], lower2)
+        lower_poly = dist_m - rho_p - reach_b * turn - rho_m - lim_hi
+        lower = np.maximum(lower - reach_b, lower_poly)  # or its circumscribed disc
         return lower, dist_m - lim_mid, tm
 
     def resolve(self, below: float, only: int | None = None) -> list[tuple[float, float]]:

@@ -84,6 +84,9 @@ class MoverTable:
     vertex, m), ``rad0`` (radius, m), ``grow`` (growth, m/s), ``t_last`` (its last time, at
     least 0, s), ``disc`` (no vertices), ``sizes`` (vertex count); ``verts``: each vertex
     count's table of the movers' vertices, shape (movers, count, 2) (zeros for the others).
+    The compiled bounds' form (:func:`._bisection_bounds.disc_robot_bounds_kernel`):
+    ``columns``, shape (movers, 6), the columns reach, rad0, grow, t_last, disc (1.0) and
+    sizes; ``padded``, shape (movers, largest count, 2), each mover's vertices first.
     """
 
     def __init__(self, movers: Sequence[MovingObstacle]) -> None:
@@ -103,6 +106,12 @@ class MoverTable:
             )
             for size in np.unique(self.sizes)
         }
+        self.columns = np.column_stack(
+            [self.reach, self.rad0, self.grow, self.t_last, self.disc, self.sizes]
+        ).astype(np.float64)
+        self.padded = np.zeros((len(movers), int(np.max(self.sizes, initial=1)), 2))
+        for j, m in enumerate(movers):
+            self.padded[j, : m.shape_vertices.shape[0]] = m.shape_vertices
         for value in (*vars(self.seg).values(), *vars(self).values(), *self.verts.values()):
             if isinstance(value, np.ndarray):
                 value.setflags(write=False)

@@ -43,6 +43,7 @@ from numba import njit
 
 from trajopt.kernel_cache import watch_compiles
 from trajopt.moving._disc_windows import mover_pieces, near_pairs
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 
 watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
@@ -95,7 +96,6 @@ class PolygonPieces:
         self.pieces = mover_pieces(movers, 0.0)
         who = self.pieces[:, 0].astype(np.int64)
         u, w = self.pieces[:, 1], self.pieces[:, 2]
-        head0, turn = np.zeros(u.shape), np.zeros(u.shape)
         m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
         self.verts = np.zeros((len(movers), m_max, 2))
         self.poly = np.zeros(len(movers), dtype=bool)
@@ -107,14 +107,15 @@ class PolygonPieces:
             self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
             self.poly[j] = v.shape[0] >= 3
             reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
-            mine = who == j
-            uj, wj = u[mine], w[mine]
-            h_u = np.interp(uj, m.times, m.headings)
-            fin = np.isfinite(wj)
-            h_w = np.interp(np.where(fin, wj, uj), m.times, m.headings)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                head0[mine] = h_u
-                turn[mine] = np.where(fin, (h_w - h_u) / np.where(fin, wj - uj, 1.0), 0.0)
+        # the headings at both ends of each piece, numpy.interp's (bit for bit), all at once
+        seg = mover_table(movers).seg
+        fin = np.isfinite(w)
+        at = np.concatenate([u, np.where(fin, w, u)])
+        two = np.concatenate([who, who])
+        heads = seg.at(seg.row(two, at), at)[:, 2]
+        head0, h_w = heads[: u.shape[0]], heads[u.shape[0] :]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            turn = np.where(fin, (h_w - head0) / np.where(fin, w - u, 1.0), 0.0)
         self.edges = np.roll(self.verts, -1, axis=1) - self.verts
         self.head0, self.turn, self.reach = head0, turn, reach
         self.bound = self.pieces.copy()

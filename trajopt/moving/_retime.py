@@ -144,14 +144,19 @@ class _PathTables:
         return None
 
     def segment(self, s0: float, s1: float, v0: float = 0.0, a0: float = 0.0) -> Piece | None:
-        """Return the path's piece ``[s0, s1]`` timed by :func:`trajopt.time_parameterize`."""
+        """Return the path's piece ``[s0, s1]`` timed by :func:`trajopt.time_parameterize`.
+
+        The whole path is timed as itself (its arc-length table and compiled look-ups
+        already made), a part of it as its :class:`~trajopt.geometry.CurveSegment`.
+        """
         path = self.path
         u_lo, u_hi = path.domain
         ua = u_lo if s0 <= 0.0 else float(path.u_at_s(s0))
         ub = u_hi if s1 >= self.length else float(path.u_at_s(s1))
+        whole = ua == u_lo and ub == u_hi
         try:
             tr = time_parameterize(
-                CurveSegment(path, ua, ub),
+                path if whole else CurveSegment(path, ua, ub),
                 self.robot,
                 v_start=v0,
                 a_start=a0,

@@ -386,9 +386,9 @@ def pass_band(
         taus, s_t, at, packed = [], [], [], []
         t = min(t_from, sched[0][0])
         for launch, pc in sched:
-            tau = np.append(np.arange(0.0, pc.duration, BAND_DT), pc.duration)
+            tau, s_pc = band_samples(pc)
             taus.append(tau)
-            s_t.append(pc.s_at(tau))
+            s_t.append(s_pc)
             at.append(np.full(tau.shape, launch))
             packed.append(np.full(tau.shape, t))
             t += pc.duration
@@ -402,6 +402,18 @@ def pass_band(
         early = (np.concatenate(packed) + tau)[np.maximum(k, 0)]
         lo = np.minimum(lo, np.where(k >= 0, early, min(t_from, sched[0][0])))
     return lo, hi
+
+
+def band_samples(piece: Piece) -> tuple[np.ndarray, np.ndarray]:
+    """Return a drive's times every :data:`BAND_DT` (s) from 0 to its end and its arc length (m) there.
+
+    Kept on the piece (:func:`pass_band` asks again when the launch floor moves its start).
+    """
+    key = ("band", BAND_DT)
+    if key not in piece.memo:
+        tau = np.append(np.arange(0.0, piece.duration, BAND_DT), piece.duration)
+        piece.memo[key] = (tau, piece.s_at(tau))
+    return piece.memo[key]
 
 
 def tail_occupancy(

@@ -339,3 +339,92 @@ def test_point_polygon_distance_against_dense_edges_and_matplotlib(m):
         else:
             assert ref - 0.5 * step - 1e-12 <= got[i] <= ref + 1e-12
     assert m < 3 or 0 < n_inside < n
+
+
+def _numpy_disc_robot_bounds(bis, t0, t1, mj, g0):
+    """The bisection's bounds for a disc robot as arrays (the form the kernel replaced)."""
+    from trajopt.moving._certificate import point_polygon_distance, second_order_lower
+
+    model, seg, extra = bis.model, bis.seg, bis.extra
+    tm, h = 0.5 * (t0 + t1), 0.5 * (t1 - t0)
+    uniq, inv = np.unique(t0 + 1j * t1, return_inverse=True)
+    inv = inv.reshape(-1)
+    u0, u1 = uniq.real, uniq.imag
+    p, rho_p, v_rob = (x[inv] for x in model.at(u0, 0.5 * (u0 + u1), u1))
+    g = g0 + (tm >= seg.next[g0])
+    vel, w = seg.vel[g], seg.turn[g]
+    pose = seg.at(g, tm)
+    rho_m = (np.hypot(vel[:, 0], vel[:, 1]) + bis.reach[mj] * np.abs(w)) * h
+    t_last = bis.t_last[mj]
+    lim_mid = extra + (bis.rad0[mj] + bis.grow[mj] * np.clip(tm, 0.0, t_last))
+    lim_hi = extra + (bis.rad0[mj] + bis.grow[mj] * np.clip(t1, 0.0, t_last))
+    dist = np.empty(tm.shape[0])
+    for size in np.unique(bis.sizes[mj]):
+        sel = bis.sizes[mj] == size
+        v = bis.verts[int(size)][mj[sel]]
+        ps = pose[sel]
+        ch, sh = np.cos(ps[:, 2])[:, None], np.sin(ps[:, 2])[:, None]
+        x = ps[:, 0:1] + ch * v[:, :, 0] - sh * v[:, :, 1]
+        y = ps[:, 1:2] + sh * v[:, :, 0] + ch * v[:, :, 1]
+        dist[sel] = point_polygon_distance(p[sel], np.stack([x, y], axis=-1))
+    lower = dist - rho_p - rho_m - lim_hi
+    dm = bis.disc[mj]
+    if np.any(dm):
+        d = p[dm] - pose[dm, :2]
+        c2 = np.broadcast_to(model.c2_local, u0.shape)[inv][dm]
+        lower2 = second_order_lower(d, v_rob[dm] - vel[dm], h[dm], c2) - lim_hi[dm]
+        lower[dm] = np.fmax(lower[dm], lower2)
+    return lower, dist - lim_mid, tm
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_compiled_disc_robot_bounds_are_the_arrays_and_bound_dense_samples(seed):
+    """The bisection's compiled bounds for a disc robot (polygons of 3 and 4 vertices and
+    disc movers, turning, growing, before, between and after their times) equal the array
+    form they replaced, bit for bit, on random intervals; each is below the slack sampled
+    every 1 ms over its interval, and the middle's is the reference's slack there."""
+    from trajopt.moving._certificate import _Bisection
+    from trajopt.moving._robot_windows import robot_windows
+
+    rng = np.random.default_rng(40 + seed)
+    traj = time_parameterize(_curve([0.6, -0.5, 0.4], 4.0), ROBOT)
+    tri = [(0.0, -0.3), (0.5, 0.2), (-0.2, 0.3)]
+    movers = []
+    for i in range(6):
+        t_a = float(rng.uniform(0.5, 6.0))
+        p = rng.uniform([-1.0, -1.5], [5.0, 1.5])
+        v = rng.uniform(-0.6, 0.6, 2)
+        movers.append(
+            MovingObstacle.from_waypoints(
+                [1.0, t_a + 1.0, 9.0],
+                [p, p + t_a * v, p + t_a * v + (8.0 - t_a) * v[::-1]],
+                radius=float(rng.uniform(0.0, 0.2)),
+                growth=float(rng.choice([0.0, 0.03])),
+                headings=[0.0, float(rng.uniform(-1.5, 1.5)), 1.0] if i % 3 else None,
+                vertices=(SQUARE if i % 3 == 1 else tri) if i % 3 else None,
+                name=f"m{i}",
+            )
+        )
+    margin = 0.05
+    model, a, b = robot_windows(traj)[0]
+    bis = _Bisection(model, movers, a, b, ROBOT.radius + margin, 1e-6, None)
+    n = 300
+    t0 = rng.uniform(-0.5, 10.0, n)
+    t1 = t0 + rng.choice([1e-3, 0.05, 0.5], n) * rng.uniform(0.0, 1.0, n)
+    t1[:10] = t0[:10]  # instants
+    mj = rng.integers(0, len(movers), n)
+    for i in range(n):  # within one waypoint segment of its mover (as the bisection's)
+        later = movers[mj[i]].times[movers[mj[i]].times > t0[i]]
+        t1[i] = min(t1[i], later[0]) if later.size else t1[i]
+    g0 = bis.seg.row(mj, t0)
+    got = bis._bounds(t0, t1, mj, g0)
+    want = _numpy_disc_robot_bounds(bis, t0, t1, mj, g0)
+    for x, y in zip(got, want, strict=True):
+        assert np.array_equal(x, y)
+    lower, slack_mid, tm = got
+    for i in range(n):
+        ts = np.linspace(t0[i], t1[i], max(2, int((t1[i] - t0[i]) / 1e-3) + 2))
+        true = slack(traj, movers[mj[i]], ts, margin=margin)
+        assert lower[i] <= np.min(true) + 1e-9
+        mid = slack(traj, movers[mj[i]], np.array([tm[i]]), margin=margin)[0]
+        assert slack_mid[i] == pytest.approx(mid, abs=1e-9)

@@ -320,3 +320,26 @@ def test_the_signed_distance_of_overlapping_polygons_is_minus_their_penetration_
         want = -gap if diff.contains(origin) else gap
         got = _signed_distance(pa, pa.shape[0], pb, pb.shape[0])
         assert got == pytest.approx(want, abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_pieces_headings_are_numpy_interp_of_each_mover(seed):
+    """Each piece's start heading and turn rate are those of ``numpy.interp`` on its own
+    mover's waypoints (bit for bit): pieces from 0 (inside a segment or before the first
+    time), at the waypoint times and the standing after the last (turn 0)."""
+    rng = np.random.default_rng(100 + seed)
+    movers = _random_movers(rng, 7)
+    tracks = PolygonPieces(movers)
+    who = tracks.pieces[:, 0].astype(np.int64)
+    u, w = tracks.pieces[:, 1], tracks.pieces[:, 2]
+    for j, m in enumerate(movers):
+        mine = who == j
+        for ui, wi, h0, turn in zip(
+            u[mine], w[mine], tracks.head0[mine], tracks.turn[mine], strict=True
+        ):
+            h_u = np.interp(ui, m.times, m.headings)
+            assert h0 == h_u
+            if np.isfinite(wi):
+                assert turn == (np.interp(wi, m.times, m.headings) - h_u) / (wi - ui)
+            else:
+                assert turn == 0.0

@@ -284,6 +284,12 @@ def test_a_re_timed_trajectory_re_timed_again_cold_as_when_its_plan_came_first()
     assert cold.duration == warm.duration and certify_movers(cold, [later]).ok
     for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j"):
         assert np.array_equal(getattr(warm, name), getattr(cold, name))
+    # the cold tables' one drive (0, L): the path timed from rest, the plan's own timing
+    tb = _retime._TABLES[-1]
+    own = tb.drives[(0.0, tb.length)]
+    assert own.duration == plan.duration
+    phases = np.column_stack([plan.phase_t, plan.phase_s, plan.phase_v, plan.phase_a])
+    assert np.array_equal(own.rows[:, :4], phases)
 
 
 CART = [(-0.45, -0.25), (0.45, -0.25), (0.45, 0.25), (-0.45, 0.25)]
