@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit
 
 from trajopt.kernel_cache import watch_compiles
+from trajopt.moving._polygon_distance import point_edge
 
 watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
@@ -83,14 +84,10 @@ def disc_robot_bounds_kernel(
                 ay = my + s * verts[j, k, 0] + c * verts[j, k, 1]
                 bx = mx + c * verts[j, k1, 0] - s * verts[j, k1, 1]
                 by = my + s * verts[j, k1, 0] + c * verts[j, k1, 1]
-                ex, ey = bx - ax, by - ay
-                qx, qy = px - ax, py - ay
-                ee = max(ex * ex + ey * ey, 1e-300)
-                lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
-                r = math.hypot(qx - lam * ex, qy - lam * ey)
+                r, left = point_edge(px, py, ax, ay, bx, by)
                 if r < dist:
                     dist = r
-                if not ex * qy - ey * qx >= 0.0:
+                if not left:
                     inside = False
             if inside:
                 dist = 0.0

@@ -13,6 +13,23 @@ watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @njit(cache=True)
+def point_edge(px, py, ax, ay, bx, by):  # pragma: no cover - compiled
+    """Return the distance (m) from ``(px, py)`` to the edge ``a -> b`` and whether it is on its left.
+
+    The closest point of the segment: the projection's parameter clipped to ``[0, 1]``, the
+    edge's squared length floored at 1e-300; "on its left" includes on the edge's line (a
+    cross product ``>= 0``; ``False`` for NaN). The step every convex-polygon distance
+    loop of the certificate takes per edge (:func:`point_polygon_kernel`,
+    :func:`trajopt.moving._bisection_bounds.disc_robot_bounds_kernel`).
+    """
+    ex, ey = bx - ax, by - ay
+    qx, qy = px - ax, py - ay
+    ee = max(ex * ex + ey * ey, 1e-300)
+    lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
+    return math.hypot(qx - lam * ex, qy - lam * ey), ex * qy - ey * qx >= 0.0
+
+
+@njit(cache=True)
 def point_polygon_kernel(p, w):  # pragma: no cover - compiled
     """Return the distance (m) from each point ``p[i]`` to the convex CCW polygon ``w[i]``; 0 inside.
 
@@ -41,16 +58,11 @@ def point_polygon_kernel(p, w):  # pragma: no cover - compiled
         dist = math.inf
         inside = True
         for k in range(m):
-            ax, ay = w[i, k, 0], w[i, k, 1]
             k1 = k + 1 if k + 1 < m else 0
-            ex, ey = w[i, k1, 0] - ax, w[i, k1, 1] - ay
-            qx, qy = px - ax, py - ay
-            ee = max(ex * ex + ey * ey, 1e-300)
-            lam = min(max((qx * ex + qy * ey) / ee, 0.0), 1.0)
-            r = math.hypot(qx - lam * ex, qy - lam * ey)
+            r, left = point_edge(px, py, w[i, k, 0], w[i, k, 1], w[i, k1, 0], w[i, k1, 1])
             if r < dist:
                 dist = r
-            if not ex * qy - ey * qx >= 0.0:
+            if not left:
                 inside = False
         out[i] = 0.0 if inside else dist
     return out
