@@ -24,6 +24,7 @@ import pytest
 import trajopt
 import trajopt.planning
 from tests.trajopt.moving.reference import brute_min, check_trajectory, dense_min
+from tests.trajopt.moving.scenes import RES, loop_occupancy
 from tests.trajopt.replan.test_replan_car import forward_scene
 from trajopt.errors import BlockedError
 
@@ -279,23 +280,11 @@ def test_a_car_braked_and_planned_from_the_stop_is_re_timed():
     assert check.ok and check.static_slack >= -1e-6
 
 
-RES = 0.05
-
-
 def _loop():
     """Two 1 m corridors (y = 1 and y = 4) joined at both ends, a niche at x = 6 (5 cm cells)."""
     from astar.grid import OccupancyGrid
 
-    occ = np.ones((100, 240), dtype=bool)
-    for x0, x1, y0, y1 in [
-        (0.5, 11.5, 0.5, 1.5),
-        (0.5, 11.5, 3.5, 4.5),
-        (0.5, 1.5, 0.5, 4.5),
-        (10.5, 11.5, 0.5, 4.5),
-        (5.5, 6.5, 1.5, 2.3),
-    ]:
-        occ[round(y0 / RES) : round(y1 / RES), round(x0 / RES) : round(x1 / RES)] = False
-    return OccupancyGrid(occ, RES, (0.0, 0.0))
+    return OccupancyGrid(loop_occupancy(), RES, (0.0, 0.0))
 
 
 @pytest.fixture(scope="module")

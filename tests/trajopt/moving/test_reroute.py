@@ -27,17 +27,13 @@ from tests.trajopt.moving.reference import (
     positions,
     slack_at,
 )
+from tests.trajopt.moving.scenes import RES, loop_occupancy, rooms_occupancy
 from trajopt.errors import BlockedError
 from trajopt.moving._swept_kernel import square_segment_distance
 
-RES = 0.05
-
 
 def _grid(shape, rooms):
-    occ = np.ones(shape, dtype=bool)
-    for x0, x1, y0, y1 in rooms:
-        occ[round(y0 / RES) : round(y1 / RES), round(x0 / RES) : round(x1 / RES)] = False
-    return OccupancyGrid(occ, RES, (0.0, 0.0))
+    return OccupancyGrid(rooms_occupancy(shape, rooms), RES, (0.0, 0.0))
 
 
 def _static_clearance(traj, grid, dt=0.02):
@@ -205,16 +201,7 @@ def test_car_headings_face_on_then_along_the_way_in():
 @pytest.fixture(scope="module")
 def loop():
     """Two 1 m corridors (y = 1 and y = 4) joined at both ends, and a niche at x = 6."""
-    grid = _grid(
-        (100, 240),
-        [
-            (0.5, 11.5, 0.5, 1.5),
-            (0.5, 11.5, 3.5, 4.5),
-            (0.5, 1.5, 0.5, 4.5),
-            (10.5, 11.5, 0.5, 4.5),
-            (5.5, 6.5, 1.5, 2.3),
-        ],
-    )
+    grid = OccupancyGrid(loop_occupancy(), RES, (0.0, 0.0))
     return grid, trajopt.Planner(grid, trajopt.Robot())
 
 

@@ -22,25 +22,12 @@ import pytest
 import trajopt
 from astar.grid import OccupancyGrid
 from tests.trajopt.moving.reference import brute_min, check_trajectory, dense_min
+from tests.trajopt.moving.scenes import RES, loop_occupancy
 from trajopt.replan._keep import keep_rest
 
-RES = 0.05
 LATENCY = 0.05
 MARGIN = 0.05
 START, GOAL = (1.0, 1.0), (11.0, 1.0)
-
-
-def _loop_grid():
-    occ = np.ones((100, 240), dtype=bool)
-    for x0, x1, y0, y1 in [
-        (0.5, 11.5, 0.5, 1.5),
-        (0.5, 11.5, 3.5, 4.5),
-        (0.5, 1.5, 0.5, 4.5),
-        (10.5, 11.5, 0.5, 4.5),
-        (5.5, 6.5, 1.5, 2.3),
-    ]:
-        occ[round(y0 / RES) : round(y1 / RES), round(x0 / RES) : round(x1 / RES)] = False
-    return occ
 
 
 def _cart(x=6.0, y_park=1.0, t_park=3.0):
@@ -64,7 +51,7 @@ def _on_clock(m, t0):
 @pytest.fixture(scope="module", params=["differential", "omni"])
 def rerouted(request):
     """A planner on the loop and its first plan, re-routed the long way round the cart."""
-    grid = OccupancyGrid(_loop_grid(), RES, (0.0, 0.0))
+    grid = OccupancyGrid(loop_occupancy(), RES, (0.0, 0.0))
     planner = trajopt.Planner(grid, trajopt.Robot(drive=request.param))
     headings = {"start_heading": -0.5, "goal_heading": 1.0} if request.param == "omni" else {}
     first = planner.plan(START, GOAL, moving_obstacles=[_cart()], mover_margin=MARGIN, **headings)
@@ -149,7 +136,7 @@ def _xy(traj):
 def test_the_same_static_map_given_again_keeps_the_detour(rerouted):
     """A map update equal to the static map: the cart's marks are not counted as freed cells."""
     grid, planner, first = rerouted
-    same = OccupancyGrid(_loop_grid(), RES, (0.0, 0.0))
+    same = OccupancyGrid(loop_occupancy(), RES, (0.0, 0.0))
     try:
         out = planner.replan(
             first, 1.0, grid=same, latency=LATENCY, moving_obstacles=[_cart(t_park=3.2)],
@@ -172,7 +159,7 @@ def test_the_same_static_map_given_again_keeps_the_detour(rerouted):
 )
 def test_a_static_map_changed_where_it_matters_is_not_kept(rerouted, change, why):
     grid, planner, first = rerouted
-    occ = _loop_grid()
+    occ = loop_occupancy()
     rows, cols = change
     occ[rows, cols] = not occ[rows, cols].all()  # occupy free cells, or free a walled block
     changed = OccupancyGrid(occ, RES, (0.0, 0.0))
@@ -224,7 +211,7 @@ def test_predictions_that_block_the_kept_detour_stop_and_go_the_short_way(rerout
 @pytest.fixture(scope="module")
 def car_rerouted():
     """A car on the loop and its first plan, re-routed the long way round the cart."""
-    grid = OccupancyGrid(_loop_grid(), RES, (0.0, 0.0))
+    grid = OccupancyGrid(loop_occupancy(), RES, (0.0, 0.0))
     robot = trajopt.Robot(
         drive="ackermann", min_turning_radius=0.6, radius=0.2, wheelbase=0.3, steer_rate_max=1.0
     )
@@ -284,7 +271,7 @@ def test_a_car_does_not_keep_its_re_routed_rest_when_the_static_map_changed(car_
     smp = first.sample(np.linspace(0.0, first.duration, 4000))
     k = int(np.argmin(np.hypot(smp.x - 6.0, smp.y - 4.0)))  # where the detour passes x = 6
     assert abs(smp.x[k] - 6.0) < 0.05 and smp.y[k] > 3.5
-    occ = _loop_grid()
+    occ = loop_occupancy()
     occ[int((smp.y[k] + 0.1) / RES), int(smp.x[k] / RES)] = True
     changed = OccupancyGrid(occ, RES, (0.0, 0.0))
     movers = [_cart(t_park=3.2)]
