@@ -683,6 +683,21 @@ def windows_kernel(
 
 
 @njit(cache=True)
+def piece_at(rows, lo, hi, t):  # pragma: no cover - compiled
+    """Return the last piece among ``lo..hi`` whose start time ``rows[., 0]`` (s) is at most ``t``; ``lo`` if none.
+
+    A binary search over the pieces of one mover's track (their starts increase).
+    """
+    while lo < hi:
+        m = (lo + hi + 1) // 2
+        if rows[m, 0] <= t:
+            lo = m
+        else:
+            hi = m - 1
+    return lo
+
+
+@njit(cache=True)
 def launch_bound_kernel(
     launch, tau, mover, pts, pad, rows, first, head0, turn, verts, edges, poly
 ):  # pragma: no cover - compiled
@@ -712,14 +727,7 @@ def launch_bound_kernel(
         a, b = first[j], first[j + 1]
         for li in range(launch.shape[0]):
             t = launch[li] + tau[r]
-            lo_i, hi_i = a, b - 1  # the last piece with u <= t (the first if none)
-            while lo_i < hi_i:
-                m = (lo_i + hi_i + 1) // 2
-                if rows[m, 0] <= t:
-                    lo_i = m
-                else:
-                    hi_i = m - 1
-            p = lo_i
+            p = piece_at(rows, a, b - 1, t)
             out[li, r] = _clearance(
                 pts[r, 0], pts[r, 1], rows[p], head0[p], turn[p], pad[r], verts, edges, poly, j, t
             )
@@ -762,17 +770,7 @@ def launch_min_kernel(
                 continue
             j = mover[r]
             t = launch[li] + tau[r]
-            lo_i, hi_i = (
-                first[j],
-                first[j + 1] - 1,
-            )  # the last piece with u <= t (the first if none)
-            while lo_i < hi_i:
-                m = (lo_i + hi_i + 1) // 2
-                if rows[m, 0] <= t:
-                    lo_i = m
-                else:
-                    hi_i = m - 1
-            p = lo_i
+            p = piece_at(rows, first[j], first[j + 1] - 1, t)
             if not np.isnan(at[r]):
                 rate = 0.0  # the largest lip of the pieces between the two times
                 for pp in range(min(p, held[r]), max(p, held[r]) + 1):
