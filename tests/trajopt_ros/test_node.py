@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import signal
 import threading
@@ -101,10 +102,25 @@ def test_error_code_tables_match_generated_constants(interfaces):
     assert SmoothPath.Result.TIMEOUT == codes.SMOOTH_PATH["timeout"]
 
 
+_ACTION_NODES = itertools.count()
+
+
 def _send(client_node, action_type, name, goal, feedback=None, timeout=20.0):
+    """Send ``goal`` to the action ``name`` and wait until it is accepted.
+
+    rclpy's ``ActionClient`` joins its node's waitables before it has made its lock, so one
+    built on the spun client node can kill the executor's thread (an ``AttributeError`` on
+    ``_lock``) and with it every later test: it is built on a node of its own, handed to the
+    executor only once built.
+    """
+    import rclpy
     from rclpy.action import ActionClient
 
-    ac = ActionClient(client_node, action_type, name)
+    node = rclpy.create_node(
+        f"trajopt_test_action_{next(_ACTION_NODES)}", context=client_node.context
+    )
+    ac = ActionClient(node, action_type, name)
+    client_node.executor.add_node(node)
     assert ac.wait_for_server(timeout_sec=15.0)
     fut = ac.send_goal_async(goal, feedback_callback=feedback)
     handle = h.wait_for(lambda: fut.done() and fut.result(), timeout, "goal accepted")
