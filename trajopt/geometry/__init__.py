@@ -5,7 +5,8 @@
 * :class:`BSplineCurve`, the smoother's curve;
 * :func:`kappa_bound`: a certified upper bound of a curve's curvature on an interval;
 * :func:`polygon_clearance`, :func:`polyline_clearance`: exact distances from the raw map
-  (occupied cells taken as closed squares);
+  (occupied cells taken as closed squares); :func:`derive_blocks`: the occupied blocks these
+  search, for a map changed in a window, from the unchanged map's;
 * :func:`convex_hull`;
 * :func:`length_unit`: the length unit the corridor and the smoother count in;
 * :func:`rounded_polygon`: the outline of a convex polygon rounded by a radius (a mover's shape).
@@ -19,6 +20,7 @@ from trajopt.geometry._bspline import (
 )
 from trajopt.geometry._clearance import (
     box_clearance,
+    derive_blocks,
     grid_cells,
     min_points_clearance,
     point_segment_distance,
@@ -78,6 +80,7 @@ __all__ = [
     "clamped_uniform_knots",
     "concatenate",
     "convex_hull",
+    "derive_blocks",
     "derivative_control_points",
     "gather",
     "grid_cells",

@@ -392,15 +392,45 @@ def occupied_blocks(occ: np.ndarray, bs: int = CLEARANCE_BLOCK) -> np.ndarray:
     Cached per array when ``occ`` is read-only (an :class:`astar.OccupancyGrid`'s is), so
     that it cannot change under the cache.
     """
+    return per_map(_BLOCKS, occ, lambda: _blocks_of(occ, bs))
 
-    def build() -> np.ndarray:
-        ny, nx = occ.shape
-        by, bx = -(-ny // bs), -(-nx // bs)
-        pad = np.zeros((by * bs, bx * bs), dtype=bool)
-        pad[:ny, :nx] = occ
-        return np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
 
-    return per_map(_BLOCKS, occ, build)
+def _blocks_of(occ: np.ndarray, bs: int) -> np.ndarray:
+    """Which ``bs x bs`` blocks of ``occ`` hold an occupied cell (the last ones cut by its edge)."""
+    ny, nx = occ.shape
+    by, bx = -(-ny // bs), -(-nx // bs)
+    pad = np.zeros((by * bs, bx * bs), dtype=bool)
+    pad[:ny, :nx] = occ
+    return np.ascontiguousarray(pad.reshape(by, bs, bx, bs).any(axis=(1, 3)))
+
+
+def derive_blocks(
+    occ: np.ndarray, base: np.ndarray, window: tuple[int, int, int, int] | None
+) -> None:
+    """Keep the blocks of :func:`occupied_blocks` for ``occ`` made from those kept for ``base``.
+
+    ``occ`` equals ``base`` (same shape) outside the cell box ``window`` ``(x0, x1, y0, y1)``
+    (inclusive; ``None``: everywhere), as a map derived from a planner's with cells marked
+    (:meth:`trajopt.planning.PlannerCaches.derived`). A block holds an occupied cell of
+    ``occ`` exactly as it does of ``base`` unless it meets the window, so ``base``'s blocks
+    are copied and those meeting the window computed again from ``occ``: the same values as
+    :func:`occupied_blocks` of ``occ`` computed afresh, for the cost of the window's blocks.
+    Does nothing unless ``base``'s blocks are kept and ``occ`` is read-only (and so kept);
+    counts as a use of ``base``'s (:func:`per_map`).
+    """
+    bs = CLEARANCE_BLOCK
+    hit = _BLOCKS.get(id(base))
+    if hit is None or hit[0] is not base or occ.shape != base.shape or occ.flags.writeable:
+        return
+    _BLOCKS[id(base)] = _BLOCKS.pop(id(base))  # a use: the unchanged map's are evicted last
+    blk = np.array(hit[1])
+    if window is not None:
+        x0, x1, y0, y1 = window
+        bx0, by0 = x0 // bs, y0 // bs
+        part = occ[by0 * bs : (y1 // bs + 1) * bs, bx0 * bs : (x1 // bs + 1) * bs]
+        sub = _blocks_of(part, bs)
+        blk[by0 : by0 + sub.shape[0], bx0 : bx0 + sub.shape[1]] = sub
+    per_map(_BLOCKS, occ, lambda: blk)
 
 
 def per_map(cache: dict, occ: np.ndarray, build: Any) -> Any:

@@ -28,7 +28,7 @@ from astar.costmap import Costmap
 from astar.errors import InvalidInputError as AstarInputError
 from astar.grid import OccupancyGrid
 from trajopt.errors import InvalidInputError
-from trajopt.geometry import length_unit
+from trajopt.geometry import derive_blocks, length_unit
 from trajopt.planning._label_kernel import label_kernel
 from trajopt.planning._memory import check_memory
 from trajopt.planning._options import PlannerOptions
@@ -215,7 +215,9 @@ class PlannerCaches:
         The new caches start from what these have built (the inflated grid, the clearance
         cost, the component labels, the coarse blocks, the landmarks: values that
         :meth:`update` replaces rather than changes) and are then updated to ``grid``
-        (:meth:`update`: recomputed only where the change reaches). A footprint robot's disc
+        (:meth:`update`: recomputed only where the change reaches). The occupied blocks the
+        smoother's clearance searches on the raw map are derived from this map's where it
+        has them (:func:`trajopt.geometry.derive_blocks`). A footprint robot's disc
         models are derived the same way. A re-route plans on such a map (the movers' swept
         regions marked, :func:`trajopt.moving.reroute`).
 
@@ -241,7 +243,9 @@ class PlannerCaches:
             out._components = self._components
             out._coarse = self._coarse
             out._discs = {}
-            out.update(grid)
+            change = out.update(grid)
+            if not change["reset"]:  # the raw map's clearance blocks, from this map's
+                derive_blocks(grid.occupied, self.grid.occupied, change["window"])
             out._discs = {r: d.derived(grid) for r, d in self._discs.items()}
             return out
 

@@ -9,7 +9,14 @@ import pytest
 
 import astar
 from tests.reference import square_clearance
-from trajopt.geometry._clearance import min_points_clearance, per_map
+from trajopt.geometry import derive_blocks
+from trajopt.geometry._clearance import (
+    _BLOCKS,
+    CLEARANCE_BLOCK,
+    min_points_clearance,
+    occupied_blocks,
+    per_map,
+)
 
 
 @pytest.mark.parametrize("seed", range(40))
@@ -74,3 +81,54 @@ def test_per_map_keeps_the_maps_used_last():
     use(9, writable)
     use(9, writable)
     assert builds[9] == 2 and all(v[0] is not writable for v in cache.values())
+
+
+def brute_blocks(occ: np.ndarray, bs: int) -> np.ndarray:
+    """Whether each ``bs x bs`` block holds an occupied cell, by a loop over the blocks."""
+    ny, nx = occ.shape
+    out = np.zeros((-(-ny // bs), -(-nx // bs)), dtype=bool)
+    for by in range(out.shape[0]):
+        for bx in range(out.shape[1]):
+            out[by, bx] = bool(occ[by * bs : (by + 1) * bs, bx * bs : (bx + 1) * bs].any())
+    return out
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_derive_blocks_equals_the_blocks_of_the_changed_map(seed: int) -> None:
+    """A map changed in a window (cells blocked and freed): its blocks derived from the
+    unchanged map's are the blocks of a loop over its own cells, and are what
+    :func:`occupied_blocks` then returns for it."""
+    rng = np.random.default_rng(seed)
+    ny, nx = (int(v) for v in rng.integers(5, 70, size=2))
+    base = rng.random((ny, nx)) < rng.uniform(0.0, 0.05)
+    base.flags.writeable = False
+    occupied_blocks(base)  # kept for the unchanged map
+    x0, x1 = sorted(int(v) for v in rng.integers(0, nx, size=2))
+    y0, y1 = sorted(int(v) for v in rng.integers(0, ny, size=2))
+    occ = np.array(base)
+    occ[y0 : y1 + 1, x0 : x1 + 1] = rng.random((y1 - y0 + 1, x1 - x0 + 1)) < 0.3
+    occ.flags.writeable = False
+    derive_blocks(occ, base, (x0, x1, y0, y1))
+    assert _BLOCKS[id(occ)][0] is occ  # kept: occupied_blocks builds nothing for it
+    got = occupied_blocks(occ)
+    assert got.dtype == np.bool_ and np.array_equal(got, brute_blocks(occ, CLEARANCE_BLOCK))
+    same = np.array(base)  # no window: a map equal to the unchanged one
+    same.flags.writeable = False
+    derive_blocks(same, base, None)
+    assert np.array_equal(occupied_blocks(same), brute_blocks(base, CLEARANCE_BLOCK))
+
+
+def test_derive_blocks_needs_the_unchanged_maps_blocks_and_a_read_only_map() -> None:
+    """Nothing kept without the unchanged map's blocks, or for a writable (changeable) map."""
+    base = np.zeros((20, 20), dtype=bool)
+    base.flags.writeable = False
+    occ = np.array(base)
+    occ[3, 4] = True
+    occ.flags.writeable = False
+    derive_blocks(occ, base, (4, 4, 3, 3))  # base's blocks never built
+    assert id(occ) not in _BLOCKS
+    occupied_blocks(base)
+    writable = np.array(occ)
+    derive_blocks(writable, base, (4, 4, 3, 3))
+    assert id(writable) not in _BLOCKS
+    assert np.array_equal(occupied_blocks(occ), brute_blocks(occ, CLEARANCE_BLOCK))

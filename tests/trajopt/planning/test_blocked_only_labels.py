@@ -4,8 +4,8 @@ re-route's marks).
 :func:`update_labels` labels only the box after such a change, and the derived caches patch the
 inflated grid and the clearance cost from the blocked cells alone; the labels are checked against
 a brute-force breadth-first search with the search's own move rules
-(``tests.reference.reachable_cells``), and the marked map's derived caches against caches
-built afresh for it.
+(``tests.reference.reachable_cells``), and the marked map's derived caches (and the raw
+map's clearance blocks derived for it) against caches built afresh for it.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import pytest
 import astar
 import trajopt
 from tests.reference import reachable_cells
+from trajopt.geometry._clearance import _BLOCKS, occupied_blocks
 from trajopt.planning._caches import PlannerCaches, component_labels, update_labels
 
 
@@ -77,6 +78,9 @@ def test_derived_caches_of_a_marked_map_equal_fresh_ones(inflation):
     planner = trajopt.Planner(grid, trajopt.Robot(radius=0.12), inflation=inflation)
     caches = planner.caches
     assert caches.components is not None and caches.search_cost is not None  # built
+    occupied_blocks(
+        caches.grid.occupied
+    )  # the raw map's clearance blocks kept (as a fit keeps them)
     for k in range(6):
         marked = occ.copy()
         x0, y0 = int(rng.integers(0, 70)), int(rng.integers(0, 50))
@@ -90,3 +94,7 @@ def test_derived_caches_of_a_marked_map_equal_fresh_ones(inflation):
         np.testing.assert_array_equal(a == 0, b == 0)
         pairs = np.unique(np.stack([a[a > 0], b[b > 0]]), axis=1)
         assert np.unique(pairs[0]).size == np.unique(pairs[1]).size == pairs.shape[1]
+        assert _BLOCKS[id(new.occupied)][0] is new.occupied  # derived: kept, not built
+        fresh_occ = np.array(marked)  # a fresh array: its blocks built from its cells
+        fresh_occ.flags.writeable = False
+        np.testing.assert_array_equal(occupied_blocks(new.occupied), occupied_blocks(fresh_occ))
