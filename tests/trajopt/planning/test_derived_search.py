@@ -1,4 +1,4 @@
-"""Tests of the searches on a re-route's marked map (:meth:`PlannerCaches.derived`).
+"""Tests of trajopt.planning: the searches on a re-route's marked map (:meth:`PlannerCaches.derived`).
 
 Marks only block cells, so the planner's ALT landmarks, computed on its own map, stay exact
 lower bounds on the marked one: the derived caches carry them over rebased (the same distance
