@@ -147,7 +147,8 @@ class _PathTables:
         """Return the path's piece ``[s0, s1]`` timed by :func:`trajopt.time_parameterize`.
 
         The whole path is timed as itself (its arc-length table and compiled look-ups
-        already made), a part of it as its :class:`~trajopt.geometry.CurveSegment`.
+        already made; from rest, on the tables' own cap table, not built again), a part of
+        it as its :class:`~trajopt.geometry.CurveSegment`.
         """
         path = self.path
         u_lo, u_hi = path.domain
@@ -161,6 +162,7 @@ class _PathTables:
                 v_start=v0,
                 a_start=a0,
                 speed_limits=self.speed_limits,
+                cap_table=self.table if whole and v0 == 0.0 and a0 == 0.0 else None,
             )
         except (TimingError, InvalidInputError, ValueError):
             return None
