@@ -428,3 +428,23 @@ def test_compiled_disc_robot_bounds_are_the_arrays_and_bound_dense_samples(seed)
         assert lower[i] <= np.min(true) + 1e-9
         mid = slack(traj, movers[mj[i]], np.array([tm[i]]), margin=margin)[0]
         assert slack_mid[i] == pytest.approx(mid, abs=1e-9)
+
+
+def test_curve_motion_arc_length_is_the_phase_polynomials_bit_for_bit():
+    # the robot's s(t) in the certificate (compiled, one loop) against the phase polynomials
+    # in numpy, at times before the start, on the phase starts, inside and after the end
+    from trajopt.moving._robot_windows import robot_windows
+
+    traj = time_parameterize(_curve([0.0, 0.4, -0.3, 0.2, 0.0], 4.0), ROBOT)
+    model = robot_windows(traj)[0][0]
+    pt, ps, pv, pa, pj = traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j
+    dur, length = traj.duration, float(traj.length)
+    t = np.concatenate([[-1.0, 0.0], pt, np.linspace(-0.5, dur + 0.5, 2001), [dur, dur + 3.0]])
+    tt = np.clip(t, 0.0, dur)
+    k = np.clip(np.searchsorted(pt, tt, side="right") - 1, 0, pt.shape[0] - 1)
+    tau = tt - pt[k]
+    s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
+    ref = np.where(tt >= dur, length, np.clip(s, 0.0, length))
+    assert np.array_equal(model.s_at(t), ref)
+    s0, s1 = model.s_ends(t[::-1].copy(), t)
+    assert np.array_equal(s0, ref[::-1]) and np.array_equal(s1, ref)
