@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
-from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
+from trajopt.moving._path_bounds import RangeMax, arc_kappa_kernel, kappa_table_of, path_boxes_of
 
 
 def profile_bounds(traj: Any) -> tuple[float, float]:
@@ -41,7 +41,7 @@ class CurveMotion:
         self.vmax, self.amax = profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
         self.s_edges, k = kappa_table_of(traj.path)
-        self.kmax = RangeMax(k)
+        self.kmax = RangeMax(k).table[:, :, None]  # its maxima over index ranges
         self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
@@ -76,10 +76,7 @@ class CurveMotion:
         x, y, th, sm, v = tr.pose(tm - off)
         p = np.stack([x, y], axis=-1)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
-        last = self.s_edges.shape[0] - 2
-        i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
-        i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)
-        kap = self.kmax(i0, np.maximum(i0, i1))  # |kappa| on the arc [s0, s1] (1/m)
+        kap = arc_kappa_kernel(self.s_edges, self.kmax, s0, s1)  # |kappa| on [s0, s1] (1/m)
         self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
         self.c2_local = kap * self.vmax**2 + self.amax
         return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
