@@ -184,6 +184,15 @@ def test_mover_segments_are_numpy_interp_bit_for_bit():
             assert np.array_equal(seg.vel[g], np.where(inside[:, None], vel, 0.0))
         else:
             assert not np.any(seg.vel[g]) and not np.any(seg.turn[g])
+    # all movers at once, interleaved (the compiled rows and poses, one loop)
+    j = rng.integers(0, len(movers), 300)
+    t = rng.uniform(-2.0, 12.0, 300)
+    g = seg.row(j, t)
+    for jj, m in enumerate(movers):
+        sel = j == jj
+        assert np.array_equal(g[sel], seg.row(np.full(int(sel.sum()), jj), t[sel]))
+        c, h = m.pose_at(t[sel])
+        assert np.array_equal(seg.at(g, t)[sel], np.column_stack([c, h]))
 
 
 def test_mover_table_is_kept_for_the_same_movers_only():
