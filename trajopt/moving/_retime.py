@@ -138,7 +138,8 @@ class _PathTables:
         piece of the path then).
         """
         tb, rk = self.table, self.rk
-        for vcap in (self.vtop, tb.range_min(state[0], s1)):
+        for low in (False, True):  # the lowest cap looked up only when needed
+            vcap = tb.range_min(state[0], s1) if low else self.vtop
             rows = rk.solve(state, (s1, 0.0, 0.0), vcap)
             if rows is not None and _under_caps(tb, rows):
                 return _piece_of_rows(rows, s1)
