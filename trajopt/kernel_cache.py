@@ -74,6 +74,8 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.moving._polygon_march",
     "trajopt.moving._polygon_distance",
     "trajopt.moving._bisection_bounds",
+    "trajopt.moving._path_bounds",
+    "trajopt.moving._mover_segments",
     "trajopt.moving._grid_kernels",
     "trajopt.moving._swept_kernel",
     "trajopt.moving._reach_kernel",

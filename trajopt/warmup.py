@@ -155,7 +155,10 @@ def _exercise_timing() -> None:
 
 
 def _exercise_moving() -> None:
-    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked, and proved so); mark a swept region."""
+    """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked, and proved so); mark a swept region.
+
+    The certificates of these re-timings reach the path bounds' look-ups (trajopt.moving._path_bounds).
+    """
     from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve
     from trajopt.moving import (

@@ -2,8 +2,9 @@
 
 :class:`MoverSegments` lets the moving-obstacle certificate
 (:func:`trajopt.moving.certify_movers`) evaluate every mover's pose and rates on many time
-intervals with one gather instead of one ``numpy.interp`` per mover; :func:`mover_table`
-keeps it, with the movers' sizes and shapes, for the last movers certified.
+intervals with one gather instead of one ``numpy.interp`` per mover (compiled:
+:func:`rows_kernel`, :func:`poses_kernel`); :func:`mover_table` keeps it, with the movers'
+sizes and shapes, for the last movers certified.
 """
 
 from __future__ import annotations
@@ -11,8 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from numba import njit
 
+from trajopt.kernel_cache import watch_compiles
 from trajopt.moving._obstacle import MovingObstacle
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 class MoverSegments:
@@ -55,26 +60,101 @@ class MoverSegments:
     def row(self, j: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Return the row of mover ``j``'s segment holding each ``t`` (s), shape (n,).
 
-        The segment ``k`` with ``t_k <= t < t_{k+1}`` (``searchsorted`` right, less one).
+        The segment ``k`` with ``t_k <= t < t_{k+1}`` (``searchsorted`` right, less one);
+        compiled (:func:`rows_kernel`).
         """
-        out = np.empty(t.shape[0], dtype=np.int64)
-        for jj in np.unique(j):
-            sel = j == jj
-            r = int(self.base[jj])
-            n = int(self.n[jj])
-            out[sel] = r + np.searchsorted(self.start[r + 1 : r + n + 1], t[sel], side="right")
-        return out
+        return rows_kernel(
+            self.base,
+            self.n,
+            self.start,
+            np.ascontiguousarray(j, dtype=np.int64),
+            np.ascontiguousarray(t, dtype=np.float64),
+        )
 
     def at(self, g: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Return the pose ``(x, y, heading)`` (m, m, rad), shape (n, 3), at times ``t`` (s) on rows ``g``.
 
-        ``g`` (n,) must be the rows holding ``t`` (:meth:`row`).
+        ``g`` (n,) must be the rows holding ``t`` (:meth:`row`); compiled
+        (:func:`poses_kernel`).
         """
-        p = self.pose[g]
-        slope = np.column_stack([self.vel[g], self.turn[g]])
-        run = self.moves[g] & (t != self.start[g])
-        off = np.where(run, t - np.where(run, self.start[g], 0.0), 0.0)
-        return np.where(run[:, None], slope * off[:, None] + p, p)
+        return poses_kernel(
+            self.pose,
+            self.vel,
+            self.turn,
+            self.moves,
+            self.start,
+            np.ascontiguousarray(g, dtype=np.int64),
+            np.ascontiguousarray(t, dtype=np.float64),
+        )
+
+
+@njit(cache=True)
+def rows_kernel(base, n, start, j, t):  # pragma: no cover - compiled
+    """Return :meth:`MoverSegments.row`: mover ``j[q]``'s row holding ``t[q]`` (s).
+
+    Parameters
+    ----------
+    base, n : ndarray of int64, shape (movers,)
+        Each mover's first row and its waypoint count.
+    start : ndarray, shape (rows,)
+        Each row's start time (s).
+    j : ndarray of int64, shape (m,)
+        The movers.
+    t : ndarray, shape (m,)
+        The times (s).
+
+    Returns
+    -------
+    ndarray of int64, shape (m,)
+    """
+    m = t.shape[0]
+    out = np.empty(m, dtype=np.int64)
+    for q in range(m):
+        r = base[j[q]]
+        out[q] = r + np.searchsorted(start[r + 1 : r + n[j[q]] + 1], t[q], side="right")
+    return out
+
+
+@njit(cache=True)
+def poses_kernel(pose, vel, turn, moves, start, g, t):  # pragma: no cover - compiled
+    """Return :meth:`MoverSegments.at`: the pose (m, m, rad), shape (m, 3), at ``t[q]`` on row ``g[q]``.
+
+    The row's start pose, plus its rates times the time since its start when it is
+    interpolated there (``numpy.interp``'s floats: ``slope (t - t_k) + p_k``).
+
+    Parameters
+    ----------
+    pose : ndarray, shape (rows, 3)
+        Each row's start pose.
+    vel, turn : ndarray, shape (rows, 2) and (rows,)
+        Each row's velocity (m/s) and turn rate (rad/s).
+    moves : ndarray of bool, shape (rows,)
+        Interpolated rows.
+    start : ndarray, shape (rows,)
+        Each row's start time (s).
+    g : ndarray of int64, shape (m,)
+        The rows holding the times.
+    t : ndarray, shape (m,)
+        The times (s).
+
+    Returns
+    -------
+    ndarray, shape (m, 3)
+    """
+    m = t.shape[0]
+    out = np.empty((m, 3))
+    for q in range(m):
+        r = g[q]
+        if moves[r] and t[q] != start[r]:
+            off = t[q] - start[r]
+            out[q, 0] = vel[r, 0] * off + pose[r, 0]
+            out[q, 1] = vel[r, 1] * off + pose[r, 1]
+            out[q, 2] = turn[r] * off + pose[r, 2]
+        else:
+            out[q, 0] = pose[r, 0]
+            out[q, 1] = pose[r, 1]
+            out[q, 2] = pose[r, 2]
+    return out
 
 
 class MoverTable:

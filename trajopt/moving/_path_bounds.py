@@ -4,7 +4,10 @@
 polynomial pieces), :class:`PathBoxes` the points over arc-length ranges; both are kept for
 the last few paths (:func:`kappa_table_of`, :func:`path_boxes_of`), found again by the
 object or by its geometry (:func:`geometry_key`): a re-plan's kept rest is a new curve object
-of the same geometry. :class:`RangeMax` answers maxima over index ranges.
+of the same geometry. :class:`RangeMax` answers maxima over index ranges. The look-ups the
+certificate makes per interval are compiled, :class:`RangeMax`'s query inside them:
+:func:`boxes_kernel` (:meth:`PathBoxes.box`) and :func:`arc_kappa_kernel` (the curvature
+bound over an arc).
 """
 
 from __future__ import annotations
@@ -13,8 +16,12 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from trajopt.geometry import kappa_bound
+from trajopt.kernel_cache import watch_compiles
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 def kappa_table(curve: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -132,12 +139,18 @@ class PathBoxes:
         self.ranges = RangeMax(np.stack([-pts[:, 0], pts[:, 0], -pts[:, 1], pts[:, 1]], axis=1))
 
     def box(self, s0: np.ndarray, s1: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Return ``(x_min, x_max, y_min, y_max)`` (m) of the path over ``[s0, s1]`` (m), elementwise."""
-        last = self.s.shape[0] - 1
-        i0 = np.clip(np.searchsorted(self.s, s0, side="right") - 1, 0, last)
-        i1 = np.maximum(np.clip(np.searchsorted(self.s, s1, side="left"), 0, last), i0)
-        x0, x1, y0, y1 = self.ranges(i0, i1).T
-        return -x0 - self.pad, x1 + self.pad, -y0 - self.pad, y1 + self.pad
+        """Return ``(x_min, x_max, y_min, y_max)`` (m) of the path over ``[s0, s1]`` (m), elementwise.
+
+        ``s0``, ``s1`` of shape (n,); compiled (:func:`boxes_kernel`).
+        """
+        out = boxes_kernel(
+            self.s,
+            self.ranges.table,
+            self.pad,
+            np.ascontiguousarray(s0, dtype=np.float64),
+            np.ascontiguousarray(s1, dtype=np.float64),
+        )
+        return out[0], out[1], out[2], out[3]
 
 
 #: The path boxes of the last curves certified (curve, its key, boxes), most recent last.
@@ -173,9 +186,90 @@ class RangeMax:
     def __call__(self, i0: np.ndarray, i1: np.ndarray) -> np.ndarray:
         """Return the maximum over ``values[i0 : i1 + 1]`` (``i0 <= i1``), elementwise.
 
-        Shape ``i0.shape`` (plus the columns of a 2-D ``values``).
+        Shape ``i0.shape`` (plus the columns of a 2-D ``values``). The array form of the
+        compiled look-ups' query (:func:`boxes_kernel`, :func:`arc_kappa_kernel`).
         """
         n = i1 - i0 + 1
         lev = np.floor(np.log2(np.maximum(n, 1))).astype(np.int64)
         tb = self.table
         return np.maximum(tb[lev, i0], tb[lev, i1 - (1 << lev) + 1])
+
+
+@njit(cache=True)
+def _range_max(table, i0, i1, k):  # pragma: no cover - compiled
+    """Return the maximum of column ``k`` over rows ``i0 .. i1`` of a :class:`RangeMax` table (levels, n, c).
+
+    :meth:`RangeMax.__call__`'s query, the same float (``numpy.maximum``'s choice, NaN too).
+    """
+    span = i1 - i0 + 1
+    lev = 0
+    while (2 << lev) <= span:  # floor(log2(max(span, 1)))
+        lev += 1
+    x = table[lev, i0, k]
+    y = table[lev, i1 - (1 << lev) + 1, k]
+    if x != x or y != y:  # numpy.maximum: NaN wins
+        return x + y
+    return x if x >= y else y
+
+
+@njit(cache=True)
+def boxes_kernel(s, table, pad, s0, s1):  # pragma: no cover - compiled
+    """Return :meth:`PathBoxes.box` of the arcs ``[s0, s1]`` (m): rows x_min, x_max, y_min, y_max.
+
+    Parameters
+    ----------
+    s : ndarray, shape (k,)
+        The samples' arc lengths (m), non-decreasing.
+    table : ndarray, shape (levels, k, 4)
+        The :class:`RangeMax` table of the samples' ``(-x, x, -y, y)`` (m).
+    pad : float
+        The boxes' growth (m).
+    s0, s1 : ndarray, shape (n,)
+        The arcs' ends (m).
+
+    Returns
+    -------
+    ndarray, shape (4, n)
+        The boxes (m): the samples from the last at or before ``s0`` to the first at or
+        after ``s1``, their extremes grown by ``pad``.
+    """
+    n = s0.shape[0]
+    last = s.shape[0] - 1
+    out = np.empty((4, n))
+    for q in range(n):
+        i0 = min(max(np.searchsorted(s, s0[q], side="right") - 1, 0), last)
+        i1 = max(min(max(np.searchsorted(s, s1[q], side="left"), 0), last), i0)
+        out[0, q] = -_range_max(table, i0, i1, 0) - pad
+        out[1, q] = _range_max(table, i0, i1, 1) + pad
+        out[2, q] = -_range_max(table, i0, i1, 2) - pad
+        out[3, q] = _range_max(table, i0, i1, 3) + pad
+    return out
+
+
+@njit(cache=True)
+def arc_kappa_kernel(s_edges, table, s0, s1):  # pragma: no cover - compiled
+    """Return the bound (1/m) of ``|kappa|`` on each arc ``[s0, s1]`` (m) from :func:`kappa_table`.
+
+    Parameters
+    ----------
+    s_edges : ndarray, shape (k + 1,)
+        The table's interval edges (m).
+    table : ndarray, shape (levels, k, 1)
+        The :class:`RangeMax` table of its bounds (1/m).
+    s0, s1 : ndarray, shape (n,)
+        The arcs' ends (m).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The largest bound of the intervals from the one holding ``s0`` (the later one on an
+        edge) to the one holding ``s1`` (the earlier one on an edge).
+    """
+    n = s0.shape[0]
+    last = s_edges.shape[0] - 2
+    out = np.empty(n)
+    for q in range(n):
+        i0 = min(max(np.searchsorted(s_edges, s0[q], side="right") - 1, 0), last)
+        i1 = min(max(np.searchsorted(s_edges, s1[q], side="left") - 1, 0), last)
+        out[q] = _range_max(table, i0, max(i0, i1), 0)
+    return out

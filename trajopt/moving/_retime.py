@@ -55,6 +55,7 @@ from trajopt.moving._certificate import (
     convex_distance,
     shape_at,
 )
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._path_bounds import geometry_key, kappa_max
 from trajopt.moving._shape_windows import ShapeWindows, launch_floor
@@ -137,7 +138,8 @@ class _PathTables:
         piece of the path then).
         """
         tb, rk = self.table, self.rk
-        for vcap in (self.vtop, tb.range_min(state[0], s1)):
+        for low in (False, True):  # the lowest cap looked up only when needed
+            vcap = tb.range_min(state[0], s1) if low else self.vtop
             rows = rk.solve(state, (s1, 0.0, 0.0), vcap)
             if rows is not None and _under_caps(tb, rows):
                 return _piece_of_rows(rows, s1)
@@ -147,7 +149,8 @@ class _PathTables:
         """Return the path's piece ``[s0, s1]`` timed by :func:`trajopt.time_parameterize`.
 
         The whole path is timed as itself (its arc-length table and compiled look-ups
-        already made), a part of it as its :class:`~trajopt.geometry.CurveSegment`.
+        already made; from rest, on the tables' own cap table, not built again), a part of
+        it as its :class:`~trajopt.geometry.CurveSegment`.
         """
         path = self.path
         u_lo, u_hi = path.domain
@@ -161,6 +164,7 @@ class _PathTables:
                 v_start=v0,
                 a_start=a0,
                 speed_limits=self.speed_limits,
+                cap_table=self.table if whole and v0 == 0.0 and a0 == 0.0 else None,
             )
         except (TimingError, InvalidInputError, ValueError):
             return None
@@ -240,6 +244,9 @@ def _robot_shape(traj: Trajectory, margin: float) -> tuple[float, np.ndarray | N
 
 
 def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float) -> None:
+    """Refuse a mover that overlaps the robot at ``t = 0`` (:class:`InvalidInputError`)."""
+    if not movers:
+        return
     u0 = traj.path.domain[0]
     p0 = np.asarray(traj.path(u0), dtype=float).reshape(1, 2)
     robot: np.ndarray = p0[:, None, :]
@@ -253,9 +260,13 @@ def _overlap_at_start(traj: Any, movers: Sequence[MovingObstacle], margin: float
     reach_r = (
         float(np.max(np.hypot(*(robot[0] - p0[0]).T))) if fp is not None else traj.robot.radius
     )
-    c = np.array([m.position_at(0.0) for m in movers]).reshape(-1, 2)
-    reach_m = [m.radius_at(0.0) + np.max(np.hypot(*m.shape_vertices.T)) for m in movers]
-    gap = np.hypot(*(c - p0[0]).T) - np.array(reach_m, dtype=float) - reach_r - margin
+    # their places and reaches at t = 0 from the certificate's table of these movers (kept
+    # for it): numpy.interp's positions, radius_at(0) plus the farthest vertex
+    table = mover_table(movers)
+    zero = np.zeros(len(movers))
+    c = table.seg.at(table.seg.row(np.arange(len(movers)), zero), zero)[:, :2]
+    reach_m = (table.rad0 + table.grow * zero) + table.reach
+    gap = np.hypot(*(c - p0[0]).T) - reach_m - reach_r - margin
     for m in (m for m, g in zip(movers, gap, strict=True) if not g > 1e-9):
         d = float(convex_distance(robot, shape_at(m, np.zeros(1)))[0])
         need = margin + float(m.radius_at(0.0)) + (traj.robot.radius if fp is None else 0.0)

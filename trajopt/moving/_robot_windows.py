@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
-from trajopt.moving._path_bounds import RangeMax, kappa_table_of, path_boxes_of
+from trajopt.moving._path_bounds import RangeMax, arc_kappa_kernel, kappa_table_of, path_boxes_of
 
 
 def profile_bounds(traj: Any) -> tuple[float, float]:
@@ -41,46 +41,42 @@ class CurveMotion:
         self.vmax, self.amax = profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
         self.s_edges, k = kappa_table_of(traj.path)
-        self.kmax = RangeMax(k)
+        self.kmax = RangeMax(k).table[:, :, None]  # its maxima over index ranges
         self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
-        self.length = float(traj.length)
-        self.phases = (traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j)
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
-        """Return the arc length (m) at the curve's own times ``t`` (s): ``traj.motion``'s ``s``."""
-        pt, ps, pv, pa, pj = self.phases
-        dur = self.traj.duration
-        tt = np.clip(t, 0.0, dur)
-        k = np.clip(np.searchsorted(pt, tt, side="right") - 1, 0, pt.shape[0] - 1)
-        tau = tt - pt[k]
-        s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
-        return np.where(tt >= dur, self.length, np.clip(s, 0.0, self.length))
+        """Return the arc length (m) at the curve's own times ``t`` (s): ``traj.motion``'s ``s``.
+
+        ``t`` clipped to ``[0, duration]``, ``s`` to ``[0, length]``, exactly ``length`` from
+        ``duration`` on (compiled, one loop: :meth:`trajopt.Trajectory.motion`).
+        """
+        return self.traj.motion(t)[0]
+
+    def s_ends(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return :meth:`s_at` at the global times ``t0`` and ``t1`` (s), shape (n,) each: one call."""
+        n = t0.shape[0]
+        s = self.s_at(np.concatenate([t0, t1]) - self.offset)
+        return s[:n], s[n:]
 
     def box(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return ``(x_min, x_max, y_min, y_max)`` (m): a box holding the robot's reference point during ``[t0, t1]``."""
-        s0 = self.s_at(t0 - self.offset)
-        s1 = self.s_at(t1 - self.offset)
+        s0, s1 = self.s_ends(t0, t1)
         return path_boxes_of(self.traj.path).box(s0, s1)
 
     def box_rho(self, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return :meth:`box` and a bound (m) of :meth:`at`'s ``rho_P``: the arc ``s(t1) - s(t0)``."""
-        s0 = self.s_at(t0 - self.offset)
-        s1 = self.s_at(t1 - self.offset)
+        s0, s1 = self.s_ends(t0, t1)
         x0, x1, y0, y1 = path_boxes_of(self.traj.path).box(s0, s1)
         return x0, x1, y0, y1, (s1 - s0).clip(0.0) * (1.0 + 1e-9) + 1e-12
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
         tr, off = self.traj, self.offset
-        s0 = self.s_at(t0 - off)
-        s1 = self.s_at(t1 - off)
+        s0, s1 = self.s_ends(t0, t1)
         x, y, th, sm, v = tr.pose(tm - off)
         p = np.stack([x, y], axis=-1)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
-        last = self.s_edges.shape[0] - 2
-        i0 = np.clip(np.searchsorted(self.s_edges, s0, side="right") - 1, 0, last)
-        i1 = np.clip(np.searchsorted(self.s_edges, s1, side="left") - 1, 0, last)
-        kap = self.kmax(i0, np.maximum(i0, i1))  # |kappa| on the arc [s0, s1] (1/m)
+        kap = arc_kappa_kernel(self.s_edges, self.kmax, s0, s1)  # |kappa| on [s0, s1] (1/m)
         self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
         self.c2_local = kap * self.vmax**2 + self.amax
         return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)

@@ -54,6 +54,7 @@ def time_parameterize(
     dt: float = 0.02,
     speed_limits: SpeedLimits | None = None,
     a_start: float = 0.0,
+    cap_table: CapTable | None = None,
 ) -> Trajectory:
     """Time a curve with a near time-optimal, jerk-limited speed profile.
 
@@ -76,6 +77,11 @@ def time_parameterize(
         robot's state); the acceleration at ``s = L`` is 0. The profile starts from
         ``(v_start, a_start)`` under the jerk limit and brakes first where the cap ahead
         requires it.
+    cap_table : CapTable, optional
+        The curve's cap table when the caller has it: :func:`build_cap_table` of this
+        ``curve``, ``robot``, ``curve.length``, ``v_start``, ``v_end`` and ``speed_limits``
+        (the same arguments; the table is then not built again, and the result is the same
+        as without it). Default: built here.
 
     Returns
     -------
@@ -86,7 +92,8 @@ def time_parameterize(
     Raises
     ------
     InvalidInputError
-        Wrong types, non-finite or negative speeds, a bad ``dt``, a curve without length.
+        Wrong types, non-finite or negative speeds, a bad ``dt``, a curve without length, a
+        ``cap_table`` that is not a :class:`CapTable` or not of the curve's length.
     TimingError
         A boundary speed is above the speed cap there, the path is too short to change from
         ``v_start`` to ``v_end``, the cap is ~0 somewhere (a cusp), or ``v_start`` cannot be
@@ -116,12 +123,26 @@ def time_parameterize(
     if not (math.isfinite(length) and length > 0.0):
         raise InvalidInputError(f"curve.length must be finite and > 0 m, got {length!r}")
 
+    if cap_table is not None:
+        if not isinstance(cap_table, CapTable):
+            raise InvalidInputError(
+                f"cap_table must be a trajopt.timing.CapTable, got {type(cap_table).__name__}"
+            )
+        if cap_table.length != length:
+            raise InvalidInputError(
+                f"cap_table.length must be the curve's length {length!r} m, got "
+                f"{cap_table.length!r} m (a table of another curve)"
+            )
+
     amax, jmax = robot.a_max, robot.j_max
     stats: dict[str, Any] = {}
 
     # ---------------------------------------------------------------- 1. cap table
     t0 = time.perf_counter()
-    table = build_cap_table(curve, robot, length, v_start, v_end, speed_limits)
+    if cap_table is None:
+        table = build_cap_table(curve, robot, length, v_start, v_end, speed_limits)
+    else:
+        table = cap_table
     d_change = _change_distance(v_start, v_end, jmax, amax) if a_start == 0.0 else 0.0
     if d_change > length * (1.0 + 1e-9):
         raise TimingError(

@@ -155,7 +155,7 @@ def test_bad_arguments(line):
 
 def test_mover_segments_are_numpy_interp_bit_for_bit():
     """Poses and rates gathered for several movers equal numpy.interp and the waypoint slopes."""
-    from trajopt.moving._mover_segments import MoverSegments
+    from trajopt.moving._mover_segments import mover_table
 
     rng = np.random.default_rng(3)
     movers = [
@@ -168,7 +168,7 @@ def test_mover_segments_are_numpy_interp_bit_for_bit():
         )
         for n in (1, 2, 3, 6)
     ]
-    seg = MoverSegments(movers)
+    seg = mover_table(movers).seg  # read-only, as the certificate's (one compiled signature)
     for j, m in enumerate(movers):
         t = np.concatenate([m.times, rng.uniform(-2.0, 12.0, 200), [m.times[-1] + 1.0]])
         g = seg.row(np.full(t.shape, j), t)
@@ -184,6 +184,15 @@ def test_mover_segments_are_numpy_interp_bit_for_bit():
             assert np.array_equal(seg.vel[g], np.where(inside[:, None], vel, 0.0))
         else:
             assert not np.any(seg.vel[g]) and not np.any(seg.turn[g])
+    # all movers at once, interleaved (the compiled rows and poses, one loop)
+    j = rng.integers(0, len(movers), 300)
+    t = rng.uniform(-2.0, 12.0, 300)
+    g = seg.row(j, t)
+    for jj, m in enumerate(movers):
+        sel = j == jj
+        assert np.array_equal(g[sel], seg.row(np.full(int(sel.sum()), jj), t[sel]))
+        c, h = m.pose_at(t[sel])
+        assert np.array_equal(seg.at(g, t)[sel], np.column_stack([c, h]))
 
 
 def test_mover_table_is_kept_for_the_same_movers_only():
@@ -428,3 +437,23 @@ def test_compiled_disc_robot_bounds_are_the_arrays_and_bound_dense_samples(seed)
         assert lower[i] <= np.min(true) + 1e-9
         mid = slack(traj, movers[mj[i]], np.array([tm[i]]), margin=margin)[0]
         assert slack_mid[i] == pytest.approx(mid, abs=1e-9)
+
+
+def test_curve_motion_arc_length_is_the_phase_polynomials_bit_for_bit():
+    # the robot's s(t) in the certificate (compiled, one loop) against the phase polynomials
+    # in numpy, at times before the start, on the phase starts, inside and after the end
+    from trajopt.moving._robot_windows import robot_windows
+
+    traj = time_parameterize(_curve([0.0, 0.4, -0.3, 0.2, 0.0], 4.0), ROBOT)
+    model = robot_windows(traj)[0][0]
+    pt, ps, pv, pa, pj = traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j
+    dur, length = traj.duration, float(traj.length)
+    t = np.concatenate([[-1.0, 0.0], pt, np.linspace(-0.5, dur + 0.5, 2001), [dur, dur + 3.0]])
+    tt = np.clip(t, 0.0, dur)
+    k = np.clip(np.searchsorted(pt, tt, side="right") - 1, 0, pt.shape[0] - 1)
+    tau = tt - pt[k]
+    s = ps[k] + tau * (pv[k] + tau * (0.5 * pa[k] + tau * pj[k] / 6.0))
+    ref = np.where(tt >= dur, length, np.clip(s, 0.0, length))
+    assert np.array_equal(model.s_at(t), ref)
+    s0, s1 = model.s_ends(t[::-1].copy(), t)
+    assert np.array_equal(s0, ref[::-1]) and np.array_equal(s1, ref)

@@ -89,3 +89,48 @@ def test_range_maxima_are_the_maxima_of_the_ranges(n, cols, seed):
     got = RangeMax(values)(i0, i1)
     want = np.array([values[a : b + 1].max(axis=0) for a, b in zip(i0, i1, strict=True)])
     assert np.array_equal(got, want)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=8), st.floats(1.0, 30.0))
+def test_compiled_boxes_and_arc_curvature_are_the_arrays_bit_for_bit(ys, length):
+    from trajopt.moving._path_bounds import arc_kappa_kernel, kappa_table
+
+    path = _wiggle(ys, length)
+    total = float(path.length)
+    rng = np.random.default_rng(len(ys))
+    s0 = np.concatenate([rng.uniform(-0.1, 1.1, 300) * total, [0.0, total, -1.0]])
+    s1 = np.minimum(s0 + rng.uniform(0.0, 0.3, s0.shape[0]) * total, total + 0.5)
+    # the boxes: the array form of PathBoxes.box
+    boxes = PathBoxes(path)
+    last = boxes.s.shape[0] - 1
+    i0 = np.clip(np.searchsorted(boxes.s, s0, side="right") - 1, 0, last)
+    i1 = np.maximum(np.clip(np.searchsorted(boxes.s, s1, side="left"), 0, last), i0)
+    x0, x1, y0, y1 = boxes.ranges(i0, i1).T
+    want = (-x0 - boxes.pad, x1 + boxes.pad, -y0 - boxes.pad, y1 + boxes.pad)
+    for got, ref in zip(boxes.box(s0, s1), want, strict=True):
+        assert np.array_equal(got, ref)
+    # the curvature bound over an arc: the array form, and above |kappa| sampled on the arc
+    edges, k = kappa_table(path)
+    rm = RangeMax(k)
+    last = edges.shape[0] - 2
+    i0 = np.clip(np.searchsorted(edges, s0, side="right") - 1, 0, last)
+    i1 = np.clip(np.searchsorted(edges, s1, side="left") - 1, 0, last)
+    want = rm(i0, np.maximum(i0, i1))
+    got = arc_kappa_kernel(edges, rm.table[:, :, None], s0, s1)
+    assert np.array_equal(got, want)
+    for a, b, bound in zip(s0[:40], s1[:40], got[:40], strict=True):
+        s = np.linspace(max(a, 0.0), min(b, total), 50)
+        kappa = np.abs(np.asarray(path.curvature(path.u_at_s(s))))
+        assert np.all(kappa <= bound * (1.0 + 1e-9) + 1e-12)
+
+
+def test_compiled_range_maxima_of_infinite_and_nan_values_are_numpys():
+    from trajopt.moving._path_bounds import arc_kappa_kernel
+
+    values = np.array([1.0, -np.inf, np.inf, np.nan, 0.0, -0.0, 2.0])
+    rm = RangeMax(values)
+    edges = np.arange(8.0)
+    i0, i1 = (x.ravel() for x in np.meshgrid(np.arange(7), np.arange(7)))
+    got = arc_kappa_kernel(edges, rm.table[:, :, None], i0 + 0.5, i1 + 0.5)
+    assert np.array_equal(got, rm(i0, np.maximum(i0, i1)), equal_nan=True)

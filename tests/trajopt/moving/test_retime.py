@@ -119,6 +119,38 @@ def test_a_mover_on_the_robot_at_the_start_is_refused(line6):
         retime_for_movers(line6, [m])
 
 
+@pytest.mark.parametrize("gap", [-1e-3, 1e-3])
+def test_the_quick_filter_of_the_start_overlap_keeps_the_near_mover(line6, gap):
+    # among far movers (some mid-segment at t = 0, some growing), a cart whose edge is `gap`
+    # from the robot's disc at t = 0 (its place interpolated between waypoints before and
+    # after 0): refused exactly when it overlaps (the distance by hand: the edge at x - 0.45)
+    from trajopt.moving import _retime
+
+    rng = np.random.default_rng(5)
+    far = [
+        MovingObstacle.from_waypoints(
+            [-1.0 - j, 2.0, 5.0],
+            rng.uniform(4.0, 9.0, (3, 2)),
+            radius=0.2,
+            growth=0.05 * j,
+            vertices=CART if j % 2 else None,
+            name=f"far{j}",
+        )
+        for j in range(8)
+    ]
+    x = 0.45 + 0.05 + float(ROBOT.radius) + gap  # the cart's centre at t = 0 (m)
+    near = MovingObstacle.from_waypoints(
+        [-1.0, 1.0], [(x - 0.5, 0.0), (x + 0.5, 0.0)], radius=0.05, vertices=CART, name="near"
+    )
+    movers = [*far[:4], near, *far[4:]]
+    if gap < 0.0:
+        with pytest.raises(InvalidInputError, match="'near' overlaps the robot at t = 0"):
+            _retime._overlap_at_start(line6, movers, 0.0)
+    else:
+        _retime._overlap_at_start(line6, movers, 0.0)
+    _retime._overlap_at_start(line6, [], 0.0)  # no movers: nothing to refuse
+
+
 def test_a_turning_polygon_mover_is_let_pass(line6):
     cart = MovingObstacle.from_waypoints(
         [0.0, 12.0],

@@ -16,7 +16,7 @@ from trajopt.geometry._bspline import BSplineCurve, clamped_uniform_knots
 from trajopt.geometry._curve import ParametricCurve
 from trajopt.motion._trajectory import Trajectory
 from trajopt.robot._robot import Robot
-from trajopt.timing import time_parameterize
+from trajopt.timing import build_cap_table, time_parameterize
 
 TOL = 1e-3  # relative tolerance of the curvature-dependent limits on dense samples
 
@@ -214,6 +214,29 @@ def test_invalid_inputs():
     for bad in (0.0, -0.01, 1.0, math.nan):
         with pytest.raises(InvalidInputError, match="dt"):
             time_parameterize(c, ROBOT, dt=bad)
+
+
+@pytest.mark.parametrize(
+    ("make", "v_start", "v_end"),
+    [(hairpin, 0.0, 0.0), (lambda: line(2.0), 0.3, 0.0), (lambda: lsq_circle(0.8, 0.5), 0.0, 0.2)],
+)
+def test_a_prebuilt_cap_table_times_the_same_bit_for_bit(make, v_start, v_end):
+    c = make()
+    own = time_parameterize(c, ROBOT, v_start=v_start, v_end=v_end)
+    table = build_cap_table(c, ROBOT, float(c.length), v_start, v_end)
+    given_table = time_parameterize(c, ROBOT, v_start=v_start, v_end=v_end, cap_table=table)
+    assert given_table.duration == own.duration
+    for name in ("phase_t", "phase_s", "phase_v", "phase_a", "phase_j", "theta_grid", "u_grid"):
+        assert np.array_equal(getattr(given_table, name), getattr(own, name))
+
+
+def test_a_bad_cap_table_is_refused():
+    c = line(1.0)
+    with pytest.raises(InvalidInputError, match="cap_table must be a trajopt.timing.CapTable"):
+        time_parameterize(c, ROBOT, cap_table="table")  # type: ignore[arg-type]
+    other = build_cap_table(line(2.0), ROBOT, 2.0, 0.0, 0.0)
+    with pytest.raises(InvalidInputError, match=r"cap_table.length must be .* got 2.0 m"):
+        time_parameterize(c, ROBOT, cap_table=other)
 
 
 def test_default_robot_and_stats():
