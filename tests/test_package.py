@@ -119,17 +119,24 @@ def _tree(path: Path) -> ast.Module:
 
 
 @functools.cache
+def _nodes(tree: ast.AST) -> tuple[ast.AST, ...]:
+    """Every node of ``tree``, in ``ast.walk`` order (walked once per tree: several tests
+    read every node of every file, and walking is most of their time)."""
+    return tuple(ast.walk(tree))
+
+
+@functools.cache
 def _absolute_imports(path: Path) -> tuple[tuple[str, int], ...]:
     """``(imported module, line)`` of every absolute import outside TYPE_CHECKING."""
     tree = _tree(path)
     guarded = {
         id(sub)
-        for node in ast.walk(tree)
+        for node in _nodes(tree)
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
         for sub in ast.walk(node)
     }
     out = []
-    for node in ast.walk(tree):
+    for node in _nodes(tree):
         if id(node) in guarded:
             continue
         if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
@@ -171,7 +178,7 @@ def _drive_composes(here: str, target: str, path: Path, line: int) -> bool:
     tree = _tree(path)
     return any(
         isinstance(fn, ast.FunctionDef) and fn.lineno < line <= (fn.end_lineno or fn.lineno)
-        for fn in ast.walk(tree)
+        for fn in _nodes(tree)
     )
 
 
@@ -239,7 +246,7 @@ def _class_switches(tree: ast.AST) -> list[int]:
     """
     validation = {
         id(sub)
-        for node in ast.walk(tree)
+        for node in _nodes(tree)
         if isinstance(node, ast.If) and all(isinstance(b, ast.Raise) for b in node.body)
         for sub in ast.walk(node.test)
     }
@@ -250,7 +257,7 @@ def _class_switches(tree: ast.AST) -> list[int]:
         }
 
     out = []
-    for node in ast.walk(tree):
+    for node in _nodes(tree):
         if id(node) in validation:
             continue
         if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "isinstance":
@@ -304,7 +311,7 @@ def test_packages_use_each_other_through_their_faces():
     for path in sorted(root.rglob("*.py")):
         rel = path.relative_to(root.parent).with_suffix("")
         here = ".".join(rel.parts).removesuffix(".__init__")
-        for node in ast.walk(_tree(path)):
+        for node in _nodes(_tree(path)):
             if not isinstance(node, ast.ImportFrom | ast.Import) or getattr(node, "level", 0):
                 continue
             mods = (
@@ -326,7 +333,7 @@ def test_no_drive_is_named_outside_the_drives():
     for path in sorted(root.rglob("*.py")):
         if path.relative_to(root).parts[0] == "drive":
             continue
-        for node in ast.walk(_tree(path)):
+        for node in _nodes(_tree(path)):
             if not isinstance(node, ast.Compare):
                 continue
             sides = [node.left, *node.comparators]
