@@ -153,7 +153,7 @@ def body_at(body: np.ndarray, poses: np.ndarray) -> np.ndarray:
     return np.stack([x, y], axis=-1)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _seg_meet(ax, ay, bx, by, cx, cy, dx, dy) -> bool:  # pragma: no cover - compiled
     """Closed segments ``a b`` and ``c d`` share a point (touching counts)."""
     o1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
@@ -175,7 +175,7 @@ def _seg_meet(ax, ay, bx, by, cx, cy, dx, dy) -> bool:  # pragma: no cover - com
     return False
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _overlaps_kernel(body, poses, verts, starts, out):  # pragma: no cover - compiled
     """``out[i]``: the convex ``body`` at ``poses[i]`` meets a polygon (see body_overlaps)."""
     k = body.shape[0]
@@ -248,10 +248,10 @@ def body_overlaps(body: np.ndarray, poses: np.ndarray, polygons) -> np.ndarray:
     ``(x, y, theta)`` meets a simple polygon iff an edge of one meets an edge of the other
     (closed segments, orientation tests), or, when no boundaries meet, a body corner lies
     inside the polygon (the body inside it) or a polygon vertex lies inside the body (the
-    polygon inside it). A compiled loop (numba, compiled in each process: a cache written
-    under one module name cannot be loaded under another, and the suite is imported both as
-    ``parking_cases`` by the benchmark and as ``benchmarks.parking_cases`` by the tests):
-    about a microsecond per pose against a car park's polygons.
+    polygon inside it). A compiled loop (numba, cached on disk beside this file: numba names
+    the cache after the source file, so the benchmark, which imports the suite as
+    ``parking_cases``, and the tests, which import it as ``benchmarks.parking_cases``, load
+    the same compiled code): about a microsecond per pose against a car park's polygons.
 
     Parameters
     ----------

@@ -106,6 +106,17 @@ def test_checker_agrees_with_shapely_on_random_poses():
         assert 0.05 < mine.mean() < 0.95  # both answers occur
 
 
+def test_the_checkers_kernels_are_cached_on_disk():
+    """The kernels are compiled once per checkout, not once per session (a compile is
+    seconds): numba names its cache files after the source file, not the module, so the
+    benchmark's ``parking_cases`` and the tests' ``benchmarks.parking_cases`` share them.
+    The shapely test above checks what the kernels compute."""
+    from numba.core.caching import NullCache
+
+    for kernel in (pc._seg_meet, pc._overlaps_kernel):
+        assert not isinstance(kernel._cache, NullCache), kernel
+
+
 # ------------------------------------------------------------------ the suite
 
 
