@@ -16,6 +16,28 @@ from tests.trajopt_ros import helpers as h  # noqa: E402
 from tests.trajopt_ros.conftest import NodeProcess  # noqa: E402
 
 TOL = 1e-6
+#: The signals test_shutdown_by_signal stops a fresh node with, one node each
+SIGNALS = (signal.SIGTERM,)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def signal_nodes(request, ros_env):
+    """A fresh node per signal of test_shutdown_by_signal (namespace ``/sig<number>``, no map
+    published there), started when the module starts, so that their start-up (seconds of
+    imports) runs beside the session node's instead of inside the test; none when that test
+    is not selected. Each is stopped at the end of the module if its test has not."""
+    selected = any(
+        getattr(i, "originalname", None) == "test_shutdown_by_signal"
+        and getattr(i, "module", None) is request.module
+        for i in request.session.items
+    )
+    nodes = {
+        sig: NodeProcess(ros_env, "-r", f"__ns:=/sig{int(sig)}", name="trajopt_sig")
+        for sig in (SIGNALS if selected else ())
+    }
+    yield nodes
+    for node in nodes.values():
+        node.stop()
 
 
 @pytest.fixture(scope="module")
@@ -317,12 +339,12 @@ def test_bad_parameter_file_refused_at_start(ros_env, tmp_path):
     assert "robot.drive" in out and "tank" in out
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM])
-def test_shutdown_by_signal(ros_env, client, sig):
+@pytest.mark.parametrize("sig", SIGNALS)
+def test_shutdown_by_signal(signal_nodes, client, sig):
     from nav_msgs.srv import GetPlan
 
-    node = NodeProcess(ros_env, "-r", "__ns:=/sig", name="trajopt_sig")
-    srv = client.create_client(GetPlan, "/sig/get_plan")
+    node, ns = signal_nodes[sig], f"/sig{int(sig)}"  # started with the module, no map yet
+    srv = client.create_client(GetPlan, f"{ns}/get_plan")
     assert srv.wait_for_service(timeout_sec=30.0), node.output()
     # before any map: refused with its reason, and a malformed map is refused too
     req = GetPlan.Request(start=h.pose(1.0, 1.0), goal=h.pose(5.0, 1.0))
@@ -334,7 +356,7 @@ def test_shutdown_by_signal(ros_env, client, sig):
     qos = QoSProfile(
         depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
     )
-    pub = client.create_publisher(OccupancyGrid, "/sig/map", qos)
+    pub = client.create_publisher(OccupancyGrid, f"{ns}/map", qos)
     bad = h.grid_msg(h.wall_map())
     bad.data = bad.data[:-1]
     pub.publish(bad)
