@@ -22,6 +22,12 @@
   run rewrites the assertions of every test module and compiles every source again before
   the first test (about 10 s of the collection on the shared 2-core machine), and every
   fresh process a test starts compiles the sources again.
+* The objects alive when collection ends (the imported packages and their dependencies, the
+  collected tests: most of the heap, about a million objects) are frozen (``gc.freeze``)
+  until the session finishes: the collector's full passes during the tests then walk only
+  what the tests made, not that whole heap again (two dozen full passes, about 0.4 s each,
+  were some 7 s of the suite). They are unfrozen when the session finishes, so pytest's
+  closing collections (for unraisable exceptions) see every object as before.
 * The notebooks execute in the background lane too, after the queued processes, from the
   moment their tests are collected on (when no ``-k``, ``-m`` other than the default,
   ``--deselect``, ``--lf`` or ``--sw`` can drop them later; else from the end of collection
@@ -32,6 +38,7 @@
 
 from __future__ import annotations
 
+import gc
 import os
 import sys
 from pathlib import Path
@@ -146,6 +153,10 @@ def pytest_collection_finish(session: pytest.Session) -> None:
     background thread (tests/notebook_runner.py)."""
     if session.config.option.collectonly:
         return
+    # the heap so far is the imports and the collected tests (module docstring); collected
+    # first, so that no garbage is frozen with it
+    gc.collect()
+    gc.freeze()
     from tests import processes
 
     if processes.early_wanted():
@@ -161,7 +172,8 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 
 def pytest_sessionfinish(session: pytest.Session) -> None:
     """Stop the notebook runner (drop what has not started) and the modules' processes still
-    running; remove their scratch files."""
+    running; remove their scratch files. Unfreeze the heap frozen when collection ended."""
+    gc.unfreeze()
     if "tests.notebook_runner" in sys.modules:
         sys.modules["tests.notebook_runner"].shutdown()
     if "tests.processes" in sys.modules:
