@@ -21,20 +21,27 @@ SIGNALS = (signal.SIGTERM,)
 
 
 @pytest.fixture(scope="module", autouse=True)
-def signal_nodes(request, ros_env):
-    """A fresh node per signal of test_shutdown_by_signal (namespace ``/sig<number>``, no map
-    published there), started when the module starts, so that their start-up (seconds of
-    imports) runs beside the session node's instead of inside the test; none when that test
-    is not selected. Each is stopped at the end of the module if its test has not."""
-    selected = any(
-        getattr(i, "originalname", None) == "test_shutdown_by_signal"
-        and getattr(i, "module", None) is request.module
+def fresh_nodes(request, ros_env, tmp_path_factory):
+    """The fresh nodes of the module's tests, started when the module starts, so that their
+    start-up (seconds of imports) runs beside the session node's instead of inside each test;
+    only those of the selected tests. ``("sig", signal)``: a node per signal of
+    test_shutdown_by_signal (namespace ``/sig<number>``, no map published there); ``"bad"``:
+    a node given a parameter file with a bad drive (test_bad_parameter_file_refused_at_start).
+    Each still running is stopped at the end of the module."""
+    selected = {
+        getattr(i, "originalname", None)
         for i in request.session.items
-    )
-    nodes = {
-        sig: NodeProcess(ros_env, "-r", f"__ns:=/sig{int(sig)}", name="trajopt_sig")
-        for sig in (SIGNALS if selected else ())
+        if getattr(i, "module", None) is request.module
     }
+    nodes = {}
+    if "test_shutdown_by_signal" in selected:
+        for sig in SIGNALS:
+            ns = f"__ns:=/sig{int(sig)}"
+            nodes["sig", sig] = NodeProcess(ros_env, "-r", ns, name="trajopt_sig")
+    if "test_bad_parameter_file_refused_at_start" in selected:
+        params = tmp_path_factory.mktemp("bad_params") / "bad.yaml"
+        params.write_text("trajopt_bad:\n  ros__parameters:\n    robot:\n      drive: tank\n")
+        nodes["bad"] = NodeProcess(ros_env, "--params-file", str(params), name="trajopt_bad")
     yield nodes
     for node in nodes.values():
         node.stop()
@@ -329,10 +336,8 @@ def test_parameters_from_yaml_and_refused_changes(served, client):
     assert [vals[0].double_value, vals[1].double_value] == [0.5, 0.8]
 
 
-def test_bad_parameter_file_refused_at_start(ros_env, tmp_path):
-    params = tmp_path / "bad.yaml"
-    params.write_text("trajopt_bad:\n  ros__parameters:\n    robot:\n      drive: tank\n")
-    node = NodeProcess(ros_env, "--params-file", str(params), name="trajopt_bad")
+def test_bad_parameter_file_refused_at_start(fresh_nodes):
+    node = fresh_nodes["bad"]  # started with the module, its parameter file's drive "tank"
     code = node.proc.wait(60)
     assert code == 2
     out = node.output()
@@ -340,10 +345,10 @@ def test_bad_parameter_file_refused_at_start(ros_env, tmp_path):
 
 
 @pytest.mark.parametrize("sig", SIGNALS)
-def test_shutdown_by_signal(signal_nodes, client, sig):
+def test_shutdown_by_signal(fresh_nodes, client, sig):
     from nav_msgs.srv import GetPlan
 
-    node, ns = signal_nodes[sig], f"/sig{int(sig)}"  # started with the module, no map yet
+    node, ns = fresh_nodes["sig", sig], f"/sig{int(sig)}"  # started with the module, no map
     srv = client.create_client(GetPlan, f"{ns}/get_plan")
     assert srv.wait_for_service(timeout_sec=30.0), node.output()
     # before any map: refused with its reason, and a malformed map is refused too
