@@ -31,8 +31,8 @@ BOX = [[-0.3, -0.15], [0.3, -0.15], [0.3, 0.15], [-0.3, 0.15]]
 def _collect_animations():
     """Collect the module's unrendered animations once, at its end, their warning filtered.
 
-    One collection for the module: a full ``gc.collect`` late in the suite walks a large
-    heap (a second or more each), so it is not run after every test.
+    One collection for the module, not one after every test: each full ``gc.collect``
+    walks every object not frozen (tests/conftest.py freezes the heap as a module starts).
     """
     yield
     with warnings.catch_warnings():
