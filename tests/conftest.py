@@ -26,8 +26,9 @@
   is alive then (the imports, the collected tests, the session's fixtures; most of a heap
   that ends near a million objects) lives on, and the collector's full passes during the
   module then walk only what the module made, not that whole heap again (in a 138 s run, 21
-  full passes took 9.6 s). The heap is unfrozen when the session finishes, so pytest's
-  closing collections (for unraisable exceptions) see every object as before.
+  full passes took 9.6 s; frozen so, 140 passes took 4.0 s, most of it pytest's 5 closing
+  ones). The heap is unfrozen when the session finishes, so pytest's closing collections
+  (for unraisable exceptions) see every object as before.
 * The notebooks execute in the background lane too, after the queued processes, from the
   moment their tests are collected on (when no ``-k``, ``-m`` other than the default,
   ``--deselect``, ``--lf`` or ``--sw`` can drop them later; else from the end of collection
