@@ -171,9 +171,9 @@ class BSplineCurve(ParametricCurve):
         out = arc_pose(
             self.t, self.c, self.k, t1, c1, nodes, s_nodes, gs, gu, lo, hi, GL_X, GL_W, ss
         )
-        return out[:, 0:2], self.heading_of(out[:, 4], out[:, 2], out[:, 3]), out[:, 4]
+        return out[:, 0:2], self._heading_of(out[:, 4], out[:, 2], out[:, 3]), out[:, 4]
 
-    def heading_of(self, u: np.ndarray, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    def _heading_of(self, u: np.ndarray, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
         """Return :meth:`heading` at ``u`` given the tangent ``(dx, dy)`` there (m per unit of ``u``), shape (n,).
 
         ``numpy.arctan2(dy, dx)`` (not the compiled ``atan2``: numpy's may differ in the last
