@@ -141,7 +141,7 @@ def _around_the_wall(planner: Planner, start, goal) -> np.ndarray:
 
 
 def _exercise_timing() -> None:
-    """Time a cubic B-spline (an S-bend) from rest and between moving states; evaluate poses."""
+    """Time a cubic B-spline (an S-bend) from rest and between moving states; evaluate poses (at times, at arc lengths)."""
     from trajopt.geometry import BSplineCurve, clamped_uniform_knots
     from trajopt.robot import Robot
     from trajopt.timing import time_parameterize
@@ -152,6 +152,10 @@ def _exercise_timing() -> None:
     traj = time_parameterize(curve, robot)
     time_parameterize(curve, robot, v_start=0.05, v_end=0.05)
     traj.pose(np.linspace(0.0, traj.duration, 5))  # the arc-length inversion (arc_newton)
+    # the poses at arc lengths in one call (arc_pose: the certificate's robot on a B-spline)
+    curve.pose_at_s(
+        traj.motion(np.linspace(0.0, traj.duration, 5))[0], traj.theta_grid_s, traj.u_grid
+    )
 
 
 def _exercise_moving() -> None:

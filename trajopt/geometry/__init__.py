@@ -2,7 +2,8 @@
 
 * :class:`ParametricCurve` (arc length, heading, curvature of any planar curve),
   :class:`PolylineCurve` and :class:`CurveSegment`;
-* :class:`BSplineCurve`, the smoother's curve;
+* :class:`BSplineCurve`, the smoother's curve (:meth:`BSplineCurve.pose_at_s`: positions and
+  headings at arc lengths, compiled: :func:`arc_pose`);
 * :func:`kappa_bound`: a certified upper bound of a curve's curvature on an interval;
 * :func:`polygon_clearance`, :func:`polyline_clearance`: exact distances from the raw map
   (occupied cells taken as closed squares); :func:`derive_blocks`: the occupied blocks these
@@ -14,6 +15,7 @@
 
 from trajopt.geometry._bspline import (
     BSplineCurve,
+    arc_pose,
     clamped_uniform_knots,
     concatenate,
     derivative_control_points,
@@ -76,6 +78,7 @@ __all__ = [
     "TIP_M",
     "TIP_RTOL",
     "ZERO_SPEED_RATIO",
+    "arc_pose",
     "box_clearance",
     "clamped_uniform_knots",
     "concatenate",

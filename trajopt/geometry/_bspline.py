@@ -10,7 +10,7 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from trajopt.errors import InvalidInputError
-from trajopt.geometry._curve import GL_W, GL_X, ParametricCurve
+from trajopt.geometry._curve import GL_W, GL_X, STILL_SPEED_RATIO, ParametricCurve
 from trajopt.kernel_cache import watch_compiles
 
 
@@ -123,6 +123,68 @@ class BSplineCurve(ParametricCurve):
         ss = np.ascontiguousarray(np.broadcast_to(np.asarray(s, dtype=np.float64), out.shape))
         arc_newton(t1, c1, self.k - 1, nodes, s_nodes, ss, out, lo, hi, GL_X, GL_W)
         return out
+
+    def pose_at_s(
+        self, s: np.ndarray, grid_s: np.ndarray, grid_u: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the positions (m) and headings (rad) at arc lengths ``s`` (m), and their parameters.
+
+        The parameter at each ``s``: ``numpy.interp`` of the table ``(grid_s, grid_u)`` (a
+        first guess), refined by :meth:`refine_u_at_s`'s Newton steps; the position and the
+        tangent by de Boor's algorithm; all in one compiled call (:func:`arc_pose`), the same
+        floats as those calls one after another. The heading is :meth:`heading`'s
+        (``numpy.arctan2`` of the tangent, the limit direction where the tangent vanishes).
+
+        Parameters
+        ----------
+        s : ndarray, shape (n,)
+            Arc lengths (m) from the start.
+        grid_s, grid_u : ndarray, shape (g,)
+            A table of arc lengths (m, non-decreasing) and the parameters at them, ``g >= 2``
+            (a :class:`trajopt.Trajectory`'s ``theta_grid_s`` and ``u_grid``).
+
+        Returns
+        -------
+        xy : ndarray, shape (n, 2)
+            Positions (m).
+        theta : ndarray, shape (n,)
+            Headings (rad), in (-pi, pi].
+        u : ndarray, shape (n,)
+            Parameters, in :attr:`domain`.
+
+        Raises
+        ------
+        InvalidInputError
+            ``grid_s`` and ``grid_u`` not of one shape (g,) with ``g >= 2``.
+        """
+        gs = np.ascontiguousarray(grid_s, dtype=np.float64)
+        gu = np.ascontiguousarray(grid_u, dtype=np.float64)
+        if gs.ndim != 1 or gs.shape != gu.shape or gs.shape[0] < 2:
+            raise InvalidInputError(
+                f"grid_s and grid_u must have one shape (g,) with g >= 2, got {gs.shape} and "
+                f"{gu.shape}"
+            )
+        nodes, s_nodes, _ = self._arc_table()
+        t1, c1 = self._derivative_coefficients(1)
+        ss = np.ascontiguousarray(np.asarray(s, dtype=np.float64).reshape(-1))
+        lo, hi = self.domain
+        out = arc_pose(
+            self.t, self.c, self.k, t1, c1, nodes, s_nodes, gs, gu, lo, hi, GL_X, GL_W, ss
+        )
+        return out[:, 0:2], self._heading_of(out[:, 4], out[:, 2], out[:, 3]), out[:, 4]
+
+    def _heading_of(self, u: np.ndarray, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        """Return :meth:`heading` at ``u`` given the tangent ``(dx, dy)`` there (m per unit of ``u``), shape (n,).
+
+        ``numpy.arctan2(dy, dx)`` (not the compiled ``atan2``: numpy's may differ in the last
+        bit), the limit direction where the tangent vanishes: the same floats as
+        :meth:`heading`.
+        """
+        theta = np.arctan2(dy, dx)
+        still = np.hypot(dx, dy) <= STILL_SPEED_RATIO * self.mean_speed()
+        if np.any(still):
+            theta = np.where(still, self._limit_heading(u, theta), theta)
+        return theta
 
     def derivative(self, nu: int = 1) -> BSplineCurve:
         """Return the ``nu``-th derivative as a new B-spline of degree ``k - nu``."""
@@ -417,6 +479,80 @@ def de_boor(t, c, k, u):  # pragma: no cover - compiled
                     d[i, a] = (1.0 - alpha) * d[i - 1, a] + alpha * d[i, a]
         for a in range(dim):
             out[q, a] = d[k, a]
+    return out
+
+
+@njit(cache=True)
+def arc_pose(
+    t, c, k, t1, c1, nodes, s_nodes, grid_s, grid_u, lo, hi, gl_x, gl_w, s
+):  # pragma: no cover - compiled
+    """Return the position, tangent and parameter of the spline ``(t, c, k)`` at arc lengths ``s``.
+
+    Each parameter: ``numpy.interp(s, grid_s, grid_u)`` (its floats: the table's value at
+    or beyond its ends and at its nodes, else ``slope (s - s_j) + u_j``, then
+    ``slope (s - s_{j+1}) + u_{j+1}`` if that is NaN, then ``u_j`` if the two values
+    are equal), refined by :func:`arc_newton`; the position and the tangent by
+    :func:`de_boor` on the spline and on its derivative ``(t1, c1, k - 1)``. The same floats
+    as ``numpy.interp``, :meth:`BSplineCurve.refine_u_at_s` and :meth:`BSplineCurve.__call__`
+    one after another.
+
+    Parameters
+    ----------
+    t, c, k : ndarray, ndarray, int
+        The spline: knots, shape (n + k + 1,); control points (m), shape (n, 2); degree.
+    t1, c1 : ndarray
+        Its derivative's knots and control points (m per unit of ``u``).
+    nodes, s_nodes : ndarray, shape (q,)
+        Its arc-length table (parameters, arc lengths in m).
+    grid_s, grid_u : ndarray, shape (g,)
+        The first guesses' table (arc lengths in m, non-decreasing; parameters), ``g >= 2``.
+    lo, hi : float
+        The domain.
+    gl_x, gl_w : ndarray, shape (5,)
+        Gauss-Legendre nodes on ``[-1, 1]`` and weights.
+    s : ndarray, shape (m,)
+        Arc lengths (m).
+
+    Returns
+    -------
+    ndarray, shape (m, 5)
+        ``x, y`` (m), ``x', y'`` (m per unit of ``u``) and ``u`` per row (NaN where ``s`` is NaN).
+    """
+    m = s.shape[0]
+    g = grid_s.shape[0]
+    u = np.empty(m)
+    for q in range(m):
+        x = s[q]
+        if x != x:
+            u[q] = x
+            continue
+        if x < grid_s[0]:
+            u[q] = grid_u[0]
+            continue
+        if x > grid_s[g - 1]:
+            u[q] = grid_u[g - 1]
+            continue
+        j = np.searchsorted(grid_s, x, side="right") - 1
+        if j >= g - 1 or grid_s[j] == x:
+            u[q] = grid_u[j]
+            continue
+        slope = (grid_u[j + 1] - grid_u[j]) / (grid_s[j + 1] - grid_s[j])
+        r = slope * (x - grid_s[j]) + grid_u[j]
+        if r != r:
+            r = slope * (x - grid_s[j + 1]) + grid_u[j + 1]
+            if r != r and grid_u[j] == grid_u[j + 1]:
+                r = grid_u[j]
+        u[q] = r
+    arc_newton(t1, c1, k - 1, nodes, s_nodes, s, u, lo, hi, gl_x, gl_w)
+    xy = de_boor(t, c, k, u)
+    d = de_boor(t1, c1, k - 1, u)
+    out = np.empty((m, 5))
+    for q in range(m):
+        out[q, 0] = xy[q, 0]
+        out[q, 1] = xy[q, 1]
+        out[q, 2] = d[q, 0]
+        out[q, 3] = d[q, 1]
+        out[q, 4] = u[q]
     return out
 
 

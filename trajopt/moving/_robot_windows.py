@@ -15,7 +15,9 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import InvalidInputError
+from trajopt.geometry import BSplineCurve
 from trajopt.moving._path_bounds import RangeMax, arc_kappa_kernel, kappa_table_of, path_boxes_of
+from trajopt.smoother import SmoothPath
 
 
 def profile_bounds(traj: Any) -> tuple[float, float]:
@@ -33,11 +35,30 @@ def profile_bounds(traj: Any) -> tuple[float, float]:
     return vmax, amax
 
 
+def spline_of(path: Any) -> BSplineCurve | None:
+    """Return the B-spline ``path`` evaluates unchanged (itself, a smooth path's curve), else ``None``."""
+    if type(path) is BSplineCurve:
+        return path
+    if isinstance(path, SmoothPath) and type(path.curve) is BSplineCurve:
+        return path.curve
+    return None
+
+
 class CurveMotion:
-    """The robot on one timed curve, played from global time ``offset`` on its own clock."""
+    """The robot on one timed curve, played from global time ``offset`` on its own clock.
+
+    On a B-spline driven forwards with its arc-length table (the planner's trajectories),
+    :meth:`at` evaluates the arc lengths at an interval's ends and middle in one compiled call
+    (:meth:`trajopt.Trajectory.motion`) and the pose at the middles in another
+    (:meth:`trajopt.geometry.BSplineCurve.pose_at_s`): the floats of
+    :meth:`trajopt.Trajectory.pose`. Otherwise :meth:`at` calls ``pose``.
+    """
 
     def __init__(self, traj: Any, offset: float) -> None:
         self.traj, self.offset = traj, float(offset)
+        spline = spline_of(traj.path)
+        reverse = traj.robot.drive.signed_speed and traj.direction < 0
+        self.spline = None if reverse or traj.u_grid.shape[0] < 2 else spline
         self.vmax, self.amax = profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
         self.s_edges, k = kappa_table_of(traj.path)
@@ -71,10 +92,16 @@ class CurveMotion:
 
     def at(self, t0: np.ndarray, tm: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
         """Return the position (m), shape (n, 2), its bound ``rho_P`` (m) and velocity (m/s) at ``tm``."""
-        tr, off = self.traj, self.offset
-        s0, s1 = self.s_ends(t0, t1)
-        x, y, th, sm, v = tr.pose(tm - off)
-        p = np.stack([x, y], axis=-1)
+        tr, off, spline = self.traj, self.offset, self.spline
+        if spline is not None:
+            n = t0.shape[0]
+            s, v, _, _ = tr.motion(np.concatenate([t0, t1, tm]) - off)
+            s0, s1, sm, v = s[:n], s[n : 2 * n], s[2 * n :], v[2 * n :]
+            p, th, _ = spline.pose_at_s(sm, tr.theta_grid_s, tr.u_grid)
+        else:
+            s0, s1 = self.s_ends(t0, t1)
+            x, y, th, sm, v = tr.pose(tm - off)
+            p = np.stack([x, y], axis=-1)
         rho = np.maximum(sm - s0, s1 - sm).clip(0.0) * (1.0 + 1e-9) + 1e-12
         kap = arc_kappa_kernel(self.s_edges, self.kmax, s0, s1)  # |kappa| on [s0, s1] (1/m)
         self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
