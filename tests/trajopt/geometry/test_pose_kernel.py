@@ -1,4 +1,4 @@
-"""Tests of BSplineCurve.pose_at_s (compiled: trajopt.geometry.arc_pose).
+"""Tests of trajopt.geometry: BSplineCurve.pose_at_s (compiled: trajopt.geometry.arc_pose).
 
 Bit for bit against the calls it replaces one after another (numpy.interp of the table,
 refine_u_at_s, the curve and its heading), and against independent references: scipy's

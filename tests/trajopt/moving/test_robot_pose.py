@@ -1,4 +1,4 @@
-"""Tests of the certificate's robot model on a B-spline (CurveMotion.at, two compiled calls).
+"""Tests of trajopt.moving: the certificate's robot model on a B-spline (CurveMotion.at, two compiled calls).
 
 Its arc lengths, positions, headings and speeds are Trajectory.motion's and Trajectory.pose's
 bit for bit (the calls it replaces); a trajectory off that road (no B-spline) is evaluated by
