@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import path_curves
 from trajopt.moving._reach_kernel import reach_kernel
@@ -271,12 +272,14 @@ def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0
     at = plan.sample(np.zeros(1))
     p0 = np.array([float(at.x[0]), float(at.y[0])])
     ahead = np.array([math.cos(float(at.theta[0])), math.sin(float(at.theta[0]))])
+    # each mover's farthest vertex plus its last radius (radius_at(t_last)'s floats), all at
+    # once from the certificate's table of these movers (kept)
+    table = mover_table(movers)
+    reaches = table.reach + (table.rad0 + table.grow * table.t_last)
     gaps = _track_distances(movers, p0)
     pts = s = None
-    for m, gap in zip(movers, gaps, strict=True):
-        reach = float(np.max(np.hypot(*m.shape_vertices.T))) + float(m.radius_at(m.t_last))
-        if gap > limit + reach + HEAD_ON_RUN:
-            continue  # it never comes near the path's start
+    for j in np.flatnonzero(~(gaps > limit + reaches + HEAD_ON_RUN)).tolist():
+        m, reach = movers[j], float(reaches[j])  # the others never come near the path's start
         t_end = max(float(m.t_last), 0.0)
         t = np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end)
         p = m.position_at(t)

@@ -26,7 +26,9 @@ import numpy as np
 
 from trajopt.errors import BlockedError
 from trajopt.moving._certificate import point_polygon_distance, shape_at
+from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._reach_steps import reach_from_rest
 from trajopt.moving._st_grid import reach_bound
 
 #: Arc-length spacing (m) of the path points checked.
@@ -91,26 +93,33 @@ def parked_on_path(
     back = getattr(robot.drive, "v_max_backwards", None)
     v0 = abs(float(getattr(plan, "v_start", 0.0)))
     v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
-    t_stops = [max(settle_time(m), 0.0) for m in movers]
-    reaches = reach_bound(np.array(t_stops), v_top, robot.a_max, robot.j_max, v0).tolist()
-    if min(reaches) >= sum(float(c.length) for c in curves):
+    t_stops = np.array([max(settle_time(m), 0.0) for m in movers])
+    if v0 > 0.0:
+        reaches = reach_bound(t_stops, v_top, robot.a_max, robot.j_max, v0)
+    else:
+        reaches = reach_from_rest(t_stops, v_top, float(robot.a_max), float(robot.j_max))
+    if float(np.min(reaches)) >= sum(float(c.length) for c in curves):
         return None  # the robot may be past the whole path before any mover stands still
     coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
-    near = []  # the movers whose final shape's bounding disc comes near some coarse point
-    close = np.zeros(s_coarse.shape[0], dtype=bool)
-    for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
-        if reach >= off:
-            continue  # no point of the path lies beyond it
-        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
-        centre = m.position_at(np.array([t_stop])).reshape(2)
-        bound = float(np.max(np.hypot(*m.shape_vertices.T)))  # the shape within it of centre
-        d = np.hypot(*(coarse - centre).T) - bound
-        hit = d < limit + 0.5 * SCREEN_DS  # a point between is nearer than ds/2 to one
-        if hit.any():
-            near.append((m, t_stop, reach, limit))
-            close |= hit
-    if not near:
+    # every mover at once, from the certificate's table of them (kept): its place when it
+    # stands (numpy.interp's), the limit (its radius then: radius_at's floats) and the
+    # bound of its shape about that place (its farthest vertex)
+    table = mover_table(movers)
+    centre = table.seg.at(table.seg.row(np.arange(len(movers)), t_stops), t_stops)[:, :2]
+    radius = table.rad0 + table.grow * np.clip(t_stops, 0.0, table.t_last)
+    limits = float(robot.inscribed_radius) + radius + margin
+    d = (
+        np.hypot(coarse[None, :, 0] - centre[:, 0:1], coarse[None, :, 1] - centre[:, 1:2])
+        - table.reach[:, None]
+    )
+    hits = d < (limits + 0.5 * SCREEN_DS)[:, None]  # a point between is nearer than ds/2 to one
+    hits &= (reaches < off)[:, None]  # else no point of the path lies beyond it
+    # the movers whose final shape's bounding disc comes near some coarse point
+    rows = np.flatnonzero(hits.any(axis=1))
+    if not rows.size:
         return None
+    close = hits.any(axis=0)
+    near = [(movers[j], float(t_stops[j]), float(reaches[j]), float(limits[j])) for j in rows]
     # the fine points within SCREEN_DS of arc of a close coarse point: no other can be near
     p, s_cum, off = _path_points(curves, PARKED_DS, s_coarse[close], SCREEN_DS)
     for m, t_stop, reach, limit in near:
@@ -160,7 +169,16 @@ def _path_points(
 def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float) -> bool:
     """Whether a mover is closer than ``limit`` plus its radius (m) to ``start`` (m) at ``t = 0``."""
     p = np.asarray(start, dtype=float).reshape(1, 2)
-    for m in movers:
+    if not movers:
+        return False
+    # the far movers first, all at once from the certificate's table of them (kept): their
+    # places at t = 0 (numpy.interp's) less their farthest vertex and radius then are beyond
+    # the limit (by more than rounding) for the most; the distance to the shape is at least that
+    table = mover_table(movers)
+    zero = np.zeros(len(movers))
+    centre = table.seg.at(table.seg.row(np.arange(len(movers)), zero), zero)[:, :2]
+    gap = np.hypot(*(centre - p[0]).T) - table.reach - table.rad0 - limit
+    for m in (m for m, g in zip(movers, gap.tolist(), strict=True) if not g > 1e-9):
         d = float(point_polygon_distance(p, shape_at(m, np.array([0.0])))[0])
         if d < limit + float(m.radius_at(0.0)):
             return True
