@@ -25,11 +25,13 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError
+from trajopt.geometry import BSplineCurve
 from trajopt.moving._certificate import point_polygon_distance, shape_at
 from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._reach_steps import reach_from_rest
 from trajopt.moving._st_grid import reach_bound
+from trajopt.smoother import SmoothPath
 
 #: Arc-length spacing (m) of the path points checked.
 PARKED_DS = 0.02
@@ -38,6 +40,9 @@ PARKED_DS = 0.02
 #: half this of is nowhere within the limit of the path; the fine points are evaluated only
 #: within this much arc of a screening point that one comes that close to.
 SCREEN_DS = 0.25
+#: Distance (m) a mover's bound must clear the path's discs (:func:`span_discs`) by, beyond
+#: the screen's, to be left out without its points: far above the rounding of the bounds.
+SPAN_SLACK = 1e-9
 
 
 def settle_time(mover: MovingObstacle) -> float:
@@ -98,9 +103,9 @@ def parked_on_path(
         reaches = reach_bound(t_stops, v_top, robot.a_max, robot.j_max, v0)
     else:
         reaches = reach_from_rest(t_stops, v_top, float(robot.a_max), float(robot.j_max))
-    if float(np.min(reaches)) >= sum(float(c.length) for c in curves):
+    length = sum(float(c.length) for c in curves)
+    if float(np.min(reaches)) >= length:
         return None  # the robot may be past the whole path before any mover stands still
-    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
     # every mover at once, from the certificate's table of them (kept): its place when it
     # stands (numpy.interp's), the limit (its radius then: radius_at's floats) and the
     # bound of its shape about that place (its farthest vertex)
@@ -108,12 +113,25 @@ def parked_on_path(
     centre = table.seg.at(table.seg.row(np.arange(len(movers)), t_stops), t_stops)[:, :2]
     radius = table.rad0 + table.grow * np.clip(t_stops, 0.0, table.t_last)
     limits = float(robot.inscribed_radius) + radius + margin
+    live = reaches < length  # else no point of the path lies beyond it
+    discs = span_discs(curves)
+    if discs is not None:  # the movers whose shape is nowhere near the path's discs: no hit
+        cen, rad = discs
+        gap = np.min(
+            np.hypot(centre[:, None, 0] - cen[None, :, 0], centre[:, None, 1] - cen[None, :, 1])
+            - rad[None, :],
+            axis=1,
+        )
+        live &= ~(gap - table.reach > limits + 0.5 * SCREEN_DS + SPAN_SLACK)
+    if not live.any():
+        return None
+    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
     d = (
         np.hypot(coarse[None, :, 0] - centre[:, 0:1], coarse[None, :, 1] - centre[:, 1:2])
         - table.reach[:, None]
     )
     hits = d < (limits + 0.5 * SCREEN_DS)[:, None]  # a point between is nearer than ds/2 to one
-    hits &= (reaches < off)[:, None]  # else no point of the path lies beyond it
+    hits &= live[:, None]
     # the movers whose final shape's bounding disc comes near some coarse point
     rows = np.flatnonzero(hits.any(axis=1))
     if not rows.size:
@@ -137,6 +155,35 @@ def parked_on_path(
                 t=t_stop,
             )
     return None
+
+
+def span_discs(curves: list[Any]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Return discs that hold the curves' paths: centres (m, shape (n, 2)) and radii (m, shape (n,)).
+
+    A B-spline of degree ``k`` over its domain is, on each knot span, a convex combination of
+    ``k + 1`` consecutive control points: it lies in their convex hull, inside the disc about
+    their mean through the farthest of them. One disc per ``k + 1`` consecutive control
+    points of each curve. ``None`` when a curve's path is not a B-spline (a
+    :class:`~trajopt.geometry.BSplineCurve`, or a :class:`~trajopt.smoother.SmoothPath` of
+    one).
+    """
+    cen, rad = [], []
+    for c in curves:
+        path = c.path
+        spline = path if isinstance(path, BSplineCurve) else None
+        if isinstance(path, SmoothPath) and isinstance(path.curve, BSplineCurve):
+            spline = path.curve
+        if spline is None:
+            return None
+        k = int(spline.k)
+        pts = np.asarray(spline.c, dtype=float)
+        win = np.lib.stride_tricks.sliding_window_view(pts, (k + 1, 2))[:, 0]
+        mid = win.mean(axis=1)
+        cen.append(mid)
+        rad.append(
+            np.max(np.hypot(win[..., 0] - mid[:, None, 0], win[..., 1] - mid[:, None, 1]), axis=1)
+        )
+    return np.concatenate(cen), np.concatenate(rad)
 
 
 def _path_points(

@@ -160,3 +160,14 @@ def test_meets_head_on_equals_every_mover(base):
         assert trajopt.moving.meets_head_on(base, movers, 0.0) == want
         seen.add(want)
     assert seen == {True, False}
+
+
+def test_span_discs_hold_the_path(base):
+    from trajopt.moving._parked import path_curves, span_discs
+
+    cen, rad = span_discs(path_curves(base))
+    lo, hi = base.path.domain
+    p = np.asarray(base.path(np.linspace(lo, hi, 20001)), dtype=float)
+    d = np.hypot(p[:, None, 0] - cen[None, :, 0], p[:, None, 1] - cen[None, :, 1]) - rad[None]
+    assert np.all(np.min(d, axis=1) <= 1e-12)  # every sample inside some disc
+    assert np.max(rad) < 0.5 * base.length  # and the discs are local, not one about it all
