@@ -31,7 +31,6 @@ from trajopt.moving._mover_segments import mover_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._reach_steps import reach_from_rest
 from trajopt.moving._st_grid import reach_bound
-from trajopt.smoother import SmoothPath
 
 #: Arc-length spacing (m) of the path points checked.
 PARKED_DS = 0.02
@@ -167,6 +166,9 @@ def span_discs(curves: list[Any]) -> tuple[np.ndarray, np.ndarray] | None:
     :class:`~trajopt.geometry.BSplineCurve`, or a :class:`~trajopt.smoother.SmoothPath` of
     one).
     """
+    # loaded by then (the plans' paths come from it), not with this module
+    from trajopt.smoother import SmoothPath
+
     cen, rad = [], []
     for c in curves:
         path = c.path
