@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError
-from trajopt.moving._mover_segments import mover_table
+from trajopt.moving._mover_places import MoverPlaces
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import path_curves
 from trajopt.moving._reach_kernel import reach_kernel
@@ -272,21 +272,20 @@ def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0
     at = plan.sample(np.zeros(1))
     p0 = np.array([float(at.x[0]), float(at.y[0])])
     ahead = np.array([math.cos(float(at.theta[0])), math.sin(float(at.theta[0]))])
-    # each mover's farthest vertex plus its last radius (radius_at(t_last)'s floats), all at
-    # once from the certificate's table of these movers (kept)
-    table = mover_table(movers)
-    reaches = table.reach + (table.rad0 + table.grow * table.t_last)
+    # each mover's farthest vertex plus its last radius (radius_at(t_last)'s floats), all at once
+    places = MoverPlaces(movers)
+    reaches = places.reach + (places.rad0 + places.grow * places.t_last)
     gaps = _track_distances(movers, p0)
     idx = np.flatnonzero(~(gaps > limit + reaches + HEAD_ON_RUN))
     if not idx.size:
         return False  # none comes near the path's start
     # the others' reference points every HEAD_ON_DT s, all at once (numpy.interp's floats)
-    times = [np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end) for t_end in table.t_last[idx]]
+    times = [np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end) for t_end in places.t_last[idx]]
     count = np.array([t.shape[0] for t in times])
     first = np.cumsum(count) - count
     t_all = np.concatenate(times)
     owner = np.repeat(idx, count)
-    p_all = table.seg.at(table.seg.row(owner, t_all), t_all)[:, :2]
+    p_all = places.at(owner, t_all)
     v = np.diff(p_all, axis=0)  # a step within a mover where the owners on both ends agree
     close = np.hypot(*(p_all[1:] - p0).T) <= (limit + reaches[owner[1:]]) + HEAD_ON_RUN
     against = v[:, 0] * ahead[0] + v[:, 1] * ahead[1] < -0.5 * np.hypot(*v.T)

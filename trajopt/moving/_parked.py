@@ -27,7 +27,8 @@ import numpy as np
 from trajopt.errors import BlockedError
 from trajopt.geometry import BSplineCurve
 from trajopt.moving._certificate import point_polygon_distance, shape_at
-from trajopt.moving._mover_segments import mover_table
+from trajopt.moving._mover_places import TABLE_FROM, MoverPlaces
+from trajopt.moving._mover_segments import kept_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._reach_steps import reach_from_rest
 from trajopt.moving._st_grid import reach_bound
@@ -105,13 +106,12 @@ def parked_on_path(
     length = sum(float(c.length) for c in curves)
     if float(np.min(reaches)) >= length:
         return None  # the robot may be past the whole path before any mover stands still
-    # every mover at once, from the certificate's table of them (kept): its place when it
-    # stands (numpy.interp's), the limit (its radius then: radius_at's floats) and the
-    # bound of its shape about that place (its farthest vertex)
-    table = mover_table(movers)
-    centre = table.seg.at(table.seg.row(np.arange(len(movers)), t_stops), t_stops)[:, :2]
-    radius = table.rad0 + table.grow * np.clip(t_stops, 0.0, table.t_last)
-    limits = float(robot.inscribed_radius) + radius + margin
+    # every mover at once: its place when it stands (numpy.interp's), the limit (its radius
+    # then: radius_at's floats) and the bound of its shape about that place (its farthest
+    # vertex)
+    places = MoverPlaces(movers)
+    centre = places.at(np.arange(len(movers)), t_stops)
+    limits = float(robot.inscribed_radius) + places.radius_at(t_stops) + margin
     live = reaches < length  # else no point of the path lies beyond it
     discs = span_discs(curves)
     if discs is not None:  # the movers whose shape is nowhere near the path's discs: no hit
@@ -121,13 +121,13 @@ def parked_on_path(
             - rad[None, :],
             axis=1,
         )
-        live &= ~(gap - table.reach > limits + 0.5 * SCREEN_DS + SPAN_SLACK)
+        live &= ~(gap - places.reach > limits + 0.5 * SCREEN_DS + SPAN_SLACK)
     if not live.any():
         return None
     coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
     d = (
         np.hypot(coarse[None, :, 0] - centre[:, 0:1], coarse[None, :, 1] - centre[:, 1:2])
-        - table.reach[:, None]
+        - places.reach[:, None]
     )
     hits = d < (limits + 0.5 * SCREEN_DS)[:, None]  # a point between is nearer than ds/2 to one
     hits &= live[:, None]
@@ -220,13 +220,15 @@ def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float
     p = np.asarray(start, dtype=float).reshape(1, 2)
     if not movers:
         return False
-    # the far movers first, all at once from the certificate's table of them (kept): their
-    # places at t = 0 (numpy.interp's) less their farthest vertex and radius then are beyond
-    # the limit (by more than rounding) for the most; the distance to the shape is at least that
-    table = mover_table(movers)
-    zero = np.zeros(len(movers))
-    centre = table.seg.at(table.seg.row(np.arange(len(movers)), zero), zero)[:, :2]
-    gap = np.hypot(*(centre - p[0]).T) - table.reach - table.rad0 - limit
+    # the far movers first, all at once: their places at t = 0 (numpy.interp's) less their
+    # farthest vertex and radius then are beyond the limit (by more than rounding) for the
+    # most; the distance to the shape is at least that
+    # (a few movers with no kept table: each measured, the screen would cost more)
+    gap = np.zeros(len(movers))
+    if len(movers) >= TABLE_FROM or kept_table(movers) is not None:
+        places = MoverPlaces(movers)
+        centre = places.at(np.arange(len(movers)), gap)
+        gap = np.hypot(*(centre - p[0]).T) - places.reach - places.rad0 - limit
     for m in (m for m, g in zip(movers, gap.tolist(), strict=True) if not g > 1e-9):
         d = float(point_polygon_distance(p, shape_at(m, np.array([0.0])))[0])
         if d < limit + float(m.radius_at(0.0)):

@@ -96,8 +96,8 @@ def _parked_brute(base, movers, margin):
 def test_parked_on_path_equals_every_mover_at_every_point(base, seed):
     rng = np.random.default_rng(seed)
     claims = 0
-    for _ in range(12):
-        movers = _movers(base, rng)
+    for i in range(12):
+        movers = _movers(base, rng, n=2 if i % 3 == 0 else 10)  # few: read one by one
         margin = float(rng.choice([0.0, 0.05]))
         proof = trajopt.moving.parked_on_path(base, movers, margin)
         want = _parked_brute(base, movers, margin)
@@ -111,8 +111,8 @@ def test_over_start_equals_every_mover(base, seed):
     rng = np.random.default_rng(10 + seed)
     start = _at(base, np.zeros(1))[0]
     seen = set()
-    for _ in range(20):
-        movers = _movers(base, rng, n=6)
+    for i in range(20):
+        movers = _movers(base, rng, n=1 if i % 2 else 6)
         # one more mover just inside or just outside the limit (1 mm)
         limit = float(rng.uniform(0.1, 0.4))
         inside = bool(rng.random() < 0.5)
@@ -154,8 +154,8 @@ def _head_on_brute(base, movers, margin):
 def test_meets_head_on_equals_every_mover(base):
     rng = np.random.default_rng(7)
     seen = set()
-    for _ in range(30):
-        movers = _movers(base, rng, n=6)
+    for i in range(30):
+        movers = _movers(base, rng, n=2 if i % 2 else 6)
         want = _head_on_brute(base, movers, 0.0)
         assert trajopt.moving.meets_head_on(base, movers, 0.0) == want
         seen.add(want)
@@ -171,3 +171,24 @@ def test_span_discs_hold_the_path(base):
     d = np.hypot(p[:, None, 0] - cen[None, :, 0], p[:, None, 1] - cen[None, :, 1]) - rad[None]
     assert np.all(np.min(d, axis=1) <= 1e-12)  # every sample inside some disc
     assert np.max(rad) < 0.5 * base.length  # and the discs are local, not one about it all
+
+
+def test_mover_places_read_one_by_one_or_from_the_table_are_numpy_interps(base):
+    from trajopt.moving._mover_places import MoverPlaces
+    from trajopt.moving._mover_segments import mover_table
+
+    rng = np.random.default_rng(5)
+    for n in (2, 3):  # below TABLE_FROM: read one by one, then from the table once it is kept
+        movers = _movers(base, rng, n=n)
+        j = np.repeat(np.arange(n), 7)
+        t = rng.uniform(-2.0, 40.0, j.shape[0])
+        want = np.concatenate([m.position_at(t[j == i]) for i, m in enumerate(movers)])
+        one_by_one = MoverPlaces(movers)
+        assert one_by_one.table is None
+        np.testing.assert_array_equal(one_by_one.at(j, t), want)
+        mover_table(movers)
+        kept = MoverPlaces(movers)
+        assert kept.table is not None
+        np.testing.assert_array_equal(kept.at(j, t), want)
+        for name in ("reach", "rad0", "grow", "t_last"):
+            np.testing.assert_array_equal(getattr(one_by_one, name), getattr(kept, name))
