@@ -69,7 +69,7 @@ class MoverPlaces:
         out = np.empty((t.shape[0], 2))
         if not t.shape[0]:
             return out
-        cut = np.flatnonzero(np.diff(j)) + 1
-        for a, b in zip(np.r_[0, cut], np.r_[cut, j.shape[0]], strict=True):
+        cut = (np.flatnonzero(j[1:] != j[:-1]) + 1).tolist()
+        for a, b in zip([0, *cut], [*cut, j.shape[0]], strict=True):
             out[a:b] = self.movers[int(j[a])].position_at(t[a:b])
         return out
