@@ -218,3 +218,15 @@ def mover_table(movers: Sequence[MovingObstacle]) -> MoverTable:
     _TABLES.append((key, table))
     del _TABLES[:-_TABLES_KEPT]
     return table
+
+
+def kept_table(movers: Sequence[MovingObstacle]) -> MoverTable | None:
+    """Return the kept :class:`MoverTable` of ``movers`` (:func:`mover_table`'s), or ``None``.
+
+    Nothing is built, and the order of the kept tables is left as it is.
+    """
+    key = tuple(movers)
+    for kept, table in _TABLES:
+        if len(kept) == len(key) and all(a is b for a, b in zip(kept, key, strict=True)):
+            return table
+    return None

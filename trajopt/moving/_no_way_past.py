@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError
+from trajopt.moving._mover_places import MoverPlaces
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._parked import path_curves
 from trajopt.moving._reach_kernel import reach_kernel
@@ -271,19 +272,29 @@ def meets_head_on(plan: Any, movers: Sequence[MovingObstacle], margin: float = 0
     at = plan.sample(np.zeros(1))
     p0 = np.array([float(at.x[0]), float(at.y[0])])
     ahead = np.array([math.cos(float(at.theta[0])), math.sin(float(at.theta[0]))])
+    # each mover's farthest vertex plus its last radius (radius_at(t_last)'s floats), all at once
+    places = MoverPlaces(movers)
+    reaches = places.reach + (places.rad0 + places.grow * places.t_last)
     gaps = _track_distances(movers, p0)
+    idx = np.flatnonzero(~(gaps > limit + reaches + HEAD_ON_RUN))
+    if not idx.size:
+        return False  # none comes near the path's start
+    # the others' reference points every HEAD_ON_DT s, all at once (numpy.interp's floats)
+    times = [np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end) for t_end in places.t_last[idx]]
+    count = np.array([t.shape[0] for t in times])
+    first = np.cumsum(count) - count
+    t_all = np.concatenate(times)
+    owner = np.repeat(idx, count)
+    p_all = places.at(owner, t_all)
+    v = np.diff(p_all, axis=0)  # a step within a mover where the owners on both ends agree
+    close = np.hypot(*(p_all[1:] - p0).T) <= (limit + reaches[owner[1:]]) + HEAD_ON_RUN
+    against = v[:, 0] * ahead[0] + v[:, 1] * ahead[1] < -0.5 * np.hypot(*v.T)
+    coming = close & against & (owner[1:] == owner[:-1])
     pts = s = None
-    for m, gap in zip(movers, gaps, strict=True):
-        reach = float(np.max(np.hypot(*m.shape_vertices.T))) + float(m.radius_at(m.t_last))
-        if gap > limit + reach + HEAD_ON_RUN:
-            continue  # it never comes near the path's start
-        t_end = max(float(m.t_last), 0.0)
-        t = np.append(np.arange(0.0, t_end, HEAD_ON_DT), t_end)
-        p = m.position_at(t)
-        v = np.diff(p, axis=0)
-        close = np.hypot(*(p[1:] - p0).T) <= limit + reach + HEAD_ON_RUN
-        if not np.any(close & (v[:, 0] * ahead[0] + v[:, 1] * ahead[1] < -0.5 * np.hypot(*v.T))):
-            continue  # it comes near the start only across the heading or with it
+    for q in np.flatnonzero(np.bincount(owner[1:][coming], minlength=len(movers))[idx]).tolist():
+        # it comes near the start against the robot's heading (the others only across or with it)
+        reach, t = float(reaches[idx[q]]), times[q]
+        p = p_all[first[q] : first[q] + count[q]]
         if pts is None:
             s = np.linspace(0.0, length, int(math.ceil(length / HEAD_ON_DS)) + 1)
             pts = _points(curves, s)

@@ -25,8 +25,12 @@ from typing import Any
 import numpy as np
 
 from trajopt.errors import BlockedError
+from trajopt.geometry import BSplineCurve
 from trajopt.moving._certificate import point_polygon_distance, shape_at
+from trajopt.moving._mover_places import TABLE_FROM, MoverPlaces
+from trajopt.moving._mover_segments import kept_table
 from trajopt.moving._obstacle import MovingObstacle
+from trajopt.moving._reach_steps import reach_from_rest
 from trajopt.moving._st_grid import reach_bound
 
 #: Arc-length spacing (m) of the path points checked.
@@ -36,6 +40,9 @@ PARKED_DS = 0.02
 #: half this of is nowhere within the limit of the path; the fine points are evaluated only
 #: within this much arc of a screening point that one comes that close to.
 SCREEN_DS = 0.25
+#: Distance (m) a mover's bound must clear the path's discs (:func:`span_discs`) by, beyond
+#: the screen's, to be left out without its points: far above the rounding of the bounds.
+SPAN_SLACK = 1e-9
 
 
 def settle_time(mover: MovingObstacle) -> float:
@@ -91,26 +98,45 @@ def parked_on_path(
     back = getattr(robot.drive, "v_max_backwards", None)
     v0 = abs(float(getattr(plan, "v_start", 0.0)))
     v_top = max(float(robot.v_max), float(back(robot)) if back is not None else 0.0, v0)
-    t_stops = [max(settle_time(m), 0.0) for m in movers]
-    reaches = reach_bound(np.array(t_stops), v_top, robot.a_max, robot.j_max, v0).tolist()
-    if min(reaches) >= sum(float(c.length) for c in curves):
+    t_stops = np.array([max(settle_time(m), 0.0) for m in movers])
+    if v0 > 0.0:
+        reaches = reach_bound(t_stops, v_top, robot.a_max, robot.j_max, v0)
+    else:
+        reaches = reach_from_rest(t_stops, v_top, float(robot.a_max), float(robot.j_max))
+    length = sum(float(c.length) for c in curves)
+    if float(np.min(reaches)) >= length:
         return None  # the robot may be past the whole path before any mover stands still
-    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
-    near = []  # the movers whose final shape's bounding disc comes near some coarse point
-    close = np.zeros(s_coarse.shape[0], dtype=bool)
-    for m, t_stop, reach in zip(movers, t_stops, reaches, strict=True):
-        if reach >= off:
-            continue  # no point of the path lies beyond it
-        limit = float(robot.inscribed_radius) + float(m.radius_at(t_stop)) + margin
-        centre = m.position_at(np.array([t_stop])).reshape(2)
-        bound = float(np.max(np.hypot(*m.shape_vertices.T)))  # the shape within it of centre
-        d = np.hypot(*(coarse - centre).T) - bound
-        hit = d < limit + 0.5 * SCREEN_DS  # a point between is nearer than ds/2 to one
-        if hit.any():
-            near.append((m, t_stop, reach, limit))
-            close |= hit
-    if not near:
+    # every mover at once: its place when it stands (numpy.interp's), the limit (its radius
+    # then: radius_at's floats) and the bound of its shape about that place (its farthest
+    # vertex)
+    places = MoverPlaces(movers)
+    centre = places.at(np.arange(len(movers)), t_stops)
+    limits = float(robot.inscribed_radius) + places.radius_at(t_stops) + margin
+    live = reaches < length  # else no point of the path lies beyond it
+    discs = span_discs(curves)
+    if discs is not None:  # the movers whose shape is nowhere near the path's discs: no hit
+        cen, rad = discs
+        gap = np.min(
+            np.hypot(centre[:, None, 0] - cen[None, :, 0], centre[:, None, 1] - cen[None, :, 1])
+            - rad[None, :],
+            axis=1,
+        )
+        live &= ~(gap - places.reach > limits + 0.5 * SCREEN_DS + SPAN_SLACK)
+    if not live.any():
         return None
+    coarse, s_coarse, off = _path_points(curves, SCREEN_DS)
+    d = (
+        np.hypot(coarse[None, :, 0] - centre[:, 0:1], coarse[None, :, 1] - centre[:, 1:2])
+        - places.reach[:, None]
+    )
+    hits = d < (limits + 0.5 * SCREEN_DS)[:, None]  # a point between is nearer than ds/2 to one
+    hits &= live[:, None]
+    # the movers whose final shape's bounding disc comes near some coarse point
+    rows = np.flatnonzero(hits.any(axis=1))
+    if not rows.size:
+        return None
+    close = hits.any(axis=0)
+    near = [(movers[j], float(t_stops[j]), float(reaches[j]), float(limits[j])) for j in rows]
     # the fine points within SCREEN_DS of arc of a close coarse point: no other can be near
     p, s_cum, off = _path_points(curves, PARKED_DS, s_coarse[close], SCREEN_DS)
     for m, t_stop, reach, limit in near:
@@ -128,6 +154,38 @@ def parked_on_path(
                 t=t_stop,
             )
     return None
+
+
+def span_discs(curves: list[Any]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Return discs that hold the curves' paths: centres (m, shape (n, 2)) and radii (m, shape (n,)).
+
+    A B-spline of degree ``k`` over its domain is, on each knot span, a convex combination of
+    ``k + 1`` consecutive control points: it lies in their convex hull, inside the disc about
+    their mean through the farthest of them. One disc per ``k + 1`` consecutive control
+    points of each curve. ``None`` when a curve's path is not a B-spline (a
+    :class:`~trajopt.geometry.BSplineCurve`, or a :class:`~trajopt.smoother.SmoothPath` of
+    one).
+    """
+    # loaded by then (the plans' paths come from it), not with this module
+    from trajopt.smoother import SmoothPath
+
+    cen, rad = [], []
+    for c in curves:
+        path = c.path
+        spline = path if isinstance(path, BSplineCurve) else None
+        if isinstance(path, SmoothPath) and isinstance(path.curve, BSplineCurve):
+            spline = path.curve
+        if spline is None:
+            return None
+        k = int(spline.k)
+        pts = np.asarray(spline.c, dtype=float)
+        win = np.lib.stride_tricks.sliding_window_view(pts, (k + 1, 2))[:, 0]
+        mid = win.mean(axis=1)
+        cen.append(mid)
+        rad.append(
+            np.max(np.hypot(win[..., 0] - mid[:, None, 0], win[..., 1] - mid[:, None, 1]), axis=1)
+        )
+    return np.concatenate(cen), np.concatenate(rad)
 
 
 def _path_points(
@@ -160,7 +218,18 @@ def _path_points(
 def over_start(start: np.ndarray, movers: Sequence[MovingObstacle], limit: float) -> bool:
     """Whether a mover is closer than ``limit`` plus its radius (m) to ``start`` (m) at ``t = 0``."""
     p = np.asarray(start, dtype=float).reshape(1, 2)
-    for m in movers:
+    if not movers:
+        return False
+    # the far movers first, all at once: their places at t = 0 (numpy.interp's) less their
+    # farthest vertex and radius then are beyond the limit (by more than rounding) for the
+    # most; the distance to the shape is at least that
+    # (a few movers with no kept table: each measured, the screen would cost more)
+    gap = np.zeros(len(movers))
+    if len(movers) >= TABLE_FROM or kept_table(movers) is not None:
+        places = MoverPlaces(movers)
+        centre = places.at(np.arange(len(movers)), gap)
+        gap = np.hypot(*(centre - p[0]).T) - places.reach - places.rad0 - limit
+    for m in (m for m, g in zip(movers, gap.tolist(), strict=True) if not g > 1e-9):
         d = float(point_polygon_distance(p, shape_at(m, np.array([0.0])))[0])
         if d < limit + float(m.radius_at(0.0)):
             return True

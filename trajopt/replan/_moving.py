@@ -67,6 +67,7 @@ heading), so it is tried rather than dropped.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -145,6 +146,12 @@ def retime_replan(
         )
     head_on: list[bool] = []
 
+    @functools.cache
+    def seen_from(t0: float) -> tuple[MovingObstacle, ...]:
+        # the movers seen from t0 of their clock, made once per t0: the quick proofs and a
+        # chain's tail's re-timing see the same objects, whose table the certificate keeps
+        return tuple(shift_clock(m, t0) for m in movers)
+
     def head_on_proof(plan: Any, seen: Sequence[MovingObstacle], margin: float) -> Any:
         head_on.append(meets_head_on(plan, seen, margin))
         return no_way_past(plan, seen, margin) if head_on[-1] else None
@@ -154,17 +161,17 @@ def retime_replan(
         as_is = certify_movers(out, shifted, margin=margin)
     proof = None
     if as_is is None or not as_is.ok:  # the proofs only for a path that must be re-timed
-        proof = blocked_along(out, movers, margin, ts, shifted, (parked_on_path, head_on_proof))
+        proof = blocked_along(out, seen_from, margin, ts, shifted, (parked_on_path, head_on_proof))
     try:
         if proof is not None:
             raise proof
-        timed, moving = _retimed(out, movers, margin, ts, shifted, as_is)
+        timed, moving = _retimed(out, seen_from, margin, ts, shifted, as_is)
         moving["route"] = "retimed"
     except BlockedError as exc:
         if from_stop is None:
             raise
         if proof is None and not any(head_on):  # is the path followed blocked from the stop on?
-            proof = blocked_along(out, movers, margin, ts, shifted, (no_way_past,))
+            proof = blocked_along(out, seen_from, margin, ts, shifted, (no_way_past,))
         timed, moving = _stop_and_go_on(
             out, movers, margin, ts, shifted, from_stop, exc, along=proof
         )
@@ -178,7 +185,7 @@ def retime_replan(
 
 def _retimed(
     out: PlanResult,
-    movers: Sequence[MovingObstacle],
+    seen_from: Callable[[float], Sequence[MovingObstacle]],
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
@@ -203,7 +210,7 @@ def _retimed(
         return _retimed_omni(out, margin, ts, shifted)
     head, tail = split_at_rest(out)
     if tail:
-        timed, moving = _retime_tail(out, head, tail, movers, margin, ts, shifted)
+        timed, moving = _retime_tail(out, head, tail, seen_from, margin, ts, shifted)
         moving["certificate"] = _joined_head(
             head, float(moving["head_s"]), moving.pop("tail_certificate"), out, shifted, margin
         )
@@ -336,7 +343,7 @@ def _head_certificate(
 
 def blocked_along(
     out: PlanResult,
-    movers: Sequence[MovingObstacle],
+    seen_from: Callable[[float], Sequence[MovingObstacle]],
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
@@ -349,7 +356,8 @@ def blocked_along(
     moving state against ``shifted`` (their reach bound from a moving start, ``v_max t``, holds
     every motion along the path, those that brake to a stop on it and go on from rest
     included), or a chain's tail, a plan from rest after the head, against the movers seen
-    from the head's end. Either way nothing along that path from the stop gets past. Its time
+    from the head's end (``seen_from(t0)``: the movers seen from ``t0`` of their clock, the
+    objects its re-timing is given too). Either way nothing along that path from the stop gets past. Its time
     is on the movers' clock; ``None`` when they find nothing or a mover is within the robot's
     circumscribed radius of the start at ``t = 0`` (the re-timing decides, or refuses that as
     bad input).
@@ -363,7 +371,7 @@ def blocked_along(
         t_head = sum(float(p.duration) - t_in for p, t_in in head)
         plan = tail[0] if len(tail) == 1 else TrajectoryChain(tuple(tail), out.robot, {}, None)
         t0 = ts + t_head
-        seen = [shift_clock(m, t0) for m in movers]
+        seen = seen_from(t0)
     start = plan.sample(np.array([0.0]))
     if over_start((float(start.x[0]), float(start.y[0])), seen, float(out.robot.radius) + margin):
         return None  # a mover over the robot (its circumscribed disc): the re-timing refuses it
@@ -416,7 +424,7 @@ def _retime_tail(
     out: TrajectoryChain,
     head: list[tuple[Any, float]],
     tail: list[Any],
-    movers: Sequence[MovingObstacle],
+    seen_from: Callable[[float], Sequence[MovingObstacle]],
     margin: float,
     ts: float,
     shifted: Sequence[MovingObstacle],
@@ -433,7 +441,7 @@ def _retime_tail(
         if len(tail) == 1
         else TrajectoryChain(tuple(tail), out.robot, dict(out.stats), out.steps)
     )
-    seen = [shift_clock(m, ts + t_head) for m in movers]
+    seen = seen_from(ts + t_head)
     try:
         timed = retime_chain(plan, seen, margin=margin)
     except BlockedError as exc:
