@@ -1,4 +1,4 @@
-"""Tests of the all-movers screens of the quick proofs (trajopt.moving.parked_on_path, over_start,
+"""Tests of trajopt.moving: the all-movers screens of the quick proofs (trajopt.moving.parked_on_path, over_start,
 meets_head_on) and the kept reach bound from rest.
 
 Each against a brute force written here: every mover, every path point at the proof's spacing,
