@@ -161,7 +161,8 @@ def _exercise_timing() -> None:
 def _exercise_moving() -> None:
     """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked, and proved so); mark a swept region.
 
-    The certificates of these re-timings reach the path bounds' look-ups (trajopt.moving._path_bounds).
+    The certificates of these re-timings reach the path bounds' look-ups (trajopt.moving._path_bounds),
+    their tightened launches a drive's arc lengths at its times (trajopt.moving._st_search).
     """
     from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve

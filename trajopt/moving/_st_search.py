@@ -19,7 +19,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
+from trajopt.kernel_cache import watch_compiles
 from trajopt.moving._st_grid import NEVER_STEP, STGrid
 from trajopt.moving._st_kernels import (
     arrive_kernel,
@@ -31,6 +33,8 @@ from trajopt.moving._st_kernels import (
 N_EVEN_STOPS = 10
 #: The fronts of the forbidden regions are rounded back to multiples of this many nodes.
 STOP_LATTICE = 5
+
+watch_compiles()  # a first compilation logs one notice (trajopt.kernel_cache)
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,14 +81,75 @@ class Piece:
         return self.memo[key]
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
-        """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends."""
-        tt = np.minimum(np.maximum(t, 0.0), self.duration)
-        rows = self.rows
-        k = np.maximum(np.searchsorted(rows[:, 0], tt, side="right") - 1, 0)
+        """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends.
+
+        Compiled (:func:`piece_s_kernel`); ``t`` of any shape, the result of its shape.
+        """
+        tt = np.asarray(t, dtype=np.float64)
+        out = piece_s_kernel(
+            _plain(self.rows),
+            float(self.duration),
+            float(self.s0),
+            float(self.s1),
+            _plain(tt).reshape(-1),
+        )
+        return out.reshape(tt.shape)
+
+
+def _plain(x: np.ndarray) -> np.ndarray:
+    """Return ``x`` as a writable C-contiguous float64 array (one compiled signature per rank)."""
+    if x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable:
+        return x
+    return np.array(x, dtype=np.float64, order="C")
+
+
+@njit(cache=True)
+def piece_s_kernel(rows, duration, s0, s1, t):  # pragma: no cover - compiled
+    """Return a drive's arc length (m) at its own times ``t`` (s), clipped to its ends.
+
+    Parameters
+    ----------
+    rows : ndarray, shape (p, 5)
+        The drive's phases ``(t, s, v, a, j)`` from its start (s, m, m/s, m/s², m/s³),
+        ``t`` non-decreasing.
+    duration, s0, s1 : float
+        Its duration (s) and ends (m).
+    t : ndarray, shape (n,)
+        The times (s), clipped to ``[0, duration]``.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The phase holding each time (the last whose start is at or before it, the first
+        before the first start) evaluated in Horner form, clipped to ``[s0, s1]``; ``s1``
+        from ``duration`` on. The same floats as the array expression (``numpy.maximum``'s
+        and ``numpy.minimum``'s clipping, ``numpy.searchsorted(..., side="right") - 1``).
+    """
+    n = t.shape[0]
+    p = rows.shape[0]
+    out = np.empty(n)
+    for q in range(n):
+        tt = t[q]
+        if not (tt >= 0.0 or tt != tt):  # numpy.maximum(t, 0.0)
+            tt = 0.0
+        if not (tt <= duration or tt != tt):  # numpy.minimum(., duration)
+            tt = duration
+        lo, hi = 0, p  # the first phase starting after tt: searchsorted, side="right"
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if tt < rows[mid, 0]:
+                hi = mid
+            else:
+                lo = mid + 1
+        k = max(lo - 1, 0)
         tau = tt - rows[k, 0]
         s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
-        s = np.minimum(np.maximum(s, self.s0), self.s1)
-        return np.where(tt >= self.duration, self.s1, s)
+        if not (s >= s0 or s != s):
+            s = s0
+        if not (s <= s1 or s != s):
+            s = s1
+        out[q] = s1 if tt >= duration else s
+    return out
 
 
 def fill_visits(pieces: Sequence[Piece], grid: STGrid) -> None:

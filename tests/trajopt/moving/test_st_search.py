@@ -208,3 +208,45 @@ def test_the_search_from_a_moving_start_equals_the_loop(spy, v0, a0):
         except (BlockedError, InvalidInputError):
             pass
     assert len(spy) >= 4 and all(spy)
+
+
+def _s_at_array(piece: Piece, t: np.ndarray) -> np.ndarray:
+    """The drive's arc lengths at ``t`` as one array expression (numpy's clipping and search)."""
+    tt = np.minimum(np.maximum(t, 0.0), piece.duration)
+    rows = piece.rows
+    k = np.maximum(np.searchsorted(rows[:, 0], tt, side="right") - 1, 0)
+    tau = tt - rows[k, 0]
+    s = rows[k, 1] + tau * (rows[k, 2] + tau * (0.5 * rows[k, 3] + tau * rows[k, 4] / 6.0))
+    s = np.minimum(np.maximum(s, piece.s0), piece.s1)
+    return np.where(tt >= piece.duration, piece.s1, s)
+
+
+def test_a_drives_compiled_arc_lengths_are_the_array_expressions_and_integrate_its_jerk():
+    rng = np.random.default_rng(5)
+    for trial in range(300):
+        p = int(rng.integers(1, 9))
+        t0 = np.sort(rng.uniform(0.0, 5.0, p))
+        t0[0] = 0.0
+        if trial % 3 == 0 and p > 2:
+            t0[2] = t0[1]  # a phase of zero duration
+        rows = np.column_stack([t0, np.cumsum(rng.uniform(0.0, 1.0, p)), *rng.normal(size=(3, p))])
+        duration = float(t0[-1] + rng.uniform(0.0, 2.0))
+        piece = Piece(rows, duration, float(rows[0, 1]), float(rows[-1, 1] + rng.uniform(0, 1)))
+        t = np.concatenate(
+            [rng.uniform(-1.0, duration + 1.0, 200), t0, [duration, -0.0, 2.0 * duration]]
+        )
+        assert piece.s_at(t).tobytes() == _s_at_array(piece, t).tobytes()
+        assert piece.s_at(t.reshape(-1, 1)).shape == (t.shape[0], 1)
+        assert piece.s_at(t[::2]).tobytes() == _s_at_array(piece, t[::2]).tobytes()
+    # a drive of the path's timing: its arc lengths integrate its jerk (dense Euler steps)
+    traj = time_parameterize(PolylineCurve(np.array([[0.0, 0.0], [3.0, 0.0]])), ROBOT)
+    rows = np.column_stack([traj.phase_t, traj.phase_s, traj.phase_v, traj.phase_a, traj.phase_j])
+    piece = Piece(rows, float(traj.duration), 0.0, float(traj.length))
+    dt = 1e-5
+    t = np.arange(0.0, traj.duration, dt)
+    jerk = traj.phase_j[np.searchsorted(traj.phase_t, t, side="right") - 1]
+    a = np.concatenate([[0.0], np.cumsum(jerk * dt)])[:-1]
+    v = np.concatenate([[0.0], np.cumsum(a * dt)])[:-1]
+    s = np.concatenate([[0.0], np.cumsum(v * dt)])[:-1]
+    assert np.max(np.abs(piece.s_at(t) - s)) < 1e-3
+    assert piece.s_at(np.array([traj.duration]))[0] == traj.length
