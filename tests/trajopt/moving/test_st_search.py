@@ -4,7 +4,9 @@ The search sets the arrivals of a stop's drives to all later stops at once and p
 drives worth timing by one vectorised bound; the reference below is the former loop, which
 tested and set them one drive at a time. On random crossings of a straight path and on a
 curved one, every search that ``retime_for_movers`` runs (spied on; its grid, drives and
-bounds) must give the same schedule, arrival and words as the reference.
+bounds) must give the same schedule, arrival and words as the reference. A drive's arc
+lengths at its times (compiled) are the array expression's, bit for bit, and integrate its
+jerk.
 """
 
 from __future__ import annotations
