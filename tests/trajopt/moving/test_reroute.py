@@ -1028,3 +1028,35 @@ def test_a_cart_ending_beside_the_path_is_passed_no_later_than_the_waiting_witne
     assert mv["route"] == "rerouted" and mv["final_places"]["result"].startswith("ok")
     assert out.duration <= witness + 1e-6
     assert check_trajectory(out, [cart], margin=margin, grid=grid).ok
+
+
+def test_marks_where_the_robot_may_meet_are_the_reached_masks_outside_the_kept_discs():
+    """``mark_swept`` with ``reach``: the map's cells, plus each region's
+    ``reached_swept_mask`` (a mask of the whole grid, checked by hand above) outside the kept
+    discs (centres within their radius); ``None`` when that adds nothing. Random tracks, times
+    before the first waypoint and after the last, a mover of one waypoint."""
+    rng = np.random.default_rng(7)
+    grid = _grid((60, 80), [(0.5, 3.5, 0.5, 2.5)])
+    x = (np.arange(grid.shape[1]) + 0.5) * RES
+    y = (np.arange(grid.shape[0]) + 0.5) * RES
+    origin = np.array([0.8, 1.5])
+    keep = [(origin, 0.3), (np.array([3.2, 1.5]), 0.25)]
+    kept = np.zeros(grid.shape, dtype=bool)
+    for p, r in keep:
+        kept |= np.hypot(x[None, :] - p[0], y[:, None] - p[1]) <= r
+    for k in range(12):
+        n = 1 if k == 0 else int(rng.integers(2, 8))
+        times = np.cumsum(rng.uniform(0.2, 1.0, n)) - 0.5
+        pts = np.array([2.0, 1.5]) + np.cumsum(rng.normal(0.0, 0.4, (n, 2)), axis=0)
+        m = trajopt.moving.MovingObstacle.from_waypoints(times, pts, radius=0.15, name="m")
+        t0 = float(rng.uniform(times[0] - 1.0, times[-1]))
+        t1 = float(rng.uniform(t0, times[-1] + 1.0))
+        for late in ((0.0, 0.0), (1.5, 2.0)):
+            reach = (origin, 0.5, 0.165)
+            got = trajopt.moving.mark_swept(grid, [(m, t0, t1)], 0.02, keep, reach, late)
+            add = trajopt.moving.reached_swept_mask(grid, m, t0, t1, 0.02, *reach, late) & ~kept
+            want = np.asarray(grid.occupied) | add
+            if np.array_equal(want, np.asarray(grid.occupied)):
+                assert got is None
+            else:
+                assert np.array_equal(got.occupied, want)
