@@ -15,7 +15,11 @@ For each it records the outcome (``stats["moving"]["route"]``: ``retimed``, ``re
 ``waited``; or ``BlockedError``), the wall time, and checks every returned plan with the
 certificate and on 1 ms samples (the reference of ``tests/trajopt/moving/reference.py``).
 The ratio is each query's time with the mover over its plain plan's; the issue's target is a
-re-route within 2x a plain plan. ``reroute ms`` is the share after the re-timing along the
+re-route within 2x a plain plan. With ``--rounds R`` every query's plain plan and its plans with
+movers are timed ``R`` times, round by round over all the queries (a fresh mover each time, so
+no table kept for a mover or a curve of the same query is found), and the ratio is its median
+time with the mover over its plain plan's median (one sample each is noisy on a shared
+machine; the other columns and the second table stay the first round's). ``reroute ms`` is the share after the re-timing along the
 static path was found blocked (``stats["moving"]["reroute_time_s"]``: marking the map,
 planning and re-timing the new route), and ``rr ratio`` its ratio to the plain plan; the
 rest is the static plan (its search alone where the screen of its grid path finds it
@@ -64,6 +68,7 @@ Run from the repository root (needs the shared data, ``$TRAJOPT_DATA`` or
     python benchmarks/bench_moving_reroute.py
     python benchmarks/bench_moving_reroute.py --queries 10 --seed 3
     python benchmarks/bench_moving_reroute.py --part replan --queries 10
+    python benchmarks/bench_moving_reroute.py --part plan --maps turtlebot3_world --rounds 7
 """
 
 from __future__ import annotations
@@ -75,6 +80,7 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -201,7 +207,16 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--part", choices=("plan", "replan", "both"), default="both")
     ap.add_argument(
+        "--maps", nargs="+", choices=MAPS, default=list(MAPS), help="the maps (default: all)"
+    )
+    ap.add_argument(
         "--repeat", type=int, default=3, help="timings of each re-plan and its plain plan"
+    )
+    ap.add_argument(
+        "--rounds",
+        type=int,
+        default=1,
+        help="plan part: timings of each plan and its plain plan, round by round (medians)",
     )
     args = ap.parse_args()
     d = data_dir() / "ros"
@@ -231,12 +246,15 @@ def plan_part(d: Path, args: argparse.Namespace) -> None:
     raises: list[float] = []
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
-        planner = trajopt.Planner(grid, robot)
         qs = queries(grid, robot, args.queries, rng)
+        if name not in args.maps:  # its queries drawn all the same, as in a run of every map
+            continue
+        planner = trajopt.Planner(grid, robot)
         kinds = (("stop", stop_mover), ("head-on", head_on_mover), ("trapped", trapped_mover))
         rows = {k: {"n": 0, "t0": [], "t1": [], "ratio": [], "rr": [], "rr_ratio": [],
                     "slack": math.inf, "out": {}, "proof": [], "cpu": [], "raise": []}
                 for k, _ in kinds}  # fmt: skip
+        timed: list[tuple[tuple, Any, list[float], dict[str, list[float]]]] = []
         for p0, p1 in qs:
             try:
                 planner.plan(p0, p1)  # warm (the first plan of a map pays its caches)
@@ -245,6 +263,7 @@ def plan_part(d: Path, args: argparse.Namespace) -> None:
                 plain = time.perf_counter() - t0
             except TrajoptError:
                 continue
+            timed.append(((p0, p1), base, [plain], {}))
             for kind, make in kinds:
                 row = rows[kind]
                 mover = make(base)
@@ -260,6 +279,7 @@ def plan_part(d: Path, args: argparse.Namespace) -> None:
                     what = type(exc).__name__
                     out = None
                 took = time.perf_counter() - t0
+                timed[-1][3][kind] = [took]
                 row["cpu"].append(1e3 * (time.process_time() - c0))
                 row["proof"].append(1e3 * proof)
                 if out is None and what == "blocked":
@@ -279,8 +299,12 @@ def plan_part(d: Path, args: argparse.Namespace) -> None:
                     rr = out.stats["moving"]["reroute_time_s"]
                     row["rr"].append(1e3 * rr)
                     row["rr_ratio"].append(rr / plain)
-                    row["ratio"].append(took / plain)
-                    ratios_all.setdefault(kind, []).append(took / plain)
+                    row["counted"] = [*row.get("counted", []), len(timed) - 1]
+                    if args.rounds == 1:
+                        row["ratio"].append(took / plain)
+                        ratios_all.setdefault(kind, []).append(took / plain)
+        if args.rounds > 1:
+            more_rounds(planner, kinds, timed, rows, ratios_all, args.rounds)
         for kind, row in rows.items():
             raises += row["raise"]
             if not row["n"]:
@@ -312,6 +336,39 @@ def plan_part(d: Path, args: argparse.Namespace) -> None:
             f"all maps, {kind}: re-route / plain plan, median {statistics.median(r):.2f}x, "
             f"max {max(r):.2f}x over {len(r)} re-routes"
         )
+
+
+def more_rounds(planner, kinds, timed, rows, ratios_all, rounds: int) -> None:
+    """Time every query's plain plan and its plans with movers ``rounds - 1`` times more.
+
+    Round by round over all the queries (a fresh mover each time, so that no table kept for a
+    mover or a curve of the same query is found), as the first round's; each query's ratio
+    becomes its median time with the mover over its plain plan's median, and the ``plain ms``
+    and ``mover ms`` columns the medians of those medians.
+    """
+    for _ in range(rounds - 1):
+        for (p0, p1), base, plains, tooks in timed:
+            t0 = time.perf_counter()
+            planner.plan(p0, p1)
+            plains.append(time.perf_counter() - t0)
+            for kind, make in kinds:
+                mover = make(base)
+                t0 = time.perf_counter()
+                try:
+                    planner.plan(p0, p1, moving_obstacles=[mover], mover_margin=0.02)
+                except TrajoptError:
+                    pass
+                tooks[kind].append(time.perf_counter() - t0)
+    for kind, row in rows.items():
+        med = [
+            (statistics.median(plains), statistics.median(tooks[kind]))
+            for _, _, plains, tooks in timed
+        ]
+        row["t0"] = [1e3 * a for a, _ in med]
+        row["t1"] = [1e3 * b for _, b in med]
+        for q in row.get("counted", []):
+            row["ratio"].append(med[q][1] / med[q][0])
+            ratios_all.setdefault(kind, []).append(med[q][1] / med[q][0])
 
 
 def rest_stop_mover(base, t_r):
@@ -376,8 +433,10 @@ def replan_part(d: Path, args: argparse.Namespace) -> None:
     failed = 0
     for name in MAPS:
         grid = astar.load_map(d / f"{name}.yaml")
-        planner = trajopt.Planner(grid, robot)
         qs = queries(grid, robot, args.queries, rng)
+        if name not in args.maps:  # its queries drawn all the same, as in a run of every map
+            continue
+        planner = trajopt.Planner(grid, robot)
         kinds = (("stop", lambda b: rest_stop_mover(b, REPLAN_AT)), ("head-on", head_on_mover))
         rows = {k: {"out": {}, "plain": [], "took": [], "ratio": [], "first": [], "bad": 0, "n": 0,
                     "slack": math.inf, "jump": 0.0} for k, _ in kinds}  # fmt: skip

@@ -69,7 +69,9 @@ class MoverPlaces:
         out = np.empty((t.shape[0], 2))
         if not t.shape[0]:
             return out
-        cut = (np.flatnonzero(j[1:] != j[:-1]) + 1).tolist()
+        cut = (np.flatnonzero(j[1:] != j[:-1]) + 1).tolist() if len(self.movers) > 1 else []
         for a, b in zip([0, *cut], [*cut, j.shape[0]], strict=True):
-            out[a:b] = self.movers[int(j[a])].position_at(t[a:b])
+            m = self.movers[int(j[a])]  # position_at's floats, without its heading
+            out[a:b, 0] = np.interp(t[a:b], m.times, m.positions[:, 0])
+            out[a:b, 1] = np.interp(t[a:b], m.times, m.positions[:, 1])
         return out

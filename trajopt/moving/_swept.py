@@ -143,18 +143,34 @@ def reached_swept_mask(
         ``mask[iy, ix]``: the cell may hold the grown mover when a robot could be near it;
         a subset of :func:`swept_mask` over ``[t0, t1]`` (with ``box``, of the box's shape).
     """
-    ox, oy, res, nx, ny = _frame(grid, box)
     t0, t1 = float(t0), float(t1)
+    reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
+    return _reached(_frame(grid, box), mover, t0, t1, _capsules(mover, t0, t1, grow), reach, late)
+
+
+def _reached(
+    frame: tuple[float, float, float, int, int],
+    mover: MovingObstacle,
+    t0: float,
+    t1: float,
+    caps: tuple[np.ndarray, np.ndarray, float],
+    reach: tuple[np.ndarray, float, float],
+    late: tuple[float, float],
+) -> np.ndarray:
+    """:func:`reached_swept_mask` on ``frame`` (:func:`_frame`'s) from the region's capsules.
+
+    ``caps``: :func:`_capsules` of the mover over ``[t0, t1]`` (its track's segments, whose
+    ends are its places at ``t0``, its waypoint times between and ``t1``, and the radius).
+    """
+    a, b, radius = caps
     times = mover.times
     knots = np.concatenate([[t0], times[(times > t0) & (times < t1)], [t1] if t1 > t0 else []])
-    pts = mover.position_at(knots)
+    pts = np.vstack([a, b[-1:]]) if knots.shape[0] > 1 else a  # the track at the knots
     a = np.vstack([pts[:-1], pts[-1:]])  # each segment, then the last place for ever
     b = np.vstack([pts[1:], pts[-1:]])
     last = math.inf if t1 >= mover.t_last else t1
     spans = (np.append(knots[:-1], knots[-1]), np.append(knots[1:], last))
-    radius = _capsules(mover, t0, t1, grow)[2]
-    reach = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
-    return _capsule_mask((ox, oy, res, nx, ny), a, b, radius, spans, reach, late)
+    return _capsule_mask(frame, a, b, radius, spans, reach, late)
 
 
 def _capsule_mask(
@@ -278,11 +294,14 @@ def mark_swept(
         return None  # every capsule off the map
     bx0, bx1, by0, by1 = box
     add = np.zeros((by1 - by0 + 1, bx1 - bx0 + 1), dtype=bool)
-    for (mover, t0, t1), (a, b, radius) in zip(regions, caps, strict=True):
+    frame = _frame(grid, box)
+    for (mover, t0, t1), cap in zip(regions, caps, strict=True):
         if reach is None:
-            add |= _capsule_mask(_frame(grid, box), a, b, radius)
+            add |= _capsule_mask(frame, *cap)
         else:
-            add |= reached_swept_mask(grid, mover, t0, t1, grow, *reach, late, box=box)
+            origin, speed, slack = reach
+            timed = (np.asarray(origin, dtype=float).reshape(2), float(speed), float(slack))
+            add |= _reached(frame, mover, float(t0), float(t1), cap, timed, late)
     ox, oy = (float(v) for v in grid.origin)
     for p, r in keep:
         ix0 = max(bx0, int(math.floor((float(p[0]) - r - ox) / res)))

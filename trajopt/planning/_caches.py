@@ -386,7 +386,11 @@ def component_labels(occupied: np.ndarray) -> np.ndarray:
     >>> component_labels(occ).tolist()
     [[1, 0, 2], [0, 2, 2]]
     """
-    out = label_kernel(np.ascontiguousarray(occupied, dtype=np.bool_))
+    occ = np.ascontiguousarray(occupied, dtype=np.bool_)
+    if occ.flags.writeable:  # one compiled signature, a grid's own read-only cells': a view
+        occ = occ.view()  # (a writable array, as the derived caches' box, compiled another:
+        occ.flags.writeable = False  # 4 s inside a process's first re-route on a fresh cache)
+    out = label_kernel(occ)
     out.flags.writeable = False
     return out
 

@@ -90,14 +90,20 @@ class _Polyline:
         return np.stack([x, y], axis=-1)
 
 
+#: The screen's robot faces the grid path's point this far along (m), not its first step, which
+#: may be 45 degrees or more off the curve (:func:`trajopt.moving.meets_head_on` then missed 2
+#: of ``benchmarks/bench_moving_reroute.py``'s 60 head-on and trapped queries; 0.1-1 m: none).
+GRID_HEADING_M = 0.25
+
+
 @dataclass(frozen=True)
 class _GridCurve(_Curve):
     """A grid path (:class:`_Polyline`) as the quick proofs and their screen read a plan."""
 
     def sample(self, t: np.ndarray) -> SimpleNamespace:
-        """Return the start, at rest, facing along the first segment (``t`` not read; shape (1,))."""
+        """Return the start, at rest, facing :data:`GRID_HEADING_M` along (``t`` not read; shape (1,))."""
         p = self.path.points
-        d = p[min(1, p.shape[0] - 1)] - p[0]
+        d = self.path(np.array([min(GRID_HEADING_M, self.path.length)]))[0] - p[0]
         theta = float(np.arctan2(d[1], d[0]))
         return SimpleNamespace(x=p[:1, 0], y=p[:1, 1], theta=np.array([theta]))
 

@@ -356,6 +356,41 @@ def test_check_grid_path_sees_the_search_grid_path(loop):
         run_query(planner.options, planner.caches, PlanRequest(start, goal, check_grid_path=refuse))
 
 
+def test_the_grid_path_screen_faces_along_the_path_not_its_first_step():
+    """The screen's robot faces the grid path's point ``GRID_HEADING_M`` along it (here worked
+    out by hand), not its first step: a grid path whose first step goes north before it runs
+    east, a walker coming west along it to the start; facing the first step, the head-on
+    screen misses the walker (it comes across that heading), facing along the path it sees
+    it, and the sweep on the grid path then finds it blocked."""
+    import types
+
+    import trajopt.planning._moving as among
+
+    xs = np.arange(1.05, 5.0 + 1e-9, 0.05)
+    points = np.vstack([[1.0, 1.0], [1.0, 1.05], np.stack([xs, np.full_like(xs, 1.05)], axis=1)])
+    robot = trajopt.Robot()
+    plan = among._GridCurve(among._Polyline(points), robot)
+    at = plan.sample(np.zeros(1))
+    assert among.GRID_HEADING_M == 0.25
+    # 0.05 m north, then 0.20 m east: the point (1.20, 1.05)
+    assert math.isclose(float(at.theta[0]), math.atan2(0.05, 0.20), abs_tol=1e-12)
+    assert (float(at.x[0]), float(at.y[0])) == (1.0, 1.0)
+    walker = trajopt.MovingObstacle.from_waypoints(
+        [0.0, 8.0], [(5.0, 1.05), (1.0, 1.05)], radius=0.2, name="walker"
+    )
+    north = types.SimpleNamespace(
+        path=plan.path, robot=robot, own_orientation=False, single_curve=True,
+        length=plan.length, sample=lambda t: types.SimpleNamespace(
+            x=at.x, y=at.y, theta=np.array([math.pi / 2])
+        ),
+    )  # fmt: skip
+    assert not trajopt.moving.meets_head_on(north, [walker], 0.02)
+    assert trajopt.moving.meets_head_on(plan, [walker], 0.02)
+    with pytest.raises(among._GridBlocked) as found:
+        among._GridScreen((walker,), 0.02, robot)(points)
+    assert found.value.blocked.mover == "walker"
+
+
 def test_a_grid_path_screen_that_finds_no_re_route_plans_as_without_it(loop, monkeypatch):
     """When no re-route from the screen's finding works, the query is planned as without the
     screen: here the finding is made up (the cart passes; a re-timing waits for it), and the
@@ -993,3 +1028,35 @@ def test_a_cart_ending_beside_the_path_is_passed_no_later_than_the_waiting_witne
     assert mv["route"] == "rerouted" and mv["final_places"]["result"].startswith("ok")
     assert out.duration <= witness + 1e-6
     assert check_trajectory(out, [cart], margin=margin, grid=grid).ok
+
+
+def test_marks_where_the_robot_may_meet_are_the_reached_masks_outside_the_kept_discs():
+    """``mark_swept`` with ``reach``: the map's cells, plus each region's
+    ``reached_swept_mask`` (a mask of the whole grid, checked by hand above) outside the kept
+    discs (centres within their radius); ``None`` when that adds nothing. Random tracks, times
+    before the first waypoint and after the last, a mover of one waypoint."""
+    rng = np.random.default_rng(7)
+    grid = _grid((60, 80), [(0.5, 3.5, 0.5, 2.5)])
+    x = (np.arange(grid.shape[1]) + 0.5) * RES
+    y = (np.arange(grid.shape[0]) + 0.5) * RES
+    origin = np.array([0.8, 1.5])
+    keep = [(origin, 0.3), (np.array([3.2, 1.5]), 0.25)]
+    kept = np.zeros(grid.shape, dtype=bool)
+    for p, r in keep:
+        kept |= np.hypot(x[None, :] - p[0], y[:, None] - p[1]) <= r
+    for k in range(12):
+        n = 1 if k == 0 else int(rng.integers(2, 8))
+        times = np.cumsum(rng.uniform(0.2, 1.0, n)) - 0.5
+        pts = np.array([2.0, 1.5]) + np.cumsum(rng.normal(0.0, 0.4, (n, 2)), axis=0)
+        m = trajopt.moving.MovingObstacle.from_waypoints(times, pts, radius=0.15, name="m")
+        t0 = float(rng.uniform(times[0] - 1.0, times[-1]))
+        t1 = float(rng.uniform(t0, times[-1] + 1.0))
+        for late in ((0.0, 0.0), (1.5, 2.0)):
+            reach = (origin, 0.5, 0.165)
+            got = trajopt.moving.mark_swept(grid, [(m, t0, t1)], 0.02, keep, reach, late)
+            add = trajopt.moving.reached_swept_mask(grid, m, t0, t1, 0.02, *reach, late) & ~kept
+            want = np.asarray(grid.occupied) | add
+            if np.array_equal(want, np.asarray(grid.occupied)):
+                assert got is None
+            else:
+                assert np.array_equal(got.occupied, want)

@@ -289,3 +289,27 @@ def test_an_end_shut_in_by_marks_is_one_no_search_leaves(seed):
             assert said  # a full ring shuts the start in
         if gap >= 1.2 and joined:
             assert not said
+
+
+def test_the_kernel_gets_read_only_cells_whatever_it_is_given(monkeypatch):
+    """``component_labels`` hands its compiled kernel a read-only array, from writable cells
+    too (as a derived caches' box is): one compiled signature, the one a plan's own read-only
+    inflated grid compiles (a writable array compiled a second one, about 4 s inside a
+    process's first re-route on a fresh cache). The labels are the same either way."""
+    import trajopt.planning._caches as caches_module
+
+    seen = []
+    kernel = caches_module.label_kernel
+
+    def spy(occ):
+        seen.append(occ.flags.writeable)
+        return kernel(occ)
+
+    monkeypatch.setattr(caches_module, "label_kernel", spy)
+    occ = np.array([[0, 1, 0], [1, 0, 0]], dtype=bool)
+    frozen = occ.copy()
+    frozen.flags.writeable = False
+    a, b = component_labels(occ), component_labels(frozen)
+    c = component_labels(np.ones((4, 5), dtype=bool)[1:3, 1:4] & False)  # a slice's copy
+    assert seen == [False, False, False] and occ.flags.writeable  # the caller's array kept
+    assert a.tolist() == b.tolist() == [[1, 0, 2], [0, 2, 2]] and c.tolist() == [[1] * 3] * 2
