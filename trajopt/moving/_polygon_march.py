@@ -738,20 +738,25 @@ def launch_bound_kernel(
 def launch_min_kernel(
     launch, tau, mover, pts, pad, rows, first, head0, turn, lip, verts, edges, poly
 ):  # pragma: no cover - compiled
-    """Return the least clearance (m) over the points at each launch: :func:`launch_bound_kernel`'s row minima.
+    """Return the least clearance (m) over the points at each launch where it is positive: :func:`launch_bound_kernel`'s row minima.
 
-    The same minimum, bit for bit, with fewer tests: a point's clearance changes at most at
-    the ``lip`` (m/s) of the pieces of its mover's track between two times, so a value tested
-    at one launch bounds it from below at another; a point whose bound is above the least
-    value found so far at this launch (by more than 1e-9 m, against rounding) cannot hold the
-    minimum and is not tested. Each launch first tests the point that held the minimum at
-    the one before. Arguments as :func:`launch_bound_kernel`, besides ``lip``, shape (p,):
-    each piece's bound (:attr:`PolygonPieces.lip`).
+    Where the row's minimum is positive it is returned bit for bit, with fewer tests: a
+    point's clearance changes at most at the ``lip`` (m/s) of the pieces of its mover's track
+    between two times, so a value tested at one launch bounds it from below at another; a
+    point whose bound is above the least value found so far at this launch (by more than
+    1e-9 m, against rounding) cannot hold the minimum and is not tested. Where a point's
+    clearance is zero or less the launch is not proved whatever the minimum
+    (:meth:`._shape_windows.ShapeWindows._exact` uses only the positive ones), so the first
+    such clearance found is returned and the launch's other points are not tested. Each
+    launch first tests the point that held its value at the one before. Arguments as
+    :func:`launch_bound_kernel`, besides ``lip``, shape (p,): each piece's bound
+    (:attr:`PolygonPieces.lip`).
 
     Returns
     -------
     ndarray, shape (L,)
-        ``inf`` where there are no points.
+        The least clearance where it is positive, a clearance of zero or less (of one
+        point) where the least is; ``inf`` where there are no points.
     """
     nl, q = launch.shape[0], tau.shape[0]
     out = np.full(nl, np.inf)
@@ -783,6 +788,8 @@ def launch_min_kernel(
             val[r], at[r], held[r] = g, launch[li], p
             if g < best:
                 best, arg_now = g, r
+            if g <= 0.0:  # the launch is not proved: its least value is not needed
+                break
         if best < np.inf:
             arg = arg_now
         out[li] = best

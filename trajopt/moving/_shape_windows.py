@@ -257,8 +257,10 @@ class ShapeWindows(FineWindows):
         mid = 0.5 * (lo + hi)
         rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
         lip_all = float(np.max(lip[rows], initial=0.0))
-        # the least bound over the points at each launch (compiled, the same minimum as
-        # ``g``'s rows' with fewer tests: :func:`._polygon_march.launch_min_kernel`)
+        # the least bound over the points at each launch where it is positive, a bound of
+        # zero or less where it is not (compiled, the same minimum as ``g``'s rows' with
+        # fewer tests: :func:`._polygon_march.launch_min_kernel`); only the positive ones
+        # prove launches
         near = (tau[rows], who[rows].astype(np.int64), pts[rows], pad[rows])
         safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
         left, right = lo, hi

@@ -10,6 +10,8 @@ march both strides over many grid times and steps one at a time.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import shapely
@@ -218,7 +220,8 @@ def test_the_launch_bound_is_the_clearance_at_the_launch_plus_tau():
 @pytest.mark.parametrize("seed", range(6))
 def test_the_least_launch_bound_is_the_minimum_over_the_points(seed):
     """The pruned minimum per launch equals, bit for bit, the minimum over the points of the
-    full table (:func:`launch_bound_kernel`, itself checked against shapely above): on
+    full table (:func:`launch_bound_kernel`, itself checked against shapely above) where
+    that is positive, and is one point's clearance of zero or less where it is not: on
     launches a step apart (the refinement's grids) and jumping back and forth, with points
     along a drive (many nearly as close as the least) and scattered ones."""
     rng = np.random.default_rng(seed)
@@ -231,17 +234,22 @@ def test_the_least_launch_bound_is_the_minimum_over_the_points(seed):
     mover = rng.integers(0, 4, q)
     pad = rng.uniform(0.0, 0.2, q)
     starts = np.searchsorted(tracks.who, np.arange(len(movers) + 1))
-    for launch in (
-        np.arange(0.0, 4.0, 1e-2),
-        np.arange(1.3, 1.5, 1e-3),
-        rng.uniform(-0.5, 8.0, 50),
-        np.zeros(0),
-    ):
-        args = (tracks.rows, starts, tracks.head0, tracks.turn)
-        shape = (tracks.verts, tracks.edges, tracks.poly)
-        want = launch_bound_kernel(launch, tau, mover, pts, pad, *args, *shape)
-        got = launch_min_kernel(launch, tau, mover, pts, pad, *args, tracks.lip, *shape)
-        assert np.array_equal(got, np.min(want, axis=1, initial=np.inf))
+    seen = []
+    args = (tracks.rows, starts, tracks.head0, tracks.turn)
+    shape = (tracks.verts, tracks.edges, tracks.poly)
+    launches = (np.arange(0.0, 4.0, 1e-2), np.arange(1.3, 1.5, 1e-3), rng.uniform(-0.5, 8.0, 50))
+    # the pads as drawn (most launches not proved) and 0.6 m less (many proved)
+    for launch, off in itertools.product((*launches, np.zeros(0)), (0.0, 0.6)):
+        want = launch_bound_kernel(launch, tau, mover, pts, pad - off, *args, *shape)
+        got = launch_min_kernel(launch, tau, mover, pts, pad - off, *args, tracks.lip, *shape)
+        least = np.min(want, axis=1, initial=np.inf)
+        proved = least > 0.0
+        assert np.array_equal(got[proved], least[proved])
+        # not proved: one point's clearance of zero or less (the least is not needed)
+        assert np.all(got[~proved] <= 0.0)
+        assert all(g in row for g, row in zip(got[~proved], want[~proved], strict=True))
+        seen += [int(proved.sum()), int((~proved).sum())]
+    assert sum(seen[0::2]) > 0 and sum(seen[1::2]) > 0  # both kinds of launch are tested
     none = launch_min_kernel(
         np.arange(3.0), tau[:0], mover[:0], pts[:0], pad[:0], *args, tracks.lip, *shape
     )
