@@ -186,6 +186,26 @@ class ShapeWindows(FineWindows):
         counts = np.bincount(node, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
 
+    def fetch_points(self, places: Sequence[float]) -> None:
+        """Make the windows of the path's points at ``places`` (m) not kept yet, in one march.
+
+        The points' windows are those :meth:`point_windows` makes one at a time, the same
+        floats: each pair of a point and a piece of a track is marched on its own, and the
+        pairs of one point keep their order (by piece, then time).
+        """
+        if self.where is None:
+            return
+        new = [s for s in dict.fromkeys(places) if s not in self._points]
+        if len(new) < 2:
+            return
+        pts = self.where(np.array(new, dtype=float))
+        _, pi, lo, hi = self.tracks.windows(pts, self.limit + POINT_PAD, FINE_STEP)
+        order = np.argsort(pi, kind="stable")
+        pi, lo, hi = pi[order], lo[order], hi[order]
+        ptr = np.concatenate([[0], np.cumsum(np.bincount(pi, minlength=len(new)))])
+        for k, s in enumerate(new):
+            self._points[s] = (lo[ptr[k] : ptr[k + 1]], hi[ptr[k] : ptr[k + 1]])
+
     def point_windows(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Return the windows (s) of the path's point at ``s`` (m), the limit plus 0.1 mm (kept by ``s``)."""
         if s not in self._points:
@@ -345,11 +365,9 @@ def launch_floor(
             mine = idx % FLOOR_EVERY == 0
             off = t_j - sched[0][0]
             x_lo, x_hi, _, _ = blocked_launches(
-                idx[mine] // FLOOR_EVERY, a[mine] + off, b[mine] + off, ptr, w_lo, w_hi
+                idx[mine] // FLOOR_EVERY, a[mine] + off, b[mine] + off, ptr, w_lo, w_hi, lo
             )
             f_lo.append(x_lo)
             f_hi.append(x_hi)
-        x_lo, x_hi = np.concatenate(f_lo), np.concatenate(f_hi)
-        keep = x_hi > lo
-        floor = min(floor, sweep(x_lo[keep], x_hi[keep], lo))
+        floor = min(floor, sweep(np.concatenate(f_lo), np.concatenate(f_hi), lo))
     return float(floor)

@@ -13,7 +13,8 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 
 :func:`close_kernel` is the point-to-segment test of the pair filter
 (:func:`._disc_windows.near_pairs`), :func:`near_pairs_kernel` that filter whole, :func:`least_free_kernel` the sweep of the rests'
-shortening (:func:`._tighten.sweep`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+shortening (:func:`._tighten.sweep`), :func:`blocked_launches_kernel` the launches a motion's
+stays near the fine nodes meet their windows at (:func:`._tighten.blocked_launches`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
 order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
 span with ``numpy.nan_to_num``'s replacements), so the same floats.
@@ -453,3 +454,30 @@ def least_free_kernel(f_lo, f_hi, lo, eps):  # pragma: no cover - compiled
         top = max(top, f_hi[j])
         prev = max(top + eps, lo)
     return prev
+
+
+@njit(cache=True)
+def blocked_launches_kernel(node, a, b, ptr, lo, hi, after):  # pragma: no cover - compiled
+    """Return the launches ``(lo_w - b, hi_w - a)`` (s) of :func:`._tighten.blocked_launches`, those ending after ``after``.
+
+    Stay ``j`` (near node ``node[j]`` during ``[L + a[j], L + b[j]]``) against each window
+    ``(lo, hi)[ptr[i]:ptr[i + 1]]`` of its node, in order of stay, then window; only the
+    intervals with ``hi_w - a > after`` (s) are returned, with their ``j`` and window index.
+    The same subtractions and comparison as the numpy form, so the same floats.
+    """
+    total = 0
+    for j in range(node.shape[0]):
+        total += ptr[node[j] + 1] - ptr[node[j]]
+    f_lo = np.empty(total)
+    f_hi = np.empty(total)
+    which = np.empty(total, dtype=np.int64)
+    run = np.empty(total, dtype=np.int64)
+    m = 0
+    for j in range(node.shape[0]):
+        aj, bj = a[j], b[j]
+        for r in range(ptr[node[j]], ptr[node[j] + 1]):
+            x = hi[r] - aj
+            if x > after:
+                f_lo[m], f_hi[m], which[m], run[m] = lo[r] - bj, x, j, r
+                m += 1
+    return f_lo[:m].copy(), f_hi[:m].copy(), which[:m].copy(), run[:m].copy()
