@@ -98,15 +98,14 @@ class PolygonPieces:
         u, w = self.pieces[:, 1], self.pieces[:, 2]
         m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
         self.verts = np.zeros((len(movers), m_max, 2))
-        self.poly = np.zeros(len(movers), dtype=bool)
-        reach = np.zeros(len(movers))
         self.nv = np.array([m.shape_vertices.shape[0] for m in movers], dtype=np.int64)
         for j, m in enumerate(movers):
             v = m.shape_vertices
             self.verts[j, : v.shape[0]] = v
             self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
-            self.poly[j] = v.shape[0] >= 3
-            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
+        self.poly = self.nv >= 3
+        # the farthest vertex (the padding repeats one, so the same maximum)
+        reach = np.max(np.hypot(self.verts[:, :, 0], self.verts[:, :, 1]), axis=1, initial=0.0)
         # the headings at both ends of each piece, numpy.interp's (bit for bit), all at once
         seg = mover_table(movers).seg
         fin = np.isfinite(w)
@@ -116,7 +115,8 @@ class PolygonPieces:
         head0, h_w = heads[: u.shape[0]], heads[u.shape[0] :]
         with np.errstate(invalid="ignore", divide="ignore"):
             turn = np.where(fin, (h_w - head0) / np.where(fin, w - u, 1.0), 0.0)
-        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
+        nxt = np.concatenate([self.verts[:, 1:], self.verts[:, :1]], axis=1)
+        self.edges = nxt - self.verts
         self.head0, self.turn, self.reach = head0, turn, reach
         self.bound = self.pieces.copy()
         self.bound[:, 7] += reach[who]

@@ -14,7 +14,8 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 :func:`close_kernel` is the point-to-segment test of the pair filter
 (:func:`._disc_windows.near_pairs`), :func:`near_pairs_kernel` that filter whole, :func:`least_free_kernel` the sweep of the rests'
 shortening (:func:`._tighten.sweep`), :func:`blocked_launches_kernel` the launches a motion's
-stays near the fine nodes meet their windows at (:func:`._tighten.blocked_launches`), :func:`track_knots_kernel` and :func:`mover_pieces_kernel` cut the movers' tracks into
+stays near the fine nodes meet their windows at (:func:`._tighten.blocked_launches`), :func:`pass_band_kernel` the times a schedule can be near each fine node
+(:func:`._tighten.pass_band`), :func:`track_knots_kernel` and :func:`mover_pieces_kernel` cut the movers' tracks into
 linear pieces (:func:`._disc_windows.track_knots`, :func:`._disc_windows.mover_pieces`:
 ``numpy.interp``'s centres, the numpy form's operations), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
@@ -589,3 +590,50 @@ def mover_pieces_kernel(n_j, tk, pos, t_last, radius, growth, limit):  # pragma:
         rows[r, 8] = growth[j] if mid < t_last[j] else 0.0
         r += 1
     return rows
+
+
+@njit(cache=True)
+def _first_at_least(a, v):  # pragma: no cover - compiled
+    """Return the first index ``i`` with ``a[i] >= v`` of the non-decreasing ``a`` (``len(a)`` if none): ``numpy.searchsorted``'s left side."""
+    lo_i, hi_i = 0, a.shape[0]
+    while lo_i < hi_i:
+        mid = (lo_i + hi_i) // 2
+        if a[mid] < v:
+            lo_i = mid + 1
+        else:
+            hi_i = mid
+    return lo_i
+
+
+@njit(cache=True)
+def pass_band_kernel(
+    s, half, tau, s_cat, first, launch, pack, end, start, lo, hi
+):  # pragma: no cover
+    """Lower ``lo`` and raise ``hi`` (s, shape (n,)) to one schedule's entries and exits of the nodes ``s`` (m).
+
+    The numpy form of :func:`._tighten.pass_band` for one schedule: its drives' samples
+    ``tau`` (s) and arc lengths ``s_cat`` (m), drive ``d``'s at ``first[d]:first[d + 1]``,
+    launched at ``launch[d]`` as it is and at ``pack[d]`` back to back; the arc lengths'
+    running maximum; node ``i`` is left at the sample ``k``, the first at or past
+    ``s_i + half`` (at ``launch + tau[k]``; ``end`` when none), and entered at the sample
+    before the first at or past ``s_i - half`` (at ``pack + tau[k]``; ``start`` when none).
+    The same additions and comparisons, so the same floats.
+    """
+    m = tau.shape[0]
+    run = np.empty(m)
+    late = np.empty(m)
+    early = np.empty(m)
+    top = -np.inf
+    for d in range(first.shape[0] - 1):
+        for k in range(first[d], first[d + 1]):
+            top = s_cat[k] if k == 0 else max(top, s_cat[k])
+            run[k] = top
+            late[k] = launch[d] + tau[k]
+            early[k] = pack[d] + tau[k]
+    for i in range(s.shape[0]):
+        k = _first_at_least(run, s[i] + half)
+        x = late[min(k, m - 1)] if k < m else end
+        hi[i] = max(hi[i], x)
+        k = _first_at_least(run, s[i] - half) - 1
+        x = early[max(k, 0)] if k >= 0 else start
+        lo[i] = min(lo[i], x)

@@ -34,7 +34,7 @@ import numpy as np
 
 from trajopt.moving._disc_windows import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_kernels import blocked_launches_kernel, least_free_kernel
+from trajopt.moving._st_kernels import blocked_launches_kernel, least_free_kernel, pass_band_kernel
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -396,25 +396,32 @@ def pass_band(
         return np.full(s.shape, -np.inf), np.full(s.shape, np.inf)
     lo = np.full(s.shape, np.inf)
     hi = np.full(s.shape, -np.inf)
+    nodes = np.ascontiguousarray(s, dtype=np.float64)
     for sched in latest:
-        taus, s_t, at, packed = [], [], [], []
+        taus, s_t, launch, pack = [], [], [], []
         t = min(t_from, sched[0][0])
-        for launch, pc in sched:
+        for t_j, pc in sched:
             tau, s_pc = band_samples(pc)
             taus.append(tau)
             s_t.append(s_pc)
-            at.append(np.full(tau.shape, launch))
-            packed.append(np.full(tau.shape, t))
+            launch.append(t_j)
+            pack.append(t)
             t += pc.duration
-        tau, s_all = np.concatenate(taus), np.maximum.accumulate(np.concatenate(s_t))
-        n = tau.shape[0]
-        k = np.searchsorted(s_all, s + 0.5 * h, side="left")
-        end = sched[-1][0] + sched[-1][1].duration
-        late = (np.concatenate(at) + tau)[np.minimum(k, n - 1)]
-        hi = np.maximum(hi, np.where(k < n, late, end))
-        k = np.searchsorted(s_all, s - 0.5 * h, side="left") - 1
-        early = (np.concatenate(packed) + tau)[np.maximum(k, 0)]
-        lo = np.minimum(lo, np.where(k >= 0, early, min(t_from, sched[0][0])))
+        first = np.concatenate([[0], np.cumsum([x.shape[0] for x in taus])]).astype(np.int64)
+        # compiled: the numpy form's running maximum, searches and sums (the same floats)
+        pass_band_kernel(
+            nodes,
+            0.5 * h,
+            np.concatenate(taus),
+            np.concatenate(s_t).astype(np.float64),
+            first,
+            np.array(launch, dtype=np.float64),
+            np.array(pack, dtype=np.float64),
+            float(sched[-1][0] + sched[-1][1].duration),
+            float(min(t_from, sched[0][0])),
+            lo,
+            hi,
+        )
     return lo, hi
 
 
