@@ -593,16 +593,17 @@ def mover_pieces_kernel(n_j, tk, pos, t_last, radius, growth, limit):  # pragma:
 
 
 @njit(cache=True)
-def _first_at_least(a, v):  # pragma: no cover - compiled
-    """Return the first index ``i`` with ``a[i] >= v`` of the non-decreasing ``a`` (``len(a)`` if none): ``numpy.searchsorted``'s left side."""
-    lo_i, hi_i = 0, a.shape[0]
-    while lo_i < hi_i:
-        mid = (lo_i + hi_i) // 2
-        if a[mid] < v:
-            lo_i = mid + 1
-        else:
-            hi_i = mid
-    return lo_i
+def _first_at_least(a, v, k):  # pragma: no cover - compiled
+    """Return the first index ``i`` with ``a[i] >= v`` of the non-decreasing ``a`` (``len(a)`` if none): ``numpy.searchsorted``'s left side.
+
+    Walked from ``k`` (a guess no later than the answer: the answer for a smaller ``v``), or
+    from 0 when ``k`` is already past it.
+    """
+    if k > 0 and not a[k - 1] < v:
+        k = 0
+    while k < a.shape[0] and a[k] < v:
+        k += 1
+    return k
 
 
 @njit(cache=True)
@@ -630,10 +631,9 @@ def pass_band_kernel(
             run[k] = top
             late[k] = launch[d] + tau[k]
             early[k] = pack[d] + tau[k]
+    k_hi, k_lo = 0, 0  # the nodes in order: each search walks on from the last one's
     for i in range(s.shape[0]):
-        k = _first_at_least(run, s[i] + half)
-        x = late[min(k, m - 1)] if k < m else end
-        hi[i] = max(hi[i], x)
-        k = _first_at_least(run, s[i] - half) - 1
-        x = early[max(k, 0)] if k >= 0 else start
-        lo[i] = min(lo[i], x)
+        k_hi = _first_at_least(run, s[i] + half, k_hi)
+        hi[i] = max(hi[i], late[k_hi] if k_hi < m else end)
+        k_lo = _first_at_least(run, s[i] - half, k_lo)
+        lo[i] = min(lo[i], early[k_lo - 1] if k_lo > 0 else start)

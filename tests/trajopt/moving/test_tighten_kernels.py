@@ -104,8 +104,9 @@ def test_the_pass_band_equals_the_samples_walked_node_by_node():
     latest = [[(1.7, first), (1.7 + first.duration + 0.8, second)], [(3.9, whole)]]
     s = np.linspace(0.0, 3.0, 151)
     h = float(s[1] - s[0])
-    for t_from in (0.4, 2.5):
-        lo, hi = pass_band(s, h, latest, t_from)
-        want_lo, want_hi = _band_brute(s, h, latest, t_from)
+    shuffled = np.random.default_rng(1).permutation(s)  # nodes out of order, too
+    for t_from, nodes in ((0.4, s), (2.5, s), (0.4, shuffled)):
+        lo, hi = pass_band(nodes, h, latest, t_from)
+        want_lo, want_hi = _band_brute(nodes, h, latest, t_from)
         assert np.array_equal(lo, want_lo) and np.array_equal(hi, want_hi)
         assert np.all(lo <= hi)
