@@ -22,9 +22,11 @@ from trajopt.moving._polygon_march import (
     FROZEN_PAD,
     PolygonPieces,
     _signed_distance,
+    float_arange,
     launch_bound_kernel,
     launch_min_kernel,
     polygon_runs,
+    refine_samples_kernel,
 )
 
 
@@ -351,3 +353,46 @@ def test_pieces_headings_are_numpy_interp_of_each_mover(seed):
                 assert turn == (np.interp(wi, m.times, m.headings) - h_u) / (wi - ui)
             else:
                 assert turn == 0.0
+
+
+def test_float_arange_is_numpy_arange():
+    # the refinement's launch grids: numpy.arange's values, bit for bit, for the starts,
+    # stops and steps it uses (a stop half a step past the end), empty ranges included
+    rng = np.random.default_rng(11)
+    for _ in range(3000):
+        start = float(rng.uniform(-5.0, 40.0))
+        step = float(rng.choice([1e-2, 1e-3, 1e-4, 0.37]))
+        stop = start + float(rng.uniform(-0.02, 0.4)) + 0.5 * step
+        assert np.array_equal(float_arange(start, stop, step), np.arange(start, stop, step))
+
+
+def test_the_refinement_samples_cover_each_owners_spans():
+    # random spans of three owners (some touching, some nested, some of zero length): the
+    # samples of an owner lie in its spans, start and end each union of them, and are at
+    # most dt apart inside one (brute force on a fine grid of the union)
+    rng = np.random.default_rng(5)
+    dt = 1e-3
+    for _ in range(30):
+        q = int(rng.integers(1, 12))
+        a = np.round(rng.uniform(0.0, 0.3, q), 3)  # on a grid: touching ends happen
+        b = a + np.round(rng.choice([0.0, 0.004, 0.02, 0.05], q), 3)
+        owner = rng.integers(0, 3, q)
+        tau, who = refine_samples_kernel(a, b, owner, dt)
+        for o in np.unique(owner):
+            mine = tau[who == o]
+            sa, sb = a[owner == o], b[owner == o]
+            inside = (mine[:, None] >= sa[None, :] - 1e-12) & (mine[:, None] <= sb[None, :] + 1e-12)
+            assert inside.any(axis=1).all()
+            # the union's pieces (brute force: sort, join overlapping or touching spans)
+            order = np.argsort(sa, kind="stable")
+            parts = []
+            for x, y in zip(sa[order], sb[order], strict=True):
+                if parts and x <= parts[-1][1]:
+                    parts[-1][1] = max(parts[-1][1], y)
+                else:
+                    parts.append([x, y])
+            for x, y in parts:
+                run = mine[(mine >= x) & (mine <= y)]
+                assert run[0] == x and run[-1] == y
+                assert np.all(np.diff(run) <= dt * (1 + 1e-9) + 1e-15)
+            assert mine.shape[0] == sum(max(int(np.ceil((y - x) / dt)), 1) + 1 for x, y in parts)
