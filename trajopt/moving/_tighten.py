@@ -367,6 +367,8 @@ def tail_s(schedule: Schedule, k: int) -> Callable[[np.ndarray], np.ndarray]:
     pieces = [pc for _, pc in schedule[k:]]
 
     def s_of(tau: np.ndarray) -> np.ndarray:
+        if len(pieces) == 1:  # one drive (the same floats as picking its times out)
+            return np.asarray(pieces[0].s_at(tau - offs[0]), dtype=float)
         j = np.clip(np.searchsorted(offs, tau, side="right") - 1, 0, len(pieces) - 1)
         out = np.empty(tau.shape)
         for i in np.unique(j):
