@@ -19,7 +19,9 @@ from trajopt.moving._st_kernels import (
     close_kernel,
     disc_windows_kernel,
     inside_times_kernel,
+    mover_pieces_kernel,
     near_pairs_kernel,
+    track_knots_kernel,
 )
 
 #: Consecutive points per box of :func:`near_pairs`'s first test.
@@ -215,7 +217,8 @@ def track_knots(
     A mover's knots are ``a``, its waypoint times strictly between ``a`` and ``b``, and
     ``b`` (``a < b``); its centre at them is what ``numpy.interp`` gives, bit for bit: a
     waypoint at its time, the first or last waypoint outside the times, else
-    ``slope (t - t_k) + p_k`` on the waypoints' segment.
+    ``slope (t - t_k) + p_k`` on the waypoints' segment (compiled:
+    :func:`._st_kernels.track_knots_kernel`).
 
     Parameters
     ----------
@@ -234,40 +237,18 @@ def track_knots(
         The centre (m) at each knot.
     """
     m = len(movers)
-    n_j = np.array([mv.times.shape[0] for mv in movers])
-    tk = np.concatenate([mv.times for mv in movers])
-    pos = np.concatenate([mv.positions for mv in movers])
-    j = np.arange(m)
-    own = np.repeat(j, n_j)
-    base = np.cumsum(n_j) - n_j  # each mover's first waypoint
-    last = base + n_j - 1
-    a = np.broadcast_to(np.asarray(a, dtype=float), (m,))
-    b = np.broadcast_to(np.asarray(b, dtype=float), (m,))
+    n_j, tk, pos = _waypoints(movers)
+    a = np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (m,)))
+    b = np.ascontiguousarray(np.broadcast_to(np.asarray(b, dtype=float), (m,)))
+    return track_knots_kernel(n_j, tk, pos, a, b)
 
-    def centre_at(x: np.ndarray) -> np.ndarray:
-        k = base + np.bincount(own, weights=tk <= x[own], minlength=m).astype(np.int64) - 1
-        out = np.where((x < tk[base])[:, None], pos[base], pos[last])
-        between = (x >= tk[base]) & (x < tk[last])  # then base <= k < last
-        if between.any():
-            kb, xb = k[between], x[between]
-            slope = (pos[kb + 1] - pos[kb]) / (tk[kb + 1] - tk[kb])[:, None]
-            at = slope * (xb - tk[kb])[:, None] + pos[kb]
-            out[between] = np.where((tk[kb] == xb)[:, None], pos[kb], at)
-        return out
 
-    inner = (tk > a[own]) & (tk < b[own])
-    lead = base + np.bincount(own, weights=tk <= a[own], minlength=m).astype(np.int64)
-    cnt = 2 + np.bincount(own, weights=inner, minlength=m).astype(np.int64)
-    first = np.cumsum(cnt) - cnt
-    end = first + cnt - 1
-    total = int(first[-1] + cnt[-1])
-    knots, centre = np.empty(total), np.empty((total, 2))
-    knots[first], centre[first] = a, centre_at(a)
-    knots[end], centre[end] = b, centre_at(b)
-    idx = np.flatnonzero(inner)
-    slot = first[own[idx]] + 1 + idx - lead[own[idx]]
-    knots[slot], centre[slot] = tk[idx], pos[idx]
-    return np.repeat(j, cnt), knots, centre
+def _waypoints(movers: Sequence[MovingObstacle]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return each mover's number of waypoints, and their times (s) and positions (m) one mover after another."""
+    n_j = np.array([mv.times.shape[0] for mv in movers], dtype=np.int64)
+    tk = np.ascontiguousarray(np.concatenate([mv.times for mv in movers]), dtype=np.float64)
+    pos = np.ascontiguousarray(np.concatenate([mv.positions for mv in movers]), dtype=np.float64)
+    return n_j, tk, pos
 
 
 def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
@@ -276,32 +257,18 @@ def mover_pieces(movers: Sequence[MovingObstacle], limit: float) -> np.ndarray:
     Rows ``(mover, u, w, x, y, vx, vy, r, g)``: from ``u`` to ``w`` (s; ``w = inf`` for the
     last, the mover standing) the centre moves from ``(x, y)`` at ``(vx, vy)`` (m, m/s) and
     ``limit`` plus the radius is ``r + g (t - u)`` (m). A mover's knots are ``0``, its times
-    after 0 and ``t_end = max(t_last, 0) + 1`` (:func:`track_knots`).
+    after 0 and ``t_end = max(t_last, 0) + 1`` (:func:`track_knots`). Compiled
+    (:func:`._st_kernels.mover_pieces_kernel`).
     """
     if len(movers) == 0:
         return np.zeros((0, 9))
-    t_first = np.array([float(m.times[0]) for m in movers])
-    t_last = np.array([m.t_last for m in movers])
-    t_end = np.maximum(t_last, 0.0) + 1.0
-    owner, knots, pk = track_knots(movers, 0.0, t_end)
-    row = np.flatnonzero(owner[1:] == owner[:-1])  # each knot but a mover's last
-    who = owner[row]
-    u, w = knots[row], knots[row + 1]
-    mid = 0.5 * (u + w)
-    inside = (mid > t_first[who]) & (mid < t_last[who])
-    vel = np.where(inside[:, None], (pk[row + 1] - pk[row]) / (w - u)[:, None], 0.0)
-    radius = np.array([m.radius for m in movers], dtype=float)
-    growth = np.array([m.growth for m in movers], dtype=float)
-    return np.column_stack(
-        [
-            who.astype(float),
-            u,
-            np.where(w >= t_end[who], np.inf, w),
-            pk[row, 0],
-            pk[row, 1],
-            vel[:, 0],
-            vel[:, 1],
-            limit + radius[who] + growth[who] * np.clip(u, 0.0, np.maximum(t_last, 0.0)[who]),
-            np.where(mid < t_last[who], growth[who], 0.0),
-        ]
+    n_j, tk, pos = _waypoints(movers)
+    return mover_pieces_kernel(
+        n_j,
+        tk,
+        pos,
+        np.array([m.t_last for m in movers], dtype=np.float64),
+        np.array([m.radius for m in movers], dtype=np.float64),
+        np.array([m.growth for m in movers], dtype=np.float64),
+        float(limit),
     )

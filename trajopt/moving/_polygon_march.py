@@ -31,7 +31,9 @@ g`` (m/s). One exact evaluation ``f(t)`` (:func:`_clearance`) therefore proves t
 :func:`launch_bound_kernel` gives the clearance of points at times after a launch (the
 refinement of :meth:`._shape_windows.ShapeWindows._exact`), and :func:`launch_min_kernel`
 its least value over the points per launch, skipping the points that the same Lipschitz
-bound shows cannot hold it.
+bound shows cannot hold it. The refinement itself is compiled in two steps around the
+path's evaluation: :func:`refine_samples_kernel` (the motion's sample times) and
+:func:`launch_refine_kernel` (the launches not proved).
 """
 
 from __future__ import annotations
@@ -98,15 +100,14 @@ class PolygonPieces:
         u, w = self.pieces[:, 1], self.pieces[:, 2]
         m_max = max((m.shape_vertices.shape[0] for m in movers), default=1)
         self.verts = np.zeros((len(movers), m_max, 2))
-        self.poly = np.zeros(len(movers), dtype=bool)
-        reach = np.zeros(len(movers))
         self.nv = np.array([m.shape_vertices.shape[0] for m in movers], dtype=np.int64)
         for j, m in enumerate(movers):
             v = m.shape_vertices
             self.verts[j, : v.shape[0]] = v
             self.verts[j, v.shape[0] :] = v[0]  # repeated: edges of zero length
-            self.poly[j] = v.shape[0] >= 3
-            reach[j] = float(np.max(np.hypot(v[:, 0], v[:, 1])))
+        self.poly = self.nv >= 3
+        # the farthest vertex (the padding repeats one, so the same maximum)
+        reach = np.max(np.hypot(self.verts[:, :, 0], self.verts[:, :, 1]), axis=1, initial=0.0)
         # the headings at both ends of each piece, numpy.interp's (bit for bit), all at once
         seg = mover_table(movers).seg
         fin = np.isfinite(w)
@@ -116,7 +117,8 @@ class PolygonPieces:
         head0, h_w = heads[: u.shape[0]], heads[u.shape[0] :]
         with np.errstate(invalid="ignore", divide="ignore"):
             turn = np.where(fin, (h_w - head0) / np.where(fin, w - u, 1.0), 0.0)
-        self.edges = np.roll(self.verts, -1, axis=1) - self.verts
+        nxt = np.concatenate([self.verts[:, 1:], self.verts[:, :1]], axis=1)
+        self.edges = nxt - self.verts
         self.head0, self.turn, self.reach = head0, turn, reach
         self.bound = self.pieces.copy()
         self.bound[:, 7] += reach[who]
@@ -738,20 +740,25 @@ def launch_bound_kernel(
 def launch_min_kernel(
     launch, tau, mover, pts, pad, rows, first, head0, turn, lip, verts, edges, poly
 ):  # pragma: no cover - compiled
-    """Return the least clearance (m) over the points at each launch: :func:`launch_bound_kernel`'s row minima.
+    """Return the least clearance (m) over the points at each launch where it is positive: :func:`launch_bound_kernel`'s row minima.
 
-    The same minimum, bit for bit, with fewer tests: a point's clearance changes at most at
-    the ``lip`` (m/s) of the pieces of its mover's track between two times, so a value tested
-    at one launch bounds it from below at another; a point whose bound is above the least
-    value found so far at this launch (by more than 1e-9 m, against rounding) cannot hold the
-    minimum and is not tested. Each launch first tests the point that held the minimum at
-    the one before. Arguments as :func:`launch_bound_kernel`, besides ``lip``, shape (p,):
-    each piece's bound (:attr:`PolygonPieces.lip`).
+    Where the row's minimum is positive it is returned bit for bit, with fewer tests: a
+    point's clearance changes at most at the ``lip`` (m/s) of the pieces of its mover's track
+    between two times, so a value tested at one launch bounds it from below at another; a
+    point whose bound is above the least value found so far at this launch (by more than
+    1e-9 m, against rounding) cannot hold the minimum and is not tested. Where a point's
+    clearance is zero or less the launch is not proved whatever the minimum
+    (:meth:`._shape_windows.ShapeWindows._exact` uses only the positive ones), so the first
+    such clearance found is returned and the launch's other points are not tested. Each
+    launch first tests the point that held its value at the one before. Arguments as
+    :func:`launch_bound_kernel`, besides ``lip``, shape (p,): each piece's bound
+    (:attr:`PolygonPieces.lip`).
 
     Returns
     -------
     ndarray, shape (L,)
-        ``inf`` where there are no points.
+        The least clearance where it is positive, a clearance of zero or less (of one
+        point) where the least is; ``inf`` where there are no points.
     """
     nl, q = launch.shape[0], tau.shape[0]
     out = np.full(nl, np.inf)
@@ -783,7 +790,181 @@ def launch_min_kernel(
             val[r], at[r], held[r] = g, launch[li], p
             if g < best:
                 best, arg_now = g, r
+            if g <= 0.0:  # the launch is not proved: its least value is not needed
+                break
         if best < np.inf:
             arg = arg_now
         out[li] = best
     return out
+
+
+@njit(cache=True)
+def float_arange(start, stop, step):  # pragma: no cover - compiled
+    """Return ``numpy.arange(start, stop, step)`` for floats, the same values.
+
+    NumPy's length, ``ceil((stop - start) / step)`` (none when not positive), and its fill:
+    ``start``, ``start + step``, then ``start + i delta`` with ``delta`` the difference of
+    the first two.
+    """
+    n = np.ceil((stop - start) / step)
+    if not n > 0.0:
+        return np.zeros(0)
+    m = int(n)
+    out = np.empty(m)
+    out[0] = start
+    if m > 1:
+        out[1] = start + step
+        delta = out[1] - start
+        for i in range(2, m):
+            out[i] = start + i * delta
+    return out
+
+
+@njit(cache=True)
+def refine_samples_kernel(a, b, owner, dt):  # pragma: no cover - compiled
+    """Return the refinement's sample times ``tau`` (s) and their movers: each owner's spans merged, sampled every ``dt``.
+
+    :func:`._tighten.merged_spans` (the spans ``[a_j, b_j]`` of one owner that overlap or
+    touch made one, the same floats and decisions: its stable sort by owner, then start,
+    and its running maximum of ``owner * big + b``), then each merged span ``[a, b]`` at
+    ``min(a + k dt, b)``, ``k = 0 .. max(ceil((b - a) / dt), 1)``: the numpy form of
+    :meth:`._shape_windows.ShapeWindows._exact`.
+    """
+    q = a.shape[0]
+    if q == 0:
+        return np.zeros(0), np.zeros(0, dtype=np.int64)
+    order = np.argsort(a, kind="mergesort")
+    order = order[np.argsort(owner[order], kind="mergesort")]
+    big = 2.0 * (np.max(np.abs(b)) + np.max(np.abs(a)) + 1.0)
+    m_a = np.empty(q)
+    m_b = np.empty(q)
+    m_o = np.empty(q, dtype=np.int64)
+    nm = 0
+    top = -np.inf
+    prev_o = -1
+    for k in range(q):
+        r = order[k]
+        o = owner[r]
+        key = o * big + b[r]
+        if k == 0 or o != prev_o:
+            new = True
+            top = key
+        else:
+            new = a[r] > top - prev_o * big
+            top = max(top, key)
+        if new:
+            m_a[nm], m_b[nm], m_o[nm] = a[r], b[r], o
+            nm += 1
+        else:
+            m_b[nm - 1] = max(m_b[nm - 1], b[r])
+        prev_o = o
+    total = 0
+    for k in range(nm):
+        total += max(int(np.ceil((m_b[k] - m_a[k]) / dt)), 1) + 1
+    tau = np.empty(total)
+    who = np.empty(total, dtype=np.int64)
+    x = 0
+    for k in range(nm):
+        n = max(int(np.ceil((m_b[k] - m_a[k]) / dt)), 1) + 1
+        for i in range(n):
+            tau[x] = min(m_a[k] + i * dt, m_b[k])
+            who[x] = m_o[k]
+            x += 1
+    return tau, who
+
+
+@njit(cache=True)
+def launch_refine_kernel(
+    tau,
+    who,
+    pts,
+    lip_m,
+    speed,
+    limit,
+    dt,
+    lo,
+    hi,
+    steps,
+    rows,
+    first,
+    head0,
+    turn,
+    lip,
+    verts,
+    edges,
+    poly,
+):  # pragma: no cover - compiled
+    """Return the open intervals ``(f_lo, f_hi)`` (s) of the launches in ``[lo, hi]`` not proved clear.
+
+    The numpy form of :meth:`._shape_windows.ShapeWindows._exact` after the path's points,
+    the same floats: the points' pads ``dt / 2 (speed + lip) + limit`` (m; ``lip`` the most
+    of the mover's pieces, ``lip_m``); the points whose bound at the middle launch is above
+    ``lip`` times the half range left out; then per launch step of ``steps`` the launches
+    from ``left`` to ``right`` (``numpy.arange``'s, :func:`float_arange`), their least
+    bound (:func:`launch_min_kernel`), each positive one proving the launches within
+    ``bound / lip_all`` of it, the next level between the first proved launch and one step
+    before it; last, the complement in ``[lo, hi]`` of the proved launches (sorted by
+    start, the running maximum of the ends; ``hi`` itself allowed).
+    """
+    q = tau.shape[0]
+    pad = np.empty(q)
+    lip_r = np.empty(q)
+    half = 0.5 * dt
+    for r in range(q):
+        lip_r[r] = lip_m[who[r]]
+        pad[r] = half * (speed + lip_r[r]) + limit
+    mid = 0.5 * (lo + hi)
+    at_mid = launch_bound_kernel(
+        np.array([mid]), tau, who, pts, pad, rows, first, head0, turn, verts, edges, poly
+    )[0]
+    keep = np.zeros(q, dtype=np.bool_)
+    lip_all = 0.0
+    for r in range(q):
+        if at_mid[r] <= lip_r[r] * (mid - lo):
+            keep[r] = True
+            lip_all = max(lip_all, lip_r[r])
+    idx = np.flatnonzero(keep)
+    n_tau, n_who, n_pts, n_pad = tau[idx], who[idx], pts[idx], pad[idx]
+    cap = 16
+    s_lo = np.empty(cap)
+    s_hi = np.empty(cap)
+    ns = 0
+    left, right = lo, hi
+    for level in range(steps.shape[0]):
+        dl = steps[level]
+        launch = float_arange(left, right + 0.5 * dl, dl)
+        bound = launch_min_kernel(
+            launch, n_tau, n_who, n_pts, n_pad, rows, first, head0, turn, lip, verts, edges, poly
+        )
+        found = -1
+        for li in range(launch.shape[0]):
+            if not bound[li] > 0.0:
+                continue
+            reach = bound[li] / max(lip_all, 1e-300)
+            if not reach > 0.0:
+                continue
+            if ns == cap:
+                cap *= 2
+                s_lo = np.concatenate((s_lo, np.empty(cap - ns)))
+                s_hi = np.concatenate((s_hi, np.empty(cap - ns)))
+            s_lo[ns], s_hi[ns] = launch[li] - reach, launch[li] + reach
+            ns += 1
+            if found < 0:
+                found = li
+        if found < 0:
+            break
+        left, right = max(lo, launch[found] - dl), launch[found]
+    order = np.argsort(s_lo[:ns], kind="mergesort")
+    f_lo = np.empty(ns + 1)
+    f_hi = np.empty(ns + 1)
+    f_lo[0] = lo - 1.0
+    top = -np.inf
+    for k in range(ns):
+        top = s_hi[order[k]] if k == 0 else max(top, s_hi[order[k]])
+        f_hi[k] = s_lo[order[k]]
+        f_lo[k + 1] = top
+    f_hi[ns] = hi
+    out = np.empty(ns + 1, dtype=np.bool_)
+    for k in range(ns + 1):
+        out[k] = f_hi[k] > f_lo[k]
+    return f_lo[out], f_hi[out]

@@ -32,9 +32,9 @@ from trajopt.moving._disc_windows import close_pairs, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import (
     PolygonPieces,
-    launch_bound_kernel,
-    launch_min_kernel,
+    launch_refine_kernel,
     pieces_of,
+    refine_samples_kernel,
     windows_kernel,
 )
 from trajopt.moving._st_kernels import disc_windows_kernel
@@ -43,7 +43,6 @@ from trajopt.moving._tighten import (
     POINT_PAD,
     FineWindows,
     blocked_launches,
-    merged_spans,
     near_times,
     pieces_meeting,
     sweep,
@@ -178,6 +177,10 @@ class ShapeWindows(FineWindows):
         self._points: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self.tracks = ShapeTracks.of(movers)
         self.pieces = self.tracks.bound
+        # each mover's largest piece bound (m/s) and its pieces' rows, for the refinement
+        self.lip_m = np.zeros(len(self.movers))
+        np.maximum.at(self.lip_m, self.tracks.who, self.tracks.lip)
+        self.starts = np.searchsorted(self.tracks.who, np.arange(len(self.movers) + 1))
         if band is None:
             band = (np.zeros(s.shape), np.full(s.shape, np.inf))
         owner, node, lo, hi = self.tracks.windows(pts, limit + 0.5 * self.h, NODE_STEP, band)
@@ -185,6 +188,26 @@ class ShapeWindows(FineWindows):
         node, self.lo, self.hi, self.owner = node[order], lo[order], hi[order], owner[order]
         counts = np.bincount(node, minlength=s.shape[0])
         self.ptr = np.concatenate([[0], np.cumsum(counts)])
+
+    def fetch_points(self, places: Sequence[float]) -> None:
+        """Make the windows of the path's points at ``places`` (m) not kept yet, in one march.
+
+        The points' windows are those :meth:`point_windows` makes one at a time, the same
+        floats: each pair of a point and a piece of a track is marched on its own, and the
+        pairs of one point keep their order (by piece, then time).
+        """
+        if self.where is None:
+            return
+        new = [s for s in dict.fromkeys(places) if s not in self._points]
+        if len(new) < 2:
+            return
+        pts = self.where(np.array(new, dtype=float))
+        _, pi, lo, hi = self.tracks.windows(pts, self.limit + POINT_PAD, FINE_STEP)
+        order = np.argsort(pi, kind="stable")
+        pi, lo, hi = pi[order], lo[order], hi[order]
+        ptr = np.concatenate([[0], np.cumsum(np.bincount(pi, minlength=len(new)))])
+        for k, s in enumerate(new):
+            self._points[s] = (lo[ptr[k] : ptr[k + 1]], hi[ptr[k] : ptr[k + 1]])
 
     def point_windows(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Return the windows (s) of the path's point at ``s`` (m), the limit plus 0.1 mm (kept by ``s``)."""
@@ -221,77 +244,36 @@ class ShapeWindows(FineWindows):
         returned. The points that keep more than ``lip`` times the range at its middle are
         left out (they are clear at every launch in it).
         """
-        a, b, owner = merged_spans(a, b, owner)
-        n = np.maximum(np.ceil((b - a) / REFINE_TAU).astype(np.int64), 1) + 1
-        idx = np.repeat(np.arange(a.shape[0]), n)
-        step = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-        tau = np.minimum(a[idx] + step * REFINE_TAU, b[idx])
-        who = owner[idx]
-        pts = self.where(s_of(tau))
+        # compiled in two steps around the path's points (the numpy form's floats):
+        # the merged spans' sample times, then the levels and the complement
+        tau, who = refine_samples_kernel(
+            np.ascontiguousarray(a, dtype=np.float64),
+            np.ascontiguousarray(b, dtype=np.float64),
+            np.ascontiguousarray(owner, dtype=np.int64),
+            REFINE_TAU,
+        )
+        pts = np.ascontiguousarray(self.where(s_of(tau)), dtype=np.float64)
         tr = self.tracks
-        lip_m = np.zeros(len(self.movers))
-        np.maximum.at(lip_m, tr.pieces[:, 0].astype(np.int64), tr.lip)
-        lip = lip_m[who]
-        pad = 0.5 * REFINE_TAU * (self.speed + lip) + self.limit
-
-        pts = np.ascontiguousarray(pts, dtype=np.float64)
-        starts = np.searchsorted(tr.who, np.arange(len(self.movers) + 1))
-
-        def g(launch: np.ndarray, rows: np.ndarray) -> np.ndarray:
-            """Return the clearance bound (m), shape (len(launch), len(rows))."""
-            return launch_bound_kernel(
-                np.ascontiguousarray(launch, dtype=np.float64),
-                tau[rows],
-                who[rows].astype(np.int64),
-                pts[rows],
-                pad[rows],
-                tr.rows,
-                starts,
-                tr.head0,
-                tr.turn,
-                tr.verts,
-                tr.edges,
-                tr.poly,
-            )
-
-        mid = 0.5 * (lo + hi)
-        rows = np.flatnonzero(g(np.array([mid]), np.arange(tau.shape[0]))[0] <= lip * (mid - lo))
-        lip_all = float(np.max(lip[rows], initial=0.0))
-        # the least bound over the points at each launch (compiled, the same minimum as
-        # ``g``'s rows' with fewer tests: :func:`._polygon_march.launch_min_kernel`)
-        near = (tau[rows], who[rows].astype(np.int64), pts[rows], pad[rows])
-        safe_lo, safe_hi = [np.zeros(0)], [np.zeros(0)]
-        left, right = lo, hi
-        for dl in LAUNCH_STEPS:
-            launch = np.arange(left, right + 0.5 * dl, dl)
-            bound = launch_min_kernel(
-                np.ascontiguousarray(launch, dtype=np.float64),
-                *near,
-                tr.rows,
-                starts,
-                tr.head0,
-                tr.turn,
-                tr.lip,
-                tr.verts,
-                tr.edges,
-                tr.poly,
-            )
-            reach = np.where(bound > 0.0, bound / max(lip_all, 1e-300), -np.inf)
-            ok = reach > 0.0
-            safe_lo.append(launch[ok] - reach[ok])
-            safe_hi.append(launch[ok] + reach[ok])
-            if not ok.any():
-                break
-            first = int(np.argmax(ok))
-            left, right = max(lo, float(launch[first]) - dl), float(launch[first])
-        # the complement in [lo, hi] of the proved launches
-        s_lo, s_hi = np.concatenate(safe_lo), np.concatenate(safe_hi)
-        order = np.argsort(s_lo)
-        s_lo, s_hi = s_lo[order], np.maximum.accumulate(s_hi[order]) if s_hi.size else s_hi
-        f_lo = np.concatenate([[lo - 1.0], s_hi])
-        f_hi = np.concatenate([s_lo, [hi]])  # hi itself: the fine nodes allow it
-        keep = f_hi > f_lo
-        return f_lo[keep], f_hi[keep]
+        return launch_refine_kernel(
+            tau,
+            who,
+            pts,
+            self.lip_m,
+            float(self.speed),
+            float(self.limit),
+            REFINE_TAU,
+            float(lo),
+            float(hi),
+            np.array(LAUNCH_STEPS),
+            tr.rows,
+            self.starts,
+            tr.head0,
+            tr.turn,
+            tr.lip,
+            tr.verts,
+            tr.edges,
+            tr.poly,
+        )
 
 
 def launch_floor(
@@ -343,11 +325,9 @@ def launch_floor(
             mine = idx % FLOOR_EVERY == 0
             off = t_j - sched[0][0]
             x_lo, x_hi, _, _ = blocked_launches(
-                idx[mine] // FLOOR_EVERY, a[mine] + off, b[mine] + off, ptr, w_lo, w_hi
+                idx[mine] // FLOOR_EVERY, a[mine] + off, b[mine] + off, ptr, w_lo, w_hi, lo
             )
             f_lo.append(x_lo)
             f_hi.append(x_hi)
-        x_lo, x_hi = np.concatenate(f_lo), np.concatenate(f_hi)
-        keep = x_hi > lo
-        floor = min(floor, sweep(x_lo[keep], x_hi[keep], lo))
+        floor = min(floor, sweep(np.concatenate(f_lo), np.concatenate(f_hi), lo))
     return float(floor)

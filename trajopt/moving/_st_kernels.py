@@ -13,7 +13,11 @@ arrival at ``t_(k + n)`` yet, that arrival and its parent (the dynamic programme
 
 :func:`close_kernel` is the point-to-segment test of the pair filter
 (:func:`._disc_windows.near_pairs`), :func:`near_pairs_kernel` that filter whole, :func:`least_free_kernel` the sweep of the rests'
-shortening (:func:`._tighten.sweep`), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
+shortening (:func:`._tighten.sweep`), :func:`blocked_launches_kernel` the launches a motion's
+stays near the fine nodes meet their windows at (:func:`._tighten.blocked_launches`), :func:`pass_band_kernel` the times a schedule can be near each fine node
+(:func:`._tighten.pass_band`), :func:`track_knots_kernel` and :func:`mover_pieces_kernel` cut the movers' tracks into
+linear pieces (:func:`._disc_windows.track_knots`, :func:`._disc_windows.mover_pieces`:
+``numpy.interp``'s centres, the numpy form's operations), :func:`disc_windows_kernel` solves the closed-form windows of pairs of a point and a piece of
 a disc mover's track (:func:`._disc_windows.disc_windows`): the same operations, in the same
 order, as the numpy form (:func:`._disc_windows.inside_times`, then the clip to the piece's
 span with ``numpy.nan_to_num``'s replacements), so the same floats.
@@ -453,3 +457,183 @@ def least_free_kernel(f_lo, f_hi, lo, eps):  # pragma: no cover - compiled
         top = max(top, f_hi[j])
         prev = max(top + eps, lo)
     return prev
+
+
+@njit(cache=True)
+def blocked_launches_kernel(node, a, b, ptr, lo, hi, after):  # pragma: no cover - compiled
+    """Return the launches ``(lo_w - b, hi_w - a)`` (s) of :func:`._tighten.blocked_launches`, those ending after ``after``.
+
+    Stay ``j`` (near node ``node[j]`` during ``[L + a[j], L + b[j]]``) against each window
+    ``(lo, hi)[ptr[i]:ptr[i + 1]]`` of its node, in order of stay, then window; only the
+    intervals with ``hi_w - a > after`` (s) are returned, with their ``j`` and window index.
+    The same subtractions and comparison as the numpy form, so the same floats.
+    """
+    total = 0
+    for j in range(node.shape[0]):
+        total += ptr[node[j] + 1] - ptr[node[j]]
+    f_lo = np.empty(total)
+    f_hi = np.empty(total)
+    which = np.empty(total, dtype=np.int64)
+    run = np.empty(total, dtype=np.int64)
+    m = 0
+    for j in range(node.shape[0]):
+        aj, bj = a[j], b[j]
+        for r in range(ptr[node[j]], ptr[node[j] + 1]):
+            x = hi[r] - aj
+            if x > after:
+                f_lo[m], f_hi[m], which[m], run[m] = lo[r] - bj, x, j, r
+                m += 1
+    return f_lo[:m].copy(), f_hi[:m].copy(), which[:m].copy(), run[:m].copy()
+
+
+@njit(cache=True)
+def _centre_at(tk, pos, f, last, x, out, o):  # pragma: no cover - compiled
+    """Write into ``out[o]`` the centre (m) at ``x`` (s) of the mover with waypoints ``f..last``: ``numpy.interp``'s."""
+    if x < tk[f]:
+        out[o, 0], out[o, 1] = pos[f, 0], pos[f, 1]
+        return
+    if not x < tk[last]:
+        out[o, 0], out[o, 1] = pos[last, 0], pos[last, 1]
+        return
+    k = f - 1  # the last waypoint at or before x
+    for i in range(f, last + 1):
+        if tk[i] <= x:
+            k = i
+    if tk[k] == x:
+        out[o, 0], out[o, 1] = pos[k, 0], pos[k, 1]
+        return
+    dt = tk[k + 1] - tk[k]
+    for c in range(2):
+        out[o, c] = (pos[k + 1, c] - pos[k, c]) / dt * (x - tk[k]) + pos[k, c]
+
+
+@njit(cache=True)
+def track_knots_kernel(n_j, tk, pos, a, b):  # pragma: no cover - compiled
+    """Return ``(owner, knots, centre)`` of :func:`._disc_windows.track_knots` (its docstring).
+
+    ``n_j`` (shape (m,)): each mover's number of waypoints, ``tk`` (s) and ``pos`` (m) their
+    times and positions one mover after another, ``a``, ``b`` (s, shape (m,)) each mover's
+    range. The centre at ``a`` and ``b`` is ``numpy.interp``'s (the waypoint at its time,
+    the first or last outside the times, else ``slope (t - t_k) + p_k``, the same
+    operations), at a waypoint strictly inside the range its position.
+    """
+    m = n_j.shape[0]
+    base = np.empty(m, dtype=np.int64)
+    total = 0
+    acc = 0
+    for j in range(m):
+        base[j] = acc
+        acc += n_j[j]
+        total += 2
+        for i in range(base[j], acc):
+            if tk[i] > a[j] and tk[i] < b[j]:
+                total += 1
+    owner = np.empty(total, dtype=np.int64)
+    knots = np.empty(total)
+    centre = np.empty((total, 2))
+    o = 0
+    for j in range(m):
+        f, last = base[j], base[j] + n_j[j] - 1
+        owner[o], knots[o] = j, a[j]
+        _centre_at(tk, pos, f, last, a[j], centre, o)
+        o += 1
+        for i in range(f, last + 1):
+            if tk[i] > a[j] and tk[i] < b[j]:
+                owner[o], knots[o] = j, tk[i]
+                centre[o, 0], centre[o, 1] = pos[i, 0], pos[i, 1]
+                o += 1
+        owner[o], knots[o] = j, b[j]
+        _centre_at(tk, pos, f, last, b[j], centre, o)
+        o += 1
+    return owner, knots, centre
+
+
+@njit(cache=True)
+def mover_pieces_kernel(n_j, tk, pos, t_last, radius, growth, limit):  # pragma: no cover - compiled
+    """Return the rows of :func:`._disc_windows.mover_pieces` (its docstring), shape (p, 9).
+
+    The knots of :func:`track_knots_kernel` from 0 to ``t_end = max(t_last, 0) + 1``; per
+    pair of consecutive knots ``u < w`` of a mover, the numpy form's operations: the
+    velocity ``(c(w) - c(u)) / (w - u)`` where the middle is strictly inside the waypoint
+    times (else 0), ``w = inf`` from ``t_end`` on, the limit ``limit + r + g clip(u, 0,
+    max(t_last, 0))`` and the growth where the middle is before ``t_last``.
+    """
+    m = n_j.shape[0]
+    hi_t = np.empty(m)
+    t_end = np.empty(m)
+    t_first = np.empty(m)
+    acc = 0
+    for j in range(m):
+        hi_t[j] = max(t_last[j], 0.0)
+        t_end[j] = hi_t[j] + 1.0
+        t_first[j] = tk[acc]
+        acc += n_j[j]
+    owner, knots, pk = track_knots_kernel(n_j, tk, pos, np.zeros(m), t_end)
+    rows = np.empty((owner.shape[0] - m, 9))
+    r = 0
+    for k in range(owner.shape[0] - 1):
+        j = owner[k]
+        if owner[k + 1] != j:
+            continue
+        u, w = knots[k], knots[k + 1]
+        mid = 0.5 * (u + w)
+        rows[r, 0] = j
+        rows[r, 1] = u
+        rows[r, 2] = np.inf if w >= t_end[j] else w
+        rows[r, 3], rows[r, 4] = pk[k, 0], pk[k, 1]
+        if mid > t_first[j] and mid < t_last[j]:
+            rows[r, 5] = (pk[k + 1, 0] - pk[k, 0]) / (w - u)
+            rows[r, 6] = (pk[k + 1, 1] - pk[k, 1]) / (w - u)
+        else:
+            rows[r, 5], rows[r, 6] = 0.0, 0.0
+        rows[r, 7] = limit + radius[j] + growth[j] * min(max(u, 0.0), hi_t[j])
+        rows[r, 8] = growth[j] if mid < t_last[j] else 0.0
+        r += 1
+    return rows
+
+
+@njit(cache=True)
+def _first_at_least(a, v, k):  # pragma: no cover - compiled
+    """Return the first index ``i`` with ``a[i] >= v`` of the non-decreasing ``a`` (``len(a)`` if none): ``numpy.searchsorted``'s left side.
+
+    Walked from ``k`` (a guess no later than the answer: the answer for a smaller ``v``), or
+    from 0 when ``k`` is already past it.
+    """
+    if k > 0 and not a[k - 1] < v:
+        k = 0
+    while k < a.shape[0] and a[k] < v:
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def pass_band_kernel(
+    s, half, tau, s_cat, first, launch, pack, end, start, lo, hi
+):  # pragma: no cover
+    """Lower ``lo`` and raise ``hi`` (s, shape (n,)) to one schedule's entries and exits of the nodes ``s`` (m).
+
+    The numpy form of :func:`._tighten.pass_band` for one schedule: its drives' samples
+    ``tau`` (s) and arc lengths ``s_cat`` (m), drive ``d``'s at ``first[d]:first[d + 1]``,
+    launched at ``launch[d]`` as it is and at ``pack[d]`` back to back; the arc lengths'
+    running maximum; node ``i`` is left at the sample ``k``, the first at or past
+    ``s_i + half`` (at ``launch + tau[k]``; ``end`` when none), and entered at the sample
+    before the first at or past ``s_i - half`` (at ``pack + tau[k]``; ``start`` when none).
+    The same additions and comparisons, so the same floats.
+    """
+    m = tau.shape[0]
+    run = np.empty(m)
+    late = np.empty(m)
+    early = np.empty(m)
+    top = -np.inf
+    for d in range(first.shape[0] - 1):
+        for k in range(first[d], first[d + 1]):
+            top = s_cat[k] if k == 0 else max(top, s_cat[k])
+            run[k] = top
+            late[k] = launch[d] + tau[k]
+            early[k] = pack[d] + tau[k]
+    k_hi, k_lo = 0, 0  # the nodes in order: each search walks on from the last one's
+    for i in range(s.shape[0]):
+        k_hi = _first_at_least(run, s[i] + half, k_hi)
+        hi[i] = max(hi[i], late[k_hi] if k_hi < m else end)
+        k_lo = _first_at_least(run, s[i] - half, k_lo)
+        lo[i] = min(lo[i], early[k_lo - 1] if k_lo > 0 else start)

@@ -34,7 +34,7 @@ import numpy as np
 
 from trajopt.moving._disc_windows import close_pairs, disc_windows, mover_pieces, near_pairs
 from trajopt.moving._obstacle import MovingObstacle
-from trajopt.moving._st_kernels import least_free_kernel
+from trajopt.moving._st_kernels import blocked_launches_kernel, least_free_kernel, pass_band_kernel
 from trajopt.moving._st_search import Piece
 
 #: The fine nodes' largest spacing (m): the robot's share of the pad is half of it.
@@ -138,6 +138,7 @@ class FineWindows:
         against the exact windows of the path's point there (:meth:`point_windows`).
         """
         r_lo, r_hi = [np.zeros(0)], [np.zeros(0)]
+        self.fetch_points([s_r for s_r, _, _ in rests])
         for s_r, a_r, b_r in rests:
             w_lo, w_hi = self.point_windows(s_r)
             r_lo.append(w_lo - b_r)
@@ -146,10 +147,8 @@ class FineWindows:
         node = np.concatenate([o[0] for o in occupancy])
         a = np.concatenate([o[1] for o in occupancy])
         b = np.concatenate([o[2] for o in occupancy])
-        f_lo, f_hi, which, run = blocked_launches(node, a, b, self.ptr, self.lo, self.hi)
-        keep = f_hi > lo
-        f_lo, f_hi = f_lo[keep], f_hi[keep]
-        span_a, span_b, owner = a[which][keep], b[which][keep], self.owner[run][keep]
+        f_lo, f_hi, which, run = blocked_launches(node, a, b, self.ptr, self.lo, self.hi, lo)
+        span_a, span_b, owner = a[which], b[which], self.owner[run]
         cur = sweep(np.append(f_lo, rest_lo), np.append(f_hi, rest_hi), lo)
         if s_of is None or self.where is None:
             return cur if cur <= hi else None
@@ -174,6 +173,15 @@ class FineWindows:
                 break
             cur = new
         return cur if cur <= hi else None
+
+    def fetch_points(self, places: Sequence[float]) -> None:
+        """Make the windows of the path's points at ``places`` (m) that are not kept yet (:meth:`point_windows`).
+
+        One at a time here (disc movers' windows are closed-form); movers of other shapes
+        make them all in one march (:meth:`._shape_windows.ShapeWindows.fetch_points`).
+        """
+        for s in places:
+            self.point_windows(s)
 
     def point_windows(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Return the windows (s) of the path's point at ``s`` (m): exact, the limit plus 0.1 mm.
@@ -253,19 +261,25 @@ def blocked_launches(
     ptr: np.ndarray,
     lo: np.ndarray,
     hi: np.ndarray,
+    after: float = -math.inf,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Return the launches ``(lo_w - b, hi_w - a)`` (s) at which a motion meets a node's window.
 
     The motion is near node ``node[j]`` during ``[L + a[j], L + b[j]]``; the windows of node
-    ``i`` are ``(lo, hi)[ptr[i]:ptr[i + 1]]``. Also returns, per interval, its ``j`` and its
-    window's index.
+    ``i`` are ``(lo, hi)[ptr[i]:ptr[i + 1]]``. Only the intervals ending after ``after``
+    (s) are returned (an interval ending at or before the earliest launch asked about blocks
+    none). Also returns, per interval, its ``j`` and its window's index. Compiled
+    (:func:`._st_kernels.blocked_launches_kernel`).
     """
-    counts = ptr[node + 1] - ptr[node]
-    total = int(counts.sum())
-    which = np.repeat(np.arange(node.shape[0]), counts)
-    first = np.repeat(ptr[node], counts)
-    run = first + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-    return lo[run] - b[which], hi[run] - a[which], which, run
+    return blocked_launches_kernel(
+        np.ascontiguousarray(node, dtype=np.int64),
+        np.ascontiguousarray(a, dtype=np.float64),
+        np.ascontiguousarray(b, dtype=np.float64),
+        np.ascontiguousarray(ptr, dtype=np.int64),
+        np.ascontiguousarray(lo, dtype=np.float64),
+        np.ascontiguousarray(hi, dtype=np.float64),
+        float(after),
+    )
 
 
 def merged_spans(
@@ -353,6 +367,8 @@ def tail_s(schedule: Schedule, k: int) -> Callable[[np.ndarray], np.ndarray]:
     pieces = [pc for _, pc in schedule[k:]]
 
     def s_of(tau: np.ndarray) -> np.ndarray:
+        if len(pieces) == 1:  # one drive (the same floats as picking its times out)
+            return np.asarray(pieces[0].s_at(tau - offs[0]), dtype=float)
         j = np.clip(np.searchsorted(offs, tau, side="right") - 1, 0, len(pieces) - 1)
         out = np.empty(tau.shape)
         for i in np.unique(j):
@@ -382,25 +398,32 @@ def pass_band(
         return np.full(s.shape, -np.inf), np.full(s.shape, np.inf)
     lo = np.full(s.shape, np.inf)
     hi = np.full(s.shape, -np.inf)
+    nodes = np.ascontiguousarray(s, dtype=np.float64)
     for sched in latest:
-        taus, s_t, at, packed = [], [], [], []
+        taus, s_t, launch, pack = [], [], [], []
         t = min(t_from, sched[0][0])
-        for launch, pc in sched:
+        for t_j, pc in sched:
             tau, s_pc = band_samples(pc)
             taus.append(tau)
             s_t.append(s_pc)
-            at.append(np.full(tau.shape, launch))
-            packed.append(np.full(tau.shape, t))
+            launch.append(t_j)
+            pack.append(t)
             t += pc.duration
-        tau, s_all = np.concatenate(taus), np.maximum.accumulate(np.concatenate(s_t))
-        n = tau.shape[0]
-        k = np.searchsorted(s_all, s + 0.5 * h, side="left")
-        end = sched[-1][0] + sched[-1][1].duration
-        late = (np.concatenate(at) + tau)[np.minimum(k, n - 1)]
-        hi = np.maximum(hi, np.where(k < n, late, end))
-        k = np.searchsorted(s_all, s - 0.5 * h, side="left") - 1
-        early = (np.concatenate(packed) + tau)[np.maximum(k, 0)]
-        lo = np.minimum(lo, np.where(k >= 0, early, min(t_from, sched[0][0])))
+        first = np.concatenate([[0], np.cumsum([x.shape[0] for x in taus])]).astype(np.int64)
+        # compiled: the numpy form's running maximum, searches and sums (the same floats)
+        pass_band_kernel(
+            nodes,
+            0.5 * h,
+            np.concatenate(taus),
+            np.concatenate(s_t).astype(np.float64),
+            first,
+            np.array(launch, dtype=np.float64),
+            np.array(pack, dtype=np.float64),
+            float(sched[-1][0] + sched[-1][1].duration),
+            float(min(t_from, sched[0][0])),
+            lo,
+            hi,
+        )
     return lo, hi
 
 

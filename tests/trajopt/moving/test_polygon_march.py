@@ -10,6 +10,8 @@ march both strides over many grid times and steps one at a time.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import shapely
@@ -20,9 +22,11 @@ from trajopt.moving._polygon_march import (
     FROZEN_PAD,
     PolygonPieces,
     _signed_distance,
+    float_arange,
     launch_bound_kernel,
     launch_min_kernel,
     polygon_runs,
+    refine_samples_kernel,
 )
 
 
@@ -218,7 +222,8 @@ def test_the_launch_bound_is_the_clearance_at_the_launch_plus_tau():
 @pytest.mark.parametrize("seed", range(6))
 def test_the_least_launch_bound_is_the_minimum_over_the_points(seed):
     """The pruned minimum per launch equals, bit for bit, the minimum over the points of the
-    full table (:func:`launch_bound_kernel`, itself checked against shapely above): on
+    full table (:func:`launch_bound_kernel`, itself checked against shapely above) where
+    that is positive, and is one point's clearance of zero or less where it is not: on
     launches a step apart (the refinement's grids) and jumping back and forth, with points
     along a drive (many nearly as close as the least) and scattered ones."""
     rng = np.random.default_rng(seed)
@@ -231,17 +236,22 @@ def test_the_least_launch_bound_is_the_minimum_over_the_points(seed):
     mover = rng.integers(0, 4, q)
     pad = rng.uniform(0.0, 0.2, q)
     starts = np.searchsorted(tracks.who, np.arange(len(movers) + 1))
-    for launch in (
-        np.arange(0.0, 4.0, 1e-2),
-        np.arange(1.3, 1.5, 1e-3),
-        rng.uniform(-0.5, 8.0, 50),
-        np.zeros(0),
-    ):
-        args = (tracks.rows, starts, tracks.head0, tracks.turn)
-        shape = (tracks.verts, tracks.edges, tracks.poly)
-        want = launch_bound_kernel(launch, tau, mover, pts, pad, *args, *shape)
-        got = launch_min_kernel(launch, tau, mover, pts, pad, *args, tracks.lip, *shape)
-        assert np.array_equal(got, np.min(want, axis=1, initial=np.inf))
+    seen = []
+    args = (tracks.rows, starts, tracks.head0, tracks.turn)
+    shape = (tracks.verts, tracks.edges, tracks.poly)
+    launches = (np.arange(0.0, 4.0, 1e-2), np.arange(1.3, 1.5, 1e-3), rng.uniform(-0.5, 8.0, 50))
+    # the pads as drawn (most launches not proved) and 0.6 m less (many proved)
+    for launch, off in itertools.product((*launches, np.zeros(0)), (0.0, 0.6)):
+        want = launch_bound_kernel(launch, tau, mover, pts, pad - off, *args, *shape)
+        got = launch_min_kernel(launch, tau, mover, pts, pad - off, *args, tracks.lip, *shape)
+        least = np.min(want, axis=1, initial=np.inf)
+        proved = least > 0.0
+        assert np.array_equal(got[proved], least[proved])
+        # not proved: one point's clearance of zero or less (the least is not needed)
+        assert np.all(got[~proved] <= 0.0)
+        assert all(g in row for g, row in zip(got[~proved], want[~proved], strict=True))
+        seen += [int(proved.sum()), int((~proved).sum())]
+    assert sum(seen[0::2]) > 0 and sum(seen[1::2]) > 0  # both kinds of launch are tested
     none = launch_min_kernel(
         np.arange(3.0), tau[:0], mover[:0], pts[:0], pad[:0], *args, tracks.lip, *shape
     )
@@ -343,3 +353,46 @@ def test_pieces_headings_are_numpy_interp_of_each_mover(seed):
                 assert turn == (np.interp(wi, m.times, m.headings) - h_u) / (wi - ui)
             else:
                 assert turn == 0.0
+
+
+def test_float_arange_is_numpy_arange():
+    # the refinement's launch grids: numpy.arange's values, bit for bit, for the starts,
+    # stops and steps it uses (a stop half a step past the end), empty ranges included
+    rng = np.random.default_rng(11)
+    for _ in range(3000):
+        start = float(rng.uniform(-5.0, 40.0))
+        step = float(rng.choice([1e-2, 1e-3, 1e-4, 0.37]))
+        stop = start + float(rng.uniform(-0.02, 0.4)) + 0.5 * step
+        assert np.array_equal(float_arange(start, stop, step), np.arange(start, stop, step))
+
+
+def test_the_refinement_samples_cover_each_owners_spans():
+    # random spans of three owners (some touching, some nested, some of zero length): the
+    # samples of an owner lie in its spans, start and end each union of them, and are at
+    # most dt apart inside one (brute force on a fine grid of the union)
+    rng = np.random.default_rng(5)
+    dt = 1e-3
+    for _ in range(30):
+        q = int(rng.integers(1, 12))
+        a = np.round(rng.uniform(0.0, 0.3, q), 3)  # on a grid: touching ends happen
+        b = a + np.round(rng.choice([0.0, 0.004, 0.02, 0.05], q), 3)
+        owner = rng.integers(0, 3, q)
+        tau, who = refine_samples_kernel(a, b, owner, dt)
+        for o in np.unique(owner):
+            mine = tau[who == o]
+            sa, sb = a[owner == o], b[owner == o]
+            inside = (mine[:, None] >= sa[None, :] - 1e-12) & (mine[:, None] <= sb[None, :] + 1e-12)
+            assert inside.any(axis=1).all()
+            # the union's pieces (brute force: sort, join overlapping or touching spans)
+            order = np.argsort(sa, kind="stable")
+            parts = []
+            for x, y in zip(sa[order], sb[order], strict=True):
+                if parts and x <= parts[-1][1]:
+                    parts[-1][1] = max(parts[-1][1], y)
+                else:
+                    parts.append([x, y])
+            for x, y in parts:
+                run = mine[(mine >= x) & (mine <= y)]
+                assert run[0] == x and run[-1] == y
+                assert np.all(np.diff(run) <= dt * (1 + 1e-9) + 1e-15)
+            assert mine.shape[0] == sum(max(int(np.ceil((y - x) / dt)), 1) + 1 for x, y in parts)

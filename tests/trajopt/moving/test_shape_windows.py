@@ -220,3 +220,37 @@ def test_the_launch_floor_is_no_later_than_the_fine_windows_earliest_launch(seed
         floor = launch_floor(s, pts, carts, limit, band, [sched], 0.0)
         assert earliest is not None and floor <= earliest + 1e-9, (floor, earliest)
         assert floor >= earliest - 1.0 or earliest < 1.0, (floor, earliest)  # and near it
+
+
+def test_the_points_fetched_together_get_the_windows_of_one_at_a_time():
+    # the rests' points of a path past turning carts (and a standing one): the windows
+    # fetched in one march equal, float for float, those made point by point, and hold
+    # every 1 ms sample at which the point is within the limit (the reference's distance)
+    rng = np.random.default_rng(3)
+    movers = _movers(rng)
+    limit = 0.3
+
+    def where(s_at):
+        s_at = np.asarray(s_at, dtype=float)
+        return np.column_stack([s_at - 1.5, 0.4 * np.sin(s_at)])
+
+    s = np.linspace(0.0, 3.0, 301)
+    places = [0.0, 0.7, 1.2, 1.2, 2.05, 3.0]
+    together = ShapeWindows(s, where(s), movers, limit, where=where, speed=0.6)
+    together.fetch_points(places)
+    alone = ShapeWindows(s, where(s), movers, limit, where=where, speed=0.6)
+    t = np.arange(0.0, 9.0, 1e-3)
+    hit = 0
+    for x in places:
+        lo, hi = together.point_windows(x)
+        one_lo, one_hi = alone.point_windows(x)
+        assert np.array_equal(lo, one_lo) and np.array_equal(hi, one_hi)
+        near = np.zeros(t.shape, dtype=bool)
+        for m in movers:
+            near |= slack_at(where(np.full(t.shape, x)), m, t, limit) < 0.0
+        cov = np.zeros(t.shape, dtype=bool)
+        for a, b in zip(lo, hi, strict=True):
+            cov |= (t > a) & (t < b)
+        assert not np.any(near & ~cov)
+        hit += int(near.any())
+    assert hit >= 2  # some of the points do meet the movers
