@@ -72,6 +72,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.motion._phase_motion",
     "trajopt.moving._st_kernels",
     "trajopt.moving._st_search",
+    "trajopt.moving._node_times",
     "trajopt.moving._polygon_march",
     "trajopt.moving._polygon_distance",
     "trajopt.moving._bisection_bounds",

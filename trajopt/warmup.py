@@ -162,7 +162,8 @@ def _exercise_moving() -> None:
     """Re-time a straight drive around two crossing movers (a stop on the way: the (s, t) search), a crossing cart and a parked one (blocked, and proved so); mark a swept region.
 
     The certificates of these re-timings reach the path bounds' look-ups (trajopt.moving._path_bounds),
-    their tightened launches a drive's arc lengths at its times (trajopt.moving._st_search).
+    their tightened launches a drive's arc lengths at its times (trajopt.moving._st_search),
+    the search's stops their forbidden and resting times (trajopt.moving._node_times).
     """
     from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve

@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from trajopt.kernel_cache import watch_compiles
+from trajopt.moving._node_times import column_kernel, rest_kernel
 from trajopt.moving._st_grid import NEVER_STEP, STGrid
 from trajopt.moving._st_kernels import (
     arrive_kernel,
@@ -232,14 +233,6 @@ def least_times(d: np.ndarray, v_top: float, a_top: float, j_top: float) -> np.n
     return np.where(2.0 * d_up <= d, 2.0 * t_up + (d - 2.0 * d_up) / v_top, short)
 
 
-def _rest_closure(arrive: np.ndarray, blocked_col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Resting times after the arrivals ``arrive`` while the node stays free; each one's arrival."""
-    idx = np.arange(arrive.shape[0])
-    last_arr = np.maximum.accumulate(np.where(arrive, idx, -1))
-    last_blk = np.maximum.accumulate(np.where(blocked_col, idx, -1))
-    return (last_arr >= 0) & (last_arr > last_blk), last_arr
-
-
 def search(
     grid: STGrid,
     drive: Callable[[float, float], Piece | None],
@@ -292,21 +285,21 @@ def search(
     sa = np.asarray(stops)
     steps = np.arange(kk)
     lt = least_times(sa[None, :] - sa[:, None], v_top, a_top, j_top)  # lt[w, v]: w -> v
-    goal_col = grid.column(int(nodes[-1]))
+    ptr, _, m_lo, m_hi = (np.asarray(x, dtype=np.int64) for x in grid.merged)
+    goal_col = column_kernel(ptr, m_lo, m_hi, kk, int(nodes[-1]))
     last_goal = int(np.max(np.flatnonzero(goal_col))) if goal_col.any() else -1
     # arrivals[w, k]: the robot comes to rest at stop w at t_k; parent (stop, start index, piece)
     arrivals = np.zeros((w_n, kk), dtype=bool)
     parent = np.full((3, w_n, kk), -1, dtype=np.int64)  # (stop, start index, drive) of each
-    ptr, _, m_lo, m_hi = (np.asarray(x, dtype=np.int64) for x in grid.merged)
     pieces: list[Piece] = []
-    start_col = grid.column(int(nodes[0]))
+    start_col = column_kernel(ptr, m_lo, m_hi, kk, int(nodes[0]))
     arrivals[0, 0] = not start_col[0]
     resting: list[tuple[np.ndarray, np.ndarray]] = []
     best: tuple[float, int, int, Piece] | None = None  # (arrival, from stop, start index, drive)
     goal = w_n - 1
     for w in range(goal):
-        col = start_col if w == 0 else grid.column(int(nodes[w]))
-        rest, since = _rest_closure(arrivals[w], col)
+        col = start_col if w == 0 else column_kernel(ptr, m_lo, m_hi, kk, int(nodes[w]))
+        rest, since = rest_kernel(arrivals[w], col)  # compiled (trajopt.moving._node_times)
         if w == 0 and moving:  # no rest: the launch leaves at t = 0
             rest = np.zeros(kk, dtype=bool)
             rest[0] = arrivals[0, 0]

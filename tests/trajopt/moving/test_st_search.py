@@ -24,7 +24,6 @@ from trajopt.moving import MovingObstacle, retime_for_movers
 from trajopt.moving._st_grid import STGrid
 from trajopt.moving._st_search import (
     Piece,
-    _rest_closure,
     describe,
     fill_visits,
     least_times,
@@ -36,6 +35,14 @@ from trajopt.robot import Robot
 from trajopt.timing import time_parameterize
 
 ROBOT = Robot(v_max=0.6, a_max=0.6, j_max=2.0)
+
+
+def _rest_closure(arrive: np.ndarray, blocked_col: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Resting times after the arrivals ``arrive`` while the node stays free; each one's arrival."""
+    idx = np.arange(arrive.shape[0])
+    last_arr = np.maximum.accumulate(np.where(arrive, idx, -1))
+    last_blk = np.maximum.accumulate(np.where(blocked_col, idx, -1))
+    return (last_arr >= 0) & (last_arr > last_blk), last_arr
 
 
 def _search_before(
