@@ -73,6 +73,7 @@ KERNEL_MODULES: tuple[str, ...] = (
     "trajopt.moving._st_kernels",
     "trajopt.moving._st_search",
     "trajopt.moving._node_times",
+    "trajopt.moving._grid_runs",
     "trajopt.moving._polygon_march",
     "trajopt.moving._polygon_distance",
     "trajopt.moving._bisection_bounds",

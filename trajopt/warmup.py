@@ -163,7 +163,8 @@ def _exercise_moving() -> None:
 
     The certificates of these re-timings reach the path bounds' look-ups (trajopt.moving._path_bounds),
     their tightened launches a drive's arc lengths at its times (trajopt.moving._st_search),
-    the search's stops their forbidden and resting times (trajopt.moving._node_times).
+    the search's stops their forbidden and resting times (trajopt.moving._node_times), the
+    grids their runs grouped and merged per node (trajopt.moving._grid_runs).
     """
     from trajopt.errors import BlockedError
     from trajopt.geometry import PolylineCurve

@@ -41,6 +41,7 @@ import numpy as np
 
 from trajopt.moving._disc_windows import inside_times, near_pairs
 from trajopt.moving._grid_kernels import dense_kernel, sweep_kernel
+from trajopt.moving._grid_runs import runs_kernel
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import polygon_runs
 
@@ -86,13 +87,13 @@ class STGrid:
         owner: np.ndarray,
     ) -> None:
         self.s, self.t, self.ds, self.dt = s, t, float(ds), float(dt)
-        order = np.argsort(col, kind="stable")
-        self.lo, self.hi, self.owner = lo[order], hi[order], owner[order]
-        counts = np.bincount(col, minlength=s.shape[0])
-        self.ptr = np.concatenate([[0], np.cumsum(counts)])
-        self.col = np.repeat(np.arange(s.shape[0]), counts)
+        # grouped by node and merged per node in one compiled pass (trajopt.moving._grid_runs)
+        out = runs_kernel(
+            s.shape[0], *(np.ascontiguousarray(x, dtype=np.int64) for x in (col, lo, hi, owner))
+        )
+        self.ptr, self.col, self.lo, self.hi, self.owner = out[:5]
+        self._merged: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = out[5:]
         self._dense: tuple[np.ndarray, np.ndarray] | None = None
-        self._merged: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def index(self, s: np.ndarray) -> np.ndarray:
         """Nearest node index of arc lengths ``s`` (m)."""
@@ -111,28 +112,12 @@ class STGrid:
 
     @property
     def merged(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The runs of all movers merged per node: ``(ptr, col, lo, hi)`` (built on first use).
+        """The runs of all movers merged per node: ``(ptr, col, lo, hi)``.
 
         The same forbidden nodes as the runs of each mover, with overlapping or adjacent runs
         of a node (of any movers: a mover's runs at a node are split where its track's pieces
         meet) made one; ``ptr`` of shape (n + 1,), the others (q,), in order of node and time.
         """
-        if self._merged is None:
-            kk, n = self.t.shape[0], self.s.shape[0]
-            order = np.argsort(self.col * (kk + 1) + self.lo, kind="stable")
-            c, lo, hi = self.col[order], self.lo[order], self.hi[order]
-            top = np.int64(FOREVER)
-            ends = np.maximum.accumulate(c * (2 * top) + np.minimum(hi, top)) - c * (2 * top)
-            new = np.ones(c.shape[0], dtype=bool)
-            new[1:] = (c[1:] != c[:-1]) | (lo[1:] > ends[:-1] + 1)
-            first = np.flatnonzero(new)
-            if first.size:
-                hi = np.maximum.reduceat(hi, first)
-            else:
-                hi = hi[first]
-            c, lo = c[first], lo[first]
-            ptr = np.concatenate([[0], np.cumsum(np.bincount(c, minlength=n))])
-            self._merged = (ptr, c, lo, hi)
         return self._merged
 
     def _paint(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
