@@ -167,6 +167,7 @@ class MoverTable:
     The compiled bounds' form (:func:`._bisection_bounds.disc_robot_bounds_kernel`):
     ``columns``, shape (movers, 6), the columns reach, rad0, grow, t_last, disc (1.0) and
     sizes; ``padded``, shape (movers, largest count, 2), each mover's vertices first.
+    ``movers``: the movers themselves; :attr:`shape_speed` their shapes' speed bounds.
     """
 
     def __init__(self, movers: Sequence[MovingObstacle]) -> None:
@@ -195,6 +196,37 @@ class MoverTable:
         for value in (*vars(self.seg).values(), *vars(self).values(), *self.verts.values()):
             if isinstance(value, np.ndarray):
                 value.setflags(write=False)
+        self.movers = tuple(movers)
+        self._shape_speed: np.ndarray | None = None
+
+    @property
+    def shape_speed(self) -> np.ndarray:
+        """Each mover's :meth:`MovingObstacle.shape_speed_max` (m/s), shape (movers,), all at once.
+
+        The pieces of every track in one pass, each mover's largest by
+        ``numpy.maximum.reduceat``: the same operations on the same floats (0 for a mover
+        with one waypoint). Computed on first use, read-only.
+        """
+        if self._shape_speed is None:
+            ms = self.movers
+            n_j = np.array([m.times.shape[0] for m in ms], dtype=np.int64)
+            tk = np.concatenate([m.times for m in ms])
+            pos = np.concatenate([m.positions for m in ms])
+            hd = np.concatenate([m.headings for m in ms])
+            own = np.repeat(np.arange(n_j.shape[0]), n_j)
+            pair = np.flatnonzero(own[1:] == own[:-1])  # consecutive waypoints of one mover
+            dt = tk[pair + 1] - tk[pair]
+            d = pos[pair + 1] - pos[pair]
+            w = np.abs(hd[pair + 1] - hd[pair]) / dt
+            v = np.hypot(d[:, 0], d[:, 1]) / dt + self.reach[own[pair]] * w
+            out = np.zeros(n_j.shape[0])
+            moving = n_j >= 2
+            if pair.size:
+                starts = np.cumsum(n_j - 1) - (n_j - 1)
+                out[moving] = np.maximum.reduceat(v, starts[moving])
+            out.setflags(write=False)
+            self._shape_speed = out
+        return self._shape_speed
 
 
 #: The tables of the last movers certified (:func:`mover_table`), most recent last.

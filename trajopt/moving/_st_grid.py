@@ -42,6 +42,7 @@ import numpy as np
 from trajopt.moving._disc_windows import inside_times, near_pairs
 from trajopt.moving._grid_kernels import dense_kernel, sweep_kernel
 from trajopt.moving._grid_runs import runs_kernel
+from trajopt.moving._mover_segments import kept_table
 from trajopt.moving._obstacle import MovingObstacle
 from trajopt.moving._polygon_march import polygon_runs
 
@@ -310,9 +311,11 @@ def st_grid(
     runs: list[tuple[np.ndarray, ...]] = []
     discs: list[tuple[int, MovingObstacle, float]] = []
     shapes: list[tuple[int, MovingObstacle, float]] = []
+    table = kept_table(movers) if sufficient else None  # the certificate's, when kept
     for j, m in enumerate(movers):
         if sufficient:
-            pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (m.shape_speed_max() + m.growth)
+            u = m.shape_speed_max() if table is None else float(table.shape_speed[j])
+            pad = 0.5 * (ds + dt * speed) * stretch + 0.5 * dt * (u + m.growth)
         else:
             pad = -0.5 * ds * stretch
         if polys is None and m.vertices is None:
