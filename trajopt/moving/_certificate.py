@@ -279,6 +279,14 @@ def certify_movers(
     return MoverCertificate(True, "clear", best[0], best[1], best[2], horizon, tol, total)
 
 
+def _group_starts(keys: np.ndarray) -> np.ndarray:
+    """Return the indices where a run of equal ``keys`` starts, shape (groups,) (0 first)."""
+    new = np.empty(keys.shape[0], dtype=bool)
+    new[:1] = True
+    np.not_equal(keys[1:], keys[:-1], out=new[1:])
+    return np.flatnonzero(new)
+
+
 def _cover(a: float, b: float, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Intervals ``(t0, t1)`` (s) of at most :data:`COVER_DT` covering ``[a, b]``, cut at ``times``."""
     knots = np.unique(np.concatenate([[a, b], times[(times > a) & (times < b)]]))
@@ -525,7 +533,7 @@ class _Bisection:
             if np.any(bad):
                 # each mover's first smallest witness (its intervals are contiguous, in order)
                 order = np.lexsort((np.arange(bad.size), np.where(bad, slack_mid, np.inf), mj))
-                first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+                first = order[_group_starts(mj[order])]
                 for i in first[bad[first]]:
                     j = int(mj[i])
                     if j < stop:
@@ -534,7 +542,7 @@ class _Bisection:
             done = lower >= -tol
             if np.any(done):
                 order = np.lexsort((np.arange(done.size), np.where(done, lower, np.inf), mj))
-                first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+                first = order[_group_starts(mj[order])]
                 i = first[done[first]]
                 j = mj[i]
                 better = lower[i] < proven[j]
@@ -548,11 +556,12 @@ class _Bisection:
             # alone); the parts meet at the same floats (a + width k / POLYGON_SPLIT)
             n, width = POLYGON_SPLIT, b0 - a0
             cuts = [a0] + [a0 + width * (k / n) for k in range(1, n)] + [b0]
-            order = np.argsort(np.tile(j0, n), kind="stable")
+            jj = np.concatenate([j0] * n)
+            order = np.argsort(jj, kind="stable")
             t0 = np.concatenate(cuts[:-1])[order]
             t1 = np.concatenate(cuts[1:])[order]
-            mj = np.tile(j0, n)[order]
-            g0 = np.tile(gg, n)[order]
+            mj = jj[order]
+            g0 = np.concatenate([gg] * n)[order]
             pos = np.zeros(t0.shape[0], dtype=np.int64)
             level += 1
         self.proven, self.proven_t, self.proven_key = proven, proven_t, proven_key
@@ -664,7 +673,7 @@ class _Bisection:
             lower, _, tm = self._bounds(t0, t1, mj, g0)
             # each mover's least (first place on a tie), against its least so far
             order = np.lexsort((pos, lower, mj))
-            first = order[np.flatnonzero(np.r_[True, mj[order][1:] != mj[order][:-1]])]
+            first = order[_group_starts(mj[order])]
             for i in first:
                 j = int(mj[i])
                 if (lower[i], 0, pos[i]) < (self.proven[j], *self.proven_key[j]):

@@ -155,11 +155,26 @@ class PathBoxes:
 
 #: The path boxes of the last curves certified (curve, its key, boxes), most recent last.
 _BOXES: list[tuple[Any, tuple[Any, ...], PathBoxes]] = []
+_KAPPA_RANGES: list[tuple[Any, tuple[Any, ...], tuple[np.ndarray, float, np.ndarray]]] = []
 
 
 def path_boxes_of(curve: Any) -> PathBoxes:
     """Return :class:`PathBoxes` of ``curve``, reused as :func:`kappa_table_of` reuses its tables."""
     return _kept(_BOXES, curve, PathBoxes)
+
+
+def kappa_ranges_of(curve: Any) -> tuple[np.ndarray, float, np.ndarray]:
+    """Return ``(s_edges, k_top, table)``: :func:`kappa_table_of`, its largest value and its :class:`RangeMax` table.
+
+    ``table`` of shape (levels, n, 1) (:func:`arc_kappa_kernel`'s form); reused as
+    :func:`kappa_table_of` reuses its tables.
+    """
+    return _kept(_KAPPA_RANGES, curve, _kappa_ranges)
+
+
+def _kappa_ranges(curve: Any) -> tuple[np.ndarray, float, np.ndarray]:
+    s_edges, k = kappa_table_of(curve)
+    return s_edges, float(np.max(k)), RangeMax(k).table[:, :, None]
 
 
 class RangeMax:

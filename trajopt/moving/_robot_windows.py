@@ -16,7 +16,7 @@ import numpy as np
 
 from trajopt.errors import InvalidInputError
 from trajopt.geometry import BSplineCurve
-from trajopt.moving._path_bounds import RangeMax, arc_kappa_kernel, kappa_table_of, path_boxes_of
+from trajopt.moving._path_bounds import arc_kappa_kernel, kappa_ranges_of, path_boxes_of
 from trajopt.smoother import SmoothPath
 
 
@@ -61,9 +61,9 @@ class CurveMotion:
         self.spline = None if reverse or traj.u_grid.shape[0] < 2 else spline
         self.vmax, self.amax = profile_bounds(traj)
         # the heading turns at most kappa per metre: bounds per arc-length interval
-        self.s_edges, k = kappa_table_of(traj.path)
-        self.kmax = RangeMax(k).table[:, :, None]  # its maxima over index ranges
-        self.c2 = float(np.max(k)) * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
+        # its maxima over index ranges (kept with the path's table)
+        self.s_edges, k_top, self.kmax = kappa_ranges_of(traj.path)
+        self.c2 = k_top * self.vmax**2 + self.amax  # |P''| (m/s^2), inf if unknown
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
         """Return the arc length (m) at the curve's own times ``t`` (s): ``traj.motion``'s ``s``.
@@ -106,7 +106,10 @@ class CurveMotion:
         kap = arc_kappa_kernel(self.s_edges, self.kmax, s0, s1)  # |kappa| on [s0, s1] (1/m)
         self.theta, self.turn = th, np.minimum(kap * rho, math.pi)
         self.c2_local = kap * self.vmax**2 + self.amax
-        return p, rho, np.stack([v * np.cos(th), v * np.sin(th)], axis=-1)
+        vel = np.empty((th.shape[0], 2))
+        np.multiply(v, np.cos(th), out=vel[:, 0])
+        np.multiply(v, np.sin(th), out=vel[:, 1])
+        return p, rho, vel
 
 
 class StillMotion:

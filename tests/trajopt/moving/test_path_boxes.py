@@ -134,3 +134,24 @@ def test_compiled_range_maxima_of_infinite_and_nan_values_are_numpys():
     i0, i1 = (x.ravel() for x in np.meshgrid(np.arange(7), np.arange(7)))
     got = arc_kappa_kernel(edges, rm.table[:, :, None], i0 + 0.5, i1 + 0.5)
     assert np.array_equal(got, rm(i0, np.maximum(i0, i1)), equal_nan=True)
+
+
+def test_kept_curvature_ranges_are_the_tables_and_the_dense_curvature_bound():
+    from trajopt.moving._path_bounds import arc_kappa_kernel, kappa_ranges_of, kappa_table
+
+    curve = _wiggle([0.8, -1.2, 0.5, 1.0], 6.0)
+    edges, k_top, table = kappa_ranges_of(curve)
+    ref_edges, k = kappa_table(curve)
+    assert np.array_equal(edges, ref_edges)
+    assert k_top == float(np.max(k))
+    assert np.array_equal(table, RangeMax(k).table[:, :, None])
+    assert kappa_ranges_of(curve)[2] is table  # kept: the next look-up builds nothing
+    # the bound of an arc range is at least the curvature sampled densely in it
+    s = np.linspace(0.0, curve.length, 4001)
+    kap = np.abs(np.asarray(curve.curvature(curve.u_at_s(s)), dtype=float))
+    rng = np.random.default_rng(5)
+    for _ in range(30):
+        a, b = np.sort(rng.uniform(0.0, curve.length, 2))
+        got = arc_kappa_kernel(edges, table, np.array([a]), np.array([b]))[0]
+        inside = (s >= a) & (s <= b)
+        assert not inside.any() or got >= np.max(kap[inside]) - 1e-9
