@@ -51,15 +51,15 @@ class Piece:
     s1: float
     memo: dict = field(default_factory=dict, compare=False, repr=False)
 
-    def nodes(self, grid: STGrid) -> np.ndarray:
-        """Return the grid node (index) of the drive at each grid step from its start, shape (m,).
+    def walk(self, grid: STGrid) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:
+        """Return ``(nodes, steps, i0, first, last)``: :meth:`nodes`, its steps and :meth:`visits`.
 
-        The nearest node of :meth:`s_at` at the steps ``0, dt, ..., ceil(duration / dt) dt``
-        (compiled: :func:`._st_kernels.drive_nodes_kernel`); kept on the piece with
-        :meth:`visits`.
+        Computed once per grid spacing and kept on the piece (one look-up for the search's
+        batches).
         """
         key = (grid.dt, grid.ds, grid.s.shape[0])
-        if key not in self.memo:
+        got = self.memo.get(key)
+        if got is None:
             idx, first, last = drive_nodes_kernel(
                 np.ascontiguousarray(self.rows, dtype=float),
                 float(self.duration),
@@ -70,16 +70,23 @@ class Piece:
                 key[2],
                 NEVER_STEP,
             )
-            self.memo[key] = idx
-            self.memo[("visits", *key)] = (int(idx[0]), first, last)
-        return self.memo[key]
+            got = (idx, idx.shape[0] - 1, int(idx[0]), first, last)
+            self.memo[key] = got
+        return got
+
+    def nodes(self, grid: STGrid) -> np.ndarray:
+        """Return the grid node (index) of the drive at each grid step from its start, shape (m,).
+
+        The nearest node of :meth:`s_at` at the steps ``0, dt, ..., ceil(duration / dt) dt``
+        (compiled: :func:`._st_kernels.drive_nodes_kernel`); kept on the piece with
+        :meth:`visits` (:meth:`walk`).
+        """
+        return self.walk(grid)[0]
 
     def visits(self, grid: STGrid) -> tuple[int, np.ndarray, np.ndarray]:
         """Return :func:`._st_grid.visits` of :meth:`nodes` (kept on the piece)."""
-        key = ("visits", grid.dt, grid.ds, grid.s.shape[0])
-        if key not in self.memo:
-            self.nodes(grid)
-        return self.memo[key]
+        _, _, i0, first, last = self.walk(grid)
+        return i0, first, last
 
     def s_at(self, t: np.ndarray) -> np.ndarray:
         """Return the arc length (m) at the drive's times ``t`` (s), clipped to its ends.
@@ -322,8 +329,7 @@ def search(
         if best is None or lower[-1] < best[0]:
             piece = launch(stops[goal]) if moving and w == 0 else drive(stops[w], stops[goal])
             if piece is not None:
-                n = piece.nodes(grid).shape[0] - 1
-                i0, first_v, last_v = piece.visits(grid)
+                _, n, i0, first_v, last_v = piece.walk(grid)
                 ok = ~blocked_starts_kernel(ptr, m_lo, m_hi, kk, i0, first_v, last_v) & rest
                 ok &= steps + n > last_goal
                 if ok.any():
@@ -343,22 +349,21 @@ def search(
                 batch.append(piece)
         if not batch:
             continue
-        fill_visits(batch, grid)
         # the drive to stop v leaving at t_k arrives at t_(k + n) (the drives of one batch go
         # to distinct stops): blocked starts and arrivals in one compiled pass
-        vis = [pc.visits(grid) for pc in batch]
-        size = np.array([x[1].shape[0] for x in vis], dtype=np.int64)
+        walks = [pc.walk(grid) for pc in batch]
+        size = np.array([x[3].shape[0] for x in walks], dtype=np.int64)
         arrive_kernel(
             ptr,
             m_lo,
             m_hi,
             rest,
-            np.array([x[0] for x in vis], dtype=np.int64),
+            np.array([x[2] for x in walks], dtype=np.int64),
             np.cumsum(size) - size,
             size,
-            np.concatenate([x[1] for x in vis]),
-            np.concatenate([x[2] for x in vis]),
-            np.array([pc.nodes(grid).shape[0] - 1 for pc in batch], dtype=np.int64),
+            np.concatenate([x[3] for x in walks]),
+            np.concatenate([x[4] for x in walks]),
+            np.array([x[1] for x in walks], dtype=np.int64),
             np.array(vs, dtype=np.int64),
             w,
             len(pieces),
